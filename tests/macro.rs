@@ -564,8 +564,9 @@ fn libm_trig_gives_the_same_dynamics() {
     }
 }
 
-/// xArm7's placements are 3.7e-6 off signed permutations: the generator also traces the
-/// two-step inertia carry through them (`NEAR_PERMUTATION`) and emits it where cheaper — its
+/// xArm7's placements are 3.7e-6 off signed permutations, each a turn about x: the generator also
+/// traces the two-step inertia carry through them (`NEAR_PERMUTATION`, `axis_turn`) and emits it
+/// where cheaper — its
 /// mass matrix in fewer operations than any candidate with exact permutations only — and every
 /// function still equals every interpreted algorithm.
 #[test]

@@ -6,7 +6,9 @@
 //! frames ([`BodyFrames`]).
 
 use crate::options::Options;
-use kanegen_dynamics::params::{coordinate_axis, is_near_signed_permutation, NEAR_PERMUTATION};
+use kanegen_dynamics::params::{
+    axis_turn, coordinate_axis, is_near_signed_permutation, NEAR_PERMUTATION,
+};
 use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, JointKind, Model};
 use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
@@ -259,8 +261,8 @@ pub fn choose(
         Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
-    // Placements near a signed permutation, per subject: the two-step inertia carry through
-    // them is traced as well (`kanegen_dynamics::params::NEAR_PERMUTATION`).
+    // Placements near a signed permutation or turning about one axis, per subject: the two-step
+    // inertia carry through them is traced as well (`kanegen_dynamics::params::NEAR_PERMUTATION`).
     let near_model = has_near_permutation(model);
     let near_canonical = canonical.as_ref().is_some_and(has_near_permutation);
     let n = model.dof();
@@ -274,8 +276,8 @@ pub fn choose(
             };
             let mut t = trace(Subject::Model(subject), f, m, &spec)?;
             let mut c = t.trace.counts(Convention::Emitted);
-            // The CRBA's carry is the only one it changes (not ABA's), kept where cheaper.
-            if near && carries_inertia(f, m) {
+            // It changes the CRBA's carries and Newton–Euler's rotations (not ABA's); kept where cheaper.
+            if near && takes_two_steps(f, m) {
                 let near = Spec {
                     two_step_placement: NEAR_PERMUTATION,
                     ..spec.clone()
@@ -318,21 +320,23 @@ pub fn takes_trig(choices: &[Choice]) -> bool {
 }
 
 /// Whether a revolute joint about a coordinate axis of `model` is placed near a signed
-/// permutation ([`NEAR_PERMUTATION`]) but not exactly on one: the two-step inertia carry is then
-/// worth a second trace.
+/// permutation ([`NEAR_PERMUTATION`]) or by a turn about one coordinate axis ([`axis_turn`]), but
+/// not exactly on a permutation: the two-step inertia carry is then worth a second trace.
 fn has_near_permutation(model: &Model) -> bool {
     model.joints().iter().any(|j| {
         j.kind == JointKind::Revolute
             && coordinate_axis(j.axis).is_some()
-            && is_near_signed_permutation(&j.origin.rotation, NEAR_PERMUTATION)
+            && (is_near_signed_permutation(&j.origin.rotation, NEAR_PERMUTATION)
+                || axis_turn(&j.origin.rotation).is_some())
             && !is_near_signed_permutation(&j.origin.rotation, 0.0)
     })
 }
 
-/// Whether `f` by `m` runs the CRBA, whose inertia carry ([`NEAR_PERMUTATION`]) may go in two
-/// steps: a function of the mass matrix by `crba`, not forward dynamics by ABA.
-fn carries_inertia(f: Function, m: Methods) -> bool {
-    f.uses_mass_matrix()
-        && m.mass_matrix == MassMatrixMethod::Crba
-        && !(f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)
+/// Whether `f` by `m` runs an algorithm whose carries ([`NEAR_PERMUTATION`]) may go in two
+/// steps: the CRBA (its inertia and force carries) or the classical Newton–Euler bias (its vector
+/// rotations, `kanegen_dynamics::joint::rotate_up`); not forward dynamics by ABA.
+fn takes_two_steps(f: Function, m: Methods) -> bool {
+    let crba = f.uses_mass_matrix() && m.mass_matrix == MassMatrixMethod::Crba;
+    let newton_euler = f.uses_bias() && m.bias == BiasMethod::NewtonEuler;
+    (crba || newton_euler) && !(f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)
 }

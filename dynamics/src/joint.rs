@@ -6,7 +6,7 @@
 //! `[0; axis]` (prismatic), the axis having the same coordinates in the joint and child frames.
 //! Each revolute `q_j` costs one `sin_cos` per call of [`xup`].
 
-use crate::linalg::{axis_rotation, Vec3};
+use crate::linalg::{axis_rotation, Mat3, Vec3};
 use crate::params::JointParams;
 use crate::scalar::Scalar;
 use crate::spatial::{Force, Motion, RbInertia, Xform};
@@ -50,7 +50,9 @@ pub fn xup_trig<S: Scalar>(jp: &JointParams<S>, q: &S) -> XupTrig<S> {
 /// permutation, or within [`crate::params::NEAR_PERMUTATION`] of one
 /// ([`JointParams::placement_permutation`]), goes in two steps, `Xtreeᵀ (XJᵀ I XJ) Xtree`: the
 /// joint's own turn in double-angle form ([`RbInertia::turned_about_axis`], sharing `q`'s sine
-/// and cosine with `x`), then the placement (its true rotation); any other joint through `x` at
+/// and cosine with `x`), then the placement (its true rotation: in the same double-angle form
+/// when it turns about one coordinate axis, [`JointParams::placement_turn`]; the tracer also takes
+/// the two steps through such placements where that is cheaper); any other joint through `x` at
 /// once (measured: after a dense placement the two steps cost more, as the products of the
 /// double-angle terms with the placement's numbers are not shared).
 pub fn carry_inertia<S: Scalar>(
@@ -62,13 +64,56 @@ pub fn carry_inertia<S: Scalar>(
         (Some((s, c)), Some(k)) if jp.placement_permutation => {
             // The axis is ±e_k exactly: s·u_k is ±s.
             let turned = i.turned_about_axis(k, &(s.clone() * jp.axis.at(k)), c);
-            let tree = Xform {
-                e: jp.upsilon.transpose(),
-                r: jp.l.clone(),
-            };
-            tree.tr_inertia(&turned)
+            match &jp.placement_turn {
+                // Υ = Θ_kp(α): Υ Ī Υᵀ is the turn about e_kp, then the shift by `l`.
+                Some((kp, sp, cp)) => Xform {
+                    e: Mat3::identity(),
+                    r: jp.l.clone(),
+                }
+                .tr_inertia(&turned.turned_about_axis(*kp, sp, cp)),
+                None => Xform {
+                    e: jp.upsilon.transpose(),
+                    r: jp.l.clone(),
+                }
+                .tr_inertia(&turned),
+            }
         }
         _ => x.tr_inertia(i),
+    }
+}
+
+/// `E v` for `Xup_j = (E, r)`: a vector of the parent's coordinates in body `j`'s. Where the
+/// inertia carry goes in two steps ([`carry_inertia`]) through a placement that turns about one
+/// axis ([`JointParams::placement_turn`]), so does the vector: `E = Θᵀ Υᵀ`, the placement's turn
+/// by `−α`, then the joint's by `−q_j`, eight products where `E` at once takes up to nine and the
+/// four of `E`'s own entries (a signed permutation `Υ` folds either way, and goes at once).
+pub fn rotate_up<S: Scalar>(jp: &JointParams<S>, (x, trig): &XupTrig<S>, v: &Vec3<S>) -> Vec3<S> {
+    match (trig, jp.coordinate_axis, &jp.placement_turn) {
+        (Some((s, c)), Some(k), Some((kp, sp, cp))) if jp.placement_permutation => v
+            .turned_about_axis(*kp, &-sp.clone(), cp)
+            .turned_about_axis(k, &-(s.clone() * jp.axis.at(k)), c),
+        _ => x.e.mul_vec(v),
+    }
+}
+
+/// `Eᵀ v` for `Xup_j = (E, r)`: a vector of body `j`'s coordinates in its parent's, in two steps
+/// where [`rotate_up`] takes two (`Eᵀ = Υ Θ`).
+pub fn rotate_down<S: Scalar>(jp: &JointParams<S>, (x, trig): &XupTrig<S>, v: &Vec3<S>) -> Vec3<S> {
+    match (trig, jp.coordinate_axis, &jp.placement_turn) {
+        (Some((s, c)), Some(k), Some((kp, sp, cp))) if jp.placement_permutation => v
+            .turned_about_axis(k, &(s.clone() * jp.axis.at(k)), c)
+            .turned_about_axis(*kp, sp, cp),
+        _ => x.e.tr_mul_vec(v),
+    }
+}
+
+/// `Xup_jᵀ f`: a force of body `j` carried to its parent ([`Xform::tr_apply`]), its rotations by
+/// [`rotate_down`].
+pub fn carry_force<S: Scalar>(jp: &JointParams<S>, xt: &XupTrig<S>, f: &Force<S>) -> Force<S> {
+    let lin = rotate_down(jp, xt, &f.lin);
+    Force {
+        ang: rotate_down(jp, xt, &f.ang) + xt.0.r.cross(&lin),
+        lin,
     }
 }
 

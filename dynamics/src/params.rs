@@ -32,6 +32,13 @@ pub struct JointParams<S> {
     /// ([`NEAR_PERMUTATION`]). The carry uses the true `upsilon` either way: the choice changes
     /// the operation count, not the result.
     pub placement_permutation: bool,
+    /// `Some((k, sin α, cos α))` when `upsilon` is exactly the turn by an angle `α` about the
+    /// coordinate axis `e_k` and not a signed permutation ([`axis_turn`]; model structure, like
+    /// `kind`): the second step of a two-step carry then turns the inertia about `e_k` in the
+    /// double-angle form ([`crate::spatial::RbInertia::turned_about_axis`]) instead of taking the
+    /// full congruence through `upsilon`. URDF writes such placements as `rpy` with one non-zero
+    /// angle (`rpy = "1.5708 0 0"`).
+    pub placement_turn: Option<(usize, S, S)>,
     /// `m_j`.
     pub mass: S,
     /// `d^{(j)}_j`: centre of mass in the body frame.
@@ -57,9 +64,10 @@ impl<S: Scalar> JointParams<S> {
 /// How far from a signed permutation a joint placement may be for the two-step inertia carry to
 /// be worth a trace ([`JointParams::placement_permutation`]). Measured on emitted code: xArm7's
 /// URDF writes `rpy = 1.5708` for π/2, which leaves entries of 3.7e-6 in every placement, and
-/// the two steps take its mass matrix from 920 to 782 operations; on UR5 (residues of 4.9e-12)
-/// they cost more (M 172 against 217), as after random (dense) placements (random N = 2: 58
-/// against 88). Hence a candidate, not a rule.
+/// the two steps take its mass matrix from 920 to 782 operations with the placement's full
+/// rotation as the second step, and to 750 with its turn about x ([`axis_turn`]); on UR5
+/// (residues of 4.9e-12) the full-rotation second step costs more (M 172 against 217), as after
+/// random (dense) placements (random N = 2: 58 against 88). Hence a candidate, not a rule.
 pub const NEAR_PERMUTATION: f64 = 1e-4;
 
 /// Whether every entry of `r` is within `tol` of 0 or ±1, with one near ±1 per row.
@@ -70,6 +78,20 @@ pub fn is_near_signed_permutation(r: &[[f64; 3]; 3], tol: f64) -> bool {
             && row
                 .iter()
                 .all(|x| x.abs() <= tol || (x.abs() - 1.0).abs() <= tol)
+    })
+}
+
+/// `Some((k, s, c))` when `r` is exactly the rotation by the angle of sine `s` and cosine `c`
+/// about `e_k` (row and column `k` are `e_k`; with `(a, b) = (k + 1, k + 2) mod 3`,
+/// `r_aa = r_bb = c` and `r_ba = −r_ab = s`) and not a signed permutation (`s ≠ 0`, `c ≠ 0`):
+/// [`JointParams::placement_turn`].
+#[must_use]
+pub fn axis_turn(r: &[[f64; 3]; 3]) -> Option<(usize, f64, f64)> {
+    (0..3).find_map(|k| {
+        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+        let axis_fixed = r[k][k] == 1.0 && [a, b].iter().all(|&m| r[k][m] == 0.0 && r[m][k] == 0.0);
+        let (c, s) = (r[a][a], r[b][a]);
+        (axis_fixed && r[b][b] == c && r[a][b] == -s && s != 0.0 && c != 0.0).then_some((k, s, c))
     })
 }
 
@@ -125,6 +147,8 @@ impl<S: Scalar> Params<S> {
                         axis: Vec3::from_f64(j.axis),
                         coordinate_axis: coordinate_axis(j.axis),
                         placement_permutation: is_near_signed_permutation(&j.origin.rotation, 0.0),
+                        placement_turn: axis_turn(&j.origin.rotation)
+                            .map(|(k, s, c)| (k, S::constant(s), S::constant(c))),
                         inertia: RbInertia::from_com(&mass, &com, &inertia_com),
                         mass,
                         com,

@@ -185,13 +185,9 @@ impl<S: Scalar> RbInertia<S> {
         ibar.0[k][a] = ak;
         ibar.0[b][k] = bk.clone();
         ibar.0[k][b] = bk;
-        let mut h = self.h.clone();
-        let (ha, hb) = turn(self.h.at(a), self.h.at(b));
-        h.0[a] = ha;
-        h.0[b] = hb;
         RbInertia {
             m: self.m.clone(),
-            h,
+            h: self.h.turned_about_axis(k, s, c),
             ibar,
         }
     }

@@ -687,6 +687,9 @@ fn floating_dynamics_traces_on_sym() {
                             axis: Vec3(j.axis.0.map(Sym::constant)),
                             coordinate_axis: j.coordinate_axis,
                             placement_permutation: j.placement_permutation,
+                            placement_turn: j
+                                .placement_turn
+                                .map(|(k, s, c)| (k, Sym::constant(s), Sym::constant(c))),
                             inertia: kanegen_dynamics::spatial::RbInertia::from_com(
                                 &mass,
                                 &com,

@@ -409,6 +409,67 @@ fn half_qd_a_qd_is_the_kinetic_energy() {
     eprintln!("½ q̇ᵀAq̇ vs Σ body energies: max rel err {worst:.2e}");
 }
 
+/// The two-step inertia carry through placements that turn about one coordinate axis
+/// (`JointParams::placement_turn`: xArm7's `rpy = "±1.5708 0 0"`) gives the Lagrange mass matrix,
+/// as the one-step carry does.
+#[test]
+fn two_step_carry_through_turned_placements_matches_lagrange() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/erd/xarm7.urdf");
+    let model = kanegen_model::io::parse_urdf(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let one_step = Params::<f64>::new(&model);
+    let mut two_step = one_step.clone();
+    let mut turned = 0;
+    for jp in &mut two_step.joints {
+        if jp.placement_turn.is_some() {
+            jp.placement_permutation = true;
+            turned += 1;
+        }
+    }
+    assert_eq!(turned, 6, "xArm7 places joints 2 to 7 by a turn about x");
+    let mut r = rng(41);
+    let mut worst = 0.0f64;
+    for _ in 0..20 {
+        let n = model.dof();
+        let (q, qd) = (random_vec(&mut r, n, 3.0), random_vec(&mut r, n, 2.0));
+        let reference = lagrange_mass_matrix(&model, &q, &qd);
+        let a1 = crba::mass_matrix(&one_step, &q);
+        let a2 = crba::mass_matrix(&two_step, &q);
+        assert!(rel_err(&flat(&a1), &flat(&reference)) < 1e-12);
+        worst = worst.max(rel_err(&flat(&a2), &flat(&reference)));
+    }
+    println!("two-step carry through turned placements against Lagrange: {worst:.2e}");
+    assert!(worst < 1e-12, "{worst:e}");
+}
+
+/// `axis_turn` recognises a turn about each coordinate axis, and nothing else.
+#[test]
+fn axis_turn_reads_single_axis_rotations() {
+    use kanegen_dynamics::params::axis_turn;
+    let (s, c) = 1.2f64.sin_cos();
+    for k in 0..3 {
+        let mut r = Mat3::<f64>::identity().0;
+        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+        (r[a][a], r[a][b], r[b][a], r[b][b]) = (c, -s, s, c);
+        assert_eq!(axis_turn(&r), Some((k, s, c)));
+        // Transposed: the turn by −α.
+        let t = Mat3(r).transpose().0;
+        assert_eq!(axis_turn(&t), Some((k, -s, c)));
+        // Not a turn: a scaled block, or an off-axis entry.
+        let mut scaled = r;
+        scaled[b][b] = 0.5 * c;
+        assert_eq!(axis_turn(&scaled), None);
+        let mut off = r;
+        off[k][a] = 1e-9;
+        assert_eq!(axis_turn(&off), None);
+    }
+    // Signed permutations and the identity are no turn (their carry is already free).
+    assert_eq!(axis_turn(&Mat3::<f64>::identity().0), None);
+    assert_eq!(
+        axis_turn(&[[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]),
+        None
+    );
+}
+
 #[test]
 fn mass_matrix_is_symmetric_positive_definite() {
     for n in 1..=32 {

@@ -10,7 +10,7 @@
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4168 (`mass_matrix` 276, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 1003, `mass_matrix_and_nonlinear_effects` 593, `forward_dynamics_with_wrenches` 1006, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4092 (`mass_matrix` 267, `nonlinear_effects` 309, `inverse_dynamics` 324, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -25,7 +25,7 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 3469 | 2908 | 0 | 0 | 7 | 6377 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
-//! | `mass_matrix` * | `crba` | — | — | model | 490 | 464 | 0 | 0 | 7 | 954 |
+//! | `mass_matrix` * | `crba` | — | — | model | 456 | 450 | 0 | 0 | 7 | 906 |
 //! | `mass_matrix` | `crba` | — | — | canonical | 511 | 479 | 0 | 0 | 7 | 990 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 1147 | 881 | 0 | 0 | 7 | 2028 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1162 | 896 | 0 | 0 | 7 | 2058 |
@@ -33,7 +33,7 @@
 //! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 1579 | 1291 | 0 | 0 | 7 | 2870 |
 //! | `nonlinear_effects` | — | `rnea` | — | model | 631 | 502 | 0 | 0 | 7 | 1133 |
 //! | `nonlinear_effects` | — | `rnea` | — | canonical | 633 | 502 | 0 | 0 | 7 | 1135 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 528 | 428 | 0 | 0 | 7 | 956 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 509 | 415 | 0 | 0 | 7 | 924 |
 //! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 530 | 428 | 0 | 0 | 7 | 958 |
 //! | `inverse_dynamics` | — | `recurrent` | — | model | 670 | 548 | 0 | 0 | 7 | 1218 |
 //! | `inverse_dynamics` | — | `recurrent` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
@@ -41,15 +41,15 @@
 //! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
 //! | `inverse_dynamics` | — | `rnea` | — | model | 670 | 548 | 0 | 0 | 7 | 1218 |
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 543 | 458 | 0 | 0 | 7 | 1001 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 523 | 444 | 0 | 0 | 7 | 967 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 545 | 458 | 0 | 0 | 7 | 1003 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2137 | 1784 | 10 | 0 | 7 | 3921 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2103 | 1770 | 10 | 0 | 7 | 3873 |
 //! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2173 | 1814 | 10 | 0 | 7 | 3987 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2554 | 2179 | 10 | 0 | 7 | 4733 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2520 | 2165 | 10 | 0 | 7 | 4685 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2590 | 2209 | 10 | 0 | 7 | 4799 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1613 | 1403 | 10 | 0 | 7 | 3016 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1585 | 1389 | 10 | 0 | 7 | 2974 |
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1636 | 1418 | 10 | 0 | 7 | 3054 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 1510 | 1329 | 10 | 0 | 7 | 2839 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 1463 | 1302 | 10 | 0 | 7 | 2765 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1533 | 1344 | 10 | 0 | 7 | 2877 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
@@ -57,17 +57,17 @@
 //! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 2937 | 2528 | 13 | 0 | 7 | 5465 |
 //! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2066 | 13 | 0 | 7 | 4611 |
 //! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 2562 | 2081 | 13 | 0 | 7 | 4643 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 1992 | 13 | 0 | 7 | 4434 |
+//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 2423 | 1979 | 13 | 0 | 7 | 4402 |
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 2459 | 2007 | 13 | 0 | 7 | 4466 |
 //! | `forward_dynamics` | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 1601 | 1280 | 12 | 0 | 7 | 2881 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1637 | 1345 | 0 | 0 | 7 | 2982 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1603 | 1331 | 0 | 0 | 7 | 2934 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1673 | 1375 | 0 | 0 | 7 | 3048 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2054 | 1740 | 0 | 0 | 7 | 3794 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2020 | 1726 | 0 | 0 | 7 | 3746 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2090 | 1770 | 0 | 0 | 7 | 3860 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1113 | 964 | 0 | 0 | 7 | 2077 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1085 | 950 | 0 | 0 | 7 | 2035 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1136 | 979 | 0 | 0 | 7 | 2115 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1010 | 890 | 0 | 0 | 7 | 1900 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 963 | 863 | 0 | 0 | 7 | 1826 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1033 | 905 | 0 | 0 | 7 | 1938 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
@@ -75,16 +75,16 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 2326 | 2001 | 0 | 0 | 7 | 4327 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 1934 | 1539 | 0 | 0 | 7 | 3473 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1831 | 1465 | 0 | 0 | 7 | 3296 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1812 | 1452 | 0 | 0 | 7 | 3264 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 1848 | 1480 | 0 | 0 | 7 | 3328 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2281 | 1928 | 10 | 0 | 7 | 4209 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2698 | 2323 | 10 | 0 | 7 | 5021 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1613 | 1451 | 10 | 0 | 7 | 3064 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 1510 | 1377 | 10 | 0 | 7 | 2887 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2247 | 1914 | 10 | 0 | 7 | 4161 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2664 | 2309 | 10 | 0 | 7 | 4973 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1585 | 1437 | 10 | 0 | 7 | 3022 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 1463 | 1350 | 10 | 0 | 7 | 2813 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 2040 | 13 | 0 | 7 | 4482 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 2423 | 2027 | 13 | 0 | 7 | 4450 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 1592 | 1325 | 12 | 0 | 7 | 2917 |
 //! | `momentum` * | — | — | — | model | 350 | 283 | 0 | 0 | 7 | 633 |
 //! | `base_reaction` * | — | `recurrent` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
@@ -161,12 +161,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 490u64,
-            add: 464u64,
+            mul: 456u64,
+            add: 450u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 276u64,
+            fma: 267u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -174,12 +174,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 528u64,
-            add: 428u64,
+            mul: 509u64,
+            add: 415u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 317u64,
+            fma: 309u64,
         },
         OpCount {
             function: "inverse_dynamics",
@@ -187,12 +187,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 543u64,
-            add: 458u64,
+            mul: 523u64,
+            add: 444u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 332u64,
+            fma: 324u64,
         },
         OpCount {
             function: "forward_dynamics",
@@ -200,12 +200,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1510u64,
-            add: 1329u64,
+            mul: 1463u64,
+            add: 1302u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 1003u64,
+            fma: 986u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -213,12 +213,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1010u64,
-            add: 890u64,
+            mul: 963u64,
+            add: 863u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 593u64,
+            fma: 576u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -226,12 +226,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1510u64,
-            add: 1377u64,
+            mul: 1463u64,
+            add: 1350u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 1006u64,
+            fma: 989u64,
         },
         OpCount {
             function: "momentum",
@@ -372,8 +372,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 490u64,
-            add: 464u64,
+            mul: 456u64,
+            add: 450u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -476,8 +476,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 528u64,
-            add: 428u64,
+            mul: 509u64,
+            add: 415u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -580,8 +580,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 543u64,
-            add: 458u64,
+            mul: 523u64,
+            add: 444u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -606,8 +606,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2137u64,
-            add: 1784u64,
+            mul: 2103u64,
+            add: 1770u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -632,8 +632,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2554u64,
-            add: 2179u64,
+            mul: 2520u64,
+            add: 2165u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -658,8 +658,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1613u64,
-            add: 1403u64,
+            mul: 1585u64,
+            add: 1389u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -684,8 +684,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1510u64,
-            add: 1329u64,
+            mul: 1463u64,
+            add: 1302u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -788,8 +788,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2442u64,
-            add: 1992u64,
+            mul: 2423u64,
+            add: 1979u64,
             div: 13u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -840,8 +840,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 1637u64,
-            add: 1345u64,
+            mul: 1603u64,
+            add: 1331u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -866,8 +866,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 2054u64,
-            add: 1740u64,
+            mul: 2020u64,
+            add: 1726u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -892,8 +892,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 1113u64,
-            add: 964u64,
+            mul: 1085u64,
+            add: 950u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -918,8 +918,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1010u64,
-            add: 890u64,
+            mul: 963u64,
+            add: 863u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1022,8 +1022,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1831u64,
-            add: 1465u64,
+            mul: 1812u64,
+            add: 1452u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1048,8 +1048,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2281u64,
-            add: 1928u64,
+            mul: 2247u64,
+            add: 1914u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1061,8 +1061,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2698u64,
-            add: 2323u64,
+            mul: 2664u64,
+            add: 2309u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1074,8 +1074,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1613u64,
-            add: 1451u64,
+            mul: 1585u64,
+            add: 1437u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1087,8 +1087,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1510u64,
-            add: 1377u64,
+            mul: 1463u64,
+            add: 1350u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1139,8 +1139,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2442u64,
-            add: 2040u64,
+            mul: 2423u64,
+            add: 2027u64,
             div: 13u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1227,7 +1227,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 490 mul, 464 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 276 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 456 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 267 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -1240,698 +1240,656 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = 0.00000000020510342851533115 * c_q8;
-        let x8 = 0.00000000020510342851533115 * s_q8;
-        let x9 = 0.00000000020510342851533115 * c_q9;
-        let x10 = 0.00000000020510342851533115 * s_q9;
-        let x11 = x9 - x10;
-        let x12 = x9 + x10;
-        let x13 = 0.00000000020510342851533115 * s_q12;
-        let x14 = 0.00000000020510342851533115 * c_q12;
-        let x15 = 0.00000000020510342851533115 * c_q13;
-        let x16 = s_q13 * s_q13;
-        let x17 = s_q13 * c_q13;
-        let x18 = Self::mul_add(x17, 0.001562, x16 * 1.2025609200000003);
-        let x19 = 0.000781 + Self::mul_add(x16, -0.001562, x17 * 1.2025609200000003);
-        let x20 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x21 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x22 = 4.806620000000001 * s_q13;
-        let x23 = 4.806620000000001 * c_q13;
-        let x24 = 0.00000000020510342851533115 * x22;
-        let x25 = Self::mul_add(-0.00000000020510342851533115, x18, x20);
-        let x26 = 0.00000000020510342851533115 * x20;
-        let x27 = 1.4135609200000003 + x26;
-        let x28 = x20 + -0.0000000002899261911072858;
-        let x29 = 0.16 * x22;
-        let x30 = 0.55 * x23;
-        let x31 = x29 + x30;
-        let x32 = x31 + (Self::mul_add(0.00000000020510342851533115, x25, x27) + x31);
-        let x33 = Self::mul_add(
+        let x7 = 0.00000000020510342851533115 * c_q9;
+        let x8 = 0.00000000020510342851533115 * s_q9;
+        let x9 = x7 - x8;
+        let x10 = x7 + x8;
+        let x11 = s_q13 * s_q13;
+        let x12 = s_q13 * c_q13;
+        let x13 = Self::mul_add(x12, 0.001562, x11 * 1.2025609200000003);
+        let x14 = 0.000781 + Self::mul_add(x11, -0.001562, x12 * 1.2025609200000003);
+        let x15 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x16 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 1.4135609200000003 + x13;
+        let x20 = x15 + x15;
+        let x21 = Self::mul_add(0.00000000020510342851533115, x20, x19);
+        let x22 = 0.00000000020510342851533115 * x17;
+        let x23 = 0.16 * x17;
+        let x24 = 0.55 * x18;
+        let x25 = x23 + x24;
+        let x26 = x25 - (x13 - x21 - x25);
+        let x27 = Self::mul_add(
             0.55,
-            x22,
+            x17,
             Self::mul_add(
                 0.16,
-                x23,
-                Self::mul_add(-0.00000000020510342851533115, x21, x19),
+                x18,
+                Self::mul_add(-0.00000000020510342851533115, x16, x14),
             ),
         );
-        let x34 = 3.6140000000000003 + x24;
-        let x35 = 17.135250000000003 + x23;
-        let x36 = -1.9877000000000002
+        let x28 = 3.6140000000000003 + x22;
+        let x29 = 17.135250000000003 + x18;
+        let x30 = -1.9877000000000002
             - Self::mul_add(
                 0.55,
-                x24,
-                Self::mul_add(0.00000000020510342851533115, x19, x21),
+                x22,
+                Self::mul_add(0.00000000020510342851533115, x14, x16),
             );
-        let x37 = -0.809539999555672
+        let x31 = -0.809539999555672
+            - Self::mul_add(
+                0.16,
+                x22,
+                x15 - Self::mul_add(-0.00000000020510342851533115, x19, x20),
+            );
+        let x32 = -5.252920330000002 + (x23 + (-1.2025609200000003 + x13 + x23));
+        let x33 = -2.741639999592316 - x27;
+        let x34 = 9.740442170000001 + (x24 + (1.4135609200000003 - x21 + x24));
+        let x35 = s_q12 * s_q12;
+        let x36 = s_q12 * c_q12;
+        let x37 = x26 - x32;
+        let x38 = x30 + x30;
+        let x39 = Self::mul_add(x36, x38, x35 * x37);
+        let x40 = x32 + x39;
+        let x41 = x30 + Self::mul_add(-x35, x38, x36 * x37);
+        let x42 = Self::mul_add(-s_q12, x33, c_q12 * x31);
+        let x43 = Self::mul_add(c_q12, x33, s_q12 * x31);
+        let x44 = Self::mul_add(-s_q12, x29, c_q12 * x28);
+        let x45 = Self::mul_add(c_q12, x29, s_q12 * x28);
+        let x46 = x34 - x40;
+        let x47 = x43 + x43;
+        let x48 = Self::mul_add(-0.00000000020510342851533115, x47, x46);
+        let x49 = Self::mul_add(-0.00000000020510342851533115, x41, x42);
+        let x50 = Self::mul_add(-0.00000000020510342851533115, x45, x17);
+        let x51 = x22 + x45;
+        let x52 = x51 * 0.36;
+        let x53 = x52 + (x26 - x39 + x52);
+        let x54 = 7.078399999258757 + x50;
+        let x55 = 0.01675
+            - Self::mul_add(
+                x44,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x42, x41),
+            );
+        let x56 = -9.142025249762803 + (x52 + (x40 + x48 + x52));
+        let x57 = 2.5482240016099564
             + Self::mul_add(
-                -0.16,
-                x24,
-                Self::mul_add(-0.00000000020510342851533115, x27, x25),
-            );
-        let x38 = -5.252920330000002 + (x29 + (-1.2025609200000003 + x18 + x29));
-        let x39 = -2.741639999592316 - x33;
-        let x40 = 9.740442170000001
-            + (x30
-                - (Self::mul_add(0.00000000020510342851533115, x28, x18 + x26) - x30));
-        let x41 = s_q12 * s_q12;
-        let x42 = s_q12 * c_q12;
-        let x43 = x32 - x38;
-        let x44 = x36 + x36;
-        let x45 = Self::mul_add(x42, x44, x41 * x43);
-        let x46 = x38 + x45;
-        let x47 = x36 + Self::mul_add(-x41, x44, x42 * x43);
-        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x37);
-        let x49 = Self::mul_add(c_q12, x39, s_q12 * x37);
-        let x50 = Self::mul_add(-s_q12, x35, c_q12 * x34);
-        let x51 = Self::mul_add(c_q12, x35, s_q12 * x34);
-        let x52 = Self::mul_add(-0.00000000020510342851533115, x51, x22);
-        let x53 = x24 + x51;
-        let x54 = Self::mul_add(-0.00000000020510342851533115, x47, x48);
-        let x55 = Self::mul_add(-0.00000000020510342851533115, x46, x49);
-        let x56 = 0.00000000020510342851533115 * x49;
-        let x57 = x40 - x56;
-        let x58 = Self::mul_add(0.00000000020510342851533115, x40, x49);
-        let x59 = -x58;
-        let x60 = x53 * 0.36;
-        let x61 = x60 + (x32 - x45 + x60);
-        let x62 = 7.078399999258757 + x52;
-        let x63 = 0.01675
-            - Self::mul_add(
                 x50,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x48, x47),
+                0.36,
+                x43 - Self::mul_add(0.00000000020510342851533115, x46, x47),
             );
-        let x64 = -9.142025249762803
-            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x55, x57) + x60));
-        let x65 = 2.5482240016099564
-            - Self::mul_add(
-                x52,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x57, x55),
-            );
-        let x66 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x58, x46 + x56);
-        let x67 = s_q11 * s_q11;
-        let x68 = s_q11 * c_q11;
-        let x69 = x61 - x64;
-        let x70 = x54 + x54;
-        let x71 = Self::mul_add(x68, x70, x67 * x69);
-        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x50);
-        let x73 = Self::mul_add(c_q11, x62, s_q11 * x50);
-        let x74 = 0.275 * x53;
-        let x75 = x73 * 0.63;
-        let x76 = x74 - x75;
-        let x77 = Self::mul_add(x72, 0.63, x54 + Self::mul_add(-x67, x70, x68 * x69));
-        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
-        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
-        let x80 = x66 - x75;
-        let x81 = x76 + (x61 - x71 + x76);
-        let x82 = -45.1584 + x73;
-        let x83 = -0.6328 + x78;
-        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
-        let x85 = -24.35164200091464 - Self::mul_add(x53, 0.63, -x79);
-        let x86 = 28.2393615 - (x75 - x80);
-        let x87 = s_q10 * s_q10;
-        let x88 = s_q10 * c_q10;
-        let x89 = x81 - x84;
-        let x90 = x77 + x77;
-        let x91 = Self::mul_add(x88, x90, x87 * x89);
-        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
-        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
-        let x94 = c_q10 * x72;
-        let x95 = Self::mul_add(-s_q10, x82, x94);
-        let x96 = s_q10 * x72;
-        let x97 = Self::mul_add(c_q10, x82, x96);
-        let x98 = x97 * 0.87;
-        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
-        let x100 = x86 - x98;
-        let x101 = x98 - (x81 - x91 - x98);
-        let x102 = -81.53205 + x97;
-        let x103 = -0.00214 + x92;
-        let x104 = -63.36336825000001 + (x84 + x91);
-        let x105 = -36.18604050126307 + Self::mul_add(x53, -0.87, x93);
-        let x106 = 69.99836825 - (x98 - x100);
-        let x107 = s_q9 * s_q9;
-        let x108 = s_q9 * c_q9;
-        let x109 = x101 + x104;
-        let x110 = x99 + x99;
-        let x111 = Self::mul_add(-x108, x110, x107 * x109);
-        let x112 = x101 - x111;
-        let x113 = x104 - x111;
-        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
-        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
-        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
-        let x117 = c_q9 * x95;
-        let x118 = Self::mul_add(-s_q9, x102, x117);
-        let x119 = s_q9 * x95;
-        let x120 = Self::mul_add(c_q9, x102, x119);
-        let x121 = 0.00000000020510342851533115 * x53;
-        let x122 = x120 - x121;
-        let x123 = 0.00000000020510342851533115 * x120;
-        let x124 = x53 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
-        let x125 = x118 + x121;
-        let x126 = 0.00000000020510342851533115 * x115;
-        let x127 = x114 + x126;
-        let x128 = 0.00000000020510342851533115 * x116;
-        let x129 = x113 + x128;
-        let x130 = 0.00000000020510342851533115 * x106;
-        let x131 = x116 + x130;
-        let x132 = 0.00000000020510342851533115 * x114;
-        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
-        let x134 = x106 + (x126 - x128);
-        let x135 = x115 - x130;
-        let x136 = 0.00000000020510342851533115 * x131;
-        let x137 = 0.4 * x125;
-        let x138 = 0.275 * x124;
-        let x139 = x137 - x138;
-        let x140 = x139 + (x129 + x136 + x139);
-        let x141 = Self::mul_add(
+        let x58 = 9.223235249762805 + (x34 - x48);
+        let x59 = s_q11 * s_q11;
+        let x60 = s_q11 * c_q11;
+        let x61 = x53 - x56;
+        let x62 = x49 + x49;
+        let x63 = Self::mul_add(x60, x62, x59 * x61);
+        let x64 = Self::mul_add(-s_q11, x54, c_q11 * x44);
+        let x65 = Self::mul_add(c_q11, x54, s_q11 * x44);
+        let x66 = 0.275 * x51;
+        let x67 = x65 * 0.63;
+        let x68 = x66 - x67;
+        let x69 = Self::mul_add(x64, 0.63, x49 + Self::mul_add(-x59, x62, x60 * x61));
+        let x70 = Self::mul_add(0.275, x64, Self::mul_add(-s_q11, x57, c_q11 * x55));
+        let x71 = Self::mul_add(0.275, x65, Self::mul_add(c_q11, x57, s_q11 * x55));
+        let x72 = x58 - x67;
+        let x73 = x68 + (x53 - x63 + x68);
+        let x74 = -45.1584 + x65;
+        let x75 = -0.6328 + x70;
+        let x76 = -24.4950615 + (x66 + (x56 + x63 + x66));
+        let x77 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x71);
+        let x78 = 28.2393615 - (x67 - x72);
+        let x79 = s_q10 * s_q10;
+        let x80 = s_q10 * c_q10;
+        let x81 = x73 - x76;
+        let x82 = x69 + x69;
+        let x83 = Self::mul_add(x80, x82, x79 * x81);
+        let x84 = Self::mul_add(-s_q10, x77, c_q10 * x75);
+        let x85 = Self::mul_add(c_q10, x77, s_q10 * x75);
+        let x86 = c_q10 * x64;
+        let x87 = Self::mul_add(-s_q10, x74, x86);
+        let x88 = s_q10 * x64;
+        let x89 = Self::mul_add(c_q10, x74, x88);
+        let x90 = x89 * 0.87;
+        let x91 = Self::mul_add(x87, 0.87, x69 + Self::mul_add(-x79, x82, x80 * x81));
+        let x92 = x78 - x90;
+        let x93 = x90 - (x73 - x83 - x90);
+        let x94 = -81.53205 + x89;
+        let x95 = -0.00214 + x84;
+        let x96 = -63.36336825000001 + (x76 + x83);
+        let x97 = -36.18604050126307 + Self::mul_add(x51, -0.87, x85);
+        let x98 = 69.99836825 - (x90 - x92);
+        let x99 = s_q9 * s_q9;
+        let x100 = s_q9 * c_q9;
+        let x101 = x93 + x96;
+        let x102 = x91 + x91;
+        let x103 = Self::mul_add(-x100, x102, x99 * x101);
+        let x104 = x93 - x103;
+        let x105 = x96 - x103;
+        let x106 = x91 - Self::mul_add(x99, x102, x100 * x101);
+        let x107 = Self::mul_add(-s_q9, x97, c_q9 * x95);
+        let x108 = Self::mul_add(c_q9, x97, s_q9 * x95);
+        let x109 = c_q9 * x87;
+        let x110 = Self::mul_add(-s_q9, x94, x109);
+        let x111 = s_q9 * x87;
+        let x112 = Self::mul_add(c_q9, x94, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = 0.00000000020510342851533115 * x112;
+        let x116 = x51 - Self::mul_add(0.00000000020510342851533115, x110, -x115);
+        let x117 = x110 + x113;
+        let x118 = 0.00000000020510342851533115 * x107;
+        let x119 = x106 + x118;
+        let x120 = 0.00000000020510342851533115 * x108;
+        let x121 = x105 + x120;
+        let x122 = 0.00000000020510342851533115 * x98;
+        let x123 = x108 + x122;
+        let x124 = 0.00000000020510342851533115 * x106;
+        let x125 = x107 - Self::mul_add(0.00000000020510342851533115, x104, x124);
+        let x126 = x98 + (x118 - x120);
+        let x127 = x107 - x122;
+        let x128 = 0.00000000020510342851533115 * x123;
+        let x129 = 0.4 * x117;
+        let x130 = 0.275 * x116;
+        let x131 = x129 - x130;
+        let x132 = x131 + (x121 + x128 + x131);
+        let x133 = Self::mul_add(
             0.275,
-            x125,
+            x117,
             -Self::mul_add(
                 0.4,
-                x124,
-                Self::mul_add(-0.00000000020510342851533115, x134, x133),
+                x116,
+                Self::mul_add(-0.00000000020510342851533115, x126, x125),
             ),
         );
-        let x142 = -0.000000008530897668050218 + x122;
-        let x143 = -12.701650001451807 - x124;
-        let x144 = -0.0000000234896432582596
+        let x134 = -0.000000008530897668050218 + x114;
+        let x135 = -12.701650001451807 - x116;
+        let x136 = -0.0000000234896432582596
             + Self::mul_add(
                 -0.275,
-                x122,
-                x131
+                x114,
+                x123
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x129,
-                        0.00000000020510342851533115 * x127,
+                        x121,
+                        0.00000000020510342851533115 * x119,
                     ),
             );
-        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
-        let x146 = -111.7548902508081
-            + (x137
-                + (x134
+        let x137 = -0.002139996587640933 + Self::mul_add(-0.4, x114, x119 - x128);
+        let x138 = -111.7548902508081
+            + (x129
+                + (x126
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
-                        0.00000000020510342851533115 * x133,
-                    ) + x137));
-        let x147 = 5.080660024070365 - x141;
-        let x148 = 113.3918902508081
-            - (x138
-                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
-                    + x138));
-        let x149 = s_q8 * s_q8;
-        let x150 = s_q8 * c_q8;
-        let x151 = x140 - x146;
-        let x152 = x144 + x144;
-        let x153 = Self::mul_add(x150, x152, x149 * x151);
-        let x154 = x140 - x153;
-        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
-        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
-        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
-        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
-        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
-        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
-        let x163 = 0.00000000020510342851533115 * x156;
-        let x164 = x148 - x163;
-        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
-        let x166 = -x165;
-        let x167 = 0.35 * x161;
-        let x168 = x167
-            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x167);
-        let x169 = 48.0240000085309 + x160;
-        let x170 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
-        let x171 = -16.80768997608804
+                        x108 + Self::mul_add(-0.00000000020510342851533115, x105, x124),
+                        0.00000000020510342851533115 * x125,
+                    ) + x129));
+        let x139 = 5.080660024070365 - x133;
+        let x140 = 113.3918902508081
+            - (x130
+                + (Self::mul_add(0.00000000020510342851533115, x127, x104 + x118)
+                    + x130));
+        let x141 = s_q8 * s_q8;
+        let x142 = s_q8 * c_q8;
+        let x143 = x132 - x138;
+        let x144 = x136 + x136;
+        let x145 = Self::mul_add(x142, x144, x141 * x143);
+        let x146 = x132 - x145;
+        let x147 = x136 + Self::mul_add(-x141, x144, x142 * x143);
+        let x148 = Self::mul_add(-s_q8, x139, c_q8 * x137);
+        let x149 = Self::mul_add(c_q8, x139, s_q8 * x137);
+        let x150 = Self::mul_add(-s_q8, x135, c_q8 * x134);
+        let x151 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x152 = x140 - x146;
+        let x153 = x148 + x148;
+        let x154 = Self::mul_add(-0.00000000020510342851533115, x153, x152);
+        let x155 = Self::mul_add(0.00000000020510342851533115, x117, x150);
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x150, x117);
+        let x157 = 0.35 * x155;
+        let x158 = x157 - (x146 + x154 - x157);
+        let x159 = 48.0240000085309 + x156;
+        let x160 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x147, x149);
+        let x161 = -16.80768997608804
+            + Self::mul_add(
+                -0.35,
+                x156,
+                x148 - Self::mul_add(0.00000000020510342851533115, x152, x153),
+            );
+        let x162 = 130.43769025763282 - (x157 - (x138 + x145 - x157));
+        let x163 = 0.1132
             - Self::mul_add(
                 0.35,
-                x160,
-                Self::mul_add(0.00000000020510342851533115, x164, x162),
+                x151,
+                Self::mul_add(0.00000000020510342851533115, x149, x147),
             );
-        let x172 = 130.43769025763282 - (x167 - (x146 + x153 - x167));
-        let x173 = 0.1132
-            - Self::mul_add(
-                0.35,
-                x159,
-                Self::mul_add(0.00000000020510342851533115, x157, x155),
-            );
-        let x174 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
-        let x175 = s_q7 * s_q7;
-        let x176 = s_q7 * c_q7;
-        let x177 = x168 + x172;
-        let x178 = x170 + x170;
-        let x179 = Self::mul_add(-x176, x178, x175 * x177);
-        let x180 = Self::mul_add(-s_q7, x159, c_q7 * x169);
-        let x181 = Self::mul_add(c_q7, x159, s_q7 * x169);
-        let x182 = -x181;
-        let x183 = 0.75 * x161;
-        let x184 = 0.65 * x180;
-        let x185 = x183 - x184;
-        let x186 = Self::mul_add(-0.75, x180, Self::mul_add(-s_q7, x173, c_q7 * x171));
-        let x187 = Self::mul_add(
+        let x164 = 132.47349025763282 + (x140 - x154);
+        let x165 = s_q7 * s_q7;
+        let x166 = s_q7 * c_q7;
+        let x167 = x158 + x162;
+        let x168 = x160 + x160;
+        let x169 = Self::mul_add(-x166, x168, x165 * x167);
+        let x170 = Self::mul_add(-s_q7, x151, c_q7 * x159);
+        let x171 = Self::mul_add(c_q7, x151, s_q7 * x159);
+        let x172 = -x171;
+        let x173 = 0.75 * x155;
+        let x174 = 0.65 * x170;
+        let x175 = x173 - x174;
+        let x176 = Self::mul_add(-0.75, x170, Self::mul_add(-s_q7, x163, c_q7 * x161));
+        let x177 = Self::mul_add(
             -0.65,
-            x181,
-            x170 - Self::mul_add(x175, x178, x176 * x177),
+            x171,
+            x160 - Self::mul_add(x165, x168, x166 * x167),
         );
-        let x188 = Self::mul_add(-0.75, x181, Self::mul_add(c_q7, x173, s_q7 * x171));
-        let x189 = x174 + x184;
-        let x190 = 110.5455 + x180;
-        let x191 = 180.9502499901501 - x161;
-        let x192 = 1394.5960312283303 - (x183 + (x168 - x179 + x183));
-        let x193 = -117.61766249359756 + Self::mul_add(0.65, x161, x186);
-        let x194 = 1466.4506062283303 - (x185 - (x172 - x179 - x185));
-        let x195 = 1271.854575 + (x184 + x189);
-        let x196 = -x191;
-        let x197 = -x190;
-        let x198 = Self::mul_add(x8, x142, x7 * x143);
-        let x199 = Self::mul_add(
+        let x178 = Self::mul_add(-0.75, x171, Self::mul_add(c_q7, x163, s_q7 * x161));
+        let x179 = x164 + x174;
+        let x180 = 110.5455 + x170;
+        let x181 = 180.9502499901501 - x155;
+        let x182 = 1394.5960312283303 - (x173 + (x158 - x169 + x173));
+        let x183 = -117.61766249359756 + Self::mul_add(0.65, x155, x176);
+        let x184 = 1466.4506062283303 - (x175 - (x162 - x169 - x175));
+        let x185 = 1271.854575 + (x174 + x179);
+        let x186 = -x181;
+        let x187 = -x180;
+        let x188 = 0.00000000020510342851533115 * x151;
+        let x189 = Self::mul_add(0.00000000020510342851533115, x140, x148);
+        let x190 = -x189;
+        let x191 = Self::mul_add(
             -0.35,
-            x158,
-            x148 - Self::mul_add(-x8, x147, x7 * x145),
+            x150,
+            Self::mul_add(-0.00000000020510342851533115, x148, x140),
         );
-        let x200 = Self::mul_add(0.35, x198, x157);
-        let x201 = Self::mul_add(-s_q7, x158, c_q7 * x198);
-        let x202 = Self::mul_add(c_q7, x158, s_q7 * x198);
-        let x203 = Self::mul_add(-0.75, x202, Self::mul_add(-s_q7, x200, c_q7 * x199));
-        let x204 = Self::mul_add(c_q7, x200, s_q7 * x199)
-            + Self::mul_add(-0.65, x159, 0.75 * x201);
-        let x205 = -Self::mul_add(-0.65, x202, x165);
-        let x206 = x12 * x95;
-        let x207 = Self::mul_add(x11, x102, x206);
-        let x208 = x131 + Self::mul_add(-0.275, x120, 0.4 * x207);
-        let x209 = Self::mul_add(
-            0.4,
-            x118,
-            x106 + Self::mul_add(-x12, x105, x11 * x103),
+        let x192 = Self::mul_add(0.35, x188, x149);
+        let x193 = Self::mul_add(-s_q7, x150, c_q7 * x188);
+        let x194 = Self::mul_add(c_q7, x150, s_q7 * x188);
+        let x195 = Self::mul_add(-0.75, x194, Self::mul_add(-s_q7, x192, c_q7 * x191));
+        let x196 = Self::mul_add(c_q7, x192, s_q7 * x191)
+            + Self::mul_add(-0.65, x151, 0.75 * x193);
+        let x197 = -Self::mul_add(-0.65, x194, x189);
+        let x198 = x10 * x87;
+        let x199 = Self::mul_add(x9, x94, x198);
+        let x200 = x123 + Self::mul_add(-0.275, x112, 0.4 * x199);
+        let x201 = Self::mul_add(0.4, x110, x98 + Self::mul_add(-x10, x97, x9 * x95));
+        let x202 = Self::mul_add(-0.275, x110, x127);
+        let x203 = Self::mul_add(s_q8, x199, c_q8 * x110);
+        let x204 = Self::mul_add(-c_q8, x199, s_q8 * x110);
+        let x205 = x115 - x203;
+        let x206 = Self::mul_add(0.00000000020510342851533115, x203, x112);
+        let x207 = Self::mul_add(-s_q8, x201, c_q8 * x200);
+        let x208 = Self::mul_add(0.00000000020510342851533115, x202, x207);
+        let x209 = -x208;
+        let x210 = Self::mul_add(
+            -0.35,
+            x204,
+            Self::mul_add(-0.00000000020510342851533115, x207, x202),
         );
-        let x210 = Self::mul_add(-0.275, x118, x135);
-        let x211 = x120 + Self::mul_add(x8, x207, x7 * x118);
-        let x212 = Self::mul_add(-c_q8, x207, s_q8 * x118);
-        let x213 = x123 - Self::mul_add(s_q8, x207, c_q8 * x118);
-        let x214 = Self::mul_add(
-            0.00000000020510342851533115,
-            x210,
-            Self::mul_add(-s_q8, x209, c_q8 * x208),
-        );
+        let x211 = Self::mul_add(-0.35, x206, Self::mul_add(c_q8, x201, s_q8 * x200));
+        let x212 = Self::mul_add(s_q7, x204, c_q7 * x206);
+        let x213 = -x212;
+        let x214 = Self::mul_add(-c_q7, x204, s_q7 * x206);
         let x215 = -x214;
-        let x216 = Self::mul_add(
-            -0.35,
-            x212,
-            x210 - Self::mul_add(-x8, x209, x7 * x208),
-        );
-        let x217 = Self::mul_add(-0.35, x211, Self::mul_add(c_q8, x209, s_q8 * x208));
-        let x218 = Self::mul_add(s_q7, x212, c_q7 * x211);
-        let x219 = -x218;
-        let x220 = Self::mul_add(-c_q7, x212, s_q7 * x211);
-        let x221 = -x220;
-        let x222 = Self::mul_add(0.75, x220, Self::mul_add(-s_q7, x217, c_q7 * x216));
-        let x223 = Self::mul_add(c_q7, x217, s_q7 * x216)
-            - Self::mul_add(0.65, x213, 0.75 * x218);
-        let x224 = -Self::mul_add(0.65, x220, x214);
-        let x225 = Self::mul_add(-s_q9, x97, x117);
-        let x226 = Self::mul_add(x11, x97, x206);
-        let x227 = Self::mul_add(c_q9, x97, x119);
-        let x228 = 0.00000000020510342851533115 * x100;
-        let x229 = Self::mul_add(c_q9, x93, s_q9 * x92) + x228
-            + Self::mul_add(-0.275, x227, 0.4 * x226);
-        let x230 = Self::mul_add(0.4, x225, x100 + Self::mul_add(-x12, x93, x11 * x92));
-        let x231 = Self::mul_add(
+        let x216 = Self::mul_add(0.75, x214, Self::mul_add(-s_q7, x211, c_q7 * x210));
+        let x217 = Self::mul_add(c_q7, x211, s_q7 * x210)
+            - Self::mul_add(0.65, x205, 0.75 * x212);
+        let x218 = -Self::mul_add(0.65, x214, x208);
+        let x219 = Self::mul_add(-s_q9, x89, x109);
+        let x220 = Self::mul_add(x9, x89, x198);
+        let x221 = Self::mul_add(c_q9, x89, x111);
+        let x222 = 0.00000000020510342851533115 * x92;
+        let x223 = Self::mul_add(c_q9, x85, s_q9 * x84) + x222
+            + Self::mul_add(-0.275, x221, 0.4 * x220);
+        let x224 = Self::mul_add(0.4, x219, x92 + Self::mul_add(-x10, x85, x9 * x84));
+        let x225 = Self::mul_add(
             0.275,
-            x225,
-            x228 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+            x219,
+            x222 - Self::mul_add(-s_q9, x85, c_q9 * x84),
         );
-        let x232 = -x231;
-        let x233 = x227 + Self::mul_add(x8, x226, x7 * x225);
-        let x234 = Self::mul_add(-c_q8, x226, s_q8 * x225);
+        let x226 = -x225;
+        let x227 = Self::mul_add(s_q8, x220, c_q8 * x219);
+        let x228 = Self::mul_add(-c_q8, x220, s_q8 * x219);
+        let x229 = Self::mul_add(-0.00000000020510342851533115, x221, x227);
+        let x230 = -x229;
+        let x231 = Self::mul_add(0.00000000020510342851533115, x227, x221);
+        let x232 = Self::mul_add(-s_q8, x224, c_q8 * x223);
+        let x233 = Self::mul_add(-0.00000000020510342851533115, x225, x232);
+        let x234 = -x233;
         let x235 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x227,
-            Self::mul_add(s_q8, x226, c_q8 * x225),
+            0.35,
+            x228,
+            Self::mul_add(0.00000000020510342851533115, x232, x225),
         );
-        let x236 = -x235;
-        let x237 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x231,
-            Self::mul_add(-s_q8, x230, c_q8 * x229),
-        );
+        let x236 = Self::mul_add(-0.35, x231, Self::mul_add(c_q8, x224, s_q8 * x223));
+        let x237 = Self::mul_add(s_q7, x228, c_q7 * x231);
         let x238 = -x237;
-        let x239 = Self::mul_add(0.35, x234, x231 + Self::mul_add(-x8, x230, x7 * x229));
-        let x240 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x230, s_q8 * x229));
-        let x241 = Self::mul_add(s_q7, x234, c_q7 * x233);
-        let x242 = -x241;
-        let x243 = Self::mul_add(-c_q7, x234, s_q7 * x233);
-        let x244 = -x243;
-        let x245 = -Self::mul_add(-0.75, x243, Self::mul_add(s_q7, x240, c_q7 * x239));
-        let x246 = -(Self::mul_add(-c_q7, x240, s_q7 * x239)
-            + Self::mul_add(-0.65, x235, 0.75 * x241));
-        let x247 = -Self::mul_add(0.65, x243, x237);
-        let x248 = Self::mul_add(c_q10, x73, x96);
-        let x249 = Self::mul_add(-s_q10, x73, x94);
-        let x250 = Self::mul_add(-s_q10, x79, c_q10 * x78);
-        let x251 = Self::mul_add(c_q10, x79, s_q10 * x78);
-        let x252 = Self::mul_add(-0.87, x248, x80);
-        let x253 = Self::mul_add(-c_q9, x249, s_q9 * x248);
-        let x254 = Self::mul_add(x12, x249, x11 * x248);
-        let x255 = Self::mul_add(s_q9, x249, c_q9 * x248);
-        let x256 = 0.00000000020510342851533115 * x252;
-        let x257 = Self::mul_add(c_q9, x251, s_q9 * x250) + x256
-            + Self::mul_add(-0.275, x255, 0.4 * x254);
-        let x258 = Self::mul_add(
+        let x239 = Self::mul_add(-c_q7, x228, s_q7 * x231);
+        let x240 = -x239;
+        let x241 = -Self::mul_add(-0.75, x239, Self::mul_add(s_q7, x236, c_q7 * x235));
+        let x242 = -(Self::mul_add(-c_q7, x236, s_q7 * x235)
+            + Self::mul_add(-0.65, x229, 0.75 * x237));
+        let x243 = -Self::mul_add(0.65, x239, x233);
+        let x244 = Self::mul_add(c_q10, x65, x88);
+        let x245 = Self::mul_add(-s_q10, x65, x86);
+        let x246 = Self::mul_add(-s_q10, x71, c_q10 * x70);
+        let x247 = Self::mul_add(c_q10, x71, s_q10 * x70);
+        let x248 = Self::mul_add(-0.87, x244, x72);
+        let x249 = Self::mul_add(-c_q9, x245, s_q9 * x244);
+        let x250 = Self::mul_add(x10, x245, x9 * x244);
+        let x251 = Self::mul_add(s_q9, x245, c_q9 * x244);
+        let x252 = 0.00000000020510342851533115 * x248;
+        let x253 = Self::mul_add(c_q9, x247, s_q9 * x246) + x252
+            + Self::mul_add(-0.275, x251, 0.4 * x250);
+        let x254 = Self::mul_add(
             -0.4,
-            x253,
-            x252 + Self::mul_add(-x12, x251, x11 * x250),
+            x249,
+            x248 + Self::mul_add(-x10, x247, x9 * x246),
         );
-        let x259 = Self::mul_add(
+        let x255 = Self::mul_add(
             -0.275,
-            x253,
-            x256 - Self::mul_add(-s_q9, x251, c_q9 * x250),
+            x249,
+            x252 - Self::mul_add(-s_q9, x247, c_q9 * x246),
         );
-        let x260 = -x259;
-        let x261 = x255 - Self::mul_add(-x8, x254, x7 * x253);
-        let x262 = Self::mul_add(c_q8, x254, s_q8 * x253);
-        let x263 = Self::mul_add(
-            0.00000000020510342851533115,
-            x255,
-            Self::mul_add(-s_q8, x254, c_q8 * x253),
-        );
+        let x256 = -x255;
+        let x257 = Self::mul_add(-s_q8, x250, c_q8 * x249);
+        let x258 = Self::mul_add(c_q8, x250, s_q8 * x249);
+        let x259 = Self::mul_add(0.00000000020510342851533115, x251, x257);
+        let x260 = Self::mul_add(-0.00000000020510342851533115, x257, x251);
+        let x261 = Self::mul_add(-s_q8, x254, c_q8 * x253);
+        let x262 = Self::mul_add(-0.00000000020510342851533115, x255, x261);
+        let x263 = -x262;
         let x264 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x259,
-            Self::mul_add(-s_q8, x258, c_q8 * x257),
-        );
-        let x265 = -x264;
-        let x266 = Self::mul_add(
             -0.35,
-            x262,
-            x259 + Self::mul_add(-x8, x258, x7 * x257),
+            x258,
+            Self::mul_add(0.00000000020510342851533115, x261, x255),
         );
-        let x267 = Self::mul_add(-0.35, x261, Self::mul_add(c_q8, x258, s_q8 * x257));
-        let x268 = Self::mul_add(-s_q7, x262, c_q7 * x261);
+        let x265 = Self::mul_add(-0.35, x260, Self::mul_add(c_q8, x254, s_q8 * x253));
+        let x266 = Self::mul_add(-s_q7, x258, c_q7 * x260);
+        let x267 = -x266;
+        let x268 = Self::mul_add(c_q7, x258, s_q7 * x260);
         let x269 = -x268;
-        let x270 = Self::mul_add(c_q7, x262, s_q7 * x261);
-        let x271 = -x270;
-        let x272 = -Self::mul_add(-0.75, x270, Self::mul_add(s_q7, x267, c_q7 * x266));
-        let x273 = -(Self::mul_add(-c_q7, x267, s_q7 * x266)
-            + Self::mul_add(0.65, x263, 0.75 * x268));
-        let x274 = -Self::mul_add(0.65, x270, x264);
-        let x275 = Self::mul_add(-x14, x34, x13 * x35);
-        let x276 = Self::mul_add(0.36, x275, x48);
-        let x277 = Self::mul_add(x51, 0.36, x40 - Self::mul_add(x14, x39, x13 * x37));
-        let x278 = Self::mul_add(s_q11, x275, c_q11 * x51);
-        let x279 = Self::mul_add(-c_q11, x275, s_q11 * x51);
+        let x270 = -Self::mul_add(-0.75, x268, Self::mul_add(s_q7, x265, c_q7 * x264));
+        let x271 = -(Self::mul_add(-c_q7, x265, s_q7 * x264)
+            + Self::mul_add(0.65, x259, 0.75 * x266));
+        let x272 = -Self::mul_add(0.65, x268, x262);
+        let x273 = 0.00000000020510342851533115 * x44;
+        let x274 = Self::mul_add(0.00000000020510342851533115, x34, x43);
+        let x275 = -x274;
+        let x276 = Self::mul_add(-0.36, x273, x42);
+        let x277 = Self::mul_add(
+            x45,
+            0.36,
+            Self::mul_add(-0.00000000020510342851533115, x43, x34),
+        );
+        let x278 = Self::mul_add(-s_q11, x273, c_q11 * x45);
+        let x279 = Self::mul_add(c_q11, x273, s_q11 * x45);
         let x280 = Self::mul_add(-s_q11, x277, c_q11 * x276)
-            - Self::mul_add(x50, -0.63, 0.275 * x279);
+            - Self::mul_add(x44, -0.63, 0.275 * x279);
         let x281 = Self::mul_add(0.275, x278, Self::mul_add(c_q11, x277, s_q11 * x276));
-        let x282 = Self::mul_add(0.63, x278, x58);
+        let x282 = Self::mul_add(0.63, x278, x274);
         let x283 = -x282;
         let x284 = Self::mul_add(-s_q10, x279, c_q10 * x278);
         let x285 = Self::mul_add(c_q10, x279, s_q10 * x278);
         let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
-        let x287 = Self::mul_add(x50, 0.87, Self::mul_add(-s_q10, x281, c_q10 * x280));
+        let x287 = Self::mul_add(x44, 0.87, Self::mul_add(-s_q10, x281, c_q10 * x280));
         let x288 = Self::mul_add(0.87, x284, x282);
         let x289 = -x288;
-        let x290 = 0.00000000020510342851533115 * x50;
-        let x291 = Self::mul_add(c_q9, x285, s_q9 * x284) + x290;
-        let x292 = x50 + Self::mul_add(-x12, x285, x11 * x284);
-        let x293 = x290 - Self::mul_add(-s_q9, x285, c_q9 * x284);
-        let x294 = 0.00000000020510342851533115 * x288;
-        let x295 = Self::mul_add(c_q9, x286, s_q9 * x287) - x294
-            + Self::mul_add(0.275, x293, 0.4 * x292);
+        let x290 = x273 + Self::mul_add(c_q9, x285, s_q9 * x284);
+        let x291 = x44 + Self::mul_add(-x10, x285, x9 * x284);
+        let x292 = x273 - Self::mul_add(-s_q9, x285, c_q9 * x284);
+        let x293 = 0.00000000020510342851533115 * x288;
+        let x294 = Self::mul_add(c_q9, x286, s_q9 * x287) - x293
+            + Self::mul_add(0.275, x292, 0.4 * x291);
+        let x295 = Self::mul_add(0.4, x290, x288 - Self::mul_add(-x10, x286, x9 * x287));
         let x296 = Self::mul_add(
-            0.4,
-            x291,
-            x288 - Self::mul_add(-x12, x286, x11 * x287),
-        );
-        let x297 = Self::mul_add(
             0.275,
-            x291,
-            x294 + Self::mul_add(-s_q9, x286, c_q9 * x287),
+            x290,
+            x293 + Self::mul_add(-s_q9, x286, c_q9 * x287),
         );
-        let x298 = x293 + Self::mul_add(-x8, x292, x7 * x291);
-        let x299 = Self::mul_add(c_q8, x292, s_q8 * x291);
-        let x300 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x293,
-            Self::mul_add(-s_q8, x292, c_q8 * x291),
+        let x297 = Self::mul_add(-s_q8, x291, c_q8 * x290);
+        let x298 = Self::mul_add(c_q8, x291, s_q8 * x290);
+        let x299 = Self::mul_add(-0.00000000020510342851533115, x292, x297);
+        let x300 = Self::mul_add(0.00000000020510342851533115, x297, x292);
+        let x301 = Self::mul_add(s_q8, x295, c_q8 * x294);
+        let x302 = Self::mul_add(0.00000000020510342851533115, x296, x301);
+        let x303 = -x302;
+        let x304 = Self::mul_add(
+            0.35,
+            x298,
+            Self::mul_add(-0.00000000020510342851533115, x301, x296),
         );
-        let x301 = Self::mul_add(
-            0.00000000020510342851533115,
-            x297,
-            Self::mul_add(s_q8, x296, c_q8 * x295),
-        );
-        let x302 = -x301;
-        let x303 = Self::mul_add(0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
-        let x304 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
-        let x305 = Self::mul_add(s_q7, x299, c_q7 * x298);
-        let x306 = Self::mul_add(-c_q7, x299, s_q7 * x298);
-        let x307 = Self::mul_add(-0.75, x306, Self::mul_add(-s_q7, x304, c_q7 * x303));
-        let x308 = Self::mul_add(c_q7, x304, s_q7 * x303)
-            + Self::mul_add(-0.65, x300, 0.75 * x305);
-        let x309 = -Self::mul_add(-0.65, x306, x301);
-        let x310 = 4.806620000000001 * x15;
-        let x311 = x31
-            + (1.4135609200000003
-                + Self::mul_add(
-                    0.00000000020510342851533115 * s_q13,
-                    -0.9614610000000001,
-                    x15 * 0.0145,
-                ));
-        let x312 = Self::mul_add(-0.16, x310, x21);
-        let x313 = Self::mul_add(-0.55, x310, x28);
-        let x314 = Self::mul_add(s_q12, x22, c_q12 * x310);
-        let x315 = x23 - Self::mul_add(-x14, x22, x13 * x310);
-        let x316 = Self::mul_add(
-            0.00000000020510342851533115,
-            x23,
-            Self::mul_add(-c_q12, x22, s_q12 * x310),
-        );
-        let x317 = Self::mul_add(
-            0.00000000020510342851533115,
-            x313,
-            Self::mul_add(-c_q12, x312, s_q12 * x311),
-        );
-        let x318 = -x317;
-        let x319 = Self::mul_add(0.36, x315, Self::mul_add(s_q12, x312, c_q12 * x311));
-        let x320 = Self::mul_add(
+        let x305 = Self::mul_add(0.35, x300, Self::mul_add(-c_q8, x295, s_q8 * x294));
+        let x306 = Self::mul_add(s_q7, x298, c_q7 * x300);
+        let x307 = Self::mul_add(-c_q7, x298, s_q7 * x300);
+        let x308 = Self::mul_add(-0.75, x307, Self::mul_add(-s_q7, x305, c_q7 * x304));
+        let x309 = Self::mul_add(c_q7, x305, s_q7 * x304)
+            + Self::mul_add(-0.65, x299, 0.75 * x306);
+        let x310 = -Self::mul_add(-0.65, x307, x302);
+        let x311 = 0.00000000020510342851533115 * x18;
+        let x312 = x25
+            + Self::mul_add(0.00000000020510342851533115, x15, 1.4135609200000003);
+        let x313 = Self::mul_add(-0.16, x311, x16);
+        let x314 = Self::mul_add(-0.55, x311, x15 + -0.0000000002899261911072858);
+        let x315 = Self::mul_add(s_q12, x17, c_q12 * x311);
+        let x316 = Self::mul_add(-c_q12, x17, s_q12 * x311);
+        let x317 = Self::mul_add(-0.00000000020510342851533115, x316, x18);
+        let x318 = x311 + x316;
+        let x319 = Self::mul_add(-c_q12, x313, s_q12 * x312);
+        let x320 = Self::mul_add(0.00000000020510342851533115, x314, x319);
+        let x321 = -x320;
+        let x322 = Self::mul_add(0.36, x317, Self::mul_add(s_q12, x313, c_q12 * x312));
+        let x323 = Self::mul_add(
             -0.36,
-            x314,
-            x313 - Self::mul_add(-x14, x312, x13 * x311),
+            x315,
+            Self::mul_add(-0.00000000020510342851533115, x319, x314),
         );
-        let x321 = Self::mul_add(-s_q11, x315, c_q11 * x314);
-        let x322 = Self::mul_add(c_q11, x315, s_q11 * x314);
-        let x323 = Self::mul_add(-s_q11, x320, c_q11 * x319)
-            + Self::mul_add(0.63, x316, 0.275 * x322);
-        let x324 = Self::mul_add(-0.275, x321, Self::mul_add(c_q11, x320, s_q11 * x319));
-        let x325 = Self::mul_add(-0.63, x321, x317);
-        let x326 = -x325;
-        let x327 = Self::mul_add(-s_q10, x322, c_q10 * x321);
-        let x328 = Self::mul_add(c_q10, x322, s_q10 * x321);
-        let x329 = Self::mul_add(c_q10, x324, s_q10 * x323);
-        let x330 = Self::mul_add(0.87, x316, Self::mul_add(-s_q10, x324, c_q10 * x323));
-        let x331 = Self::mul_add(-0.87, x327, x325);
-        let x332 = -x331;
-        let x333 = 0.00000000020510342851533115 * x316;
-        let x334 = Self::mul_add(c_q9, x328, s_q9 * x327) - x333;
-        let x335 = x316 - Self::mul_add(-x12, x328, x11 * x327);
-        let x336 = x333 + Self::mul_add(-s_q9, x328, c_q9 * x327);
-        let x337 = 0.00000000020510342851533115 * x331;
-        let x338 = Self::mul_add(c_q9, x329, s_q9 * x330) - x337
-            + Self::mul_add(0.275, x336, 0.4 * x335);
-        let x339 = Self::mul_add(
+        let x324 = Self::mul_add(-s_q11, x317, c_q11 * x315);
+        let x325 = Self::mul_add(c_q11, x317, s_q11 * x315);
+        let x326 = Self::mul_add(-s_q11, x323, c_q11 * x322)
+            + Self::mul_add(0.63, x318, 0.275 * x325);
+        let x327 = Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x323, s_q11 * x322));
+        let x328 = Self::mul_add(-0.63, x324, x320);
+        let x329 = -x328;
+        let x330 = Self::mul_add(-s_q10, x325, c_q10 * x324);
+        let x331 = Self::mul_add(c_q10, x325, s_q10 * x324);
+        let x332 = Self::mul_add(c_q10, x327, s_q10 * x326);
+        let x333 = Self::mul_add(0.87, x318, Self::mul_add(-s_q10, x327, c_q10 * x326));
+        let x334 = Self::mul_add(-0.87, x330, x328);
+        let x335 = -x334;
+        let x336 = 0.00000000020510342851533115 * x318;
+        let x337 = Self::mul_add(c_q9, x331, s_q9 * x330) - x336;
+        let x338 = x318 - Self::mul_add(-x10, x331, x9 * x330);
+        let x339 = x336 + Self::mul_add(-s_q9, x331, c_q9 * x330);
+        let x340 = 0.00000000020510342851533115 * x334;
+        let x341 = Self::mul_add(c_q9, x332, s_q9 * x333) - x340
+            + Self::mul_add(0.275, x339, 0.4 * x338);
+        let x342 = Self::mul_add(
             -0.4,
-            x334,
-            x331 - Self::mul_add(-x12, x329, x11 * x330),
+            x337,
+            x334 - Self::mul_add(-x10, x332, x9 * x333),
         );
-        let x340 = Self::mul_add(
-            -0.275,
-            x334,
-            x337 + Self::mul_add(-s_q9, x329, c_q9 * x330),
-        );
-        let x341 = x336 - Self::mul_add(x8, x335, x7 * x334);
-        let x342 = Self::mul_add(-c_q8, x335, s_q8 * x334);
         let x343 = Self::mul_add(
-            0.00000000020510342851533115,
-            x336,
-            Self::mul_add(s_q8, x335, c_q8 * x334),
+            -0.275,
+            x337,
+            x340 + Self::mul_add(-s_q9, x332, c_q9 * x333),
         );
-        let x344 = -x343;
-        let x345 = Self::mul_add(
-            0.00000000020510342851533115,
-            x340,
-            Self::mul_add(s_q8, x339, c_q8 * x338),
+        let x344 = Self::mul_add(s_q8, x338, c_q8 * x337);
+        let x345 = Self::mul_add(-c_q8, x338, s_q8 * x337);
+        let x346 = Self::mul_add(0.00000000020510342851533115, x339, x344);
+        let x347 = -x346;
+        let x348 = Self::mul_add(-0.00000000020510342851533115, x344, x339);
+        let x349 = Self::mul_add(s_q8, x342, c_q8 * x341);
+        let x350 = Self::mul_add(0.00000000020510342851533115, x343, x349);
+        let x351 = -x350;
+        let x352 = Self::mul_add(
+            -0.35,
+            x345,
+            Self::mul_add(-0.00000000020510342851533115, x349, x343),
         );
-        let x346 = -x345;
-        let x347 = Self::mul_add(-0.35, x342, x340 - Self::mul_add(x8, x339, x7 * x338));
-        let x348 = Self::mul_add(0.35, x341, Self::mul_add(-c_q8, x339, s_q8 * x338));
-        let x349 = Self::mul_add(-s_q7, x342, c_q7 * x341);
-        let x350 = Self::mul_add(c_q7, x342, s_q7 * x341);
-        let x351 = Self::mul_add(-0.75, x350, Self::mul_add(-s_q7, x348, c_q7 * x347));
-        let x352 = Self::mul_add(c_q7, x348, s_q7 * x347)
-            + Self::mul_add(0.65, x343, 0.75 * x349);
-        let x353 = -Self::mul_add(-0.65, x350, x345);
+        let x353 = Self::mul_add(0.35, x348, Self::mul_add(-c_q8, x342, s_q8 * x341));
+        let x354 = Self::mul_add(-s_q7, x345, c_q7 * x348);
+        let x355 = Self::mul_add(c_q7, x345, s_q7 * x348);
+        let x356 = Self::mul_add(-0.75, x355, Self::mul_add(-s_q7, x353, c_q7 * x352));
+        let x357 = Self::mul_add(c_q7, x353, s_q7 * x352)
+            + Self::mul_add(0.65, x346, 0.75 * x354);
+        let x358 = -Self::mul_add(-0.65, x355, x350);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x191,
-                x182,
-                x182,
-                x201,
-                x219,
-                x242,
-                x269,
-                x305,
-                x349,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x196,
-                0.0,
-                x190,
-                x180,
-                x202,
-                x221,
-                x244,
-                x271,
-                x306,
-                x350,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
                 x181,
-                x197,
-                0.0,
-                0.0,
-                x159,
+                x172,
+                x172,
+                x193,
                 x213,
-                x236,
-                x263,
-                x300,
-                x344,
-            ],
-            [
-                0.0,
-                x196,
-                x181,
-                x192,
-                x187,
-                x193,
-                x186,
-                x203,
-                x222,
-                x245,
-                x272,
-                x307,
-                x351,
-            ],
-            [
-                x191,
-                0.0,
-                x197,
-                x187,
-                x194,
-                x188,
-                x188,
-                x204,
-                x223,
-                x246,
-                x273,
-                x308,
-                x352,
-            ],
-            [
-                x182,
-                x190,
-                0.0,
-                x193,
-                x188,
-                x195,
-                x189,
-                x205,
-                x224,
-                x247,
-                x274,
-                x309,
-                x353,
-            ],
-            [
-                x182,
-                x180,
-                0.0,
-                x186,
-                x188,
-                x189,
-                x174,
-                x166,
-                x215,
                 x238,
-                x265,
-                x302,
-                x346,
+                x267,
+                x306,
+                x354,
             ],
             [
-                x201,
-                x202,
-                x159,
-                x203,
-                x204,
-                x205,
-                x166,
-                x148,
-                x210,
-                x232,
-                x260,
-                x297,
-                x340,
-            ],
-            [
-                x219,
-                x221,
-                x213,
-                x222,
-                x223,
-                x224,
+                0.0,
+                1170.07,
+                0.0,
+                x186,
+                0.0,
+                x180,
+                x170,
+                x194,
                 x215,
-                x210,
-                x106,
-                x100,
-                x252,
-                x289,
-                x332,
+                x240,
+                x269,
+                x307,
+                x355,
             ],
-            [x242, x244, x236, x245, x246, x247, x238, x232, x100, x86, x80, x283, x326],
-            [x269, x271, x263, x272, x273, x274, x265, x260, x252, x80, x66, x59, x318],
-            [x305, x306, x300, x307, x308, x309, x302, x297, x289, x283, x59, x40, x313],
             [
-                x349,
-                x350,
-                x344,
+                0.0,
+                0.0,
+                1170.07,
+                x171,
+                x187,
+                0.0,
+                0.0,
+                x151,
+                x205,
+                x230,
+                x259,
+                x299,
+                x347,
+            ],
+            [
+                0.0,
+                x186,
+                x171,
+                x182,
+                x177,
+                x183,
+                x176,
+                x195,
+                x216,
+                x241,
+                x270,
+                x308,
+                x356,
+            ],
+            [
+                x181,
+                0.0,
+                x187,
+                x177,
+                x184,
+                x178,
+                x178,
+                x196,
+                x217,
+                x242,
+                x271,
+                x309,
+                x357,
+            ],
+            [
+                x172,
+                x180,
+                0.0,
+                x183,
+                x178,
+                x185,
+                x179,
+                x197,
+                x218,
+                x243,
+                x272,
+                x310,
+                x358,
+            ],
+            [
+                x172,
+                x170,
+                0.0,
+                x176,
+                x178,
+                x179,
+                x164,
+                x190,
+                x209,
+                x234,
+                x263,
+                x303,
                 x351,
-                x352,
-                x353,
-                x346,
-                x340,
-                x332,
-                x326,
-                x318,
-                x313,
+            ],
+            [
+                x193,
+                x194,
+                x151,
+                x195,
+                x196,
+                x197,
+                x190,
+                x140,
+                x202,
+                x226,
+                x256,
+                x296,
+                x343,
+            ],
+            [x213, x215, x205, x216, x217, x218, x209, x202, x98, x92, x248, x289, x335],
+            [x238, x240, x230, x241, x242, x243, x234, x226, x92, x78, x72, x283, x329],
+            [x267, x269, x259, x270, x271, x272, x263, x256, x248, x72, x58, x275, x321],
+            [
+                x306,
+                x307,
+                x299,
+                x308,
+                x309,
+                x310,
+                x303,
+                x296,
+                x289,
+                x283,
+                x275,
+                x34,
+                x314,
+            ],
+            [
+                x354,
+                x355,
+                x347,
+                x356,
+                x357,
+                x358,
+                x351,
+                x343,
+                x335,
+                x329,
+                x321,
+                x314,
                 1.4135609200000003,
             ],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 528 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 509 mul, 415 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 309 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -1975,518 +1933,484 @@ impl FreeFloating7 {
             x24,
             Self::mul_add(0.1132, x11, x10 * 16.80768997608804),
         );
-        let x30 = 0.00000000020510342851533115 * c_q8;
-        let x31 = 0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x11, s_q8, x10 * x30));
-        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x11, c_q8, x10 * x31));
-        let x34 = Self::mul_add(0.35, x23 - x26, Self::mul_add(-s_q7, x19, c_q7 * x18));
-        let x35 = Self::mul_add(0.35, Self::mul_add(-x11, x24, x22), x21);
-        let x36 = Self::mul_add(0.35, Self::mul_add(x10, x10, x25), x20);
-        let x37 = Self::mul_add(c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
-        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-c_q8, x35, x31 * x34));
-        let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
-        let x40 = Self::mul_add(v[7], x33, Self::mul_add(-x23, s_q8, x22 * x30));
-        let x41 = Self::mul_add(-v[7], x32, Self::mul_add(x23, c_q8, x22 * x31));
-        let x42 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x10);
-        let x43 = x33 * x33;
-        let x44 = x42 * x42;
-        let x45 = x32 * x33;
-        let x46 = x22 - x45;
-        let x47 = x32 * x42;
-        let x48 = x32 * x32;
-        let x49 = x44 + x48;
-        let x50 = x33 * x42;
-        let x51 = x40 + x50;
-        let x52 = Self::mul_add(
-            x42,
-            0.002139996587640933,
-            x33 * 0.0000000234896432582596,
-        );
+        let x30 = Self::mul_add(0.00000000020510342851533115, x10, x24);
+        let x31 = Self::mul_add(x11, s_q8, c_q8 * x30);
+        let x32 = Self::mul_add(-x11, c_q8, s_q8 * x30);
+        let x33 = Self::mul_add(0.35, x23 - x26, Self::mul_add(-s_q7, x19, c_q7 * x18));
+        let x34 = Self::mul_add(0.35, Self::mul_add(-x11, x24, x22), x21);
+        let x35 = Self::mul_add(0.35, Self::mul_add(x10, x10, x25), x20);
+        let x36 = Self::mul_add(-0.00000000020510342851533115, x35, x33);
+        let x37 = Self::mul_add(0.00000000020510342851533115, x33, x35);
+        let x38 = Self::mul_add(s_q8, x34, c_q8 * x37);
+        let x39 = Self::mul_add(-c_q8, x34, s_q8 * x37);
+        let x40 = 0.00000000020510342851533115 * x22;
+        let x41 = Self::mul_add(v[7], x32, Self::mul_add(-x23, s_q8, c_q8 * x40));
+        let x42 = Self::mul_add(-v[7], x31, Self::mul_add(x23, c_q8, s_q8 * x40));
+        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x10);
+        let x44 = x32 * x32;
+        let x45 = x43 * x43;
+        let x46 = x31 * x32;
+        let x47 = x22 - x46;
+        let x48 = x31 * x43;
+        let x49 = x31 * x31;
+        let x50 = x45 + x49;
+        let x51 = x32 * x43;
+        let x52 = x41 + x51;
         let x53 = Self::mul_add(
-            5.080660024070365,
-            x42,
-            Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
+            x43,
+            0.002139996587640933,
+            x32 * 0.0000000234896432582596,
         );
         let x54 = Self::mul_add(
-            113.3918902508081,
-            x42,
-            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
+            5.080660024070365,
+            x43,
+            Self::mul_add(x32, -111.7548902508081, x31 * 0.0000000234896432582596),
         );
         let x55 = Self::mul_add(
-            x39,
+            113.3918902508081,
+            x43,
+            Self::mul_add(5.080660024070366, x32, x31 * 0.002139996587640933),
+        );
+        let x56 = Self::mul_add(
+            x36,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
                 x22,
-                Self::mul_add(x41, -111.7548902508081, x40 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x32, x54, x42 * x52),
+                Self::mul_add(x42, -111.7548902508081, x41 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x31, x55, x43 * x53),
         );
-        let x56 = 0.00000000020510342851533115 * c_q9;
-        let x57 = 0.00000000020510342851533115 * s_q9;
-        let x58 = x56 - x57;
-        let x59 = x56 + x57;
-        let x60 = Self::mul_add(-x42, c_q9, Self::mul_add(-x33, x58, x32 * s_q9));
-        let x61 = Self::mul_add(x42, s_q9, Self::mul_add(x33, x59, x32 * c_q9));
-        let x62 = x37 + Self::mul_add(-0.4, x41 + x47, 0.275 * x46);
-        let x63 = x38 + Self::mul_add(0.4, x40 - x50, 0.275 * x49);
-        let x64 = x39 - Self::mul_add(-0.4, x43 + x48, 0.275 * x51);
-        let x65 = Self::mul_add(-c_q9, x64, Self::mul_add(-x58, x63, s_q9 * x62));
-        let x66 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x64,
-            Self::mul_add(-0.00000000020510342851533115, x62, x63),
-        );
+        let x57 = 0.00000000020510342851533115 * c_q9;
+        let x58 = 0.00000000020510342851533115 * s_q9;
+        let x59 = x57 - x58;
+        let x60 = x57 + x58;
+        let x61 = Self::mul_add(-x43, c_q9, Self::mul_add(-x32, x59, x31 * s_q9));
+        let x62 = Self::mul_add(x43, s_q9, Self::mul_add(x32, x60, x31 * c_q9));
+        let x63 = x38 + Self::mul_add(-0.4, x42 + x48, 0.275 * x47);
+        let x64 = x39 + Self::mul_add(0.4, x41 - x51, 0.275 * x50);
+        let x65 = x36 - Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
+        let x66 = Self::mul_add(-c_q9, x65, Self::mul_add(-x59, x64, s_q9 * x63));
         let x67 = Self::mul_add(
             -0.00000000020510342851533115,
-            x22,
-            Self::mul_add(-0.00000000020510342851533115, x40, x41),
+            x65,
+            Self::mul_add(-0.00000000020510342851533115, x63, x64),
         );
-        let x68 = Self::mul_add(
-            -v[8],
-            x61,
-            Self::mul_add(-x22, c_q9, Self::mul_add(-x41, x58, x40 * s_q9)),
-        );
+        let x68 = x40 - Self::mul_add(-0.00000000020510342851533115, x41, x42);
         let x69 = Self::mul_add(
-            v[8],
-            x60,
-            Self::mul_add(x22, s_q9, Self::mul_add(x41, x59, x40 * c_q9)),
+            -v[8],
+            x62,
+            Self::mul_add(-x22, c_q9, Self::mul_add(-x42, x59, x41 * s_q9)),
         );
-        let x70 = v[8]
+        let x70 = Self::mul_add(
+            v[8],
+            x61,
+            Self::mul_add(x22, s_q9, Self::mul_add(x42, x60, x41 * c_q9)),
+        );
+        let x71 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x42,
-                Self::mul_add(-0.00000000020510342851533115, x32, x33),
+                x43,
+                Self::mul_add(-0.00000000020510342851533115, x31, x32),
             );
-        let x71 = Self::mul_add(x60, x61, x67);
-        let x72 = Self::mul_add(x60, x60, x70 * x70);
-        let x73 = Self::mul_add(-x61, x70, x68);
-        let x74 = x70 * 0.00214;
-        let x75 = Self::mul_add(x70, -36.18604050126307, x61 * 63.36336825000001);
-        let x76 = Self::mul_add(
-            69.99836825,
-            x70,
-            Self::mul_add(x61, 36.18604050126307, x60 * 0.00214),
-        );
+        let x72 = Self::mul_add(-x61, x62, x68);
+        let x73 = Self::mul_add(x61, x61, x71 * x71);
+        let x74 = Self::mul_add(-x62, x71, x69);
+        let x75 = x71 * 0.00214;
+        let x76 = Self::mul_add(x71, -36.18604050126307, x62 * 63.36336825000001);
         let x77 = Self::mul_add(
-            x66,
-            81.53205,
-            Self::mul_add(x67, 0.00214, -Self::mul_add(x61, x76, x70 * x75)),
+            69.99836825,
+            x71,
+            Self::mul_add(x62, 36.18604050126307, x61 * 0.00214),
         );
         let x78 = Self::mul_add(
-            x65,
+            x67,
+            -81.53205,
+            Self::mul_add(x68, 0.00214, Self::mul_add(x62, x77, x71 * x76)),
+        );
+        let x79 = Self::mul_add(
+            x66,
             -81.53205,
             Self::mul_add(
-                69.99836825,
-                x67,
-                Self::mul_add(x69, 36.18604050126307, x68 * 0.00214),
-            ) + Self::mul_add(x60, x75, x61 * x74),
+                -69.99836825,
+                x68,
+                Self::mul_add(x70, 36.18604050126307, x69 * 0.00214),
+            ) + Self::mul_add(x61, x76, x62 * x75),
         );
-        let x79 = Self::mul_add(x61, s_q10, x60 * c_q10);
-        let x80 = Self::mul_add(-x61, c_q10, x60 * s_q10);
-        let x81 = Self::mul_add(x71, -0.87, x65);
-        let x82 = Self::mul_add(
-            x72,
+        let x80 = Self::mul_add(x62, s_q10, x61 * c_q10);
+        let x81 = Self::mul_add(-x62, c_q10, x61 * s_q10);
+        let x82 = Self::mul_add(x72, 0.87, x66);
+        let x83 = Self::mul_add(
+            x73,
             0.87,
-            Self::mul_add(s_q9, x64, Self::mul_add(x59, x63, c_q9 * x62)),
+            Self::mul_add(s_q9, x65, Self::mul_add(x60, x64, c_q9 * x63)),
         );
-        let x83 = Self::mul_add(x73, 0.87, x66);
-        let x84 = Self::mul_add(s_q10, x82, c_q10 * x81);
-        let x85 = Self::mul_add(v[9], x80, Self::mul_add(x69, s_q10, x68 * c_q10));
-        let x86 = Self::mul_add(-v[9], x79, Self::mul_add(-x69, c_q10, x68 * s_q10));
-        let x87 = v[9] + x70;
-        let x88 = Self::mul_add(-x79, x80, x67);
-        let x89 = x79 * x79;
-        let x90 = Self::mul_add(x87, x87, x89);
-        let x91 = x80 * x87;
-        let x92 = x85 + x91;
-        let x93 = x87 * 0.6328;
-        let x94 = Self::mul_add(x87, 24.35164200091464, x80 * 24.4950615);
-        let x95 = Self::mul_add(
-            28.2393615,
-            x87,
-            Self::mul_add(x80, -24.351642000914637, x79 * 0.6328),
-        );
+        let x84 = Self::mul_add(x74, 0.87, x67);
+        let x85 = Self::mul_add(s_q10, x83, c_q10 * x82);
+        let x86 = Self::mul_add(v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
+        let x87 = Self::mul_add(-v[9], x80, Self::mul_add(-x70, c_q10, x69 * s_q10));
+        let x88 = v[9] + x71;
+        let x89 = Self::mul_add(x80, x81, x68);
+        let x90 = x80 * x80;
+        let x91 = Self::mul_add(x88, x88, x90);
+        let x92 = x81 * x88;
+        let x93 = x86 + x92;
+        let x94 = x88 * 0.6328;
+        let x95 = Self::mul_add(x88, 24.35164200091464, x81 * 24.4950615);
         let x96 = Self::mul_add(
-            x83,
-            45.1584,
-            Self::mul_add(x67, 0.6328, Self::mul_add(x80, x95, x87 * x94)),
+            28.2393615,
+            x88,
+            Self::mul_add(x81, -24.351642000914637, x80 * 0.6328),
         );
         let x97 = Self::mul_add(
             x84,
             -45.1584,
+            Self::mul_add(x68, 0.6328, -Self::mul_add(x81, x96, x88 * x95)),
+        );
+        let x98 = Self::mul_add(
+            x85,
+            -45.1584,
             Self::mul_add(
-                28.2393615,
-                x67,
-                Self::mul_add(x86, -24.351642000914637, x85 * 0.6328),
-            ) - Self::mul_add(x79, x94, x80 * x93),
+                -28.2393615,
+                x68,
+                Self::mul_add(x87, -24.351642000914637, x86 * 0.6328),
+            ) - Self::mul_add(x80, x95, x81 * x94),
         );
-        let x98 = Self::mul_add(-x80, s_q11, x79 * c_q11);
-        let x99 = Self::mul_add(x80, c_q11, x79 * s_q11);
-        let x100 = x84 - Self::mul_add(-0.275, Self::mul_add(x79, x87, x86), x88 * 0.63);
-        let x101 = Self::mul_add(-c_q10, x82, s_q10 * x81)
-            - Self::mul_add(0.275, x85 - x91, x90 * 0.63);
-        let x102 = x83 + Self::mul_add(-0.275, Self::mul_add(x80, x80, x89), x92 * 0.63);
-        let x103 = Self::mul_add(-s_q11, x101, c_q11 * x100);
-        let x104 = Self::mul_add(v[10], x99, Self::mul_add(-x86, s_q11, x85 * c_q11));
-        let x105 = Self::mul_add(-v[10], x98, Self::mul_add(x86, c_q11, x85 * s_q11));
-        let x106 = v[10] + x87;
-        let x107 = x98 * x98;
-        let x108 = x99 * x106;
-        let x109 = 0.01675 * x106;
-        let x110 = Self::mul_add(-2.5482240016099564, x106, x99 * 9.142025249762803);
-        let x111 = Self::mul_add(
-            -9.223235249762805,
-            x106,
-            Self::mul_add(-2.5482240016099564, x99, 0.01675 * x98),
-        );
+        let x99 = Self::mul_add(-x81, s_q11, x80 * c_q11);
+        let x100 = Self::mul_add(x81, c_q11, x80 * s_q11);
+        let x101 = x85 + Self::mul_add(0.275, Self::mul_add(x80, x88, x87), x89 * 0.63);
+        let x102 = Self::mul_add(-c_q10, x83, s_q10 * x82)
+            - Self::mul_add(0.275, x86 - x92, x91 * 0.63);
+        let x103 = x84 + Self::mul_add(-0.275, Self::mul_add(x81, x81, x90), x93 * 0.63);
+        let x104 = Self::mul_add(-s_q11, x102, c_q11 * x101);
+        let x105 = Self::mul_add(v[10], x100, Self::mul_add(-x87, s_q11, x86 * c_q11));
+        let x106 = Self::mul_add(-v[10], x99, Self::mul_add(x87, c_q11, x86 * s_q11));
+        let x107 = v[10] + x88;
+        let x108 = x99 * x99;
+        let x109 = x100 * x107;
+        let x110 = 0.01675 * x107;
+        let x111 = Self::mul_add(-2.5482240016099564, x107, x100 * 9.142025249762803);
         let x112 = Self::mul_add(
-            7.078399999258757,
-            x102,
-            Self::mul_add(0.01675, x67, -Self::mul_add(-x99, x111, x106 * x110)),
+            -9.223235249762805,
+            x107,
+            Self::mul_add(-2.5482240016099564, x100, 0.01675 * x99),
         );
         let x113 = Self::mul_add(
             -7.078399999258757,
             x103,
+            Self::mul_add(0.01675, x68, Self::mul_add(-x100, x112, x107 * x111)),
+        );
+        let x114 = Self::mul_add(
+            -7.078399999258757,
+            x104,
             Self::mul_add(
-                -9.223235249762805,
-                x67,
-                Self::mul_add(-2.5482240016099564, x105, 0.01675 * x104),
-            ) - Self::mul_add(-x98, x110, x99 * x109),
+                9.223235249762805,
+                x68,
+                Self::mul_add(-2.5482240016099564, x106, 0.01675 * x105),
+            ) - Self::mul_add(-x99, x111, x100 * x110),
         );
-        let x114 = 0.00000000020510342851533115 * s_q12;
-        let x115 = 0.00000000020510342851533115 * c_q12;
-        let x116 = Self::mul_add(x106, s_q12, Self::mul_add(x99, x114, x98 * c_q12));
-        let x117 = Self::mul_add(-x106, c_q12, Self::mul_add(-x99, x115, x98 * s_q12));
-        let x118 = Self::mul_add(Self::mul_add(x98, x106, x105), 0.36, x103);
+        let x115 = Self::mul_add(0.00000000020510342851533115, x100, x107);
+        let x116 = Self::mul_add(s_q12, x115, x99 * c_q12);
+        let x117 = Self::mul_add(-c_q12, x115, x99 * s_q12);
+        let x118 = Self::mul_add(Self::mul_add(x99, x107, x106), 0.36, x104);
         let x119 = Self::mul_add(
-            x104 - x108,
+            x105 - x109,
             -0.36,
-            Self::mul_add(c_q11, x101, s_q11 * x100),
+            Self::mul_add(c_q11, x102, s_q11 * x101),
         );
-        let x120 = Self::mul_add(Self::mul_add(x99, x99, x107), -0.36, x102);
-        let x121 = Self::mul_add(s_q12, x120, Self::mul_add(x114, x119, c_q12 * x118));
-        let x122 = Self::mul_add(-c_q12, x120, Self::mul_add(-x115, x119, s_q12 * x118));
-        let x123 = Self::mul_add(-0.00000000020510342851533115, x120, x119);
-        let x124 = Self::mul_add(-0.00000000020510342851533115, x67, x105);
-        let x125 = Self::mul_add(
-            v[11],
-            x117,
-            Self::mul_add(x67, s_q12, Self::mul_add(x105, x114, x104 * c_q12)),
-        );
-        let x126 = Self::mul_add(
-            -v[11],
-            x116,
-            Self::mul_add(-x67, c_q12, Self::mul_add(-x105, x115, x104 * s_q12)),
-        );
-        let x127 = v[11] + Self::mul_add(-0.00000000020510342851533115, x106, x99);
-        let x128 = x117 * x117;
-        let x129 = x127 * x127;
-        let x130 = x116 * x117;
-        let x131 = x124 - x130;
-        let x132 = x116 * x127;
-        let x133 = x116 * x116;
-        let x134 = x129 + x133;
-        let x135 = x117 * x127;
-        let x136 = x125 + x135;
-        let x137 = Self::mul_add(x127, 0.809539999555672, x117 * 1.9877000000000002);
-        let x138 = Self::mul_add(
-            x127,
+        let x120 = Self::mul_add(Self::mul_add(x100, x100, x108), -0.36, x103);
+        let x121 = Self::mul_add(0.00000000020510342851533115, x119, x120);
+        let x122 = Self::mul_add(-0.00000000020510342851533115, x120, x119);
+        let x123 = Self::mul_add(s_q12, x121, c_q12 * x118);
+        let x124 = Self::mul_add(-c_q12, x121, s_q12 * x118);
+        let x125 = Self::mul_add(-0.00000000020510342851533115, x106, x68);
+        let x126 = Self::mul_add(0.00000000020510342851533115, x68, x106);
+        let x127 = Self::mul_add(v[11], x117, Self::mul_add(-s_q12, x125, x105 * c_q12));
+        let x128 = Self::mul_add(-v[11], x116, Self::mul_add(c_q12, x125, x105 * s_q12));
+        let x129 = v[11] + Self::mul_add(-0.00000000020510342851533115, x107, x100);
+        let x130 = x117 * x117;
+        let x131 = x129 * x129;
+        let x132 = x116 * x117;
+        let x133 = x126 - x132;
+        let x134 = x116 * x129;
+        let x135 = x116 * x116;
+        let x136 = x131 + x135;
+        let x137 = x117 * x129;
+        let x138 = x127 + x137;
+        let x139 = Self::mul_add(x129, 0.809539999555672, x117 * 1.9877000000000002);
+        let x140 = Self::mul_add(
+            x129,
             -2.741639999592316,
             Self::mul_add(x117, -5.252920330000002, x116 * 1.9877000000000002),
         );
-        let x139 = Self::mul_add(
+        let x141 = Self::mul_add(
             9.740442170000001,
-            x127,
+            x129,
             Self::mul_add(x117, -2.7416399995923166, x116 * 0.809539999555672),
         );
-        let x140 = Self::mul_add(
+        let x142 = Self::mul_add(
             -3.6140000000000003,
-            x123,
+            x122,
             Self::mul_add(
-                x124,
+                x126,
                 -2.741639999592316,
-                Self::mul_add(x126, -5.252920330000002, x125 * 1.9877000000000002),
-            ) + Self::mul_add(-x116, x139, x127 * x137),
+                Self::mul_add(x128, -5.252920330000002, x127 * 1.9877000000000002),
+            ) + Self::mul_add(-x116, x141, x129 * x139),
         );
-        let x141 = 0.00000000020510342851533115 * c_q13;
-        let x142 = 0.00000000020510342851533115 * s_q13;
-        let x143 = Self::mul_add(-x127, c_q13, Self::mul_add(x117, s_q13, x116 * x141));
-        let x144 = Self::mul_add(-x127, s_q13, Self::mul_add(-x117, c_q13, x116 * x142));
-        let x145 = x121 + Self::mul_add(-0.16, x126 + x132, 0.55 * x131);
-        let x146 = x123 - Self::mul_add(-0.16, x128 + x133, 0.55 * x136);
-        let x147 = Self::mul_add(
-            -c_q13,
-            x146,
-            Self::mul_add(
-                s_q13,
-                x122 + Self::mul_add(0.16, x125 - x135, 0.55 * x134),
-                x141 * x145,
-            ),
-        );
-        let x148 = Self::mul_add(0.00000000020510342851533115, x124, x125);
-        let x149 = Self::mul_add(
-            v[12],
-            x144,
-            Self::mul_add(-x124, c_q13, Self::mul_add(x126, s_q13, x125 * x141)),
-        );
-        let x150 = Self::mul_add(
-            -v[12],
-            x143,
-            Self::mul_add(-x124, s_q13, Self::mul_add(-x126, c_q13, x125 * x142)),
-        );
-        let x151 = v[12] - Self::mul_add(0.00000000020510342851533115, x127, x116);
-        let x152 = 4.806620000000001 * Self::mul_add(x143, x144, x148);
-        let x153 = 4.806620000000001 * Self::mul_add(x143, x143, x151 * x151);
-        let x154 = 4.806620000000001 * Self::mul_add(x144, x151, x149);
-        let x155 = Self::mul_add(x151, 0.0145, 0.000781 * x144);
-        let x156 = Self::mul_add(
-            x151,
-            -0.9614610000000001,
-            Self::mul_add(x144, 1.2025609200000003, 0.000781 * x143),
-        );
+        let x143 = Self::mul_add(-0.00000000020510342851533115, x116, x129);
+        let x144 = Self::mul_add(-x117, s_q13, c_q13 * x143);
+        let x145 = Self::mul_add(x117, c_q13, s_q13 * x143);
+        let x146 = x123 + Self::mul_add(-0.16, x128 + x134, 0.55 * x133);
+        let x147 = x122 - Self::mul_add(-0.16, x130 + x135, 0.55 * x138);
+        let x148 = Self::mul_add(0.00000000020510342851533115, x126, x127);
+        let x149 = Self::mul_add(-0.00000000020510342851533115, x127, x126);
+        let x150 = Self::mul_add(v[12], x145, Self::mul_add(-x128, s_q13, c_q13 * x149));
+        let x151 = Self::mul_add(-v[12], x144, Self::mul_add(x128, c_q13, s_q13 * x149));
+        let x152 = v[12] - Self::mul_add(0.00000000020510342851533115, x129, x116);
+        let x153 = 4.806620000000001 * Self::mul_add(x144, x145, x148);
+        let x154 = 4.806620000000001 * Self::mul_add(x144, x144, x152 * x152);
+        let x155 = 4.806620000000001 * Self::mul_add(x145, x152, x150);
+        let x156 = Self::mul_add(x152, -0.0145, 0.000781 * x145);
         let x157 = Self::mul_add(
-            -1.4135609200000003,
-            x151,
-            Self::mul_add(x144, -0.9614610000000001, x143 * 0.0145),
+            x152,
+            0.9614610000000001,
+            Self::mul_add(x145, 1.2025609200000003, 0.000781 * x144),
         );
         let x158 = Self::mul_add(
-            x148,
-            0.9614610000000001,
-            Self::mul_add(x150, 1.2025609200000003, 0.000781 * x149),
-        ) + Self::mul_add(-x143, x157, x151 * x155);
+            1.4135609200000003,
+            x152,
+            Self::mul_add(x145, -0.9614610000000001, x144 * 0.0145),
+        );
         let x159 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x146, x145),
-            Self::mul_add(x148, -0.0145, 0.000781 * x150)
-                - Self::mul_add(-x144, x157, x151 * x156),
-        );
+            x148,
+            -0.9614610000000001,
+            Self::mul_add(x151, 1.2025609200000003, 0.000781 * x150),
+        ) + Self::mul_add(x144, x158, x152 * x156);
         let x160 = Self::mul_add(
+            -4.806620000000001,
+            Self::mul_add(0.00000000020510342851533115, x147, x146),
+            Self::mul_add(x148, 0.0145, 0.000781 * x151)
+                - Self::mul_add(x145, x158, x152 * x157),
+        );
+        let x161 = Self::mul_add(
             4.806620000000001,
-            x147,
             Self::mul_add(
-                1.4135609200000003,
-                x148,
-                Self::mul_add(x150, -0.9614610000000001, x149 * 0.0145),
-            ) - Self::mul_add(-x143, x156, x144 * x155),
-        );
-        let x161 = x154 - Self::mul_add(-x142, x153, x141 * x152);
-        let x162 = Self::mul_add(c_q13, x153, s_q13 * x152);
-        let x163 = Self::mul_add(
-            0.00000000020510342851533115,
-            x154,
-            Self::mul_add(-s_q13, x153, c_q13 * x152),
-        );
-        let x164 = Self::mul_add(
-            -0.55,
-            x161,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x160,
-                Self::mul_add(s_q13, x158, c_q13 * x159),
+                -s_q13,
+                x124 + Self::mul_add(0.16, x127 - x137, 0.55 * x136),
+                c_q13 * Self::mul_add(-0.00000000020510342851533115, x146, x147),
             ),
+            Self::mul_add(
+                -1.4135609200000003,
+                x148,
+                Self::mul_add(x151, -0.9614610000000001, x150 * 0.0145),
+            ) + Self::mul_add(-x144, x157, x145 * x156),
         );
-        let x165 = Self::mul_add(
-            -17.135250000000003,
-            x131,
-            3.6140000000000003 * (x128 + x129),
-        ) + x161;
-        let x166 = Self::mul_add(
-            17.135250000000003,
-            x134,
-            3.6140000000000003 * (x124 + x130),
-        ) + x162;
-        let x167 = Self::mul_add(
-            17.135250000000003,
-            x136,
-            3.6140000000000003 * (x126 - x132),
-        ) + x163;
+        let x162 = -x161;
+        let x163 = Self::mul_add(-s_q13, x154, c_q13 * x153);
+        let x164 = Self::mul_add(c_q13, x154, s_q13 * x153);
+        let x165 = Self::mul_add(-0.00000000020510342851533115, x155, x163);
+        let x166 = Self::mul_add(0.00000000020510342851533115, x163, x155);
+        let x167 = Self::mul_add(s_q13, x159, c_q13 * x160);
         let x168 = Self::mul_add(
             -17.135250000000003,
-            x123,
-            Self::mul_add(x124, 0.809539999555672, x126 * 1.9877000000000002)
-                - Self::mul_add(-x117, x139, x127 * x138),
-        )
-            + (x160 - Self::mul_add(x142, x158, x141 * x159)
-                + Self::mul_add(0.55, x163, 0.16 * x162));
-        let x169 = x140
-            - Self::mul_add(-0.16, x161, Self::mul_add(-c_q13, x158, s_q13 * x159));
+            x133,
+            3.6140000000000003 * (x130 + x131),
+        ) - x166;
+        let x169 = Self::mul_add(
+            17.135250000000003,
+            x136,
+            3.6140000000000003 * (x126 + x132),
+        ) + x164;
         let x170 = Self::mul_add(
-            9.740442170000001,
-            x124,
-            Self::mul_add(x126, -2.7416399995923166, x125 * 0.809539999555672),
-        ) - Self::mul_add(-x116, x138, x117 * x137)
-            + Self::mul_add(3.6140000000000003, x122, 17.135250000000003 * x121) + x164;
-        let x171 = -x170;
-        let x172 = Self::mul_add(-s_q12, x166, c_q12 * x165);
-        let x173 = x167 + Self::mul_add(x115, x166, x114 * x165);
-        let x174 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(-x98, x99, x67),
-            -x172,
-        );
-        let x175 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x106, x106, x107),
-            -x173,
-        );
-        let x176 = Self::mul_add(
-            7.078399999258757,
-            x104 + x108,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x167,
-                Self::mul_add(c_q12, x166, s_q12 * x165),
-            ),
-        );
-        let x177 = x112
-            - Self::mul_add(0.36, x173, Self::mul_add(s_q12, x169, c_q12 * x168));
-        let x178 = Self::mul_add(-2.5482240016099564, x67, x105 * 9.142025249762803)
-            + Self::mul_add(-x98, x111, x106 * x109)
-            - Self::mul_add(-0.36, x172, x170 + Self::mul_add(-x115, x169, x114 * x168));
-        let x179 = x113
-            - Self::mul_add(
-                -0.00000000020510342851533115,
-                x170,
-                Self::mul_add(-c_q12, x169, s_q12 * x168),
-            );
-        let x180 = Self::mul_add(s_q11, x175, c_q11 * x174);
-        let x181 = Self::mul_add(-c_q11, x175, s_q11 * x174);
-        let x182 = Self::mul_add(x88, 45.1584, -x180);
-        let x183 = Self::mul_add(45.1584, x90, x181);
-        let x184 = Self::mul_add(45.1584, x92, -x176);
-        let x185 = x96
-            - (Self::mul_add(s_q11, x178, c_q11 * x177)
-                - Self::mul_add(-0.63, x176, 0.275 * x181));
-        let x186 = Self::mul_add(x67, 24.35164200091464, x86 * 24.4950615)
-            - Self::mul_add(-x79, x95, x87 * x93)
-            - Self::mul_add(0.275, x180, Self::mul_add(-c_q11, x178, s_q11 * x177));
-        let x187 = x97 - Self::mul_add(0.63, x180, x179);
-        let x188 = -x187;
-        let x189 = Self::mul_add(s_q10, x183, c_q10 * x182);
-        let x190 = Self::mul_add(x71, 81.53205, x189);
-        let x191 = Self::mul_add(
-            81.53205,
-            x72,
-            -Self::mul_add(-c_q10, x183, s_q10 * x182),
-        );
-        let x192 = Self::mul_add(81.53205, x73, x184);
-        let x193 = x77
-            + Self::mul_add(0.87, x184, Self::mul_add(-s_q10, x186, c_q10 * x185));
-        let x194 = Self::mul_add(x67, -36.18604050126307, x69 * 63.36336825000001)
-            + Self::mul_add(-x60, x76, x70 * x74)
-            - Self::mul_add(c_q10, x186, s_q10 * x185);
-        let x195 = x78 + Self::mul_add(0.87, x189, x187);
-        let x196 = -x195;
-        let x197 = 0.00000000020510342851533115 * x192;
-        let x198 = Self::mul_add(-c_q9, x191, s_q9 * x190) + x197;
-        let x199 = x192 + Self::mul_add(x59, x191, x58 * x190);
-        let x200 = x197 - Self::mul_add(s_q9, x191, c_q9 * x190);
-        let x201 = 0.00000000020510342851533115 * x195;
-        let x202 = Self::mul_add(
-            x46,
-            -12.701650001451807,
-            (x43 + x44) * 0.000000008530897668050218,
-        ) - x198;
-        let x203 = Self::mul_add(
-            12.701650001451807,
-            x49,
-            0.000000008530897668050218 * (x22 + x45),
-        ) - x199;
-        let x204 = Self::mul_add(
-            12.701650001451807,
-            x51,
-            0.000000008530897668050218 * (x41 - x47),
-        ) - x200;
-        let x205 = Self::mul_add(
-            x39,
-            12.701650001451807,
-            Self::mul_add(x22, 0.002139996587640933, x41 * 0.0000000234896432582596)
-                - Self::mul_add(-x33, x54, x42 * x53),
+            17.135250000000003,
+            x138,
+            3.6140000000000003 * (x128 - x134),
+        ) + x165;
+        let x171 = Self::mul_add(
+            -17.135250000000003,
+            x122,
+            Self::mul_add(x126, 0.809539999555672, x128 * 1.9877000000000002)
+                - Self::mul_add(-x117, x141, x129 * x140),
         )
-            + (Self::mul_add(-c_q9, x194, s_q9 * x193) - x201
-                + Self::mul_add(0.275, x200, 0.4 * x199));
-        let x206 = x55
-            + Self::mul_add(0.4, x198, x195 - Self::mul_add(x59, x194, x58 * x193));
+            - (Self::mul_add(-0.00000000020510342851533115, x167, x161)
+                - Self::mul_add(0.55, x165, 0.16 * x164));
+        let x172 = x142
+            + Self::mul_add(-0.16, x166, Self::mul_add(-c_q13, x159, s_q13 * x160));
+        let x173 = Self::mul_add(
+            9.740442170000001,
+            x126,
+            Self::mul_add(x128, -2.7416399995923166, x127 * 0.809539999555672),
+        ) - Self::mul_add(-x116, x140, x117 * x139)
+            + Self::mul_add(3.6140000000000003, x124, 17.135250000000003 * x123)
+            - Self::mul_add(
+                -0.55,
+                x166,
+                Self::mul_add(0.00000000020510342851533115, x161, x167),
+            );
+        let x174 = -x173;
+        let x175 = Self::mul_add(-s_q12, x169, c_q12 * x168);
+        let x176 = Self::mul_add(c_q12, x169, s_q12 * x168);
+        let x177 = Self::mul_add(0.00000000020510342851533115, x176, x170);
+        let x178 = Self::mul_add(-c_q12, x172, s_q12 * x171);
+        let x179 = Self::mul_add(7.078399999258757, Self::mul_add(x99, x100, x68), x175);
+        let x180 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x107, x107, x108),
+            -x177,
+        );
+        let x181 = Self::mul_add(
+            7.078399999258757,
+            x105 + x109,
+            Self::mul_add(-0.00000000020510342851533115, x170, x176),
+        );
+        let x182 = x113
+            + Self::mul_add(0.36, x177, Self::mul_add(s_q12, x172, c_q12 * x171));
+        let x183 = Self::mul_add(2.5482240016099564, x68, x106 * 9.142025249762803)
+            + Self::mul_add(-x99, x112, x107 * x110)
+            - Self::mul_add(
+                -0.36,
+                x175,
+                Self::mul_add(0.00000000020510342851533115, x178, x173),
+            );
+        let x184 = x114 - Self::mul_add(-0.00000000020510342851533115, x173, x178);
+        let x185 = Self::mul_add(-s_q11, x180, c_q11 * x179);
+        let x186 = Self::mul_add(c_q11, x180, s_q11 * x179);
+        let x187 = Self::mul_add(x89, 45.1584, -x185);
+        let x188 = Self::mul_add(45.1584, x91, -x186);
+        let x189 = Self::mul_add(45.1584, x93, -x181);
+        let x190 = x97
+            - (Self::mul_add(-s_q11, x183, c_q11 * x182)
+                - Self::mul_add(0.63, x181, 0.275 * x186));
+        let x191 = Self::mul_add(x68, -24.35164200091464, x87 * 24.4950615)
+            - Self::mul_add(-x80, x96, x88 * x94)
+            + Self::mul_add(0.275, x185, Self::mul_add(c_q11, x183, s_q11 * x182));
+        let x192 = x98 - Self::mul_add(-0.63, x185, x184);
+        let x193 = -x192;
+        let x194 = Self::mul_add(-s_q10, x188, c_q10 * x187);
+        let x195 = Self::mul_add(x72, 81.53205, x194);
+        let x196 = Self::mul_add(
+            81.53205,
+            x73,
+            Self::mul_add(c_q10, x188, s_q10 * x187),
+        );
+        let x197 = Self::mul_add(81.53205, x74, x189);
+        let x198 = x78
+            + Self::mul_add(-0.87, x189, Self::mul_add(s_q10, x191, c_q10 * x190));
+        let x199 = Self::mul_add(x68, 36.18604050126307, x70 * 63.36336825000001)
+            + Self::mul_add(-x61, x77, x71 * x75)
+            + Self::mul_add(-c_q10, x191, s_q10 * x190);
+        let x200 = x79 + Self::mul_add(-0.87, x194, x192);
+        let x201 = -x200;
+        let x202 = 0.00000000020510342851533115 * x197;
+        let x203 = Self::mul_add(c_q9, x196, s_q9 * x195) - x202;
+        let x204 = x197 - Self::mul_add(-x60, x196, x59 * x195);
+        let x205 = x202 + Self::mul_add(-s_q9, x196, c_q9 * x195);
+        let x206 = 0.00000000020510342851533115 * x200;
         let x207 = Self::mul_add(
+            x47,
+            -12.701650001451807,
+            (x44 + x45) * 0.000000008530897668050218,
+        ) + x203;
+        let x208 = Self::mul_add(
+            12.701650001451807,
+            x50,
+            0.000000008530897668050218 * (x22 + x46),
+        ) - x204;
+        let x209 = Self::mul_add(
+            12.701650001451807,
+            x52,
+            0.000000008530897668050218 * (x42 - x48),
+        ) - x205;
+        let x210 = Self::mul_add(
+            x36,
+            12.701650001451807,
+            Self::mul_add(x22, 0.002139996587640933, x42 * 0.0000000234896432582596)
+                - Self::mul_add(-x32, x55, x43 * x54),
+        )
+            - (Self::mul_add(c_q9, x199, s_q9 * x198) + x206
+                - Self::mul_add(0.275, x205, 0.4 * x204));
+        let x211 = x56
+            + Self::mul_add(-0.4, x203, x200 + Self::mul_add(-x60, x199, x59 * x198));
+        let x212 = Self::mul_add(
             113.3918902508081,
             x22,
-            Self::mul_add(5.080660024070366, x41, x40 * 0.002139996587640933),
-        ) - Self::mul_add(-x32, x53, x33 * x52)
-            - Self::mul_add(x38, 0.000000008530897668050218, x37 * 12.701650001451807)
-            - Self::mul_add(0.275, x198, x201 + Self::mul_add(s_q9, x194, c_q9 * x193));
-        let x208 = -x207;
-        let x209 = x204 + Self::mul_add(-x31, x203, x30 * x202);
-        let x210 = Self::mul_add(c_q8, x203, s_q8 * x202);
-        let x211 = Self::mul_add(48.0240000085309, Self::mul_add(x24, x24, x25), x209);
-        let x212 = Self::mul_add(48.0240000085309, x10 * x11, -x210);
-        let x213 = Self::mul_add(
+            Self::mul_add(5.080660024070366, x42, x41 * 0.002139996587640933),
+        ) - Self::mul_add(-x31, x54, x32 * x53)
+            - Self::mul_add(x39, 0.000000008530897668050218, x38 * 12.701650001451807)
+            - Self::mul_add(
+                -0.275,
+                x203,
+                x206 - Self::mul_add(-s_q9, x199, c_q9 * x198),
+            );
+        let x213 = -x212;
+        let x214 = Self::mul_add(-s_q8, x208, c_q8 * x207);
+        let x215 = Self::mul_add(c_q8, x208, s_q8 * x207);
+        let x216 = Self::mul_add(0.00000000020510342851533115, x214, x209);
+        let x217 = Self::mul_add(s_q8, x211, c_q8 * x210);
+        let x218 = Self::mul_add(48.0240000085309, Self::mul_add(x24, x24, x25), x216);
+        let x219 = Self::mul_add(48.0240000085309, x10 * x11, -x215);
+        let x220 = Self::mul_add(
             48.0240000085309,
             x23 + x26,
-            -Self::mul_add(
-                -0.00000000020510342851533115,
-                x204,
-                Self::mul_add(-s_q8, x203, c_q8 * x202),
-            ),
+            -Self::mul_add(-0.00000000020510342851533115, x209, x214),
         );
-        let x214 = Self::mul_add(x23, 0.07309, Self::mul_add(x11, x29, x24 * x28))
-            - Self::mul_add(0.35, x210, x207 + Self::mul_add(x31, x206, x30 * x205));
-        let x215 = Self::mul_add(
+        let x221 = Self::mul_add(x23, 0.07309, Self::mul_add(x11, x29, x24 * x28))
+            - Self::mul_add(
+                0.35,
+                x215,
+                Self::mul_add(0.00000000020510342851533115, x217, x212),
+            );
+        let x222 = Self::mul_add(
             48.0240000085309,
             x20,
             Self::mul_add(-130.43769025763282, x23, x22 * 0.07309)
                 + Self::mul_add(x10, x29, x24 * x27),
-        ) + Self::mul_add(-0.35, x209, Self::mul_add(-c_q8, x206, s_q8 * x205));
-        let x216 = Self::mul_add(
+        ) + Self::mul_add(-0.35, x216, Self::mul_add(-c_q8, x211, s_q8 * x210));
+        let x223 = Self::mul_add(
             48.0240000085309,
             x21,
             Self::mul_add(-0.1132, x23, x22 * 16.80768997608804)
                 + Self::mul_add(-x10, x28, x11 * x27),
-        )
-            - Self::mul_add(
-                -0.00000000020510342851533115,
-                x207,
-                Self::mul_add(s_q8, x206, c_q8 * x205),
-            );
-        let x217 = Self::mul_add(-s_q7, x212, c_q7 * x211);
-        let x218 = Self::mul_add(c_q7, x212, s_q7 * x211);
-        let x219 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x220 = 1466.4506062283303 * v[4];
-        let x221 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x222 = -(x217
+        ) - Self::mul_add(-0.00000000020510342851533115, x212, x217);
+        let x224 = Self::mul_add(-s_q7, x219, c_q7 * x218);
+        let x225 = Self::mul_add(c_q7, x219, s_q7 * x218);
+        let x226 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x227 = 1466.4506062283303 * v[4];
+        let x228 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x229 = -(x224
             + Self::mul_add(
                 1170.07,
                 x7,
                 Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
             ));
-        let x223 = -(x218
+        let x230 = -(x225
             - Self::mul_add(
                 1170.07,
                 x8,
                 Self::mul_add(180.9502499901501, x16, 110.5455 * x14),
             ));
-        let x224 = x213
+        let x231 = x220
             - Self::mul_add(
                 1170.07,
                 x9,
                 -Self::mul_add(-180.9502499901501, x17, 110.5455 * x15),
             );
-        let x225 = Self::mul_add(0.75, x218, Self::mul_add(-s_q7, x215, c_q7 * x214))
+        let x232 = Self::mul_add(0.75, x225, Self::mul_add(-s_q7, x222, c_q7 * x221))
             - Self::mul_add(
                 180.9502499901501,
                 x8,
-                Self::mul_add(v[4], x221, v[5] * x220),
+                Self::mul_add(v[4], x228, v[5] * x227),
             );
-        let x226 = Self::mul_add(c_q7, x215, s_q7 * x214)
-            - Self::mul_add(0.65, x213, 0.75 * x217)
-            + (Self::mul_add(v[3], x221, v[5] * x219)
+        let x233 = Self::mul_add(c_q7, x222, s_q7 * x221)
+            - Self::mul_add(0.65, x220, 0.75 * x224)
+            + (Self::mul_add(v[3], x228, v[5] * x226)
                 - Self::mul_add(-110.5455, x9, 180.9502499901501 * x7));
-        let x227 = Self::mul_add(-0.65, x218, x216)
-            - Self::mul_add(-110.5455, x8, Self::mul_add(-v[3], x220, v[4] * x219));
-        [x222, x223, x224, x225, x226, x227, x216, x208, x196, x188, x179, x171, x160]
+        let x234 = Self::mul_add(-0.65, x225, x223)
+            - Self::mul_add(-110.5455, x8, Self::mul_add(-v[3], x227, v[4] * x226));
+        [x229, x230, x231, x232, x233, x234, x223, x213, x201, x193, x184, x174, x162]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `newton-euler`: 543 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 332 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 523 mul, 444 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 324 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -2551,531 +2475,495 @@ impl FreeFloating7 {
                 Self::mul_add(0.1132, x25, x24 * 16.80768997608804),
             ) - Self::mul_add(-x10, x31, x11 * x30),
         );
-        let x35 = 0.00000000020510342851533115 * c_q8;
-        let x36 = 0.00000000020510342851533115 * s_q8;
-        let x37 = Self::mul_add(x27, c_q8, Self::mul_add(x11, s_q8, x10 * x35));
-        let x38 = Self::mul_add(x27, s_q8, Self::mul_add(-x11, c_q8, x10 * x36));
-        let x39 = Self::mul_add(-0.35, x25 - x29, Self::mul_add(s_q7, x21, c_q7 * x20));
-        let x40 = Self::mul_add(0.35, Self::mul_add(x11, x27, x24), x23);
-        let x41 = Self::mul_add(-0.35, Self::mul_add(x10, x10, x28), x22);
-        let x42 = Self::mul_add(c_q8, x41, Self::mul_add(s_q8, x40, x35 * x39));
-        let x43 = Self::mul_add(s_q8, x41, Self::mul_add(-c_q8, x40, x36 * x39));
-        let x44 = Self::mul_add(-0.00000000020510342851533115, x41, x39);
-        let x45 = Self::mul_add(
-            -v[7],
-            x38,
-            Self::mul_add(x26, c_q8, Self::mul_add(x25, s_q8, x24 * x35)),
-        );
-        let x46 = Self::mul_add(
-            v[7],
-            x37,
-            Self::mul_add(x26, s_q8, Self::mul_add(-x25, c_q8, x24 * x36)),
-        );
-        let x47 = a[7] + Self::mul_add(-0.00000000020510342851533115, x26, x24);
-        let x48 = v[7] + Self::mul_add(-0.00000000020510342851533115, x27, x10);
-        let x49 = x38 * x38;
-        let x50 = x48 * x48;
-        let x51 = x37 * x38;
-        let x52 = x47 + x51;
-        let x53 = x37 * x48;
-        let x54 = x37 * x37;
-        let x55 = x50 + x54;
-        let x56 = x38 * x48;
-        let x57 = x45 - x56;
-        let x58 = Self::mul_add(
-            x48,
-            0.002139996587640933,
-            x38 * 0.0000000234896432582596,
-        );
+        let x35 = Self::mul_add(0.00000000020510342851533115, x10, x27);
+        let x36 = Self::mul_add(x11, s_q8, c_q8 * x35);
+        let x37 = Self::mul_add(-x11, c_q8, s_q8 * x35);
+        let x38 = Self::mul_add(-0.35, x25 - x29, Self::mul_add(s_q7, x21, c_q7 * x20));
+        let x39 = Self::mul_add(0.35, Self::mul_add(x11, x27, x24), x23);
+        let x40 = Self::mul_add(-0.35, Self::mul_add(x10, x10, x28), x22);
+        let x41 = Self::mul_add(-0.00000000020510342851533115, x40, x38);
+        let x42 = Self::mul_add(0.00000000020510342851533115, x38, x40);
+        let x43 = Self::mul_add(s_q8, x39, c_q8 * x42);
+        let x44 = Self::mul_add(-c_q8, x39, s_q8 * x42);
+        let x45 = Self::mul_add(0.00000000020510342851533115, x24, x26);
+        let x46 = Self::mul_add(-v[7], x37, Self::mul_add(x25, s_q8, c_q8 * x45));
+        let x47 = Self::mul_add(v[7], x36, Self::mul_add(-x25, c_q8, s_q8 * x45));
+        let x48 = a[7] + Self::mul_add(-0.00000000020510342851533115, x26, x24);
+        let x49 = v[7] + Self::mul_add(-0.00000000020510342851533115, x27, x10);
+        let x50 = x37 * x37;
+        let x51 = x49 * x49;
+        let x52 = x36 * x37;
+        let x53 = x48 + x52;
+        let x54 = x36 * x49;
+        let x55 = x36 * x36;
+        let x56 = x51 + x55;
+        let x57 = x37 * x49;
+        let x58 = x46 - x57;
         let x59 = Self::mul_add(
-            5.080660024070365,
-            x48,
-            Self::mul_add(x38, -111.7548902508081, x37 * 0.0000000234896432582596),
+            x49,
+            0.002139996587640933,
+            x37 * 0.0000000234896432582596,
         );
         let x60 = Self::mul_add(
-            113.3918902508081,
-            x48,
-            Self::mul_add(5.080660024070366, x38, x37 * 0.002139996587640933),
+            5.080660024070365,
+            x49,
+            Self::mul_add(x37, -111.7548902508081, x36 * 0.0000000234896432582596),
         );
         let x61 = Self::mul_add(
-            x44,
+            113.3918902508081,
+            x49,
+            Self::mul_add(5.080660024070366, x37, x36 * 0.002139996587640933),
+        );
+        let x62 = Self::mul_add(
+            x41,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x47,
-                Self::mul_add(x46, -111.7548902508081, x45 * 0.0000000234896432582596),
-            ) - Self::mul_add(-x37, x60, x48 * x58),
+                x48,
+                Self::mul_add(x47, -111.7548902508081, x46 * 0.0000000234896432582596),
+            ) - Self::mul_add(-x36, x61, x49 * x59),
         );
-        let x62 = 0.00000000020510342851533115 * c_q9;
-        let x63 = 0.00000000020510342851533115 * s_q9;
-        let x64 = x62 - x63;
-        let x65 = x62 + x63;
-        let x66 = Self::mul_add(-x48, c_q9, Self::mul_add(-x38, x64, x37 * s_q9));
-        let x67 = Self::mul_add(x48, s_q9, Self::mul_add(x38, x65, x37 * c_q9));
-        let x68 = x42 + Self::mul_add(-0.4, x46 - x53, 0.275 * x52);
-        let x69 = x43 - Self::mul_add(-0.4, x45 + x56, 0.275 * x55);
-        let x70 = x44 - Self::mul_add(0.4, x49 + x54, 0.275 * x57);
-        let x71 = Self::mul_add(-c_q9, x70, Self::mul_add(-x64, x69, s_q9 * x68));
-        let x72 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x70,
-            Self::mul_add(-0.00000000020510342851533115, x68, x69),
-        );
+        let x63 = 0.00000000020510342851533115 * c_q9;
+        let x64 = 0.00000000020510342851533115 * s_q9;
+        let x65 = x63 - x64;
+        let x66 = x63 + x64;
+        let x67 = Self::mul_add(-x49, c_q9, Self::mul_add(-x37, x65, x36 * s_q9));
+        let x68 = Self::mul_add(x49, s_q9, Self::mul_add(x37, x66, x36 * c_q9));
+        let x69 = x43 + Self::mul_add(-0.4, x47 - x54, 0.275 * x53);
+        let x70 = x44 - Self::mul_add(-0.4, x46 + x57, 0.275 * x56);
+        let x71 = x41 - Self::mul_add(0.4, x50 + x55, 0.275 * x58);
+        let x72 = Self::mul_add(-c_q9, x71, Self::mul_add(-x65, x70, s_q9 * x69));
         let x73 = Self::mul_add(
-            v[8],
-            x67,
-            Self::mul_add(-x47, c_q9, Self::mul_add(-x46, x64, x45 * s_q9)),
+            -0.00000000020510342851533115,
+            x71,
+            Self::mul_add(-0.00000000020510342851533115, x69, x70),
         );
         let x74 = Self::mul_add(
-            -v[8],
-            x66,
-            Self::mul_add(x47, s_q9, Self::mul_add(x46, x65, x45 * c_q9)),
+            v[8],
+            x68,
+            Self::mul_add(-x48, c_q9, Self::mul_add(-x47, x65, x46 * s_q9)),
         );
-        let x75 = a[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x47,
-                Self::mul_add(-0.00000000020510342851533115, x45, x46),
-            );
-        let x76 = v[8]
+        let x75 = Self::mul_add(
+            -v[8],
+            x67,
+            Self::mul_add(x48, s_q9, Self::mul_add(x47, x66, x46 * c_q9)),
+        );
+        let x76 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x48,
-                Self::mul_add(-0.00000000020510342851533115, x37, x38),
+                Self::mul_add(-0.00000000020510342851533115, x46, x47),
             );
-        let x77 = Self::mul_add(-x66, x67, x75);
-        let x78 = Self::mul_add(x66, x66, x76 * x76);
-        let x79 = Self::mul_add(x67, x76, x73);
-        let x80 = x76 * 0.00214;
-        let x81 = Self::mul_add(x76, -36.18604050126307, x67 * 63.36336825000001);
-        let x82 = Self::mul_add(
-            69.99836825,
-            x76,
-            Self::mul_add(x67, 36.18604050126307, x66 * 0.00214),
-        );
+        let x77 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x49,
+                Self::mul_add(-0.00000000020510342851533115, x36, x37),
+            );
+        let x78 = Self::mul_add(-x67, x68, x76);
+        let x79 = Self::mul_add(x67, x67, x77 * x77);
+        let x80 = Self::mul_add(x68, x77, x74);
+        let x81 = x77 * 0.00214;
+        let x82 = Self::mul_add(x77, -36.18604050126307, x68 * 63.36336825000001);
         let x83 = Self::mul_add(
-            x72,
-            81.53205,
-            Self::mul_add(x75, 0.00214, Self::mul_add(x67, x82, x76 * x81)),
+            69.99836825,
+            x77,
+            Self::mul_add(x68, 36.18604050126307, x67 * 0.00214),
         );
         let x84 = Self::mul_add(
-            x71,
+            x73,
+            81.53205,
+            Self::mul_add(x76, 0.00214, Self::mul_add(x68, x83, x77 * x82)),
+        );
+        let x85 = Self::mul_add(
+            x72,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x75,
-                Self::mul_add(x74, 36.18604050126307, x73 * 0.00214),
-            ) - Self::mul_add(x66, x81, x67 * x80),
+                x76,
+                Self::mul_add(x75, 36.18604050126307, x74 * 0.00214),
+            ) - Self::mul_add(x67, x82, x68 * x81),
         );
-        let x85 = Self::mul_add(x67, s_q10, x66 * c_q10);
-        let x86 = Self::mul_add(-x67, c_q10, x66 * s_q10);
-        let x87 = Self::mul_add(x77, -0.87, x71);
-        let x88 = Self::mul_add(
-            x78,
+        let x86 = Self::mul_add(x68, s_q10, x67 * c_q10);
+        let x87 = Self::mul_add(-x68, c_q10, x67 * s_q10);
+        let x88 = Self::mul_add(x78, -0.87, x72);
+        let x89 = Self::mul_add(
+            x79,
             -0.87,
-            Self::mul_add(s_q9, x70, Self::mul_add(x65, x69, c_q9 * x68)),
+            Self::mul_add(s_q9, x71, Self::mul_add(x66, x70, c_q9 * x69)),
         );
-        let x89 = Self::mul_add(x79, 0.87, x72);
-        let x90 = Self::mul_add(s_q10, x88, c_q10 * x87);
-        let x91 = Self::mul_add(-v[9], x86, Self::mul_add(x74, s_q10, x73 * c_q10));
-        let x92 = Self::mul_add(v[9], x85, Self::mul_add(-x74, c_q10, x73 * s_q10));
-        let x93 = a[9] + x75;
-        let x94 = v[9] + x76;
-        let x95 = Self::mul_add(x85, x86, x93);
-        let x96 = x85 * x85;
-        let x97 = Self::mul_add(x94, x94, x96);
-        let x98 = x86 * x94;
-        let x99 = x91 - x98;
-        let x100 = x94 * 0.6328;
-        let x101 = Self::mul_add(x94, 24.35164200091464, x86 * 24.4950615);
-        let x102 = Self::mul_add(
-            28.2393615,
-            x94,
-            Self::mul_add(x86, -24.351642000914637, x85 * 0.6328),
-        );
+        let x90 = Self::mul_add(x80, 0.87, x73);
+        let x91 = Self::mul_add(s_q10, x89, c_q10 * x88);
+        let x92 = Self::mul_add(-v[9], x87, Self::mul_add(x75, s_q10, x74 * c_q10));
+        let x93 = Self::mul_add(v[9], x86, Self::mul_add(-x75, c_q10, x74 * s_q10));
+        let x94 = a[9] + x76;
+        let x95 = v[9] + x77;
+        let x96 = Self::mul_add(x86, x87, x94);
+        let x97 = x86 * x86;
+        let x98 = Self::mul_add(x95, x95, x97);
+        let x99 = x87 * x95;
+        let x100 = x92 - x99;
+        let x101 = x95 * 0.6328;
+        let x102 = Self::mul_add(x95, 24.35164200091464, x87 * 24.4950615);
         let x103 = Self::mul_add(
-            x89,
-            45.1584,
-            Self::mul_add(x93, 0.6328, -Self::mul_add(x86, x102, x94 * x101)),
+            28.2393615,
+            x95,
+            Self::mul_add(x87, -24.351642000914637, x86 * 0.6328),
         );
         let x104 = Self::mul_add(
             x90,
+            45.1584,
+            Self::mul_add(x94, 0.6328, -Self::mul_add(x87, x103, x95 * x102)),
+        );
+        let x105 = Self::mul_add(
+            x91,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x93,
-                Self::mul_add(x92, -24.351642000914637, x91 * 0.6328),
-            ) + Self::mul_add(x85, x101, x86 * x100),
+                x94,
+                Self::mul_add(x93, -24.351642000914637, x92 * 0.6328),
+            ) + Self::mul_add(x86, x102, x87 * x101),
         );
-        let x105 = Self::mul_add(-x86, s_q11, x85 * c_q11);
-        let x106 = Self::mul_add(x86, c_q11, x85 * s_q11);
-        let x107 = x90
-            - Self::mul_add(-0.275, Self::mul_add(-x85, x94, x92), x95 * 0.63);
-        let x108 = Self::mul_add(-c_q10, x88, s_q10 * x87)
-            + Self::mul_add(-0.275, x91 + x98, x97 * 0.63);
-        let x109 = x89 + Self::mul_add(0.275, Self::mul_add(x86, x86, x96), x99 * 0.63);
-        let x110 = Self::mul_add(-s_q11, x108, c_q11 * x107);
-        let x111 = Self::mul_add(-v[10], x106, Self::mul_add(-x92, s_q11, x91 * c_q11));
-        let x112 = Self::mul_add(v[10], x105, Self::mul_add(x92, c_q11, x91 * s_q11));
-        let x113 = a[10] + x93;
-        let x114 = v[10] + x94;
-        let x115 = x105 * x105;
-        let x116 = x106 * x114;
-        let x117 = 0.01675 * x114;
-        let x118 = Self::mul_add(-2.5482240016099564, x114, x106 * 9.142025249762803);
-        let x119 = Self::mul_add(
-            -9.223235249762805,
-            x114,
-            Self::mul_add(-2.5482240016099564, x106, 0.01675 * x105),
-        );
+        let x106 = Self::mul_add(-x87, s_q11, x86 * c_q11);
+        let x107 = Self::mul_add(x87, c_q11, x86 * s_q11);
+        let x108 = x91
+            - Self::mul_add(-0.275, Self::mul_add(-x86, x95, x93), x96 * 0.63);
+        let x109 = Self::mul_add(-c_q10, x89, s_q10 * x88)
+            + Self::mul_add(-0.275, x92 + x99, x98 * 0.63);
+        let x110 = x90 + Self::mul_add(0.275, Self::mul_add(x87, x87, x97), x100 * 0.63);
+        let x111 = Self::mul_add(-s_q11, x109, c_q11 * x108);
+        let x112 = Self::mul_add(-v[10], x107, Self::mul_add(-x93, s_q11, x92 * c_q11));
+        let x113 = Self::mul_add(v[10], x106, Self::mul_add(x93, c_q11, x92 * s_q11));
+        let x114 = a[10] + x94;
+        let x115 = v[10] + x95;
+        let x116 = x106 * x106;
+        let x117 = x107 * x115;
+        let x118 = 0.01675 * x115;
+        let x119 = Self::mul_add(-2.5482240016099564, x115, x107 * 9.142025249762803);
         let x120 = Self::mul_add(
-            7.078399999258757,
-            x109,
-            Self::mul_add(0.01675, x113, Self::mul_add(-x106, x119, x114 * x118)),
+            -9.223235249762805,
+            x115,
+            Self::mul_add(-2.5482240016099564, x107, 0.01675 * x106),
         );
         let x121 = Self::mul_add(
-            -7.078399999258757,
+            7.078399999258757,
             x110,
+            Self::mul_add(0.01675, x114, Self::mul_add(-x107, x120, x115 * x119)),
+        );
+        let x122 = Self::mul_add(
+            -7.078399999258757,
+            x111,
             Self::mul_add(
                 -9.223235249762805,
-                x113,
-                Self::mul_add(-2.5482240016099564, x112, 0.01675 * x111),
-            ) + Self::mul_add(-x105, x118, x106 * x117),
+                x114,
+                Self::mul_add(-2.5482240016099564, x113, 0.01675 * x112),
+            ) + Self::mul_add(-x106, x119, x107 * x118),
         );
-        let x122 = 0.00000000020510342851533115 * s_q12;
-        let x123 = 0.00000000020510342851533115 * c_q12;
-        let x124 = Self::mul_add(x114, s_q12, Self::mul_add(x106, x122, x105 * c_q12));
-        let x125 = Self::mul_add(-x114, c_q12, Self::mul_add(-x106, x123, x105 * s_q12));
-        let x126 = Self::mul_add(Self::mul_add(-x105, x114, x112), 0.36, x110);
+        let x123 = Self::mul_add(0.00000000020510342851533115, x107, x115);
+        let x124 = Self::mul_add(s_q12, x123, x106 * c_q12);
+        let x125 = Self::mul_add(-c_q12, x123, x106 * s_q12);
+        let x126 = Self::mul_add(Self::mul_add(-x106, x115, x113), 0.36, x111);
         let x127 = Self::mul_add(
-            x111 + x116,
+            x112 + x117,
             -0.36,
-            Self::mul_add(c_q11, x108, s_q11 * x107),
+            Self::mul_add(c_q11, x109, s_q11 * x108),
         );
-        let x128 = Self::mul_add(Self::mul_add(x106, x106, x115), 0.36, x109);
-        let x129 = Self::mul_add(s_q12, x128, Self::mul_add(x122, x127, c_q12 * x126));
-        let x130 = Self::mul_add(-c_q12, x128, Self::mul_add(-x123, x127, s_q12 * x126));
-        let x131 = Self::mul_add(-0.00000000020510342851533115, x128, x127);
-        let x132 = Self::mul_add(
-            -v[11],
-            x125,
-            Self::mul_add(x113, s_q12, Self::mul_add(x112, x122, x111 * c_q12)),
-        );
-        let x133 = Self::mul_add(
-            v[11],
-            x124,
-            Self::mul_add(-x113, c_q12, Self::mul_add(-x112, x123, x111 * s_q12)),
-        );
-        let x134 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x112);
-        let x135 = v[11] + Self::mul_add(-0.00000000020510342851533115, x114, x106);
-        let x136 = x125 * x125;
-        let x137 = x135 * x135;
-        let x138 = x124 * x125;
-        let x139 = x134 + x138;
-        let x140 = x124 * x135;
-        let x141 = x124 * x124;
-        let x142 = x137 + x141;
-        let x143 = x125 * x135;
-        let x144 = x132 - x143;
-        let x145 = Self::mul_add(x135, 0.809539999555672, x125 * 1.9877000000000002);
-        let x146 = Self::mul_add(
-            x135,
+        let x128 = Self::mul_add(Self::mul_add(x107, x107, x116), 0.36, x110);
+        let x129 = Self::mul_add(0.00000000020510342851533115, x127, x128);
+        let x130 = Self::mul_add(-0.00000000020510342851533115, x128, x127);
+        let x131 = Self::mul_add(s_q12, x129, c_q12 * x126);
+        let x132 = Self::mul_add(-c_q12, x129, s_q12 * x126);
+        let x133 = Self::mul_add(0.00000000020510342851533115, x113, x114);
+        let x134 = Self::mul_add(-v[11], x125, Self::mul_add(s_q12, x133, x112 * c_q12));
+        let x135 = Self::mul_add(v[11], x124, Self::mul_add(-c_q12, x133, x112 * s_q12));
+        let x136 = a[11] + Self::mul_add(-0.00000000020510342851533115, x114, x113);
+        let x137 = v[11] + Self::mul_add(-0.00000000020510342851533115, x115, x107);
+        let x138 = x125 * x125;
+        let x139 = x137 * x137;
+        let x140 = x124 * x125;
+        let x141 = x136 + x140;
+        let x142 = x124 * x137;
+        let x143 = x124 * x124;
+        let x144 = x139 + x143;
+        let x145 = x125 * x137;
+        let x146 = x134 - x145;
+        let x147 = Self::mul_add(x137, 0.809539999555672, x125 * 1.9877000000000002);
+        let x148 = Self::mul_add(
+            x137,
             -2.741639999592316,
             Self::mul_add(x125, -5.252920330000002, x124 * 1.9877000000000002),
         );
-        let x147 = Self::mul_add(
+        let x149 = Self::mul_add(
             9.740442170000001,
-            x135,
+            x137,
             Self::mul_add(x125, -2.7416399995923166, x124 * 0.809539999555672),
         );
-        let x148 = Self::mul_add(
+        let x150 = Self::mul_add(
             -3.6140000000000003,
-            x131,
+            x130,
             Self::mul_add(
-                x134,
+                x136,
                 -2.741639999592316,
-                Self::mul_add(x133, -5.252920330000002, x132 * 1.9877000000000002),
-            ) - Self::mul_add(-x124, x147, x135 * x145),
+                Self::mul_add(x135, -5.252920330000002, x134 * 1.9877000000000002),
+            ) - Self::mul_add(-x124, x149, x137 * x147),
         );
-        let x149 = 0.00000000020510342851533115 * c_q13;
-        let x150 = 0.00000000020510342851533115 * s_q13;
-        let x151 = Self::mul_add(-x135, c_q13, Self::mul_add(x125, s_q13, x124 * x149));
-        let x152 = Self::mul_add(-x135, s_q13, Self::mul_add(-x125, c_q13, x124 * x150));
-        let x153 = x129 + Self::mul_add(-0.16, x133 - x140, 0.55 * x139);
-        let x154 = x131 - Self::mul_add(0.16, x136 + x141, 0.55 * x144);
-        let x155 = Self::mul_add(
-            -c_q13,
-            x154,
-            Self::mul_add(
-                s_q13,
-                x130 - Self::mul_add(-0.16, x132 + x143, 0.55 * x142),
-                x149 * x153,
-            ),
-        );
-        let x156 = Self::mul_add(
-            -v[12],
-            x152,
-            Self::mul_add(-x134, c_q13, Self::mul_add(x133, s_q13, x132 * x149)),
-        );
+        let x151 = Self::mul_add(-0.00000000020510342851533115, x124, x137);
+        let x152 = Self::mul_add(-x125, s_q13, c_q13 * x151);
+        let x153 = Self::mul_add(x125, c_q13, s_q13 * x151);
+        let x154 = x131 + Self::mul_add(-0.16, x135 - x142, 0.55 * x141);
+        let x155 = x130 - Self::mul_add(0.16, x138 + x143, 0.55 * x146);
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x134, x136);
         let x157 = Self::mul_add(
-            v[12],
-            x151,
-            Self::mul_add(-x134, s_q13, Self::mul_add(-x133, c_q13, x132 * x150)),
+            -v[12],
+            x153,
+            Self::mul_add(-x135, s_q13, c_q13 * x156),
         );
-        let x158 = a[12] - Self::mul_add(0.00000000020510342851533115, x134, x132);
-        let x159 = v[12] - Self::mul_add(0.00000000020510342851533115, x135, x124);
-        let x160 = 4.806620000000001 * Self::mul_add(x151, x152, x158);
-        let x161 = 4.806620000000001 * Self::mul_add(x151, x151, x159 * x159);
-        let x162 = 4.806620000000001 * Self::mul_add(-x152, x159, x156);
-        let x163 = Self::mul_add(x159, 0.0145, 0.000781 * x152);
-        let x164 = Self::mul_add(
-            x159,
-            -0.9614610000000001,
-            Self::mul_add(x152, 1.2025609200000003, 0.000781 * x151),
-        );
+        let x158 = Self::mul_add(v[12], x152, Self::mul_add(x135, c_q13, s_q13 * x156));
+        let x159 = a[12] - Self::mul_add(0.00000000020510342851533115, x136, x134);
+        let x160 = v[12] - Self::mul_add(0.00000000020510342851533115, x137, x124);
+        let x161 = 4.806620000000001 * Self::mul_add(x152, x153, x159);
+        let x162 = 4.806620000000001 * Self::mul_add(x152, x152, x160 * x160);
+        let x163 = 4.806620000000001 * Self::mul_add(-x153, x160, x157);
+        let x164 = Self::mul_add(x160, -0.0145, 0.000781 * x153);
         let x165 = Self::mul_add(
-            -1.4135609200000003,
-            x159,
-            Self::mul_add(x152, -0.9614610000000001, x151 * 0.0145),
+            x160,
+            0.9614610000000001,
+            Self::mul_add(x153, 1.2025609200000003, 0.000781 * x152),
         );
         let x166 = Self::mul_add(
-            x158,
-            -0.9614610000000001,
-            Self::mul_add(x157, 1.2025609200000003, 0.000781 * x156),
-        ) - Self::mul_add(-x151, x165, x159 * x163);
+            1.4135609200000003,
+            x160,
+            Self::mul_add(x153, -0.9614610000000001, x152 * 0.0145),
+        );
         let x167 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x154, x153),
-            Self::mul_add(x158, 0.0145, 0.000781 * x157)
-                + Self::mul_add(-x152, x165, x159 * x164),
-        );
+            x159,
+            0.9614610000000001,
+            Self::mul_add(x158, 1.2025609200000003, 0.000781 * x157),
+        ) - Self::mul_add(x152, x166, x160 * x164);
         let x168 = Self::mul_add(
+            -4.806620000000001,
+            Self::mul_add(0.00000000020510342851533115, x155, x154),
+            Self::mul_add(x159, -0.0145, 0.000781 * x158)
+                + Self::mul_add(x153, x166, x160 * x165),
+        );
+        let x169 = Self::mul_add(
             4.806620000000001,
-            x155,
             Self::mul_add(
-                -1.4135609200000003,
-                x158,
-                Self::mul_add(x157, -0.9614610000000001, x156 * 0.0145),
-            ) + Self::mul_add(-x151, x164, x152 * x163),
-        );
-        let x169 = -x168;
-        let x170 = x162 + Self::mul_add(-x150, x161, x149 * x160);
-        let x171 = Self::mul_add(c_q13, x161, s_q13 * x160);
-        let x172 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x162,
-            Self::mul_add(-s_q13, x161, c_q13 * x160),
-        );
-        let x173 = Self::mul_add(
-            -0.55,
-            x170,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x168,
-                Self::mul_add(s_q13, x166, c_q13 * x167),
+                -s_q13,
+                x132 - Self::mul_add(-0.16, x134 + x145, 0.55 * x144),
+                c_q13 * Self::mul_add(-0.00000000020510342851533115, x154, x155),
             ),
+            Self::mul_add(
+                1.4135609200000003,
+                x159,
+                Self::mul_add(x158, -0.9614610000000001, x157 * 0.0145),
+            ) - Self::mul_add(-x152, x165, x153 * x164),
         );
-        let x174 = Self::mul_add(
-            17.135250000000003,
-            x139,
-            3.6140000000000003 * (x136 + x137),
-        ) - x170;
+        let x170 = Self::mul_add(-s_q13, x162, c_q13 * x161);
+        let x171 = Self::mul_add(c_q13, x162, s_q13 * x161);
+        let x172 = Self::mul_add(0.00000000020510342851533115, x163, x170);
+        let x173 = Self::mul_add(-0.00000000020510342851533115, x170, x163);
+        let x174 = Self::mul_add(s_q13, x167, c_q13 * x168);
         let x175 = Self::mul_add(
-            -17.135250000000003,
-            x142,
-            3.6140000000000003 * (x134 - x138),
-        ) - x171;
-        let x176 = Self::mul_add(
             17.135250000000003,
-            x144,
-            3.6140000000000003 * (x133 + x140),
-        ) - x172;
-        let x177 = Self::mul_add(
+            x141,
+            3.6140000000000003 * (x138 + x139),
+        ) + x173;
+        let x176 = Self::mul_add(
             -17.135250000000003,
-            x131,
-            Self::mul_add(x134, 0.809539999555672, x133 * 1.9877000000000002)
-                + Self::mul_add(-x125, x147, x135 * x146),
+            x144,
+            3.6140000000000003 * (x136 - x140),
+        ) - x171;
+        let x177 = Self::mul_add(
+            17.135250000000003,
+            x146,
+            3.6140000000000003 * (x135 + x142),
+        ) - x172;
+        let x178 = Self::mul_add(
+            -17.135250000000003,
+            x130,
+            Self::mul_add(x136, 0.809539999555672, x135 * 1.9877000000000002)
+                + Self::mul_add(-x125, x149, x137 * x148),
         )
-            + (x168 - Self::mul_add(x150, x166, x149 * x167)
-                - Self::mul_add(0.55, x172, 0.16 * x171));
-        let x178 = x148
-            - Self::mul_add(-0.16, x170, Self::mul_add(-c_q13, x166, s_q13 * x167));
-        let x179 = Self::mul_add(
+            - (Self::mul_add(-0.00000000020510342851533115, x174, x169)
+                + Self::mul_add(0.55, x172, 0.16 * x171));
+        let x179 = x150
+            + Self::mul_add(-0.16, x173, Self::mul_add(-c_q13, x167, s_q13 * x168));
+        let x180 = Self::mul_add(
             9.740442170000001,
-            x134,
-            Self::mul_add(x133, -2.7416399995923166, x132 * 0.809539999555672),
-        ) + Self::mul_add(-x124, x146, x125 * x145)
-            + Self::mul_add(3.6140000000000003, x130, 17.135250000000003 * x129) + x173;
-        let x180 = Self::mul_add(s_q12, x175, c_q12 * x174);
-        let x181 = x176 - Self::mul_add(-x123, x175, x122 * x174);
-        let x182 = Self::mul_add(
+            x136,
+            Self::mul_add(x135, -2.7416399995923166, x134 * 0.809539999555672),
+        ) + Self::mul_add(-x124, x148, x125 * x147)
+            + Self::mul_add(3.6140000000000003, x132, 17.135250000000003 * x131)
+            - Self::mul_add(
+                -0.55,
+                x173,
+                Self::mul_add(0.00000000020510342851533115, x169, x174),
+            );
+        let x181 = Self::mul_add(s_q12, x176, c_q12 * x175);
+        let x182 = Self::mul_add(-c_q12, x176, s_q12 * x175);
+        let x183 = Self::mul_add(-0.00000000020510342851533115, x182, x177);
+        let x184 = Self::mul_add(-c_q12, x179, s_q12 * x178);
+        let x185 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x105, x106, x113),
-            x180,
-        );
-        let x183 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x114, x114, x115),
+            Self::mul_add(x106, x107, x114),
             x181,
         );
-        let x184 = Self::mul_add(
+        let x186 = Self::mul_add(
             7.078399999258757,
-            x111 - x116,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x176,
-                Self::mul_add(-c_q12, x175, s_q12 * x174),
-            ),
+            Self::mul_add(x115, x115, x116),
+            x183,
         );
-        let x185 = x120
-            - Self::mul_add(0.36, x181, Self::mul_add(s_q12, x178, c_q12 * x177));
-        let x186 = Self::mul_add(-2.5482240016099564, x113, x112 * 9.142025249762803)
-            - Self::mul_add(-x105, x119, x114 * x117)
-            - Self::mul_add(0.36, x180, x179 + Self::mul_add(-x123, x178, x122 * x177));
-        let x187 = x121
+        let x187 = Self::mul_add(
+            7.078399999258757,
+            x112 - x117,
+            -Self::mul_add(0.00000000020510342851533115, x177, x182),
+        );
+        let x188 = x121
+            - Self::mul_add(0.36, x183, Self::mul_add(s_q12, x179, c_q12 * x178));
+        let x189 = Self::mul_add(-2.5482240016099564, x114, x113 * 9.142025249762803)
+            - Self::mul_add(-x106, x120, x115 * x118)
             - Self::mul_add(
-                -0.00000000020510342851533115,
-                x179,
-                Self::mul_add(-c_q12, x178, s_q12 * x177),
+                0.36,
+                x181,
+                Self::mul_add(0.00000000020510342851533115, x184, x180),
             );
-        let x188 = -x187;
-        let x189 = Self::mul_add(-s_q11, x183, c_q11 * x182);
-        let x190 = Self::mul_add(c_q11, x183, s_q11 * x182);
-        let x191 = Self::mul_add(x95, 45.1584, -x189);
-        let x192 = Self::mul_add(45.1584, x97, -x190);
-        let x193 = Self::mul_add(45.1584, x99, -x184);
-        let x194 = x103
-            - (Self::mul_add(s_q11, x186, c_q11 * x185)
-                - Self::mul_add(-0.63, x184, 0.275 * x190));
-        let x195 = Self::mul_add(x93, 24.35164200091464, x92 * 24.4950615)
-            + Self::mul_add(-x85, x102, x94 * x100)
-            - Self::mul_add(0.275, x189, Self::mul_add(-c_q11, x186, s_q11 * x185));
-        let x196 = x104 - Self::mul_add(0.63, x189, x187);
-        let x197 = Self::mul_add(-s_q10, x192, c_q10 * x191);
-        let x198 = Self::mul_add(x77, 81.53205, x197);
-        let x199 = Self::mul_add(
+        let x190 = x122 - Self::mul_add(-0.00000000020510342851533115, x180, x184);
+        let x191 = -x190;
+        let x192 = Self::mul_add(-s_q11, x186, c_q11 * x185);
+        let x193 = Self::mul_add(c_q11, x186, s_q11 * x185);
+        let x194 = Self::mul_add(x96, 45.1584, -x192);
+        let x195 = Self::mul_add(45.1584, x98, -x193);
+        let x196 = Self::mul_add(45.1584, x100, -x187);
+        let x197 = x104
+            - (Self::mul_add(s_q11, x189, c_q11 * x188)
+                - Self::mul_add(-0.63, x187, 0.275 * x193));
+        let x198 = Self::mul_add(x94, 24.35164200091464, x93 * 24.4950615)
+            + Self::mul_add(-x86, x103, x95 * x101)
+            - Self::mul_add(0.275, x192, Self::mul_add(-c_q11, x189, s_q11 * x188));
+        let x199 = x105 - Self::mul_add(0.63, x192, x190);
+        let x200 = Self::mul_add(-s_q10, x195, c_q10 * x194);
+        let x201 = Self::mul_add(x78, 81.53205, x200);
+        let x202 = Self::mul_add(
             81.53205,
-            x78,
-            Self::mul_add(c_q10, x192, s_q10 * x191),
+            x79,
+            Self::mul_add(c_q10, x195, s_q10 * x194),
         );
-        let x200 = Self::mul_add(81.53205, x79, x193);
-        let x201 = x83
-            + Self::mul_add(0.87, x193, Self::mul_add(-s_q10, x195, c_q10 * x194));
-        let x202 = Self::mul_add(x75, -36.18604050126307, x74 * 63.36336825000001)
-            - Self::mul_add(-x66, x82, x76 * x80)
-            - Self::mul_add(c_q10, x195, s_q10 * x194);
-        let x203 = x84 + Self::mul_add(0.87, x197, x196);
-        let x204 = 0.00000000020510342851533115 * x200;
-        let x205 = Self::mul_add(c_q9, x199, s_q9 * x198) + x204;
-        let x206 = x200 + Self::mul_add(-x65, x199, x64 * x198);
-        let x207 = x204 - Self::mul_add(-s_q9, x199, c_q9 * x198);
-        let x208 = 0.00000000020510342851533115 * x203;
-        let x209 = Self::mul_add(
-            x52,
-            12.701650001451807,
-            (x49 + x50) * 0.000000008530897668050218,
-        ) + x205;
-        let x210 = Self::mul_add(
-            -12.701650001451807,
-            x55,
-            0.000000008530897668050218 * (x47 - x51),
-        ) - x206;
-        let x211 = Self::mul_add(
-            12.701650001451807,
-            x57,
-            0.000000008530897668050218 * (x46 + x53),
-        ) - x207;
+        let x203 = Self::mul_add(81.53205, x80, x196);
+        let x204 = x84
+            + Self::mul_add(0.87, x196, Self::mul_add(-s_q10, x198, c_q10 * x197));
+        let x205 = Self::mul_add(x76, -36.18604050126307, x75 * 63.36336825000001)
+            - Self::mul_add(-x67, x83, x77 * x81)
+            - Self::mul_add(c_q10, x198, s_q10 * x197);
+        let x206 = x85 + Self::mul_add(0.87, x200, x199);
+        let x207 = 0.00000000020510342851533115 * x203;
+        let x208 = Self::mul_add(c_q9, x202, s_q9 * x201) + x207;
+        let x209 = x203 + Self::mul_add(-x66, x202, x65 * x201);
+        let x210 = x207 - Self::mul_add(-s_q9, x202, c_q9 * x201);
+        let x211 = 0.00000000020510342851533115 * x206;
         let x212 = Self::mul_add(
-            x44,
+            x53,
             12.701650001451807,
-            Self::mul_add(x47, 0.002139996587640933, x46 * 0.0000000234896432582596)
-                + Self::mul_add(-x38, x60, x48 * x59),
-        )
-            + (Self::mul_add(-c_q9, x202, s_q9 * x201) - x208
-                + Self::mul_add(0.275, x207, 0.4 * x206));
-        let x213 = x61
-            + Self::mul_add(0.4, x205, x203 - Self::mul_add(x65, x202, x64 * x201));
+            (x50 + x51) * 0.000000008530897668050218,
+        ) + x208;
+        let x213 = Self::mul_add(
+            -12.701650001451807,
+            x56,
+            0.000000008530897668050218 * (x48 - x52),
+        ) - x209;
         let x214 = Self::mul_add(
+            12.701650001451807,
+            x58,
+            0.000000008530897668050218 * (x47 + x54),
+        ) - x210;
+        let x215 = Self::mul_add(
+            x41,
+            12.701650001451807,
+            Self::mul_add(x48, 0.002139996587640933, x47 * 0.0000000234896432582596)
+                + Self::mul_add(-x37, x61, x49 * x60),
+        )
+            + (Self::mul_add(-c_q9, x205, s_q9 * x204) - x211
+                + Self::mul_add(0.275, x210, 0.4 * x209));
+        let x216 = x62
+            + Self::mul_add(0.4, x208, x206 - Self::mul_add(x66, x205, x65 * x204));
+        let x217 = Self::mul_add(
             113.3918902508081,
-            x47,
-            Self::mul_add(5.080660024070366, x46, x45 * 0.002139996587640933),
-        ) + Self::mul_add(-x37, x59, x38 * x58)
-            - Self::mul_add(x43, 0.000000008530897668050218, x42 * 12.701650001451807)
-            - Self::mul_add(0.275, x205, x208 + Self::mul_add(s_q9, x202, c_q9 * x201));
-        let x215 = x211 - Self::mul_add(x36, x210, x35 * x209);
-        let x216 = Self::mul_add(-c_q8, x210, s_q8 * x209);
-        let x217 = Self::mul_add(48.0240000085309, Self::mul_add(x27, x27, x28), -x215);
-        let x218 = Self::mul_add(48.0240000085309, Self::mul_add(-x10, x11, x26), x216);
-        let x219 = Self::mul_add(
+            x48,
+            Self::mul_add(5.080660024070366, x47, x46 * 0.002139996587640933),
+        ) + Self::mul_add(-x36, x60, x37 * x59)
+            - Self::mul_add(x44, 0.000000008530897668050218, x43 * 12.701650001451807)
+            - Self::mul_add(0.275, x208, x211 + Self::mul_add(s_q9, x205, c_q9 * x204));
+        let x218 = Self::mul_add(s_q8, x213, c_q8 * x212);
+        let x219 = Self::mul_add(-c_q8, x213, s_q8 * x212);
+        let x220 = Self::mul_add(-0.00000000020510342851533115, x218, x214);
+        let x221 = Self::mul_add(s_q8, x216, c_q8 * x215);
+        let x222 = Self::mul_add(48.0240000085309, Self::mul_add(x27, x27, x28), -x220);
+        let x223 = Self::mul_add(48.0240000085309, Self::mul_add(-x10, x11, x26), x219);
+        let x224 = Self::mul_add(
             48.0240000085309,
             x25 + x29,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x211,
-                Self::mul_add(s_q8, x210, c_q8 * x209),
-            ),
+            -Self::mul_add(0.00000000020510342851533115, x214, x218),
         );
-        let x220 = Self::mul_add(x26, -16.80768997608804, x25 * 0.07309)
+        let x225 = Self::mul_add(x26, -16.80768997608804, x25 * 0.07309)
             + Self::mul_add(x11, x32, x27 * x31)
-            + Self::mul_add(-0.35, x216, x214 + Self::mul_add(x36, x213, x35 * x212));
-        let x221 = x33
-            + Self::mul_add(-0.35, x215, Self::mul_add(-c_q8, x213, s_q8 * x212));
-        let x222 = x34
-            - Self::mul_add(
-                -0.00000000020510342851533115,
-                x214,
-                Self::mul_add(s_q8, x213, c_q8 * x212),
+            + Self::mul_add(
+                -0.35,
+                x219,
+                Self::mul_add(0.00000000020510342851533115, x221, x217),
             );
-        let x223 = -x222;
-        let x224 = Self::mul_add(s_q7, x218, c_q7 * x217);
-        let x225 = Self::mul_add(-c_q7, x218, s_q7 * x217);
-        let x226 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x227 = 1466.4506062283303 * v[4];
-        let x228 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x229 = -(x224
+        let x226 = x33
+            + Self::mul_add(-0.35, x220, Self::mul_add(-c_q8, x216, s_q8 * x215));
+        let x227 = x34 - Self::mul_add(-0.00000000020510342851533115, x217, x221);
+        let x228 = -x227;
+        let x229 = Self::mul_add(s_q7, x223, c_q7 * x222);
+        let x230 = Self::mul_add(-c_q7, x223, s_q7 * x222);
+        let x231 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x232 = 1466.4506062283303 * v[4];
+        let x233 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x234 = -(x229
             - Self::mul_add(
                 1170.07,
                 x7,
                 -Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
             ));
-        let x230 = -(x225
+        let x235 = -(x230
             - Self::mul_add(
                 1170.07,
                 x8,
                 Self::mul_add(-180.9502499901501, x17, 110.5455 * x16),
             ));
-        let x231 = x219
+        let x236 = x224
             + Self::mul_add(
                 1170.07,
                 x9,
                 -Self::mul_add(180.9502499901501, x19, 110.5455 * x18),
             );
-        let x232 = Self::mul_add(0.75, x225, Self::mul_add(s_q7, x221, c_q7 * x220))
+        let x237 = Self::mul_add(0.75, x230, Self::mul_add(s_q7, x226, c_q7 * x225))
             + Self::mul_add(
                 -180.9502499901501,
                 x8,
                 Self::mul_add(a[5], -117.61766249359756, 1394.5960312283303 * a[3])
-                    - Self::mul_add(v[4], x228, v[5] * x227),
+                    - Self::mul_add(v[4], x233, v[5] * x232),
             );
-        let x233 = Self::mul_add(-c_q7, x221, s_q7 * x220)
-            - Self::mul_add(0.65, x219, 0.75 * x224)
+        let x238 = Self::mul_add(-c_q7, x226, s_q7 * x225)
+            - Self::mul_add(0.65, x224, 0.75 * x229)
             + (Self::mul_add(
                 1466.4506062283303,
                 a[4],
-                Self::mul_add(v[3], x228, v[5] * x226),
+                Self::mul_add(v[3], x233, v[5] * x231),
             ) + Self::mul_add(-110.5455, x9, 180.9502499901501 * x7));
-        let x234 = -(Self::mul_add(0.65, x225, x222)
+        let x239 = -(Self::mul_add(0.65, x230, x227)
             + Self::mul_add(
                 -110.5455,
                 x8,
                 Self::mul_add(-1271.854575, a[5], a[3] * 117.61766249359758)
-                    + Self::mul_add(-v[3], x227, v[4] * x226),
+                    + Self::mul_add(-v[3], x232, v[4] * x231),
             ));
-        [x229, x230, x231, x232, x233, x234, x223, x214, x203, x196, x188, x179, x169]
+        [x234, x235, x236, x237, x238, x239, x228, x217, x206, x199, x191, x180, x169]
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1510 mul, 1329 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1003 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1463 mul, 1302 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -3088,1830 +2976,1766 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = 0.00000000020510342851533115 * c_q8;
-        let x8 = 0.00000000020510342851533115 * s_q8;
-        let x9 = 0.00000000020510342851533115 * c_q9;
-        let x10 = 0.00000000020510342851533115 * s_q9;
-        let x11 = x9 - x10;
-        let x12 = x9 + x10;
-        let x13 = 0.00000000020510342851533115 * s_q12;
-        let x14 = 0.00000000020510342851533115 * c_q12;
-        let x15 = 0.00000000020510342851533115 * c_q13;
-        let x16 = 0.00000000020510342851533115 * s_q13;
-        let x17 = s_q13 * s_q13;
-        let x18 = s_q13 * c_q13;
-        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
-        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
-        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x23 = 4.806620000000001 * s_q13;
-        let x24 = 4.806620000000001 * c_q13;
-        let x25 = 0.00000000020510342851533115 * x23;
-        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
-        let x27 = 0.00000000020510342851533115 * x21;
-        let x28 = 1.4135609200000003 + x27;
-        let x29 = x21 + -0.0000000002899261911072858;
-        let x30 = 0.16 * x23;
-        let x31 = 0.55 * x24;
-        let x32 = x30 + x31;
-        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
-        let x34 = Self::mul_add(
+        let x7 = 0.00000000020510342851533115 * c_q9;
+        let x8 = 0.00000000020510342851533115 * s_q9;
+        let x9 = x7 - x8;
+        let x10 = x7 + x8;
+        let x11 = s_q13 * s_q13;
+        let x12 = s_q13 * c_q13;
+        let x13 = Self::mul_add(x12, 0.001562, x11 * 1.2025609200000003);
+        let x14 = 0.000781 + Self::mul_add(x11, -0.001562, x12 * 1.2025609200000003);
+        let x15 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x16 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 1.4135609200000003 + x13;
+        let x20 = x15 + x15;
+        let x21 = Self::mul_add(0.00000000020510342851533115, x20, x19);
+        let x22 = 0.00000000020510342851533115 * x17;
+        let x23 = 0.16 * x17;
+        let x24 = 0.55 * x18;
+        let x25 = x23 + x24;
+        let x26 = x25 - (x13 - x21 - x25);
+        let x27 = Self::mul_add(
             0.55,
-            x23,
+            x17,
             Self::mul_add(
                 0.16,
-                x24,
-                Self::mul_add(-0.00000000020510342851533115, x22, x20),
+                x18,
+                Self::mul_add(-0.00000000020510342851533115, x16, x14),
             ),
         );
-        let x35 = 3.6140000000000003 + x25;
-        let x36 = 17.135250000000003 + x24;
-        let x37 = -1.9877000000000002
+        let x28 = 3.6140000000000003 + x22;
+        let x29 = 17.135250000000003 + x18;
+        let x30 = -1.9877000000000002
             - Self::mul_add(
                 0.55,
-                x25,
-                Self::mul_add(0.00000000020510342851533115, x20, x22),
+                x22,
+                Self::mul_add(0.00000000020510342851533115, x14, x16),
             );
-        let x38 = -0.809539999555672
+        let x31 = -0.809539999555672
+            - Self::mul_add(
+                0.16,
+                x22,
+                x15 - Self::mul_add(-0.00000000020510342851533115, x19, x20),
+            );
+        let x32 = -5.252920330000002 + (x23 + (-1.2025609200000003 + x13 + x23));
+        let x33 = -2.741639999592316 - x27;
+        let x34 = 9.740442170000001 + (x24 + (1.4135609200000003 - x21 + x24));
+        let x35 = s_q12 * s_q12;
+        let x36 = s_q12 * c_q12;
+        let x37 = x26 - x32;
+        let x38 = x30 + x30;
+        let x39 = Self::mul_add(x36, x38, x35 * x37);
+        let x40 = x32 + x39;
+        let x41 = x30 + Self::mul_add(-x35, x38, x36 * x37);
+        let x42 = Self::mul_add(-s_q12, x33, c_q12 * x31);
+        let x43 = Self::mul_add(c_q12, x33, s_q12 * x31);
+        let x44 = Self::mul_add(-s_q12, x29, c_q12 * x28);
+        let x45 = Self::mul_add(c_q12, x29, s_q12 * x28);
+        let x46 = x34 - x40;
+        let x47 = x43 + x43;
+        let x48 = Self::mul_add(-0.00000000020510342851533115, x47, x46);
+        let x49 = Self::mul_add(-0.00000000020510342851533115, x41, x42);
+        let x50 = Self::mul_add(-0.00000000020510342851533115, x45, x17);
+        let x51 = x22 + x45;
+        let x52 = x51 * 0.36;
+        let x53 = x52 + (x26 - x39 + x52);
+        let x54 = 7.078399999258757 + x50;
+        let x55 = 0.01675
+            - Self::mul_add(
+                x44,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x42, x41),
+            );
+        let x56 = -9.142025249762803 + (x52 + (x40 + x48 + x52));
+        let x57 = 2.5482240016099564
             + Self::mul_add(
-                -0.16,
-                x25,
-                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+                x50,
+                0.36,
+                x43 - Self::mul_add(0.00000000020510342851533115, x46, x47),
             );
-        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
-        let x40 = -2.741639999592316 - x34;
-        let x41 = 9.740442170000001
-            + (x31
-                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
-        let x42 = s_q12 * s_q12;
-        let x43 = s_q12 * c_q12;
-        let x44 = x33 - x39;
-        let x45 = x37 + x37;
-        let x46 = Self::mul_add(x43, x45, x42 * x44);
-        let x47 = x39 + x46;
-        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
-        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
-        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
-        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
-        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
-        let x54 = x25 + x52;
-        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
-        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
-        let x57 = 0.00000000020510342851533115 * x50;
-        let x58 = x41 - x57;
-        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
-        let x60 = x54 * 0.36;
-        let x61 = x60 + (x33 - x46 + x60);
-        let x62 = 7.078399999258757 + x53;
-        let x63 = 0.01675
-            - Self::mul_add(
-                x51,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x49, x48),
-            );
-        let x64 = -9.142025249762803
-            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x60));
-        let x65 = 2.5482240016099564
-            - Self::mul_add(
-                x53,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x58, x56),
-            );
-        let x66 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
-        let x67 = s_q11 * s_q11;
-        let x68 = s_q11 * c_q11;
-        let x69 = x61 - x64;
-        let x70 = x55 + x55;
-        let x71 = Self::mul_add(x68, x70, x67 * x69);
-        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x51);
-        let x73 = Self::mul_add(c_q11, x62, s_q11 * x51);
-        let x74 = 0.275 * x54;
-        let x75 = x73 * 0.63;
-        let x76 = x74 - x75;
-        let x77 = Self::mul_add(x72, 0.63, x55 + Self::mul_add(-x67, x70, x68 * x69));
-        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
-        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
-        let x80 = x66 - x75;
-        let x81 = x76 + (x61 - x71 + x76);
-        let x82 = -45.1584 + x73;
-        let x83 = -0.6328 + x78;
-        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
-        let x85 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x79);
-        let x86 = 28.2393615 - (x75 - x80);
-        let x87 = s_q10 * s_q10;
-        let x88 = s_q10 * c_q10;
-        let x89 = x81 - x84;
-        let x90 = x77 + x77;
-        let x91 = Self::mul_add(x88, x90, x87 * x89);
-        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
-        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
-        let x94 = c_q10 * x72;
-        let x95 = Self::mul_add(-s_q10, x82, x94);
-        let x96 = s_q10 * x72;
-        let x97 = Self::mul_add(c_q10, x82, x96);
-        let x98 = x97 * 0.87;
-        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
-        let x100 = x86 - x98;
-        let x101 = x98 - (x81 - x91 - x98);
-        let x102 = -81.53205 + x97;
-        let x103 = -0.00214 + x92;
-        let x104 = -63.36336825000001 + (x84 + x91);
-        let x105 = -36.18604050126307 + Self::mul_add(x54, -0.87, x93);
-        let x106 = 69.99836825 - (x98 - x100);
-        let x107 = s_q9 * s_q9;
-        let x108 = s_q9 * c_q9;
-        let x109 = x101 + x104;
-        let x110 = x99 + x99;
-        let x111 = Self::mul_add(-x108, x110, x107 * x109);
-        let x112 = x101 - x111;
-        let x113 = x104 - x111;
-        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
-        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
-        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
-        let x117 = c_q9 * x95;
-        let x118 = Self::mul_add(-s_q9, x102, x117);
-        let x119 = s_q9 * x95;
-        let x120 = Self::mul_add(c_q9, x102, x119);
-        let x121 = 0.00000000020510342851533115 * x54;
-        let x122 = x120 - x121;
-        let x123 = 0.00000000020510342851533115 * x120;
-        let x124 = x54 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
-        let x125 = x118 + x121;
-        let x126 = 0.00000000020510342851533115 * x115;
-        let x127 = x114 + x126;
-        let x128 = 0.00000000020510342851533115 * x116;
-        let x129 = x113 + x128;
-        let x130 = 0.00000000020510342851533115 * x106;
-        let x131 = x116 + x130;
-        let x132 = 0.00000000020510342851533115 * x114;
-        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
-        let x134 = x106 + (x126 - x128);
-        let x135 = x115 - x130;
-        let x136 = 0.00000000020510342851533115 * x131;
-        let x137 = 0.4 * x125;
-        let x138 = 0.275 * x124;
-        let x139 = x137 - x138;
-        let x140 = x139 + (x129 + x136 + x139);
-        let x141 = Self::mul_add(
+        let x58 = 9.223235249762805 + (x34 - x48);
+        let x59 = s_q11 * s_q11;
+        let x60 = s_q11 * c_q11;
+        let x61 = x53 - x56;
+        let x62 = x49 + x49;
+        let x63 = Self::mul_add(x60, x62, x59 * x61);
+        let x64 = Self::mul_add(-s_q11, x54, c_q11 * x44);
+        let x65 = Self::mul_add(c_q11, x54, s_q11 * x44);
+        let x66 = 0.275 * x51;
+        let x67 = x65 * 0.63;
+        let x68 = x66 - x67;
+        let x69 = Self::mul_add(x64, 0.63, x49 + Self::mul_add(-x59, x62, x60 * x61));
+        let x70 = Self::mul_add(0.275, x64, Self::mul_add(-s_q11, x57, c_q11 * x55));
+        let x71 = Self::mul_add(0.275, x65, Self::mul_add(c_q11, x57, s_q11 * x55));
+        let x72 = x58 - x67;
+        let x73 = x68 + (x53 - x63 + x68);
+        let x74 = -45.1584 + x65;
+        let x75 = -0.6328 + x70;
+        let x76 = -24.4950615 + (x66 + (x56 + x63 + x66));
+        let x77 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x71);
+        let x78 = 28.2393615 - (x67 - x72);
+        let x79 = s_q10 * s_q10;
+        let x80 = s_q10 * c_q10;
+        let x81 = x73 - x76;
+        let x82 = x69 + x69;
+        let x83 = Self::mul_add(x80, x82, x79 * x81);
+        let x84 = Self::mul_add(-s_q10, x77, c_q10 * x75);
+        let x85 = Self::mul_add(c_q10, x77, s_q10 * x75);
+        let x86 = c_q10 * x64;
+        let x87 = Self::mul_add(-s_q10, x74, x86);
+        let x88 = s_q10 * x64;
+        let x89 = Self::mul_add(c_q10, x74, x88);
+        let x90 = x89 * 0.87;
+        let x91 = Self::mul_add(x87, 0.87, x69 + Self::mul_add(-x79, x82, x80 * x81));
+        let x92 = x78 - x90;
+        let x93 = x90 - (x73 - x83 - x90);
+        let x94 = -81.53205 + x89;
+        let x95 = -0.00214 + x84;
+        let x96 = -63.36336825000001 + (x76 + x83);
+        let x97 = -36.18604050126307 + Self::mul_add(x51, -0.87, x85);
+        let x98 = 69.99836825 - (x90 - x92);
+        let x99 = s_q9 * s_q9;
+        let x100 = s_q9 * c_q9;
+        let x101 = x93 + x96;
+        let x102 = x91 + x91;
+        let x103 = Self::mul_add(-x100, x102, x99 * x101);
+        let x104 = x93 - x103;
+        let x105 = x96 - x103;
+        let x106 = x91 - Self::mul_add(x99, x102, x100 * x101);
+        let x107 = Self::mul_add(-s_q9, x97, c_q9 * x95);
+        let x108 = Self::mul_add(c_q9, x97, s_q9 * x95);
+        let x109 = c_q9 * x87;
+        let x110 = Self::mul_add(-s_q9, x94, x109);
+        let x111 = s_q9 * x87;
+        let x112 = Self::mul_add(c_q9, x94, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = 0.00000000020510342851533115 * x112;
+        let x116 = x51 - Self::mul_add(0.00000000020510342851533115, x110, -x115);
+        let x117 = x110 + x113;
+        let x118 = 0.00000000020510342851533115 * x107;
+        let x119 = x106 + x118;
+        let x120 = 0.00000000020510342851533115 * x108;
+        let x121 = x105 + x120;
+        let x122 = 0.00000000020510342851533115 * x98;
+        let x123 = x108 + x122;
+        let x124 = 0.00000000020510342851533115 * x106;
+        let x125 = x107 - Self::mul_add(0.00000000020510342851533115, x104, x124);
+        let x126 = x98 + (x118 - x120);
+        let x127 = x107 - x122;
+        let x128 = 0.00000000020510342851533115 * x123;
+        let x129 = 0.4 * x117;
+        let x130 = 0.275 * x116;
+        let x131 = x129 - x130;
+        let x132 = x131 + (x121 + x128 + x131);
+        let x133 = Self::mul_add(
             0.275,
-            x125,
+            x117,
             -Self::mul_add(
                 0.4,
-                x124,
-                Self::mul_add(-0.00000000020510342851533115, x134, x133),
+                x116,
+                Self::mul_add(-0.00000000020510342851533115, x126, x125),
             ),
         );
-        let x142 = -0.000000008530897668050218 + x122;
-        let x143 = -12.701650001451807 - x124;
-        let x144 = -0.0000000234896432582596
+        let x134 = -0.000000008530897668050218 + x114;
+        let x135 = -12.701650001451807 - x116;
+        let x136 = -0.0000000234896432582596
             + Self::mul_add(
                 -0.275,
-                x122,
-                x131
+                x114,
+                x123
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x129,
-                        0.00000000020510342851533115 * x127,
+                        x121,
+                        0.00000000020510342851533115 * x119,
                     ),
             );
-        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
-        let x146 = -111.7548902508081
-            + (x137
-                + (x134
+        let x137 = -0.002139996587640933 + Self::mul_add(-0.4, x114, x119 - x128);
+        let x138 = -111.7548902508081
+            + (x129
+                + (x126
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
-                        0.00000000020510342851533115 * x133,
-                    ) + x137));
-        let x147 = 5.080660024070365 - x141;
-        let x148 = 113.3918902508081
-            - (x138
-                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
-                    + x138));
-        let x149 = s_q8 * s_q8;
-        let x150 = s_q8 * c_q8;
-        let x151 = x140 - x146;
-        let x152 = x144 + x144;
-        let x153 = Self::mul_add(x150, x152, x149 * x151);
-        let x154 = x140 - x153;
-        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
-        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
-        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
-        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
-        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
-        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
-        let x163 = 0.00000000020510342851533115 * x156;
-        let x164 = x148 - x163;
-        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
-        let x166 = 0.35 * x161;
-        let x167 = x166
-            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x166);
-        let x168 = 48.0240000085309 + x160;
-        let x169 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
-        let x170 = -16.80768997608804
+                        x108 + Self::mul_add(-0.00000000020510342851533115, x105, x124),
+                        0.00000000020510342851533115 * x125,
+                    ) + x129));
+        let x139 = 5.080660024070365 - x133;
+        let x140 = 113.3918902508081
+            - (x130
+                + (Self::mul_add(0.00000000020510342851533115, x127, x104 + x118)
+                    + x130));
+        let x141 = s_q8 * s_q8;
+        let x142 = s_q8 * c_q8;
+        let x143 = x132 - x138;
+        let x144 = x136 + x136;
+        let x145 = Self::mul_add(x142, x144, x141 * x143);
+        let x146 = x132 - x145;
+        let x147 = x136 + Self::mul_add(-x141, x144, x142 * x143);
+        let x148 = Self::mul_add(-s_q8, x139, c_q8 * x137);
+        let x149 = Self::mul_add(c_q8, x139, s_q8 * x137);
+        let x150 = Self::mul_add(-s_q8, x135, c_q8 * x134);
+        let x151 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x152 = x140 - x146;
+        let x153 = x148 + x148;
+        let x154 = Self::mul_add(-0.00000000020510342851533115, x153, x152);
+        let x155 = Self::mul_add(0.00000000020510342851533115, x117, x150);
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x150, x117);
+        let x157 = 0.35 * x155;
+        let x158 = x157 - (x146 + x154 - x157);
+        let x159 = 48.0240000085309 + x156;
+        let x160 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x147, x149);
+        let x161 = -16.80768997608804
+            + Self::mul_add(
+                -0.35,
+                x156,
+                x148 - Self::mul_add(0.00000000020510342851533115, x152, x153),
+            );
+        let x162 = 130.43769025763282 - (x157 - (x138 + x145 - x157));
+        let x163 = 0.1132
             - Self::mul_add(
                 0.35,
-                x160,
-                Self::mul_add(0.00000000020510342851533115, x164, x162),
+                x151,
+                Self::mul_add(0.00000000020510342851533115, x149, x147),
             );
-        let x171 = 130.43769025763282 - (x166 - (x146 + x153 - x166));
-        let x172 = 0.1132
-            - Self::mul_add(
-                0.35,
-                x159,
-                Self::mul_add(0.00000000020510342851533115, x157, x155),
-            );
-        let x173 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
-        let x174 = s_q7 * s_q7;
-        let x175 = s_q7 * c_q7;
-        let x176 = x167 + x171;
-        let x177 = x169 + x169;
-        let x178 = Self::mul_add(-x175, x177, x174 * x176);
-        let x179 = Self::mul_add(-s_q7, x159, c_q7 * x168);
-        let x180 = Self::mul_add(c_q7, x159, s_q7 * x168);
-        let x181 = 0.75 * x161;
-        let x182 = 0.65 * x179;
-        let x183 = x181 - x182;
-        let x184 = Self::mul_add(-0.75, x179, Self::mul_add(-s_q7, x172, c_q7 * x170));
-        let x185 = x173 + x182;
-        let x186 = 110.5455 + x179;
-        let x187 = 180.9502499901501 - x161;
-        let x188 = Self::mul_add(x8, x142, x7 * x143);
-        let x189 = Self::mul_add(
+        let x164 = 132.47349025763282 + (x140 - x154);
+        let x165 = s_q7 * s_q7;
+        let x166 = s_q7 * c_q7;
+        let x167 = x158 + x162;
+        let x168 = x160 + x160;
+        let x169 = Self::mul_add(-x166, x168, x165 * x167);
+        let x170 = Self::mul_add(-s_q7, x151, c_q7 * x159);
+        let x171 = Self::mul_add(c_q7, x151, s_q7 * x159);
+        let x172 = 0.75 * x155;
+        let x173 = 0.65 * x170;
+        let x174 = x172 - x173;
+        let x175 = Self::mul_add(-0.75, x170, Self::mul_add(-s_q7, x163, c_q7 * x161));
+        let x176 = x164 + x173;
+        let x177 = 110.5455 + x170;
+        let x178 = 180.9502499901501 - x155;
+        let x179 = 0.00000000020510342851533115 * x151;
+        let x180 = Self::mul_add(0.00000000020510342851533115, x140, x148);
+        let x181 = Self::mul_add(
             -0.35,
-            x158,
-            x148 - Self::mul_add(-x8, x147, x7 * x145),
+            x150,
+            Self::mul_add(-0.00000000020510342851533115, x148, x140),
         );
-        let x190 = Self::mul_add(0.35, x188, x157);
-        let x191 = Self::mul_add(-s_q7, x158, c_q7 * x188);
-        let x192 = Self::mul_add(c_q7, x158, s_q7 * x188);
-        let x193 = x12 * x95;
-        let x194 = Self::mul_add(x11, x102, x193);
-        let x195 = x131 + Self::mul_add(-0.275, x120, 0.4 * x194);
+        let x182 = Self::mul_add(0.35, x179, x149);
+        let x183 = Self::mul_add(-s_q7, x150, c_q7 * x179);
+        let x184 = Self::mul_add(c_q7, x150, s_q7 * x179);
+        let x185 = x10 * x87;
+        let x186 = Self::mul_add(x9, x94, x185);
+        let x187 = x123 + Self::mul_add(-0.275, x112, 0.4 * x186);
+        let x188 = Self::mul_add(0.4, x110, x98 + Self::mul_add(-x10, x97, x9 * x95));
+        let x189 = Self::mul_add(-0.275, x110, x127);
+        let x190 = Self::mul_add(s_q8, x186, c_q8 * x110);
+        let x191 = Self::mul_add(-c_q8, x186, s_q8 * x110);
+        let x192 = x115 - x190;
+        let x193 = Self::mul_add(0.00000000020510342851533115, x190, x112);
+        let x194 = Self::mul_add(-s_q8, x188, c_q8 * x187);
+        let x195 = Self::mul_add(0.00000000020510342851533115, x189, x194);
         let x196 = Self::mul_add(
-            0.4,
-            x118,
-            x106 + Self::mul_add(-x12, x105, x11 * x103),
-        );
-        let x197 = Self::mul_add(-0.275, x118, x135);
-        let x198 = x120 + Self::mul_add(x8, x194, x7 * x118);
-        let x199 = Self::mul_add(-c_q8, x194, s_q8 * x118);
-        let x200 = x123 - Self::mul_add(s_q8, x194, c_q8 * x118);
-        let x201 = Self::mul_add(
-            0.00000000020510342851533115,
-            x197,
-            Self::mul_add(-s_q8, x196, c_q8 * x195),
-        );
-        let x202 = Self::mul_add(
             -0.35,
-            x199,
-            x197 - Self::mul_add(-x8, x196, x7 * x195),
+            x191,
+            Self::mul_add(-0.00000000020510342851533115, x194, x189),
         );
-        let x203 = Self::mul_add(-0.35, x198, Self::mul_add(c_q8, x196, s_q8 * x195));
-        let x204 = Self::mul_add(s_q7, x199, c_q7 * x198);
-        let x205 = Self::mul_add(-c_q7, x199, s_q7 * x198);
-        let x206 = Self::mul_add(-s_q9, x97, x117);
-        let x207 = Self::mul_add(x11, x97, x193);
-        let x208 = Self::mul_add(c_q9, x97, x119);
-        let x209 = 0.00000000020510342851533115 * x100;
-        let x210 = Self::mul_add(c_q9, x93, s_q9 * x92) + x209
-            + Self::mul_add(-0.275, x208, 0.4 * x207);
-        let x211 = Self::mul_add(0.4, x206, x100 + Self::mul_add(-x12, x93, x11 * x92));
-        let x212 = Self::mul_add(
+        let x197 = Self::mul_add(-0.35, x193, Self::mul_add(c_q8, x188, s_q8 * x187));
+        let x198 = Self::mul_add(s_q7, x191, c_q7 * x193);
+        let x199 = Self::mul_add(-c_q7, x191, s_q7 * x193);
+        let x200 = Self::mul_add(-s_q9, x89, x109);
+        let x201 = Self::mul_add(x9, x89, x185);
+        let x202 = Self::mul_add(c_q9, x89, x111);
+        let x203 = 0.00000000020510342851533115 * x92;
+        let x204 = Self::mul_add(c_q9, x85, s_q9 * x84) + x203
+            + Self::mul_add(-0.275, x202, 0.4 * x201);
+        let x205 = Self::mul_add(0.4, x200, x92 + Self::mul_add(-x10, x85, x9 * x84));
+        let x206 = Self::mul_add(
             0.275,
-            x206,
-            x209 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+            x200,
+            x203 - Self::mul_add(-s_q9, x85, c_q9 * x84),
         );
-        let x213 = x208 + Self::mul_add(x8, x207, x7 * x206);
-        let x214 = Self::mul_add(-c_q8, x207, s_q8 * x206);
-        let x215 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x207 = Self::mul_add(s_q8, x201, c_q8 * x200);
+        let x208 = Self::mul_add(-c_q8, x201, s_q8 * x200);
+        let x209 = Self::mul_add(-0.00000000020510342851533115, x202, x207);
+        let x210 = Self::mul_add(0.00000000020510342851533115, x207, x202);
+        let x211 = Self::mul_add(-s_q8, x205, c_q8 * x204);
+        let x212 = Self::mul_add(-0.00000000020510342851533115, x206, x211);
+        let x213 = Self::mul_add(
+            0.35,
             x208,
-            Self::mul_add(s_q8, x207, c_q8 * x206),
+            Self::mul_add(0.00000000020510342851533115, x211, x206),
         );
-        let x216 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            Self::mul_add(-s_q8, x211, c_q8 * x210),
-        );
-        let x217 = Self::mul_add(0.35, x214, x212 + Self::mul_add(-x8, x211, x7 * x210));
-        let x218 = Self::mul_add(-0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
-        let x219 = Self::mul_add(s_q7, x214, c_q7 * x213);
-        let x220 = Self::mul_add(-c_q7, x214, s_q7 * x213);
-        let x221 = Self::mul_add(c_q10, x73, x96);
-        let x222 = Self::mul_add(-s_q10, x73, x94);
-        let x223 = Self::mul_add(-s_q10, x79, c_q10 * x78);
-        let x224 = Self::mul_add(c_q10, x79, s_q10 * x78);
-        let x225 = Self::mul_add(-0.87, x221, x80);
-        let x226 = Self::mul_add(-c_q9, x222, s_q9 * x221);
-        let x227 = Self::mul_add(x12, x222, x11 * x221);
-        let x228 = Self::mul_add(s_q9, x222, c_q9 * x221);
-        let x229 = 0.00000000020510342851533115 * x225;
-        let x230 = Self::mul_add(c_q9, x224, s_q9 * x223) + x229
-            + Self::mul_add(-0.275, x228, 0.4 * x227);
-        let x231 = Self::mul_add(
+        let x214 = Self::mul_add(-0.35, x210, Self::mul_add(c_q8, x205, s_q8 * x204));
+        let x215 = Self::mul_add(s_q7, x208, c_q7 * x210);
+        let x216 = Self::mul_add(-c_q7, x208, s_q7 * x210);
+        let x217 = Self::mul_add(c_q10, x65, x88);
+        let x218 = Self::mul_add(-s_q10, x65, x86);
+        let x219 = Self::mul_add(-s_q10, x71, c_q10 * x70);
+        let x220 = Self::mul_add(c_q10, x71, s_q10 * x70);
+        let x221 = Self::mul_add(-0.87, x217, x72);
+        let x222 = Self::mul_add(-c_q9, x218, s_q9 * x217);
+        let x223 = Self::mul_add(x10, x218, x9 * x217);
+        let x224 = Self::mul_add(s_q9, x218, c_q9 * x217);
+        let x225 = 0.00000000020510342851533115 * x221;
+        let x226 = Self::mul_add(c_q9, x220, s_q9 * x219) + x225
+            + Self::mul_add(-0.275, x224, 0.4 * x223);
+        let x227 = Self::mul_add(
             -0.4,
-            x226,
-            x225 + Self::mul_add(-x12, x224, x11 * x223),
+            x222,
+            x221 + Self::mul_add(-x10, x220, x9 * x219),
         );
-        let x232 = Self::mul_add(
+        let x228 = Self::mul_add(
             -0.275,
-            x226,
-            x229 - Self::mul_add(-s_q9, x224, c_q9 * x223),
+            x222,
+            x225 - Self::mul_add(-s_q9, x220, c_q9 * x219),
         );
-        let x233 = x228 - Self::mul_add(-x8, x227, x7 * x226);
-        let x234 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x229 = Self::mul_add(-s_q8, x223, c_q8 * x222);
+        let x230 = Self::mul_add(c_q8, x223, s_q8 * x222);
+        let x231 = Self::mul_add(0.00000000020510342851533115, x224, x229);
+        let x232 = Self::mul_add(-0.00000000020510342851533115, x229, x224);
+        let x233 = Self::mul_add(-s_q8, x227, c_q8 * x226);
+        let x234 = Self::mul_add(-0.00000000020510342851533115, x228, x233);
         let x235 = Self::mul_add(
-            0.00000000020510342851533115,
-            x228,
-            Self::mul_add(-s_q8, x227, c_q8 * x226),
-        );
-        let x236 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x232,
-            Self::mul_add(-s_q8, x231, c_q8 * x230),
-        );
-        let x237 = Self::mul_add(
             -0.35,
-            x234,
-            x232 + Self::mul_add(-x8, x231, x7 * x230),
+            x230,
+            Self::mul_add(0.00000000020510342851533115, x233, x228),
         );
-        let x238 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x231, s_q8 * x230));
-        let x239 = Self::mul_add(-s_q7, x234, c_q7 * x233);
-        let x240 = Self::mul_add(c_q7, x234, s_q7 * x233);
-        let x241 = Self::mul_add(-x14, x35, x13 * x36);
-        let x242 = Self::mul_add(0.36, x241, x49);
-        let x243 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
-        let x244 = Self::mul_add(s_q11, x241, c_q11 * x52);
-        let x245 = Self::mul_add(-c_q11, x241, s_q11 * x52);
-        let x246 = Self::mul_add(-s_q11, x243, c_q11 * x242)
-            - Self::mul_add(x51, -0.63, 0.275 * x245);
-        let x247 = Self::mul_add(0.275, x244, Self::mul_add(c_q11, x243, s_q11 * x242));
-        let x248 = Self::mul_add(0.63, x244, x59);
-        let x249 = Self::mul_add(-s_q10, x245, c_q10 * x244);
-        let x250 = Self::mul_add(c_q10, x245, s_q10 * x244);
-        let x251 = Self::mul_add(c_q10, x247, s_q10 * x246);
-        let x252 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x247, c_q10 * x246));
-        let x253 = Self::mul_add(0.87, x249, x248);
-        let x254 = 0.00000000020510342851533115 * x51;
-        let x255 = Self::mul_add(c_q9, x250, s_q9 * x249) + x254;
-        let x256 = x51 + Self::mul_add(-x12, x250, x11 * x249);
-        let x257 = x254 - Self::mul_add(-s_q9, x250, c_q9 * x249);
-        let x258 = 0.00000000020510342851533115 * x253;
-        let x259 = Self::mul_add(c_q9, x251, s_q9 * x252) - x258
-            + Self::mul_add(0.275, x257, 0.4 * x256);
-        let x260 = Self::mul_add(
-            0.4,
-            x255,
-            x253 - Self::mul_add(-x12, x251, x11 * x252),
+        let x236 = Self::mul_add(-0.35, x232, Self::mul_add(c_q8, x227, s_q8 * x226));
+        let x237 = Self::mul_add(-s_q7, x230, c_q7 * x232);
+        let x238 = Self::mul_add(c_q7, x230, s_q7 * x232);
+        let x239 = 0.00000000020510342851533115 * x44;
+        let x240 = Self::mul_add(0.00000000020510342851533115, x34, x43);
+        let x241 = Self::mul_add(-0.36, x239, x42);
+        let x242 = Self::mul_add(
+            x45,
+            0.36,
+            Self::mul_add(-0.00000000020510342851533115, x43, x34),
         );
-        let x261 = Self::mul_add(
+        let x243 = Self::mul_add(-s_q11, x239, c_q11 * x45);
+        let x244 = Self::mul_add(c_q11, x239, s_q11 * x45);
+        let x245 = Self::mul_add(-s_q11, x242, c_q11 * x241)
+            - Self::mul_add(x44, -0.63, 0.275 * x244);
+        let x246 = Self::mul_add(0.275, x243, Self::mul_add(c_q11, x242, s_q11 * x241));
+        let x247 = Self::mul_add(0.63, x243, x240);
+        let x248 = Self::mul_add(-s_q10, x244, c_q10 * x243);
+        let x249 = Self::mul_add(c_q10, x244, s_q10 * x243);
+        let x250 = Self::mul_add(c_q10, x246, s_q10 * x245);
+        let x251 = Self::mul_add(x44, 0.87, Self::mul_add(-s_q10, x246, c_q10 * x245));
+        let x252 = Self::mul_add(0.87, x248, x247);
+        let x253 = x239 + Self::mul_add(c_q9, x249, s_q9 * x248);
+        let x254 = x44 + Self::mul_add(-x10, x249, x9 * x248);
+        let x255 = x239 - Self::mul_add(-s_q9, x249, c_q9 * x248);
+        let x256 = 0.00000000020510342851533115 * x252;
+        let x257 = Self::mul_add(c_q9, x250, s_q9 * x251) - x256
+            + Self::mul_add(0.275, x255, 0.4 * x254);
+        let x258 = Self::mul_add(0.4, x253, x252 - Self::mul_add(-x10, x250, x9 * x251));
+        let x259 = Self::mul_add(
             0.275,
-            x255,
-            x258 + Self::mul_add(-s_q9, x251, c_q9 * x252),
+            x253,
+            x256 + Self::mul_add(-s_q9, x250, c_q9 * x251),
         );
-        let x262 = x257 + Self::mul_add(-x8, x256, x7 * x255);
-        let x263 = Self::mul_add(c_q8, x256, s_q8 * x255);
-        let x264 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x257,
-            Self::mul_add(-s_q8, x256, c_q8 * x255),
-        );
-        let x265 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x260 = Self::mul_add(-s_q8, x254, c_q8 * x253);
+        let x261 = Self::mul_add(c_q8, x254, s_q8 * x253);
+        let x262 = Self::mul_add(-0.00000000020510342851533115, x255, x260);
+        let x263 = Self::mul_add(0.00000000020510342851533115, x260, x255);
+        let x264 = Self::mul_add(s_q8, x258, c_q8 * x257);
+        let x265 = Self::mul_add(0.00000000020510342851533115, x259, x264);
+        let x266 = Self::mul_add(
+            0.35,
             x261,
-            Self::mul_add(s_q8, x260, c_q8 * x259),
+            Self::mul_add(-0.00000000020510342851533115, x264, x259),
         );
-        let x266 = Self::mul_add(0.35, x263, x261 - Self::mul_add(x8, x260, x7 * x259));
-        let x267 = Self::mul_add(0.35, x262, Self::mul_add(-c_q8, x260, s_q8 * x259));
-        let x268 = Self::mul_add(s_q7, x263, c_q7 * x262);
-        let x269 = Self::mul_add(-c_q7, x263, s_q7 * x262);
-        let x270 = 4.806620000000001 * x15;
-        let x271 = x32
-            + (1.4135609200000003
-                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
-        let x272 = Self::mul_add(-0.16, x270, x22);
-        let x273 = Self::mul_add(-0.55, x270, x29);
-        let x274 = Self::mul_add(s_q12, x23, c_q12 * x270);
-        let x275 = x24 - Self::mul_add(-x14, x23, x13 * x270);
-        let x276 = Self::mul_add(
-            0.00000000020510342851533115,
-            x24,
-            Self::mul_add(-c_q12, x23, s_q12 * x270),
-        );
-        let x277 = Self::mul_add(
-            0.00000000020510342851533115,
-            x273,
-            Self::mul_add(-c_q12, x272, s_q12 * x271),
-        );
-        let x278 = Self::mul_add(0.36, x275, Self::mul_add(s_q12, x272, c_q12 * x271));
-        let x279 = Self::mul_add(
+        let x267 = Self::mul_add(0.35, x263, Self::mul_add(-c_q8, x258, s_q8 * x257));
+        let x268 = Self::mul_add(s_q7, x261, c_q7 * x263);
+        let x269 = Self::mul_add(-c_q7, x261, s_q7 * x263);
+        let x270 = 0.00000000020510342851533115 * x18;
+        let x271 = x25
+            + Self::mul_add(0.00000000020510342851533115, x15, 1.4135609200000003);
+        let x272 = Self::mul_add(-0.16, x270, x16);
+        let x273 = Self::mul_add(-0.55, x270, x15 + -0.0000000002899261911072858);
+        let x274 = Self::mul_add(s_q12, x17, c_q12 * x270);
+        let x275 = Self::mul_add(-c_q12, x17, s_q12 * x270);
+        let x276 = Self::mul_add(-0.00000000020510342851533115, x275, x18);
+        let x277 = x270 + x275;
+        let x278 = Self::mul_add(-c_q12, x272, s_q12 * x271);
+        let x279 = Self::mul_add(0.00000000020510342851533115, x273, x278);
+        let x280 = Self::mul_add(0.36, x276, Self::mul_add(s_q12, x272, c_q12 * x271));
+        let x281 = Self::mul_add(
             -0.36,
             x274,
-            x273 - Self::mul_add(-x14, x272, x13 * x271),
+            Self::mul_add(-0.00000000020510342851533115, x278, x273),
         );
-        let x280 = Self::mul_add(-s_q11, x275, c_q11 * x274);
-        let x281 = Self::mul_add(c_q11, x275, s_q11 * x274);
-        let x282 = Self::mul_add(-s_q11, x279, c_q11 * x278)
-            + Self::mul_add(0.63, x276, 0.275 * x281);
-        let x283 = Self::mul_add(-0.275, x280, Self::mul_add(c_q11, x279, s_q11 * x278));
-        let x284 = Self::mul_add(-0.63, x280, x277);
-        let x285 = Self::mul_add(-s_q10, x281, c_q10 * x280);
-        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
-        let x287 = Self::mul_add(c_q10, x283, s_q10 * x282);
-        let x288 = Self::mul_add(0.87, x276, Self::mul_add(-s_q10, x283, c_q10 * x282));
-        let x289 = Self::mul_add(-0.87, x285, x284);
-        let x290 = 0.00000000020510342851533115 * x276;
-        let x291 = Self::mul_add(c_q9, x286, s_q9 * x285) - x290;
-        let x292 = x276 - Self::mul_add(-x12, x286, x11 * x285);
-        let x293 = x290 + Self::mul_add(-s_q9, x286, c_q9 * x285);
-        let x294 = 0.00000000020510342851533115 * x289;
-        let x295 = Self::mul_add(c_q9, x287, s_q9 * x288) - x294
-            + Self::mul_add(0.275, x293, 0.4 * x292);
-        let x296 = Self::mul_add(
+        let x282 = Self::mul_add(-s_q11, x276, c_q11 * x274);
+        let x283 = Self::mul_add(c_q11, x276, s_q11 * x274);
+        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
+            + Self::mul_add(0.63, x277, 0.275 * x283);
+        let x285 = Self::mul_add(-0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
+        let x286 = Self::mul_add(-0.63, x282, x279);
+        let x287 = Self::mul_add(-s_q10, x283, c_q10 * x282);
+        let x288 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x289 = Self::mul_add(c_q10, x285, s_q10 * x284);
+        let x290 = Self::mul_add(0.87, x277, Self::mul_add(-s_q10, x285, c_q10 * x284));
+        let x291 = Self::mul_add(-0.87, x287, x286);
+        let x292 = 0.00000000020510342851533115 * x277;
+        let x293 = Self::mul_add(c_q9, x288, s_q9 * x287) - x292;
+        let x294 = x277 - Self::mul_add(-x10, x288, x9 * x287);
+        let x295 = x292 + Self::mul_add(-s_q9, x288, c_q9 * x287);
+        let x296 = 0.00000000020510342851533115 * x291;
+        let x297 = Self::mul_add(c_q9, x289, s_q9 * x290) - x296
+            + Self::mul_add(0.275, x295, 0.4 * x294);
+        let x298 = Self::mul_add(
             -0.4,
-            x291,
-            x289 - Self::mul_add(-x12, x287, x11 * x288),
-        );
-        let x297 = Self::mul_add(
-            -0.275,
-            x291,
-            x294 + Self::mul_add(-s_q9, x287, c_q9 * x288),
-        );
-        let x298 = x293 - Self::mul_add(x8, x292, x7 * x291);
-        let x299 = Self::mul_add(-c_q8, x292, s_q8 * x291);
-        let x300 = Self::mul_add(
-            0.00000000020510342851533115,
             x293,
-            Self::mul_add(s_q8, x292, c_q8 * x291),
+            x291 - Self::mul_add(-x10, x289, x9 * x290),
         );
-        let x301 = Self::mul_add(
-            0.00000000020510342851533115,
-            x297,
-            Self::mul_add(s_q8, x296, c_q8 * x295),
+        let x299 = Self::mul_add(
+            -0.275,
+            x293,
+            x296 + Self::mul_add(-s_q9, x289, c_q9 * x290),
         );
-        let x302 = Self::mul_add(-0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
-        let x303 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
-        let x304 = Self::mul_add(-s_q7, x299, c_q7 * x298);
-        let x305 = Self::mul_add(c_q7, x299, s_q7 * x298);
-        let x306 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x307 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x308 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x309 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x310 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x311 = v[4] * v[4];
-        let x312 = Self::mul_add(v[5], v[5], x311);
-        let x313 = v[3] * v[4];
-        let x314 = v[3] * v[5];
-        let x315 = v[4] * v[5];
-        let x316 = Self::mul_add(v[3], v[3], x311);
-        let x317 = x306 + Self::mul_add(-0.75, x314, 0.65 * x312);
-        let x318 = x307 + Self::mul_add(0.75, x315, 0.65 * x313);
-        let x319 = x308 - Self::mul_add(-0.75, x316, 0.65 * x314);
-        let x320 = Self::mul_add(c_q7, x318, s_q7 * x317);
-        let x321 = v[6] * x310;
-        let x322 = v[6] * x309;
-        let x323 = v[5] + v[6];
-        let x324 = x310 * x310;
-        let x325 = x309 * x323;
-        let x326 = Self::mul_add(x323, -16.80768997608804, x310 * 0.07309);
-        let x327 = Self::mul_add(
-            -0.1132,
-            x323,
-            Self::mul_add(130.43769025763282, x310, x309 * 0.07309),
+        let x300 = Self::mul_add(s_q8, x294, c_q8 * x293);
+        let x301 = Self::mul_add(-c_q8, x294, s_q8 * x293);
+        let x302 = Self::mul_add(0.00000000020510342851533115, x295, x300);
+        let x303 = Self::mul_add(-0.00000000020510342851533115, x300, x295);
+        let x304 = Self::mul_add(s_q8, x298, c_q8 * x297);
+        let x305 = Self::mul_add(0.00000000020510342851533115, x299, x304);
+        let x306 = Self::mul_add(
+            -0.35,
+            x301,
+            Self::mul_add(-0.00000000020510342851533115, x304, x299),
         );
-        let x328 = Self::mul_add(
-            -132.47349025763282,
-            x323,
-            Self::mul_add(0.1132, x310, x309 * 16.80768997608804),
-        );
-        let x329 = Self::mul_add(c_q8, x323, Self::mul_add(s_q8, x310, x7 * x309));
-        let x330 = Self::mul_add(s_q8, x323, Self::mul_add(-c_q8, x310, x8 * x309));
+        let x307 = Self::mul_add(0.35, x303, Self::mul_add(-c_q8, x298, s_q8 * x297));
+        let x308 = Self::mul_add(-s_q7, x301, c_q7 * x303);
+        let x309 = Self::mul_add(c_q7, x301, s_q7 * x303);
+        let x310 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x311 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x312 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x313 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x314 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x315 = v[4] * v[4];
+        let x316 = Self::mul_add(v[5], v[5], x315);
+        let x317 = v[3] * v[4];
+        let x318 = v[3] * v[5];
+        let x319 = v[4] * v[5];
+        let x320 = Self::mul_add(v[3], v[3], x315);
+        let x321 = x310 + Self::mul_add(-0.75, x318, 0.65 * x316);
+        let x322 = x311 + Self::mul_add(0.75, x319, 0.65 * x317);
+        let x323 = x312 - Self::mul_add(-0.75, x320, 0.65 * x318);
+        let x324 = Self::mul_add(c_q7, x322, s_q7 * x321);
+        let x325 = v[6] * x314;
+        let x326 = v[6] * x313;
+        let x327 = v[5] + v[6];
+        let x328 = x314 * x314;
+        let x329 = x313 * x327;
+        let x330 = Self::mul_add(x327, -16.80768997608804, x314 * 0.07309);
         let x331 = Self::mul_add(
+            -0.1132,
+            x327,
+            Self::mul_add(130.43769025763282, x314, x313 * 0.07309),
+        );
+        let x332 = Self::mul_add(
+            -132.47349025763282,
+            x327,
+            Self::mul_add(0.1132, x314, x313 * 16.80768997608804),
+        );
+        let x333 = Self::mul_add(0.00000000020510342851533115, x313, x327);
+        let x334 = Self::mul_add(s_q8, x314, c_q8 * x333);
+        let x335 = Self::mul_add(-c_q8, x314, s_q8 * x333);
+        let x336 = Self::mul_add(
             0.35,
-            x322 - x325,
-            Self::mul_add(-s_q7, x318, c_q7 * x317),
+            x326 - x329,
+            Self::mul_add(-s_q7, x322, c_q7 * x321),
         );
-        let x332 = Self::mul_add(0.35, Self::mul_add(-x310, x323, x321), x320);
-        let x333 = Self::mul_add(0.35, Self::mul_add(x309, x309, x324), x319);
-        let x334 = Self::mul_add(c_q8, x333, Self::mul_add(s_q8, x332, x7 * x331));
-        let x335 = Self::mul_add(s_q8, x333, Self::mul_add(-c_q8, x332, x8 * x331));
-        let x336 = Self::mul_add(-0.00000000020510342851533115, x333, x331);
-        let x337 = Self::mul_add(v[7], x330, Self::mul_add(-s_q8, x322, x7 * x321));
-        let x338 = Self::mul_add(-v[7], x329, Self::mul_add(c_q8, x322, x8 * x321));
-        let x339 = v[7] + Self::mul_add(-0.00000000020510342851533115, x323, x309);
-        let x340 = x330 * x330;
-        let x341 = x339 * x339;
-        let x342 = x329 * x330;
-        let x343 = x321 - x342;
-        let x344 = x329 * x339;
-        let x345 = x329 * x329;
-        let x346 = x341 + x345;
-        let x347 = x330 * x339;
-        let x348 = x337 + x347;
-        let x349 = Self::mul_add(
-            x339,
+        let x337 = Self::mul_add(0.35, Self::mul_add(-x314, x327, x325), x324);
+        let x338 = Self::mul_add(0.35, Self::mul_add(x313, x313, x328), x323);
+        let x339 = Self::mul_add(-0.00000000020510342851533115, x338, x336);
+        let x340 = Self::mul_add(0.00000000020510342851533115, x336, x338);
+        let x341 = Self::mul_add(s_q8, x337, c_q8 * x340);
+        let x342 = Self::mul_add(-c_q8, x337, s_q8 * x340);
+        let x343 = 0.00000000020510342851533115 * x325;
+        let x344 = Self::mul_add(v[7], x335, Self::mul_add(-s_q8, x326, c_q8 * x343));
+        let x345 = Self::mul_add(-v[7], x334, Self::mul_add(c_q8, x326, s_q8 * x343));
+        let x346 = v[7] + Self::mul_add(-0.00000000020510342851533115, x327, x313);
+        let x347 = x335 * x335;
+        let x348 = x346 * x346;
+        let x349 = x334 * x335;
+        let x350 = x325 - x349;
+        let x351 = x334 * x346;
+        let x352 = x334 * x334;
+        let x353 = x348 + x352;
+        let x354 = x335 * x346;
+        let x355 = x344 + x354;
+        let x356 = Self::mul_add(
+            x346,
             0.002139996587640933,
-            x330 * 0.0000000234896432582596,
+            x335 * 0.0000000234896432582596,
         );
-        let x350 = Self::mul_add(
+        let x357 = Self::mul_add(
             5.080660024070365,
-            x339,
-            Self::mul_add(x330, -111.7548902508081, x329 * 0.0000000234896432582596),
+            x346,
+            Self::mul_add(x335, -111.7548902508081, x334 * 0.0000000234896432582596),
         );
-        let x351 = Self::mul_add(
+        let x358 = Self::mul_add(
             113.3918902508081,
-            x339,
-            Self::mul_add(5.080660024070366, x330, x329 * 0.002139996587640933),
+            x346,
+            Self::mul_add(5.080660024070366, x335, x334 * 0.002139996587640933),
         );
-        let x352 = Self::mul_add(
-            x336,
+        let x359 = Self::mul_add(
+            x339,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x321,
-                Self::mul_add(x338, -111.7548902508081, x337 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x329, x351, x339 * x349),
+                x325,
+                Self::mul_add(x345, -111.7548902508081, x344 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x334, x358, x346 * x356),
         );
-        let x353 = Self::mul_add(-c_q9, x339, Self::mul_add(-x11, x330, s_q9 * x329));
-        let x354 = Self::mul_add(s_q9, x339, Self::mul_add(x12, x330, c_q9 * x329));
-        let x355 = x334 + Self::mul_add(-0.4, x338 + x344, 0.275 * x343);
-        let x356 = x335 + Self::mul_add(0.4, x337 - x347, 0.275 * x346);
-        let x357 = x336 - Self::mul_add(-0.4, x340 + x345, 0.275 * x348);
-        let x358 = Self::mul_add(-c_q9, x357, Self::mul_add(-x11, x356, s_q9 * x355));
-        let x359 = Self::mul_add(
+        let x360 = Self::mul_add(-c_q9, x346, Self::mul_add(-x9, x335, s_q9 * x334));
+        let x361 = Self::mul_add(s_q9, x346, Self::mul_add(x10, x335, c_q9 * x334));
+        let x362 = x341 + Self::mul_add(-0.4, x345 + x351, 0.275 * x350);
+        let x363 = x342 + Self::mul_add(0.4, x344 - x354, 0.275 * x353);
+        let x364 = x339 - Self::mul_add(-0.4, x347 + x352, 0.275 * x355);
+        let x365 = Self::mul_add(-c_q9, x364, Self::mul_add(-x9, x363, s_q9 * x362));
+        let x366 = Self::mul_add(
             -0.00000000020510342851533115,
-            x357,
-            Self::mul_add(-0.00000000020510342851533115, x355, x356),
+            x364,
+            Self::mul_add(-0.00000000020510342851533115, x362, x363),
         );
-        let x360 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x321,
-            Self::mul_add(-0.00000000020510342851533115, x337, x338),
-        );
-        let x361 = Self::mul_add(
+        let x367 = x343 - Self::mul_add(-0.00000000020510342851533115, x344, x345);
+        let x368 = Self::mul_add(
             -v[8],
-            x354,
-            Self::mul_add(-c_q9, x321, Self::mul_add(-x11, x338, s_q9 * x337)),
+            x361,
+            Self::mul_add(-c_q9, x325, Self::mul_add(-x9, x345, s_q9 * x344)),
         );
-        let x362 = Self::mul_add(
+        let x369 = Self::mul_add(
             v[8],
-            x353,
-            Self::mul_add(s_q9, x321, Self::mul_add(x12, x338, c_q9 * x337)),
+            x360,
+            Self::mul_add(s_q9, x325, Self::mul_add(x10, x345, c_q9 * x344)),
         );
-        let x363 = v[8]
+        let x370 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x339,
-                Self::mul_add(-0.00000000020510342851533115, x329, x330),
+                x346,
+                Self::mul_add(-0.00000000020510342851533115, x334, x335),
             );
-        let x364 = Self::mul_add(x353, x354, x360);
-        let x365 = Self::mul_add(x353, x353, x363 * x363);
-        let x366 = Self::mul_add(-x354, x363, x361);
-        let x367 = x363 * 0.00214;
-        let x368 = Self::mul_add(x363, -36.18604050126307, x354 * 63.36336825000001);
-        let x369 = Self::mul_add(
+        let x371 = Self::mul_add(-x360, x361, x367);
+        let x372 = Self::mul_add(x360, x360, x370 * x370);
+        let x373 = Self::mul_add(-x361, x370, x368);
+        let x374 = x370 * 0.00214;
+        let x375 = Self::mul_add(x370, -36.18604050126307, x361 * 63.36336825000001);
+        let x376 = Self::mul_add(
             69.99836825,
-            x363,
-            Self::mul_add(x354, 36.18604050126307, x353 * 0.00214),
+            x370,
+            Self::mul_add(x361, 36.18604050126307, x360 * 0.00214),
         );
-        let x370 = Self::mul_add(
-            x359,
-            81.53205,
-            Self::mul_add(x360, 0.00214, -Self::mul_add(x354, x369, x363 * x368)),
+        let x377 = Self::mul_add(
+            x366,
+            -81.53205,
+            Self::mul_add(x367, 0.00214, Self::mul_add(x361, x376, x370 * x375)),
         );
-        let x371 = Self::mul_add(
-            x358,
+        let x378 = Self::mul_add(
+            x365,
             -81.53205,
             Self::mul_add(
-                69.99836825,
-                x360,
-                Self::mul_add(x362, 36.18604050126307, x361 * 0.00214),
-            ) + Self::mul_add(x353, x368, x354 * x367),
+                -69.99836825,
+                x367,
+                Self::mul_add(x369, 36.18604050126307, x368 * 0.00214),
+            ) + Self::mul_add(x360, x375, x361 * x374),
         );
-        let x372 = Self::mul_add(s_q10, x354, c_q10 * x353);
-        let x373 = Self::mul_add(-c_q10, x354, s_q10 * x353);
-        let x374 = Self::mul_add(-0.87, x364, x358);
-        let x375 = Self::mul_add(
+        let x379 = Self::mul_add(s_q10, x361, c_q10 * x360);
+        let x380 = Self::mul_add(-c_q10, x361, s_q10 * x360);
+        let x381 = Self::mul_add(0.87, x371, x365);
+        let x382 = Self::mul_add(
             0.87,
-            x365,
-            Self::mul_add(s_q9, x357, Self::mul_add(x12, x356, c_q9 * x355)),
+            x372,
+            Self::mul_add(s_q9, x364, Self::mul_add(x10, x363, c_q9 * x362)),
         );
-        let x376 = Self::mul_add(0.87, x366, x359);
-        let x377 = Self::mul_add(s_q10, x375, c_q10 * x374);
-        let x378 = Self::mul_add(v[9], x373, Self::mul_add(s_q10, x362, c_q10 * x361));
-        let x379 = Self::mul_add(-v[9], x372, Self::mul_add(-c_q10, x362, s_q10 * x361));
-        let x380 = v[9] + x363;
-        let x381 = Self::mul_add(-x372, x373, x360);
-        let x382 = x372 * x372;
-        let x383 = Self::mul_add(x380, x380, x382);
-        let x384 = x373 * x380;
-        let x385 = x378 + x384;
-        let x386 = x380 * 0.6328;
-        let x387 = Self::mul_add(x380, 24.35164200091464, x373 * 24.4950615);
-        let x388 = Self::mul_add(
+        let x383 = Self::mul_add(0.87, x373, x366);
+        let x384 = Self::mul_add(s_q10, x382, c_q10 * x381);
+        let x385 = Self::mul_add(v[9], x380, Self::mul_add(s_q10, x369, c_q10 * x368));
+        let x386 = Self::mul_add(-v[9], x379, Self::mul_add(-c_q10, x369, s_q10 * x368));
+        let x387 = v[9] + x370;
+        let x388 = Self::mul_add(x379, x380, x367);
+        let x389 = x379 * x379;
+        let x390 = Self::mul_add(x387, x387, x389);
+        let x391 = x380 * x387;
+        let x392 = x385 + x391;
+        let x393 = x387 * 0.6328;
+        let x394 = Self::mul_add(x387, 24.35164200091464, x380 * 24.4950615);
+        let x395 = Self::mul_add(
             28.2393615,
-            x380,
-            Self::mul_add(x373, -24.351642000914637, x372 * 0.6328),
+            x387,
+            Self::mul_add(x380, -24.351642000914637, x379 * 0.6328),
         );
-        let x389 = Self::mul_add(
-            x376,
-            45.1584,
-            Self::mul_add(x360, 0.6328, Self::mul_add(x373, x388, x380 * x387)),
+        let x396 = Self::mul_add(
+            x383,
+            -45.1584,
+            Self::mul_add(x367, 0.6328, -Self::mul_add(x380, x395, x387 * x394)),
         );
-        let x390 = Self::mul_add(
-            x377,
+        let x397 = Self::mul_add(
+            x384,
             -45.1584,
             Self::mul_add(
-                28.2393615,
-                x360,
-                Self::mul_add(x379, -24.351642000914637, x378 * 0.6328),
-            ) - Self::mul_add(x372, x387, x373 * x386),
+                -28.2393615,
+                x367,
+                Self::mul_add(x386, -24.351642000914637, x385 * 0.6328),
+            ) - Self::mul_add(x379, x394, x380 * x393),
         );
-        let x391 = Self::mul_add(-s_q11, x373, c_q11 * x372);
-        let x392 = Self::mul_add(c_q11, x373, s_q11 * x372);
-        let x393 = x377
-            - Self::mul_add(-0.275, Self::mul_add(x372, x380, x379), 0.63 * x381);
-        let x394 = Self::mul_add(-c_q10, x375, s_q10 * x374)
-            - Self::mul_add(0.275, x378 - x384, 0.63 * x383);
-        let x395 = x376
-            + Self::mul_add(-0.275, Self::mul_add(x373, x373, x382), 0.63 * x385);
-        let x396 = Self::mul_add(-s_q11, x394, c_q11 * x393);
-        let x397 = Self::mul_add(v[10], x392, Self::mul_add(-s_q11, x379, c_q11 * x378));
-        let x398 = Self::mul_add(-v[10], x391, Self::mul_add(c_q11, x379, s_q11 * x378));
-        let x399 = v[10] + x380;
-        let x400 = x391 * x391;
-        let x401 = x392 * x399;
-        let x402 = 0.01675 * x399;
-        let x403 = Self::mul_add(-2.5482240016099564, x399, x392 * 9.142025249762803);
-        let x404 = Self::mul_add(
+        let x398 = Self::mul_add(-s_q11, x380, c_q11 * x379);
+        let x399 = Self::mul_add(c_q11, x380, s_q11 * x379);
+        let x400 = x384
+            + Self::mul_add(0.275, Self::mul_add(x379, x387, x386), 0.63 * x388);
+        let x401 = Self::mul_add(-c_q10, x382, s_q10 * x381)
+            - Self::mul_add(0.275, x385 - x391, 0.63 * x390);
+        let x402 = x383
+            + Self::mul_add(-0.275, Self::mul_add(x380, x380, x389), 0.63 * x392);
+        let x403 = Self::mul_add(-s_q11, x401, c_q11 * x400);
+        let x404 = Self::mul_add(v[10], x399, Self::mul_add(-s_q11, x386, c_q11 * x385));
+        let x405 = Self::mul_add(-v[10], x398, Self::mul_add(c_q11, x386, s_q11 * x385));
+        let x406 = v[10] + x387;
+        let x407 = x398 * x398;
+        let x408 = x399 * x406;
+        let x409 = 0.01675 * x406;
+        let x410 = Self::mul_add(-2.5482240016099564, x406, x399 * 9.142025249762803);
+        let x411 = Self::mul_add(
             -9.223235249762805,
-            x399,
-            Self::mul_add(-2.5482240016099564, x392, 0.01675 * x391),
+            x406,
+            Self::mul_add(-2.5482240016099564, x399, 0.01675 * x398),
         );
-        let x405 = Self::mul_add(
-            7.078399999258757,
-            x395,
-            Self::mul_add(0.01675, x360, -Self::mul_add(-x392, x404, x399 * x403)),
-        );
-        let x406 = Self::mul_add(
+        let x412 = Self::mul_add(
             -7.078399999258757,
-            x396,
-            Self::mul_add(
-                -9.223235249762805,
-                x360,
-                Self::mul_add(-2.5482240016099564, x398, 0.01675 * x397),
-            ) - Self::mul_add(-x391, x403, x392 * x402),
+            x402,
+            Self::mul_add(0.01675, x367, Self::mul_add(-x399, x411, x406 * x410)),
         );
-        let x407 = Self::mul_add(s_q12, x399, Self::mul_add(x13, x392, c_q12 * x391));
-        let x408 = Self::mul_add(-c_q12, x399, Self::mul_add(-x14, x392, s_q12 * x391));
-        let x409 = Self::mul_add(0.36, Self::mul_add(x391, x399, x398), x396);
-        let x410 = Self::mul_add(
+        let x413 = Self::mul_add(
+            -7.078399999258757,
+            x403,
+            Self::mul_add(
+                9.223235249762805,
+                x367,
+                Self::mul_add(-2.5482240016099564, x405, 0.01675 * x404),
+            ) - Self::mul_add(-x398, x410, x399 * x409),
+        );
+        let x414 = Self::mul_add(0.00000000020510342851533115, x399, x406);
+        let x415 = Self::mul_add(s_q12, x414, c_q12 * x398);
+        let x416 = Self::mul_add(-c_q12, x414, s_q12 * x398);
+        let x417 = Self::mul_add(0.36, Self::mul_add(x398, x406, x405), x403);
+        let x418 = Self::mul_add(
             -0.36,
-            x397 - x401,
-            Self::mul_add(c_q11, x394, s_q11 * x393),
+            x404 - x408,
+            Self::mul_add(c_q11, x401, s_q11 * x400),
         );
-        let x411 = Self::mul_add(-0.36, Self::mul_add(x392, x392, x400), x395);
-        let x412 = Self::mul_add(s_q12, x411, Self::mul_add(x13, x410, c_q12 * x409));
-        let x413 = Self::mul_add(-c_q12, x411, Self::mul_add(-x14, x410, s_q12 * x409));
-        let x414 = Self::mul_add(-0.00000000020510342851533115, x411, x410);
-        let x415 = Self::mul_add(-0.00000000020510342851533115, x360, x398);
-        let x416 = Self::mul_add(
-            v[11],
-            x408,
-            Self::mul_add(s_q12, x360, Self::mul_add(x13, x398, c_q12 * x397)),
-        );
-        let x417 = Self::mul_add(
-            -v[11],
-            x407,
-            Self::mul_add(-c_q12, x360, Self::mul_add(-x14, x398, s_q12 * x397)),
-        );
-        let x418 = v[11] + Self::mul_add(-0.00000000020510342851533115, x399, x392);
-        let x419 = x408 * x408;
-        let x420 = x418 * x418;
-        let x421 = x407 * x408;
-        let x422 = x415 - x421;
-        let x423 = x407 * x418;
-        let x424 = x407 * x407;
-        let x425 = x420 + x424;
-        let x426 = x408 * x418;
-        let x427 = x416 + x426;
-        let x428 = Self::mul_add(x418, 0.809539999555672, x408 * 1.9877000000000002);
-        let x429 = Self::mul_add(
-            x418,
-            -2.741639999592316,
-            Self::mul_add(x408, -5.252920330000002, x407 * 1.9877000000000002),
-        );
-        let x430 = Self::mul_add(
-            9.740442170000001,
-            x418,
-            Self::mul_add(x408, -2.7416399995923166, x407 * 0.809539999555672),
-        );
-        let x431 = Self::mul_add(
-            -3.6140000000000003,
-            x414,
-            Self::mul_add(
-                x415,
-                -2.741639999592316,
-                Self::mul_add(x417, -5.252920330000002, x416 * 1.9877000000000002),
-            ) + Self::mul_add(-x407, x430, x418 * x428),
-        );
-        let x432 = Self::mul_add(-c_q13, x418, Self::mul_add(s_q13, x408, x15 * x407));
-        let x433 = Self::mul_add(-s_q13, x418, Self::mul_add(-c_q13, x408, x16 * x407));
-        let x434 = x412 + Self::mul_add(-0.16, x417 + x423, 0.55 * x422);
-        let x435 = x414 - Self::mul_add(-0.16, x419 + x424, 0.55 * x427);
-        let x436 = Self::mul_add(
-            -c_q13,
-            x435,
-            Self::mul_add(
-                s_q13,
-                x413 + Self::mul_add(0.16, x416 - x426, 0.55 * x425),
-                x15 * x434,
-            ),
-        );
-        let x437 = Self::mul_add(0.00000000020510342851533115, x415, x416);
-        let x438 = Self::mul_add(
-            v[12],
-            x433,
-            Self::mul_add(-c_q13, x415, Self::mul_add(s_q13, x417, x15 * x416)),
-        );
+        let x419 = Self::mul_add(-0.36, Self::mul_add(x399, x399, x407), x402);
+        let x420 = Self::mul_add(0.00000000020510342851533115, x418, x419);
+        let x421 = Self::mul_add(-0.00000000020510342851533115, x419, x418);
+        let x422 = Self::mul_add(s_q12, x420, c_q12 * x417);
+        let x423 = Self::mul_add(-c_q12, x420, s_q12 * x417);
+        let x424 = Self::mul_add(-0.00000000020510342851533115, x405, x367);
+        let x425 = Self::mul_add(0.00000000020510342851533115, x367, x405);
+        let x426 = Self::mul_add(v[11], x416, Self::mul_add(-s_q12, x424, c_q12 * x404));
+        let x427 = Self::mul_add(-v[11], x415, Self::mul_add(c_q12, x424, s_q12 * x404));
+        let x428 = v[11] + Self::mul_add(-0.00000000020510342851533115, x406, x399);
+        let x429 = x416 * x416;
+        let x430 = x428 * x428;
+        let x431 = x415 * x416;
+        let x432 = x425 - x431;
+        let x433 = x415 * x428;
+        let x434 = x415 * x415;
+        let x435 = x430 + x434;
+        let x436 = x416 * x428;
+        let x437 = x426 + x436;
+        let x438 = Self::mul_add(x428, 0.809539999555672, x416 * 1.9877000000000002);
         let x439 = Self::mul_add(
-            -v[12],
-            x432,
-            Self::mul_add(-s_q13, x415, Self::mul_add(-c_q13, x417, x16 * x416)),
+            x428,
+            -2.741639999592316,
+            Self::mul_add(x416, -5.252920330000002, x415 * 1.9877000000000002),
         );
-        let x440 = v[12] - Self::mul_add(0.00000000020510342851533115, x418, x407);
-        let x441 = 4.806620000000001 * Self::mul_add(x432, x433, x437);
-        let x442 = 4.806620000000001 * Self::mul_add(x432, x432, x440 * x440);
-        let x443 = 4.806620000000001 * Self::mul_add(x433, x440, x438);
-        let x444 = Self::mul_add(0.0145, x440, 0.000781 * x433);
-        let x445 = Self::mul_add(
-            -0.9614610000000001,
-            x440,
-            Self::mul_add(1.2025609200000003, x433, 0.000781 * x432),
-        );
-        let x446 = Self::mul_add(
-            -1.4135609200000003,
-            x440,
-            Self::mul_add(-0.9614610000000001, x433, 0.0145 * x432),
-        );
-        let x447 = Self::mul_add(
-            0.9614610000000001,
-            x437,
-            Self::mul_add(1.2025609200000003, x439, 0.000781 * x438),
-        ) + Self::mul_add(-x432, x446, x440 * x444);
-        let x448 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x435, x434),
-            Self::mul_add(-0.0145, x437, 0.000781 * x439)
-                - Self::mul_add(-x433, x446, x440 * x445),
-        );
-        let x449 = Self::mul_add(
-            4.806620000000001,
-            x436,
-            Self::mul_add(
-                1.4135609200000003,
-                x437,
-                Self::mul_add(-0.9614610000000001, x439, 0.0145 * x438),
-            ) - Self::mul_add(-x432, x445, x433 * x444),
-        );
-        let x450 = x443 - Self::mul_add(-x16, x442, x15 * x441);
-        let x451 = Self::mul_add(c_q13, x442, s_q13 * x441);
-        let x452 = Self::mul_add(
-            0.00000000020510342851533115,
-            x443,
-            Self::mul_add(-s_q13, x442, c_q13 * x441),
-        );
-        let x453 = Self::mul_add(
-            -0.55,
-            x450,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x449,
-                Self::mul_add(s_q13, x447, c_q13 * x448),
-            ),
-        );
-        let x454 = Self::mul_add(
-            -17.135250000000003,
-            x422,
-            3.6140000000000003 * (x419 + x420),
-        ) + x450;
-        let x455 = Self::mul_add(
-            17.135250000000003,
-            x425,
-            3.6140000000000003 * (x415 + x421),
-        ) + x451;
-        let x456 = Self::mul_add(
-            17.135250000000003,
-            x427,
-            3.6140000000000003 * (x417 - x423),
-        ) + x452;
-        let x457 = Self::mul_add(
-            -17.135250000000003,
-            x414,
-            Self::mul_add(x415, 0.809539999555672, x417 * 1.9877000000000002)
-                - Self::mul_add(-x408, x430, x418 * x429),
-        )
-            + (x449 - Self::mul_add(x16, x447, x15 * x448)
-                + Self::mul_add(0.55, x452, 0.16 * x451));
-        let x458 = x431
-            - Self::mul_add(-0.16, x450, Self::mul_add(-c_q13, x447, s_q13 * x448));
-        let x459 = Self::mul_add(
+        let x440 = Self::mul_add(
             9.740442170000001,
-            x415,
-            Self::mul_add(x417, -2.7416399995923166, x416 * 0.809539999555672),
-        ) - Self::mul_add(-x407, x429, x408 * x428)
-            + Self::mul_add(3.6140000000000003, x413, 17.135250000000003 * x412) + x453;
-        let x460 = Self::mul_add(-s_q12, x455, c_q12 * x454);
-        let x461 = x456 + Self::mul_add(x14, x455, x13 * x454);
-        let x462 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(-x391, x392, x360),
-            -x460,
+            x428,
+            Self::mul_add(x416, -2.7416399995923166, x415 * 0.809539999555672),
         );
-        let x463 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x399, x399, x400),
-            -x461,
-        );
-        let x464 = Self::mul_add(
-            7.078399999258757,
-            x397 + x401,
+        let x441 = Self::mul_add(
+            -3.6140000000000003,
+            x421,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x456,
-                Self::mul_add(c_q12, x455, s_q12 * x454),
-            ),
+                x425,
+                -2.741639999592316,
+                Self::mul_add(x427, -5.252920330000002, x426 * 1.9877000000000002),
+            ) + Self::mul_add(-x415, x440, x428 * x438),
         );
-        let x465 = x405
-            - Self::mul_add(0.36, x461, Self::mul_add(s_q12, x458, c_q12 * x457));
-        let x466 = Self::mul_add(-2.5482240016099564, x360, x398 * 9.142025249762803)
-            + Self::mul_add(-x391, x404, x399 * x402)
-            - Self::mul_add(-0.36, x460, x459 + Self::mul_add(-x14, x458, x13 * x457));
-        let x467 = x406
+        let x442 = Self::mul_add(-0.00000000020510342851533115, x415, x428);
+        let x443 = Self::mul_add(-s_q13, x416, c_q13 * x442);
+        let x444 = Self::mul_add(c_q13, x416, s_q13 * x442);
+        let x445 = x422 + Self::mul_add(-0.16, x427 + x433, 0.55 * x432);
+        let x446 = x421 - Self::mul_add(-0.16, x429 + x434, 0.55 * x437);
+        let x447 = Self::mul_add(0.00000000020510342851533115, x425, x426);
+        let x448 = Self::mul_add(-0.00000000020510342851533115, x426, x425);
+        let x449 = Self::mul_add(v[12], x444, Self::mul_add(-s_q13, x427, c_q13 * x448));
+        let x450 = Self::mul_add(-v[12], x443, Self::mul_add(c_q13, x427, s_q13 * x448));
+        let x451 = v[12] - Self::mul_add(0.00000000020510342851533115, x428, x415);
+        let x452 = 4.806620000000001 * Self::mul_add(x443, x444, x447);
+        let x453 = 4.806620000000001 * Self::mul_add(x443, x443, x451 * x451);
+        let x454 = 4.806620000000001 * Self::mul_add(x444, x451, x449);
+        let x455 = Self::mul_add(-0.0145, x451, 0.000781 * x444);
+        let x456 = Self::mul_add(
+            0.9614610000000001,
+            x451,
+            Self::mul_add(1.2025609200000003, x444, 0.000781 * x443),
+        );
+        let x457 = Self::mul_add(
+            1.4135609200000003,
+            x451,
+            Self::mul_add(-0.9614610000000001, x444, 0.0145 * x443),
+        );
+        let x458 = Self::mul_add(
+            -0.9614610000000001,
+            x447,
+            Self::mul_add(1.2025609200000003, x450, 0.000781 * x449),
+        ) + Self::mul_add(x443, x457, x451 * x455);
+        let x459 = Self::mul_add(
+            -4.806620000000001,
+            Self::mul_add(0.00000000020510342851533115, x446, x445),
+            Self::mul_add(0.0145, x447, 0.000781 * x450)
+                - Self::mul_add(x444, x457, x451 * x456),
+        );
+        let x460 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(
+                -s_q13,
+                x423 + Self::mul_add(0.16, x426 - x436, 0.55 * x435),
+                c_q13 * Self::mul_add(-0.00000000020510342851533115, x445, x446),
+            ),
+            Self::mul_add(
+                -1.4135609200000003,
+                x447,
+                Self::mul_add(-0.9614610000000001, x450, 0.0145 * x449),
+            ) + Self::mul_add(-x443, x456, x444 * x455),
+        );
+        let x461 = Self::mul_add(-s_q13, x453, c_q13 * x452);
+        let x462 = Self::mul_add(c_q13, x453, s_q13 * x452);
+        let x463 = Self::mul_add(-0.00000000020510342851533115, x454, x461);
+        let x464 = Self::mul_add(0.00000000020510342851533115, x461, x454);
+        let x465 = Self::mul_add(s_q13, x458, c_q13 * x459);
+        let x466 = Self::mul_add(
+            -17.135250000000003,
+            x432,
+            3.6140000000000003 * (x429 + x430),
+        ) - x464;
+        let x467 = Self::mul_add(
+            17.135250000000003,
+            x435,
+            3.6140000000000003 * (x425 + x431),
+        ) + x462;
+        let x468 = Self::mul_add(
+            17.135250000000003,
+            x437,
+            3.6140000000000003 * (x427 - x433),
+        ) + x463;
+        let x469 = Self::mul_add(
+            -17.135250000000003,
+            x421,
+            Self::mul_add(x425, 0.809539999555672, x427 * 1.9877000000000002)
+                - Self::mul_add(-x416, x440, x428 * x439),
+        )
+            - (Self::mul_add(-0.00000000020510342851533115, x465, x460)
+                - Self::mul_add(0.55, x463, 0.16 * x462));
+        let x470 = x441
+            + Self::mul_add(-0.16, x464, Self::mul_add(-c_q13, x458, s_q13 * x459));
+        let x471 = Self::mul_add(
+            9.740442170000001,
+            x425,
+            Self::mul_add(x427, -2.7416399995923166, x426 * 0.809539999555672),
+        ) - Self::mul_add(-x415, x439, x416 * x438)
+            + Self::mul_add(3.6140000000000003, x423, 17.135250000000003 * x422)
             - Self::mul_add(
-                -0.00000000020510342851533115,
-                x459,
-                Self::mul_add(-c_q12, x458, s_q12 * x457),
+                -0.55,
+                x464,
+                Self::mul_add(0.00000000020510342851533115, x460, x465),
             );
-        let x468 = Self::mul_add(s_q11, x463, c_q11 * x462);
-        let x469 = Self::mul_add(-c_q11, x463, s_q11 * x462);
-        let x470 = Self::mul_add(x381, 45.1584, -x468);
-        let x471 = Self::mul_add(45.1584, x383, x469);
-        let x472 = Self::mul_add(45.1584, x385, -x464);
-        let x473 = x389
-            - (Self::mul_add(s_q11, x466, c_q11 * x465)
-                - Self::mul_add(-0.63, x464, 0.275 * x469));
-        let x474 = Self::mul_add(x360, 24.35164200091464, x379 * 24.4950615)
-            - Self::mul_add(-x372, x388, x380 * x386)
-            - Self::mul_add(0.275, x468, Self::mul_add(-c_q11, x466, s_q11 * x465));
-        let x475 = x390 - Self::mul_add(0.63, x468, x467);
-        let x476 = Self::mul_add(s_q10, x471, c_q10 * x470);
-        let x477 = Self::mul_add(x364, 81.53205, x476);
+        let x472 = Self::mul_add(-s_q12, x467, c_q12 * x466);
+        let x473 = Self::mul_add(c_q12, x467, s_q12 * x466);
+        let x474 = Self::mul_add(0.00000000020510342851533115, x473, x468);
+        let x475 = Self::mul_add(-c_q12, x470, s_q12 * x469);
+        let x476 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x398, x399, x367),
+            x472,
+        );
+        let x477 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x406, x406, x407),
+            -x474,
+        );
         let x478 = Self::mul_add(
-            81.53205,
-            x365,
-            -Self::mul_add(-c_q10, x471, s_q10 * x470),
+            7.078399999258757,
+            x404 + x408,
+            Self::mul_add(-0.00000000020510342851533115, x468, x473),
         );
-        let x479 = Self::mul_add(81.53205, x366, x472);
-        let x480 = x370
-            + Self::mul_add(0.87, x472, Self::mul_add(-s_q10, x474, c_q10 * x473));
-        let x481 = Self::mul_add(x360, -36.18604050126307, x362 * 63.36336825000001)
-            + Self::mul_add(-x353, x369, x363 * x367)
-            - Self::mul_add(c_q10, x474, s_q10 * x473);
-        let x482 = x371 + Self::mul_add(0.87, x476, x475);
-        let x483 = 0.00000000020510342851533115 * x479;
-        let x484 = Self::mul_add(-c_q9, x478, s_q9 * x477) + x483;
-        let x485 = x479 + Self::mul_add(x12, x478, x11 * x477);
-        let x486 = x483 - Self::mul_add(s_q9, x478, c_q9 * x477);
-        let x487 = 0.00000000020510342851533115 * x482;
-        let x488 = Self::mul_add(
-            x343,
-            -12.701650001451807,
-            (x340 + x341) * 0.000000008530897668050218,
-        ) - x484;
-        let x489 = Self::mul_add(
-            12.701650001451807,
-            x346,
-            0.000000008530897668050218 * (x321 + x342),
-        ) - x485;
-        let x490 = Self::mul_add(
-            12.701650001451807,
-            x348,
-            0.000000008530897668050218 * (x338 - x344),
-        ) - x486;
-        let x491 = Self::mul_add(
-            x336,
-            12.701650001451807,
-            Self::mul_add(x321, 0.002139996587640933, x338 * 0.0000000234896432582596)
-                - Self::mul_add(-x330, x351, x339 * x350),
-        )
-            + (Self::mul_add(-c_q9, x481, s_q9 * x480) - x487
-                + Self::mul_add(0.275, x486, 0.4 * x485));
-        let x492 = x352
-            + Self::mul_add(0.4, x484, x482 - Self::mul_add(x12, x481, x11 * x480));
-        let x493 = Self::mul_add(
-            113.3918902508081,
-            x321,
-            Self::mul_add(5.080660024070366, x338, x337 * 0.002139996587640933),
-        ) - Self::mul_add(-x329, x350, x330 * x349)
-            - Self::mul_add(x335, 0.000000008530897668050218, x334 * 12.701650001451807)
-            - Self::mul_add(0.275, x484, x487 + Self::mul_add(s_q9, x481, c_q9 * x480));
-        let x494 = x490 + Self::mul_add(-x8, x489, x7 * x488);
-        let x495 = Self::mul_add(c_q8, x489, s_q8 * x488);
-        let x496 = Self::mul_add(
-            48.0240000085309,
-            Self::mul_add(x323, x323, x324),
-            x494,
-        );
-        let x497 = Self::mul_add(48.0240000085309, x309 * x310, -x495);
-        let x498 = Self::mul_add(
-            48.0240000085309,
-            x322 + x325,
-            -Self::mul_add(
-                -0.00000000020510342851533115,
-                x490,
-                Self::mul_add(-s_q8, x489, c_q8 * x488),
-            ),
-        );
-        let x499 = Self::mul_add(x322, 0.07309, Self::mul_add(x310, x328, x323 * x327))
-            - Self::mul_add(0.35, x495, x493 + Self::mul_add(x8, x492, x7 * x491));
-        let x500 = Self::mul_add(
-            48.0240000085309,
-            x319,
-            Self::mul_add(-130.43769025763282, x322, x321 * 0.07309)
-                + Self::mul_add(x309, x328, x323 * x326),
-        ) + Self::mul_add(-0.35, x494, Self::mul_add(-c_q8, x492, s_q8 * x491));
-        let x501 = Self::mul_add(
-            48.0240000085309,
-            x320,
-            Self::mul_add(-0.1132, x322, x321 * 16.80768997608804)
-                + Self::mul_add(-x309, x327, x310 * x326),
-        )
+        let x479 = x412
+            + Self::mul_add(0.36, x474, Self::mul_add(s_q12, x470, c_q12 * x469));
+        let x480 = Self::mul_add(2.5482240016099564, x367, x405 * 9.142025249762803)
+            + Self::mul_add(-x398, x411, x406 * x409)
             - Self::mul_add(
-                -0.00000000020510342851533115,
-                x493,
-                Self::mul_add(s_q8, x492, c_q8 * x491),
+                -0.36,
+                x472,
+                Self::mul_add(0.00000000020510342851533115, x475, x471),
             );
-        let x502 = Self::mul_add(-s_q7, x497, c_q7 * x496);
-        let x503 = Self::mul_add(c_q7, x497, s_q7 * x496);
-        let x504 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x505 = 1466.4506062283303 * v[4];
-        let x506 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x507 = x502
+        let x481 = x413 - Self::mul_add(-0.00000000020510342851533115, x471, x475);
+        let x482 = Self::mul_add(-s_q11, x477, c_q11 * x476);
+        let x483 = Self::mul_add(c_q11, x477, s_q11 * x476);
+        let x484 = Self::mul_add(x388, 45.1584, -x482);
+        let x485 = Self::mul_add(45.1584, x390, -x483);
+        let x486 = Self::mul_add(45.1584, x392, -x478);
+        let x487 = x396
+            - (Self::mul_add(-s_q11, x480, c_q11 * x479)
+                - Self::mul_add(0.63, x478, 0.275 * x483));
+        let x488 = Self::mul_add(x367, -24.35164200091464, x386 * 24.4950615)
+            - Self::mul_add(-x379, x395, x387 * x393)
+            + Self::mul_add(0.275, x482, Self::mul_add(c_q11, x480, s_q11 * x479));
+        let x489 = x397 - Self::mul_add(-0.63, x482, x481);
+        let x490 = Self::mul_add(-s_q10, x485, c_q10 * x484);
+        let x491 = Self::mul_add(x371, 81.53205, x490);
+        let x492 = Self::mul_add(
+            81.53205,
+            x372,
+            Self::mul_add(c_q10, x485, s_q10 * x484),
+        );
+        let x493 = Self::mul_add(81.53205, x373, x486);
+        let x494 = x377
+            + Self::mul_add(-0.87, x486, Self::mul_add(s_q10, x488, c_q10 * x487));
+        let x495 = Self::mul_add(x367, 36.18604050126307, x369 * 63.36336825000001)
+            + Self::mul_add(-x360, x376, x370 * x374)
+            + Self::mul_add(-c_q10, x488, s_q10 * x487);
+        let x496 = x378 + Self::mul_add(-0.87, x490, x489);
+        let x497 = 0.00000000020510342851533115 * x493;
+        let x498 = Self::mul_add(c_q9, x492, s_q9 * x491) - x497;
+        let x499 = x493 - Self::mul_add(-x10, x492, x9 * x491);
+        let x500 = x497 + Self::mul_add(-s_q9, x492, c_q9 * x491);
+        let x501 = 0.00000000020510342851533115 * x496;
+        let x502 = Self::mul_add(
+            x350,
+            -12.701650001451807,
+            (x347 + x348) * 0.000000008530897668050218,
+        ) + x498;
+        let x503 = Self::mul_add(
+            12.701650001451807,
+            x353,
+            0.000000008530897668050218 * (x325 + x349),
+        ) - x499;
+        let x504 = Self::mul_add(
+            12.701650001451807,
+            x355,
+            0.000000008530897668050218 * (x345 - x351),
+        ) - x500;
+        let x505 = Self::mul_add(
+            x339,
+            12.701650001451807,
+            Self::mul_add(x325, 0.002139996587640933, x345 * 0.0000000234896432582596)
+                - Self::mul_add(-x335, x358, x346 * x357),
+        )
+            - (Self::mul_add(c_q9, x495, s_q9 * x494) + x501
+                - Self::mul_add(0.275, x500, 0.4 * x499));
+        let x506 = x359
+            + Self::mul_add(-0.4, x498, x496 + Self::mul_add(-x10, x495, x9 * x494));
+        let x507 = Self::mul_add(
+            113.3918902508081,
+            x325,
+            Self::mul_add(5.080660024070366, x345, x344 * 0.002139996587640933),
+        ) - Self::mul_add(-x334, x357, x335 * x356)
+            - Self::mul_add(x342, 0.000000008530897668050218, x341 * 12.701650001451807)
+            - Self::mul_add(
+                -0.275,
+                x498,
+                x501 - Self::mul_add(-s_q9, x495, c_q9 * x494),
+            );
+        let x508 = Self::mul_add(-s_q8, x503, c_q8 * x502);
+        let x509 = Self::mul_add(c_q8, x503, s_q8 * x502);
+        let x510 = Self::mul_add(0.00000000020510342851533115, x508, x504);
+        let x511 = Self::mul_add(s_q8, x506, c_q8 * x505);
+        let x512 = Self::mul_add(
+            48.0240000085309,
+            Self::mul_add(x327, x327, x328),
+            x510,
+        );
+        let x513 = Self::mul_add(48.0240000085309, x313 * x314, -x509);
+        let x514 = Self::mul_add(
+            48.0240000085309,
+            x326 + x329,
+            -Self::mul_add(-0.00000000020510342851533115, x504, x508),
+        );
+        let x515 = Self::mul_add(x326, 0.07309, Self::mul_add(x314, x332, x327 * x331))
+            - Self::mul_add(
+                0.35,
+                x509,
+                Self::mul_add(0.00000000020510342851533115, x511, x507),
+            );
+        let x516 = Self::mul_add(
+            48.0240000085309,
+            x323,
+            Self::mul_add(-130.43769025763282, x326, x325 * 0.07309)
+                + Self::mul_add(x313, x332, x327 * x330),
+        ) + Self::mul_add(-0.35, x510, Self::mul_add(-c_q8, x506, s_q8 * x505));
+        let x517 = Self::mul_add(
+            48.0240000085309,
+            x324,
+            Self::mul_add(-0.1132, x326, x325 * 16.80768997608804)
+                + Self::mul_add(-x313, x331, x314 * x330),
+        ) - Self::mul_add(-0.00000000020510342851533115, x507, x511);
+        let x518 = Self::mul_add(-s_q7, x513, c_q7 * x512);
+        let x519 = Self::mul_add(c_q7, x513, s_q7 * x512);
+        let x520 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x521 = 1466.4506062283303 * v[4];
+        let x522 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x523 = x518
             + Self::mul_add(
                 1170.07,
-                x306,
-                Self::mul_add(-180.9502499901501, x314, 110.5455 * x312),
+                x310,
+                Self::mul_add(-180.9502499901501, x318, 110.5455 * x316),
             );
-        let x508 = x503
+        let x524 = x519
             - Self::mul_add(
                 1170.07,
-                x307,
-                Self::mul_add(180.9502499901501, x315, 110.5455 * x313),
+                x311,
+                Self::mul_add(180.9502499901501, x319, 110.5455 * x317),
             );
-        let x509 = x498
+        let x525 = x514
             - Self::mul_add(
                 1170.07,
-                x308,
-                -Self::mul_add(-180.9502499901501, x316, 110.5455 * x314),
+                x312,
+                -Self::mul_add(-180.9502499901501, x320, 110.5455 * x318),
             );
-        let x510 = x187 * 0.0008546497218115156;
-        let x511 = x180 * 0.0008546497218115156;
-        let x512 = x191 * 0.0008546497218115156;
-        let x513 = x204 * 0.0008546497218115156;
-        let x514 = x219 * 0.0008546497218115156;
-        let x515 = x239 * 0.0008546497218115156;
-        let x516 = x268 * 0.0008546497218115156;
-        let x517 = x304 * 0.0008546497218115156;
-        let x518 = x186 * 0.0008546497218115156;
-        let x519 = x179 * 0.0008546497218115156;
-        let x520 = x192 * 0.0008546497218115156;
-        let x521 = x205 * 0.0008546497218115156;
-        let x522 = x220 * 0.0008546497218115156;
-        let x523 = x240 * 0.0008546497218115156;
-        let x524 = x269 * 0.0008546497218115156;
-        let x525 = x305 * 0.0008546497218115156;
-        let x526 = x159 * 0.0008546497218115156;
-        let x527 = x200 * 0.0008546497218115156;
-        let x528 = x215 * 0.0008546497218115156;
-        let x529 = x235 * 0.0008546497218115156;
-        let x530 = x264 * 0.0008546497218115156;
-        let x531 = x300 * 0.0008546497218115156;
-        let x532 = x187 * x510;
-        let x533 = x180 * x511;
-        let x534 = 1.0
-            / (1394.5960312283303 - (x181 + (x167 - x178 + x181)) - x532 - x533);
-        let x535 = Self::mul_add(
-            x180,
-            x518,
-            Self::mul_add(-0.65, x180, x169 - Self::mul_add(x174, x177, x175 * x176)),
+        let x526 = x178 * 0.0008546497218115156;
+        let x527 = x171 * 0.0008546497218115156;
+        let x528 = x183 * 0.0008546497218115156;
+        let x529 = x198 * 0.0008546497218115156;
+        let x530 = x215 * 0.0008546497218115156;
+        let x531 = x237 * 0.0008546497218115156;
+        let x532 = x268 * 0.0008546497218115156;
+        let x533 = x308 * 0.0008546497218115156;
+        let x534 = x177 * 0.0008546497218115156;
+        let x535 = x170 * 0.0008546497218115156;
+        let x536 = x184 * 0.0008546497218115156;
+        let x537 = x199 * 0.0008546497218115156;
+        let x538 = x216 * 0.0008546497218115156;
+        let x539 = x238 * 0.0008546497218115156;
+        let x540 = x269 * 0.0008546497218115156;
+        let x541 = x309 * 0.0008546497218115156;
+        let x542 = x151 * 0.0008546497218115156;
+        let x543 = x192 * 0.0008546497218115156;
+        let x544 = x209 * 0.0008546497218115156;
+        let x545 = x231 * 0.0008546497218115156;
+        let x546 = x262 * 0.0008546497218115156;
+        let x547 = x302 * 0.0008546497218115156;
+        let x548 = x178 * x526;
+        let x549 = x171 * x527;
+        let x550 = 1.0
+            / (1394.5960312283303 - (x172 + (x158 - x169 + x172)) - x548 - x549);
+        let x551 = Self::mul_add(
+            x171,
+            x534,
+            Self::mul_add(-0.65, x171, x160 - Self::mul_add(x165, x168, x166 * x167)),
         );
-        let x536 = x534 * x535;
-        let x537 = Self::mul_add(
-            x187,
-            x518,
-            -117.61766249359756 + Self::mul_add(0.65, x161, x184),
-        );
-        let x538 = x534 * x537;
-        let x539 = Self::mul_add(x187, x519, x184);
-        let x540 = x534 * x539;
-        let x541 = Self::mul_add(
-            x187,
-            x520,
-            Self::mul_add(-0.75, x192, Self::mul_add(-s_q7, x190, c_q7 * x189)),
-        );
-        let x542 = Self::mul_add(-x180, x526, x541);
-        let x543 = x534 * x542;
-        let x544 = Self::mul_add(
-            -x187,
-            x521,
-            Self::mul_add(0.75, x205, Self::mul_add(-s_q7, x203, c_q7 * x202)),
-        );
-        let x545 = Self::mul_add(-x180, x527, x544);
-        let x546 = x534 * x545;
-        let x547 = Self::mul_add(
-            x187,
-            x522,
-            Self::mul_add(-0.75, x220, Self::mul_add(s_q7, x218, c_q7 * x217)),
-        );
-        let x548 = Self::mul_add(-x180, x528, x547);
-        let x549 = x534 * x548;
-        let x550 = Self::mul_add(
-            x187,
-            x523,
-            Self::mul_add(-0.75, x240, Self::mul_add(s_q7, x238, c_q7 * x237)),
-        );
-        let x551 = Self::mul_add(x180, x529, x550);
-        let x552 = x534 * x551;
+        let x552 = x550 * x551;
         let x553 = Self::mul_add(
-            x187,
-            x524,
+            x178,
+            x534,
+            -117.61766249359756 + Self::mul_add(0.65, x155, x175),
+        );
+        let x554 = x550 * x553;
+        let x555 = Self::mul_add(x178, x535, x175);
+        let x556 = x550 * x555;
+        let x557 = Self::mul_add(
+            x178,
+            x536,
+            Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x182, c_q7 * x181)),
+        );
+        let x558 = Self::mul_add(-x171, x542, x557);
+        let x559 = x550 * x558;
+        let x560 = Self::mul_add(
+            -x178,
+            x537,
+            Self::mul_add(0.75, x199, Self::mul_add(-s_q7, x197, c_q7 * x196)),
+        );
+        let x561 = Self::mul_add(-x171, x543, x560);
+        let x562 = x550 * x561;
+        let x563 = Self::mul_add(
+            x178,
+            x538,
+            Self::mul_add(-0.75, x216, Self::mul_add(s_q7, x214, c_q7 * x213)),
+        );
+        let x564 = Self::mul_add(-x171, x544, x563);
+        let x565 = x550 * x564;
+        let x566 = Self::mul_add(
+            x178,
+            x539,
+            Self::mul_add(-0.75, x238, Self::mul_add(s_q7, x236, c_q7 * x235)),
+        );
+        let x567 = Self::mul_add(x171, x545, x566);
+        let x568 = x550 * x567;
+        let x569 = Self::mul_add(
+            x178,
+            x540,
             Self::mul_add(-0.75, x269, Self::mul_add(-s_q7, x267, c_q7 * x266)),
         );
-        let x554 = Self::mul_add(-x180, x530, x553);
-        let x555 = x534 * x554;
-        let x556 = Self::mul_add(
-            x187,
-            x525,
-            Self::mul_add(-0.75, x305, Self::mul_add(-s_q7, x303, c_q7 * x302)),
-        );
-        let x557 = Self::mul_add(x180, x531, x556);
-        let x558 = x534 * x557;
-        let x559 = x186 * x518;
-        let x560 = 1.0
-            / Self::mul_add(
-                -x535,
-                x536,
-                1466.4506062283303 - (x183 - (x171 - x178 - x183)) - x532 - x559,
-            );
-        let x561 = Self::mul_add(
-            x187,
-            x511,
-            Self::mul_add(-0.75, x180, Self::mul_add(c_q7, x172, s_q7 * x170)),
-        );
-        let x562 = Self::mul_add(-x535, x538, x561);
-        let x563 = x560 * x562;
-        let x564 = Self::mul_add(-x535, x540, x561);
-        let x565 = x560 * x564;
-        let x566 = Self::mul_add(
-            x186,
-            x526,
-            Self::mul_add(
-                -x187,
-                x512,
-                Self::mul_add(c_q7, x190, s_q7 * x189)
-                    + Self::mul_add(-0.65, x159, 0.75 * x191),
-            ),
-        );
-        let x567 = Self::mul_add(-x535, x543, x566);
-        let x568 = x560 * x567;
-        let x569 = Self::mul_add(
-            x186,
-            x527,
-            Self::mul_add(
-                x187,
-                x513,
-                Self::mul_add(c_q7, x203, s_q7 * x202)
-                    - Self::mul_add(0.65, x200, 0.75 * x204),
-            ),
-        );
-        let x570 = Self::mul_add(-x535, x546, x569);
-        let x571 = x560 * x570;
+        let x570 = Self::mul_add(-x171, x546, x569);
+        let x571 = x550 * x570;
         let x572 = Self::mul_add(
-            x186,
-            x528,
-            Self::mul_add(
-                -x187,
-                x514,
-                Self::mul_add(-c_q7, x218, s_q7 * x217)
-                    + Self::mul_add(-0.65, x215, 0.75 * x219),
-            ),
+            x178,
+            x541,
+            Self::mul_add(-0.75, x309, Self::mul_add(-s_q7, x307, c_q7 * x306)),
         );
-        let x573 = Self::mul_add(-x535, x549, x572);
-        let x574 = x560 * x573;
-        let x575 = Self::mul_add(
-            -x186,
-            x529,
-            Self::mul_add(
-                -x187,
-                x515,
-                Self::mul_add(-c_q7, x238, s_q7 * x237)
-                    + Self::mul_add(0.65, x235, 0.75 * x239),
-            ),
-        );
-        let x576 = Self::mul_add(-x535, x552, x575);
-        let x577 = x560 * x576;
-        let x578 = Self::mul_add(
-            x186,
-            x530,
-            Self::mul_add(
-                -x187,
-                x516,
-                Self::mul_add(c_q7, x267, s_q7 * x266)
-                    + Self::mul_add(-0.65, x264, 0.75 * x268),
-            ),
-        );
-        let x579 = Self::mul_add(-x535, x555, x578);
-        let x580 = x560 * x579;
-        let x581 = Self::mul_add(
-            -x186,
-            x531,
-            Self::mul_add(
-                -x187,
-                x517,
-                Self::mul_add(c_q7, x303, s_q7 * x302)
-                    + Self::mul_add(0.65, x300, 0.75 * x304),
-            ),
-        );
-        let x582 = Self::mul_add(-x535, x558, x581);
-        let x583 = x560 * x582;
-        let x584 = 1.0
+        let x573 = Self::mul_add(x171, x547, x572);
+        let x574 = x550 * x573;
+        let x575 = x177 * x534;
+        let x576 = 1.0
             / Self::mul_add(
-                x562,
-                x563,
-                Self::mul_add(x537, x538, x559 - (1271.854575 + (x182 + x185) - x533)),
+                -x551,
+                x552,
+                1466.4506062283303 - (x174 - (x162 - x169 - x174)) - x548 - x575,
             );
-        let x585 = Self::mul_add(
-            -x562,
-            x565,
-            Self::mul_add(-x537, x540, Self::mul_add(-x186, x519, x185 - x533)),
-        );
-        let x586 = x584 * x585;
-        let x587 = x180 * x512;
-        let x588 = Self::mul_add(
-            x537,
-            x543,
-            Self::mul_add(x186, x520, Self::mul_add(-0.65, x192, x165) - x587),
-        );
-        let x589 = Self::mul_add(x562, x568, x588);
-        let x590 = x584 * x589;
-        let x591 = x180 * x513;
-        let x592 = Self::mul_add(
-            x537,
-            x546,
-            Self::mul_add(-x186, x521, Self::mul_add(0.65, x205, x201) + x591),
-        );
-        let x593 = Self::mul_add(x562, x571, x592);
-        let x594 = x584 * x593;
-        let x595 = x180 * x514;
-        let x596 = Self::mul_add(
-            -x537,
-            x549,
-            Self::mul_add(-x186, x522, Self::mul_add(0.65, x220, x216) + x595),
-        );
-        let x597 = Self::mul_add(-x562, x574, x596);
-        let x598 = x584 * x597;
-        let x599 = x180 * x515;
-        let x600 = Self::mul_add(
-            -x537,
-            x552,
-            Self::mul_add(-x186, x523, Self::mul_add(0.65, x240, x236) + x599),
-        );
-        let x601 = Self::mul_add(-x562, x577, x600);
-        let x602 = x584 * x601;
-        let x603 = x180 * x516;
-        let x604 = Self::mul_add(
-            x537,
-            x555,
-            Self::mul_add(x186, x524, Self::mul_add(-0.65, x269, x265) - x603),
-        );
-        let x605 = Self::mul_add(x562, x580, x604);
-        let x606 = x584 * x605;
-        let x607 = x180 * x517;
-        let x608 = Self::mul_add(
-            x537,
-            x558,
-            Self::mul_add(x186, x525, Self::mul_add(-0.65, x305, x301) - x607),
-        );
-        let x609 = Self::mul_add(x562, x583, x608);
-        let x610 = x584 * x609;
-        let x611 = Self::mul_add(
-            -x564,
-            x565,
-            Self::mul_add(-x539, x540, Self::mul_add(-x179, x519, x173 - x533)),
-        );
-        let x612 = 1.0 / Self::mul_add(x585, x586, x611);
-        let x613 = Self::mul_add(
-            x564,
-            x568,
-            Self::mul_add(x539, x543, Self::mul_add(x179, x520, x165 - x587)),
-        );
-        let x614 = Self::mul_add(x585, x590, x613);
-        let x615 = x612 * x614;
-        let x616 = Self::mul_add(
-            x564,
-            x571,
-            Self::mul_add(x539, x546, Self::mul_add(-x179, x521, x201 + x591)),
-        );
-        let x617 = Self::mul_add(x585, x594, x616);
-        let x618 = x612 * x617;
-        let x619 = Self::mul_add(
-            -x564,
-            x574,
-            Self::mul_add(-x539, x549, Self::mul_add(-x179, x522, x216 + x595)),
-        );
-        let x620 = Self::mul_add(x585, x598, x619);
-        let x621 = x612 * x620;
-        let x622 = Self::mul_add(
-            -x564,
-            x577,
-            Self::mul_add(-x539, x552, Self::mul_add(-x179, x523, x236 + x599)),
-        );
-        let x623 = Self::mul_add(x585, x602, x622);
-        let x624 = x612 * x623;
-        let x625 = Self::mul_add(
-            x564,
-            x580,
-            Self::mul_add(x539, x555, Self::mul_add(x179, x524, x265 - x603)),
-        );
-        let x626 = Self::mul_add(x585, x606, x625);
-        let x627 = x612 * x626;
-        let x628 = Self::mul_add(
-            x564,
-            x583,
-            Self::mul_add(x539, x558, Self::mul_add(x179, x525, x301 - x607)),
-        );
-        let x629 = Self::mul_add(x585, x610, x628);
-        let x630 = x612 * x629;
-        let x631 = Self::mul_add(
-            -x159,
-            x526,
-            Self::mul_add(-x192, x520, Self::mul_add(-x191, x512, x148)),
-        );
-        let x632 = Self::mul_add(
-            x589,
-            x590,
-            Self::mul_add(-x567, x568, Self::mul_add(-x542, x543, x631)),
-        );
-        let x633 = 1.0 / Self::mul_add(-x614, x615, x632);
-        let x634 = Self::mul_add(
-            -x159,
+        let x577 = Self::mul_add(
+            x178,
             x527,
-            Self::mul_add(x192, x521, Self::mul_add(x191, x513, x197)),
+            Self::mul_add(-0.75, x171, Self::mul_add(c_q7, x163, s_q7 * x161)),
         );
+        let x578 = Self::mul_add(-x551, x554, x577);
+        let x579 = x576 * x578;
+        let x580 = Self::mul_add(-x551, x556, x577);
+        let x581 = x576 * x580;
+        let x582 = Self::mul_add(
+            x177,
+            x542,
+            Self::mul_add(
+                -x178,
+                x528,
+                Self::mul_add(c_q7, x182, s_q7 * x181)
+                    + Self::mul_add(-0.65, x151, 0.75 * x183),
+            ),
+        );
+        let x583 = Self::mul_add(-x551, x559, x582);
+        let x584 = x576 * x583;
+        let x585 = Self::mul_add(
+            x177,
+            x543,
+            Self::mul_add(
+                x178,
+                x529,
+                Self::mul_add(c_q7, x197, s_q7 * x196)
+                    - Self::mul_add(0.65, x192, 0.75 * x198),
+            ),
+        );
+        let x586 = Self::mul_add(-x551, x562, x585);
+        let x587 = x576 * x586;
+        let x588 = Self::mul_add(
+            x177,
+            x544,
+            Self::mul_add(
+                -x178,
+                x530,
+                Self::mul_add(-c_q7, x214, s_q7 * x213)
+                    + Self::mul_add(-0.65, x209, 0.75 * x215),
+            ),
+        );
+        let x589 = Self::mul_add(-x551, x565, x588);
+        let x590 = x576 * x589;
+        let x591 = Self::mul_add(
+            -x177,
+            x545,
+            Self::mul_add(
+                -x178,
+                x531,
+                Self::mul_add(-c_q7, x236, s_q7 * x235)
+                    + Self::mul_add(0.65, x231, 0.75 * x237),
+            ),
+        );
+        let x592 = Self::mul_add(-x551, x568, x591);
+        let x593 = x576 * x592;
+        let x594 = Self::mul_add(
+            x177,
+            x546,
+            Self::mul_add(
+                -x178,
+                x532,
+                Self::mul_add(c_q7, x267, s_q7 * x266)
+                    + Self::mul_add(-0.65, x262, 0.75 * x268),
+            ),
+        );
+        let x595 = Self::mul_add(-x551, x571, x594);
+        let x596 = x576 * x595;
+        let x597 = Self::mul_add(
+            -x177,
+            x547,
+            Self::mul_add(
+                -x178,
+                x533,
+                Self::mul_add(c_q7, x307, s_q7 * x306)
+                    + Self::mul_add(0.65, x302, 0.75 * x308),
+            ),
+        );
+        let x598 = Self::mul_add(-x551, x574, x597);
+        let x599 = x576 * x598;
+        let x600 = 1.0
+            / Self::mul_add(
+                x578,
+                x579,
+                Self::mul_add(x553, x554, x575 - (1271.854575 + (x173 + x176) - x549)),
+            );
+        let x601 = Self::mul_add(
+            -x578,
+            x581,
+            Self::mul_add(-x553, x556, Self::mul_add(-x177, x535, x176 - x549)),
+        );
+        let x602 = x600 * x601;
+        let x603 = x171 * x528;
+        let x604 = Self::mul_add(
+            x553,
+            x559,
+            Self::mul_add(x177, x536, Self::mul_add(-0.65, x184, x180) - x603),
+        );
+        let x605 = Self::mul_add(x578, x584, x604);
+        let x606 = x600 * x605;
+        let x607 = x171 * x529;
+        let x608 = Self::mul_add(
+            x553,
+            x562,
+            Self::mul_add(-x177, x537, Self::mul_add(0.65, x199, x195) + x607),
+        );
+        let x609 = Self::mul_add(x578, x587, x608);
+        let x610 = x600 * x609;
+        let x611 = x171 * x530;
+        let x612 = Self::mul_add(
+            -x553,
+            x565,
+            Self::mul_add(-x177, x538, Self::mul_add(0.65, x216, x212) + x611),
+        );
+        let x613 = Self::mul_add(-x578, x590, x612);
+        let x614 = x600 * x613;
+        let x615 = x171 * x531;
+        let x616 = Self::mul_add(
+            -x553,
+            x568,
+            Self::mul_add(-x177, x539, Self::mul_add(0.65, x238, x234) + x615),
+        );
+        let x617 = Self::mul_add(-x578, x593, x616);
+        let x618 = x600 * x617;
+        let x619 = x171 * x532;
+        let x620 = Self::mul_add(
+            x553,
+            x571,
+            Self::mul_add(x177, x540, Self::mul_add(-0.65, x269, x265) - x619),
+        );
+        let x621 = Self::mul_add(x578, x596, x620);
+        let x622 = x600 * x621;
+        let x623 = x171 * x533;
+        let x624 = Self::mul_add(
+            x553,
+            x574,
+            Self::mul_add(x177, x541, Self::mul_add(-0.65, x309, x305) - x623),
+        );
+        let x625 = Self::mul_add(x578, x599, x624);
+        let x626 = x600 * x625;
+        let x627 = Self::mul_add(
+            -x580,
+            x581,
+            Self::mul_add(-x555, x556, Self::mul_add(-x170, x535, x164 - x549)),
+        );
+        let x628 = 1.0 / Self::mul_add(x601, x602, x627);
+        let x629 = Self::mul_add(
+            x580,
+            x584,
+            Self::mul_add(x555, x559, Self::mul_add(x170, x536, x180 - x603)),
+        );
+        let x630 = Self::mul_add(x601, x606, x629);
+        let x631 = x628 * x630;
+        let x632 = Self::mul_add(
+            x580,
+            x587,
+            Self::mul_add(x555, x562, Self::mul_add(-x170, x537, x195 + x607)),
+        );
+        let x633 = Self::mul_add(x601, x610, x632);
+        let x634 = x628 * x633;
         let x635 = Self::mul_add(
-            x589,
-            x594,
-            Self::mul_add(-x567, x571, Self::mul_add(-x542, x546, x634)),
+            -x580,
+            x590,
+            Self::mul_add(-x555, x565, Self::mul_add(-x170, x538, x212 + x611)),
         );
-        let x636 = Self::mul_add(-x614, x618, x635);
-        let x637 = x633 * x636;
+        let x636 = Self::mul_add(x601, x614, x635);
+        let x637 = x628 * x636;
         let x638 = Self::mul_add(
-            -x159,
-            x528,
-            Self::mul_add(-x192, x522, Self::mul_add(-x191, x514, x212)),
+            -x580,
+            x593,
+            Self::mul_add(-x555, x568, Self::mul_add(-x170, x539, x234 + x615)),
         );
-        let x639 = Self::mul_add(
-            -x589,
-            x598,
-            Self::mul_add(-x567, x574, Self::mul_add(-x542, x549, x638)),
+        let x639 = Self::mul_add(x601, x618, x638);
+        let x640 = x628 * x639;
+        let x641 = Self::mul_add(
+            x580,
+            x596,
+            Self::mul_add(x555, x571, Self::mul_add(x170, x540, x265 - x619)),
         );
-        let x640 = Self::mul_add(x614, x621, x639);
-        let x641 = x633 * x640;
-        let x642 = Self::mul_add(
-            x159,
-            x529,
-            Self::mul_add(-x192, x523, Self::mul_add(-x191, x515, x232)),
+        let x642 = Self::mul_add(x601, x622, x641);
+        let x643 = x628 * x642;
+        let x644 = Self::mul_add(
+            x580,
+            x599,
+            Self::mul_add(x555, x574, Self::mul_add(x170, x541, x305 - x623)),
         );
-        let x643 = Self::mul_add(
-            -x589,
-            x602,
-            Self::mul_add(-x567, x577, Self::mul_add(-x542, x552, x642)),
-        );
-        let x644 = Self::mul_add(x614, x624, x643);
-        let x645 = x633 * x644;
-        let x646 = Self::mul_add(
-            -x159,
-            x530,
-            Self::mul_add(-x192, x524, Self::mul_add(-x191, x516, x261)),
-        );
+        let x645 = Self::mul_add(x601, x626, x644);
+        let x646 = x628 * x645;
         let x647 = Self::mul_add(
-            x589,
-            x606,
-            Self::mul_add(-x567, x580, Self::mul_add(-x542, x555, x646)),
+            -x151,
+            x542,
+            Self::mul_add(-x184, x536, Self::mul_add(-x183, x528, x140)),
         );
-        let x648 = Self::mul_add(-x614, x627, x647);
-        let x649 = x633 * x648;
+        let x648 = Self::mul_add(
+            x605,
+            x606,
+            Self::mul_add(-x583, x584, Self::mul_add(-x558, x559, x647)),
+        );
+        let x649 = 1.0 / Self::mul_add(-x630, x631, x648);
         let x650 = Self::mul_add(
-            x159,
-            x531,
-            Self::mul_add(-x192, x525, Self::mul_add(-x191, x517, x297)),
+            -x151,
+            x543,
+            Self::mul_add(x184, x537, Self::mul_add(x183, x529, x189)),
         );
         let x651 = Self::mul_add(
-            x589,
+            x605,
             x610,
-            Self::mul_add(-x567, x583, Self::mul_add(-x542, x558, x650)),
+            Self::mul_add(-x583, x587, Self::mul_add(-x558, x562, x650)),
         );
-        let x652 = Self::mul_add(-x614, x630, x651);
-        let x653 = x633 * x652;
+        let x652 = Self::mul_add(-x630, x634, x651);
+        let x653 = x649 * x652;
         let x654 = Self::mul_add(
-            -x200,
-            x527,
-            Self::mul_add(-x205, x521, Self::mul_add(-x204, x513, x106)),
+            -x151,
+            x544,
+            Self::mul_add(-x184, x538, Self::mul_add(-x183, x530, x206)),
         );
         let x655 = Self::mul_add(
-            x593,
-            x594,
-            Self::mul_add(-x570, x571, Self::mul_add(-x545, x546, x654)),
+            -x605,
+            x614,
+            Self::mul_add(-x583, x590, Self::mul_add(-x558, x565, x654)),
         );
-        let x656 = 1.0 / Self::mul_add(-x636, x637, Self::mul_add(-x617, x618, x655));
-        let x657 = Self::mul_add(
-            x200,
-            x528,
-            Self::mul_add(-x205, x522, Self::mul_add(-x204, x514, x100)),
-        );
+        let x656 = Self::mul_add(x630, x637, x655);
+        let x657 = x649 * x656;
         let x658 = Self::mul_add(
-            x593,
-            x598,
-            Self::mul_add(x570, x574, Self::mul_add(x545, x549, x657)),
+            x151,
+            x545,
+            Self::mul_add(-x184, x539, Self::mul_add(-x183, x531, x228)),
         );
-        let x659 = Self::mul_add(x636, x641, Self::mul_add(-x617, x621, x658));
-        let x660 = x656 * x659;
-        let x661 = Self::mul_add(
-            -x200,
-            x529,
-            Self::mul_add(-x205, x523, Self::mul_add(-x204, x515, x225)),
+        let x659 = Self::mul_add(
+            -x605,
+            x618,
+            Self::mul_add(-x583, x593, Self::mul_add(-x558, x568, x658)),
         );
+        let x660 = Self::mul_add(x630, x640, x659);
+        let x661 = x649 * x660;
         let x662 = Self::mul_add(
-            x593,
-            x602,
-            Self::mul_add(x570, x577, Self::mul_add(x545, x552, x661)),
+            -x151,
+            x546,
+            Self::mul_add(-x184, x540, Self::mul_add(-x183, x532, x259)),
         );
-        let x663 = Self::mul_add(x636, x645, Self::mul_add(-x617, x624, x662));
-        let x664 = x656 * x663;
-        let x665 = Self::mul_add(
-            x200,
-            x530,
-            Self::mul_add(-x205, x524, Self::mul_add(-x204, x516, x253)),
+        let x663 = Self::mul_add(
+            x605,
+            x622,
+            Self::mul_add(-x583, x596, Self::mul_add(-x558, x571, x662)),
         );
+        let x664 = Self::mul_add(-x630, x643, x663);
+        let x665 = x649 * x664;
         let x666 = Self::mul_add(
-            -x593,
-            x606,
-            Self::mul_add(x570, x580, Self::mul_add(x545, x555, x665)),
+            x151,
+            x547,
+            Self::mul_add(-x184, x541, Self::mul_add(-x183, x533, x299)),
         );
-        let x667 = Self::mul_add(x636, x649, Self::mul_add(x617, x627, x666));
-        let x668 = x656 * x667;
-        let x669 = Self::mul_add(
-            -x200,
-            x531,
-            Self::mul_add(-x205, x525, Self::mul_add(-x204, x517, x289)),
+        let x667 = Self::mul_add(
+            x605,
+            x626,
+            Self::mul_add(-x583, x599, Self::mul_add(-x558, x574, x666)),
         );
+        let x668 = Self::mul_add(-x630, x646, x667);
+        let x669 = x649 * x668;
         let x670 = Self::mul_add(
-            -x593,
-            x610,
-            Self::mul_add(x570, x583, Self::mul_add(x545, x558, x669)),
+            -x192,
+            x543,
+            Self::mul_add(-x199, x537, Self::mul_add(-x198, x529, x98)),
         );
-        let x671 = Self::mul_add(x636, x653, Self::mul_add(x617, x630, x670));
-        let x672 = x656 * x671;
-        let x673 = Self::mul_add(
-            -x215,
-            x528,
-            Self::mul_add(-x220, x522, Self::mul_add(-x219, x514, x86)),
-        );
-        let x674 = Self::mul_add(
-            x597,
-            x598,
-            Self::mul_add(-x573, x574, Self::mul_add(-x548, x549, x673)),
-        );
-        let x675 = Self::mul_add(
-            -x659,
-            x660,
-            Self::mul_add(-x640, x641, Self::mul_add(-x620, x621, x674)),
-        );
-        let x676 = 1.0 / x675;
-        let x677 = Self::mul_add(
-            x215,
-            x529,
-            Self::mul_add(-x220, x523, Self::mul_add(-x219, x515, x80)),
-        );
-        let x678 = Self::mul_add(
-            x597,
-            x602,
-            Self::mul_add(-x573, x577, Self::mul_add(-x548, x552, x677)),
-        );
-        let x679 = Self::mul_add(
-            -x659,
-            x664,
-            Self::mul_add(-x640, x645, Self::mul_add(-x620, x624, x678)),
-        );
-        let x680 = x676 * x679;
-        let x681 = Self::mul_add(
-            -x215,
-            x530,
-            Self::mul_add(-x220, x524, Self::mul_add(-x219, x516, x248)),
-        );
-        let x682 = Self::mul_add(
-            -x597,
-            x606,
-            Self::mul_add(-x573, x580, Self::mul_add(-x548, x555, x681)),
-        );
-        let x683 = Self::mul_add(
-            -x659,
-            x668,
-            Self::mul_add(-x640, x649, Self::mul_add(x620, x627, x682)),
-        );
-        let x684 = x676 * x683;
-        let x685 = Self::mul_add(
-            x215,
-            x531,
-            Self::mul_add(-x220, x525, Self::mul_add(-x219, x517, x284)),
-        );
-        let x686 = Self::mul_add(
-            -x597,
-            x610,
-            Self::mul_add(-x573, x583, Self::mul_add(-x548, x558, x685)),
-        );
-        let x687 = Self::mul_add(
-            -x659,
-            x672,
-            Self::mul_add(-x640, x653, Self::mul_add(x620, x630, x686)),
-        );
-        let x688 = x676 * x687;
-        let x689 = Self::mul_add(
-            -x235,
-            x529,
-            Self::mul_add(-x240, x523, Self::mul_add(-x239, x515, x66)),
-        );
-        let x690 = Self::mul_add(
-            x601,
-            x602,
-            Self::mul_add(-x576, x577, Self::mul_add(-x551, x552, x689)),
-        );
-        let x691 = Self::mul_add(
-            -x663,
-            x664,
-            Self::mul_add(-x644, x645, Self::mul_add(-x623, x624, x690)),
-        );
-        let x692 = 1.0 / Self::mul_add(-x679, x680, x691);
-        let x693 = Self::mul_add(
-            x235,
-            x530,
-            Self::mul_add(-x240, x524, Self::mul_add(-x239, x516, x59)),
-        );
-        let x694 = Self::mul_add(
-            -x601,
-            x606,
-            Self::mul_add(-x576, x580, Self::mul_add(-x551, x555, x693)),
-        );
-        let x695 = Self::mul_add(
-            -x663,
-            x668,
-            Self::mul_add(-x644, x649, Self::mul_add(x623, x627, x694)),
-        );
-        let x696 = Self::mul_add(-x679, x684, x695);
-        let x697 = x692 * x696;
-        let x698 = Self::mul_add(
-            -x235,
-            x531,
-            Self::mul_add(-x240, x525, Self::mul_add(-x239, x517, x277)),
-        );
-        let x699 = Self::mul_add(
-            -x601,
-            x610,
-            Self::mul_add(-x576, x583, Self::mul_add(-x551, x558, x698)),
-        );
-        let x700 = Self::mul_add(
-            -x663,
-            x672,
-            Self::mul_add(-x644, x653, Self::mul_add(x623, x630, x699)),
-        );
-        let x701 = Self::mul_add(-x679, x688, x700);
-        let x702 = x692 * x701;
-        let x703 = Self::mul_add(
-            -x264,
-            x530,
-            Self::mul_add(-x269, x524, Self::mul_add(-x268, x516, x41)),
-        );
-        let x704 = Self::mul_add(
-            x605,
-            x606,
-            Self::mul_add(-x579, x580, Self::mul_add(-x554, x555, x703)),
-        );
-        let x705 = Self::mul_add(
-            -x667,
-            x668,
-            Self::mul_add(-x648, x649, Self::mul_add(-x626, x627, x704)),
-        );
-        let x706 = 1.0 / Self::mul_add(-x696, x697, Self::mul_add(-x683, x684, x705));
-        let x707 = Self::mul_add(
-            x264,
-            x531,
-            Self::mul_add(-x269, x525, Self::mul_add(-x268, x517, x273)),
-        );
-        let x708 = Self::mul_add(
-            x605,
-            x610,
-            Self::mul_add(-x579, x583, Self::mul_add(-x554, x558, x707)),
-        );
-        let x709 = Self::mul_add(
-            -x667,
-            x672,
-            Self::mul_add(-x648, x653, Self::mul_add(-x626, x630, x708)),
-        );
-        let x710 = Self::mul_add(-x696, x702, Self::mul_add(-x683, x688, x709));
-        let x711 = x706 * x710;
-        let x712 = Self::mul_add(
-            -x300,
-            x531,
-            Self::mul_add(-x305, x525, Self::mul_add(-x304, x517, 1.4135609200000003)),
-        );
-        let x713 = Self::mul_add(
+        let x671 = Self::mul_add(
             x609,
             x610,
-            Self::mul_add(-x582, x583, Self::mul_add(-x557, x558, x712)),
+            Self::mul_add(-x586, x587, Self::mul_add(-x561, x562, x670)),
         );
+        let x672 = 1.0 / Self::mul_add(-x652, x653, Self::mul_add(-x633, x634, x671));
+        let x673 = Self::mul_add(
+            x192,
+            x544,
+            Self::mul_add(-x199, x538, Self::mul_add(-x198, x530, x92)),
+        );
+        let x674 = Self::mul_add(
+            x609,
+            x614,
+            Self::mul_add(x586, x590, Self::mul_add(x561, x565, x673)),
+        );
+        let x675 = Self::mul_add(x652, x657, Self::mul_add(-x633, x637, x674));
+        let x676 = x672 * x675;
+        let x677 = Self::mul_add(
+            -x192,
+            x545,
+            Self::mul_add(-x199, x539, Self::mul_add(-x198, x531, x221)),
+        );
+        let x678 = Self::mul_add(
+            x609,
+            x618,
+            Self::mul_add(x586, x593, Self::mul_add(x561, x568, x677)),
+        );
+        let x679 = Self::mul_add(x652, x661, Self::mul_add(-x633, x640, x678));
+        let x680 = x672 * x679;
+        let x681 = Self::mul_add(
+            x192,
+            x546,
+            Self::mul_add(-x199, x540, Self::mul_add(-x198, x532, x252)),
+        );
+        let x682 = Self::mul_add(
+            -x609,
+            x622,
+            Self::mul_add(x586, x596, Self::mul_add(x561, x571, x681)),
+        );
+        let x683 = Self::mul_add(x652, x665, Self::mul_add(x633, x643, x682));
+        let x684 = x672 * x683;
+        let x685 = Self::mul_add(
+            -x192,
+            x547,
+            Self::mul_add(-x199, x541, Self::mul_add(-x198, x533, x291)),
+        );
+        let x686 = Self::mul_add(
+            -x609,
+            x626,
+            Self::mul_add(x586, x599, Self::mul_add(x561, x574, x685)),
+        );
+        let x687 = Self::mul_add(x652, x669, Self::mul_add(x633, x646, x686));
+        let x688 = x672 * x687;
+        let x689 = Self::mul_add(
+            -x209,
+            x544,
+            Self::mul_add(-x216, x538, Self::mul_add(-x215, x530, x78)),
+        );
+        let x690 = Self::mul_add(
+            x613,
+            x614,
+            Self::mul_add(-x589, x590, Self::mul_add(-x564, x565, x689)),
+        );
+        let x691 = Self::mul_add(
+            -x675,
+            x676,
+            Self::mul_add(-x656, x657, Self::mul_add(-x636, x637, x690)),
+        );
+        let x692 = 1.0 / x691;
+        let x693 = Self::mul_add(
+            x209,
+            x545,
+            Self::mul_add(-x216, x539, Self::mul_add(-x215, x531, x72)),
+        );
+        let x694 = Self::mul_add(
+            x613,
+            x618,
+            Self::mul_add(-x589, x593, Self::mul_add(-x564, x568, x693)),
+        );
+        let x695 = Self::mul_add(
+            -x675,
+            x680,
+            Self::mul_add(-x656, x661, Self::mul_add(-x636, x640, x694)),
+        );
+        let x696 = x692 * x695;
+        let x697 = Self::mul_add(
+            -x209,
+            x546,
+            Self::mul_add(-x216, x540, Self::mul_add(-x215, x532, x247)),
+        );
+        let x698 = Self::mul_add(
+            -x613,
+            x622,
+            Self::mul_add(-x589, x596, Self::mul_add(-x564, x571, x697)),
+        );
+        let x699 = Self::mul_add(
+            -x675,
+            x684,
+            Self::mul_add(-x656, x665, Self::mul_add(x636, x643, x698)),
+        );
+        let x700 = x692 * x699;
+        let x701 = Self::mul_add(
+            x209,
+            x547,
+            Self::mul_add(-x216, x541, Self::mul_add(-x215, x533, x286)),
+        );
+        let x702 = Self::mul_add(
+            -x613,
+            x626,
+            Self::mul_add(-x589, x599, Self::mul_add(-x564, x574, x701)),
+        );
+        let x703 = Self::mul_add(
+            -x675,
+            x688,
+            Self::mul_add(-x656, x669, Self::mul_add(x636, x646, x702)),
+        );
+        let x704 = x692 * x703;
+        let x705 = Self::mul_add(
+            -x231,
+            x545,
+            Self::mul_add(-x238, x539, Self::mul_add(-x237, x531, x58)),
+        );
+        let x706 = Self::mul_add(
+            x617,
+            x618,
+            Self::mul_add(-x592, x593, Self::mul_add(-x567, x568, x705)),
+        );
+        let x707 = Self::mul_add(
+            -x679,
+            x680,
+            Self::mul_add(-x660, x661, Self::mul_add(-x639, x640, x706)),
+        );
+        let x708 = 1.0 / Self::mul_add(-x695, x696, x707);
+        let x709 = Self::mul_add(
+            x231,
+            x546,
+            Self::mul_add(-x238, x540, Self::mul_add(-x237, x532, x240)),
+        );
+        let x710 = Self::mul_add(
+            -x617,
+            x622,
+            Self::mul_add(-x592, x596, Self::mul_add(-x567, x571, x709)),
+        );
+        let x711 = Self::mul_add(
+            -x679,
+            x684,
+            Self::mul_add(-x660, x665, Self::mul_add(x639, x643, x710)),
+        );
+        let x712 = Self::mul_add(-x695, x700, x711);
+        let x713 = x708 * x712;
         let x714 = Self::mul_add(
-            -x671,
-            x672,
-            Self::mul_add(-x652, x653, Self::mul_add(-x629, x630, x713)),
+            -x231,
+            x547,
+            Self::mul_add(-x238, x541, Self::mul_add(-x237, x533, x279)),
         );
         let x715 = Self::mul_add(
-            -x710,
-            x711,
-            Self::mul_add(-x701, x702, Self::mul_add(-x687, x688, x714)),
+            -x617,
+            x626,
+            Self::mul_add(-x592, x599, Self::mul_add(-x567, x574, x714)),
         );
-        let x716 = 1.0 / x715;
-        let x717 = Self::mul_add(
-            -x508,
-            x510,
-            Self::mul_add(0.75, x503, Self::mul_add(-s_q7, x500, c_q7 * x499))
-                - Self::mul_add(
-                    180.9502499901501,
-                    x307,
-                    Self::mul_add(v[4], x506, v[5] * x505),
-                ),
+        let x716 = Self::mul_add(
+            -x679,
+            x688,
+            Self::mul_add(-x660, x669, Self::mul_add(x639, x646, x715)),
         );
-        let x718 = Self::mul_add(-x509, x511, x717);
+        let x717 = Self::mul_add(-x695, x704, x716);
+        let x718 = x708 * x717;
         let x719 = Self::mul_add(
-            x509,
-            x518,
-            Self::mul_add(
-                x507,
-                x510,
-                Self::mul_add(c_q7, x500, s_q7 * x499)
-                    - Self::mul_add(0.65, x498, 0.75 * x502)
-                    + (Self::mul_add(v[3], x506, v[5] * x504)
-                        - Self::mul_add(-110.5455, x308, 180.9502499901501 * x306)),
-            ),
+            -x262,
+            x546,
+            Self::mul_add(-x269, x540, Self::mul_add(-x268, x532, x34)),
         );
-        let x720 = Self::mul_add(-x536, x718, x719);
-        let x721 = x507 * x511;
-        let x722 = Self::mul_add(
-            x508,
-            x518,
-            Self::mul_add(-0.65, x503, x501)
-                - Self::mul_add(-110.5455, x307, Self::mul_add(-v[3], x505, v[4] * x504))
-                - x721,
+        let x720 = Self::mul_add(
+            x621,
+            x622,
+            Self::mul_add(-x595, x596, Self::mul_add(-x570, x571, x719)),
         );
-        let x723 = Self::mul_add(-x563, x720, Self::mul_add(-x538, x718, x722));
+        let x721 = Self::mul_add(
+            -x683,
+            x684,
+            Self::mul_add(-x664, x665, Self::mul_add(-x642, x643, x720)),
+        );
+        let x722 = 1.0 / Self::mul_add(-x712, x713, Self::mul_add(-x699, x700, x721));
+        let x723 = Self::mul_add(
+            x262,
+            x547,
+            Self::mul_add(-x269, x541, Self::mul_add(-x268, x533, x273)),
+        );
         let x724 = Self::mul_add(
-            x565,
-            x720,
-            Self::mul_add(x540, x718, Self::mul_add(-x508, x519, tau[0] - x501 + x721)),
+            x621,
+            x626,
+            Self::mul_add(-x595, x599, Self::mul_add(-x570, x574, x723)),
         );
-        let x725 = Self::mul_add(-x586, x723, x724);
-        let x726 = Self::mul_add(
-            x509,
-            x526,
-            Self::mul_add(-x508, x520, Self::mul_add(-x507, x512, tau[1] + x493)),
+        let x725 = Self::mul_add(
+            -x683,
+            x688,
+            Self::mul_add(-x664, x669, Self::mul_add(-x642, x646, x724)),
         );
-        let x727 = Self::mul_add(
-            x590,
-            x723,
-            Self::mul_add(x568, x720, Self::mul_add(x543, x718, x726)),
+        let x726 = Self::mul_add(-x712, x718, Self::mul_add(-x699, x704, x725));
+        let x727 = x722 * x726;
+        let x728 = Self::mul_add(
+            -x302,
+            x547,
+            Self::mul_add(-x309, x541, Self::mul_add(-x308, x533, 1.4135609200000003)),
         );
-        let x728 = Self::mul_add(x615, x725, x727);
         let x729 = Self::mul_add(
-            x509,
-            x527,
-            Self::mul_add(x508, x521, Self::mul_add(x507, x513, tau[2] + x482)),
+            x625,
+            x626,
+            Self::mul_add(-x598, x599, Self::mul_add(-x573, x574, x728)),
         );
         let x730 = Self::mul_add(
-            x594,
-            x723,
-            Self::mul_add(x571, x720, Self::mul_add(x546, x718, x729)),
+            -x687,
+            x688,
+            Self::mul_add(-x668, x669, Self::mul_add(-x645, x646, x729)),
         );
-        let x731 = Self::mul_add(-x637, x728, Self::mul_add(x618, x725, x730));
-        let x732 = Self::mul_add(
-            -x509,
-            x528,
-            Self::mul_add(x508, x522, Self::mul_add(x507, x514, tau[3] + x475)),
+        let x731 = Self::mul_add(
+            -x726,
+            x727,
+            Self::mul_add(-x717, x718, Self::mul_add(-x703, x704, x730)),
         );
+        let x732 = 1.0 / x731;
         let x733 = Self::mul_add(
-            x598,
-            x723,
-            Self::mul_add(-x574, x720, Self::mul_add(-x549, x718, x732)),
+            -x524,
+            x526,
+            Self::mul_add(0.75, x519, Self::mul_add(-s_q7, x516, c_q7 * x515))
+                - Self::mul_add(
+                    180.9502499901501,
+                    x311,
+                    Self::mul_add(v[4], x522, v[5] * x521),
+                ),
         );
-        let x734 = Self::mul_add(
-            -x660,
-            x731,
-            Self::mul_add(x641, x728, Self::mul_add(x621, x725, x733)),
-        );
+        let x734 = Self::mul_add(-x525, x527, x733);
         let x735 = Self::mul_add(
-            x509,
-            x529,
-            Self::mul_add(x508, x523, Self::mul_add(x507, x515, tau[4] - x467)),
+            x525,
+            x534,
+            Self::mul_add(
+                x523,
+                x526,
+                Self::mul_add(c_q7, x516, s_q7 * x515)
+                    - Self::mul_add(0.65, x514, 0.75 * x518)
+                    + (Self::mul_add(v[3], x522, v[5] * x520)
+                        - Self::mul_add(-110.5455, x312, 180.9502499901501 * x310)),
+            ),
         );
-        let x736 = Self::mul_add(
-            x602,
-            x723,
-            Self::mul_add(-x577, x720, Self::mul_add(-x552, x718, x735)),
+        let x736 = Self::mul_add(-x552, x734, x735);
+        let x737 = x523 * x527;
+        let x738 = Self::mul_add(
+            x524,
+            x534,
+            Self::mul_add(-0.65, x519, x517)
+                - Self::mul_add(-110.5455, x311, Self::mul_add(-v[3], x521, v[4] * x520))
+                - x737,
         );
-        let x737 = Self::mul_add(
-            -x664,
-            x731,
-            Self::mul_add(x645, x728, Self::mul_add(x624, x725, x736)),
-        );
-        let x738 = Self::mul_add(-x680, x734, x737);
-        let x739 = Self::mul_add(
-            x509,
-            x530,
-            Self::mul_add(-x508, x524, Self::mul_add(-x507, x516, tau[5] + x459)),
-        );
+        let x739 = Self::mul_add(-x579, x736, Self::mul_add(-x554, x734, x738));
         let x740 = Self::mul_add(
-            x606,
-            x723,
-            Self::mul_add(x580, x720, Self::mul_add(x555, x718, x739)),
+            x581,
+            x736,
+            Self::mul_add(x556, x734, Self::mul_add(-x524, x535, tau[0] - x517 + x737)),
         );
-        let x741 = Self::mul_add(
-            x668,
-            x731,
-            Self::mul_add(-x649, x728, Self::mul_add(x627, x725, x740)),
+        let x741 = Self::mul_add(-x602, x739, x740);
+        let x742 = Self::mul_add(
+            x525,
+            x542,
+            Self::mul_add(-x524, x536, Self::mul_add(-x523, x528, tau[1] + x507)),
         );
-        let x742 = Self::mul_add(x697, x738, Self::mul_add(x684, x734, x741));
         let x743 = Self::mul_add(
-            -x509,
-            x531,
-            Self::mul_add(-x508, x525, Self::mul_add(-x507, x517, tau[6] - x449)),
+            x606,
+            x739,
+            Self::mul_add(x584, x736, Self::mul_add(x559, x734, x742)),
         );
-        let x744 = Self::mul_add(
-            x610,
-            x723,
-            Self::mul_add(x583, x720, Self::mul_add(x558, x718, x743)),
-        );
+        let x744 = Self::mul_add(x631, x741, x743);
         let x745 = Self::mul_add(
-            x672,
-            x731,
-            Self::mul_add(-x653, x728, Self::mul_add(x630, x725, x744)),
+            x525,
+            x543,
+            Self::mul_add(x524, x537, Self::mul_add(x523, x529, tau[2] + x496)),
         );
         let x746 = Self::mul_add(
-            -x711,
-            x742,
-            Self::mul_add(x702, x738, Self::mul_add(x688, x734, x745)),
+            x610,
+            x739,
+            Self::mul_add(x587, x736, Self::mul_add(x562, x734, x745)),
         );
-        let x747 = x716 * x746;
-        let x748 = Self::mul_add(-x711, x747, x706 * x742);
-        let x749 = Self::mul_add(x702, x747, Self::mul_add(x697, x748, x692 * x738));
+        let x747 = Self::mul_add(-x653, x744, Self::mul_add(x634, x741, x746));
+        let x748 = Self::mul_add(
+            -x525,
+            x544,
+            Self::mul_add(x524, x538, Self::mul_add(x523, x530, tau[3] + x489)),
+        );
+        let x749 = Self::mul_add(
+            x614,
+            x739,
+            Self::mul_add(-x590, x736, Self::mul_add(-x565, x734, x748)),
+        );
         let x750 = Self::mul_add(
-            x688,
+            -x676,
             x747,
-            Self::mul_add(x684, x748, Self::mul_add(-x680, x749, x676 * x734)),
+            Self::mul_add(x657, x744, Self::mul_add(x637, x741, x749)),
         );
         let x751 = Self::mul_add(
-            x668,
-            x748,
-            Self::mul_add(-x664, x749, Self::mul_add(-x660, x750, x656 * x731)),
+            x525,
+            x545,
+            Self::mul_add(x524, x539, Self::mul_add(x523, x531, tau[4] - x481)),
         );
-        let x752 = Self::mul_add(x672, x747, x751);
+        let x752 = Self::mul_add(
+            x618,
+            x739,
+            Self::mul_add(-x593, x736, Self::mul_add(-x568, x734, x751)),
+        );
         let x753 = Self::mul_add(
-            x645,
-            x749,
-            Self::mul_add(x641, x750, Self::mul_add(-x637, x752, x633 * x728)),
+            -x680,
+            x747,
+            Self::mul_add(x661, x744, Self::mul_add(x640, x741, x752)),
         );
-        let x754 = Self::mul_add(-x653, x747, Self::mul_add(-x649, x748, x753));
+        let x754 = Self::mul_add(-x696, x750, x753);
         let x755 = Self::mul_add(
-            x621,
-            x750,
-            Self::mul_add(x618, x752, Self::mul_add(x615, x754, x612 * x725)),
+            x525,
+            x546,
+            Self::mul_add(-x524, x540, Self::mul_add(-x523, x532, tau[5] + x471)),
         );
         let x756 = Self::mul_add(
-            x630,
-            x747,
-            Self::mul_add(x627, x748, Self::mul_add(x624, x749, x755)),
+            x622,
+            x739,
+            Self::mul_add(x596, x736, Self::mul_add(x571, x734, x755)),
         );
         let x757 = Self::mul_add(
-            -x594,
-            x752,
-            Self::mul_add(-x590, x754, Self::mul_add(x586, x756, x584 * x723)),
+            x684,
+            x747,
+            Self::mul_add(-x665, x744, Self::mul_add(x643, x741, x756)),
         );
-        let x758 = Self::mul_add(
-            -x606,
-            x748,
-            Self::mul_add(-x602, x749, Self::mul_add(-x598, x750, x757)),
+        let x758 = Self::mul_add(x713, x754, Self::mul_add(x700, x750, x757));
+        let x759 = Self::mul_add(
+            -x525,
+            x547,
+            Self::mul_add(-x524, x541, Self::mul_add(-x523, x533, tau[6] + x460)),
         );
-        let x759 = Self::mul_add(-x610, x747, x758);
         let x760 = Self::mul_add(
-            x568,
-            x754,
-            Self::mul_add(x565, x756, Self::mul_add(x563, x759, x560 * x720)),
+            x626,
+            x739,
+            Self::mul_add(x599, x736, Self::mul_add(x574, x734, x759)),
         );
         let x761 = Self::mul_add(
-            -x577,
-            x749,
-            Self::mul_add(-x574, x750, Self::mul_add(x571, x752, x760)),
-        );
-        let x762 = Self::mul_add(x583, x747, Self::mul_add(x580, x748, x761));
-        let x763 = -x762;
-        let x764 = Self::mul_add(
-            x540,
-            x756,
-            Self::mul_add(x538, x759, Self::mul_add(-x536, x762, x534 * x718)),
-        );
-        let x765 = Self::mul_add(
-            -x549,
-            x750,
-            Self::mul_add(x546, x752, Self::mul_add(x543, x754, x764)),
-        );
-        let x766 = Self::mul_add(
-            x558,
+            x688,
             x747,
-            Self::mul_add(x555, x748, Self::mul_add(-x552, x749, x765)),
+            Self::mul_add(-x669, x744, Self::mul_add(x646, x741, x760)),
         );
-        let x767 = -x766;
-        let x768 = Self::mul_add(
-            x526,
-            x754,
-            Self::mul_add(
-                x518,
-                x762,
-                Self::mul_add(-x511, x766, x509 * 0.0008546497218115156),
-            ),
+        let x762 = Self::mul_add(
+            -x727,
+            x758,
+            Self::mul_add(x718, x754, Self::mul_add(x704, x750, x761)),
         );
+        let x763 = x732 * x762;
+        let x764 = Self::mul_add(-x727, x763, x722 * x758);
+        let x765 = Self::mul_add(x718, x763, Self::mul_add(x713, x764, x708 * x754));
+        let x766 = Self::mul_add(
+            x704,
+            x763,
+            Self::mul_add(x700, x764, Self::mul_add(-x696, x765, x692 * x750)),
+        );
+        let x767 = Self::mul_add(
+            x684,
+            x764,
+            Self::mul_add(-x680, x765, Self::mul_add(-x676, x766, x672 * x747)),
+        );
+        let x768 = Self::mul_add(x688, x763, x767);
         let x769 = Self::mul_add(
-            x529,
-            x749,
-            Self::mul_add(-x528, x750, Self::mul_add(x527, x752, x768)),
+            x661,
+            x765,
+            Self::mul_add(x657, x766, Self::mul_add(-x653, x768, x649 * x744)),
         );
-        let x770 = -Self::mul_add(-x531, x747, Self::mul_add(x530, x748, x769));
+        let x770 = Self::mul_add(-x669, x763, Self::mul_add(-x665, x764, x769));
         let x771 = Self::mul_add(
-            -x519,
-            x756,
-            Self::mul_add(
-                -x518,
-                x759,
-                Self::mul_add(-x510, x766, x508 * 0.0008546497218115156),
-            ),
+            x637,
+            x766,
+            Self::mul_add(x634, x768, Self::mul_add(x631, x770, x628 * x741)),
         );
         let x772 = Self::mul_add(
-            x522,
-            x750,
-            Self::mul_add(x521, x752, Self::mul_add(-x520, x754, x771)),
+            x646,
+            x763,
+            Self::mul_add(x643, x764, Self::mul_add(x640, x765, x771)),
         );
         let x773 = Self::mul_add(
-            -x525,
-            x747,
-            Self::mul_add(-x524, x748, Self::mul_add(x523, x749, x772)),
+            -x610,
+            x768,
+            Self::mul_add(-x606, x770, Self::mul_add(x602, x772, x600 * x739)),
         );
         let x774 = Self::mul_add(
-            x511,
-            x756,
+            -x622,
+            x764,
+            Self::mul_add(-x618, x765, Self::mul_add(-x614, x766, x773)),
+        );
+        let x775 = Self::mul_add(-x626, x763, x774);
+        let x776 = Self::mul_add(
+            x584,
+            x770,
+            Self::mul_add(x581, x772, Self::mul_add(x579, x775, x576 * x736)),
+        );
+        let x777 = Self::mul_add(
+            -x593,
+            x765,
+            Self::mul_add(-x590, x766, Self::mul_add(x587, x768, x776)),
+        );
+        let x778 = Self::mul_add(x599, x763, Self::mul_add(x596, x764, x777));
+        let x779 = -x778;
+        let x780 = Self::mul_add(
+            x556,
+            x772,
+            Self::mul_add(x554, x775, Self::mul_add(-x552, x778, x550 * x734)),
+        );
+        let x781 = Self::mul_add(
+            -x565,
+            x766,
+            Self::mul_add(x562, x768, Self::mul_add(x559, x770, x780)),
+        );
+        let x782 = Self::mul_add(
+            x574,
+            x763,
+            Self::mul_add(x571, x764, Self::mul_add(-x568, x765, x781)),
+        );
+        let x783 = -x782;
+        let x784 = Self::mul_add(
+            x542,
+            x770,
             Self::mul_add(
-                x511,
-                x759,
-                Self::mul_add(x510, x762, x507 * 0.0008546497218115156),
+                x534,
+                x778,
+                Self::mul_add(-x527, x782, x525 * 0.0008546497218115156),
             ),
         );
-        let x775 = Self::mul_add(
-            x514,
-            x750,
-            Self::mul_add(x513, x752, Self::mul_add(-x512, x754, x774)),
+        let x785 = Self::mul_add(
+            x545,
+            x765,
+            Self::mul_add(-x544, x766, Self::mul_add(x543, x768, x784)),
         );
-        let x776 = Self::mul_add(
-            -x517,
-            x747,
-            Self::mul_add(-x516, x748, Self::mul_add(x515, x749, x775)),
+        let x786 = -Self::mul_add(-x547, x763, Self::mul_add(x546, x764, x785));
+        let x787 = Self::mul_add(
+            -x535,
+            x772,
+            Self::mul_add(
+                -x534,
+                x775,
+                Self::mul_add(-x526, x782, x524 * 0.0008546497218115156),
+            ),
         );
-        [x776, x773, x770, x767, x763, x759, x756, x754, x752, x750, x749, x748, x747]
+        let x788 = Self::mul_add(
+            x538,
+            x766,
+            Self::mul_add(x537, x768, Self::mul_add(-x536, x770, x787)),
+        );
+        let x789 = Self::mul_add(
+            -x541,
+            x763,
+            Self::mul_add(-x540, x764, Self::mul_add(x539, x765, x788)),
+        );
+        let x790 = Self::mul_add(
+            x527,
+            x772,
+            Self::mul_add(
+                x527,
+                x775,
+                Self::mul_add(x526, x778, x523 * 0.0008546497218115156),
+            ),
+        );
+        let x791 = Self::mul_add(
+            x530,
+            x766,
+            Self::mul_add(x529, x768, Self::mul_add(-x528, x770, x790)),
+        );
+        let x792 = Self::mul_add(
+            -x533,
+            x763,
+            Self::mul_add(-x532, x764, Self::mul_add(x531, x765, x791)),
+        );
+        [x792, x789, x786, x783, x779, x775, x772, x770, x768, x766, x765, x764, x763]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1010 mul, 890 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 593 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 963 mul, 863 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 576 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -4927,1074 +4751,1011 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = 0.00000000020510342851533115 * c_q8;
-        let x8 = 0.00000000020510342851533115 * s_q8;
-        let x9 = 0.00000000020510342851533115 * c_q9;
-        let x10 = 0.00000000020510342851533115 * s_q9;
-        let x11 = x9 - x10;
-        let x12 = x9 + x10;
-        let x13 = 0.00000000020510342851533115 * s_q12;
-        let x14 = 0.00000000020510342851533115 * c_q12;
-        let x15 = 0.00000000020510342851533115 * c_q13;
-        let x16 = 0.00000000020510342851533115 * s_q13;
-        let x17 = s_q13 * s_q13;
-        let x18 = s_q13 * c_q13;
-        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
-        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
-        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x23 = 4.806620000000001 * s_q13;
-        let x24 = 4.806620000000001 * c_q13;
-        let x25 = 0.00000000020510342851533115 * x23;
-        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
-        let x27 = 0.00000000020510342851533115 * x21;
-        let x28 = 1.4135609200000003 + x27;
-        let x29 = x21 + -0.0000000002899261911072858;
-        let x30 = 0.16 * x23;
-        let x31 = 0.55 * x24;
-        let x32 = x30 + x31;
-        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
-        let x34 = Self::mul_add(
+        let x7 = 0.00000000020510342851533115 * c_q9;
+        let x8 = 0.00000000020510342851533115 * s_q9;
+        let x9 = x7 - x8;
+        let x10 = x7 + x8;
+        let x11 = s_q13 * s_q13;
+        let x12 = s_q13 * c_q13;
+        let x13 = Self::mul_add(x12, 0.001562, x11 * 1.2025609200000003);
+        let x14 = 0.000781 + Self::mul_add(x11, -0.001562, x12 * 1.2025609200000003);
+        let x15 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x16 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 1.4135609200000003 + x13;
+        let x20 = x15 + x15;
+        let x21 = Self::mul_add(0.00000000020510342851533115, x20, x19);
+        let x22 = 0.00000000020510342851533115 * x17;
+        let x23 = 0.16 * x17;
+        let x24 = 0.55 * x18;
+        let x25 = x23 + x24;
+        let x26 = x25 - (x13 - x21 - x25);
+        let x27 = Self::mul_add(
             0.55,
-            x23,
+            x17,
             Self::mul_add(
                 0.16,
-                x24,
-                Self::mul_add(-0.00000000020510342851533115, x22, x20),
+                x18,
+                Self::mul_add(-0.00000000020510342851533115, x16, x14),
             ),
         );
-        let x35 = 3.6140000000000003 + x25;
-        let x36 = 17.135250000000003 + x24;
-        let x37 = -1.9877000000000002
+        let x28 = 3.6140000000000003 + x22;
+        let x29 = 17.135250000000003 + x18;
+        let x30 = -1.9877000000000002
             - Self::mul_add(
                 0.55,
-                x25,
-                Self::mul_add(0.00000000020510342851533115, x20, x22),
+                x22,
+                Self::mul_add(0.00000000020510342851533115, x14, x16),
             );
-        let x38 = -0.809539999555672
+        let x31 = -0.809539999555672
+            - Self::mul_add(
+                0.16,
+                x22,
+                x15 - Self::mul_add(-0.00000000020510342851533115, x19, x20),
+            );
+        let x32 = -5.252920330000002 + (x23 + (-1.2025609200000003 + x13 + x23));
+        let x33 = -2.741639999592316 - x27;
+        let x34 = 9.740442170000001 + (x24 + (1.4135609200000003 - x21 + x24));
+        let x35 = s_q12 * s_q12;
+        let x36 = s_q12 * c_q12;
+        let x37 = x26 - x32;
+        let x38 = x30 + x30;
+        let x39 = Self::mul_add(x36, x38, x35 * x37);
+        let x40 = x32 + x39;
+        let x41 = x30 + Self::mul_add(-x35, x38, x36 * x37);
+        let x42 = Self::mul_add(-s_q12, x33, c_q12 * x31);
+        let x43 = Self::mul_add(c_q12, x33, s_q12 * x31);
+        let x44 = Self::mul_add(-s_q12, x29, c_q12 * x28);
+        let x45 = Self::mul_add(c_q12, x29, s_q12 * x28);
+        let x46 = x34 - x40;
+        let x47 = x43 + x43;
+        let x48 = Self::mul_add(-0.00000000020510342851533115, x47, x46);
+        let x49 = Self::mul_add(-0.00000000020510342851533115, x41, x42);
+        let x50 = Self::mul_add(-0.00000000020510342851533115, x45, x17);
+        let x51 = x22 + x45;
+        let x52 = x51 * 0.36;
+        let x53 = x52 + (x26 - x39 + x52);
+        let x54 = 7.078399999258757 + x50;
+        let x55 = 0.01675
+            - Self::mul_add(
+                x44,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x42, x41),
+            );
+        let x56 = -9.142025249762803 + (x52 + (x40 + x48 + x52));
+        let x57 = 2.5482240016099564
             + Self::mul_add(
-                -0.16,
-                x25,
-                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+                x50,
+                0.36,
+                x43 - Self::mul_add(0.00000000020510342851533115, x46, x47),
             );
-        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
-        let x40 = -2.741639999592316 - x34;
-        let x41 = 9.740442170000001
-            + (x31
-                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
-        let x42 = s_q12 * s_q12;
-        let x43 = s_q12 * c_q12;
-        let x44 = x33 - x39;
-        let x45 = x37 + x37;
-        let x46 = Self::mul_add(x43, x45, x42 * x44);
-        let x47 = x39 + x46;
-        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
-        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
-        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
-        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
-        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
-        let x54 = x25 + x52;
-        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
-        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
-        let x57 = 0.00000000020510342851533115 * x50;
-        let x58 = x41 - x57;
-        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
-        let x60 = -x59;
-        let x61 = x54 * 0.36;
-        let x62 = x61 + (x33 - x46 + x61);
-        let x63 = 7.078399999258757 + x53;
-        let x64 = 0.01675
-            - Self::mul_add(
-                x51,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x49, x48),
-            );
-        let x65 = -9.142025249762803
-            + (x61 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x61));
-        let x66 = 2.5482240016099564
-            - Self::mul_add(
-                x53,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x58, x56),
-            );
-        let x67 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
-        let x68 = s_q11 * s_q11;
-        let x69 = s_q11 * c_q11;
-        let x70 = x62 - x65;
-        let x71 = x55 + x55;
-        let x72 = Self::mul_add(x69, x71, x68 * x70);
-        let x73 = Self::mul_add(-s_q11, x63, c_q11 * x51);
-        let x74 = Self::mul_add(c_q11, x63, s_q11 * x51);
-        let x75 = 0.275 * x54;
-        let x76 = x74 * 0.63;
-        let x77 = x75 - x76;
-        let x78 = Self::mul_add(x73, 0.63, x55 + Self::mul_add(-x68, x71, x69 * x70));
-        let x79 = Self::mul_add(0.275, x73, Self::mul_add(-s_q11, x66, c_q11 * x64));
-        let x80 = Self::mul_add(0.275, x74, Self::mul_add(c_q11, x66, s_q11 * x64));
-        let x81 = x67 - x76;
-        let x82 = x77 + (x62 - x72 + x77);
-        let x83 = -45.1584 + x74;
-        let x84 = -0.6328 + x79;
-        let x85 = -24.4950615 + (x75 + (x65 + x72 + x75));
-        let x86 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x80);
-        let x87 = 28.2393615 - (x76 - x81);
-        let x88 = s_q10 * s_q10;
-        let x89 = s_q10 * c_q10;
-        let x90 = x82 - x85;
-        let x91 = x78 + x78;
-        let x92 = Self::mul_add(x89, x91, x88 * x90);
-        let x93 = Self::mul_add(-s_q10, x86, c_q10 * x84);
-        let x94 = Self::mul_add(c_q10, x86, s_q10 * x84);
-        let x95 = c_q10 * x73;
-        let x96 = Self::mul_add(-s_q10, x83, x95);
-        let x97 = s_q10 * x73;
-        let x98 = Self::mul_add(c_q10, x83, x97);
-        let x99 = x98 * 0.87;
-        let x100 = Self::mul_add(x96, 0.87, x78 + Self::mul_add(-x88, x91, x89 * x90));
-        let x101 = x87 - x99;
-        let x102 = x99 - (x82 - x92 - x99);
-        let x103 = -81.53205 + x98;
-        let x104 = -0.00214 + x93;
-        let x105 = -63.36336825000001 + (x85 + x92);
-        let x106 = -36.18604050126307 + Self::mul_add(x54, -0.87, x94);
-        let x107 = 69.99836825 - (x99 - x101);
-        let x108 = s_q9 * s_q9;
-        let x109 = s_q9 * c_q9;
-        let x110 = x102 + x105;
-        let x111 = x100 + x100;
-        let x112 = Self::mul_add(-x109, x111, x108 * x110);
-        let x113 = x102 - x112;
-        let x114 = x105 - x112;
-        let x115 = x100 - Self::mul_add(x108, x111, x109 * x110);
-        let x116 = Self::mul_add(-s_q9, x106, c_q9 * x104);
-        let x117 = Self::mul_add(c_q9, x106, s_q9 * x104);
-        let x118 = c_q9 * x96;
-        let x119 = Self::mul_add(-s_q9, x103, x118);
-        let x120 = s_q9 * x96;
-        let x121 = Self::mul_add(c_q9, x103, x120);
-        let x122 = 0.00000000020510342851533115 * x54;
-        let x123 = x121 - x122;
-        let x124 = 0.00000000020510342851533115 * x121;
-        let x125 = x54 - Self::mul_add(0.00000000020510342851533115, x119, -x124);
-        let x126 = x119 + x122;
-        let x127 = 0.00000000020510342851533115 * x116;
-        let x128 = x115 + x127;
-        let x129 = 0.00000000020510342851533115 * x117;
-        let x130 = x114 + x129;
-        let x131 = 0.00000000020510342851533115 * x107;
-        let x132 = x117 + x131;
-        let x133 = 0.00000000020510342851533115 * x115;
-        let x134 = x116 - Self::mul_add(0.00000000020510342851533115, x113, x133);
-        let x135 = x107 + (x127 - x129);
-        let x136 = x116 - x131;
-        let x137 = 0.00000000020510342851533115 * x132;
-        let x138 = 0.4 * x126;
-        let x139 = 0.275 * x125;
-        let x140 = x138 - x139;
-        let x141 = x140 + (x130 + x137 + x140);
-        let x142 = Self::mul_add(
+        let x58 = 9.223235249762805 + (x34 - x48);
+        let x59 = s_q11 * s_q11;
+        let x60 = s_q11 * c_q11;
+        let x61 = x53 - x56;
+        let x62 = x49 + x49;
+        let x63 = Self::mul_add(x60, x62, x59 * x61);
+        let x64 = Self::mul_add(-s_q11, x54, c_q11 * x44);
+        let x65 = Self::mul_add(c_q11, x54, s_q11 * x44);
+        let x66 = 0.275 * x51;
+        let x67 = x65 * 0.63;
+        let x68 = x66 - x67;
+        let x69 = Self::mul_add(x64, 0.63, x49 + Self::mul_add(-x59, x62, x60 * x61));
+        let x70 = Self::mul_add(0.275, x64, Self::mul_add(-s_q11, x57, c_q11 * x55));
+        let x71 = Self::mul_add(0.275, x65, Self::mul_add(c_q11, x57, s_q11 * x55));
+        let x72 = x58 - x67;
+        let x73 = x68 + (x53 - x63 + x68);
+        let x74 = -45.1584 + x65;
+        let x75 = -0.6328 + x70;
+        let x76 = -24.4950615 + (x66 + (x56 + x63 + x66));
+        let x77 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x71);
+        let x78 = 28.2393615 - (x67 - x72);
+        let x79 = s_q10 * s_q10;
+        let x80 = s_q10 * c_q10;
+        let x81 = x73 - x76;
+        let x82 = x69 + x69;
+        let x83 = Self::mul_add(x80, x82, x79 * x81);
+        let x84 = Self::mul_add(-s_q10, x77, c_q10 * x75);
+        let x85 = Self::mul_add(c_q10, x77, s_q10 * x75);
+        let x86 = c_q10 * x64;
+        let x87 = Self::mul_add(-s_q10, x74, x86);
+        let x88 = s_q10 * x64;
+        let x89 = Self::mul_add(c_q10, x74, x88);
+        let x90 = x89 * 0.87;
+        let x91 = Self::mul_add(x87, 0.87, x69 + Self::mul_add(-x79, x82, x80 * x81));
+        let x92 = x78 - x90;
+        let x93 = x90 - (x73 - x83 - x90);
+        let x94 = -81.53205 + x89;
+        let x95 = -0.00214 + x84;
+        let x96 = -63.36336825000001 + (x76 + x83);
+        let x97 = -36.18604050126307 + Self::mul_add(x51, -0.87, x85);
+        let x98 = 69.99836825 - (x90 - x92);
+        let x99 = s_q9 * s_q9;
+        let x100 = s_q9 * c_q9;
+        let x101 = x93 + x96;
+        let x102 = x91 + x91;
+        let x103 = Self::mul_add(-x100, x102, x99 * x101);
+        let x104 = x93 - x103;
+        let x105 = x96 - x103;
+        let x106 = x91 - Self::mul_add(x99, x102, x100 * x101);
+        let x107 = Self::mul_add(-s_q9, x97, c_q9 * x95);
+        let x108 = Self::mul_add(c_q9, x97, s_q9 * x95);
+        let x109 = c_q9 * x87;
+        let x110 = Self::mul_add(-s_q9, x94, x109);
+        let x111 = s_q9 * x87;
+        let x112 = Self::mul_add(c_q9, x94, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = 0.00000000020510342851533115 * x112;
+        let x116 = x51 - Self::mul_add(0.00000000020510342851533115, x110, -x115);
+        let x117 = x110 + x113;
+        let x118 = 0.00000000020510342851533115 * x107;
+        let x119 = x106 + x118;
+        let x120 = 0.00000000020510342851533115 * x108;
+        let x121 = x105 + x120;
+        let x122 = 0.00000000020510342851533115 * x98;
+        let x123 = x108 + x122;
+        let x124 = 0.00000000020510342851533115 * x106;
+        let x125 = x107 - Self::mul_add(0.00000000020510342851533115, x104, x124);
+        let x126 = x98 + (x118 - x120);
+        let x127 = x107 - x122;
+        let x128 = 0.00000000020510342851533115 * x123;
+        let x129 = 0.4 * x117;
+        let x130 = 0.275 * x116;
+        let x131 = x129 - x130;
+        let x132 = x131 + (x121 + x128 + x131);
+        let x133 = Self::mul_add(
             0.275,
-            x126,
+            x117,
             -Self::mul_add(
                 0.4,
-                x125,
-                Self::mul_add(-0.00000000020510342851533115, x135, x134),
+                x116,
+                Self::mul_add(-0.00000000020510342851533115, x126, x125),
             ),
         );
-        let x143 = -0.000000008530897668050218 + x123;
-        let x144 = -12.701650001451807 - x125;
-        let x145 = -0.0000000234896432582596
+        let x134 = -0.000000008530897668050218 + x114;
+        let x135 = -12.701650001451807 - x116;
+        let x136 = -0.0000000234896432582596
             + Self::mul_add(
                 -0.275,
-                x123,
-                x132
+                x114,
+                x123
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x130,
-                        0.00000000020510342851533115 * x128,
+                        x121,
+                        0.00000000020510342851533115 * x119,
                     ),
             );
-        let x146 = -0.002139996587640933 + Self::mul_add(-0.4, x123, x128 - x137);
-        let x147 = -111.7548902508081
-            + (x138
-                + (x135
+        let x137 = -0.002139996587640933 + Self::mul_add(-0.4, x114, x119 - x128);
+        let x138 = -111.7548902508081
+            + (x129
+                + (x126
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x117 + Self::mul_add(-0.00000000020510342851533115, x114, x133),
-                        0.00000000020510342851533115 * x134,
-                    ) + x138));
-        let x148 = 5.080660024070365 - x142;
-        let x149 = 113.3918902508081
-            - (x139
-                + (Self::mul_add(0.00000000020510342851533115, x136, x113 + x127)
-                    + x139));
-        let x150 = s_q8 * s_q8;
-        let x151 = s_q8 * c_q8;
-        let x152 = x141 - x147;
-        let x153 = x145 + x145;
-        let x154 = Self::mul_add(x151, x153, x150 * x152);
-        let x155 = x141 - x154;
-        let x156 = x145 + Self::mul_add(-x150, x153, x151 * x152);
-        let x157 = Self::mul_add(-s_q8, x148, c_q8 * x146);
-        let x158 = Self::mul_add(c_q8, x148, s_q8 * x146);
-        let x159 = Self::mul_add(-s_q8, x144, c_q8 * x143);
-        let x160 = Self::mul_add(c_q8, x144, s_q8 * x143);
-        let x161 = Self::mul_add(-0.00000000020510342851533115, x159, x126);
-        let x162 = Self::mul_add(0.00000000020510342851533115, x126, x159);
-        let x163 = Self::mul_add(-0.00000000020510342851533115, x155, x157);
-        let x164 = 0.00000000020510342851533115 * x157;
-        let x165 = x149 - x164;
-        let x166 = Self::mul_add(0.00000000020510342851533115, x149, x157);
-        let x167 = -x166;
-        let x168 = 0.35 * x162;
-        let x169 = x168
-            - (Self::mul_add(-0.00000000020510342851533115, x163, x165) - x168);
-        let x170 = 48.0240000085309 + x161;
-        let x171 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x156, x158);
-        let x172 = -16.80768997608804
+                        x108 + Self::mul_add(-0.00000000020510342851533115, x105, x124),
+                        0.00000000020510342851533115 * x125,
+                    ) + x129));
+        let x139 = 5.080660024070365 - x133;
+        let x140 = 113.3918902508081
+            - (x130
+                + (Self::mul_add(0.00000000020510342851533115, x127, x104 + x118)
+                    + x130));
+        let x141 = s_q8 * s_q8;
+        let x142 = s_q8 * c_q8;
+        let x143 = x132 - x138;
+        let x144 = x136 + x136;
+        let x145 = Self::mul_add(x142, x144, x141 * x143);
+        let x146 = x132 - x145;
+        let x147 = x136 + Self::mul_add(-x141, x144, x142 * x143);
+        let x148 = Self::mul_add(-s_q8, x139, c_q8 * x137);
+        let x149 = Self::mul_add(c_q8, x139, s_q8 * x137);
+        let x150 = Self::mul_add(-s_q8, x135, c_q8 * x134);
+        let x151 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x152 = x140 - x146;
+        let x153 = x148 + x148;
+        let x154 = Self::mul_add(-0.00000000020510342851533115, x153, x152);
+        let x155 = Self::mul_add(0.00000000020510342851533115, x117, x150);
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x150, x117);
+        let x157 = 0.35 * x155;
+        let x158 = x157 - (x146 + x154 - x157);
+        let x159 = 48.0240000085309 + x156;
+        let x160 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x147, x149);
+        let x161 = -16.80768997608804
+            + Self::mul_add(
+                -0.35,
+                x156,
+                x148 - Self::mul_add(0.00000000020510342851533115, x152, x153),
+            );
+        let x162 = 130.43769025763282 - (x157 - (x138 + x145 - x157));
+        let x163 = 0.1132
             - Self::mul_add(
                 0.35,
-                x161,
-                Self::mul_add(0.00000000020510342851533115, x165, x163),
+                x151,
+                Self::mul_add(0.00000000020510342851533115, x149, x147),
             );
-        let x173 = 130.43769025763282 - (x168 - (x147 + x154 - x168));
-        let x174 = 0.1132
-            - Self::mul_add(
-                0.35,
-                x160,
-                Self::mul_add(0.00000000020510342851533115, x158, x156),
-            );
-        let x175 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x166, x155 + x164);
-        let x176 = s_q7 * s_q7;
-        let x177 = s_q7 * c_q7;
-        let x178 = x169 + x173;
-        let x179 = x171 + x171;
-        let x180 = Self::mul_add(-x177, x179, x176 * x178);
-        let x181 = Self::mul_add(-s_q7, x160, c_q7 * x170);
-        let x182 = Self::mul_add(c_q7, x160, s_q7 * x170);
-        let x183 = -x182;
-        let x184 = 0.75 * x162;
-        let x185 = 0.65 * x181;
-        let x186 = x184 - x185;
-        let x187 = Self::mul_add(-0.75, x181, Self::mul_add(-s_q7, x174, c_q7 * x172));
-        let x188 = Self::mul_add(
+        let x164 = 132.47349025763282 + (x140 - x154);
+        let x165 = s_q7 * s_q7;
+        let x166 = s_q7 * c_q7;
+        let x167 = x158 + x162;
+        let x168 = x160 + x160;
+        let x169 = Self::mul_add(-x166, x168, x165 * x167);
+        let x170 = Self::mul_add(-s_q7, x151, c_q7 * x159);
+        let x171 = Self::mul_add(c_q7, x151, s_q7 * x159);
+        let x172 = -x171;
+        let x173 = 0.75 * x155;
+        let x174 = 0.65 * x170;
+        let x175 = x173 - x174;
+        let x176 = Self::mul_add(-0.75, x170, Self::mul_add(-s_q7, x163, c_q7 * x161));
+        let x177 = Self::mul_add(
             -0.65,
-            x182,
-            x171 - Self::mul_add(x176, x179, x177 * x178),
+            x171,
+            x160 - Self::mul_add(x165, x168, x166 * x167),
         );
-        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
-        let x190 = x175 + x185;
-        let x191 = 110.5455 + x181;
-        let x192 = 180.9502499901501 - x162;
-        let x193 = 1394.5960312283303 - (x184 + (x169 - x180 + x184));
-        let x194 = -117.61766249359756 + Self::mul_add(0.65, x162, x187);
-        let x195 = 1466.4506062283303 - (x186 - (x173 - x180 - x186));
-        let x196 = 1271.854575 + (x185 + x190);
-        let x197 = -x192;
-        let x198 = -x191;
-        let x199 = Self::mul_add(x8, x143, x7 * x144);
-        let x200 = Self::mul_add(
+        let x178 = Self::mul_add(-0.75, x171, Self::mul_add(c_q7, x163, s_q7 * x161));
+        let x179 = x164 + x174;
+        let x180 = 110.5455 + x170;
+        let x181 = 180.9502499901501 - x155;
+        let x182 = 1394.5960312283303 - (x173 + (x158 - x169 + x173));
+        let x183 = -117.61766249359756 + Self::mul_add(0.65, x155, x176);
+        let x184 = 1466.4506062283303 - (x175 - (x162 - x169 - x175));
+        let x185 = 1271.854575 + (x174 + x179);
+        let x186 = -x181;
+        let x187 = -x180;
+        let x188 = 0.00000000020510342851533115 * x151;
+        let x189 = Self::mul_add(0.00000000020510342851533115, x140, x148);
+        let x190 = -x189;
+        let x191 = Self::mul_add(
             -0.35,
-            x159,
-            x149 - Self::mul_add(-x8, x148, x7 * x146),
+            x150,
+            Self::mul_add(-0.00000000020510342851533115, x148, x140),
         );
-        let x201 = Self::mul_add(0.35, x199, x158);
-        let x202 = Self::mul_add(-s_q7, x159, c_q7 * x199);
-        let x203 = Self::mul_add(c_q7, x159, s_q7 * x199);
-        let x204 = Self::mul_add(-0.75, x203, Self::mul_add(-s_q7, x201, c_q7 * x200));
-        let x205 = Self::mul_add(c_q7, x201, s_q7 * x200)
-            + Self::mul_add(-0.65, x160, 0.75 * x202);
-        let x206 = -Self::mul_add(-0.65, x203, x166);
-        let x207 = x12 * x96;
-        let x208 = Self::mul_add(x11, x103, x207);
-        let x209 = x132 + Self::mul_add(-0.275, x121, 0.4 * x208);
+        let x192 = Self::mul_add(0.35, x188, x149);
+        let x193 = Self::mul_add(-s_q7, x150, c_q7 * x188);
+        let x194 = Self::mul_add(c_q7, x150, s_q7 * x188);
+        let x195 = Self::mul_add(-0.75, x194, Self::mul_add(-s_q7, x192, c_q7 * x191));
+        let x196 = Self::mul_add(c_q7, x192, s_q7 * x191)
+            + Self::mul_add(-0.65, x151, 0.75 * x193);
+        let x197 = -Self::mul_add(-0.65, x194, x189);
+        let x198 = x10 * x87;
+        let x199 = Self::mul_add(x9, x94, x198);
+        let x200 = x123 + Self::mul_add(-0.275, x112, 0.4 * x199);
+        let x201 = Self::mul_add(0.4, x110, x98 + Self::mul_add(-x10, x97, x9 * x95));
+        let x202 = Self::mul_add(-0.275, x110, x127);
+        let x203 = Self::mul_add(s_q8, x199, c_q8 * x110);
+        let x204 = Self::mul_add(-c_q8, x199, s_q8 * x110);
+        let x205 = x115 - x203;
+        let x206 = Self::mul_add(0.00000000020510342851533115, x203, x112);
+        let x207 = Self::mul_add(-s_q8, x201, c_q8 * x200);
+        let x208 = Self::mul_add(0.00000000020510342851533115, x202, x207);
+        let x209 = -x208;
         let x210 = Self::mul_add(
-            0.4,
-            x119,
-            x107 + Self::mul_add(-x12, x106, x11 * x104),
-        );
-        let x211 = Self::mul_add(-0.275, x119, x136);
-        let x212 = x121 + Self::mul_add(x8, x208, x7 * x119);
-        let x213 = Self::mul_add(-c_q8, x208, s_q8 * x119);
-        let x214 = x124 - Self::mul_add(s_q8, x208, c_q8 * x119);
-        let x215 = Self::mul_add(
-            0.00000000020510342851533115,
-            x211,
-            Self::mul_add(-s_q8, x210, c_q8 * x209),
-        );
-        let x216 = -x215;
-        let x217 = Self::mul_add(
             -0.35,
-            x213,
-            x211 - Self::mul_add(-x8, x210, x7 * x209),
+            x204,
+            Self::mul_add(-0.00000000020510342851533115, x207, x202),
         );
-        let x218 = Self::mul_add(-0.35, x212, Self::mul_add(c_q8, x210, s_q8 * x209));
-        let x219 = Self::mul_add(s_q7, x213, c_q7 * x212);
-        let x220 = -x219;
-        let x221 = Self::mul_add(-c_q7, x213, s_q7 * x212);
-        let x222 = -x221;
-        let x223 = Self::mul_add(0.75, x221, Self::mul_add(-s_q7, x218, c_q7 * x217));
-        let x224 = Self::mul_add(c_q7, x218, s_q7 * x217)
-            - Self::mul_add(0.65, x214, 0.75 * x219);
-        let x225 = -Self::mul_add(0.65, x221, x215);
-        let x226 = Self::mul_add(-s_q9, x98, x118);
-        let x227 = Self::mul_add(x11, x98, x207);
-        let x228 = Self::mul_add(c_q9, x98, x120);
-        let x229 = 0.00000000020510342851533115 * x101;
-        let x230 = Self::mul_add(c_q9, x94, s_q9 * x93) + x229
-            + Self::mul_add(-0.275, x228, 0.4 * x227);
-        let x231 = Self::mul_add(0.4, x226, x101 + Self::mul_add(-x12, x94, x11 * x93));
-        let x232 = Self::mul_add(
+        let x211 = Self::mul_add(-0.35, x206, Self::mul_add(c_q8, x201, s_q8 * x200));
+        let x212 = Self::mul_add(s_q7, x204, c_q7 * x206);
+        let x213 = -x212;
+        let x214 = Self::mul_add(-c_q7, x204, s_q7 * x206);
+        let x215 = -x214;
+        let x216 = Self::mul_add(0.75, x214, Self::mul_add(-s_q7, x211, c_q7 * x210));
+        let x217 = Self::mul_add(c_q7, x211, s_q7 * x210)
+            - Self::mul_add(0.65, x205, 0.75 * x212);
+        let x218 = -Self::mul_add(0.65, x214, x208);
+        let x219 = Self::mul_add(-s_q9, x89, x109);
+        let x220 = Self::mul_add(x9, x89, x198);
+        let x221 = Self::mul_add(c_q9, x89, x111);
+        let x222 = 0.00000000020510342851533115 * x92;
+        let x223 = Self::mul_add(c_q9, x85, s_q9 * x84) + x222
+            + Self::mul_add(-0.275, x221, 0.4 * x220);
+        let x224 = Self::mul_add(0.4, x219, x92 + Self::mul_add(-x10, x85, x9 * x84));
+        let x225 = Self::mul_add(
             0.275,
-            x226,
-            x229 - Self::mul_add(-s_q9, x94, c_q9 * x93),
+            x219,
+            x222 - Self::mul_add(-s_q9, x85, c_q9 * x84),
         );
-        let x233 = -x232;
-        let x234 = x228 + Self::mul_add(x8, x227, x7 * x226);
-        let x235 = Self::mul_add(-c_q8, x227, s_q8 * x226);
-        let x236 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x226 = -x225;
+        let x227 = Self::mul_add(s_q8, x220, c_q8 * x219);
+        let x228 = Self::mul_add(-c_q8, x220, s_q8 * x219);
+        let x229 = Self::mul_add(-0.00000000020510342851533115, x221, x227);
+        let x230 = -x229;
+        let x231 = Self::mul_add(0.00000000020510342851533115, x227, x221);
+        let x232 = Self::mul_add(-s_q8, x224, c_q8 * x223);
+        let x233 = Self::mul_add(-0.00000000020510342851533115, x225, x232);
+        let x234 = -x233;
+        let x235 = Self::mul_add(
+            0.35,
             x228,
-            Self::mul_add(s_q8, x227, c_q8 * x226),
+            Self::mul_add(0.00000000020510342851533115, x232, x225),
         );
-        let x237 = -x236;
-        let x238 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x232,
-            Self::mul_add(-s_q8, x231, c_q8 * x230),
-        );
-        let x239 = -x238;
-        let x240 = Self::mul_add(0.35, x235, x232 + Self::mul_add(-x8, x231, x7 * x230));
-        let x241 = Self::mul_add(-0.35, x234, Self::mul_add(c_q8, x231, s_q8 * x230));
-        let x242 = Self::mul_add(s_q7, x235, c_q7 * x234);
-        let x243 = -x242;
-        let x244 = Self::mul_add(-c_q7, x235, s_q7 * x234);
-        let x245 = -x244;
-        let x246 = -Self::mul_add(-0.75, x244, Self::mul_add(s_q7, x241, c_q7 * x240));
-        let x247 = -(Self::mul_add(-c_q7, x241, s_q7 * x240)
-            + Self::mul_add(-0.65, x236, 0.75 * x242));
-        let x248 = -Self::mul_add(0.65, x244, x238);
-        let x249 = Self::mul_add(c_q10, x74, x97);
-        let x250 = Self::mul_add(-s_q10, x74, x95);
-        let x251 = Self::mul_add(-s_q10, x80, c_q10 * x79);
-        let x252 = Self::mul_add(c_q10, x80, s_q10 * x79);
-        let x253 = Self::mul_add(-0.87, x249, x81);
-        let x254 = Self::mul_add(-c_q9, x250, s_q9 * x249);
-        let x255 = Self::mul_add(x12, x250, x11 * x249);
-        let x256 = Self::mul_add(s_q9, x250, c_q9 * x249);
-        let x257 = 0.00000000020510342851533115 * x253;
-        let x258 = Self::mul_add(c_q9, x252, s_q9 * x251) + x257
-            + Self::mul_add(-0.275, x256, 0.4 * x255);
-        let x259 = Self::mul_add(
+        let x236 = Self::mul_add(-0.35, x231, Self::mul_add(c_q8, x224, s_q8 * x223));
+        let x237 = Self::mul_add(s_q7, x228, c_q7 * x231);
+        let x238 = -x237;
+        let x239 = Self::mul_add(-c_q7, x228, s_q7 * x231);
+        let x240 = -x239;
+        let x241 = -Self::mul_add(-0.75, x239, Self::mul_add(s_q7, x236, c_q7 * x235));
+        let x242 = -(Self::mul_add(-c_q7, x236, s_q7 * x235)
+            + Self::mul_add(-0.65, x229, 0.75 * x237));
+        let x243 = -Self::mul_add(0.65, x239, x233);
+        let x244 = Self::mul_add(c_q10, x65, x88);
+        let x245 = Self::mul_add(-s_q10, x65, x86);
+        let x246 = Self::mul_add(-s_q10, x71, c_q10 * x70);
+        let x247 = Self::mul_add(c_q10, x71, s_q10 * x70);
+        let x248 = Self::mul_add(-0.87, x244, x72);
+        let x249 = Self::mul_add(-c_q9, x245, s_q9 * x244);
+        let x250 = Self::mul_add(x10, x245, x9 * x244);
+        let x251 = Self::mul_add(s_q9, x245, c_q9 * x244);
+        let x252 = 0.00000000020510342851533115 * x248;
+        let x253 = Self::mul_add(c_q9, x247, s_q9 * x246) + x252
+            + Self::mul_add(-0.275, x251, 0.4 * x250);
+        let x254 = Self::mul_add(
             -0.4,
-            x254,
-            x253 + Self::mul_add(-x12, x252, x11 * x251),
+            x249,
+            x248 + Self::mul_add(-x10, x247, x9 * x246),
         );
-        let x260 = Self::mul_add(
+        let x255 = Self::mul_add(
             -0.275,
-            x254,
-            x257 - Self::mul_add(-s_q9, x252, c_q9 * x251),
+            x249,
+            x252 - Self::mul_add(-s_q9, x247, c_q9 * x246),
         );
-        let x261 = -x260;
-        let x262 = x256 - Self::mul_add(-x8, x255, x7 * x254);
-        let x263 = Self::mul_add(c_q8, x255, s_q8 * x254);
+        let x256 = -x255;
+        let x257 = Self::mul_add(-s_q8, x250, c_q8 * x249);
+        let x258 = Self::mul_add(c_q8, x250, s_q8 * x249);
+        let x259 = Self::mul_add(0.00000000020510342851533115, x251, x257);
+        let x260 = Self::mul_add(-0.00000000020510342851533115, x257, x251);
+        let x261 = Self::mul_add(-s_q8, x254, c_q8 * x253);
+        let x262 = Self::mul_add(-0.00000000020510342851533115, x255, x261);
+        let x263 = -x262;
         let x264 = Self::mul_add(
-            0.00000000020510342851533115,
-            x256,
-            Self::mul_add(-s_q8, x255, c_q8 * x254),
-        );
-        let x265 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x260,
-            Self::mul_add(-s_q8, x259, c_q8 * x258),
-        );
-        let x266 = -x265;
-        let x267 = Self::mul_add(
             -0.35,
-            x263,
-            x260 + Self::mul_add(-x8, x259, x7 * x258),
+            x258,
+            Self::mul_add(0.00000000020510342851533115, x261, x255),
         );
-        let x268 = Self::mul_add(-0.35, x262, Self::mul_add(c_q8, x259, s_q8 * x258));
-        let x269 = Self::mul_add(-s_q7, x263, c_q7 * x262);
-        let x270 = -x269;
-        let x271 = Self::mul_add(c_q7, x263, s_q7 * x262);
-        let x272 = -x271;
-        let x273 = -Self::mul_add(-0.75, x271, Self::mul_add(s_q7, x268, c_q7 * x267));
-        let x274 = -(Self::mul_add(-c_q7, x268, s_q7 * x267)
-            + Self::mul_add(0.65, x264, 0.75 * x269));
-        let x275 = -Self::mul_add(0.65, x271, x265);
-        let x276 = Self::mul_add(-x14, x35, x13 * x36);
-        let x277 = Self::mul_add(0.36, x276, x49);
-        let x278 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
-        let x279 = Self::mul_add(s_q11, x276, c_q11 * x52);
-        let x280 = Self::mul_add(-c_q11, x276, s_q11 * x52);
-        let x281 = Self::mul_add(-s_q11, x278, c_q11 * x277)
-            - Self::mul_add(x51, -0.63, 0.275 * x280);
-        let x282 = Self::mul_add(0.275, x279, Self::mul_add(c_q11, x278, s_q11 * x277));
-        let x283 = Self::mul_add(0.63, x279, x59);
-        let x284 = -x283;
-        let x285 = Self::mul_add(-s_q10, x280, c_q10 * x279);
-        let x286 = Self::mul_add(c_q10, x280, s_q10 * x279);
-        let x287 = Self::mul_add(c_q10, x282, s_q10 * x281);
-        let x288 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x282, c_q10 * x281));
-        let x289 = Self::mul_add(0.87, x285, x283);
-        let x290 = -x289;
-        let x291 = 0.00000000020510342851533115 * x51;
-        let x292 = Self::mul_add(c_q9, x286, s_q9 * x285) + x291;
-        let x293 = x51 + Self::mul_add(-x12, x286, x11 * x285);
-        let x294 = x291 - Self::mul_add(-s_q9, x286, c_q9 * x285);
-        let x295 = 0.00000000020510342851533115 * x289;
-        let x296 = Self::mul_add(c_q9, x287, s_q9 * x288) - x295
-            + Self::mul_add(0.275, x294, 0.4 * x293);
-        let x297 = Self::mul_add(
-            0.4,
-            x292,
-            x289 - Self::mul_add(-x12, x287, x11 * x288),
+        let x265 = Self::mul_add(-0.35, x260, Self::mul_add(c_q8, x254, s_q8 * x253));
+        let x266 = Self::mul_add(-s_q7, x258, c_q7 * x260);
+        let x267 = -x266;
+        let x268 = Self::mul_add(c_q7, x258, s_q7 * x260);
+        let x269 = -x268;
+        let x270 = -Self::mul_add(-0.75, x268, Self::mul_add(s_q7, x265, c_q7 * x264));
+        let x271 = -(Self::mul_add(-c_q7, x265, s_q7 * x264)
+            + Self::mul_add(0.65, x259, 0.75 * x266));
+        let x272 = -Self::mul_add(0.65, x268, x262);
+        let x273 = 0.00000000020510342851533115 * x44;
+        let x274 = Self::mul_add(0.00000000020510342851533115, x34, x43);
+        let x275 = -x274;
+        let x276 = Self::mul_add(-0.36, x273, x42);
+        let x277 = Self::mul_add(
+            x45,
+            0.36,
+            Self::mul_add(-0.00000000020510342851533115, x43, x34),
         );
-        let x298 = Self::mul_add(
+        let x278 = Self::mul_add(-s_q11, x273, c_q11 * x45);
+        let x279 = Self::mul_add(c_q11, x273, s_q11 * x45);
+        let x280 = Self::mul_add(-s_q11, x277, c_q11 * x276)
+            - Self::mul_add(x44, -0.63, 0.275 * x279);
+        let x281 = Self::mul_add(0.275, x278, Self::mul_add(c_q11, x277, s_q11 * x276));
+        let x282 = Self::mul_add(0.63, x278, x274);
+        let x283 = -x282;
+        let x284 = Self::mul_add(-s_q10, x279, c_q10 * x278);
+        let x285 = Self::mul_add(c_q10, x279, s_q10 * x278);
+        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
+        let x287 = Self::mul_add(x44, 0.87, Self::mul_add(-s_q10, x281, c_q10 * x280));
+        let x288 = Self::mul_add(0.87, x284, x282);
+        let x289 = -x288;
+        let x290 = x273 + Self::mul_add(c_q9, x285, s_q9 * x284);
+        let x291 = x44 + Self::mul_add(-x10, x285, x9 * x284);
+        let x292 = x273 - Self::mul_add(-s_q9, x285, c_q9 * x284);
+        let x293 = 0.00000000020510342851533115 * x288;
+        let x294 = Self::mul_add(c_q9, x286, s_q9 * x287) - x293
+            + Self::mul_add(0.275, x292, 0.4 * x291);
+        let x295 = Self::mul_add(0.4, x290, x288 - Self::mul_add(-x10, x286, x9 * x287));
+        let x296 = Self::mul_add(
             0.275,
-            x292,
-            x295 + Self::mul_add(-s_q9, x287, c_q9 * x288),
+            x290,
+            x293 + Self::mul_add(-s_q9, x286, c_q9 * x287),
         );
-        let x299 = x294 + Self::mul_add(-x8, x293, x7 * x292);
-        let x300 = Self::mul_add(c_q8, x293, s_q8 * x292);
-        let x301 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x294,
-            Self::mul_add(-s_q8, x293, c_q8 * x292),
-        );
-        let x302 = Self::mul_add(
-            0.00000000020510342851533115,
-            x298,
-            Self::mul_add(s_q8, x297, c_q8 * x296),
-        );
+        let x297 = Self::mul_add(-s_q8, x291, c_q8 * x290);
+        let x298 = Self::mul_add(c_q8, x291, s_q8 * x290);
+        let x299 = Self::mul_add(-0.00000000020510342851533115, x292, x297);
+        let x300 = Self::mul_add(0.00000000020510342851533115, x297, x292);
+        let x301 = Self::mul_add(s_q8, x295, c_q8 * x294);
+        let x302 = Self::mul_add(0.00000000020510342851533115, x296, x301);
         let x303 = -x302;
-        let x304 = Self::mul_add(0.35, x300, x298 - Self::mul_add(x8, x297, x7 * x296));
-        let x305 = Self::mul_add(0.35, x299, Self::mul_add(-c_q8, x297, s_q8 * x296));
-        let x306 = Self::mul_add(s_q7, x300, c_q7 * x299);
-        let x307 = Self::mul_add(-c_q7, x300, s_q7 * x299);
+        let x304 = Self::mul_add(
+            0.35,
+            x298,
+            Self::mul_add(-0.00000000020510342851533115, x301, x296),
+        );
+        let x305 = Self::mul_add(0.35, x300, Self::mul_add(-c_q8, x295, s_q8 * x294));
+        let x306 = Self::mul_add(s_q7, x298, c_q7 * x300);
+        let x307 = Self::mul_add(-c_q7, x298, s_q7 * x300);
         let x308 = Self::mul_add(-0.75, x307, Self::mul_add(-s_q7, x305, c_q7 * x304));
         let x309 = Self::mul_add(c_q7, x305, s_q7 * x304)
-            + Self::mul_add(-0.65, x301, 0.75 * x306);
+            + Self::mul_add(-0.65, x299, 0.75 * x306);
         let x310 = -Self::mul_add(-0.65, x307, x302);
-        let x311 = 4.806620000000001 * x15;
-        let x312 = x32
-            + (1.4135609200000003
-                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
-        let x313 = Self::mul_add(-0.16, x311, x22);
-        let x314 = Self::mul_add(-0.55, x311, x29);
-        let x315 = Self::mul_add(s_q12, x23, c_q12 * x311);
-        let x316 = x24 - Self::mul_add(-x14, x23, x13 * x311);
-        let x317 = Self::mul_add(
-            0.00000000020510342851533115,
-            x24,
-            Self::mul_add(-c_q12, x23, s_q12 * x311),
-        );
-        let x318 = Self::mul_add(
-            0.00000000020510342851533115,
-            x314,
-            Self::mul_add(-c_q12, x313, s_q12 * x312),
-        );
-        let x319 = -x318;
-        let x320 = Self::mul_add(0.36, x316, Self::mul_add(s_q12, x313, c_q12 * x312));
-        let x321 = Self::mul_add(
+        let x311 = 0.00000000020510342851533115 * x18;
+        let x312 = x25
+            + Self::mul_add(0.00000000020510342851533115, x15, 1.4135609200000003);
+        let x313 = Self::mul_add(-0.16, x311, x16);
+        let x314 = Self::mul_add(-0.55, x311, x15 + -0.0000000002899261911072858);
+        let x315 = Self::mul_add(s_q12, x17, c_q12 * x311);
+        let x316 = Self::mul_add(-c_q12, x17, s_q12 * x311);
+        let x317 = Self::mul_add(-0.00000000020510342851533115, x316, x18);
+        let x318 = x311 + x316;
+        let x319 = Self::mul_add(-c_q12, x313, s_q12 * x312);
+        let x320 = Self::mul_add(0.00000000020510342851533115, x314, x319);
+        let x321 = -x320;
+        let x322 = Self::mul_add(0.36, x317, Self::mul_add(s_q12, x313, c_q12 * x312));
+        let x323 = Self::mul_add(
             -0.36,
             x315,
-            x314 - Self::mul_add(-x14, x313, x13 * x312),
+            Self::mul_add(-0.00000000020510342851533115, x319, x314),
         );
-        let x322 = Self::mul_add(-s_q11, x316, c_q11 * x315);
-        let x323 = Self::mul_add(c_q11, x316, s_q11 * x315);
-        let x324 = Self::mul_add(-s_q11, x321, c_q11 * x320)
-            + Self::mul_add(0.63, x317, 0.275 * x323);
-        let x325 = Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x321, s_q11 * x320));
-        let x326 = Self::mul_add(-0.63, x322, x318);
-        let x327 = -x326;
-        let x328 = Self::mul_add(-s_q10, x323, c_q10 * x322);
-        let x329 = Self::mul_add(c_q10, x323, s_q10 * x322);
-        let x330 = Self::mul_add(c_q10, x325, s_q10 * x324);
-        let x331 = Self::mul_add(0.87, x317, Self::mul_add(-s_q10, x325, c_q10 * x324));
-        let x332 = Self::mul_add(-0.87, x328, x326);
-        let x333 = -x332;
-        let x334 = 0.00000000020510342851533115 * x317;
-        let x335 = Self::mul_add(c_q9, x329, s_q9 * x328) - x334;
-        let x336 = x317 - Self::mul_add(-x12, x329, x11 * x328);
-        let x337 = x334 + Self::mul_add(-s_q9, x329, c_q9 * x328);
-        let x338 = 0.00000000020510342851533115 * x332;
-        let x339 = Self::mul_add(c_q9, x330, s_q9 * x331) - x338
-            + Self::mul_add(0.275, x337, 0.4 * x336);
-        let x340 = Self::mul_add(
+        let x324 = Self::mul_add(-s_q11, x317, c_q11 * x315);
+        let x325 = Self::mul_add(c_q11, x317, s_q11 * x315);
+        let x326 = Self::mul_add(-s_q11, x323, c_q11 * x322)
+            + Self::mul_add(0.63, x318, 0.275 * x325);
+        let x327 = Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x323, s_q11 * x322));
+        let x328 = Self::mul_add(-0.63, x324, x320);
+        let x329 = -x328;
+        let x330 = Self::mul_add(-s_q10, x325, c_q10 * x324);
+        let x331 = Self::mul_add(c_q10, x325, s_q10 * x324);
+        let x332 = Self::mul_add(c_q10, x327, s_q10 * x326);
+        let x333 = Self::mul_add(0.87, x318, Self::mul_add(-s_q10, x327, c_q10 * x326));
+        let x334 = Self::mul_add(-0.87, x330, x328);
+        let x335 = -x334;
+        let x336 = 0.00000000020510342851533115 * x318;
+        let x337 = Self::mul_add(c_q9, x331, s_q9 * x330) - x336;
+        let x338 = x318 - Self::mul_add(-x10, x331, x9 * x330);
+        let x339 = x336 + Self::mul_add(-s_q9, x331, c_q9 * x330);
+        let x340 = 0.00000000020510342851533115 * x334;
+        let x341 = Self::mul_add(c_q9, x332, s_q9 * x333) - x340
+            + Self::mul_add(0.275, x339, 0.4 * x338);
+        let x342 = Self::mul_add(
             -0.4,
-            x335,
-            x332 - Self::mul_add(-x12, x330, x11 * x331),
-        );
-        let x341 = Self::mul_add(
-            -0.275,
-            x335,
-            x338 + Self::mul_add(-s_q9, x330, c_q9 * x331),
-        );
-        let x342 = x337 - Self::mul_add(x8, x336, x7 * x335);
-        let x343 = Self::mul_add(-c_q8, x336, s_q8 * x335);
-        let x344 = Self::mul_add(
-            0.00000000020510342851533115,
             x337,
-            Self::mul_add(s_q8, x336, c_q8 * x335),
+            x334 - Self::mul_add(-x10, x332, x9 * x333),
         );
-        let x345 = -x344;
-        let x346 = Self::mul_add(
-            0.00000000020510342851533115,
-            x341,
-            Self::mul_add(s_q8, x340, c_q8 * x339),
+        let x343 = Self::mul_add(
+            -0.275,
+            x337,
+            x340 + Self::mul_add(-s_q9, x332, c_q9 * x333),
         );
+        let x344 = Self::mul_add(s_q8, x338, c_q8 * x337);
+        let x345 = Self::mul_add(-c_q8, x338, s_q8 * x337);
+        let x346 = Self::mul_add(0.00000000020510342851533115, x339, x344);
         let x347 = -x346;
-        let x348 = Self::mul_add(-0.35, x343, x341 - Self::mul_add(x8, x340, x7 * x339));
-        let x349 = Self::mul_add(0.35, x342, Self::mul_add(-c_q8, x340, s_q8 * x339));
-        let x350 = Self::mul_add(-s_q7, x343, c_q7 * x342);
-        let x351 = Self::mul_add(c_q7, x343, s_q7 * x342);
-        let x352 = Self::mul_add(-0.75, x351, Self::mul_add(-s_q7, x349, c_q7 * x348));
-        let x353 = Self::mul_add(c_q7, x349, s_q7 * x348)
-            + Self::mul_add(0.65, x344, 0.75 * x350);
-        let x354 = -Self::mul_add(-0.65, x351, x346);
-        let x355 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x356 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x357 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x358 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x359 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x360 = v[4] * v[4];
-        let x361 = Self::mul_add(v[5], v[5], x360);
-        let x362 = v[3] * v[4];
-        let x363 = v[3] * v[5];
-        let x364 = v[4] * v[5];
-        let x365 = Self::mul_add(v[3], v[3], x360);
-        let x366 = x355 + Self::mul_add(-0.75, x363, 0.65 * x361);
-        let x367 = x356 + Self::mul_add(0.75, x364, 0.65 * x362);
-        let x368 = x357 - Self::mul_add(-0.75, x365, 0.65 * x363);
-        let x369 = Self::mul_add(c_q7, x367, s_q7 * x366);
-        let x370 = v[6] * x359;
-        let x371 = v[6] * x358;
-        let x372 = v[5] + v[6];
-        let x373 = x359 * x359;
-        let x374 = x358 * x372;
-        let x375 = Self::mul_add(x372, -16.80768997608804, x359 * 0.07309);
-        let x376 = Self::mul_add(
-            -0.1132,
-            x372,
-            Self::mul_add(130.43769025763282, x359, x358 * 0.07309),
+        let x348 = Self::mul_add(-0.00000000020510342851533115, x344, x339);
+        let x349 = Self::mul_add(s_q8, x342, c_q8 * x341);
+        let x350 = Self::mul_add(0.00000000020510342851533115, x343, x349);
+        let x351 = -x350;
+        let x352 = Self::mul_add(
+            -0.35,
+            x345,
+            Self::mul_add(-0.00000000020510342851533115, x349, x343),
         );
-        let x377 = Self::mul_add(
-            -132.47349025763282,
-            x372,
-            Self::mul_add(0.1132, x359, x358 * 16.80768997608804),
-        );
-        let x378 = Self::mul_add(c_q8, x372, Self::mul_add(s_q8, x359, x7 * x358));
-        let x379 = Self::mul_add(s_q8, x372, Self::mul_add(-c_q8, x359, x8 * x358));
+        let x353 = Self::mul_add(0.35, x348, Self::mul_add(-c_q8, x342, s_q8 * x341));
+        let x354 = Self::mul_add(-s_q7, x345, c_q7 * x348);
+        let x355 = Self::mul_add(c_q7, x345, s_q7 * x348);
+        let x356 = Self::mul_add(-0.75, x355, Self::mul_add(-s_q7, x353, c_q7 * x352));
+        let x357 = Self::mul_add(c_q7, x353, s_q7 * x352)
+            + Self::mul_add(0.65, x346, 0.75 * x354);
+        let x358 = -Self::mul_add(-0.65, x355, x350);
+        let x359 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x360 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x361 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x362 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x363 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x364 = v[4] * v[4];
+        let x365 = Self::mul_add(v[5], v[5], x364);
+        let x366 = v[3] * v[4];
+        let x367 = v[3] * v[5];
+        let x368 = v[4] * v[5];
+        let x369 = Self::mul_add(v[3], v[3], x364);
+        let x370 = x359 + Self::mul_add(-0.75, x367, 0.65 * x365);
+        let x371 = x360 + Self::mul_add(0.75, x368, 0.65 * x366);
+        let x372 = x361 - Self::mul_add(-0.75, x369, 0.65 * x367);
+        let x373 = Self::mul_add(c_q7, x371, s_q7 * x370);
+        let x374 = v[6] * x363;
+        let x375 = v[6] * x362;
+        let x376 = v[5] + v[6];
+        let x377 = x363 * x363;
+        let x378 = x362 * x376;
+        let x379 = Self::mul_add(x376, -16.80768997608804, x363 * 0.07309);
         let x380 = Self::mul_add(
+            -0.1132,
+            x376,
+            Self::mul_add(130.43769025763282, x363, x362 * 0.07309),
+        );
+        let x381 = Self::mul_add(
+            -132.47349025763282,
+            x376,
+            Self::mul_add(0.1132, x363, x362 * 16.80768997608804),
+        );
+        let x382 = Self::mul_add(0.00000000020510342851533115, x362, x376);
+        let x383 = Self::mul_add(s_q8, x363, c_q8 * x382);
+        let x384 = Self::mul_add(-c_q8, x363, s_q8 * x382);
+        let x385 = Self::mul_add(
             0.35,
-            x371 - x374,
-            Self::mul_add(-s_q7, x367, c_q7 * x366),
+            x375 - x378,
+            Self::mul_add(-s_q7, x371, c_q7 * x370),
         );
-        let x381 = Self::mul_add(0.35, Self::mul_add(-x359, x372, x370), x369);
-        let x382 = Self::mul_add(0.35, Self::mul_add(x358, x358, x373), x368);
-        let x383 = Self::mul_add(c_q8, x382, Self::mul_add(s_q8, x381, x7 * x380));
-        let x384 = Self::mul_add(s_q8, x382, Self::mul_add(-c_q8, x381, x8 * x380));
-        let x385 = Self::mul_add(-0.00000000020510342851533115, x382, x380);
-        let x386 = Self::mul_add(v[7], x379, Self::mul_add(-s_q8, x371, x7 * x370));
-        let x387 = Self::mul_add(-v[7], x378, Self::mul_add(c_q8, x371, x8 * x370));
-        let x388 = v[7] + Self::mul_add(-0.00000000020510342851533115, x372, x358);
-        let x389 = x379 * x379;
-        let x390 = x388 * x388;
-        let x391 = x378 * x379;
-        let x392 = x370 - x391;
-        let x393 = x378 * x388;
-        let x394 = x378 * x378;
-        let x395 = x390 + x394;
-        let x396 = x379 * x388;
-        let x397 = x386 + x396;
-        let x398 = Self::mul_add(
-            x388,
+        let x386 = Self::mul_add(0.35, Self::mul_add(-x363, x376, x374), x373);
+        let x387 = Self::mul_add(0.35, Self::mul_add(x362, x362, x377), x372);
+        let x388 = Self::mul_add(-0.00000000020510342851533115, x387, x385);
+        let x389 = Self::mul_add(0.00000000020510342851533115, x385, x387);
+        let x390 = Self::mul_add(s_q8, x386, c_q8 * x389);
+        let x391 = Self::mul_add(-c_q8, x386, s_q8 * x389);
+        let x392 = 0.00000000020510342851533115 * x374;
+        let x393 = Self::mul_add(v[7], x384, Self::mul_add(-s_q8, x375, c_q8 * x392));
+        let x394 = Self::mul_add(-v[7], x383, Self::mul_add(c_q8, x375, s_q8 * x392));
+        let x395 = v[7] + Self::mul_add(-0.00000000020510342851533115, x376, x362);
+        let x396 = x384 * x384;
+        let x397 = x395 * x395;
+        let x398 = x383 * x384;
+        let x399 = x374 - x398;
+        let x400 = x383 * x395;
+        let x401 = x383 * x383;
+        let x402 = x397 + x401;
+        let x403 = x384 * x395;
+        let x404 = x393 + x403;
+        let x405 = Self::mul_add(
+            x395,
             0.002139996587640933,
-            x379 * 0.0000000234896432582596,
+            x384 * 0.0000000234896432582596,
         );
-        let x399 = Self::mul_add(
+        let x406 = Self::mul_add(
             5.080660024070365,
-            x388,
-            Self::mul_add(x379, -111.7548902508081, x378 * 0.0000000234896432582596),
+            x395,
+            Self::mul_add(x384, -111.7548902508081, x383 * 0.0000000234896432582596),
         );
-        let x400 = Self::mul_add(
+        let x407 = Self::mul_add(
             113.3918902508081,
-            x388,
-            Self::mul_add(5.080660024070366, x379, x378 * 0.002139996587640933),
+            x395,
+            Self::mul_add(5.080660024070366, x384, x383 * 0.002139996587640933),
         );
-        let x401 = Self::mul_add(
-            x385,
+        let x408 = Self::mul_add(
+            x388,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x370,
-                Self::mul_add(x387, -111.7548902508081, x386 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x378, x400, x388 * x398),
+                x374,
+                Self::mul_add(x394, -111.7548902508081, x393 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x383, x407, x395 * x405),
         );
-        let x402 = Self::mul_add(-c_q9, x388, Self::mul_add(-x11, x379, s_q9 * x378));
-        let x403 = Self::mul_add(s_q9, x388, Self::mul_add(x12, x379, c_q9 * x378));
-        let x404 = x383 + Self::mul_add(-0.4, x387 + x393, 0.275 * x392);
-        let x405 = x384 + Self::mul_add(0.4, x386 - x396, 0.275 * x395);
-        let x406 = x385 - Self::mul_add(-0.4, x389 + x394, 0.275 * x397);
-        let x407 = Self::mul_add(-c_q9, x406, Self::mul_add(-x11, x405, s_q9 * x404));
-        let x408 = Self::mul_add(
+        let x409 = Self::mul_add(-c_q9, x395, Self::mul_add(-x9, x384, s_q9 * x383));
+        let x410 = Self::mul_add(s_q9, x395, Self::mul_add(x10, x384, c_q9 * x383));
+        let x411 = x390 + Self::mul_add(-0.4, x394 + x400, 0.275 * x399);
+        let x412 = x391 + Self::mul_add(0.4, x393 - x403, 0.275 * x402);
+        let x413 = x388 - Self::mul_add(-0.4, x396 + x401, 0.275 * x404);
+        let x414 = Self::mul_add(-c_q9, x413, Self::mul_add(-x9, x412, s_q9 * x411));
+        let x415 = Self::mul_add(
             -0.00000000020510342851533115,
-            x406,
-            Self::mul_add(-0.00000000020510342851533115, x404, x405),
+            x413,
+            Self::mul_add(-0.00000000020510342851533115, x411, x412),
         );
-        let x409 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x370,
-            Self::mul_add(-0.00000000020510342851533115, x386, x387),
-        );
-        let x410 = Self::mul_add(
+        let x416 = x392 - Self::mul_add(-0.00000000020510342851533115, x393, x394);
+        let x417 = Self::mul_add(
             -v[8],
-            x403,
-            Self::mul_add(-c_q9, x370, Self::mul_add(-x11, x387, s_q9 * x386)),
+            x410,
+            Self::mul_add(-c_q9, x374, Self::mul_add(-x9, x394, s_q9 * x393)),
         );
-        let x411 = Self::mul_add(
+        let x418 = Self::mul_add(
             v[8],
-            x402,
-            Self::mul_add(s_q9, x370, Self::mul_add(x12, x387, c_q9 * x386)),
+            x409,
+            Self::mul_add(s_q9, x374, Self::mul_add(x10, x394, c_q9 * x393)),
         );
-        let x412 = v[8]
+        let x419 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x388,
-                Self::mul_add(-0.00000000020510342851533115, x378, x379),
+                x395,
+                Self::mul_add(-0.00000000020510342851533115, x383, x384),
             );
-        let x413 = Self::mul_add(x402, x403, x409);
-        let x414 = Self::mul_add(x402, x402, x412 * x412);
-        let x415 = Self::mul_add(-x403, x412, x410);
-        let x416 = x412 * 0.00214;
-        let x417 = Self::mul_add(x412, -36.18604050126307, x403 * 63.36336825000001);
-        let x418 = Self::mul_add(
+        let x420 = Self::mul_add(-x409, x410, x416);
+        let x421 = Self::mul_add(x409, x409, x419 * x419);
+        let x422 = Self::mul_add(-x410, x419, x417);
+        let x423 = x419 * 0.00214;
+        let x424 = Self::mul_add(x419, -36.18604050126307, x410 * 63.36336825000001);
+        let x425 = Self::mul_add(
             69.99836825,
-            x412,
-            Self::mul_add(x403, 36.18604050126307, x402 * 0.00214),
+            x419,
+            Self::mul_add(x410, 36.18604050126307, x409 * 0.00214),
         );
-        let x419 = Self::mul_add(
-            x408,
-            81.53205,
-            Self::mul_add(x409, 0.00214, -Self::mul_add(x403, x418, x412 * x417)),
+        let x426 = Self::mul_add(
+            x415,
+            -81.53205,
+            Self::mul_add(x416, 0.00214, Self::mul_add(x410, x425, x419 * x424)),
         );
-        let x420 = Self::mul_add(
-            x407,
+        let x427 = Self::mul_add(
+            x414,
             -81.53205,
             Self::mul_add(
-                69.99836825,
-                x409,
-                Self::mul_add(x411, 36.18604050126307, x410 * 0.00214),
-            ) + Self::mul_add(x402, x417, x403 * x416),
+                -69.99836825,
+                x416,
+                Self::mul_add(x418, 36.18604050126307, x417 * 0.00214),
+            ) + Self::mul_add(x409, x424, x410 * x423),
         );
-        let x421 = Self::mul_add(s_q10, x403, c_q10 * x402);
-        let x422 = Self::mul_add(-c_q10, x403, s_q10 * x402);
-        let x423 = Self::mul_add(-0.87, x413, x407);
-        let x424 = Self::mul_add(
+        let x428 = Self::mul_add(s_q10, x410, c_q10 * x409);
+        let x429 = Self::mul_add(-c_q10, x410, s_q10 * x409);
+        let x430 = Self::mul_add(0.87, x420, x414);
+        let x431 = Self::mul_add(
             0.87,
-            x414,
-            Self::mul_add(s_q9, x406, Self::mul_add(x12, x405, c_q9 * x404)),
+            x421,
+            Self::mul_add(s_q9, x413, Self::mul_add(x10, x412, c_q9 * x411)),
         );
-        let x425 = Self::mul_add(0.87, x415, x408);
-        let x426 = Self::mul_add(s_q10, x424, c_q10 * x423);
-        let x427 = Self::mul_add(v[9], x422, Self::mul_add(s_q10, x411, c_q10 * x410));
-        let x428 = Self::mul_add(-v[9], x421, Self::mul_add(-c_q10, x411, s_q10 * x410));
-        let x429 = v[9] + x412;
-        let x430 = Self::mul_add(-x421, x422, x409);
-        let x431 = x421 * x421;
-        let x432 = Self::mul_add(x429, x429, x431);
-        let x433 = x422 * x429;
-        let x434 = x427 + x433;
-        let x435 = x429 * 0.6328;
-        let x436 = Self::mul_add(x429, 24.35164200091464, x422 * 24.4950615);
-        let x437 = Self::mul_add(
+        let x432 = Self::mul_add(0.87, x422, x415);
+        let x433 = Self::mul_add(s_q10, x431, c_q10 * x430);
+        let x434 = Self::mul_add(v[9], x429, Self::mul_add(s_q10, x418, c_q10 * x417));
+        let x435 = Self::mul_add(-v[9], x428, Self::mul_add(-c_q10, x418, s_q10 * x417));
+        let x436 = v[9] + x419;
+        let x437 = Self::mul_add(x428, x429, x416);
+        let x438 = x428 * x428;
+        let x439 = Self::mul_add(x436, x436, x438);
+        let x440 = x429 * x436;
+        let x441 = x434 + x440;
+        let x442 = x436 * 0.6328;
+        let x443 = Self::mul_add(x436, 24.35164200091464, x429 * 24.4950615);
+        let x444 = Self::mul_add(
             28.2393615,
-            x429,
-            Self::mul_add(x422, -24.351642000914637, x421 * 0.6328),
+            x436,
+            Self::mul_add(x429, -24.351642000914637, x428 * 0.6328),
         );
-        let x438 = Self::mul_add(
-            x425,
-            45.1584,
-            Self::mul_add(x409, 0.6328, Self::mul_add(x422, x437, x429 * x436)),
+        let x445 = Self::mul_add(
+            x432,
+            -45.1584,
+            Self::mul_add(x416, 0.6328, -Self::mul_add(x429, x444, x436 * x443)),
         );
-        let x439 = Self::mul_add(
-            x426,
+        let x446 = Self::mul_add(
+            x433,
             -45.1584,
             Self::mul_add(
-                28.2393615,
-                x409,
-                Self::mul_add(x428, -24.351642000914637, x427 * 0.6328),
-            ) - Self::mul_add(x421, x436, x422 * x435),
+                -28.2393615,
+                x416,
+                Self::mul_add(x435, -24.351642000914637, x434 * 0.6328),
+            ) - Self::mul_add(x428, x443, x429 * x442),
         );
-        let x440 = Self::mul_add(-s_q11, x422, c_q11 * x421);
-        let x441 = Self::mul_add(c_q11, x422, s_q11 * x421);
-        let x442 = x426
-            - Self::mul_add(-0.275, Self::mul_add(x421, x429, x428), 0.63 * x430);
-        let x443 = Self::mul_add(-c_q10, x424, s_q10 * x423)
-            - Self::mul_add(0.275, x427 - x433, 0.63 * x432);
-        let x444 = x425
-            + Self::mul_add(-0.275, Self::mul_add(x422, x422, x431), 0.63 * x434);
-        let x445 = Self::mul_add(-s_q11, x443, c_q11 * x442);
-        let x446 = Self::mul_add(v[10], x441, Self::mul_add(-s_q11, x428, c_q11 * x427));
-        let x447 = Self::mul_add(-v[10], x440, Self::mul_add(c_q11, x428, s_q11 * x427));
-        let x448 = v[10] + x429;
-        let x449 = x440 * x440;
-        let x450 = x441 * x448;
-        let x451 = 0.01675 * x448;
-        let x452 = Self::mul_add(-2.5482240016099564, x448, x441 * 9.142025249762803);
-        let x453 = Self::mul_add(
+        let x447 = Self::mul_add(-s_q11, x429, c_q11 * x428);
+        let x448 = Self::mul_add(c_q11, x429, s_q11 * x428);
+        let x449 = x433
+            + Self::mul_add(0.275, Self::mul_add(x428, x436, x435), 0.63 * x437);
+        let x450 = Self::mul_add(-c_q10, x431, s_q10 * x430)
+            - Self::mul_add(0.275, x434 - x440, 0.63 * x439);
+        let x451 = x432
+            + Self::mul_add(-0.275, Self::mul_add(x429, x429, x438), 0.63 * x441);
+        let x452 = Self::mul_add(-s_q11, x450, c_q11 * x449);
+        let x453 = Self::mul_add(v[10], x448, Self::mul_add(-s_q11, x435, c_q11 * x434));
+        let x454 = Self::mul_add(-v[10], x447, Self::mul_add(c_q11, x435, s_q11 * x434));
+        let x455 = v[10] + x436;
+        let x456 = x447 * x447;
+        let x457 = x448 * x455;
+        let x458 = 0.01675 * x455;
+        let x459 = Self::mul_add(-2.5482240016099564, x455, x448 * 9.142025249762803);
+        let x460 = Self::mul_add(
             -9.223235249762805,
-            x448,
-            Self::mul_add(-2.5482240016099564, x441, 0.01675 * x440),
+            x455,
+            Self::mul_add(-2.5482240016099564, x448, 0.01675 * x447),
         );
-        let x454 = Self::mul_add(
-            7.078399999258757,
-            x444,
-            Self::mul_add(0.01675, x409, -Self::mul_add(-x441, x453, x448 * x452)),
-        );
-        let x455 = Self::mul_add(
+        let x461 = Self::mul_add(
             -7.078399999258757,
-            x445,
-            Self::mul_add(
-                -9.223235249762805,
-                x409,
-                Self::mul_add(-2.5482240016099564, x447, 0.01675 * x446),
-            ) - Self::mul_add(-x440, x452, x441 * x451),
+            x451,
+            Self::mul_add(0.01675, x416, Self::mul_add(-x448, x460, x455 * x459)),
         );
-        let x456 = Self::mul_add(s_q12, x448, Self::mul_add(x13, x441, c_q12 * x440));
-        let x457 = Self::mul_add(-c_q12, x448, Self::mul_add(-x14, x441, s_q12 * x440));
-        let x458 = Self::mul_add(0.36, Self::mul_add(x440, x448, x447), x445);
-        let x459 = Self::mul_add(
+        let x462 = Self::mul_add(
+            -7.078399999258757,
+            x452,
+            Self::mul_add(
+                9.223235249762805,
+                x416,
+                Self::mul_add(-2.5482240016099564, x454, 0.01675 * x453),
+            ) - Self::mul_add(-x447, x459, x448 * x458),
+        );
+        let x463 = Self::mul_add(0.00000000020510342851533115, x448, x455);
+        let x464 = Self::mul_add(s_q12, x463, c_q12 * x447);
+        let x465 = Self::mul_add(-c_q12, x463, s_q12 * x447);
+        let x466 = Self::mul_add(0.36, Self::mul_add(x447, x455, x454), x452);
+        let x467 = Self::mul_add(
             -0.36,
-            x446 - x450,
-            Self::mul_add(c_q11, x443, s_q11 * x442),
+            x453 - x457,
+            Self::mul_add(c_q11, x450, s_q11 * x449),
         );
-        let x460 = Self::mul_add(-0.36, Self::mul_add(x441, x441, x449), x444);
-        let x461 = Self::mul_add(s_q12, x460, Self::mul_add(x13, x459, c_q12 * x458));
-        let x462 = Self::mul_add(-c_q12, x460, Self::mul_add(-x14, x459, s_q12 * x458));
-        let x463 = Self::mul_add(-0.00000000020510342851533115, x460, x459);
-        let x464 = Self::mul_add(-0.00000000020510342851533115, x409, x447);
-        let x465 = Self::mul_add(
-            v[11],
-            x457,
-            Self::mul_add(s_q12, x409, Self::mul_add(x13, x447, c_q12 * x446)),
-        );
-        let x466 = Self::mul_add(
-            -v[11],
-            x456,
-            Self::mul_add(-c_q12, x409, Self::mul_add(-x14, x447, s_q12 * x446)),
-        );
-        let x467 = v[11] + Self::mul_add(-0.00000000020510342851533115, x448, x441);
-        let x468 = x457 * x457;
-        let x469 = x467 * x467;
-        let x470 = x456 * x457;
-        let x471 = x464 - x470;
-        let x472 = x456 * x467;
-        let x473 = x456 * x456;
-        let x474 = x469 + x473;
-        let x475 = x457 * x467;
-        let x476 = x465 + x475;
-        let x477 = Self::mul_add(x467, 0.809539999555672, x457 * 1.9877000000000002);
-        let x478 = Self::mul_add(
-            x467,
-            -2.741639999592316,
-            Self::mul_add(x457, -5.252920330000002, x456 * 1.9877000000000002),
-        );
-        let x479 = Self::mul_add(
-            9.740442170000001,
-            x467,
-            Self::mul_add(x457, -2.7416399995923166, x456 * 0.809539999555672),
-        );
-        let x480 = Self::mul_add(
-            -3.6140000000000003,
-            x463,
-            Self::mul_add(
-                x464,
-                -2.741639999592316,
-                Self::mul_add(x466, -5.252920330000002, x465 * 1.9877000000000002),
-            ) + Self::mul_add(-x456, x479, x467 * x477),
-        );
-        let x481 = Self::mul_add(-c_q13, x467, Self::mul_add(s_q13, x457, x15 * x456));
-        let x482 = Self::mul_add(-s_q13, x467, Self::mul_add(-c_q13, x457, x16 * x456));
-        let x483 = x461 + Self::mul_add(-0.16, x466 + x472, 0.55 * x471);
-        let x484 = x463 - Self::mul_add(-0.16, x468 + x473, 0.55 * x476);
-        let x485 = Self::mul_add(
-            -c_q13,
-            x484,
-            Self::mul_add(
-                s_q13,
-                x462 + Self::mul_add(0.16, x465 - x475, 0.55 * x474),
-                x15 * x483,
-            ),
-        );
-        let x486 = Self::mul_add(0.00000000020510342851533115, x464, x465);
-        let x487 = Self::mul_add(
-            v[12],
-            x482,
-            Self::mul_add(-c_q13, x464, Self::mul_add(s_q13, x466, x15 * x465)),
-        );
+        let x468 = Self::mul_add(-0.36, Self::mul_add(x448, x448, x456), x451);
+        let x469 = Self::mul_add(0.00000000020510342851533115, x467, x468);
+        let x470 = Self::mul_add(-0.00000000020510342851533115, x468, x467);
+        let x471 = Self::mul_add(s_q12, x469, c_q12 * x466);
+        let x472 = Self::mul_add(-c_q12, x469, s_q12 * x466);
+        let x473 = Self::mul_add(-0.00000000020510342851533115, x454, x416);
+        let x474 = Self::mul_add(0.00000000020510342851533115, x416, x454);
+        let x475 = Self::mul_add(v[11], x465, Self::mul_add(-s_q12, x473, c_q12 * x453));
+        let x476 = Self::mul_add(-v[11], x464, Self::mul_add(c_q12, x473, s_q12 * x453));
+        let x477 = v[11] + Self::mul_add(-0.00000000020510342851533115, x455, x448);
+        let x478 = x465 * x465;
+        let x479 = x477 * x477;
+        let x480 = x464 * x465;
+        let x481 = x474 - x480;
+        let x482 = x464 * x477;
+        let x483 = x464 * x464;
+        let x484 = x479 + x483;
+        let x485 = x465 * x477;
+        let x486 = x475 + x485;
+        let x487 = Self::mul_add(x477, 0.809539999555672, x465 * 1.9877000000000002);
         let x488 = Self::mul_add(
-            -v[12],
-            x481,
-            Self::mul_add(-s_q13, x464, Self::mul_add(-c_q13, x466, x16 * x465)),
+            x477,
+            -2.741639999592316,
+            Self::mul_add(x465, -5.252920330000002, x464 * 1.9877000000000002),
         );
-        let x489 = v[12] - Self::mul_add(0.00000000020510342851533115, x467, x456);
-        let x490 = 4.806620000000001 * Self::mul_add(x481, x482, x486);
-        let x491 = 4.806620000000001 * Self::mul_add(x481, x481, x489 * x489);
-        let x492 = 4.806620000000001 * Self::mul_add(x482, x489, x487);
-        let x493 = Self::mul_add(0.0145, x489, 0.000781 * x482);
-        let x494 = Self::mul_add(
-            -0.9614610000000001,
-            x489,
-            Self::mul_add(1.2025609200000003, x482, 0.000781 * x481),
-        );
-        let x495 = Self::mul_add(
-            -1.4135609200000003,
-            x489,
-            Self::mul_add(-0.9614610000000001, x482, 0.0145 * x481),
-        );
-        let x496 = Self::mul_add(
-            0.9614610000000001,
-            x486,
-            Self::mul_add(1.2025609200000003, x488, 0.000781 * x487),
-        ) + Self::mul_add(-x481, x495, x489 * x493);
-        let x497 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x484, x483),
-            Self::mul_add(-0.0145, x486, 0.000781 * x488)
-                - Self::mul_add(-x482, x495, x489 * x494),
-        );
-        let x498 = Self::mul_add(
-            4.806620000000001,
-            x485,
-            Self::mul_add(
-                1.4135609200000003,
-                x486,
-                Self::mul_add(-0.9614610000000001, x488, 0.0145 * x487),
-            ) - Self::mul_add(-x481, x494, x482 * x493),
-        );
-        let x499 = x492 - Self::mul_add(-x16, x491, x15 * x490);
-        let x500 = Self::mul_add(c_q13, x491, s_q13 * x490);
-        let x501 = Self::mul_add(
-            0.00000000020510342851533115,
-            x492,
-            Self::mul_add(-s_q13, x491, c_q13 * x490),
-        );
-        let x502 = Self::mul_add(
-            -0.55,
-            x499,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x498,
-                Self::mul_add(s_q13, x496, c_q13 * x497),
-            ),
-        );
-        let x503 = Self::mul_add(
-            -17.135250000000003,
-            x471,
-            3.6140000000000003 * (x468 + x469),
-        ) + x499;
-        let x504 = Self::mul_add(
-            17.135250000000003,
-            x474,
-            3.6140000000000003 * (x464 + x470),
-        ) + x500;
-        let x505 = Self::mul_add(
-            17.135250000000003,
-            x476,
-            3.6140000000000003 * (x466 - x472),
-        ) + x501;
-        let x506 = Self::mul_add(
-            -17.135250000000003,
-            x463,
-            Self::mul_add(x464, 0.809539999555672, x466 * 1.9877000000000002)
-                - Self::mul_add(-x457, x479, x467 * x478),
-        )
-            + (x498 - Self::mul_add(x16, x496, x15 * x497)
-                + Self::mul_add(0.55, x501, 0.16 * x500));
-        let x507 = x480
-            - Self::mul_add(-0.16, x499, Self::mul_add(-c_q13, x496, s_q13 * x497));
-        let x508 = Self::mul_add(
+        let x489 = Self::mul_add(
             9.740442170000001,
-            x464,
-            Self::mul_add(x466, -2.7416399995923166, x465 * 0.809539999555672),
-        ) - Self::mul_add(-x456, x478, x457 * x477)
-            + Self::mul_add(3.6140000000000003, x462, 17.135250000000003 * x461) + x502;
-        let x509 = -x508;
-        let x510 = Self::mul_add(-s_q12, x504, c_q12 * x503);
-        let x511 = x505 + Self::mul_add(x14, x504, x13 * x503);
-        let x512 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(-x440, x441, x409),
-            -x510,
+            x477,
+            Self::mul_add(x465, -2.7416399995923166, x464 * 0.809539999555672),
         );
-        let x513 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x448, x448, x449),
-            -x511,
-        );
-        let x514 = Self::mul_add(
-            7.078399999258757,
-            x446 + x450,
+        let x490 = Self::mul_add(
+            -3.6140000000000003,
+            x470,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x505,
-                Self::mul_add(c_q12, x504, s_q12 * x503),
-            ),
+                x474,
+                -2.741639999592316,
+                Self::mul_add(x476, -5.252920330000002, x475 * 1.9877000000000002),
+            ) + Self::mul_add(-x464, x489, x477 * x487),
         );
-        let x515 = x454
-            - Self::mul_add(0.36, x511, Self::mul_add(s_q12, x507, c_q12 * x506));
-        let x516 = Self::mul_add(-2.5482240016099564, x409, x447 * 9.142025249762803)
-            + Self::mul_add(-x440, x453, x448 * x451)
-            - Self::mul_add(-0.36, x510, x508 + Self::mul_add(-x14, x507, x13 * x506));
-        let x517 = x455
+        let x491 = Self::mul_add(-0.00000000020510342851533115, x464, x477);
+        let x492 = Self::mul_add(-s_q13, x465, c_q13 * x491);
+        let x493 = Self::mul_add(c_q13, x465, s_q13 * x491);
+        let x494 = x471 + Self::mul_add(-0.16, x476 + x482, 0.55 * x481);
+        let x495 = x470 - Self::mul_add(-0.16, x478 + x483, 0.55 * x486);
+        let x496 = Self::mul_add(0.00000000020510342851533115, x474, x475);
+        let x497 = Self::mul_add(-0.00000000020510342851533115, x475, x474);
+        let x498 = Self::mul_add(v[12], x493, Self::mul_add(-s_q13, x476, c_q13 * x497));
+        let x499 = Self::mul_add(-v[12], x492, Self::mul_add(c_q13, x476, s_q13 * x497));
+        let x500 = v[12] - Self::mul_add(0.00000000020510342851533115, x477, x464);
+        let x501 = 4.806620000000001 * Self::mul_add(x492, x493, x496);
+        let x502 = 4.806620000000001 * Self::mul_add(x492, x492, x500 * x500);
+        let x503 = 4.806620000000001 * Self::mul_add(x493, x500, x498);
+        let x504 = Self::mul_add(-0.0145, x500, 0.000781 * x493);
+        let x505 = Self::mul_add(
+            0.9614610000000001,
+            x500,
+            Self::mul_add(1.2025609200000003, x493, 0.000781 * x492),
+        );
+        let x506 = Self::mul_add(
+            1.4135609200000003,
+            x500,
+            Self::mul_add(-0.9614610000000001, x493, 0.0145 * x492),
+        );
+        let x507 = Self::mul_add(
+            -0.9614610000000001,
+            x496,
+            Self::mul_add(1.2025609200000003, x499, 0.000781 * x498),
+        ) + Self::mul_add(x492, x506, x500 * x504);
+        let x508 = Self::mul_add(
+            -4.806620000000001,
+            Self::mul_add(0.00000000020510342851533115, x495, x494),
+            Self::mul_add(0.0145, x496, 0.000781 * x499)
+                - Self::mul_add(x493, x506, x500 * x505),
+        );
+        let x509 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(
+                -s_q13,
+                x472 + Self::mul_add(0.16, x475 - x485, 0.55 * x484),
+                c_q13 * Self::mul_add(-0.00000000020510342851533115, x494, x495),
+            ),
+            Self::mul_add(
+                -1.4135609200000003,
+                x496,
+                Self::mul_add(-0.9614610000000001, x499, 0.0145 * x498),
+            ) + Self::mul_add(-x492, x505, x493 * x504),
+        );
+        let x510 = -x509;
+        let x511 = Self::mul_add(-s_q13, x502, c_q13 * x501);
+        let x512 = Self::mul_add(c_q13, x502, s_q13 * x501);
+        let x513 = Self::mul_add(-0.00000000020510342851533115, x503, x511);
+        let x514 = Self::mul_add(0.00000000020510342851533115, x511, x503);
+        let x515 = Self::mul_add(s_q13, x507, c_q13 * x508);
+        let x516 = Self::mul_add(
+            -17.135250000000003,
+            x481,
+            3.6140000000000003 * (x478 + x479),
+        ) - x514;
+        let x517 = Self::mul_add(
+            17.135250000000003,
+            x484,
+            3.6140000000000003 * (x474 + x480),
+        ) + x512;
+        let x518 = Self::mul_add(
+            17.135250000000003,
+            x486,
+            3.6140000000000003 * (x476 - x482),
+        ) + x513;
+        let x519 = Self::mul_add(
+            -17.135250000000003,
+            x470,
+            Self::mul_add(x474, 0.809539999555672, x476 * 1.9877000000000002)
+                - Self::mul_add(-x465, x489, x477 * x488),
+        )
+            - (Self::mul_add(-0.00000000020510342851533115, x515, x509)
+                - Self::mul_add(0.55, x513, 0.16 * x512));
+        let x520 = x490
+            + Self::mul_add(-0.16, x514, Self::mul_add(-c_q13, x507, s_q13 * x508));
+        let x521 = Self::mul_add(
+            9.740442170000001,
+            x474,
+            Self::mul_add(x476, -2.7416399995923166, x475 * 0.809539999555672),
+        ) - Self::mul_add(-x464, x488, x465 * x487)
+            + Self::mul_add(3.6140000000000003, x472, 17.135250000000003 * x471)
             - Self::mul_add(
-                -0.00000000020510342851533115,
-                x508,
-                Self::mul_add(-c_q12, x507, s_q12 * x506),
+                -0.55,
+                x514,
+                Self::mul_add(0.00000000020510342851533115, x509, x515),
             );
-        let x518 = Self::mul_add(s_q11, x513, c_q11 * x512);
-        let x519 = Self::mul_add(-c_q11, x513, s_q11 * x512);
-        let x520 = Self::mul_add(x430, 45.1584, -x518);
-        let x521 = Self::mul_add(45.1584, x432, x519);
-        let x522 = Self::mul_add(45.1584, x434, -x514);
-        let x523 = x438
-            - (Self::mul_add(s_q11, x516, c_q11 * x515)
-                - Self::mul_add(-0.63, x514, 0.275 * x519));
-        let x524 = Self::mul_add(x409, 24.35164200091464, x428 * 24.4950615)
-            - Self::mul_add(-x421, x437, x429 * x435)
-            - Self::mul_add(0.275, x518, Self::mul_add(-c_q11, x516, s_q11 * x515));
-        let x525 = x439 - Self::mul_add(0.63, x518, x517);
-        let x526 = -x525;
-        let x527 = Self::mul_add(s_q10, x521, c_q10 * x520);
-        let x528 = Self::mul_add(x413, 81.53205, x527);
+        let x522 = -x521;
+        let x523 = Self::mul_add(-s_q12, x517, c_q12 * x516);
+        let x524 = Self::mul_add(c_q12, x517, s_q12 * x516);
+        let x525 = Self::mul_add(0.00000000020510342851533115, x524, x518);
+        let x526 = Self::mul_add(-c_q12, x520, s_q12 * x519);
+        let x527 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x447, x448, x416),
+            x523,
+        );
+        let x528 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x455, x455, x456),
+            -x525,
+        );
         let x529 = Self::mul_add(
-            81.53205,
-            x414,
-            -Self::mul_add(-c_q10, x521, s_q10 * x520),
+            7.078399999258757,
+            x453 + x457,
+            Self::mul_add(-0.00000000020510342851533115, x518, x524),
         );
-        let x530 = Self::mul_add(81.53205, x415, x522);
-        let x531 = x419
-            + Self::mul_add(0.87, x522, Self::mul_add(-s_q10, x524, c_q10 * x523));
-        let x532 = Self::mul_add(x409, -36.18604050126307, x411 * 63.36336825000001)
-            + Self::mul_add(-x402, x418, x412 * x416)
-            - Self::mul_add(c_q10, x524, s_q10 * x523);
-        let x533 = x420 + Self::mul_add(0.87, x527, x525);
-        let x534 = -x533;
-        let x535 = 0.00000000020510342851533115 * x530;
-        let x536 = Self::mul_add(-c_q9, x529, s_q9 * x528) + x535;
-        let x537 = x530 + Self::mul_add(x12, x529, x11 * x528);
-        let x538 = x535 - Self::mul_add(s_q9, x529, c_q9 * x528);
-        let x539 = 0.00000000020510342851533115 * x533;
-        let x540 = Self::mul_add(
-            x392,
-            -12.701650001451807,
-            (x389 + x390) * 0.000000008530897668050218,
-        ) - x536;
-        let x541 = Self::mul_add(
-            12.701650001451807,
-            x395,
-            0.000000008530897668050218 * (x370 + x391),
-        ) - x537;
-        let x542 = Self::mul_add(
-            12.701650001451807,
-            x397,
-            0.000000008530897668050218 * (x387 - x393),
-        ) - x538;
-        let x543 = Self::mul_add(
-            x385,
-            12.701650001451807,
-            Self::mul_add(x370, 0.002139996587640933, x387 * 0.0000000234896432582596)
-                - Self::mul_add(-x379, x400, x388 * x399),
-        )
-            + (Self::mul_add(-c_q9, x532, s_q9 * x531) - x539
-                + Self::mul_add(0.275, x538, 0.4 * x537));
-        let x544 = x401
-            + Self::mul_add(0.4, x536, x533 - Self::mul_add(x12, x532, x11 * x531));
-        let x545 = Self::mul_add(
-            113.3918902508081,
-            x370,
-            Self::mul_add(5.080660024070366, x387, x386 * 0.002139996587640933),
-        ) - Self::mul_add(-x378, x399, x379 * x398)
-            - Self::mul_add(x384, 0.000000008530897668050218, x383 * 12.701650001451807)
-            - Self::mul_add(0.275, x536, x539 + Self::mul_add(s_q9, x532, c_q9 * x531));
-        let x546 = -x545;
-        let x547 = x542 + Self::mul_add(-x8, x541, x7 * x540);
-        let x548 = Self::mul_add(c_q8, x541, s_q8 * x540);
-        let x549 = Self::mul_add(
-            48.0240000085309,
-            Self::mul_add(x372, x372, x373),
-            x547,
-        );
-        let x550 = Self::mul_add(48.0240000085309, x358 * x359, -x548);
-        let x551 = Self::mul_add(
-            48.0240000085309,
-            x371 + x374,
-            -Self::mul_add(
-                -0.00000000020510342851533115,
-                x542,
-                Self::mul_add(-s_q8, x541, c_q8 * x540),
-            ),
-        );
-        let x552 = Self::mul_add(x371, 0.07309, Self::mul_add(x359, x377, x372 * x376))
-            - Self::mul_add(0.35, x548, x545 + Self::mul_add(x8, x544, x7 * x543));
-        let x553 = Self::mul_add(
-            48.0240000085309,
-            x368,
-            Self::mul_add(-130.43769025763282, x371, x370 * 0.07309)
-                + Self::mul_add(x358, x377, x372 * x375),
-        ) + Self::mul_add(-0.35, x547, Self::mul_add(-c_q8, x544, s_q8 * x543));
-        let x554 = Self::mul_add(
-            48.0240000085309,
-            x369,
-            Self::mul_add(-0.1132, x371, x370 * 16.80768997608804)
-                + Self::mul_add(-x358, x376, x359 * x375),
-        )
+        let x530 = x461
+            + Self::mul_add(0.36, x525, Self::mul_add(s_q12, x520, c_q12 * x519));
+        let x531 = Self::mul_add(2.5482240016099564, x416, x454 * 9.142025249762803)
+            + Self::mul_add(-x447, x460, x455 * x458)
             - Self::mul_add(
-                -0.00000000020510342851533115,
-                x545,
-                Self::mul_add(s_q8, x544, c_q8 * x543),
+                -0.36,
+                x523,
+                Self::mul_add(0.00000000020510342851533115, x526, x521),
             );
-        let x555 = Self::mul_add(-s_q7, x550, c_q7 * x549);
-        let x556 = Self::mul_add(c_q7, x550, s_q7 * x549);
-        let x557 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x558 = 1466.4506062283303 * v[4];
-        let x559 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x560 = -(x555
+        let x532 = x462 - Self::mul_add(-0.00000000020510342851533115, x521, x526);
+        let x533 = Self::mul_add(-s_q11, x528, c_q11 * x527);
+        let x534 = Self::mul_add(c_q11, x528, s_q11 * x527);
+        let x535 = Self::mul_add(x437, 45.1584, -x533);
+        let x536 = Self::mul_add(45.1584, x439, -x534);
+        let x537 = Self::mul_add(45.1584, x441, -x529);
+        let x538 = x445
+            - (Self::mul_add(-s_q11, x531, c_q11 * x530)
+                - Self::mul_add(0.63, x529, 0.275 * x534));
+        let x539 = Self::mul_add(x416, -24.35164200091464, x435 * 24.4950615)
+            - Self::mul_add(-x428, x444, x436 * x442)
+            + Self::mul_add(0.275, x533, Self::mul_add(c_q11, x531, s_q11 * x530));
+        let x540 = x446 - Self::mul_add(-0.63, x533, x532);
+        let x541 = -x540;
+        let x542 = Self::mul_add(-s_q10, x536, c_q10 * x535);
+        let x543 = Self::mul_add(x420, 81.53205, x542);
+        let x544 = Self::mul_add(
+            81.53205,
+            x421,
+            Self::mul_add(c_q10, x536, s_q10 * x535),
+        );
+        let x545 = Self::mul_add(81.53205, x422, x537);
+        let x546 = x426
+            + Self::mul_add(-0.87, x537, Self::mul_add(s_q10, x539, c_q10 * x538));
+        let x547 = Self::mul_add(x416, 36.18604050126307, x418 * 63.36336825000001)
+            + Self::mul_add(-x409, x425, x419 * x423)
+            + Self::mul_add(-c_q10, x539, s_q10 * x538);
+        let x548 = x427 + Self::mul_add(-0.87, x542, x540);
+        let x549 = -x548;
+        let x550 = 0.00000000020510342851533115 * x545;
+        let x551 = Self::mul_add(c_q9, x544, s_q9 * x543) - x550;
+        let x552 = x545 - Self::mul_add(-x10, x544, x9 * x543);
+        let x553 = x550 + Self::mul_add(-s_q9, x544, c_q9 * x543);
+        let x554 = 0.00000000020510342851533115 * x548;
+        let x555 = Self::mul_add(
+            x399,
+            -12.701650001451807,
+            (x396 + x397) * 0.000000008530897668050218,
+        ) + x551;
+        let x556 = Self::mul_add(
+            12.701650001451807,
+            x402,
+            0.000000008530897668050218 * (x374 + x398),
+        ) - x552;
+        let x557 = Self::mul_add(
+            12.701650001451807,
+            x404,
+            0.000000008530897668050218 * (x394 - x400),
+        ) - x553;
+        let x558 = Self::mul_add(
+            x388,
+            12.701650001451807,
+            Self::mul_add(x374, 0.002139996587640933, x394 * 0.0000000234896432582596)
+                - Self::mul_add(-x384, x407, x395 * x406),
+        )
+            - (Self::mul_add(c_q9, x547, s_q9 * x546) + x554
+                - Self::mul_add(0.275, x553, 0.4 * x552));
+        let x559 = x408
+            + Self::mul_add(-0.4, x551, x548 + Self::mul_add(-x10, x547, x9 * x546));
+        let x560 = Self::mul_add(
+            113.3918902508081,
+            x374,
+            Self::mul_add(5.080660024070366, x394, x393 * 0.002139996587640933),
+        ) - Self::mul_add(-x383, x406, x384 * x405)
+            - Self::mul_add(x391, 0.000000008530897668050218, x390 * 12.701650001451807)
+            - Self::mul_add(
+                -0.275,
+                x551,
+                x554 - Self::mul_add(-s_q9, x547, c_q9 * x546),
+            );
+        let x561 = -x560;
+        let x562 = Self::mul_add(-s_q8, x556, c_q8 * x555);
+        let x563 = Self::mul_add(c_q8, x556, s_q8 * x555);
+        let x564 = Self::mul_add(0.00000000020510342851533115, x562, x557);
+        let x565 = Self::mul_add(s_q8, x559, c_q8 * x558);
+        let x566 = Self::mul_add(
+            48.0240000085309,
+            Self::mul_add(x376, x376, x377),
+            x564,
+        );
+        let x567 = Self::mul_add(48.0240000085309, x362 * x363, -x563);
+        let x568 = Self::mul_add(
+            48.0240000085309,
+            x375 + x378,
+            -Self::mul_add(-0.00000000020510342851533115, x557, x562),
+        );
+        let x569 = Self::mul_add(x375, 0.07309, Self::mul_add(x363, x381, x376 * x380))
+            - Self::mul_add(
+                0.35,
+                x563,
+                Self::mul_add(0.00000000020510342851533115, x565, x560),
+            );
+        let x570 = Self::mul_add(
+            48.0240000085309,
+            x372,
+            Self::mul_add(-130.43769025763282, x375, x374 * 0.07309)
+                + Self::mul_add(x362, x381, x376 * x379),
+        ) + Self::mul_add(-0.35, x564, Self::mul_add(-c_q8, x559, s_q8 * x558));
+        let x571 = Self::mul_add(
+            48.0240000085309,
+            x373,
+            Self::mul_add(-0.1132, x375, x374 * 16.80768997608804)
+                + Self::mul_add(-x362, x380, x363 * x379),
+        ) - Self::mul_add(-0.00000000020510342851533115, x560, x565);
+        let x572 = Self::mul_add(-s_q7, x567, c_q7 * x566);
+        let x573 = Self::mul_add(c_q7, x567, s_q7 * x566);
+        let x574 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x575 = 1466.4506062283303 * v[4];
+        let x576 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x577 = -(x572
             + Self::mul_add(
                 1170.07,
-                x355,
-                Self::mul_add(-180.9502499901501, x363, 110.5455 * x361),
+                x359,
+                Self::mul_add(-180.9502499901501, x367, 110.5455 * x365),
             ));
-        let x561 = -(x556
+        let x578 = -(x573
             - Self::mul_add(
                 1170.07,
-                x356,
-                Self::mul_add(180.9502499901501, x364, 110.5455 * x362),
+                x360,
+                Self::mul_add(180.9502499901501, x368, 110.5455 * x366),
             ));
-        let x562 = x551
+        let x579 = x568
             - Self::mul_add(
                 1170.07,
-                x357,
-                -Self::mul_add(-180.9502499901501, x365, 110.5455 * x363),
+                x361,
+                -Self::mul_add(-180.9502499901501, x369, 110.5455 * x367),
             );
-        let x563 = Self::mul_add(0.75, x556, Self::mul_add(-s_q7, x553, c_q7 * x552))
+        let x580 = Self::mul_add(0.75, x573, Self::mul_add(-s_q7, x570, c_q7 * x569))
             - Self::mul_add(
                 180.9502499901501,
-                x356,
-                Self::mul_add(v[4], x559, v[5] * x558),
+                x360,
+                Self::mul_add(v[4], x576, v[5] * x575),
             );
-        let x564 = Self::mul_add(c_q7, x553, s_q7 * x552)
-            - Self::mul_add(0.65, x551, 0.75 * x555)
-            + (Self::mul_add(v[3], x559, v[5] * x557)
-                - Self::mul_add(-110.5455, x357, 180.9502499901501 * x355));
-        let x565 = Self::mul_add(-0.65, x556, x554)
-            - Self::mul_add(-110.5455, x356, Self::mul_add(-v[3], x558, v[4] * x557));
+        let x581 = Self::mul_add(c_q7, x570, s_q7 * x569)
+            - Self::mul_add(0.65, x568, 0.75 * x572)
+            + (Self::mul_add(v[3], x576, v[5] * x574)
+                - Self::mul_add(-110.5455, x361, 180.9502499901501 * x359));
+        let x582 = Self::mul_add(-0.65, x573, x571)
+            - Self::mul_add(-110.5455, x360, Self::mul_add(-v[3], x575, v[4] * x574));
         (
             [
                 [
@@ -6002,217 +5763,217 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x192,
-                    x183,
-                    x183,
-                    x202,
-                    x220,
-                    x243,
-                    x270,
-                    x306,
-                    x350,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x197,
-                    0.0,
-                    x191,
                     x181,
-                    x203,
-                    x222,
-                    x245,
-                    x272,
-                    x307,
-                    x351,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
-                    x182,
-                    x198,
-                    0.0,
-                    0.0,
-                    x160,
-                    x214,
-                    x237,
-                    x264,
-                    x301,
-                    x345,
-                ],
-                [
-                    0.0,
-                    x197,
-                    x182,
+                    x172,
+                    x172,
                     x193,
-                    x188,
-                    x194,
-                    x187,
-                    x204,
-                    x223,
-                    x246,
-                    x273,
-                    x308,
-                    x352,
-                ],
-                [
-                    x192,
-                    0.0,
-                    x198,
-                    x188,
-                    x195,
-                    x189,
-                    x189,
-                    x205,
-                    x224,
-                    x247,
-                    x274,
-                    x309,
-                    x353,
-                ],
-                [
-                    x183,
-                    x191,
-                    0.0,
-                    x194,
-                    x189,
-                    x196,
-                    x190,
-                    x206,
-                    x225,
-                    x248,
-                    x275,
-                    x310,
+                    x213,
+                    x238,
+                    x267,
+                    x306,
                     x354,
                 ],
                 [
-                    x183,
-                    x181,
                     0.0,
+                    1170.07,
+                    0.0,
+                    x186,
+                    0.0,
+                    x180,
+                    x170,
+                    x194,
+                    x215,
+                    x240,
+                    x269,
+                    x307,
+                    x355,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    1170.07,
+                    x171,
                     x187,
-                    x189,
-                    x190,
-                    x175,
-                    x167,
-                    x216,
-                    x239,
-                    x266,
-                    x303,
+                    0.0,
+                    0.0,
+                    x151,
+                    x205,
+                    x230,
+                    x259,
+                    x299,
                     x347,
                 ],
                 [
-                    x202,
-                    x203,
-                    x160,
-                    x204,
-                    x205,
-                    x206,
-                    x167,
-                    x149,
-                    x211,
-                    x233,
-                    x261,
-                    x298,
-                    x341,
-                ],
-                [
-                    x220,
-                    x222,
-                    x214,
-                    x223,
-                    x224,
-                    x225,
+                    0.0,
+                    x186,
+                    x171,
+                    x182,
+                    x177,
+                    x183,
+                    x176,
+                    x195,
                     x216,
-                    x211,
-                    x107,
-                    x101,
-                    x253,
-                    x290,
-                    x333,
-                ],
-                [
-                    x243,
-                    x245,
-                    x237,
-                    x246,
-                    x247,
-                    x248,
-                    x239,
-                    x233,
-                    x101,
-                    x87,
-                    x81,
-                    x284,
-                    x327,
-                ],
-                [
+                    x241,
                     x270,
+                    x308,
+                    x356,
+                ],
+                [
+                    x181,
+                    0.0,
+                    x187,
+                    x177,
+                    x184,
+                    x178,
+                    x178,
+                    x196,
+                    x217,
+                    x242,
+                    x271,
+                    x309,
+                    x357,
+                ],
+                [
+                    x172,
+                    x180,
+                    0.0,
+                    x183,
+                    x178,
+                    x185,
+                    x179,
+                    x197,
+                    x218,
+                    x243,
                     x272,
-                    x264,
-                    x273,
-                    x274,
+                    x310,
+                    x358,
+                ],
+                [
+                    x172,
+                    x170,
+                    0.0,
+                    x176,
+                    x178,
+                    x179,
+                    x164,
+                    x190,
+                    x209,
+                    x234,
+                    x263,
+                    x303,
+                    x351,
+                ],
+                [
+                    x193,
+                    x194,
+                    x151,
+                    x195,
+                    x196,
+                    x197,
+                    x190,
+                    x140,
+                    x202,
+                    x226,
+                    x256,
+                    x296,
+                    x343,
+                ],
+                [
+                    x213,
+                    x215,
+                    x205,
+                    x216,
+                    x217,
+                    x218,
+                    x209,
+                    x202,
+                    x98,
+                    x92,
+                    x248,
+                    x289,
+                    x335,
+                ],
+                [
+                    x238,
+                    x240,
+                    x230,
+                    x241,
+                    x242,
+                    x243,
+                    x234,
+                    x226,
+                    x92,
+                    x78,
+                    x72,
+                    x283,
+                    x329,
+                ],
+                [
+                    x267,
+                    x269,
+                    x259,
+                    x270,
+                    x271,
+                    x272,
+                    x263,
+                    x256,
+                    x248,
+                    x72,
+                    x58,
                     x275,
-                    x266,
-                    x261,
-                    x253,
-                    x81,
-                    x67,
-                    x60,
-                    x319,
+                    x321,
                 ],
                 [
                     x306,
                     x307,
-                    x301,
+                    x299,
                     x308,
                     x309,
                     x310,
                     x303,
-                    x298,
-                    x290,
-                    x284,
-                    x60,
-                    x41,
+                    x296,
+                    x289,
+                    x283,
+                    x275,
+                    x34,
                     x314,
                 ],
                 [
-                    x350,
-                    x351,
-                    x345,
-                    x352,
-                    x353,
                     x354,
+                    x355,
                     x347,
-                    x341,
-                    x333,
-                    x327,
-                    x319,
+                    x356,
+                    x357,
+                    x358,
+                    x351,
+                    x343,
+                    x335,
+                    x329,
+                    x321,
                     x314,
                     1.4135609200000003,
                 ],
             ],
             [
-                x560,
+                x577,
+                x578,
+                x579,
+                x580,
+                x581,
+                x582,
+                x571,
                 x561,
-                x562,
-                x563,
-                x564,
-                x565,
-                x554,
-                x546,
-                x534,
-                x526,
-                x517,
-                x509,
-                x498,
+                x549,
+                x541,
+                x532,
+                x522,
+                x510,
             ],
         )
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1510 mul, 1377 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1006 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1463 mul, 1350 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -6230,1858 +5991,1790 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = 0.00000000020510342851533115 * c_q8;
-        let x8 = 0.00000000020510342851533115 * s_q8;
-        let x9 = 0.00000000020510342851533115 * c_q9;
-        let x10 = 0.00000000020510342851533115 * s_q9;
-        let x11 = x9 - x10;
-        let x12 = x9 + x10;
-        let x13 = 0.00000000020510342851533115 * s_q12;
-        let x14 = 0.00000000020510342851533115 * c_q12;
-        let x15 = 0.00000000020510342851533115 * c_q13;
-        let x16 = 0.00000000020510342851533115 * s_q13;
-        let x17 = s_q13 * s_q13;
-        let x18 = s_q13 * c_q13;
-        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
-        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
-        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x23 = 4.806620000000001 * s_q13;
-        let x24 = 4.806620000000001 * c_q13;
-        let x25 = 0.00000000020510342851533115 * x23;
-        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
-        let x27 = 0.00000000020510342851533115 * x21;
-        let x28 = 1.4135609200000003 + x27;
-        let x29 = x21 + -0.0000000002899261911072858;
-        let x30 = 0.16 * x23;
-        let x31 = 0.55 * x24;
-        let x32 = x30 + x31;
-        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
-        let x34 = Self::mul_add(
+        let x7 = 0.00000000020510342851533115 * c_q9;
+        let x8 = 0.00000000020510342851533115 * s_q9;
+        let x9 = x7 - x8;
+        let x10 = x7 + x8;
+        let x11 = s_q13 * s_q13;
+        let x12 = s_q13 * c_q13;
+        let x13 = Self::mul_add(x12, 0.001562, x11 * 1.2025609200000003);
+        let x14 = 0.000781 + Self::mul_add(x11, -0.001562, x12 * 1.2025609200000003);
+        let x15 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x16 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 1.4135609200000003 + x13;
+        let x20 = x15 + x15;
+        let x21 = Self::mul_add(0.00000000020510342851533115, x20, x19);
+        let x22 = 0.00000000020510342851533115 * x17;
+        let x23 = 0.16 * x17;
+        let x24 = 0.55 * x18;
+        let x25 = x23 + x24;
+        let x26 = x25 - (x13 - x21 - x25);
+        let x27 = Self::mul_add(
             0.55,
-            x23,
+            x17,
             Self::mul_add(
                 0.16,
-                x24,
-                Self::mul_add(-0.00000000020510342851533115, x22, x20),
+                x18,
+                Self::mul_add(-0.00000000020510342851533115, x16, x14),
             ),
         );
-        let x35 = 3.6140000000000003 + x25;
-        let x36 = 17.135250000000003 + x24;
-        let x37 = -1.9877000000000002
+        let x28 = 3.6140000000000003 + x22;
+        let x29 = 17.135250000000003 + x18;
+        let x30 = -1.9877000000000002
             - Self::mul_add(
                 0.55,
-                x25,
-                Self::mul_add(0.00000000020510342851533115, x20, x22),
+                x22,
+                Self::mul_add(0.00000000020510342851533115, x14, x16),
             );
-        let x38 = -0.809539999555672
+        let x31 = -0.809539999555672
+            - Self::mul_add(
+                0.16,
+                x22,
+                x15 - Self::mul_add(-0.00000000020510342851533115, x19, x20),
+            );
+        let x32 = -5.252920330000002 + (x23 + (-1.2025609200000003 + x13 + x23));
+        let x33 = -2.741639999592316 - x27;
+        let x34 = 9.740442170000001 + (x24 + (1.4135609200000003 - x21 + x24));
+        let x35 = s_q12 * s_q12;
+        let x36 = s_q12 * c_q12;
+        let x37 = x26 - x32;
+        let x38 = x30 + x30;
+        let x39 = Self::mul_add(x36, x38, x35 * x37);
+        let x40 = x32 + x39;
+        let x41 = x30 + Self::mul_add(-x35, x38, x36 * x37);
+        let x42 = Self::mul_add(-s_q12, x33, c_q12 * x31);
+        let x43 = Self::mul_add(c_q12, x33, s_q12 * x31);
+        let x44 = Self::mul_add(-s_q12, x29, c_q12 * x28);
+        let x45 = Self::mul_add(c_q12, x29, s_q12 * x28);
+        let x46 = x34 - x40;
+        let x47 = x43 + x43;
+        let x48 = Self::mul_add(-0.00000000020510342851533115, x47, x46);
+        let x49 = Self::mul_add(-0.00000000020510342851533115, x41, x42);
+        let x50 = Self::mul_add(-0.00000000020510342851533115, x45, x17);
+        let x51 = x22 + x45;
+        let x52 = x51 * 0.36;
+        let x53 = x52 + (x26 - x39 + x52);
+        let x54 = 7.078399999258757 + x50;
+        let x55 = 0.01675
+            - Self::mul_add(
+                x44,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x42, x41),
+            );
+        let x56 = -9.142025249762803 + (x52 + (x40 + x48 + x52));
+        let x57 = 2.5482240016099564
             + Self::mul_add(
-                -0.16,
-                x25,
-                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+                x50,
+                0.36,
+                x43 - Self::mul_add(0.00000000020510342851533115, x46, x47),
             );
-        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
-        let x40 = -2.741639999592316 - x34;
-        let x41 = 9.740442170000001
-            + (x31
-                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
-        let x42 = s_q12 * s_q12;
-        let x43 = s_q12 * c_q12;
-        let x44 = x33 - x39;
-        let x45 = x37 + x37;
-        let x46 = Self::mul_add(x43, x45, x42 * x44);
-        let x47 = x39 + x46;
-        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
-        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
-        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
-        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
-        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
-        let x54 = x25 + x52;
-        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
-        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
-        let x57 = 0.00000000020510342851533115 * x50;
-        let x58 = x41 - x57;
-        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
-        let x60 = x54 * 0.36;
-        let x61 = x60 + (x33 - x46 + x60);
-        let x62 = 7.078399999258757 + x53;
-        let x63 = 0.01675
-            - Self::mul_add(
-                x51,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x49, x48),
-            );
-        let x64 = -9.142025249762803
-            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x60));
-        let x65 = 2.5482240016099564
-            - Self::mul_add(
-                x53,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x58, x56),
-            );
-        let x66 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
-        let x67 = s_q11 * s_q11;
-        let x68 = s_q11 * c_q11;
-        let x69 = x61 - x64;
-        let x70 = x55 + x55;
-        let x71 = Self::mul_add(x68, x70, x67 * x69);
-        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x51);
-        let x73 = Self::mul_add(c_q11, x62, s_q11 * x51);
-        let x74 = 0.275 * x54;
-        let x75 = x73 * 0.63;
-        let x76 = x74 - x75;
-        let x77 = Self::mul_add(x72, 0.63, x55 + Self::mul_add(-x67, x70, x68 * x69));
-        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
-        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
-        let x80 = x66 - x75;
-        let x81 = x76 + (x61 - x71 + x76);
-        let x82 = -45.1584 + x73;
-        let x83 = -0.6328 + x78;
-        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
-        let x85 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x79);
-        let x86 = 28.2393615 - (x75 - x80);
-        let x87 = s_q10 * s_q10;
-        let x88 = s_q10 * c_q10;
-        let x89 = x81 - x84;
-        let x90 = x77 + x77;
-        let x91 = Self::mul_add(x88, x90, x87 * x89);
-        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
-        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
-        let x94 = c_q10 * x72;
-        let x95 = Self::mul_add(-s_q10, x82, x94);
-        let x96 = s_q10 * x72;
-        let x97 = Self::mul_add(c_q10, x82, x96);
-        let x98 = x97 * 0.87;
-        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
-        let x100 = x86 - x98;
-        let x101 = x98 - (x81 - x91 - x98);
-        let x102 = -81.53205 + x97;
-        let x103 = -0.00214 + x92;
-        let x104 = -63.36336825000001 + (x84 + x91);
-        let x105 = -36.18604050126307 + Self::mul_add(x54, -0.87, x93);
-        let x106 = 69.99836825 - (x98 - x100);
-        let x107 = s_q9 * s_q9;
-        let x108 = s_q9 * c_q9;
-        let x109 = x101 + x104;
-        let x110 = x99 + x99;
-        let x111 = Self::mul_add(-x108, x110, x107 * x109);
-        let x112 = x101 - x111;
-        let x113 = x104 - x111;
-        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
-        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
-        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
-        let x117 = c_q9 * x95;
-        let x118 = Self::mul_add(-s_q9, x102, x117);
-        let x119 = s_q9 * x95;
-        let x120 = Self::mul_add(c_q9, x102, x119);
-        let x121 = 0.00000000020510342851533115 * x54;
-        let x122 = x120 - x121;
-        let x123 = 0.00000000020510342851533115 * x120;
-        let x124 = x54 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
-        let x125 = x118 + x121;
-        let x126 = 0.00000000020510342851533115 * x115;
-        let x127 = x114 + x126;
-        let x128 = 0.00000000020510342851533115 * x116;
-        let x129 = x113 + x128;
-        let x130 = 0.00000000020510342851533115 * x106;
-        let x131 = x116 + x130;
-        let x132 = 0.00000000020510342851533115 * x114;
-        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
-        let x134 = x106 + (x126 - x128);
-        let x135 = x115 - x130;
-        let x136 = 0.00000000020510342851533115 * x131;
-        let x137 = 0.4 * x125;
-        let x138 = 0.275 * x124;
-        let x139 = x137 - x138;
-        let x140 = x139 + (x129 + x136 + x139);
-        let x141 = Self::mul_add(
+        let x58 = 9.223235249762805 + (x34 - x48);
+        let x59 = s_q11 * s_q11;
+        let x60 = s_q11 * c_q11;
+        let x61 = x53 - x56;
+        let x62 = x49 + x49;
+        let x63 = Self::mul_add(x60, x62, x59 * x61);
+        let x64 = Self::mul_add(-s_q11, x54, c_q11 * x44);
+        let x65 = Self::mul_add(c_q11, x54, s_q11 * x44);
+        let x66 = 0.275 * x51;
+        let x67 = x65 * 0.63;
+        let x68 = x66 - x67;
+        let x69 = Self::mul_add(x64, 0.63, x49 + Self::mul_add(-x59, x62, x60 * x61));
+        let x70 = Self::mul_add(0.275, x64, Self::mul_add(-s_q11, x57, c_q11 * x55));
+        let x71 = Self::mul_add(0.275, x65, Self::mul_add(c_q11, x57, s_q11 * x55));
+        let x72 = x58 - x67;
+        let x73 = x68 + (x53 - x63 + x68);
+        let x74 = -45.1584 + x65;
+        let x75 = -0.6328 + x70;
+        let x76 = -24.4950615 + (x66 + (x56 + x63 + x66));
+        let x77 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x71);
+        let x78 = 28.2393615 - (x67 - x72);
+        let x79 = s_q10 * s_q10;
+        let x80 = s_q10 * c_q10;
+        let x81 = x73 - x76;
+        let x82 = x69 + x69;
+        let x83 = Self::mul_add(x80, x82, x79 * x81);
+        let x84 = Self::mul_add(-s_q10, x77, c_q10 * x75);
+        let x85 = Self::mul_add(c_q10, x77, s_q10 * x75);
+        let x86 = c_q10 * x64;
+        let x87 = Self::mul_add(-s_q10, x74, x86);
+        let x88 = s_q10 * x64;
+        let x89 = Self::mul_add(c_q10, x74, x88);
+        let x90 = x89 * 0.87;
+        let x91 = Self::mul_add(x87, 0.87, x69 + Self::mul_add(-x79, x82, x80 * x81));
+        let x92 = x78 - x90;
+        let x93 = x90 - (x73 - x83 - x90);
+        let x94 = -81.53205 + x89;
+        let x95 = -0.00214 + x84;
+        let x96 = -63.36336825000001 + (x76 + x83);
+        let x97 = -36.18604050126307 + Self::mul_add(x51, -0.87, x85);
+        let x98 = 69.99836825 - (x90 - x92);
+        let x99 = s_q9 * s_q9;
+        let x100 = s_q9 * c_q9;
+        let x101 = x93 + x96;
+        let x102 = x91 + x91;
+        let x103 = Self::mul_add(-x100, x102, x99 * x101);
+        let x104 = x93 - x103;
+        let x105 = x96 - x103;
+        let x106 = x91 - Self::mul_add(x99, x102, x100 * x101);
+        let x107 = Self::mul_add(-s_q9, x97, c_q9 * x95);
+        let x108 = Self::mul_add(c_q9, x97, s_q9 * x95);
+        let x109 = c_q9 * x87;
+        let x110 = Self::mul_add(-s_q9, x94, x109);
+        let x111 = s_q9 * x87;
+        let x112 = Self::mul_add(c_q9, x94, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = 0.00000000020510342851533115 * x112;
+        let x116 = x51 - Self::mul_add(0.00000000020510342851533115, x110, -x115);
+        let x117 = x110 + x113;
+        let x118 = 0.00000000020510342851533115 * x107;
+        let x119 = x106 + x118;
+        let x120 = 0.00000000020510342851533115 * x108;
+        let x121 = x105 + x120;
+        let x122 = 0.00000000020510342851533115 * x98;
+        let x123 = x108 + x122;
+        let x124 = 0.00000000020510342851533115 * x106;
+        let x125 = x107 - Self::mul_add(0.00000000020510342851533115, x104, x124);
+        let x126 = x98 + (x118 - x120);
+        let x127 = x107 - x122;
+        let x128 = 0.00000000020510342851533115 * x123;
+        let x129 = 0.4 * x117;
+        let x130 = 0.275 * x116;
+        let x131 = x129 - x130;
+        let x132 = x131 + (x121 + x128 + x131);
+        let x133 = Self::mul_add(
             0.275,
-            x125,
+            x117,
             -Self::mul_add(
                 0.4,
-                x124,
-                Self::mul_add(-0.00000000020510342851533115, x134, x133),
+                x116,
+                Self::mul_add(-0.00000000020510342851533115, x126, x125),
             ),
         );
-        let x142 = -0.000000008530897668050218 + x122;
-        let x143 = -12.701650001451807 - x124;
-        let x144 = -0.0000000234896432582596
+        let x134 = -0.000000008530897668050218 + x114;
+        let x135 = -12.701650001451807 - x116;
+        let x136 = -0.0000000234896432582596
             + Self::mul_add(
                 -0.275,
-                x122,
-                x131
+                x114,
+                x123
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x129,
-                        0.00000000020510342851533115 * x127,
+                        x121,
+                        0.00000000020510342851533115 * x119,
                     ),
             );
-        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
-        let x146 = -111.7548902508081
-            + (x137
-                + (x134
+        let x137 = -0.002139996587640933 + Self::mul_add(-0.4, x114, x119 - x128);
+        let x138 = -111.7548902508081
+            + (x129
+                + (x126
                     + Self::mul_add(
                         -0.00000000020510342851533115,
-                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
-                        0.00000000020510342851533115 * x133,
-                    ) + x137));
-        let x147 = 5.080660024070365 - x141;
-        let x148 = 113.3918902508081
-            - (x138
-                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
-                    + x138));
-        let x149 = s_q8 * s_q8;
-        let x150 = s_q8 * c_q8;
-        let x151 = x140 - x146;
-        let x152 = x144 + x144;
-        let x153 = Self::mul_add(x150, x152, x149 * x151);
-        let x154 = x140 - x153;
-        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
-        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
-        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
-        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
-        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
-        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
-        let x163 = 0.00000000020510342851533115 * x156;
-        let x164 = x148 - x163;
-        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
-        let x166 = 0.35 * x161;
-        let x167 = x166
-            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x166);
-        let x168 = 48.0240000085309 + x160;
-        let x169 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
-        let x170 = -16.80768997608804
+                        x108 + Self::mul_add(-0.00000000020510342851533115, x105, x124),
+                        0.00000000020510342851533115 * x125,
+                    ) + x129));
+        let x139 = 5.080660024070365 - x133;
+        let x140 = 113.3918902508081
+            - (x130
+                + (Self::mul_add(0.00000000020510342851533115, x127, x104 + x118)
+                    + x130));
+        let x141 = s_q8 * s_q8;
+        let x142 = s_q8 * c_q8;
+        let x143 = x132 - x138;
+        let x144 = x136 + x136;
+        let x145 = Self::mul_add(x142, x144, x141 * x143);
+        let x146 = x132 - x145;
+        let x147 = x136 + Self::mul_add(-x141, x144, x142 * x143);
+        let x148 = Self::mul_add(-s_q8, x139, c_q8 * x137);
+        let x149 = Self::mul_add(c_q8, x139, s_q8 * x137);
+        let x150 = Self::mul_add(-s_q8, x135, c_q8 * x134);
+        let x151 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x152 = x140 - x146;
+        let x153 = x148 + x148;
+        let x154 = Self::mul_add(-0.00000000020510342851533115, x153, x152);
+        let x155 = Self::mul_add(0.00000000020510342851533115, x117, x150);
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x150, x117);
+        let x157 = 0.35 * x155;
+        let x158 = x157 - (x146 + x154 - x157);
+        let x159 = 48.0240000085309 + x156;
+        let x160 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x147, x149);
+        let x161 = -16.80768997608804
+            + Self::mul_add(
+                -0.35,
+                x156,
+                x148 - Self::mul_add(0.00000000020510342851533115, x152, x153),
+            );
+        let x162 = 130.43769025763282 - (x157 - (x138 + x145 - x157));
+        let x163 = 0.1132
             - Self::mul_add(
                 0.35,
-                x160,
-                Self::mul_add(0.00000000020510342851533115, x164, x162),
+                x151,
+                Self::mul_add(0.00000000020510342851533115, x149, x147),
             );
-        let x171 = 130.43769025763282 - (x166 - (x146 + x153 - x166));
-        let x172 = 0.1132
-            - Self::mul_add(
-                0.35,
-                x159,
-                Self::mul_add(0.00000000020510342851533115, x157, x155),
-            );
-        let x173 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
-        let x174 = s_q7 * s_q7;
-        let x175 = s_q7 * c_q7;
-        let x176 = x167 + x171;
-        let x177 = x169 + x169;
-        let x178 = Self::mul_add(-x175, x177, x174 * x176);
-        let x179 = Self::mul_add(-s_q7, x159, c_q7 * x168);
-        let x180 = Self::mul_add(c_q7, x159, s_q7 * x168);
-        let x181 = 0.75 * x161;
-        let x182 = 0.65 * x179;
-        let x183 = x181 - x182;
-        let x184 = Self::mul_add(-0.75, x179, Self::mul_add(-s_q7, x172, c_q7 * x170));
-        let x185 = x173 + x182;
-        let x186 = 110.5455 + x179;
-        let x187 = 180.9502499901501 - x161;
-        let x188 = Self::mul_add(x8, x142, x7 * x143);
-        let x189 = Self::mul_add(
+        let x164 = 132.47349025763282 + (x140 - x154);
+        let x165 = s_q7 * s_q7;
+        let x166 = s_q7 * c_q7;
+        let x167 = x158 + x162;
+        let x168 = x160 + x160;
+        let x169 = Self::mul_add(-x166, x168, x165 * x167);
+        let x170 = Self::mul_add(-s_q7, x151, c_q7 * x159);
+        let x171 = Self::mul_add(c_q7, x151, s_q7 * x159);
+        let x172 = 0.75 * x155;
+        let x173 = 0.65 * x170;
+        let x174 = x172 - x173;
+        let x175 = Self::mul_add(-0.75, x170, Self::mul_add(-s_q7, x163, c_q7 * x161));
+        let x176 = x164 + x173;
+        let x177 = 110.5455 + x170;
+        let x178 = 180.9502499901501 - x155;
+        let x179 = 0.00000000020510342851533115 * x151;
+        let x180 = Self::mul_add(0.00000000020510342851533115, x140, x148);
+        let x181 = Self::mul_add(
             -0.35,
-            x158,
-            x148 - Self::mul_add(-x8, x147, x7 * x145),
+            x150,
+            Self::mul_add(-0.00000000020510342851533115, x148, x140),
         );
-        let x190 = Self::mul_add(0.35, x188, x157);
-        let x191 = Self::mul_add(-s_q7, x158, c_q7 * x188);
-        let x192 = Self::mul_add(c_q7, x158, s_q7 * x188);
-        let x193 = x12 * x95;
-        let x194 = Self::mul_add(x11, x102, x193);
-        let x195 = x131 + Self::mul_add(-0.275, x120, 0.4 * x194);
+        let x182 = Self::mul_add(0.35, x179, x149);
+        let x183 = Self::mul_add(-s_q7, x150, c_q7 * x179);
+        let x184 = Self::mul_add(c_q7, x150, s_q7 * x179);
+        let x185 = x10 * x87;
+        let x186 = Self::mul_add(x9, x94, x185);
+        let x187 = x123 + Self::mul_add(-0.275, x112, 0.4 * x186);
+        let x188 = Self::mul_add(0.4, x110, x98 + Self::mul_add(-x10, x97, x9 * x95));
+        let x189 = Self::mul_add(-0.275, x110, x127);
+        let x190 = Self::mul_add(s_q8, x186, c_q8 * x110);
+        let x191 = Self::mul_add(-c_q8, x186, s_q8 * x110);
+        let x192 = x115 - x190;
+        let x193 = Self::mul_add(0.00000000020510342851533115, x190, x112);
+        let x194 = Self::mul_add(-s_q8, x188, c_q8 * x187);
+        let x195 = Self::mul_add(0.00000000020510342851533115, x189, x194);
         let x196 = Self::mul_add(
-            0.4,
-            x118,
-            x106 + Self::mul_add(-x12, x105, x11 * x103),
-        );
-        let x197 = Self::mul_add(-0.275, x118, x135);
-        let x198 = x120 + Self::mul_add(x8, x194, x7 * x118);
-        let x199 = Self::mul_add(-c_q8, x194, s_q8 * x118);
-        let x200 = x123 - Self::mul_add(s_q8, x194, c_q8 * x118);
-        let x201 = Self::mul_add(
-            0.00000000020510342851533115,
-            x197,
-            Self::mul_add(-s_q8, x196, c_q8 * x195),
-        );
-        let x202 = Self::mul_add(
             -0.35,
-            x199,
-            x197 - Self::mul_add(-x8, x196, x7 * x195),
+            x191,
+            Self::mul_add(-0.00000000020510342851533115, x194, x189),
         );
-        let x203 = Self::mul_add(-0.35, x198, Self::mul_add(c_q8, x196, s_q8 * x195));
-        let x204 = Self::mul_add(s_q7, x199, c_q7 * x198);
-        let x205 = Self::mul_add(-c_q7, x199, s_q7 * x198);
-        let x206 = Self::mul_add(-s_q9, x97, x117);
-        let x207 = Self::mul_add(x11, x97, x193);
-        let x208 = Self::mul_add(c_q9, x97, x119);
-        let x209 = 0.00000000020510342851533115 * x100;
-        let x210 = Self::mul_add(c_q9, x93, s_q9 * x92) + x209
-            + Self::mul_add(-0.275, x208, 0.4 * x207);
-        let x211 = Self::mul_add(0.4, x206, x100 + Self::mul_add(-x12, x93, x11 * x92));
-        let x212 = Self::mul_add(
+        let x197 = Self::mul_add(-0.35, x193, Self::mul_add(c_q8, x188, s_q8 * x187));
+        let x198 = Self::mul_add(s_q7, x191, c_q7 * x193);
+        let x199 = Self::mul_add(-c_q7, x191, s_q7 * x193);
+        let x200 = Self::mul_add(-s_q9, x89, x109);
+        let x201 = Self::mul_add(x9, x89, x185);
+        let x202 = Self::mul_add(c_q9, x89, x111);
+        let x203 = 0.00000000020510342851533115 * x92;
+        let x204 = Self::mul_add(c_q9, x85, s_q9 * x84) + x203
+            + Self::mul_add(-0.275, x202, 0.4 * x201);
+        let x205 = Self::mul_add(0.4, x200, x92 + Self::mul_add(-x10, x85, x9 * x84));
+        let x206 = Self::mul_add(
             0.275,
-            x206,
-            x209 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+            x200,
+            x203 - Self::mul_add(-s_q9, x85, c_q9 * x84),
         );
-        let x213 = x208 + Self::mul_add(x8, x207, x7 * x206);
-        let x214 = Self::mul_add(-c_q8, x207, s_q8 * x206);
-        let x215 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x207 = Self::mul_add(s_q8, x201, c_q8 * x200);
+        let x208 = Self::mul_add(-c_q8, x201, s_q8 * x200);
+        let x209 = Self::mul_add(-0.00000000020510342851533115, x202, x207);
+        let x210 = Self::mul_add(0.00000000020510342851533115, x207, x202);
+        let x211 = Self::mul_add(-s_q8, x205, c_q8 * x204);
+        let x212 = Self::mul_add(-0.00000000020510342851533115, x206, x211);
+        let x213 = Self::mul_add(
+            0.35,
             x208,
-            Self::mul_add(s_q8, x207, c_q8 * x206),
+            Self::mul_add(0.00000000020510342851533115, x211, x206),
         );
-        let x216 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            Self::mul_add(-s_q8, x211, c_q8 * x210),
-        );
-        let x217 = Self::mul_add(0.35, x214, x212 + Self::mul_add(-x8, x211, x7 * x210));
-        let x218 = Self::mul_add(-0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
-        let x219 = Self::mul_add(s_q7, x214, c_q7 * x213);
-        let x220 = Self::mul_add(-c_q7, x214, s_q7 * x213);
-        let x221 = Self::mul_add(c_q10, x73, x96);
-        let x222 = Self::mul_add(-s_q10, x73, x94);
-        let x223 = Self::mul_add(-s_q10, x79, c_q10 * x78);
-        let x224 = Self::mul_add(c_q10, x79, s_q10 * x78);
-        let x225 = Self::mul_add(-0.87, x221, x80);
-        let x226 = Self::mul_add(-c_q9, x222, s_q9 * x221);
-        let x227 = Self::mul_add(x12, x222, x11 * x221);
-        let x228 = Self::mul_add(s_q9, x222, c_q9 * x221);
-        let x229 = 0.00000000020510342851533115 * x225;
-        let x230 = Self::mul_add(c_q9, x224, s_q9 * x223) + x229
-            + Self::mul_add(-0.275, x228, 0.4 * x227);
-        let x231 = Self::mul_add(
+        let x214 = Self::mul_add(-0.35, x210, Self::mul_add(c_q8, x205, s_q8 * x204));
+        let x215 = Self::mul_add(s_q7, x208, c_q7 * x210);
+        let x216 = Self::mul_add(-c_q7, x208, s_q7 * x210);
+        let x217 = Self::mul_add(c_q10, x65, x88);
+        let x218 = Self::mul_add(-s_q10, x65, x86);
+        let x219 = Self::mul_add(-s_q10, x71, c_q10 * x70);
+        let x220 = Self::mul_add(c_q10, x71, s_q10 * x70);
+        let x221 = Self::mul_add(-0.87, x217, x72);
+        let x222 = Self::mul_add(-c_q9, x218, s_q9 * x217);
+        let x223 = Self::mul_add(x10, x218, x9 * x217);
+        let x224 = Self::mul_add(s_q9, x218, c_q9 * x217);
+        let x225 = 0.00000000020510342851533115 * x221;
+        let x226 = Self::mul_add(c_q9, x220, s_q9 * x219) + x225
+            + Self::mul_add(-0.275, x224, 0.4 * x223);
+        let x227 = Self::mul_add(
             -0.4,
-            x226,
-            x225 + Self::mul_add(-x12, x224, x11 * x223),
+            x222,
+            x221 + Self::mul_add(-x10, x220, x9 * x219),
         );
-        let x232 = Self::mul_add(
+        let x228 = Self::mul_add(
             -0.275,
-            x226,
-            x229 - Self::mul_add(-s_q9, x224, c_q9 * x223),
+            x222,
+            x225 - Self::mul_add(-s_q9, x220, c_q9 * x219),
         );
-        let x233 = x228 - Self::mul_add(-x8, x227, x7 * x226);
-        let x234 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x229 = Self::mul_add(-s_q8, x223, c_q8 * x222);
+        let x230 = Self::mul_add(c_q8, x223, s_q8 * x222);
+        let x231 = Self::mul_add(0.00000000020510342851533115, x224, x229);
+        let x232 = Self::mul_add(-0.00000000020510342851533115, x229, x224);
+        let x233 = Self::mul_add(-s_q8, x227, c_q8 * x226);
+        let x234 = Self::mul_add(-0.00000000020510342851533115, x228, x233);
         let x235 = Self::mul_add(
-            0.00000000020510342851533115,
-            x228,
-            Self::mul_add(-s_q8, x227, c_q8 * x226),
-        );
-        let x236 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x232,
-            Self::mul_add(-s_q8, x231, c_q8 * x230),
-        );
-        let x237 = Self::mul_add(
             -0.35,
-            x234,
-            x232 + Self::mul_add(-x8, x231, x7 * x230),
+            x230,
+            Self::mul_add(0.00000000020510342851533115, x233, x228),
         );
-        let x238 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x231, s_q8 * x230));
-        let x239 = Self::mul_add(-s_q7, x234, c_q7 * x233);
-        let x240 = Self::mul_add(c_q7, x234, s_q7 * x233);
-        let x241 = Self::mul_add(-x14, x35, x13 * x36);
-        let x242 = Self::mul_add(0.36, x241, x49);
-        let x243 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
-        let x244 = Self::mul_add(s_q11, x241, c_q11 * x52);
-        let x245 = Self::mul_add(-c_q11, x241, s_q11 * x52);
-        let x246 = Self::mul_add(-s_q11, x243, c_q11 * x242)
-            - Self::mul_add(x51, -0.63, 0.275 * x245);
-        let x247 = Self::mul_add(0.275, x244, Self::mul_add(c_q11, x243, s_q11 * x242));
-        let x248 = Self::mul_add(0.63, x244, x59);
-        let x249 = Self::mul_add(-s_q10, x245, c_q10 * x244);
-        let x250 = Self::mul_add(c_q10, x245, s_q10 * x244);
-        let x251 = Self::mul_add(c_q10, x247, s_q10 * x246);
-        let x252 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x247, c_q10 * x246));
-        let x253 = Self::mul_add(0.87, x249, x248);
-        let x254 = 0.00000000020510342851533115 * x51;
-        let x255 = Self::mul_add(c_q9, x250, s_q9 * x249) + x254;
-        let x256 = x51 + Self::mul_add(-x12, x250, x11 * x249);
-        let x257 = x254 - Self::mul_add(-s_q9, x250, c_q9 * x249);
-        let x258 = 0.00000000020510342851533115 * x253;
-        let x259 = Self::mul_add(c_q9, x251, s_q9 * x252) - x258
-            + Self::mul_add(0.275, x257, 0.4 * x256);
-        let x260 = Self::mul_add(
-            0.4,
-            x255,
-            x253 - Self::mul_add(-x12, x251, x11 * x252),
+        let x236 = Self::mul_add(-0.35, x232, Self::mul_add(c_q8, x227, s_q8 * x226));
+        let x237 = Self::mul_add(-s_q7, x230, c_q7 * x232);
+        let x238 = Self::mul_add(c_q7, x230, s_q7 * x232);
+        let x239 = 0.00000000020510342851533115 * x44;
+        let x240 = Self::mul_add(0.00000000020510342851533115, x34, x43);
+        let x241 = Self::mul_add(-0.36, x239, x42);
+        let x242 = Self::mul_add(
+            x45,
+            0.36,
+            Self::mul_add(-0.00000000020510342851533115, x43, x34),
         );
-        let x261 = Self::mul_add(
+        let x243 = Self::mul_add(-s_q11, x239, c_q11 * x45);
+        let x244 = Self::mul_add(c_q11, x239, s_q11 * x45);
+        let x245 = Self::mul_add(-s_q11, x242, c_q11 * x241)
+            - Self::mul_add(x44, -0.63, 0.275 * x244);
+        let x246 = Self::mul_add(0.275, x243, Self::mul_add(c_q11, x242, s_q11 * x241));
+        let x247 = Self::mul_add(0.63, x243, x240);
+        let x248 = Self::mul_add(-s_q10, x244, c_q10 * x243);
+        let x249 = Self::mul_add(c_q10, x244, s_q10 * x243);
+        let x250 = Self::mul_add(c_q10, x246, s_q10 * x245);
+        let x251 = Self::mul_add(x44, 0.87, Self::mul_add(-s_q10, x246, c_q10 * x245));
+        let x252 = Self::mul_add(0.87, x248, x247);
+        let x253 = x239 + Self::mul_add(c_q9, x249, s_q9 * x248);
+        let x254 = x44 + Self::mul_add(-x10, x249, x9 * x248);
+        let x255 = x239 - Self::mul_add(-s_q9, x249, c_q9 * x248);
+        let x256 = 0.00000000020510342851533115 * x252;
+        let x257 = Self::mul_add(c_q9, x250, s_q9 * x251) - x256
+            + Self::mul_add(0.275, x255, 0.4 * x254);
+        let x258 = Self::mul_add(0.4, x253, x252 - Self::mul_add(-x10, x250, x9 * x251));
+        let x259 = Self::mul_add(
             0.275,
-            x255,
-            x258 + Self::mul_add(-s_q9, x251, c_q9 * x252),
+            x253,
+            x256 + Self::mul_add(-s_q9, x250, c_q9 * x251),
         );
-        let x262 = x257 + Self::mul_add(-x8, x256, x7 * x255);
-        let x263 = Self::mul_add(c_q8, x256, s_q8 * x255);
-        let x264 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x257,
-            Self::mul_add(-s_q8, x256, c_q8 * x255),
-        );
-        let x265 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x260 = Self::mul_add(-s_q8, x254, c_q8 * x253);
+        let x261 = Self::mul_add(c_q8, x254, s_q8 * x253);
+        let x262 = Self::mul_add(-0.00000000020510342851533115, x255, x260);
+        let x263 = Self::mul_add(0.00000000020510342851533115, x260, x255);
+        let x264 = Self::mul_add(s_q8, x258, c_q8 * x257);
+        let x265 = Self::mul_add(0.00000000020510342851533115, x259, x264);
+        let x266 = Self::mul_add(
+            0.35,
             x261,
-            Self::mul_add(s_q8, x260, c_q8 * x259),
+            Self::mul_add(-0.00000000020510342851533115, x264, x259),
         );
-        let x266 = Self::mul_add(0.35, x263, x261 - Self::mul_add(x8, x260, x7 * x259));
-        let x267 = Self::mul_add(0.35, x262, Self::mul_add(-c_q8, x260, s_q8 * x259));
-        let x268 = Self::mul_add(s_q7, x263, c_q7 * x262);
-        let x269 = Self::mul_add(-c_q7, x263, s_q7 * x262);
-        let x270 = 4.806620000000001 * x15;
-        let x271 = x32
-            + (1.4135609200000003
-                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
-        let x272 = Self::mul_add(-0.16, x270, x22);
-        let x273 = Self::mul_add(-0.55, x270, x29);
-        let x274 = Self::mul_add(s_q12, x23, c_q12 * x270);
-        let x275 = x24 - Self::mul_add(-x14, x23, x13 * x270);
-        let x276 = Self::mul_add(
-            0.00000000020510342851533115,
-            x24,
-            Self::mul_add(-c_q12, x23, s_q12 * x270),
-        );
-        let x277 = Self::mul_add(
-            0.00000000020510342851533115,
-            x273,
-            Self::mul_add(-c_q12, x272, s_q12 * x271),
-        );
-        let x278 = Self::mul_add(0.36, x275, Self::mul_add(s_q12, x272, c_q12 * x271));
-        let x279 = Self::mul_add(
+        let x267 = Self::mul_add(0.35, x263, Self::mul_add(-c_q8, x258, s_q8 * x257));
+        let x268 = Self::mul_add(s_q7, x261, c_q7 * x263);
+        let x269 = Self::mul_add(-c_q7, x261, s_q7 * x263);
+        let x270 = 0.00000000020510342851533115 * x18;
+        let x271 = x25
+            + Self::mul_add(0.00000000020510342851533115, x15, 1.4135609200000003);
+        let x272 = Self::mul_add(-0.16, x270, x16);
+        let x273 = Self::mul_add(-0.55, x270, x15 + -0.0000000002899261911072858);
+        let x274 = Self::mul_add(s_q12, x17, c_q12 * x270);
+        let x275 = Self::mul_add(-c_q12, x17, s_q12 * x270);
+        let x276 = Self::mul_add(-0.00000000020510342851533115, x275, x18);
+        let x277 = x270 + x275;
+        let x278 = Self::mul_add(-c_q12, x272, s_q12 * x271);
+        let x279 = Self::mul_add(0.00000000020510342851533115, x273, x278);
+        let x280 = Self::mul_add(0.36, x276, Self::mul_add(s_q12, x272, c_q12 * x271));
+        let x281 = Self::mul_add(
             -0.36,
             x274,
-            x273 - Self::mul_add(-x14, x272, x13 * x271),
+            Self::mul_add(-0.00000000020510342851533115, x278, x273),
         );
-        let x280 = Self::mul_add(-s_q11, x275, c_q11 * x274);
-        let x281 = Self::mul_add(c_q11, x275, s_q11 * x274);
-        let x282 = Self::mul_add(-s_q11, x279, c_q11 * x278)
-            + Self::mul_add(0.63, x276, 0.275 * x281);
-        let x283 = Self::mul_add(-0.275, x280, Self::mul_add(c_q11, x279, s_q11 * x278));
-        let x284 = Self::mul_add(-0.63, x280, x277);
-        let x285 = Self::mul_add(-s_q10, x281, c_q10 * x280);
-        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
-        let x287 = Self::mul_add(c_q10, x283, s_q10 * x282);
-        let x288 = Self::mul_add(0.87, x276, Self::mul_add(-s_q10, x283, c_q10 * x282));
-        let x289 = Self::mul_add(-0.87, x285, x284);
-        let x290 = 0.00000000020510342851533115 * x276;
-        let x291 = Self::mul_add(c_q9, x286, s_q9 * x285) - x290;
-        let x292 = x276 - Self::mul_add(-x12, x286, x11 * x285);
-        let x293 = x290 + Self::mul_add(-s_q9, x286, c_q9 * x285);
-        let x294 = 0.00000000020510342851533115 * x289;
-        let x295 = Self::mul_add(c_q9, x287, s_q9 * x288) - x294
-            + Self::mul_add(0.275, x293, 0.4 * x292);
-        let x296 = Self::mul_add(
+        let x282 = Self::mul_add(-s_q11, x276, c_q11 * x274);
+        let x283 = Self::mul_add(c_q11, x276, s_q11 * x274);
+        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
+            + Self::mul_add(0.63, x277, 0.275 * x283);
+        let x285 = Self::mul_add(-0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
+        let x286 = Self::mul_add(-0.63, x282, x279);
+        let x287 = Self::mul_add(-s_q10, x283, c_q10 * x282);
+        let x288 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x289 = Self::mul_add(c_q10, x285, s_q10 * x284);
+        let x290 = Self::mul_add(0.87, x277, Self::mul_add(-s_q10, x285, c_q10 * x284));
+        let x291 = Self::mul_add(-0.87, x287, x286);
+        let x292 = 0.00000000020510342851533115 * x277;
+        let x293 = Self::mul_add(c_q9, x288, s_q9 * x287) - x292;
+        let x294 = x277 - Self::mul_add(-x10, x288, x9 * x287);
+        let x295 = x292 + Self::mul_add(-s_q9, x288, c_q9 * x287);
+        let x296 = 0.00000000020510342851533115 * x291;
+        let x297 = Self::mul_add(c_q9, x289, s_q9 * x290) - x296
+            + Self::mul_add(0.275, x295, 0.4 * x294);
+        let x298 = Self::mul_add(
             -0.4,
-            x291,
-            x289 - Self::mul_add(-x12, x287, x11 * x288),
-        );
-        let x297 = Self::mul_add(
-            -0.275,
-            x291,
-            x294 + Self::mul_add(-s_q9, x287, c_q9 * x288),
-        );
-        let x298 = x293 - Self::mul_add(x8, x292, x7 * x291);
-        let x299 = Self::mul_add(-c_q8, x292, s_q8 * x291);
-        let x300 = Self::mul_add(
-            0.00000000020510342851533115,
             x293,
-            Self::mul_add(s_q8, x292, c_q8 * x291),
+            x291 - Self::mul_add(-x10, x289, x9 * x290),
         );
-        let x301 = Self::mul_add(
-            0.00000000020510342851533115,
-            x297,
-            Self::mul_add(s_q8, x296, c_q8 * x295),
+        let x299 = Self::mul_add(
+            -0.275,
+            x293,
+            x296 + Self::mul_add(-s_q9, x289, c_q9 * x290),
         );
-        let x302 = Self::mul_add(-0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
-        let x303 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
-        let x304 = Self::mul_add(-s_q7, x299, c_q7 * x298);
-        let x305 = Self::mul_add(c_q7, x299, s_q7 * x298);
-        let x306 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x307 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x308 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x309 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x310 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x311 = v[4] * v[4];
-        let x312 = Self::mul_add(v[5], v[5], x311);
-        let x313 = v[3] * v[4];
-        let x314 = v[3] * v[5];
-        let x315 = v[4] * v[5];
-        let x316 = Self::mul_add(v[3], v[3], x311);
-        let x317 = x306 + Self::mul_add(-0.75, x314, 0.65 * x312);
-        let x318 = x307 + Self::mul_add(0.75, x315, 0.65 * x313);
-        let x319 = x308 - Self::mul_add(-0.75, x316, 0.65 * x314);
-        let x320 = Self::mul_add(c_q7, x318, s_q7 * x317);
-        let x321 = v[6] * x310;
-        let x322 = v[6] * x309;
-        let x323 = v[5] + v[6];
-        let x324 = x310 * x310;
-        let x325 = x309 * x323;
-        let x326 = Self::mul_add(x323, -16.80768997608804, x310 * 0.07309);
-        let x327 = Self::mul_add(
-            -0.1132,
-            x323,
-            Self::mul_add(130.43769025763282, x310, x309 * 0.07309),
+        let x300 = Self::mul_add(s_q8, x294, c_q8 * x293);
+        let x301 = Self::mul_add(-c_q8, x294, s_q8 * x293);
+        let x302 = Self::mul_add(0.00000000020510342851533115, x295, x300);
+        let x303 = Self::mul_add(-0.00000000020510342851533115, x300, x295);
+        let x304 = Self::mul_add(s_q8, x298, c_q8 * x297);
+        let x305 = Self::mul_add(0.00000000020510342851533115, x299, x304);
+        let x306 = Self::mul_add(
+            -0.35,
+            x301,
+            Self::mul_add(-0.00000000020510342851533115, x304, x299),
         );
-        let x328 = Self::mul_add(
-            -132.47349025763282,
-            x323,
-            Self::mul_add(0.1132, x310, x309 * 16.80768997608804),
-        );
-        let x329 = Self::mul_add(c_q8, x323, Self::mul_add(s_q8, x310, x7 * x309));
-        let x330 = Self::mul_add(s_q8, x323, Self::mul_add(-c_q8, x310, x8 * x309));
+        let x307 = Self::mul_add(0.35, x303, Self::mul_add(-c_q8, x298, s_q8 * x297));
+        let x308 = Self::mul_add(-s_q7, x301, c_q7 * x303);
+        let x309 = Self::mul_add(c_q7, x301, s_q7 * x303);
+        let x310 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x311 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x312 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x313 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x314 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x315 = v[4] * v[4];
+        let x316 = Self::mul_add(v[5], v[5], x315);
+        let x317 = v[3] * v[4];
+        let x318 = v[3] * v[5];
+        let x319 = v[4] * v[5];
+        let x320 = Self::mul_add(v[3], v[3], x315);
+        let x321 = x310 + Self::mul_add(-0.75, x318, 0.65 * x316);
+        let x322 = x311 + Self::mul_add(0.75, x319, 0.65 * x317);
+        let x323 = x312 - Self::mul_add(-0.75, x320, 0.65 * x318);
+        let x324 = Self::mul_add(c_q7, x322, s_q7 * x321);
+        let x325 = v[6] * x314;
+        let x326 = v[6] * x313;
+        let x327 = v[5] + v[6];
+        let x328 = x314 * x314;
+        let x329 = x313 * x327;
+        let x330 = Self::mul_add(x327, -16.80768997608804, x314 * 0.07309);
         let x331 = Self::mul_add(
+            -0.1132,
+            x327,
+            Self::mul_add(130.43769025763282, x314, x313 * 0.07309),
+        );
+        let x332 = Self::mul_add(
+            -132.47349025763282,
+            x327,
+            Self::mul_add(0.1132, x314, x313 * 16.80768997608804),
+        );
+        let x333 = Self::mul_add(0.00000000020510342851533115, x313, x327);
+        let x334 = Self::mul_add(s_q8, x314, c_q8 * x333);
+        let x335 = Self::mul_add(-c_q8, x314, s_q8 * x333);
+        let x336 = Self::mul_add(
             0.35,
-            x322 - x325,
-            Self::mul_add(-s_q7, x318, c_q7 * x317),
+            x326 - x329,
+            Self::mul_add(-s_q7, x322, c_q7 * x321),
         );
-        let x332 = Self::mul_add(0.35, Self::mul_add(-x310, x323, x321), x320);
-        let x333 = Self::mul_add(0.35, Self::mul_add(x309, x309, x324), x319);
-        let x334 = Self::mul_add(c_q8, x333, Self::mul_add(s_q8, x332, x7 * x331));
-        let x335 = Self::mul_add(s_q8, x333, Self::mul_add(-c_q8, x332, x8 * x331));
-        let x336 = Self::mul_add(-0.00000000020510342851533115, x333, x331);
-        let x337 = Self::mul_add(v[7], x330, Self::mul_add(-s_q8, x322, x7 * x321));
-        let x338 = Self::mul_add(-v[7], x329, Self::mul_add(c_q8, x322, x8 * x321));
-        let x339 = v[7] + Self::mul_add(-0.00000000020510342851533115, x323, x309);
-        let x340 = x330 * x330;
-        let x341 = x339 * x339;
-        let x342 = x329 * x330;
-        let x343 = x321 - x342;
-        let x344 = x329 * x339;
-        let x345 = x329 * x329;
-        let x346 = x341 + x345;
-        let x347 = x330 * x339;
-        let x348 = x337 + x347;
-        let x349 = Self::mul_add(
-            x339,
+        let x337 = Self::mul_add(0.35, Self::mul_add(-x314, x327, x325), x324);
+        let x338 = Self::mul_add(0.35, Self::mul_add(x313, x313, x328), x323);
+        let x339 = Self::mul_add(-0.00000000020510342851533115, x338, x336);
+        let x340 = Self::mul_add(0.00000000020510342851533115, x336, x338);
+        let x341 = Self::mul_add(s_q8, x337, c_q8 * x340);
+        let x342 = Self::mul_add(-c_q8, x337, s_q8 * x340);
+        let x343 = 0.00000000020510342851533115 * x325;
+        let x344 = Self::mul_add(v[7], x335, Self::mul_add(-s_q8, x326, c_q8 * x343));
+        let x345 = Self::mul_add(-v[7], x334, Self::mul_add(c_q8, x326, s_q8 * x343));
+        let x346 = v[7] + Self::mul_add(-0.00000000020510342851533115, x327, x313);
+        let x347 = x335 * x335;
+        let x348 = x346 * x346;
+        let x349 = x334 * x335;
+        let x350 = x325 - x349;
+        let x351 = x334 * x346;
+        let x352 = x334 * x334;
+        let x353 = x348 + x352;
+        let x354 = x335 * x346;
+        let x355 = x344 + x354;
+        let x356 = Self::mul_add(
+            x346,
             0.002139996587640933,
-            x330 * 0.0000000234896432582596,
+            x335 * 0.0000000234896432582596,
         );
-        let x350 = Self::mul_add(
+        let x357 = Self::mul_add(
             5.080660024070365,
-            x339,
-            Self::mul_add(x330, -111.7548902508081, x329 * 0.0000000234896432582596),
+            x346,
+            Self::mul_add(x335, -111.7548902508081, x334 * 0.0000000234896432582596),
         );
-        let x351 = Self::mul_add(
+        let x358 = Self::mul_add(
             113.3918902508081,
-            x339,
-            Self::mul_add(5.080660024070366, x330, x329 * 0.002139996587640933),
+            x346,
+            Self::mul_add(5.080660024070366, x335, x334 * 0.002139996587640933),
         );
-        let x352 = Self::mul_add(
-            x336,
+        let x359 = Self::mul_add(
+            x339,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x321,
-                Self::mul_add(x338, -111.7548902508081, x337 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x329, x351, x339 * x349),
+                x325,
+                Self::mul_add(x345, -111.7548902508081, x344 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x334, x358, x346 * x356),
         );
-        let x353 = Self::mul_add(-c_q9, x339, Self::mul_add(-x11, x330, s_q9 * x329));
-        let x354 = Self::mul_add(s_q9, x339, Self::mul_add(x12, x330, c_q9 * x329));
-        let x355 = x334 + Self::mul_add(-0.4, x338 + x344, 0.275 * x343);
-        let x356 = x335 + Self::mul_add(0.4, x337 - x347, 0.275 * x346);
-        let x357 = x336 - Self::mul_add(-0.4, x340 + x345, 0.275 * x348);
-        let x358 = Self::mul_add(-c_q9, x357, Self::mul_add(-x11, x356, s_q9 * x355));
-        let x359 = Self::mul_add(
+        let x360 = Self::mul_add(-c_q9, x346, Self::mul_add(-x9, x335, s_q9 * x334));
+        let x361 = Self::mul_add(s_q9, x346, Self::mul_add(x10, x335, c_q9 * x334));
+        let x362 = x341 + Self::mul_add(-0.4, x345 + x351, 0.275 * x350);
+        let x363 = x342 + Self::mul_add(0.4, x344 - x354, 0.275 * x353);
+        let x364 = x339 - Self::mul_add(-0.4, x347 + x352, 0.275 * x355);
+        let x365 = Self::mul_add(-c_q9, x364, Self::mul_add(-x9, x363, s_q9 * x362));
+        let x366 = Self::mul_add(
             -0.00000000020510342851533115,
-            x357,
-            Self::mul_add(-0.00000000020510342851533115, x355, x356),
+            x364,
+            Self::mul_add(-0.00000000020510342851533115, x362, x363),
         );
-        let x360 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x321,
-            Self::mul_add(-0.00000000020510342851533115, x337, x338),
-        );
-        let x361 = Self::mul_add(
+        let x367 = x343 - Self::mul_add(-0.00000000020510342851533115, x344, x345);
+        let x368 = Self::mul_add(
             -v[8],
-            x354,
-            Self::mul_add(-c_q9, x321, Self::mul_add(-x11, x338, s_q9 * x337)),
+            x361,
+            Self::mul_add(-c_q9, x325, Self::mul_add(-x9, x345, s_q9 * x344)),
         );
-        let x362 = Self::mul_add(
+        let x369 = Self::mul_add(
             v[8],
-            x353,
-            Self::mul_add(s_q9, x321, Self::mul_add(x12, x338, c_q9 * x337)),
+            x360,
+            Self::mul_add(s_q9, x325, Self::mul_add(x10, x345, c_q9 * x344)),
         );
-        let x363 = v[8]
+        let x370 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x339,
-                Self::mul_add(-0.00000000020510342851533115, x329, x330),
+                x346,
+                Self::mul_add(-0.00000000020510342851533115, x334, x335),
             );
-        let x364 = Self::mul_add(x353, x354, x360);
-        let x365 = Self::mul_add(x353, x353, x363 * x363);
-        let x366 = Self::mul_add(-x354, x363, x361);
-        let x367 = x363 * 0.00214;
-        let x368 = Self::mul_add(x363, -36.18604050126307, x354 * 63.36336825000001);
-        let x369 = Self::mul_add(
+        let x371 = Self::mul_add(-x360, x361, x367);
+        let x372 = Self::mul_add(x360, x360, x370 * x370);
+        let x373 = Self::mul_add(-x361, x370, x368);
+        let x374 = x370 * 0.00214;
+        let x375 = Self::mul_add(x370, -36.18604050126307, x361 * 63.36336825000001);
+        let x376 = Self::mul_add(
             69.99836825,
-            x363,
-            Self::mul_add(x354, 36.18604050126307, x353 * 0.00214),
+            x370,
+            Self::mul_add(x361, 36.18604050126307, x360 * 0.00214),
         );
-        let x370 = Self::mul_add(
-            x359,
-            81.53205,
-            Self::mul_add(x360, 0.00214, -Self::mul_add(x354, x369, x363 * x368)),
+        let x377 = Self::mul_add(
+            x366,
+            -81.53205,
+            Self::mul_add(x367, 0.00214, Self::mul_add(x361, x376, x370 * x375)),
         );
-        let x371 = Self::mul_add(
-            x358,
+        let x378 = Self::mul_add(
+            x365,
             -81.53205,
             Self::mul_add(
-                69.99836825,
-                x360,
-                Self::mul_add(x362, 36.18604050126307, x361 * 0.00214),
-            ) + Self::mul_add(x353, x368, x354 * x367),
+                -69.99836825,
+                x367,
+                Self::mul_add(x369, 36.18604050126307, x368 * 0.00214),
+            ) + Self::mul_add(x360, x375, x361 * x374),
         );
-        let x372 = Self::mul_add(s_q10, x354, c_q10 * x353);
-        let x373 = Self::mul_add(-c_q10, x354, s_q10 * x353);
-        let x374 = Self::mul_add(-0.87, x364, x358);
-        let x375 = Self::mul_add(
+        let x379 = Self::mul_add(s_q10, x361, c_q10 * x360);
+        let x380 = Self::mul_add(-c_q10, x361, s_q10 * x360);
+        let x381 = Self::mul_add(0.87, x371, x365);
+        let x382 = Self::mul_add(
             0.87,
-            x365,
-            Self::mul_add(s_q9, x357, Self::mul_add(x12, x356, c_q9 * x355)),
+            x372,
+            Self::mul_add(s_q9, x364, Self::mul_add(x10, x363, c_q9 * x362)),
         );
-        let x376 = Self::mul_add(0.87, x366, x359);
-        let x377 = Self::mul_add(s_q10, x375, c_q10 * x374);
-        let x378 = Self::mul_add(v[9], x373, Self::mul_add(s_q10, x362, c_q10 * x361));
-        let x379 = Self::mul_add(-v[9], x372, Self::mul_add(-c_q10, x362, s_q10 * x361));
-        let x380 = v[9] + x363;
-        let x381 = Self::mul_add(-x372, x373, x360);
-        let x382 = x372 * x372;
-        let x383 = Self::mul_add(x380, x380, x382);
-        let x384 = x373 * x380;
-        let x385 = x378 + x384;
-        let x386 = x380 * 0.6328;
-        let x387 = Self::mul_add(x380, 24.35164200091464, x373 * 24.4950615);
-        let x388 = Self::mul_add(
+        let x383 = Self::mul_add(0.87, x373, x366);
+        let x384 = Self::mul_add(s_q10, x382, c_q10 * x381);
+        let x385 = Self::mul_add(v[9], x380, Self::mul_add(s_q10, x369, c_q10 * x368));
+        let x386 = Self::mul_add(-v[9], x379, Self::mul_add(-c_q10, x369, s_q10 * x368));
+        let x387 = v[9] + x370;
+        let x388 = Self::mul_add(x379, x380, x367);
+        let x389 = x379 * x379;
+        let x390 = Self::mul_add(x387, x387, x389);
+        let x391 = x380 * x387;
+        let x392 = x385 + x391;
+        let x393 = x387 * 0.6328;
+        let x394 = Self::mul_add(x387, 24.35164200091464, x380 * 24.4950615);
+        let x395 = Self::mul_add(
             28.2393615,
-            x380,
-            Self::mul_add(x373, -24.351642000914637, x372 * 0.6328),
+            x387,
+            Self::mul_add(x380, -24.351642000914637, x379 * 0.6328),
         );
-        let x389 = Self::mul_add(
-            x376,
-            45.1584,
-            Self::mul_add(x360, 0.6328, Self::mul_add(x373, x388, x380 * x387)),
+        let x396 = Self::mul_add(
+            x383,
+            -45.1584,
+            Self::mul_add(x367, 0.6328, -Self::mul_add(x380, x395, x387 * x394)),
         );
-        let x390 = Self::mul_add(
-            x377,
+        let x397 = Self::mul_add(
+            x384,
             -45.1584,
             Self::mul_add(
-                28.2393615,
-                x360,
-                Self::mul_add(x379, -24.351642000914637, x378 * 0.6328),
-            ) - Self::mul_add(x372, x387, x373 * x386),
+                -28.2393615,
+                x367,
+                Self::mul_add(x386, -24.351642000914637, x385 * 0.6328),
+            ) - Self::mul_add(x379, x394, x380 * x393),
         );
-        let x391 = Self::mul_add(-s_q11, x373, c_q11 * x372);
-        let x392 = Self::mul_add(c_q11, x373, s_q11 * x372);
-        let x393 = x377
-            - Self::mul_add(-0.275, Self::mul_add(x372, x380, x379), 0.63 * x381);
-        let x394 = Self::mul_add(-c_q10, x375, s_q10 * x374)
-            - Self::mul_add(0.275, x378 - x384, 0.63 * x383);
-        let x395 = x376
-            + Self::mul_add(-0.275, Self::mul_add(x373, x373, x382), 0.63 * x385);
-        let x396 = Self::mul_add(-s_q11, x394, c_q11 * x393);
-        let x397 = Self::mul_add(v[10], x392, Self::mul_add(-s_q11, x379, c_q11 * x378));
-        let x398 = Self::mul_add(-v[10], x391, Self::mul_add(c_q11, x379, s_q11 * x378));
-        let x399 = v[10] + x380;
-        let x400 = x391 * x391;
-        let x401 = x392 * x399;
-        let x402 = 0.01675 * x399;
-        let x403 = Self::mul_add(-2.5482240016099564, x399, x392 * 9.142025249762803);
-        let x404 = Self::mul_add(
+        let x398 = Self::mul_add(-s_q11, x380, c_q11 * x379);
+        let x399 = Self::mul_add(c_q11, x380, s_q11 * x379);
+        let x400 = x384
+            + Self::mul_add(0.275, Self::mul_add(x379, x387, x386), 0.63 * x388);
+        let x401 = Self::mul_add(-c_q10, x382, s_q10 * x381)
+            - Self::mul_add(0.275, x385 - x391, 0.63 * x390);
+        let x402 = x383
+            + Self::mul_add(-0.275, Self::mul_add(x380, x380, x389), 0.63 * x392);
+        let x403 = Self::mul_add(-s_q11, x401, c_q11 * x400);
+        let x404 = Self::mul_add(v[10], x399, Self::mul_add(-s_q11, x386, c_q11 * x385));
+        let x405 = Self::mul_add(-v[10], x398, Self::mul_add(c_q11, x386, s_q11 * x385));
+        let x406 = v[10] + x387;
+        let x407 = x398 * x398;
+        let x408 = x399 * x406;
+        let x409 = 0.01675 * x406;
+        let x410 = Self::mul_add(-2.5482240016099564, x406, x399 * 9.142025249762803);
+        let x411 = Self::mul_add(
             -9.223235249762805,
-            x399,
-            Self::mul_add(-2.5482240016099564, x392, 0.01675 * x391),
+            x406,
+            Self::mul_add(-2.5482240016099564, x399, 0.01675 * x398),
         );
-        let x405 = Self::mul_add(
-            7.078399999258757,
-            x395,
-            Self::mul_add(0.01675, x360, -Self::mul_add(-x392, x404, x399 * x403)),
-        );
-        let x406 = Self::mul_add(
+        let x412 = Self::mul_add(
             -7.078399999258757,
-            x396,
-            Self::mul_add(
-                -9.223235249762805,
-                x360,
-                Self::mul_add(-2.5482240016099564, x398, 0.01675 * x397),
-            ) - Self::mul_add(-x391, x403, x392 * x402),
+            x402,
+            Self::mul_add(0.01675, x367, Self::mul_add(-x399, x411, x406 * x410)),
         );
-        let x407 = Self::mul_add(s_q12, x399, Self::mul_add(x13, x392, c_q12 * x391));
-        let x408 = Self::mul_add(-c_q12, x399, Self::mul_add(-x14, x392, s_q12 * x391));
-        let x409 = Self::mul_add(0.36, Self::mul_add(x391, x399, x398), x396);
-        let x410 = Self::mul_add(
+        let x413 = Self::mul_add(
+            -7.078399999258757,
+            x403,
+            Self::mul_add(
+                9.223235249762805,
+                x367,
+                Self::mul_add(-2.5482240016099564, x405, 0.01675 * x404),
+            ) - Self::mul_add(-x398, x410, x399 * x409),
+        );
+        let x414 = Self::mul_add(0.00000000020510342851533115, x399, x406);
+        let x415 = Self::mul_add(s_q12, x414, c_q12 * x398);
+        let x416 = Self::mul_add(-c_q12, x414, s_q12 * x398);
+        let x417 = Self::mul_add(0.36, Self::mul_add(x398, x406, x405), x403);
+        let x418 = Self::mul_add(
             -0.36,
-            x397 - x401,
-            Self::mul_add(c_q11, x394, s_q11 * x393),
+            x404 - x408,
+            Self::mul_add(c_q11, x401, s_q11 * x400),
         );
-        let x411 = Self::mul_add(-0.36, Self::mul_add(x392, x392, x400), x395);
-        let x412 = Self::mul_add(s_q12, x411, Self::mul_add(x13, x410, c_q12 * x409));
-        let x413 = Self::mul_add(-c_q12, x411, Self::mul_add(-x14, x410, s_q12 * x409));
-        let x414 = Self::mul_add(-0.00000000020510342851533115, x411, x410);
-        let x415 = Self::mul_add(-0.00000000020510342851533115, x360, x398);
-        let x416 = Self::mul_add(
-            v[11],
-            x408,
-            Self::mul_add(s_q12, x360, Self::mul_add(x13, x398, c_q12 * x397)),
-        );
-        let x417 = Self::mul_add(
-            -v[11],
-            x407,
-            Self::mul_add(-c_q12, x360, Self::mul_add(-x14, x398, s_q12 * x397)),
-        );
-        let x418 = v[11] + Self::mul_add(-0.00000000020510342851533115, x399, x392);
-        let x419 = x408 * x408;
-        let x420 = x418 * x418;
-        let x421 = x407 * x408;
-        let x422 = x415 - x421;
-        let x423 = x407 * x418;
-        let x424 = x407 * x407;
-        let x425 = x420 + x424;
-        let x426 = x408 * x418;
-        let x427 = x416 + x426;
-        let x428 = Self::mul_add(x418, 0.809539999555672, x408 * 1.9877000000000002);
-        let x429 = Self::mul_add(
-            x418,
-            -2.741639999592316,
-            Self::mul_add(x408, -5.252920330000002, x407 * 1.9877000000000002),
-        );
-        let x430 = Self::mul_add(
-            9.740442170000001,
-            x418,
-            Self::mul_add(x408, -2.7416399995923166, x407 * 0.809539999555672),
-        );
-        let x431 = Self::mul_add(
-            -3.6140000000000003,
-            x414,
-            Self::mul_add(
-                x415,
-                -2.741639999592316,
-                Self::mul_add(x417, -5.252920330000002, x416 * 1.9877000000000002),
-            ) + Self::mul_add(-x407, x430, x418 * x428),
-        );
-        let x432 = Self::mul_add(-c_q13, x418, Self::mul_add(s_q13, x408, x15 * x407));
-        let x433 = Self::mul_add(-s_q13, x418, Self::mul_add(-c_q13, x408, x16 * x407));
-        let x434 = x412 + Self::mul_add(-0.16, x417 + x423, 0.55 * x422);
-        let x435 = x414 - Self::mul_add(-0.16, x419 + x424, 0.55 * x427);
-        let x436 = Self::mul_add(
-            -c_q13,
-            x435,
-            Self::mul_add(
-                s_q13,
-                x413 + Self::mul_add(0.16, x416 - x426, 0.55 * x425),
-                x15 * x434,
-            ),
-        );
-        let x437 = Self::mul_add(0.00000000020510342851533115, x415, x416);
-        let x438 = Self::mul_add(
-            v[12],
-            x433,
-            Self::mul_add(-c_q13, x415, Self::mul_add(s_q13, x417, x15 * x416)),
-        );
+        let x419 = Self::mul_add(-0.36, Self::mul_add(x399, x399, x407), x402);
+        let x420 = Self::mul_add(0.00000000020510342851533115, x418, x419);
+        let x421 = Self::mul_add(-0.00000000020510342851533115, x419, x418);
+        let x422 = Self::mul_add(s_q12, x420, c_q12 * x417);
+        let x423 = Self::mul_add(-c_q12, x420, s_q12 * x417);
+        let x424 = Self::mul_add(-0.00000000020510342851533115, x405, x367);
+        let x425 = Self::mul_add(0.00000000020510342851533115, x367, x405);
+        let x426 = Self::mul_add(v[11], x416, Self::mul_add(-s_q12, x424, c_q12 * x404));
+        let x427 = Self::mul_add(-v[11], x415, Self::mul_add(c_q12, x424, s_q12 * x404));
+        let x428 = v[11] + Self::mul_add(-0.00000000020510342851533115, x406, x399);
+        let x429 = x416 * x416;
+        let x430 = x428 * x428;
+        let x431 = x415 * x416;
+        let x432 = x425 - x431;
+        let x433 = x415 * x428;
+        let x434 = x415 * x415;
+        let x435 = x430 + x434;
+        let x436 = x416 * x428;
+        let x437 = x426 + x436;
+        let x438 = Self::mul_add(x428, 0.809539999555672, x416 * 1.9877000000000002);
         let x439 = Self::mul_add(
-            -v[12],
-            x432,
-            Self::mul_add(-s_q13, x415, Self::mul_add(-c_q13, x417, x16 * x416)),
+            x428,
+            -2.741639999592316,
+            Self::mul_add(x416, -5.252920330000002, x415 * 1.9877000000000002),
         );
-        let x440 = v[12] - Self::mul_add(0.00000000020510342851533115, x418, x407);
-        let x441 = Self::mul_add(0.0145, x440, 0.000781 * x433);
-        let x442 = Self::mul_add(
-            -0.9614610000000001,
-            x440,
-            Self::mul_add(1.2025609200000003, x433, 0.000781 * x432),
+        let x440 = Self::mul_add(
+            9.740442170000001,
+            x428,
+            Self::mul_add(x416, -2.7416399995923166, x415 * 0.809539999555672),
         );
-        let x443 = Self::mul_add(
-            -1.4135609200000003,
-            x440,
-            Self::mul_add(-0.9614610000000001, x433, 0.0145 * x432),
-        );
-        let x444 = Self::mul_add(
-            4.806620000000001,
-            x436,
+        let x441 = Self::mul_add(
+            -3.6140000000000003,
+            x421,
             Self::mul_add(
-                1.4135609200000003,
-                x437,
-                Self::mul_add(-0.9614610000000001, x439, 0.0145 * x438),
-            ) - Self::mul_add(-x432, x442, x433 * x441),
+                x425,
+                -2.741639999592316,
+                Self::mul_add(x427, -5.252920330000002, x426 * 1.9877000000000002),
+            ) + Self::mul_add(-x415, x440, x428 * x438),
         );
-        let x445 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x432, x433, x437),
-            f_ext[7][0],
-        );
-        let x446 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x432, x432, x440 * x440),
-            f_ext[7][1],
-        );
-        let x447 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x433, x440, x438),
-            f_ext[7][2],
-        );
-        let x448 = f_ext[7][3]
-            - Self::mul_add(
-                4.806620000000001,
-                Self::mul_add(0.00000000020510342851533115, x435, x434),
-                Self::mul_add(-0.0145, x437, 0.000781 * x439)
-                    - Self::mul_add(-x433, x443, x440 * x442),
-            );
-        let x449 = f_ext[7][4]
-            + (Self::mul_add(
-                0.9614610000000001,
-                x437,
-                Self::mul_add(1.2025609200000003, x439, 0.000781 * x438),
-            ) + Self::mul_add(-x432, x443, x440 * x441));
-        let x450 = f_ext[7][5] - x444;
-        let x451 = x447 - Self::mul_add(-x16, x446, x15 * x445);
-        let x452 = Self::mul_add(c_q13, x446, s_q13 * x445);
+        let x442 = Self::mul_add(-0.00000000020510342851533115, x415, x428);
+        let x443 = Self::mul_add(-s_q13, x416, c_q13 * x442);
+        let x444 = Self::mul_add(c_q13, x416, s_q13 * x442);
+        let x445 = x422 + Self::mul_add(-0.16, x427 + x433, 0.55 * x432);
+        let x446 = x421 - Self::mul_add(-0.16, x429 + x434, 0.55 * x437);
+        let x447 = Self::mul_add(0.00000000020510342851533115, x425, x426);
+        let x448 = Self::mul_add(-0.00000000020510342851533115, x426, x425);
+        let x449 = Self::mul_add(v[12], x444, Self::mul_add(-s_q13, x427, c_q13 * x448));
+        let x450 = Self::mul_add(-v[12], x443, Self::mul_add(c_q13, x427, s_q13 * x448));
+        let x451 = v[12] - Self::mul_add(0.00000000020510342851533115, x428, x415);
+        let x452 = Self::mul_add(-0.0145, x451, 0.000781 * x444);
         let x453 = Self::mul_add(
-            0.00000000020510342851533115,
-            x447,
-            Self::mul_add(-s_q13, x446, c_q13 * x445),
+            0.9614610000000001,
+            x451,
+            Self::mul_add(1.2025609200000003, x444, 0.000781 * x443),
         );
         let x454 = Self::mul_add(
-            0.55,
+            1.4135609200000003,
             x451,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x450,
-                Self::mul_add(-s_q13, x449, c_q13 * x448),
-            ),
+            Self::mul_add(-0.9614610000000001, x444, 0.0145 * x443),
         );
-        let x455 = f_ext[6][0]
+        let x455 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(
+                -s_q13,
+                x423 + Self::mul_add(0.16, x426 - x436, 0.55 * x435),
+                c_q13 * Self::mul_add(-0.00000000020510342851533115, x445, x446),
+            ),
+            Self::mul_add(
+                -1.4135609200000003,
+                x447,
+                Self::mul_add(-0.9614610000000001, x450, 0.0145 * x449),
+            ) + Self::mul_add(-x443, x453, x444 * x452),
+        );
+        let x456 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(x443, x444, x447),
+            f_ext[7][0],
+        );
+        let x457 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(x443, x443, x451 * x451),
+            f_ext[7][1],
+        );
+        let x458 = Self::mul_add(
+            -4.806620000000001,
+            Self::mul_add(x444, x451, x449),
+            f_ext[7][2],
+        );
+        let x459 = f_ext[7][3]
+            + Self::mul_add(
+                -4.806620000000001,
+                Self::mul_add(0.00000000020510342851533115, x446, x445),
+                Self::mul_add(0.0145, x447, 0.000781 * x450)
+                    - Self::mul_add(x444, x454, x451 * x453),
+            );
+        let x460 = f_ext[7][4]
+            - (Self::mul_add(
+                -0.9614610000000001,
+                x447,
+                Self::mul_add(1.2025609200000003, x450, 0.000781 * x449),
+            ) + Self::mul_add(x443, x454, x451 * x452));
+        let x461 = f_ext[7][5] + x455;
+        let x462 = Self::mul_add(-s_q13, x457, c_q13 * x456);
+        let x463 = Self::mul_add(c_q13, x457, s_q13 * x456);
+        let x464 = Self::mul_add(0.00000000020510342851533115, x458, x462);
+        let x465 = Self::mul_add(-0.00000000020510342851533115, x462, x458);
+        let x466 = Self::mul_add(-s_q13, x460, c_q13 * x459);
+        let x467 = f_ext[6][0]
             + Self::mul_add(
                 -17.135250000000003,
-                x422,
-                3.6140000000000003 * (x419 + x420),
-            ) + x451;
-        let x456 = f_ext[6][1]
-            + Self::mul_add(17.135250000000003, x425, 3.6140000000000003 * (x415 + x421))
-            + x452;
-        let x457 = f_ext[6][2]
-            - Self::mul_add(17.135250000000003, x427, 3.6140000000000003 * (x417 - x423))
-            - x453;
-        let x458 = f_ext[6][3]
+                x432,
+                3.6140000000000003 * (x429 + x430),
+            ) + x465;
+        let x468 = f_ext[6][1]
+            + Self::mul_add(17.135250000000003, x435, 3.6140000000000003 * (x425 + x431))
+            + x463;
+        let x469 = f_ext[6][2]
+            - Self::mul_add(17.135250000000003, x437, 3.6140000000000003 * (x427 - x433))
+            - x464;
+        let x470 = f_ext[6][3]
             - Self::mul_add(
                 -17.135250000000003,
-                x414,
-                Self::mul_add(x415, 0.809539999555672, x417 * 1.9877000000000002)
-                    - Self::mul_add(-x408, x430, x418 * x429),
+                x421,
+                Self::mul_add(x425, 0.809539999555672, x427 * 1.9877000000000002)
+                    - Self::mul_add(-x416, x440, x428 * x439),
             )
-            + (x450 - Self::mul_add(-x16, x449, x15 * x448)
-                - Self::mul_add(0.55, x453, 0.16 * x452));
-        let x459 = f_ext[6][4] + x431
-            + Self::mul_add(0.16, x451, Self::mul_add(c_q13, x449, s_q13 * x448));
-        let x460 = f_ext[6][5]
+            + (Self::mul_add(-0.00000000020510342851533115, x466, x461)
+                - Self::mul_add(0.55, x464, 0.16 * x463));
+        let x471 = f_ext[6][4] + x441
+            + Self::mul_add(0.16, x465, Self::mul_add(c_q13, x460, s_q13 * x459));
+        let x472 = f_ext[6][5]
             + (Self::mul_add(
                 9.740442170000001,
-                x415,
-                Self::mul_add(x417, -2.7416399995923166, x416 * 0.809539999555672),
-            ) - Self::mul_add(-x407, x429, x408 * x428)
-                + Self::mul_add(3.6140000000000003, x413, 17.135250000000003 * x412))
-            - x454;
-        let x461 = Self::mul_add(-s_q12, x456, c_q12 * x455);
-        let x462 = x457 - Self::mul_add(x14, x456, x13 * x455);
-        let x463 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(-x391, x392, x360),
-            f_ext[5][0],
-        ) + x461;
-        let x464 = Self::mul_add(
+                x425,
+                Self::mul_add(x427, -2.7416399995923166, x426 * 0.809539999555672),
+            ) - Self::mul_add(-x415, x439, x416 * x438)
+                + Self::mul_add(3.6140000000000003, x423, 17.135250000000003 * x422))
+            - Self::mul_add(
+                0.55,
+                x465,
+                Self::mul_add(0.00000000020510342851533115, x461, x466),
+            );
+        let x473 = Self::mul_add(-s_q12, x468, c_q12 * x467);
+        let x474 = Self::mul_add(c_q12, x468, s_q12 * x467);
+        let x475 = Self::mul_add(-0.00000000020510342851533115, x474, x469);
+        let x476 = Self::mul_add(c_q12, x471, s_q12 * x470);
+        let x477 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x399, x399, x400),
+            Self::mul_add(x398, x399, x367),
+            f_ext[5][0],
+        ) + x473;
+        let x478 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x406, x406, x407),
             f_ext[5][1],
-        ) + x462;
-        let x465 = Self::mul_add(-7.078399999258757, x397 + x401, f_ext[5][2])
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x457,
-                Self::mul_add(c_q12, x456, s_q12 * x455),
+        ) + x475;
+        let x479 = Self::mul_add(-7.078399999258757, x404 + x408, f_ext[5][2])
+            - Self::mul_add(0.00000000020510342851533115, x469, x474);
+        let x480 = f_ext[5][3] - x412
+            + Self::mul_add(0.36, x475, Self::mul_add(-s_q12, x471, c_q12 * x470));
+        let x481 = f_ext[5][4]
+            - (Self::mul_add(2.5482240016099564, x367, x405 * 9.142025249762803)
+                + Self::mul_add(-x398, x411, x406 * x409))
+            + Self::mul_add(
+                -0.36,
+                x473,
+                Self::mul_add(-0.00000000020510342851533115, x476, x472),
             );
-        let x466 = f_ext[5][3] + x405
-            + Self::mul_add(0.36, x462, Self::mul_add(-s_q12, x459, c_q12 * x458));
-        let x467 = f_ext[5][4]
-            - (Self::mul_add(-2.5482240016099564, x360, x398 * 9.142025249762803)
-                + Self::mul_add(-x391, x404, x399 * x402))
-            + Self::mul_add(-0.36, x461, x460 - Self::mul_add(x14, x459, x13 * x458));
-        let x468 = f_ext[5][5] - x406
+        let x482 = f_ext[5][5] - x413
+            - Self::mul_add(0.00000000020510342851533115, x472, x476);
+        let x483 = Self::mul_add(-s_q11, x478, c_q11 * x477);
+        let x484 = Self::mul_add(c_q11, x478, s_q11 * x477);
+        let x485 = Self::mul_add(x388, -45.1584, f_ext[4][0]) + x483;
+        let x486 = Self::mul_add(-45.1584, x390, f_ext[4][1]) + x484;
+        let x487 = Self::mul_add(45.1584, x392, f_ext[4][2]) + x479;
+        let x488 = f_ext[4][3] + x396
+            + (Self::mul_add(-s_q11, x481, c_q11 * x480)
+                + Self::mul_add(-0.63, x479, 0.275 * x484));
+        let x489 = f_ext[4][4]
+            - (Self::mul_add(x367, -24.35164200091464, x386 * 24.4950615)
+                - Self::mul_add(-x379, x395, x387 * x393))
+            + Self::mul_add(-0.275, x483, Self::mul_add(c_q11, x481, s_q11 * x480));
+        let x490 = f_ext[4][5] + x397 + Self::mul_add(0.63, x483, x482);
+        let x491 = Self::mul_add(-s_q10, x486, c_q10 * x485);
+        let x492 = Self::mul_add(x371, -81.53205, f_ext[3][0]) + x491;
+        let x493 = Self::mul_add(-81.53205, x372, f_ext[3][1])
+            + Self::mul_add(c_q10, x486, s_q10 * x485);
+        let x494 = Self::mul_add(81.53205, x373, f_ext[3][2]) + x487;
+        let x495 = f_ext[3][3] + x377
+            + Self::mul_add(-0.87, x487, Self::mul_add(-s_q10, x489, c_q10 * x488));
+        let x496 = f_ext[3][4]
+            + (Self::mul_add(x367, 36.18604050126307, x369 * 63.36336825000001)
+                + Self::mul_add(-x360, x376, x370 * x374))
+            + Self::mul_add(c_q10, x489, s_q10 * x488);
+        let x497 = f_ext[3][5] + x378 + Self::mul_add(0.87, x491, x490);
+        let x498 = 0.00000000020510342851533115 * x494;
+        let x499 = Self::mul_add(c_q9, x493, s_q9 * x492) + x498;
+        let x500 = x494 + Self::mul_add(-x10, x493, x9 * x492);
+        let x501 = x498 - Self::mul_add(-s_q9, x493, c_q9 * x492);
+        let x502 = 0.00000000020510342851533115 * x497;
+        let x503 = f_ext[2][0]
             - Self::mul_add(
-                0.00000000020510342851533115,
-                x460,
-                Self::mul_add(c_q12, x459, s_q12 * x458),
-            );
-        let x469 = Self::mul_add(-s_q11, x464, c_q11 * x463);
-        let x470 = Self::mul_add(c_q11, x464, s_q11 * x463);
-        let x471 = Self::mul_add(x381, 45.1584, f_ext[4][0]) + x469;
-        let x472 = Self::mul_add(-45.1584, x383, f_ext[4][1]) + x470;
-        let x473 = Self::mul_add(45.1584, x385, f_ext[4][2]) + x465;
-        let x474 = f_ext[4][3] - x389
-            + (Self::mul_add(-s_q11, x467, c_q11 * x466)
-                + Self::mul_add(-0.63, x465, 0.275 * x470));
-        let x475 = f_ext[4][4]
-            - (Self::mul_add(x360, 24.35164200091464, x379 * 24.4950615)
-                - Self::mul_add(-x372, x388, x380 * x386))
-            + Self::mul_add(-0.275, x469, Self::mul_add(c_q11, x467, s_q11 * x466));
-        let x476 = f_ext[4][5] + x390 + Self::mul_add(0.63, x469, x468);
-        let x477 = Self::mul_add(-s_q10, x472, c_q10 * x471);
-        let x478 = Self::mul_add(x364, 81.53205, f_ext[3][0]) + x477;
-        let x479 = Self::mul_add(-81.53205, x365, f_ext[3][1])
-            + Self::mul_add(c_q10, x472, s_q10 * x471);
-        let x480 = Self::mul_add(81.53205, x366, f_ext[3][2]) + x473;
-        let x481 = f_ext[3][3] - x370
-            + Self::mul_add(-0.87, x473, Self::mul_add(-s_q10, x475, c_q10 * x474));
-        let x482 = f_ext[3][4]
-            + (Self::mul_add(x360, -36.18604050126307, x362 * 63.36336825000001)
-                + Self::mul_add(-x353, x369, x363 * x367))
-            + Self::mul_add(c_q10, x475, s_q10 * x474);
-        let x483 = f_ext[3][5] + x371 + Self::mul_add(0.87, x477, x476);
-        let x484 = 0.00000000020510342851533115 * x480;
-        let x485 = Self::mul_add(c_q9, x479, s_q9 * x478) + x484;
-        let x486 = x480 + Self::mul_add(-x12, x479, x11 * x478);
-        let x487 = x484 - Self::mul_add(-s_q9, x479, c_q9 * x478);
-        let x488 = 0.00000000020510342851533115 * x483;
-        let x489 = f_ext[2][0]
-            - Self::mul_add(
-                x343,
+                x350,
                 -12.701650001451807,
-                (x340 + x341) * 0.000000008530897668050218,
-            ) + x485;
-        let x490 = f_ext[2][1]
+                (x347 + x348) * 0.000000008530897668050218,
+            ) + x499;
+        let x504 = f_ext[2][1]
             - Self::mul_add(
                 12.701650001451807,
-                x346,
-                0.000000008530897668050218 * (x321 + x342),
-            ) + x486;
-        let x491 = f_ext[2][2]
+                x353,
+                0.000000008530897668050218 * (x325 + x349),
+            ) + x500;
+        let x505 = f_ext[2][2]
             + Self::mul_add(
                 12.701650001451807,
-                x348,
-                0.000000008530897668050218 * (x338 - x344),
-            ) - x487;
-        let x492 = f_ext[2][3]
+                x355,
+                0.000000008530897668050218 * (x345 - x351),
+            ) - x501;
+        let x506 = f_ext[2][3]
             - Self::mul_add(
-                x336,
+                x339,
                 12.701650001451807,
                 Self::mul_add(
-                    x321,
+                    x325,
                     0.002139996587640933,
-                    x338 * 0.0000000234896432582596,
-                ) - Self::mul_add(-x330, x351, x339 * x350),
+                    x345 * 0.0000000234896432582596,
+                ) - Self::mul_add(-x335, x358, x346 * x357),
             )
-            + (Self::mul_add(c_q9, x482, s_q9 * x481) + x488
-                - Self::mul_add(0.275, x487, 0.4 * x486));
-        let x493 = f_ext[2][4] + x352
-            + Self::mul_add(0.4, x485, x483 + Self::mul_add(-x12, x482, x11 * x481));
-        let x494 = f_ext[2][5]
+            + (Self::mul_add(c_q9, x496, s_q9 * x495) + x502
+                - Self::mul_add(0.275, x501, 0.4 * x500));
+        let x507 = f_ext[2][4] + x359
+            + Self::mul_add(0.4, x499, x497 + Self::mul_add(-x10, x496, x9 * x495));
+        let x508 = f_ext[2][5]
             + (Self::mul_add(
                 113.3918902508081,
-                x321,
-                Self::mul_add(5.080660024070366, x338, x337 * 0.002139996587640933),
-            ) - Self::mul_add(-x329, x350, x330 * x349)
+                x325,
+                Self::mul_add(5.080660024070366, x345, x344 * 0.002139996587640933),
+            ) - Self::mul_add(-x334, x357, x335 * x356)
                 - Self::mul_add(
-                    x335,
+                    x342,
                     0.000000008530897668050218,
-                    x334 * 12.701650001451807,
+                    x341 * 12.701650001451807,
                 ))
-            - Self::mul_add(0.275, x485, x488 - Self::mul_add(-s_q9, x482, c_q9 * x481));
-        let x495 = x491 - Self::mul_add(-x8, x490, x7 * x489);
-        let x496 = Self::mul_add(c_q8, x490, s_q8 * x489);
-        let x497 = Self::mul_add(
+            - Self::mul_add(0.275, x499, x502 - Self::mul_add(-s_q9, x496, c_q9 * x495));
+        let x509 = Self::mul_add(-s_q8, x504, c_q8 * x503);
+        let x510 = Self::mul_add(c_q8, x504, s_q8 * x503);
+        let x511 = Self::mul_add(-0.00000000020510342851533115, x509, x505);
+        let x512 = Self::mul_add(-s_q8, x507, c_q8 * x506);
+        let x513 = Self::mul_add(
             48.0240000085309,
-            Self::mul_add(x323, x323, x324),
+            Self::mul_add(x327, x327, x328),
             f_ext[1][0],
-        ) + x495;
-        let x498 = Self::mul_add(48.0240000085309, x309 * x310, f_ext[1][1]) + x496;
-        let x499 = Self::mul_add(-48.0240000085309, x322 + x325, f_ext[1][2])
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x491,
-                Self::mul_add(-s_q8, x490, c_q8 * x489),
+        ) + x511;
+        let x514 = Self::mul_add(48.0240000085309, x313 * x314, f_ext[1][1]) + x510;
+        let x515 = Self::mul_add(-48.0240000085309, x326 + x329, f_ext[1][2])
+            - Self::mul_add(0.00000000020510342851533115, x505, x509);
+        let x516 = f_ext[1][3]
+            - Self::mul_add(x326, 0.07309, Self::mul_add(x314, x332, x327 * x331))
+            + Self::mul_add(
+                -0.35,
+                x510,
+                Self::mul_add(-0.00000000020510342851533115, x512, x508),
             );
-        let x500 = f_ext[1][3]
-            - Self::mul_add(x322, 0.07309, Self::mul_add(x310, x328, x323 * x327))
-            + Self::mul_add(-0.35, x496, x494 - Self::mul_add(-x8, x493, x7 * x492));
-        let x501 = f_ext[1][4]
+        let x517 = f_ext[1][4]
             - Self::mul_add(
                 48.0240000085309,
-                x319,
-                Self::mul_add(-130.43769025763282, x322, x321 * 0.07309)
-                    + Self::mul_add(x309, x328, x323 * x326),
-            ) + Self::mul_add(0.35, x495, Self::mul_add(c_q8, x493, s_q8 * x492));
-        let x502 = f_ext[1][5]
+                x323,
+                Self::mul_add(-130.43769025763282, x326, x325 * 0.07309)
+                    + Self::mul_add(x313, x332, x327 * x330),
+            ) + Self::mul_add(0.35, x511, Self::mul_add(c_q8, x507, s_q8 * x506));
+        let x518 = f_ext[1][5]
             - Self::mul_add(
                 48.0240000085309,
-                x320,
-                Self::mul_add(-0.1132, x322, x321 * 16.80768997608804)
-                    + Self::mul_add(-x309, x327, x310 * x326),
-            )
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x494,
-                Self::mul_add(-s_q8, x493, c_q8 * x492),
-            );
-        let x503 = Self::mul_add(-s_q7, x498, c_q7 * x497);
-        let x504 = Self::mul_add(c_q7, x498, s_q7 * x497);
-        let x505 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x506 = 1466.4506062283303 * v[4];
-        let x507 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x508 = x503
+                x324,
+                Self::mul_add(-0.1132, x326, x325 * 16.80768997608804)
+                    + Self::mul_add(-x313, x331, x314 * x330),
+            ) - Self::mul_add(0.00000000020510342851533115, x508, x512);
+        let x519 = Self::mul_add(-s_q7, x514, c_q7 * x513);
+        let x520 = Self::mul_add(c_q7, x514, s_q7 * x513);
+        let x521 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x522 = 1466.4506062283303 * v[4];
+        let x523 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x524 = x519
             + (f_ext[0][0]
                 + Self::mul_add(
                     1170.07,
-                    x306,
-                    Self::mul_add(-180.9502499901501, x314, 110.5455 * x312),
+                    x310,
+                    Self::mul_add(-180.9502499901501, x318, 110.5455 * x316),
                 ));
-        let x509 = x504
+        let x525 = x520
             + (f_ext[0][1]
                 - Self::mul_add(
                     1170.07,
-                    x307,
-                    Self::mul_add(180.9502499901501, x315, 110.5455 * x313),
+                    x311,
+                    Self::mul_add(180.9502499901501, x319, 110.5455 * x317),
                 ));
-        let x510 = x499
+        let x526 = x515
             + (f_ext[0][2]
                 + Self::mul_add(
                     1170.07,
-                    x308,
-                    -Self::mul_add(-180.9502499901501, x316, 110.5455 * x314),
+                    x312,
+                    -Self::mul_add(-180.9502499901501, x320, 110.5455 * x318),
                 ));
-        let x511 = x187 * 0.0008546497218115156;
-        let x512 = x180 * 0.0008546497218115156;
-        let x513 = x191 * 0.0008546497218115156;
-        let x514 = x204 * 0.0008546497218115156;
-        let x515 = x219 * 0.0008546497218115156;
-        let x516 = x239 * 0.0008546497218115156;
-        let x517 = x268 * 0.0008546497218115156;
-        let x518 = x304 * 0.0008546497218115156;
-        let x519 = x186 * 0.0008546497218115156;
-        let x520 = x179 * 0.0008546497218115156;
-        let x521 = x192 * 0.0008546497218115156;
-        let x522 = x205 * 0.0008546497218115156;
-        let x523 = x220 * 0.0008546497218115156;
-        let x524 = x240 * 0.0008546497218115156;
-        let x525 = x269 * 0.0008546497218115156;
-        let x526 = x305 * 0.0008546497218115156;
-        let x527 = x159 * 0.0008546497218115156;
-        let x528 = x200 * 0.0008546497218115156;
-        let x529 = x215 * 0.0008546497218115156;
-        let x530 = x235 * 0.0008546497218115156;
-        let x531 = x264 * 0.0008546497218115156;
-        let x532 = x300 * 0.0008546497218115156;
-        let x533 = x187 * x511;
-        let x534 = x180 * x512;
-        let x535 = 1.0
-            / (1394.5960312283303 - (x181 + (x167 - x178 + x181)) - x533 - x534);
-        let x536 = Self::mul_add(
-            x180,
-            x519,
-            Self::mul_add(-0.65, x180, x169 - Self::mul_add(x174, x177, x175 * x176)),
+        let x527 = x178 * 0.0008546497218115156;
+        let x528 = x171 * 0.0008546497218115156;
+        let x529 = x183 * 0.0008546497218115156;
+        let x530 = x198 * 0.0008546497218115156;
+        let x531 = x215 * 0.0008546497218115156;
+        let x532 = x237 * 0.0008546497218115156;
+        let x533 = x268 * 0.0008546497218115156;
+        let x534 = x308 * 0.0008546497218115156;
+        let x535 = x177 * 0.0008546497218115156;
+        let x536 = x170 * 0.0008546497218115156;
+        let x537 = x184 * 0.0008546497218115156;
+        let x538 = x199 * 0.0008546497218115156;
+        let x539 = x216 * 0.0008546497218115156;
+        let x540 = x238 * 0.0008546497218115156;
+        let x541 = x269 * 0.0008546497218115156;
+        let x542 = x309 * 0.0008546497218115156;
+        let x543 = x151 * 0.0008546497218115156;
+        let x544 = x192 * 0.0008546497218115156;
+        let x545 = x209 * 0.0008546497218115156;
+        let x546 = x231 * 0.0008546497218115156;
+        let x547 = x262 * 0.0008546497218115156;
+        let x548 = x302 * 0.0008546497218115156;
+        let x549 = x178 * x527;
+        let x550 = x171 * x528;
+        let x551 = 1.0
+            / (1394.5960312283303 - (x172 + (x158 - x169 + x172)) - x549 - x550);
+        let x552 = Self::mul_add(
+            x171,
+            x535,
+            Self::mul_add(-0.65, x171, x160 - Self::mul_add(x165, x168, x166 * x167)),
         );
-        let x537 = x535 * x536;
-        let x538 = Self::mul_add(
-            x187,
-            x519,
-            -117.61766249359756 + Self::mul_add(0.65, x161, x184),
-        );
-        let x539 = x535 * x538;
-        let x540 = Self::mul_add(x187, x520, x184);
-        let x541 = x535 * x540;
-        let x542 = Self::mul_add(
-            x187,
-            x521,
-            Self::mul_add(-0.75, x192, Self::mul_add(-s_q7, x190, c_q7 * x189)),
-        );
-        let x543 = Self::mul_add(-x180, x527, x542);
-        let x544 = x535 * x543;
-        let x545 = Self::mul_add(
-            -x187,
-            x522,
-            Self::mul_add(0.75, x205, Self::mul_add(-s_q7, x203, c_q7 * x202)),
-        );
-        let x546 = Self::mul_add(-x180, x528, x545);
-        let x547 = x535 * x546;
-        let x548 = Self::mul_add(
-            x187,
-            x523,
-            Self::mul_add(-0.75, x220, Self::mul_add(s_q7, x218, c_q7 * x217)),
-        );
-        let x549 = Self::mul_add(-x180, x529, x548);
-        let x550 = x535 * x549;
-        let x551 = Self::mul_add(
-            x187,
-            x524,
-            Self::mul_add(-0.75, x240, Self::mul_add(s_q7, x238, c_q7 * x237)),
-        );
-        let x552 = Self::mul_add(x180, x530, x551);
-        let x553 = x535 * x552;
+        let x553 = x551 * x552;
         let x554 = Self::mul_add(
-            x187,
-            x525,
+            x178,
+            x535,
+            -117.61766249359756 + Self::mul_add(0.65, x155, x175),
+        );
+        let x555 = x551 * x554;
+        let x556 = Self::mul_add(x178, x536, x175);
+        let x557 = x551 * x556;
+        let x558 = Self::mul_add(
+            x178,
+            x537,
+            Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x182, c_q7 * x181)),
+        );
+        let x559 = Self::mul_add(-x171, x543, x558);
+        let x560 = x551 * x559;
+        let x561 = Self::mul_add(
+            -x178,
+            x538,
+            Self::mul_add(0.75, x199, Self::mul_add(-s_q7, x197, c_q7 * x196)),
+        );
+        let x562 = Self::mul_add(-x171, x544, x561);
+        let x563 = x551 * x562;
+        let x564 = Self::mul_add(
+            x178,
+            x539,
+            Self::mul_add(-0.75, x216, Self::mul_add(s_q7, x214, c_q7 * x213)),
+        );
+        let x565 = Self::mul_add(-x171, x545, x564);
+        let x566 = x551 * x565;
+        let x567 = Self::mul_add(
+            x178,
+            x540,
+            Self::mul_add(-0.75, x238, Self::mul_add(s_q7, x236, c_q7 * x235)),
+        );
+        let x568 = Self::mul_add(x171, x546, x567);
+        let x569 = x551 * x568;
+        let x570 = Self::mul_add(
+            x178,
+            x541,
             Self::mul_add(-0.75, x269, Self::mul_add(-s_q7, x267, c_q7 * x266)),
         );
-        let x555 = Self::mul_add(-x180, x531, x554);
-        let x556 = x535 * x555;
-        let x557 = Self::mul_add(
-            x187,
-            x526,
-            Self::mul_add(-0.75, x305, Self::mul_add(-s_q7, x303, c_q7 * x302)),
-        );
-        let x558 = Self::mul_add(x180, x532, x557);
-        let x559 = x535 * x558;
-        let x560 = x186 * x519;
-        let x561 = 1.0
-            / Self::mul_add(
-                -x536,
-                x537,
-                1466.4506062283303 - (x183 - (x171 - x178 - x183)) - x533 - x560,
-            );
-        let x562 = Self::mul_add(
-            x187,
-            x512,
-            Self::mul_add(-0.75, x180, Self::mul_add(c_q7, x172, s_q7 * x170)),
-        );
-        let x563 = Self::mul_add(-x536, x539, x562);
-        let x564 = x561 * x563;
-        let x565 = Self::mul_add(-x536, x541, x562);
-        let x566 = x561 * x565;
-        let x567 = Self::mul_add(
-            x186,
-            x527,
-            Self::mul_add(
-                -x187,
-                x513,
-                Self::mul_add(c_q7, x190, s_q7 * x189)
-                    + Self::mul_add(-0.65, x159, 0.75 * x191),
-            ),
-        );
-        let x568 = Self::mul_add(-x536, x544, x567);
-        let x569 = x561 * x568;
-        let x570 = Self::mul_add(
-            x186,
-            x528,
-            Self::mul_add(
-                x187,
-                x514,
-                Self::mul_add(c_q7, x203, s_q7 * x202)
-                    - Self::mul_add(0.65, x200, 0.75 * x204),
-            ),
-        );
-        let x571 = Self::mul_add(-x536, x547, x570);
-        let x572 = x561 * x571;
+        let x571 = Self::mul_add(-x171, x547, x570);
+        let x572 = x551 * x571;
         let x573 = Self::mul_add(
-            x186,
-            x529,
-            Self::mul_add(
-                -x187,
-                x515,
-                Self::mul_add(-c_q7, x218, s_q7 * x217)
-                    + Self::mul_add(-0.65, x215, 0.75 * x219),
-            ),
+            x178,
+            x542,
+            Self::mul_add(-0.75, x309, Self::mul_add(-s_q7, x307, c_q7 * x306)),
         );
-        let x574 = Self::mul_add(-x536, x550, x573);
-        let x575 = x561 * x574;
-        let x576 = Self::mul_add(
-            -x186,
-            x530,
-            Self::mul_add(
-                -x187,
-                x516,
-                Self::mul_add(-c_q7, x238, s_q7 * x237)
-                    + Self::mul_add(0.65, x235, 0.75 * x239),
-            ),
-        );
-        let x577 = Self::mul_add(-x536, x553, x576);
-        let x578 = x561 * x577;
-        let x579 = Self::mul_add(
-            x186,
-            x531,
-            Self::mul_add(
-                -x187,
-                x517,
-                Self::mul_add(c_q7, x267, s_q7 * x266)
-                    + Self::mul_add(-0.65, x264, 0.75 * x268),
-            ),
-        );
-        let x580 = Self::mul_add(-x536, x556, x579);
-        let x581 = x561 * x580;
-        let x582 = Self::mul_add(
-            -x186,
-            x532,
-            Self::mul_add(
-                -x187,
-                x518,
-                Self::mul_add(c_q7, x303, s_q7 * x302)
-                    + Self::mul_add(0.65, x300, 0.75 * x304),
-            ),
-        );
-        let x583 = Self::mul_add(-x536, x559, x582);
-        let x584 = x561 * x583;
-        let x585 = 1.0
+        let x574 = Self::mul_add(x171, x548, x573);
+        let x575 = x551 * x574;
+        let x576 = x177 * x535;
+        let x577 = 1.0
             / Self::mul_add(
-                x563,
-                x564,
-                Self::mul_add(x538, x539, x560 - (1271.854575 + (x182 + x185) - x534)),
+                -x552,
+                x553,
+                1466.4506062283303 - (x174 - (x162 - x169 - x174)) - x549 - x576,
             );
-        let x586 = Self::mul_add(
-            -x563,
-            x566,
-            Self::mul_add(-x538, x541, Self::mul_add(-x186, x520, x185 - x534)),
-        );
-        let x587 = x585 * x586;
-        let x588 = x180 * x513;
-        let x589 = Self::mul_add(
-            x538,
-            x544,
-            Self::mul_add(x186, x521, Self::mul_add(-0.65, x192, x165) - x588),
-        );
-        let x590 = Self::mul_add(x563, x569, x589);
-        let x591 = x585 * x590;
-        let x592 = x180 * x514;
-        let x593 = Self::mul_add(
-            x538,
-            x547,
-            Self::mul_add(-x186, x522, Self::mul_add(0.65, x205, x201) + x592),
-        );
-        let x594 = Self::mul_add(x563, x572, x593);
-        let x595 = x585 * x594;
-        let x596 = x180 * x515;
-        let x597 = Self::mul_add(
-            -x538,
-            x550,
-            Self::mul_add(-x186, x523, Self::mul_add(0.65, x220, x216) + x596),
-        );
-        let x598 = Self::mul_add(-x563, x575, x597);
-        let x599 = x585 * x598;
-        let x600 = x180 * x516;
-        let x601 = Self::mul_add(
-            -x538,
-            x553,
-            Self::mul_add(-x186, x524, Self::mul_add(0.65, x240, x236) + x600),
-        );
-        let x602 = Self::mul_add(-x563, x578, x601);
-        let x603 = x585 * x602;
-        let x604 = x180 * x517;
-        let x605 = Self::mul_add(
-            x538,
-            x556,
-            Self::mul_add(x186, x525, Self::mul_add(-0.65, x269, x265) - x604),
-        );
-        let x606 = Self::mul_add(x563, x581, x605);
-        let x607 = x585 * x606;
-        let x608 = x180 * x518;
-        let x609 = Self::mul_add(
-            x538,
-            x559,
-            Self::mul_add(x186, x526, Self::mul_add(-0.65, x305, x301) - x608),
-        );
-        let x610 = Self::mul_add(x563, x584, x609);
-        let x611 = x585 * x610;
-        let x612 = Self::mul_add(
-            -x565,
-            x566,
-            Self::mul_add(-x540, x541, Self::mul_add(-x179, x520, x173 - x534)),
-        );
-        let x613 = 1.0 / Self::mul_add(x586, x587, x612);
-        let x614 = Self::mul_add(
-            x565,
-            x569,
-            Self::mul_add(x540, x544, Self::mul_add(x179, x521, x165 - x588)),
-        );
-        let x615 = Self::mul_add(x586, x591, x614);
-        let x616 = x613 * x615;
-        let x617 = Self::mul_add(
-            x565,
-            x572,
-            Self::mul_add(x540, x547, Self::mul_add(-x179, x522, x201 + x592)),
-        );
-        let x618 = Self::mul_add(x586, x595, x617);
-        let x619 = x613 * x618;
-        let x620 = Self::mul_add(
-            -x565,
-            x575,
-            Self::mul_add(-x540, x550, Self::mul_add(-x179, x523, x216 + x596)),
-        );
-        let x621 = Self::mul_add(x586, x599, x620);
-        let x622 = x613 * x621;
-        let x623 = Self::mul_add(
-            -x565,
-            x578,
-            Self::mul_add(-x540, x553, Self::mul_add(-x179, x524, x236 + x600)),
-        );
-        let x624 = Self::mul_add(x586, x603, x623);
-        let x625 = x613 * x624;
-        let x626 = Self::mul_add(
-            x565,
-            x581,
-            Self::mul_add(x540, x556, Self::mul_add(x179, x525, x265 - x604)),
-        );
-        let x627 = Self::mul_add(x586, x607, x626);
-        let x628 = x613 * x627;
-        let x629 = Self::mul_add(
-            x565,
-            x584,
-            Self::mul_add(x540, x559, Self::mul_add(x179, x526, x301 - x608)),
-        );
-        let x630 = Self::mul_add(x586, x611, x629);
-        let x631 = x613 * x630;
-        let x632 = Self::mul_add(
-            -x159,
-            x527,
-            Self::mul_add(-x192, x521, Self::mul_add(-x191, x513, x148)),
-        );
-        let x633 = Self::mul_add(
-            x590,
-            x591,
-            Self::mul_add(-x568, x569, Self::mul_add(-x543, x544, x632)),
-        );
-        let x634 = 1.0 / Self::mul_add(-x615, x616, x633);
-        let x635 = Self::mul_add(
-            -x159,
+        let x578 = Self::mul_add(
+            x178,
             x528,
-            Self::mul_add(x192, x522, Self::mul_add(x191, x514, x197)),
+            Self::mul_add(-0.75, x171, Self::mul_add(c_q7, x163, s_q7 * x161)),
         );
+        let x579 = Self::mul_add(-x552, x555, x578);
+        let x580 = x577 * x579;
+        let x581 = Self::mul_add(-x552, x557, x578);
+        let x582 = x577 * x581;
+        let x583 = Self::mul_add(
+            x177,
+            x543,
+            Self::mul_add(
+                -x178,
+                x529,
+                Self::mul_add(c_q7, x182, s_q7 * x181)
+                    + Self::mul_add(-0.65, x151, 0.75 * x183),
+            ),
+        );
+        let x584 = Self::mul_add(-x552, x560, x583);
+        let x585 = x577 * x584;
+        let x586 = Self::mul_add(
+            x177,
+            x544,
+            Self::mul_add(
+                x178,
+                x530,
+                Self::mul_add(c_q7, x197, s_q7 * x196)
+                    - Self::mul_add(0.65, x192, 0.75 * x198),
+            ),
+        );
+        let x587 = Self::mul_add(-x552, x563, x586);
+        let x588 = x577 * x587;
+        let x589 = Self::mul_add(
+            x177,
+            x545,
+            Self::mul_add(
+                -x178,
+                x531,
+                Self::mul_add(-c_q7, x214, s_q7 * x213)
+                    + Self::mul_add(-0.65, x209, 0.75 * x215),
+            ),
+        );
+        let x590 = Self::mul_add(-x552, x566, x589);
+        let x591 = x577 * x590;
+        let x592 = Self::mul_add(
+            -x177,
+            x546,
+            Self::mul_add(
+                -x178,
+                x532,
+                Self::mul_add(-c_q7, x236, s_q7 * x235)
+                    + Self::mul_add(0.65, x231, 0.75 * x237),
+            ),
+        );
+        let x593 = Self::mul_add(-x552, x569, x592);
+        let x594 = x577 * x593;
+        let x595 = Self::mul_add(
+            x177,
+            x547,
+            Self::mul_add(
+                -x178,
+                x533,
+                Self::mul_add(c_q7, x267, s_q7 * x266)
+                    + Self::mul_add(-0.65, x262, 0.75 * x268),
+            ),
+        );
+        let x596 = Self::mul_add(-x552, x572, x595);
+        let x597 = x577 * x596;
+        let x598 = Self::mul_add(
+            -x177,
+            x548,
+            Self::mul_add(
+                -x178,
+                x534,
+                Self::mul_add(c_q7, x307, s_q7 * x306)
+                    + Self::mul_add(0.65, x302, 0.75 * x308),
+            ),
+        );
+        let x599 = Self::mul_add(-x552, x575, x598);
+        let x600 = x577 * x599;
+        let x601 = 1.0
+            / Self::mul_add(
+                x579,
+                x580,
+                Self::mul_add(x554, x555, x576 - (1271.854575 + (x173 + x176) - x550)),
+            );
+        let x602 = Self::mul_add(
+            -x579,
+            x582,
+            Self::mul_add(-x554, x557, Self::mul_add(-x177, x536, x176 - x550)),
+        );
+        let x603 = x601 * x602;
+        let x604 = x171 * x529;
+        let x605 = Self::mul_add(
+            x554,
+            x560,
+            Self::mul_add(x177, x537, Self::mul_add(-0.65, x184, x180) - x604),
+        );
+        let x606 = Self::mul_add(x579, x585, x605);
+        let x607 = x601 * x606;
+        let x608 = x171 * x530;
+        let x609 = Self::mul_add(
+            x554,
+            x563,
+            Self::mul_add(-x177, x538, Self::mul_add(0.65, x199, x195) + x608),
+        );
+        let x610 = Self::mul_add(x579, x588, x609);
+        let x611 = x601 * x610;
+        let x612 = x171 * x531;
+        let x613 = Self::mul_add(
+            -x554,
+            x566,
+            Self::mul_add(-x177, x539, Self::mul_add(0.65, x216, x212) + x612),
+        );
+        let x614 = Self::mul_add(-x579, x591, x613);
+        let x615 = x601 * x614;
+        let x616 = x171 * x532;
+        let x617 = Self::mul_add(
+            -x554,
+            x569,
+            Self::mul_add(-x177, x540, Self::mul_add(0.65, x238, x234) + x616),
+        );
+        let x618 = Self::mul_add(-x579, x594, x617);
+        let x619 = x601 * x618;
+        let x620 = x171 * x533;
+        let x621 = Self::mul_add(
+            x554,
+            x572,
+            Self::mul_add(x177, x541, Self::mul_add(-0.65, x269, x265) - x620),
+        );
+        let x622 = Self::mul_add(x579, x597, x621);
+        let x623 = x601 * x622;
+        let x624 = x171 * x534;
+        let x625 = Self::mul_add(
+            x554,
+            x575,
+            Self::mul_add(x177, x542, Self::mul_add(-0.65, x309, x305) - x624),
+        );
+        let x626 = Self::mul_add(x579, x600, x625);
+        let x627 = x601 * x626;
+        let x628 = Self::mul_add(
+            -x581,
+            x582,
+            Self::mul_add(-x556, x557, Self::mul_add(-x170, x536, x164 - x550)),
+        );
+        let x629 = 1.0 / Self::mul_add(x602, x603, x628);
+        let x630 = Self::mul_add(
+            x581,
+            x585,
+            Self::mul_add(x556, x560, Self::mul_add(x170, x537, x180 - x604)),
+        );
+        let x631 = Self::mul_add(x602, x607, x630);
+        let x632 = x629 * x631;
+        let x633 = Self::mul_add(
+            x581,
+            x588,
+            Self::mul_add(x556, x563, Self::mul_add(-x170, x538, x195 + x608)),
+        );
+        let x634 = Self::mul_add(x602, x611, x633);
+        let x635 = x629 * x634;
         let x636 = Self::mul_add(
-            x590,
-            x595,
-            Self::mul_add(-x568, x572, Self::mul_add(-x543, x547, x635)),
+            -x581,
+            x591,
+            Self::mul_add(-x556, x566, Self::mul_add(-x170, x539, x212 + x612)),
         );
-        let x637 = Self::mul_add(-x615, x619, x636);
-        let x638 = x634 * x637;
+        let x637 = Self::mul_add(x602, x615, x636);
+        let x638 = x629 * x637;
         let x639 = Self::mul_add(
-            -x159,
-            x529,
-            Self::mul_add(-x192, x523, Self::mul_add(-x191, x515, x212)),
+            -x581,
+            x594,
+            Self::mul_add(-x556, x569, Self::mul_add(-x170, x540, x234 + x616)),
         );
-        let x640 = Self::mul_add(
-            -x590,
-            x599,
-            Self::mul_add(-x568, x575, Self::mul_add(-x543, x550, x639)),
+        let x640 = Self::mul_add(x602, x619, x639);
+        let x641 = x629 * x640;
+        let x642 = Self::mul_add(
+            x581,
+            x597,
+            Self::mul_add(x556, x572, Self::mul_add(x170, x541, x265 - x620)),
         );
-        let x641 = Self::mul_add(x615, x622, x640);
-        let x642 = x634 * x641;
-        let x643 = Self::mul_add(
-            x159,
-            x530,
-            Self::mul_add(-x192, x524, Self::mul_add(-x191, x516, x232)),
+        let x643 = Self::mul_add(x602, x623, x642);
+        let x644 = x629 * x643;
+        let x645 = Self::mul_add(
+            x581,
+            x600,
+            Self::mul_add(x556, x575, Self::mul_add(x170, x542, x305 - x624)),
         );
-        let x644 = Self::mul_add(
-            -x590,
-            x603,
-            Self::mul_add(-x568, x578, Self::mul_add(-x543, x553, x643)),
-        );
-        let x645 = Self::mul_add(x615, x625, x644);
-        let x646 = x634 * x645;
-        let x647 = Self::mul_add(
-            -x159,
-            x531,
-            Self::mul_add(-x192, x525, Self::mul_add(-x191, x517, x261)),
-        );
+        let x646 = Self::mul_add(x602, x627, x645);
+        let x647 = x629 * x646;
         let x648 = Self::mul_add(
-            x590,
-            x607,
-            Self::mul_add(-x568, x581, Self::mul_add(-x543, x556, x647)),
+            -x151,
+            x543,
+            Self::mul_add(-x184, x537, Self::mul_add(-x183, x529, x140)),
         );
-        let x649 = Self::mul_add(-x615, x628, x648);
-        let x650 = x634 * x649;
+        let x649 = Self::mul_add(
+            x606,
+            x607,
+            Self::mul_add(-x584, x585, Self::mul_add(-x559, x560, x648)),
+        );
+        let x650 = 1.0 / Self::mul_add(-x631, x632, x649);
         let x651 = Self::mul_add(
-            x159,
-            x532,
-            Self::mul_add(-x192, x526, Self::mul_add(-x191, x518, x297)),
+            -x151,
+            x544,
+            Self::mul_add(x184, x538, Self::mul_add(x183, x530, x189)),
         );
         let x652 = Self::mul_add(
-            x590,
+            x606,
             x611,
-            Self::mul_add(-x568, x584, Self::mul_add(-x543, x559, x651)),
+            Self::mul_add(-x584, x588, Self::mul_add(-x559, x563, x651)),
         );
-        let x653 = Self::mul_add(-x615, x631, x652);
-        let x654 = x634 * x653;
+        let x653 = Self::mul_add(-x631, x635, x652);
+        let x654 = x650 * x653;
         let x655 = Self::mul_add(
-            -x200,
-            x528,
-            Self::mul_add(-x205, x522, Self::mul_add(-x204, x514, x106)),
+            -x151,
+            x545,
+            Self::mul_add(-x184, x539, Self::mul_add(-x183, x531, x206)),
         );
         let x656 = Self::mul_add(
-            x594,
-            x595,
-            Self::mul_add(-x571, x572, Self::mul_add(-x546, x547, x655)),
+            -x606,
+            x615,
+            Self::mul_add(-x584, x591, Self::mul_add(-x559, x566, x655)),
         );
-        let x657 = 1.0 / Self::mul_add(-x637, x638, Self::mul_add(-x618, x619, x656));
-        let x658 = Self::mul_add(
-            x200,
-            x529,
-            Self::mul_add(-x205, x523, Self::mul_add(-x204, x515, x100)),
-        );
+        let x657 = Self::mul_add(x631, x638, x656);
+        let x658 = x650 * x657;
         let x659 = Self::mul_add(
-            x594,
-            x599,
-            Self::mul_add(x571, x575, Self::mul_add(x546, x550, x658)),
+            x151,
+            x546,
+            Self::mul_add(-x184, x540, Self::mul_add(-x183, x532, x228)),
         );
-        let x660 = Self::mul_add(x637, x642, Self::mul_add(-x618, x622, x659));
-        let x661 = x657 * x660;
-        let x662 = Self::mul_add(
-            -x200,
-            x530,
-            Self::mul_add(-x205, x524, Self::mul_add(-x204, x516, x225)),
+        let x660 = Self::mul_add(
+            -x606,
+            x619,
+            Self::mul_add(-x584, x594, Self::mul_add(-x559, x569, x659)),
         );
+        let x661 = Self::mul_add(x631, x641, x660);
+        let x662 = x650 * x661;
         let x663 = Self::mul_add(
-            x594,
-            x603,
-            Self::mul_add(x571, x578, Self::mul_add(x546, x553, x662)),
+            -x151,
+            x547,
+            Self::mul_add(-x184, x541, Self::mul_add(-x183, x533, x259)),
         );
-        let x664 = Self::mul_add(x637, x646, Self::mul_add(-x618, x625, x663));
-        let x665 = x657 * x664;
-        let x666 = Self::mul_add(
-            x200,
-            x531,
-            Self::mul_add(-x205, x525, Self::mul_add(-x204, x517, x253)),
+        let x664 = Self::mul_add(
+            x606,
+            x623,
+            Self::mul_add(-x584, x597, Self::mul_add(-x559, x572, x663)),
         );
+        let x665 = Self::mul_add(-x631, x644, x664);
+        let x666 = x650 * x665;
         let x667 = Self::mul_add(
-            -x594,
-            x607,
-            Self::mul_add(x571, x581, Self::mul_add(x546, x556, x666)),
+            x151,
+            x548,
+            Self::mul_add(-x184, x542, Self::mul_add(-x183, x534, x299)),
         );
-        let x668 = Self::mul_add(x637, x650, Self::mul_add(x618, x628, x667));
-        let x669 = x657 * x668;
-        let x670 = Self::mul_add(
-            -x200,
-            x532,
-            Self::mul_add(-x205, x526, Self::mul_add(-x204, x518, x289)),
+        let x668 = Self::mul_add(
+            x606,
+            x627,
+            Self::mul_add(-x584, x600, Self::mul_add(-x559, x575, x667)),
         );
+        let x669 = Self::mul_add(-x631, x647, x668);
+        let x670 = x650 * x669;
         let x671 = Self::mul_add(
-            -x594,
-            x611,
-            Self::mul_add(x571, x584, Self::mul_add(x546, x559, x670)),
+            -x192,
+            x544,
+            Self::mul_add(-x199, x538, Self::mul_add(-x198, x530, x98)),
         );
-        let x672 = Self::mul_add(x637, x654, Self::mul_add(x618, x631, x671));
-        let x673 = x657 * x672;
-        let x674 = Self::mul_add(
-            -x215,
-            x529,
-            Self::mul_add(-x220, x523, Self::mul_add(-x219, x515, x86)),
-        );
-        let x675 = Self::mul_add(
-            x598,
-            x599,
-            Self::mul_add(-x574, x575, Self::mul_add(-x549, x550, x674)),
-        );
-        let x676 = Self::mul_add(
-            -x660,
-            x661,
-            Self::mul_add(-x641, x642, Self::mul_add(-x621, x622, x675)),
-        );
-        let x677 = 1.0 / x676;
-        let x678 = Self::mul_add(
-            x215,
-            x530,
-            Self::mul_add(-x220, x524, Self::mul_add(-x219, x516, x80)),
-        );
-        let x679 = Self::mul_add(
-            x598,
-            x603,
-            Self::mul_add(-x574, x578, Self::mul_add(-x549, x553, x678)),
-        );
-        let x680 = Self::mul_add(
-            -x660,
-            x665,
-            Self::mul_add(-x641, x646, Self::mul_add(-x621, x625, x679)),
-        );
-        let x681 = x677 * x680;
-        let x682 = Self::mul_add(
-            -x215,
-            x531,
-            Self::mul_add(-x220, x525, Self::mul_add(-x219, x517, x248)),
-        );
-        let x683 = Self::mul_add(
-            -x598,
-            x607,
-            Self::mul_add(-x574, x581, Self::mul_add(-x549, x556, x682)),
-        );
-        let x684 = Self::mul_add(
-            -x660,
-            x669,
-            Self::mul_add(-x641, x650, Self::mul_add(x621, x628, x683)),
-        );
-        let x685 = x677 * x684;
-        let x686 = Self::mul_add(
-            x215,
-            x532,
-            Self::mul_add(-x220, x526, Self::mul_add(-x219, x518, x284)),
-        );
-        let x687 = Self::mul_add(
-            -x598,
-            x611,
-            Self::mul_add(-x574, x584, Self::mul_add(-x549, x559, x686)),
-        );
-        let x688 = Self::mul_add(
-            -x660,
-            x673,
-            Self::mul_add(-x641, x654, Self::mul_add(x621, x631, x687)),
-        );
-        let x689 = x677 * x688;
-        let x690 = Self::mul_add(
-            -x235,
-            x530,
-            Self::mul_add(-x240, x524, Self::mul_add(-x239, x516, x66)),
-        );
-        let x691 = Self::mul_add(
-            x602,
-            x603,
-            Self::mul_add(-x577, x578, Self::mul_add(-x552, x553, x690)),
-        );
-        let x692 = Self::mul_add(
-            -x664,
-            x665,
-            Self::mul_add(-x645, x646, Self::mul_add(-x624, x625, x691)),
-        );
-        let x693 = 1.0 / Self::mul_add(-x680, x681, x692);
-        let x694 = Self::mul_add(
-            x235,
-            x531,
-            Self::mul_add(-x240, x525, Self::mul_add(-x239, x517, x59)),
-        );
-        let x695 = Self::mul_add(
-            -x602,
-            x607,
-            Self::mul_add(-x577, x581, Self::mul_add(-x552, x556, x694)),
-        );
-        let x696 = Self::mul_add(
-            -x664,
-            x669,
-            Self::mul_add(-x645, x650, Self::mul_add(x624, x628, x695)),
-        );
-        let x697 = Self::mul_add(-x680, x685, x696);
-        let x698 = x693 * x697;
-        let x699 = Self::mul_add(
-            -x235,
-            x532,
-            Self::mul_add(-x240, x526, Self::mul_add(-x239, x518, x277)),
-        );
-        let x700 = Self::mul_add(
-            -x602,
-            x611,
-            Self::mul_add(-x577, x584, Self::mul_add(-x552, x559, x699)),
-        );
-        let x701 = Self::mul_add(
-            -x664,
-            x673,
-            Self::mul_add(-x645, x654, Self::mul_add(x624, x631, x700)),
-        );
-        let x702 = Self::mul_add(-x680, x689, x701);
-        let x703 = x693 * x702;
-        let x704 = Self::mul_add(
-            -x264,
-            x531,
-            Self::mul_add(-x269, x525, Self::mul_add(-x268, x517, x41)),
-        );
-        let x705 = Self::mul_add(
-            x606,
-            x607,
-            Self::mul_add(-x580, x581, Self::mul_add(-x555, x556, x704)),
-        );
-        let x706 = Self::mul_add(
-            -x668,
-            x669,
-            Self::mul_add(-x649, x650, Self::mul_add(-x627, x628, x705)),
-        );
-        let x707 = 1.0 / Self::mul_add(-x697, x698, Self::mul_add(-x684, x685, x706));
-        let x708 = Self::mul_add(
-            x264,
-            x532,
-            Self::mul_add(-x269, x526, Self::mul_add(-x268, x518, x273)),
-        );
-        let x709 = Self::mul_add(
-            x606,
-            x611,
-            Self::mul_add(-x580, x584, Self::mul_add(-x555, x559, x708)),
-        );
-        let x710 = Self::mul_add(
-            -x668,
-            x673,
-            Self::mul_add(-x649, x654, Self::mul_add(-x627, x631, x709)),
-        );
-        let x711 = Self::mul_add(-x697, x703, Self::mul_add(-x684, x689, x710));
-        let x712 = x707 * x711;
-        let x713 = Self::mul_add(
-            -x300,
-            x532,
-            Self::mul_add(-x305, x526, Self::mul_add(-x304, x518, 1.4135609200000003)),
-        );
-        let x714 = Self::mul_add(
+        let x672 = Self::mul_add(
             x610,
             x611,
-            Self::mul_add(-x583, x584, Self::mul_add(-x558, x559, x713)),
+            Self::mul_add(-x587, x588, Self::mul_add(-x562, x563, x671)),
         );
+        let x673 = 1.0 / Self::mul_add(-x653, x654, Self::mul_add(-x634, x635, x672));
+        let x674 = Self::mul_add(
+            x192,
+            x545,
+            Self::mul_add(-x199, x539, Self::mul_add(-x198, x531, x92)),
+        );
+        let x675 = Self::mul_add(
+            x610,
+            x615,
+            Self::mul_add(x587, x591, Self::mul_add(x562, x566, x674)),
+        );
+        let x676 = Self::mul_add(x653, x658, Self::mul_add(-x634, x638, x675));
+        let x677 = x673 * x676;
+        let x678 = Self::mul_add(
+            -x192,
+            x546,
+            Self::mul_add(-x199, x540, Self::mul_add(-x198, x532, x221)),
+        );
+        let x679 = Self::mul_add(
+            x610,
+            x619,
+            Self::mul_add(x587, x594, Self::mul_add(x562, x569, x678)),
+        );
+        let x680 = Self::mul_add(x653, x662, Self::mul_add(-x634, x641, x679));
+        let x681 = x673 * x680;
+        let x682 = Self::mul_add(
+            x192,
+            x547,
+            Self::mul_add(-x199, x541, Self::mul_add(-x198, x533, x252)),
+        );
+        let x683 = Self::mul_add(
+            -x610,
+            x623,
+            Self::mul_add(x587, x597, Self::mul_add(x562, x572, x682)),
+        );
+        let x684 = Self::mul_add(x653, x666, Self::mul_add(x634, x644, x683));
+        let x685 = x673 * x684;
+        let x686 = Self::mul_add(
+            -x192,
+            x548,
+            Self::mul_add(-x199, x542, Self::mul_add(-x198, x534, x291)),
+        );
+        let x687 = Self::mul_add(
+            -x610,
+            x627,
+            Self::mul_add(x587, x600, Self::mul_add(x562, x575, x686)),
+        );
+        let x688 = Self::mul_add(x653, x670, Self::mul_add(x634, x647, x687));
+        let x689 = x673 * x688;
+        let x690 = Self::mul_add(
+            -x209,
+            x545,
+            Self::mul_add(-x216, x539, Self::mul_add(-x215, x531, x78)),
+        );
+        let x691 = Self::mul_add(
+            x614,
+            x615,
+            Self::mul_add(-x590, x591, Self::mul_add(-x565, x566, x690)),
+        );
+        let x692 = Self::mul_add(
+            -x676,
+            x677,
+            Self::mul_add(-x657, x658, Self::mul_add(-x637, x638, x691)),
+        );
+        let x693 = 1.0 / x692;
+        let x694 = Self::mul_add(
+            x209,
+            x546,
+            Self::mul_add(-x216, x540, Self::mul_add(-x215, x532, x72)),
+        );
+        let x695 = Self::mul_add(
+            x614,
+            x619,
+            Self::mul_add(-x590, x594, Self::mul_add(-x565, x569, x694)),
+        );
+        let x696 = Self::mul_add(
+            -x676,
+            x681,
+            Self::mul_add(-x657, x662, Self::mul_add(-x637, x641, x695)),
+        );
+        let x697 = x693 * x696;
+        let x698 = Self::mul_add(
+            -x209,
+            x547,
+            Self::mul_add(-x216, x541, Self::mul_add(-x215, x533, x247)),
+        );
+        let x699 = Self::mul_add(
+            -x614,
+            x623,
+            Self::mul_add(-x590, x597, Self::mul_add(-x565, x572, x698)),
+        );
+        let x700 = Self::mul_add(
+            -x676,
+            x685,
+            Self::mul_add(-x657, x666, Self::mul_add(x637, x644, x699)),
+        );
+        let x701 = x693 * x700;
+        let x702 = Self::mul_add(
+            x209,
+            x548,
+            Self::mul_add(-x216, x542, Self::mul_add(-x215, x534, x286)),
+        );
+        let x703 = Self::mul_add(
+            -x614,
+            x627,
+            Self::mul_add(-x590, x600, Self::mul_add(-x565, x575, x702)),
+        );
+        let x704 = Self::mul_add(
+            -x676,
+            x689,
+            Self::mul_add(-x657, x670, Self::mul_add(x637, x647, x703)),
+        );
+        let x705 = x693 * x704;
+        let x706 = Self::mul_add(
+            -x231,
+            x546,
+            Self::mul_add(-x238, x540, Self::mul_add(-x237, x532, x58)),
+        );
+        let x707 = Self::mul_add(
+            x618,
+            x619,
+            Self::mul_add(-x593, x594, Self::mul_add(-x568, x569, x706)),
+        );
+        let x708 = Self::mul_add(
+            -x680,
+            x681,
+            Self::mul_add(-x661, x662, Self::mul_add(-x640, x641, x707)),
+        );
+        let x709 = 1.0 / Self::mul_add(-x696, x697, x708);
+        let x710 = Self::mul_add(
+            x231,
+            x547,
+            Self::mul_add(-x238, x541, Self::mul_add(-x237, x533, x240)),
+        );
+        let x711 = Self::mul_add(
+            -x618,
+            x623,
+            Self::mul_add(-x593, x597, Self::mul_add(-x568, x572, x710)),
+        );
+        let x712 = Self::mul_add(
+            -x680,
+            x685,
+            Self::mul_add(-x661, x666, Self::mul_add(x640, x644, x711)),
+        );
+        let x713 = Self::mul_add(-x696, x701, x712);
+        let x714 = x709 * x713;
         let x715 = Self::mul_add(
-            -x672,
-            x673,
-            Self::mul_add(-x653, x654, Self::mul_add(-x630, x631, x714)),
+            -x231,
+            x548,
+            Self::mul_add(-x238, x542, Self::mul_add(-x237, x534, x279)),
         );
         let x716 = Self::mul_add(
-            -x711,
-            x712,
-            Self::mul_add(-x702, x703, Self::mul_add(-x688, x689, x715)),
+            -x618,
+            x627,
+            Self::mul_add(-x593, x600, Self::mul_add(-x568, x575, x715)),
         );
-        let x717 = 1.0 / x716;
-        let x718 = Self::mul_add(
-            x509,
-            x511,
-            Self::mul_add(-0.75, x504, Self::mul_add(-s_q7, x501, c_q7 * x500))
+        let x717 = Self::mul_add(
+            -x680,
+            x689,
+            Self::mul_add(-x661, x670, Self::mul_add(x640, x647, x716)),
+        );
+        let x718 = Self::mul_add(-x696, x705, x717);
+        let x719 = x709 * x718;
+        let x720 = Self::mul_add(
+            -x262,
+            x547,
+            Self::mul_add(-x269, x541, Self::mul_add(-x268, x533, x34)),
+        );
+        let x721 = Self::mul_add(
+            x622,
+            x623,
+            Self::mul_add(-x596, x597, Self::mul_add(-x571, x572, x720)),
+        );
+        let x722 = Self::mul_add(
+            -x684,
+            x685,
+            Self::mul_add(-x665, x666, Self::mul_add(-x643, x644, x721)),
+        );
+        let x723 = 1.0 / Self::mul_add(-x713, x714, Self::mul_add(-x700, x701, x722));
+        let x724 = Self::mul_add(
+            x262,
+            x548,
+            Self::mul_add(-x269, x542, Self::mul_add(-x268, x534, x273)),
+        );
+        let x725 = Self::mul_add(
+            x622,
+            x627,
+            Self::mul_add(-x596, x600, Self::mul_add(-x571, x575, x724)),
+        );
+        let x726 = Self::mul_add(
+            -x684,
+            x689,
+            Self::mul_add(-x665, x670, Self::mul_add(-x643, x647, x725)),
+        );
+        let x727 = Self::mul_add(-x713, x719, Self::mul_add(-x700, x705, x726));
+        let x728 = x723 * x727;
+        let x729 = Self::mul_add(
+            -x302,
+            x548,
+            Self::mul_add(-x309, x542, Self::mul_add(-x308, x534, 1.4135609200000003)),
+        );
+        let x730 = Self::mul_add(
+            x626,
+            x627,
+            Self::mul_add(-x599, x600, Self::mul_add(-x574, x575, x729)),
+        );
+        let x731 = Self::mul_add(
+            -x688,
+            x689,
+            Self::mul_add(-x669, x670, Self::mul_add(-x646, x647, x730)),
+        );
+        let x732 = Self::mul_add(
+            -x727,
+            x728,
+            Self::mul_add(-x718, x719, Self::mul_add(-x704, x705, x731)),
+        );
+        let x733 = 1.0 / x732;
+        let x734 = Self::mul_add(
+            x525,
+            x527,
+            Self::mul_add(-0.75, x520, Self::mul_add(-s_q7, x517, c_q7 * x516))
                 + (f_ext[0][3]
                     + Self::mul_add(
                         180.9502499901501,
-                        x307,
-                        Self::mul_add(v[4], x507, v[5] * x506),
+                        x311,
+                        Self::mul_add(v[4], x523, v[5] * x522),
                     )),
         );
-        let x719 = Self::mul_add(-x510, x512, x718);
-        let x720 = Self::mul_add(
-            x510,
-            x519,
+        let x735 = Self::mul_add(-x526, x528, x734);
+        let x736 = Self::mul_add(
+            x526,
+            x535,
             Self::mul_add(
-                -x508,
-                x511,
-                Self::mul_add(c_q7, x501, s_q7 * x500)
-                    + Self::mul_add(-0.65, x499, 0.75 * x503)
+                -x524,
+                x527,
+                Self::mul_add(c_q7, x517, s_q7 * x516)
+                    + Self::mul_add(-0.65, x515, 0.75 * x519)
                     + (f_ext[0][4]
-                        - (Self::mul_add(v[3], x507, v[5] * x505)
-                            - Self::mul_add(-110.5455, x308, 180.9502499901501 * x306))),
+                        - (Self::mul_add(v[3], x523, v[5] * x521)
+                            - Self::mul_add(-110.5455, x312, 180.9502499901501 * x310))),
             ),
         );
-        let x721 = Self::mul_add(-x537, x719, x720);
-        let x722 = x508 * x512;
-        let x723 = Self::mul_add(
-            -x509,
-            x519,
-            Self::mul_add(0.65, x504, x502)
+        let x737 = Self::mul_add(-x553, x735, x736);
+        let x738 = x524 * x528;
+        let x739 = Self::mul_add(
+            -x525,
+            x535,
+            Self::mul_add(0.65, x520, x518)
                 + (f_ext[0][5]
                     + Self::mul_add(
                         -110.5455,
-                        x307,
-                        Self::mul_add(-v[3], x506, v[4] * x505),
-                    )) + x722,
+                        x311,
+                        Self::mul_add(-v[3], x522, v[4] * x521),
+                    )) + x738,
         );
-        let x724 = Self::mul_add(-x564, x721, Self::mul_add(-x539, x719, x723));
-        let x725 = Self::mul_add(
-            -x566,
-            x721,
-            Self::mul_add(-x541, x719, Self::mul_add(-x509, x520, tau[0] + x502 + x722)),
-        );
-        let x726 = Self::mul_add(x587, x724, x725);
-        let x727 = Self::mul_add(
-            -x510,
-            x527,
-            Self::mul_add(-x509, x521, Self::mul_add(-x508, x513, tau[1] + x494)),
-        );
-        let x728 = Self::mul_add(
-            -x591,
-            x724,
-            Self::mul_add(-x569, x721, Self::mul_add(-x544, x719, x727)),
-        );
-        let x729 = Self::mul_add(x616, x726, x728);
-        let x730 = Self::mul_add(
-            -x510,
-            x528,
-            Self::mul_add(x509, x522, Self::mul_add(x508, x514, tau[2] + x483)),
-        );
-        let x731 = Self::mul_add(
-            -x595,
-            x724,
-            Self::mul_add(-x572, x721, Self::mul_add(-x547, x719, x730)),
-        );
-        let x732 = Self::mul_add(-x638, x729, Self::mul_add(x619, x726, x731));
-        let x733 = Self::mul_add(
-            x510,
-            x529,
-            Self::mul_add(x509, x523, Self::mul_add(x508, x515, tau[3] + x476)),
-        );
-        let x734 = Self::mul_add(
-            -x599,
-            x724,
-            Self::mul_add(x575, x721, Self::mul_add(x550, x719, x733)),
-        );
-        let x735 = Self::mul_add(
-            -x661,
-            x732,
-            Self::mul_add(x642, x729, Self::mul_add(x622, x726, x734)),
-        );
-        let x736 = Self::mul_add(
-            -x510,
-            x530,
-            Self::mul_add(x509, x524, Self::mul_add(x508, x516, tau[4] + x468)),
-        );
-        let x737 = Self::mul_add(
-            -x603,
-            x724,
-            Self::mul_add(x578, x721, Self::mul_add(x553, x719, x736)),
-        );
-        let x738 = Self::mul_add(
-            -x665,
-            x732,
-            Self::mul_add(x646, x729, Self::mul_add(x625, x726, x737)),
-        );
-        let x739 = Self::mul_add(-x681, x735, x738);
-        let x740 = Self::mul_add(
-            -x510,
-            x531,
-            Self::mul_add(-x509, x525, Self::mul_add(-x508, x517, tau[5] + x460)),
-        );
+        let x740 = Self::mul_add(-x580, x737, Self::mul_add(-x555, x735, x739));
         let x741 = Self::mul_add(
-            -x607,
-            x724,
-            Self::mul_add(-x581, x721, Self::mul_add(-x556, x719, x740)),
+            -x582,
+            x737,
+            Self::mul_add(-x557, x735, Self::mul_add(-x525, x536, tau[0] + x518 + x738)),
         );
-        let x742 = Self::mul_add(
-            x669,
-            x732,
-            Self::mul_add(-x650, x729, Self::mul_add(x628, x726, x741)),
+        let x742 = Self::mul_add(x603, x740, x741);
+        let x743 = Self::mul_add(
+            -x526,
+            x543,
+            Self::mul_add(-x525, x537, Self::mul_add(-x524, x529, tau[1] + x508)),
         );
-        let x743 = Self::mul_add(x698, x739, Self::mul_add(x685, x735, x742));
         let x744 = Self::mul_add(
-            x510,
-            x532,
-            Self::mul_add(-x509, x526, Self::mul_add(-x508, x518, tau[6] + x450)),
+            -x607,
+            x740,
+            Self::mul_add(-x585, x737, Self::mul_add(-x560, x735, x743)),
         );
-        let x745 = Self::mul_add(
-            -x611,
-            x724,
-            Self::mul_add(-x584, x721, Self::mul_add(-x559, x719, x744)),
-        );
+        let x745 = Self::mul_add(x632, x742, x744);
         let x746 = Self::mul_add(
-            x673,
-            x732,
-            Self::mul_add(-x654, x729, Self::mul_add(x631, x726, x745)),
+            -x526,
+            x544,
+            Self::mul_add(x525, x538, Self::mul_add(x524, x530, tau[2] + x497)),
         );
         let x747 = Self::mul_add(
-            -x712,
-            x743,
-            Self::mul_add(x703, x739, Self::mul_add(x689, x735, x746)),
+            -x611,
+            x740,
+            Self::mul_add(-x588, x737, Self::mul_add(-x563, x735, x746)),
         );
-        let x748 = x717 * x747;
-        let x749 = Self::mul_add(-x712, x748, x707 * x743);
-        let x750 = Self::mul_add(x703, x748, Self::mul_add(x698, x749, x693 * x739));
+        let x748 = Self::mul_add(-x654, x745, Self::mul_add(x635, x742, x747));
+        let x749 = Self::mul_add(
+            x526,
+            x545,
+            Self::mul_add(x525, x539, Self::mul_add(x524, x531, tau[3] + x490)),
+        );
+        let x750 = Self::mul_add(
+            -x615,
+            x740,
+            Self::mul_add(x591, x737, Self::mul_add(x566, x735, x749)),
+        );
         let x751 = Self::mul_add(
-            x689,
+            -x677,
             x748,
-            Self::mul_add(x685, x749, Self::mul_add(-x681, x750, x677 * x735)),
+            Self::mul_add(x658, x745, Self::mul_add(x638, x742, x750)),
         );
         let x752 = Self::mul_add(
-            x669,
-            x749,
-            Self::mul_add(-x665, x750, Self::mul_add(-x661, x751, x657 * x732)),
+            -x526,
+            x546,
+            Self::mul_add(x525, x540, Self::mul_add(x524, x532, tau[4] + x482)),
         );
-        let x753 = Self::mul_add(x673, x748, x752);
+        let x753 = Self::mul_add(
+            -x619,
+            x740,
+            Self::mul_add(x594, x737, Self::mul_add(x569, x735, x752)),
+        );
         let x754 = Self::mul_add(
-            x646,
-            x750,
-            Self::mul_add(x642, x751, Self::mul_add(-x638, x753, x634 * x729)),
+            -x681,
+            x748,
+            Self::mul_add(x662, x745, Self::mul_add(x641, x742, x753)),
         );
-        let x755 = Self::mul_add(-x654, x748, Self::mul_add(-x650, x749, x754));
+        let x755 = Self::mul_add(-x697, x751, x754);
         let x756 = Self::mul_add(
-            x622,
-            x751,
-            Self::mul_add(x619, x753, Self::mul_add(x616, x755, x613 * x726)),
+            -x526,
+            x547,
+            Self::mul_add(-x525, x541, Self::mul_add(-x524, x533, tau[5] + x472)),
         );
         let x757 = Self::mul_add(
-            x631,
-            x748,
-            Self::mul_add(x628, x749, Self::mul_add(x625, x750, x756)),
+            -x623,
+            x740,
+            Self::mul_add(-x597, x737, Self::mul_add(-x572, x735, x756)),
         );
         let x758 = Self::mul_add(
-            x595,
-            x753,
-            Self::mul_add(x591, x755, Self::mul_add(-x587, x757, x585 * x724)),
+            x685,
+            x748,
+            Self::mul_add(-x666, x745, Self::mul_add(x644, x742, x757)),
         );
-        let x759 = Self::mul_add(
-            x607,
-            x749,
-            Self::mul_add(x603, x750, Self::mul_add(x599, x751, x758)),
+        let x759 = Self::mul_add(x714, x755, Self::mul_add(x701, x751, x758));
+        let x760 = Self::mul_add(
+            x526,
+            x548,
+            Self::mul_add(-x525, x542, Self::mul_add(-x524, x534, tau[6] + x461)),
         );
-        let x760 = Self::mul_add(x611, x748, x759);
-        let x761 = -x760;
+        let x761 = Self::mul_add(
+            -x627,
+            x740,
+            Self::mul_add(-x600, x737, Self::mul_add(-x575, x735, x760)),
+        );
         let x762 = Self::mul_add(
-            -x569,
-            x755,
-            Self::mul_add(-x566, x757, Self::mul_add(x564, x760, x561 * x721)),
+            x689,
+            x748,
+            Self::mul_add(-x670, x745, Self::mul_add(x647, x742, x761)),
         );
         let x763 = Self::mul_add(
-            x578,
-            x750,
-            Self::mul_add(x575, x751, Self::mul_add(-x572, x753, x762)),
+            -x728,
+            x759,
+            Self::mul_add(x719, x755, Self::mul_add(x705, x751, x762)),
         );
-        let x764 = Self::mul_add(-x584, x748, Self::mul_add(-x581, x749, x763));
-        let x765 = Self::mul_add(
-            -x541,
-            x757,
-            Self::mul_add(x539, x760, Self::mul_add(-x537, x764, x535 * x719)),
-        );
-        let x766 = Self::mul_add(
-            x550,
-            x751,
-            Self::mul_add(-x547, x753, Self::mul_add(-x544, x755, x765)),
-        );
+        let x764 = x733 * x763;
+        let x765 = Self::mul_add(-x728, x764, x723 * x759);
+        let x766 = Self::mul_add(x719, x764, Self::mul_add(x714, x765, x709 * x755));
         let x767 = Self::mul_add(
-            -x559,
-            x748,
-            Self::mul_add(-x556, x749, Self::mul_add(x553, x750, x766)),
+            x705,
+            x764,
+            Self::mul_add(x701, x765, Self::mul_add(-x697, x766, x693 * x751)),
         );
         let x768 = Self::mul_add(
-            -x527,
-            x755,
-            Self::mul_add(
-                x519,
-                x764,
-                Self::mul_add(-x512, x767, x510 * 0.0008546497218115156),
-            ),
+            x685,
+            x765,
+            Self::mul_add(-x681, x766, Self::mul_add(-x677, x767, x673 * x748)),
         );
-        let x769 = Self::mul_add(
-            -x530,
-            x750,
-            Self::mul_add(x529, x751, Self::mul_add(-x528, x753, x768)),
+        let x769 = Self::mul_add(x689, x764, x768);
+        let x770 = Self::mul_add(
+            x662,
+            x766,
+            Self::mul_add(x658, x767, Self::mul_add(-x654, x769, x650 * x745)),
         );
-        let x770 = Self::mul_add(x532, x748, Self::mul_add(-x531, x749, x769));
-        let x771 = Self::mul_add(
-            -x520,
-            x757,
-            Self::mul_add(
-                x519,
-                x760,
-                Self::mul_add(x511, x767, x509 * 0.0008546497218115156),
-            ),
-        );
+        let x771 = Self::mul_add(-x670, x764, Self::mul_add(-x666, x765, x770));
         let x772 = Self::mul_add(
-            x523,
-            x751,
-            Self::mul_add(x522, x753, Self::mul_add(-x521, x755, x771)),
+            x638,
+            x767,
+            Self::mul_add(x635, x769, Self::mul_add(x632, x771, x629 * x742)),
         );
         let x773 = Self::mul_add(
-            -x526,
-            x748,
-            Self::mul_add(-x525, x749, Self::mul_add(x524, x750, x772)),
+            x647,
+            x764,
+            Self::mul_add(x644, x765, Self::mul_add(x641, x766, x772)),
         );
         let x774 = Self::mul_add(
-            x512,
-            x757,
-            Self::mul_add(
-                -x512,
-                x760,
-                Self::mul_add(-x511, x764, x508 * 0.0008546497218115156),
-            ),
+            x611,
+            x769,
+            Self::mul_add(x607, x771, Self::mul_add(-x603, x773, x601 * x740)),
         );
         let x775 = Self::mul_add(
-            x515,
-            x751,
-            Self::mul_add(x514, x753, Self::mul_add(-x513, x755, x774)),
+            x623,
+            x765,
+            Self::mul_add(x619, x766, Self::mul_add(x615, x767, x774)),
         );
-        let x776 = Self::mul_add(
-            -x518,
-            x748,
-            Self::mul_add(-x517, x749, Self::mul_add(x516, x750, x775)),
+        let x776 = Self::mul_add(x627, x764, x775);
+        let x777 = -x776;
+        let x778 = Self::mul_add(
+            -x585,
+            x771,
+            Self::mul_add(-x582, x773, Self::mul_add(x580, x776, x577 * x737)),
         );
-        [x776, x773, x770, x767, x764, x761, x757, x755, x753, x751, x750, x749, x748]
+        let x779 = Self::mul_add(
+            x594,
+            x766,
+            Self::mul_add(x591, x767, Self::mul_add(-x588, x769, x778)),
+        );
+        let x780 = Self::mul_add(-x600, x764, Self::mul_add(-x597, x765, x779));
+        let x781 = Self::mul_add(
+            -x557,
+            x773,
+            Self::mul_add(x555, x776, Self::mul_add(-x553, x780, x551 * x735)),
+        );
+        let x782 = Self::mul_add(
+            x566,
+            x767,
+            Self::mul_add(-x563, x769, Self::mul_add(-x560, x771, x781)),
+        );
+        let x783 = Self::mul_add(
+            -x575,
+            x764,
+            Self::mul_add(-x572, x765, Self::mul_add(x569, x766, x782)),
+        );
+        let x784 = Self::mul_add(
+            -x543,
+            x771,
+            Self::mul_add(
+                x535,
+                x780,
+                Self::mul_add(-x528, x783, x526 * 0.0008546497218115156),
+            ),
+        );
+        let x785 = Self::mul_add(
+            -x546,
+            x766,
+            Self::mul_add(x545, x767, Self::mul_add(-x544, x769, x784)),
+        );
+        let x786 = Self::mul_add(x548, x764, Self::mul_add(-x547, x765, x785));
+        let x787 = Self::mul_add(
+            -x536,
+            x773,
+            Self::mul_add(
+                x535,
+                x776,
+                Self::mul_add(x527, x783, x525 * 0.0008546497218115156),
+            ),
+        );
+        let x788 = Self::mul_add(
+            x539,
+            x767,
+            Self::mul_add(x538, x769, Self::mul_add(-x537, x771, x787)),
+        );
+        let x789 = Self::mul_add(
+            -x542,
+            x764,
+            Self::mul_add(-x541, x765, Self::mul_add(x540, x766, x788)),
+        );
+        let x790 = Self::mul_add(
+            x528,
+            x773,
+            Self::mul_add(
+                -x528,
+                x776,
+                Self::mul_add(-x527, x780, x524 * 0.0008546497218115156),
+            ),
+        );
+        let x791 = Self::mul_add(
+            x531,
+            x767,
+            Self::mul_add(x530, x769, Self::mul_add(-x529, x771, x790)),
+        );
+        let x792 = Self::mul_add(
+            -x534,
+            x764,
+            Self::mul_add(-x533, x765, Self::mul_add(x532, x766, x791)),
+        );
+        [x792, x789, x786, x783, x780, x777, x773, x771, x769, x767, x766, x765, x764]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///

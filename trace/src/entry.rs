@@ -28,7 +28,7 @@ use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
-use kanegen_dynamics::params::is_near_signed_permutation;
+use kanegen_dynamics::params::{axis_turn, is_near_signed_permutation};
 use kanegen_dynamics::regroup::regrouped;
 use kanegen_dynamics::spatial::RbInertia;
 use kanegen_dynamics::{
@@ -111,8 +111,9 @@ pub fn trace(
             };
             if spec.two_step_placement > 0.0 {
                 for (jp, j) in p.joints.iter_mut().zip(model.joints()) {
-                    jp.placement_permutation =
-                        is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement);
+                    jp.placement_permutation = jp.placement_permutation
+                        || is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement)
+                        || axis_turn(&j.origin.rotation).is_some();
                 }
             }
             if spec.runtime_payload {
@@ -535,6 +536,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
                 axis,
                 coordinate_axis: None,
                 placement_permutation: false,
+                placement_turn: None,
                 mass,
                 com,
                 inertia_com,

@@ -95,8 +95,10 @@ pub struct Spec {
     /// method.
     pub paper_14b: bool,
     /// Joint placements within this of a signed permutation, entry by entry, carry inertias in
-    /// two steps (`kanegen_dynamics::params::JointParams::placement_permutation`); only for a
-    /// model. 0 (default): exact permutations only. The same results, other operation counts.
+    /// two steps (`kanegen_dynamics::params::JointParams::placement_permutation`), as do (when
+    /// it is not 0) placements that turn about one coordinate axis
+    /// (`kanegen_dynamics::params::axis_turn`); only for a model. 0 (default): exact
+    /// permutations only. The same results, other operation counts.
     pub two_step_placement: f64,
 }
 

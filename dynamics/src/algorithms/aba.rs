@@ -69,7 +69,7 @@
 //! emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
 //! and its joint placements signed permutations and offsets along one axis, which fold. A
 //! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: on the
-//! 7-dof free-flyer of `kanegen-generated` the two are close (ABA 2869; LDLᵀ 2948, and 2839
+//! 7-dof free-flyer of `kanegen-generated` the two are close (ABA 2869; LDLᵀ 2948, and 2765
 //! with the two-step inertia carry through its near-permutation placements, which it emits). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!

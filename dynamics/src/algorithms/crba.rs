@@ -20,7 +20,7 @@
 //! ```
 
 use crate::base::{FloatingBase, FLOATING_BASE_DOF};
-use crate::joint::{carry_inertia, inertia_s, s_tr, xup_trig, XupTrig};
+use crate::joint::{carry_force, carry_inertia, inertia_s, s_tr, xup_trig, XupTrig};
 use crate::linalg::Vec3;
 use crate::params::Params;
 use crate::scalar::Scalar;
@@ -69,7 +69,7 @@ pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
         h[i][i] = s_tr(&p.joints[i], &f);
         let mut j = i;
         while let Some(lambda) = p.joints[j].parent {
-            f = xup[j].0.tr_apply(&f);
+            f = carry_force(&p.joints[j], &xup[j], &f);
             j = lambda;
             let hij = s_tr(&p.joints[j], &f);
             h[j][i] = hij.clone();
@@ -139,7 +139,7 @@ pub fn floating_mass_matrix<S: Scalar>(
         // Over the ancestors as in `mass_matrix`, then from the subtree's root onto the base.
         let mut j = i;
         loop {
-            f = xup[j].0.tr_apply(&f);
+            f = carry_force(&p.joints[j], &xup[j], &f);
             let Some(lambda) = p.joints[j].parent else {
                 break;
             };

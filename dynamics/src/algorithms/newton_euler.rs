@@ -37,12 +37,12 @@
 //! ```
 
 use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
-use crate::joint::xup;
+use crate::joint::{rotate_down, rotate_up, xup_trig, XupTrig};
 use crate::linalg::{Mat3, Vec3};
 use crate::loads::{LoadFrame, Loads};
-use crate::params::Params;
+use crate::params::{JointParams, Params};
 use crate::scalar::Scalar;
-use crate::spatial::{RbInertia, Xform};
+use crate::spatial::RbInertia;
 use kanegen_model::JointKind;
 
 /// The motion of one body in its own coordinates: angular velocity, angular acceleration and the
@@ -147,11 +147,12 @@ fn subtract_external<S: Scalar>(
     w
 }
 
-/// `Eᵀ` applied to a child's wrench, moved to the parent origin: `(Eᵀ f, Eᵀ n + r × Eᵀ f)`.
-fn carry<S: Scalar>(x: &Xform<S>, w: &Wrench<S>) -> Wrench<S> {
-    let f = x.e.tr_mul_vec(&w.f);
+/// `Eᵀ` applied to a child's wrench, moved to the parent origin: `(Eᵀ f, Eᵀ n + r × Eᵀ f)`
+/// (rotations by [`rotate_down`]).
+fn carry<S: Scalar>(jp: &JointParams<S>, x: &XupTrig<S>, w: &Wrench<S>) -> Wrench<S> {
+    let f = rotate_down(jp, x, &w.f);
     Wrench {
-        n: x.e.tr_mul_vec(&w.n) + x.r.cross(&f),
+        n: rotate_down(jp, x, &w.n) + x.0.r.cross(&f),
         f,
     }
 }
@@ -180,27 +181,27 @@ fn passes<S: Scalar>(
         "an external wrench names a body past the end of the chain"
     );
     let need_rot = loads.external.iter().any(|e| e.frame == LoadFrame::Base);
-    let mut xups: Vec<Xform<S>> = Vec::with_capacity(n);
+    let mut xups: Vec<XupTrig<S>> = Vec::with_capacity(n);
     let mut motion: Vec<BodyMotion<S>> = Vec::with_capacity(n);
     let mut e0s: Vec<Mat3<S>> = Vec::with_capacity(if need_rot { n } else { 0 });
     let mut w: Vec<Wrench<S>> = Vec::with_capacity(n);
     for (j, jp) in p.joints.iter().enumerate() {
         let parent = jp.parent.map_or(&start.m, |l| &motion[l]);
-        let x = xup(jp, &q[j]);
+        let x = xup_trig(jp, &q[j]);
         let u = &jp.axis;
-        // ω in body coordinates before the joint's own rate: E ω_λ.
-        let w_in = x.e.mul_vec(&parent.w);
+        // ω in body coordinates before the joint's own rate: E ω_λ (E by `rotate_up`).
+        let w_in = rotate_up(jp, &x, &parent.w);
         // a_λ + U_λ r: the classical acceleration of O_j, parent coordinates (9.95).
         let u_parent = UMatrix {
             w: parent.w.clone(),
             wd: parent.wd.clone(),
         };
-        let a_origin = x.e.mul_vec(&(&parent.a + &u_parent.mul_vec(&x.r)));
+        let a_origin = rotate_up(jp, &x, &(&parent.a + &u_parent.mul_vec(&x.0.r)));
         let m = match jp.kind {
             JointKind::Revolute => {
                 let uqd = u.scale(&qd[j]);
                 // ω̇_j = E ω̇_λ + (E ω_λ) × u q̇_j (+ u q̈_j)   (9.90)
-                let mut wd = x.e.mul_vec(&parent.wd) + w_in.cross(&uqd);
+                let mut wd = rotate_up(jp, &x, &parent.wd) + w_in.cross(&uqd);
                 if let Some(qdd) = qdd {
                     wd = wd + u.scale(&qdd[j]);
                 }
@@ -220,14 +221,14 @@ fn passes<S: Scalar>(
                 }
                 BodyMotion {
                     w: w_in,
-                    wd: x.e.mul_vec(&parent.wd),
+                    wd: rotate_up(jp, &x, &parent.wd),
                     a,
                 }
             }
         };
         if need_rot {
             let e0_parent = jp.parent.map_or(&start.e0, |l| &e0s[l]);
-            e0s.push(x.e.mul_mat(e0_parent));
+            e0s.push(x.0.e.mul_mat(e0_parent));
         }
         let e0 = if need_rot { &e0s[j] } else { &start.e0 };
         w.push(subtract_external(
@@ -247,7 +248,7 @@ fn passes<S: Scalar>(
             JointKind::Revolute => jp.axis.dot(&w[j].n),
             JointKind::Prismatic => jp.axis.dot(&w[j].f),
         };
-        let carried = carry(&xups[j], &w[j]);
+        let carried = carry(jp, &xups[j], &w[j]);
         match jp.parent {
             Some(l) => w[l] = w[l].clone().plus(carried),
             None => {
