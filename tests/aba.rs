@@ -2,7 +2,7 @@
 //! random chain of 32 joints with gravity (`benches/data/random_n32.toml`: general geometry,
 //! ABA 25462 operations against 37129 for the cheapest LDLᵀ) through `kanegen::dynamics!`, and
 //! the free-floating 7-dof arm of `kanegen-generated` with ABA forced (its checked-in file takes
-//! LDLᵀ, 2765 operations against ABA's 2869): the emitted code says so in `OP_COUNTS`, and
+//! LDLᵀ, 2735 operations against ABA's 2869): the emitted code says so in `OP_COUNTS`, and
 //! equals the interpreted ABA to 1e-12 (8e-14 measured), and LDLᵀ to 1e-12 on the free-flyer,
 //! to 1e-10 on the 32-joint chain (cond(M) up to 1e5 there; 8e-13 measured).
 //! SSRMS (coordinate axes) keeps LDLᵀ, the cheaper there, and equals both to 1e-12.

@@ -7,7 +7,7 @@
 
 use crate::options::Options;
 use kanegen_dynamics::params::{
-    axis_turn, coordinate_axis, is_near_signed_permutation, NEAR_PERMUTATION,
+    axis_turn, coordinate_axis, is_near_signed_permutation, mdh_split, NEAR_PERMUTATION,
 };
 use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, JointKind, Model};
@@ -277,7 +277,7 @@ pub fn choose(
             let mut t = trace(Subject::Model(subject), f, m, &spec)?;
             let mut c = t.trace.counts(Convention::Emitted);
             // It changes the CRBA's carries and Newton–Euler's rotations (not ABA's); kept where cheaper.
-            if near && takes_two_steps(f, m) {
+            if near && takes_two_steps(f, m, n) {
                 let near = Spec {
                     two_step_placement: NEAR_PERMUTATION,
                     ..spec.clone()
@@ -320,22 +320,32 @@ pub fn takes_trig(choices: &[Choice]) -> bool {
 }
 
 /// Whether a revolute joint about a coordinate axis of `model` is placed near a signed
-/// permutation ([`NEAR_PERMUTATION`]) or by a turn about one coordinate axis ([`axis_turn`]), but
-/// not exactly on a permutation: the two-step inertia carry is then worth a second trace.
+/// permutation ([`NEAR_PERMUTATION`]), by a turn about one coordinate axis ([`axis_turn`]) or by
+/// two whose second is about the joint's axis ([`mdh_split`]), but not exactly on a permutation:
+/// the two-step carries are then worth a second trace.
 fn has_near_permutation(model: &Model) -> bool {
     model.joints().iter().any(|j| {
+        let rot = &j.origin.rotation;
         j.kind == JointKind::Revolute
-            && coordinate_axis(j.axis).is_some()
-            && (is_near_signed_permutation(&j.origin.rotation, NEAR_PERMUTATION)
-                || axis_turn(&j.origin.rotation).is_some())
-            && !is_near_signed_permutation(&j.origin.rotation, 0.0)
+            && coordinate_axis(j.axis).is_some_and(|k| {
+                (is_near_signed_permutation(rot, NEAR_PERMUTATION)
+                    || axis_turn(rot).is_some()
+                    || mdh_split(rot, k).is_some())
+                    && !is_near_signed_permutation(rot, 0.0)
+            })
     })
 }
 
 /// Whether `f` by `m` runs an algorithm whose carries ([`NEAR_PERMUTATION`]) may go in two
 /// steps: the CRBA (its inertia and force carries) or the classical Newton–Euler bias (its vector
-/// rotations, `kanegen_dynamics::joint::rotate_up`); not forward dynamics by ABA.
-fn takes_two_steps(f: Function, m: Methods) -> bool {
+/// rotations, `kanegen_dynamics::joint::rotate_up`); not forward dynamics by ABA. Above
+/// [`SIZE_RULE_N`] joints not for a function of the mass matrix: its code is compact there (loops
+/// over the model's own tables, [`crate::compact`]) and a second trace of O(N²) operations only
+/// costs memory (`generate` at N = 200 went from under 1 GB to 1066 MB with it).
+fn takes_two_steps(f: Function, m: Methods, n: usize) -> bool {
+    if f.uses_mass_matrix() && n > SIZE_RULE_N {
+        return false;
+    }
     let crba = f.uses_mass_matrix() && m.mass_matrix == MassMatrixMethod::Crba;
     let newton_euler = f.uses_bias() && m.bias == BiasMethod::NewtonEuler;
     (crba || newton_euler) && !(f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)

@@ -262,21 +262,51 @@ pub fn emit_body_streamed(
             _ => format!("{counter}"),
         }
     };
-    // With the type's own `sincos`: the sines and cosines of the inputs (joint angles) in one
-    // `Self::sincos_n` at the top, so their polynomials run side by side in vector registers.
+    // With the type's own `sincos`: the sines and cosines of the inputs (joint angles), or of an
+    // input plus a constant (a joint's angle offset, `JointParams::angle_offset`) used by them
+    // alone, in one `Self::sincos_n` at the top, so their polynomials run side by side in vector
+    // registers. The sums are written into the call and not bound apart (`hoisted`).
+    let mut hoisted: HashSet<u32> = HashSet::new();
     if *table_sincos {
-        let mut args: Vec<u32> = trig
+        // The input of a hoistable argument, and the constant added to it.
+        let input_plus = |a: u32| -> Option<(u32, Option<f64>)> {
+            let input = |s: Sym| matches!(nodes[&s.id()], Node::Input(_)).then_some(s.id());
+            let konst = |s: Sym| match nodes[&s.id()] {
+                Node::Const(c) => Some(c),
+                _ => None,
+            };
+            match nodes[&a] {
+                Node::Input(_) => Some((a, None)),
+                Node::Add(x, y) => {
+                    let (s, c) = trig[&a];
+                    let trig_uses = usize::from(s.is_some()) + usize::from(c.is_some());
+                    if uses.get(&a).copied() != Some(trig_uses) {
+                        return None;
+                    }
+                    match (input(x), konst(y), konst(x), input(y)) {
+                        (Some(i), Some(c), ..) | (.., Some(c), Some(i)) => Some((i, Some(c))),
+                        _ => None,
+                    }
+                }
+                _ => None,
+            }
+        };
+        let mut args: Vec<(u32, u32, Option<f64>)> = trig
             .keys()
-            .copied()
-            .filter(|a| matches!(nodes[a], Node::Input(_)))
+            .filter_map(|&a| input_plus(a).map(|(i, c)| (a, i, c)))
             .collect();
-        args.sort_unstable();
+        // By input, as the joints are numbered.
+        args.sort_unstable_by_key(|&(a, i, _)| (i, a));
         if args.len() > 1 {
             let mut pats = Vec::new();
             let mut xs = Vec::new();
-            for a in args {
-                let base = trig_base(a, counter);
+            let mut bases = HashSet::new();
+            for (a, i, offset) in args {
+                let mut base = trig_base(i, counter);
                 counter += 1;
+                if !bases.insert(base.clone()) {
+                    base = format!("{base}_{counter}");
+                }
                 let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
                 let (s, c) = trig[&a];
                 let bind = |node: Option<u32>, name: &proc_macro2::Ident| match node {
@@ -288,17 +318,31 @@ pub fn emit_body_streamed(
                 };
                 let (ps, pc) = (bind(s, &sn), bind(c, &cn));
                 pats.push(quote!((#ps, #pc)));
-                let x = &inputs[match nodes[&a] {
-                    Node::Input(i) => i as usize,
+                let x = &inputs[match nodes[&i] {
+                    Node::Input(k) => k as usize,
                     _ => unreachable!("filtered to inputs"),
                 }];
-                xs.push(x.clone());
+                xs.push(match offset {
+                    None => x.clone(),
+                    Some(c) => {
+                        hoisted.insert(a);
+                        let lit = constant(c.abs(), float).tokens;
+                        if c.is_sign_negative() {
+                            quote!(#x - #lit)
+                        } else {
+                            quote!(#x + #lit)
+                        }
+                    }
+                });
             }
             stmt(quote!(let [#(#pats),*] = Self::sincos_n([#(#xs),*]);));
         }
     }
     for (id, node) in &sched {
         let id = *id;
+        if hoisted.contains(&id) {
+            continue; // written into the `sincos_n` call
+        }
         let see_through = match node {
             Node::Mul(..) => fma.is_some() && inlined_id(id),
             Node::Neg(..) => fma.is_some(),

@@ -20,12 +20,21 @@ pub fn xup<S: Scalar>(jp: &JointParams<S>, q: &S) -> Xform<S> {
 /// `Xup_j` with `(sin q_j, cos q_j)` for a revolute joint (`None` for a prismatic one).
 pub type XupTrig<S> = (Xform<S>, Option<(S, S)>);
 
+/// `(sin q_j, cos q_j)` of a revolute joint, of `q_j` plus its
+/// [`JointParams::angle_offset`] where it has one.
+pub fn joint_sin_cos<S: Scalar>(jp: &JointParams<S>, q: &S) -> (S, S) {
+    match &jp.angle_offset {
+        Some(offset) => (q.clone() + offset.clone()).sin_cos(),
+        None => q.clone().sin_cos(),
+    }
+}
+
 /// [`xup`], and `(sin q_j, cos q_j)` for a revolute joint (`None` for a prismatic one), for
 /// callers that use them again ([`carry_inertia`]) without a second `sin_cos`.
 pub fn xup_trig<S: Scalar>(jp: &JointParams<S>, q: &S) -> XupTrig<S> {
     match jp.kind {
         JointKind::Revolute => {
-            let (s, c) = q.clone().sin_cos();
+            let (s, c) = joint_sin_cos(jp, q);
             // E = Θᵀ Υᵀ = (Υ Θ)ᵀ, r = l.
             let e = jp
                 .upsilon

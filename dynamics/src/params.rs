@@ -7,7 +7,7 @@
 use crate::linalg::{Mat3, Vec3};
 use crate::scalar::Scalar;
 use crate::spatial::RbInertia;
-use kanegen_model::{JointKind, Model};
+use kanegen_model::{Joint, JointKind, Model};
 
 /// One joint and its child body, with every number in the scalar type `S`.
 #[derive(Clone, Debug)]
@@ -39,6 +39,13 @@ pub struct JointParams<S> {
     /// full congruence through `upsilon`. URDF writes such placements as `rpy` with one non-zero
     /// angle (`rpy = "1.5708 0 0"`).
     pub placement_turn: Option<(usize, S, S)>,
+    /// A constant added to the joint angle of a revolute joint before its sine and cosine
+    /// ([`crate::joint::joint_sin_cos`]; `None`: nothing added). [`Params::new`] sets none; a
+    /// tracer sets one where it splits a placement `Υ = Θ_k1(α) Θ_u(θ₀)` whose second turn is
+    /// about the joint's own axis `u` ([`mdh_split`], the modified Denavit–Hartenberg `θ` offset
+    /// of canonical frames): then `Υ Θ_u(q) = Θ_k1(α) Θ_u(q + θ₀)`, `upsilon` is `Θ_k1(α)` and
+    /// this is `θ₀`, the same joint with one turn fewer.
+    pub angle_offset: Option<S>,
     /// `m_j`.
     pub mass: S,
     /// `d^{(j)}_j`: centre of mass in the body frame.
@@ -52,6 +59,33 @@ pub struct JointParams<S> {
 }
 
 impl<S: Scalar> JointParams<S> {
+    /// For a revolute joint about a coordinate axis whose placement is two turns, the second
+    /// about the joint's own axis ([`mdh_split`]: canonical frames' `Θ_x(α) Θ_z(θ₀)`): the second
+    /// turn goes into the joint angle ([`JointParams::angle_offset`], `q + θ₀` before the sine
+    /// and cosine) and the first stays as the placement (`upsilon`, with exact zeros and ones;
+    /// [`JointParams::placement_turn`]), and the carries go in two steps
+    /// ([`JointParams::placement_permutation`]), not through a dense `E`. The same joint, to the
+    /// split's tolerance; the body frames do not move. `joint` is the model's joint these
+    /// parameters were made from. Returns whether it split.
+    pub fn split_placement(&mut self, joint: &Joint) -> bool {
+        let Some(k) = self
+            .coordinate_axis
+            .filter(|_| joint.kind == JointKind::Revolute)
+        else {
+            return false;
+        };
+        let Some((first, theta0)) = mdh_split(&joint.origin.rotation, k) else {
+            return false;
+        };
+        let (kp, sp, cp) = first.unwrap_or((k, 0.0, 1.0));
+        self.upsilon = Mat3::from_f64(turn_matrix(kp, sp, cp));
+        self.placement_turn = first.map(|(k1, s, c)| (k1, S::constant(s), S::constant(c)));
+        self.placement_permutation = true;
+        // Θ_k(θ₀) Θ_u(q) = Θ_u(q + u_k θ₀) for the axis u = ±e_k.
+        self.angle_offset = Some(S::constant(joint.axis[k] * theta0));
+        true
+    }
+
     /// Sets `mass`, `com` and `inertia_com`, and `inertia` from them.
     pub fn set_inertial(&mut self, mass: S, com: Vec3<S>, inertia_com: Mat3<S>) {
         self.inertia = RbInertia::from_com(&mass, &com, &inertia_com);
@@ -81,18 +115,78 @@ pub fn is_near_signed_permutation(r: &[[f64; 3]; 3], tol: f64) -> bool {
     })
 }
 
+/// A turn about a coordinate axis: `(k, sin α, cos α)` for the turn by `α` about `e_k`.
+pub type AxisTurn = (usize, f64, f64);
+
 /// `Some((k, s, c))` when `r` is exactly the rotation by the angle of sine `s` and cosine `c`
 /// about `e_k` (row and column `k` are `e_k`; with `(a, b) = (k + 1, k + 2) mod 3`,
 /// `r_aa = r_bb = c` and `r_ba = −r_ab = s`) and not a signed permutation (`s ≠ 0`, `c ≠ 0`):
 /// [`JointParams::placement_turn`].
 #[must_use]
-pub fn axis_turn(r: &[[f64; 3]; 3]) -> Option<(usize, f64, f64)> {
+pub fn axis_turn(r: &[[f64; 3]; 3]) -> Option<AxisTurn> {
     (0..3).find_map(|k| {
         let (a, b) = ((k + 1) % 3, (k + 2) % 3);
         let axis_fixed = r[k][k] == 1.0 && [a, b].iter().all(|&m| r[k][m] == 0.0 && r[m][k] == 0.0);
         let (c, s) = (r[a][a], r[b][a]);
         (axis_fixed && r[b][b] == c && r[a][b] == -s && s != 0.0 && c != 0.0).then_some((k, s, c))
     })
+}
+
+/// The rotation by the angle of sine `s` and cosine `c` about `e_k`, with exact zeros and ones
+/// (the matrix [`axis_turn`] reads).
+#[must_use]
+pub fn turn_matrix(k: usize, s: f64, c: f64) -> [[f64; 3]; 3] {
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    let mut r = [[0.0; 3]; 3];
+    r[k][k] = 1.0;
+    (r[a][a], r[a][b], r[b][a], r[b][b]) = (c, -s, s, c);
+    r
+}
+
+/// How far [`mdh_split`]'s two turns may be from the placement, entry by entry: representation
+/// residues only, as [`kanegen_model::canonical::DEFAULT_SNAP`].
+pub const MDH_SPLIT_TOL: f64 = 1e-15;
+
+/// A placement `r` split as `Θ_k1(α) Θ_k(θ₀)`, the second turn about the joint's coordinate axis
+/// `e_k`: `Some((first, θ₀))` with `first = Some((k1, sin α, cos α))` (`None` when `r` is `Θ_k(θ₀)`
+/// alone), when the product of the two turns is within [`MDH_SPLIT_TOL`] of `r` and something
+/// is left to gain (not a signed permutation, and not already a single turn about another axis,
+/// [`axis_turn`]). Canonical frames ([`kanegen_model::Model::canonical`]) place every joint so:
+/// `α` the twist about the common normal `x`, `θ₀` the constant part of the modified
+/// Denavit–Hartenberg `θ`.
+#[must_use]
+pub fn mdh_split(r: &[[f64; 3]; 3], k: usize) -> Option<(Option<AxisTurn>, f64)> {
+    if is_near_signed_permutation(r, 0.0) || axis_turn(r).is_some() {
+        return None;
+    }
+    let close = |m: &[[f64; 3]; 3]| {
+        (0..3).all(|i| (0..3).all(|j| (m[i][j] - r[i][j]).abs() <= MDH_SPLIT_TOL))
+    };
+    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+    // Θ_k(θ₀) alone.
+    let (s0, c0) = (r[b][a], r[a][a]);
+    if close(&turn_matrix(k, s0, c0)) {
+        return Some((None, s0.atan2(c0)));
+    }
+    for k1 in [a, b] {
+        // Row k1 of Θ_k1(α) Θ_k(θ₀) is row k1 of Θ_k(θ₀); column k is Θ_k1(α) e_k.
+        let (s0, c0) = if k1 == a {
+            (-r[a][b], r[a][a])
+        } else {
+            (r[b][a], r[b][b])
+        };
+        let (a1, b1) = ((k1 + 1) % 3, (k1 + 2) % 3);
+        let (s1, c1) = if k == a1 {
+            (r[b1][k], r[a1][k])
+        } else {
+            (-r[a1][k], r[b1][k])
+        };
+        let m = Mat3(turn_matrix(k1, s1, c1)).mul_mat(&Mat3(turn_matrix(k, s0, c0)));
+        if close(&m.0) {
+            return Some((Some((k1, s1, c1)), s0.atan2(c0)));
+        }
+    }
+    None
 }
 
 /// `Some(k)` when `axis` is `±e_k`: exactly one non-zero component.
@@ -149,6 +243,7 @@ impl<S: Scalar> Params<S> {
                         placement_permutation: is_near_signed_permutation(&j.origin.rotation, 0.0),
                         placement_turn: axis_turn(&j.origin.rotation)
                             .map(|(k, s, c)| (k, S::constant(s), S::constant(c))),
+                        angle_offset: None,
                         inertia: RbInertia::from_com(&mass, &com, &inertia_com),
                         mass,
                         com,

@@ -690,6 +690,7 @@ fn floating_dynamics_traces_on_sym() {
                             placement_turn: j
                                 .placement_turn
                                 .map(|(k, s, c)| (k, Sym::constant(s), Sym::constant(c))),
+                            angle_offset: j.angle_offset.map(Sym::constant),
                             inertia: kanegen_dynamics::spatial::RbInertia::from_com(
                                 &mass,
                                 &com,

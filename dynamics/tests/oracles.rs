@@ -441,6 +441,57 @@ fn two_step_carry_through_turned_placements_matches_lagrange() {
     assert!(worst < 1e-12, "{worst:e}");
 }
 
+/// Canonical frames place every joint but the first by `Θ_x(α) Θ_z(θ₀)`: split
+/// (`JointParams::split_placement`, `θ₀` into the joint angle and the carries in two turns), the
+/// CRBA, the Newton–Euler bias, the spatial RNEA, ABA and the paper's base-frame algorithm still
+/// give the Lagrange `A`, `b` and `q̈` of the canonical model.
+#[test]
+fn split_placements_match_lagrange() {
+    use kanegen_dynamics::algorithms::{aba, newton_euler, recurrent};
+    use kanegen_dynamics::ldlt;
+    let (mut splits, mut revolute, mut worst) = (0, 0, 0.0f64);
+    for n in [2, 5, 8] {
+        for seed in 0..3u64 {
+            let c = chain(n, 700 + 10 * n as u64 + seed)
+                .canonical()
+                .unwrap()
+                .model;
+            let mut p = Params::<f64>::new(&c);
+            for (jp, j) in p.joints.iter_mut().zip(c.joints()) {
+                revolute += usize::from(j.kind == JointKind::Revolute);
+                splits += usize::from(jp.split_placement(j));
+            }
+            let s = state(&mut rng(seed + 31 * n as u64), n);
+            let a_ref = lagrange_mass_matrix(&c, &s.q, &s.qd);
+            let h = lagrange_h(&c, &s.q, &s.qd, Some(&s.g));
+            let b_ref: Vec<f64> = s.tau.iter().zip(&h).map(|(t, h)| t - h).collect();
+            let l = loads(&s, vec![]);
+            let errs = [
+                rel_err(&flat(&crba::mass_matrix(&p, &s.q)), &flat(&a_ref)),
+                rel_err(
+                    &flat(&recurrent::mass_matrix(&p, &s.q, recurrent::Variant::R2)),
+                    &flat(&a_ref),
+                ),
+                rel_err(&newton_euler::bias(&p, &s.q, &s.qd, &l), &b_ref),
+                rel_err(&rnea::bias(&p, &s.q, &s.qd, &l), &b_ref),
+            ];
+            let qdd_ref = ldlt::solve(&ldlt::ldlt(&a_ref), &b_ref);
+            let e_aba = rel_err(&aba::forward_dynamics(&p, &s.q, &s.qd, &l), &qdd_ref);
+            for (k, e) in errs.into_iter().chain([e_aba]).enumerate() {
+                assert!(e < 1e-10, "N={n} seed={seed} #{k}: rel err {e:e}");
+                worst = worst.max(e);
+            }
+        }
+    }
+    // Every revolute joint past the first of each chain (the first is placed on the base, whose
+    // frame canonical frames leave).
+    assert!(
+        splits * 10 >= revolute * 6,
+        "{splits} of {revolute} revolute joints split"
+    );
+    eprintln!("split placements against Lagrange: {splits} of {revolute} revolute joints split, max rel err {worst:.2e}");
+}
+
 /// `axis_turn` recognises a turn about each coordinate axis, and nothing else.
 #[test]
 fn axis_turn_reads_single_axis_rotations() {

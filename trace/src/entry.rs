@@ -114,6 +114,7 @@ pub fn trace(
                     jp.placement_permutation = jp.placement_permutation
                         || is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement)
                         || axis_turn(&j.origin.rotation).is_some();
+                    jp.split_placement(j);
                 }
             }
             if spec.runtime_payload {
@@ -537,6 +538,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
                 coordinate_axis: None,
                 placement_permutation: false,
                 placement_turn: None,
+                angle_offset: None,
                 mass,
                 com,
                 inertia_com,

@@ -53,24 +53,27 @@
 //! | model | N | LDLᵀ, CRBA + RNEA | LDLᵀ, cheapest | ABA | div (cheapest LDLᵀ / ABA) | emitted |
 //! |---|---:|---:|---:|---:|---:|---|
 //! | SSRMS (Nguyen & Hughes 1994) | 7 | 871 | 791 | 943 | 7 / 5 | LDLᵀ |
-//! | random chain | 4 | 1047 | 954 | 1322 | 4 / 3 | LDLᵀ |
-//! | random chain | 8 | 3461 | 3204 | 3502 | 8 / 7 | LDLᵀ |
-//! | random chain | 16 | 11249 | 10393 | 7863 | 16 / 15 | ABA |
+//! | random chain | 4 | 907 | 798 | 1322 | 4 / 3 | LDLᵀ |
+//! | random chain | 8 | 3037 | 2728 | 3502 | 8 / 7 | LDLᵀ |
+//! | random chain | 16 | 10161 | 9452 | 7863 | 16 / 15 | ABA |
 //! | random chain | 32 | 42249 | 34889 | 16582 | 32 / 31 | ABA |
 //! | random chain | 64 | 194617 | 158121 | 34023 | 64 / 63 | ABA |
 //!
 //! On the random chains ABA costs `545 N − 858` (within one operation; in the chains' own
 //! frames, with dense rotations and skew axes, it was `823 N − 874`), LDLᵀ grows like `N³/6` on
 //! top of the mass matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is
-//! cheaper than LDLᵀ on the CRBA and the RNEA from **N = 9** (4047 against 4207), and than the
-//! generator's cheapest LDLᵀ from **N = 10** (4592 against 4675), which is where generated code
-//! switches to it; at N = 64 it needs 4.6× fewer operations. On SSRMS (N = 7) ABA costs 943 against 871 for LDLᵀ
+//! cheaper than LDLᵀ on the CRBA and the RNEA from **N = 11** (5137 against 5226), and than the
+//! generator's cheapest LDLᵀ from **N = 13** (6227 against 6438), which is where generated code
+//! switches to it (N = 9 and 10 before the CRBA and the Newton–Euler bias carried through
+//! canonical frames' placements in two turns, `JointParams::split_placement`; from N = 25 the
+//! mass matrix is traced without them, `codegen::choose`); at N = 64 it needs 4.6× fewer
+//! operations. On SSRMS (N = 7) ABA costs 943 against 871 for LDLᵀ
 //! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler bias costs 791 and is
 //! emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
 //! and its joint placements signed permutations and offsets along one axis, which fold. A
 //! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: on the
-//! 7-dof free-flyer of `kanegen-generated` the two are close (ABA 2869; LDLᵀ 2948, and 2765
-//! with the two-step inertia carry through its near-permutation placements, which it emits). The
+//! 7-dof free-flyer of `kanegen-generated` the two are close (ABA 2869; LDLᵀ 2948, and 2735
+//! with the two-step carries through its placements, which it emits). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!
 //! # The run-time path: a workspace

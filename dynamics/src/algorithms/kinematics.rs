@@ -15,6 +15,7 @@
 //! | `ω_j`, `v_j`, `ε_j`, `w_j` (eq. 3–5) | [`BodyMotion`] |
 
 use crate::base::{FloatingBase, FloatingState, FLOATING_BASE_DOF};
+use crate::joint::joint_sin_cos;
 use crate::linalg::{axis_rotation, Mat3, Vec3};
 use crate::loads::{LoadFrame, Loads};
 use crate::params::Params;
@@ -98,7 +99,7 @@ pub fn base_frame_from<S: Scalar>(
         let (tau, r) = match jp.kind {
             JointKind::Revolute => {
                 // (1) τ_j = τ̂_j Θ_j, Θ_j the rotation about the axis by q_j.
-                let (s, c) = qj.clone().sin_cos();
+                let (s, c) = joint_sin_cos(jp, qj);
                 (tau_hat.mul_mat(&axis_rotation(&jp.axis, &s, &c)), r0)
             }
             JointKind::Prismatic => (tau_hat, r0 + a.scale(qj)),
