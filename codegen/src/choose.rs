@@ -261,10 +261,10 @@ pub fn choose(
         Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
-    // Placements near a signed permutation or turning about one axis, per subject: the two-step
-    // inertia carry through them is traced as well (`kanegen_dynamics::params::NEAR_PERMUTATION`).
-    let near_model = has_near_permutation(model);
-    let near_canonical = canonical.as_ref().is_some_and(has_near_permutation);
+    // Placements near a signed permutation or made of turns about coordinate axes, per subject:
+    // the two-step carries through them are traced as well (`has_two_step_placements`).
+    let near_model = has_two_step_placements(model);
+    let near_canonical = canonical.as_ref().is_some_and(has_two_step_placements);
     let n = model.dof();
     let kept: Vec<Methods> = all.iter().copied().filter(|m| can_win(f, *m, n)).collect();
     for m in if kept.is_empty() { all } else { kept } {
@@ -323,7 +323,7 @@ pub fn takes_trig(choices: &[Choice]) -> bool {
 /// permutation ([`NEAR_PERMUTATION`]), by a turn about one coordinate axis ([`axis_turn`]) or by
 /// two whose second is about the joint's axis ([`mdh_split`]), but not exactly on a permutation:
 /// the two-step carries are then worth a second trace.
-fn has_near_permutation(model: &Model) -> bool {
+fn has_two_step_placements(model: &Model) -> bool {
     model.joints().iter().any(|j| {
         let rot = &j.origin.rotation;
         j.kind == JointKind::Revolute

@@ -17,7 +17,8 @@ pub fn xup<S: Scalar>(jp: &JointParams<S>, q: &S) -> Xform<S> {
     xup_trig(jp, q).0
 }
 
-/// `Xup_j` with `(sin q_j, cos q_j)` for a revolute joint (`None` for a prismatic one).
+/// `Xup_j` with `(sin q_j, cos q_j)` for a revolute joint ([`joint_sin_cos`]: of `q_j` plus its
+/// angle offset where it has one; `None` for a prismatic one).
 pub type XupTrig<S> = (Xform<S>, Option<(S, S)>);
 
 /// `(sin q_j, cos q_j)` of a revolute joint, of `q_j` plus its
