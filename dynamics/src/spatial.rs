@@ -162,13 +162,6 @@ impl<S: Scalar> RbInertia<S> {
     pub fn turned_about_axis(&self, k: usize, s: &S, c: &S) -> RbInertia<S> {
         let (a, b) = ((k + 1) % 3, (k + 2) % 3);
         let i = &self.ibar;
-        // A vector's turned components: (c x_a − s x_b, s x_a + c x_b).
-        let turn = |xa: S, xb: S| {
-            (
-                c.clone() * xa.clone() - s.clone() * xb.clone(),
-                s.clone() * xa + c.clone() * xb,
-            )
-        };
         let u = s.clone() * s.clone();
         let w = c.clone() * s.clone();
         let d = i.at(a, a) - i.at(b, b);
@@ -180,7 +173,9 @@ impl<S: Scalar> RbInertia<S> {
         let ab = i.at(a, b) + (w * d - u * e);
         ibar.0[a][b] = ab.clone();
         ibar.0[b][a] = ab;
-        let (ak, bk) = turn(i.at(a, k), i.at(b, k));
+        // Column k turns as a vector (its k entry stays).
+        let col = i.col(k).turned_about_axis(k, s, c);
+        let (ak, bk) = (col.at(a), col.at(b));
         ibar.0[a][k] = ak.clone();
         ibar.0[k][a] = ak;
         ibar.0[b][k] = bk.clone();
