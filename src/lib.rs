@@ -141,8 +141,13 @@ pub mod ode;
 #[doc(hidden)]
 pub mod __private {
     pub use kanegen_macros::{dynamics, scene};
+    pub use kanegen_runtime as runtime;
     pub use libm;
 }
+
+/// The `no_std` runtime that generated code, the simulator and the run-time path share
+/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine and kernels.
+pub use kanegen_runtime as runtime;
 
 #[cfg(feature = "std")]
 pub use kanegen_codegen as codegen;

@@ -1,5 +1,5 @@
 //! The `kanegen` facade without default features is `no_std`: its normal dependencies are only
-//! the macro crate and `libm`, and a `#![no_std]` crate with one `dynamics!` and one `scene!`
+//! the macro crate, the runtime and `libm`, and a `#![no_std]` crate with one `dynamics!` and one `scene!`
 //! builds — for the host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
 //! installed (`.ci/run` installs it; without it the cross build is skipped with a printed reason).
 
@@ -16,7 +16,7 @@ fn cargo() -> Command {
 
 /// The crates directly under `kanegen` in `cargo tree -e normal` without default features.
 #[test]
-fn facade_without_default_features_depends_on_the_macro_and_libm_only() {
+fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_only() {
     let out = cargo()
         .current_dir(root())
         .args([
@@ -46,7 +46,11 @@ fn facade_without_default_features_depends_on_the_macro_and_libm_only() {
         .filter_map(|l| l.strip_prefix('1'))
         .map(|l| l.split_whitespace().next().unwrap_or("").to_string())
         .collect();
-    assert_eq!(deps, ["kanegen-macros", "libm"], "cargo tree:\n{text}");
+    assert_eq!(
+        deps,
+        ["kanegen-macros", "kanegen-runtime", "libm"],
+        "cargo tree:\n{text}"
+    );
     // With the defaults, the CLI and the library crates come in.
     let out = cargo()
         .current_dir(root())

@@ -28,6 +28,13 @@ pub struct Options {
     /// The `libm` path as tokens, overriding [`Options::libm_path`] in the code (not in the
     /// header): the `dynamics!` macro passes `$crate::__private::libm`, which no string spells.
     pub libm_tokens: Option<TokenStream>,
+    /// Path of the `kanegen-runtime` crate in the generated code: `kanegen_runtime` for a crate
+    /// depending on it, `kanegen::__private::runtime` (the facade's) for the output of the
+    /// `dynamics!` macro.
+    pub runtime_path: String,
+    /// The runtime path as tokens, overriding [`Options::runtime_path`] in the code (not in the
+    /// header): the `dynamics!` macro passes `$crate::__private::runtime`.
+    pub runtime_tokens: Option<TokenStream>,
     /// Name of the generated payload struct (used with [`Options::runtime_payload`]).
     pub payload_name: String,
     /// Name of the generated struct of [`OP_COUNTS`](crate#op-counts) entries.
@@ -201,6 +208,23 @@ impl Options {
         })
     }
 
+    /// The path of `kanegen-runtime` in the emitted code: [`Options::runtime_tokens`], else
+    /// [`Options::runtime_path`] parsed.
+    ///
+    /// # Errors
+    /// If [`Options::runtime_path`] is not a Rust path.
+    #[allow(dead_code)]
+    pub(crate) fn runtime(&self) -> Result<TokenStream, Error> {
+        Ok(match &self.runtime_tokens {
+            Some(t) => t.clone(),
+            None => {
+                let p: syn::Path = syn::parse_str(&self.runtime_path)
+                    .map_err(|e| Error(format!("runtime path `{}`: {e}", self.runtime_path)))?;
+                quote!(#p)
+            }
+        })
+    }
+
     /// Whether the emitted code takes sines and cosines from its own `Self::sincos`
     /// ([`crate::sincos`]): `f64` code without [`Options::libm_trig`].
     #[must_use]
@@ -219,6 +243,8 @@ impl Options {
             runtime_payload: false,
             libm_path: "libm".into(),
             libm_tokens: None,
+            runtime_path: "kanegen_runtime".into(),
+            runtime_tokens: None,
             payload_name: "Payload".into(),
             op_count_name: "OpCount".into(),
             float: Float::F64,

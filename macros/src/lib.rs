@@ -216,6 +216,8 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     let runtime = &input.runtime;
     opts.libm_path = "kanegen::__private::libm".into();
     opts.libm_tokens = Some(quote!(#runtime::__private::libm));
+    opts.runtime_path = "kanegen::__private::runtime".into();
+    opts.runtime_tokens = Some(quote!(#runtime::__private::runtime));
     opts.payload_name = format!("{name}Payload");
     opts.op_count_name = format!("{name}OpCount");
     opts.float = input.float;

@@ -137,6 +137,8 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     opts.base = Some(kind);
     opts.libm_path = "kanegen::__private::libm".into();
     opts.libm_tokens = Some(quote!(#runtime::__private::libm));
+    opts.runtime_path = "kanegen::__private::runtime".into();
+    opts.runtime_tokens = Some(quote!(#runtime::__private::runtime));
     opts.payload_name = format!("{dyn_name}Payload");
     opts.op_count_name = format!("{dyn_name}OpCount");
     let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| format!("{rel}: {e}"))?;

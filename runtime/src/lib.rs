@@ -1,0 +1,18 @@
+//! kanegen's `no_std` runtime: what every other part of kanegen runs on, written once.
+//!
+//! It sits at the bottom of the crate graph and depends on nothing of kanegen's (only `libm`),
+//! so the simulator (`kanegen-sim`), the run-time path (`kanegen-dynamics`), the code that
+//! `dynamics!` and `scene!` emit (through the facade, `kanegen::runtime`) and the checked-in
+//! generated files (`kanegen-generated`) all call the same code:
+//!
+//! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
+//!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
+#![no_std]
+#![warn(missing_docs)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod scalar;
+
+pub use scalar::{Real, Scalar, Symbolic};
