@@ -10,6 +10,8 @@
 //! - `generate` and `count` stay within measured memory and time (peak resident memory of the
 //!   child, from `getrusage`).
 
+mod precondition;
+
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -83,7 +85,7 @@ fn broken_pipe_ends_quietly_with_exit_0() {
 #[test]
 fn full_disk_is_a_clean_error() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
-        eprintln!("no /dev/full on this system: skipped");
+        precondition::absent("dev_full", "no /dev/full on this system");
         return;
     };
     let o = kanegen()
