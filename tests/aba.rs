@@ -142,7 +142,7 @@ fn generated_aba_equals_interpreted_forward_dynamics() {
             assert!(e < TOL, "random N = 32 seed {seed} wrenches {with}: {e:e}");
             worst = worst.max(e);
             // LDLᵀ: another algorithm, whose rounding grows with cond(M) (up to 1e5 on these
-            // 32-joint chains; README, hard cases): to 1e-10.
+            // 32-joint chains; docs/numerics.md, hard cases): to 1e-10.
             let ldlt = Methods::SPATIAL.forward_dynamics(&p, &q, &qd, &loads);
             let e = rel_err(&have, &ldlt);
             assert!(

@@ -1,4 +1,4 @@
-//! Issue 14 (reliability): what the binary promises about its outputs, tested on the binary.
+//! Reliability: what the binary promises about its outputs, tested on the binary.
 //!
 //! - a closed pipe ends quietly with exit 0; a full disk (`/dev/full`) is a clean error;
 //! - an output path that is a directory, under a file, or an input is refused before any work,
@@ -383,8 +383,8 @@ fn measure(args: &[&str]) -> (f64, f64) {
 }
 
 /// `generate` on a 200-joint chain of general geometry stays under 1 GB of peak memory
-/// (measured 0.40 GB and 10 s, compact code; 0.70 GB and 92 s with straight-line code at issue
-/// 14, 19.4 GB and 241 s before it; README, "Limits and guarantees").
+/// (measured 0.40 GB and 10 s, compact code; `docs/limits.md`, "Memory and time of `generate`
+/// and `count`").
 #[cfg(target_os = "linux")]
 #[test]
 fn generate_at_n_200_stays_under_1_gb() {

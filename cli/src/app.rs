@@ -209,7 +209,7 @@ enum Command {
         #[arg(long)]
         allow_nonphysical: bool,
     },
-    /// Simulate a scene file (TOML, README.md "Simulation scenes"): write trajectory.csv,
+    /// Simulate a scene file (TOML, docs/scenes.md): write trajectory.csv,
     /// summary.json and SVG plots into --out, print a summary.
     Simulate {
         /// Scene file (.toml).

@@ -150,7 +150,7 @@ fn auto_picks_compact_for_large_models_only() {
     let g = generate_items(&ssrms, &auto).unwrap();
     let line = form_line(&g.header);
     assert!(line.starts_with("Form: unrolled"), "{line}");
-    // The limit sits between the measured crossovers (README "Compact code").
+    // The limit sits between the measured crossovers (docs/performance.md, "Compact against unrolled").
     let mc = |g: &kanegen_codegen::Generated| {
         g.choices
             .iter()

@@ -15,8 +15,8 @@
 //! - [`ldlt`]: the branch-free LDLᵀ of forward dynamics; [`metrics`]: error measures.
 //! - [`scalars`]: research scalars (dual, compensated, double-double, exact rationals), a leaf.
 //!
-//! The specification is the seed paper as rendered in `paper_en.md`; algorithm files cite its
-//! equation numbers, or RBDA's.
+//! The specification is the seed paper as written out in `docs/paper.md`; algorithm files cite
+//! its equation numbers, or RBDA's.
 //!
 //! ```
 //! use kanegen_dynamics::{Loads, Methods, Params};

@@ -5,7 +5,7 @@
 //! `OP_COUNTS`, `CANDIDATES` and the functions of `M(q) q̈ + c(q, q̇) = τ` on `&[f64; N]` arrays
 //! (`&[f32; N]` for `ssrms_f32`): `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
 //! `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)` and
-//! `mass_matrix_and_nonlinear_effects(q, qd)` (README, "Generated API"). The models are in space:
+//! `mass_matrix_and_nonlinear_effects(q, qd)` (`docs/codegen.md`, "Generated API and its sign convention"). The models are in space:
 //! no gravity.
 //!
 //! | module | struct | model | regenerate with `kanegen generate MODEL …` |

@@ -1,7 +1,7 @@
 //! Simulation scenes: a TOML file naming a model, the base (fixed or free-floating),
 //! an optional payload, the effects (gravity, joint damping, constant or tabulated wrenches), the joint
 //! drives, the initial state, the integrator, and payload captures and releases at given times
-//! (`[[events]]`, free-floating base; see [`crate::events`]). See README.md, "Simulation scenes".
+//! (`[[events]]`, free-floating base; see [`crate::events`]). See `docs/scenes.md`.
 //!
 //! Every table rejects unknown keys, and every validation error names its key
 //! (`simulation.tolerance: must be > 0`). "Effects decide the code": only the effects a scene

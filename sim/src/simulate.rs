@@ -427,7 +427,7 @@ impl<'a> SceneSystem<'a> {
 
     /// Linear and angular momentum (inertial frame, about the inertial origin) of a free-floating
     /// system; `None` on a fixed base. With `[effects] rotor` this is the momentum of the bodies,
-    /// which the armature model conserves (see [`crate::events`] and README, "rotor").
+    /// which the armature model conserves (see [`crate::events`] and `docs/scenes.md`, "What the simulator does").
     #[must_use]
     pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let (q, qd, st) = self.split(x);

@@ -1,5 +1,5 @@
 //! `kanegen generate MODEL`: unrolled, allocation-free, `no_std` Rust for one model (see
-//! [`kanegen_codegen`] and the README section "Code generation").
+//! [`kanegen_codegen`] and `docs/codegen.md`).
 
 use kanegen_codegen::{generate_file, Float, Options};
 use kanegen_model::{BaseKind, Model, ModelError};
