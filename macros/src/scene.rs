@@ -1,5 +1,5 @@
 //! The expansion of `kanegen::scene!`: a simulator specialized at compile time for one scene file
-//! (`kanegen_sim::scene`, the parser the interpreted simulator uses).
+//! (`kanegen_scene`, the parser the interpreted simulator uses as `kanegen_sim::scene`).
 //!
 //! It emits the scene model's generated dynamics ([`kanegen_codegen::generate_items`], type
 //! `NameDynamics`, with the scene's base, gravity and payload), a state type `NameState` and
@@ -11,7 +11,7 @@
 //! capture impulse. A scene error is a compile error naming the key and the scene file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
-use kanegen_sim::scene::{BaseSpec, Drives, EventKind, Integrator, Scene, WrenchProfile};
+use kanegen_scene::{BaseSpec, Drives, EventKind, Integrator, Scene, WrenchProfile};
 use proc_macro2::{Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use syn::{Ident, LitStr};

@@ -5,7 +5,7 @@
 //! after and the generated Jacobian and placement of a frame at the payload's centre of mass.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Model};
-use kanegen_sim::scene::{BaseSpec, EventKind, Scene};
+use kanegen_scene::{BaseSpec, EventKind, Scene};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 use syn::Ident;
