@@ -135,7 +135,10 @@ macro_rules! scene {
     };
 }
 
-pub mod ode;
+/// The integrators of [`scene!`]'s simulators and of the interpreted simulator
+/// (`kanegen-runtime`'s, `no_std`): RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
+/// midpoint rule, with their [`Stats`](ode::Stats) and stop reasons ([`Stop`](ode::Stop)).
+pub use kanegen_runtime::ode;
 
 /// Support for the code emitted by [`dynamics!`] and [`scene!`]; not a public API.
 #[doc(hidden)]

@@ -7,12 +7,15 @@
 //!
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
+//! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
+//!   midpoint rule) over slices with caller-provided scratch, for the simulator and `scene!`.
 #![no_std]
 #![warn(missing_docs)]
 
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod ode;
 pub mod scalar;
 
 pub use scalar::{Real, Scalar, Symbolic};

@@ -302,7 +302,7 @@ pub enum Integrator {
     /// energy error, unit quaternion without projection; see `integrate::midpoint`).
     Midpoint,
     /// Adaptive Rodas4, the stiffly accurate L-stable Rosenbrock method (`integrator =
-    /// "rosenbrock"`, the simulator's `kanegen_sim::rosenbrock`) with `rtol = atol = tolerance`, for stiff scenes
+    /// "rosenbrock"`, `kanegen_runtime::ode::rosenbrock`) with `rtol = atol = tolerance`, for stiff scenes
     /// (flexible joints); its steps land on the output times.
     Rosenbrock,
 }
@@ -415,20 +415,7 @@ impl SceneWrench {
                 time,
                 force,
                 moment,
-            } => {
-                // First sample strictly after t (time is strictly increasing, at least 2 long).
-                let k = time.partition_point(|&tk| tk <= t);
-                if k == 0 {
-                    return (force[0], moment[0]);
-                }
-                if k == time.len() {
-                    return (force[k - 1], moment[k - 1]);
-                }
-                let s = (t - time[k - 1]) / (time[k] - time[k - 1]);
-                let lerp =
-                    |v: &[[f64; 3]]| [0, 1, 2].map(|i| v[k - 1][i] + s * (v[k][i] - v[k - 1][i]));
-                (lerp(force), lerp(moment))
-            }
+            } => kanegen_runtime::ode::table(t, time, force, moment),
         }
     }
 
