@@ -7,12 +7,19 @@
 //!
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
+//! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
+//! - [`ldlt`]: LDLᵀ factorization and solve over slices, allocating nothing.
+//! - [`inertia`]: the parallel-axis shift of a rigid body's inertia.
 #![no_std]
 #![warn(missing_docs)]
 
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod fma;
+pub mod inertia;
+pub mod ldlt;
 pub mod scalar;
+pub mod sincos;
 
 pub use scalar::{Real, Scalar, Symbolic};
