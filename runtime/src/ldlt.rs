@@ -8,8 +8,8 @@
 //!
 //! ```
 //! use kanegen_runtime::ldlt::{factor_in_place, solve_in_place};
-//! let mut a = [4.0, 2.0, 2.0, 3.0];
-//! let mut d_inv = [0.0; 2];
+//! let mut a: [f64; 4] = [4.0, 2.0, 2.0, 3.0];
+//! let mut d_inv = [0.0_f64; 2];
 //! factor_in_place(&mut a, 2, &mut d_inv).unwrap();
 //! let mut x = [2.0, 1.0];
 //! solve_in_place(&a, 2, &d_inv, &mut x).unwrap();
@@ -114,7 +114,7 @@ mod tests {
         let mut a = [4.0, 2.0, 0.0, 2.0, 5.0, 1.0, 0.0, 1.0, 3.0];
         let mut d_inv = [0.0; 3];
         factor_in_place(&mut a, 3, &mut d_inv).unwrap();
-        let mut x = [2.0, -1.0, 5.0];
+        let mut x: [f64; 3] = [2.0, -1.0, 5.0];
         solve_in_place(&a, 3, &d_inv, &mut x).unwrap();
         for (got, want) in x.iter().zip([1.0, -1.0, 2.0]) {
             assert!((got - want).abs() < 1e-15, "{x:?}");
