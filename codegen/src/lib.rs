@@ -371,12 +371,12 @@ fn generate_items_with(
     let sincos_item = opts.table_sincos() && (compact || choose::takes_trig(&choices));
     let target_mul_add = !opts.fma && opts.target_fma;
     let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
-        mul_add_fn(opts.float)
+        mul_add_fn(opts.float, &opts.runtime()?)
     } else {
         quote!()
     };
     let sincos_item = if sincos_item {
-        sincos::item(&opts.libm()?, target_mul_add)
+        sincos::item(&opts.runtime()?, target_mul_add)
     } else {
         quote!()
     };
@@ -601,56 +601,21 @@ pub use kanegen_dynamics;
 /// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
 
-/// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build
-/// targets it, `a·b + c` (two roundings, bit-identical to unfused code) elsewhere.
-fn mul_add_fn(float: Float) -> TokenStream {
-    let (ty, x86, set, get, arm_dup, arm_fma, arm_get) = match float {
-        Float::F64 => (
-            quote!(f64),
-            quote!(_mm_fmadd_sd),
-            quote!(_mm_set_sd),
-            quote!(_mm_cvtsd_f64),
-            quote!(vdup_n_f64),
-            quote!(vfma_f64),
-            quote!(vget_lane_f64),
-        ),
-        Float::F32 => (
-            quote!(f32),
-            quote!(_mm_fmadd_ss),
-            quote!(_mm_set_ss),
-            quote!(_mm_cvtss_f32),
-            quote!(vdup_n_f32),
-            quote!(vfma_f32),
-            quote!(vget_lane_f32),
-        ),
+/// The private `mul_add` of [`Options::target_fma`], forwarding to the runtime's
+/// (`kanegen_runtime::fma`): one fused instruction where the build targets it, `a·b + c` (two
+/// roundings, bit-identical to unfused code) elsewhere.
+fn mul_add_fn(float: Float, runtime: &TokenStream) -> TokenStream {
+    let (ty, f) = match float {
+        Float::F64 => (quote!(f64), quote!(mul_add)),
+        Float::F32 => (quote!(f32), quote!(mul_add_f32)),
     };
     quote! {
         /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
         /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-        /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
-        /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
+        /// elsewhere.
         #[inline(always)]
-        #[allow(unsafe_code)]
         fn mul_add(a: #ty, b: #ty, c: #ty) -> #ty {
-            #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-            {
-                use core::arch::x86_64::{#get, #x86, #set};
-                // SAFETY: the build targets FMA (the `cfg` above), so the instruction exists.
-                unsafe { #get(#x86(#set(a), #set(b), #set(c))) }
-            }
-            #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
-            {
-                use core::arch::aarch64::{#arm_dup, #arm_fma, #arm_get};
-                // SAFETY: AArch64 with NEON (the `cfg` above) has the fused multiply-add.
-                unsafe { #arm_get::<0>(#arm_fma(#arm_dup(c), #arm_dup(a), #arm_dup(b))) }
-            }
-            #[cfg(not(any(
-                all(target_arch = "x86_64", target_feature = "fma"),
-                all(target_arch = "aarch64", target_feature = "neon")
-            )))]
-            {
-                a * b + c
-            }
+            #runtime::fma::#f(a, b, c)
         }
     }
 }

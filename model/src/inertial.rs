@@ -29,7 +29,9 @@ pub struct Inertial {
     pub inertia: M3,
 }
 
-/// `m (|c|² 1 − c cᵀ)`: the parallel-axis term of a point mass `m` at `c`.
+/// `m (|c|² 1 − c cᵀ)`: the parallel-axis term of a point mass `m` at `c` (Steiner's theorem),
+/// the model's one, in `f64` ([`Inertial::merge`]; the traced algorithms shift by
+/// `kanegen_runtime::inertia::parallel_axis`, in the operations of `m c̃ c̃ᵀ`).
 #[must_use]
 pub fn steiner(m: f64, c: &V3) -> M3 {
     let n2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
@@ -64,11 +66,10 @@ impl Inertial {
         let mut inertia = [[0.0; 3]; 3];
         for part in [a, b] {
             let d: V3 = core::array::from_fn(|k| part.com[k] - c[k]);
-            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let shift = steiner(part.mass, &d);
             for r in 0..3 {
                 for s in 0..3 {
-                    let e = if r == s { d2 } else { 0.0 };
-                    inertia[r][s] += part.inertia[r][s] + part.mass * (e - d[r] * d[s]);
+                    inertia[r][s] += part.inertia[r][s] + shift[r][s];
                 }
             }
         }
