@@ -407,8 +407,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             }
             let algs = match algorithm {
                 Some(a) => vec![checked_methods(&chain, Some(a))?],
-                None if chain.is_chain() => Methods::ALL.to_vec(),
-                None => vec![Methods::SPATIAL],
+                None => commands::count::emittable(&chain),
             };
             let g = gravity_arg(gravity)?;
             let explicit = algorithm.is_some();
