@@ -164,14 +164,19 @@ impl Size {
     }
 }
 
-/// Decides the form: `size` is the emitted `mul + add` of the cheapest unrolled
-/// `mass_matrix_and_nonlinear_effects` as far as it was traced (read under [`Form::Auto`] for
-/// a supported model only; `None` otherwise).
+/// Decides the form of a model of `n` joints: `why_not` is [`unsupported`] of the model,
+/// `size` the emitted `mul + add` of its cheapest unrolled `mass_matrix_and_nonlinear_effects`
+/// as far as it was traced (read under [`Form::Auto`] for a supported model only; `None`
+/// otherwise).
 ///
 /// # Errors
 /// [`Form::Compact`] asked for a model it does not support.
-pub fn decide(model: &Model, opts: &Options, size: Option<Size>) -> Result<Decision, Error> {
-    let why_not = unsupported(model, opts);
+pub fn decide(
+    opts: &Options,
+    n: usize,
+    why_not: Option<&str>,
+    size: Option<Size>,
+) -> Result<Decision, Error> {
     let compact = |why: String| Decision {
         form: Form::Compact,
         line: format!(
@@ -185,7 +190,6 @@ pub fn decide(model: &Model, opts: &Options, size: Option<Size>) -> Result<Decis
         form: Form::Unrolled,
         line: format!("Form: unrolled straight-line code ({why})."),
     };
-    let n = model.dof();
     Ok(match (opts.form, why_not, size) {
         (Form::Compact, Some(why), _) => {
             return Err(Error(format!(

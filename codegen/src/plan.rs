@@ -207,7 +207,8 @@ fn decide_form(
     subjects: &Subjects,
     opts: &Options,
 ) -> Result<(Decision, Vec<(Choice, Traced)>), Error> {
-    let (size, traced) = match (opts.form, compact::unsupported(model, opts)) {
+    let why_not = compact::unsupported(model, opts);
+    let (size, traced) = match (opts.form, why_not) {
         (Form::Auto, None) => {
             let fs = [
                 Function::MassMatrix,
@@ -225,7 +226,7 @@ fn decide_form(
         }
         _ => (None, Vec::new()),
     };
-    let decision = compact::decide(model, opts, size)?;
+    let decision = compact::decide(opts, model.dof(), why_not, size)?;
     // Compact: the whole model's unrolled `M` and `(M, c)` are not emitted.
     let traced = if decision.form == Form::Compact {
         Vec::new()
@@ -236,9 +237,9 @@ fn decide_form(
 }
 
 /// The choice and graph of `f` (no graph for a compact body): traced unless the form is
-/// compact and `f` has a compact body, which an O(N) Newton–Euler function under
-/// [`Form::Auto`] keeps only when its unrolled body is above
-/// [`compact::LINEAR_AUTO_LIMIT`] ([`size_on_prefixes`]).
+/// compact and `f` has a compact body; an O(N) Newton–Euler function under [`Form::Auto`]
+/// keeps its unrolled body (traced whole) when that is within [`compact::LINEAR_AUTO_LIMIT`],
+/// sized on prefixes first ([`size_on_prefixes`]).
 fn plan_body(
     model: &Model,
     subjects: &Subjects,
