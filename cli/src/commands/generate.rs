@@ -6,7 +6,7 @@ use kanegen_model::{BaseKind, Model, ModelError};
 
 /// Most joints `kanegen generate` accepts without `--allow-large`. Large models take the compact
 /// form, decided from a traced prefix ([`kanegen_codegen::plan`]), so generating is quick at
-/// that size (random chain N = 1000: 1.8 s, 58 MB, 1.6 MB of code); beyond it the generated
+/// that size (random chain N = 1000: 0.55–3.4 s, 59 MB, 1.6 MB of code); beyond it the generated
 /// code is what grows: its functions keep O(N) arrays on the caller's stack, and its frame
 /// functions stay straight-line (6·N Jacobian entries).
 pub const MAX_N: usize = 1000;
