@@ -473,17 +473,17 @@ fn messages_name_what_is_wrong() {
     );
 }
 
-/// `generate` refuses more than 256 joints before any work, naming the flag that allows it.
+/// `generate` refuses more than 1000 joints before any work, naming the flag that allows it.
 #[test]
-fn generate_refuses_more_than_256_joints_without_allow_large() {
+fn generate_refuses_more_than_1000_joints_without_allow_large() {
     let d = tmp("large");
-    let model = d.join("chain257.toml");
+    let model = d.join("chain1001.toml");
     let chain = kanegen::model::random::random_chain(
         &kanegen::model::random::ChainSpec {
-            n: 257,
+            n: 1001,
             ..Default::default()
         },
-        257,
+        1001,
     );
     std::fs::write(&model, kanegen::model::io::to_toml(&chain)).unwrap();
     let t = Instant::now();
@@ -494,7 +494,7 @@ fn generate_refuses_more_than_256_joints_without_allow_large() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("257 joints") && err.contains("--allow-large"),
+        err.contains("1001 joints") && err.contains("--allow-large"),
         "{err}"
     );
     assert!(o.stdout.is_empty());
