@@ -29,10 +29,12 @@ kanegen::dynamics!(
     algorithm = "aba",
 );
 
+// Straight-line code, whose candidates are traced (a compact type's functions in loops are not).
 kanegen::dynamics!(
     RandomN32,
     "benches/data/random_n32.toml",
     gravity = [0.3, -1.2, -9.81],
+    form = "unrolled",
 );
 
 const TOL: f64 = 1e-12;
