@@ -149,7 +149,7 @@ pub mod __private {
 }
 
 /// The `no_std` runtime that generated code, the simulator and the run-time path share
-/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine and kernels.
+/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine, LDLᵀ and the parallel-axis shift.
 pub use kanegen_runtime as runtime;
 
 #[cfg(feature = "std")]
