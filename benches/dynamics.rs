@@ -1,4 +1,4 @@
-//! Generated code against the interpreted f64 algorithms (`recurrent`, `crba-base`, `spatial`):
+//! Generated code against the interpreted f64 algorithms (`recurrent`, `crba-inertial`, `spatial`):
 //! SSRMS (the checked-in `kanegen-generated` code) and random chains N = 2, 4, 8, 16, 32
 //! (compiled here through `kanegen::dynamics!` from `benches/data/random_n*.toml`).
 //!
@@ -17,7 +17,7 @@ kanegen::dynamics!(Rand8, "benches/data/random_n8.toml");
 kanegen::dynamics!(Rand16, "benches/data/random_n16.toml");
 kanegen::dynamics!(Rand32, "benches/data/random_n32.toml");
 
-const INTERPRETED: [Methods; 3] = [Methods::RECURRENT, Methods::CRBA_BASE, Methods::SPATIAL];
+const INTERPRETED: [Methods; 3] = [Methods::RECURRENT, Methods::CRBA_INERTIAL, Methods::SPATIAL];
 
 fn load(path: &str) -> Model {
     kanegen::model::io::load_model(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path))

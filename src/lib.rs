@@ -46,8 +46,8 @@ extern crate std;
 /// `-C target-cpu=native`; AArch64), `a·b + c` elsewhere, where results are bit-identical to
 /// unfused code; `target_fma = false` writes every product and sum out instead.
 /// `regroup = false` keeps the model's own inertial parameters in the local-frame algorithms
-/// (by default each revolute body's axis mass is carried by its parent, Khalil and
-/// Kleinfinger's base parameters: the same `M`, `c` and `τ` in fewer operations; the header says
+/// (by default each revolute body's axis mass is carried by its parent, as Khalil and
+/// Kleinfinger regroup the inertial parameters: the same `M`, `c` and `τ` in fewer operations; the header says
 /// what moved). `canonical = false` traces every function in the model's own body frames only
 /// (by default the joint-space functions are also traced in canonical frames, every joint axis
 /// z, and the cheaper is emitted; the header's table says which). `f64` code takes sines and
@@ -57,8 +57,8 @@ extern crate std;
 /// tracing: rotations within `TOL` of a signed permutation become it, smaller offsets and
 /// inertia entries 0 (Panda's `cos(π/2) = 6.1e-17` residues: (M, c) in 1455 operations instead
 /// of 2122 before canonical frames); the header says how many numbers moved and by how much. `algorithm = NAME` forces
-/// one algorithm (`recurrent`, the paper's; `recurrent-r1`, `kane-direct`, `crba-base`,
-/// `spatial`, `aba`) for every function with a mass-matrix, bias or forward method instead of
+/// one algorithm (`recurrent`, the paper's; `recurrent-r1`, `kane-direct`, `crba-inertial`,
+/// `spatial`, `aba`) for every function with a mass-matrix, nonlinear-effects or forward method instead of
 /// the cheapest candidate; a chain-only algorithm on a tree is a compile error naming the
 /// branching joint.
 ///

@@ -49,7 +49,11 @@ macro_rules! assert_aba_chosen {
         for f in $fs {
             let c = $t::OP_COUNTS.iter().find(|c| c.function == f).unwrap();
             assert_eq!(c.forward_method, Some("aba"), "{f}");
-            assert_eq!((c.mass_matrix_method, c.bias_method), (None, None), "{f}");
+            assert_eq!(
+                (c.mass_matrix_method, c.nonlinear_effects_method),
+                (None, None),
+                "{f}"
+            );
             // The cheapest of its candidates, which include LDLᵀ.
             let cands: Vec<_> = $t::CANDIDATES.iter().filter(|x| x.function == f).collect();
             assert!(cands.iter().any(|x| x.forward_method == Some("ldlt")));

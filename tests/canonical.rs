@@ -38,8 +38,8 @@ fn compare(a: &Model, b: &Model, seed: u64) -> f64 {
             &crba::mass_matrix(&pb, &q),
         ));
         worst = worst.max(rel_err(
-            &rnea::bias(&pa, &q, &qd, &gravity()),
-            &rnea::bias(&pb, &q, &qd, &gravity()),
+            &rnea::tau_minus_c(&pa, &q, &qd, &gravity()),
+            &rnea::tau_minus_c(&pb, &q, &qd, &gravity()),
         ));
         for (fa, fb) in pa.frames.iter().zip(&pb.frames) {
             let (ta, ra) = frames::placement(&pa, &q, fa);
@@ -67,8 +67,8 @@ fn compare(a: &Model, b: &Model, seed: u64) -> f64 {
                 &floating::mass_matrix(m.mass_matrix, &pb, &bb, &s, &q),
             ));
             worst = worst.max(rel_err(
-                &floating::bias(m.bias, &pa, &ba, &s, &q, &qd, &gravity()),
-                &floating::bias(m.bias, &pb, &bb, &s, &q, &qd, &gravity()),
+                &floating::tau_minus_c(m.nonlinear_effects, &pa, &ba, &s, &q, &qd, &gravity()),
+                &floating::tau_minus_c(m.nonlinear_effects, &pb, &bb, &s, &q, &qd, &gravity()),
             ));
         }
     }

@@ -209,16 +209,16 @@ fn floating_rotor_is_the_armature_model() {
     );
     let r = scene.rotor.as_ref().unwrap();
     let nu_dot = &dx[7 + n..];
-    let scale = d.b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let scale = d.tau_minus_c.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     for i in 0..6 + n {
-        let mut lhs: f64 = (0..6 + n).map(|j| d.a[i][j] * nu_dot[j]).sum();
+        let mut lhs: f64 = (0..6 + n).map(|j| d.mass_matrix[i][j] * nu_dot[j]).sum();
         if i >= 6 {
             lhs += r.reflected[i - 6] * nu_dot[i];
         }
         assert!(
-            (lhs - d.b[i]).abs() <= 1e-10 * scale,
+            (lhs - d.tau_minus_c[i]).abs() <= 1e-10 * scale,
             "row {i}: {lhs} vs {}",
-            d.b[i]
+            d.tau_minus_c[i]
         );
     }
     let run_r = run(&scene);

@@ -4,7 +4,7 @@
 use kanegen::cli::commands::generate::GENERATED;
 use kanegen::dynamics::metrics::rel_err;
 use kanegen::dynamics::Params;
-use kanegen::dynamics::{BiasMethod, Loads, MassMatrixMethod, Methods};
+use kanegen::dynamics::{Loads, MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen::model::random::{random_vec, rng};
 use kanegen::model::Model;
 use kanegen_generated::{
@@ -51,7 +51,11 @@ struct Fns {
 
 /// The methods of an `OP_COUNTS` entry (an unused method is reported as the CRBA / RNEA;
 /// forward dynamics by `aba` is [`Methods::ABA`]).
-fn methods_of(mass: Option<&str>, bias: Option<&str>, forward: Option<&str>) -> Methods {
+fn methods_of(
+    mass: Option<&str>,
+    nonlinear_effects: Option<&str>,
+    forward: Option<&str>,
+) -> Methods {
     if forward == Some("aba") {
         return Methods::ABA;
     }
@@ -59,7 +63,9 @@ fn methods_of(mass: Option<&str>, bias: Option<&str>, forward: Option<&str>) -> 
         mass_matrix: mass.map_or(MassMatrixMethod::Crba, |m| {
             MassMatrixMethod::from_name(m).unwrap()
         }),
-        bias: bias.map_or(BiasMethod::Rnea, |b| BiasMethod::from_name(b).unwrap()),
+        nonlinear_effects: nonlinear_effects.map_or(NonlinearEffectsMethod::Rnea, |b| {
+            NonlinearEffectsMethod::from_name(b).unwrap()
+        }),
         ..Methods::SPATIAL
     }
 }
@@ -102,7 +108,11 @@ macro_rules! fns {
             chosen: |name| {
                 let c = <$t>::OP_COUNTS.iter().find(|c| c.function == name).unwrap();
                 (
-                    methods_of(c.mass_matrix_method, c.bias_method, c.forward_method),
+                    methods_of(
+                        c.mass_matrix_method,
+                        c.nonlinear_effects_method,
+                        c.forward_method,
+                    ),
                     c.mul + c.add,
                 )
             },
@@ -136,12 +146,14 @@ fn compare(chain: &Model, f: &Fns, seed: u64) {
             let e = rel_err(&a_have, &flat(alg.mass_matrix.mass_matrix(&p, &q)));
             assert!(e < 1e-12, "{}: A vs {alg}: {e:e}", chain.name());
             // c = −b(τ = 0), and b = τ − c.
-            let b = alg.bias.bias(&p, &q, &qd, &loads);
+            let b = alg.nonlinear_effects.tau_minus_c(&p, &q, &qd, &loads);
             let c = (f.nonlinear_effects)(&q, &qd);
             let tau_minus_c: Vec<f64> = tau.iter().zip(&c).map(|(t, c)| t - c).collect();
             let e = rel_err(&tau_minus_c, &b);
             assert!(e < 1e-12, "{}: τ − c vs b of {alg}: {e:e}", chain.name());
-            let h = alg.bias.bias(&p, &q, &qd, &Loads::default());
+            let h = alg
+                .nonlinear_effects
+                .tau_minus_c(&p, &q, &qd, &Loads::default());
             let minus_h: Vec<f64> = c.iter().map(|c| -c).collect();
             let e = rel_err(&minus_h, &h);
             assert!(e < 1e-12, "{}: −c vs −h of {alg}: {e:e}", chain.name());
@@ -178,7 +190,7 @@ fn generated_code_equals_interpreted_algorithms() {
 }
 
 /// `--algorithm recurrent` forces the paper's algorithm: every function with a mass-matrix or
-/// bias method traces it alone and says so (one candidate, the header's line), its code equals
+/// nonlinear-effects method traces it alone and says so (one candidate, the header's line), its code equals
 /// the interpreted recurrent algorithm and the cheapest generated code (other algorithms) to
 /// 1e-12, and it costs more operations than the cheapest; on a tree it is refused by name.
 #[test]
@@ -191,11 +203,11 @@ fn the_recurrent_algorithm_can_be_forced() {
     let model = g.model(root()).unwrap();
     compare(&model, &fns!(SsrmsRecurrent), 12);
     for e in SsrmsRecurrent::OP_COUNTS {
-        let uses = e.mass_matrix_method.is_some() || e.bias_method.is_some();
+        let uses = e.mass_matrix_method.is_some() || e.nonlinear_effects_method.is_some();
         if uses {
             assert!(
                 e.mass_matrix_method.is_none_or(|m| m == "recurrent")
-                    && e.bias_method.is_none_or(|b| b == "recurrent"),
+                    && e.nonlinear_effects_method.is_none_or(|b| b == "recurrent"),
                 "{}",
                 e.function
             );
@@ -277,9 +289,13 @@ fn locked_joint_matches_full_model() {
                 tau: Some(tau6),
                 ..Loads::default()
             };
-            let mut b7 = Methods::RECURRENT.bias.bias(&pf, &q, &qd, &l7);
+            let mut b7 = Methods::RECURRENT
+                .nonlinear_effects
+                .tau_minus_c(&pf, &q, &qd, &l7);
             b7.remove(index);
-            let b6 = Methods::SPATIAL.bias.bias(&pl, &q6, &qd6, &l6);
+            let b6 = Methods::SPATIAL
+                .nonlinear_effects
+                .tau_minus_c(&pl, &q6, &qd6, &l6);
             assert!(rel_err(&b6, &b7) < 1e-12, "b, lock {index}={v}");
         }
     }

@@ -216,8 +216,8 @@ macro_rules! compare {
             let c = $c::nonlinear_effects(&q, &qd);
             close("c vs unrolled", &c, &$u::nonlinear_effects(&q, &qd), 1e-12);
             let ci: Vec<f64> = alg
-                .bias
-                .bias(&p, &q, &qd, &loads)
+                .nonlinear_effects
+                .tau_minus_c(&p, &q, &qd, &loads)
                 .iter()
                 .map(|b| -b)
                 .collect();

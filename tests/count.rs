@@ -33,7 +33,7 @@ fn count_reports_every_method_function_and_convention() {
     assert_eq!(
         lines.len(),
         (5 + 4) * 3,
-        "(5 mass-matrix methods + 4 bias methods) × 3 conventions"
+        "(5 mass-matrix methods + 4 nonlinear-effects methods) × 3 conventions"
     );
     for key in [
         "method",
@@ -54,12 +54,12 @@ fn count_reports_every_method_function_and_convention() {
         ("mass_matrix", "recurrent"),
         ("mass_matrix", "recurrent-r1"),
         ("mass_matrix", "kane-direct"),
-        ("mass_matrix", "crba-base"),
+        ("mass_matrix", "crba-inertial"),
         ("mass_matrix", "crba"),
-        ("bias", "recurrent"),
-        ("bias", "kane-direct"),
-        ("bias", "rnea"),
-        ("bias", "newton-euler"),
+        ("tau_minus_c", "recurrent"),
+        ("tau_minus_c", "kane-direct"),
+        ("tau_minus_c", "rnea"),
+        ("tau_minus_c", "newton-euler"),
     ];
     for (f, alg) in methods {
         {
@@ -81,7 +81,7 @@ fn count_reports_every_method_function_and_convention() {
             assert!(tot(e) > 0);
             // At most one sin/cos pair per joint. The local-frame algorithms need none for joint 1
             // without gravity (A and h are invariant to rotating the whole arm about the fixed
-            // first axis), so their emitted code drops it; the base-frame ones keep all 7. The
+            // first axis), so their emitted code drops it; the inertial-frame ones keep all 7. The
             // CRBA's M needs none for the last joint either: SSRMS's last body is isotropic about
             // its axis (iyy = izz = 44.41 about x), and the double-angle turn of its inertia
             // (`RbInertia::turned_about_axis`) has no terms in the angle, where the congruence
@@ -97,7 +97,7 @@ fn count_reports_every_method_function_and_convention() {
     }
 }
 
-/// `count` lists every method the generator may emit: on a chain each mass-matrix and bias
+/// `count` lists every method the generator may emit: on a chain each mass-matrix and nonlinear-effects
 /// method (`newton-euler` included), on a tree the local-frame ones (`crba`; `rnea`,
 /// `newton-euler`), each in three conventions.
 #[test]
@@ -129,19 +129,22 @@ fn count_lists_every_method_the_generator_may_emit() {
         methods("tests/data/compact/tree7.toml"),
         pairs(&[
             ("mass_matrix", "crba"),
-            ("bias", "rnea"),
-            ("bias", "newton-euler")
+            ("tau_minus_c", "rnea"),
+            ("tau_minus_c", "newton-euler")
         ])
     );
     let chain = methods("tests/data/compact/chain3.toml");
-    for bias in ["recurrent", "kane-direct", "rnea", "newton-euler"] {
-        assert!(chain.contains(&("bias".into(), bias.into())), "{bias}");
+    for method in ["recurrent", "kane-direct", "rnea", "newton-euler"] {
+        assert!(
+            chain.contains(&("tau_minus_c".into(), method.into())),
+            "{method}"
+        );
     }
     for mass in [
         "recurrent",
         "recurrent-r1",
         "kane-direct",
-        "crba-base",
+        "crba-inertial",
         "crba",
     ] {
         assert!(

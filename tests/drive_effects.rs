@@ -7,7 +7,8 @@
 //!   term is not (the rotor inertia acts in the solve, not beside it);
 //! - with viscous + Coulomb friction and no drives that energy falls at every sample;
 //! - scenes without the effects run and count exactly as on `main` before them (golden files
-//!   `tests/data/golden/`, written by main's `kanegen` at 6f58384);
+//!   `tests/data/golden/`, written by main's `kanegen` at 6f58384; the counts' labels since renamed: `tau_minus_c`
+//!   for `bias`, `crba-inertial` for `crba-base`);
 //! - `count SCENE` lists `coulomb` and `rotor` with nonzero costs;
 //! - bad values name the key (and its line).
 //!
@@ -200,7 +201,11 @@ fn count_lists_the_drive_effects() {
     let effects = v["effects"].as_array().unwrap();
     for name in ["coulomb", "rotor", "damping"] {
         let lines: Vec<_> = effects.iter().filter(|e| e["effect"] == name).collect();
-        assert_eq!(lines.len(), 3 * 2, "{name}: 3 bias methods × 2 conventions");
+        assert_eq!(
+            lines.len(),
+            3 * 2,
+            "{name}: 3 nonlinear-effects methods × 2 conventions"
+        );
         for l in lines {
             let total = l["mul"].as_i64().unwrap() + l["add"].as_i64().unwrap();
             assert!(total > 0, "{name}: {l}");

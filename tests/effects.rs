@@ -6,7 +6,7 @@
 
 use kanegen::dynamics::algorithms::floating;
 use kanegen::dynamics::algorithms::frames::generalized_jacobian;
-use kanegen::dynamics::algorithms::kinematics::floating_base_frame;
+use kanegen::dynamics::algorithms::kinematics::floating_inertial_frame;
 use kanegen::dynamics::base::FLOATING_BASE_DOF;
 use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen::dynamics::linalg::{Mat3, Vec3};
@@ -45,7 +45,7 @@ fn trace_b(chain: &Model, alg: Methods, gravity: bool) -> kanegen::trace::sym::T
         gravity: g,
         external: Vec::new(),
     };
-    let b = alg.bias.bias(&p, &q, &qd, &loads);
+    let b = alg.nonlinear_effects.tau_minus_c(&p, &q, &qd, &loads);
     t.finish(&b)
 }
 
@@ -193,14 +193,14 @@ fn count_scene_reports_the_cost_of_each_enabled_effect() {
         .as_array()
         .unwrap()
         .iter()
-        .find(|c| c["function"] == "bias" && c["convention"] == "emitted")
+        .find(|c| c["function"] == "tau_minus_c" && c["convention"] == "emitted")
         .unwrap();
     assert!(b["mul"].as_u64().unwrap() > 0);
 }
 
 /// Origin of the last arm body (inertial frame).
 fn tip(chain: &Model, base: &FloatingBase<f64>, st: &FloatingState<f64>, q: &[f64]) -> [f64; 3] {
-    let kin = floating_base_frame(&Params::new(chain), base, st, q);
+    let kin = floating_inertial_frame(&Params::new(chain), base, st, q);
     let mut x = st.position.clone();
     for k in &kin[FLOATING_BASE_DOF..] {
         x = &x + &k.r;
@@ -255,7 +255,7 @@ integrator = "dopri5"
         &qd,
         &Loads::default(),
     )
-    .a;
+    .mass_matrix;
     let nb = FLOATING_BASE_DOF;
     let a_bb: Vec<Vec<f64>> = a[..nb].iter().map(|r| r[..nb].to_vec()).collect();
     let rhs: Vec<f64> = (0..nb)

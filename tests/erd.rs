@@ -131,7 +131,7 @@ fn fixed_base_eval_matches_pinocchio_on_real_urdfs() {
                 "recurrent",
                 "recurrent-r1",
                 "kane-direct",
-                "crba-base",
+                "crba-inertial",
                 "spatial",
             ]
         } else {

@@ -305,7 +305,11 @@ fn count_lists_flexible() {
         .iter()
         .filter(|e| e["effect"] == "flexible")
         .collect();
-    assert_eq!(lines.len(), 3 * 2, "3 bias methods × 2 conventions");
+    assert_eq!(
+        lines.len(),
+        3 * 2,
+        "3 nonlinear-effects methods × 2 conventions"
+    );
     for l in lines {
         assert_eq!(
             (l["mul"].as_i64(), l["add"].as_i64(), l["div"].as_i64()),

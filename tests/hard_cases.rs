@@ -153,9 +153,9 @@ fn measure(chain: &Model, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
         &consts(qd),
         &drives(tau),
     );
-    let fw = ldlt(&dw.a);
-    let xw = to_f64_vec(&solve(&fw, &dw.b));
-    let aw = to_f64_mat(&dw.a);
+    let fw = ldlt(&dw.mass_matrix);
+    let xw = to_f64_vec(&solve(&fw, &dw.tau_minus_c));
+    let aw = to_f64_mat(&dw.mass_matrix);
     let n = aw.len();
     let (cond, lambda_min) = cond2(DMatrix::from_fn(n, n, |i, j| aw[i][j]));
     let (cond_s, _) = cond2(DMatrix::from_fn(n, n, |i, j| {
@@ -165,15 +165,15 @@ fn measure(chain: &Model, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
 
     let p = Params::<f64>::new(chain);
     let d = alg.dynamics(&p, q, qd, &drives(tau));
-    let f = ldlt(&d.a);
-    let x = solve(&f, &d.b);
+    let f = ldlt(&d.mass_matrix);
+    let x = solve(&f, &d.tau_minus_c);
     let (mut r2, mut b2) = (0.0, 0.0);
     for i in 0..n {
-        let s = (0..n).fold(Wide::constant(d.b[i]), |s, j| {
-            s - Wide::constant(d.a[i][j]) * Wide::constant(x[j])
+        let s = (0..n).fold(Wide::constant(d.tau_minus_c[i]), |s, j| {
+            s - Wide::constant(d.mass_matrix[i][j]) * Wide::constant(x[j])
         });
         r2 += s.to_f64().powi(2);
-        b2 += d.b[i].powi(2);
+        b2 += d.tau_minus_c[i].powi(2);
     }
     let x32 = alg.forward_dynamics(
         &Params::<f32>::new(chain),
@@ -186,8 +186,8 @@ fn measure(chain: &Model, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
         cond,
         cond_s,
         lambda_min,
-        err_a: rel_err_mat(&d.a, &aw),
-        err_b: rel_err(&d.b, &to_f64_vec(&dw.b)),
+        err_a: rel_err_mat(&d.mass_matrix, &aw),
+        err_b: rel_err(&d.tau_minus_c, &to_f64_vec(&dw.tau_minus_c)),
         err_qdd: rel_err(&x, &xw),
         err_qdd_f32: rel_err(&to_f64_vec(&x32), &xw),
         residual: (r2 / b2).sqrt(),
@@ -655,12 +655,21 @@ fn case5_fast_joints() {
             assert_spd_and_bounded(&label, &m);
 
             let (qw, qdw) = (consts::<Wide>(&q), consts::<Wide>(&qd));
-            let bwr = Methods::RECURRENT.bias.bias(&pw, &qw, &qdw, &drives(&tau));
-            let bws = Methods::SPATIAL.bias.bias(&pw, &qw, &qdw, &drives(&tau));
+            let bwr =
+                Methods::RECURRENT
+                    .nonlinear_effects
+                    .tau_minus_c(&pw, &qw, &qdw, &drives(&tau));
+            let bws = Methods::SPATIAL
+                .nonlinear_effects
+                .tau_minus_c(&pw, &qw, &qdw, &drives(&tau));
             let reference = to_f64_vec(&bwr);
-            let br = Methods::RECURRENT.bias.bias(&p, &q, &qd, &drives(&tau));
-            let bs = Methods::SPATIAL.bias.bias(&p, &q, &qd, &drives(&tau));
-            let b32 = Methods::RECURRENT.bias.bias(
+            let br = Methods::RECURRENT
+                .nonlinear_effects
+                .tau_minus_c(&p, &q, &qd, &drives(&tau));
+            let bs = Methods::SPATIAL
+                .nonlinear_effects
+                .tau_minus_c(&p, &q, &qd, &drives(&tau));
+            let b32 = Methods::RECURRENT.nonlinear_effects.tau_minus_c(
                 &p32,
                 &consts::<f32>(&q),
                 &consts::<f32>(&qd),

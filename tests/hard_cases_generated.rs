@@ -93,11 +93,14 @@ fn reference(model: &Model, q: &[f64], qd: &[f64], tau: &[f64]) -> Reference {
         ..Loads::default()
     };
     let d = Methods::RECURRENT.dynamics(&p, &wide(q), &wide(qd), &loads);
-    let qdd = to_f64(&solve(&ldlt(&d.a), &d.b));
-    let b0 = Methods::RECURRENT
-        .bias
-        .bias(&p, &wide(q), &wide(qd), &Loads::default());
-    let m: Vec<Vec<f64>> = d.a.iter().map(|r| to_f64(r)).collect();
+    let qdd = to_f64(&solve(&ldlt(&d.mass_matrix), &d.tau_minus_c));
+    let b0 = Methods::RECURRENT.nonlinear_effects.tau_minus_c(
+        &p,
+        &wide(q),
+        &wide(qd),
+        &Loads::default(),
+    );
+    let m: Vec<Vec<f64>> = d.mass_matrix.iter().map(|r| to_f64(r)).collect();
     let n = m.len();
     let ev = SymmetricEigen::new(DMatrix::from_fn(n, n, |i, j| m[i][j])).eigenvalues;
     let (lo, hi) = ev.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &e| {

@@ -82,8 +82,8 @@ macro_rules! check_constant_model {
                 assert!(e < 1e-12, "{}: M vs {alg}: {e:e}", $file);
                 // c = −b(τ = 0): the field's sign.
                 let c: Vec<f64> = alg
-                    .bias
-                    .bias(&p, &q, &qd, &Loads::default())
+                    .nonlinear_effects
+                    .tau_minus_c(&p, &q, &qd, &Loads::default())
                     .iter()
                     .map(|b| -b)
                     .collect();
@@ -131,7 +131,7 @@ fn random_models_through_the_macro_equal_interpreted() {
         assert!(candidates
             .iter()
             .any(|c| c.mass_matrix_method == chosen.mass_matrix_method
-                && c.bias_method == chosen.bias_method));
+                && c.nonlinear_effects_method == chosen.nonlinear_effects_method));
     }
 }
 
@@ -217,12 +217,12 @@ fn runtime_payload_and_gravity_equal_interpreted_with_modified_chain() {
             let neg = |v: Vec<f64>| -> Vec<f64> { v.iter().map(|x| -x).collect() };
             let e = rel_err(
                 &Random5Gravity::nonlinear_effects(&q, &qd, &payload),
-                &neg(alg.bias.bias(&p, &q, &qd, &grav)),
+                &neg(alg.nonlinear_effects.tau_minus_c(&p, &q, &qd, &grav)),
             );
             assert!(e < 1e-12, "c: {e:e}");
             let e = rel_err(
                 &Random5Gravity::gravity(&q, &payload),
-                &neg(alg.bias.bias(&p, &q, &[0.0; 5], &grav)),
+                &neg(alg.nonlinear_effects.tau_minus_c(&p, &q, &[0.0; 5], &grav)),
             );
             assert!(e < 1e-12, "gravity: {e:e}");
             let e = rel_err(

@@ -91,7 +91,7 @@ fn eval_matches_pinocchio_references() {
             "recurrent",
             "recurrent-r1",
             "kane-direct",
-            "crba-base",
+            "crba-inertial",
             "spatial",
         ] {
             for (key, gravity) in [

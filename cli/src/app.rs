@@ -49,7 +49,7 @@ fn checked_methods(model: &Model, given: Option<Methods>) -> Result<Methods> {
     if let Some(j) = model.first_branch() {
         anyhow::ensure!(
             methods == Methods::SPATIAL,
-            "--algorithm {methods}: the paper's base-frame algorithms handle serial chains only, \
+            "--algorithm {methods}: the paper's inertial-frame algorithms handle serial chains only, \
              and `{}` is a tree (joint `{}` does not hang from the joint before it); use \
              --algorithm spatial",
             model.name(),
@@ -74,7 +74,8 @@ enum Command {
         /// also with "base": {"position", "quaternion" [x, y, z, w], "v", "omega"} (base frame).
         #[arg(long)]
         states: PathBuf,
-        /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-base (serial chains), spatial
+        /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-inertial (serial chains;
+        /// `crba-base` is its earlier name, still accepted), spatial
         /// (any tree). Default: recurrent for a chain, spatial for a tree.
         #[arg(long, value_parser = parse_algorithm)]
         algorithm: Option<Methods>,
@@ -165,7 +166,8 @@ enum Command {
         /// `rpy = 1.570796325`); the header says what was snapped.
         #[arg(long, default_value_t = kanegen_model::canonical::DEFAULT_SNAP, value_name = "TOL")]
         snap: f64,
-        /// Force one algorithm (recurrent, recurrent-r1, kane-direct, crba-base, spatial, aba)
+        /// Force one algorithm (recurrent, recurrent-r1, kane-direct, crba-inertial, spatial, aba;
+        /// crba-base is accepted for crba-inertial)
         /// instead of the cheapest candidate per function.
         #[arg(long, value_parser = parse_forced)]
         algorithm: Option<Methods>,

@@ -1,6 +1,6 @@
 //! Which methods a generated function uses: every candidate is traced and the one with the
 //! fewest emitted operations (`mul + add`) wins, the first in report order on ties. Forward
-//! dynamics has two kinds of candidate: LDLᵀ on `M` and `c` (one per bias method) and the
+//! dynamics has two kinds of candidate: LDLᵀ on `M` and `c` (one per nonlinear-effects method) and the
 //! articulated-body algorithm ([`Methods::ABA`], which uses neither), last. Each candidate of a
 //! joint-space function is traced twice: in the model's own body frames and in its canonical
 //! frames ([`BodyFrames`]).
@@ -9,7 +9,7 @@ use crate::options::Options;
 use kanegen_dynamics::params::{
     axis_turn, coordinate_axis, is_near_signed_permutation, mdh_split, NEAR_PERMUTATION,
 };
-use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::{BaseKind, JointKind, Model};
 use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
 
@@ -110,11 +110,12 @@ impl Choice {
         (self.function.uses_mass_matrix() && !self.is_aba(m)).then(|| m.mass_matrix.name())
     }
 
-    /// The bias method's name when the candidate `m` uses one (forward dynamics by the
+    /// The nonlinear-effects method's name when the candidate `m` uses one (forward dynamics by the
     /// articulated-body algorithm does not).
     #[must_use]
-    pub fn bias_method(&self, m: Methods) -> Option<&'static str> {
-        (self.function.uses_bias() && !self.is_aba(m)).then(|| m.bias.name())
+    pub fn nonlinear_effects_method(&self, m: Methods) -> Option<&'static str> {
+        (self.function.uses_nonlinear_effects() && !self.is_aba(m))
+            .then(|| m.nonlinear_effects.name())
     }
 
     /// The forward method's name (`ldlt`, `aba`) for forward dynamics, `None` otherwise.
@@ -145,13 +146,13 @@ pub fn spec(model: &Model, opts: &Options) -> Spec {
     }
 }
 
-/// The candidates of `f`: every mass-matrix method for `M`; every bias method (with the chosen
+/// The candidates of `f`: every mass-matrix method for `M`; every nonlinear-effects method (with the chosen
 /// mass-matrix method `mass`, and for a function with `M` on a chain also with `crba` and
-/// `crba-base`) for a function with a bias, and for forward dynamics then the articulated-body
+/// `crba-inertial`) for a function with `c`, and for forward dynamics then the articulated-body
 /// algorithm ([`Methods::ABA`]); the chosen method alone for the others.
 /// On a tree only the local-frame methods (`crba`, `rnea`, `newton-euler`, `aba`) are
 /// candidates: the paper's
-/// base-frame algorithms handle serial chains only.
+/// inertial-frame algorithms handle serial chains only.
 #[must_use]
 pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Methods> {
     let mass_methods: &[MassMatrixMethod] = if chain {
@@ -159,27 +160,30 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
     } else {
         &[MassMatrixMethod::Crba]
     };
-    let bias_methods: &[BiasMethod] = if chain {
-        &BiasMethod::ALL
+    let nonlinear_effects_methods: &[NonlinearEffectsMethod] = if chain {
+        &NonlinearEffectsMethod::ALL
     } else {
-        &[BiasMethod::Rnea, BiasMethod::NewtonEuler]
+        &[
+            NonlinearEffectsMethod::Rnea,
+            NonlinearEffectsMethod::NewtonEuler,
+        ]
     };
     if f == Function::MassMatrix {
         mass_methods
             .iter()
             .map(|&mass_matrix| Methods {
                 mass_matrix,
-                bias: BiasMethod::Rnea,
+                nonlinear_effects: NonlinearEffectsMethod::Rnea,
                 forward: ForwardMethod::Ldlt,
             })
             .collect()
-    } else if f.uses_bias() {
+    } else if f.uses_nonlinear_effects() {
         // With `M` too: the mass-matrix method chosen for `M` and the two CRBAs, whose counts
-        // are close (random N = 16: `crba` 6122 against `crba-base` 6134 for `M`, but 8672
-        // against 8401 with the bias, which shares more with the base-frame one).
+        // are close (random N = 16: `crba` 6122 against `crba-inertial` 6134 for `M`, but 8672
+        // against 8401 with `c`, which shares more with the inertial-frame one).
         let mut masses = vec![mass];
         if f.uses_mass_matrix() && chain {
-            for m in [MassMatrixMethod::Crba, MassMatrixMethod::CrbaBase] {
+            for m in [MassMatrixMethod::Crba, MassMatrixMethod::CrbaInertial] {
                 if !masses.contains(&m) {
                     masses.push(m);
                 }
@@ -188,11 +192,13 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
         let mut c: Vec<Methods> = masses
             .iter()
             .flat_map(|&mass_matrix| {
-                bias_methods.iter().map(move |&bias| Methods {
-                    mass_matrix,
-                    bias,
-                    forward: ForwardMethod::Ldlt,
-                })
+                nonlinear_effects_methods
+                    .iter()
+                    .map(move |&nonlinear_effects| Methods {
+                        mass_matrix,
+                        nonlinear_effects,
+                        forward: ForwardMethod::Ldlt,
+                    })
             })
             .collect();
         if f.is_forward_dynamics() {
@@ -202,7 +208,7 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
     } else {
         vec![Methods {
             mass_matrix: mass,
-            bias: BiasMethod::Rnea,
+            nonlinear_effects: NonlinearEffectsMethod::Rnea,
             forward: ForwardMethod::Ldlt,
         }]
     }
@@ -213,8 +219,8 @@ pub const SIZE_RULE_N: usize = 24;
 
 /// Whether candidate `m` of `f` can win on a chain of `n` joints. Up to [`SIZE_RULE_N`] joints
 /// every candidate can. Above it the direct Kane sums (`kane-direct`, O(N³) for `M` and O(N²)
-/// for the bias) and the recurrent mass matrices (`recurrent`, `recurrent-r1`: O(N²) with a larger
-/// constant than `crba-base`) are skipped. Measured on random chains (emitted `mul + add`, `A`
+/// for `c`) and the recurrent mass matrices (`recurrent`, `recurrent-r1`: O(N²) with a larger
+/// constant than `crba-inertial`) are skipped. Measured on random chains (emitted `mul + add`, `A`
 /// and `b` alone): at N = 16 `kane-direct` M costs 2.8×, `recurrent` 2.2× and `kane-direct` b
 /// 1.6× the cheapest, at N = 24 4.1×, 2.6× and 1.9×, and the ratios grow with N; tracing them
 /// is what made `generate` O(N³) in memory (2.3 M emitted operations for `kane-direct` M at
@@ -231,8 +237,9 @@ pub fn can_win(f: Function, m: Methods, n: usize) -> bool {
                 | MassMatrixMethod::Recurrent
                 | MassMatrixMethod::RecurrentR1
         );
-    let bias_ok = !f.uses_bias() || m.bias != BiasMethod::KaneDirect;
-    mass_ok && bias_ok
+    let c_ok =
+        !f.uses_nonlinear_effects() || m.nonlinear_effects != NonlinearEffectsMethod::KaneDirect;
+    mass_ok && c_ok
 }
 
 /// The models a function's candidates are traced on: the model in its own frames and, where
@@ -271,7 +278,7 @@ impl Subjects {
 
 /// Traces every candidate of `f` that [`can_win`], in every [`BodyFrames::for_function`], and
 /// keeps the cheapest (the model's own frames on ties); with [`Options::algorithm`], traces that
-/// one for a function with a mass-matrix or bias method. Derives the model's [`Subjects`] first;
+/// one for a function with a mass-matrix or nonlinear-effects method. Derives the model's [`Subjects`] first;
 /// [`choose_in`] takes them derived.
 ///
 /// # Errors
@@ -305,7 +312,7 @@ pub fn choose_in(
     let frames = BodyFrames::for_function(f, opts);
     let all = match opts.algorithm {
         // Forced: the one algorithm for whatever it computes, the others as usual.
-        Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
+        Some(m) if f.uses_mass_matrix() || f.uses_nonlinear_effects() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
     let n = model.dof();
@@ -380,7 +387,7 @@ fn has_two_step_placements(model: &Model) -> bool {
 }
 
 /// Whether `f` by `m` runs an algorithm whose carries ([`NEAR_PERMUTATION`]) may go in two
-/// steps: the CRBA (its inertia and force carries) or the classical Newton–Euler bias (its vector
+/// steps: the CRBA (its inertia and force carries) or the classical Newton–Euler `c` (its vector
 /// rotations, `kanegen_dynamics::joint::rotate_up`); not forward dynamics by ABA. Above
 /// [`SIZE_RULE_N`] joints not for a function of the mass matrix: its code is compact there (loops
 /// over the model's own tables, [`crate::compact`]) and a second trace of O(N²) operations only
@@ -390,6 +397,7 @@ fn takes_two_steps(f: Function, m: Methods, n: usize) -> bool {
         return false;
     }
     let crba = f.uses_mass_matrix() && m.mass_matrix == MassMatrixMethod::Crba;
-    let newton_euler = f.uses_bias() && m.bias == BiasMethod::NewtonEuler;
+    let newton_euler =
+        f.uses_nonlinear_effects() && m.nonlinear_effects == NonlinearEffectsMethod::NewtonEuler;
     (crba || newton_euler) && !(f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)
 }

@@ -70,7 +70,7 @@
 //! `M + c` 1.04, 1.14, 1.29; forward dynamics 1.13, 1.14, 1.14.
 
 use crate::options::{Error, Float, Form, Options};
-use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::{BaseKind, JointKind, Model};
 use kanegen_trace::Function;
 use proc_macro2::{Literal, TokenStream};
@@ -222,7 +222,7 @@ pub fn methods(f: Function) -> Methods {
     } else {
         Methods {
             mass_matrix: MassMatrixMethod::Crba,
-            bias: BiasMethod::Rnea,
+            nonlinear_effects: NonlinearEffectsMethod::Rnea,
             forward: ForwardMethod::Ldlt,
         }
     }

@@ -131,7 +131,7 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
             None => "Algorithm: per function the cheapest candidate (below).".into(),
             Some(m) => format!(
                 "Algorithm: forced to `{}` (`algorithm` option) for every function with a \
-                 mass-matrix, bias or forward method; without it each takes the cheapest \
+                 mass-matrix, nonlinear-effects or forward method; without it each takes the cheapest \
                  candidate.",
                 m.name()
             ),
@@ -198,7 +198,7 @@ fn count_table(plan: &Plan) -> Vec<String> {
          axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):"
             .into(),
         String::new(),
-        "| function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |"
+        "| function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |"
             .into(),
         "|---|---|---|---|---|---:|---:|---:|---:|---:|---:|".into(),
     ];
@@ -212,7 +212,7 @@ fn count_table(plan: &Plan) -> Vec<String> {
                 "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 fp.name,
                 name(ch.mass_matrix_method(*m)),
-                name(ch.bias_method(*m)),
+                name(ch.nonlinear_effects_method(*m)),
                 name(ch.forward_method(*m)),
                 cand.frames.name(),
                 c.mul,
@@ -233,9 +233,9 @@ fn regroup_line(model: &Model, regroup: Option<&RegroupReport>) -> String {
         return "Inertial parameters: the model's own (regrouping off).".into();
     };
     format!(
-        "Inertial parameters: regrouped for the local-frame algorithms (the base parameters of \
-         Khalil and Kleinfinger: what a joint cannot move is carried by its parent): {} of {} \
-         bodies gave, {} → {} non-zero numbers in the spatial inertias{}. The same joint-space \
+        "Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger \
+         regroup them (what a joint cannot move is carried by its parent): {} of {} bodies \
+         gave, {} → {} non-zero numbers in the spatial inertias{}. The same joint-space \
          dynamics; `base_reaction`, where generated, reads the model's own numbers.",
         r.moved,
         model.dof(),

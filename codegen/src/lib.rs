@@ -17,8 +17,8 @@
 //! The generated type has `OP_COUNTS`, one entry per emitted function, and `CANDIDATES`, one per
 //! traced candidate, both of a generated struct (`OpCount` in files from [`generate_file`],
 //! `NameOpCount` from the `dynamics!` macro) with the fields `function`, `mass_matrix_method`,
-//! `bias_method` (`None` when unused), `forward_method` (`ldlt` or `aba` for forward dynamics,
-//! `None` otherwise; `aba` uses no mass-matrix or bias method), `mul`, `add`, `div`, `sqrt`,
+//! `nonlinear_effects_method` (`None` when unused), `forward_method` (`ldlt` or `aba` for forward dynamics,
+//! `None` otherwise; `aba` uses no mass-matrix or nonlinear-effects method), `mul`, `add`, `div`, `sqrt`,
 //! `sincos` and `fma` (fused multiply-adds formed; only emitted code forms them, so
 //! `CANDIDATES` lists 0). A function in compact loops is not traced: its `OP_COUNTS` entry names
 //! its loops' methods with 0 operations, and `CANDIDATES` has none of it.
@@ -275,8 +275,8 @@ fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (Str
             .mass_matrix_method(choice.chosen)
             .map(|m| format!("mass matrix `{m}`")),
         choice
-            .bias_method(choice.chosen)
-            .map(|m| format!("bias `{m}`")),
+            .nonlinear_effects_method(choice.chosen)
+            .map(|m| format!("nonlinear effects `{m}`")),
         choice
             .forward_method(choice.chosen)
             .map(|m| format!("forward `{m}`")),
@@ -329,14 +329,14 @@ fn op_count_entries(
         };
         let (mm, bm, fm) = (
             opt(ch.mass_matrix_method(m)),
-            opt(ch.bias_method(m)),
+            opt(ch.nonlinear_effects_method(m)),
             opt(ch.forward_method(m)),
         );
         let (mul, add, div, sqrt, sincos) = (c.mul, c.add, c.div, c.sqrt, c.sincos);
         quote!(#op_ty {
             function: #function,
             mass_matrix_method: #mm,
-            bias_method: #bm,
+            nonlinear_effects_method: #bm,
             forward_method: #fm,
             frames: #frames,
             mul: #mul,
@@ -422,9 +422,9 @@ fn type_items(
             pub function: &'static str,
             /// Its mass-matrix method.
             pub mass_matrix_method: Option<&'static str>,
-            /// Its bias method.
-            pub bias_method: Option<&'static str>,
-            /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+            /// Its nonlinear-effects method.
+            pub nonlinear_effects_method: Option<&'static str>,
+            /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
             /// the articulated-body algorithm, which uses neither), for forward dynamics.
             pub forward_method: Option<&'static str>,
             /// The body frames it is traced in: `model` (the model's own) or `canonical` (every

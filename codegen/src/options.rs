@@ -75,9 +75,9 @@ pub struct Options {
     /// `Self::sincos` ([`crate::sincos`]: a table and short polynomials, branch-free, within
     /// 1 ulp of 1 of libm's). Default `false`; `f32` code always uses libm's `sincosf`.
     pub libm_trig: bool,
-    /// Force one algorithm for every function that has a mass-matrix, bias or forward method
+    /// Force one algorithm for every function that has a mass-matrix, nonlinear-effects or forward method
     /// instead of the cheapest candidate: a preset of [`Methods::PRESETS`] (`recurrent`, the
-    /// paper's; `recurrent-r1`, `kane-direct`, `crba-base`, `spatial`) or [`Methods::ABA`]
+    /// paper's; `recurrent-r1`, `kane-direct`, `crba-inertial`, `spatial`) or [`Methods::ABA`]
     /// (`aba`), by [`forced_algorithm`]. Default `None`: the cheapest. The header says which.
     pub algorithm: Option<Methods>,
     /// Straight-line or compact code ([`Form`], default [`Form::Auto`]: chosen by size, see

@@ -32,7 +32,7 @@ fn chain(n: usize) -> Model {
 /// One row of the table: emitted counts of the generated `forward_dynamics` (regrouped
 /// parameters, no gravity, in the body frames the generator chose, as it traces them) by LDLᵀ on the CRBA's `M` and the
 /// RNEA's `c`, by the cheapest LDLᵀ candidate the generator has (its chosen mass-matrix method,
-/// every bias method), and by ABA; and the method it emits.
+/// every nonlinear-effects method), and by ABA; and the method it emits.
 struct Row {
     spatial: Counts,
     best_ldlt: Counts,

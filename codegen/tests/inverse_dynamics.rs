@@ -39,7 +39,7 @@ fn generated_inverse_dynamics_grows_linearly_from_8_to_32() {
     }
     // The mass matrix's cost per joint grows (quadratic): at least 10 % more per joint with every
     // 8 joints (1286, 4974, 10914, 16782 from N = 8 to 32: 161, 311, 455, 524 per joint; its
-    // steps are not monotone, as the cheapest method changes from the local CRBA to `crba-base`
+    // steps are not monotone, as the cheapest method changes from the local CRBA to `crba-inertial`
     // at N = 24).
     let per_joint: Vec<f64> = m
         .iter()

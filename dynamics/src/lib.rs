@@ -10,7 +10,7 @@
 //! - [`params`]: a model's numbers in a scalar type; [`loads`]: drives, gravity, wrenches;
 //!   [`base`]: the fixed or free-floating base and its conventions.
 //! - [`algorithms`]: one file per algorithm; [`Methods`] chooses the mass-matrix method, the
-//!   bias method and the forward-dynamics method ([`ForwardMethod`]: LDLᵀ or the
+//!   nonlinear-effects method and the forward-dynamics method ([`ForwardMethod`]: LDLᵀ or the
 //!   articulated-body algorithm) separately.
 //! - [`ldlt`]: the branch-free LDLᵀ of forward dynamics; [`metrics`]: error measures.
 //! - `scalars` (feature `research`): research scalars (dual, compensated, double-double, exact
@@ -45,7 +45,9 @@ pub mod scalar;
 pub mod scalars;
 pub mod spatial;
 
-pub use algorithms::methods::{BiasMethod, Dynamics, ForwardMethod, MassMatrixMethod, Methods};
+pub use algorithms::methods::{
+    Dynamics, ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod,
+};
 pub use base::{FloatingBase, FloatingState};
 pub use loads::{ExternalWrench, LoadFrame, Loads};
 pub use params::{FrameParams, JointParams, MethodError, Params};

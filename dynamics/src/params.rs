@@ -271,7 +271,7 @@ impl<S> Params<S> {
         self.joints.len()
     }
 
-    /// Whether the tree is a serial chain (`λ(j) = j − 1`), as the paper's base-frame algorithms
+    /// Whether the tree is a serial chain (`λ(j) = j − 1`), as the paper's inertial-frame algorithms
     /// need.
     #[must_use]
     pub fn is_chain(&self) -> bool {
@@ -319,11 +319,11 @@ impl<S> Params<S> {
     }
 }
 
-/// A serial-chain-only method (the paper's base-frame algorithms) asked to run on a kinematic
+/// A serial-chain-only method (the paper's inertial-frame algorithms) asked to run on a kinematic
 /// tree: which method, and where the tree first branches.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MethodError {
-    /// The method, by its report name (`"recurrent"`, `"crba-base"`, `"kane-direct"`, …).
+    /// The method, by its report name (`"recurrent"`, `"crba-inertial"`, `"kane-direct"`, …).
     pub method: &'static str,
     /// The first joint (0-based) whose parent is not the body of the joint before it.
     pub joint: usize,

@@ -340,11 +340,14 @@ fn forward_method_names() {
 
 /// `(A + diag(0…0, a)) x = b` by LDLᵀ: the armature on the last `a.len()` diagonal entries.
 fn solve_with_armature(mut d: kanegen_dynamics::Dynamics<f64>, a: &[f64]) -> Vec<f64> {
-    let off = d.a.len() - a.len();
+    let off = d.mass_matrix.len() - a.len();
     for (i, ai) in a.iter().enumerate() {
-        d.a[off + i][off + i] += ai;
+        d.mass_matrix[off + i][off + i] += ai;
     }
-    kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
+    kanegen_dynamics::ldlt::solve(
+        &kanegen_dynamics::ldlt::ldlt(&d.mass_matrix),
+        &d.tau_minus_c,
+    )
 }
 
 /// The workspace path ([`aba::forward_dynamics_in`], [`aba::floating_in`]) with an armature

@@ -1,4 +1,4 @@
-//! Tests of the recurrent algorithm (variants R1, R2, P) and the base-frame CRBA against oracles
+//! Tests of the recurrent algorithm (variants R1, R2, P) and the inertial-frame CRBA against oracles
 //! written here, independent of the recursions:
 //! - poses of every body composed directly from the model with nalgebra (checks eq. (1), (2), (6));
 //! - velocities (3) against central differences of those poses;
@@ -6,8 +6,8 @@
 //! - `b` from Lagrange's equations by central differences, gravity from the potential, external
 //!   wrenches from virtual work.
 
-use kanegen_dynamics::algorithms::crba_base;
-use kanegen_dynamics::algorithms::kinematics::{base_frame, motion};
+use kanegen_dynamics::algorithms::crba_inertial;
+use kanegen_dynamics::algorithms::kinematics::{inertial_frame, motion};
 use kanegen_dynamics::algorithms::recurrent::{self, Variant};
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::metrics::rel_err_mat as rel_err;
@@ -95,7 +95,7 @@ fn axes(ch: &Model, q: &[f64]) -> Vec<Vector3<f64>> {
 /// Kinetic energy `Σ ½ m v·v + v·(ω × c) + ½ ω·I ω` with `v, ω` from eq. (3).
 fn kinetic_energy(ch: &Model, q: &[f64], qd: &[f64]) -> f64 {
     let p = Params::<f64>::new(ch);
-    let kin = base_frame(&p, q);
+    let kin = inertial_frame(&p, q);
     let mot = motion(&kin, qd);
     kin.iter()
         .zip(&mot)
@@ -135,7 +135,7 @@ fn all_mass_matrices(ch: &Model, q: &[f64]) -> Vec<(&'static str, Mat)> {
     vec![
         ("R2", recurrent::mass_matrix(&p, q, Variant::R2)),
         ("R1", recurrent::mass_matrix(&p, q, Variant::R1)),
-        ("crba-base", crba_base::mass_matrix(&p, q)),
+        ("crba-inertial", crba_inertial::mass_matrix(&p, q)),
         (
             "dispatch recurrent",
             Methods::RECURRENT.mass_matrix.mass_matrix(&p, q),
@@ -145,8 +145,8 @@ fn all_mass_matrices(ch: &Model, q: &[f64]) -> Vec<(&'static str, Mat)> {
             Methods::RECURRENT_R1.mass_matrix.mass_matrix(&p, q),
         ),
         (
-            "dispatch crba-base",
-            Methods::CRBA_BASE.mass_matrix.mass_matrix(&p, q),
+            "dispatch crba-inertial",
+            Methods::CRBA_INERTIAL.mass_matrix.mass_matrix(&p, q),
         ),
     ]
 }
@@ -154,13 +154,13 @@ fn all_mass_matrices(ch: &Model, q: &[f64]) -> Vec<(&'static str, Mat)> {
 const SEEDS: std::ops::Range<u64> = 0..6;
 
 #[test]
-fn base_frame_matches_poses_composed_with_nalgebra() {
+fn inertial_frame_matches_poses_composed_with_nalgebra() {
     let mut worst: f64 = 0.0;
     for n in 1..=8 {
         for seed in SEEDS {
             let ch = chain(n, 0.3, seed);
             let (q, _) = state(n, seed);
-            let kin = base_frame(&Params::<f64>::new(&ch), &q);
+            let kin = inertial_frame(&Params::<f64>::new(&ch), &q);
             let ps = poses(&ch, &q);
             let ax = axes(&ch, &q);
             let mut o_prev = Vector3::zeros();
@@ -185,10 +185,10 @@ fn base_frame_matches_poses_composed_with_nalgebra() {
             }
         }
     }
-    println!("base_frame vs nalgebra poses: max abs err {worst:.2e}");
+    println!("inertial_frame vs nalgebra poses: max abs err {worst:.2e}");
     assert!(
         worst < 1e-12,
-        "base_frame disagrees with composed poses: {worst:e}"
+        "inertial_frame disagrees with composed poses: {worst:e}"
     );
 }
 
@@ -200,7 +200,7 @@ fn motion_velocities_match_pose_differences() {
         for seed in SEEDS {
             let ch = chain(n, 0.3, seed);
             let (q, qd) = state(n, seed);
-            let kin = base_frame(&Params::<f64>::new(&ch), &q);
+            let kin = inertial_frame(&Params::<f64>::new(&ch), &q);
             let mot = motion(&kin, &qd);
             let qp: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a + h * b).collect();
             let qm: Vec<f64> = q.iter().zip(&qd).map(|(a, b)| a - h * b).collect();
@@ -261,7 +261,7 @@ fn mass_matrices_agree_with_kinetic_energy_oracle() {
         }
     }
     assert!(prismatic_seen > 100, "too few prismatic joints exercised");
-    println!("A vs kinetic-energy oracle (R1, R2, crba-base): max rel err {worst:.2e}");
+    println!("A vs kinetic-energy oracle (R1, R2, crba-inertial): max rel err {worst:.2e}");
 }
 
 #[test]
@@ -311,11 +311,16 @@ fn all_biases(
 ) -> Vec<(&'static str, Vec<f64>)> {
     let p = Params::<f64>::new(ch);
     vec![
-        ("recurrent", recurrent::bias(&p, q, qd, loads)),
-        ("crba-base", crba_base::bias(&p, q, qd, loads)),
+        ("recurrent", recurrent::tau_minus_c(&p, q, qd, loads)),
+        (
+            "crba-inertial",
+            crba_inertial::tau_minus_c(&p, q, qd, loads),
+        ),
         (
             "dispatch recurrent-r1",
-            Methods::RECURRENT_R1.bias.bias(&p, q, qd, loads),
+            Methods::RECURRENT_R1
+                .nonlinear_effects
+                .tau_minus_c(&p, q, qd, loads),
         ),
     ]
 }
@@ -459,7 +464,7 @@ fn gravity_external_wrenches_and_drives_enter_b_correctly() {
                 external: ext,
             };
             let p = Params::<f64>::new(&ch);
-            let b_vel = recurrent::bias(&p, &q, &qd, &Loads::default());
+            let b_vel = recurrent::tau_minus_c(&p, &q, &qd, &Loads::default());
             let b_grav = gravity_force(&ch, &q, g);
             let expected: Vec<f64> = (0..n)
                 .map(|k| b_vel[k] + b_grav[k] + w1[k] + w2[k] + tau[k])
@@ -569,7 +574,7 @@ mod count {
     }
 }
 
-/// Raw counts (paper convention) of `A` from base-frame inputs equal the exact polynomial fits of
+/// Raw counts (paper convention) of `A` from inertial-frame inputs equal the exact polynomial fits of
 /// the corrected Table 1 and its baselines (`docs/paper.md`, "Operation counts"; revolute chains).
 #[test]
 fn paper_convention_counts_match_the_corrected_table() {
@@ -578,7 +583,7 @@ fn paper_convention_counts_match_the_corrected_table() {
         let ch = chain(n as usize, 0.0, 3);
         let (q, _) = state(n as usize, 3);
         let qc: Vec<C> = q.iter().map(|&x| C(x)).collect();
-        let kin = base_frame(&Params::<C>::new(&ch), &qc);
+        let kin = inertial_frame(&Params::<C>::new(&ch), &qc);
         let total = |f: &dyn Fn() -> Vec<Vec<C>>| {
             count::reset();
             f();
@@ -593,19 +598,19 @@ fn paper_convention_counts_match_the_corrected_table() {
             (78 * n2 - 54 * n, 117 * n2 - 97 * n + 6),
             "P, N = {n}"
         );
-        let ((rm, ra), _) = total(&|| recurrent::mass_matrix_base(&kin, Variant::R2));
+        let ((rm, ra), _) = total(&|| recurrent::mass_matrix_inertial(&kin, Variant::R2));
         assert_eq!(
             (rm as i64, ra as i64),
             (36 * n2 - 24 * n, 60 * n2 - 53 * n + 6),
             "R2, N = {n}"
         );
-        let ((cm, ca), _) = total(&|| crba_base::mass_matrix_base(&kin));
+        let ((cm, ca), _) = total(&|| crba_inertial::mass_matrix_inertial(&kin));
         assert_eq!(
             (2 * cm as i64, 2 * ca as i64),
             (12 * n2 + 144 * n - 114, 15 * n2 + 203 * n - 176),
-            "crba-base, N = {n}"
+            "crba-inertial, N = {n}"
         );
-        let ((m1, a1), per) = total(&|| recurrent::mass_matrix_base(&kin, Variant::R1));
+        let ((m1, a1), per) = total(&|| recurrent::mass_matrix_inertial(&kin, Variant::R1));
         let corr = per.get("R1-corr").copied().unwrap_or((0, 0));
         if n >= 3 {
             assert_eq!(

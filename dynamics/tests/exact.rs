@@ -94,7 +94,11 @@ fn wide_rel(x: &[Wide], y: &[Exact]) -> f64 {
 }
 
 fn all_exact(d: &Dynamics<Exact>) -> bool {
-    d.a.iter().flatten().chain(&d.b).all(Exact::is_exact)
+    d.mass_matrix
+        .iter()
+        .flatten()
+        .chain(&d.tau_minus_c)
+        .all(Exact::is_exact)
 }
 
 #[test]
@@ -111,7 +115,7 @@ fn all_algorithms_agree_exactly_and_wide_is_within_1e_30() {
         let reference = Methods::RECURRENT.dynamics(&pe, &q, &qd, &le);
         assert!(all_exact(&reference), "{name}: exactness lost");
         let bits = reference
-            .a
+            .mass_matrix
             .iter()
             .flatten()
             .map(Exact::bits)
@@ -121,33 +125,33 @@ fn all_algorithms_agree_exactly_and_wide_is_within_1e_30() {
             let d = alg.dynamics(&pe, &q, &qd, &le);
             assert!(all_exact(&d), "{name} {alg}: exactness lost");
             assert_eq!(
-                d.a, reference.a,
+                d.mass_matrix, reference.mass_matrix,
                 "{name} {alg}: A differs from recurrent's, exactly"
             );
             assert_eq!(
-                d.b, reference.b,
+                d.tau_minus_c, reference.tau_minus_c,
                 "{name} {alg}: b differs from recurrent's, exactly"
             );
         }
         for i in 0..n {
             for j in 0..n {
                 assert_eq!(
-                    reference.a[i][j], reference.a[j][i],
+                    reference.mass_matrix[i][j], reference.mass_matrix[j][i],
                     "{name}: A not symmetric"
                 );
             }
         }
         // Exact LDLᵀ: positive pivots, and A q̈ = b with no residual at all.
-        let f = ldlt(&reference.a);
+        let f = ldlt(&reference.mass_matrix);
         assert!(f
             .d
             .iter()
             .all(|d| d.is_exact() && d.value() > &Default::default()));
-        let qdd = solve(&f, &reference.b);
+        let qdd = solve(&f, &reference.tau_minus_c);
         for i in 0..n {
             let r = (0..n).fold(Exact::zero(), |s, j| {
-                s + reference.a[i][j].clone() * qdd[j].clone()
-            }) - reference.b[i].clone();
+                s + reference.mass_matrix[i][j].clone() * qdd[j].clone()
+            }) - reference.tau_minus_c[i].clone();
             assert!(r.is_zero(), "{name}: residual of A q̈ = b in row {i}");
         }
 
@@ -156,16 +160,16 @@ fn all_algorithms_agree_exactly_and_wide_is_within_1e_30() {
         let qdw: Vec<Wide> = qd.iter().map(Exact::to_wide).collect();
         let lw = loads(tau.iter().map(Exact::to_wide).collect(), n);
         let dw = Methods::RECURRENT.dynamics(&Params::<Wide>::new(chain), &qw, &qdw, &lw);
-        let qddw = solve(&ldlt(&dw.a), &dw.b);
-        let ea = wide_rel(&dw.a.concat(), &reference.a.concat());
-        let eb = wide_rel(&dw.b, &reference.b);
+        let qddw = solve(&ldlt(&dw.mass_matrix), &dw.tau_minus_c);
+        let ea = wide_rel(&dw.mass_matrix.concat(), &reference.mass_matrix.concat());
+        let eb = wide_rel(&dw.tau_minus_c, &reference.tau_minus_c);
         let eq = wide_rel(&qddw, &qdd);
         let qf: Vec<f64> = qw.iter().map(Real::to_f64).collect();
         let qdf: Vec<f64> = qdw.iter().map(Real::to_f64).collect();
         let lf = loads(tau.iter().map(Real::to_f64).collect(), n);
         let df = Methods::RECURRENT.dynamics(&Params::<f64>::new(chain), &qf, &qdf, &lf);
-        let qddf = solve(&ldlt(&df.a), &df.b);
-        let fa = rel_err_mat(&df.a, &to_f64_mat(&reference.a));
+        let qddf = solve(&ldlt(&df.mass_matrix), &df.tau_minus_c);
+        let fa = rel_err_mat(&df.mass_matrix, &to_f64_mat(&reference.mass_matrix));
         let fq = rel_err(&qddf, &to_f64_vec(&qdd));
         println!(
             "{name}: rationals up to {bits} bits; wide vs exact: A {ea:.2e}, b {eb:.2e}, \
@@ -220,7 +224,7 @@ fn free_floating_energy_is_exactly_half_nu_a_nu() {
         let m = nu.len();
         let quad = (0..m).fold(Exact::zero(), |s, i| {
             (0..m).fold(s, |s, j| {
-                s + nu[i].clone() * d.a[i][j].clone() * nu[j].clone()
+                s + nu[i].clone() * d.mass_matrix[i][j].clone() * nu[j].clone()
             })
         });
         let diff = quad * Exact::constant(0.5) - t.clone();

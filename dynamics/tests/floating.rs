@@ -12,7 +12,7 @@ use kanegen_dynamics::algorithms::floating::{
     self, kinetic_energy, kinetic_energy_by_bodies, momentum, momentum_by_bodies,
 };
 use kanegen_dynamics::algorithms::frames::{floating_jacobian, generalized_jacobian};
-use kanegen_dynamics::algorithms::kinematics::{floating_base_frame, floating_motion};
+use kanegen_dynamics::algorithms::kinematics::{floating_inertial_frame, floating_motion};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::ldlt::{ldlt, solve};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
@@ -27,7 +27,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 
-/// The base-frame algorithms (virtual-joint extension) and the independent spatial one.
+/// The inertial-frame algorithms (virtual-joint extension) and the independent spatial one.
 const ALGS: [Methods; 5] = Methods::ALL;
 
 fn repo() -> PathBuf {
@@ -126,7 +126,7 @@ fn random_case(n: usize, seed: u64, prismatic: f64, with_loads: bool) -> Case {
 
 fn dynamics(alg: Methods, c: &Case) -> (Vec<Vec<f64>>, Vec<f64>) {
     let d = floating::dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &c.loads);
-    (d.a, d.b)
+    (d.mass_matrix, d.tau_minus_c)
 }
 
 fn nu(state: &FloatingState<f64>, qd: &[f64]) -> Vec<f64> {
@@ -224,7 +224,7 @@ fn free_floating_mass_matrix_matches_pinocchio() {
         let zeros = vec![0.0; chain.dof()];
         for alg in ALGS {
             let d = floating::dynamics(alg, &p, &base, &state, &q, &zeros, &Loads::default());
-            let e = rel_mat(&d.a, &reference);
+            let e = rel_mat(&d.mass_matrix, &reference);
             println!("{id:28} {alg:13} A rel err vs Pinocchio {e:.2e}");
             assert!(e < 1e-9, "{id} {alg}: {e:e}");
         }
@@ -330,9 +330,12 @@ fn base_wrench_and_gravity_enter_the_base_rows() {
         let fb = state.rotation.tr_mul_vec(&f);
         let mb = state.rotation.tr_mul_vec(&m);
         let want: Vec<f64> = fb.0.iter().chain(mb.0.iter()).copied().collect();
-        let e = rel_vec(&d.b[..6], &want);
+        let e = rel_vec(&d.tau_minus_c[..6], &want);
         assert!(e < 1e-12, "{alg}: {e:e}");
-        assert!(d.b[6..].iter().all(|x| x.abs() < 1e-12), "{alg}: arm rows");
+        assert!(
+            d.tau_minus_c[6..].iter().all(|x| x.abs() < 1e-12),
+            "{alg}: arm rows"
+        );
     }
 }
 
@@ -569,7 +572,7 @@ fn generalized_jacobian_gives_the_end_effector_motion_at_zero_momentum() {
             "n={n}: momentum not zero"
         );
         // End-effector velocity from the body motion recursion.
-        let kin = floating_base_frame(&c.p, &c.base, &state, &c.q);
+        let kin = floating_inertial_frame(&c.p, &c.base, &state, &c.q);
         let mot = floating_motion(&kin, &state, &c.qd);
         let (kl, ml) = (kin.last().unwrap(), mot.last().unwrap());
         let ve = &ml.v + &ml.omega.cross(&kl.orientation.mul_vec(&point));
@@ -609,11 +612,17 @@ fn uniform_gravity_is_a_base_acceleration() {
         for alg in ALGS {
             let d0 = floating::dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &c.loads);
             let d1 = floating::dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &with_g);
-            let diff: Vec<f64> = d1.b.iter().zip(&d0.b).map(|(x, y)| x - y).collect();
-            let want: Vec<f64> =
-                d0.a.iter()
-                    .map(|row| (0..3).map(|m| row[m] * gb.at(m)).sum())
-                    .collect();
+            let diff: Vec<f64> = d1
+                .tau_minus_c
+                .iter()
+                .zip(&d0.tau_minus_c)
+                .map(|(x, y)| x - y)
+                .collect();
+            let want: Vec<f64> = d0
+                .mass_matrix
+                .iter()
+                .map(|row| (0..3).map(|m| row[m] * gb.at(m)).sum())
+                .collect();
             let e = rel_vec(&diff, &want);
             assert!(e < 1e-12, "n={n} {alg}: {e:e}");
             let rest = FloatingState {
@@ -728,7 +737,11 @@ fn floating_dynamics_traces_on_sym() {
                     .collect(),
             };
             let d = floating::dynamics(alg, &p, &base, &state, &q, &qd, &loads);
-            d.a.into_iter().flatten().chain(d.b).collect()
+            d.mass_matrix
+                .into_iter()
+                .flatten()
+                .chain(d.tau_minus_c)
+                .collect()
         });
         let out = t.eval(&inputs);
         let m = 6 + n;
@@ -780,7 +793,12 @@ fn wrench_on_the_last_body_is_its_jacobian_transpose() {
         for alg in ALGS {
             let d0 = floating::dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &c.loads);
             let d1 = floating::dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &loads);
-            let diff: Vec<f64> = d1.b.iter().zip(&d0.b).map(|(x, y)| x - y).collect();
+            let diff: Vec<f64> = d1
+                .tau_minus_c
+                .iter()
+                .zip(&d0.tau_minus_c)
+                .map(|(x, y)| x - y)
+                .collect();
             let e = rel_vec(&diff, &want);
             assert!(e < 1e-11, "n={n} {alg}: {e:e}");
         }

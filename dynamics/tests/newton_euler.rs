@@ -73,8 +73,8 @@ fn fixed_base_agrees_with_the_spatial_rnea() {
             );
             let l = loads(n, 10 + k as u64, 0);
             let e_b = rel_err(
-                &newton_euler::bias(&p, &q, &qd, &l),
-                &rnea::bias(&p, &q, &qd, &l),
+                &newton_euler::tau_minus_c(&p, &q, &qd, &l),
+                &rnea::tau_minus_c(&p, &q, &qd, &l),
             );
             let e_id = rel_err(
                 &newton_euler::inverse_dynamics(&p, &q, &qd, &qdd, &l),
@@ -113,8 +113,8 @@ fn floating_base_agrees_with_the_spatial_rnea() {
         let base_acc: [f64; 6] = core::array::from_fn(|i| w[(i + 3) % 12] * 1.7);
         let l = loads(n, 30 + k as u64, BASE_BODY);
         let e_b = rel_err(
-            &newton_euler::floating_bias(&p, &base, &s, &q, &qd, &l),
-            &rnea::floating_bias(&p, &base, &s, &q, &qd, &l),
+            &newton_euler::floating_tau_minus_c(&p, &base, &s, &q, &qd, &l),
+            &rnea::floating_tau_minus_c(&p, &base, &s, &q, &qd, &l),
         );
         let e_id = rel_err(
             &newton_euler::floating_inverse_dynamics(&p, &base, &s, &q, &qd, &base_acc, &qdd, &l),
@@ -141,8 +141,8 @@ fn a_perturbed_inertia_is_detected() {
     let (q, qd) = (random_vec(&mut g, n, 2.0), random_vec(&mut g, n, 1.5));
     let l = loads(n, 6, 0);
     let e = rel_err(
-        &newton_euler::bias(&p2, &q, &qd, &l),
-        &rnea::bias(&p, &q, &qd, &l),
+        &newton_euler::tau_minus_c(&p2, &q, &qd, &l),
+        &rnea::tau_minus_c(&p, &q, &qd, &l),
     );
     assert!(e > 1e-6, "{e:e}");
 }

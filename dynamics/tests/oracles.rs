@@ -300,7 +300,7 @@ fn lagrange_oracle_matches_spatial_a_and_b() {
             let h = lagrange_h(&c, &s.q, &s.qd, Some(&s.g));
             let b_ref: Vec<f64> = s.tau.iter().zip(&h).map(|(t, h)| t - h).collect();
             let a = crba::mass_matrix(&p, &s.q);
-            let b = rnea::bias(&p, &s.q, &s.qd, &loads(&s, vec![]));
+            let b = rnea::tau_minus_c(&p, &s.q, &s.qd, &loads(&s, vec![]));
             let (ea, eb) = (rel_err(&flat(&a), &flat(&a_ref)), rel_err(&b, &b_ref));
             assert!(ea < 1e-10, "A: N={n} seed={seed}: rel err {ea:e}");
             assert!(eb < 1e-10, "b: N={n} seed={seed}: rel err {eb:e}");
@@ -308,7 +308,7 @@ fn lagrange_oracle_matches_spatial_a_and_b() {
             worst_b = worst_b.max(eb);
             // Velocity products alone (no gravity, no drives) — a sharper test of the Coriolis terms.
             let h0 = lagrange_h(&c, &s.q, &s.qd, None);
-            let b0 = rnea::bias(&p, &s.q, &s.qd, &no_loads());
+            let b0 = rnea::tau_minus_c(&p, &s.q, &s.qd, &no_loads());
             // (Scaled by the full b: for N = 1 the velocity products vanish identically.)
             let scale = b_ref.iter().chain(&h0).map(|x| x.abs()).fold(0.0, f64::max);
             let e0 = b0
@@ -344,7 +344,7 @@ fn lagrange_oracle_discriminates() {
     let h = lagrange_h(&c, &s.q, &s.qd, Some(&s.g));
     let b_ref: Vec<f64> = s.tau.iter().zip(&h).map(|(t, h)| t - h).collect();
     let zero = vec![0.0; 5];
-    let b_static = rnea::bias(&p, &s.q, &zero, &loads(&s, vec![]));
+    let b_static = rnea::tau_minus_c(&p, &s.q, &zero, &loads(&s, vec![]));
     assert!(rel_err(&b_static, &b_ref) > 1e-3);
     let mut p2 = p.clone();
     let j2 = p2.joints[2].clone();
@@ -365,8 +365,8 @@ fn external_wrenches_by_virtual_power() {
             let ext = random_wrenches(&mut r, n);
             let q_ref = virtual_power_forces(&c, &s.q, &ext);
             for (name, bias) in [
-                ("spatial", rnea::bias::<f64> as BiasFn),
-                ("kane-direct", kane_direct::bias::<f64>),
+                ("spatial", rnea::tau_minus_c::<f64> as BiasFn),
+                ("kane-direct", kane_direct::tau_minus_c::<f64>),
             ] {
                 let with = bias(&p, &s.q, &s.qd, &loads(&s, ext.clone()));
                 let without = bias(&p, &s.q, &s.qd, &loads(&s, vec![]));
@@ -443,7 +443,7 @@ fn two_step_carry_through_turned_placements_matches_lagrange() {
 
 /// Canonical frames place every joint but the first by `Θ_x(α) Θ_z(θ₀)`: split
 /// (`JointParams::split_placement`, `θ₀` into the joint angle and the carries in two turns), the
-/// CRBA, the Newton–Euler bias, the spatial RNEA, ABA and the paper's base-frame algorithm still
+/// CRBA, the Newton–Euler bias, the spatial RNEA, ABA and the paper's inertial-frame algorithm still
 /// give the Lagrange `A`, `b` and `q̈` of the canonical model.
 #[test]
 fn split_placements_match_lagrange() {
@@ -472,8 +472,8 @@ fn split_placements_match_lagrange() {
                     &flat(&recurrent::mass_matrix(&p, &s.q, recurrent::Variant::R2)),
                     &flat(&a_ref),
                 ),
-                rel_err(&newton_euler::bias(&p, &s.q, &s.qd, &l), &b_ref),
-                rel_err(&rnea::bias(&p, &s.q, &s.qd, &l), &b_ref),
+                rel_err(&newton_euler::tau_minus_c(&p, &s.q, &s.qd, &l), &b_ref),
+                rel_err(&rnea::tau_minus_c(&p, &s.q, &s.qd, &l), &b_ref),
             ];
             let qdd_ref = ldlt::solve(&ldlt::ldlt(&a_ref), &b_ref);
             let e_aba = rel_err(&aba::forward_dynamics(&p, &s.q, &s.qd, &l), &qdd_ref);
@@ -560,8 +560,8 @@ fn kane_vs_spatial(n: usize, seed: u64) -> (f64, f64) {
         &flat(&crba::mass_matrix(&p, &s.q)),
     );
     let eb = rel_err(
-        &kane_direct::bias(&p, &s.q, &s.qd, &l),
-        &rnea::bias(&p, &s.q, &s.qd, &l),
+        &kane_direct::tau_minus_c(&p, &s.q, &s.qd, &l),
+        &rnea::tau_minus_c(&p, &s.q, &s.qd, &l),
     );
     (ea, eb)
 }

@@ -3,7 +3,7 @@
 //! its "conventions" text):
 //!
 //! - fixed base, 10 states each: `A` and `b` without and with gravity `(0, 0, −9.81)` by the
-//!   local-frame methods (CRBA + RNEA) on every model, and by every base-frame method on the
+//!   local-frame methods (CRBA + RNEA) on every model, and by every inertial-frame method on the
 //!   serial chains; the world placement of every fixed link frame;
 //! - free-flyer, 10 states each: `A`, `b` (gravity zero), the total momentum (inertial frame,
 //!   about the origin, and about the base origin in base coordinates), the kinetic energy, and
@@ -21,7 +21,7 @@ use kanegen_dynamics::algorithms::{floating, frames, momentum, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::metrics::{rel_err, rel_err_mat};
-use kanegen_dynamics::{BiasMethod, Loads, MassMatrixMethod, Methods, Params};
+use kanegen_dynamics::{Loads, MassMatrixMethod, Methods, NonlinearEffectsMethod, Params};
 use kanegen_model::io::load_model;
 use kanegen_model::{BaseKind, Inertial, Model};
 use serde_json::Value;
@@ -146,7 +146,7 @@ struct Worst {
     b0: f64,
     bg: f64,
     frames: f64,
-    base_frame_methods: f64,
+    inertial_frame_methods: f64,
 }
 
 #[test]
@@ -194,23 +194,26 @@ fn fixed_base_matches_pinocchio() {
             let b0_ref = f64s(&s["b_gravity_zero"]);
             let bg_ref = f64s(&s["b_gravity"]);
             let d0 = Methods::SPATIAL.dynamics(&p, &q, &qd, &Loads::default());
-            let bg = Methods::SPATIAL.bias.bias(&p, &q, &qd, &gravity);
-            w.a = w.a.max(rel_err_mat(&r.mat_to_pin(&d0.a, 0), &a_ref));
-            w.b0 = w.b0.max(rel_err(&r.to_pin(&d0.b, 0), &b0_ref));
+            let bg = Methods::SPATIAL
+                .nonlinear_effects
+                .tau_minus_c(&p, &q, &qd, &gravity);
+            w.a =
+                w.a.max(rel_err_mat(&r.mat_to_pin(&d0.mass_matrix, 0), &a_ref));
+            w.b0 = w.b0.max(rel_err(&r.to_pin(&d0.tau_minus_c, 0), &b0_ref));
             w.bg = w.bg.max(rel_err(&r.to_pin(&bg, 0), &bg_ref));
             if chain {
                 for m in MassMatrixMethod::ALL {
                     let a = m.mass_matrix(&p, &q);
                     let e = rel_err_mat(&r.mat_to_pin(&a, 0), &a_ref);
                     assert!(e < TOL, "{} {}: A {e:e}", r.name, m.name());
-                    w.base_frame_methods = w.base_frame_methods.max(e);
+                    w.inertial_frame_methods = w.inertial_frame_methods.max(e);
                 }
-                for m in BiasMethod::ALL {
+                for m in NonlinearEffectsMethod::ALL {
                     for (loads, want) in [(&Loads::default(), &b0_ref), (&gravity, &bg_ref)] {
-                        let b = m.bias(&p, &q, &qd, loads);
+                        let b = m.tau_minus_c(&p, &q, &qd, loads);
                         let e = rel_err(&r.to_pin(&b, 0), want);
                         assert!(e < TOL, "{} {}: b {e:e}", r.name, m.name());
-                        w.base_frame_methods = w.base_frame_methods.max(e);
+                        w.inertial_frame_methods = w.inertial_frame_methods.max(e);
                     }
                 }
             } else {
@@ -232,7 +235,7 @@ fn fixed_base_matches_pinocchio() {
             }
         }
         println!(
-            "{:26} {:5} N={:2}  A {:.1e}  b(g=0) {:.1e}  b(g) {:.1e}  frames {:.1e}  base-frame methods {}",
+            "{:26} {:5} N={:2}  A {:.1e}  b(g=0) {:.1e}  b(g) {:.1e}  frames {:.1e}  inertial-frame methods {}",
             r.name,
             if chain { "chain" } else { "tree" },
             r.model.dof(),
@@ -241,7 +244,7 @@ fn fixed_base_matches_pinocchio() {
             w.bg,
             w.frames,
             if chain {
-                format!("{:.1e}", w.base_frame_methods)
+                format!("{:.1e}", w.inertial_frame_methods)
             } else {
                 "-".into()
             }
@@ -312,13 +315,13 @@ fn free_flyer_matches_pinocchio() {
             );
             let a_ref = mat(&s["A"]);
             let b_ref = f64s(&s["b_gravity_zero"]);
-            ea = ea.max(rel_err_mat(&r.mat_to_pin(&d.a, 6), &a_ref));
-            eb = eb.max(rel_err(&r.to_pin(&d.b, 6), &b_ref));
+            ea = ea.max(rel_err_mat(&r.mat_to_pin(&d.mass_matrix, 6), &a_ref));
+            eb = eb.max(rel_err(&r.to_pin(&d.tau_minus_c, 6), &b_ref));
             if r.model.is_chain() {
                 for m in Methods::ALL {
                     let d = floating::dynamics(m, &p, &base, &state, &q, &qd, &Loads::default());
-                    let e = rel_err_mat(&r.mat_to_pin(&d.a, 6), &a_ref)
-                        .max(rel_err(&r.to_pin(&d.b, 6), &b_ref));
+                    let e = rel_err_mat(&r.mat_to_pin(&d.mass_matrix, 6), &a_ref)
+                        .max(rel_err(&r.to_pin(&d.tau_minus_c, 6), &b_ref));
                     assert!(e < TOL, "{} {m}: {e:e}", r.name);
                     eother = eother.max(e);
                 }
@@ -350,7 +353,7 @@ fn free_flyer_matches_pinocchio() {
             "{:26} free-flyer  A {ea:.1e}  b {eb:.1e}  momentum {ep:.1e} (base {epb:.1e})  T {et:.1e}  ID(ν̇=0) {eid:.1e}{}",
             r.name,
             if r.model.is_chain() {
-                format!("  base-frame methods {eother:.1e}")
+                format!("  inertial-frame methods {eother:.1e}")
             } else {
                 String::new()
             }

@@ -79,8 +79,8 @@ fn fixed_base_joint_space_dynamics_are_unchanged() {
                 &crba::mass_matrix(&p, &q),
             ),
             rel_err(
-                &rnea::bias(&r.params, &q, &qd, &l),
-                &rnea::bias(&p, &q, &qd, &l),
+                &rnea::tau_minus_c(&r.params, &q, &qd, &l),
+                &rnea::tau_minus_c(&p, &q, &qd, &l),
             ),
             rel_err(
                 &rnea::inverse_dynamics(&r.params, &q, &qd, &qdd, &l),
@@ -138,8 +138,8 @@ fn what_a_fixed_base_receives_is_dropped_and_a_floating_base_keeps_it() {
                 &floating::mass_matrix(sp.mass_matrix, &p, &base, &s, &q),
             ),
             rel_err(
-                &floating::bias(sp.bias, &r.params, rb, &s, &q, &qd, &l),
-                &floating::bias(sp.bias, &p, &base, &s, &q, &qd, &l),
+                &floating::tau_minus_c(sp.nonlinear_effects, &r.params, rb, &s, &q, &qd, &l),
+                &floating::tau_minus_c(sp.nonlinear_effects, &p, &base, &s, &q, &qd, &l),
             ),
             rel_err(
                 &momentum::momentum_base(&r.params, rb, &s, &q, &qd),

@@ -19,7 +19,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use kanegen_dynamics::algorithms::{
-    crba, crba_base, floating, frames, kane_direct, kinematics, momentum, recurrent, rnea,
+    crba, crba_inertial, floating, frames, kane_direct, kinematics, momentum, recurrent, rnea,
 };
 use kanegen_dynamics::base::{FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::ldlt::{ldlt, solve};
@@ -27,7 +27,8 @@ use kanegen_dynamics::linalg::{axis_rotation, Mat3, Vec3};
 use kanegen_dynamics::metrics::{rel_err, rel_err_mat};
 use kanegen_dynamics::scalars::dual::Dual;
 use kanegen_dynamics::{
-    BiasMethod, ExternalWrench, FrameParams, LoadFrame, Loads, MassMatrixMethod, Methods, Params,
+    ExternalWrench, FrameParams, LoadFrame, Loads, MassMatrixMethod, Methods,
+    NonlinearEffectsMethod, Params,
 };
 use kanegen_model::random::{
     random_chain, random_inertial, random_rotation, random_tree, random_vec, rng, ChainSpec,
@@ -254,8 +255,8 @@ fn mass_matrix_and_gravity_are_jacobian_sums() {
             ..Loads::default()
         };
         let bg = sub(
-            &rnea::bias(&p, &s.q, &s.qd, &with_g),
-            &rnea::bias(&p, &s.q, &s.qd, &Loads::default()),
+            &rnea::tau_minus_c(&p, &s.q, &s.qd, &with_g),
+            &rnea::tau_minus_c(&p, &s.q, &s.qd, &Loads::default()),
         );
         let eg = rel_err(&bg, &gen_g);
         worst = (worst.0.max(ea), worst.1.max(eg));
@@ -300,7 +301,7 @@ fn rnea_bias_is_lagrange_on_trees() {
         let n = model.dof();
         let p = Params::<f64>::new(model);
         let s = state(&mut rng(200 + k as u64), n);
-        let b = rnea::bias(&p, &s.q, &s.qd, &Loads::default());
+        let b = rnea::tau_minus_c(&p, &s.q, &s.qd, &Loads::default());
         let want = lagrange_bias(model, &s.q, &s.qd);
         let e = rel_err(&b, &want);
         worst = worst.max(e);
@@ -341,8 +342,8 @@ fn external_wrenches_by_virtual_power_on_trees() {
             ..Loads::default()
         };
         let got = sub(
-            &rnea::bias(&p, &s.q, &s.qd, &loads),
-            &rnea::bias(&p, &s.q, &s.qd, &Loads::default()),
+            &rnea::tau_minus_c(&p, &s.q, &s.qd, &loads),
+            &rnea::tau_minus_c(&p, &s.q, &s.qd, &Loads::default()),
         );
         let e = rel_err(&got, &want);
         worst = worst.max(e);
@@ -572,7 +573,7 @@ fn floating_inverse_dynamics_is_a_nudot_minus_b() {
             );
             let mut nud = s.base_acc.to_vec();
             nud.extend(&s.qdd);
-            let want = sub(&mat_vec(&d.a, &nud), &d.b);
+            let want = sub(&mat_vec(&d.mass_matrix, &nud), &d.tau_minus_c);
             let id = rnea::floating_inverse_dynamics(
                 &p,
                 &s.base,
@@ -885,12 +886,15 @@ fn check_names_the_method_and_the_first_branching_joint() {
             assert!(text.contains("serial chains only"), "{text}");
         }
     }
-    assert!(!BiasMethod::Recurrent.supports_trees() && BiasMethod::Rnea.supports_trees());
+    assert!(
+        !NonlinearEffectsMethod::Recurrent.supports_trees()
+            && NonlinearEffectsMethod::Rnea.supports_trees()
+    );
     assert!(MassMatrixMethod::ALL
         .iter()
         .all(|m| m.supports_trees() == (*m == MassMatrixMethod::Crba)));
     let e = Methods {
-        bias: BiasMethod::KaneDirect,
+        nonlinear_effects: NonlinearEffectsMethod::KaneDirect,
         ..Methods::SPATIAL
     }
     .check(&p)
@@ -919,24 +923,24 @@ panics_on_a_tree! {
     recurrent_r1_panics_on_a_tree, "method `recurrent-r1` handles serial chains only",
         |p, q| MassMatrixMethod::RecurrentR1.mass_matrix(&p, &q);
     recurrent_bias_panics_on_a_tree, "method `recurrent` handles serial chains only",
-        |p, q| recurrent::bias(&p, &q, &q, &Loads::default());
+        |p, q| recurrent::tau_minus_c(&p, &q, &q, &Loads::default());
     kane_direct_panics_on_a_tree, "method `kane-direct` handles serial chains only",
-        |p, q| kane_direct::bias(&p, &q, &q, &Loads::default());
-    crba_base_panics_on_a_tree, "method `crba-base` handles serial chains only",
-        |p, q| crba_base::mass_matrix(&p, &q);
-    base_frame_kinematics_panics_on_a_tree, "handles serial chains only",
-        |p, q| kinematics::base_frame(&p, &q);
-    floating_virtual_joints_panic_on_a_tree, "method `crba-base` handles serial chains only",
+        |p, q| kane_direct::tau_minus_c(&p, &q, &q, &Loads::default());
+    crba_inertial_panics_on_a_tree, "method `crba-inertial` handles serial chains only",
+        |p, q| crba_inertial::mass_matrix(&p, &q);
+    inertial_frame_kinematics_panics_on_a_tree, "handles serial chains only",
+        |p, q| kinematics::inertial_frame(&p, &q);
+    floating_virtual_joints_panic_on_a_tree, "method `crba-inertial` handles serial chains only",
         |p, q| floating::mass_matrix(
-            MassMatrixMethod::CrbaBase,
+            MassMatrixMethod::CrbaInertial,
             &p,
             &FloatingBase::from_inertial(&random_inertial(&mut rng(1), 10.0, 1.0)),
             &FloatingState::at_rest(),
             &q,
         );
     floating_bias_virtual_joints_panic_on_a_tree, "method `recurrent` handles serial chains only",
-        |p, q| floating::bias(
-            BiasMethod::Recurrent,
+        |p, q| floating::tau_minus_c(
+            NonlinearEffectsMethod::Recurrent,
             &p,
             &FloatingBase::from_inertial(&random_inertial(&mut rng(1), 10.0, 1.0)),
             &FloatingState::at_rest(),

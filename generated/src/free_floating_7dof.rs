@@ -6,7 +6,7 @@
 //! Base: free-floating (`root`, 1000 kg). `q = [p₀ (3), quaternion x, y, z, w (4), joints (7)]`, `v = [v_b (3), ω_b (3), q̇ (7)]`: the base origin's position in the inertial frame, the base's attitude (base to inertial), its linear and angular velocity in base coordinates (Pinocchio's free-flyer).
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
@@ -15,7 +15,7 @@
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` | `recurrent` | — | — | model | 1825 | 2486 | 0 | 0 | 7 | 4311 |
 //! | `mass_matrix` | `recurrent` | — | — | canonical | 1840 | 2501 | 0 | 0 | 7 | 4341 |
@@ -23,8 +23,8 @@
 //! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 2119 | 2570 | 0 | 0 | 7 | 4689 |
 //! | `mass_matrix` | `kane-direct` | — | — | model | 3454 | 2893 | 0 | 0 | 7 | 6347 |
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 3469 | 2908 | 0 | 0 | 7 | 6377 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
+//! | `mass_matrix` | `crba-inertial` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
+//! | `mass_matrix` | `crba-inertial` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
 //! | `mass_matrix` | `crba` | — | — | model | 456 | 450 | 0 | 0 | 7 | 906 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 445 | 439 | 0 | 0 | 7 | 884 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 1147 | 881 | 0 | 0 | 7 | 2028 |
@@ -51,14 +51,14 @@
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1578 | 1378 | 10 | 0 | 7 | 2956 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1463 | 1302 | 10 | 0 | 7 | 2765 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 1449 | 1286 | 10 | 0 | 7 | 2735 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 2922 | 2513 | 13 | 0 | 7 | 5435 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 2937 | 2528 | 13 | 0 | 7 | 5465 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2066 | 13 | 0 | 7 | 4611 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 2562 | 2081 | 13 | 0 | 7 | 4643 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 2423 | 1979 | 13 | 0 | 7 | 4402 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 2430 | 1985 | 13 | 0 | 7 | 4415 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | model | 2922 | 2513 | 13 | 0 | 7 | 5435 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | canonical | 2937 | 2528 | 13 | 0 | 7 | 5465 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | model | 2545 | 2066 | 13 | 0 | 7 | 4611 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | canonical | 2562 | 2081 | 13 | 0 | 7 | 4643 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | model | 2423 | 1979 | 13 | 0 | 7 | 4402 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | canonical | 2430 | 1985 | 13 | 0 | 7 | 4415 |
 //! | `forward_dynamics` | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 1601 | 1280 | 12 | 0 | 7 | 2881 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1603 | 1331 | 0 | 0 | 7 | 2934 |
@@ -69,22 +69,22 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1078 | 939 | 0 | 0 | 7 | 2017 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 963 | 863 | 0 | 0 | 7 | 1826 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 949 | 847 | 0 | 0 | 7 | 1796 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 2311 | 1986 | 0 | 0 | 7 | 4297 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 2326 | 2001 | 0 | 0 | 7 | 4327 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 1934 | 1539 | 0 | 0 | 7 | 3473 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1812 | 1452 | 0 | 0 | 7 | 3264 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 1819 | 1458 | 0 | 0 | 7 | 3277 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | model | 2311 | 1986 | 0 | 0 | 7 | 4297 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | canonical | 2326 | 2001 | 0 | 0 | 7 | 4327 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | model | 1934 | 1539 | 0 | 0 | 7 | 3473 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | model | 1812 | 1452 | 0 | 0 | 7 | 3264 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | canonical | 1819 | 1458 | 0 | 0 | 7 | 3277 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2247 | 1914 | 10 | 0 | 7 | 4161 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2664 | 2309 | 10 | 0 | 7 | 4973 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1585 | 1437 | 10 | 0 | 7 | 3022 |
 //! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 1463 | 1350 | 10 | 0 | 7 | 2813 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 2423 | 2027 | 13 | 0 | 7 | 4450 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 2423 | 2027 | 13 | 0 | 7 | 4450 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 1592 | 1325 | 12 | 0 | 7 | 2917 |
 //! | `momentum` * | — | — | — | model | 350 | 283 | 0 | 0 | 7 | 633 |
 //! | `base_reaction` * | — | `recurrent` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
@@ -101,9 +101,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -158,7 +158,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 445u64,
@@ -171,7 +171,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 504u64,
@@ -184,7 +184,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 518u64,
@@ -197,7 +197,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1449u64,
@@ -210,7 +210,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 949u64,
@@ -223,7 +223,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1463u64,
@@ -236,7 +236,7 @@ impl FreeFloating7 {
         OpCount {
             function: "momentum",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 350u64,
@@ -249,7 +249,7 @@ impl FreeFloating7 {
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 688u64,
@@ -265,7 +265,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 1825u64,
@@ -278,7 +278,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 1840u64,
@@ -291,7 +291,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 2104u64,
@@ -304,7 +304,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 2119u64,
@@ -317,7 +317,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 3454u64,
@@ -330,7 +330,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 3469u64,
@@ -342,8 +342,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 1303u64,
@@ -355,8 +355,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 1318u64,
@@ -369,7 +369,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 456u64,
@@ -382,7 +382,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 445u64,
@@ -395,7 +395,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1147u64,
@@ -408,7 +408,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 1162u64,
@@ -421,7 +421,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 1564u64,
@@ -434,7 +434,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 1579u64,
@@ -447,7 +447,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 631u64,
@@ -460,7 +460,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 633u64,
@@ -473,7 +473,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 509u64,
@@ -486,7 +486,7 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 504u64,
@@ -499,7 +499,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 670u64,
@@ -512,7 +512,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 672u64,
@@ -525,7 +525,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 670u64,
@@ -538,7 +538,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 672u64,
@@ -551,7 +551,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 670u64,
@@ -564,7 +564,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 672u64,
@@ -577,7 +577,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 523u64,
@@ -590,7 +590,7 @@ impl FreeFloating7 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 518u64,
@@ -603,7 +603,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2103u64,
@@ -616,7 +616,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2104u64,
@@ -629,7 +629,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2520u64,
@@ -642,7 +642,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2521u64,
@@ -655,7 +655,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1585u64,
@@ -668,7 +668,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1578u64,
@@ -681,7 +681,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1463u64,
@@ -694,7 +694,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1449u64,
@@ -706,8 +706,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2505u64,
@@ -719,8 +719,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2520u64,
@@ -732,8 +732,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2922u64,
@@ -745,8 +745,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2937u64,
@@ -758,8 +758,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2545u64,
@@ -771,8 +771,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2562u64,
@@ -784,8 +784,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2423u64,
@@ -797,8 +797,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 2430u64,
@@ -811,7 +811,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 1592u64,
@@ -824,7 +824,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
             mul: 1601u64,
@@ -837,7 +837,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1603u64,
@@ -850,7 +850,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 1604u64,
@@ -863,7 +863,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 2020u64,
@@ -876,7 +876,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 2021u64,
@@ -889,7 +889,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 1085u64,
@@ -902,7 +902,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 1078u64,
@@ -915,7 +915,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 963u64,
@@ -928,7 +928,7 @@ impl FreeFloating7 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 949u64,
@@ -940,8 +940,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1894u64,
@@ -953,8 +953,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 1909u64,
@@ -966,8 +966,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 2311u64,
@@ -979,8 +979,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 2326u64,
@@ -992,8 +992,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 1934u64,
@@ -1005,8 +1005,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 1951u64,
@@ -1018,8 +1018,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 1812u64,
@@ -1031,8 +1031,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 1819u64,
@@ -1045,7 +1045,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2247u64,
@@ -1058,7 +1058,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2664u64,
@@ -1071,7 +1071,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1585u64,
@@ -1084,7 +1084,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1463u64,
@@ -1096,8 +1096,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2649u64,
@@ -1109,8 +1109,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 3066u64,
@@ -1122,8 +1122,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2545u64,
@@ -1135,8 +1135,8 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2423u64,
@@ -1149,7 +1149,7 @@ impl FreeFloating7 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 1592u64,
@@ -1162,7 +1162,7 @@ impl FreeFloating7 {
         OpCount {
             function: "momentum",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 350u64,
@@ -1175,7 +1175,7 @@ impl FreeFloating7 {
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 688u64,
@@ -1188,7 +1188,7 @@ impl FreeFloating7 {
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 688u64,
@@ -1201,7 +1201,7 @@ impl FreeFloating7 {
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 688u64,
@@ -1214,7 +1214,7 @@ impl FreeFloating7 {
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 688u64,
@@ -1857,7 +1857,7 @@ impl FreeFloating7 {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 504 mul, 412 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 308 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 504 mul, 412 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 308 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -2382,7 +2382,7 @@ impl FreeFloating7 {
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `newton-euler`: 518 mul, 441 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 518 mul, 441 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -2928,7 +2928,7 @@ impl FreeFloating7 {
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1449 mul, 1286 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 1449 mul, 1286 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -4684,7 +4684,7 @@ impl FreeFloating7 {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 949 mul, 847 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 576 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 949 mul, 847 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 576 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -5900,7 +5900,7 @@ impl FreeFloating7 {
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1463 mul, 1350 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 1463 mul, 1350 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -8062,7 +8062,7 @@ impl FreeFloating7 {
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
-    /// Methods: bias `recurrent`: 688 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 426 fused where the target has FMA.
+    /// Methods: nonlinear effects `recurrent`: 688 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 426 fused where the target has FMA.
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),

@@ -6,7 +6,7 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
@@ -15,7 +15,7 @@
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` | `recurrent` | — | — | model | 468 | 392 | 0 | 0 | 6 | 860 |
 //! | `mass_matrix` | `recurrent` | — | — | canonical | 468 | 392 | 0 | 0 | 6 | 860 |
@@ -23,8 +23,8 @@
 //! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 519 | 422 | 0 | 0 | 6 | 941 |
 //! | `mass_matrix` | `kane-direct` | — | — | model | 505 | 352 | 0 | 0 | 6 | 857 |
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 505 | 352 | 0 | 0 | 6 | 857 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` | `crba-inertial` | — | — | model | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` | `crba-inertial` | — | — | canonical | 450 | 339 | 0 | 0 | 6 | 789 |
 //! | `mass_matrix` | `crba` | — | — | model | 118 | 115 | 0 | 0 | 5 | 233 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 118 | 114 | 0 | 0 | 5 | 232 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 537 | 386 | 0 | 0 | 6 | 923 |
@@ -51,14 +51,14 @@
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 458 | 366 | 6 | 0 | 5 | 824 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 424 | 343 | 6 | 0 | 5 | 767 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 424 | 342 | 6 | 0 | 5 | 766 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 801 | 647 | 6 | 0 | 6 | 1448 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 801 | 647 | 6 | 0 | 6 | 1448 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 844 | 689 | 6 | 0 | 6 | 1533 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 844 | 689 | 6 | 0 | 6 | 1533 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 790 | 591 | 6 | 0 | 6 | 1381 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 790 | 591 | 6 | 0 | 6 | 1381 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 756 | 567 | 6 | 0 | 6 | 1323 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 756 | 567 | 6 | 0 | 6 | 1323 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | model | 801 | 647 | 6 | 0 | 6 | 1448 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | canonical | 801 | 647 | 6 | 0 | 6 | 1448 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | model | 844 | 689 | 6 | 0 | 6 | 1533 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | canonical | 844 | 689 | 6 | 0 | 6 | 1533 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | model | 790 | 591 | 6 | 0 | 6 | 1381 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | canonical | 790 | 591 | 6 | 0 | 6 | 1381 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | model | 756 | 567 | 6 | 0 | 6 | 1323 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | canonical | 756 | 567 | 6 | 0 | 6 | 1323 |
 //! | `forward_dynamics` | — | — | `aba` | model | 567 | 411 | 5 | 0 | 5 | 978 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 574 | 414 | 5 | 0 | 5 | 988 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 655 | 501 | 0 | 0 | 6 | 1156 |
@@ -69,22 +69,22 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 372 | 295 | 0 | 0 | 5 | 667 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 338 | 272 | 0 | 0 | 5 | 610 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 338 | 271 | 0 | 0 | 5 | 609 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 715 | 576 | 0 | 0 | 6 | 1291 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 715 | 576 | 0 | 0 | 6 | 1291 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 758 | 618 | 0 | 0 | 6 | 1376 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 758 | 618 | 0 | 0 | 6 | 1376 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 704 | 520 | 0 | 0 | 6 | 1224 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 704 | 520 | 0 | 0 | 6 | 1224 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 670 | 496 | 0 | 0 | 6 | 1166 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 670 | 496 | 0 | 0 | 6 | 1166 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | model | 715 | 576 | 0 | 0 | 6 | 1291 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | canonical | 715 | 576 | 0 | 0 | 6 | 1291 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | model | 758 | 618 | 0 | 0 | 6 | 1376 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | canonical | 758 | 618 | 0 | 0 | 6 | 1376 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | model | 704 | 520 | 0 | 0 | 6 | 1224 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | canonical | 704 | 520 | 0 | 0 | 6 | 1224 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | model | 670 | 496 | 0 | 0 | 6 | 1166 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | canonical | 670 | 496 | 0 | 0 | 6 | 1166 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 817 | 649 | 6 | 0 | 6 | 1466 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 860 | 691 | 6 | 0 | 6 | 1551 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 464 | 399 | 6 | 0 | 5 | 863 |
 //! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 430 | 375 | 6 | 0 | 5 | 805 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 877 | 724 | 6 | 0 | 6 | 1601 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 920 | 766 | 6 | 0 | 6 | 1686 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 796 | 623 | 6 | 0 | 6 | 1419 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 762 | 599 | 6 | 0 | 6 | 1361 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `recurrent` | `ldlt` | model | 877 | 724 | 6 | 0 | 6 | 1601 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `kane-direct` | `ldlt` | model | 920 | 766 | 6 | 0 | 6 | 1686 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 796 | 623 | 6 | 0 | 6 | 1419 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 762 | 599 | 6 | 0 | 6 | 1361 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 573 | 443 | 5 | 0 | 5 | 1016 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -96,9 +96,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -148,7 +148,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 118u64,
@@ -161,7 +161,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 220u64,
@@ -174,7 +174,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 232u64,
@@ -187,7 +187,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
@@ -200,7 +200,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 338u64,
@@ -213,7 +213,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 430u64,
@@ -229,7 +229,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 468u64,
@@ -242,7 +242,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 468u64,
@@ -255,7 +255,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 519u64,
@@ -268,7 +268,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 519u64,
@@ -281,7 +281,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 505u64,
@@ -294,7 +294,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 505u64,
@@ -306,8 +306,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 450u64,
@@ -319,8 +319,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 450u64,
@@ -333,7 +333,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 118u64,
@@ -346,7 +346,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 118u64,
@@ -359,7 +359,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 537u64,
@@ -372,7 +372,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 537u64,
@@ -385,7 +385,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 580u64,
@@ -398,7 +398,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 580u64,
@@ -411,7 +411,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 254u64,
@@ -424,7 +424,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 254u64,
@@ -437,7 +437,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 220u64,
@@ -450,7 +450,7 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 220u64,
@@ -463,7 +463,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 689u64,
@@ -476,7 +476,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 689u64,
@@ -489,7 +489,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 732u64,
@@ -502,7 +502,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 732u64,
@@ -515,7 +515,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 278u64,
@@ -528,7 +528,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 278u64,
@@ -541,7 +541,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 232u64,
@@ -554,7 +554,7 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 232u64,
@@ -567,7 +567,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 741u64,
@@ -580,7 +580,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 741u64,
@@ -593,7 +593,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 784u64,
@@ -606,7 +606,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 784u64,
@@ -619,7 +619,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 458u64,
@@ -632,7 +632,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 458u64,
@@ -645,7 +645,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 424u64,
@@ -658,7 +658,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
@@ -670,8 +670,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 801u64,
@@ -683,8 +683,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 801u64,
@@ -696,8 +696,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 844u64,
@@ -709,8 +709,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 844u64,
@@ -722,8 +722,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 790u64,
@@ -735,8 +735,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 790u64,
@@ -748,8 +748,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 756u64,
@@ -761,8 +761,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 756u64,
@@ -775,7 +775,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 567u64,
@@ -788,7 +788,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
             mul: 574u64,
@@ -801,7 +801,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 655u64,
@@ -814,7 +814,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 655u64,
@@ -827,7 +827,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 698u64,
@@ -840,7 +840,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 698u64,
@@ -853,7 +853,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 372u64,
@@ -866,7 +866,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 372u64,
@@ -879,7 +879,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 338u64,
@@ -892,7 +892,7 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 338u64,
@@ -904,8 +904,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 715u64,
@@ -917,8 +917,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 715u64,
@@ -930,8 +930,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 758u64,
@@ -943,8 +943,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 758u64,
@@ -956,8 +956,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 704u64,
@@ -969,8 +969,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 704u64,
@@ -982,8 +982,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 670u64,
@@ -995,8 +995,8 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 670u64,
@@ -1009,7 +1009,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 817u64,
@@ -1022,7 +1022,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 860u64,
@@ -1035,7 +1035,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 464u64,
@@ -1048,7 +1048,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 430u64,
@@ -1060,8 +1060,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 877u64,
@@ -1073,8 +1073,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 920u64,
@@ -1086,8 +1086,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 796u64,
@@ -1099,8 +1099,8 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 762u64,
@@ -1113,7 +1113,7 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 573u64,
@@ -1269,7 +1269,7 @@ impl Srms {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -1441,7 +1441,7 @@ impl Srms {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 134 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 134 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -1644,7 +1644,7 @@ impl Srms {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 424 mul, 342 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 424 mul, 342 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -2054,7 +2054,7 @@ impl Srms {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 338 mul, 271 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 338 mul, 271 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -2377,7 +2377,7 @@ impl Srms {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 430 mul, 375 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 430 mul, 375 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],

@@ -6,7 +6,7 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
@@ -15,7 +15,7 @@
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` | `recurrent` | — | — | model | 681 | 661 | 0 | 0 | 7 | 1342 |
 //! | `mass_matrix` | `recurrent` | — | — | canonical | 681 | 661 | 0 | 0 | 7 | 1342 |
@@ -23,8 +23,8 @@
 //! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 778 | 703 | 0 | 0 | 7 | 1481 |
 //! | `mass_matrix` | `kane-direct` | — | — | model | 709 | 510 | 0 | 0 | 7 | 1219 |
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 709 | 510 | 0 | 0 | 7 | 1219 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` | `crba-inertial` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` | `crba-inertial` | — | — | canonical | 577 | 454 | 0 | 0 | 7 | 1031 |
 //! | `mass_matrix` | `crba` | — | — | model | 120 | 99 | 0 | 0 | 5 | 219 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 120 | 97 | 0 | 0 | 5 | 217 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
@@ -51,14 +51,14 @@
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 499 | 372 | 7 | 0 | 6 | 871 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 453 | 342 | 7 | 0 | 6 | 795 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 452 | 339 | 7 | 0 | 6 | 791 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 1034 | 865 | 7 | 0 | 7 | 1899 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 1034 | 865 | 7 | 0 | 7 | 1899 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 1124 | 951 | 7 | 0 | 7 | 2075 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 1124 | 951 | 7 | 0 | 7 | 2075 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 959 | 735 | 7 | 0 | 7 | 1694 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 956 | 733 | 7 | 0 | 7 | 1689 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 910 | 701 | 7 | 0 | 7 | 1611 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 909 | 700 | 7 | 0 | 7 | 1609 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | model | 1034 | 865 | 7 | 0 | 7 | 1899 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | canonical | 1034 | 865 | 7 | 0 | 7 | 1899 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | model | 1124 | 951 | 7 | 0 | 7 | 2075 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | canonical | 1124 | 951 | 7 | 0 | 7 | 2075 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | model | 959 | 735 | 7 | 0 | 7 | 1694 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | canonical | 956 | 733 | 7 | 0 | 7 | 1689 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | model | 910 | 701 | 7 | 0 | 7 | 1611 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | canonical | 909 | 700 | 7 | 0 | 7 | 1609 |
 //! | `forward_dynamics` | — | — | `aba` | model | 554 | 388 | 5 | 0 | 6 | 942 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 554 | 389 | 5 | 0 | 6 | 943 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 738 | 549 | 0 | 0 | 7 | 1287 |
@@ -69,22 +69,22 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 373 | 271 | 0 | 0 | 6 | 644 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 327 | 241 | 0 | 0 | 6 | 568 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 326 | 238 | 0 | 0 | 6 | 564 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 908 | 760 | 0 | 0 | 7 | 1668 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 908 | 760 | 0 | 0 | 7 | 1668 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 998 | 846 | 0 | 0 | 7 | 1844 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 998 | 846 | 0 | 0 | 7 | 1844 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 833 | 630 | 0 | 0 | 7 | 1463 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 830 | 628 | 0 | 0 | 7 | 1458 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 784 | 596 | 0 | 0 | 7 | 1380 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 783 | 595 | 0 | 0 | 7 | 1378 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | model | 908 | 760 | 0 | 0 | 7 | 1668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | canonical | 908 | 760 | 0 | 0 | 7 | 1668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | model | 998 | 846 | 0 | 0 | 7 | 1844 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | canonical | 998 | 846 | 0 | 0 | 7 | 1844 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | model | 833 | 630 | 0 | 0 | 7 | 1463 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | canonical | 830 | 628 | 0 | 0 | 7 | 1458 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | model | 784 | 596 | 0 | 0 | 7 | 1380 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | canonical | 783 | 595 | 0 | 0 | 7 | 1378 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 968 | 755 | 7 | 0 | 7 | 1723 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 1058 | 841 | 7 | 0 | 7 | 1899 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 514 | 420 | 7 | 0 | 6 | 934 |
 //! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 465 | 386 | 7 | 0 | 6 | 851 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 1138 | 970 | 7 | 0 | 7 | 2108 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 1228 | 1056 | 7 | 0 | 7 | 2284 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 922 | 745 | 7 | 0 | 7 | 1667 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `recurrent` | `ldlt` | model | 1138 | 970 | 7 | 0 | 7 | 2108 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `kane-direct` | `ldlt` | model | 1228 | 1056 | 7 | 0 | 7 | 2284 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 922 | 745 | 7 | 0 | 7 | 1667 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 566 | 433 | 5 | 0 | 6 | 999 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -96,9 +96,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -149,7 +149,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 120u64,
@@ -162,7 +162,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 206u64,
@@ -175,7 +175,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 216u64,
@@ -188,7 +188,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
@@ -201,7 +201,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 326u64,
@@ -214,7 +214,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 465u64,
@@ -230,7 +230,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 681u64,
@@ -243,7 +243,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 681u64,
@@ -256,7 +256,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 778u64,
@@ -269,7 +269,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 778u64,
@@ -282,7 +282,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 709u64,
@@ -295,7 +295,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 709u64,
@@ -307,8 +307,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 577u64,
@@ -320,8 +320,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 577u64,
@@ -334,7 +334,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 120u64,
@@ -347,7 +347,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 120u64,
@@ -360,7 +360,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 618u64,
@@ -373,7 +373,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 618u64,
@@ -386,7 +386,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 708u64,
@@ -399,7 +399,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 708u64,
@@ -412,7 +412,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 256u64,
@@ -425,7 +425,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 253u64,
@@ -438,7 +438,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 207u64,
@@ -451,7 +451,7 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 206u64,
@@ -464,7 +464,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 777u64,
@@ -477,7 +477,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 777u64,
@@ -490,7 +490,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 867u64,
@@ -503,7 +503,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 867u64,
@@ -516,7 +516,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 268u64,
@@ -529,7 +529,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 265u64,
@@ -542,7 +542,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 217u64,
@@ -555,7 +555,7 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 216u64,
@@ -568,7 +568,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 864u64,
@@ -581,7 +581,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 864u64,
@@ -594,7 +594,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 954u64,
@@ -607,7 +607,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 954u64,
@@ -620,7 +620,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 502u64,
@@ -633,7 +633,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 499u64,
@@ -646,7 +646,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 453u64,
@@ -659,7 +659,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
@@ -671,8 +671,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1034u64,
@@ -684,8 +684,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1034u64,
@@ -697,8 +697,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1124u64,
@@ -710,8 +710,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1124u64,
@@ -723,8 +723,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 959u64,
@@ -736,8 +736,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 956u64,
@@ -749,8 +749,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 910u64,
@@ -762,8 +762,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 909u64,
@@ -776,7 +776,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 554u64,
@@ -789,7 +789,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
             mul: 554u64,
@@ -802,7 +802,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 738u64,
@@ -815,7 +815,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 738u64,
@@ -828,7 +828,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 828u64,
@@ -841,7 +841,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 828u64,
@@ -854,7 +854,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 376u64,
@@ -867,7 +867,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 373u64,
@@ -880,7 +880,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 327u64,
@@ -893,7 +893,7 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 326u64,
@@ -905,8 +905,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 908u64,
@@ -918,8 +918,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 908u64,
@@ -931,8 +931,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 998u64,
@@ -944,8 +944,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 998u64,
@@ -957,8 +957,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 833u64,
@@ -970,8 +970,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 830u64,
@@ -983,8 +983,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 784u64,
@@ -996,8 +996,8 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 783u64,
@@ -1010,7 +1010,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 968u64,
@@ -1023,7 +1023,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1058u64,
@@ -1036,7 +1036,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 514u64,
@@ -1049,7 +1049,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 465u64,
@@ -1061,8 +1061,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1138u64,
@@ -1074,8 +1074,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1228u64,
@@ -1087,8 +1087,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 971u64,
@@ -1100,8 +1100,8 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 922u64,
@@ -1114,7 +1114,7 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 566u64,
@@ -1273,7 +1273,7 @@ impl Ssrms {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
@@ -1446,7 +1446,7 @@ impl Ssrms {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
@@ -1626,7 +1626,7 @@ impl Ssrms {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
@@ -2083,7 +2083,7 @@ impl Ssrms {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -2408,7 +2408,7 @@ impl Ssrms {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],

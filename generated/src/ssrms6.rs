@@ -6,7 +6,7 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
@@ -15,7 +15,7 @@
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` | `recurrent` | — | — | model | 429 | 352 | 0 | 0 | 6 | 781 |
 //! | `mass_matrix` | `recurrent` | — | — | canonical | 429 | 352 | 0 | 0 | 6 | 781 |
@@ -23,8 +23,8 @@
 //! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 469 | 372 | 0 | 0 | 6 | 841 |
 //! | `mass_matrix` | `kane-direct` | — | — | model | 442 | 295 | 0 | 0 | 6 | 737 |
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 442 | 295 | 0 | 0 | 6 | 737 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 412 | 299 | 0 | 0 | 6 | 711 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` | `crba-inertial` | — | — | model | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` | `crba-inertial` | — | — | canonical | 412 | 299 | 0 | 0 | 6 | 711 |
 //! | `mass_matrix` | `crba` | — | — | model | 76 | 67 | 0 | 0 | 4 | 143 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 76 | 65 | 0 | 0 | 4 | 141 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 493 | 340 | 0 | 0 | 6 | 833 |
@@ -51,14 +51,14 @@
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 351 | 256 | 6 | 0 | 5 | 607 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 317 | 233 | 6 | 0 | 5 | 550 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 317 | 231 | 6 | 0 | 5 | 548 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 764 | 605 | 6 | 0 | 6 | 1369 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 764 | 605 | 6 | 0 | 6 | 1369 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 805 | 641 | 6 | 0 | 6 | 1446 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 805 | 641 | 6 | 0 | 6 | 1446 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 687 | 494 | 6 | 0 | 6 | 1181 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 687 | 494 | 6 | 0 | 6 | 1181 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 653 | 469 | 6 | 0 | 6 | 1122 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 653 | 469 | 6 | 0 | 6 | 1122 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | model | 764 | 605 | 6 | 0 | 6 | 1369 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | canonical | 764 | 605 | 6 | 0 | 6 | 1369 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | model | 805 | 641 | 6 | 0 | 6 | 1446 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | canonical | 805 | 641 | 6 | 0 | 6 | 1446 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | model | 687 | 494 | 6 | 0 | 6 | 1181 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | canonical | 687 | 494 | 6 | 0 | 6 | 1181 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | model | 653 | 469 | 6 | 0 | 6 | 1122 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | canonical | 653 | 469 | 6 | 0 | 6 | 1122 |
 //! | `forward_dynamics` | — | — | `aba` | model | 421 | 292 | 4 | 0 | 5 | 713 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 423 | 294 | 4 | 0 | 5 | 717 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 569 | 407 | 0 | 0 | 6 | 976 |
@@ -69,22 +69,22 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 265 | 189 | 0 | 0 | 5 | 454 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 231 | 166 | 0 | 0 | 5 | 397 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 231 | 164 | 0 | 0 | 5 | 395 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 678 | 534 | 0 | 0 | 6 | 1212 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 678 | 534 | 0 | 0 | 6 | 1212 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 719 | 570 | 0 | 0 | 6 | 1289 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 719 | 570 | 0 | 0 | 6 | 1289 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 601 | 423 | 0 | 0 | 6 | 1024 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 601 | 423 | 0 | 0 | 6 | 1024 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 567 | 398 | 0 | 0 | 6 | 965 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 567 | 398 | 0 | 0 | 6 | 965 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | model | 678 | 534 | 0 | 0 | 6 | 1212 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | canonical | 678 | 534 | 0 | 0 | 6 | 1212 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | model | 719 | 570 | 0 | 0 | 6 | 1289 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | canonical | 719 | 570 | 0 | 0 | 6 | 1289 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | model | 601 | 423 | 0 | 0 | 6 | 1024 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | canonical | 601 | 423 | 0 | 0 | 6 | 1024 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | model | 567 | 398 | 0 | 0 | 6 | 965 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | canonical | 567 | 398 | 0 | 0 | 6 | 965 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 737 | 557 | 6 | 0 | 6 | 1294 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 778 | 593 | 6 | 0 | 6 | 1371 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 363 | 296 | 6 | 0 | 5 | 659 |
 //! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 329 | 271 | 6 | 0 | 5 | 600 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 846 | 688 | 6 | 0 | 6 | 1534 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 887 | 724 | 6 | 0 | 6 | 1611 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 699 | 532 | 6 | 0 | 6 | 1231 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 665 | 507 | 6 | 0 | 6 | 1172 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `recurrent` | `ldlt` | model | 846 | 688 | 6 | 0 | 6 | 1534 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `kane-direct` | `ldlt` | model | 887 | 724 | 6 | 0 | 6 | 1611 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 699 | 532 | 6 | 0 | 6 | 1231 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 665 | 507 | 6 | 0 | 6 | 1172 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 433 | 331 | 4 | 0 | 5 | 764 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -96,9 +96,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -148,7 +148,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 76u64,
@@ -161,7 +161,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 155u64,
@@ -174,7 +174,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 171u64,
@@ -187,7 +187,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 317u64,
@@ -200,7 +200,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 231u64,
@@ -213,7 +213,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 329u64,
@@ -229,7 +229,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 429u64,
@@ -242,7 +242,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 429u64,
@@ -255,7 +255,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 469u64,
@@ -268,7 +268,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 469u64,
@@ -281,7 +281,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 442u64,
@@ -294,7 +294,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 442u64,
@@ -306,8 +306,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 412u64,
@@ -319,8 +319,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 412u64,
@@ -333,7 +333,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 76u64,
@@ -346,7 +346,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 76u64,
@@ -359,7 +359,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 493u64,
@@ -372,7 +372,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 493u64,
@@ -385,7 +385,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 534u64,
@@ -398,7 +398,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 534u64,
@@ -411,7 +411,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 189u64,
@@ -424,7 +424,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 189u64,
@@ -437,7 +437,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 155u64,
@@ -450,7 +450,7 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 155u64,
@@ -463,7 +463,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 595u64,
@@ -476,7 +476,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 595u64,
@@ -489,7 +489,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 636u64,
@@ -502,7 +502,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 636u64,
@@ -515,7 +515,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 208u64,
@@ -528,7 +528,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 207u64,
@@ -541,7 +541,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 172u64,
@@ -554,7 +554,7 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 171u64,
@@ -567,7 +567,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 655u64,
@@ -580,7 +580,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 655u64,
@@ -593,7 +593,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 696u64,
@@ -606,7 +606,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 696u64,
@@ -619,7 +619,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 351u64,
@@ -632,7 +632,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 351u64,
@@ -645,7 +645,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 317u64,
@@ -658,7 +658,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 317u64,
@@ -670,8 +670,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 764u64,
@@ -683,8 +683,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 764u64,
@@ -696,8 +696,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 805u64,
@@ -709,8 +709,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 805u64,
@@ -722,8 +722,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 687u64,
@@ -735,8 +735,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 687u64,
@@ -748,8 +748,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 653u64,
@@ -761,8 +761,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 653u64,
@@ -775,7 +775,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 421u64,
@@ -788,7 +788,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
             mul: 423u64,
@@ -801,7 +801,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 569u64,
@@ -814,7 +814,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 569u64,
@@ -827,7 +827,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 610u64,
@@ -840,7 +840,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 610u64,
@@ -853,7 +853,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 265u64,
@@ -866,7 +866,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 265u64,
@@ -879,7 +879,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 231u64,
@@ -892,7 +892,7 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 231u64,
@@ -904,8 +904,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 678u64,
@@ -917,8 +917,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 678u64,
@@ -930,8 +930,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 719u64,
@@ -943,8 +943,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 719u64,
@@ -956,8 +956,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 601u64,
@@ -969,8 +969,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 601u64,
@@ -982,8 +982,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 567u64,
@@ -995,8 +995,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 567u64,
@@ -1009,7 +1009,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 737u64,
@@ -1022,7 +1022,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 778u64,
@@ -1035,7 +1035,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 363u64,
@@ -1048,7 +1048,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 329u64,
@@ -1060,8 +1060,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 846u64,
@@ -1073,8 +1073,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 887u64,
@@ -1086,8 +1086,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 699u64,
@@ -1099,8 +1099,8 @@ impl Ssrms6 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 665u64,
@@ -1113,7 +1113,7 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 433u64,
@@ -1225,7 +1225,7 @@ impl Ssrms6 {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 155 mul, 99 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 80 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 155 mul, 99 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 80 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -1349,7 +1349,7 @@ impl Ssrms6 {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 171 mul, 123 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 95 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 171 mul, 123 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 95 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -1506,7 +1506,7 @@ impl Ssrms6 {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 317 mul, 231 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 176 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 317 mul, 231 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 176 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
@@ -1814,7 +1814,7 @@ impl Ssrms6 {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 231 mul, 164 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 115 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 231 mul, 164 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 115 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -2044,7 +2044,7 @@ impl Ssrms6 {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 329 mul, 271 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 190 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 329 mul, 271 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 190 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],

@@ -6,7 +6,7 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Precision: `f32`: inputs, outputs and every intermediate; the model's numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, `sqrtf`.
@@ -16,7 +16,7 @@
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` | `recurrent` | — | — | model | 681 | 661 | 0 | 0 | 7 | 1342 |
 //! | `mass_matrix` | `recurrent` | — | — | canonical | 681 | 661 | 0 | 0 | 7 | 1342 |
@@ -24,8 +24,8 @@
 //! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 778 | 703 | 0 | 0 | 7 | 1481 |
 //! | `mass_matrix` | `kane-direct` | — | — | model | 709 | 510 | 0 | 0 | 7 | 1219 |
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 709 | 510 | 0 | 0 | 7 | 1219 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` | `crba-inertial` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` | `crba-inertial` | — | — | canonical | 577 | 454 | 0 | 0 | 7 | 1031 |
 //! | `mass_matrix` | `crba` | — | — | model | 120 | 99 | 0 | 0 | 5 | 219 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 120 | 97 | 0 | 0 | 5 | 217 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
@@ -52,14 +52,14 @@
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 499 | 372 | 7 | 0 | 6 | 871 |
 //! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 453 | 342 | 7 | 0 | 6 | 795 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 452 | 339 | 7 | 0 | 6 | 791 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 1034 | 865 | 7 | 0 | 7 | 1899 |
-//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 1034 | 865 | 7 | 0 | 7 | 1899 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 1124 | 951 | 7 | 0 | 7 | 2075 |
-//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 1124 | 951 | 7 | 0 | 7 | 2075 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 959 | 735 | 7 | 0 | 7 | 1694 |
-//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 956 | 733 | 7 | 0 | 7 | 1689 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 910 | 701 | 7 | 0 | 7 | 1611 |
-//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 909 | 700 | 7 | 0 | 7 | 1609 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | model | 1034 | 865 | 7 | 0 | 7 | 1899 |
+//! | `forward_dynamics` | `crba-inertial` | `recurrent` | `ldlt` | canonical | 1034 | 865 | 7 | 0 | 7 | 1899 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | model | 1124 | 951 | 7 | 0 | 7 | 2075 |
+//! | `forward_dynamics` | `crba-inertial` | `kane-direct` | `ldlt` | canonical | 1124 | 951 | 7 | 0 | 7 | 2075 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | model | 959 | 735 | 7 | 0 | 7 | 1694 |
+//! | `forward_dynamics` | `crba-inertial` | `rnea` | `ldlt` | canonical | 956 | 733 | 7 | 0 | 7 | 1689 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | model | 910 | 701 | 7 | 0 | 7 | 1611 |
+//! | `forward_dynamics` | `crba-inertial` | `newton-euler` | `ldlt` | canonical | 909 | 700 | 7 | 0 | 7 | 1609 |
 //! | `forward_dynamics` | — | — | `aba` | model | 554 | 388 | 5 | 0 | 6 | 942 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 554 | 389 | 5 | 0 | 6 | 943 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 738 | 549 | 0 | 0 | 7 | 1287 |
@@ -70,22 +70,22 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 373 | 271 | 0 | 0 | 6 | 644 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 327 | 241 | 0 | 0 | 6 | 568 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 326 | 238 | 0 | 0 | 6 | 564 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 908 | 760 | 0 | 0 | 7 | 1668 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 908 | 760 | 0 | 0 | 7 | 1668 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 998 | 846 | 0 | 0 | 7 | 1844 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 998 | 846 | 0 | 0 | 7 | 1844 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 833 | 630 | 0 | 0 | 7 | 1463 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 830 | 628 | 0 | 0 | 7 | 1458 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 784 | 596 | 0 | 0 | 7 | 1380 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 783 | 595 | 0 | 0 | 7 | 1378 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | model | 908 | 760 | 0 | 0 | 7 | 1668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `recurrent` | — | canonical | 908 | 760 | 0 | 0 | 7 | 1668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | model | 998 | 846 | 0 | 0 | 7 | 1844 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `kane-direct` | — | canonical | 998 | 846 | 0 | 0 | 7 | 1844 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | model | 833 | 630 | 0 | 0 | 7 | 1463 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `rnea` | — | canonical | 830 | 628 | 0 | 0 | 7 | 1458 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | model | 784 | 596 | 0 | 0 | 7 | 1380 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-inertial` | `newton-euler` | — | canonical | 783 | 595 | 0 | 0 | 7 | 1378 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 968 | 755 | 7 | 0 | 7 | 1723 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 1058 | 841 | 7 | 0 | 7 | 1899 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 514 | 420 | 7 | 0 | 6 | 934 |
 //! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 465 | 386 | 7 | 0 | 6 | 851 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 1138 | 970 | 7 | 0 | 7 | 2108 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 1228 | 1056 | 7 | 0 | 7 | 2284 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
-//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 922 | 745 | 7 | 0 | 7 | 1667 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `recurrent` | `ldlt` | model | 1138 | 970 | 7 | 0 | 7 | 2108 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `kane-direct` | `ldlt` | model | 1228 | 1056 | 7 | 0 | 7 | 2284 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
+//! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 922 | 745 | 7 | 0 | 7 | 1667 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 566 | 433 | 5 | 0 | 6 | 999 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -97,9 +97,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -150,7 +150,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 120u64,
@@ -163,7 +163,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 206u64,
@@ -176,7 +176,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 216u64,
@@ -189,7 +189,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
@@ -202,7 +202,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 326u64,
@@ -215,7 +215,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 465u64,
@@ -231,7 +231,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 681u64,
@@ -244,7 +244,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 681u64,
@@ -257,7 +257,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 778u64,
@@ -270,7 +270,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 778u64,
@@ -283,7 +283,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 709u64,
@@ -296,7 +296,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 709u64,
@@ -308,8 +308,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 577u64,
@@ -321,8 +321,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: None,
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 577u64,
@@ -335,7 +335,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 120u64,
@@ -348,7 +348,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
             mul: 120u64,
@@ -361,7 +361,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 618u64,
@@ -374,7 +374,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 618u64,
@@ -387,7 +387,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 708u64,
@@ -400,7 +400,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 708u64,
@@ -413,7 +413,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 256u64,
@@ -426,7 +426,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 253u64,
@@ -439,7 +439,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 207u64,
@@ -452,7 +452,7 @@ impl SsrmsF32 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 206u64,
@@ -465,7 +465,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 777u64,
@@ -478,7 +478,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 777u64,
@@ -491,7 +491,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 867u64,
@@ -504,7 +504,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 867u64,
@@ -517,7 +517,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 268u64,
@@ -530,7 +530,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 265u64,
@@ -543,7 +543,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 217u64,
@@ -556,7 +556,7 @@ impl SsrmsF32 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 216u64,
@@ -569,7 +569,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 864u64,
@@ -582,7 +582,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 864u64,
@@ -595,7 +595,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 954u64,
@@ -608,7 +608,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 954u64,
@@ -621,7 +621,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 502u64,
@@ -634,7 +634,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 499u64,
@@ -647,7 +647,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 453u64,
@@ -660,7 +660,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
@@ -672,8 +672,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1034u64,
@@ -685,8 +685,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1034u64,
@@ -698,8 +698,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1124u64,
@@ -711,8 +711,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 1124u64,
@@ -724,8 +724,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 959u64,
@@ -737,8 +737,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 956u64,
@@ -750,8 +750,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 910u64,
@@ -763,8 +763,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 909u64,
@@ -777,7 +777,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 554u64,
@@ -790,7 +790,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
             mul: 554u64,
@@ -803,7 +803,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 738u64,
@@ -816,7 +816,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 738u64,
@@ -829,7 +829,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 828u64,
@@ -842,7 +842,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 828u64,
@@ -855,7 +855,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 376u64,
@@ -868,7 +868,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 373u64,
@@ -881,7 +881,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 327u64,
@@ -894,7 +894,7 @@ impl SsrmsF32 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 326u64,
@@ -906,8 +906,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 908u64,
@@ -919,8 +919,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
             mul: 908u64,
@@ -932,8 +932,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
             mul: 998u64,
@@ -945,8 +945,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
             mul: 998u64,
@@ -958,8 +958,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "model",
             mul: 833u64,
@@ -971,8 +971,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
             mul: 830u64,
@@ -984,8 +984,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 784u64,
@@ -997,8 +997,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
             mul: 783u64,
@@ -1011,7 +1011,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 968u64,
@@ -1024,7 +1024,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1058u64,
@@ -1037,7 +1037,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 514u64,
@@ -1050,7 +1050,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 465u64,
@@ -1062,8 +1062,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("recurrent"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1138u64,
@@ -1075,8 +1075,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("kane-direct"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1228u64,
@@ -1088,8 +1088,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("rnea"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 971u64,
@@ -1101,8 +1101,8 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-base"),
-            bias_method: Some("newton-euler"),
+            mass_matrix_method: Some("crba-inertial"),
+            nonlinear_effects_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 922u64,
@@ -1115,7 +1115,7 @@ impl SsrmsF32 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: Some("aba"),
             frames: "model",
             mul: 566u64,
@@ -1272,7 +1272,7 @@ impl SsrmsF32 {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f32; 7], qd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -1435,7 +1435,7 @@ impl SsrmsF32 {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
+    /// Methods: nonlinear effects `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f32; 7], qd: &[f32; 7], qdd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -1601,7 +1601,7 @@ impl SsrmsF32 {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f32; 7], qd: &[f32; 7], tau: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -2047,7 +2047,7 @@ impl SsrmsF32 {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f32; 7],
@@ -2364,7 +2364,7 @@ impl SsrmsF32 {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f32; 7],

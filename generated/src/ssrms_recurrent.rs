@@ -6,16 +6,16 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
-//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
-//! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, bias or forward method; without it each takes the cheapest candidate.
+//! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, nonlinear-effects or forward method; without it each takes the cheapest candidate.
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! | function | mass matrix | nonlinear effects | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
 //! | `mass_matrix` * | `recurrent` | — | — | model | 681 | 661 | 0 | 0 | 7 | 1342 |
 //! | `nonlinear_effects` * | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
@@ -33,9 +33,9 @@ pub struct OpCount {
     pub function: &'static str,
     /// Its mass-matrix method.
     pub mass_matrix_method: Option<&'static str>,
-    /// Its bias method.
-    pub bias_method: Option<&'static str>,
-    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// Its nonlinear-effects method.
+    pub nonlinear_effects_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
@@ -86,7 +86,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 681u64,
@@ -99,7 +99,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 618u64,
@@ -112,7 +112,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1059u64,
@@ -125,7 +125,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1138u64,
@@ -138,7 +138,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1012u64,
@@ -151,7 +151,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1242u64,
@@ -167,7 +167,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
-            bias_method: None,
+            nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
             mul: 681u64,
@@ -180,7 +180,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 618u64,
@@ -193,7 +193,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1059u64,
@@ -206,7 +206,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1138u64,
@@ -219,7 +219,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
             mul: 1012u64,
@@ -232,7 +232,7 @@ impl SsrmsRecurrent {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("recurrent"),
-            bias_method: Some("recurrent"),
+            nonlinear_effects_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1242u64,
@@ -996,7 +996,7 @@ impl SsrmsRecurrent {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
+    /// Methods: nonlinear effects `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
@@ -1445,7 +1445,7 @@ impl SsrmsRecurrent {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `recurrent`: 1059 mul, 1016 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 601 fused where the target has FMA.
+    /// Methods: nonlinear effects `recurrent`: 1059 mul, 1016 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 601 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
@@ -2560,7 +2560,7 @@ impl SsrmsRecurrent {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `recurrent`, bias `recurrent`, forward `ldlt`: 1138 mul, 1072 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 660 fused where the target has FMA.
+    /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`, forward `ldlt`: 1138 mul, 1072 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 660 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
@@ -3790,7 +3790,7 @@ impl SsrmsRecurrent {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `recurrent`, bias `recurrent`: 1012 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 562 fused where the target has FMA.
+    /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`: 1012 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 562 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -4858,7 +4858,7 @@ impl SsrmsRecurrent {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `recurrent`, bias `recurrent`, forward `ldlt`: 1242 mul, 1177 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 732 fused where the target has FMA.
+    /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`, forward `ldlt`: 1242 mul, 1177 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 732 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],

@@ -630,8 +630,11 @@ impl System for SceneSystem<'_> {
                     // H[6+i][6+i] of the (6+N) mass matrix before the LDLᵀ solve.
                     Some(_) => {
                         let mut d = floating::dynamics(alg, &self.params, b, &st, q, qd, &loads);
-                        self.add_armature(&mut d.a);
-                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
+                        self.add_armature(&mut d.mass_matrix);
+                        kanegen_dynamics::ldlt::solve(
+                            &kanegen_dynamics::ldlt::ldlt(&d.mass_matrix),
+                            &d.tau_minus_c,
+                        )
                     }
                 };
                 floating_kinematics(n, x, &st, qd, dx);
@@ -644,8 +647,11 @@ impl System for SceneSystem<'_> {
                     // diagonal before the LDLᵀ solve.
                     Some(_) => {
                         let mut d = alg.dynamics(&self.params, q, qd, &loads);
-                        self.add_armature(&mut d.a);
-                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
+                        self.add_armature(&mut d.mass_matrix);
+                        kanegen_dynamics::ldlt::solve(
+                            &kanegen_dynamics::ldlt::ldlt(&d.mass_matrix),
+                            &d.tau_minus_c,
+                        )
                     }
                 };
                 dx[..n].copy_from_slice(qd);

@@ -5,16 +5,16 @@ use crate::entry::{trace, TraceError, Traced};
 use crate::function::Function;
 use crate::spec::{Effect, Spec, Subject};
 use crate::sym::{Convention, Counts};
-use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::Model;
 use serde::Serialize;
 
 /// One line of a count report (the JSON contract).
 #[derive(Clone, Debug, Serialize)]
 pub struct CountLine {
-    /// `mass_matrix` (`A`) or `bias` (`b = Q − h`).
+    /// `mass_matrix` (`M`) or `tau_minus_c` (`τ − c`, with the applied loads).
     pub function: String,
-    /// The mass-matrix method (for `mass_matrix`) or the bias method (for `bias`).
+    /// The mass-matrix method (for `mass_matrix`) or the nonlinear-effects method (for `tau_minus_c`).
     pub method: String,
     /// `paper`, `folded` or `emitted`.
     pub convention: String,
@@ -50,7 +50,7 @@ impl CountLine {
 pub struct EffectLine {
     /// `gravity`, `wrench[i]` or `damping`.
     pub effect: String,
-    /// The bias method.
+    /// The nonlinear-effects method.
     pub method: String,
     /// `emitted` or `paper`.
     pub convention: String,
@@ -62,16 +62,16 @@ pub struct EffectLine {
     pub div: i64,
 }
 
-/// Any mass-matrix method will do for a function that only uses the bias method.
-fn with_bias(bias: BiasMethod) -> Methods {
+/// Any mass-matrix method will do for a function that only uses the nonlinear-effects method.
+fn with_nonlinear_effects(nonlinear_effects: NonlinearEffectsMethod) -> Methods {
     Methods {
         mass_matrix: MassMatrixMethod::Crba,
-        bias,
+        nonlinear_effects,
         ..Methods::SPATIAL
     }
 }
 
-/// Traces `A` of every method in `mass` and `b` of every method in `bias` for `model` under
+/// Traces `M` of every method in `mass` and `τ − c` of every method in `nonlinear_effects` for `model` under
 /// `spec`, and lists their counts under every convention.
 ///
 /// # Errors
@@ -79,7 +79,7 @@ fn with_bias(bias: BiasMethod) -> Methods {
 pub fn count_lines(
     model: &Model,
     mass: &[MassMatrixMethod],
-    bias: &[BiasMethod],
+    nonlinear_effects: &[NonlinearEffectsMethod],
     spec: &Spec,
 ) -> Result<Vec<CountLine>, TraceError> {
     let mut lines = Vec::new();
@@ -96,14 +96,14 @@ pub fn count_lines(
         let t = trace(Subject::Model(model), Function::MassMatrix, methods, spec)?;
         push("mass_matrix", m.name(), &t);
     }
-    for &b in bias {
+    for &b in nonlinear_effects {
         let t = trace(
             Subject::Model(model),
             Function::GeneralizedForces,
-            with_bias(b),
+            with_nonlinear_effects(b),
             spec,
         )?;
-        push("bias", b.name(), &t);
+        push("tau_minus_c", b.name(), &t);
     }
     Ok(lines)
 }
@@ -112,20 +112,20 @@ fn diff(a: u64, b: u64) -> i64 {
     i64::try_from(a).unwrap_or(i64::MAX) - i64::try_from(b).unwrap_or(i64::MAX)
 }
 
-/// For each effect of `spec` and each bias method, the operations it adds to `b` (emitted and
+/// For each effect of `spec` and each nonlinear-effects method, the operations it adds to `b` (emitted and
 /// paper conventions): `b` with all of the spec's effects minus `b` with all but that one.
 ///
 /// # Errors
 /// As [`trace`].
 pub fn effect_lines(
     model: &Model,
-    bias: &[BiasMethod],
+    nonlinear_effects: &[NonlinearEffectsMethod],
     spec: &Spec,
 ) -> Result<Vec<EffectLine>, TraceError> {
     let all = spec.effects();
     let mut lines = Vec::new();
-    for &b in bias {
-        let methods = with_bias(b);
+    for &b in nonlinear_effects {
+        let methods = with_nonlinear_effects(b);
         let full = trace(
             Subject::Model(model),
             Function::GeneralizedForces,

@@ -32,8 +32,8 @@ use kanegen_dynamics::params::{axis_turn, is_near_signed_permutation};
 use kanegen_dynamics::regroup::regrouped;
 use kanegen_dynamics::spatial::RbInertia;
 use kanegen_dynamics::{
-    BiasMethod, ExternalWrench, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods, Params,
-    Scalar,
+    ExternalWrench, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods,
+    NonlinearEffectsMethod, Params, Scalar,
 };
 use kanegen_model::JointKind;
 use std::collections::HashMap;
@@ -69,7 +69,7 @@ pub struct TraceError {
 /// traced.
 ///
 /// # Errors
-/// A combination that makes no sense: gravity's term without gravity, a base-frame subject with
+/// A combination that makes no sense: gravity's term without gravity, an inertial-frame subject with
 /// a local-frame method or with effects, the paper's (14b) bookkeeping outside Table 1's setting,
 /// a runtime payload without a model, a wrench on a body that does not exist, or a function not
 /// (yet) traced for a free-floating base.
@@ -123,16 +123,16 @@ pub fn trace(
             Some(p)
         }
         Subject::Generic { n } => Some(generic_params(n, &mut input)),
-        Subject::BaseFrame { .. } => None,
+        Subject::InertialFrame { .. } => None,
     };
-    if let (Subject::BaseFrame { n }, None) = (subject, &params) {
-        let kin = base_frame_inputs(n, &mut input);
+    if let (Subject::InertialFrame { n }, None) = (subject, &params) {
+        let kin = inertial_frame_inputs(n, &mut input);
         let a = if spec.paper_14b {
             recurrent::mass_matrix_paper_bookkeeping(&kin)
         } else {
             methods
                 .mass_matrix
-                .from_base_frame(&kin)
+                .from_inertial_frame(&kin)
                 .expect("the CRBA is rejected by check")
         };
         let out = upper(&a);
@@ -262,7 +262,7 @@ pub fn trace(
                 .unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial));
             let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
             let b = |qd: &[Sym], l: &Loads<Sym>| {
-                floating::bias(methods.bias, &p, &base, &state, &q, qd, l)
+                floating::tau_minus_c(methods.nonlinear_effects, &p, &base, &state, &q, qd, l)
             };
             let fd =
                 |l: &Loads<Sym>| floating::forward_dynamics(methods, &p, &base, &state, &q, &qd, l);
@@ -276,8 +276,8 @@ pub fn trace(
                         omega_b: Vec3::zero(),
                         ..state.clone()
                     };
-                    negated(floating::bias(
-                        methods.bias,
+                    negated(floating::tau_minus_c(
+                        methods.nonlinear_effects,
                         &p,
                         &base,
                         &rest,
@@ -306,7 +306,8 @@ pub fn trace(
                         rnea::base_reaction(&p, &state, &q, &qd, &base_acc, joints, &loads(None))
                             .to_vec()
                     } else {
-                        let id = if methods.bias == BiasMethod::NewtonEuler {
+                        let id = if methods.nonlinear_effects == NonlinearEffectsMethod::NewtonEuler
+                        {
                             newton_euler::floating_inverse_dynamics
                         } else {
                             rnea::floating_inverse_dynamics
@@ -335,9 +336,23 @@ pub fn trace(
         }
         _ => match function {
             Function::MassMatrix => upper(&methods.mass_matrix.mass_matrix(&p, &q)),
-            Function::GeneralizedForces => methods.bias.bias(&p, &q, &qd, &loads(arg(Arg::Tau))),
-            Function::NonlinearEffects => negated(methods.bias.bias(&p, &q, &qd, &loads(None))),
-            Function::Gravity => negated(methods.bias.bias(&p, &q, &zeros, &gravity_only)),
+            Function::GeneralizedForces => {
+                methods
+                    .nonlinear_effects
+                    .tau_minus_c(&p, &q, &qd, &loads(arg(Arg::Tau)))
+            }
+            Function::NonlinearEffects => negated(methods.nonlinear_effects.tau_minus_c(
+                &p,
+                &q,
+                &qd,
+                &loads(None),
+            )),
+            Function::Gravity => negated(methods.nonlinear_effects.tau_minus_c(
+                &p,
+                &q,
+                &zeros,
+                &gravity_only,
+            )),
             Function::InverseDynamics => {
                 let qdd = qdd.expect("inverse dynamics takes q̈");
                 let tau = methods.inverse_dynamics(&p, &q, &qd, &qdd, &loads(None));
@@ -352,7 +367,12 @@ pub fn trace(
             }
             Function::MassMatrixAndNonlinearEffects => {
                 let mut v = upper(&methods.mass_matrix.mass_matrix(&p, &q));
-                v.extend(negated(methods.bias.bias(&p, &q, &qd, &loads(None))));
+                v.extend(negated(methods.nonlinear_effects.tau_minus_c(
+                    &p,
+                    &q,
+                    &qd,
+                    &loads(None),
+                )));
                 v
             }
             Function::FramePlacement(k) => {
@@ -385,13 +405,13 @@ fn check(
         return Err("the gravity term needs gravity".into());
     }
     if spec.paper_14b
-        && !(matches!(subject, Subject::BaseFrame { .. })
+        && !(matches!(subject, Subject::InertialFrame { .. })
             && methods.mass_matrix == MassMatrixMethod::RecurrentR1
             && function == Function::MassMatrix)
     {
         return Err(
             "the printed (14b) (inexact for N ≥ 3) is traced only as Table 1 counts it: the \
-             recurrent-r1 mass matrix from base-frame inputs"
+             recurrent-r1 mass matrix from inertial-frame inputs"
                 .into(),
         );
     }
@@ -401,15 +421,17 @@ fn check(
         || spec.runtime_payload
         || spec.base != Base::Fixed;
     match subject {
-        Subject::BaseFrame { .. } => {
+        Subject::InertialFrame { .. } => {
             if function != Function::MassMatrix {
-                return Err("a base-frame subject has only the mass matrix".into());
+                return Err("an inertial-frame subject has only the mass matrix".into());
             }
             if methods.mass_matrix == MassMatrixMethod::Crba {
-                return Err("the local-frame CRBA does not start from base-frame inputs".into());
+                return Err(
+                    "the local-frame CRBA does not start from inertial-frame inputs".into(),
+                );
             }
             if effects {
-                return Err("a base-frame subject takes no effects".into());
+                return Err("an inertial-frame subject takes no effects".into());
             }
         }
         Subject::Generic { .. } if effects => {
@@ -449,17 +471,20 @@ fn check(
         }
     }
     if let Subject::Model(m) = subject {
-        // The paper's base-frame algorithms handle serial chains only.
+        // The paper's inertial-frame algorithms handle serial chains only.
         let p = Params::<f64>::new(m);
         let uses = |b: bool| b || floating;
         if uses(function.uses_mass_matrix()) {
             methods.mass_matrix.check(&p).map_err(|e| e.to_string())?;
         }
-        if uses(function.uses_bias()) {
-            methods.bias.check(&p).map_err(|e| e.to_string())?;
+        if uses(function.uses_nonlinear_effects()) {
+            methods
+                .nonlinear_effects
+                .check(&p)
+                .map_err(|e| e.to_string())?;
         }
     }
-    let _ = BiasMethod::ALL; // every bias method traces every remaining combination
+    let _ = NonlinearEffectsMethod::ALL; // every nonlinear-effects method traces every remaining combination
     Ok(())
 }
 
@@ -551,9 +576,12 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
     }
 }
 
-/// `n` revolute bodies' base-frame quantities of eq. (1), (2), (6) as inputs (general geometry
+/// `n` revolute bodies' inertial-frame quantities of eq. (1), (2), (6) as inputs (general geometry
 /// and inertia; inertia tensors symmetric).
-fn base_frame_inputs(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Vec<BodyKinematics<Sym>> {
+fn inertial_frame_inputs(
+    n: usize,
+    input: &mut impl FnMut(Input) -> Sym,
+) -> Vec<BodyKinematics<Sym>> {
     (0..n)
         .map(|j| {
             let r = vec_input(input, &format!("r{j}_"));

@@ -194,10 +194,10 @@ impl Function {
         )
     }
 
-    /// Whether its result involves the bias forces (and so a bias method; with LDLᵀ for forward
+    /// Whether its result involves the bias forces (and so a nonlinear-effects method; with LDLᵀ for forward
     /// dynamics).
     #[must_use]
-    pub fn uses_bias(self) -> bool {
+    pub fn uses_nonlinear_effects(self) -> bool {
         matches!(
             self,
             Function::GeneralizedForces

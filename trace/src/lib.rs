@@ -10,8 +10,8 @@
 //! ```
 //! use kanegen_dynamics::Methods;
 //! use kanegen_trace::{trace, Convention, Function, Spec, Subject};
-//! // The paper's mass matrix for 3 general bodies, from its base-frame inputs (Table 1's start).
-//! let t = trace(Subject::BaseFrame { n: 3 }, Function::MassMatrix, Methods::RECURRENT,
+//! // The paper's mass matrix for 3 general bodies, from its inertial-frame inputs (Table 1's start).
+//! let t = trace(Subject::InertialFrame { n: 3 }, Function::MassMatrix, Methods::RECURRENT,
 //!     &Spec::default()).unwrap();
 //! let c = t.trace.counts(Convention::Paper);
 //! assert!(c.mul > 0 && c.add > 0);

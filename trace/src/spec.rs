@@ -17,10 +17,10 @@ pub enum Subject<'a> {
         /// Degrees of freedom.
         n: usize,
     },
-    /// `n` revolute bodies starting from the base-frame quantities of the paper's eq. (1), (2),
+    /// `n` revolute bodies starting from the inertial-frame quantities of the paper's eq. (1), (2),
     /// (6) as inputs (`r_{j−1,j}`, `a_j`, `m_j`, `c_j`, `I_j`): where the paper's Table 1 starts
-    /// counting. Only for the base-frame mass-matrix methods.
-    BaseFrame {
+    /// counting. Only for the inertial-frame mass-matrix methods.
+    InertialFrame {
         /// Degrees of freedom.
         n: usize,
     },
@@ -32,7 +32,7 @@ impl Subject<'_> {
     pub fn dof(&self) -> usize {
         match self {
             Subject::Model(m) => m.dof(),
-            Subject::Generic { n } | Subject::BaseFrame { n } => *n,
+            Subject::Generic { n } | Subject::InertialFrame { n } => *n,
         }
     }
 }
@@ -91,7 +91,7 @@ pub struct Spec {
     /// model, and not for the base reaction (a per-body wrench regrouping changes).
     pub regroup: bool,
     /// Evaluate (14b) as printed, without the exact correction: the paper's Table 1 bookkeeping,
-    /// **inexact for N ≥ 3**; only with [`Subject::BaseFrame`] and the `recurrent-r1` mass-matrix
+    /// **inexact for N ≥ 3**; only with [`Subject::InertialFrame`] and the `recurrent-r1` mass-matrix
     /// method.
     pub paper_14b: bool,
     /// Joint placements within this of a signed permutation, entry by entry, carry inertias in

@@ -1,7 +1,7 @@
 //! Table 1 of the paper reproduced by tracing (`kanegen table1`).
 //!
 //! Each algorithm's mass-matrix part is traced on [`Sym`] for `N = 1..=12` over chains with general
-//! geometry and inertia: the base-frame inputs `r_{j−1,j}`, `a_j`, `m_j`, `c_j`, `I_j` (the paper's
+//! geometry and inertia: the inertial-frame inputs `r_{j−1,j}`, `a_j`, `m_j`, `c_j`, `I_j` (the paper's
 //! Table 1 starts from them, `docs/paper.md`, "Operation counts") are all independent symbolic inputs, so no
 //! count depends on a particular model's zeros. The `spatial` algorithm works in local frames and
 //! is traced from `q` with every model parameter symbolic, so its count includes the kinematics.
@@ -33,8 +33,8 @@ pub enum TableAlgorithm {
     RecurrentP,
     /// `kane-direct`: the direct sums (9).
     KaneDirect,
-    /// `crba-base`: composite rigid bodies in base-frame notation.
-    CrbaBase,
+    /// `crba-inertial`: composite rigid bodies in inertial-frame notation.
+    CrbaInertial,
     /// `spatial`: Featherstone's CRBA in local frames, from `q` (includes kinematics).
     Spatial,
 }
@@ -46,7 +46,7 @@ impl TableAlgorithm {
         TableAlgorithm::Recurrent,
         TableAlgorithm::RecurrentP,
         TableAlgorithm::KaneDirect,
-        TableAlgorithm::CrbaBase,
+        TableAlgorithm::CrbaInertial,
         TableAlgorithm::Spatial,
     ];
     /// Name used in reports (the CLI's algorithm names, plus `recurrent-p`).
@@ -56,7 +56,7 @@ impl TableAlgorithm {
             TableAlgorithm::Recurrent => "recurrent",
             TableAlgorithm::RecurrentP => "recurrent-p",
             TableAlgorithm::KaneDirect => "kane-direct",
-            TableAlgorithm::CrbaBase => "crba-base",
+            TableAlgorithm::CrbaInertial => "crba-inertial",
             TableAlgorithm::Spatial => "spatial",
         }
     }
@@ -68,21 +68,21 @@ impl TableAlgorithm {
             TableAlgorithm::Recurrent => (MassMatrixMethod::Recurrent, false),
             TableAlgorithm::RecurrentP => (MassMatrixMethod::RecurrentR1, true),
             TableAlgorithm::KaneDirect => (MassMatrixMethod::KaneDirect, false),
-            TableAlgorithm::CrbaBase => (MassMatrixMethod::CrbaBase, false),
+            TableAlgorithm::CrbaInertial => (MassMatrixMethod::CrbaInertial, false),
             TableAlgorithm::Spatial => (MassMatrixMethod::Crba, false),
         }
     }
 }
 
 /// Traces the mass-matrix computation of `alg` for `n` bodies with general geometry and inertia;
-/// the outputs are the `N(N+1)/2` non-overlapping elements `A_ij`, `i ≤ j`. The base-frame
-/// algorithms start from the base-frame inputs of eq. (1), (2), (6) ([`Subject::BaseFrame`]),
+/// the outputs are the `N(N+1)/2` non-overlapping elements `A_ij`, `i ≤ j`. The inertial-frame
+/// algorithms start from the inertial-frame inputs of eq. (1), (2), (6) ([`Subject::InertialFrame`]),
 /// `spatial` from `q` with every model parameter symbolic ([`Subject::Generic`]).
 pub fn trace_mass_matrix(alg: TableAlgorithm, n: usize) -> Trace {
     let (mass_matrix, paper_14b) = alg.method();
     let subject = match alg {
         TableAlgorithm::Spatial => Subject::Generic { n },
-        _ => Subject::BaseFrame { n },
+        _ => Subject::InertialFrame { n },
     };
     let methods = Methods {
         mass_matrix,

@@ -1,7 +1,7 @@
 //! The paper's printed (14b) — what Table 1 counts — evaluated through the tracer, the only way
 //! to evaluate it: it is exact for N ≤ 2 and wrong for N ≥ 3.
 
-use kanegen_dynamics::algorithms::kinematics::base_frame;
+use kanegen_dynamics::algorithms::kinematics::inertial_frame;
 use kanegen_dynamics::algorithms::recurrent::{self, Variant};
 use kanegen_dynamics::metrics::rel_err_mat as rel_err;
 use kanegen_dynamics::{Params, Scalar};
@@ -15,7 +15,7 @@ fn paper_a(model: &kanegen_model::Model, q: &[f64]) -> Vec<Vec<f64>> {
     let n = q.len();
     let t = record(|_| {
         let qs: Vec<Sym> = q.iter().map(|&x| Sym::constant(x)).collect();
-        let kin = base_frame(&Params::<Sym>::new(model), &qs);
+        let kin = inertial_frame(&Params::<Sym>::new(model), &qs);
         recurrent::mass_matrix_paper_bookkeeping(&kin)
             .into_iter()
             .flatten()

@@ -341,10 +341,10 @@ macro_rules! dump_model {
             .iter()
             .map(|o| {
                 format!(
-                    "{{\"function\": \"{}\", \"mass_matrix_method\": {}, \"bias_method\": {}, \"mul\": {}, \"add\": {}, \"div\": {}, \"sqrt\": {}, \"sincos\": {}, \"fma\": {}}}",
+                    "{{\"function\": \"{}\", \"mass_matrix_method\": {}, \"nonlinear_effects_method\": {}, \"mul\": {}, \"add\": {}, \"div\": {}, \"sqrt\": {}, \"sincos\": {}, \"fma\": {}}}",
                     o.function,
                     opt(o.mass_matrix_method),
-                    opt(o.bias_method),
+                    opt(o.nonlinear_effects_method),
                     o.mul,
                     o.add,
                     o.div,

@@ -82,13 +82,13 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
             "M+c".into(),
             Box::new(move |q, qd| {
                 let d = methods.dynamics(p, q, qd, &Loads::default());
-                d.a[0][0] + d.a[6][6] + d.b[0] + d.b[6]
+                d.mass_matrix[0][0] + d.mass_matrix[6][6] + d.tau_minus_c[0] + d.tau_minus_c[6]
             }),
         ));
     }
     let fast = [
         ("recurrent", Methods::RECURRENT),
-        ("crba-base", Methods::CRBA_BASE),
+        ("crba-inertial", Methods::CRBA_INERTIAL),
         ("spatial", Methods::SPATIAL),
     ];
     c.push((

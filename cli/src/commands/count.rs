@@ -3,7 +3,7 @@
 
 use crate::scene_spec;
 use kanegen_codegen::choose::candidates;
-use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::{BaseKind, Model};
 use kanegen_sim::scene::{BaseSpec, Scene};
 use kanegen_trace::count::{count_lines, effect_lines, CountLine, EffectLine};
@@ -20,7 +20,7 @@ pub struct CountReport {
     pub n: usize,
     /// `fixed` or `free-floating`.
     pub base: String,
-    /// Whether gravity was included in `bias`.
+    /// Whether gravity was included in `tau_minus_c`.
     pub gravity: bool,
     /// One line per function, method and convention.
     pub counts: Vec<CountLine>,
@@ -37,7 +37,7 @@ pub const DIRECT_MAX_N: usize = 100;
 
 /// Every pair of methods the generator may emit a function of `model` by
 /// ([`kanegen_codegen::choose::candidates`] of `M` and of `c`): on a chain every mass-matrix and
-/// every bias method, `newton-euler` included; on a tree the local-frame ones (`crba`; `rnea`,
+/// every nonlinear-effects method, `newton-euler` included; on a tree the local-frame ones (`crba`; `rnea`,
 /// `newton-euler`).
 #[must_use]
 pub fn emittable(model: &Model) -> Vec<Methods> {
@@ -52,19 +52,19 @@ pub fn emittable(model: &Model) -> Vec<Methods> {
 }
 
 /// The methods of a selection of presets, each listed once, in report order.
-fn methods_of(presets: &[Methods]) -> (Vec<MassMatrixMethod>, Vec<BiasMethod>) {
+fn methods_of(presets: &[Methods]) -> (Vec<MassMatrixMethod>, Vec<NonlinearEffectsMethod>) {
     let mass = MassMatrixMethod::ALL
         .into_iter()
         .filter(|m| presets.iter().any(|p| p.mass_matrix == *m))
         .collect();
-    let bias = BiasMethod::ALL
+    let nonlinear_effects = NonlinearEffectsMethod::ALL
         .into_iter()
-        .filter(|b| presets.iter().any(|p| p.bias == *b))
+        .filter(|b| presets.iter().any(|p| p.nonlinear_effects == *b))
         .collect();
-    (mass, bias)
+    (mass, nonlinear_effects)
 }
 
-/// Counts of `A` for every mass-matrix method and of `b` for every bias method of `presets`, on
+/// Counts of `A` for every mass-matrix method and of `b` for every nonlinear-effects method of `presets`, on
 /// the model's base (free-floating: `6 + N` speeds, the base state as inputs).
 ///
 /// # Errors
@@ -89,11 +89,11 @@ pub fn count_with_progress(
     explicit: bool,
     progress: &dyn Fn(usize, usize),
 ) -> Result<CountReport, TraceError> {
-    let (mut mass, mut bias) = methods_of(presets);
+    let (mut mass, mut nonlinear_effects) = methods_of(presets);
     let mut omitted = Vec::new();
     if !explicit && model.dof() > DIRECT_MAX_N {
         mass.retain(|m| *m != MassMatrixMethod::KaneDirect);
-        bias.retain(|b| *b != BiasMethod::KaneDirect);
+        nonlinear_effects.retain(|b| *b != NonlinearEffectsMethod::KaneDirect);
         omitted.push(format!(
             "kane-direct (N = {} > {DIRECT_MAX_N}: O(N³); --algorithm kane-direct counts it)",
             model.dof()
@@ -106,13 +106,13 @@ pub fn count_with_progress(
         },
         ..Spec::with_gravity(gravity)
     };
-    let total = mass.len() + bias.len();
+    let total = mass.len() + nonlinear_effects.len();
     let mut counts = Vec::new();
     for (k, m) in mass.iter().enumerate() {
         counts.extend(count_lines(model, &[*m], &[], &spec)?);
         progress(k + 1, total);
     }
-    for (k, b) in bias.iter().enumerate() {
+    for (k, b) in nonlinear_effects.iter().enumerate() {
         counts.extend(count_lines(model, &[], &[*b], &spec)?);
         progress(mass.len() + k + 1, total);
     }
@@ -191,7 +191,7 @@ pub struct SceneCountReport {
     pub n: usize,
     /// `A` and `b` (all the scene's effects) per method and convention.
     pub counts: Vec<CountLine>,
-    /// Per effect, bias method and convention (`emitted`, `paper`): the operations it adds.
+    /// Per effect, nonlinear-effects method and convention (`emitted`, `paper`): the operations it adds.
     pub effects: Vec<EffectLine>,
     /// Per payload event kind (`capture`, `release`), mass-matrix method and convention: the
     /// operations of one event (`method` is the mass-matrix method; see
@@ -209,9 +209,9 @@ pub fn count_scene(
     name: &str,
     presets: &[Methods],
 ) -> Result<SceneCountReport, TraceError> {
-    let (mass, bias) = methods_of(presets);
+    let (mass, nonlinear_effects) = methods_of(presets);
     let spec = scene_spec::spec(scene);
-    let counts = count_lines(&scene.model, &mass, &bias, &spec)?;
+    let counts = count_lines(&scene.model, &mass, &nonlinear_effects, &spec)?;
     Ok(SceneCountReport {
         scene: name.into(),
         base: match scene.base {
@@ -221,8 +221,8 @@ pub fn count_scene(
         .into(),
         n: scene.model.dof(),
         effects: {
-            let mut e = effect_lines(&scene.model, &bias, &spec)?;
-            e.extend(drive_effect_lines(scene, &bias));
+            let mut e = effect_lines(&scene.model, &nonlinear_effects, &spec)?;
+            e.extend(drive_effect_lines(scene, &nonlinear_effects));
             e
         },
         events: crate::commands::count_events::event_effect_lines(scene, &mass, &counts),
@@ -231,14 +231,17 @@ pub fn count_scene(
 }
 
 /// The drive effects outside the traced `A` and `b` (the viscous part of `friction` is
-/// `damping`, traced with `b`), counted from their formulas, per bias method (the same for
+/// `damping`, traced with `b`), counted from their formulas, per nonlinear-effects method (the same for
 /// each) and convention: `coulomb` subtracts `τ_c,i tanh(q̇_i · (1/v_s))` from `b` (2 mul,
 /// 1 add and one `tanh` per joint); `rotor` adds the constant `I_m,i n_i²` to `A_ii` (1 add per
 /// joint) before the solve; `flexible` (Spong's joints) forms the spring-damper torque
 /// `K_i (θ_i − q_i) + D_i (θ̇_i − q̇_i)` (2 mul, 3 add; 1 mul, 1 add without `D_i`) and the
 /// motor acceleration `(τ_m,i − τ_s,i) / B_i` (1 add, 1 div) per joint. `emitted` leaves out the
 /// joints whose coefficient is 0 (folded away), `paper` counts every joint.
-fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
+fn drive_effect_lines(
+    scene: &Scene,
+    nonlinear_effects: &[NonlinearEffectsMethod],
+) -> Vec<EffectLine> {
     let nonzero = |v: &[f64]| v.iter().filter(|x| **x != 0.0).count() as i64;
     let n = scene.model.dof() as i64;
     let mut lines = Vec::new();
@@ -255,7 +258,7 @@ fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
     .into_iter()
     .flatten()
     .collect();
-    for b in bias {
+    for b in nonlinear_effects {
         for &(effect, coef, mul_per_joint) in &effects {
             for conv in ["emitted", "paper"] {
                 let k = if conv == "paper" { n } else { nonzero(coef) };

@@ -56,7 +56,10 @@ pub fn eval_states(
                 gravity: gravity.map(Vec3),
                 external: Vec::new(),
             };
-            let Dynamics { a, b } = match (&s.base, &base) {
+            let Dynamics {
+                mass_matrix: a,
+                tau_minus_c: b,
+            } = match (&s.base, &base) {
                 (Some(bs), Some(base)) => {
                     let state = FloatingState {
                         position: Vec3(bs.position),

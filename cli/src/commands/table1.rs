@@ -122,8 +122,8 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
                 0,
             ),
             (
-                "crba-base, traced (paper conv.)".into(),
-                total_of(TableAlgorithm::CrbaBase, "paper"),
+                "crba-inertial, traced (paper conv.)".into(),
+                total_of(TableAlgorithm::CrbaInertial, "paper"),
                 BLUE,
                 0,
             ),
@@ -134,8 +134,8 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
                 0,
             ),
             (
-                "crba-base, emitted".into(),
-                total_of(TableAlgorithm::CrbaBase, "emitted"),
+                "crba-inertial, emitted".into(),
+                total_of(TableAlgorithm::CrbaInertial, "emitted"),
                 RGBColor(0, 120, 160),
                 0,
             ),

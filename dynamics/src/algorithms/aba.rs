@@ -45,7 +45,7 @@
 //! regrouped parameters, in the body frames the generator chose (`kanegen_codegen`'s defaults:
 //! the random chains in canonical frames, every joint axis z). LDLᵀ on the CRBA's `M` and the
 //! RNEA's `c`; LDLᵀ as the generator pairs it, with its cheapest mass-matrix method and its
-//! cheapest bias method (on the random chains up to N = 9 the CRBA and the classical
+//! cheapest nonlinear-effects method (on the random chains up to N = 9 the CRBA and the classical
 //! Newton–Euler); this algorithm. The random chains are `random_chain(N, seed 1000 + N)` of
 //! `benches/data` (general geometry: dense rotations, skew axes). `codegen/tests/aba.rs` measures
 //! them again and fails when this table is stale.
@@ -64,11 +64,11 @@
 //! top of the mass matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is
 //! cheaper than LDLᵀ on the CRBA and the RNEA from **N = 11** (5137 against 5226), and than the
 //! generator's cheapest LDLᵀ from **N = 13** (6227 against 6438), which is where generated code
-//! switches to it (N = 9 and 10 before the CRBA and the Newton–Euler bias carried through
+//! switches to it (N = 9 and 10 before the CRBA and the Newton–Euler `c` carried through
 //! canonical frames' placements in two turns, `JointParams::split_placement`; from N = 25 the
 //! mass matrix is traced without them, `codegen::choose`); at N = 64 it needs 4.6× fewer
 //! operations. On SSRMS (N = 7) ABA costs 943 against 871 for LDLᵀ
-//! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler bias costs 791 and is
+//! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler `c` costs 791 and is
 //! emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
 //! and its joint placements signed permutations and offsets along one axis, which fold. A
 //! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: on the
@@ -105,7 +105,7 @@
 //! let p = Params::<f64>::new(&tree);
 //! let (q, qd) = ([0.1, -0.4, 0.9, 0.3, -1.2], [0.5, 0.2, -0.3, 0.1, 0.7]);
 //! let loads = Loads { tau: Some(vec![1.0, -2.0, 0.5, 0.0, 3.0]), ..Loads::default() };
-//! // The same q̈ as LDLᵀ on the CRBA mass matrix and the RNEA bias.
+//! // The same q̈ as LDLᵀ on the CRBA mass matrix and the RNEA `τ − c`.
 //! let qdd = aba::forward_dynamics(&p, &q, &qd, &loads);
 //! let want = Methods::SPATIAL.forward_dynamics(&p, &q, &qd, &loads);
 //! assert!(qdd.iter().zip(&want).all(|(x, y)| (x - y).abs() < 1e-9 * (1.0 + y.abs())));
@@ -491,7 +491,7 @@ fn accelerations<S: Scalar>(
 /// `q`, `q̇`: joint positions and velocities, length `N`; `loads`: the drives `τ` (zero when
 /// absent), gravity `g` in the base frame (the base acceleration `a_0 = [0; −g]`) and external
 /// wrenches (force at `O_j`, moment about `O_j`, in the body's or the base frame), as
-/// [`crate::algorithms::rnea::bias`] takes them. One division per joint. Section `"spatial:aba"`.
+/// [`crate::algorithms::rnea::tau_minus_c`] takes them. One division per joint. Section `"spatial:aba"`.
 /// Allocates a [`Workspace`] and calls [`forward_dynamics_in`].
 pub fn forward_dynamics<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
     let mut ws = Workspace::new(p);
@@ -546,7 +546,7 @@ pub fn forward_dynamics_in<S: Scalar>(
 /// [`FloatingBase::inertia`]), `p^A_0 = v_0 ×* I_0 v_0 − f^x_0`; the joints on the base carry
 /// their `I^a`, `p^a` onto it, and `a'_0 = −(I^A_0)⁻¹ p^A_0` by a 6×6 LDLᵀ. Gravity is left
 /// out of the passes (every `a'_i = a_i − a_grav` obeys the same recursion) and put back on the
-/// base: `a_0 = a'_0 + [0; R₀ᵀ g]`. Loads as [`crate::algorithms::rnea::floating_bias`] takes
+/// base: `a_0 = a'_0 + [0; R₀ᵀ g]`. Loads as [`crate::algorithms::rnea::floating_tau_minus_c`] takes
 /// them (inertial-frame wrenches rotated into body coordinates with `E_0j R₀ᵀ`).
 /// Section `"spatial:aba"`. Allocates a [`Workspace`] and calls [`floating_in`].
 pub fn floating<S: Scalar>(

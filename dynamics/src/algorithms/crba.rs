@@ -1,5 +1,5 @@
 //! The composite-rigid-body algorithm in local body coordinates (RBDA Table 6.2; spatial_v2
-//! `HandC`, the `H` part): an independent cross-check of the paper's base-frame algorithms (it
+//! `HandC`, the `H` part): an independent cross-check of the paper's inertial-frame algorithms (it
 //! does not use `kinematics.rs`), and the fixed- and floating-base mass matrix of choice for
 //! generated code.
 //!

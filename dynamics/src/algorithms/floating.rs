@@ -1,5 +1,5 @@
-//! An arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
-//! `(6+N)×(6+N)`, `b` has `6+N` entries. The conventions are stated once, in [`crate::base`];
+//! An arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `M` is
+//! `(6+N)×(6+N)`, `τ − c` has `6+N` entries. The conventions are stated once, in [`crate::base`];
 //! they are repeated here for the reader.
 //!
 //! # Conventions
@@ -10,9 +10,9 @@
 //! - **Generalized velocity** `ν = [v_b (3), ω_b (3), q̇ (N)]` (Pinocchio free-flyer): `v_b` the
 //!   linear velocity of the base-frame origin and `ω_b` the base's angular velocity, both in
 //!   **base** coordinates.
-//! - `A ν̇ = b`, `b = Q − h`, where `ν̇` is the time derivative of the components of `ν` (so
+//! - `M ν̇ + c = τ` (the paper's `A ν̇ = b`, `b = τ − c`), where `ν̇` is the time derivative of the components of `ν` (so
 //!   `v̇_b` is the derivative of the base-coordinate components, not the base origin's
-//!   acceleration). Rows `0..3` of `b` hold the external + gravity force on the system and rows
+//!   acceleration). Rows `0..3` of `τ − c` hold the external + gravity force on the system and rows
 //!   `3..6` its moment about the base origin, both in base coordinates, minus the velocity-product
 //!   terms; rows `6..` are the arm's rows.
 //! - **Position state** for integrators: `[p₀ (3), quat (4: x, y, z, w), q (N)]`, with
@@ -26,15 +26,15 @@
 //!
 //! # How (one algorithm source)
 //!
-//! The base-frame algorithms (`recurrent`, `recurrent-r1`, `crba-base`, `kane-direct`) run
-//! unchanged on the extended body list of [`kinematics::floating_base_frame`]: the base as six
+//! The inertial-frame algorithms (`recurrent`, `recurrent-r1`, `crba-inertial`, `kane-direct`) run
+//! unchanged on the extended body list of [`kinematics::floating_inertial_frame`]: the base as six
 //! virtual joints (3 prismatic, then 3 revolute, axes `R₀e_m` through `p₀`) whose partial
 //! velocities are exactly those of `ν_b`, everything in the inertial frame. The velocity-product
 //! recursion starts from the base body's true motion ([`kinematics::floating_base_motion`]).
-//! This extension is **serial-chain only**, like the base-frame algorithms (it panics on a tree).
+//! This extension is **serial-chain only**, like the inertial-frame algorithms (it panics on a tree).
 //! `spatial` ([`Methods::SPATIAL`]) is an independent implementation that takes any kinematic
 //! tree: Featherstone's floating-base CRBA and RNEA in body coordinates
-//! ([`crba::floating_mass_matrix`], [`rnea::floating_bias`]).
+//! ([`crba::floating_mass_matrix`], [`rnea::floating_tau_minus_c`]).
 //!
 //! Momentum and kinetic energy ([`momentum()`], [`kinetic_energy()`], re-exported from
 //! [`crate::algorithms::momentum`]) take any tree; [`momentum_by_bodies`] and
@@ -62,9 +62,11 @@
 //! ```
 
 use crate::algorithms::kinematics::{
-    self, floating_base_frame, floating_motion, BodyKinematics, BodyMotion,
+    self, floating_inertial_frame, floating_motion, BodyKinematics, BodyMotion,
 };
-use crate::algorithms::methods::{BiasMethod, Dynamics, ForwardMethod, MassMatrixMethod, Methods};
+use crate::algorithms::methods::{
+    Dynamics, ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod,
+};
 use crate::algorithms::{aba, crba, kane_direct, newton_euler, recurrent, rnea};
 use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
 use crate::linalg::Vec3;
@@ -103,10 +105,10 @@ fn extended_loads<S: Scalar>(loads: &Loads<S>, n: usize) -> Loads<S> {
     }
 }
 
-/// `A` (`(6+N)×(6+N)`) of the arm `p` on the free-floating base `base` at arm positions `q`.
-/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`] (serial
-/// chains only); [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`] (any tree). `A`
-/// does not depend on the base pose; `state` is the pose the base-frame methods express their
+/// `M` (`(6+N)×(6+N)`) of the arm `p` on the free-floating base `base` at arm positions `q`.
+/// The inertial-frame methods run on the virtual-joint extension of [`floating_inertial_frame`] (serial
+/// chains only); [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`] (any tree). `M`
+/// does not depend on the base pose; `state` is the pose the inertial-frame methods express their
 /// quantities in.
 ///
 /// # Panics
@@ -120,24 +122,24 @@ pub fn mass_matrix<S: Scalar>(
 ) -> Vec<Vec<S>> {
     match method {
         MassMatrixMethod::Crba => crba::floating_mass_matrix(p, base, q),
-        base_frame => {
-            p.assert_chain(base_frame.name());
-            base_frame
-                .from_base_frame(&floating_base_frame(p, base, state, q))
-                .expect("every method but the CRBA starts from base-frame quantities")
+        inertial_frame => {
+            p.assert_chain(inertial_frame.name());
+            inertial_frame
+                .from_inertial_frame(&floating_inertial_frame(p, base, state, q))
+                .expect("every method but the CRBA starts from inertial-frame quantities")
         }
     }
 }
 
-/// `b` (`6+N` entries) of `A ν̇ = b` for the arm `p` on the free-floating base `base` in the state
+/// `τ − c` (`6+N` entries) of `M ν̇ + c = τ` for the arm `p` on the free-floating base `base` in the state
 /// `state`, with arm rates `qd` and `loads` (conventions of [`crate::base`]).
-/// [`BiasMethod::Rnea`] runs [`rnea::floating_bias`] (any tree), the base-frame methods the
+/// [`NonlinearEffectsMethod::Rnea`] runs [`rnea::floating_tau_minus_c`] (any tree), the inertial-frame methods the
 /// virtual-joint extension (serial chains only).
 ///
 /// # Panics
-/// A serial-chain-only method on a tree ([`BiasMethod::check`]).
-pub fn bias<S: Scalar>(
-    method: BiasMethod,
+/// A serial-chain-only method on a tree ([`NonlinearEffectsMethod::check`]).
+pub fn tau_minus_c<S: Scalar>(
+    method: NonlinearEffectsMethod,
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -148,26 +150,30 @@ pub fn bias<S: Scalar>(
     let n = p.dof();
     assert_eq!(qd.len(), n, "qd has the wrong length");
     match method {
-        BiasMethod::Rnea => return rnea::floating_bias(p, base, state, q, qd, loads),
-        BiasMethod::NewtonEuler => {
-            return newton_euler::floating_bias(p, base, state, q, qd, loads)
+        NonlinearEffectsMethod::Rnea => {
+            return rnea::floating_tau_minus_c(p, base, state, q, qd, loads)
         }
-        BiasMethod::Recurrent | BiasMethod::KaneDirect => {}
+        NonlinearEffectsMethod::NewtonEuler => {
+            return newton_euler::floating_tau_minus_c(p, base, state, q, qd, loads)
+        }
+        NonlinearEffectsMethod::Recurrent | NonlinearEffectsMethod::KaneDirect => {}
     }
     p.assert_chain(method.name());
-    let kin = floating_base_frame(p, base, state, q);
+    let kin = floating_inertial_frame(p, base, state, q);
     let mot = floating_motion(&kin, state, qd);
     let ext = extended_loads(loads, n);
     let f_ie = kinematics::inertial_external(&kin, &mot, &ext);
     let tau = ext.tau.as_deref();
     match method {
-        BiasMethod::Recurrent => recurrent::bias_base(&kin, &f_ie, tau),
-        BiasMethod::KaneDirect => kane_direct::bias_base(&kin, &f_ie, tau),
-        BiasMethod::Rnea | BiasMethod::NewtonEuler => unreachable!("handled above"),
+        NonlinearEffectsMethod::Recurrent => recurrent::tau_minus_c_inertial(&kin, &f_ie, tau),
+        NonlinearEffectsMethod::KaneDirect => kane_direct::tau_minus_c_inertial(&kin, &f_ie, tau),
+        NonlinearEffectsMethod::Rnea | NonlinearEffectsMethod::NewtonEuler => {
+            unreachable!("handled above")
+        }
     }
 }
 
-/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]); any tree with
+/// `M` and `τ − c` of the free-floating system ([`mass_matrix`], [`tau_minus_c`]); any tree with
 /// [`Methods::SPATIAL`].
 pub fn dynamics<S: Scalar>(
     methods: Methods,
@@ -179,12 +185,12 @@ pub fn dynamics<S: Scalar>(
     loads: &Loads<S>,
 ) -> Dynamics<S> {
     Dynamics {
-        a: mass_matrix(methods.mass_matrix, p, base, state, q),
-        b: bias(methods.bias, p, base, state, q, qd, loads),
+        mass_matrix: mass_matrix(methods.mass_matrix, p, base, state, q),
+        tau_minus_c: tau_minus_c(methods.nonlinear_effects, p, base, state, q, qd, loads),
     }
 }
 
-/// Forward dynamics `ν̇ = A⁻¹ b` (`[v̇_b; ω̇_b; q̈]`): by the branch-free LDLᵀ of
+/// Forward dynamics `ν̇ = M⁻¹ (τ − c)` (`[v̇_b; ω̇_b; q̈]`): by the branch-free LDLᵀ of
 /// [`crate::ldlt`] on [`dynamics`] ([`ForwardMethod::Ldlt`]), or by the floating-base
 /// articulated-body algorithm ([`ForwardMethod::Aba`], [`aba::floating`]; any tree).
 pub fn forward_dynamics<S: Scalar>(
@@ -199,14 +205,14 @@ pub fn forward_dynamics<S: Scalar>(
     match methods.forward {
         ForwardMethod::Ldlt => {
             let d = dynamics(methods, p, base, state, q, qd, loads);
-            crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+            crate::ldlt::solve(&crate::ldlt::ldlt(&d.mass_matrix), &d.tau_minus_c)
         }
         ForwardMethod::Aba => aba::floating(p, base, state, q, qd, loads),
     }
 }
 
 /// Positions (inertial frame, from the inertial origin) of the frame origins of the extended
-/// bodies of [`floating_base_frame`].
+/// bodies of [`floating_inertial_frame`].
 fn positions<S: Scalar>(kin: &[BodyKinematics<S>], state: &FloatingState<S>) -> Vec<Vec3<S>> {
     let mut x = state.position.clone();
     kin.iter()
@@ -244,7 +250,7 @@ pub fn momentum_by_bodies<S: Scalar>(
     q: &[S],
     qd: &[S],
 ) -> (Vec3<S>, Vec3<S>) {
-    let kin = floating_base_frame(p, base, state, q);
+    let kin = floating_inertial_frame(p, base, state, q);
     let mot = floating_motion(&kin, state, qd);
     let x = positions(&kin, state);
     let mut lin = Vec3::zero();
@@ -269,7 +275,7 @@ pub fn kinetic_energy_by_bodies<S: Scalar>(
     q: &[S],
     qd: &[S],
 ) -> S {
-    let kin = floating_base_frame(p, base, state, q);
+    let kin = floating_inertial_frame(p, base, state, q);
     let mot = floating_motion(&kin, state, qd);
     let x = positions(&kin, state);
     let two = S::constant(2.0);

@@ -44,7 +44,7 @@ struct PartialVelocities<S> {
 
 /// Eq. (3): `R_j = R_{j-1} + R^rel_j`, `T_j = T_{j-1} + r̃ᵀ_{j-1,j} R_{j-1} + T^rel_j`, fixed base
 /// (`T_{-1} = R_{-1} = 0`). `R^rel_j` (revolute) or `T^rel_j` (prismatic) has the single non-zero
-/// column `j`, the joint axis in the base frame.
+/// column `j`, the joint axis in the inertial frame.
 fn partial_velocities<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<PartialVelocities<S>> {
     S::section("(3)");
     let mut out: Vec<PartialVelocities<S>> = Vec::with_capacity(kin.len());
@@ -80,10 +80,10 @@ fn partial_velocities<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<PartialVeloci
     out
 }
 
-/// Eq. (9) from base-frame inputs (eq. (1), (2), (6): [`kinematics::base_frame`]): the generalized
+/// Eq. (9) from inertial-frame inputs (eq. (1), (2), (6): [`kinematics::inertial_frame`]): the generalized
 /// inertia matrix `A`, full and symmetric (upper triangle accumulated, then mirrored).
 /// Section `"(9)"` (the partial velocities are traced under `"(3)"`).
-pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
+pub fn mass_matrix_inertial<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
     let n = kin.len();
     let pv = partial_velocities(kin);
     S::section("(9)");
@@ -127,31 +127,31 @@ pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
     p.assert_chain("kane-direct");
-    mass_matrix_base(&kinematics::base_frame(p, q))
+    mass_matrix_inertial(&kinematics::inertial_frame(p, q))
 }
 
 /// The generalized forces `b(q, q̇, loads) = Q − h` by the direct sum (10), with the resultants
-/// (11) (gravity at each centre of mass, external wrenches at `O_j` in the body or base frame) and
+/// (11) (gravity at each centre of mass, external wrenches at `O_j` in the body or the base frame) and
 /// the joint drives `loads.tau` (added when present). Section `"(10)"`.
 ///
 /// # Panics
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
-pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+pub fn tau_minus_c<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
     p.assert_chain("kane-direct");
     let n = p.dof();
     if let Some(tau) = &loads.tau {
         assert_eq!(tau.len(), n, "loads.tau has the wrong length");
     }
-    let kin = kinematics::base_frame(p, q);
+    let kin = kinematics::inertial_frame(p, q);
     let mot = kinematics::motion(&kin, qd);
     let fie = kinematics::inertial_external(&kin, &mot, loads);
-    bias_base(&kin, &fie, loads.tau.as_deref())
+    tau_minus_c_inertial(&kin, &fie, loads.tau.as_deref())
 }
 
-/// The direct sum (10) from base-frame inputs: the kinematics `kin` of eq. (1), (2), (6), the
+/// The direct sum (10) from inertial-frame inputs: the kinematics `kin` of eq. (1), (2), (6), the
 /// resultants `fie[j] = (f^IE_j, m^IE_j)` of eq. (11) and the joint drives `tau` (added when
 /// present). Section `"(10)"` (the partial velocities are traced under `"(3)"`).
-pub fn bias_base<S: Scalar>(
+pub fn tau_minus_c_inertial<S: Scalar>(
     kin: &[BodyKinematics<S>],
     fie: &[(Vec3<S>, Vec3<S>)],
     tau: Option<&[S]>,

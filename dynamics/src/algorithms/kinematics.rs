@@ -1,7 +1,7 @@
-//! Base-frame kinematics of the paper, eq. (1)–(7) and the resultants (11).
+//! Inertial-frame kinematics of the paper, eq. (1)–(7) and the resultants (11).
 //!
-//! Shared by the base-frame algorithms (`recurrent`, `kane-direct`, `crba-base`), which are
-//! **serial-chain only**: [`base_frame`] and [`floating_base_frame`] panic on a kinematic tree
+//! Shared by the inertial-frame algorithms (`recurrent`, `kane-direct`, `crba-inertial`), which are
+//! **serial-chain only**: [`inertial_frame`] and [`floating_inertial_frame`] panic on a kinematic tree
 //! ([`Params::assert_chain`]). Indices here are 0-based: body `j` is moved by joint `j`, its
 //! predecessor is `j − 1` and "body −1" is the base, whose frame is the inertial frame (fixed
 //! base: zero velocity and acceleration).
@@ -10,7 +10,7 @@
 //! |---|---|
 //! | `τ_j` | [`BodyKinematics::orientation`] |
 //! | `r_{j-1,j}` | [`BodyKinematics::r`] |
-//! | `R^rel_j` non-zero column / `T^rel_j` non-zero column | [`BodyKinematics::axis`] (joint axis, base frame) |
+//! | `R^rel_j` non-zero column / `T^rel_j` non-zero column | [`BodyKinematics::axis`] (joint axis, inertial frame) |
 //! | `m_j`, `c_j`, `I_j` (eq. 6, about `O_j`) | `m`, `c`, `inertia` |
 //! | `ω_j`, `v_j`, `ε_j`, `w_j` (eq. 3–5) | [`BodyMotion`] |
 
@@ -23,16 +23,16 @@ use crate::scalar::Scalar;
 use kanegen_model::JointKind;
 use kanegen_runtime::inertia::parallel_axis;
 
-/// Position-level quantities of one body in the base frame.
+/// Position-level quantities of one body in the inertial frame.
 #[derive(Clone, Debug)]
 pub struct BodyKinematics<S> {
     /// Kind of the joint that moves this body.
     pub kind: JointKind,
-    /// `τ_j`: orientation of the body frame in the base frame (eq. (1)).
+    /// `τ_j`: orientation of the body frame in the inertial frame (eq. (1)).
     pub orientation: Mat3<S>,
     /// `r_{j-1,j}`: from `O_{j-1}` (the base origin for `j = 0`) to `O_j` (eq. (2)).
     pub r: Vec3<S>,
-    /// Unit joint axis in the base frame: the non-zero column of `R^rel_j` (revolute) or
+    /// Unit joint axis in the inertial frame: the non-zero column of `R^rel_j` (revolute) or
     /// `T^rel_j` (prismatic).
     pub axis: Vec3<S>,
     /// `m_j`.
@@ -43,7 +43,7 @@ pub struct BodyKinematics<S> {
     pub inertia: Mat3<S>,
 }
 
-/// Velocity-level quantities of one body in the base frame (eq. (3)–(5)).
+/// Velocity-level quantities of one body in the inertial frame (eq. (3)–(5)).
 #[derive(Clone, Debug)]
 pub struct BodyMotion<S> {
     /// `ω_j`: angular velocity.
@@ -70,22 +70,22 @@ pub fn body_inertia_about_origin<S: Scalar>(
 }
 
 /// Eq. (1), (2), (6): orientations, joint-to-joint vectors, axes and inertial quantities of every
-/// body in the base frame.
-pub fn base_frame<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<BodyKinematics<S>> {
-    base_frame_from(p, q, None)
+/// body in the inertial frame.
+pub fn inertial_frame<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<BodyKinematics<S>> {
+    inertial_frame_from(p, q, None)
 }
 
-/// [`base_frame`] with the base body's orientation `τ_{-1}` given: `None` is the fixed base
+/// [`inertial_frame`] with the base body's orientation `τ_{-1}` given: `None` is the fixed base
 /// (`τ_{-1} = 1`, the base frame is the reference frame); `Some(R₀)` expresses every quantity in
 /// the frame in which the base frame has orientation `R₀` (the inertial frame of a free-floating
 /// base, see [`crate::algorithms::floating`]). Vectors `r_{j-1,j}` stay relative, so `r_{-1,0}`
 /// starts at the base-frame origin.
-pub fn base_frame_from<S: Scalar>(
+pub fn inertial_frame_from<S: Scalar>(
     p: &Params<S>,
     q: &[S],
     tau_base: Option<&Mat3<S>>,
 ) -> Vec<BodyKinematics<S>> {
-    p.assert_chain("base-frame kinematics (1)-(7)");
+    p.assert_chain("inertial-frame kinematics (1)-(7)");
     assert_eq!(q.len(), p.dof(), "q has the wrong length");
     let mut out: Vec<BodyKinematics<S>> = Vec::with_capacity(p.dof());
     let mut tau_prev = tau_base.cloned().unwrap_or_else(Mat3::identity);
@@ -188,7 +188,7 @@ pub fn motion_from<S: Scalar>(
 }
 
 /// Eq. (7) and (11): resultant inertial plus external force `f^IE_j` (at `O_j`) and moment
-/// `m^IE_j` (about `O_j`) of every body, in the base frame. Gravity `g` acts at the centre of mass:
+/// `m^IE_j` (about `O_j`) of every body, in the inertial frame. Gravity `g` acts at the centre of mass:
 /// force `m_j g`, moment `c_j × g`. Only the loads present in `loads` are traced.
 pub fn inertial_external<S: Scalar>(
     kin: &[BodyKinematics<S>],
@@ -238,10 +238,10 @@ pub fn inertial_external<S: Scalar>(
 /// all at `q = 0` with `r = 0` between them (virtual body 0 stores `r = p₀`, its position from
 /// the inertial origin, which no recursion reads). All six virtual bodies have the base's
 /// orientation `τ = R₀`; bodies `0..5` are massless and body 5 carries the base body's inertia,
-/// so the base-frame algorithms' prismatic/revolute formulas give the `(6+N)×(6+N)` matrix `A`
+/// so the inertial-frame algorithms' prismatic/revolute formulas give the `(6+N)×(6+N)` matrix `A`
 /// with no change. Because each virtual axis is `R₀e_m`, a row `a·F` of an inertial-frame
 /// vector `F` is directly its base-coordinate component `(R₀ᵀF)_m`.
-pub fn floating_base_frame<S: Scalar>(
+pub fn floating_inertial_frame<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -283,7 +283,7 @@ pub fn floating_base_frame<S: Scalar>(
             },
         });
     }
-    out.extend(base_frame_from(p, q, Some(r0)));
+    out.extend(inertial_frame_from(p, q, Some(r0)));
     out
 }
 
@@ -303,7 +303,7 @@ pub fn floating_base_motion<S: Scalar>(state: &FloatingState<S>) -> BodyMotion<S
     }
 }
 
-/// Eq. (3)–(5) for the extended bodies of [`floating_base_frame`]: the six virtual bodies move
+/// Eq. (3)–(5) for the extended bodies of [`floating_inertial_frame`]: the six virtual bodies move
 /// with the base body ([`floating_base_motion`]), the arm's bodies follow by [`motion_from`].
 pub fn floating_motion<S: Scalar>(
     kin: &[BodyKinematics<S>],

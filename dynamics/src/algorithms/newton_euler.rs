@@ -2,8 +2,8 @@
 //! M. W. Walker and R. P. C. Paul, "On-line computational scheme for mechanical manipulators",
 //! 1980; in the customized form of W. Khalil and J.-F. Kleinfinger, "Minimum operations and
 //! minimum parameters of the dynamic models of tree structure robots", 1987, and Khalil & Dombre,
-//! *Modeling, Identification and Control of Robots*, 2002, §9.5): inverse dynamics and the bias
-//! forces with 3-vectors instead of spatial vectors.
+//! *Modeling, Identification and Control of Robots*, 2002, §9.5): inverse dynamics and `τ − c`
+//! with 3-vectors instead of spatial vectors.
 //!
 //! The spatial RNEA ([`crate::algorithms::rnea`]) carries each body's twist `[ω; v]`; this one
 //! carries `ω`, `ω̇` and the *classical* acceleration `a` of the body origin, which needs no linear
@@ -22,7 +22,7 @@
 //!
 //! Gravity is the fictitious base acceleration `a_0 = −g` (as in the spatial RNEA). The results
 //! equal the spatial RNEA's; the traced operation counts differ, and code generation keeps the
-//! cheaper ([`crate::BiasMethod::NewtonEuler`]). Any kinematic tree, fixed or free-floating base.
+//! cheaper ([`crate::NonlinearEffectsMethod::NewtonEuler`]). Any kinematic tree, fixed or free-floating base.
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::{newton_euler, rnea};
@@ -31,8 +31,8 @@
 //! let model = random_chain(&ChainSpec { n: 4, ..Default::default() }, 2);
 //! let p = Params::<f64>::new(&model);
 //! let (q, qd) = ([0.1, -0.4, 0.9, 0.3], [0.5, 0.2, -0.3, 1.0]);
-//! let a = newton_euler::bias(&p, &q, &qd, &Loads::default());
-//! let b = rnea::bias(&p, &q, &qd, &Loads::default());
+//! let a = newton_euler::tau_minus_c(&p, &q, &qd, &Loads::default());
+//! let b = rnea::tau_minus_c(&p, &q, &qd, &Loads::default());
 //! assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-10));
 //! ```
 
@@ -288,9 +288,9 @@ fn with_drives<S: Scalar>(c: Vec<S>, loads: &Loads<S>) -> Vec<S> {
     }
 }
 
-/// The generalized forces `b = Q − C(q, q̇, f_ext)` with `q̈ = 0`, fixed base; arguments and
-/// loads as [`crate::algorithms::rnea::bias`]. Section `"newton-euler"`.
-pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+/// `τ − c(q, q̇, f_ext)` with `q̈ = 0`, fixed base; arguments and
+/// loads as [`crate::algorithms::rnea::tau_minus_c`]. Section `"newton-euler"`.
+pub fn tau_minus_c<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
     S::section("newton-euler");
     let (c, _) = passes(p, q, qd, None, loads, &fixed_start(loads));
     with_drives(c, loads)
@@ -356,10 +356,10 @@ fn base_total<S: Scalar>(
     }
 }
 
-/// `b` (`6 + N` entries) of the tree `p` on the free-floating base `base` in the state `state`,
-/// as [`crate::algorithms::rnea::floating_bias`]: `b_base = −[f_0; n_0]`, `b_arm = τ − C`.
+/// `τ − c` (`6 + N` entries) of the tree `p` on the free-floating base `base` in the state `state`,
+/// as [`crate::algorithms::rnea::floating_tau_minus_c`]: `b_base = −[f_0; n_0]`, `b_arm = τ − C`.
 /// Section `"newton-euler"`.
-pub fn floating_bias<S: Scalar>(
+pub fn floating_tau_minus_c<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,

@@ -7,7 +7,7 @@
 //! **Indices.** The paper numbers bodies `1..N`; here they are `0..n` (paper body `j` is our
 //! `j − 1`, the paper's `N` is our `n − 1`). `r_{i,j}` is the vector from `O_i` to `O_j`.
 //!
-//! **Inputs.** [`mass_matrix_base`] starts from the base-frame quantities of eq. (1), (2), (6)
+//! **Inputs.** [`mass_matrix_inertial`] starts from the inertial-frame quantities of eq. (1), (2), (6)
 //! ([`BodyKinematics`]: `r_{j-1,j}`, `a_j`, `m_j`, `c_j`, `I_j`), which is where Table 1 starts
 //! counting. Its arithmetic follows the paper's counting convention (docs/paper.md, "Operation counts"):
 //! 3×3 products accumulate from zero, skew matrices carry literal zeros, cumulative sums start
@@ -19,7 +19,7 @@
 //! N ≥ 3**, on symbolic scalars only.
 //!
 //! **Prismatic joints.** The paper treats revolute joints only. Pairs with a prismatic joint use
-//! the formulas of docs/paper.md, I6 (see [`mass_matrix_base`]); revolute pairs keep (16), (20),
+//! the formulas of docs/paper.md, I6 (see [`mass_matrix_inertial`]); revolute pairs keep (16), (20),
 //! which stay exact because `r_{i,k}` includes the joint translations.
 //!
 //! ```
@@ -39,7 +39,7 @@
 //! }
 //! ```
 
-use crate::algorithms::kinematics::{base_frame, inertial_external, motion, BodyKinematics};
+use crate::algorithms::kinematics::{inertial_external, inertial_frame, motion, BodyKinematics};
 use crate::linalg::{Mat3, Vec3};
 use crate::loads::Loads;
 use crate::params::Params;
@@ -113,7 +113,7 @@ fn skew_skew_t<S: Scalar>(x: &Vec3<S>, y: &Vec3<S>) -> Mat3<S> {
     skew(x).mul_mat(&skew(y).transpose())
 }
 
-/// The generalized inertia matrix `A` (full symmetric, `a[i][j]`) from base-frame inputs, by
+/// The generalized inertia matrix `A` (full symmetric, `a[i][j]`) from inertial-frame inputs, by
 /// (12)–(16) and (20), with (14b) in the form `variant`.
 ///
 /// This is the entry point the Table-1 op-count tracer runs on symbolic inputs, so its operation
@@ -129,11 +129,11 @@ fn skew_skew_t<S: Scalar>(x: &Vec3<S>, y: &Vec3<S>) -> Mat3<S> {
 /// - prismatic `i <` revolute `j`: `A_ij = e_i · (a_j × C^Σ_{j,j})`.
 ///
 /// Panics if `kin` is empty.
-pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>], variant: Variant) -> Vec<Vec<S>> {
+pub fn mass_matrix_inertial<S: Scalar>(kin: &[BodyKinematics<S>], variant: Variant) -> Vec<Vec<S>> {
     mass_matrix_form(kin, variant.into())
 }
 
-/// **Inexact for `N ≥ 3` — not a dynamics algorithm.** [`mass_matrix_base`] with (14b) in the
+/// **Inexact for `N ≥ 3` — not a dynamics algorithm.** [`mass_matrix_inertial`] with (14b) in the
 /// printed scalar form without the correction of [`Variant::R1`]: the structure whose operations
 /// the paper's Table 1 counts, kept only so the op-count tracer can reproduce that bookkeeping.
 /// It takes a [`Symbolic`] scalar, so it cannot be evaluated numerically by mistake.
@@ -356,8 +356,8 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
     a
 }
 
-/// The generalized inertia matrix `A(q)` of the paper's recurrent algorithm: base-frame
-/// kinematics (1), (2), (6) ([`base_frame`]) then [`mass_matrix_base`].
+/// The generalized inertia matrix `A(q)` of the paper's recurrent algorithm: inertial-frame
+/// kinematics (1), (2), (6) ([`inertial_frame`]) then [`mass_matrix_inertial`].
 ///
 /// # Panics
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
@@ -366,32 +366,32 @@ pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S], variant: Variant) -> Vec<V
         Variant::R2 => "recurrent",
         Variant::R1 => "recurrent-r1",
     });
-    let kin = base_frame(p, q);
-    mass_matrix_base(&kin, variant)
+    let kin = inertial_frame(p, q);
+    mass_matrix_inertial(&kin, variant)
 }
 
 /// The generalized forces `b(q, q̇) = Q − h` of `A q̈ = b` (eq. (8)): kinematics (1)–(7),
-/// resultants (11), then [`bias_base`] with the joint drives `loads.tau` when given.
+/// resultants (11), then [`tau_minus_c_inertial`] with the joint drives `loads.tau` when given.
 ///
 /// # Panics
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
-pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+pub fn tau_minus_c<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
     p.assert_chain("recurrent");
-    let kin = base_frame(p, q);
+    let kin = inertial_frame(p, q);
     let mot = motion(&kin, qd);
     let f_ie = inertial_external(&kin, &mot, loads);
-    bias_base(&kin, &f_ie, loads.tau.as_deref())
+    tau_minus_c_inertial(&kin, &f_ie, loads.tau.as_deref())
 }
 
 /// The backward force recursion (17)–(19) and the projection (21), from the resultants
-/// `f_ie[j] = (f^IE_j, m^IE_j)` of eq. (11) (force at `O_j`, moment about `O_j`, base frame).
+/// `f_ie[j] = (f^IE_j, m^IE_j)` of eq. (11) (force at `O_j`, moment about `O_j`, inertial frame).
 ///
 /// (19b) is evaluated by the O(N) recursion
 /// `m^ΣO_j = m^IE_j + m^ΣO_{j+1} + r_{j,j+1} × f^Σ_{j+1}`, equivalent to the printed double sum
 /// `m^Σ_j + Σ_{k>j} r̃_{j,k} f^IE_k` (docs/paper.md, R10); it absorbs (18), so `m^Σ_j` is not
 /// formed separately (`m^ΣO_N = m^Σ_N = m^IE_N`, (18a), (19a)).
 /// `b_j = a_j · m^ΣO_j` (revolute) or `a_j · f^Σ_j` (prismatic), plus `tau[j]` when given (21).
-pub fn bias_base<S: Scalar>(
+pub fn tau_minus_c_inertial<S: Scalar>(
     kin: &[BodyKinematics<S>],
     f_ie: &[(Vec3<S>, Vec3<S>)],
     tau: Option<&[S]>,

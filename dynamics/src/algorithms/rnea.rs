@@ -1,5 +1,5 @@
 //! The recursive Newton–Euler algorithm in local body coordinates (RBDA Table 5.1; spatial_v2
-//! `ID`, and the `C` part of `HandC`): inverse dynamics in one O(N) pass, and the bias forces
+//! `ID`, and the `C` part of `HandC`): inverse dynamics in one O(N) pass, and `τ − c`
 //! with `q̈ = 0`. Spatial algebra and conventions: [`crate::spatial`].
 //!
 //! Any kinematic tree (`λ(i)` = [`crate::JointParams::parent`]). Forward pass:
@@ -10,7 +10,7 @@
 //! `E_0i = E_i E_0λ(i)` along the body's own path. On a serial chain the operations are exactly
 //! those of the chain algorithm.
 //!
-//! On a free-floating base (RBDA ch. 9, Pinocchio's free-flyer): [`floating_bias`] (`ν̇ = 0`),
+//! On a free-floating base (RBDA ch. 9, Pinocchio's free-flyer): [`floating_tau_minus_c`] (`ν̇ = 0`),
 //! [`floating_inverse_dynamics`] and the arm's reaction on the base, [`base_reaction`].
 //!
 //! ```
@@ -23,7 +23,7 @@
 //! // τ = H q̈ + C: one O(N) pass against the mass matrix and the q̈ = 0 pass.
 //! let tau = rnea::inverse_dynamics(&p, &q, &qd, &qdd, &Loads::default());
 //! let h = crba::mass_matrix(&p, &q);
-//! let b = rnea::bias(&p, &q, &qd, &Loads::default());
+//! let b = rnea::tau_minus_c(&p, &q, &qd, &Loads::default());
 //! for i in 0..3 {
 //!     let hq: f64 = (0..3).map(|j| h[i][j] * qdd[j]).sum();
 //!     assert!((tau[i] - (hq - b[i])).abs() < 1e-9);
@@ -183,14 +183,14 @@ fn with_drives<S: Scalar>(c: Vec<S>, loads: &Loads<S>) -> Vec<S> {
     }
 }
 
-/// The generalized forces `b = Q − C(q, q̇, f_ext)` with `q̈ = 0`, fixed base.
+/// `τ − c(q, q̇, f_ext)` (RBDA's `τ − C`) with `q̈ = 0`, fixed base.
 ///
 /// `p`: the model's parameters; `q`, `q̇`: joint positions and velocities, length `N`; `loads`:
 /// joint drives `Q = loads.tau` (added when present), gravity `g` in the base frame (entered as
 /// the base acceleration `a_0 = [0; −g]`), and external wrenches (force at `O_j`, moment about
 /// `O_j`; base-frame ones are rotated into body coordinates with the body's orientation), which
 /// enter `C` as `−f^x_j`. Section `"spatial:rnea"`.
-pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+pub fn tau_minus_c<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
     S::section("spatial:rnea");
     let (c, _) = passes(p, q, qd, None, loads, fixed_start(loads));
     with_drives(c, loads)
@@ -253,14 +253,14 @@ fn isolated_base<S: Scalar>(
     subtract_external(f0, loads, BASE_BODY, &start.e0)
 }
 
-/// The generalized forces `b` (`6 + N` entries) of the arm `p` (any kinematic tree) on the
+/// `τ − c` (`6 + N` entries) of the arm `p` (any kinematic tree) on the
 /// free-floating base `base` in the state `state` (conventions of [`crate::base`]), RNEA with
 /// `ν̇ = 0`: base `v_0 = [ω_b; v_b]`, `a_0 = [0; −R₀ᵀ g]`,
-/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm as in [`bias`],
+/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm as in [`tau_minus_c`],
 /// `f_0 += Σ_{λ(i) = base} Xup_iᵀ f_i`; then `b_base = −[f_0.f; f_0.n]`,
 /// `b_arm,j = τ_j − S_jᵀ f_j`. Inertial-frame wrenches are rotated into body coordinates with
 /// `E_{0j} R₀ᵀ`. Section `"spatial:floating"`.
-pub fn floating_bias<S: Scalar>(
+pub fn floating_tau_minus_c<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -292,7 +292,7 @@ pub fn floating_bias<S: Scalar>(
 /// - `w_b = [f; n]`: the external wrench an actuator would have to apply to the base body, force
 ///   and moment about the base origin in base coordinates; `τ`: the joint drives.
 ///
-/// One O(N) pass: [`floating_bias`]'s recursion with `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]` and `q̈`.
+/// One O(N) pass: [`floating_tau_minus_c`]'s recursion with `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]` and `q̈`.
 /// Section `"spatial:floating"`.
 #[allow(clippy::too_many_arguments)] // the state of a free-floating system, as in Pinocchio
 pub fn floating_inverse_dynamics<S: Scalar>(

@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 pub struct EffectRow {
     /// `gravity`, `wrench[i]` or `damping`.
     pub effect: String,
-    /// Multiplications plus additions the effect adds to the emitted `b` (the scene's bias method).
+    /// Multiplications plus additions the effect adds to the emitted `b` (the scene's nonlinear-effects method).
     pub ops: i64,
     /// `max |x(T) − x_without(T)| / max |x(T)|`: the final state with the effect against the one
     /// without it, same integrator settings.
@@ -45,7 +45,11 @@ fn final_state(scene: &Scene) -> Result<Vec<f64>> {
 /// Cost and trajectory change of every effect `scene` names.
 pub fn effects_report(scene: &Scene) -> Result<Vec<EffectRow>> {
     let spec = scene_spec::spec(scene);
-    let lines = effect_lines(&scene.model, &[scene.simulation.algorithm.bias], &spec)?;
+    let lines = effect_lines(
+        &scene.model,
+        &[scene.simulation.algorithm.nonlinear_effects],
+        &spec,
+    )?;
     let x = final_state(scene)?;
     let mut rows = Vec::new();
     for e in spec.effects() {

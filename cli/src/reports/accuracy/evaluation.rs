@@ -98,11 +98,11 @@ pub fn random_states(n: usize, count: usize, seed: u64) -> Vec<State> {
 /// `A`, `b` and `q̈` (or `ν̇`), read back as `f64`.
 #[derive(Clone, Debug)]
 pub struct Evaluated {
-    /// The mass matrix.
-    pub a: Vec<Vec<f64>>,
-    /// `b = Q − h`.
-    pub b: Vec<f64>,
-    /// `A⁻¹ b` by the branch-free LDLᵀ.
+    /// `M`, the mass matrix.
+    pub mass_matrix: Vec<Vec<f64>>,
+    /// `τ − c`.
+    pub tau_minus_c: Vec<f64>,
+    /// `M⁻¹ (τ − c)` by the branch-free LDLᵀ.
     pub qdd: Vec<f64>,
 }
 
@@ -150,8 +150,11 @@ pub fn dynamics_on<S: Scalar>(
             floating::dynamics(alg, &p, &base, &st, q, qd, &loads)
         }
     };
-    let qdd = kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b);
-    (d.a, d.b, qdd)
+    let qdd = kanegen_dynamics::ldlt::solve(
+        &kanegen_dynamics::ldlt::ldlt(&d.mass_matrix),
+        &d.tau_minus_c,
+    );
+    (d.mass_matrix, d.tau_minus_c, qdd)
 }
 
 /// Evaluates `A`, `b` and `A⁻¹ b` of `subject` at `state` on the scalar `S` with `alg`.
@@ -161,8 +164,8 @@ pub fn evaluate<S: Real>(subject: &Subject, alg: Methods, state: &State) -> Eval
     let (a, b, qdd) = dynamics_on(subject, alg, &c(&state.q), &c(&state.qd), c(&state.tau));
     let f = |v: &[S]| -> Vec<f64> { v.iter().map(Real::to_f64).collect() };
     Evaluated {
-        a: a.iter().map(|r| f(r)).collect(),
-        b: f(&b),
+        mass_matrix: a.iter().map(|r| f(r)).collect(),
+        tau_minus_c: f(&b),
         qdd: f(&qdd),
     }
 }
@@ -217,8 +220,8 @@ pub fn errors(results: &[Evaluated], reference: &[Evaluated]) -> [f64; 3] {
         .zip(reference)
         .fold([0.0_f64; 3], |m, (x, r)| {
             [
-                m[0].max(rel_err_mat(&x.a, &r.a)),
-                m[1].max(rel_err(&x.b, &r.b)),
+                m[0].max(rel_err_mat(&x.mass_matrix, &r.mass_matrix)),
+                m[1].max(rel_err(&x.tau_minus_c, &r.tau_minus_c)),
                 m[2].max(rel_err(&x.qdd, &r.qdd)),
             ]
         })
@@ -316,19 +319,19 @@ pub type StateFn = fn(&[f64], &[f64], &[f64]) -> Vec<f64>;
 pub struct GeneratedFns {
     /// The precision name of the row.
     pub precision: &'static str,
-    /// `A(q)`.
+    /// `M(q)`.
     pub mass_matrix: fn(&[f64]) -> Vec<Vec<f64>>,
-    /// `b(q, q̇, τ)`.
-    pub bias: StateFn,
-    /// `q̈ = A⁻¹ b` (the generated unrolled LDLᵀ).
+    /// `τ − c(q, q̇)`.
+    pub tau_minus_c: StateFn,
+    /// `q̈ = M⁻¹ (τ − c)` (the generated unrolled LDLᵀ).
     pub forward_dynamics: StateFn,
 }
 
 impl GeneratedFns {
     fn evaluate(&self, s: &State) -> Evaluated {
         Evaluated {
-            a: (self.mass_matrix)(&s.q),
-            b: (self.bias)(&s.q, &s.qd, &s.tau),
+            mass_matrix: (self.mass_matrix)(&s.q),
+            tau_minus_c: (self.tau_minus_c)(&s.q, &s.qd, &s.tau),
             qdd: (self.forward_dynamics)(&s.q, &s.qd, &s.tau),
         }
     }
@@ -361,7 +364,10 @@ pub fn evaluation_report(
         .iter()
         .map(|s| evaluate::<Wide>(subject, alg, s))
         .collect();
-    let cond_a = reference.iter().map(|r| cond(&r.a)).fold(0.0, f64::max);
+    let cond_a = reference
+        .iter()
+        .map(|r| cond(&r.mass_matrix))
+        .fold(0.0, f64::max);
     let mut rows: Vec<(String, String, [f64; 3])> = INTERPRETED
         .iter()
         .map(|&(name, f)| {

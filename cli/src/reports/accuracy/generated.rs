@@ -31,7 +31,7 @@ macro_rules! generated_fns {
                 .map(|r| r.iter().map(|&x| f64::from(x)).collect())
                 .collect()
         }
-        fn bias(q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
+        fn tau_minus_c(q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
             let c = <$ty>::nonlinear_effects(&arr(q), &arr(qd));
             let tau = arr(tau);
             (0..N).map(|i| f64::from(tau[i] - c[i])).collect()
@@ -44,7 +44,7 @@ macro_rules! generated_fns {
         GeneratedFns {
             precision: $precision,
             mass_matrix,
-            bias,
+            tau_minus_c,
             forward_dynamics,
         }
     }};

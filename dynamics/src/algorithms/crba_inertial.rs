@@ -1,7 +1,7 @@
-//! The composite-rigid-body algorithm (Stepanenko's method, the CRBA) in the paper's base-frame
+//! The composite-rigid-body algorithm (Stepanenko's method, the CRBA) in the paper's inertial-frame
 //! notation: the comparison baseline of Table 1 (Stepanenko's method, `docs/paper.md`).
 //!
-//! It starts from the same base-frame inputs as the recurrent algorithm ([`BodyKinematics`]:
+//! It starts from the same inertial-frame inputs as the recurrent algorithm ([`BodyKinematics`]:
 //! `r_{j-1,j}`, `a_j`, `m_j`, `c_j`, `I_j` about `O_j`) and the same reference points `O_i`.
 //! Indices are 0-based (paper body `j` is our `j − 1`).
 //!
@@ -15,10 +15,10 @@
 //!    Moving the reference point down the chain, `n ← n + r_{i,i+1} × f`, and
 //!    `A_ij = a_i · n` (revolute `i`) or `e_i · f` (prismatic `i`).
 //!
-//! `b` reuses the recurrent algorithm's base-frame force recursion
-//! ([`recurrent::bias_base`]).
+//! `b` reuses the recurrent algorithm's inertial-frame force recursion
+//! ([`recurrent::tau_minus_c_inertial`]).
 
-use crate::algorithms::kinematics::{base_frame, inertial_external, motion, BodyKinematics};
+use crate::algorithms::kinematics::{inertial_external, inertial_frame, motion, BodyKinematics};
 use crate::algorithms::recurrent;
 use crate::linalg::{Mat3, Vec3};
 use crate::loads::Loads;
@@ -26,11 +26,11 @@ use crate::params::Params;
 use crate::scalar::Scalar;
 use kanegen_model::JointKind;
 
-/// The generalized inertia matrix `A` (full symmetric, `a[i][j]`) from base-frame inputs by the
+/// The generalized inertia matrix `A` (full symmetric, `a[i][j]`) from inertial-frame inputs by the
 /// composite-rigid-body algorithm. Panics if `kin` is empty.
-pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
+pub fn mass_matrix_inertial<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
     let n = kin.len();
-    assert!(n > 0, "crba_base: empty chain");
+    assert!(n > 0, "crba_inertial: empty chain");
     let last = n - 1;
 
     S::section("crba:composite");
@@ -80,26 +80,26 @@ pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
     a
 }
 
-/// The generalized inertia matrix `A(q)`: base-frame kinematics (1), (2), (6) then
-/// [`mass_matrix_base`].
+/// The generalized inertia matrix `A(q)`: inertial-frame kinematics (1), (2), (6) then
+/// [`mass_matrix_inertial`].
 ///
 /// # Panics
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
-    p.assert_chain("crba-base");
-    mass_matrix_base(&base_frame(p, q))
+    p.assert_chain("crba-inertial");
+    mass_matrix_inertial(&inertial_frame(p, q))
 }
 
-/// The generalized forces `b(q, q̇) = Q − h`: the same base-frame computation as the recurrent
+/// The generalized forces `b(q, q̇) = Q − h`: the same inertial-frame computation as the recurrent
 /// algorithm — kinematics (1)–(7), resultants (11) and the force recursion (17)–(21) of
-/// [`recurrent::bias_base`] (a CRBA computes only `A`; `b` comes from an inverse-dynamics pass).
+/// [`recurrent::tau_minus_c_inertial`] (a CRBA computes only `A`; `b` comes from an inverse-dynamics pass).
 ///
 /// # Panics
 /// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
-pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
-    p.assert_chain("crba-base");
-    let kin = base_frame(p, q);
+pub fn tau_minus_c<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    p.assert_chain("crba-inertial");
+    let kin = inertial_frame(p, q);
     let mot = motion(&kin, qd);
     let f_ie = inertial_external(&kin, &mot, loads);
-    recurrent::bias_base(&kin, &f_ie, loads.tau.as_deref())
+    recurrent::tau_minus_c_inertial(&kin, &f_ie, loads.tau.as_deref())
 }
