@@ -144,13 +144,43 @@ pub fn mass_matrix_paper_bookkeeping<S: Symbolic>(kin: &[BodyKinematics<S>]) -> 
 fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<Vec<S>> {
     let n = kin.len();
     assert!(n > 0, "recurrent: empty chain");
-    let last = n - 1; // the paper's N
-    let m = |j: usize| &kin[j].m;
-    let c = |j: usize| &kin[j].c;
 
     // ---- Stage 1 ----
+    let r = chain_vectors(kin);
+    let m_sigma = cumulative_masses(kin);
+    let c_ij = first_moments_about_joints(kin, &r);
+
+    // ---- 1. Inertia matrices of the sub-chains ----
+    let mut m_rr1 = own_inertias(kin);
+    let m_rr2 = match variant {
+        Form::R2 => translational_inertias_exact(kin, &r),
+        Form::R1 | Form::P => {
+            let m_rr2 = translational_inertias_scalar(kin, &r, &m_sigma);
+            if variant == Form::R1 && n >= 3 {
+                fold_r1_correction(&r, &m_sigma, &mut m_rr1);
+            }
+            m_rr2
+        }
+    };
+    let m_rr3 = coupling_inertias(kin, &r);
+
+    // ---- 2. Resultant inertia matrices about the joints ----
+    let m_sig_rr = resultant_inertias(n, &m_rr1, &m_rr2, &m_rr3);
+
+    // ---- Pairs with a prismatic joint (docs/paper.md, I6) ----
+    let c_sigma = kin
+        .iter()
+        .any(|k| k.kind == JointKind::Prismatic)
+        .then(|| composite_first_moments(kin, &c_ij));
+
+    // ---- 4. (20) A_ij = a_iᵀ M^Σ,rr_{i,j} a_j ----
+    project_on_axes(kin, &m_sig_rr, &m_sigma, c_sigma.as_ref())
+}
+
+/// (12) `r_{i,j} = r_{i,i+1} + r_{i+1,j}`, `j = N..3`, `i = j−2..1`; `r_{i,i+1} = r_{j-1,j}` of (2).
+fn chain_vectors<S: Scalar>(kin: &[BodyKinematics<S>]) -> Upper<Vec3<S>> {
+    let n = kin.len();
     S::section("(12)");
-    // (12) r_{i,j} = r_{i,i+1} + r_{i+1,j},  j = N..3, i = j−2..1;  r_{i,i+1} = r_{j-1,j} of (2).
     let mut r: Upper<Vec3<S>> = Upper::new(n);
     for (j, k) in kin.iter().enumerate().skip(1) {
         r.set(j - 1, j, k.r.clone());
@@ -161,123 +191,173 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
             r.set(i, j, rij);
         }
     }
+    r
+}
 
+/// (12a) `m^Σ_i = m_i + m^Σ_{i+1}`, `m^Σ_{N+1} = 0` (N additions); `n + 1` entries.
+fn cumulative_masses<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<S> {
+    let n = kin.len();
     S::section("(12a)");
-    // (12a) m^Σ_i = m_i + m^Σ_{i+1},  m^Σ_{N+1} = 0  (N additions).
     let mut m_sigma = vec![S::zero(); n + 1];
     for i in (0..n).rev() {
-        m_sigma[i] = m(i).clone() + m_sigma[i + 1].clone();
+        m_sigma[i] = kin[i].m.clone() + m_sigma[i + 1].clone();
     }
+    m_sigma
+}
 
+/// (12b) `C_{i,j} = m_j r_{i,j} + c_j`, `i = N−1..1`, `j = N..i+1`.
+fn first_moments_about_joints<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    r: &Upper<Vec3<S>>,
+) -> Upper<Vec3<S>> {
+    let n = kin.len();
     S::section("(12b)");
-    // (12b) C_{i,j} = m_j r_{i,j} + c_j,  i = N−1..1, j = N..i+1.
     let mut c_ij: Upper<Vec3<S>> = Upper::new(n);
-    for i in (0..last).rev() {
+    for i in (0..n - 1).rev() {
         for j in (i + 1..n).rev() {
-            c_ij.set(i, j, r.get(i, j).scale(m(j)) + c(j).clone());
+            c_ij.set(i, j, r.get(i, j).scale(&kin[j].m) + kin[j].c.clone());
         }
     }
+    c_ij
+}
 
-    // ---- 1. Inertia matrices of the sub-chains ----
+/// (13a) `M^rr,1_N = I_N`; (13b) `M^rr,1_j = I_j + M^rr,1_{j+1}`.
+fn own_inertias<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Mat3<S>> {
+    let last = kin.len() - 1;
     S::section("(13)");
-    // (13a) M^rr,1_N = I_N;  (13b) M^rr,1_j = I_j + M^rr,1_{j+1}.
-    let mut m_rr1: Vec<Mat3<S>> = vec![Mat3::zero(); n];
+    let mut m_rr1: Vec<Mat3<S>> = vec![Mat3::zero(); kin.len()];
     m_rr1[last] = kin[last].inertia.clone();
     for j in (0..last).rev() {
         m_rr1[j] = &kin[j].inertia + &m_rr1[j + 1];
     }
+    m_rr1
+}
 
-    // M^rr,2_{i,j} = Σ_{k>j} m_k r̃_{i,k} r̃ᵀ_{j,k},  i ≤ j ≤ N−1.
+/// `M^rr,2_{i,j} = Σ_{k>j} m_k r̃_{i,k} r̃ᵀ_{j,k}`, `i ≤ j ≤ N−1`, in the exact form R2 of (14b):
+/// `S_{i,N} = m_N r_{i,N}`, `S_{i,j} = m_j r_{i,j} + S_{i,j+1}` (the cost of (12b)), then
+/// (14a) `M^rr,2_{i,N−1} = S̃_{i,N} r̃ᵀ_{N−1,N}` and
+/// (14b) `M^rr,2_{i,j} = S̃_{i,j+1} r̃ᵀ_{j,j+1} + M^rr,2_{i,j+1}`, `i = N−2..1`, `j = N−2..i`.
+fn translational_inertias_exact<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    r: &Upper<Vec3<S>>,
+) -> Upper<Mat3<S>> {
+    let n = kin.len();
+    let last = n - 1;
+    let m = |j: usize| &kin[j].m;
     let mut m_rr2: Upper<Mat3<S>> = Upper::new(n);
-    if variant == Form::R2 {
-        S::section("(14)S");
-        // S_{i,N} = m_N r_{i,N};  S_{i,j} = m_j r_{i,j} + S_{i,j+1}  (R2; the cost of (12b)).
-        let mut s_ij: Upper<Vec3<S>> = Upper::new(n);
-        for i in (0..last).rev() {
-            s_ij.set(i, last, r.get(i, last).scale(m(last)));
-            for j in (i + 1..last).rev() {
-                let s = r.get(i, j).scale(m(j)) + s_ij.get(i, j + 1).clone();
-                s_ij.set(i, j, s);
-            }
-        }
-        if n >= 2 {
-            S::section("(14a)");
-            // (14a) M^rr,2_{i,N−1} = S̃_{i,N} r̃ᵀ_{N−1,N}  (= m_N r̃_{i,N} r̃ᵀ_{N−1,N}).
-            for i in 0..last {
-                m_rr2.set(
-                    i,
-                    last - 1,
-                    skew_skew_t(s_ij.get(i, last), r.get(last - 1, last)),
-                );
-            }
-        }
-        S::section("(14b)");
-        // (14b) M^rr,2_{i,j} = S̃_{i,j+1} r̃ᵀ_{j,j+1} + M^rr,2_{i,j+1},  i = N−2..1, j = N−2..i.
-        for i in (0..last.saturating_sub(1)).rev() {
-            for j in (i..last - 1).rev() {
-                let x =
-                    skew_skew_t(s_ij.get(i, j + 1), r.get(j, j + 1)) + m_rr2.get(i, j + 1).clone();
-                m_rr2.set(i, j, x);
-            }
-        }
-    } else {
-        if n >= 2 {
-            S::section("(14a)");
-            // (14a) M^rr,2_{i,N−1} = m_N r̃_{i,N} r̃ᵀ_{N−1,N}  (36 m + 27 a per matrix).
-            for i in 0..last {
-                let x = skew_skew_t(r.get(i, last), r.get(last - 1, last)).scale(m(last));
-                m_rr2.set(i, last - 1, x);
-            }
-        }
-        S::section("(14b)");
-        // (14b) scalar form M^rr,2_{i,j} = m^Σ_{j+1} r̃_{i,j+1} r̃ᵀ_{j,j+1} + M^rr,2_{i,j+1}
-        // (36 m + 36 a per matrix). Not an identity: it misses Q_j (see R1-corr below).
-        for i in (0..last.saturating_sub(1)).rev() {
-            for j in (i..last - 1).rev() {
-                let x = skew_skew_t(r.get(i, j + 1), r.get(j, j + 1)).scale(&m_sigma[j + 1])
-                    + m_rr2.get(i, j + 1).clone();
-                m_rr2.set(i, j, x);
-            }
-        }
-        if variant == Form::R1 && n >= 3 {
-            S::section("R1-corr");
-            // Σ_{k≥l} m_k r_{i,k} = m^Σ_l r_{i,l} + p_l, so the scalar form misses
-            // Q_j = Σ_{l>j} p̃_l r̃ᵀ_{l−1,l}, independent of i; fold it into M^rr,1_j (j ≤ N−2).
-            // p_{N−1} = m^Σ_N r_{N−1,N};  p_l = m^Σ_{l+1} r_{l,l+1} + p_{l+1}  (p_N = 0).
-            let mut p_l: Vec<Vec3<S>> = vec![Vec3::zero(); n];
-            p_l[last - 1] = r.get(last - 1, last).scale(&m_sigma[last]);
-            for l in (1..last - 1).rev() {
-                p_l[l] = r.get(l, l + 1).scale(&m_sigma[l + 1]) + p_l[l + 1].clone();
-            }
-            // Q_{N−2} = p̃_{N−1} r̃ᵀ_{N−2,N−1};  Q_j = p̃_{j+1} r̃ᵀ_{j,j+1} + Q_{j+1}.
-            let mut q_j = skew_skew_t(&p_l[last - 1], r.get(last - 2, last - 1));
-            m_rr1[last - 2] = &m_rr1[last - 2] + &q_j;
-            for j in (0..last - 2).rev() {
-                q_j = skew_skew_t(&p_l[j + 1], r.get(j, j + 1)) + q_j;
-                m_rr1[j] = &m_rr1[j] + &q_j;
-            }
+    S::section("(14)S");
+    let mut s_ij: Upper<Vec3<S>> = Upper::new(n);
+    for i in (0..last).rev() {
+        s_ij.set(i, last, r.get(i, last).scale(m(last)));
+        for j in (i + 1..last).rev() {
+            let s = r.get(i, j).scale(m(j)) + s_ij.get(i, j + 1).clone();
+            s_ij.set(i, j, s);
         }
     }
+    if n >= 2 {
+        S::section("(14a)");
+        for i in 0..last {
+            m_rr2.set(
+                i,
+                last - 1,
+                skew_skew_t(s_ij.get(i, last), r.get(last - 1, last)),
+            );
+        }
+    }
+    S::section("(14b)");
+    for i in (0..last.saturating_sub(1)).rev() {
+        for j in (i..last - 1).rev() {
+            let x = skew_skew_t(s_ij.get(i, j + 1), r.get(j, j + 1)) + m_rr2.get(i, j + 1).clone();
+            m_rr2.set(i, j, x);
+        }
+    }
+    m_rr2
+}
 
-    // M^rr,3_{i,j} = Σ_{k>j} c̃_k r̃ᵀ_{i,k},  i ≤ j ≤ N−1  (R7).
+/// `M^rr,2` in the printed scalar form: (14a) `M^rr,2_{i,N−1} = m_N r̃_{i,N} r̃ᵀ_{N−1,N}`
+/// (36 m + 27 a per matrix) and (14b) `M^rr,2_{i,j} = m^Σ_{j+1} r̃_{i,j+1} r̃ᵀ_{j,j+1} +
+/// M^rr,2_{i,j+1}` (36 m + 36 a per matrix). Not an identity: it misses `Q_j`
+/// ([`fold_r1_correction`]).
+fn translational_inertias_scalar<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    r: &Upper<Vec3<S>>,
+    m_sigma: &[S],
+) -> Upper<Mat3<S>> {
+    let n = kin.len();
+    let last = n - 1;
+    let mut m_rr2: Upper<Mat3<S>> = Upper::new(n);
+    if n >= 2 {
+        S::section("(14a)");
+        for i in 0..last {
+            let x = skew_skew_t(r.get(i, last), r.get(last - 1, last)).scale(&kin[last].m);
+            m_rr2.set(i, last - 1, x);
+        }
+    }
+    S::section("(14b)");
+    for i in (0..last.saturating_sub(1)).rev() {
+        for j in (i..last - 1).rev() {
+            let x = skew_skew_t(r.get(i, j + 1), r.get(j, j + 1)).scale(&m_sigma[j + 1])
+                + m_rr2.get(i, j + 1).clone();
+            m_rr2.set(i, j, x);
+        }
+    }
+    m_rr2
+}
+
+/// R1's correction of the scalar (14b), `N ≥ 3` (section `"R1-corr"`): `Σ_{k≥l} m_k r_{i,k} =
+/// m^Σ_l r_{i,l} + p_l`, so the scalar form misses `Q_j = Σ_{l>j} p̃_l r̃ᵀ_{l−1,l}`, independent of
+/// `i`; it is folded into `M^rr,1_j` (`j ≤ N−2`). `p_{N−1} = m^Σ_N r_{N−1,N}`,
+/// `p_l = m^Σ_{l+1} r_{l,l+1} + p_{l+1}` (`p_N = 0`); `Q_{N−2} = p̃_{N−1} r̃ᵀ_{N−2,N−1}`,
+/// `Q_j = p̃_{j+1} r̃ᵀ_{j,j+1} + Q_{j+1}`.
+fn fold_r1_correction<S: Scalar>(r: &Upper<Vec3<S>>, m_sigma: &[S], m_rr1: &mut [Mat3<S>]) {
+    let n = m_rr1.len();
+    let last = n - 1;
+    S::section("R1-corr");
+    let mut p_l: Vec<Vec3<S>> = vec![Vec3::zero(); n];
+    p_l[last - 1] = r.get(last - 1, last).scale(&m_sigma[last]);
+    for l in (1..last - 1).rev() {
+        p_l[l] = r.get(l, l + 1).scale(&m_sigma[l + 1]) + p_l[l + 1].clone();
+    }
+    let mut q_j = skew_skew_t(&p_l[last - 1], r.get(last - 2, last - 1));
+    m_rr1[last - 2] = &m_rr1[last - 2] + &q_j;
+    for j in (0..last - 2).rev() {
+        q_j = skew_skew_t(&p_l[j + 1], r.get(j, j + 1)) + q_j;
+        m_rr1[j] = &m_rr1[j] + &q_j;
+    }
+}
+
+/// `M^rr,3_{i,j} = Σ_{k>j} c̃_k r̃ᵀ_{i,k}`, `i ≤ j ≤ N−1` (R7): (15a) `M^rr,3_{i,N−1} =
+/// c̃_N r̃ᵀ_{i,N}`; (15b) `M^rr,3_{i,j} = c̃_{j+1} r̃ᵀ_{i,j+1} + M^rr,3_{i,j+1}`,
+/// `i = N−2..1`, `j = N−2..i`.
+fn coupling_inertias<S: Scalar>(kin: &[BodyKinematics<S>], r: &Upper<Vec3<S>>) -> Upper<Mat3<S>> {
+    let n = kin.len();
+    let last = n - 1;
+    let c = |j: usize| &kin[j].c;
     let mut m_rr3: Upper<Mat3<S>> = Upper::new(n);
     if n >= 2 {
         S::section("(15a)");
-        // (15a) M^rr,3_{i,N−1} = c̃_N r̃ᵀ_{i,N}.
         for i in 0..last {
             m_rr3.set(i, last - 1, skew_skew_t(c(last), r.get(i, last)));
         }
     }
     S::section("(15b)");
-    // (15b) M^rr,3_{i,j} = c̃_{j+1} r̃ᵀ_{i,j+1} + M^rr,3_{i,j+1},  i = N−2..1, j = N−2..i.
     for i in (0..last.saturating_sub(1)).rev() {
         for j in (i..last - 1).rev() {
             let x = skew_skew_t(c(j + 1), r.get(i, j + 1)) + m_rr3.get(i, j + 1).clone();
             m_rr3.set(i, j, x);
         }
     }
+    m_rr3
+}
 
-    // ---- 2. Resultant inertia matrices about the joints ----
+/// (16) the resultant inertia matrices `M^Σ,rr_{i,j}` about the joints, `i ≤ j`.
+fn resultant_inertias<S: Scalar>(
+    n: usize,
+    m_rr1: &[Mat3<S>],
+    m_rr2: &Upper<Mat3<S>>,
+    m_rr3: &Upper<Mat3<S>>,
+) -> Upper<Mat3<S>> {
+    let last = n - 1;
     S::section("(16)");
     let mut m_sig_rr: Upper<Mat3<S>> = Upper::new(n);
     for i in 0..n {
@@ -306,35 +386,51 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
             m_sig_rr.set(i, j, x);
         }
     }
+    m_sig_rr
+}
 
-    // ---- Pairs with a prismatic joint (docs/paper.md, I6) ----
-    let revolute = |j: usize| kin[j].kind == JointKind::Revolute;
-    let any_prismatic = kin.iter().any(|k| k.kind == JointKind::Prismatic);
+/// Section `"I6"` (docs/paper.md): `C^Σ_{i,j} = Σ_{k≥j} C_{i,k}`: `C^Σ_{i,N} = C_{i,N}`,
+/// `C^Σ_{i,j} = C_{i,j} + C^Σ_{i,j+1}`; on the diagonal `C_{j,j} = c_j` (`r_{j,j} = 0`).
+fn composite_first_moments<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    c_ij: &Upper<Vec3<S>>,
+) -> Upper<Vec3<S>> {
+    let n = kin.len();
+    let last = n - 1;
+    let c = |j: usize| &kin[j].c;
+    S::section("I6");
     let mut c_sigma: Upper<Vec3<S>> = Upper::new(n);
-    if any_prismatic {
-        S::section("I6");
-        // C^Σ_{i,j} = Σ_{k≥j} C_{i,k}:  C^Σ_{i,N} = C_{i,N};  C^Σ_{i,j} = C_{i,j} + C^Σ_{i,j+1};
-        // on the diagonal C_{j,j} = c_j (r_{j,j} = 0).
-        for i in 0..n {
-            let mut acc = if i == last {
-                c(last).clone()
+    for i in 0..n {
+        let mut acc = if i == last {
+            c(last).clone()
+        } else {
+            c_ij.get(i, last).clone()
+        };
+        c_sigma.set(i, last, acc.clone());
+        for j in (i..last).rev() {
+            let cij = if i == j {
+                c(j).clone()
             } else {
-                c_ij.get(i, last).clone()
+                c_ij.get(i, j).clone()
             };
-            c_sigma.set(i, last, acc.clone());
-            for j in (i..last).rev() {
-                let cij = if i == j {
-                    c(j).clone()
-                } else {
-                    c_ij.get(i, j).clone()
-                };
-                acc = cij + acc;
-                c_sigma.set(i, j, acc.clone());
-            }
+            acc = cij + acc;
+            c_sigma.set(i, j, acc.clone());
         }
     }
+    c_sigma
+}
 
-    // ---- 4. (20) A_ij = a_iᵀ M^Σ,rr_{i,j} a_j ----
+/// (20) `A_ij = a_iᵀ M^Σ,rr_{i,j} a_j` for revolute pairs, and the pairs with a prismatic joint
+/// by I6 (`c_sigma`, present when the chain has one); both triangles filled.
+fn project_on_axes<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    m_sig_rr: &Upper<Mat3<S>>,
+    m_sigma: &[S],
+    c_sigma: Option<&Upper<Vec3<S>>>,
+) -> Vec<Vec<S>> {
+    let n = kin.len();
+    let revolute = |j: usize| kin[j].kind == JointKind::Revolute;
+    let c_sigma = || c_sigma.expect("a prismatic pair has its composite first moments (I6)");
     S::section("(20)");
     let mut a = vec![vec![S::zero(); n]; n];
     for i in 0..n {
@@ -345,9 +441,9 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
                 // prismatic i ≤ prismatic j: m^Σ_j e_i·e_j
                 (false, false) => m_sigma[j].clone() * ai.dot(aj),
                 // revolute i < prismatic j: a_i · (C^Σ_{i,j} × e_j)
-                (true, false) => ai.dot(&c_sigma.get(i, j).cross(aj)),
+                (true, false) => ai.dot(&c_sigma().get(i, j).cross(aj)),
                 // prismatic i < revolute j: e_i · (a_j × C^Σ_{j,j})
-                (false, true) => ai.dot(&aj.cross(c_sigma.get(j, j))),
+                (false, true) => ai.dot(&aj.cross(c_sigma().get(j, j))),
             };
             a[j][i] = x.clone();
             a[i][j] = x;
