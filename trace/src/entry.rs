@@ -92,303 +92,432 @@ pub fn trace(
         inputs.push(i);
         s
     };
-
-    // Parameters.
-    let mut regrouped_base: Option<FloatingBase<Sym>> = None;
-    let params: Option<Params<Sym>> = match subject {
-        Subject::Model(model) => {
-            let mut p = if spec.regroup {
-                let base = match &spec.base {
-                    Base::FreeFloating(i) => Some(i),
-                    Base::Fixed => None,
-                };
-                let keep: &[usize] = if spec.runtime_payload { &[n - 1] } else { &[] };
-                let r = regrouped::<Sym>(model, base, keep);
-                regrouped_base = r.base;
-                r.params
-            } else {
-                Params::<Sym>::new(model)
-            };
-            if spec.two_step_placement > 0.0 {
-                for (jp, j) in p.joints.iter_mut().zip(model.joints()) {
-                    jp.placement_permutation = jp.placement_permutation
-                        || is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement)
-                        || axis_turn(&j.origin.rotation).is_some();
-                    jp.split_placement(j);
-                }
-            }
-            if spec.runtime_payload {
-                payload_inputs(&mut p, &mut input);
-            }
-            Some(p)
-        }
-        Subject::Generic { n } => Some(generic_params(n, &mut input)),
-        Subject::InertialFrame { .. } => None,
-    };
-    if let (Subject::InertialFrame { n }, None) = (subject, &params) {
-        let kin = inertial_frame_inputs(n, &mut input);
-        let a = if spec.paper_14b {
-            recurrent::mass_matrix_paper_bookkeeping(&kin)
-        } else {
-            methods
-                .mass_matrix
-                .from_inertial_frame(&kin)
-                .expect("the CRBA is rejected by check")
-        };
-        let out = upper(&a);
+    let (params, regrouped_base) = parameters(subject, spec, &mut input);
+    let Some(p) = params else {
+        let out = inertial_frame_mass_matrix(n, methods, spec, &mut input);
         return Ok(Traced {
             trace: t.finish(&out),
             inputs,
         });
-    }
-    let p = params.expect("a model or generic subject has parameters");
-
-    // Arguments.
+    };
     let floating = matches!(spec.base, Base::FreeFloating(_));
-    let mut args: HashMap<Arg, Vec<Sym>> = HashMap::new();
-    let mut rows: Vec<[Sym; 6]> = Vec::new();
-    for &a in function.args(floating) {
-        if a == Arg::FExt {
-            rows = (0..a.len(n, floating))
-                .map(|r| core::array::from_fn(|c| input(Input::Row(a, r, c))))
-                .collect();
-        } else {
-            let v = (0..a.len(n, floating))
-                .map(|i| input(Input::Joint(a, i)))
-                .collect();
-            args.insert(a, v);
-        }
-    }
-    let arg = |a: Arg| args.get(&a).cloned();
-    let zeros = vec![Sym::zero(); n];
-    // The joint parts of the arguments, and the free-floating base state from q[..7], v[..6].
-    let full_q = arg(Arg::Q).expect("every function takes q");
-    let (q, qd, qdd, state) = if floating {
-        let v = arg(Arg::V);
-        let a = arg(Arg::A);
-        let v3 = |x: &[Sym], k: usize| Vec3([x[k], x[k + 1], x[k + 2]]);
-        let state = FloatingState {
-            position: v3(&full_q, 0),
-            rotation: quat_to_matrix(&[full_q[3], full_q[4], full_q[5], full_q[6]]),
-            v_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 0)),
-            omega_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 3)),
-        };
-        let joints = |x: Option<Vec<Sym>>, skip| x.map(|x| x[skip..].to_vec());
-        (
-            full_q[7..].to_vec(),
-            joints(v, 6).unwrap_or_else(|| zeros.clone()),
-            a,
-            Some(state),
-        )
-    } else {
-        (
-            full_q,
-            arg(Arg::Qd).unwrap_or_else(|| zeros.clone()),
-            arg(Arg::Qdd),
-            None,
-        )
-    };
-
-    // Effects.
-    let mut external: Vec<ExternalWrench<Sym>> = spec
-        .wrenches
-        .iter()
-        .enumerate()
-        .map(|(index, w)| {
-            let (force, moment) = match &w.value {
-                WrenchValue::Constant { force, moment } => {
-                    (Vec3::from_f64(*force), Vec3::from_f64(*moment))
-                }
-                WrenchValue::Runtime => {
-                    let mut c = |k: usize| {
-                        input(Input::Wrench {
-                            index,
-                            component: k,
-                        })
-                    };
-                    (Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
-                }
-            };
-            ExternalWrench {
-                body: w.body,
-                frame: w.frame,
-                force,
-                moment,
-            }
-        })
-        .collect();
-    // `f_ext`: one body-frame wrench per body (free-floating: the base first).
-    external.extend(rows.iter().enumerate().map(|(r, w)| ExternalWrench {
-        body: match (floating, r) {
-            (true, 0) => BASE_BODY,
-            (true, r) => r - 1,
-            (false, r) => r,
-        },
-        frame: LoadFrame::Body,
-        force: Vec3([w[0], w[1], w[2]]),
-        moment: Vec3([w[3], w[4], w[5]]),
-    }));
-    let gravity = spec.gravity.map(Vec3::from_f64);
-    // Damping as a drive: τ_d = −d q̇.
-    let damping: Option<Vec<Sym>> = spec.damping.as_ref().map(|d| {
-        d.iter()
-            .zip(&qd)
-            .map(|(di, qdi)| Sym::constant(*di) * *qdi)
-            .collect()
-    });
-    let drives = |tau: Option<Vec<Sym>>| -> Option<Vec<Sym>> {
-        match (tau, &damping) {
-            (Some(t), Some(d)) => Some(t.iter().zip(d).map(|(t, d)| *t - *d).collect()),
-            (Some(t), None) => Some(t),
-            (None, Some(d)) => Some(d.iter().map(|d| -*d).collect()),
-            (None, None) => None,
-        }
-    };
-    let loads = |tau: Option<Vec<Sym>>| Loads {
-        tau: drives(tau),
-        gravity: gravity.clone(),
-        external: external.clone(),
-    };
-    let gravity_only = Loads {
-        tau: None,
-        gravity: gravity.clone(),
-        external: Vec::new(),
-    };
-
-    let out: Vec<Sym> = match (&spec.base, state) {
+    let args = Arguments::new(function, n, floating, &mut input);
+    let effects = Effects::new(spec, &args, floating, &mut input);
+    let out = match (&spec.base, &args.state) {
         (Base::FreeFloating(inertial), Some(state)) => {
-            let base = regrouped_base
-                .clone()
-                .unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial));
-            let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
-            let b = |qd: &[Sym], l: &Loads<Sym>| {
-                floating::tau_minus_c(methods.nonlinear_effects, &p, &base, &state, &q, qd, l)
+            let base =
+                regrouped_base.unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial));
+            let system = FloatingSystem {
+                p: &p,
+                base: &base,
+                state,
             };
-            let fd =
-                |l: &Loads<Sym>| floating::forward_dynamics(methods, &p, &base, &state, &q, &qd, l);
-            match function {
-                Function::MassMatrix => upper(&m(methods.mass_matrix)),
-                Function::GeneralizedForces => b(&qd, &loads(arg(Arg::Tau))),
-                Function::NonlinearEffects => negated(b(&qd, &loads(None))),
-                Function::Gravity => {
-                    let rest = FloatingState {
-                        v_b: Vec3::zero(),
-                        omega_b: Vec3::zero(),
-                        ..state.clone()
-                    };
-                    negated(floating::tau_minus_c(
-                        methods.nonlinear_effects,
-                        &p,
-                        &base,
-                        &rest,
-                        &q,
-                        &zeros,
-                        &gravity_only,
-                    ))
-                }
-                Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
-                    fd(&loads(arg(Arg::Tau)))
-                }
-                Function::MassMatrixAndNonlinearEffects => {
-                    let mut v = upper(&m(methods.mass_matrix));
-                    v.extend(negated(b(&qd, &loads(None))));
-                    v
-                }
-                Function::Momentum => {
-                    let (lin, ang) = floating::momentum(&p, &base, &state, &q, &qd);
-                    lin.0.into_iter().chain(ang.0).collect()
-                }
-                Function::InverseDynamics | Function::BaseReaction => {
-                    let a = qdd.expect("takes a");
-                    let base_acc: [Sym; 6] = core::array::from_fn(|k| a[k]);
-                    let joints = &a[6..];
-                    if function == Function::BaseReaction {
-                        rnea::base_reaction(&p, &state, &q, &qd, &base_acc, joints, &loads(None))
-                            .to_vec()
-                    } else {
-                        let id = if methods.nonlinear_effects == NonlinearEffectsMethod::NewtonEuler
-                        {
-                            newton_euler::floating_inverse_dynamics
-                        } else {
-                            rnea::floating_inverse_dynamics
-                        };
-                        let mut tau =
-                            id(&p, &base, &state, &q, &qd, &base_acc, joints, &loads(None));
-                        if let Some(d) = &damping {
-                            for (t, d) in tau[6..].iter_mut().zip(d) {
-                                *t = *t + *d;
-                            }
-                        }
-                        tau
-                    }
-                }
-                Function::FramePlacement(k) => {
-                    let (x, r) = frames::floating_placement(&p, &state, &q, &p.frames[k]);
-                    placement_outputs(x, r)
-                }
-                Function::FrameJacobian(k) => {
-                    frames::floating_jacobian(&p, &state, &q, &p.frames[k]).concat()
-                }
-                Function::GeneralizedJacobian(k) => {
-                    frames::generalized_jacobian(&p, &base, &state, &q, &p.frames[k]).concat()
-                }
-            }
+            floating_outputs(function, methods, &system, &args, &effects)
         }
-        _ => match function {
-            Function::MassMatrix => upper(&methods.mass_matrix.mass_matrix(&p, &q)),
-            Function::GeneralizedForces => {
-                methods
-                    .nonlinear_effects
-                    .tau_minus_c(&p, &q, &qd, &loads(arg(Arg::Tau)))
-            }
-            Function::NonlinearEffects => negated(methods.nonlinear_effects.tau_minus_c(
-                &p,
-                &q,
-                &qd,
-                &loads(None),
-            )),
-            Function::Gravity => negated(methods.nonlinear_effects.tau_minus_c(
-                &p,
-                &q,
-                &zeros,
-                &gravity_only,
-            )),
-            Function::InverseDynamics => {
-                let qdd = qdd.expect("inverse dynamics takes q̈");
-                let tau = methods.inverse_dynamics(&p, &q, &qd, &qdd, &loads(None));
-                match &damping {
-                    // τ = M q̈ + c with the damping force d q̇ inside c.
-                    Some(d) => tau.iter().zip(d).map(|(t, d)| *t + *d).collect(),
-                    None => tau,
-                }
-            }
-            Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
-                methods.forward_dynamics(&p, &q, &qd, &loads(arg(Arg::Tau)))
-            }
-            Function::MassMatrixAndNonlinearEffects => {
-                let mut v = upper(&methods.mass_matrix.mass_matrix(&p, &q));
-                v.extend(negated(methods.nonlinear_effects.tau_minus_c(
-                    &p,
-                    &q,
-                    &qd,
-                    &loads(None),
-                )));
-                v
-            }
-            Function::FramePlacement(k) => {
-                let (x, r) = frames::placement(&p, &q, &p.frames[k]);
-                placement_outputs(x, r)
-            }
-            Function::FrameJacobian(k) => frames::jacobian(&p, &q, &p.frames[k]).concat(),
-            Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_) => {
-                unreachable!("rejected by check: free-floating only")
-            }
-        },
+        _ => fixed_outputs(function, methods, &p, &args, &effects),
     };
     Ok(Traced {
         trace: t.finish(&out),
         inputs,
     })
+}
+
+/// The subject's parameters (`None` for an inertial-frame subject, whose inputs are the paper's
+/// kinematic quantities), and the free-floating base the regrouping hands back (`None` when it
+/// does not run or the base is fixed). A runtime payload's inputs are created here.
+fn parameters(
+    subject: Subject,
+    spec: &Spec,
+    input: &mut impl FnMut(Input) -> Sym,
+) -> (Option<Params<Sym>>, Option<FloatingBase<Sym>>) {
+    let model = match subject {
+        Subject::Model(model) => model,
+        Subject::Generic { n } => return (Some(generic_params(n, input)), None),
+        Subject::InertialFrame { .. } => return (None, None),
+    };
+    let mut regrouped_base = None;
+    let mut p = if spec.regroup {
+        let base = match &spec.base {
+            Base::FreeFloating(i) => Some(i),
+            Base::Fixed => None,
+        };
+        let keep: &[usize] = if spec.runtime_payload {
+            &[model.dof() - 1]
+        } else {
+            &[]
+        };
+        let r = regrouped::<Sym>(model, base, keep);
+        regrouped_base = r.base;
+        r.params
+    } else {
+        Params::<Sym>::new(model)
+    };
+    if spec.two_step_placement > 0.0 {
+        for (jp, j) in p.joints.iter_mut().zip(model.joints()) {
+            jp.placement_permutation = jp.placement_permutation
+                || is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement)
+                || axis_turn(&j.origin.rotation).is_some();
+            jp.split_placement(j);
+        }
+    }
+    if spec.runtime_payload {
+        payload_inputs(&mut p, input);
+    }
+    (Some(p), regrouped_base)
+}
+
+/// Table 1's subject: the mass matrix (upper triangle) of `n` bodies from the paper's
+/// inertial-frame inputs, by `methods.mass_matrix` or, with [`Spec::paper_14b`], by the paper's
+/// printed (14b).
+fn inertial_frame_mass_matrix(
+    n: usize,
+    methods: Methods,
+    spec: &Spec,
+    input: &mut impl FnMut(Input) -> Sym,
+) -> Vec<Sym> {
+    let kin = inertial_frame_inputs(n, input);
+    let a = if spec.paper_14b {
+        recurrent::mass_matrix_paper_bookkeeping(&kin)
+    } else {
+        methods
+            .mass_matrix
+            .from_inertial_frame(&kin)
+            .expect("the CRBA is rejected by check")
+    };
+    upper(&a)
+}
+
+/// The function's arguments as inputs: the joint parts `q`, `q̇`, `q̈` (`q̇` zero when not an
+/// argument), a free-floating base's state from `q[..7]`, `v[..6]`, and the rows of `f_ext`.
+struct Arguments {
+    /// Every argument but `f_ext`, whole.
+    args: HashMap<Arg, Vec<Sym>>,
+    /// `f_ext`: one body-frame wrench per body (free-floating: the base first).
+    rows: Vec<[Sym; 6]>,
+    /// `N` zeros.
+    zeros: Vec<Sym>,
+    q: Vec<Sym>,
+    qd: Vec<Sym>,
+    qdd: Option<Vec<Sym>>,
+    state: Option<FloatingState<Sym>>,
+}
+
+impl Arguments {
+    /// Creates the inputs of `function`'s arguments ([`Function::args`]), in order.
+    fn new(
+        function: Function,
+        n: usize,
+        floating: bool,
+        input: &mut impl FnMut(Input) -> Sym,
+    ) -> Self {
+        let mut args: HashMap<Arg, Vec<Sym>> = HashMap::new();
+        let mut rows: Vec<[Sym; 6]> = Vec::new();
+        for &a in function.args(floating) {
+            if a == Arg::FExt {
+                rows = (0..a.len(n, floating))
+                    .map(|r| core::array::from_fn(|c| input(Input::Row(a, r, c))))
+                    .collect();
+            } else {
+                let v = (0..a.len(n, floating))
+                    .map(|i| input(Input::Joint(a, i)))
+                    .collect();
+                args.insert(a, v);
+            }
+        }
+        let arg = |a: Arg| args.get(&a).cloned();
+        let zeros = vec![Sym::zero(); n];
+        let full_q = arg(Arg::Q).expect("every function takes q");
+        let (q, qd, qdd, state) = if floating {
+            let v = arg(Arg::V);
+            let a = arg(Arg::A);
+            let v3 = |x: &[Sym], k: usize| Vec3([x[k], x[k + 1], x[k + 2]]);
+            let state = FloatingState {
+                position: v3(&full_q, 0),
+                rotation: quat_to_matrix(&[full_q[3], full_q[4], full_q[5], full_q[6]]),
+                v_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 0)),
+                omega_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 3)),
+            };
+            let joints = |x: Option<Vec<Sym>>, skip| x.map(|x| x[skip..].to_vec());
+            (
+                full_q[7..].to_vec(),
+                joints(v, 6).unwrap_or_else(|| zeros.clone()),
+                a,
+                Some(state),
+            )
+        } else {
+            (
+                full_q,
+                arg(Arg::Qd).unwrap_or_else(|| zeros.clone()),
+                arg(Arg::Qdd),
+                None,
+            )
+        };
+        Arguments {
+            args,
+            rows,
+            zeros,
+            q,
+            qd,
+            qdd,
+            state,
+        }
+    }
+
+    /// Argument `a`, whole (`None` when the function does not take it).
+    fn arg(&self, a: Arg) -> Option<Vec<Sym>> {
+        self.args.get(&a).cloned()
+    }
+}
+
+/// The spec's effects on the traced system: the external wrenches (the spec's, then `f_ext`'s
+/// rows), gravity and the damping drive `τ_d = −d q̇`.
+struct Effects {
+    external: Vec<ExternalWrench<Sym>>,
+    gravity: Option<Vec3<Sym>>,
+    damping: Option<Vec<Sym>>,
+}
+
+impl Effects {
+    /// Creates the runtime wrenches' inputs (after the arguments').
+    fn new(
+        spec: &Spec,
+        args: &Arguments,
+        floating: bool,
+        input: &mut impl FnMut(Input) -> Sym,
+    ) -> Self {
+        let mut external: Vec<ExternalWrench<Sym>> = spec
+            .wrenches
+            .iter()
+            .enumerate()
+            .map(|(index, w)| {
+                let (force, moment) = match &w.value {
+                    WrenchValue::Constant { force, moment } => {
+                        (Vec3::from_f64(*force), Vec3::from_f64(*moment))
+                    }
+                    WrenchValue::Runtime => {
+                        let mut c = |k: usize| {
+                            input(Input::Wrench {
+                                index,
+                                component: k,
+                            })
+                        };
+                        (Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
+                    }
+                };
+                ExternalWrench {
+                    body: w.body,
+                    frame: w.frame,
+                    force,
+                    moment,
+                }
+            })
+            .collect();
+        external.extend(args.rows.iter().enumerate().map(|(r, w)| ExternalWrench {
+            body: match (floating, r) {
+                (true, 0) => BASE_BODY,
+                (true, r) => r - 1,
+                (false, r) => r,
+            },
+            frame: LoadFrame::Body,
+            force: Vec3([w[0], w[1], w[2]]),
+            moment: Vec3([w[3], w[4], w[5]]),
+        }));
+        let gravity = spec.gravity.map(Vec3::from_f64);
+        let damping: Option<Vec<Sym>> = spec.damping.as_ref().map(|d| {
+            d.iter()
+                .zip(&args.qd)
+                .map(|(di, qdi)| Sym::constant(*di) * *qdi)
+                .collect()
+        });
+        Effects {
+            external,
+            gravity,
+            damping,
+        }
+    }
+
+    /// The joint drives: `tau` minus the damping force.
+    fn drives(&self, tau: Option<Vec<Sym>>) -> Option<Vec<Sym>> {
+        match (tau, &self.damping) {
+            (Some(t), Some(d)) => Some(t.iter().zip(d).map(|(t, d)| *t - *d).collect()),
+            (Some(t), None) => Some(t),
+            (None, Some(d)) => Some(d.iter().map(|d| -*d).collect()),
+            (None, None) => None,
+        }
+    }
+
+    /// Every load, with the drives `tau`.
+    fn loads(&self, tau: Option<Vec<Sym>>) -> Loads<Sym> {
+        Loads {
+            tau: self.drives(tau),
+            gravity: self.gravity.clone(),
+            external: self.external.clone(),
+        }
+    }
+
+    /// Gravity alone.
+    fn gravity_only(&self) -> Loads<Sym> {
+        Loads {
+            tau: None,
+            gravity: self.gravity.clone(),
+            external: Vec::new(),
+        }
+    }
+}
+
+/// The arm's parameters on its free-floating base, in the traced state.
+struct FloatingSystem<'a> {
+    p: &'a Params<Sym>,
+    base: &'a FloatingBase<Sym>,
+    state: &'a FloatingState<Sym>,
+}
+
+/// The outputs of `function` on a free-floating base.
+fn floating_outputs(
+    function: Function,
+    methods: Methods,
+    system: &FloatingSystem,
+    args: &Arguments,
+    effects: &Effects,
+) -> Vec<Sym> {
+    let FloatingSystem { p, base, state } = *system;
+    let (q, qd) = (&args.q, &args.qd);
+    let loads = |tau| effects.loads(tau);
+    let m = |method| floating::mass_matrix(method, p, base, state, q);
+    let b = |qd: &[Sym], l: &Loads<Sym>| {
+        floating::tau_minus_c(methods.nonlinear_effects, p, base, state, q, qd, l)
+    };
+    let fd = |l: &Loads<Sym>| floating::forward_dynamics(methods, p, base, state, q, qd, l);
+    match function {
+        Function::MassMatrix => upper(&m(methods.mass_matrix)),
+        Function::GeneralizedForces => b(qd, &loads(args.arg(Arg::Tau))),
+        Function::NonlinearEffects => negated(b(qd, &loads(None))),
+        Function::Gravity => {
+            let rest = FloatingState {
+                v_b: Vec3::zero(),
+                omega_b: Vec3::zero(),
+                ..state.clone()
+            };
+            negated(floating::tau_minus_c(
+                methods.nonlinear_effects,
+                p,
+                base,
+                &rest,
+                q,
+                &args.zeros,
+                &effects.gravity_only(),
+            ))
+        }
+        Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
+            fd(&loads(args.arg(Arg::Tau)))
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            let mut v = upper(&m(methods.mass_matrix));
+            v.extend(negated(b(qd, &loads(None))));
+            v
+        }
+        Function::Momentum => {
+            let (lin, ang) = floating::momentum(p, base, state, q, qd);
+            lin.0.into_iter().chain(ang.0).collect()
+        }
+        Function::InverseDynamics | Function::BaseReaction => {
+            floating_inverse_dynamics(function, methods, system, args, effects)
+        }
+        Function::FramePlacement(k) => {
+            let (x, r) = frames::floating_placement(p, state, q, &p.frames[k]);
+            placement_outputs(x, r)
+        }
+        Function::FrameJacobian(k) => frames::floating_jacobian(p, state, q, &p.frames[k]).concat(),
+        Function::GeneralizedJacobian(k) => {
+            frames::generalized_jacobian(p, base, state, q, &p.frames[k]).concat()
+        }
+    }
+}
+
+/// Inverse dynamics on a free-floating base (`τ` with the base's wrench first, damping inside
+/// `c`), or the arm's reaction on its base, from the accelerations `a = [a_b; q̈]`.
+fn floating_inverse_dynamics(
+    function: Function,
+    methods: Methods,
+    system: &FloatingSystem,
+    args: &Arguments,
+    effects: &Effects,
+) -> Vec<Sym> {
+    let FloatingSystem { p, base, state } = *system;
+    let (q, qd) = (&args.q, &args.qd);
+    let a = args.qdd.as_ref().expect("takes a");
+    let base_acc: [Sym; 6] = core::array::from_fn(|k| a[k]);
+    let joints = &a[6..];
+    if function == Function::BaseReaction {
+        return rnea::base_reaction(p, state, q, qd, &base_acc, joints, &effects.loads(None))
+            .to_vec();
+    }
+    let id = if methods.nonlinear_effects == NonlinearEffectsMethod::NewtonEuler {
+        newton_euler::floating_inverse_dynamics
+    } else {
+        rnea::floating_inverse_dynamics
+    };
+    let mut tau = id(
+        p,
+        base,
+        state,
+        q,
+        qd,
+        &base_acc,
+        joints,
+        &effects.loads(None),
+    );
+    if let Some(d) = &effects.damping {
+        for (t, d) in tau[6..].iter_mut().zip(d) {
+            *t = *t + *d;
+        }
+    }
+    tau
+}
+
+/// The outputs of `function` on a fixed base.
+fn fixed_outputs(
+    function: Function,
+    methods: Methods,
+    p: &Params<Sym>,
+    args: &Arguments,
+    effects: &Effects,
+) -> Vec<Sym> {
+    let (q, qd) = (&args.q, &args.qd);
+    let loads = |tau| effects.loads(tau);
+    let tau_minus_c =
+        |qd: &[Sym], l: &Loads<Sym>| methods.nonlinear_effects.tau_minus_c(p, q, qd, l);
+    match function {
+        Function::MassMatrix => upper(&methods.mass_matrix.mass_matrix(p, q)),
+        Function::GeneralizedForces => tau_minus_c(qd, &loads(args.arg(Arg::Tau))),
+        Function::NonlinearEffects => negated(tau_minus_c(qd, &loads(None))),
+        Function::Gravity => negated(tau_minus_c(&args.zeros, &effects.gravity_only())),
+        Function::InverseDynamics => {
+            let qdd = args.qdd.as_ref().expect("inverse dynamics takes q̈");
+            let tau = methods.inverse_dynamics(p, q, qd, qdd, &loads(None));
+            match &effects.damping {
+                // τ = M q̈ + c with the damping force d q̇ inside c.
+                Some(d) => tau.iter().zip(d).map(|(t, d)| *t + *d).collect(),
+                None => tau,
+            }
+        }
+        Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
+            methods.forward_dynamics(p, q, qd, &loads(args.arg(Arg::Tau)))
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            let mut v = upper(&methods.mass_matrix.mass_matrix(p, q));
+            v.extend(negated(tau_minus_c(qd, &loads(None))));
+            v
+        }
+        Function::FramePlacement(k) => {
+            let (x, r) = frames::placement(p, q, &p.frames[k]);
+            placement_outputs(x, r)
+        }
+        Function::FrameJacobian(k) => frames::jacobian(p, q, &p.frames[k]).concat(),
+        Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_) => {
+            unreachable!("rejected by check: free-floating only")
+        }
+    }
 }
 
 fn check(
