@@ -7,7 +7,6 @@ use crate::options::{Error, Float, Options};
 use kanegen_trace::{Input, Node, PayloadField, Sym, Traced};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
-use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 
 /// Operator precedence of an emitted expression (higher binds tighter).
@@ -197,358 +196,458 @@ pub fn emit_body_streamed(
     shape: Shape,
     stmt: &mut dyn FnMut(TokenStream),
 ) -> Body {
-    let inputs: Vec<TokenStream> = t.inputs.iter().map(input_tokens).collect();
-    let Emitter {
-        libm,
-        float,
-        fma,
-        table_sincos,
-    } = emitter;
-    let float = *float;
-    let trace = &t.trace;
-    let sched = trace.schedule();
-    let outputs: HashSet<u32> = trace.outputs().iter().map(|s| s.id()).collect();
-    let nodes: HashMap<u32, Node> = sched.iter().copied().collect();
-    let mut uses: HashMap<u32, usize> = HashMap::new();
-    // Sine and cosine nodes per argument.
-    let mut trig: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
+    let sched = t.trace.schedule();
+    let mut g = GraphEmitter::new(t, emitter, &sched);
+    if emitter.table_sincos {
+        g.hoist_sincos(stmt);
+    }
     for (id, node) in &sched {
-        match *node {
-            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
-                *uses.entry(a.id()).or_default() += 1;
-                *uses.entry(b.id()).or_default() += 1;
+        g.emit_node(*id, node, stmt);
+    }
+    let out: Vec<TokenStream> = t
+        .trace
+        .outputs()
+        .iter()
+        .map(|s| g.exprs[&s.id()].at(P_NEG))
+        .collect();
+    Body {
+        tokens: result_tokens(&out, shape),
+        fmas: g.fmas,
+    }
+}
+
+/// The state of emitting one graph in schedule order.
+struct GraphEmitter<'a> {
+    emitter: &'a Emitter,
+    /// The Rust expression of each input.
+    inputs: Vec<TokenStream>,
+    outputs: HashSet<u32>,
+    nodes: HashMap<u32, Node>,
+    /// How many nodes read each node.
+    uses: HashMap<u32, usize>,
+    /// Sine and cosine nodes per argument.
+    trig: HashMap<u32, (Option<u32>, Option<u32>)>,
+    /// The expression of each emitted node not yet read by its one user (inlined) or bound to
+    /// a name. An inlined node's expression is taken out when its one user reads it: memory
+    /// stays linear in the emitted code, and a long single-use chain is moved into its user,
+    /// not copied. A node its user may look through (a product that fuses, an inlined negation
+    /// that a fused call unwraps) builds its own expression from copies, so the user can still
+    /// take the operands.
+    exprs: HashMap<u32, Expr>,
+    /// Fused calls nested in an inlined expression: past `MAX_CALL_NESTING` the expression is
+    /// bound to a name, so a long fused sum reads as a few short lines instead of a staircase
+    /// (formatted, each level indents every line below it: N = 100 code grew 10× before).
+    nesting: HashMap<u32, u32>,
+    /// Sine–cosine arguments written into the `sincos_n` call, not bound apart.
+    hoisted: HashSet<u32>,
+    /// Names given so far (the `x…` and sine–cosine suffixes).
+    counter: usize,
+    /// Fused multiply-adds formed.
+    fmas: u64,
+}
+
+impl<'a> GraphEmitter<'a> {
+    /// The uses and the sine–cosine pairs of the scheduled graph.
+    fn new(t: &Traced, emitter: &'a Emitter, sched: &[(u32, Node)]) -> Self {
+        let mut uses: HashMap<u32, usize> = HashMap::new();
+        let mut trig: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
+        for (id, node) in sched {
+            match *node {
+                Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                    *uses.entry(a.id()).or_default() += 1;
+                    *uses.entry(b.id()).or_default() += 1;
+                }
+                Node::Neg(a) | Node::Sqrt(a) => *uses.entry(a.id()).or_default() += 1,
+                Node::Sin(a) => {
+                    *uses.entry(a.id()).or_default() += 1;
+                    trig.entry(a.id()).or_default().0 = Some(*id);
+                }
+                Node::Cos(a) => {
+                    *uses.entry(a.id()).or_default() += 1;
+                    trig.entry(a.id()).or_default().1 = Some(*id);
+                }
+                Node::Const(_) | Node::Input(_) => {}
             }
-            Node::Neg(a) | Node::Sqrt(a) => *uses.entry(a.id()).or_default() += 1,
-            Node::Sin(a) => {
-                *uses.entry(a.id()).or_default() += 1;
-                trig.entry(a.id()).or_default().0 = Some(*id);
-            }
-            Node::Cos(a) => {
-                *uses.entry(a.id()).or_default() += 1;
-                trig.entry(a.id()).or_default().1 = Some(*id);
-            }
-            Node::Const(_) | Node::Input(_) => {}
+        }
+        GraphEmitter {
+            emitter,
+            inputs: t.inputs.iter().map(input_tokens).collect(),
+            outputs: t.trace.outputs().iter().map(|s| s.id()).collect(),
+            nodes: sched.iter().copied().collect(),
+            uses,
+            trig,
+            exprs: HashMap::new(),
+            nesting: HashMap::new(),
+            hoisted: HashSet::new(),
+            counter: 0,
+            fmas: 0,
         }
     }
-    // Inlined (single-use, not an output): its expression appears once, in its user's.
-    let inlined_id = |id: u32| !outputs.contains(&id) && uses.get(&id).copied() == Some(1);
-    let inlined = |s: Sym| inlined_id(s.id());
-    // The factors of a product that fuses into its user: an inlined multiplication.
-    let product = |s: Sym| match nodes.get(&s.id()) {
-        Some(Node::Mul(a, b)) if fma.is_some() && inlined(s) => Some((*a, *b)),
-        _ => None,
-    };
-    let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
-    // An inlined node's expression is taken out when its one user reads it: memory stays linear
-    // in the emitted code, and a long single-use chain is moved into its user, not copied. A
-    // node its user may look through (a product that fuses, an inlined negation that a fused
-    // call unwraps) builds its own expression from copies, so the user can still take the
-    // operands.
-    let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
-    // Fused calls nested in an inlined expression: past `MAX_CALL_NESTING` the expression is
-    // bound to a name, so a long fused sum reads as a few short lines instead of a staircase
-    // (formatted, each level indents every line below it: N = 100 code grew 10× before).
-    let mut nesting: HashMap<u32, u32> = HashMap::new();
-    let mut counter = 0usize;
-    let mut fmas = 0u64;
-    // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
-    let trig_base = |arg: u32, counter: usize| -> String {
-        match nodes[&arg] {
-            Node::Input(i) => inputs[i as usize]
+
+    /// Inlined (single-use, not an output): its expression appears once, in its user's.
+    fn inlined_id(&self, id: u32) -> bool {
+        !self.outputs.contains(&id) && self.uses.get(&id).copied() == Some(1)
+    }
+
+    fn inlined(&self, s: Sym) -> bool {
+        self.inlined_id(s.id())
+    }
+
+    /// The factors of a product that fuses into its user: an inlined multiplication.
+    fn product(&self, s: Sym) -> Option<(Sym, Sym)> {
+        match self.nodes.get(&s.id()) {
+            Some(Node::Mul(a, b)) if self.emitter.fma.is_some() && self.inlined(s) => {
+                Some((*a, *b))
+            }
+            _ => None,
+        }
+    }
+
+    fn is_const(&self, s: Sym) -> bool {
+        matches!(self.nodes.get(&s.id()), Some(Node::Const(_)))
+    }
+
+    /// A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
+    fn trig_base(&self, arg: u32) -> String {
+        match self.nodes[&arg] {
+            Node::Input(i) => self.inputs[i as usize]
                 .to_string()
                 .chars()
                 .filter(char::is_ascii_alphanumeric)
                 .collect(),
-            _ => format!("{counter}"),
+            _ => format!("{}", self.counter),
         }
-    };
-    // With the type's own `sincos`: the sines and cosines of the inputs (joint angles), or of an
-    // input plus a constant (a joint's angle offset, `JointParams::angle_offset`) used by them
-    // alone, in one `Self::sincos_n` at the top, so their polynomials run side by side in vector
-    // registers. The sums are written into the call and not bound apart (`hoisted`).
-    let mut hoisted: HashSet<u32> = HashSet::new();
-    if *table_sincos {
-        // The input of a hoistable argument, and the constant added to it.
-        let input_plus = |a: u32| -> Option<(u32, Option<f64>)> {
-            let input = |s: Sym| matches!(nodes[&s.id()], Node::Input(_)).then_some(s.id());
-            let konst = |s: Sym| match nodes[&s.id()] {
-                Node::Const(c) => Some(c),
-                _ => None,
-            };
-            match nodes[&a] {
-                Node::Input(_) => Some((a, None)),
-                Node::Add(x, y) => {
-                    let (s, c) = trig[&a];
-                    let trig_uses = usize::from(s.is_some()) + usize::from(c.is_some());
-                    if uses.get(&a).copied() != Some(trig_uses) {
-                        return None;
-                    }
-                    match (input(x), konst(y), konst(x), input(y)) {
-                        (Some(i), Some(c), ..) | (.., Some(c), Some(i)) => Some((i, Some(c))),
-                        _ => None,
-                    }
-                }
-                _ => None,
-            }
+    }
+
+    /// The input of a hoistable sine–cosine argument `a`, and the constant added to it.
+    fn input_plus(&self, a: u32) -> Option<(u32, Option<f64>)> {
+        let nodes = &self.nodes;
+        let input = |s: Sym| matches!(nodes[&s.id()], Node::Input(_)).then_some(s.id());
+        let konst = |s: Sym| match nodes[&s.id()] {
+            Node::Const(c) => Some(c),
+            _ => None,
         };
-        let mut args: Vec<(u32, u32, Option<f64>)> = trig
+        match nodes[&a] {
+            Node::Input(_) => Some((a, None)),
+            Node::Add(x, y) => {
+                let (s, c) = self.trig[&a];
+                let trig_uses = usize::from(s.is_some()) + usize::from(c.is_some());
+                if self.uses.get(&a).copied() != Some(trig_uses) {
+                    return None;
+                }
+                match (input(x), konst(y), konst(x), input(y)) {
+                    (Some(i), Some(c), ..) | (.., Some(c), Some(i)) => Some((i, Some(c))),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// With the type's own `sincos`: the sines and cosines of the inputs (joint angles), or of
+    /// an input plus a constant (a joint's angle offset, `JointParams::angle_offset`) used by
+    /// them alone, in one `Self::sincos_n` at the top, so their polynomials run side by side in
+    /// vector registers. The sums are written into the call and not bound apart (`hoisted`).
+    fn hoist_sincos(&mut self, stmt: &mut dyn FnMut(TokenStream)) {
+        let mut args: Vec<(u32, u32, Option<f64>)> = self
+            .trig
             .keys()
-            .filter_map(|&a| input_plus(a).map(|(i, c)| (a, i, c)))
+            .filter_map(|&a| self.input_plus(a).map(|(i, c)| (a, i, c)))
             .collect();
         // By input, as the joints are numbered.
         args.sort_unstable_by_key(|&(a, i, _)| (i, a));
-        if args.len() > 1 {
-            let mut pats = Vec::new();
-            let mut xs = Vec::new();
-            let mut bases = HashSet::new();
-            for (a, i, offset) in args {
-                let mut base = trig_base(i, counter);
-                counter += 1;
-                if !bases.insert(base.clone()) {
-                    base = format!("{base}_{counter}");
-                }
-                let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
-                let (s, c) = trig[&a];
-                let bind = |node: Option<u32>, name: &proc_macro2::Ident| match node {
-                    Some(n) => {
-                        exprs.borrow_mut().insert(n, Expr::atom(quote!(#name)));
-                        quote!(#name)
-                    }
-                    None => quote!(_),
-                };
-                let (ps, pc) = (bind(s, &sn), bind(c, &cn));
-                pats.push(quote!((#ps, #pc)));
-                let x = &inputs[match nodes[&i] {
-                    Node::Input(k) => k as usize,
-                    _ => unreachable!("filtered to inputs"),
-                }];
-                xs.push(match offset {
-                    None => x.clone(),
-                    Some(c) => {
-                        hoisted.insert(a);
-                        let lit = constant(c.abs(), float).tokens;
-                        if c.is_sign_negative() {
-                            quote!(#x - #lit)
-                        } else {
-                            quote!(#x + #lit)
-                        }
-                    }
-                });
+        if args.len() <= 1 {
+            return;
+        }
+        let mut pats = Vec::new();
+        let mut xs = Vec::new();
+        let mut bases = HashSet::new();
+        for (a, i, offset) in args {
+            let mut base = self.trig_base(i);
+            self.counter += 1;
+            if !bases.insert(base.clone()) {
+                base = format!("{base}_{}", self.counter);
             }
-            stmt(quote!(let [#(#pats),*] = Self::sincos_n([#(#xs),*]);));
+            let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
+            let (s, c) = self.trig[&a];
+            let mut bind = |node: Option<u32>, name: &proc_macro2::Ident| match node {
+                Some(n) => {
+                    self.exprs.insert(n, Expr::atom(quote!(#name)));
+                    quote!(#name)
+                }
+                None => quote!(_),
+            };
+            let (ps, pc) = (bind(s, &sn), bind(c, &cn));
+            pats.push(quote!((#ps, #pc)));
+            let x = &self.inputs[match self.nodes[&i] {
+                Node::Input(k) => k as usize,
+                _ => unreachable!("filtered to inputs"),
+            }];
+            xs.push(match offset {
+                None => x.clone(),
+                Some(c) => {
+                    self.hoisted.insert(a);
+                    let lit = constant(c.abs(), self.emitter.float).tokens;
+                    if c.is_sign_negative() {
+                        quote!(#x - #lit)
+                    } else {
+                        quote!(#x + #lit)
+                    }
+                }
+            });
+        }
+        stmt(quote!(let [#(#pats),*] = Self::sincos_n([#(#xs),*]);));
+    }
+
+    /// Emits node `id`: records its expression, or binds it to a name by a `let`.
+    fn emit_node(&mut self, id: u32, node: &Node, stmt: &mut dyn FnMut(TokenStream)) {
+        if self.hoisted.contains(&id) {
+            return; // written into the `sincos_n` call
+        }
+        match node {
+            Node::Const(x) => {
+                self.exprs.insert(id, constant(*x, self.emitter.float));
+                return;
+            }
+            Node::Input(i) => {
+                let e = Expr::atom(self.inputs[*i as usize].clone());
+                self.exprs.insert(id, e);
+                return;
+            }
+            Node::Sin(a) | Node::Cos(a) => {
+                self.emit_trig(id, *a, stmt);
+                return;
+            }
+            _ => {}
+        }
+        let deepest = self.deepest_operand(node);
+        let fmas_before = self.fmas;
+        let expr = self.arithmetic(id, node);
+        let depth = deepest + u32::from(self.fmas > fmas_before);
+        let bind = self.outputs.contains(&id)
+            || self.uses.get(&id).copied().unwrap_or(0) > 1
+            || matches!(node, Node::Div(..) | Node::Sqrt(..))
+            || depth > MAX_CALL_NESTING;
+        if bind {
+            let name = format_ident!("x{}", self.counter);
+            self.counter += 1;
+            let e = expr.tokens;
+            stmt(quote!(let #name = #e;));
+            self.exprs.insert(id, Expr::atom(quote!(#name)));
+        } else {
+            self.nesting.insert(id, depth);
+            self.exprs.insert(id, expr);
         }
     }
-    for (id, node) in &sched {
-        let id = *id;
-        if hoisted.contains(&id) {
-            continue; // written into the `sincos_n` call
-        }
-        let see_through = match node {
-            Node::Mul(..) => fma.is_some() && inlined_id(id),
-            Node::Neg(..) => fma.is_some(),
-            _ => false,
-        };
-        let get = |s: Sym| {
-            if !see_through && inlined(s) {
-                exprs
-                    .borrow_mut()
-                    .remove(&s.id())
-                    .expect("an operand is emitted before its user")
-            } else {
-                exprs.borrow()[&s.id()].clone()
-            }
-        };
-        // `−s` as a call argument: constants negated, an inlined negation unwrapped.
-        let neg = |s: Sym| -> TokenStream {
-            match nodes.get(&s.id()) {
-                Some(Node::Const(x)) => constant(-x, float).tokens,
-                Some(Node::Neg(z)) if inlined(s) => {
-                    exprs.borrow_mut().remove(&s.id()); // looked through
-                    get(*z).tokens
-                }
-                _ => {
-                    let e = get(s).at(P_NEG);
-                    quote!(-#e)
-                }
-            }
-        };
-        // The factors of the fusing product `m`, its own expression dropped (looked through).
-        let factors = |m: Sym| {
-            exprs.borrow_mut().remove(&m.id());
-            product(m).expect("checked")
-        };
-        let call = |a: TokenStream, b: TokenStream, c: TokenStream| {
-            let f = fma
-                .as_ref()
-                .expect("products fuse only with an fma function");
-            Expr::atom(quote!(#f(#a, #b, #c)))
-        };
+
+    /// Nesting of a node's expression before fusion: its deepest operand's (a looked-through
+    /// product counts as its factors).
+    fn deepest_operand(&self, node: &Node) -> u32 {
         let operands: &[Sym] = match node {
             Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => &[*a, *b],
             Node::Neg(a) | Node::Sqrt(a) => core::slice::from_ref(a),
             _ => &[],
         };
-        // Nesting of this node's expression: its deepest operand's (a looked-through product
-        // counts as its factors), one more when it becomes a fused call.
-        let deepest = operands
+        operands
             .iter()
-            .flat_map(|o| match product(*o) {
+            .flat_map(|o| match self.product(*o) {
                 Some((a, b)) => [a, b],
                 None => [*o, *o],
             })
-            .map(|o| nesting.get(&o.id()).copied().unwrap_or(0))
+            .map(|o| self.nesting.get(&o.id()).copied().unwrap_or(0))
             .max()
-            .unwrap_or(0);
-        let fmas_before = fmas;
-        let expr = match node {
-            Node::Const(x) => {
-                exprs.borrow_mut().insert(id, constant(*x, float));
-                continue;
+            .unwrap_or(0)
+    }
+
+    /// The sine and/or cosine of `a`, bound by one call when both are used: the type's own
+    /// `sincos` (a table and short polynomials) takes both at the price of one; libm has `sin`
+    /// and `cos` apart.
+    fn emit_trig(&mut self, id: u32, a: Sym, stmt: &mut dyn FnMut(TokenStream)) {
+        if self.exprs.contains_key(&id) {
+            return; // bound together with its partner by one sincos
+        }
+        let arg = self.take(a, false).tokens;
+        let base = self.trig_base(a.id());
+        self.counter += 1;
+        let (libm, float) = (&self.emitter.libm, self.emitter.float);
+        let (sin_call, cos_call, sincos_call) = if self.emitter.table_sincos {
+            (
+                quote!(Self::sincos(#arg).0),
+                quote!(Self::sincos(#arg).1),
+                quote!(Self::sincos(#arg)),
+            )
+        } else {
+            let (s, c, sc) = (
+                float.libm_fn("sin"),
+                float.libm_fn("cos"),
+                float.libm_fn("sincos"),
+            );
+            (
+                quote!(#libm::#s(#arg)),
+                quote!(#libm::#c(#arg)),
+                quote!(#libm::#sc(#arg)),
+            )
+        };
+        match self.trig[&a.id()] {
+            (Some(s), Some(c)) => {
+                let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
+                stmt(quote!(let (#sn, #cn) = #sincos_call;));
+                self.exprs.insert(s, Expr::atom(quote!(#sn)));
+                self.exprs.insert(c, Expr::atom(quote!(#cn)));
             }
-            Node::Input(i) => {
-                exprs
-                    .borrow_mut()
-                    .insert(id, Expr::atom(inputs[*i as usize].clone()));
-                continue;
+            (Some(s), None) => {
+                let sn = format_ident!("s_{}", base);
+                stmt(quote!(let #sn = #sin_call;));
+                self.exprs.insert(s, Expr::atom(quote!(#sn)));
             }
-            Node::Sin(a) | Node::Cos(a) => {
-                if exprs.borrow().contains_key(&id) {
-                    continue; // bound together with its partner by one sincos
-                }
-                let arg = get(*a).tokens;
-                let base = trig_base(a.id(), counter);
-                counter += 1;
-                // The type's own `sincos` (a table and short polynomials) takes both at the
-                // price of one; libm has `sin` and `cos` apart.
-                let (sin_call, cos_call, sincos_call) = if *table_sincos {
-                    (
-                        quote!(Self::sincos(#arg).0),
-                        quote!(Self::sincos(#arg).1),
-                        quote!(Self::sincos(#arg)),
-                    )
-                } else {
-                    let (s, c, sc) = (
-                        float.libm_fn("sin"),
-                        float.libm_fn("cos"),
-                        float.libm_fn("sincos"),
-                    );
-                    (
-                        quote!(#libm::#s(#arg)),
-                        quote!(#libm::#c(#arg)),
-                        quote!(#libm::#sc(#arg)),
-                    )
-                };
-                match trig[&a.id()] {
-                    (Some(s), Some(c)) => {
-                        let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
-                        stmt(quote!(let (#sn, #cn) = #sincos_call;));
-                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
-                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
-                    }
-                    (Some(s), None) => {
-                        let sn = format_ident!("s_{}", base);
-                        stmt(quote!(let #sn = #sin_call;));
-                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
-                    }
-                    (None, Some(c)) => {
-                        let cn = format_ident!("c_{}", base);
-                        stmt(quote!(let #cn = #cos_call;));
-                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
-                    }
-                    (None, None) => unreachable!("trig node without entry"),
-                }
-                continue;
+            (None, Some(c)) => {
+                let cn = format_ident!("c_{}", base);
+                stmt(quote!(let #cn = #cos_call;));
+                self.exprs.insert(c, Expr::atom(quote!(#cn)));
             }
+            (None, None) => unreachable!("trig node without entry"),
+        }
+    }
+
+    /// The expression of operand `s`: taken out when it is inlined (unless its user looks
+    /// through it, `see_through`), copied otherwise.
+    fn take(&mut self, s: Sym, see_through: bool) -> Expr {
+        if !see_through && self.inlined(s) {
+            self.exprs
+                .remove(&s.id())
+                .expect("an operand is emitted before its user")
+        } else {
+            self.exprs[&s.id()].clone()
+        }
+    }
+
+    /// `−s` as a call argument: constants negated, an inlined negation unwrapped.
+    fn neg(&mut self, s: Sym, see_through: bool) -> TokenStream {
+        match self.nodes.get(&s.id()).copied() {
+            Some(Node::Const(x)) => constant(-x, self.emitter.float).tokens,
+            Some(Node::Neg(z)) if self.inlined(s) => {
+                self.exprs.remove(&s.id()); // looked through
+                self.take(z, see_through).tokens
+            }
+            _ => {
+                let e = self.take(s, see_through).at(P_NEG);
+                quote!(-#e)
+            }
+        }
+    }
+
+    /// The factors of the fusing product `m`, its own expression dropped (looked through).
+    fn factors(&mut self, m: Sym) -> (Sym, Sym) {
+        self.exprs.remove(&m.id());
+        self.product(m).expect("checked")
+    }
+
+    /// `fma(a, b, c)`, one more fused multiply-add.
+    fn call(&mut self, a: TokenStream, b: TokenStream, c: TokenStream) -> Expr {
+        self.fmas += 1;
+        let f = self
+            .emitter
+            .fma
+            .as_ref()
+            .expect("products fuse only with an fma function");
+        Expr::atom(quote!(#f(#a, #b, #c)))
+    }
+
+    /// The expression of an arithmetic node, with products fused into their users.
+    fn arithmetic(&mut self, id: u32, node: &Node) -> Expr {
+        let st = match node {
+            Node::Mul(..) => self.emitter.fma.is_some() && self.inlined_id(id),
+            Node::Neg(..) => self.emitter.fma.is_some(),
+            _ => false,
+        };
+        match *node {
             // x + a·b, a·b + x: fma(a, b, x) (the right product first: sums accumulate
             // from the left, so the left operand is the running sum).
-            Node::Add(x, y) if product(*y).is_some() || product(*x).is_some() => {
-                fmas += 1;
-                let (m, c) = if product(*y).is_some() {
-                    (*y, *x)
+            Node::Add(x, y) if self.product(y).is_some() || self.product(x).is_some() => {
+                let (m, c) = if self.product(y).is_some() {
+                    (y, x)
                 } else {
-                    (*x, *y)
+                    (x, y)
                 };
-                let (a, b) = factors(m);
-                call(get(a).tokens, get(b).tokens, get(c).tokens)
+                let (a, b) = self.factors(m);
+                let (a, b, c) = (
+                    self.take(a, st).tokens,
+                    self.take(b, st).tokens,
+                    self.take(c, st).tokens,
+                );
+                self.call(a, b, c)
             }
             // x − a·b: fma(−a, b, x) (the constant factor negated when there is one).
-            Node::Sub(x, y) if product(*y).is_some() => {
-                fmas += 1;
-                let (a, b) = factors(*y);
-                if is_const(b) && !is_const(a) {
-                    call(get(a).tokens, neg(b), get(*x).tokens)
+            Node::Sub(x, y) if self.product(y).is_some() => {
+                let (a, b) = self.factors(y);
+                let (a, b, c) = if self.is_const(b) && !self.is_const(a) {
+                    (
+                        self.take(a, st).tokens,
+                        self.neg(b, st),
+                        self.take(x, st).tokens,
+                    )
                 } else {
-                    call(neg(a), get(b).tokens, get(*x).tokens)
-                }
+                    (
+                        self.neg(a, st),
+                        self.take(b, st).tokens,
+                        self.take(x, st).tokens,
+                    )
+                };
+                self.call(a, b, c)
             }
             // a·b − y: fma(a, b, −y).
-            Node::Sub(x, y) if product(*x).is_some() => {
-                fmas += 1;
-                let (a, b) = factors(*x);
-                call(get(a).tokens, get(b).tokens, neg(*y))
+            Node::Sub(x, y) if self.product(x).is_some() => {
+                let (a, b) = self.factors(x);
+                let (a, b, c) = (
+                    self.take(a, st).tokens,
+                    self.take(b, st).tokens,
+                    self.neg(y, st),
+                );
+                self.call(a, b, c)
             }
-            Node::Add(a, b) => {
-                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
-                Expr {
-                    tokens: quote!(#a + #b),
-                    prec: P_ADD,
-                }
-            }
-            Node::Sub(a, b) => {
-                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
-                Expr {
-                    tokens: quote!(#a - #b),
-                    prec: P_ADD,
-                }
-            }
-            Node::Mul(a, b) => {
-                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
-                Expr {
-                    tokens: quote!(#a * #b),
-                    prec: P_MUL,
-                }
-            }
-            Node::Div(a, b) => {
-                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
-                Expr {
-                    tokens: quote!(#a / #b),
-                    prec: P_MUL,
-                }
-            }
+            Node::Add(a, b) => self.binary(a, b, st, "+"),
+            Node::Sub(a, b) => self.binary(a, b, st, "-"),
+            Node::Mul(a, b) => self.binary(a, b, st, "*"),
+            Node::Div(a, b) => self.binary(a, b, st, "/"),
             Node::Neg(a) => {
-                let a = get(*a).at(P_NEG);
+                let a = self.take(a, st).at(P_NEG);
                 Expr {
                     tokens: quote!(-#a),
                     prec: P_NEG,
                 }
             }
             Node::Sqrt(a) => {
-                let a = get(*a).tokens;
-                let f = float.libm_fn("sqrt");
+                let a = self.take(a, st).tokens;
+                let (libm, f) = (&self.emitter.libm, self.emitter.float.libm_fn("sqrt"));
                 Expr::atom(quote!(#libm::#f(#a)))
             }
-        };
-        let depth = deepest + u32::from(fmas > fmas_before);
-        let bind = outputs.contains(&id)
-            || uses.get(&id).copied().unwrap_or(0) > 1
-            || matches!(node, Node::Div(..) | Node::Sqrt(..))
-            || depth > MAX_CALL_NESTING;
-        if bind {
-            let name = format_ident!("x{}", counter);
-            counter += 1;
-            let e = expr.tokens;
-            stmt(quote!(let #name = #e;));
-            exprs.borrow_mut().insert(id, Expr::atom(quote!(#name)));
-        } else {
-            nesting.insert(id, depth);
-            exprs.borrow_mut().insert(id, expr);
+            Node::Const(_) | Node::Input(_) | Node::Sin(_) | Node::Cos(_) => {
+                unreachable!("emitted by emit_node")
+            }
         }
     }
-    let out: Vec<TokenStream> = trace
-        .outputs()
-        .iter()
-        .map(|s| exprs.borrow()[&s.id()].at(P_NEG))
-        .collect();
+
+    /// `a op b` with the parentheses that keep the graph's evaluation order: sums and
+    /// differences bind the left operand at `+` and the right at `*`; products and quotients
+    /// the left at `*` and the right at unary minus.
+    fn binary(&mut self, a: Sym, b: Sym, st: bool, op: &str) -> Expr {
+        let (left, right, prec) = match op {
+            "+" | "-" => (P_ADD, P_MUL, P_ADD),
+            _ => (P_MUL, P_NEG, P_MUL),
+        };
+        let (a, b) = (self.take(a, st).at(left), self.take(b, st).at(right));
+        let tokens = match op {
+            "+" => quote!(#a + #b),
+            "-" => quote!(#a - #b),
+            "*" => quote!(#a * #b),
+            _ => quote!(#a / #b),
+        };
+        Expr { tokens, prec }
+    }
+}
+
+/// The function's result expression: the outputs `out` returned as `shape`.
+fn result_tokens(out: &[TokenStream], shape: Shape) -> TokenStream {
     // Upper triangle, row-major: index of (i, j), i ≤ j.
     let sym_matrix = |out: &[TokenStream], n: usize| {
         let idx = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
@@ -558,9 +657,9 @@ pub fn emit_body_streamed(
         });
         quote!([#(#rows),*])
     };
-    let result = match shape {
+    match shape {
         Shape::Vector(_) => quote!([#(#out),*]),
-        Shape::SymMatrix(n) => sym_matrix(&out, n),
+        Shape::SymMatrix(n) => sym_matrix(out, n),
         Shape::SymMatrixAndVector(n) => {
             let k = n * (n + 1) / 2;
             let m = sym_matrix(&out[..k], n);
@@ -576,9 +675,5 @@ pub fn emit_body_streamed(
             let rows = out[3..].chunks(3).map(|r| quote!([#(#r),*]));
             quote!(([#(#p),*], [#(#rows),*]))
         }
-    };
-    Body {
-        tokens: result,
-        fmas,
     }
 }
