@@ -243,70 +243,13 @@ fn inertial_of(
 fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
     let base = spec.base.map(|b| b.0).unwrap_or_default();
     let base_name = base.name.clone().unwrap_or_else(|| "base".to_string());
-    let base_inertial = match (base.mass, &base.inertia) {
-        (None, None) if base.com.is_none() => None,
-        (Some(m), Some(i)) => Some(inertial_of(&base_name, "base", m, base.com, i, validation)?),
-        (None, _) => {
-            return Err(ModelError::invalid(
-                &base_name,
-                "base.mass",
-                "missing (the base inertial needs mass and inertia)",
-            ))
-        }
-        (Some(_), None) => {
-            return Err(ModelError::invalid(
-                &base_name,
-                "base.inertia",
-                "missing (the base inertial needs mass and inertia)",
-            ))
-        }
-    };
-
-    let dh_base = match &spec.dh {
-        Some(dh) => {
-            let xyz = dh.base_xyz.unwrap_or([0.0; 3]);
-            bounded("dh", "dh.base_xyz", &xyz, LENGTH)?;
-            Some(Placement {
-                rotation: rotation_of("dh", "dh.base_", dh.base_rpy, dh.base_rotation)?,
-                translation: xyz,
-            })
-        }
-        None => None,
-    };
-
-    let base_kind = match base.kind.as_deref() {
-        None => BaseKind::Fixed,
-        Some(k) => BaseKind::from_name(k).ok_or_else(|| {
-            ModelError::invalid(
-                &base_name,
-                "base.type",
-                format!("unknown base type `{k}` (expected \"fixed\" or \"free-floating\")"),
-            )
-        })?,
-    };
-    // A parent named in the file: the base, an earlier joint, or an earlier joint's body.
-    let parent_of = |label: &str, field: &str, name: &str, joints: &[Joint]| {
-        if name == base_name || name == "base" {
-            return Ok(None);
-        }
-        joints
-            .iter()
-            .position(|j| j.name == name || j.body == name)
-            .map(Some)
-            .ok_or_else(|| {
-                ModelError::invalid(
-                    label,
-                    field,
-                    format!(
-                        "no joint or body `{name}` before it (a parent must be the base, `{base_name}`, or an earlier joint or its body)"
-                    ),
-                )
-            })
-    };
+    let base_inertial = base_inertial_of(&base, &base_name, validation)?;
+    let dh_frame0 = spec.dh.as_ref().map(dh_frame0_of).transpose()?;
+    let base_kind = base_kind_of(&base, &base_name)?;
     let mut labels = Vec::new();
     let mut joints: Vec<Joint> = Vec::new();
     // Standard DH: the constant distal part of the previous joint, to go into the next origin.
-    let mut carry = dh_base.unwrap_or_else(Placement::identity);
+    let mut carry = dh_frame0.unwrap_or_else(Placement::identity);
     for (k, js) in spec.joints.iter().enumerate() {
         let label = js
             .name
@@ -317,171 +260,307 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
             .clone()
             .unwrap_or_else(|| format!("joint_{}", k + 1));
         labels.push((name.clone(), label.clone()));
-        let kind = match js.kind {
-            KindSpec::Revolute => JointKind::Revolute,
-            KindSpec::Prismatic => JointKind::Prismatic,
-        };
-        let mut inertial = inertial_of(
-            &label,
-            "body",
-            js.body.mass,
-            js.body.com,
-            &js.body.inertia,
+        let context = JointContext {
+            k,
+            label: &label,
+            base_name: &base_name,
+            dh: spec.dh.as_ref(),
             validation,
-        )?;
-        let parent = match (&js.parent, &spec.dh) {
-            (None, _) => k.checked_sub(1),
-            (Some(_), Some(_)) => {
-                return Err(ModelError::invalid(
-                    &label,
-                    "parent",
-                    "a DH model ([dh]) is a serial chain: `parent` is not allowed",
-                ))
-            }
-            (Some(p), None) => parent_of(&label, "parent", p, &joints)?,
         };
-        let (origin, axis) = match &spec.dh {
-            None => {
-                for (field, present) in [
-                    ("a", js.a.is_some()),
-                    ("alpha", js.alpha.is_some()),
-                    ("d", js.d.is_some()),
-                    ("theta", js.theta.is_some()),
-                ] {
-                    if present {
-                        return Err(ModelError::invalid(
-                            &label,
-                            field,
-                            "DH parameters need a top-level [dh] table (convention = \"standard\" or \"modified\")",
-                        ));
-                    }
-                }
-                let xyz = js.xyz.unwrap_or([0.0; 3]);
-                bounded(&label, "xyz", &xyz, LENGTH)?;
-                let r = rotation_of(&label, "", js.rpy, js.rotation)?;
-                let axis = js.axis.ok_or_else(|| {
-                    ModelError::invalid(&label, "axis", "missing (required unless [dh] is given)")
-                })?;
-                finite(&label, "axis", &axis)?;
-                (
-                    Placement {
-                        rotation: r,
-                        translation: xyz,
-                    },
-                    axis,
-                )
-            }
-            Some(dh) => {
-                for (field, present) in [
-                    ("xyz", js.xyz.is_some()),
-                    ("rpy", js.rpy.is_some()),
-                    ("rotation", js.rotation.is_some()),
-                    ("axis", js.axis.is_some()),
-                ] {
-                    if present {
-                        return Err(ModelError::invalid(
-                            &label,
-                            field,
-                            "not allowed in a DH model ([dh] is given): use a, alpha, d, theta",
-                        ));
-                    }
-                }
-                let [a, alpha, d, theta] =
-                    [js.a, js.alpha, js.d, js.theta].map(|x| x.unwrap_or(0.0));
-                for (field, x, b) in [
-                    ("a", a, LENGTH),
-                    ("alpha", alpha, POSITION),
-                    ("d", d, LENGTH),
-                    ("theta", theta, POSITION),
-                ] {
-                    bounded(&label, field, &[x], b)?;
-                }
-                let origin = match dh.convention {
-                    DhConvention::Modified => {
-                        let o = Placement::rot_x(alpha)
-                            .then(&Placement::trans([a, 0.0, 0.0]))
-                            .then(&Placement::rot_z(theta))
-                            .then(&Placement::trans([0.0, 0.0, d]));
-                        let o = if k == 0 { carry.then(&o) } else { o };
-                        carry = Placement::identity();
-                        o
-                    }
-                    DhConvention::Standard => {
-                        let o = carry.then(&Placement::rot_z(theta));
-                        // Frame i in the body (joint) frame: TransZ(d) TransX(a) RotX(α).
-                        let c = Placement::trans([0.0, 0.0, d])
-                            .then(&Placement::trans([a, 0.0, 0.0]))
-                            .then(&Placement::rot_x(alpha));
-                        inertial.com = c.point(&inertial.com);
-                        inertial.inertia = rotate_inertia(&c.rotation, &inertial.inertia);
-                        carry = c;
-                        o
-                    }
-                };
-                (origin, [0.0, 0.0, 1.0])
-            }
-        };
-        joints.push(Joint {
-            body: js
-                .body
-                .name
-                .clone()
-                .unwrap_or_else(|| format!("{name}_body")),
-            name,
-            kind,
-            parent,
-            origin,
-            axis,
-            inertial,
-        });
+        let joint = joint_of(&context, name, js, &joints, &mut carry)?;
+        joints.push(joint);
     }
-    let mut frames = Vec::new();
-    for f in &spec.frames {
-        let xyz = f.xyz.unwrap_or([0.0; 3]);
-        bounded(&f.name, "frame.xyz", &xyz, LENGTH)?;
-        frames.push(Frame {
-            name: f.name.clone(),
-            parent: parent_of(&f.name, "frame.parent", &f.parent, &joints)?,
-            placement: Placement {
-                translation: xyz,
-                rotation: rotation_of(&f.name, "frame.", f.rpy, f.rotation)?,
-            },
-        });
-    }
+    let frames = frames_of(&spec.frames, &base_name, &joints)?;
     let is_dh = spec.dh.is_some();
-    let model =
-        Model::new_with(spec.name, base_name, base_inertial, joints, validation).map_err(|e| {
-            match e {
-                ModelError::Invalid {
-                    joint,
-                    field,
-                    reason,
-                } => {
-                    let joint = labels
-                        .iter()
-                        .find(|(n, _)| *n == joint)
-                        .map_or(joint, |(_, l)| l.clone());
-                    let field = match field.as_str() {
-                        "origin.rotation" if is_dh => "dh.base_rotation".to_string(),
-                        "origin.rotation" => "rotation".to_string(),
-                        "origin.translation" => "xyz".to_string(),
-                        f => f
-                            .strip_prefix("inertial.")
-                            .map(|r| format!("body.{r}"))
-                            .or_else(|| {
-                                f.strip_prefix("base.inertial.")
-                                    .map(|r| format!("base.{r}"))
-                            })
-                            .unwrap_or_else(|| f.to_string()),
-                    };
-                    ModelError::Invalid {
-                        joint,
-                        field,
-                        reason,
-                    }
-                }
-                other => other,
-            }
-        })?;
+    let model = Model::new_with(spec.name, base_name, base_inertial, joints, validation)
+        .map_err(|e| in_file_terms(e, &labels, is_dh))?;
     model.with_frames(frames)?.with_base_kind(base_kind)
+}
+
+/// The base's mass properties: all of `mass`, `inertia` (and optionally `com`), or none.
+fn base_inertial_of(
+    base: &BaseTable,
+    base_name: &str,
+    validation: Validation,
+) -> Result<Option<Inertial>, ModelError> {
+    match (base.mass, &base.inertia) {
+        (None, None) if base.com.is_none() => Ok(None),
+        (Some(m), Some(i)) => inertial_of(base_name, "base", m, base.com, i, validation).map(Some),
+        (None, _) => Err(ModelError::invalid(
+            base_name,
+            "base.mass",
+            "missing (the base inertial needs mass and inertia)",
+        )),
+        (Some(_), None) => Err(ModelError::invalid(
+            base_name,
+            "base.inertia",
+            "missing (the base inertial needs mass and inertia)",
+        )),
+    }
+}
+
+/// `[dh]`'s placement of DH frame 0 in the base body frame.
+fn dh_frame0_of(dh: &DhSpec) -> Result<Placement, ModelError> {
+    let xyz = dh.base_xyz.unwrap_or([0.0; 3]);
+    bounded("dh", "dh.base_xyz", &xyz, LENGTH)?;
+    Ok(Placement {
+        rotation: rotation_of("dh", "dh.base_", dh.base_rpy, dh.base_rotation)?,
+        translation: xyz,
+    })
+}
+
+/// `base.type`: fixed (the default) or free-floating.
+fn base_kind_of(base: &BaseTable, base_name: &str) -> Result<BaseKind, ModelError> {
+    match base.kind.as_deref() {
+        None => Ok(BaseKind::Fixed),
+        Some(k) => BaseKind::from_name(k).ok_or_else(|| {
+            ModelError::invalid(
+                base_name,
+                "base.type",
+                format!("unknown base type `{k}` (expected \"fixed\" or \"free-floating\")"),
+            )
+        }),
+    }
+}
+
+/// A parent named in the file: the base (`None`), an earlier joint, or an earlier joint's body.
+fn parent_of(
+    base_name: &str,
+    label: &str,
+    field: &str,
+    name: &str,
+    joints: &[Joint],
+) -> Result<Option<usize>, ModelError> {
+    if name == base_name || name == "base" {
+        return Ok(None);
+    }
+    joints
+        .iter()
+        .position(|j| j.name == name || j.body == name)
+        .map(Some)
+        .ok_or_else(|| {
+            ModelError::invalid(
+                label,
+                field,
+                format!(
+                    "no joint or body `{name}` before it (a parent must be the base, `{base_name}`, or an earlier joint or its body)"
+                ),
+            )
+        })
+}
+
+/// What reading joint `k` needs besides its table.
+struct JointContext<'a> {
+    /// Its index in the file.
+    k: usize,
+    /// Its name in error messages (`joint #k` when unnamed).
+    label: &'a str,
+    base_name: &'a str,
+    dh: Option<&'a DhSpec>,
+    validation: Validation,
+}
+
+/// Joint `js` (called `name`) and its body; `joints` are the ones before it, `carry` the
+/// standard-DH placement handed from the previous joint to this one's origin.
+fn joint_of(
+    cx: &JointContext,
+    name: String,
+    js: &JointSpec,
+    joints: &[Joint],
+    carry: &mut Placement,
+) -> Result<Joint, ModelError> {
+    let label = cx.label;
+    let kind = match js.kind {
+        KindSpec::Revolute => JointKind::Revolute,
+        KindSpec::Prismatic => JointKind::Prismatic,
+    };
+    let mut inertial = inertial_of(
+        label,
+        "body",
+        js.body.mass,
+        js.body.com,
+        &js.body.inertia,
+        cx.validation,
+    )?;
+    let parent = match (&js.parent, cx.dh) {
+        (None, _) => cx.k.checked_sub(1),
+        (Some(_), Some(_)) => {
+            return Err(ModelError::invalid(
+                label,
+                "parent",
+                "a DH model ([dh]) is a serial chain: `parent` is not allowed",
+            ))
+        }
+        (Some(p), None) => parent_of(cx.base_name, label, "parent", p, joints)?,
+    };
+    let (origin, axis) = match cx.dh {
+        None => explicit_placement(label, js)?,
+        Some(dh) => (
+            dh_placement(cx, js, dh, carry, &mut inertial)?,
+            [0.0, 0.0, 1.0],
+        ),
+    };
+    Ok(Joint {
+        body: js
+            .body
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("{name}_body")),
+        name,
+        kind,
+        parent,
+        origin,
+        axis,
+        inertial,
+    })
+}
+
+/// The origin (`xyz`, `rpy` or `rotation`) and the axis of a joint of a model without `[dh]`.
+fn explicit_placement(label: &str, js: &JointSpec) -> Result<(Placement, V3), ModelError> {
+    for (field, present) in [
+        ("a", js.a.is_some()),
+        ("alpha", js.alpha.is_some()),
+        ("d", js.d.is_some()),
+        ("theta", js.theta.is_some()),
+    ] {
+        if present {
+            return Err(ModelError::invalid(
+                label,
+                field,
+                "DH parameters need a top-level [dh] table (convention = \"standard\" or \"modified\")",
+            ));
+        }
+    }
+    let xyz = js.xyz.unwrap_or([0.0; 3]);
+    bounded(label, "xyz", &xyz, LENGTH)?;
+    let r = rotation_of(label, "", js.rpy, js.rotation)?;
+    let axis = js.axis.ok_or_else(|| {
+        ModelError::invalid(label, "axis", "missing (required unless [dh] is given)")
+    })?;
+    finite(label, "axis", &axis)?;
+    Ok((
+        Placement {
+            rotation: r,
+            translation: xyz,
+        },
+        axis,
+    ))
+}
+
+/// The origin of a DH joint (its axis is z) from `a`, `alpha`, `d`, `theta`. Modified DH: the
+/// whole `RotX(α) TransX(a) RotZ(θ) TransZ(d)` (after DH frame 0 for the first joint). Standard
+/// DH: `carry RotZ(θ)`, and the constant `TransZ(d) TransX(a) RotX(α)` becomes the next `carry`,
+/// the body's mass properties moved into the joint frame.
+fn dh_placement(
+    cx: &JointContext,
+    js: &JointSpec,
+    dh: &DhSpec,
+    carry: &mut Placement,
+    inertial: &mut Inertial,
+) -> Result<Placement, ModelError> {
+    let label = cx.label;
+    for (field, present) in [
+        ("xyz", js.xyz.is_some()),
+        ("rpy", js.rpy.is_some()),
+        ("rotation", js.rotation.is_some()),
+        ("axis", js.axis.is_some()),
+    ] {
+        if present {
+            return Err(ModelError::invalid(
+                label,
+                field,
+                "not allowed in a DH model ([dh] is given): use a, alpha, d, theta",
+            ));
+        }
+    }
+    let [a, alpha, d, theta] = [js.a, js.alpha, js.d, js.theta].map(|x| x.unwrap_or(0.0));
+    for (field, x, b) in [
+        ("a", a, LENGTH),
+        ("alpha", alpha, POSITION),
+        ("d", d, LENGTH),
+        ("theta", theta, POSITION),
+    ] {
+        bounded(label, field, &[x], b)?;
+    }
+    Ok(match dh.convention {
+        DhConvention::Modified => {
+            let o = Placement::rot_x(alpha)
+                .then(&Placement::trans([a, 0.0, 0.0]))
+                .then(&Placement::rot_z(theta))
+                .then(&Placement::trans([0.0, 0.0, d]));
+            let o = if cx.k == 0 { carry.then(&o) } else { o };
+            *carry = Placement::identity();
+            o
+        }
+        DhConvention::Standard => {
+            let o = carry.then(&Placement::rot_z(theta));
+            // Frame i in the body (joint) frame: TransZ(d) TransX(a) RotX(α).
+            let c = Placement::trans([0.0, 0.0, d])
+                .then(&Placement::trans([a, 0.0, 0.0]))
+                .then(&Placement::rot_x(alpha));
+            inertial.com = c.point(&inertial.com);
+            inertial.inertia = rotate_inertia(&c.rotation, &inertial.inertia);
+            *carry = c;
+            o
+        }
+    })
+}
+
+/// The `[[frame]]` tables, each on the base or an earlier joint's body.
+fn frames_of(
+    specs: &[FrameSpec],
+    base_name: &str,
+    joints: &[Joint],
+) -> Result<Vec<Frame>, ModelError> {
+    specs
+        .iter()
+        .map(|f| {
+            let xyz = f.xyz.unwrap_or([0.0; 3]);
+            bounded(&f.name, "frame.xyz", &xyz, LENGTH)?;
+            Ok(Frame {
+                name: f.name.clone(),
+                parent: parent_of(base_name, &f.name, "frame.parent", &f.parent, joints)?,
+                placement: Placement {
+                    translation: xyz,
+                    rotation: rotation_of(&f.name, "frame.", f.rpy, f.rotation)?,
+                },
+            })
+        })
+        .collect()
+}
+
+/// A model error in the file's terms: the joint by its label (`joint #k` when unnamed) and the
+/// field by the key the file spells (`xyz`, `rotation`, `body.mass`, `base.mass`…).
+fn in_file_terms(e: ModelError, labels: &[(String, String)], is_dh: bool) -> ModelError {
+    match e {
+        ModelError::Invalid {
+            joint,
+            field,
+            reason,
+        } => {
+            let joint = labels
+                .iter()
+                .find(|(n, _)| *n == joint)
+                .map_or(joint, |(_, l)| l.clone());
+            let field = match field.as_str() {
+                "origin.rotation" if is_dh => "dh.base_rotation".to_string(),
+                "origin.rotation" => "rotation".to_string(),
+                "origin.translation" => "xyz".to_string(),
+                f => f
+                    .strip_prefix("inertial.")
+                    .map(|r| format!("body.{r}"))
+                    .or_else(|| {
+                        f.strip_prefix("base.inertial.")
+                            .map(|r| format!("base.{r}"))
+                    })
+                    .unwrap_or_else(|| f.to_string()),
+            };
+            ModelError::Invalid {
+                joint,
+                field,
+                reason,
+            }
+        }
+        other => other,
+    }
 }
