@@ -27,7 +27,7 @@
 //! let (q, qd) = ([0.1, 0.2, 0.3, 0.4], [0.0; 4]);
 //! let paper = Methods::RECURRENT.dynamics(&p, &q, &qd, &Loads::default());
 //! let spatial = Methods::SPATIAL.dynamics(&p, &q, &qd, &Loads::default());
-//! assert!((paper.a[1][3] - spatial.a[1][3]).abs() < 1e-9);
+//! assert!((paper.mass_matrix[1][3] - spatial.mass_matrix[1][3]).abs() < 1e-9);
 //! ```
 #![warn(missing_docs)]
 

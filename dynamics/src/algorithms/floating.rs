@@ -55,10 +55,10 @@
 //! let state = FloatingState::<f64>::at_rest();
 //! let d = floating::dynamics(Methods::RECURRENT, &p, &base, &state, &[0.1, 0.2, 0.3], &[0.0; 3],
 //!     &Loads::default());
-//! assert_eq!(d.a.len(), 9);
+//! assert_eq!(d.mass_matrix.len(), 9);
 //! // The linear block is the total mass times the identity.
 //! let total = 100.0 + chain.joints().iter().map(|j| j.inertial.mass).sum::<f64>();
-//! assert!((d.a[0][0] - total).abs() < 1e-9 && d.a[0][1].abs() < 1e-9);
+//! assert!((d.mass_matrix[0][0] - total).abs() < 1e-9 && d.mass_matrix[0][1].abs() < 1e-9);
 //! ```
 
 use crate::algorithms::kinematics::{
