@@ -90,8 +90,23 @@ enum Command {
         /// "results": [{"A": [[…]], "b": […]}]}.
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality (published but not
-        /// physically realisable parameter sets); other checks stay.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
+        #[arg(long)]
+        allow_nonphysical: bool,
+    },
+    /// The joints in the order of q (type, parent, axis, limits, mimic), the frames, the base,
+    /// the total mass, and what the URDF reader ignored and merged.
+    Info {
+        /// Model file (.urdf or .toml).
+        model: PathBuf,
+        /// The base: fixed or free-floating (default: the model's).
+        #[arg(long, value_parser = parse_base)]
+        base: Option<BaseKind>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Accept inertias that are not physically realisable (docs/models.md).
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -124,7 +139,8 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -169,7 +185,8 @@ enum Command {
         /// instead of the cheapest candidate per function.
         #[arg(long, value_parser = parse_forced)]
         algorithm: Option<Methods>,
-        /// Accept inertia tensors that violate the triangle inequality.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
         #[arg(long)]
         allow_nonphysical: bool,
         /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
@@ -205,7 +222,7 @@ enum Command {
         /// Print JSON (one input: the report; several: {"subjects": [...]}).
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality (models only).
+        /// Accept inertias that are not physically realisable (models only; docs/models.md).
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -327,7 +344,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             let results = commands::eval::eval_states(&chain, &text, algorithm, g)
                 .with_context(|| format!("states file `{}`", states.display()))?;
             if as_json {
-                let joints: Vec<&str> = chain.joints().iter().map(|j| j.name.as_str()).collect();
+                let joints = commands::eval::coordinate_names(&chain);
                 let v = serde_json::json!({
                     "joints": joints,
                     "base": chain.base_kind().name(),
@@ -341,6 +358,12 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 )?;
             }
         }
+        Command::Info {
+            model,
+            base,
+            json: as_json,
+            allow_nonphysical,
+        } => commands::info::run(&model, base, allow_nonphysical, as_json, out)?,
         Command::Table1 {
             json: as_json,
             out: dir,
