@@ -189,6 +189,9 @@ enum Command {
         /// triangle inequality violated, rotational inertia without mass); other checks stay.
         #[arg(long)]
         allow_nonphysical: bool,
+        /// Generate every URDF mimic joint as an independent joint (Pinocchio's mimic=False).
+        #[arg(long)]
+        ignore_mimic: bool,
         /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
         /// caller's stack, and the frame functions stay straight-line).
         #[arg(long)]
@@ -459,6 +462,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             snap,
             algorithm,
             allow_nonphysical,
+            ignore_mimic,
             allow_large,
         } => {
             let target = output
@@ -466,6 +470,9 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 .map(|p| OutputFile::plan(p, force, std::slice::from_ref(&model)))
                 .transpose()?;
             let mut chain = load(&model, allow_nonphysical)?;
+            if ignore_mimic {
+                chain = chain.without_mimics();
+            }
             for l in &lock {
                 let (i, v) = l
                     .split_once('=')

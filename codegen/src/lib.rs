@@ -114,7 +114,9 @@ fn check_generable(model: &Model) -> Result<(), Error> {
     if let Some(j) = model.mimics().iter().position(Option::is_some) {
         return Err(Error(format!(
             "model `{}`: mimic joints are not supported by code generation yet (joint `{}` \
-             mimics another); `kanegen eval` computes M and c of the reduced coordinates",
+             mimics another); `kanegen eval` computes M and c of the independent coordinates, \
+             and `ignore_mimic = true` (dynamics!) or `--ignore-mimic` (kanegen generate) \
+             generates every mimic joint as an independent joint (Pinocchio's mimic=False)",
             model.name(),
             model.joints()[j].name
         )));

@@ -498,6 +498,14 @@ impl Model {
         Ok(self)
     }
 
+    /// The same model with every mimic joint an independent joint (URDF `<mimic>` ignored, as
+    /// Pinocchio's `mimic=False` reads it).
+    #[must_use]
+    pub fn without_mimics(mut self) -> Self {
+        self.mimics = vec![None; self.joints.len()];
+        self
+    }
+
     /// The joints that move no mass: no body beyond them (their own included) has mass, so
     /// their rows of `M` are zero. Decided from the structure: a joint whose subtree holds mass
     /// only on its own axis (a point mass on a revolute axis) moves no inertia either, and is
