@@ -163,7 +163,7 @@ pub enum ModelError {
     Parse(String),
     /// Some joints move no mass, so `M` is singular and forward dynamics is undefined.
     #[error(
-        "model `{model}`: {} move no mass (no body with mass beyond them): the mass \
+        "model `{model}`: these joints move no mass (no body with mass beyond them): {}; the mass \
          matrix M is singular, so forward dynamics (q̈ = M⁻¹(τ − c)) is undefined; M, c and \
          inverse dynamics are (`kanegen eval`); give a link beyond each of them mass, or make \
          them fixed joints",

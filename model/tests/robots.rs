@@ -101,7 +101,7 @@ fn massless_bodies_load_and_forward_dynamics_names_them() {
     assert_eq!(m.massless_joints(), ["finger_joint", "tip_joint"]);
     let e = m.check_forward_dynamics().unwrap_err().to_string();
     assert!(
-        e.contains("joint `finger_joint`, joint `tip_joint` move no mass") && !e.contains("wrist"),
+        e.contains("move no mass (no body with mass beyond them): joint `finger_joint`, joint `tip_joint`;") && !e.contains("wrist"),
         "{e}"
     );
     // Rotational inertia without mass is not physical.
