@@ -318,8 +318,8 @@ impl Model {
     /// free-floating.
     ///
     /// # Errors
-    /// The inertial fails the strict checks of [`crate::validate_inertial`] (finite, mass > 0,
-    /// inertia symmetric, positive definite, triangle inequality).
+    /// The inertial fails the strict checks of [`crate::validate_inertial`] (finite, mass ≥ 0,
+    /// inertia symmetric and physical: [`crate::inertial::nonphysical`]).
     pub fn with_base_inertial(mut self, inertial: Inertial) -> Result<Self, ModelError> {
         validate_inertial_with(
             &self.base,

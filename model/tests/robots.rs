@@ -122,6 +122,8 @@ fn limits_are_read() {
         .replace(r#"lower="-1" upper="2""#, r#"lower="2" upper="-1""#);
     let e = parse_urdf(&swapped).unwrap_err().to_string();
     assert!(e.contains("j1") && e.contains("lower 2 > upper -1"), "{e}");
+    // Limits survive the canonical frames (same joints).
+    assert_eq!(m.canonical_with(0.0).unwrap().model.limits(), m.limits());
 }
 
 const BOX: &str = r#"<inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>"#;
@@ -156,6 +158,11 @@ fn mimic_chains_resolve_to_the_primary() {
     let c = m.mimics()[2].unwrap();
     assert_eq!((c.primary, c.multiplier, c.offset), (0, -6.0, -1.25));
     assert!(m.mimics()[0].is_none() && m.mimics()[3].is_none());
+    let e = m.lock_joint(3, 0.0).unwrap_err().to_string();
+    assert!(e.contains("`b`") && e.contains("mimic joints"), "{e}");
+    let free = m.clone().without_mimics();
+    assert_eq!(free.coordinates(), [0, 1, 2, 3]);
+    assert_eq!(free.lock_joint(1, 0.2).unwrap().dof(), 3);
     assert_eq!(notes.merged, ["tool"]);
     let ignored: Vec<(&str, usize)> = notes
         .ignored
