@@ -269,7 +269,9 @@ fn bad_events_are_errors_naming_the_key() {
             "events[0].body (line 7): unknown body `nope`",
         ),
         (
-            "[[events]]\ntype = \"capture\"\ntime = 0.5\nmass = 1.0\ninertia = { ixx = -1.0, iyy = 1.0, izz = 1.0 }".into(),
+            // The scene allows non-physical inertias (the bMSd arm needs it), so the payload's
+            // must fail a check the override keeps: the magnitude bound.
+            "[[events]]\ntype = \"capture\"\ntime = 0.5\nmass = 1.0\ninertia = { ixx = 1e30, iyy = 1.0, izz = 1.0 }".into(),
             "events[0].inertia",
         ),
         (

@@ -238,7 +238,9 @@ fn the_recurrent_algorithm_can_be_forced() {
     }
     let src = std::fs::read_to_string(root().join(g.file)).unwrap();
     assert!(src.contains("//! Algorithm: forced to `recurrent`"));
-    let panda = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf")).unwrap();
+    let panda = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf"))
+        .unwrap()
+        .without_mimics();
     let mut o = kanegen::codegen::Options::new("Panda");
     o.algorithm = Some(kanegen::codegen::forced_algorithm("recurrent").unwrap());
     let e = kanegen::codegen::generate_items(&panda, &o)
@@ -484,7 +486,9 @@ fn f32_source_is_f32_throughout() {
 fn snapping_float_noise_saves_operations_and_says_so() {
     use kanegen::codegen::{generate_items, Options};
     use kanegen::trace::Function;
-    let panda = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf")).unwrap();
+    let panda = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf"))
+        .unwrap()
+        .without_mimics();
     let ops = |snap: f64| {
         let mut o = Options::new("Panda");
         o.snap = snap;

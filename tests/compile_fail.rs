@@ -1,4 +1,5 @@
-//! `dynamics!` rejects bad models at compile time with the reader's message at the path literal,
+//! `dynamics!` rejects bad models at compile time with the reader's message at the path literal
+//! (also a model with joints that move no mass, and one with mimic joints, naming the joints),
 //! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
 //! `algorithm = "fastest"`, `form = "rolled"`, an unknown key) at the option; `scene!` rejects a
 //! bad scene key (the scene reader's message) and a feature it does not generate (a tabulated

@@ -23,7 +23,8 @@ kanegen::dynamics!(Ur5, "tests/data/erd/ur5_robot.urdf");
 kanegen::dynamics!(
     PandaFree,
     "tests/data/erd/panda.urdf",
-    base = "free-floating"
+    base = "free-floating",
+    ignore_mimic = true
 );
 
 fn root() -> &'static Path {
@@ -146,6 +147,7 @@ fn interpreted(
 ) -> (Params<f64>, FloatingBase<f64>, FloatingState<f64>) {
     let m = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf"))
         .unwrap()
+        .without_mimics()
         .with_base_kind(BaseKind::FreeFloating)
         .unwrap();
     let state = FloatingState {

@@ -16,7 +16,12 @@ kanegen::dynamics!(
     "tests/data/erd/talos_left_arm.urdf",
     base = "free-floating"
 );
-kanegen::dynamics!(Panda, "tests/data/erd/panda.urdf", base = "free-floating");
+kanegen::dynamics!(
+    Panda,
+    "tests/data/erd/panda.urdf",
+    base = "free-floating",
+    ignore_mimic = true
+);
 kanegen::dynamics!(B1Z1, "tests/data/erd/b1-z1.urdf", base = "free-floating");
 
 fn reference(name: &str) -> Value {

@@ -91,8 +91,23 @@ enum Command {
         /// "results": [{"A": [[…]], "b": […]}]}.
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality (published but not
-        /// physically realisable parameter sets); other checks stay.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
+        #[arg(long)]
+        allow_nonphysical: bool,
+    },
+    /// The joints in the order of q (type, parent, axis, limits, mimic), the frames, the base,
+    /// the total mass, and what the URDF reader ignored and merged.
+    Info {
+        /// Model file (.urdf or .toml).
+        model: PathBuf,
+        /// The base: fixed or free-floating (default: the model's).
+        #[arg(long, value_parser = parse_base)]
+        base: Option<BaseKind>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Accept inertias that are not physically realisable (docs/models.md).
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -125,7 +140,8 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -171,9 +187,13 @@ enum Command {
         /// instead of the cheapest candidate per function.
         #[arg(long, value_parser = parse_forced)]
         algorithm: Option<Methods>,
-        /// Accept inertia tensors that violate the triangle inequality.
+        /// Accept inertias that are not physically realisable (a negative principal moment, the
+        /// triangle inequality violated, rotational inertia without mass); other checks stay.
         #[arg(long)]
         allow_nonphysical: bool,
+        /// Generate every URDF mimic joint as an independent joint (Pinocchio's mimic=False).
+        #[arg(long)]
+        ignore_mimic: bool,
         /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
         /// caller's stack, and the frame functions stay straight-line).
         #[arg(long)]
@@ -207,7 +227,7 @@ enum Command {
         /// Print JSON (one input: the report; several: {"subjects": [...]}).
         #[arg(long)]
         json: bool,
-        /// Accept inertia tensors that violate the triangle inequality (models only).
+        /// Accept inertias that are not physically realisable (models only; docs/models.md).
         #[arg(long)]
         allow_nonphysical: bool,
     },
@@ -329,7 +349,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             let results = commands::eval::eval_states(&chain, &text, algorithm, g)
                 .with_context(|| format!("states file `{}`", states.display()))?;
             if as_json {
-                let joints: Vec<&str> = chain.joints().iter().map(|j| j.name.as_str()).collect();
+                let joints = commands::eval::coordinate_names(&chain);
                 let v = serde_json::json!({
                     "joints": joints,
                     "base": chain.base_kind().name(),
@@ -343,6 +363,12 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 )?;
             }
         }
+        Command::Info {
+            model,
+            base,
+            json: as_json,
+            allow_nonphysical,
+        } => commands::info::run(&model, base, allow_nonphysical, as_json, out)?,
         Command::Table1 {
             json: as_json,
             out: dir,
@@ -438,6 +464,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             snap,
             algorithm,
             allow_nonphysical,
+            ignore_mimic,
             allow_large,
         } => {
             let target = output
@@ -445,6 +472,9 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 .map(|p| OutputFile::plan(p, force, std::slice::from_ref(&model)))
                 .transpose()?;
             let mut chain = load(&model, allow_nonphysical)?;
+            if ignore_mimic {
+                chain = chain.without_mimics();
+            }
             for l in &lock {
                 let (i, v) = l
                     .split_once('=')

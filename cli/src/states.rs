@@ -42,10 +42,12 @@ struct StatesFile {
     states: Vec<State>,
 }
 
-/// Parses and validates a states file for a model with `n` joints, on a free-floating base when
-/// `floating` (then every state needs `base`, and a fixed-base model's states must not have it);
-/// errors name the state and field.
-pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> {
+/// Parses and validates a states file for a model whose coordinates are `joints` (their names,
+/// in the order of `q`), on a free-floating base when `floating` (then every state needs `base`,
+/// and a fixed-base model's states must not have it); errors name the state and field, and a
+/// wrong length lists the joints.
+pub fn parse_states(text: &str, joints: &[&str], floating: bool) -> Result<Vec<State>> {
+    let n = joints.len();
     let mut f: StatesFile = serde_json::from_str(text).context("malformed states file")?;
     for (i, s) in f.states.iter_mut().enumerate() {
         match (&mut s.base, floating) {
@@ -93,8 +95,14 @@ pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> 
             let Some(v) = v else { continue };
             if v.len() != n {
                 bail!(
-                    "states[{i}].{name}: expected {n} values (the model has {n} joints), got {}",
-                    v.len()
+                    "states[{i}].{name}: expected {n} values, got {}: the model's coordinates \
+                     are, in this order, {}",
+                    v.len(),
+                    joints
+                        .iter()
+                        .map(|j| format!("`{j}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 );
             }
             if let Some(k) = v.iter().position(|x| !x.is_finite()) {
@@ -144,18 +152,20 @@ mod tests {
 
     #[test]
     fn rejects_wrong_lengths_and_unknown_keys() {
-        let e = parse_states(r#"{"states":[{"q":[1,2],"qd":[1]}]}"#, 2, false).unwrap_err();
+        let e =
+            parse_states(r#"{"states":[{"q":[1,2],"qd":[1]}]}"#, &["a", "b"], false).unwrap_err();
         assert!(e.to_string().contains("states[0].qd"), "{e}");
+        assert!(e.to_string().contains("in this order, `a`, `b`"), "{e}");
         let e = parse_states(
             r#"{"states":[{"q":[1,2],"qd":[1,2],"qdd":[0,0]}]}"#,
-            2,
+            &["a", "b"],
             false,
         )
         .unwrap_err();
         assert!(format!("{e:#}").contains("qdd"), "{e:#}");
         let ok = parse_states(
             r#"{"states":[{"q":[1,2],"qd":[1,2],"tau":[3,4]}]}"#,
-            2,
+            &["a", "b"],
             false,
         )
         .unwrap();
@@ -169,14 +179,14 @@ mod tests {
         let base =
             r#""base":{"position":[0,0,0],"quaternion":[0,0,0,2],"v":[0,0,0],"omega":[0,0,1]}"#;
         let with = format!(r#"{{"states":[{{"q":[1],"qd":[0],{base}}}]}}"#);
-        let s = parse_states(&with, 1, true).unwrap();
+        let s = parse_states(&with, &["a"], true).unwrap();
         assert_eq!(s[0].base.as_ref().unwrap().quaternion, [0.0, 0.0, 0.0, 1.0]);
-        let e = parse_states(&with, 1, false).unwrap_err();
+        let e = parse_states(&with, &["a"], false).unwrap_err();
         assert!(e.to_string().contains("states[0].base"), "{e}");
-        let e = parse_states(r#"{"states":[{"q":[1],"qd":[0]}]}"#, 1, true).unwrap_err();
+        let e = parse_states(r#"{"states":[{"q":[1],"qd":[0]}]}"#, &["a"], true).unwrap_err();
         assert!(e.to_string().contains("states[0].base: missing"), "{e}");
         let zero = with.replace("[0,0,0,2]", "[0,0,0,0]");
-        let e = parse_states(&zero, 1, true).unwrap_err();
+        let e = parse_states(&zero, &["a"], true).unwrap_err();
         assert!(e.to_string().contains("quaternion"), "{e}");
     }
 }

@@ -87,6 +87,7 @@ fn generate_items_with(
     header_on_struct: bool,
     mut bodies: Option<&mut Vec<String>>,
 ) -> Result<Generated, Error> {
+    check_generable(model)?;
     let names = Names::new(opts)?;
     let emitter = Emitter::new(opts)?;
     let (plan, graphs) = Plan::new(model, opts)?;
@@ -105,6 +106,24 @@ fn generate_items_with(
         choices: plan.functions.into_iter().map(|fp| fp.choice).collect(),
         fmas,
     })
+}
+
+/// What the generated type cannot be made for: mimic joints (not supported yet), and joints that
+/// move no mass (its forward dynamics would divide by a singular `M`).
+fn check_generable(model: &Model) -> Result<(), Error> {
+    if let Some(j) = model.mimics().iter().position(Option::is_some) {
+        return Err(Error(format!(
+            "model `{}`: mimic joints are not supported by code generation yet (joint `{}` \
+             mimics another); `kanegen eval` computes M and c of the independent coordinates, \
+             and `ignore_mimic = true` (dynamics!) or `--ignore-mimic` (kanegen generate) \
+             generates every mimic joint as an independent joint (Pinocchio's mimic=False)",
+            model.name(),
+            model.joints()[j].name
+        )));
+    }
+    model
+        .check_forward_dynamics()
+        .map_err(|e| Error(e.to_string()))
 }
 
 /// The identifiers of the generated type, its payload struct and its op-count struct.

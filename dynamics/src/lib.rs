@@ -38,6 +38,7 @@ pub mod ldlt;
 pub mod linalg;
 pub mod loads;
 pub mod metrics;
+pub mod mimic;
 pub mod params;
 pub mod regroup;
 pub mod scalar;

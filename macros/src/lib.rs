@@ -25,6 +25,7 @@ struct Input {
     gravity: Option<[f64; 3]>,
     base: Option<kanegen_codegen::kanegen_model::BaseKind>,
     allow_nonphysical: bool,
+    ignore_mimic: bool,
     runtime_payload: bool,
     float: kanegen_codegen::Float,
     fma: bool,
@@ -69,6 +70,7 @@ impl Parse for Input {
             gravity: None,
             base: None,
             allow_nonphysical: false,
+            ignore_mimic: false,
             runtime_payload: false,
             float: kanegen_codegen::Float::F64,
             fma: false,
@@ -113,6 +115,7 @@ impl Parse for Input {
                     );
                 }
                 "allow_nonphysical" => out.allow_nonphysical = input.parse::<LitBool>()?.value,
+                "ignore_mimic" => out.ignore_mimic = input.parse::<LitBool>()?.value,
                 "runtime_payload" => out.runtime_payload = input.parse::<LitBool>()?.value,
                 "scalar" => {
                     let ty: Ident = input.parse().map_err(|e| {
@@ -169,7 +172,7 @@ impl Parse for Input {
                     return Err(syn::Error::new(
                         key.span(),
                         format!(
-                            "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
+                            "unknown option `{other}` (expected gravity, base, allow_nonphysical, ignore_mimic, \
                              runtime_payload, scalar, fma, fma_path, target_fma, regroup, canonical, libm_trig, snap, \
                              algorithm, form)"
                         ),
@@ -206,8 +209,11 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         allow_nonphysical_inertia: input.allow_nonphysical,
     };
     // Messages name the path as written, not the machine's absolute path.
-    let model = kanegen_codegen::kanegen_model::io::load_model_with(&path, v)
+    let mut model = kanegen_codegen::kanegen_model::io::load_model_with(&path, v)
         .map_err(|e| e.to_string().replace(&abs, &rel))?;
+    if input.ignore_mimic {
+        model = model.without_mimics();
+    }
     let name = input.name.to_string();
     let mut opts = kanegen_codegen::Options::new(name.clone());
     opts.gravity = input.gravity;

@@ -205,6 +205,13 @@ impl Model {
         )
         .and_then(|m| m.with_frames(frames))
         .and_then(|m| m.with_base_kind(self.base_kind()))
+        .and_then(|m| match m.dof() == self.dof() {
+            // The same joints: their limits and couplings stay.
+            true => m
+                .with_limits(self.limits().to_vec())?
+                .with_mimics(self.mimics().to_vec()),
+            false => Ok(m),
+        })
     }
 
     /// [`Model::canonical`] with the snap tolerance `tol` (0 snaps nothing).

@@ -20,12 +20,12 @@ use serde::Serialize;
 /// Mass properties of a rigid body.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Inertial {
-    /// Mass, kg (> 0).
+    /// Mass, kg (≥ 0; 0 is a massless body, whose inertia is then 0).
     pub mass: f64,
     /// Centre of mass in the body frame, m.
     pub com: V3,
     /// Inertia tensor about the centre of mass, in body-frame axes, kg·m² (symmetric positive
-    /// definite, satisfying the triangle inequality).
+    /// semidefinite, satisfying the triangle inequality: [`nonphysical`]).
     pub inertia: M3,
 }
 
@@ -57,12 +57,17 @@ impl Inertial {
     }
 
     /// Two bodies given in the same frame, welded into one: total mass, combined centre of mass,
-    /// and the inertia about it by the parallel-axis theorem. The masses must not sum to zero.
+    /// and the inertia about it by the parallel-axis theorem. Two massless bodies give a
+    /// massless body (centre of mass at the origin, the inertias summed).
     #[must_use]
     pub fn merge(&self, other: &Inertial) -> Inertial {
         let (a, b) = (self, other);
         let m = a.mass + b.mass;
-        let c: V3 = core::array::from_fn(|k| (a.mass * a.com[k] + b.mass * b.com[k]) / m);
+        let c: V3 = if m == 0.0 {
+            [0.0; 3]
+        } else {
+            core::array::from_fn(|k| (a.mass * a.com[k] + b.mass * b.com[k]) / m)
+        };
         let mut inertia = [[0.0; 3]; 3];
         for part in [a, b] {
             let d: V3 = core::array::from_fn(|k| part.com[k] - c[k]);
@@ -113,8 +118,62 @@ pub fn validate_inertial(owner: &str, field: &str, b: &Inertial) -> Result<(), M
     validate_inertial_with(owner, field, b, Validation::default())
 }
 
-/// Checks a body's mass properties under the given [`Validation`]: finite, mass > 0, inertia
-/// symmetric, positive definite and (unless allowed) satisfying the triangle inequality.
+/// Relative tolerance of the physical checks ([`nonphysical`]): a principal moment may be
+/// negative, or exceed the sum of the other two, by this fraction of [`inertia_scale`] (float
+/// noise in published files: iCub writes `ixz = 1.35e-20` on a point mass of 0.27 kg).
+pub const PHYSICAL_TOLERANCE: f64 = 1e-9;
+
+/// What accepts a non-physical inertia, in every spelling; the physical checks' messages end
+/// with it.
+pub const NONPHYSICAL_OVERRIDE: &str = "`--allow-nonphysical` (command line) or \
+     `allow_nonphysical = true` (dynamics!, scene files) accepts it as given";
+
+/// The magnitude the physical checks compare against: the largest of `|I_ij|` (about the centre
+/// of mass) and `m |c|²` (the point mass's moment about the frame the body is given in), so a
+/// point mass away from its frame's origin has a scale even when its own inertia is only noise.
+#[must_use]
+pub fn inertia_scale(b: &Inertial) -> f64 {
+    let c2: f64 = b.com.iter().map(|x| x * x).sum();
+    b.inertia
+        .iter()
+        .flatten()
+        .fold(b.mass * c2, |m, x| m.max(x.abs()))
+}
+
+/// `Some(reason)` when a body is not physically realisable beyond [`PHYSICAL_TOLERANCE`] ×
+/// [`inertia_scale`]: a principal moment of the inertia about the centre of mass is negative
+/// (not positive semidefinite); with `triangle`, the largest principal moment exceeds the sum of
+/// the other two (the triangle inequality); a body without mass has rotational inertia. A point
+/// mass (zero inertia), a rod (one zero moment) and a massless body (mass and inertia zero) are
+/// physical.
+#[must_use]
+pub fn nonphysical(b: &Inertial, triangle: bool) -> Option<String> {
+    let tol = PHYSICAL_TOLERANCE * inertia_scale(b);
+    let ev = sym3_eigenvalues(&b.inertia);
+    let moments = format!(
+        "principal moments {:.6e}, {:.6e}, {:.6e}",
+        ev[0], ev[1], ev[2]
+    );
+    if ev[0] < -tol {
+        return Some(format!(
+            "not positive semidefinite: {moments} (one negative beyond the tolerance {tol:.1e})"
+        ));
+    }
+    if triangle && ev[2] > ev[0] + ev[1] + tol {
+        return Some(format!(
+            "violates the triangle inequality: {moments} (the largest exceeds the sum of the \
+             other two beyond the tolerance {tol:.1e})"
+        ));
+    }
+    if b.mass == 0.0 && ev[2] > 0.0 {
+        return Some(format!("mass 0 with rotational inertia: {moments}"));
+    }
+    None
+}
+
+/// Checks a body's mass properties under the given [`Validation`]: finite and within bounds,
+/// mass ≥ 0 (0: a massless body, whose inertia is then 0), inertia symmetric and, unless
+/// allowed, physical ([`nonphysical`] with the triangle inequality).
 pub fn validate_inertial_with(
     owner: &str,
     field: &str,
@@ -122,11 +181,11 @@ pub fn validate_inertial_with(
     validation: Validation,
 ) -> Result<(), ModelError> {
     bounded(owner, &format!("{field}.mass"), &[b.mass], MASS)?;
-    if b.mass <= 0.0 {
+    if b.mass < 0.0 {
         return Err(ModelError::invalid(
             owner,
             &format!("{field}.mass"),
-            format!("mass must be > 0, got {}", b.mass),
+            format!("mass must be ≥ 0, got {}", b.mass),
         ));
     }
     bounded(owner, &format!("{field}.com"), &b.com, LENGTH)?;
@@ -149,38 +208,14 @@ pub fn validate_inertial_with(
             ));
         }
     }
-    // Positive definiteness by Sylvester's criterion (leading principal minors).
-    let m1 = i[0][0];
-    let m2 = i[0][0] * i[1][1] - i[0][1] * i[1][0];
-    let m3 = i[0][0] * (i[1][1] * i[2][2] - i[1][2] * i[2][1])
-        - i[0][1] * (i[1][0] * i[2][2] - i[1][2] * i[2][0])
-        + i[0][2] * (i[1][0] * i[2][1] - i[1][1] * i[2][0]);
-    if !(m1 > 0.0 && m2 > 0.0 && m3 > 0.0) {
-        return Err(ModelError::invalid(
+    match nonphysical(b, true) {
+        Some(why) if !validation.allow_nonphysical_inertia => Err(ModelError::invalid(
             owner,
             &format!("{field}.inertia"),
-            format!(
-                "not positive definite (leading minors {m1:.6e}, {m2:.6e}, {m3:.6e}); the inertia tensor about the centre of mass must be SPD"
-            ),
-        ));
+            format!("{why}: not physically realisable; {NONPHYSICAL_OVERRIDE}"),
+        )),
+        _ => Ok(()),
     }
-    // Triangle inequality on the principal moments: each ≤ the sum of the other two.
-    let ev = sym3_eigenvalues(i);
-    let tol = 1e-9 * (ev[0] + ev[1] + ev[2]);
-    for k in 0..3 {
-        let (a, b2, c) = (ev[k], ev[(k + 1) % 3], ev[(k + 2) % 3]);
-        if a > b2 + c + tol && !validation.allow_nonphysical_inertia {
-            return Err(ModelError::invalid(
-                owner,
-                &format!("{field}.inertia"),
-                format!(
-                    "violates the triangle inequality: principal moments {:.6e}, {:.6e}, {:.6e} (not physically realisable; --allow-nonphysical accepts it)",
-                    ev[0], ev[1], ev[2]
-                ),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix, ascending: the cyclic Jacobi method (Golub and Van

@@ -40,5 +40,5 @@ pub mod placement;
 pub mod random;
 
 pub use inertial::{validate_inertial, validate_inertial_with, Inertial};
-pub use model::{BaseKind, Frame, Joint, JointKind, Model, ModelError, Validation};
+pub use model::{BaseKind, Frame, Joint, JointKind, Limits, Mimic, Model, ModelError, Validation};
 pub use placement::Placement;

@@ -13,9 +13,17 @@ impl Model {
     ///
     /// # Errors
     /// If `index` is out of range, `value` is not finite or exceeds
-    /// [`POSITION`](crate::bounds::POSITION), or the model would become empty.
+    /// [`POSITION`](crate::bounds::POSITION), the model has mimic joints (not supported), or
+    /// the model would become empty.
     pub fn lock_joint(&self, index: usize, value: f64) -> Result<Model, ModelError> {
         let n = self.joints().len();
+        if let Some(m) = self.mimics().iter().position(Option::is_some) {
+            return Err(ModelError::invalid(
+                &self.joints()[m].name,
+                "lock_joint",
+                "locking a joint of a model with mimic joints is not supported",
+            ));
+        }
         if index >= n {
             return Err(ModelError::invalid(
                 &format!("#{index}"),
@@ -83,6 +91,9 @@ impl Model {
             })
             .collect();
         joints.remove(index);
-        self.rebuilt(joints, frames, base_inertial)
+        let mut limits = self.limits().to_vec();
+        limits.remove(index);
+        self.rebuilt(joints, frames, base_inertial)?
+            .with_limits(limits)
     }
 }

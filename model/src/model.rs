@@ -50,6 +50,34 @@ pub struct Joint {
     pub inertial: Inertial,
 }
 
+/// A joint's limits as a URDF `<limit>` gives them (Pinocchio's `lowerPositionLimit`,
+/// `upperPositionLimit`, `velocityLimit`, `effortLimit`); absent values are `None`. Read and
+/// reported, never enforced by the dynamics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Limits {
+    /// Lowest position, rad or m.
+    pub lower: Option<f64>,
+    /// Highest position, rad or m.
+    pub upper: Option<f64>,
+    /// Largest speed, rad/s or m/s.
+    pub velocity: Option<f64>,
+    /// Largest drive torque or force, N·m or N.
+    pub effort: Option<f64>,
+}
+
+/// A mimic joint's coupling to its primary (URDF `<mimic>`, Pinocchio's mimic joints):
+/// `q_j = multiplier · q_primary + offset`, so `q̇_j = multiplier · q̇_primary`. The primary is
+/// resolved through chains of mimics: it is never a mimic itself.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Mimic {
+    /// The joint it follows (index into [`Model::joints`]; not a mimic joint).
+    pub primary: usize,
+    /// Factor on the primary's position.
+    pub multiplier: f64,
+    /// Added to the position, rad or m.
+    pub offset: f64,
+}
+
 /// A named frame fixed to a body (a tool flange, a camera): massless, never a body.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Frame {
@@ -102,6 +130,8 @@ pub struct Model {
     base_kind: BaseKind,
     joints: Vec<Joint>,
     frames: Vec<Frame>,
+    limits: Vec<Limits>,
+    mimics: Vec<Option<Mimic>>,
 }
 
 /// An error in a model: which joint (or body, or key) and which field, and why.
@@ -131,6 +161,20 @@ pub enum ModelError {
     /// The file could not be parsed; the message names the key or element.
     #[error("{0}")]
     Parse(String),
+    /// Some joints move no mass, so `M` is singular and forward dynamics is undefined.
+    #[error(
+        "model `{model}`: these joints move no mass (no body with mass beyond them): {}; the mass \
+         matrix M is singular, so forward dynamics (q̈ = M⁻¹(τ − c)) is undefined; M, c and \
+         inverse dynamics are (`kanegen eval`); give a link beyond each of them mass, or make \
+         them fixed joints",
+        .joints.iter().map(|j| format!("joint `{j}`")).collect::<Vec<_>>().join(", ")
+    )]
+    Singular {
+        /// The model.
+        model: String,
+        /// The joints that move no mass (or `base` for a massless free-floating system).
+        joints: Vec<String>,
+    },
     /// The file could not be read.
     #[error("cannot read `{path}`: {reason}")]
     Io {
@@ -155,8 +199,11 @@ impl ModelError {
 /// How strictly [`Model::new_with`] validates mass properties.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Validation {
-    /// Accept inertia tensors that are positive definite but violate the triangle inequality
-    /// (not physically realisable, yet present in some published parameter sets). Off by default.
+    /// Accept inertia tensors that are not physically realisable beyond
+    /// [`crate::inertial::PHYSICAL_TOLERANCE`]: a negative principal moment (not positive
+    /// semidefinite), the triangle inequality violated, or rotational inertia without mass
+    /// ([`crate::inertial::nonphysical`]); present in some published parameter sets. Every other
+    /// check stays (finite, bounded, mass ≥ 0, symmetric). Off by default.
     pub allow_nonphysical_inertia: bool,
 }
 
@@ -173,8 +220,9 @@ impl Model {
 
     /// Builds and validates a model on a fixed base, without named frames ([`Model::with_frames`],
     /// [`Model::with_base_kind`] add them). Checks, each reported with the joint and field:
-    /// finite numbers; mass > 0; inertia symmetric, positive definite and satisfying the triangle
-    /// inequality; non-zero axis (normalized here); orthonormal right-handed origin rotation;
+    /// finite numbers; mass ≥ 0 (a massless body has no inertia either); inertia symmetric,
+    /// physical ([`crate::inertial::nonphysical`]: positive semidefinite and satisfying the
+    /// triangle inequality, to a tolerance relative to its magnitude); non-zero axis (normalized here); orthonormal right-handed origin rotation;
     /// parents before children (`λ(j) < j`); unique joint and body names; at least one joint.
     pub fn new_with(
         name: impl Into<String>,
@@ -223,6 +271,7 @@ impl Model {
         if let Some(b) = &base_inertial {
             validate_inertial_with(&base, "base.inertial", b, validation)?;
         }
+        let n = joints.len();
         Ok(Model {
             name,
             base,
@@ -230,6 +279,8 @@ impl Model {
             base_kind: BaseKind::Fixed,
             joints,
             frames: Vec::new(),
+            limits: vec![Limits::default(); n],
+            mimics: vec![None; n],
         })
     }
 
@@ -267,8 +318,8 @@ impl Model {
     /// free-floating.
     ///
     /// # Errors
-    /// The inertial fails the strict checks of [`crate::validate_inertial`] (finite, mass > 0,
-    /// inertia symmetric, positive definite, triangle inequality).
+    /// The inertial fails the strict checks of [`crate::validate_inertial`] (finite, mass ≥ 0,
+    /// inertia symmetric and physical: [`crate::inertial::nonphysical`]).
     pub fn with_base_inertial(mut self, inertial: Inertial) -> Result<Self, ModelError> {
         validate_inertial_with(
             &self.base,
@@ -344,10 +395,161 @@ impl Model {
     pub fn joints(&self) -> &[Joint] {
         &self.joints
     }
-    /// Number of degrees of freedom `N`.
+    /// Number of joints `N` (bodies); with mimic joints more than the independent coordinates
+    /// ([`Model::coordinates`]).
     #[must_use]
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// The limits of each joint (in the order of [`Model::joints`]).
+    #[must_use]
+    pub fn limits(&self) -> &[Limits] {
+        &self.limits
+    }
+
+    /// The model with these joint limits (one per joint).
+    ///
+    /// # Errors
+    /// A wrong count, a limit that is NaN or negative (velocity, effort), or `lower > upper`.
+    pub fn with_limits(mut self, limits: Vec<Limits>) -> Result<Self, ModelError> {
+        if limits.len() != self.joints.len() {
+            return Err(ModelError::Parse(format!(
+                "model `{}`: {} limits for {} joints",
+                self.name,
+                limits.len(),
+                self.joints.len()
+            )));
+        }
+        for (j, l) in self.joints.iter().zip(&limits) {
+            let all = [l.lower, l.upper, l.velocity, l.effort];
+            if all.iter().flatten().any(|x| x.is_nan()) {
+                return Err(ModelError::invalid(&j.name, "limit", "a limit is NaN"));
+            }
+            if l.velocity.is_some_and(|v| v < 0.0) || l.effort.is_some_and(|e| e < 0.0) {
+                return Err(ModelError::invalid(
+                    &j.name,
+                    "limit",
+                    "velocity and effort limits must be ≥ 0",
+                ));
+            }
+            if let (Some(lo), Some(hi)) = (l.lower, l.upper) {
+                if lo > hi {
+                    return Err(ModelError::invalid(
+                        &j.name,
+                        "limit",
+                        format!("lower {lo} > upper {hi}"),
+                    ));
+                }
+            }
+        }
+        self.limits = limits;
+        Ok(self)
+    }
+
+    /// Each joint's mimic coupling (`None`: an independent coordinate).
+    #[must_use]
+    pub fn mimics(&self) -> &[Option<Mimic>] {
+        &self.mimics
+    }
+
+    /// Whether some joint mimics another.
+    #[must_use]
+    pub fn has_mimics(&self) -> bool {
+        self.mimics.iter().any(Option::is_some)
+    }
+
+    /// The independent coordinates: the indices of the joints that mimic none, in order; `q`
+    /// has one entry per coordinate.
+    #[must_use]
+    pub fn coordinates(&self) -> Vec<usize> {
+        (0..self.joints.len())
+            .filter(|&j| self.mimics[j].is_none())
+            .collect()
+    }
+
+    /// The model with these mimic couplings (one per joint), already resolved to primaries.
+    ///
+    /// # Errors
+    /// A wrong count, a primary out of range, itself a mimic or the joint itself, or a
+    /// multiplier or offset that is not finite.
+    pub fn with_mimics(mut self, mimics: Vec<Option<Mimic>>) -> Result<Self, ModelError> {
+        if mimics.len() != self.joints.len() {
+            return Err(ModelError::Parse(format!(
+                "model `{}`: {} mimic entries for {} joints",
+                self.name,
+                mimics.len(),
+                self.joints.len()
+            )));
+        }
+        for (k, m) in mimics.iter().enumerate() {
+            let Some(m) = m else { continue };
+            let name = &self.joints[k].name;
+            if m.primary >= mimics.len() || m.primary == k || mimics[m.primary].is_some() {
+                return Err(ModelError::invalid(
+                    name,
+                    "mimic.joint",
+                    format!("joint #{} is not an independent joint", m.primary),
+                ));
+            }
+            finite(name, "mimic", &[m.multiplier, m.offset])?;
+        }
+        self.mimics = mimics;
+        Ok(self)
+    }
+
+    /// The same model with every mimic joint an independent joint (URDF `<mimic>` ignored, as
+    /// Pinocchio's `mimic=False` reads it).
+    #[must_use]
+    pub fn without_mimics(mut self) -> Self {
+        self.mimics = vec![None; self.joints.len()];
+        self
+    }
+
+    /// The joints that move no mass: no body beyond them (their own included) has mass, so
+    /// their rows of `M` are zero. Decided from the structure: a joint whose subtree holds mass
+    /// only on its own axis (a point mass on a revolute axis) moves no inertia either, and is
+    /// not listed.
+    #[must_use]
+    pub fn massless_joints(&self) -> Vec<&str> {
+        let mut mass: Vec<f64> = self.joints.iter().map(|j| j.inertial.mass).collect();
+        for k in (0..self.joints.len()).rev() {
+            if let Some(p) = self.joints[k].parent {
+                mass[p] += mass[k];
+            }
+        }
+        self.joints
+            .iter()
+            .zip(mass)
+            .filter(|(_, m)| *m == 0.0)
+            .map(|(j, _)| j.name.as_str())
+            .collect()
+    }
+
+    /// Whether forward dynamics is defined structurally: every joint moves mass
+    /// ([`Model::massless_joints`]) and a free-floating system has mass.
+    ///
+    /// # Errors
+    /// [`ModelError::Singular`], naming the joints that move no mass.
+    pub fn check_forward_dynamics(&self) -> Result<(), ModelError> {
+        let mut joints: Vec<String> = self
+            .massless_joints()
+            .into_iter()
+            .map(str::to_string)
+            .collect();
+        let total = self.base_inertial.as_ref().map_or(0.0, |b| b.mass)
+            + self.joints.iter().map(|j| j.inertial.mass).sum::<f64>();
+        if self.base_kind == BaseKind::FreeFloating && total == 0.0 {
+            joints.insert(0, self.base.clone());
+        }
+        if joints.is_empty() {
+            Ok(())
+        } else {
+            Err(ModelError::Singular {
+                model: self.name.clone(),
+                joints,
+            })
+        }
     }
 }
 

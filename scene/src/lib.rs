@@ -797,6 +797,15 @@ impl Scene {
         };
         let chain = kanegen_model::io::load_model_with(&model_path, validation)
             .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
+        if chain.has_mimics() {
+            bail!(
+                "model: `{}`: mimic joints are not supported by the simulator yet",
+                model_path.display()
+            );
+        }
+        chain
+            .check_forward_dynamics()
+            .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
         let n = chain.dof();
 
         let chain0 = chain;

@@ -226,17 +226,17 @@ for spec in args.models:
         return "".join(body)
 
     open(os.path.join(args.out, f"{name}.kg_default.rs"), "w").write(kg(
-        [f'kanegen::dynamics!({ty}, "models/{name}.urdf");\n'],
+        [f'kanegen::dynamics!({ty}, "models/{name}.urdf", ignore_mimic = true);\n'],
         [f'$m!({ty}, "{name}", {name}_states, "", $($arg),*);']))
     open(os.path.join(args.out, f"{name}.kg_clean.rs"), "w").write(kg(
         [f'kanegen::dynamics!({ty}Clean, "models/{name}.clean.toml");\n'],
         [f'$m!({ty}Clean, "{name}", {name}_states, "+clean", $($arg),*);']))
     open(os.path.join(args.out, f"{name}.kg_native.rs"), "w").write(kg(
         ["// no fused multiply-add: every product and sum written out\n",
-         f'kanegen::dynamics!({ty}, "models/{name}.urdf", target_fma = false);\n',
+         f'kanegen::dynamics!({ty}, "models/{name}.urdf", target_fma = false, ignore_mimic = true);\n',
          "// the default: products fuse through Name::mul_add, one vfmadd where the target has FMA\n",
          '#[cfg(target_feature = "fma")]\n',
-         f'kanegen::dynamics!({ty}Fma, "models/{name}.urdf");\n'],
+         f'kanegen::dynamics!({ty}Fma, "models/{name}.urdf", ignore_mimic = true);\n'],
         [f'$m!({ty}, "{name}", {name}_states, "", $($arg),*);',
          '#[cfg(target_feature = "fma")]',
          f'$m!({ty}Fma, "{name}", {name}_states, "+fma", $($arg),*);']))

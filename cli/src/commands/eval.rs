@@ -6,6 +6,7 @@ use crate::states::{parse_states, State};
 use anyhow::Result;
 use kanegen_dynamics::algorithms::floating;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::{linalg::Vec3, Dynamics, Loads, Methods, Params};
 use kanegen_model::{BaseKind, Model};
 use serde::Serialize;
@@ -31,8 +32,20 @@ pub fn default_methods(model: &Model) -> Methods {
     }
 }
 
+/// The names of the model's coordinates, in the order of `q`: its joints without the mimic
+/// joints.
+#[must_use]
+pub fn coordinate_names(model: &Model) -> Vec<&str> {
+    model
+        .coordinates()
+        .into_iter()
+        .map(|j| model.joints()[j].name.as_str())
+        .collect()
+}
+
 /// Evaluates `A` and `b` in f64 at every state of a states file; `gravity` is in the base frame
-/// (fixed base) or the inertial frame (free-floating base).
+/// (fixed base) or the inertial frame (free-floating base). With mimic joints, in the
+/// independent coordinates ([`kanegen_dynamics::mimic`]).
 ///
 /// # Errors
 /// A malformed states file, naming the state and field.
@@ -43,19 +56,23 @@ pub fn eval_states(
     gravity: Option<[f64; 3]>,
 ) -> Result<Vec<EvalResult>> {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    let states = parse_states(states_json, model.dof(), floating)?;
+    let states = parse_states(states_json, &coordinate_names(model), floating)?;
     let params = Params::<f64>::new(model);
     let base = model
         .base_inertial()
         .map(FloatingBase::<f64>::from_inertial);
+    let coupling = Coupling::new(model.mimics());
+    let offset = if floating { 6 } else { 0 };
     let results: Vec<EvalResult> = states
         .iter()
         .map(|s: &State| {
             let loads = Loads {
-                tau: s.tau.clone(),
+                tau: s.tau.as_deref().map(|t| coupling.full_drives(t)),
                 gravity: gravity.map(Vec3),
                 external: Vec::new(),
             };
+            let (q, qd) = (coupling.full_positions(&s.q), coupling.full_rates(&s.qd));
+            let (q, qd) = (&q, &qd);
             let Dynamics {
                 mass_matrix: a,
                 tau_minus_c: b,
@@ -67,11 +84,14 @@ pub fn eval_states(
                         v_b: Vec3(bs.v),
                         omega_b: Vec3(bs.omega),
                     };
-                    floating::dynamics(methods, &params, base, &state, &s.q, &s.qd, &loads)
+                    floating::dynamics(methods, &params, base, &state, q, qd, &loads)
                 }
-                _ => methods.dynamics(&params, &s.q, &s.qd, &loads),
+                _ => methods.dynamics(&params, q, qd, &loads),
             };
-            EvalResult { a, b }
+            EvalResult {
+                a: coupling.reduce_matrix(&a, offset),
+                b: coupling.reduce_vector(&b, offset),
+            }
         })
         .collect();
     for (k, (r, s)) in results.iter().zip(&states).enumerate() {
@@ -114,9 +134,9 @@ pub fn render_text(model: &Model, methods: Methods, results: &[EvalResult]) -> S
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "model {} ({} joints, {} base), algorithm {methods}",
+        "model {} ({} coordinates, {} base), algorithm {methods}",
         model.name(),
-        model.dof(),
+        model.coordinates().len(),
         model.base_kind().name()
     );
     for (k, r) in results.iter().enumerate() {

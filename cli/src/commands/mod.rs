@@ -6,5 +6,6 @@ pub mod count;
 pub mod count_events;
 pub mod eval;
 pub mod generate;
+pub mod info;
 pub mod simulate;
 pub mod table1;

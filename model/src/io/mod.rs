@@ -25,7 +25,7 @@ use crate::{Model, ModelError, Validation};
 use std::path::Path;
 
 pub use toml_model::{parse_toml, InertiaSpec};
-pub use urdf::{parse_urdf, parse_urdf_with};
+pub use urdf::{parse_urdf, parse_urdf_noted, parse_urdf_with, ReadNotes};
 pub use write::to_toml;
 
 /// Reads a model file, choosing the reader by extension: `.urdf` ([`parse_urdf`]) or `.toml`
@@ -59,6 +59,29 @@ pub fn load_model_with(path: &Path, validation: Validation) -> Result<Model, Mod
             "{display}: model file has no extension (expected `.urdf` or `.toml`)"
         ))),
     }
+}
+
+/// [`load_model_with`], with the URDF reader's [`ReadNotes`] (`None` for a TOML model: that
+/// reader ignores nothing and merges nothing).
+pub fn load_model_noted(
+    path: &Path,
+    validation: Validation,
+) -> Result<(Model, Option<ReadNotes>), ModelError> {
+    let is_urdf = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"));
+    if !is_urdf {
+        return load_model_with(path, validation).map(|m| (m, None));
+    }
+    let display = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| ModelError::Io {
+        path: display.clone(),
+        reason: e.to_string(),
+    })?;
+    urdf::parse_urdf_noted(&text, validation)
+        .map(|(m, n)| (m, Some(n)))
+        .map_err(|e| prefix(&display, e))
 }
 
 /// Prefixes parse errors with the file name.

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Hand, "bad/massless.urdf");
+
+fn main() {}

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Hand, "bad/mimic.urdf");
+
+fn main() {}
