@@ -10,20 +10,19 @@
 //! ([`System::advance`]) and needs no projection.
 
 use crate::events::{self, CaptureSystem, EventReport};
-use crate::scene::{
-    BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
-};
+use crate::provider::{floating_state, RunTimeDynamics};
+use crate::scene::{BaseSpec, Drives, Event, EventKind, Integrator, Scene, SimulationSpec};
 use crate::singularity;
 use anyhow::Result;
-use kanegen_dynamics::algorithms::aba::{self, Workspace};
-use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
+use kanegen_dynamics::algorithms::floating::{kinetic_energy, momentum};
 use kanegen_dynamics::algorithms::frames;
-use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::base::{FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
-use kanegen_dynamics::{ForwardMethod, FrameParams, Loads, Params};
+use kanegen_dynamics::{ForwardMethod, FrameParams, Params};
 use kanegen_runtime::ode::{
     self, quaternion, Dopri5Options, Rk4Options, Stats, Stop, System, VecScratch,
 };
+use kanegen_runtime::scene::{self as rt_scene, Profile};
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
@@ -47,36 +46,22 @@ impl ProgressBar {
     }
 }
 
-/// A scene as a first-order system for the integrators.
+/// A scene as a first-order system for the integrators: the right-hand side of
+/// [`kanegen_runtime::scene::deriv`] over the run-time dynamics ([`RunTimeDynamics`]).
 pub struct SceneSystem<'a> {
     scene: &'a Scene,
-    params: Params<f64>,
-    base: Option<FloatingBase<f64>>,
-    /// Loads without `tau` (gravity and constant wrenches, as the scene names them).
-    passive: Loads<f64>,
-    /// Whether some wrench is tabulated in time (then `deriv` evaluates the wrenches at `t`).
-    time_varying: bool,
+    dynamics: RunTimeDynamics,
+    /// The profiles of the scene's wrenches (borrowed by its effects).
+    profiles: Vec<Profile<'a>>,
+    /// The work memory of the right-hand side, allocated once.
+    work: Vec<f64>,
     n: usize,
     /// Set (by a Ctrl-C handler) to stop the run at the next step.
     stop: Option<&'a AtomicBool>,
-    /// The run-time fast path ([`crate::scene::SimulationSpec::forward`] is
-    /// [`ForwardMethod::Aba`]): the workspace of the articulated-body algorithm, and the loads
-    /// and the accelerations of `deriv`, allocated once.
-    fast: Option<FastPath>,
-}
-
-/// The preallocated data of the run-time fast path.
-struct FastPath {
-    ws: Workspace<f64>,
-    /// The passive loads with `tau = Some(N zeros)`: `deriv` writes the torques and, when
-    /// tabulated, the wrenches in place.
-    loads: Loads<f64>,
-    /// `q̈` (fixed base) or `ν̇` (free-floating).
-    acc: Vec<f64>,
 }
 
 /// The desired trajectory of a computed-torque drive at `t`: `(q_d, q̇_d, q̈_d)` along the
-/// quintic time scaling ([`ode::quintic`]).
+/// quintic time scaling ([`kanegen_runtime::scene::quintic_reference`]).
 #[must_use]
 pub fn quintic_reference(
     q0: &[f64],
@@ -84,12 +69,15 @@ pub fn quintic_reference(
     duration: f64,
     t: f64,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let (s, ds, dds) = ode::quintic(t, duration);
-    let d: Vec<f64> = q0.iter().zip(target).map(|(a, b)| b - a).collect();
+    let r: Vec<(f64, f64, f64)> = q0
+        .iter()
+        .zip(target)
+        .map(|(a, b)| rt_scene::quintic_reference(*a, *b, duration, t))
+        .collect();
     (
-        q0.iter().zip(&d).map(|(a, di)| a + s * di).collect(),
-        d.iter().map(|di| ds * di).collect(),
-        d.iter().map(|di| dds * di).collect(),
+        r.iter().map(|x| x.0).collect(),
+        r.iter().map(|x| x.1).collect(),
+        r.iter().map(|x| x.2).collect(),
     )
 }
 
@@ -97,25 +85,16 @@ impl<'a> SceneSystem<'a> {
     /// The system of `scene`.
     #[must_use]
     pub fn new(scene: &'a Scene) -> Self {
-        let base = match &scene.base {
-            BaseSpec::Fixed => None,
-            BaseSpec::FreeFloating { inertial, .. } => Some(FloatingBase::from_inertial(inertial)),
-        };
+        let profiles = scene.wrench_profiles();
+        let work = vec![0.0; scene.effects(&profiles).work_len()];
         SceneSystem {
             scene,
-            params: Params::new(&scene.model),
-            base,
-            passive: Loads {
-                tau: None,
-                gravity: scene.gravity.map(Vec3::from_f64),
-                external: scene.wrenches.iter().map(|w| w.at(0.0)).collect(),
-            },
-            time_varying: scene.wrenches.iter().any(SceneWrench::is_tabulated),
+            dynamics: RunTimeDynamics::new(scene, scene.simulation.forward),
+            profiles,
+            work,
             n: scene.model.dof(),
             stop: None,
-            fast: None,
         }
-        .with_forward(scene.simulation.forward)
     }
 
     /// The system solving for the accelerations by `forward`: [`ForwardMethod::Aba`] is the
@@ -125,21 +104,9 @@ impl<'a> SceneSystem<'a> {
     /// side to rounding (`sim` tests).
     #[must_use]
     pub fn with_forward(mut self, forward: ForwardMethod) -> Self {
-        self.fast = match forward {
-            ForwardMethod::Ldlt => None,
-            ForwardMethod::Aba => {
-                let n = self.n;
-                let base = if self.base.is_some() { 6 } else { 0 };
-                Some(FastPath {
-                    ws: Workspace::new(&self.params),
-                    loads: Loads {
-                        tau: Some(vec![0.0; n]),
-                        ..self.passive.clone()
-                    },
-                    acc: vec![0.0; base + n],
-                })
-            }
-        };
+        let params = self.dynamics.params.clone();
+        self.dynamics = RunTimeDynamics::new(self.scene, forward);
+        self.dynamics.set_params(params);
         self
     }
 
@@ -156,7 +123,7 @@ impl<'a> SceneSystem<'a> {
         let n = self.n;
         let joint = |k: usize| self.scene.model.joints()[k].name.clone();
         let xyz = ["x", "y", "z"];
-        if self.base.is_none() {
+        if self.dynamics.base.is_none() {
             return match i / n {
                 0 => format!("q_{}", joint(i)),
                 1 => format!("qd_{}", joint(i - n)),
@@ -197,87 +164,11 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn split<'x>(&self, x: &'x [f64]) -> (&'x [f64], &'x [f64], Option<FloatingState<f64>>) {
         let n = self.n;
-        if self.base.is_none() {
+        if self.dynamics.base.is_none() {
             return (&x[..n], &x[n..2 * n], None);
         }
-        let quat: [f64; 4] = x[3..7].try_into().expect("4 entries");
-        let st = FloatingState {
-            position: Vec3::new(x[0], x[1], x[2]),
-            rotation: quat_to_matrix(&quat),
-            v_b: Vec3::new(x[7 + n], x[8 + n], x[9 + n]),
-            omega_b: Vec3::new(x[10 + n], x[11 + n], x[12 + n]),
-        };
+        let st = floating_state(x, &x[7 + n..]);
         (&x[7..7 + n], &x[13 + n..13 + 2 * n], Some(st))
-    }
-
-    /// The joint drive torques minus damping (viscous friction) and Coulomb friction at
-    /// `(t, q, q̇)`: `τ_applied = τ_drive − b q̇ − τ_c tanh(q̇ / v_s)`; `None` when the scene has
-    /// none of them.
-    #[must_use]
-    pub fn torques(&self, t: f64, q: &[f64], qd: &[f64]) -> Option<Vec<f64>> {
-        let mut tau = vec![0.0; self.n];
-        self.torques_into(t, q, qd, &mut tau).then_some(tau)
-    }
-
-    /// [`SceneSystem::torques`] into `tau` (length `N`; zeros when the scene has none of them,
-    /// then `false`). Allocates nothing except for a computed-torque drive.
-    pub fn torques_into(&self, t: f64, q: &[f64], qd: &[f64], tau: &mut [f64]) -> bool {
-        let s = self.scene;
-        let mut any = true;
-        match &s.drives {
-            Drives::None => {
-                tau.fill(0.0);
-                any = false;
-            }
-            Drives::Constant { tau: c } => tau.copy_from_slice(c),
-            Drives::Pd { kp, kd, target } => {
-                for i in 0..self.n {
-                    tau[i] = kp[i] * (target[i] - q[i]) - kd[i] * qd[i];
-                }
-            }
-            Drives::ComputedTorque {
-                kp,
-                kd,
-                target,
-                duration,
-            } => {
-                let (qr, qdr, qddr) = quintic_reference(&s.q0, target, *duration, t);
-                let cmd: Vec<f64> = (0..self.n)
-                    .map(|i| qddr[i] + kd[i] * (qdr[i] - qd[i]) + kp[i] * (qr[i] - q[i]))
-                    .collect();
-                // The controller compensates the scene's loads as they are at `t`.
-                let at_t;
-                let loads = if self.time_varying {
-                    at_t = Loads {
-                        external: s.wrenches.iter().map(|w| w.at(t)).collect(),
-                        ..self.passive.clone()
-                    };
-                    &at_t
-                } else {
-                    &self.passive
-                };
-                tau.copy_from_slice(&s.simulation.algorithm.inverse_dynamics(
-                    &self.params,
-                    q,
-                    qd,
-                    &cmd,
-                    loads,
-                ));
-            }
-        }
-        if let Some(c) = &s.damping {
-            any = true;
-            for i in 0..self.n {
-                tau[i] -= c[i] * qd[i];
-            }
-        }
-        if let Some(c) = &s.coulomb {
-            any = true;
-            for i in 0..self.n {
-                tau[i] -= c.torque(i, qd[i]);
-            }
-        }
-        any
     }
 
     /// Total energy: kinetic, plus the gravitational potential `−g · Σ m_k x_{c,k}` on a fixed
@@ -285,7 +176,7 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn energy(&self, x: &[f64]) -> Option<f64> {
         let t = self.kinetic_energy(x);
-        if self.base.is_some() {
+        if self.dynamics.base.is_some() {
             return self.scene.gravity.is_none().then_some(t);
         }
         let q = &x[..self.n];
@@ -302,7 +193,8 @@ impl<'a> SceneSystem<'a> {
             None => 0.0,
             Some(g) => {
                 let g = Vec3::from_f64(g);
-                self.params
+                self.dynamics
+                    .params
                     .joints
                     .iter()
                     .enumerate()
@@ -312,7 +204,7 @@ impl<'a> SceneSystem<'a> {
                             translation: jp.com.clone(),
                             rotation: Mat3::identity(),
                         };
-                        let (x, _) = frames::placement(&self.params, q, &com);
+                        let (x, _) = frames::placement(&self.dynamics.params, q, &com);
                         -jp.mass * g.dot(&x)
                     })
                     .sum()
@@ -337,18 +229,18 @@ impl<'a> SceneSystem<'a> {
     /// [`SceneSystem::apply_event`]).
     #[must_use]
     pub fn params(&self) -> &Params<f64> {
-        &self.params
+        &self.dynamics.params
     }
 
     /// Replaces the model's numbers (a payload captured or released).
     pub fn set_params(&mut self, params: Params<f64>) {
-        self.params = params;
+        self.dynamics.set_params(params);
     }
 
     /// The free-floating base body, `None` on a fixed base.
     #[must_use]
     pub fn floating_base(&self) -> Option<&FloatingBase<f64>> {
-        self.base.as_ref()
+        self.dynamics.base.as_ref()
     }
 
     /// `σ_min(J*)` of `frame` at state `x` ([`singularity::sigma_min`]); `None` on a fixed base
@@ -356,7 +248,13 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn sigma_min(&self, x: &[f64], frame: &FrameParams<f64>) -> Option<f64> {
         let (q, _, st) = self.split(x);
-        singularity::sigma_min(&self.params, self.base.as_ref()?, &st?, q, frame)
+        singularity::sigma_min(
+            &self.dynamics.params,
+            self.dynamics.base.as_ref()?,
+            &st?,
+            q,
+            frame,
+        )
     }
 
     /// The origin frame of the last body (the frame whose `σ_min(J*)` the summary reports).
@@ -384,9 +282,9 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn kinetic_energy(&self, x: &[f64]) -> f64 {
         let (q, qd, st) = self.split(x);
-        match (&self.base, st) {
+        match (&self.dynamics.base, st) {
             (Some(b), Some(st)) => {
-                kinetic_energy(&self.params, b, &st, q, qd) + self.rotor_energy(qd)
+                kinetic_energy(&self.dynamics.params, b, &st, q, qd) + self.rotor_energy(qd)
             }
             _ => {
                 let a = self
@@ -394,7 +292,7 @@ impl<'a> SceneSystem<'a> {
                     .simulation
                     .algorithm
                     .mass_matrix
-                    .mass_matrix(&self.params, q);
+                    .mass_matrix(&self.dynamics.params, q);
                 0.5 * (0..self.n)
                     .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
                     .sum::<f64>()
@@ -419,73 +317,10 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let (q, qd, st) = self.split(x);
-        let (b, st) = (self.base.as_ref()?, st?);
-        let (l, a) = momentum(&self.params, b, &st, q, qd);
+        let (b, st) = (self.dynamics.base.as_ref()?, st?);
+        let (l, a) = momentum(&self.dynamics.params, b, &st, q, qd);
         Some((l.into_array(), a.into_array()))
     }
-}
-
-impl SceneSystem<'_> {
-    /// [`System::deriv`] on the run-time fast path: the workspace ABA, the reflected rotor
-    /// inertia as its armature (`D_i += I_m n²`), the loads written in place.
-    fn deriv_fast(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
-        let mut fast = self.fast.take().expect("the fast path");
-        let n = self.n;
-        let (q, qd, st) = self.split(x);
-        let tau = fast.loads.tau.as_mut().expect("tau is preallocated");
-        self.torques_into(t, q, qd, tau);
-        if self.time_varying {
-            for (l, w) in fast.loads.external.iter_mut().zip(&self.scene.wrenches) {
-                *l = w.at(t);
-            }
-        }
-        let armature = self.scene.rotor.as_ref().map(|r| r.reflected.as_slice());
-        match (&self.base, st) {
-            (Some(b), Some(st)) => {
-                aba::floating_in(
-                    &self.params,
-                    &mut fast.ws,
-                    b,
-                    &st,
-                    q,
-                    qd,
-                    &fast.loads,
-                    armature,
-                    &mut fast.acc,
-                );
-                floating_kinematics(n, x, &st, qd, dx);
-                dx[7 + n..].copy_from_slice(&fast.acc);
-            }
-            _ => {
-                aba::forward_dynamics_in(
-                    &self.params,
-                    &mut fast.ws,
-                    q,
-                    qd,
-                    &fast.loads,
-                    armature,
-                    &mut fast.acc,
-                );
-                dx[..n].copy_from_slice(qd);
-                dx[n..].copy_from_slice(&fast.acc);
-            }
-        }
-        self.fast = Some(fast);
-    }
-}
-
-/// The kinematic part of a free-floating state's derivative: `ṗ₀ = R₀ v_b`, `q̇uat`, `q̇`
-/// (`dx[..7 + N]`).
-fn floating_kinematics(n: usize, x: &[f64], st: &FloatingState<f64>, qd: &[f64], dx: &mut [f64]) {
-    let pd = st.rotation.mul_vec(&st.v_b);
-    dx[..3].copy_from_slice(&pd.0);
-    // q̇uat = ½ quat ⊗ (ω, 0): u̇ = ½ (w ω + u × ω), ẇ = −½ u · ω.
-    let (u, w) = (Vec3::new(x[3], x[4], x[5]), x[6]);
-    let om = &st.omega_b;
-    let ud = (om.scale(&w) + u.cross(om)).scale(&0.5);
-    dx[3..6].copy_from_slice(&ud.0);
-    dx[6] = -0.5 * u.dot(om);
-    dx[7..7 + n].copy_from_slice(qd);
 }
 
 impl SceneSystem<'_> {
@@ -507,14 +342,14 @@ impl SceneSystem<'_> {
                 let armature = |a: &mut [Vec<f64>]| self.add_armature(a);
                 let sys = CaptureSystem {
                     method: self.scene.simulation.algorithm.mass_matrix,
-                    base: self.base.as_ref().expect("free-floating"),
+                    base: self.dynamics.base.as_ref().expect("free-floating"),
                     state: &st,
                     q,
                     armature: &armature,
                 };
                 let (nu, pay) = events::capture(
                     &sys,
-                    &self.params,
+                    &self.dynamics.params,
                     &new_params,
                     &x[7 + n..],
                     event.body,
@@ -527,7 +362,7 @@ impl SceneSystem<'_> {
             }
             EventKind::Release { .. } => ("release", (before.0, before.1)),
         };
-        self.params = new_params;
+        self.dynamics.set_params(new_params);
         let after = self.momentum(x).expect("free-floating");
         // The released payload's momentum: the system's with it minus without it.
         let pay = if kind == "release" {
@@ -574,7 +409,7 @@ impl SceneSystem<'_> {
 
 impl System for SceneSystem<'_> {
     fn dim(&self) -> usize {
-        if self.base.is_some() {
+        if self.dynamics.base.is_some() {
             13 + 2 * self.n
         } else if self.scene.flexible.is_some() {
             4 * self.n
@@ -584,80 +419,14 @@ impl System for SceneSystem<'_> {
     }
 
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
-        let n = self.n;
-        let (q, qd, st) = self.split(x);
-        // Flexible joints first: their state is `[q, q̇, θ, θ̇]`, which the fast path does not
-        // know (it evaluates the link side by the scene's algorithm).
-        if let Some(f) = &self.scene.flexible {
-            // Spong's model: the spring loads the links, the drives act on the motors.
-            let (th, thd) = (&x[2 * n..3 * n], &x[3 * n..4 * n]);
-            let tau_s = f.spring_torque(q, qd, th, thd);
-            let tau_m = self.torques(t, th, thd);
-            let mut loads = Loads {
-                tau: Some(tau_s.clone()),
-                ..self.passive.clone()
-            };
-            if self.time_varying {
-                loads.external = self.scene.wrenches.iter().map(|w| w.at(t)).collect();
-            }
-            let alg = self.scene.simulation.algorithm;
-            let qdd = alg.forward_dynamics(&self.params, q, qd, &loads);
-            dx[..n].copy_from_slice(qd);
-            dx[n..2 * n].copy_from_slice(&qdd);
-            dx[2 * n..3 * n].copy_from_slice(thd);
-            for i in 0..n {
-                let tm = tau_m.as_ref().map_or(0.0, |v| v[i]);
-                dx[3 * n + i] = (tm - tau_s[i]) / f.reflected[i];
-            }
-            return;
-        }
-        if self.fast.is_some() {
-            return self.deriv_fast(t, x, dx);
-        }
-        let mut loads = Loads {
-            tau: self.torques(t, q, qd),
-            ..self.passive.clone()
-        };
-        if self.time_varying {
-            loads.external = self.scene.wrenches.iter().map(|w| w.at(t)).collect();
-        }
-        let alg = self.scene.simulation.algorithm;
-        match (&self.base, st) {
-            (Some(b), Some(st)) => {
-                let nu_dot = match &self.scene.rotor {
-                    None => floating::forward_dynamics(alg, &self.params, b, &st, q, qd, &loads),
-                    // The armature model on a free-floating base: I_m n² on the joint diagonal
-                    // H[6+i][6+i] of the (6+N) mass matrix before the LDLᵀ solve.
-                    Some(_) => {
-                        let mut d = floating::dynamics(alg, &self.params, b, &st, q, qd, &loads);
-                        self.add_armature(&mut d.a);
-                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
-                    }
-                };
-                floating_kinematics(n, x, &st, qd, dx);
-                dx[7 + n..].copy_from_slice(&nu_dot);
-            }
-            _ => {
-                let qdd = match &self.scene.rotor {
-                    None => alg.forward_dynamics(&self.params, q, qd, &loads),
-                    // (M + diag(I_m n²)) q̈ = τ − c: the reflected rotor inertia on M's
-                    // diagonal before the LDLᵀ solve.
-                    Some(_) => {
-                        let mut d = alg.dynamics(&self.params, q, qd, &loads);
-                        self.add_armature(&mut d.a);
-                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
-                    }
-                };
-                dx[..n].copy_from_slice(qd);
-                dx[n..].copy_from_slice(&qdd);
-            }
-        }
+        let effects = self.scene.effects(&self.profiles);
+        rt_scene::deriv(&mut self.dynamics, &effects, t, x, dx, &mut self.work);
     }
 
     /// Additive, except the quaternion on a free-floating base: `quat ⊗ exp(h ω_b(at) / 2)`
     /// ([`quaternion::advance_floating`]).
     fn advance(&self, x: &[f64], h: f64, at: &[f64], f: &[f64], out: &mut [f64]) {
-        if self.base.is_some() {
+        if self.dynamics.base.is_some() {
             quaternion::advance_floating(x, h, at, f, out);
         } else {
             quaternion::advance_additive(x, h, f, out);
@@ -669,7 +438,7 @@ impl System for SceneSystem<'_> {
     }
 
     fn project(&self, x: &mut [f64]) {
-        if self.base.is_some() {
+        if self.dynamics.base.is_some() {
             quaternion::normalize_quaternion(x);
         }
     }
