@@ -1,7 +1,7 @@
 //! A scene's effects as the plain data of the right-hand side both simulators run
 //! ([`kanegen_runtime::scene`]): borrowed from the validated [`Scene`].
 
-use crate::{Drives, Scene, SceneWrench, WrenchProfile};
+use crate::{BaseSpec, Drives, Scene, SceneWrench, WrenchProfile};
 use kanegen_runtime::scene::{Coulomb, Drive, Flexible, Profile, SceneEffects};
 
 impl SceneWrench {
@@ -27,6 +27,34 @@ impl SceneWrench {
 }
 
 impl Scene {
+    /// The initial state vector in the layout of [`kanegen_runtime::scene`] (fixed base
+    /// `[q, q̇]`, with flexible joints `[q, q̇, θ, θ̇]` the motors starting at the links;
+    /// free-floating `[p₀, quat, q, v_b, ω_b, q̇]`).
+    #[must_use]
+    pub fn initial_state(&self) -> Vec<f64> {
+        match &self.base {
+            BaseSpec::Fixed if self.flexible.is_some() => {
+                [self.q0.as_slice(), &self.qd0, &self.q0, &self.qd0].concat()
+            }
+            BaseSpec::Fixed => [self.q0.as_slice(), &self.qd0].concat(),
+            BaseSpec::FreeFloating {
+                position,
+                quaternion,
+                v,
+                omega,
+                ..
+            } => [
+                position.as_slice(),
+                quaternion,
+                &self.q0,
+                v,
+                omega,
+                &self.qd0,
+            ]
+            .concat(),
+        }
+    }
+
     /// The profiles of the scene's wrenches, in order (what [`Scene::effects`] borrows).
     #[must_use]
     pub fn wrench_profiles(&self) -> Vec<Profile<'_>> {
