@@ -7,4 +7,5 @@ pub mod count_events;
 pub mod eval;
 pub mod generate;
 pub mod simulate;
+pub mod simulate_text;
 pub mod table1;
