@@ -7,7 +7,7 @@ use super::{Drive, SceneDynamics, SceneEffects};
 /// The desired `(q_d, q̇_d, q̈_d)` of joint `i` of a computed-torque drive at `t`: the quintic
 /// time scaling ([`crate::ode::quintic`]) from `q0` to `target`.
 #[must_use]
-#[inline]
+#[inline(always)]
 pub fn quintic_reference(q0: f64, target: f64, duration: f64, t: f64) -> (f64, f64, f64) {
     let (s, ds, dds) = crate::ode::quintic(t, duration);
     let d = target - q0;
@@ -18,7 +18,7 @@ pub fn quintic_reference(q0: f64, target: f64, duration: f64, t: f64) -> (f64, f
 /// damping and Coulomb friction. `cmd` (`N`) is work memory (the commanded acceleration of a
 /// computed-torque drive, whose inverse dynamics includes the wrenches `w` at `t`).
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 pub fn drive_torques<D: SceneDynamics + ?Sized>(
     dynamics: &mut D,
     fx: &SceneEffects<'_>,

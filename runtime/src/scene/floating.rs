@@ -6,7 +6,7 @@ use crate::ode::quat_to_matrix;
 /// `dq = [ṗ₀, q̇uat, q̇]` (`7 + N`) from positions `q` (`7 + N`) and speeds `v` (`6 + N`):
 /// `ṗ₀ = R₀ v_b`, `q̇uat = ½ quat ⊗ (ω_b, 0)`, i.e. `u̇ = ½ (w ω + u × ω)`, `ẇ = −½ u · ω`
 /// (quaternion `(u, w)`, body-frame `ω_b`).
-#[inline]
+#[inline(always)]
 pub fn floating_kinematics(q: &[f64], v: &[f64], dq: &mut [f64]) {
     if q.len() < 7 || v.len() < 6 || dq.len() < 7 {
         dq.fill(f64::NAN);

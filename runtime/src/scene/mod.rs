@@ -49,7 +49,7 @@ pub enum Profile<'a> {
 impl Profile<'_> {
     /// `(force, moment)` at `t`.
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, t: f64) -> ([f64; 3], [f64; 3]) {
         match *self {
             Profile::Constant { force, moment } => (force, moment),
@@ -138,7 +138,7 @@ pub struct SceneEffects<'a> {
 impl SceneEffects<'_> {
     /// `(positions, speeds)` of the provider: `(N, N)`, or `(7 + N, 6 + N)` free-floating.
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub const fn sizes(&self) -> (usize, usize) {
         if self.floating {
             (7 + self.dof, 6 + self.dof)
@@ -149,7 +149,7 @@ impl SceneEffects<'_> {
 
     /// Length of the state vector.
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub const fn dim(&self) -> usize {
         let (nq, nv) = self.sizes();
         nq + nv
@@ -162,7 +162,7 @@ impl SceneEffects<'_> {
 
     /// Length of the work memory [`deriv`] needs ([`work_len`] of these effects).
     #[must_use]
-    #[inline]
+    #[inline(always)]
     pub const fn work_len(&self) -> usize {
         work_len(
             self.dof,
@@ -219,6 +219,7 @@ pub trait SceneDynamics {
 /// `work` of [`SceneEffects::work_len`] (or more). Steps: the wrenches at `t`, the drive
 /// torques minus damping and friction on the joints the drives act on (the motors with flexible
 /// joints), the springs of flexible joints, the accelerations (with armature), the kinematics.
+#[inline(always)]
 pub fn deriv<D: SceneDynamics + ?Sized>(
     dynamics: &mut D,
     fx: &SceneEffects<'_>,
@@ -264,7 +265,7 @@ pub fn deriv<D: SceneDynamics + ?Sized>(
 }
 
 /// Each wrench's `(force, moment)` at `t` into `w` (6 a wrench).
-#[inline]
+#[inline(always)]
 fn wrench_values(profiles: &[Profile<'_>], t: f64, w: &mut [f64]) {
     for (p, wk) in profiles.iter().zip(w.chunks_exact_mut(6)) {
         let (f, m) = p.at(t);
@@ -277,7 +278,7 @@ fn wrench_values(profiles: &[Profile<'_>], t: f64, w: &mut [f64]) {
 /// spring torque `τ_s = K (θ − q) + D (θ̇ − q̇)` into `tau_s` (what loads the links) and the
 /// motor derivative `[θ̇, (τ_m − τ_s) / B]` into `dmotors`, `τ_m` the motor torque.
 #[allow(clippy::too_many_arguments)]
-#[inline]
+#[inline(always)]
 fn flexible_joints(
     f: &Flexible<'_>,
     q: &[f64],
@@ -299,7 +300,7 @@ fn flexible_joints(
 
 /// Copies `src` into `dst` entry by entry as far as both go (the forwards of a generated
 /// provider, whose arrays have the slices' lengths).
-#[inline]
+#[inline(always)]
 pub fn copy_into(dst: &mut [f64], src: &[f64]) {
     for (d, s) in dst.iter_mut().zip(src) {
         *d = *s;
