@@ -476,8 +476,6 @@ fn simulator_items(
     let dim = Literal::usize_unsuffixed(l.dim);
     let (state_ty, floating) = (&l.state_ty, l.floating);
     let m = Methods::of(sim, &ode, &dim);
-    let profiles = scene.wrench_profiles();
-    let effects = scene_provider::effects(&rt, &scene.effects(&profiles));
     // The scene's right-hand side in model phase `phase` as an `ode::System` (the quaternion
     // projected and advanced by the exponential map on a free-floating base), `work` its
     // memory.
@@ -545,44 +543,12 @@ fn simulator_items(
              quaternion renormalized on a free-floating base)."
         }
     };
-    let (duration, step, tolerance) = (lit(sim.duration), lit(sim.step), lit(sim.tolerance));
-    let every = Literal::usize_unsuffixed(sim.output_every);
-    let (nl, rel_lit) = (
-        Literal::usize_unsuffixed(l.n),
-        LitStr::new(rel, Span::call_site()),
-    );
-    let dim_doc = if l.flexible {
-        format!(
-            " Length of the flat state vector ({} + {} + {} + {}).",
-            l.nq, l.nv, l.n, l.n
-        )
-    } else {
-        format!(" Length of the flat state vector ({} + {}).", l.nq, l.nv)
-    };
+    let constants = constants(&rt, scene, l, rel);
     let (step_fn, run_scratch, step_scratch) = (&m.step_fn, &m.run_scratch, &m.step_scratch);
     quote! {
         #[allow(clippy::too_many_lines, clippy::unreadable_literal, clippy::excessive_precision)]
         impl #name {
-            /// Joint degrees of freedom.
-            pub const N: usize = #nl;
-            #[doc = #dim_doc]
-            pub const DIM: usize = #dim;
-            /// The scene file (relative to the crate).
-            pub const SCENE: &'static str = #rel_lit;
-            /// Simulated duration, s.
-            pub const DURATION: f64 = #duration;
-            /// Step (RK4), or first step tried (dopri5), s.
-            pub const STEP: f64 = #step;
-            /// dopri5 tolerance (`rtol = atol`; unused by RK4 scenes).
-            pub const TOLERANCE: f64 = #tolerance;
-            /// An output sample every this many steps (RK4), or every `OUTPUT_EVERY · STEP`
-            /// seconds (dopri5).
-            pub const OUTPUT_EVERY: usize = #every;
-            /// The scene's effects: the data of its right-hand side
-            /// (`kanegen::runtime::scene::deriv`).
-            pub const EFFECTS: #rt::scene::SceneEffects<'static> = #effects;
-            /// Length of the work memory of the right-hand side.
-            pub const WORK: usize = Self::EFFECTS.work_len();
+            #constants
 
             /// The scene's initial state.
             #[must_use]
@@ -639,5 +605,50 @@ fn simulator_items(
 
             #events
         }
+    }
+}
+
+/// The constants of `Name`: sizes, the scene file, the integrator's settings and the scene's
+/// effects (`EFFECTS`, the data of the right-hand side) with the length of its work memory.
+fn constants(rt: &TokenStream, scene: &Scene, l: &Layout, rel: &str) -> TokenStream {
+    let sim = &scene.simulation;
+    let profiles = scene.wrench_profiles();
+    let effects = scene_provider::effects(rt, &scene.effects(&profiles));
+    let (duration, step, tolerance) = (lit(sim.duration), lit(sim.step), lit(sim.tolerance));
+    let every = Literal::usize_unsuffixed(sim.output_every);
+    let (nl, dim) = (
+        Literal::usize_unsuffixed(l.n),
+        Literal::usize_unsuffixed(l.dim),
+    );
+    let rel_lit = LitStr::new(rel, Span::call_site());
+    let dim_doc = if l.flexible {
+        format!(
+            " Length of the flat state vector ({} + {} + {} + {}).",
+            l.nq, l.nv, l.n, l.n
+        )
+    } else {
+        format!(" Length of the flat state vector ({} + {}).", l.nq, l.nv)
+    };
+    quote! {
+            /// Joint degrees of freedom.
+            pub const N: usize = #nl;
+            #[doc = #dim_doc]
+            pub const DIM: usize = #dim;
+            /// The scene file (relative to the crate).
+            pub const SCENE: &'static str = #rel_lit;
+            /// Simulated duration, s.
+            pub const DURATION: f64 = #duration;
+            /// Step (RK4), or first step tried (dopri5), s.
+            pub const STEP: f64 = #step;
+            /// dopri5 tolerance (`rtol = atol`; unused by RK4 scenes).
+            pub const TOLERANCE: f64 = #tolerance;
+            /// An output sample every this many steps (RK4), or every `OUTPUT_EVERY · STEP`
+            /// seconds (dopri5).
+            pub const OUTPUT_EVERY: usize = #every;
+            /// The scene's effects: the data of its right-hand side
+            /// (`kanegen::runtime::scene::deriv`).
+            pub const EFFECTS: #rt::scene::SceneEffects<'static> = #effects;
+            /// Length of the work memory of the right-hand side.
+            pub const WORK: usize = Self::EFFECTS.work_len();
     }
 }
