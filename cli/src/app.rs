@@ -617,7 +617,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             } else {
                 print(
                     out,
-                    &format!("{}\n", kanegen_sim::simulate::render_text(&summary)),
+                    &format!("{}\n", commands::simulate_text::render_text(&summary)),
                 )?;
             }
             if let Some(d) = &planned {

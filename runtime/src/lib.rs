@@ -10,6 +10,9 @@
 //! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
 //!   midpoint rule) over slices with caller-provided scratch, for the simulator and `scene!`.
 //! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
+//! - [`scene`]: a scene's right-hand side (drives, damping, friction, wrenches, rotor inertia,
+//!   flexible joints, a free-floating base's kinematics) over a dynamics provider, written once
+//!   for the interpreted simulator and `scene!`.
 //! - [`ldlt`]: LDLᵀ factorization and solve over slices, allocating nothing.
 //! - [`inertia`]: the parallel-axis shift of a rigid body's inertia.
 #![no_std]
@@ -23,6 +26,7 @@ pub mod inertia;
 pub mod ldlt;
 pub mod ode;
 pub mod scalar;
+pub mod scene;
 pub mod sincos;
 
 pub use scalar::{Real, Scalar, Symbolic};

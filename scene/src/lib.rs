@@ -40,6 +40,7 @@ macro_rules! bail {
     };
 }
 
+mod effects;
 mod error;
 pub mod flexible;
 

@@ -39,6 +39,8 @@
 //! jump `E⁺ − E⁻` of each event (the plastic loss, or the kinetic energy the released payload
 //! carries away).
 
+use crate::scene::{Event, EventKind};
+use crate::system::SceneSystem;
 use kanegen_dynamics::algorithms::{floating, frames};
 use kanegen_dynamics::base::{FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
@@ -151,4 +153,79 @@ pub fn capture(
     let nu_new = kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&h_new), &p);
     let ang = xc.cross(&lin) + spin;
     (nu_new, (lin.into_array(), ang.into_array()))
+}
+
+impl SceneSystem<'_> {
+    /// Applies `event` at state `x` (free-floating): switches the model to `event.model` and, for
+    /// a capture, replaces `ν` by the post-capture velocity of the plastic-impact equation
+    /// ([`events::capture`], with the armature of `[effects] rotor` on both mass matrices).
+    ///
+    /// # Panics
+    /// On a fixed base (the scene parser rejects events there).
+    pub fn apply_event(&mut self, event: &Event, x: &mut [f64]) -> EventReport {
+        let n = self.n;
+        let before = self.momentum(x).expect("events need a free-floating base");
+        let e_before = self.kinetic_energy(x);
+        let new_params = Params::new(&event.model);
+        let (kind, pay) = match &event.kind {
+            EventKind::Capture { payload, v, omega } => {
+                let (q, _, st) = self.split(x);
+                let st = st.expect("free-floating");
+                let armature = |a: &mut [Vec<f64>]| self.add_armature(a);
+                let sys = CaptureSystem {
+                    method: self.scene.simulation.algorithm.mass_matrix,
+                    base: self.dynamics.base.as_ref().expect("free-floating"),
+                    state: &st,
+                    q,
+                    armature: &armature,
+                };
+                let (nu, pay) = capture(
+                    &sys,
+                    &self.dynamics.params,
+                    &new_params,
+                    &x[7 + n..],
+                    event.body,
+                    payload,
+                    *v,
+                    *omega,
+                );
+                x[7 + n..].copy_from_slice(&nu);
+                ("capture", pay)
+            }
+            EventKind::Release { .. } => ("release", (before.0, before.1)),
+        };
+        self.dynamics.set_params(new_params);
+        let after = self.momentum(x).expect("free-floating");
+        // The released payload's momentum: the system's with it minus without it.
+        let pay = if kind == "release" {
+            (add(&pay.0, &after.0, -1.0), add(&pay.1, &after.1, -1.0))
+        } else {
+            pay
+        };
+        // System and payload, before and after: the payload is free before a capture and after
+        // a release.
+        let (total_before, total_after) = if kind == "capture" {
+            (
+                (add(&before.0, &pay.0, 1.0), add(&before.1, &pay.1, 1.0)),
+                after,
+            )
+        } else {
+            (
+                before,
+                (add(&after.0, &pay.0, 1.0), add(&after.1, &pay.1, 1.0)),
+            )
+        };
+        EventReport {
+            t: event.time,
+            kind,
+            body: self.scene.model.joints()[event.body].body.clone(),
+            linear_momentum_before: total_before.0,
+            angular_momentum_before: total_before.1,
+            linear_momentum_error_rel: rel_diff(&total_after.0, &total_before.0),
+            angular_momentum_error_rel: rel_diff(&total_after.1, &total_before.1),
+            energy_change: self.kinetic_energy(x) - e_before,
+            payload_linear_momentum: pay.0,
+            payload_angular_momentum: pay.1,
+        }
+    }
 }

@@ -13,6 +13,10 @@
 pub mod events;
 pub use kanegen_scene::flexible;
 pub mod integrate;
+pub mod monitors;
+pub mod provider;
 pub use kanegen_scene as scene;
 pub mod simulate;
 pub mod singularity;
+pub mod sinks;
+pub mod system;

@@ -8,4 +8,5 @@ pub mod eval;
 pub mod generate;
 pub mod info;
 pub mod simulate;
+pub mod simulate_text;
 pub mod table1;

@@ -1,11 +1,10 @@
 //! `kanegen simulate SCENE`: the run, streamed to the files of `--out`.
 
+use super::simulate_text::{csv_header, csv_row, trajectory_csv};
 use crate::output::OutputDir;
 use anyhow::{Context, Result};
 use kanegen_sim::scene::Scene;
-use kanegen_sim::simulate::{
-    csv_header, csv_row, simulate_to, Control, Decimated, Run, Sample, Sink, Summary,
-};
+use kanegen_sim::simulate::{simulate_to, Control, Decimated, Run, Sample, Sink, Summary};
 use std::io::Write;
 use std::path::Path;
 
@@ -84,13 +83,8 @@ pub fn run(scene: &Scene, out: Option<&OutputDir>, control: Control<'_>) -> Resu
 /// into `dir` (created if needed, files replaced).
 pub fn write_outputs(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
     let d = OutputDir::plan(dir, &FILES, true, &[])?;
-    let mut csv = csv_header(scene).join(",");
-    csv.push('\n');
-    for s in &run.samples {
-        csv.push_str(&csv_row(scene, s));
-    }
     let mut files = vec![
-        ("trajectory.csv", csv.into_bytes()),
+        ("trajectory.csv", trajectory_csv(scene, run).into_bytes()),
         (
             "summary.json",
             (serde_json::to_string_pretty(&run.summary)? + "\n").into_bytes(),

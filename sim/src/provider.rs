@@ -1,0 +1,151 @@
+//! The run-time dynamics under a scene's right-hand side ([`kanegen_runtime::scene`]): the
+//! algorithms of `kanegen-dynamics` over a model's numbers, on the run-time fast path (the
+//! articulated-body algorithm in a preallocated workspace, rotor inertia as its armature) or
+//! by `A` and `b` of the scene's algorithm then LDLᵀ.
+
+use crate::scene::Scene;
+use kanegen_dynamics::algorithms::aba::{self, Workspace};
+use kanegen_dynamics::algorithms::floating;
+use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::linalg::Vec3;
+use kanegen_dynamics::{ForwardMethod, Loads, Methods, Params};
+use kanegen_runtime::scene::{forward_with_armature, SceneDynamics};
+
+/// The state of a free-floating base from the provider's positions `q = [p₀, quat, …]` and
+/// speeds `v = [v_b, ω_b, …]`.
+#[must_use]
+pub fn floating_state(q: &[f64], v: &[f64]) -> FloatingState<f64> {
+    FloatingState {
+        position: Vec3::new(q[0], q[1], q[2]),
+        rotation: quat_to_matrix(&[q[3], q[4], q[5], q[6]]),
+        v_b: Vec3::new(v[0], v[1], v[2]),
+        omega_b: Vec3::new(v[3], v[4], v[5]),
+    }
+}
+
+/// The run-time dynamics of a scene as a [`SceneDynamics`] provider.
+pub struct RunTimeDynamics {
+    /// The model's numbers (changed by a payload event).
+    pub params: Params<f64>,
+    /// The free-floating base body, `None` on a fixed base.
+    pub base: Option<FloatingBase<f64>>,
+    /// The algorithm of `A`, `b` and inverse dynamics.
+    pub algorithm: Methods,
+    /// The workspace of the articulated-body algorithm on the fast path, `None` for LDLᵀ.
+    ws: Option<Workspace<f64>>,
+    /// Gravity, `τ` (preallocated) and the scene's wrenches (their values written per call).
+    loads: Loads<f64>,
+}
+
+impl RunTimeDynamics {
+    /// The dynamics of `scene`, solving for the accelerations by `forward`.
+    #[must_use]
+    pub fn new(scene: &Scene, forward: ForwardMethod) -> Self {
+        let params = Params::new(&scene.model);
+        let base = match &scene.base {
+            crate::scene::BaseSpec::Fixed => None,
+            crate::scene::BaseSpec::FreeFloating { inertial, .. } => {
+                Some(FloatingBase::from_inertial(inertial))
+            }
+        };
+        RunTimeDynamics {
+            ws: (forward == ForwardMethod::Aba).then(|| Workspace::new(&params)),
+            params,
+            base,
+            algorithm: scene.simulation.algorithm,
+            loads: Loads {
+                tau: Some(vec![0.0; scene.model.dof()]),
+                gravity: scene.gravity.map(Vec3::from_f64),
+                external: scene.wrenches.iter().map(|w| w.at(0.0)).collect(),
+            },
+        }
+    }
+
+    /// Replaces the model's numbers (a payload captured or released).
+    pub fn set_params(&mut self, params: Params<f64>) {
+        if self.ws.is_some() {
+            self.ws = Some(Workspace::new(&params));
+        }
+        self.params = params;
+    }
+
+    /// Writes `tau` (when given) and the wrench values `w` (6 a wrench) into the loads.
+    fn set_loads(&mut self, tau: Option<&[f64]>, w: &[f64]) {
+        if let (Some(t), Some(tau)) = (self.loads.tau.as_mut(), tau) {
+            t.copy_from_slice(tau);
+        }
+        for (l, wk) in self.loads.external.iter_mut().zip(w.chunks_exact(6)) {
+            l.force = Vec3::new(wk[0], wk[1], wk[2]);
+            l.moment = Vec3::new(wk[3], wk[4], wk[5]);
+        }
+    }
+
+    /// Forward dynamics by the fast path (with `armature`) or by the scene's algorithm.
+    fn accelerations(&mut self, q: &[f64], v: &[f64], armature: Option<&[f64]>, acc: &mut [f64]) {
+        let (p, loads) = (&self.params, &self.loads);
+        match (&self.base, self.ws.as_mut()) {
+            (Some(b), Some(ws)) => {
+                let st = floating_state(q, v);
+                aba::floating_in(p, ws, b, &st, &q[7..], &v[6..], loads, armature, acc);
+            }
+            (Some(b), None) => {
+                let st = floating_state(q, v);
+                let alg = self.algorithm;
+                let a = floating::forward_dynamics(alg, p, b, &st, &q[7..], &v[6..], loads);
+                acc.copy_from_slice(&a);
+            }
+            (None, Some(ws)) => aba::forward_dynamics_in(p, ws, q, v, loads, armature, acc),
+            (None, None) => {
+                acc.copy_from_slice(&self.algorithm.forward_dynamics(p, q, v, loads));
+            }
+        }
+    }
+}
+
+impl SceneDynamics for RunTimeDynamics {
+    fn forward(&mut self, q: &[f64], v: &[f64], tau: &[f64], w: &[f64], acc: &mut [f64]) {
+        self.set_loads(Some(tau), w);
+        self.accelerations(q, v, None, acc);
+    }
+
+    fn mass_matrix(&mut self, q: &[f64], m: &mut [f64]) {
+        let a = match &self.base {
+            Some(b) => {
+                let st = floating_state(q, &[0.0; 6]);
+                floating::mass_matrix(self.algorithm.mass_matrix, &self.params, b, &st, &q[7..])
+            }
+            None => self.algorithm.mass_matrix.mass_matrix(&self.params, q),
+        };
+        for (row, dst) in a.iter().zip(m.chunks_exact_mut(a.len())) {
+            dst.copy_from_slice(row);
+        }
+    }
+
+    fn inverse(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], w: &[f64], tau: &mut [f64]) {
+        self.set_loads(None, w);
+        let id = self
+            .algorithm
+            .inverse_dynamics(&self.params, q, qd, qdd, &self.loads);
+        tau.copy_from_slice(&id);
+    }
+
+    /// The fast path takes the armature into the articulated-body algorithm (Pinocchio's
+    /// `armature`); the LDLᵀ path adds it to the mass matrix ([`forward_with_armature`]).
+    fn forward_armature(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        tau: &[f64],
+        w: &[f64],
+        armature: &[f64],
+        acc: &mut [f64],
+        work: &mut [f64],
+    ) {
+        if self.ws.is_some() {
+            self.set_loads(Some(tau), w);
+            self.accelerations(q, v, Some(armature), acc);
+        } else {
+            forward_with_armature(self, q, v, tau, w, armature, acc, work);
+        }
+    }
+}
