@@ -113,6 +113,7 @@ fn generate_items_with(
     let mut fns = Vec::new();
     let mut choices = Vec::new();
     let mut fmas = Vec::new();
+    let mut kernels = Vec::new();
     let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
     let mut names = std::collections::HashSet::new();
     let mut kept_unrolled = Vec::new();
@@ -128,7 +129,7 @@ fn generate_items_with(
         let shape = api::shape(f, n, floating);
         let ops = choice.counts().total();
         let compact_body = if compact && !compact::keeps_unrolled(opts, f, ops) {
-            compact::body(f, opts, n)
+            compact::body(f, opts)?
         } else {
             if compact && compact::has_body(f) {
                 kept_unrolled.push(format!("`{}` ({ops})", f.name()));
@@ -209,7 +210,12 @@ fn generate_items_with(
             }
             Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
         };
-        let c = choice.counts();
+        let kernel = compact_body
+            .as_ref()
+            .and_then(|_| compact::kernel_candidate(model, opts, f));
+        let c = kernel
+            .as_ref()
+            .map_or_else(|| choice.counts(), |k| k.counts);
         let mut doc1 = format!(" {}", api::doc(f, floating, choice.chosen.forward));
         if compact_body.is_some() {
             for unrolled in [
@@ -245,21 +251,31 @@ fn generate_items_with(
         .collect::<Vec<_>>()
         .join(", ");
         let doc2 = format!(
-            " {}{methods}: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted){fused}.",
-            match (compact_body.is_some(), methods.is_empty()) {
-                (true, _) =>
-                    "Compact form: loops over the model's constant tables (RBDA); \
-                              the unrolled form would emit, with ",
-                (false, true) => "",
-                (false, false) => "Methods: ",
+            " {}: {} mul, {} add, {} div, {} sqrt, {} sincos ({}){fused}.",
+            match (compact_body.is_some(), kernel.is_some(), methods.is_empty()) {
+                (true, true, _) => "Compact form: loops over the model's constant tables (RBDA), \
+                                    the kernels of `kanegen_runtime::compact`"
+                    .to_string(),
+                (true, false, _) => format!(
+                    "Compact form: loops over the model's constant tables (RBDA); the unrolled \
+                     form would emit, with {methods}"
+                ),
+                (false, _, true) => methods,
+                (false, _, false) => format!("Methods: {methods}"),
             },
             c.mul,
             c.add,
             c.div,
             c.sqrt,
-            c.sincos
+            c.sincos,
+            if kernel.is_some() {
+                "traced: every operation the loops execute"
+            } else {
+                "emitted"
+            }
         );
         fmas.push(k);
+        kernels.push(kernel);
         fns.push(quote! {
             #[doc = #doc1]
             #[doc = ""]
@@ -299,10 +315,16 @@ fn generate_items_with(
             fma: #fma,
         })
     };
-    let emitted = choices.iter().zip(&fmas).map(|(ch, k)| {
-        let chosen = ch.candidate().expect("the chosen candidate was traced");
-        entry(ch, chosen, *k)
-    });
+    let emitted = choices
+        .iter()
+        .zip(&fmas)
+        .zip(&kernels)
+        .map(|((ch, k), kernel)| {
+            let chosen = ch.candidate().expect("the chosen candidate was traced");
+            kernel
+                .as_ref()
+                .map_or_else(|| entry(ch, chosen, *k), |kc| entry(ch, kc, 0))
+        });
     let all = choices
         .iter()
         .flat_map(|ch| ch.candidates.iter().map(|c| entry(ch, c, 0)));

@@ -7,12 +7,14 @@
 //!
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
+//! - [`compact`]: the compact form's kernels (CRBA, RNEA, ABA as loops over a model's tables).
 #![no_std]
 #![warn(missing_docs)]
 
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod compact;
 pub mod scalar;
 
 pub use scalar::{Real, Scalar, Symbolic};
