@@ -83,7 +83,7 @@ fn sym_minus_outer<S: Scalar + Copy>(m: &[S; 21], w: &[S; 6], u: &[S; 6]) -> [S;
 /// velocities and bias terms outwards ([`outward`]), articulated inertias inwards ([`inward`]),
 /// accelerations outwards from `a₀` ([`Tables::a0`]). `f_ext[i] = [force; moment]` in body
 /// `i`'s frame at its origin (`None`: no wrenches, nothing computed for them).
-#[inline(always)]
+#[inline]
 pub fn aba<S: Scalar + Copy, const N: usize>(
     t: &Tables<S, N>,
     inertia: &[[S; 10]; N],

@@ -36,7 +36,7 @@ pub fn mass_matrix_and_nonlinear_effects<S: Scalar + Copy, const N: usize>(
 /// composite inertias `IC_λ(i) += IC_i` leaves first (one frame, no transform), then
 /// `F = IC_i S_i` and `H_ij = H_ji = S_jᵀ F` for `j = i` and each ancestor `j` of `i`
 /// ([`fill`]).
-#[inline(always)]
+#[inline]
 pub fn crba<S: Scalar + Copy, const N: usize>(
     t: &Tables<S, N>,
     x: &[Transform<S>; N],

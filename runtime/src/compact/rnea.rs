@@ -46,7 +46,7 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize>(
 /// `f_i = I_i a_i + v_i ×* I_i v_i`, from `a₀` ([`Tables::a0`], RBDA §5.3); backward
 /// `τ_i = S_iᵀ f_i`, `f_λ(i) += Xup_iᵀ f_i`. `None` for `q̇` or `q̈`: zero, and nothing
 /// computed for it.
-#[inline(always)]
+#[inline]
 pub fn rnea<S: Scalar + Copy, const N: usize>(
     t: &Tables<S, N>,
     x: &[Transform<S>; N],
