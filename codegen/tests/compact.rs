@@ -71,10 +71,10 @@ fn compact_source_loops_without_allocation_or_panics() {
         );
         // f64: the kernels call the type's own sine–cosine (libm's beyond its range).
         if float == Float::F32 {
-            assert!(body.contains("libm::sincosf)"));
+            assert!(body.contains("libm::sincosf"));
             assert!(!body.contains("f64"), "f32 code names no f64");
         } else {
-            assert!(body.contains("Self::sincos)") && body.contains("libm::sincos"));
+            assert!(body.contains("Self::sincos") && body.contains("libm::sincos"));
         }
         // Straight-line bodies are `let` chains; compact ones call the kernels.
         assert!(src
