@@ -1,5 +1,5 @@
 //! One `kanegen::dynamics!` expansion for SSRMS, used to measure what a macro expansion costs at
-//! compile time (README, "Code generation"). Prints `A(q)` at `q = 0`.
+//! compile time (`docs/codegen.md`). Prints `A(q)` at `q = 0`.
 //!
 //! Run: `cargo run --release --example ssrms_macro`
 

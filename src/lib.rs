@@ -33,7 +33,7 @@ extern crate std;
 /// the arguments are Pinocchio's free-flyer `q` (`NQ = 7 + N`: base position, quaternion
 /// `[x, y, z, w]`, joints) and `v` (`NV = 6 + N`: base linear and angular velocity in base
 /// coordinates, joint rates), and `momentum(q, v)`, `base_reaction(q, v, a)` and each frame's
-/// `<frame>_generalized_jacobian(q)` come in (README, "Generated API"). It also defines `NameOpCount` (the entries of
+/// `<frame>_generalized_jacobian(q)` come in (`docs/codegen.md`, "Generated API and its sign convention"). It also defines `NameOpCount` (the entries of
 /// `OP_COUNTS`) and, with `runtime_payload = true`, `NamePayload`, the last body's mass
 /// properties, taken by every function as a last argument `payload: &NamePayload`.
 ///
@@ -65,7 +65,7 @@ extern crate std;
 /// `form = "auto"` (default) emits straight-line code for small models and, above 4,000
 /// emitted operations in the unrolled `M + c` (N ≥ 8 with general geometry), compact code:
 /// loops over constant tables of the model's numbers (CRBA, RNEA, ABA), which builds in seconds
-/// at N = 64 and runs faster there (README, "Compact code"); `form = "unrolled"` and
+/// at N = 64 and runs faster there (`docs/codegen.md`, "Compact form"); `form = "unrolled"` and
 /// `form = "compact"` force one (compact: fixed base only). The header
 /// says which form was emitted and why.
 ///
@@ -90,7 +90,7 @@ macro_rules! dynamics {
     };
 }
 
-/// A simulator specialized at compile time for one scene file (README, "Simulation scenes").
+/// A simulator specialized at compile time for one scene file (`docs/scenes.md`).
 ///
 /// `scene!(Name, "scenes/x.toml")` reads the scene as `kanegen simulate` does
 /// (`kanegen::sim::scene`) and defines:
@@ -135,7 +135,10 @@ macro_rules! scene {
     };
 }
 
-pub mod ode;
+/// The integrators of [`scene!`]'s simulators and of the interpreted simulator
+/// (`kanegen-runtime`'s, `no_std`): RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
+/// midpoint rule, with their [`Stats`](ode::Stats) and stop reasons ([`Stop`](ode::Stop)).
+pub use kanegen_runtime::ode;
 
 /// Support for the code emitted by [`dynamics!`] and [`scene!`]; not a public API.
 #[doc(hidden)]
@@ -146,7 +149,7 @@ pub mod __private {
 }
 
 /// The `no_std` runtime that generated code, the simulator and the run-time path share
-/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine and kernels.
+/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine, LDLᵀ and the parallel-axis shift.
 pub use kanegen_runtime as runtime;
 
 #[cfg(feature = "std")]

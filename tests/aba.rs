@@ -29,10 +29,12 @@ kanegen::dynamics!(
     algorithm = "aba",
 );
 
+// Straight-line code, whose candidates are traced (a compact type's functions in loops are not).
 kanegen::dynamics!(
     RandomN32,
     "benches/data/random_n32.toml",
     gravity = [0.3, -1.2, -9.81],
+    form = "unrolled",
 );
 
 const TOL: f64 = 1e-12;
@@ -142,7 +144,7 @@ fn generated_aba_equals_interpreted_forward_dynamics() {
             assert!(e < TOL, "random N = 32 seed {seed} wrenches {with}: {e:e}");
             worst = worst.max(e);
             // LDLᵀ: another algorithm, whose rounding grows with cond(M) (up to 1e5 on these
-            // 32-joint chains; README, hard cases): to 1e-10.
+            // 32-joint chains; docs/numerics.md, hard cases): to 1e-10.
             let ldlt = Methods::SPATIAL.forward_dynamics(&p, &q, &qd, &loads);
             let e = rel_err(&have, &ldlt);
             assert!(

@@ -1,4 +1,4 @@
-//! `kanegen accuracy` (issue #6): the committed docs/accuracy.md is the rendering of the
+//! `kanegen accuracy`: the committed docs/accuracy.md is the rendering of the
 //! committed docs/accuracy.json, and that JSON's deterministic parts (errors, steps, operation
 //! counts, trajectory changes) agree with a fresh run; the rows say what they should (f32 loses
 //! digits that f64 keeps, fixed-step errors fall with the step at the integrator's order,

@@ -32,8 +32,8 @@ fn count_reports_every_method_function_and_convention() {
     let lines = urdf["counts"].as_array().unwrap();
     assert_eq!(
         lines.len(),
-        (5 + 3) * 3,
-        "(5 mass-matrix methods + 3 bias methods) × 3 conventions"
+        (5 + 4) * 3,
+        "(5 mass-matrix methods + 4 bias methods) × 3 conventions"
     );
     for key in [
         "method",
@@ -59,6 +59,7 @@ fn count_reports_every_method_function_and_convention() {
         ("bias", "recurrent"),
         ("bias", "kane-direct"),
         ("bias", "rnea"),
+        ("bias", "newton-euler"),
     ];
     for (f, alg) in methods {
         {
@@ -88,11 +89,65 @@ fn count_reports_every_method_function_and_convention() {
             let sc = e["sincos"].as_u64().unwrap();
             let want = match alg {
                 "crba" => 5,
-                "rnea" => 6,
+                "rnea" | "newton-euler" => 6,
                 _ => 7,
             };
             assert_eq!(sc, want, "{alg} {f}: sin/cos pairs");
         }
+    }
+}
+
+/// `count` lists every method the generator may emit: on a chain each mass-matrix and bias
+/// method (`newton-euler` included), on a tree the local-frame ones (`crba`; `rnea`,
+/// `newton-euler`), each in three conventions.
+#[test]
+fn count_lists_every_method_the_generator_may_emit() {
+    let methods = |model: &str| {
+        let report = count_json(&root().join(model));
+        let mut m: Vec<(String, String)> = report["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|l| l["convention"] == "emitted")
+            .map(|l| {
+                let s = |k: &str| l[k].as_str().unwrap().to_string();
+                (s("function"), s("method"))
+            })
+            .collect();
+        m.sort();
+        m
+    };
+    let pairs = |v: &[(&str, &str)]| {
+        let mut v: Vec<(String, String)> = v
+            .iter()
+            .map(|(f, m)| ((*f).to_string(), (*m).to_string()))
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        methods("tests/data/compact/tree7.toml"),
+        pairs(&[
+            ("mass_matrix", "crba"),
+            ("bias", "rnea"),
+            ("bias", "newton-euler")
+        ])
+    );
+    let chain = methods("tests/data/compact/chain3.toml");
+    for bias in ["recurrent", "kane-direct", "rnea", "newton-euler"] {
+        assert!(chain.contains(&("bias".into(), bias.into())), "{bias}");
+    }
+    for mass in [
+        "recurrent",
+        "recurrent-r1",
+        "kane-direct",
+        "crba-base",
+        "crba",
+    ] {
+        assert!(
+            chain.contains(&("mass_matrix".into(), mass.into())),
+            "{mass}"
+        );
     }
 }
 

@@ -1,4 +1,4 @@
-//! Drive effects (issue 15): reflected rotor inertia `I_m n²` on the diagonal of `M` and drive
+//! Drive effects: reflected rotor inertia `I_m n²` on the diagonal of `M` and drive
 //! friction (viscous = `damping`, regularized Coulomb `τ_c tanh(q̇ / v_s)`), in the interpreted
 //! simulator and `kanegen count SCENE`:
 //!

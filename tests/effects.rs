@@ -1,4 +1,4 @@
-//! Effects decide the code (issue #5): a scene without gravity has no gravity term (trace, emitted
+//! Effects decide the code: a scene without gravity has no gravity term (trace, emitted
 //! code, `kanegen count SCENE`), every enabled effect costs operations, and the simulated motion of
 //! a free-floating arm with zero momentum follows the generalized Jacobian for small steps.
 //!

@@ -1,5 +1,5 @@
 //! Flexible joints (Spong 1987, `[effects] flexible`) and the stiff integrator (Rodas4,
-//! `integrator = "rosenbrock"`), issue 15. Measured values (release build, this machine) are in
+//! `integrator = "rosenbrock"`). Measured values (release build, this machine) are in
 //! each test's doc; run with `--nocapture` to see them.
 
 use kanegen::dynamics::{Loads, Params};

@@ -5,6 +5,8 @@
 //! differs from it in the last bits — the products really are fused. Skipped, with a printed
 //! reason, on a host that is not x86-64 or whose CPU has no FMA.
 
+mod precondition;
+
 use kanegen::dynamics::metrics::rel_err;
 use kanegen::model::random::{random_vec, rng};
 use kanegen_generated::ssrms::Ssrms;
@@ -27,7 +29,10 @@ fn host_triple() -> String {
 #[test]
 fn fused_build_agrees_with_the_plain_build_and_differs_in_the_last_bits() {
     if !cfg!(target_arch = "x86_64") || !std::arch::is_x86_feature_detected!("fma") {
-        eprintln!("skipped: this host has no x86-64 FMA to run the fused build on");
+        precondition::absent(
+            "fma",
+            "this host has no x86-64 FMA to run the fused build on",
+        );
         return;
     }
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));

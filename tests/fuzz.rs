@@ -1,4 +1,4 @@
-//! Issue 14: random and adversarial models, states and scenes fed to every command's entry
+//! Fuzzing: random and adversarial models, states and scenes fed to every command's entry
 //! point (`kanegen::cli::app::run_args`, the binary's own code, in process). No run may panic,
 //! and a run that succeeds may print no non-finite number (`NaN`, `inf`, JSON `null` where a
 //! number belongs, a non-finite constant in generated code).

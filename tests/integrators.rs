@@ -1,4 +1,4 @@
-//! The structure-preserving integrator (issue #5): the Lie-group implicit midpoint rule against
+//! The structure-preserving integrator: the Lie-group implicit midpoint rule against
 //! RK4 over long horizons — bounded energy error vs. RK4's secular drift, momentum and unit
 //! quaternion without projection, empirical order 2 — and the `integrator = "midpoint"` key.
 //!

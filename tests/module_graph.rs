@@ -1,9 +1,9 @@
 //! The structure shows the pipeline: dependencies run one way.
 //!
 //! - **Crates** (`cargo metadata`): each library crate depends only on the crates before it in
-//!   model → dynamics → trace → codegen → macros, with the simulator beside the tracer (the
-//!   macros read scenes through it); only the facade depends on the CLI (an optional
-//!   dependency, for the `kanegen` binary).
+//!   model → dynamics → trace → codegen → macros, with the scene format beside the tracer (the
+//!   macros and the simulator read scenes through it) and the simulator after it; only the
+//!   facade depends on the CLI (an optional dependency, for the `kanegen` binary).
 //! - **Modules**: within every crate, no module uses a module that uses it back. Every path that
 //!   starts with `crate::`, `super::` or `self::` — in `use` items and in code — is resolved to
 //!   the longest module path it names; a `mod` declaration is not a use, and the crate root
@@ -21,12 +21,13 @@ fn root() -> &'static Path {
 }
 
 /// The crates of the workspace and where their sources are.
-const CRATES: [(&str, &str); 9] = [
+const CRATES: [(&str, &str); 10] = [
     ("kanegen", "src"),
     ("kanegen-model", "model/src"),
     ("kanegen-dynamics", "dynamics/src"),
     ("kanegen-trace", "trace/src"),
     ("kanegen-codegen", "codegen/src"),
+    ("kanegen-scene", "scene/src"),
     ("kanegen-macros", "macros/src"),
     ("kanegen-generated", "generated/src"),
     ("kanegen-sim", "sim/src"),
@@ -38,10 +39,11 @@ fn allowed(name: &str) -> &'static [&'static str] {
     match name {
         "kanegen-model" | "kanegen-generated" => &[],
         "kanegen-dynamics" => &["kanegen-model"],
-        "kanegen-trace" | "kanegen-sim" => &["kanegen-model", "kanegen-dynamics"],
+        "kanegen-trace" | "kanegen-scene" => &["kanegen-model", "kanegen-dynamics"],
+        "kanegen-sim" => &["kanegen-model", "kanegen-dynamics", "kanegen-scene"],
         "kanegen-codegen" => &["kanegen-model", "kanegen-dynamics", "kanegen-trace"],
-        // `scene!` reads scenes with the simulator's parser (sim comes before macros).
-        "kanegen-macros" => &["kanegen-codegen", "kanegen-sim"],
+        // `scene!` reads scenes with the simulator's parser, not the simulator.
+        "kanegen-macros" => &["kanegen-codegen", "kanegen-scene"],
         "kanegen-cli" => &[
             "kanegen-model",
             "kanegen-dynamics",
@@ -96,7 +98,7 @@ fn crate_dependencies_follow_the_pipeline() {
             assert!(
                 allowed(name).contains(&d),
                 "{name} must not depend on {d} (the pipeline runs model → dynamics → trace → \
-                 codegen → macros; sim beside trace; the CLI last)"
+                 codegen → macros; scene beside trace, sim after it; the CLI last)"
             );
             if d == "kanegen-cli" {
                 assert!(

@@ -1,7 +1,11 @@
 //! The `kanegen` facade without default features is `no_std`: its normal dependencies are only
-//! the macro crate, the runtime and `libm`, and a `#![no_std]` crate with one `dynamics!` and one `scene!`
-//! builds — for the host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
-//! installed (`.ci/run` installs it; without it the cross build is skipped with a printed reason).
+//! the macro crate, the runtime and `libm`, the macro crates build none of the library's
+//! optional parts (random chains, research scalars, Table 1, the simulator), and a `#![no_std]`
+//! crate with one `dynamics!` and one `scene!` builds — for the host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
+//! installed (`.ci/run` installs it; without it the cross build is skipped with a printed reason,
+//! and fails where `KANEGEN_REQUIRE` requires it).
+
+mod precondition;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -14,9 +18,8 @@ fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
-/// The crates directly under `kanegen` in `cargo tree -e normal` without default features.
-#[test]
-fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_only() {
+/// `cargo tree -p kanegen --no-default-features -e normal --format {p}` with `args` after it.
+fn tree_without_default_features(args: &[&str]) -> String {
     let out = cargo()
         .current_dir(root())
         .args([
@@ -26,13 +29,10 @@ fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_onl
             "--no-default-features",
             "-e",
             "normal",
-            "--depth",
-            "1",
-            "--prefix",
-            "depth",
             "--format",
             "{p}",
         ])
+        .args(args)
         .output()
         .expect("run cargo tree");
     assert!(
@@ -40,7 +40,13 @@ fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_onl
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let text = String::from_utf8_lossy(&out.stdout);
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The crates directly under `kanegen` in `cargo tree -e normal` without default features.
+#[test]
+fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_only() {
+    let text = tree_without_default_features(&["--depth", "1", "--prefix", "depth"]);
     let deps: Vec<String> = text
         .lines()
         .filter_map(|l| l.strip_prefix('1'))
@@ -59,6 +65,39 @@ fn facade_without_default_features_depends_on_the_macro_the_runtime_and_libm_onl
         .expect("run cargo tree");
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("kanegen-cli") && text.contains("kanegen-dynamics"));
+}
+
+/// Crates that `dynamics!` and `scene!` do without: the model's random chains (`rand`), the
+/// research scalars (`qd`, `num-bigint`), Table 1 (`serde_json`), the simulator and what only it
+/// uses (`nalgebra`, `anyhow`, `indicatif`). `docs/build.md` measures what leaving them out saves.
+const NOT_IN_THE_MACRO: [&str; 9] = [
+    "rand",
+    "rand_chacha",
+    "qd",
+    "num-bigint",
+    "serde_json",
+    "kanegen-sim",
+    "nalgebra",
+    "anyhow",
+    "indicatif",
+];
+
+/// Every crate that the facade without default features builds, macro crates included.
+#[test]
+fn facade_without_default_features_builds_only_what_the_macros_use() {
+    let text = tree_without_default_features(&["--prefix", "none"]);
+    let crates: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert!(crates.contains(&"kanegen-scene"), "cargo tree:\n{text}");
+    for name in NOT_IN_THE_MACRO {
+        assert!(
+            !crates.contains(&name),
+            "`{name}` is in the facade's graph without default features; the proc-macros do \
+             not use it (cargo tree:\n{text})"
+        );
+    }
 }
 
 fn build_no_std_crate(target: Option<&str>) {
@@ -98,9 +137,9 @@ fn no_std_crate_with_dynamics_builds() {
         build_no_std_crate(Some(TARGET));
         eprintln!("built the no_std crate for {TARGET}");
     } else {
-        eprintln!(
-            "skipped the {TARGET} build: the target is not installed \
-             (`rustup target add {TARGET}`)"
+        precondition::absent(
+            "no_std_target",
+            &format!("the {TARGET} target is not installed (`rustup target add {TARGET}`)"),
         );
     }
 }

@@ -1,4 +1,4 @@
-//! Scenes and simulation (issue #5): conservation of momentum and energy along simulated
+//! Scenes and simulation: conservation of momentum and energy along simulated
 //! trajectories, RK4's empirical order, dopri5 against a fine RK4 and an exact solution, every
 //! example scene, scene validation errors, and one CLI smoke test.
 //!

@@ -1,4 +1,4 @@
-//! The generated code's own sine–cosine (`Self::sincos`, `kanegen_codegen::sincos`) against
+//! The generated code's own sine–cosine (`Self::sincos`, forwarding to `kanegen_runtime::sincos`) against
 //! libm's: a dense sweep of joint angles, seeded random angles up to the fast path's limit, the
 //! exact values it must keep, its symmetries, and the fallback beyond the limit.
 

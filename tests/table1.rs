@@ -43,7 +43,7 @@ fn sound_rows_agree_and_rows_7_8_10_do_not() {
 
 #[test]
 fn traced_rows_have_the_findings_values() {
-    // Independent re-count (opcount_findings.md §2): row 7 = 18N² − 18N m, row 8 = 13.5N² − 13.5N m
+    // The corrected rows (docs/paper.md, "Where the printed table is wrong"): row 7 = 18N² − 18N m, row 8 = 13.5N² − 13.5N m
     // and 18N² − 27N + 9 a, row 10 = 6N² + 6N each; variant P totals 39N² − 27N m, 58.5N² − 48.5N + 3 a.
     let t = table();
     let p = |c: &[f64]| Poly::from_f64(c).to_string();

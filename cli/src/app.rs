@@ -172,8 +172,8 @@ enum Command {
         /// Accept inertia tensors that violate the triangle inequality.
         #[arg(long)]
         allow_nonphysical: bool,
-        /// Generate for more than 256 joints (tracing the candidates grows faster than N²: 0.4 GB
-        /// and 10 s at N = 200, 5.6 GB and 161 s at N = 500).
+        /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
+        /// caller's stack, and the frame functions stay straight-line).
         #[arg(long)]
         allow_large: bool,
     },
@@ -209,7 +209,7 @@ enum Command {
         #[arg(long)]
         allow_nonphysical: bool,
     },
-    /// Simulate a scene file (TOML, README.md "Simulation scenes"): write trajectory.csv,
+    /// Simulate a scene file (TOML, docs/scenes.md): write trajectory.csv,
     /// summary.json and SVG plots into --out, print a summary.
     Simulate {
         /// Scene file (.toml).
@@ -407,8 +407,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             }
             let algs = match algorithm {
                 Some(a) => vec![checked_methods(&chain, Some(a))?],
-                None if chain.is_chain() => Methods::ALL.to_vec(),
-                None => vec![Methods::SPATIAL],
+                None => commands::count::emittable(&chain),
             };
             let g = gravity_arg(gravity)?;
             let explicit = algorithm.is_some();
@@ -457,9 +456,9 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             let n = chain.dof();
             anyhow::ensure!(
                 allow_large || n <= commands::generate::MAX_N,
-                "`{}` has {n} joints, more than {}: tracing every candidate grows faster than N² (0.4 GB \
-                 and 10 s at N = 200, 5.6 GB and 161 s at N = 500); pass --allow-large to \
-                 generate it anyway",
+                "`{}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
+                 on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
+                 pass --allow-large to generate it anyway",
                 model.display(),
                 commands::generate::MAX_N
             );

@@ -1,4 +1,4 @@
-//! Where commands write, and the promises kept there (README, "Limits and guarantees"):
+//! Where commands write, and the promises kept there (`docs/limits.md`, "Guarantees"):
 //!
 //! - **Standard output**: a closed pipe (`kanegen eval … | head`) ends the run quietly with exit
 //!   code 0, like other Unix tools; any other write error is a clean error, never a panic.

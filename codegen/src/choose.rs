@@ -46,12 +46,17 @@ impl BodyFrames {
     /// own frame).
     #[must_use]
     pub fn for_function(f: Function, opts: &Options) -> &'static [BodyFrames] {
-        if opts.canonical && opts.algorithm.is_none() && f.is_joint_space() && !opts.runtime_payload
-        {
+        if f.is_joint_space() && Self::canonical_wanted(opts) {
             &[BodyFrames::Model, BodyFrames::Canonical]
         } else {
             &[BodyFrames::Model]
         }
+    }
+
+    /// Whether canonical frames are traced at all: [`Options::canonical`] on, no algorithm
+    /// forced and no runtime payload.
+    fn canonical_wanted(opts: &Options) -> bool {
+        opts.canonical && opts.algorithm.is_none() && !opts.runtime_payload
     }
 }
 
@@ -230,14 +235,63 @@ pub fn can_win(f: Function, m: Methods, n: usize) -> bool {
     mass_ok && bias_ok
 }
 
+/// The models a function's candidates are traced on: the model in its own frames and, where
+/// [`Options::canonical`] asks for them, in its canonical frames, each with whether its
+/// placements are worth a second, two-step trace. Derived once per model and shared by every
+/// function traced on it.
+#[derive(Clone, Debug)]
+pub struct Subjects {
+    /// [`Model::canonical_with`] the snap tolerance: `None` when canonical frames are off (see
+    /// [`BodyFrames::for_function`]) or the turned model fails validation (numbers at its
+    /// bounds), then only the model's own frames are traced.
+    pub canonical: Option<Model>,
+    /// Placements of the model near a signed permutation or made of turns about coordinate
+    /// axes: the two-step carries through them are traced as well
+    /// ([`has_two_step_placements`]).
+    near_model: bool,
+    /// The same of the canonical model.
+    near_canonical: bool,
+}
+
+impl Subjects {
+    /// The subjects of `model` under `opts`.
+    #[must_use]
+    pub fn new(model: &Model, opts: &Options) -> Self {
+        let canonical = BodyFrames::canonical_wanted(opts)
+            .then(|| model.canonical_with(opts.snap).ok())
+            .flatten()
+            .map(|c| c.model);
+        Subjects {
+            near_model: has_two_step_placements(model),
+            near_canonical: canonical.as_ref().is_some_and(has_two_step_placements),
+            canonical,
+        }
+    }
+}
+
 /// Traces every candidate of `f` that [`can_win`], in every [`BodyFrames::for_function`], and
 /// keeps the cheapest (the model's own frames on ties); with [`Options::algorithm`], traces that
-/// one for a function with a mass-matrix or bias method.
+/// one for a function with a mass-matrix or bias method. Derives the model's [`Subjects`] first;
+/// [`choose_in`] takes them derived.
 ///
 /// # Errors
 /// As [`trace`].
 pub fn choose(
     model: &Model,
+    f: Function,
+    mass: MassMatrixMethod,
+    opts: &Options,
+) -> Result<(Choice, Traced), TraceError> {
+    choose_in(model, &Subjects::new(model, opts), f, mass, opts)
+}
+
+/// [`choose`] on `model` with its [`Subjects`] already derived.
+///
+/// # Errors
+/// As [`trace`].
+pub fn choose_in(
+    model: &Model,
+    subjects: &Subjects,
     f: Function,
     mass: MassMatrixMethod,
     opts: &Options,
@@ -249,30 +303,19 @@ pub fn choose(
     let mut best: Option<(u64, Methods, BodyFrames, Traced)> = None;
     let mut traced = Vec::new();
     let frames = BodyFrames::for_function(f, opts);
-    // None also where the turned model fails validation (numbers at its bounds): then only
-    // the model's own frames are traced.
-    let canonical = frames
-        .contains(&BodyFrames::Canonical)
-        .then(|| model.canonical_with(opts.snap).ok())
-        .flatten()
-        .map(|c| c.model);
     let all = match opts.algorithm {
         // Forced: the one algorithm for whatever it computes, the others as usual.
         Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
-    // Placements near a signed permutation or made of turns about coordinate axes, per subject:
-    // the two-step carries through them are traced as well (`has_two_step_placements`).
-    let near_model = has_two_step_placements(model);
-    let near_canonical = canonical.as_ref().is_some_and(has_two_step_placements);
     let n = model.dof();
     let kept: Vec<Methods> = all.iter().copied().filter(|m| can_win(f, *m, n)).collect();
     for m in if kept.is_empty() { all } else { kept } {
         for &fr in frames {
-            let (subject, near) = match (fr, &canonical) {
-                (BodyFrames::Canonical, Some(c)) => (c, near_canonical),
+            let (subject, near) = match (fr, &subjects.canonical) {
+                (BodyFrames::Canonical, Some(c)) => (c, subjects.near_canonical),
                 (BodyFrames::Canonical, None) => continue,
-                (BodyFrames::Model, _) => (model, near_model),
+                (BodyFrames::Model, _) => (model, subjects.near_model),
             };
             let mut t = trace(Subject::Model(subject), f, m, &spec)?;
             let mut c = t.trace.counts(Convention::Emitted);
@@ -313,9 +356,9 @@ pub fn choose(
 /// Whether any chosen candidate takes a sine or a cosine (then the generated type carries its
 /// own `sincos`, [`crate::sincos`], and the header says so).
 #[must_use]
-pub fn takes_trig(choices: &[Choice]) -> bool {
+pub fn takes_trig<'a>(choices: impl IntoIterator<Item = &'a Choice>) -> bool {
     choices
-        .iter()
+        .into_iter()
         .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0))
 }
 

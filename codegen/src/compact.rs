@@ -71,16 +71,14 @@
 //! of the per-run ratios new / old), random N = 16, 32, 64: `M` 1.10, 1.16, 1.17; `M + c` 1.02,
 //! 1.11, 1.09; forward dynamics 1.03, 1.08, 1.04 (before the CRBA fill's range was made
 //! exclusive and the entry points' inlining matched the pasted code's, `M` at N = 64 was 1.46).
-
 pub mod counts;
 pub mod tables;
 
 use self::tables::{numbers, M3};
-use crate::choose::{BodyFrames, Candidate};
 use crate::options::{Error, Float, Form, Options};
-use kanegen_dynamics::Methods;
+use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, Model};
-use kanegen_trace::Function;
+use kanegen_trace::{Counts, Function};
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
@@ -98,17 +96,24 @@ pub const AUTO_LIMIT: u64 = 4_000;
 /// and 9,083).
 pub const LINEAR_AUTO_LIMIT: u64 = 4_000;
 
-/// Whether `f` keeps its unrolled body in a model that [`decide`] made compact: under
-/// [`Form::Auto`], an O(N) Newton–Euler function whose unrolled body has `ops` (`mul + add`)
-/// within [`LINEAR_AUTO_LIMIT`].
+/// Whether `f` may keep its unrolled body in a model that [`decide`] made compact: under
+/// [`Form::Auto`], an O(N) Newton–Euler function (then it does when its unrolled body has at
+/// most [`LINEAR_AUTO_LIMIT`] emitted operations, [`keeps_unrolled`]).
 #[must_use]
-pub fn keeps_unrolled(opts: &Options, f: Function, ops: u64) -> bool {
+pub fn may_keep_unrolled(opts: &Options, f: Function) -> bool {
     opts.form == Form::Auto
         && matches!(
             f,
             Function::NonlinearEffects | Function::Gravity | Function::InverseDynamics
         )
-        && ops <= LINEAR_AUTO_LIMIT
+}
+
+/// Whether `f` keeps its unrolled body in a model that [`decide`] made compact: it
+/// [`may_keep_unrolled`] and its unrolled body, traced as far as `size`, has at most
+/// [`LINEAR_AUTO_LIMIT`] emitted operations.
+#[must_use]
+pub fn keeps_unrolled(opts: &Options, f: Function, size: Size) -> bool {
+    may_keep_unrolled(opts, f) && !size.above(LINEAR_AUTO_LIMIT)
 }
 
 /// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
@@ -122,16 +127,16 @@ pub fn unsupported(model: &Model, opts: &Options) -> Option<&'static str> {
 }
 
 /// The traced counts of the runtime kernel that the compact body of `f` calls
-/// ([`counts::counts`]), as the candidate an `OP_COUNTS` entry reports (`None`: `f` has no
-/// compact body, or the model has more than [`counts::MAX_N`] joints).
-#[must_use]
-pub fn kernel_candidate(model: &Model, opts: &Options, f: Function) -> Option<Candidate> {
-    let counts = counts::counts(&numbers(model, opts), f, opts.runtime_payload)?;
-    Some(Candidate {
-        methods: Methods::ABA,
-        frames: BodyFrames::Model,
-        counts,
-    })
+/// ([`counts::counts`]): every operation its loops execute (0, unknown, above
+/// [`counts::MAX_N`] joints).
+///
+/// # Errors
+/// `f` has no compact body ([`has_body`]).
+pub fn kernel_counts(model: &Model, opts: &Options, f: Function) -> Result<Counts, Error> {
+    if !has_body(f) {
+        return Err(Error(format!("`{}` has no compact body", f.name())));
+    }
+    Ok(counts::counts(&numbers(model, opts), f, opts.runtime_payload).unwrap_or_default())
 }
 
 /// The form emitted and why, as the header says it.
@@ -143,51 +148,103 @@ pub struct Decision {
     pub line: String,
 }
 
-/// Decides the form: `ops` is the emitted `mul + add` of the unrolled
-/// `mass_matrix_and_nonlinear_effects` (the cheapest candidate).
+/// The emitted operations (`mul + add`) of an unrolled function's cheapest candidate, as far
+/// as they were traced: on the whole model (`joints` = its N), or on its first `joints` joints
+/// alone, a prefix already above the limit it was measured against. A prefix is a lower bound:
+/// every joint added to a chain or tree adds operations (rests on measurement; the decisions
+/// from prefixes equal those from whole traces on random chains N = 2..64 and the test models,
+/// `codegen/tests/compact.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Size {
+    /// Emitted `mul + add` traced.
+    pub ops: u64,
+    /// Joints of the model or prefix traced.
+    pub joints: usize,
+}
+
+impl Size {
+    /// Whether the traced operations are above `limit`.
+    #[must_use]
+    pub fn above(self, limit: u64) -> bool {
+        self.ops > limit
+    }
+
+    /// `N ops` for the whole model, `over N ops (its first K joints alone)` for a prefix of a
+    /// model of `n` joints.
+    fn describe(self, n: usize) -> String {
+        if self.joints >= n {
+            format!("{} emitted operations", self.ops)
+        } else {
+            format!(
+                "over {} emitted operations (its first {} joints alone)",
+                self.ops, self.joints
+            )
+        }
+    }
+}
+
+/// Decides the form of a model of `n` joints: `why_not` is [`unsupported`] of the model,
+/// `size` the emitted `mul + add` of its cheapest unrolled `mass_matrix_and_nonlinear_effects`
+/// as far as it was traced (read under [`Form::Auto`] for a supported model only; `None`
+/// otherwise).
 ///
 /// # Errors
 /// [`Form::Compact`] asked for a model it does not support.
-pub fn decide(model: &Model, opts: &Options, ops: u64) -> Result<Decision, Error> {
-    let why_not = unsupported(model, opts);
-    let counts = if model.dof() <= counts::MAX_N {
-        "`OP_COUNTS` of the compact functions are the traced counts of the runtime kernels they \
-         call (every operation their loops execute); `CANDIDATES` are the traced counts of the \
-         unrolled form."
-    } else {
-        "`OP_COUNTS` and `CANDIDATES` are the traced counts of the unrolled form (the kernels \
-         are traced up to 64 joints)."
-    };
+pub fn decide(
+    opts: &Options,
+    n: usize,
+    why_not: Option<&str>,
+    size: Option<Size>,
+) -> Result<Decision, Error> {
     let compact = |why: String| Decision {
         form: Form::Compact,
         line: format!(
             "Form: compact: loops over constant tables (CRBA, RNEA, ABA; frame functions \
-             straight-line) ({why}). {counts}"
+             straight-line) ({why}). `OP_COUNTS` of the functions in loops are the traced counts \
+             of the runtime kernels they call (every operation their loops execute); \
+             `CANDIDATES` and the table below hold the straight-line functions only."
         ),
     };
     let unrolled = |why: String| Decision {
         form: Form::Unrolled,
         line: format!("Form: unrolled straight-line code ({why})."),
     };
-    Ok(match (opts.form, why_not) {
-        (Form::Compact, Some(why)) => {
+    Ok(match (opts.form, why_not, size) {
+        (Form::Compact, Some(why), _) => {
             return Err(Error(format!(
                 "form = \"compact\" does not support {why} yet (use \"unrolled\" or \"auto\")"
             )))
         }
-        (Form::Compact, None) => compact("asked for".into()),
-        (Form::Unrolled, _) => unrolled("asked for".into()),
-        (Form::Auto, Some(why)) => {
+        (Form::Compact, None, _) => compact("asked for".into()),
+        (Form::Unrolled, ..) => unrolled("asked for".into()),
+        (Form::Auto, Some(why), _) => {
             unrolled(format!("auto: the compact form does not support {why} yet"))
         }
-        (Form::Auto, _) if ops > AUTO_LIMIT => compact(format!(
-            "auto: unrolled M + c would be {ops} emitted operations, above the {AUTO_LIMIT} limit \
-             where compact code measured faster"
+        (Form::Auto, None, Some(size)) if size.above(AUTO_LIMIT) => compact(format!(
+            "auto: unrolled M + c would be {}, above the {AUTO_LIMIT} limit where compact code \
+             measured faster",
+            size.describe(n)
         )),
-        (Form::Auto, _) => unrolled(format!(
-            "auto: {ops} emitted operations in M + c, within the {AUTO_LIMIT} limit"
+        (Form::Auto, None, size) => unrolled(format!(
+            "auto: {} emitted operations in M + c, within the {AUTO_LIMIT} limit",
+            size.map_or(0, |s| s.ops)
         )),
     })
+}
+
+/// The methods a compact body computes `f` by: the articulated-body algorithm for forward
+/// dynamics, the CRBA and the RNEA otherwise ([module docs](self)).
+#[must_use]
+pub fn methods(f: Function) -> Methods {
+    if f.is_forward_dynamics() {
+        Methods::ABA
+    } else {
+        Methods {
+            mass_matrix: MassMatrixMethod::Crba,
+            bias: BiasMethod::Rnea,
+            forward: ForwardMethod::Ldlt,
+        }
+    }
 }
 
 /// Whether the compact form has its own body for `f` (the frame functions stay straight-line).

@@ -3,11 +3,15 @@
 //! The emit stage of kanegen's pipeline: unrolled, allocation-free, `no_std` Rust for one fixed
 //! model, from graphs traced by `kanegen-trace`.
 //!
-//! For every generated function ([`api`]) the candidates are traced with the model's numbers as
-//! constants and the cheapest in emitted `mul + add` is emitted ([`choose`]); its graph becomes
-//! straight-line Rust ([`emit`]). The generated type is a unit struct with associated constants
-//! and functions ([`generate_items`]); [`generate_file`] wraps it into a formatted module file
-//! whose doc header ([`header`]) states the model, the conventions and every candidate's counts.
+//! Generation is one [`Plan`], then emission: the plan ([`plan`]) decides the form (straight-line
+//! or compact loops, [`compact`]) from traced prefixes of the model, and for every generated
+//! function ([`api`]) of straight-line code traces the candidates with the model's numbers as
+//! constants and keeps the cheapest in emitted `mul + add` ([`choose`]); its graph becomes
+//! straight-line Rust ([`emit`]). A function in compact loops calls a kernel of
+//! `kanegen_runtime::compact` over the model's tables ([`compact`]). The generated type
+//! is a unit struct with associated constants and functions ([`generate_items`]);
+//! [`generate_file`] wraps it into a formatted module file whose doc header ([`header`]) states
+//! the model, the conventions and every traced candidate's counts.
 //!
 //! # Op counts
 //!
@@ -17,7 +21,9 @@
 //! `bias_method` (`None` when unused), `forward_method` (`ldlt` or `aba` for forward dynamics,
 //! `None` otherwise; `aba` uses no mass-matrix or bias method), `mul`, `add`, `div`, `sqrt`,
 //! `sincos` and `fma` (fused multiply-adds formed; only emitted code forms them, so
-//! `CANDIDATES` lists 0).
+//! `CANDIDATES` lists 0). A function in compact loops has as `OP_COUNTS` entry its kernel traced
+//! on the tracer `Sym` ([`compact::counts`]: every operation its loops execute), and
+//! `CANDIDATES` has none of it.
 //!
 //! ```
 //! use kanegen_codegen::{generate_file, Options};
@@ -34,14 +40,17 @@ pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
+pub mod plan;
 pub mod sincos;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
 pub use options::{forced_algorithm, Error, Float, Form, Options, VERSION};
+pub use plan::Plan;
 
-use kanegen_model::{BaseKind, Model};
-use kanegen_trace::{Arg, Function};
+use kanegen_model::Model;
+use kanegen_trace::{Arg, Counts};
+use plan::{FunctionPlan, Kernel};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
@@ -80,217 +89,244 @@ fn generate_items_with(
     header_on_struct: bool,
     mut bodies: Option<&mut Vec<String>>,
 ) -> Result<Generated, Error> {
-    let based;
-    let model = match opts.base {
-        Some(kind) if kind != model.base_kind() => {
-            based = model
-                .clone()
-                .with_base_kind(kind)
-                .map_err(|e| Error(e.to_string()))?;
-            &based
-        }
-        _ => model,
-    };
-    if !(opts.snap.is_finite() && (0.0..0.1).contains(&opts.snap)) {
-        return Err(Error(format!(
-            "snap tolerance {} is not in [0, 0.1)",
-            opts.snap
-        )));
-    }
-    let snapped = model.snapped(opts.snap);
-    let model = &snapped.model;
-    let floating = model.base_kind() == BaseKind::FreeFloating;
-    let n = model.dof();
-    let nl = Literal::usize_unsuffixed(n);
-    let ty = ident("type name", &opts.type_name)?;
-    let payload_ty = ident("payload name", &opts.payload_name)?;
-    let op_ty = ident("op-count name", &opts.op_count_name)?;
+    let names = Names::new(opts)?;
     let emitter = Emitter::new(opts)?;
-    let fl = opts.float.ty();
-    let (decision, mut decided) = form_decision(model, opts)?;
-    let compact = decision.form == Form::Compact;
-
+    let (plan, graphs) = Plan::new(model, opts)?;
     let mut fns = Vec::new();
-    let mut choices = Vec::new();
     let mut fmas = Vec::new();
-    let mut kernels = Vec::new();
-    let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
-    let mut names = std::collections::HashSet::new();
-    let mut kept_unrolled = Vec::new();
-    for f in api::functions(model, opts) {
-        // `M` and `(M, c)` were traced for the form decision, with the same methods.
-        let (choice, traced) = match decided.iter().position(|(c, _)| c.function == f) {
-            Some(k) => decided.swap_remove(k),
-            None => choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?,
-        };
-        if f == Function::MassMatrix {
-            mass = choice.chosen.mass_matrix;
+    for (fp, graph) in plan.functions.iter().zip(graphs) {
+        let body = function_body(fp, graph, opts, &emitter, bodies.as_deref_mut())?;
+        fmas.push(body.fmas);
+        fns.push(function_item(&plan, fp, body, opts, &names));
+    }
+    let header = header::lines(&plan, opts, &fmas);
+    let items = type_items(&plan, opts, &names, &header, header_on_struct, &fns, &fmas)?;
+    Ok(Generated {
+        items,
+        header,
+        choices: plan.functions.into_iter().map(|fp| fp.choice).collect(),
+        fmas,
+    })
+}
+
+/// The identifiers of the generated type, its payload struct and its op-count struct.
+struct Names {
+    ty: syn::Ident,
+    payload: syn::Ident,
+    op_count: syn::Ident,
+}
+
+impl Names {
+    fn new(opts: &Options) -> Result<Self, Error> {
+        Ok(Names {
+            ty: ident("type name", &opts.type_name)?,
+            payload: ident("payload name", &opts.payload_name)?,
+            op_count: ident("op-count name", &opts.op_count_name)?,
+        })
+    }
+}
+
+/// The body of one function: the compact kernel's call, or the straight-line code of its graph.
+/// With `texts`, the body is formatted to text there (streamed statement by statement for a
+/// graph) and the returned tokens are its placeholder.
+fn function_body(
+    fp: &FunctionPlan,
+    graph: Option<kanegen_trace::Traced>,
+    opts: &Options,
+    emitter: &Emitter,
+    texts: Option<&mut Vec<String>>,
+) -> Result<Body, Error> {
+    let compact_tokens = match fp.kernel {
+        Kernel::Compact(_) => compact::body(fp.function, opts)?,
+        Kernel::Unrolled => None,
+    };
+    let body = match (texts, compact_tokens, graph) {
+        (None, Some(tokens), _) => Body { tokens, fmas: 0 },
+        (Some(texts), Some(tokens), _) => {
+            texts.push(format_body(&tokens)?);
+            Body {
+                tokens: placeholder(texts.len() - 1),
+                fmas: 0,
+            }
         }
-        let shape = api::shape(f, n, floating);
-        let ops = choice.counts().total();
-        let compact_body = if compact && !compact::keeps_unrolled(opts, f, ops) {
-            compact::body(f, opts)?
-        } else {
-            if compact && compact::has_body(f) {
-                kept_unrolled.push(format!("`{}` ({ops})", f.name()));
-            }
-            None
-        };
-        let Body {
-            tokens: body,
-            fmas: k,
-        } = match (bodies.as_deref_mut(), compact_body.clone()) {
-            (None, Some(tokens)) => Body { tokens, fmas: 0 },
-            (Some(texts), Some(tokens)) => {
-                texts.push(format_body(&tokens)?);
-                let placeholder = format_ident!("__kanegen_body_{}", texts.len() - 1);
-                Body {
-                    tokens: quote!(#placeholder()),
-                    fmas: 0,
-                }
-            }
-            (None, None) => emit::emit_body(&traced, &emitter, shape),
-            (Some(texts), None) => {
-                let mut text = String::new();
-                let mut failed = None;
-                let mut b =
-                    emit::emit_body_streamed(&traced, &emitter, shape, &mut |s| match format_body(
-                        &s,
-                    ) {
+        (None, None, Some(graph)) => emit::emit_body(&graph, emitter, fp.shape),
+        (Some(texts), None, Some(graph)) => {
+            let mut text = String::new();
+            let mut failed = None;
+            let mut b =
+                emit::emit_body_streamed(
+                    &graph,
+                    emitter,
+                    fp.shape,
+                    &mut |s| match format_body(&s) {
                         Ok(t) => text.push_str(&t),
                         Err(e) => failed = Some(e),
-                    });
-                drop(traced);
-                if let Some(e) = failed {
-                    return Err(e);
-                }
-                text.push_str(&format_body(&b.tokens)?);
-                let placeholder = format_ident!("__kanegen_body_{}", texts.len());
-                texts.push(text);
-                b.tokens = quote!(#placeholder());
-                b
-            }
-        };
-        let fname = api::fn_name(f, model);
-        if !names.insert(fname.clone()) {
-            return Err(Error(format!(
-                "two generated functions are called `{fname}` (rename a frame of the model)"
-            )));
-        }
-        let name = ident("function name", &fname)?;
-        let args = f.args(floating).iter().map(|a| {
-            let len = Literal::usize_unsuffixed(a.len(n, floating));
-            let name = format_ident!("{}", a.name());
-            if *a == Arg::FExt {
-                quote!(#name: &[[#fl; 6]; #len])
-            } else {
-                quote!(#name: &[#fl; #len])
-            }
-        });
-        let payload_arg = opts
-            .runtime_payload
-            .then(|| quote!(, payload: &#payload_ty));
-        let lit = Literal::usize_unsuffixed;
-        let ret = match api::shape(f, n, floating) {
-            Shape::Vector(k) => {
-                let k = lit(k);
-                quote!([#fl; #k])
-            }
-            Shape::SymMatrix(k) => {
-                let k = lit(k);
-                quote!([[#fl; #k]; #k])
-            }
-            Shape::SymMatrixAndVector(k) => {
-                let k = lit(k);
-                quote!(([[#fl; #k]; #k], [#fl; #k]))
-            }
-            Shape::Matrix(r, c) => {
-                let (r, c) = (lit(r), lit(c));
-                quote!([[#fl; #c]; #r])
-            }
-            Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
-        };
-        let kernel = compact_body
-            .as_ref()
-            .and_then(|_| compact::kernel_candidate(model, opts, f));
-        let c = kernel
-            .as_ref()
-            .map_or_else(|| choice.counts(), |k| k.counts);
-        let mut doc1 = format!(" {}", api::doc(f, floating, choice.chosen.forward));
-        if compact_body.is_some() {
-            for unrolled in [
-                "by an unrolled branch-free LDLᵀ",
-                "by an unrolled articulated-body algorithm",
-            ] {
-                doc1 = doc1.replace(
-                    unrolled,
-                    "by the articulated-body algorithm (RBDA Table 7.1) in loops",
+                    },
                 );
+            drop(graph);
+            if let Some(e) = failed {
+                return Err(e);
             }
+            text.push_str(&format_body(&b.tokens)?);
+            b.tokens = placeholder(texts.len());
+            texts.push(text);
+            b
         }
-        let fused = if opts.fma {
-            format!(", of which {k} fused multiply-adds")
-        } else if opts.target_fma && k > 0 {
-            format!(", of which {k} fused where the target has FMA")
-        } else {
-            String::new()
-        };
-        let methods = [
-            choice
-                .mass_matrix_method(choice.chosen)
-                .map(|m| format!("mass matrix `{m}`")),
-            choice
-                .bias_method(choice.chosen)
-                .map(|m| format!("bias `{m}`")),
-            choice
-                .forward_method(choice.chosen)
-                .map(|m| format!("forward `{m}`")),
-        ]
-        .into_iter()
-        .flatten()
-        .collect::<Vec<_>>()
-        .join(", ");
-        let doc2 = format!(
-            " {}: {} mul, {} add, {} div, {} sqrt, {} sincos ({}){fused}.",
-            match (compact_body.is_some(), kernel.is_some(), methods.is_empty()) {
-                (true, true, _) => "Compact form: loops over the model's constant tables (RBDA), \
-                                    the kernels of `kanegen_runtime::compact`"
-                    .to_string(),
-                (true, false, _) => format!(
-                    "Compact form: loops over the model's constant tables (RBDA); the unrolled \
-                     form would emit, with {methods}"
-                ),
-                (false, _, true) => methods,
-                (false, _, false) => format!("Methods: {methods}"),
-            },
-            c.mul,
-            c.add,
-            c.div,
-            c.sqrt,
-            c.sincos,
-            if kernel.is_some() {
-                "traced: every operation the loops execute"
-            } else {
-                "emitted"
-            }
-        );
-        fmas.push(k);
-        kernels.push(kernel);
-        fns.push(quote! {
-            #[doc = #doc1]
-            #[doc = ""]
-            #[doc = #doc2]
-            #[must_use]
-            pub fn #name(#(#args),* #payload_arg) -> #ret {
-                #body
-            }
-        });
-        choices.push(choice);
-    }
+        (_, None, None) => {
+            return Err(Error(format!(
+                "`{}` has neither a compact body nor a traced graph",
+                fp.name
+            )))
+        }
+    };
+    Ok(body)
+}
 
-    let entry = |ch: &Choice, cand: &choose::Candidate, fma: u64| {
+/// The placeholder of the `k`-th formatted body ([`generate_file`]).
+fn placeholder(k: usize) -> TokenStream {
+    let name = format_ident!("__kanegen_body_{}", k);
+    quote!(#name())
+}
+
+/// One generated function: its documentation (what it computes, by which methods, at what
+/// emitted cost), signature and body.
+fn function_item(
+    plan: &Plan,
+    fp: &FunctionPlan,
+    body: Body,
+    opts: &Options,
+    names: &Names,
+) -> TokenStream {
+    let fl = opts.float.ty();
+    let name = format_ident!("{}", fp.name);
+    let args = fp.args.iter().map(|(a, len)| {
+        let len = Literal::usize_unsuffixed(*len);
+        let name = format_ident!("{}", a.name());
+        if *a == Arg::FExt {
+            quote!(#name: &[[#fl; 6]; #len])
+        } else {
+            quote!(#name: &[#fl; #len])
+        }
+    });
+    let payload_ty = &names.payload;
+    let payload_arg = opts
+        .runtime_payload
+        .then(|| quote!(, payload: &#payload_ty));
+    let ret = return_type(fp.shape, &fl);
+    let (doc1, doc2) = function_docs(plan, fp, body.fmas, opts);
+    let body = body.tokens;
+    quote! {
+        #[doc = #doc1]
+        #[doc = ""]
+        #[doc = #doc2]
+        #[must_use]
+        pub fn #name(#(#args),* #payload_arg) -> #ret {
+            #body
+        }
+    }
+}
+
+/// The Rust type of a function's results.
+fn return_type(shape: Shape, fl: &TokenStream) -> TokenStream {
+    let lit = Literal::usize_unsuffixed;
+    match shape {
+        Shape::Vector(k) => {
+            let k = lit(k);
+            quote!([#fl; #k])
+        }
+        Shape::SymMatrix(k) => {
+            let k = lit(k);
+            quote!([[#fl; #k]; #k])
+        }
+        Shape::SymMatrixAndVector(k) => {
+            let k = lit(k);
+            quote!(([[#fl; #k]; #k], [#fl; #k]))
+        }
+        Shape::Matrix(r, c) => {
+            let (r, c) = (lit(r), lit(c));
+            quote!([[#fl; #c]; #r])
+        }
+        Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
+    }
+}
+
+/// The two documentation lines of a function: what it computes ([`api::doc`]), then its methods
+/// and counts (emitted; for a compact body, its loops' methods and its kernel's traced counts).
+/// `k`: fused multiply-adds formed.
+fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (String, String) {
+    let choice = &fp.choice;
+    let compact = matches!(fp.kernel, Kernel::Compact(_));
+    let mut doc1 = format!(
+        " {}",
+        api::doc(fp.function, plan.floating(), choice.chosen.forward)
+    );
+    if compact {
+        for unrolled in [
+            "by an unrolled branch-free LDLᵀ",
+            "by an unrolled articulated-body algorithm",
+        ] {
+            doc1 = doc1.replace(
+                unrolled,
+                "by the articulated-body algorithm (RBDA Table 7.1) in loops",
+            );
+        }
+    }
+    let methods = [
+        choice
+            .mass_matrix_method(choice.chosen)
+            .map(|m| format!("mass matrix `{m}`")),
+        choice
+            .bias_method(choice.chosen)
+            .map(|m| format!("bias `{m}`")),
+        choice
+            .forward_method(choice.chosen)
+            .map(|m| format!("forward `{m}`")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>()
+    .join(", ");
+    if let Kernel::Compact(c) = fp.kernel {
+        let doc2 = format!(
+            " Compact form: loops over the model's constant tables (RBDA), {methods}, the \
+             kernels of `kanegen_runtime::compact`: {} mul, {} add, {} div, {} sqrt, {} sincos \
+             (traced: every operation the loops execute).",
+            c.mul, c.add, c.div, c.sqrt, c.sincos
+        );
+        return (doc1, doc2);
+    }
+    let fused = if opts.fma {
+        format!(", of which {k} fused multiply-adds")
+    } else if opts.target_fma && k > 0 {
+        format!(", of which {k} fused where the target has FMA")
+    } else {
+        String::new()
+    };
+    let c = choice.counts();
+    let doc2 = format!(
+        " {}{methods}: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted){fused}.",
+        if methods.is_empty() { "" } else { "Methods: " },
+        c.mul,
+        c.add,
+        c.div,
+        c.sqrt,
+        c.sincos
+    );
+    (doc1, doc2)
+}
+
+/// The `OP_COUNTS` entries (one per emitted function, a compact one's its kernel's traced
+/// counts) and
+/// the `CANDIDATES` entries (one per traced candidate).
+fn op_count_entries(
+    plan: &Plan,
+    fmas: &[u64],
+    op_ty: &syn::Ident,
+) -> (Vec<TokenStream>, Vec<TokenStream>) {
+    let entry = |fp: &FunctionPlan, cand: &choose::Candidate, fma: u64| {
+        let ch = &fp.choice;
         let (m, c, frames) = (cand.methods, cand.counts, cand.frames.name());
-        let function = api::fn_name(ch.function, model);
+        let function = &fp.name;
         let opt = |x: Option<&str>| match x {
             Some(s) => quote!(Some(#s)),
             None => quote!(None),
@@ -315,65 +351,61 @@ fn generate_items_with(
             fma: #fma,
         })
     };
-    let emitted = choices
+    let emitted = plan
+        .functions
         .iter()
-        .zip(&fmas)
-        .zip(&kernels)
-        .map(|((ch, k), kernel)| {
-            let chosen = ch.candidate().expect("the chosen candidate was traced");
-            kernel
-                .as_ref()
-                .map_or_else(|| entry(ch, chosen, *k), |kc| entry(ch, kc, 0))
-        });
-    let all = choices
+        .zip(fmas)
+        .map(|(fp, k)| {
+            let kernel = |counts| choose::Candidate {
+                methods: fp.choice.chosen,
+                frames: fp.choice.frames,
+                counts,
+            };
+            match (fp.kernel, fp.choice.candidate()) {
+                (Kernel::Compact(counts), _) => entry(fp, &kernel(counts), 0),
+                (Kernel::Unrolled, Some(chosen)) => entry(fp, chosen, *k),
+                (Kernel::Unrolled, None) => entry(fp, &kernel(Counts::default()), *k),
+            }
+        })
+        .collect();
+    let all = plan
+        .functions
         .iter()
-        .flat_map(|ch| ch.candidates.iter().map(|c| entry(ch, c, 0)));
-    let n_fns = Literal::usize_unsuffixed(choices.len());
+        .flat_map(|fp| fp.choice.candidates.iter().map(move |c| (fp, c)))
+        .map(|(fp, c)| entry(fp, c, 0))
+        .collect();
+    (emitted, all)
+}
 
-    let mut header = header::lines(model, opts, &choices, &fmas, &snapped.report);
-    // The form line after the model's description, before the table of counts.
-    let at = header
-        .iter()
-        .position(|l| l.starts_with("Emitted operation counts per candidate"))
-        .map_or(header.len(), |k| k.saturating_sub(1));
-    let mut line = decision.line.clone();
-    if !kept_unrolled.is_empty() {
-        line.push_str(&format!(
-            " Straight-line all the same: {} (an O(N) function within {} emitted operations \
-             measured faster unrolled).",
-            kept_unrolled.join(", "),
-            compact::LINEAR_AUTO_LIMIT
-        ));
-    }
-    header.insert(at, line);
+/// The generated items around the functions `fns`: the documented unit struct, the payload
+/// and op-count structs, and the `impl` with the constants, the functions and their helpers.
+fn type_items(
+    plan: &Plan,
+    opts: &Options,
+    names: &Names,
+    header: &[String],
+    header_on_struct: bool,
+    fns: &[TokenStream],
+    fmas: &[u64],
+) -> Result<TokenStream, Error> {
+    let model = &plan.model;
+    let n = model.dof();
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())
     )];
-    let struct_header: &[String] = if header_on_struct { &header } else { &short };
+    let struct_header: &[String] = if header_on_struct { header } else { &short };
     let struct_docs = struct_header.iter().map(|l| {
         let l = format!(" {l}");
         quote!(#[doc = #l])
     });
-    let joint_names = model.joints().iter().map(|j| j.name.as_str());
-    let frame_names = model.frames().iter().map(|f| f.name.as_str());
-    let n_frames = Literal::usize_unsuffixed(model.frames().len());
-    let floating_consts = if floating {
-        let (nq, nv) = (
-            Literal::usize_unsuffixed(n + 7),
-            Literal::usize_unsuffixed(n + 6),
-        );
-        quote! {
-            /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
-            pub const NQ: usize = #nq;
-            /// Length of `v`: base linear and angular velocity (base frame), joint rates.
-            pub const NV: usize = #nv;
-        }
-    } else {
-        quote!()
-    };
+    let Names {
+        ty,
+        payload: payload_ty,
+        op_count: op_ty,
+    } = names;
     let payload_item = if opts.runtime_payload {
-        payload_struct(model, opts, &payload_ty)
+        payload_struct(model, opts, payload_ty)
     } else {
         quote!()
     };
@@ -382,27 +414,9 @@ fn generate_items_with(
          method; `fma`: fused multiply-adds formed, each also counted as one `mul` and one `add`).",
         opts.type_name
     );
-
-    let compact_items = if compact {
-        compact::items(model, opts)?
-    } else {
-        quote!()
-    };
-    // The type's own sine–cosine, where a function takes one (its products fused through
-    // `Self::mul_add` like the functions').
-    let sincos_item = opts.table_sincos() && (compact || choose::takes_trig(&choices));
-    let target_mul_add = !opts.fma && opts.target_fma;
-    let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
-        mul_add_fn(opts.float)
-    } else {
-        quote!()
-    };
-    let sincos_item = if sincos_item {
-        sincos::item(&opts.libm()?, target_mul_add)
-    } else {
-        quote!()
-    };
-    let items = quote! {
+    let consts = type_consts(plan, fmas, op_ty);
+    let helpers = helper_items(plan, opts, fmas)?;
+    Ok(quote! {
         #(#struct_docs)*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
         pub struct #ty;
@@ -451,60 +465,86 @@ fn generate_items_with(
             unused_parens
         )]
         impl #ty {
-            /// Degrees of freedom.
-            pub const N: usize = #nl;
-            /// Joint names, in the order of the joint entries of `q`.
-            pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
-            /// Named frames, in the model's order (one `<frame>_…` function family each).
-            pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
-            #floating_consts
-            /// Emitted operation counts of each generated function, in emission order.
-            pub const OP_COUNTS: [#op_ty; #n_fns] = [#(#emitted),*];
-            /// Emitted operation counts of every candidate traced (the cheapest is emitted).
-            pub const CANDIDATES: &'static [#op_ty] = &[#(#all),*];
+            #consts
 
             #(#fns)*
 
-            #mul_add_item
-
-            #sincos_item
-
-            #compact_items
+            #helpers
         }
-    };
-    Ok(Generated {
-        items,
-        header,
-        choices,
-        fmas,
     })
 }
 
-/// The form to emit ([`compact::decide`]): for [`Form::Auto`] from the emitted operations of the
-/// cheapest unrolled `mass_matrix_and_nonlinear_effects` — with the mass-matrix method `M`
-/// chooses, as the unrolled code would emit it. The choices traced for it (`M`, then `(M, c)`)
-/// are returned for the emitter to use rather than trace again.
-fn form_decision(
-    model: &Model,
-    opts: &Options,
-) -> Result<(compact::Decision, Vec<(Choice, kanegen_trace::Traced)>), Error> {
-    let mut traced = Vec::new();
-    let ops = match (opts.form, compact::unsupported(model, opts)) {
-        (Form::Auto, None) => {
-            let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
-            for f in [
-                Function::MassMatrix,
-                Function::MassMatrixAndNonlinearEffects,
-            ] {
-                let c = choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?;
-                mass = c.0.chosen.mass_matrix;
-                traced.push(c);
-            }
-            traced.last().map_or(0, |(c, _)| c.counts().total())
+/// The type's constants: `N`, `JOINTS`, `FRAMES`, a free-floating base's `NQ` and `NV`,
+/// `OP_COUNTS` and `CANDIDATES`.
+fn type_consts(plan: &Plan, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
+    let model = &plan.model;
+    let n = model.dof();
+    let nl = Literal::usize_unsuffixed(n);
+    let joint_names = model.joints().iter().map(|j| j.name.as_str());
+    let frame_names = model.frames().iter().map(|f| f.name.as_str());
+    let n_frames = Literal::usize_unsuffixed(model.frames().len());
+    let floating_consts = if plan.floating() {
+        let (nq, nv) = (
+            Literal::usize_unsuffixed(n + 7),
+            Literal::usize_unsuffixed(n + 6),
+        );
+        quote! {
+            /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
+            pub const NQ: usize = #nq;
+            /// Length of `v`: base linear and angular velocity (base frame), joint rates.
+            pub const NV: usize = #nv;
         }
-        _ => 0,
+    } else {
+        quote!()
     };
-    Ok((compact::decide(model, opts, ops)?, traced))
+    let n_fns = Literal::usize_unsuffixed(plan.functions.len());
+    let (emitted, all) = op_count_entries(plan, fmas, op_ty);
+    quote! {
+        /// Degrees of freedom.
+        pub const N: usize = #nl;
+        /// Joint names, in the order of the joint entries of `q`.
+        pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
+        /// Named frames, in the model's order (one `<frame>_…` function family each).
+        pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
+        #floating_consts
+        /// Emitted operation counts of each generated function, in emission order.
+        pub const OP_COUNTS: [#op_ty; #n_fns] = [#(#emitted),*];
+        /// Emitted operation counts of every candidate traced (the cheapest is emitted).
+        pub const CANDIDATES: &'static [#op_ty] = &[#(#all),*];
+    }
+}
+
+/// The private helpers after the functions: `Self::mul_add` where a product is fused for the
+/// target, the type's own sine–cosine where a function takes one, and the compact form's
+/// tables and loops.
+fn helper_items(plan: &Plan, opts: &Options, fmas: &[u64]) -> Result<TokenStream, Error> {
+    let compact = plan.compact();
+    let compact_items = if compact {
+        compact::items(&plan.model, opts)?
+    } else {
+        quote!()
+    };
+    // The type's own sine–cosine, where a function takes one (its products fused through
+    // `Self::mul_add` like the functions').
+    let sincos_item = opts.table_sincos() && (compact || choose::takes_trig(plan.choices()));
+    let target_mul_add = !opts.fma && opts.target_fma;
+    let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
+        mul_add_fn(opts.float, &opts.runtime()?)
+    } else {
+        quote!()
+    };
+    let sincos_item = if sincos_item {
+        sincos::item(&opts.runtime()?, target_mul_add)
+    } else {
+        quote!()
+    };
+    Ok(quote! {
+        #mul_add_item
+
+        #sincos_item
+
+        #compact_items
+    })
 }
 
 /// The payload struct (the last body's mass properties) and its nominal value.
@@ -623,56 +663,21 @@ pub use kanegen_dynamics;
 /// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
 
-/// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build
-/// targets it, `a·b + c` (two roundings, bit-identical to unfused code) elsewhere.
-fn mul_add_fn(float: Float) -> TokenStream {
-    let (ty, x86, set, get, arm_dup, arm_fma, arm_get) = match float {
-        Float::F64 => (
-            quote!(f64),
-            quote!(_mm_fmadd_sd),
-            quote!(_mm_set_sd),
-            quote!(_mm_cvtsd_f64),
-            quote!(vdup_n_f64),
-            quote!(vfma_f64),
-            quote!(vget_lane_f64),
-        ),
-        Float::F32 => (
-            quote!(f32),
-            quote!(_mm_fmadd_ss),
-            quote!(_mm_set_ss),
-            quote!(_mm_cvtss_f32),
-            quote!(vdup_n_f32),
-            quote!(vfma_f32),
-            quote!(vget_lane_f32),
-        ),
+/// The private `mul_add` of [`Options::target_fma`], forwarding to the runtime's
+/// (`kanegen_runtime::fma`): one fused instruction where the build targets it, `a·b + c` (two
+/// roundings, bit-identical to unfused code) elsewhere.
+fn mul_add_fn(float: Float, runtime: &TokenStream) -> TokenStream {
+    let (ty, f) = match float {
+        Float::F64 => (quote!(f64), quote!(mul_add)),
+        Float::F32 => (quote!(f32), quote!(mul_add_f32)),
     };
     quote! {
         /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
         /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-        /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
-        /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
+        /// elsewhere.
         #[inline(always)]
-        #[allow(unsafe_code)]
         fn mul_add(a: #ty, b: #ty, c: #ty) -> #ty {
-            #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-            {
-                use core::arch::x86_64::{#get, #x86, #set};
-                // SAFETY: the build targets FMA (the `cfg` above), so the instruction exists.
-                unsafe { #get(#x86(#set(a), #set(b), #set(c))) }
-            }
-            #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
-            {
-                use core::arch::aarch64::{#arm_dup, #arm_fma, #arm_get};
-                // SAFETY: AArch64 with NEON (the `cfg` above) has the fused multiply-add.
-                unsafe { #arm_get::<0>(#arm_fma(#arm_dup(c), #arm_dup(a), #arm_dup(b))) }
-            }
-            #[cfg(not(any(
-                all(target_arch = "x86_64", target_feature = "fma"),
-                all(target_arch = "aarch64", target_feature = "neon")
-            )))]
-            {
-                a * b + c
-            }
+            #runtime::fma::#f(a, b, c)
         }
     }
 }

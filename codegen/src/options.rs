@@ -213,7 +213,6 @@ impl Options {
     ///
     /// # Errors
     /// If [`Options::runtime_path`] is not a Rust path.
-    #[allow(dead_code)]
     pub(crate) fn runtime(&self) -> Result<TokenStream, Error> {
         Ok(match &self.runtime_tokens {
             Some(t) => t.clone(),

@@ -1,214 +1,31 @@
-//! The sine–cosine of the generated `f64` code: `Self::sincos(x)`, emitted into every generated
-//! type that takes a sine or a cosine ([`item`]), in place of `libm::sincos`.
+//! The sine–cosine of the generated `f64` code: `Self::sincos(x)` and `Self::sincos_n([…])`,
+//! emitted into every generated type that takes a sine or a cosine ([`item`]) in place of
+//! `libm::sincos`, one line each forwarding to the runtime's (`kanegen_runtime::sincos`: a table
+//! of 128 sines and short polynomials, branch-free and inlined for `|x| < 32768` rad,
+//! `libm::sincos` beyond), which holds the table and the algorithm.
 //!
-//! A joint angle's sine and cosine are the first thing every generated function computes, and
-//! with `libm` they cost as much as the rest of a 6-dof mass matrix: a call each, and branches on
-//! the argument's range and quadrant that a benchmark of random states mispredicts. The emitted
-//! function is inlined and branch-free on `|x| < 32768` rad:
-//!
-//! 1. `x = k·π/128 + r`, `|r| ≤ π/256`: `k` rounded by the 1.5·2⁵² shift, `r` by Cody and
-//!    Waite's two-part `π/128` (the first part has 32 significant bits, so `k·STEP_HI` is exact for
-//!    `|k| < 2²¹`, and `x − k·P1` is exact by Sterbenz' lemma);
-//! 2. `sin r`, `cos r` by their Taylor polynomials to `r⁵` and `r⁶`: the first terms left out,
-//!    `r⁷/7!` and `r⁸/8!`, are below 8.3e-18 and 1.3e-20 at `|r| = π/256`;
-//! 3. `sin(kπ/128)` and `cos(kπ/128) = sin((k + 64)π/128)` from [`SIN_TABLE`], 128 correctly
-//!    rounded sines of `[0, π)`, the sign flipped by bit 7 of the index (`sin(a + π) = −sin a`);
-//! 4. the angle sums: `sin x = sin a·cos r + cos a·sin r`, `cos x = cos a·cos r − sin a·sin r`.
-//!
-//! Beyond `|x| < 32768` (and for NaN and infinities) it calls `libm::sincos`, a branch a joint
-//! angle never takes. The functions take all joint angles' in one `Self::sincos_n([q[0], …])`
-//! at the top, each step a loop over the angles, which the compiler vectorizes: on SRMS that
-//! made `M` 1.2× faster than one `Self::sincos` per angle. The error against `libm::sincos` is measured by `kanegen accuracy`
-//! (`docs/accuracy.md`) and bounded by `tests/sincos.rs`: 1 ulp of 1 at most, and 2 ulp of
-//! the value wherever it is at least 1/16.
+//! The functions take all joint angles' in one `Self::sincos_n([q[0], …])` at the top, whose
+//! steps the compiler vectorizes. The error against `libm::sincos` is measured by `kanegen
+//! accuracy` (`docs/accuracy.md`) and bounded by `tests/sincos.rs`: 1 ulp of 1 at most, and 2 ulp
+//! of the value wherever it is at least 1/16.
 //!
 //! `f32` code keeps libm's `sincosf` (itself cheap), as does [`Options::libm_trig`](crate::Options).
 
-use proc_macro2::{Literal, TokenStream};
+use proc_macro2::TokenStream;
 use quote::quote;
 
-/// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded (computed in 300-bit arithmetic by
-/// `mpmath`; `tests` checks them against `libm::sin` and each other).
-#[allow(clippy::approx_constant)] // sin(π/4) and sin(3π/4), written as the table's other entries
-pub const SIN_TABLE: [f64; 128] = [
-    0.0,
-    0.024541228522912288,
-    0.049067674327418015,
-    0.07356456359966743,
-    0.0980171403295606,
-    0.1224106751992162,
-    0.14673047445536175,
-    0.17096188876030122,
-    0.19509032201612828,
-    0.2191012401568698,
-    0.2429801799032639,
-    0.26671275747489837,
-    0.2902846772544624,
-    0.31368174039889146,
-    0.33688985339222005,
-    0.35989503653498817,
-    0.3826834323650898,
-    0.40524131400498986,
-    0.4275550934302821,
-    0.4496113296546066,
-    0.47139673682599764,
-    0.49289819222978404,
-    0.5141027441932218,
-    0.5349976198870973,
-    0.5555702330196022,
-    0.5758081914178453,
-    0.5956993044924334,
-    0.6152315905806268,
-    0.6343932841636455,
-    0.6531728429537768,
-    0.6715589548470184,
-    0.6895405447370669,
-    0.7071067811865476,
-    0.7242470829514669,
-    0.7409511253549591,
-    0.7572088465064846,
-    0.773010453362737,
-    0.7883464276266062,
-    0.8032075314806449,
-    0.8175848131515837,
-    0.8314696123025452,
-    0.8448535652497071,
-    0.8577286100002721,
-    0.8700869911087115,
-    0.881921264348355,
-    0.8932243011955153,
-    0.9039892931234433,
-    0.9142097557035307,
-    0.9238795325112867,
-    0.9329927988347388,
-    0.9415440651830208,
-    0.9495281805930367,
-    0.9569403357322088,
-    0.9637760657954398,
-    0.970031253194544,
-    0.9757021300385286,
-    0.9807852804032304,
-    0.9852776423889412,
-    0.989176509964781,
-    0.99247953459871,
-    0.9951847266721969,
-    0.9972904566786902,
-    0.9987954562051724,
-    0.9996988186962042,
-    1.0,
-    0.9996988186962042,
-    0.9987954562051724,
-    0.9972904566786902,
-    0.9951847266721969,
-    0.99247953459871,
-    0.989176509964781,
-    0.9852776423889412,
-    0.9807852804032304,
-    0.9757021300385286,
-    0.970031253194544,
-    0.9637760657954398,
-    0.9569403357322088,
-    0.9495281805930367,
-    0.9415440651830208,
-    0.9329927988347388,
-    0.9238795325112867,
-    0.9142097557035307,
-    0.9039892931234433,
-    0.8932243011955153,
-    0.881921264348355,
-    0.8700869911087115,
-    0.8577286100002721,
-    0.8448535652497071,
-    0.8314696123025452,
-    0.8175848131515837,
-    0.8032075314806449,
-    0.7883464276266062,
-    0.773010453362737,
-    0.7572088465064846,
-    0.7409511253549591,
-    0.7242470829514669,
-    0.7071067811865476,
-    0.6895405447370669,
-    0.6715589548470184,
-    0.6531728429537768,
-    0.6343932841636455,
-    0.6152315905806268,
-    0.5956993044924334,
-    0.5758081914178453,
-    0.5555702330196022,
-    0.5349976198870973,
-    0.5141027441932218,
-    0.49289819222978404,
-    0.47139673682599764,
-    0.4496113296546066,
-    0.4275550934302821,
-    0.40524131400498986,
-    0.3826834323650898,
-    0.35989503653498817,
-    0.33688985339222005,
-    0.31368174039889146,
-    0.2902846772544624,
-    0.26671275747489837,
-    0.2429801799032639,
-    0.2191012401568698,
-    0.19509032201612828,
-    0.17096188876030122,
-    0.14673047445536175,
-    0.1224106751992162,
-    0.0980171403295606,
-    0.07356456359966743,
-    0.049067674327418015,
-    0.024541228522912288,
-];
-
-/// `128/π`: angles to table steps.
-pub const STEPS_PER_RAD: f64 = 40.74366543152521;
-/// `π/128` to 32 significant bits (`k·STEP_HI` is exact for `|k| < 2²¹`).
-pub const STEP_HI: f64 = 0.024543692605220713;
-/// `π/128 − STEP_HI` (the two parts sum to `π/128` within 5.5e-29).
-pub const STEP_LO: f64 = 9.495469541415925e-13;
-/// `1.5·2⁵²`: adding and subtracting it rounds to an integer, whose low bits are left in the
-/// sum's mantissa.
-pub const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0;
-/// The fast path's range: `|x| < LIMIT` (`|k| ≤ 1.34e6 < 2²¹`).
-pub const LIMIT: f64 = 32768.0;
-
 /// The emitted `pub fn sincos(x: f64) -> (f64, f64)` and `pub fn sincos_n<const N: usize>(x:
-/// [f64; N]) -> [(f64, f64); N]` of a generated type: `libm` is the path of
-/// the `libm` crate (the fallback); with `mul_add`, the products are fused through the type's
-/// `Self::mul_add` (one instruction where the build targets FMA), else plain `a·b + c`.
+/// [f64; N]) -> [(f64, f64); N]` of a generated type: `runtime` is the path of the
+/// `kanegen-runtime` crate; with `mul_add`, the products are fused where the build targets FMA
+/// (`sincos::sincos_n`, like the functions' `Self::mul_add`), else never
+/// (`sincos::sincos_n_unfused`).
 #[must_use]
-pub fn item(libm: &TokenStream, mul_add: bool) -> TokenStream {
-    let ma = |a: TokenStream, b: TokenStream, c: TokenStream| {
-        if mul_add {
-            quote!(Self::mul_add(#a, #b, #c))
-        } else {
-            quote!(#a * #b + #c)
-        }
+pub fn item(runtime: &TokenStream, mul_add: bool) -> TokenStream {
+    let batched = if mul_add {
+        quote!(#runtime::sincos::sincos_n)
+    } else {
+        quote!(#runtime::sincos::sincos_n_unfused)
     };
-    let lit = Literal::f64_unsuffixed;
-    let table = SIN_TABLE.iter().map(|&v| lit(v));
-    // `{:e}`: 9.49…e-13, not 0.000000000000949….
-    let lo: TokenStream = format!("{STEP_LO:e}").parse().expect("a float literal");
-    let (steps, hi, shift, limit) = (
-        lit(STEPS_PER_RAD),
-        lit(STEP_HI),
-        lit(ROUND_SHIFT),
-        lit(LIMIT),
-    );
-    // One operation per `let`: no nested expression, so plain `a * b + c` needs no parentheses.
-    // Each step is a loop over the lanes, so the compiler runs them side by side in vector
-    // registers.
-    let t = ma(quote!(x[i]), quote!(#steps), quote!(#shift));
-    let r_hi = ma(quote!(-k), quote!(#hi), quote!(x[i]));
-    let r = ma(quote!(-k), quote!(#lo), quote!(r_hi));
-    let p_s = ma(quote!(r2), quote!(S5), quote!(S3));
-    let s = ma(quote!(r3), quote!(p_s), quote!(r[i]));
-    let p_c6 = ma(quote!(r2), quote!(C6), quote!(C4));
-    let p_c = ma(quote!(r2), quote!(p_c6), quote!(C2));
-    let c = ma(quote!(r2), quote!(p_c), quote!(1.0));
-    let sin_x = ma(quote!(sin_a), quote!(cos_r[i]), quote!(cos_a * sin_r[i]));
-    let cos_x = ma(quote!(cos_a), quote!(cos_r[i]), quote!(-(sin_a * sin_r[i])));
     quote! {
         /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
         #[inline(always)]
@@ -219,91 +36,12 @@ pub fn item(libm: &TokenStream, mul_add: bool) -> TokenStream {
         }
 
         /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
-        /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
-        /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
-        /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
-        /// (`kanegen accuracy` measures it).
+        /// call), by the runtime's table sine–cosine: branch-free for `|x| < 32768`,
+        /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
         #[inline(always)]
         #[must_use]
         pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
-            /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
-            const SIN_TABLE: [f64; 128] = [#(#table),*];
-            // Taylor coefficients of sin r (r³, r⁵) and cos r (r², r⁴, r⁶).
-            const S3: f64 = -1.0 / 6.0;
-            const S5: f64 = 1.0 / 120.0;
-            const C2: f64 = -0.5;
-            const C4: f64 = 1.0 / 24.0;
-            const C6: f64 = -1.0 / 720.0;
-            let mut fast = true;
-            for v in x {
-                fast &= v > -#limit && v < #limit;
-            }
-            if !fast {
-                return x.map(#libm::sincos);
-            }
-            // x = k·π/128 + r, |r| ≤ π/256: k rounded by the 1.5·2⁵² shift, r by Cody and
-            // Waite's two-part π/128.
-            let (mut t, mut r) = ([0.0; N], [0.0; N]);
-            for i in 0..N {
-                t[i] = #t;
-                let k = t[i] - #shift;
-                let r_hi = #r_hi;
-                r[i] = #r;
-            }
-            let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
-            for i in 0..N {
-                let r2 = r[i] * r[i];
-                let r3 = r[i] * r2;
-                let p_s = #p_s;
-                sin_r[i] = #s;
-                let p_c6 = #p_c6;
-                let p_c = #p_c;
-                cos_r[i] = #c;
-            }
-            // sin and cos of k·π/128 (bit 7 of the index: the half turn, a sign).
-            let table = |j: usize| {
-                f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
-            };
-            let mut out = [(0.0, 0.0); N];
-            for i in 0..N {
-                let j = (t[i].to_bits() & 255) as usize;
-                let (sin_a, cos_a) = (table(j), table(j + 64));
-                out[i] = (#sin_x, #cos_x);
-            }
-            out
+            #batched(x)
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The table against libm's `sin` at the rounded angle, corrected by the rounding
-    /// (`sin(a + e) ≈ sin a + e·cos a`): within 1 ulp each; exactly symmetric about π/2.
-    #[test]
-    fn table_holds_the_sines() {
-        for (k, &v) in SIN_TABLE.iter().enumerate() {
-            let kf = k as f64;
-            let a = kf * core::f64::consts::PI / 128.0;
-            let e = (kf * STEP_HI - a) + kf * STEP_LO;
-            let want = libm::sin(a) + e * libm::cos(a);
-            let ulp = f64::EPSILON * want.abs().max(f64::MIN_POSITIVE);
-            assert!((v - want).abs() <= ulp, "k = {k}: {v} against {want}");
-            if k > 0 {
-                assert_eq!(v.to_bits(), SIN_TABLE[128 - k].to_bits(), "k = {k}");
-            }
-        }
-        assert_eq!(SIN_TABLE[0], 0.0);
-        assert_eq!(SIN_TABLE[64], 1.0);
-    }
-
-    /// The two parts of π/128: the first has 32 significant bits, the sum is π/128.
-    #[test]
-    fn step_split() {
-        assert_eq!(STEP_HI.to_bits() & ((1 << 21) - 1), 0);
-        assert!(((STEP_HI + STEP_LO) - core::f64::consts::PI / 128.0).abs() < 1e-18);
-        assert!((STEPS_PER_RAD * (STEP_HI + STEP_LO) - 1.0).abs() < 2.0 * f64::EPSILON);
-        assert!(LIMIT * STEPS_PER_RAD < f64::from(1u32 << 21));
     }
 }

@@ -1,10 +1,13 @@
 //! The compact form at the source level: what `generate_file` writes with `Form::Compact`
 //! (loops, no allocation, no panicking call), which form `Form::Auto` picks, and what it refuses.
 
+use kanegen_codegen::choose::choose;
 use kanegen_codegen::compact::{AUTO_LIMIT, LINEAR_AUTO_LIMIT};
-use kanegen_codegen::{generate_file, generate_items, Float, Form, Options};
+use kanegen_codegen::kanegen_dynamics::MassMatrixMethod;
+use kanegen_codegen::{generate_file, generate_items, plan, Float, Form, Options};
 use kanegen_model::random::{random_chain, random_tree, ChainSpec};
 use kanegen_model::{BaseKind, Model};
+use kanegen_trace::Function;
 use std::path::Path;
 
 fn chain(n: usize, seed: u64) -> Model {
@@ -74,7 +77,7 @@ fn compact_source_loops_without_allocation_or_panics() {
             assert!(body.contains("libm::sincosf"));
             assert!(!body.contains("f64"), "f32 code names no f64");
         } else {
-            assert!(body.contains("Self::sincos") && body.contains("libm::sincos"));
+            assert!(body.contains("Self::sincos") && body.contains("::sincos::sincos_n"));
         }
         // Straight-line bodies are `let` chains; compact ones call the kernels.
         assert!(src
@@ -119,8 +122,15 @@ fn auto_picks_compact_for_large_models_only() {
             .unwrap();
         c.counts().total()
     };
-    for name in ["nonlinear_effects", "inverse_dynamics"] {
-        assert!(ops(&sixteen, name) <= LINEAR_AUTO_LIMIT && ops(&big, name) > LINEAR_AUTO_LIMIT);
+    for (name, f) in [
+        ("nonlinear_effects", Function::NonlinearEffects),
+        ("inverse_dynamics", Function::InverseDynamics),
+    ] {
+        assert!(ops(&sixteen, name) <= LINEAR_AUTO_LIMIT);
+        assert!(traced_ops(&chain_default(64), f) > LINEAR_AUTO_LIMIT);
+        // A body in loops is not traced: no candidate, 0 operations in `OP_COUNTS`.
+        assert_eq!(ops(&big, name), 0);
+        assert!(untraced(&big, name));
         assert!(
             fn_body(&sixteen, name).contains("letx"),
             "{name} unrolled at N = 16"
@@ -155,7 +165,7 @@ fn auto_picks_compact_for_large_models_only() {
     let g = generate_items(&ssrms, &auto).unwrap();
     let line = form_line(&g.header);
     assert!(line.starts_with("Form: unrolled"), "{line}");
-    // The limit sits between the measured crossovers (README "Compact code").
+    // The limit sits between the measured crossovers (docs/performance.md, "Compact against unrolled").
     let mc = |g: &kanegen_codegen::Generated| {
         g.choices
             .iter()
@@ -165,7 +175,93 @@ fn auto_picks_compact_for_large_models_only() {
             .total()
     };
     assert!(mc(&small) <= AUTO_LIMIT && mc(&g) <= AUTO_LIMIT && mc(&eight) <= AUTO_LIMIT);
-    assert!(mc(&sixteen) > AUTO_LIMIT && mc(&big) > AUTO_LIMIT);
+    assert!(untraced(&sixteen, "mass_matrix_and_nonlinear_effects"));
+    assert!(untraced(&big, "forward_dynamics"));
+    assert!(traced_ops(&chain_default(16), Function::MassMatrixAndNonlinearEffects) > AUTO_LIMIT);
+}
+
+/// Whether the function `name` of `g` was left untraced: no candidate, the loops' methods.
+fn untraced(g: &kanegen_codegen::Generated, name: &str) -> bool {
+    let c = g
+        .choices
+        .iter()
+        .find(|c| c.function.name() == name)
+        .unwrap();
+    c.candidates.is_empty() && c.counts().total() == 0
+}
+
+/// The emitted `mul + add` of the cheapest unrolled candidate of `f` traced on the whole
+/// (snapped) model, after `M`'s choice as the generator makes it: what the form rule compared
+/// before it traced prefixes.
+fn traced_ops(model: &Model, f: Function) -> u64 {
+    let opts = Options::new("Arm");
+    let model = model.snapped(opts.snap).model;
+    let (m, _) = choose(&model, Function::MassMatrix, MassMatrixMethod::Crba, &opts).unwrap();
+    if f == Function::MassMatrix {
+        return m.counts().total();
+    }
+    let (c, _) = choose(&model, f, m.chosen.mass_matrix, &opts).unwrap();
+    c.counts().total()
+}
+
+/// The form `Form::Auto` decides from prefixes of the model (`plan::form`) is the one the
+/// whole model's traced `M + c` gives against `AUTO_LIMIT`, on random chains N = 2..64 (the
+/// default geometry and a third prismatic), random trees and the test suite's models; a
+/// compact decision on a model of more than `FIRST_PREFIX` joints traced a prefix only.
+/// Fails when a prefix costs more than its model, or the rule moves.
+#[test]
+fn prefix_decisions_equal_whole_trace_decisions() {
+    let auto = Options::new("Arm");
+    let mut models: Vec<Model> = (2..=64).map(chain_default).collect();
+    models.extend((2..=40).step_by(3).map(|n| chain(n, n as u64)));
+    models.extend([7, 10, 20, 33].map(|n| {
+        random_tree(
+            &ChainSpec {
+                n,
+                prismatic_fraction: 0.3,
+                ..Default::default()
+            },
+            n as u64,
+        )
+    }));
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data");
+    for file in [
+        "reference/ssrms_nguyen_hughes_1994.urdf",
+        "reference/srms_nguyen_hughes_1994.urdf",
+        "erd/panda.urdf",
+        "compact/chain12.toml",
+        "compact/tree10.toml",
+    ] {
+        models.push(kanegen_model::io::load_model(&data.join(file)).unwrap());
+    }
+    let (mut compact, mut unrolled) = (0, 0);
+    for model in &models {
+        let n = model.dof();
+        let decision = plan::form(model, &auto).unwrap();
+        let whole = traced_ops(model, Function::MassMatrixAndNonlinearEffects) > AUTO_LIMIT;
+        assert_eq!(
+            decision.form == Form::Compact,
+            whole,
+            "{} (N = {n}): {}",
+            model.name(),
+            decision.line
+        );
+        if whole {
+            compact += 1;
+            assert_eq!(
+                decision.line.contains("joints alone"),
+                n > plan::FIRST_PREFIX,
+                "{}",
+                decision.line
+            );
+        } else {
+            unrolled += 1;
+        }
+    }
+    assert!(
+        compact > 40 && unrolled > 10,
+        "{compact} compact, {unrolled} unrolled"
+    );
 }
 
 fn chain_default(n: usize) -> Model {
@@ -218,4 +314,30 @@ fn unsupported_models_stay_unrolled() {
         form_line(&g.header),
         "Form: unrolled straight-line code (asked for)."
     );
+}
+
+/// A random chain of 500 joints generates in seconds: the form is decided on a prefix of 16
+/// joints, and no unrolled candidate of a function in loops is traced (161 s and 5.6 GB when
+/// they all were; 1.2 s and 34 MB for `kanegen generate` since). The budget is generous for a
+/// shared machine; tracing the unrolled candidates again would exceed it.
+#[test]
+fn a_500_joint_chain_generates_compact_in_seconds() {
+    let model = chain_default(500);
+    let t = std::time::Instant::now();
+    let g = generate_items(&model, &Options::new("Chain500")).unwrap();
+    let s = t.elapsed().as_secs_f64();
+    println!("N = 500: generate_items {s:.2} s");
+    let line = form_line(&g.header);
+    assert!(line.contains("its first 16 joints alone"), "{line}");
+    for f in [
+        "mass_matrix",
+        "nonlinear_effects",
+        "inverse_dynamics",
+        "forward_dynamics",
+        "forward_dynamics_with_wrenches",
+        "mass_matrix_and_nonlinear_effects",
+    ] {
+        assert!(untraced(&g, f), "{f}");
+    }
+    assert!(s < 60.0, "{s} s");
 }

@@ -5,7 +5,7 @@
 //! and the operation counts a compact type reports (`OP_COUNTS`) are what the kernels execute,
 //! counted independently of the tracer by a scalar that counts its own operations.
 
-use kanegen_codegen::compact::kernel_candidate;
+use kanegen_codegen::compact::kernel_counts;
 use kanegen_codegen::compact::tables::{numbers, Numbers};
 use kanegen_codegen::{generate_items, Form, Options};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
@@ -289,7 +289,7 @@ const KERNELS: [Function; 7] = [
 ];
 
 /// A compact type's `OP_COUNTS` entry of a kernel function is the tracer's count of that kernel
-/// (`kernel_candidate`), and that count is what the kernel executes ([`Counted`]); a kernel
+/// (`kernel_counts`), and that count is what the kernel executes ([`Counted`]); a kernel
 /// changed without the counts following fails here.
 fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
     let t = numbers(model, opts);
@@ -298,8 +298,7 @@ fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
         if f == Function::Gravity && opts.gravity.is_none() {
             continue; // no `gravity` function in space
         }
-        let kc = kernel_candidate(model, opts, f).expect("a kernel function");
-        let c = kc.counts;
+        let c = kernel_counts(model, opts, f).expect("a kernel function");
         let ran = counted::<N>(&t, f, opts.runtime_payload);
         assert_eq!(
             [c.mul, c.add, c.div, c.sincos],

@@ -13,10 +13,11 @@
 //!   bias method and the forward-dynamics method ([`ForwardMethod`]: LDLᵀ or the
 //!   articulated-body algorithm) separately.
 //! - [`ldlt`]: the branch-free LDLᵀ of forward dynamics; [`metrics`]: error measures.
-//! - [`scalars`]: research scalars (dual, compensated, double-double, exact rationals), a leaf.
+//! - `scalars` (feature `research`): research scalars (dual, compensated, double-double, exact
+//!   rationals), a leaf.
 //!
-//! The specification is the seed paper as rendered in `paper_en.md`; algorithm files cite its
-//! equation numbers, or RBDA's.
+//! The specification is the seed paper as written out in `docs/paper.md`; algorithm files cite
+//! its equation numbers, or RBDA's.
 //!
 //! ```
 //! use kanegen_dynamics::{Loads, Methods, Params};
@@ -40,6 +41,7 @@ pub mod metrics;
 pub mod params;
 pub mod regroup;
 pub mod scalar;
+#[cfg(feature = "research")]
 pub mod scalars;
 pub mod spatial;
 

@@ -3,7 +3,7 @@
 //! Every product accumulates from zero (`0 + a₀b₀ + a₁b₁ + a₂b₂`: 3 m + 3 a under the paper's
 //! convention) and skew matrices carry literal zeros that are multiplied like any other entry. On
 //! numbers this costs nothing measurable; on the tracer it makes the raw count equal the paper's
-//! bookkeeping, and folding then removes the zeros (see `opcount_findings.md` §1).
+//! bookkeeping, and folding then removes the zeros (see `docs/paper.md`, "Operation counts").
 //!
 //! ```
 //! use kanegen_dynamics::linalg::{Mat3, Vec3};

@@ -6,8 +6,8 @@
 //! assert_eq!(rel_err(&[f64::NAN, 2.0], &[1.0, 2.0]), f64::INFINITY);
 //! ```
 
-use crate::scalar::Real;
-use crate::scalars::wide::Wide;
+#[cfg(feature = "research")]
+use crate::{scalar::Real, scalars::wide::Wide};
 
 /// `max |x − y| / max |y|` over all entries (the project's "relative error"); when `y` is all
 /// zero, the absolute error `max |x − y|`. A non-finite entry in `x` or `y` gives `∞` (a
@@ -46,6 +46,7 @@ pub fn flatten(a: &[Vec<f64>]) -> Vec<f64> {
 
 /// [`rel_err`] of double-double values, the difference taken in double-double so that errors
 /// far below `f64` resolution stay visible (how the reference itself is checked).
+#[cfg(feature = "research")]
 #[must_use]
 pub fn rel_err_wide(x: &[Wide], y: &[Wide]) -> f64 {
     assert_eq!(x.len(), y.len(), "rel_err_wide: lengths differ");

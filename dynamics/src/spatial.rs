@@ -203,11 +203,14 @@ pub struct RbInertia<S> {
 impl<S: Scalar> RbInertia<S> {
     /// spatial_v2 `mcI(m, c, I_c)`: `h = m c`, `Ī = I_c + m c̃ c̃ᵀ` (parallel axes).
     pub fn from_com(m: &S, c: &Vec3<S>, inertia_com: &Mat3<S>) -> Self {
-        let ct = Mat3::skew(c);
         RbInertia {
             m: m.clone(),
             h: c.scale(m),
-            ibar: inertia_com.clone() + ct.mul_mat(&ct.transpose()).scale(m),
+            ibar: Mat3(kanegen_runtime::inertia::parallel_axis(
+                m,
+                &c.0,
+                &inertia_com.0,
+            )),
         }
     }
     /// `I [ω; v] = [Ī ω + h × v; m v − h × ω]`.

@@ -570,9 +570,9 @@ mod count {
 }
 
 /// Raw counts (paper convention) of `A` from base-frame inputs equal the exact polynomial fits of
-/// `opcount_findings.md` §2 and §5 (revolute chains).
+/// the corrected Table 1 and its baselines (`docs/paper.md`, "Operation counts"; revolute chains).
 #[test]
-fn paper_convention_counts_match_opcount_findings() {
+fn paper_convention_counts_match_the_corrected_table() {
     use count::C;
     for n in 2..=10_i64 {
         let ch = chain(n as usize, 0.0, 3);

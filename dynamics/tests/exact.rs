@@ -1,4 +1,4 @@
-//! Exact rational arithmetic as the oracle (issue #6).
+//! Exact rational arithmetic as the oracle.
 //!
 //! At joint angles with rational sine and cosine ([`Exact::pythagorean`]) every algorithm
 //! computes `A` and `b` of the stored model with no rounding at all, so:

@@ -1,4 +1,4 @@
-//! Free-floating base (issue #5): the `(6+N)` equations of motion `A ν̇ = b` of every algorithm
+//! Free-floating base: the `(6+N)` equations of motion `A ν̇ = b` of every algorithm
 //! against Pinocchio's free-flyer mass matrices in `models/space_arms.json`, against each other,
 //! against kinetic energy and momentum computed body by body, momentum conservation under RK4
 //! integration, and the generalized Jacobian identity.

@@ -2856,32 +2856,9 @@ impl SsrmsF32 {
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
-    /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
+    /// elsewhere.
     #[inline(always)]
-    #[allow(unsafe_code)]
     fn mul_add(a: f32, b: f32, c: f32) -> f32 {
-        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-        {
-            use core::arch::x86_64::{_mm_cvtss_f32, _mm_fmadd_ss, _mm_set_ss};
-            unsafe {
-                _mm_cvtss_f32(_mm_fmadd_ss(_mm_set_ss(a), _mm_set_ss(b), _mm_set_ss(c)))
-            }
-        }
-        #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
-        {
-            use core::arch::aarch64::{vdup_n_f32, vfma_f32, vget_lane_f32};
-            unsafe {
-                vget_lane_f32::<0>(vfma_f32(vdup_n_f32(c), vdup_n_f32(a), vdup_n_f32(b)))
-            }
-        }
-        #[cfg(
-            not(
-                any(
-                    all(target_arch = "x86_64", target_feature = "fma"),
-                    all(target_arch = "aarch64", target_feature = "neon")
-                )
-            )
-        )] { a * b + c }
+        kanegen_runtime::fma::mul_add_f32(a, b, c)
     }
 }

@@ -6305,33 +6305,10 @@ impl SsrmsRecurrent {
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
-    /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
+    /// elsewhere.
     #[inline(always)]
-    #[allow(unsafe_code)]
     fn mul_add(a: f64, b: f64, c: f64) -> f64 {
-        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-        {
-            use core::arch::x86_64::{_mm_cvtsd_f64, _mm_fmadd_sd, _mm_set_sd};
-            unsafe {
-                _mm_cvtsd_f64(_mm_fmadd_sd(_mm_set_sd(a), _mm_set_sd(b), _mm_set_sd(c)))
-            }
-        }
-        #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
-        {
-            use core::arch::aarch64::{vdup_n_f64, vfma_f64, vget_lane_f64};
-            unsafe {
-                vget_lane_f64::<0>(vfma_f64(vdup_n_f64(c), vdup_n_f64(a), vdup_n_f64(b)))
-            }
-        }
-        #[cfg(
-            not(
-                any(
-                    all(target_arch = "x86_64", target_feature = "fma"),
-                    all(target_arch = "aarch64", target_feature = "neon")
-                )
-            )
-        )] { a * b + c }
+        kanegen_runtime::fma::mul_add(a, b, c)
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
@@ -6341,185 +6318,11 @@ impl SsrmsRecurrent {
         sc
     }
     /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
-    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
-    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
-    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
-    /// (`kanegen accuracy` measures it).
+    /// call), by the runtime's table sine–cosine: branch-free for `|x| < 32768`,
+    /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
     pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
-        /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
-        const SIN_TABLE: [f64; 128] = [
-            0.0,
-            0.024541228522912288,
-            0.049067674327418015,
-            0.07356456359966743,
-            0.0980171403295606,
-            0.1224106751992162,
-            0.14673047445536175,
-            0.17096188876030122,
-            0.19509032201612828,
-            0.2191012401568698,
-            0.2429801799032639,
-            0.26671275747489837,
-            0.2902846772544624,
-            0.31368174039889146,
-            0.33688985339222005,
-            0.35989503653498817,
-            0.3826834323650898,
-            0.40524131400498986,
-            0.4275550934302821,
-            0.4496113296546066,
-            0.47139673682599764,
-            0.49289819222978404,
-            0.5141027441932218,
-            0.5349976198870973,
-            0.5555702330196022,
-            0.5758081914178453,
-            0.5956993044924334,
-            0.6152315905806268,
-            0.6343932841636455,
-            0.6531728429537768,
-            0.6715589548470184,
-            0.6895405447370669,
-            0.7071067811865476,
-            0.7242470829514669,
-            0.7409511253549591,
-            0.7572088465064846,
-            0.773010453362737,
-            0.7883464276266062,
-            0.8032075314806449,
-            0.8175848131515837,
-            0.8314696123025452,
-            0.8448535652497071,
-            0.8577286100002721,
-            0.8700869911087115,
-            0.881921264348355,
-            0.8932243011955153,
-            0.9039892931234433,
-            0.9142097557035307,
-            0.9238795325112867,
-            0.9329927988347388,
-            0.9415440651830208,
-            0.9495281805930367,
-            0.9569403357322088,
-            0.9637760657954398,
-            0.970031253194544,
-            0.9757021300385286,
-            0.9807852804032304,
-            0.9852776423889412,
-            0.989176509964781,
-            0.99247953459871,
-            0.9951847266721969,
-            0.9972904566786902,
-            0.9987954562051724,
-            0.9996988186962042,
-            1.0,
-            0.9996988186962042,
-            0.9987954562051724,
-            0.9972904566786902,
-            0.9951847266721969,
-            0.99247953459871,
-            0.989176509964781,
-            0.9852776423889412,
-            0.9807852804032304,
-            0.9757021300385286,
-            0.970031253194544,
-            0.9637760657954398,
-            0.9569403357322088,
-            0.9495281805930367,
-            0.9415440651830208,
-            0.9329927988347388,
-            0.9238795325112867,
-            0.9142097557035307,
-            0.9039892931234433,
-            0.8932243011955153,
-            0.881921264348355,
-            0.8700869911087115,
-            0.8577286100002721,
-            0.8448535652497071,
-            0.8314696123025452,
-            0.8175848131515837,
-            0.8032075314806449,
-            0.7883464276266062,
-            0.773010453362737,
-            0.7572088465064846,
-            0.7409511253549591,
-            0.7242470829514669,
-            0.7071067811865476,
-            0.6895405447370669,
-            0.6715589548470184,
-            0.6531728429537768,
-            0.6343932841636455,
-            0.6152315905806268,
-            0.5956993044924334,
-            0.5758081914178453,
-            0.5555702330196022,
-            0.5349976198870973,
-            0.5141027441932218,
-            0.49289819222978404,
-            0.47139673682599764,
-            0.4496113296546066,
-            0.4275550934302821,
-            0.40524131400498986,
-            0.3826834323650898,
-            0.35989503653498817,
-            0.33688985339222005,
-            0.31368174039889146,
-            0.2902846772544624,
-            0.26671275747489837,
-            0.2429801799032639,
-            0.2191012401568698,
-            0.19509032201612828,
-            0.17096188876030122,
-            0.14673047445536175,
-            0.1224106751992162,
-            0.0980171403295606,
-            0.07356456359966743,
-            0.049067674327418015,
-            0.024541228522912288,
-        ];
-        const S3: f64 = -1.0 / 6.0;
-        const S5: f64 = 1.0 / 120.0;
-        const C2: f64 = -0.5;
-        const C4: f64 = 1.0 / 24.0;
-        const C6: f64 = -1.0 / 720.0;
-        let mut fast = true;
-        for v in x {
-            fast &= v > -32768.0 && v < 32768.0;
-        }
-        if !fast {
-            return x.map(libm::sincos);
-        }
-        let (mut t, mut r) = ([0.0; N], [0.0; N]);
-        for i in 0..N {
-            t[i] = Self::mul_add(x[i], 40.74366543152521, 6755399441055744.0);
-            let k = t[i] - 6755399441055744.0;
-            let r_hi = Self::mul_add(-k, 0.024543692605220713, x[i]);
-            r[i] = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
-        }
-        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
-        for i in 0..N {
-            let r2 = r[i] * r[i];
-            let r3 = r[i] * r2;
-            let p_s = Self::mul_add(r2, S5, S3);
-            sin_r[i] = Self::mul_add(r3, p_s, r[i]);
-            let p_c6 = Self::mul_add(r2, C6, C4);
-            let p_c = Self::mul_add(r2, p_c6, C2);
-            cos_r[i] = Self::mul_add(r2, p_c, 1.0);
-        }
-        let table = |j: usize| {
-            f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
-        };
-        let mut out = [(0.0, 0.0); N];
-        for i in 0..N {
-            let j = (t[i].to_bits() & 255) as usize;
-            let (sin_a, cos_a) = (table(j), table(j + 64));
-            out[i] = (
-                Self::mul_add(sin_a, cos_r[i], cos_a * sin_r[i]),
-                Self::mul_add(cos_a, cos_r[i], -(sin_a * sin_r[i])),
-            );
-        }
-        out
+        kanegen_runtime::sincos::sincos_n(x)
     }
 }

@@ -1,17 +1,17 @@
 //! The expansion of `kanegen::scene!`: a simulator specialized at compile time for one scene file
-//! (`kanegen_sim::scene`, the parser the interpreted simulator uses).
+//! (`kanegen_scene`, the parser the interpreted simulator uses as `kanegen_sim::scene`).
 //!
 //! It emits the scene model's generated dynamics ([`kanegen_codegen::generate_items`], type
 //! `NameDynamics`, with the scene's base, gravity and payload), a state type `NameState` and
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
-//! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. Payload captures and releases (`[[events]]`) are in
+//! them, and whose `run` calls the integrators of `kanegen-runtime` (`kanegen::ode`) on the
+//! stack, the code `kanegen_sim::integrate` runs. Payload captures and releases (`[[events]]`) are in
 //! [`crate::scene_events`]: one dynamics type per model phase, a run segment by segment, and the
 //! capture impulse. A scene error is a compile error naming the key and the scene file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
-use kanegen_sim::scene::{BaseSpec, Drives, EventKind, Integrator, Scene, WrenchProfile};
+use kanegen_scene::{BaseSpec, Drives, EventKind, Integrator, Scene, WrenchProfile};
 use proc_macro2::{Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use syn::{Ident, LitStr};
@@ -32,7 +32,7 @@ fn rows(v: &[[f64; 3]]) -> TokenStream {
 }
 
 /// The expression of a wrench's `(force, moment)` at time `t`: constant, or interpolated in
-/// its table (`kanegen::ode::table`, as the interpreted `SceneWrench::value_at`).
+/// its table (`kanegen::ode::table`, which the interpreted `SceneWrench::value_at` calls).
 fn wrench_value(runtime: &syn::Path, profile: &WrenchProfile) -> TokenStream {
     match profile {
         WrenchProfile::Constant { force, moment } => {
@@ -50,7 +50,7 @@ fn wrench_value(runtime: &syn::Path, profile: &WrenchProfile) -> TokenStream {
                 const TIME: [f64; #kl] = #tt;
                 const FORCE: [[f64; 3]; #kl] = #f;
                 const MOMENT: [[f64; 3]; #kl] = #m;
-                #runtime::ode::table(t, &TIME, &FORCE, &MOMENT)
+                #runtime::__private::runtime::ode::table(t, &TIME, &FORCE, &MOMENT)
             }}
         }
     }
@@ -241,7 +241,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 const KD: [f64; #nl] = #kd;
                 const TARGET: [f64; #nl] = #target;
                 const Q0: [f64; #nl] = #q0;
-                let (sq, dsq, ddsq) = #runtime::ode::quintic(t, #d);
+                let (sq, dsq, ddsq) = #runtime::__private::runtime::ode::quintic(t, #d);
                 let cmd: [f64; #nl] = core::array::from_fn(|i| {
                     let di = TARGET[i] - Q0[i];
                     ddsq * di + KD[i] * (dsq * di - qdj[i]) + KP[i] * ((Q0[i] + sq * di) - qj[i])
@@ -297,7 +297,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 let pl = format_ident!("{}_placement", fname);
                 Some(quote!(#dyn_ty::#pl(&s.q).1))
             }
-            (None, true, _) => Some(quote!(#runtime::ode::quat_to_matrix(&[
+            (None, true, _) => Some(quote!(#runtime::__private::runtime::ode::quat_to_matrix(&[
                 s.q[3], s.q[4], s.q[5], s.q[6]
             ]))),
             (None, false, _) => return Err(format!("{rel}: effects.wrench[{k}]: no frame")),
@@ -367,7 +367,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 for i in 0..#nl {
                     m[#off + i][#off + i] += ROTOR[i];
                 }
-                #runtime::ode::solve_spd(&m, &b).unwrap_or([f64::NAN; #nvl])
+                #runtime::__private::runtime::ode::solve_spd(&m, &b).unwrap_or([f64::NAN; #nvl])
             }}
         } else if scene.wrenches.is_empty() {
             quote!(#dy::forward_dynamics(&s.q, &s.#vname, &tau))
@@ -421,7 +421,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     } else if floating {
         quote! {
             let a = #accel;
-            let r = #runtime::ode::quat_to_matrix(&[s.q[3], s.q[4], s.q[5], s.q[6]]);
+            let r = #runtime::__private::runtime::ode::quat_to_matrix(&[s.q[3], s.q[4], s.q[5], s.q[6]]);
             let (u, w, om) = ([s.q[3], s.q[4], s.q[5]], s.q[6], [s.v[3], s.v[4], s.v[5]]);
             let mut dq = [0.0f64; #nql];
             for i in 0..3 {
@@ -471,48 +471,39 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         .concat(),
     };
     let (q0, v0) = (arr(&x0[..nq]), arr(&x0[nq..nq + nv]));
-    let project = if floating {
-        quote!(#runtime::ode::normalize_quaternion::<#dim>)
-    } else {
-        quote!(|_: &mut [f64; #dim]| {})
+    let ode = quote!(#runtime::__private::runtime::ode);
+    // The scratch of `run` (of the scene's method) and of `step` (RK4 for a dopri5 scene), on
+    // the stack, sized by the runtime for this state.
+    let (run_mod, step_mod, step_fn) = match sim.integrator {
+        Integrator::Rk4 => ("rk4", "rk4", "rk4_step"),
+        Integrator::Dopri5 => ("dopri5", "rk4", "rk4_step"),
+        Integrator::Midpoint => ("midpoint", "midpoint", "midpoint_step"),
+        Integrator::Rosenbrock => ("rosenbrock", "rosenbrock", "rosenbrock_step"),
     };
-    let advance = if floating {
-        quote!(#runtime::ode::advance_floating::<#dim>)
-    } else {
-        quote!(#runtime::ode::advance_additive::<#dim>)
-    };
-    let step_body = if sim.integrator == Integrator::Rosenbrock {
-        quote! {
-            let mut stats = #runtime::ode::Stats::default();
-            let x = #runtime::ode::rosenbrock_step(&mut f, t, &state.to_array(), h, &mut stats)?;
-        }
-    } else if sim.integrator == Integrator::Midpoint {
-        quote! {
-            let mut stats = #runtime::ode::Stats::default();
-            let x = #runtime::ode::midpoint_step(
-                &mut f, #advance, t, &state.to_array(), h, &mut stats,
-            )?;
-        }
-    } else {
-        let first = if floating {
-            quote! {
-                let mut x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);
-                #runtime::ode::normalize_quaternion(&mut x);
-            }
+    let scratch = |module: &str| {
+        let module = format_ident!("{module}");
+        let pivots = if module == "rosenbrock" {
+            dim.clone()
         } else {
-            quote!(let x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);)
+            Literal::usize_unsuffixed(0)
         };
+        quote!(#ode::ArrayScratch::<{ #ode::#module::scratch_len(#dim) }, #pivots>::new())
+    };
+    let (run_scratch, step_scratch) = (scratch(run_mod), scratch(step_mod));
+    let step_fn = format_ident!("{step_fn}");
+    // The scene's right-hand side `rhs(args…, t, state)` as an `ode::System` (the quaternion
+    // projected and advanced by the exponential map on a free-floating base).
+    let system = |rhs: TokenStream, args: TokenStream| {
         quote! {
-            #first
-            if let Some(index) = x.iter().position(|v| !v.is_finite()) {
-                return Err(#runtime::ode::Stop::NonFinite {
-                    t: t + h,
-                    index,
-                    stats: #runtime::ode::Stats { steps: 0, rejected_steps: 0, evals: 4 },
-                });
+            #ode::FnSystem::<#dim, _> {
+                rhs: |t: f64, x: &[f64; #dim]| {
+                    #rhs(#args t, &#state_ty::from_array(x)).to_array()
+                },
+                floating: #floating,
             }
         }
     };
+    let step_system = system(quote!(Self::rhs), quote!());
     let (duration, step, tolerance, max_step) = (
         lit(sim.duration),
         lit(sim.step),
@@ -520,49 +511,36 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         lit(sim.max_step),
     );
     let every = Literal::usize_unsuffixed(sim.output_every);
-    let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| match sim.integrator {
-        Integrator::Dopri5 | Integrator::Rosenbrock => {
-            let method = if sim.integrator == Integrator::Dopri5 {
-                format_ident!("dopri5")
-            } else {
-                format_ident!("rosenbrock")
-            };
-            quote! {
-                let opts = #runtime::ode::Dopri5Options {
-                    tolerance: Self::TOLERANCE,
-                    max_step: #max_step,
-                    initial_step: Self::STEP,
-                    output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
-                };
-                #runtime::ode::#method(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
+    let run_fn = format_ident!("{run_mod}");
+    let options = if matches!(sim.integrator, Integrator::Rk4 | Integrator::Midpoint) {
+        quote! {
+            #ode::Rk4Options {
+                step: Self::STEP,
+                output_every: Self::OUTPUT_EVERY,
             }
         }
-        Integrator::Rk4 => quote! {
-            let opts = #runtime::ode::Rk4Options {
-                step: Self::STEP,
-                output_every: Self::OUTPUT_EVERY,
-            };
-            #runtime::ode::rk4(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
-        },
-        Integrator::Midpoint => quote! {
-            let opts = #runtime::ode::Rk4Options {
-                step: Self::STEP,
-                output_every: Self::OUTPUT_EVERY,
-            };
-            #runtime::ode::midpoint(&mut f, #advance, #t0, #t1, &opts, &mut x, #obs)
-        },
+    } else {
+        quote! {
+            #ode::Dopri5Options {
+                tolerance: Self::TOLERANCE,
+                max_step: #max_step,
+                initial_step: Self::STEP,
+                output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
+            }
+        }
     };
+    let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| quote!(#ode::#run_fn(&mut sys, #t0, #t1, &#options, &mut x, &mut scratch, #obs));
     let run_body = if scene.events.is_empty() {
         let call = integrate(quote!(0.0), quote!(Self::DURATION), quote!(obs));
+        let sys = system(quote!(Self::rhs), quote!());
         quote! {
-            let mut f = |t: f64, x: &[f64; #dim]| {
-                Self::rhs(t, &#state_ty::from_array(x)).to_array()
-            };
+            let mut sys = #sys;
             #call
         }
     } else {
         let call = integrate(quote!(t0), quote!(t1), quote!(&mut obs));
-        crate::scene_events::run_segments(runtime, &state_ty, &dim, &call)
+        let sys = system(quote!(Self::rhs_in), quote!(phase,));
+        crate::scene_events::run_segments(runtime, &state_ty, &sys, &call)
     };
     let events =
         crate::scene_events::event_items(runtime, &scene, &state_ty, &dyn_ty, &phase_tys, nv, n);
@@ -812,11 +790,9 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 t: f64,
                 state: &mut #state_ty,
                 h: f64,
-            ) -> Result<(), #runtime::ode::Stop> {
-                let mut f = |t: f64, x: &[f64; #dim]| {
-                    Self::rhs(t, &#state_ty::from_array(x)).to_array()
-                };
-                #step_body
+            ) -> Result<(), #runtime::__private::runtime::ode::Stop> {
+                let mut x = state.to_array();
+                #ode::#step_fn(&mut #step_system, t, h, &mut x, &mut #step_scratch)?;
                 *state = #state_ty::from_array(&x);
                 Ok(())
             }
@@ -831,10 +807,15 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             /// sample up to there.
             pub fn run(
                 mut observe: impl FnMut(f64, &#state_ty),
-            ) -> Result<#runtime::ode::Stats, #runtime::ode::Stop> {
+            ) -> Result<#runtime::__private::runtime::ode::Stats, #runtime::__private::runtime::ode::Stop> {
                 let mut x = Self::initial_state().to_array();
+                let mut scratch = #run_scratch;
                 #[allow(unused_mut)]
-                let mut obs = |t: f64, x: &[f64; #dim]| observe(t, &#state_ty::from_array(x));
+                let mut obs = |t: f64, x: &[f64]| {
+                    if let Ok(x) = <&[f64; #dim]>::try_from(x) {
+                        observe(t, &#state_ty::from_array(x));
+                    }
+                };
                 #run_body
             }
 

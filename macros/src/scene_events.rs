@@ -5,7 +5,7 @@
 //! after and the generated Jacobian and placement of a frame at the payload's centre of mass.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Model};
-use kanegen_sim::scene::{BaseSpec, EventKind, Scene};
+use kanegen_scene::{BaseSpec, EventKind, Scene};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 use syn::Ident;
@@ -63,16 +63,17 @@ pub fn phase_dynamics(
     Ok((tys, items))
 }
 
-/// The body of `run` for a scene with events: one integration (`call`, from `t0` to `t1` with
-/// `f` and `x`) per segment between the event times, the event applied between segments.
+/// The body of `run` for a scene with events: one integration (`call`, from `t0` to `t1` of
+/// `sys`, the system of `phase`, with `x`) per segment between the event times, the event
+/// applied between segments.
 pub fn run_segments(
     runtime: &syn::Path,
     state_ty: &Ident,
-    dim: &Literal,
+    sys: &TokenStream,
     call: &TokenStream,
 ) -> TokenStream {
     quote! {
-        let mut stats = #runtime::ode::Stats::default();
+        let mut stats = #runtime::__private::runtime::ode::Stats::default();
         let mut t0 = 0.0;
         for phase in 0..=Self::EVENT_TIMES.len() {
             let t1 = if phase < Self::EVENT_TIMES.len() {
@@ -85,13 +86,8 @@ pub fn run_segments(
                 Self::apply_event(phase - 1, &mut st);
                 x = st.to_array();
             }
-            let mut f = |t: f64, x: &[f64; #dim]| {
-                Self::rhs_in(phase, t, &#state_ty::from_array(x)).to_array()
-            };
-            let s = { #call }?;
-            stats.steps += s.steps;
-            stats.rejected_steps += s.rejected_steps;
-            stats.evals += s.evals;
+            let mut sys = #sys;
+            stats.accumulate(#call?);
             t0 = t1;
         }
         Ok(stats)
@@ -176,7 +172,7 @@ pub fn event_items(
                         }
                         x
                     });
-                    s.v = #runtime::ode::solve_spd(&h_new, &p).unwrap_or([f64::NAN; #nvl]);
+                    s.v = #runtime::__private::runtime::ode::solve_spd(&h_new, &p).unwrap_or([f64::NAN; #nvl]);
                 })
             }
         }

@@ -29,7 +29,9 @@ pub struct Inertial {
     pub inertia: M3,
 }
 
-/// `m (|c|² 1 − c cᵀ)`: the parallel-axis term of a point mass `m` at `c`.
+/// `m (|c|² 1 − c cᵀ)`: the parallel-axis term of a point mass `m` at `c` (Steiner's theorem),
+/// the model's one, in `f64` ([`Inertial::merge`]; the traced algorithms shift by
+/// `kanegen_runtime::inertia::parallel_axis`, in the operations of `m c̃ c̃ᵀ`).
 #[must_use]
 pub fn steiner(m: f64, c: &V3) -> M3 {
     let n2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
@@ -64,11 +66,10 @@ impl Inertial {
         let mut inertia = [[0.0; 3]; 3];
         for part in [a, b] {
             let d: V3 = core::array::from_fn(|k| part.com[k] - c[k]);
-            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let shift = steiner(part.mass, &d);
             for r in 0..3 {
                 for s in 0..3 {
-                    let e = if r == s { d2 } else { 0.0 };
-                    inertia[r][s] += part.inertia[r][s] + part.mass * (e - d[r] * d[s]);
+                    inertia[r][s] += part.inertia[r][s] + shift[r][s];
                 }
             }
         }
@@ -182,9 +183,102 @@ pub fn validate_inertial_with(
     Ok(())
 }
 
-/// Eigenvalues of a symmetric 3×3 matrix.
+/// Eigenvalues of a symmetric 3×3 matrix, ascending: the cyclic Jacobi method (Golub and Van
+/// Loan, *Matrix Computations*, Algorithm 8.5.3). Each rotation zeroes one off-diagonal pair
+/// and keeps the matrix symmetric with the same eigenvalues; the sweeps converge quadratically
+/// (four to six in practice) and stop once the off-diagonal part is below rounding of the whole,
+/// so every eigenvalue is within a few ulps of the matrix norm.
 fn sym3_eigenvalues(m: &M3) -> [f64; 3] {
-    let mat = nalgebra::Matrix3::from_fn(|r, c| m[r][c]);
-    let e = mat.symmetric_eigenvalues();
-    [e[0], e[1], e[2]]
+    let mut a = *m;
+    let norm2: f64 = a.iter().flatten().map(|x| x * x).sum();
+    for _ in 0..MAX_JACOBI_SWEEPS {
+        let off2 = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        if off2 <= f64::EPSILON * f64::EPSILON * norm2 {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            // The rotation J (c at pp and qq, s at pq, −s at qp) with (JᵀAJ)_pq = 0, its
+            // tangent the smaller root of t² + 2τt − 1 = 0.
+            let tau = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = tau.signum() / (tau.abs() + tau.hypot(1.0));
+            let c = 1.0 / t.hypot(1.0);
+            let s = t * c;
+            for row in &mut a {
+                let (kp, kq) = (row[p], row[q]);
+                row[p] = c * kp - s * kq;
+                row[q] = s * kp + c * kq;
+            }
+            let (rp, rq) = (a[p], a[q]);
+            a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
+            a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
+        }
+    }
+    let mut ev = [a[0][0], a[1][1], a[2][2]];
+    ev.sort_by(f64::total_cmp);
+    ev
+}
+
+/// Most Jacobi sweeps [`sym3_eigenvalues`] makes (it needs at most six on a finite matrix).
+const MAX_JACOBI_SWEEPS: usize = 32;
+
+#[cfg(test)]
+mod tests {
+    use super::sym3_eigenvalues;
+    use proptest::prelude::*;
+
+    /// `R diag(d) Rᵀ` for the rotation by `angle` about the (unnormalized) `axis`.
+    fn with_eigenvalues(d: [f64; 3], axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+        let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let [x, y, z] = axis.map(|v| v / n);
+        let (s, c) = angle.sin_cos();
+        let k = 1.0 - c;
+        let r = [
+            [c + x * x * k, x * y * k - z * s, x * z * k + y * s],
+            [y * x * k + z * s, c + y * y * k, y * z * k - x * s],
+            [z * x * k - y * s, z * y * k + x * s, c + z * z * k],
+        ];
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..3).map(|k| r[i][k] * d[k] * r[j][k]).sum())
+        })
+    }
+
+    #[test]
+    fn diagonal_and_repeated() {
+        assert_eq!(
+            sym3_eigenvalues(&[[3.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]]),
+            [1.0, 2.0, 3.0]
+        );
+        let ev = sym3_eigenvalues(&with_eigenvalues([2.0, 2.0, 2.0], [1.0, 2.0, 3.0], 0.7));
+        for e in ev {
+            assert!((e - 2.0).abs() < 1e-14, "{ev:?}");
+        }
+    }
+
+    proptest! {
+        /// The eigenvalues of a turned diagonal matrix, to a few ulps of its trace, and the
+        /// same as nalgebra's symmetric eigen-solver.
+        #[test]
+        fn recovers_eigenvalues(
+            d in prop::array::uniform3(1e-3f64..1e3),
+            axis in prop::array::uniform3(-1.0f64..1.0),
+            angle in -3.0f64..3.0,
+        ) {
+            prop_assume!(axis.iter().map(|v| v * v).sum::<f64>() > 1e-6);
+            let m = with_eigenvalues(d, axis, angle);
+            let got = sym3_eigenvalues(&m);
+            let mut want = d;
+            want.sort_by(f64::total_cmp);
+            let tol = 1e-13 * (d[0] + d[1] + d[2]);
+            let mut na: Vec<f64> =
+                nalgebra::Matrix3::from_fn(|r, c| m[r][c]).symmetric_eigenvalues().iter().copied().collect();
+            na.sort_by(f64::total_cmp);
+            for k in 0..3 {
+                prop_assert!((got[k] - want[k]).abs() <= tol, "{got:?} vs {want:?}");
+                prop_assert!((got[k] - na[k]).abs() <= tol, "{got:?} vs nalgebra {na:?}");
+            }
+        }
+    }
 }

@@ -8,7 +8,8 @@
 //!   [`Placement`]); built only through [`Model::new`], which validates every number.
 //! - [`io`]: URDF and kanegen's TOML format in, TOML out.
 //! - [`Inertial::merge`]: the one parallel-axis merge (fixed links, locked joints, payloads).
-//! - [`random`]: seeded random chains, trees and states for tests, benchmarks and traces.
+//! - `random` (feature `random`): seeded random chains, trees and states for tests, benchmarks
+//!   and traces.
 //! - [`bounds`]: the magnitude bounds every reader checks, so products stay finite.
 //! - [`canonical`]: the same robot in frames that make its dynamics cheap (every axis `z`).
 //!
@@ -35,6 +36,7 @@ pub mod io;
 mod lock;
 mod model;
 pub mod placement;
+#[cfg(feature = "random")]
 pub mod random;
 
 pub use inertial::{validate_inertial, validate_inertial_with, Inertial};

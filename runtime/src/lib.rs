@@ -8,6 +8,11 @@
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
 //! - [`compact`]: the compact form's kernels (CRBA, RNEA, ABA as loops over a model's tables).
+//! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
+//!   midpoint rule) over slices with caller-provided scratch, for the simulator and `scene!`.
+//! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
+//! - [`ldlt`]: LDLᵀ factorization and solve over slices, allocating nothing.
+//! - [`inertia`]: the parallel-axis shift of a rigid body's inertia.
 #![no_std]
 #![warn(missing_docs)]
 
@@ -15,6 +20,11 @@
 extern crate std;
 
 pub mod compact;
+pub mod fma;
+pub mod inertia;
+pub mod ldlt;
+pub mod ode;
 pub mod scalar;
+pub mod sincos;
 
 pub use scalar::{Real, Scalar, Symbolic};

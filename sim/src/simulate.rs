@@ -10,8 +10,6 @@
 //! ([`System::advance`]) and needs no projection.
 
 use crate::events::{self, CaptureSystem, EventReport};
-use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, Stats, System};
-use crate::rosenbrock::rosenbrock;
 use crate::scene::{
     BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
 };
@@ -23,6 +21,9 @@ use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::{ForwardMethod, FrameParams, Loads, Params};
+use kanegen_runtime::ode::{
+    self, quaternion, Dopri5Options, Rk4Options, Stats, Stop, System, VecScratch,
+};
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
@@ -74,16 +75,8 @@ struct FastPath {
     acc: Vec<f64>,
 }
 
-/// Quintic time scaling `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` and its first two derivatives, `τ ∈ [0, 1]`.
-fn quintic(tau: f64) -> (f64, f64, f64) {
-    let t = tau.clamp(0.0, 1.0);
-    let s = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t);
-    let ds = 30.0 * t * t * (1.0 - t) * (1.0 - t);
-    let dds = 60.0 * t * (1.0 - t) * (1.0 - 2.0 * t);
-    (s, ds, dds)
-}
-
-/// The desired trajectory of a computed-torque drive at `t`: `(q_d, q̇_d, q̈_d)`.
+/// The desired trajectory of a computed-torque drive at `t`: `(q_d, q̇_d, q̈_d)` along the
+/// quintic time scaling ([`ode::quintic`]).
 #[must_use]
 pub fn quintic_reference(
     q0: &[f64],
@@ -91,12 +84,7 @@ pub fn quintic_reference(
     duration: f64,
     t: f64,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let (s, ds, dds) = quintic(t / duration);
-    let (ds, dds) = if t >= duration {
-        (0.0, 0.0)
-    } else {
-        (ds / duration, dds / (duration * duration))
-    };
+    let (s, ds, dds) = ode::quintic(t, duration);
     let d: Vec<f64> = q0.iter().zip(target).map(|(a, b)| b - a).collect();
     (
         q0.iter().zip(&d).map(|(a, di)| a + s * di).collect(),
@@ -427,7 +415,7 @@ impl<'a> SceneSystem<'a> {
 
     /// Linear and angular momentum (inertial frame, about the inertial origin) of a free-floating
     /// system; `None` on a fixed base. With `[effects] rotor` this is the momentum of the bodies,
-    /// which the armature model conserves (see [`crate::events`] and README, "rotor").
+    /// which the armature model conserves (see [`crate::events`] and `docs/scenes.md`, "What the simulator does").
     #[must_use]
     pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let (q, qd, st) = self.split(x);
@@ -666,34 +654,13 @@ impl System for SceneSystem<'_> {
         }
     }
 
-    /// Additive, except the quaternion: `quat ⊗ exp(h ω_b(at) / 2)` (exponential map, unit by
-    /// construction; symmetric in `h`).
+    /// Additive, except the quaternion on a free-floating base: `quat ⊗ exp(h ω_b(at) / 2)`
+    /// ([`quaternion::advance_floating`]).
     fn advance(&self, x: &[f64], h: f64, at: &[f64], f: &[f64], out: &mut [f64]) {
-        for i in 0..out.len() {
-            out[i] = x[i] + h * f[i];
-        }
         if self.base.is_some() {
-            let n = self.n;
-            let om = [at[10 + n], at[11 + n], at[12 + n]];
-            let w_norm = om.iter().map(|v| v * v).sum::<f64>().sqrt();
-            let half = 0.5 * h * w_norm;
-            // sin(half)/|ω|, with its limit h/2 at ω = 0.
-            let s = if half.abs() < 1e-8 {
-                0.5 * h * (1.0 - half * half / 6.0)
-            } else {
-                half.sin() / w_norm
-            };
-            let (rho, rw) = ([s * om[0], s * om[1], s * om[2]], half.cos());
-            let (u, w) = ([x[3], x[4], x[5]], x[6]);
-            let cross = [
-                u[1] * rho[2] - u[2] * rho[1],
-                u[2] * rho[0] - u[0] * rho[2],
-                u[0] * rho[1] - u[1] * rho[0],
-            ];
-            for i in 0..3 {
-                out[3 + i] = w * rho[i] + rw * u[i] + cross[i];
-            }
-            out[6] = w * rw - (u[0] * rho[0] + u[1] * rho[1] + u[2] * rho[2]);
+            quaternion::advance_floating(x, h, at, f, out);
+        } else {
+            quaternion::advance_additive(x, h, f, out);
         }
     }
 
@@ -703,8 +670,7 @@ impl System for SceneSystem<'_> {
 
     fn project(&self, x: &mut [f64]) {
         if self.base.is_some() {
-            let norm = x[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
-            x[3..7].iter_mut().for_each(|v| *v /= norm);
+            quaternion::normalize_quaternion(x);
         }
     }
 }
@@ -1004,7 +970,8 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     let mut stats = Stats::default();
     let mut reports = Vec::new();
     let mut t0 = 0.0;
-    let mut result: Result<(), IntegrateError> = Ok(());
+    let mut result: Result<(), Stop> = Ok(());
+    let mut scratch = VecScratch::default();
     for (seg, &t1) in ends.iter().enumerate() {
         if seg > 0 {
             let event = events[seg - 1];
@@ -1023,11 +990,11 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
             }
             reports.push(report);
         }
-        let segment = integrate_segment(&mut sys, sim, t0, t1, &mut x, &mut record);
+        let segment = integrate_segment(&mut sys, sim, (t0, t1), &mut x, &mut scratch, &mut record);
         match segment {
-            Ok(s) => accumulate(&mut stats, s),
+            Ok(s) => stats.accumulate(s),
             Err(e) => {
-                accumulate(&mut stats, e.stats());
+                stats.accumulate(e.stats());
                 result = Err(e);
                 break;
             }
@@ -1039,8 +1006,8 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
         Ok(()) => (sim.duration, None),
         Err(e) => {
             let why = match e {
-                IntegrateError::Interrupted { .. } => "interrupted".to_string(),
-                IntegrateError::NonFinite { t, index, .. } => format!(
+                Stop::Interrupted { .. } => "interrupted".to_string(),
+                Stop::NonFinite { t, index, .. } => format!(
                     "`{}` became non-finite in the step to t = {t} (the state overflowed: a \
                      singular mass matrix or an unstable drive)",
                     sys.component_name(*index)
@@ -1087,47 +1054,32 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     })
 }
 
-fn accumulate(total: &mut Stats, s: Stats) {
-    total.steps += s.steps;
-    total.rejected_steps += s.rejected_steps;
-    total.evals += s.evals;
-}
-
-/// Integrates `sys` from `t0` to `t1` (ending exactly at `t1`) with the scene's integrator,
-/// sampling through `record` as [`simulate_to`] describes (the segment's first and last states
-/// included).
+/// Integrates `sys` from `t0` to `t1` (ending exactly at `t1`) with the scene's integrator
+/// ([`kanegen_runtime::ode`], in `scratch`), sampling through `record` as [`simulate_to`]
+/// describes (the segment's first and last states included).
 fn integrate_segment(
     sys: &mut SceneSystem<'_>,
     sim: &SimulationSpec,
-    t0: f64,
-    t1: f64,
+    (t0, t1): (f64, f64),
     x: &mut [f64],
+    scratch: &mut VecScratch,
     record: &mut impl FnMut(f64, &[f64]) -> ControlFlow<()>,
-) -> Result<Stats, IntegrateError> {
-    let total = (((t1 - t0) / sim.step) - 1e-9).ceil().max(1.0) as usize;
-    let mut every = |k: usize, t: f64, x: &[f64]| {
-        if k.is_multiple_of(sim.output_every) || k == total {
-            record(t, x)
-        } else {
-            ControlFlow::Continue(())
-        }
+) -> Result<Stats, Stop> {
+    let fixed = Rk4Options {
+        step: sim.step,
+        output_every: sim.output_every,
+    };
+    let adaptive = Dopri5Options {
+        tolerance: sim.tolerance,
+        max_step: sim.max_step,
+        initial_step: sim.step,
+        output_interval: sim.step * sim.output_every as f64,
     };
     match sim.integrator {
-        Integrator::Rk4 => rk4(sys, t0, t1, sim.step, x, &mut every),
-        Integrator::Midpoint => midpoint(sys, t0, t1, sim.step, x, &mut every),
-        Integrator::Dopri5 | Integrator::Rosenbrock => {
-            let opts = Dopri5Options {
-                tolerance: sim.tolerance,
-                max_step: sim.max_step,
-                initial_step: sim.step,
-                output_interval: sim.step * sim.output_every as f64,
-            };
-            if sim.integrator == Integrator::Dopri5 {
-                dopri5(sys, t0, t1, &opts, x, record)
-            } else {
-                rosenbrock(sys, t0, t1, &opts, x, record)
-            }
-        }
+        Integrator::Rk4 => ode::rk4(sys, t0, t1, &fixed, x, scratch, record),
+        Integrator::Midpoint => ode::midpoint(sys, t0, t1, &fixed, x, scratch, record),
+        Integrator::Dopri5 => ode::dopri5(sys, t0, t1, &adaptive, x, scratch, record),
+        Integrator::Rosenbrock => ode::rosenbrock(sys, t0, t1, &adaptive, x, scratch, record),
     }
 }
 

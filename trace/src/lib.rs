@@ -3,8 +3,9 @@
 //! The third stage of kanegen's pipeline: the counting symbolic scalar [`Sym`], the one entry
 //! point [`trace`] that records a function of a model's dynamics as an expression graph, and what
 //! is read off such graphs: operation counts under three conventions ([`Convention`]), the
-//! `kanegen count` report ([`count`]), the paper's Table 1 ([`table1`]) and the exact polynomial
-//! fitter it uses ([`poly`]). The code generator emits the same graphs.
+//! `kanegen count` report ([`count`]), and, with the feature `table1`, the paper's Table 1
+//! (`table1`) and the exact polynomial fitter it uses (`poly`). The code generator emits the
+//! same graphs.
 //!
 //! ```
 //! use kanegen_dynamics::Methods;
@@ -20,9 +21,11 @@
 pub mod count;
 mod entry;
 mod function;
+#[cfg(feature = "table1")]
 pub mod poly;
 mod spec;
 pub mod sym;
+#[cfg(feature = "table1")]
 pub mod table1;
 
 pub use entry::{trace, TraceError, Traced};

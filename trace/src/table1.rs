@@ -2,7 +2,7 @@
 //!
 //! Each algorithm's mass-matrix part is traced on [`Sym`] for `N = 1..=12` over chains with general
 //! geometry and inertia: the base-frame inputs `r_{j−1,j}`, `a_j`, `m_j`, `c_j`, `I_j` (the paper's
-//! Table 1 starts from them, `opcount_findings.md` §1) are all independent symbolic inputs, so no
+//! Table 1 starts from them, `docs/paper.md`, "Operation counts") are all independent symbolic inputs, so no
 //! count depends on a particular model's zeros. The `spatial` algorithm works in local frames and
 //! is traced from `q` with every model parameter symbolic, so its count includes the kinematics.
 //!
@@ -388,7 +388,7 @@ pub fn build(traces: &BTreeMap<TableAlgorithm, Vec<TraceCounts>>) -> Table1 {
             folded: MulAdd::fitted(&f.0, &f.1),
             emitted: MulAdd::fitted(&e.0, &e.1),
             agree: None,
-            note: "the printed scalar form of (14b) is not an identity for N ≥ 3 (paper_en.md R6); this O(N) term makes it exact".into(),
+            note: "the printed scalar form of (14b) is not an identity for N ≥ 3 (docs/paper.md, R6); this O(N) term makes it exact".into(),
         });
     }
 

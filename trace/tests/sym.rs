@@ -1,5 +1,5 @@
 //! Tests of the counting symbolic scalar `Sym`: folding, hash-consing, sign normalisation,
-//! the three counting conventions on the primitives of `opcount_findings.md` §1, sections,
+//! the three counting conventions on the primitives of `docs/paper.md` ("Operation counts"), sections,
 //! evaluation and misuse panics.
 
 use kanegen_dynamics::linalg::{Mat3, Vec3};
@@ -163,7 +163,7 @@ fn sign_normalisation() {
 }
 
 // ------------------------------------------------------------------------------------------
-// The primitives of opcount_findings.md §1.
+// The primitives of the paper's counting convention (docs/paper.md, "Operation counts").
 
 #[test]
 fn skew_skew_product() {

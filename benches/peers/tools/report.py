@@ -223,7 +223,7 @@ L.append("kanegen: `cargo build --release` of the bench crate with **one** `dyna
          "(forward_dynamics_with_wrenches is generated but not compiled: unused). `check` = `cargo check "
          "--release` of the same crate (expansion + type check, no LLVM). native = `-C target-cpu=native` "
          "build with two `dynamics!` (plain and fma). CasADi: tracing + codegen (`pin_casadi_gen`, all "
-         "functions of one model) and gcc -O3 -march=native of the generated `.c`. Issue targets for one "
+         "functions of one model) and gcc -O3 -march=native of the generated `.c`. Targets for one "
          "`dynamics!`: ≤ 15 s at N = 32, ≤ 40 s at N = 64.\n")
 L.append("| model | n | kanegen build | kanegen check | kanegen clean | kanegen native (2×) | CasADi trace+codegen | gcc cse | gcc cse_nocontract |")
 L.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|")

@@ -2,11 +2,12 @@
 //! and convention, and what each of a scene's effects adds (traced by `kanegen_trace::count`).
 
 use crate::scene_spec;
+use kanegen_codegen::choose::candidates;
 use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, Model};
 use kanegen_sim::scene::{BaseSpec, Scene};
 use kanegen_trace::count::{count_lines, effect_lines, CountLine, EffectLine};
-use kanegen_trace::{Base, Spec, TraceError};
+use kanegen_trace::{Base, Function, Spec, TraceError};
 use serde::Serialize;
 use std::path::Path;
 
@@ -33,6 +34,22 @@ pub struct CountReport {
 /// operation (2.3 M operations, 0.23 GB at N = 100; about 30 GB at N = 500). `--algorithm
 /// kane-direct` still counts them.
 pub const DIRECT_MAX_N: usize = 100;
+
+/// Every pair of methods the generator may emit a function of `model` by
+/// ([`kanegen_codegen::choose::candidates`] of `M` and of `c`): on a chain every mass-matrix and
+/// every bias method, `newton-euler` included; on a tree the local-frame ones (`crba`; `rnea`,
+/// `newton-euler`).
+#[must_use]
+pub fn emittable(model: &Model) -> Vec<Methods> {
+    let chain = model.is_chain();
+    let mut all = candidates(Function::MassMatrix, MassMatrixMethod::Crba, chain);
+    for m in candidates(Function::NonlinearEffects, MassMatrixMethod::Crba, chain) {
+        if !all.contains(&m) {
+            all.push(m);
+        }
+    }
+    all
+}
 
 /// The methods of a selection of presets, each listed once, in report order.
 fn methods_of(presets: &[Methods]) -> (Vec<MassMatrixMethod>, Vec<BiasMethod>) {

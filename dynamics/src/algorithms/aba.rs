@@ -615,9 +615,9 @@ pub fn floating_in<S: Scalar>(
     const B: usize = FLOATING_BASE_DOF;
     let mut m6: [S; B * B] = core::array::from_fn(|k| ang_lin(k / B, k % B));
     let mut d_inv: [S; B] = core::array::from_fn(|_| S::zero());
-    crate::ldlt::factor_in_place(&mut m6, B, &mut d_inv);
+    crate::ldlt::factor_in_place(&mut m6, B, &mut d_inv).expect("6 × 6 buffers");
     let mut x = crate::spatial::base_rows(&pa0).map(|x| -x);
-    crate::ldlt::solve_in_place(&m6, B, &d_inv, &mut x);
+    crate::ldlt::solve_in_place(&m6, B, &d_inv, &mut x).expect("6 × 6 buffers");
     let [x0, x1, x2, x3, x4, x5] = x;
     let a0 = Motion {
         ang: Vec3::new(x3, x4, x5),

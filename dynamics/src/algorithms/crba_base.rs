@@ -1,5 +1,5 @@
 //! The composite-rigid-body algorithm (Stepanenko's method, the CRBA) in the paper's base-frame
-//! notation: the comparison baseline of `opcount_findings.md` §5.
+//! notation: the comparison baseline of Table 1 (Stepanenko's method, `docs/paper.md`).
 //!
 //! It starts from the same base-frame inputs as the recurrent algorithm ([`BodyKinematics`]:
 //! `r_{j-1,j}`, `a_j`, `m_j`, `c_j`, `I_j` about `O_j`) and the same reference points `O_i`.

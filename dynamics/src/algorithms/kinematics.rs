@@ -21,6 +21,7 @@ use crate::loads::{LoadFrame, Loads};
 use crate::params::Params;
 use crate::scalar::Scalar;
 use kanegen_model::JointKind;
+use kanegen_runtime::inertia::parallel_axis;
 
 /// Position-level quantities of one body in the base frame.
 #[derive(Clone, Debug)]
@@ -64,9 +65,8 @@ pub fn body_inertia_about_origin<S: Scalar>(
 ) -> (Vec3<S>, Mat3<S>) {
     let c = d.scale(m);
     // m(|d|²1 − d dᵀ) = m d̃ d̃ᵀ (parallel-axis theorem).
-    let sd = Mat3::skew(d);
-    let shift = sd.mul_mat(&sd.transpose()).scale(m);
-    (c, inertia_com.clone() + shift)
+    let inertia = parallel_axis(m, &d.0, &inertia_com.0);
+    (c, Mat3(inertia))
 }
 
 /// Eq. (1), (2), (6): orientations, joint-to-joint vectors, axes and inertial quantities of every

@@ -1,6 +1,6 @@
 //! The paper's recurrent algorithm: `A(q)` by (12)–(16), (20) and `b(q, q̇)` by (17)–(19), (21).
 //!
-//! Read this file beside `paper_en.md` §4. Every block cites its equation and opens a tracer
+//! Read this file beside `docs/paper.md`, "The recurrent algorithm". Every block cites its equation and opens a tracer
 //! section with the same label (`S::section("(14b)")`), so the op-count tracer attributes each
 //! operation to a row of the paper's Table 1.
 //!
@@ -9,17 +9,17 @@
 //!
 //! **Inputs.** [`mass_matrix_base`] starts from the base-frame quantities of eq. (1), (2), (6)
 //! ([`BodyKinematics`]: `r_{j-1,j}`, `a_j`, `m_j`, `c_j`, `I_j`), which is where Table 1 starts
-//! counting. Its arithmetic follows the paper's counting convention (opcount_findings.md §1):
+//! counting. Its arithmetic follows the paper's counting convention (docs/paper.md, "Operation counts"):
 //! 3×3 products accumulate from zero, skew matrices carry literal zeros, cumulative sums start
 //! from zero where the paper's count says so (`m^Σ_{N+1} = 0`).
 //!
 //! **(14b).** Its printed formula is illegible and its printed cost fits no exact identity
-//! (paper_en.md R6, I7). [`Variant`] selects an exact form, `R2` or `R1`;
+//! (docs/paper.md, R6, I7). [`Variant`] selects an exact form, `R2` or `R1`;
 //! [`mass_matrix_paper_bookkeeping`] reproduces the paper's bookkeeping, which is **wrong for
 //! N ≥ 3**, on symbolic scalars only.
 //!
 //! **Prismatic joints.** The paper treats revolute joints only. Pairs with a prismatic joint use
-//! the formulas of paper_en.md I6 (see [`mass_matrix_base`]); revolute pairs keep (16), (20),
+//! the formulas of docs/paper.md, I6 (see [`mass_matrix_base`]); revolute pairs keep (16), (20),
 //! which stay exact because `r_{i,k}` includes the joint translations.
 //!
 //! ```
@@ -46,7 +46,7 @@ use crate::params::Params;
 use crate::scalar::{Scalar, Symbolic};
 use kanegen_model::JointKind;
 
-/// The exact forms of (14b) (paper_en.md R6).
+/// The exact forms of (14b) (docs/paper.md, R6).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Variant {
     /// Exact: `M^rr,2_{i,j} = S̃_{i,j+1} r̃ᵀ_{j,j+1} + M^rr,2_{i,j+1}` with
@@ -307,7 +307,7 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
         }
     }
 
-    // ---- Pairs with a prismatic joint (paper_en.md I6) ----
+    // ---- Pairs with a prismatic joint (docs/paper.md, I6) ----
     let revolute = |j: usize| kin[j].kind == JointKind::Revolute;
     let any_prismatic = kin.iter().any(|k| k.kind == JointKind::Prismatic);
     let mut c_sigma: Upper<Vec3<S>> = Upper::new(n);
@@ -388,7 +388,7 @@ pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Ve
 ///
 /// (19b) is evaluated by the O(N) recursion
 /// `m^ΣO_j = m^IE_j + m^ΣO_{j+1} + r_{j,j+1} × f^Σ_{j+1}`, equivalent to the printed double sum
-/// `m^Σ_j + Σ_{k>j} r̃_{j,k} f^IE_k` (paper_en.md R10); it absorbs (18), so `m^Σ_j` is not
+/// `m^Σ_j + Σ_{k>j} r̃_{j,k} f^IE_k` (docs/paper.md, R10); it absorbs (18), so `m^Σ_j` is not
 /// formed separately (`m^ΣO_N = m^Σ_N = m^IE_N`, (18a), (19a)).
 /// `b_j = a_j · m^ΣO_j` (revolute) or `a_j · f^Σ_j` (prismatic), plus `tau[j]` when given (21).
 pub fn bias_base<S: Scalar>(

@@ -1,5 +1,5 @@
 //! Model readers: URDF ([`parse_urdf`]) and kanegen's TOML format ([`parse_toml`], documented in
-//! README.md, "Model files"), both producing a validated [`Model`].
+//! `docs/models.md`), both producing a validated [`Model`].
 //!
 //! ```
 //! let chain = kanegen_model::io::parse_toml(r#"

@@ -1,4 +1,4 @@
-//! kanegen's TOML model format (see README.md, "Model files"), with optional DH geometry.
+//! kanegen's TOML model format (see `docs/models.md`), with optional DH geometry.
 
 use crate::bounds::{LENGTH, POSITION};
 use crate::inertial::{bounded, finite, rotate_inertia, validate_inertial_with};
@@ -164,7 +164,7 @@ impl<'de> Deserialize<'de> for InertiaSpec {
     }
 }
 
-/// Parses kanegen's TOML model format (documented in README.md, "Model files") into a [`Model`].
+/// Parses kanegen's TOML model format (documented in `docs/models.md`) into a [`Model`].
 ///
 /// Unknown keys and syntax errors are reported by the `toml` crate (naming the key and line) as
 /// [`ModelError::Parse`]; every value error names the joint (by name, or `joint #k`, 1-based,

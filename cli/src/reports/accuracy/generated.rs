@@ -61,7 +61,7 @@ pub fn ssrms_variants() -> Vec<GeneratedFns> {
 }
 
 /// The error of the generated `f64` code's own sine–cosine (`Self::sincos`,
-/// `kanegen_codegen::sincos`: a table and short polynomials) against libm's `sincos`.
+/// `kanegen_runtime::sincos`: a table and short polynomials) against libm's `sincos`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SincosError {
     /// Angles compared: a grid on [−4π, 4π] and as many seeded random ones with |x| < 32768.

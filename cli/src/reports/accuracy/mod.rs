@@ -1,4 +1,4 @@
-//! `kanegen accuracy`: what accuracy costs in time (issue #6).
+//! `kanegen accuracy`: what accuracy costs in time.
 //!
 //! For a model or a scene, three tables (four for a scene with Coulomb friction): **evaluation** (`A`, `b`, `q̈` in `f32`, `f64`, fused
 //! multiply-add and double-double, generated and interpreted: error against the wide reference

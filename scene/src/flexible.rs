@@ -25,7 +25,7 @@
 //! `motor_inertia` `I_m` (kg·m², `> 0`), `gear_ratio` `n` (`!= 0`, default 1). Fixed base only;
 //! not with `[effects] rotor` (the motor inertia is given here).
 
-use anyhow::{anyhow, bail, Result};
+use crate::Result;
 use kanegen_model::bounds::GAIN;
 use serde::Deserialize;
 
@@ -61,8 +61,8 @@ pub struct Flexible {
     pub reflected: Vec<f64>,
 }
 
-/// `n` values, finite and within [`GAIN`] (the scene's `check_len` messages; this module does
-/// not use `scene`, which uses it).
+/// `n` values, finite and within [`GAIN`] (the messages of the parser's `check_len`, which this
+/// module does not call: the parser calls this module).
 fn checked(key: &str, v: Vec<f64>, n: usize) -> Result<Vec<f64>> {
     if v.len() != n {
         bail!(
@@ -70,7 +70,7 @@ fn checked(key: &str, v: Vec<f64>, n: usize) -> Result<Vec<f64>> {
             v.len()
         );
     }
-    GAIN.check(&v).map_err(|e| anyhow!("{key}: {e}"))?;
+    GAIN.check(&v).map_err(|e| invalid!("{key}: {e}"))?;
     Ok(v)
 }
 

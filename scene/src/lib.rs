@@ -1,23 +1,50 @@
+//! # kanegen-scene
+//!
 //! Simulation scenes: a TOML file naming a model, the base (fixed or free-floating),
 //! an optional payload, the effects (gravity, joint damping, constant or tabulated wrenches), the joint
 //! drives, the initial state, the integrator, and payload captures and releases at given times
-//! (`[[events]]`, free-floating base; see [`crate::events`]). See README.md, "Simulation scenes".
+//! (`[[events]]`, free-floating base; the simulator's `kanegen_sim::events` does them). See
+//! `docs/scenes.md`.
+//!
+//! The format as plain validated data, read by the interpreted simulator (`kanegen-sim`, which
+//! re-exports this crate as `kanegen_sim::scene`) and by the `scene!` proc-macro; it depends on
+//! the model and the dynamics' load types only, so that `scene!` builds without the simulator.
 //!
 //! Every table rejects unknown keys, and every validation error names its key
-//! (`simulation.tolerance: must be > 0`). "Effects decide the code": only the effects a scene
+//! (`simulation.tolerance: must be > 0`), with the line where the table starts for the tables
+//! that can repeat or nest ([`SceneError`]). "Effects decide the code": only the effects a scene
 //! names end up in the [`Loads`](kanegen_dynamics::Loads) of the simulation.
 //!
 //! ```
 //! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-//! let scene = kanegen_sim::scene::Scene::parse(r#"
+//! let scene = kanegen_scene::Scene::parse(r#"
 //!     model = "models/two_link.toml"
 //!     [simulation]
 //!     duration = 1.0
 //! "#, &dir).unwrap();
 //! assert_eq!(scene.q0.len(), scene.model.dof());
 //! ```
+#![warn(missing_docs)]
 
-use anyhow::{anyhow, bail, Context, Result};
+/// A [`SceneError::Invalid`] with a formatted message naming the key.
+macro_rules! invalid {
+    ($($arg:tt)*) => {
+        $crate::SceneError::invalid(format!($($arg)*))
+    };
+}
+
+/// Returns early with [`invalid!`].
+macro_rules! bail {
+    ($($arg:tt)*) => {
+        return Err(invalid!($($arg)*))
+    };
+}
+
+mod error;
+pub mod flexible;
+
+pub use error::SceneError;
+
 use kanegen_dynamics::base::BASE_BODY;
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::{ExternalWrench, ForwardMethod, LoadFrame, Methods};
@@ -26,6 +53,9 @@ use kanegen_model::io::InertiaSpec;
 use kanegen_model::{Inertial, Model, Validation};
 use serde::Deserialize;
 use std::path::Path;
+
+/// The result of reading a scene.
+pub type Result<T, E = SceneError> = std::result::Result<T, E>;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -92,7 +122,7 @@ struct RawEffects {
     wrench: Vec<RawWrench>,
     rotor: Option<toml::Spanned<RawRotor>>,
     friction: Option<toml::Spanned<RawFriction>>,
-    flexible: Option<toml::Spanned<crate::flexible::RawFlexible>>,
+    flexible: Option<toml::Spanned<flexible::RawFlexible>>,
 }
 
 #[derive(Deserialize)]
@@ -272,7 +302,7 @@ pub enum Integrator {
     /// energy error, unit quaternion without projection; see `integrate::midpoint`).
     Midpoint,
     /// Adaptive Rodas4, the stiffly accurate L-stable Rosenbrock method (`integrator =
-    /// "rosenbrock"`, [`crate::rosenbrock`]) with `rtol = atol = tolerance`, for stiff scenes
+    /// "rosenbrock"`, `kanegen_runtime::ode::rosenbrock`) with `rtol = atol = tolerance`, for stiff scenes
     /// (flexible joints); its steps land on the output times.
     Rosenbrock,
 }
@@ -385,20 +415,7 @@ impl SceneWrench {
                 time,
                 force,
                 moment,
-            } => {
-                // First sample strictly after t (time is strictly increasing, at least 2 long).
-                let k = time.partition_point(|&tk| tk <= t);
-                if k == 0 {
-                    return (force[0], moment[0]);
-                }
-                if k == time.len() {
-                    return (force[k - 1], moment[k - 1]);
-                }
-                let s = (t - time[k - 1]) / (time[k] - time[k - 1]);
-                let lerp =
-                    |v: &[[f64; 3]]| [0, 1, 2].map(|i| v[k - 1][i] + s * (v[k][i] - v[k - 1][i]));
-                (lerp(force), lerp(moment))
-            }
+            } => kanegen_runtime::ode::table(t, time, force, moment),
         }
     }
 
@@ -429,7 +446,7 @@ fn wrench_profile(
                 check_bound(&format!("{key}.{name}"), &v, FORCE)?;
                 Ok(v)
             }
-            Some(RawProfile::Table(_)) => Err(anyhow!(
+            Some(RawProfile::Table(_)) => Err(invalid!(
                 "{key}.{name}: one row per sample needs `{key}.time` (or give one vector [x, y, z])"
             )),
         };
@@ -455,7 +472,7 @@ fn wrench_profile(
         let k = format!("{key}.{name}");
         match p {
             None => Ok(vec![[0.0; 3]; time.len()]),
-            Some(RawProfile::Constant(_)) => Err(anyhow!(
+            Some(RawProfile::Constant(_)) => Err(invalid!(
                 "{k}: with `{tkey}` give one [x, y, z] row per sample time ({} rows)",
                 time.len()
             )),
@@ -538,7 +555,7 @@ pub struct Scene {
     pub coulomb: Option<Coulomb>,
     /// Flexible joints (`[effects] flexible`, Spong 1987), fixed base only: the state gains the
     /// motor positions and rates, and the drives, damping and friction act on the motors.
-    pub flexible: Option<crate::flexible::Flexible>,
+    pub flexible: Option<flexible::Flexible>,
     /// The joint drives.
     pub drives: Drives,
     /// Initial joint positions.
@@ -571,11 +588,11 @@ fn check_finite(key: &str, v: &[f64]) -> Result<()> {
 
 /// Finite and within the magnitude bound `b` ([`kanegen_model::bounds`]).
 fn check_bound(key: &str, v: &[f64], b: Bound) -> Result<()> {
-    b.check(v).map_err(|e| anyhow!("{key}: {e}"))
+    b.check(v).map_err(|e| invalid!("{key}: {e}"))
 }
 
 fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
-    let v = match g.ok_or_else(|| anyhow!("{key}: required by this drive type"))? {
+    let v = match g.ok_or_else(|| invalid!("{key}: required by this drive type"))? {
         RawGain::Scalar(x) => vec![x; n],
         RawGain::Vector(v) => {
             check_len(key, &v, n, GAIN)?;
@@ -620,7 +637,7 @@ fn with_payloads(
         joints,
         validation,
     )
-    .map_err(|e| anyhow!("{e}"))
+    .map_err(|e| invalid!("{e}"))
 }
 
 /// Validates `[[events]]` (times inside the run and increasing, known bodies, positive mass, a
@@ -664,7 +681,7 @@ fn parse_events(
         let body = match &e.body {
             None => None,
             Some(name) => Some(body_index(chain0, name).ok_or_else(|| {
-                anyhow!(
+                invalid!(
                     "{}: unknown body `{name}` (moving bodies: {})",
                     key("body"),
                     body_names(chain0)
@@ -673,7 +690,9 @@ fn parse_events(
         };
         let kind = match e.kind.as_str() {
             "capture" => {
-                let mass = e.mass.ok_or_else(|| anyhow!("{}: required", key("mass")))?;
+                let mass = e
+                    .mass
+                    .ok_or_else(|| invalid!("{}: required", key("mass")))?;
                 if !(mass.is_finite() && mass > 0.0) {
                     bail!("{}: must be > 0", key("mass"));
                 }
@@ -681,11 +700,11 @@ fn parse_events(
                 check_bound(&key("com"), &com, LENGTH)?;
                 let inertia = e
                     .inertia
-                    .ok_or_else(|| anyhow!("{}: required", key("inertia")))?
+                    .ok_or_else(|| invalid!("{}: required", key("inertia")))?
                     .0;
                 let payload = Inertial { mass, com, inertia };
                 kanegen_model::validate_inertial_with("payload", "inertia", &payload, validation)
-                    .map_err(|err| anyhow!("{}: {err}", key("inertia")))?;
+                    .map_err(|err| invalid!("{}: {err}", key("inertia")))?;
                 let v = e.v.unwrap_or([0.0; 3]);
                 let omega = e.omega.unwrap_or([0.0; 3]);
                 check_bound(&key("v"), &v, RATE)?;
@@ -713,7 +732,7 @@ fn parse_events(
                     .iter()
                     .rposition(|(b, _)| body.is_none_or(|bb| bb == *b))
                     .ok_or_else(|| {
-                        anyhow!(
+                        invalid!(
                             "{}: no payload held then (give a [payload] or capture one first)",
                             key("body")
                         )
@@ -727,7 +746,7 @@ fn parse_events(
             ),
         };
         let model = with_payloads(chain0, &attached, validation)
-            .map_err(|err| anyhow!("events[{k}] (line {line}): {err}"))?;
+            .map_err(|err| invalid!("events[{k}] (line {line}): {err}"))?;
         events.push(Event {
             time: e.time,
             body: kind.0,
@@ -746,11 +765,15 @@ impl Scene {
 
     /// [`Scene::load`] with options.
     pub fn load_with(path: &Path, options: SceneOptions) -> Result<Scene> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read scene `{}`", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        Scene::parse_with(&text, dir, options)
-            .with_context(|| format!("scene `{}`", path.display()))
+        Scene::parse_with(&text, dir, options).map_err(|e| SceneError::InFile {
+            path: path.to_path_buf(),
+            source: Box::new(e),
+        })
     }
 
     /// The model file a scene names (relative to `dir`), without validating the rest.
@@ -767,13 +790,13 @@ impl Scene {
 
     /// [`Scene::parse`] with options.
     pub fn parse_with(text: &str, dir: &Path, options: SceneOptions) -> Result<Scene> {
-        let raw: RawScene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        let raw: RawScene = toml::from_str(text).map_err(|e| invalid!("{e}"))?;
         let model_path = dir.join(&raw.model);
         let validation = Validation {
             allow_nonphysical_inertia: raw.allow_nonphysical,
         };
         let chain = kanegen_model::io::load_model_with(&model_path, validation)
-            .map_err(|e| anyhow!("model: `{}`: {e}", model_path.display()))?;
+            .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
         let n = chain.dof();
 
         let chain0 = chain;
@@ -790,11 +813,11 @@ impl Scene {
                     inertia: p.inertia.0,
                 };
                 kanegen_model::validate_inertial_with("payload", "inertia", &pay, validation)
-                    .map_err(|e| anyhow!("payload.inertia: {e}"))?;
+                    .map_err(|e| invalid!("payload.inertia: {e}"))?;
                 let holder = match &p.body {
                     None => n - 1,
                     Some(name) => body_index(&chain0, name).ok_or_else(|| {
-                        anyhow!(
+                        invalid!(
                             "payload.body: unknown body `{name}` (moving bodies: {})",
                             body_names(&chain0)
                         )
@@ -805,7 +828,7 @@ impl Scene {
         };
         let attached: Vec<(usize, Inertial)> = static_payload.into_iter().collect();
         let chain =
-            with_payloads(&chain0, &attached, validation).map_err(|e| anyhow!("payload: {e}"))?;
+            with_payloads(&chain0, &attached, validation).map_err(|e| invalid!("payload: {e}"))?;
 
         let base = match raw.base {
             None => BaseSpec::Fixed,
@@ -828,14 +851,14 @@ impl Scene {
                 "free-floating" => {
                     let model = chain.base_inertial();
                     let mass = b.mass.or(model.map(|i| i.mass)).ok_or_else(|| {
-                        anyhow!("base.mass: the model has no base inertial; give mass, com, inertia")
+                        invalid!("base.mass: the model has no base inertial; give mass, com, inertia")
                     })?;
                     let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
                     let inertia = b
                         .inertia
                         .map(|i| i.0)
                         .or(model.map(|i| i.inertia))
-                        .ok_or_else(|| anyhow!("base.inertia: the model has no base inertial"))?;
+                        .ok_or_else(|| invalid!("base.inertia: the model has no base inertial"))?;
                     if !(mass.is_finite() && mass > 0.0) {
                         bail!("base.mass: must be > 0");
                     }
@@ -847,7 +870,7 @@ impl Scene {
                         &inertial,
                         validation,
                     )
-                    .map_err(|e| anyhow!("base.inertia: {e}"))?;
+                    .map_err(|e| invalid!("base.inertia: {e}"))?;
                     let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
                     check_finite("base.quaternion", &quat)?;
                     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -901,7 +924,7 @@ impl Scene {
                     .ok_or_else(|| {
                         let names: Vec<&str> =
                             chain.joints().iter().map(|j| j.body.as_str()).collect();
-                        anyhow!(
+                        invalid!(
                             "{key}.body: unknown body `{}` (known: base, {})",
                             w.body,
                             names.join(", ")
@@ -1012,11 +1035,7 @@ impl Scene {
                          model) cannot be given with it"
                     );
                 }
-                Some(crate::flexible::Flexible::from_raw(
-                    f.into_inner(),
-                    n,
-                    line,
-                )?)
+                Some(flexible::Flexible::from_raw(f.into_inner(), n, line)?)
             }
         };
 
@@ -1054,7 +1073,7 @@ impl Scene {
                         ])?;
                         let tau = d
                             .tau
-                            .ok_or_else(|| anyhow!("drives.tau: required by type = \"constant\""))?;
+                            .ok_or_else(|| invalid!("drives.tau: required by type = \"constant\""))?;
                         check_len("drives.tau", &tau, n, FORCE)?;
                         Drives::Constant { tau }
                     }
@@ -1062,7 +1081,7 @@ impl Scene {
                         extra(&[("duration_s", d.duration_s.is_some()), ("tau", d.tau.is_some())])?;
                         let target = d
                             .target
-                            .ok_or_else(|| anyhow!("drives.target: required by type = \"pd\""))?;
+                            .ok_or_else(|| invalid!("drives.target: required by type = \"pd\""))?;
                         check_len("drives.target", &target, n, POSITION)?;
                         Drives::Pd {
                             kp: gain("drives.kp", d.kp, n)?,
@@ -1076,11 +1095,11 @@ impl Scene {
                             bail!("drives.type: computed-torque needs a fixed base");
                         }
                         let target = d.target.ok_or_else(|| {
-                            anyhow!("drives.target: required by type = \"computed-torque\"")
+                            invalid!("drives.target: required by type = \"computed-torque\"")
                         })?;
                         check_len("drives.target", &target, n, POSITION)?;
                         let duration = d.duration_s.ok_or_else(|| {
-                            anyhow!("drives.duration_s: required by type = \"computed-torque\"")
+                            invalid!("drives.duration_s: required by type = \"computed-torque\"")
                         })?;
                         if !(duration.is_finite() && duration > 0.0) {
                             bail!("drives.duration_s: must be > 0");
@@ -1173,7 +1192,7 @@ impl Scene {
             None => Methods::SPATIAL,
             Some(a) => Methods::from_name(&a).ok_or_else(|| {
                 let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
-                anyhow!(
+                invalid!(
                     "simulation.algorithm: unknown algorithm `{a}` (known: {})",
                     names.join(", ")
                 )
