@@ -19,13 +19,13 @@
 //! The kernels take the type's sine–cosine (`Self::sincos`, or libm's per
 //! [`Options::libm_trig`] and for `f32`). Nothing allocates, no function panics, `f32` works as
 //! `f64`. A compact function's `OP_COUNTS` entry is the kernel traced on the tracer `Sym` with
-//! the tables as symbolic inputs ([`counts`]): every operation its loops execute (up to
-//! [`counts::MAX_N`] joints; above, the unrolled form's counts, and the header says so). The frame
-//! functions (`<frame>_placement`, `<frame>_jacobian`) stay straight-line code: their cost
-//! grows with one path of the tree, not with its size.
+//! the tables as symbolic inputs ([`counts`]): every operation its loops execute, for any
+//! number of joints (the kernels' cores take slices, so one instance on `Sym` traces them all).
+//! The frame functions (`<frame>_placement`, `<frame>_jacobian`) stay straight-line code: their
+//! cost grows with one path of the tree, not with its size.
 //!
-//! Supported: a fixed base, chains and trees, `f64` and `f32`, gravity, a runtime payload (the last body's inertia built from it at each call), with
-//! or without regrouping. Not supported (the generator keeps the unrolled form, and
+//! Supported: a fixed base, chains and trees, `f64` and `f32`, gravity, a runtime payload (the
+//! last body's inertia built from it at each call), with or without regrouping. Not supported (the generator keeps the unrolled form, and
 //! `form = "compact"` is an error): a free-floating base.
 //!
 //! # Measured: when compact code wins
@@ -127,16 +127,13 @@ pub fn unsupported(model: &Model, opts: &Options) -> Option<&'static str> {
 }
 
 /// The traced counts of the runtime kernel that the compact body of `f` calls
-/// ([`counts::counts`]): every operation its loops execute (0, unknown, above
-/// [`counts::MAX_N`] joints).
+/// ([`counts::counts`]): every operation its loops execute.
 ///
 /// # Errors
 /// `f` has no compact body ([`has_body`]).
 pub fn kernel_counts(model: &Model, opts: &Options, f: Function) -> Result<Counts, Error> {
-    if !has_body(f) {
-        return Err(Error(format!("`{}` has no compact body", f.name())));
-    }
-    Ok(counts::counts(&numbers(model, opts), f, opts.runtime_payload).unwrap_or_default())
+    counts::counts(&numbers(model, opts), f, opts.runtime_payload)
+        .ok_or_else(|| Error(format!("`{}` has no compact body", f.name())))
 }
 
 /// The form emitted and why, as the header says it.
@@ -283,14 +280,13 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let float = opts.float;
     let rt = opts.runtime()?;
     let t = numbers(model, opts);
-    let nl = Literal::usize_unsuffixed(model.dof());
     let mats = |m: &[M3]| {
         let m = m.iter().map(|m| mat(float, m));
-        quote!([#(#m),*])
+        quote!(&[#(#m),*])
     };
     let vectors = |v: &[[f64; 3]]| {
         let v = v.iter().map(|v| vector(float, v));
-        quote!([#(#v),*])
+        quote!(&[#(#v),*])
     };
     let parent = t.parent.iter().map(|p| match p {
         Some(l) => {
@@ -311,8 +307,8 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let revolute = &t.revolute;
     let ancestor = match &t.ancestor {
         Some(rows) => {
-            let rows = rows.iter().map(|r| quote!([#(#r),*]));
-            quote!(Some([#(#rows),*]))
+            let rows = rows.iter().map(|r| quote!(#(#r,)*));
+            quote!(Some(&[#(#rows)*]))
         }
         None => quote!(None),
     };
@@ -321,29 +317,29 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         /// Compact form: the model's numbers as the runtime kernels read them
         /// (`kanegen_runtime::compact::Tables`: parents, joint kinds, the joint transforms'
         /// `A`, `B`, `C`, `l`, slide, `S`, the spatial inertias, ancestors on a tree, `a₀`).
-        const CX: #rt::compact::Tables<#fl, #nl> = #rt::compact::Tables {
-            parent: [#(#parent),*],
-            revolute: [#(#revolute),*],
+        const CX: #rt::compact::Tables<'static, #fl> = #rt::compact::Tables {
+            parent: &[#(#parent),*],
+            revolute: &[#(#revolute),*],
             a: #a,
             b: #b,
             c: #c,
             l: #l,
             slide: #slide,
-            s: [#(#s),*],
-            inertia: [#(#inertia),*],
+            s: &[#(#s),*],
+            inertia: &[#(#inertia),*],
             ancestor: #ancestor,
             a0: #a0,
         };
     })
 }
 
-/// The body of `f` in the compact form: one call of its runtime kernel
+/// The body of `f` in the compact form (a model of `n` joints): one call of its runtime kernel
 /// (`kanegen_runtime::compact`) on the type's tables (`None`: `f` stays straight-line,
 /// [`has_body`]).
 ///
 /// # Errors
 /// A runtime or libm path that is not a Rust path.
-pub fn body(f: Function, opts: &Options) -> Result<Option<TokenStream>, Error> {
+pub fn body(f: Function, opts: &Options, n: usize) -> Result<Option<TokenStream>, Error> {
     let rt = opts.runtime()?;
     let sincos = if opts.table_sincos() {
         quote!(Self::sincos)
@@ -352,10 +348,11 @@ pub fn body(f: Function, opts: &Options) -> Result<Option<TokenStream>, Error> {
         let f = opts.float.libm_fn("sincos");
         quote!(#libm::#f)
     };
+    let nl = Literal::usize_unsuffixed(n);
     let i = if opts.runtime_payload {
-        quote!(&#rt::compact::with_payload(&Self::CX.inertia, payload.mass, &payload.com, &payload.inertia))
+        quote!(&#rt::compact::with_payload::<_, #nl>(Self::CX.inertia, payload.mass, &payload.com, &payload.inertia))
     } else {
-        quote!(&Self::CX.inertia)
+        quote!(Self::CX.inertia)
     };
     let k = quote!(#rt::compact);
     Ok(Some(match f {

@@ -95,7 +95,7 @@ fn generate_items_with(
     let mut fns = Vec::new();
     let mut fmas = Vec::new();
     for (fp, graph) in plan.functions.iter().zip(graphs) {
-        let body = function_body(fp, graph, opts, &emitter, bodies.as_deref_mut())?;
+        let body = function_body(&plan, fp, graph, opts, &emitter, bodies.as_deref_mut())?;
         fmas.push(body.fmas);
         fns.push(function_item(&plan, fp, body, opts, &names));
     }
@@ -130,6 +130,7 @@ impl Names {
 /// With `texts`, the body is formatted to text there (streamed statement by statement for a
 /// graph) and the returned tokens are its placeholder.
 fn function_body(
+    plan: &Plan,
     fp: &FunctionPlan,
     graph: Option<kanegen_trace::Traced>,
     opts: &Options,
@@ -137,7 +138,7 @@ fn function_body(
     texts: Option<&mut Vec<String>>,
 ) -> Result<Body, Error> {
     let compact_tokens = match fp.kernel {
-        Kernel::Compact(_) => compact::body(fp.function, opts)?,
+        Kernel::Compact(_) => compact::body(fp.function, opts, plan.model.dof())?,
         Kernel::Unrolled => None,
     };
     let body = match (texts, compact_tokens, graph) {

@@ -82,7 +82,7 @@ fn compact_source_loops_without_allocation_or_panics() {
         // Straight-line bodies are `let` chains; compact ones call the kernels.
         assert!(src
             .replace([' ', '\n'], "")
-            .contains("kanegen_runtime::compact::mass_matrix(&Self::CX,&Self::CX.inertia,q,"));
+            .contains("kanegen_runtime::compact::mass_matrix(&Self::CX,Self::CX.inertia,q,"));
         assert!(src.contains("Compact form: loops over the model's constant tables"));
     }
 }
@@ -305,7 +305,7 @@ fn unsupported_models_stay_unrolled() {
     o.runtime_payload = true;
     let src = generate_file(&chain(3, 5), &o).unwrap();
     assert!(src.replace([' ', '\n'], "").contains(
-        "kanegen_runtime::compact::mass_matrix(&Self::CX,&kanegen_runtime::compact::with_payload("
+        "kanegen_runtime::compact::mass_matrix(&Self::CX,&kanegen_runtime::compact::with_payload::<_,"
     ));
     let mut o = Options::new("Arm");
     o.form = Form::Unrolled;

@@ -3,88 +3,138 @@
 //! payload and the arguments a symbolic *input* (so no constant folding hides a multiplication
 //! that the loops really do), counted under [`Convention::Paper`]: every operation the kernel
 //! executes, which is what the compiled loops execute (their tables are read from memory).
+//!
+//! The kernels' cores take slices of any length with caller-provided scratch, so one instance on
+//! `Sym` traces a model of any number of joints, its storage in `Vec`s. Each function is traced
+//! as its const-`N` entry point composes it: the joint transforms
+//! (`kanegen_runtime::compact::spatial::transforms`), then the CRBA, the RNEA or the ABA
+//! (`codegen/tests/compact_kernels.rs` counts the entry points themselves with a counting `f64`
+//! and compares).
 
 use crate::compact::tables::Numbers;
-use kanegen_runtime::compact::{self as k, Tables};
+use kanegen_runtime::compact::{self as k, Articulated, Bodies, Motions, Rates, Tables, Transform};
 use kanegen_runtime::Scalar;
 use kanegen_trace::sym::{Convention, Counts, Sym, Tracer};
 use kanegen_trace::Function;
 
-/// The most joints whose kernels the generator traces: the kernels are generic over the number
-/// of joints, and each size traced instantiates them on `Sym` once more in this crate (compile
-/// time). Above, a compact type reports the unrolled form's counts, and its header says so.
-pub const MAX_N: usize = 64;
-
-/// Calls `$f::<N>(args)` for `N = $n` among the listed sizes (`None` for another).
-macro_rules! at_size {
-    ($n:expr, $f:ident($a:expr, $b:expr, $c:expr), [$($k:literal)*]) => {
-        match $n {
-            $($k => Some($f::<$k>($a, $b, $c)),)*
-            _ => None,
-        }
-    };
-}
-
 /// The traced counts of the kernel that the compact body of `f` calls on a model with tables
 /// `t` (`payload`: the last body's inertia built from a runtime payload per call), or `None`
-/// for a function without a compact body or a model of more than [`MAX_N`] joints.
+/// for a function without a compact body.
 #[must_use]
 pub fn counts(t: &Numbers, f: Function, payload: bool) -> Option<Counts> {
-    at_size!(t.parent.len(), trace_kernel(t, f, payload), [1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32 33 34 35 36 37 38 39 40 41 42 43 44 45 46 47 48 49 50 51 52 53 54 55 56 57 58 59 60 61 62 63 64])?
-}
-
-/// [`counts`] for `N` joints.
-fn trace_kernel<const N: usize>(t: &Numbers, f: Function, payload: bool) -> Option<Counts> {
     let tr = Tracer::new();
+    let n = t.parent.len();
     let x = || tr.input("x");
     let v3 = || -> [Sym; 3] { core::array::from_fn(|_| x()) };
     let m3 = || -> [[Sym; 3]; 3] { core::array::from_fn(|_| v3()) };
-    let joints = || -> [Sym; N] { core::array::from_fn(|_| x()) };
-    let tables: Tables<Sym, N> = Tables {
-        parent: core::array::from_fn(|j| t.parent.get(j).copied().flatten()),
-        revolute: core::array::from_fn(|j| t.revolute.get(j).copied().unwrap_or(true)),
-        a: core::array::from_fn(|_| m3()),
-        b: core::array::from_fn(|_| m3()),
-        c: core::array::from_fn(|_| m3()),
-        l: core::array::from_fn(|_| v3()),
-        slide: core::array::from_fn(|_| v3()),
-        s: core::array::from_fn(|_| core::array::from_fn(|_| x())),
-        inertia: core::array::from_fn(|_| core::array::from_fn(|_| x())),
-        ancestor: t.ancestor.as_ref().map(|rows| {
-            core::array::from_fn(|i| {
-                core::array::from_fn(|j| rows.get(i).and_then(|r| r.get(j)) == Some(&true))
-            })
-        }),
+    let each = |make: &dyn Fn() -> [[Sym; 3]; 3]| (0..n).map(|_| make()).collect::<Vec<_>>();
+    let (a, b, c) = (each(&m3), each(&m3), each(&m3));
+    let (l, slide): (Vec<_>, Vec<_>) = (0..n).map(|_| (v3(), v3())).unzip();
+    let s: Vec<[Sym; 6]> = (0..n).map(|_| core::array::from_fn(|_| x())).collect();
+    let mut inertia: Vec<[Sym; 10]> = (0..n).map(|_| core::array::from_fn(|_| x())).collect();
+    if payload {
+        if let Some(last) = inertia.last_mut() {
+            *last = k::payload_inertia(x(), &v3(), &m3());
+        }
+    }
+    let ancestor: Option<Vec<bool>> = t.ancestor.as_ref().map(|rows| rows.concat());
+    let tables = Tables {
+        parent: &t.parent,
+        revolute: &t.revolute,
+        a: &a,
+        b: &b,
+        c: &c,
+        l: &l,
+        slide: &slide,
+        s: &s,
+        inertia: &inertia,
+        ancestor: ancestor.as_deref(),
         a0: core::array::from_fn(|_| x()),
     };
-    let inertia = if payload {
-        k::with_payload(&tables.inertia, x(), &v3(), &m3())
-    } else {
-        tables.inertia
-    };
-    let (tb, i, sc) = (&tables, &inertia, |a: Sym| a.sin_cos());
-    let out: Vec<Sym> = match f {
-        Function::MassMatrix => k::mass_matrix(tb, i, &joints(), sc).concat(),
-        Function::NonlinearEffects => {
-            k::nonlinear_effects(tb, i, &joints(), &joints(), sc).to_vec()
-        }
-        Function::Gravity => k::gravity(tb, i, &joints(), sc).to_vec(),
-        Function::InverseDynamics => {
-            k::inverse_dynamics(tb, i, &joints(), &joints(), &joints(), sc).to_vec()
-        }
-        Function::MassMatrixAndNonlinearEffects => {
-            let (m, c) = k::mass_matrix_and_nonlinear_effects(tb, i, &joints(), &joints(), sc);
-            [m.concat(), c.to_vec()].concat()
-        }
-        Function::ForwardDynamics => {
-            k::forward_dynamics(tb, i, &joints(), &joints(), &joints(), sc).to_vec()
-        }
-        Function::ForwardDynamicsWithWrenches => {
-            let f_ext = core::array::from_fn(|_| core::array::from_fn(|_| x()));
-            k::forward_dynamics_with_wrenches(tb, i, &joints(), &joints(), &joints(), &f_ext, sc)
-                .to_vec()
-        }
-        _ => return None,
-    };
+    let joints = || -> Vec<Sym> { (0..n).map(|_| x()).collect() };
+    let q = joints();
+    let out = trace_kernel(&tables, f, &q, &mut || joints(), &x)?;
     Some(tr.finish(&out).counts(Convention::Paper))
+}
+
+/// The outputs of `f`'s kernel on `tables` at `q`, as its entry point computes them
+/// (`arg`: a fresh vector of joint inputs, `x`: a fresh input), its scratch in `Vec`s.
+fn trace_kernel(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    q: &[Sym],
+    arg: &mut dyn FnMut() -> Vec<Sym>,
+    x: &dyn Fn() -> Sym,
+) -> Option<Vec<Sym>> {
+    let n = q.len();
+    let zero = Sym::zero();
+    let identity = Transform {
+        e: [[zero; 3]; 3],
+        r: [zero; 3],
+    };
+    let (mut xs, mut x0) = (vec![identity; n], vec![identity; n]);
+    let (mut s0, mut i0) = (vec![[zero; 6]; n], vec![[zero; 10]; n]);
+    let mut b = Bodies {
+        x: &mut xs,
+        x0: &mut x0,
+        s0: &mut s0,
+        i0: &mut i0,
+    };
+    let inertia = tables.inertia;
+    let mut m = vec![[[zero; 6]; 3]; n];
+    let mut out = vec![zero; n];
+    let mut rnea = |b: &Bodies<'_, Sym>, motions: Motions<'_, Sym>| {
+        k::rnea::rnea(tables, b.x, inertia, motions, &mut m, &mut out);
+        out.clone()
+    };
+    let sincos = |a: Sym| a.sin_cos();
+    if !crate::compact::has_body(f) {
+        return None;
+    }
+    k::spatial::transforms(tables, q, sincos, b.x);
+    let (qd, qdd) = (arg(), arg());
+    let (velocity, rates) = (
+        Motions::velocity(&qd),
+        Motions {
+            qd: Some(&qd),
+            qdd: Some(&qdd),
+        },
+    );
+    let rest = Motions {
+        qd: None,
+        qdd: None,
+    };
+    Some(match f {
+        Function::MassMatrix => crba(tables, &mut b),
+        Function::NonlinearEffects => rnea(&b, velocity),
+        Function::Gravity => rnea(&b, rest),
+        Function::InverseDynamics => rnea(&b, rates),
+        Function::MassMatrixAndNonlinearEffects => {
+            let h = crba(tables, &mut b);
+            [h, rnea(&b, velocity)].concat()
+        }
+        _ => {
+            let f_ext: Option<Vec<[Sym; 6]>> = (f == Function::ForwardDynamicsWithWrenches)
+                .then(|| (0..n).map(|_| core::array::from_fn(|_| x())).collect());
+            let tau = arg();
+            let rates = Rates {
+                qd: &qd,
+                tau: &tau,
+                f_ext: f_ext.as_deref(),
+            };
+            let mut bodies = vec![Articulated::zero(); n];
+            let mut qdd = vec![zero; n];
+            k::aba::aba(tables, inertia, rates, &mut b, &mut bodies, &mut qdd);
+            qdd
+        }
+    })
+}
+
+/// The CRBA's `H` (rows first) on the joint transforms of `b`.
+fn crba(tables: &Tables<'_, Sym>, b: &mut Bodies<'_, Sym>) -> Vec<Sym> {
+    let n = b.x.len();
+    let zero = Sym::zero();
+    let (mut st, mut h) = (vec![zero; 6 * n], vec![zero; n * n]);
+    k::crba::crba(tables, tables.inertia, b, &mut st, &mut h);
+    h
 }

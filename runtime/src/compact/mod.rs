@@ -14,10 +14,14 @@
 //! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`].
 //!
 //! Every kernel is generic over the scalar (`S: Scalar + Copy`: `f64`, `f32`, and the tracer
-//! `Sym` of `kanegen-trace`, which runs them to count what a compact type executes) and over the
-//! number of joints `N`. Arrays live on the stack, nothing allocates, no kernel panics (loops run
-//! over arrays of size `N`, parent indices are read with `get`), and the only branches are on
-//! the tables' flags (joint kinds, parents), never on values. Sines and cosines are the caller's
+//! `Sym` of `kanegen-trace`, which runs them to count what a compact type executes) and written
+//! once over slices of any length `N` with caller-provided scratch ([`crba::crba`],
+//! [`rnea::rnea`], [`aba::aba`] on [`Bodies`] and their own per-joint scratch), so that one
+//! instance per scalar serves every model. The entry points above are thin wrappers for
+//! `N` known at compile time: their scratch lives in arrays on the stack ([`BodyStore`]), and
+//! their results are arrays. Nothing allocates, no kernel panics (slices are read with `get` or
+//! in loops over their own length; slices shorter than `N` leave entries unwritten), and the
+//! only branches are on the tables' flags (joint kinds, parents), never on values. Sines and cosines are the caller's
 //! (`sincos`, called once per revolute joint): the generated type's own `Self::sincos` or libm's.
 //!
 //! Trees are handled through the parent table (`λ(i) < i`).
@@ -37,8 +41,9 @@ pub mod rnea;
 pub mod spatial;
 pub mod tables;
 
-pub use aba::{forward_dynamics, forward_dynamics_with_wrenches};
+pub use aba::{forward_dynamics, forward_dynamics_with_wrenches, Articulated, Rates};
 pub use crba::{mass_matrix, mass_matrix_and_nonlinear_effects};
 pub use payload::{payload_inertia, with_payload};
-pub use rnea::{gravity, inverse_dynamics, nonlinear_effects};
-pub use tables::Tables;
+pub use rnea::{gravity, inverse_dynamics, nonlinear_effects, Motions};
+pub use spatial::Transform;
+pub use tables::{Bodies, BodyStore, Tables};

@@ -22,15 +22,19 @@ pub fn payload_inertia<S: Scalar + Copy>(m: S, c: &[S; 3], ic: &[[S; 3]; 3]) -> 
     ]
 }
 
-/// `inertia` with its last body's row replaced by the payload's ([`payload_inertia`]).
+/// `inertia` (of `N` bodies) with its last body's row replaced by the payload's
+/// ([`payload_inertia`]).
 #[inline(always)]
 pub fn with_payload<S: Scalar + Copy, const N: usize>(
-    inertia: &[[S; 10]; N],
+    inertia: &[[S; 10]],
     m: S,
     c: &[S; 3],
     ic: &[[S; 3]; 3],
 ) -> [[S; 10]; N] {
-    let mut t = *inertia;
+    let mut t = [[S::zero(); 10]; N];
+    for (row, given) in t.iter_mut().zip(inertia) {
+        *row = *given;
+    }
     if let Some(last) = t.last_mut() {
         *last = payload_inertia(m, c, ic);
     }

@@ -2,7 +2,7 @@
 //! and a translation, motion and force 6-vectors `[angular; linear]`, spatial inertias as
 //! 10-vectors, and the joint transforms and base-coordinate quantities of [`Tables`].
 
-use super::tables::Tables;
+use super::tables::{Bodies, Tables};
 use crate::scalar::Scalar;
 
 /// A Plücker transform `X = [E 0; −E r̃ E]` as its rotation `E` and translation `r`
@@ -35,6 +35,24 @@ impl<S: Scalar + Copy> Transform<S> {
         let a = rot_tr(&self.e, &[f[0], f[1], f[2]]);
         let rl = cross(&self.r, &l);
         [a[0] + rl[0], a[1] + rl[1], a[2] + rl[2], l[0], l[1], l[2]]
+    }
+
+    /// `X⁻¹ m = [Eᵀ ω; Eᵀ v + r × Eᵀ ω]` for a motion `m = [ω; v]` (RBDA Table 2.5): a body's
+    /// `S_i` in base coordinates when `X` is its placement `(E_0i, p_0i)`.
+    #[inline(always)]
+    #[must_use]
+    pub fn apply_tr_motion(&self, s: &[S; 6]) -> [S; 6] {
+        let ws = rot_tr(&self.e, &[s[0], s[1], s[2]]);
+        let vs = rot_tr(&self.e, &[s[3], s[4], s[5]]);
+        let pw = cross(&self.r, &ws);
+        [
+            ws[0],
+            ws[1],
+            ws[2],
+            vs[0] + pw[0],
+            vs[1] + pw[1],
+            vs[2] + pw[2],
+        ]
     }
 
     /// `Xᵀ I X` of a spatial inertia `I` (RBDA Table 2.5): `h' = Eᵀh + m r`,
@@ -180,98 +198,71 @@ pub fn sub<S: Scalar + Copy>(a: &[S; 6], b: &[S; 6]) -> [S; 6] {
 }
 
 /// `Xup_j = XJ(q_j) Xtree_j` for every joint, as `E_j = A_j + cos q_j B_j + sin q_j C_j` and
-/// `r_j = l_j + q_j Υ_j u_j` (RBDA §4.4, Table 4.1; the module docs of [`super`]).
+/// `r_j = l_j + q_j Υ_j u_j` (RBDA §4.4, Table 4.1; the module docs of [`super`]), into `x`.
 /// `sincos` is called once per revolute joint.
 #[inline(always)]
-pub fn transforms<S: Scalar + Copy, const N: usize>(
-    t: &Tables<S, N>,
-    q: &[S; N],
+pub fn transforms<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    q: &[S],
     sincos: impl Fn(S) -> (S, S),
-) -> [Transform<S>; N] {
+    x: &mut [Transform<S>],
+) {
     let zero = S::zero();
-    let mut x = [Transform {
-        e: [[zero; 3]; 3],
-        r: [zero; 3],
-    }; N];
-    for (j, xj) in x.iter_mut().enumerate() {
-        let (s, c, d) = if t.revolute[j] {
-            let (s, c) = sincos(q[j]);
+    let kinds = x.iter_mut().zip(q).zip(t.revolute);
+    let joints = kinds
+        .zip(t.a)
+        .zip(t.b)
+        .zip(t.c)
+        .zip(t.l.iter().zip(t.slide));
+    for ((((((xj, &qj), &revolute), a), b), cc), (l, slide)) in joints {
+        let (s, c, d) = if revolute {
+            let (s, c) = sincos(qj);
             (s, c, zero)
         } else {
-            (zero, zero, q[j])
+            (zero, zero, qj)
         };
-        let (a, b, cc) = (&t.a[j], &t.b[j], &t.c[j]);
         for r in 0..3 {
             for k in 0..3 {
                 xj.e[r][k] = a[r][k] + c * b[r][k] + s * cc[r][k];
             }
-            xj.r[r] = t.l[j][r] + d * t.slide[j][r];
+            xj.r[r] = l[r] + d * slide[r];
         }
     }
-    x
 }
 
-/// Each body's placement, motion subspace and spatial inertia in base coordinates.
-#[derive(Clone, Copy, Debug)]
-pub struct World<S, const N: usize> {
-    /// `(E_0i, p_0i)`: `E_0i` rotates base to body `i` coordinates, `p_0i` is its origin.
-    pub x0: [Transform<S>; N],
-    /// `ᴼX_i S_i`.
-    pub s0: [[S; 6]; N],
-    /// `ᴼX_i* I_i ⁱX_O` (about the base origin, RBDA eq. (2.66)).
-    pub i0: [[S; 10]; N],
-}
-
-/// [`World`] from the joint transforms `x`: `E_0i = E_i E_0λ(i)`,
-/// `p_0i = p_0λ(i) + E_0λ(i)ᵀ r_i` (RBDA §2.8, composition of Plücker transforms), then
-/// `S_i` and `I_i` carried to the base (RBDA eq. (2.66)).
+/// The base-coordinate fields of [`Bodies`] from its joint transforms `x`:
+/// `E_0i = E_i E_0λ(i)`, `p_0i = p_0λ(i) + E_0λ(i)ᵀ r_i` (RBDA §2.8, composition of Plücker
+/// transforms), then `S_i` and `I_i` carried to the base (RBDA eq. (2.66)).
 #[inline(always)]
-pub fn world<S: Scalar + Copy, const N: usize>(
-    t: &Tables<S, N>,
-    x: &[Transform<S>; N],
-    inertia: &[[S; 10]; N],
-) -> World<S, N> {
-    let zero = S::zero();
-    let mut w = World {
-        x0: [Transform {
-            e: [[zero; 3]; 3],
-            r: [zero; 3],
-        }; N],
-        s0: [[zero; 6]; N],
-        i0: [[zero; 10]; N],
-    };
-    for i in 0..N {
-        let (e, r) = (&x[i].e, &x[i].r);
-        w.x0[i] = match t.parent[i].and_then(|l| w.x0.get(l)) {
-            Some(p) => {
-                let el = &p.e;
-                let e0 = core::array::from_fn(|a| {
-                    core::array::from_fn(|b| {
-                        e[a][0] * el[0][b] + e[a][1] * el[1][b] + e[a][2] * el[2][b]
-                    })
-                });
-                let d = rot_tr(el, r);
-                Transform {
-                    e: e0,
-                    r: [p.r[0] + d[0], p.r[1] + d[1], p.r[2] + d[2]],
-                }
-            }
-            None => x[i],
+pub fn world<S: Scalar + Copy>(t: &Tables<'_, S>, inertia: &[[S; 10]], w: &mut Bodies<'_, S>) {
+    for i in 0..w.x.len().min(w.x0.len()) {
+        let x = w.x[i];
+        let parent = t.parent.get(i).copied().flatten();
+        w.x0[i] = match parent.and_then(|l| w.x0.get(l)) {
+            Some(p) => compose(&x, p),
+            None => x,
         };
         let x0 = &w.x0[i];
-        let s = &t.s[i];
-        let ws = rot_tr(&x0.e, &[s[0], s[1], s[2]]);
-        let vs = rot_tr(&x0.e, &[s[3], s[4], s[5]]);
-        let pw = cross(&x0.r, &ws);
-        w.s0[i] = [
-            ws[0],
-            ws[1],
-            ws[2],
-            vs[0] + pw[0],
-            vs[1] + pw[1],
-            vs[2] + pw[2],
-        ];
-        w.i0[i] = x0.inertia_tr(&inertia[i]);
+        if let (Some(s), Some(s0)) = (t.s.get(i), w.s0.get_mut(i)) {
+            *s0 = x0.apply_tr_motion(s);
+        }
+        if let (Some(ii), Some(i0)) = (inertia.get(i), w.i0.get_mut(i)) {
+            *i0 = x0.inertia_tr(ii);
+        }
     }
-    w
+}
+
+/// `(E_0i, p_0i)` of a body from its joint transform `x` and its parent's `p`:
+/// `E_0i = E_i E_0λ`, `p_0i = p_0λ + E_0λᵀ r_i` (RBDA §2.8).
+#[inline(always)]
+fn compose<S: Scalar + Copy>(x: &Transform<S>, p: &Transform<S>) -> Transform<S> {
+    let (e, r, el) = (&x.e, &x.r, &p.e);
+    let e0 = core::array::from_fn(|a| {
+        core::array::from_fn(|b| e[a][0] * el[0][b] + e[a][1] * el[1][b] + e[a][2] * el[2][b])
+    });
+    let d = rot_tr(el, r);
+    Transform {
+        e: e0,
+        r: [p.r[0] + d[0], p.r[1] + d[1], p.r[2] + d[2]],
+    }
 }
