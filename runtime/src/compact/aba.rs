@@ -49,7 +49,7 @@ pub fn forward_dynamics_with_wrenches<S: Scalar + Copy, const N: usize>(
 }
 
 /// [`aba`] on the joint transforms of `q`, on stack storage of `N` joints.
-#[inline(always)]
+#[inline]
 fn articulated<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
@@ -171,7 +171,7 @@ fn sym_minus_outer<S: Scalar + Copy>(m: &[S; 21], w: &[S; 6], u: &[S; 6]) -> [S;
 /// and bias terms outwards ([`outward`]), articulated inertias inwards ([`inward`]),
 /// accelerations outwards from `a₀` ([`Tables::a0`], [`accelerations`]). `bodies`: scratch, one
 /// per joint.
-#[inline]
+#[inline(always)]
 pub fn aba<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],

@@ -8,7 +8,7 @@ use crate::scalar::Scalar;
 
 /// The joint-space inertia matrix `H(q)` (RBDA Table 6.2): [`crba`] on the joint transforms of
 /// `q` ([`transforms`]); `inertia` is [`Tables::inertia`] or [`with_payload`](super::with_payload)'s.
-#[inline(always)]
+#[inline]
 pub fn mass_matrix<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
@@ -33,7 +33,7 @@ pub fn mass_matrix<S: Scalar + Copy, const N: usize>(
 
 /// `(H(q), c(q, q̇))` on one set of joint transforms: [`crba`] and the recursive Newton–Euler
 /// algorithm at `q̈ = 0` ([`rnea`], RBDA Table 5.1).
-#[inline(always)]
+#[inline]
 pub fn mass_matrix_and_nonlinear_effects<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
@@ -65,7 +65,7 @@ pub fn mass_matrix_and_nonlinear_effects<S: Scalar + Copy, const N: usize>(
 /// `IC_λ(i) += IC_i` leaves first (one frame, no transform), then `F = IC_i S_i` and
 /// `H_ij = H_ji = S_jᵀ F` for `j = i` and each ancestor `j` of `i` ([`fill`]) into `h` (`N × N`,
 /// rows first). `st`: scratch of `6 N`.
-#[inline]
+#[inline(always)]
 pub fn crba<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],

@@ -28,7 +28,7 @@ impl<'a, S> Motions<'a, S> {
 }
 
 /// [`rnea`] on the joint transforms of `q` at `motions`, on stack storage of `N` joints.
-#[inline(always)]
+#[inline]
 fn newton_euler<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
@@ -94,7 +94,7 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize>(
 /// `tau`: forward `v_i = Xup_i v_λ(i) + S_i q̇_i`, `a_i = Xup_i a_λ(i) + S_i q̈_i + v_i ×ₘ S_i q̇_i`,
 /// `f_i = I_i a_i + v_i ×* I_i v_i`, from `a₀` ([`Tables::a0`], RBDA §5.3); backward
 /// `τ_i = S_iᵀ f_i`, `f_λ(i) += Xup_iᵀ f_i`. `m`: scratch of `[v_i, a_i, f_i]` per joint.
-#[inline]
+#[inline(always)]
 pub fn rnea<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     x: &[Transform<S>],
