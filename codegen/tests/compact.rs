@@ -128,7 +128,8 @@ fn auto_picks_compact_for_large_models_only() {
     ] {
         assert!(ops(&sixteen, name) <= LINEAR_AUTO_LIMIT);
         assert!(traced_ops(&chain_default(64), f) > LINEAR_AUTO_LIMIT);
-        // A body in loops is not traced: no candidate, 0 operations in `OP_COUNTS`.
+        // A body in loops has no unrolled candidate traced (its `OP_COUNTS` entry is its
+        // kernel's traced count, `compact_kernels.rs`).
         assert_eq!(ops(&big, name), 0);
         assert!(untraced(&big, name));
         assert!(
