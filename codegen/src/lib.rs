@@ -7,7 +7,8 @@
 //! or compact loops, [`compact`]) from traced prefixes of the model, and for every generated
 //! function ([`api`]) of straight-line code traces the candidates with the model's numbers as
 //! constants and keeps the cheapest in emitted `mul + add` ([`choose`]); its graph becomes
-//! straight-line Rust ([`emit`]). A function in compact loops is not traced. The generated type
+//! straight-line Rust ([`emit`]). A function in compact loops calls a kernel of
+//! `kanegen_runtime::compact` over the model's tables ([`compact`]). The generated type
 //! is a unit struct with associated constants and functions ([`generate_items`]);
 //! [`generate_file`] wraps it into a formatted module file whose doc header ([`header`]) states
 //! the model, the conventions and every traced candidate's counts.
@@ -20,8 +21,9 @@
 //! `nonlinear_effects_method` (`None` when unused), `forward_method` (`ldlt` or `aba` for forward dynamics,
 //! `None` otherwise; `aba` uses no mass-matrix or nonlinear-effects method), `mul`, `add`, `div`, `sqrt`,
 //! `sincos` and `fma` (fused multiply-adds formed; only emitted code forms them, so
-//! `CANDIDATES` lists 0). A function in compact loops is not traced: its `OP_COUNTS` entry names
-//! its loops' methods with 0 operations, and `CANDIDATES` has none of it.
+//! `CANDIDATES` lists 0). A function in compact loops has as `OP_COUNTS` entry its kernel traced
+//! on the tracer `Sym` ([`compact::counts`]: every operation its loops execute), and
+//! `CANDIDATES` has none of it.
 //!
 //! ```
 //! use kanegen_codegen::{generate_file, Options};
@@ -47,7 +49,7 @@ pub use options::{forced_algorithm, Error, Float, Form, Options, VERSION};
 pub use plan::Plan;
 
 use kanegen_model::Model;
-use kanegen_trace::Arg;
+use kanegen_trace::{Arg, Counts};
 use plan::{FunctionPlan, Kernel};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -155,7 +157,7 @@ fn function_body(
     texts: Option<&mut Vec<String>>,
 ) -> Result<Body, Error> {
     let compact_tokens = match fp.kernel {
-        Kernel::Compact => compact::body(fp.function, opts, plan.model.dof()),
+        Kernel::Compact(_) => compact::body(fp.function, opts, plan.model.dof())?,
         Kernel::Unrolled => None,
     };
     let body = match (texts, compact_tokens, graph) {
@@ -269,11 +271,11 @@ fn return_type(shape: Shape, fl: &TokenStream) -> TokenStream {
 }
 
 /// The two documentation lines of a function: what it computes ([`api::doc`]), then its methods
-/// and emitted counts (for a compact body, its loops' methods, not traced). `k`: fused
-/// multiply-adds formed.
+/// and counts (emitted; for a compact body, its loops' methods and its kernel's traced counts).
+/// `k`: fused multiply-adds formed.
 fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (String, String) {
     let choice = &fp.choice;
-    let compact = fp.kernel == Kernel::Compact;
+    let compact = matches!(fp.kernel, Kernel::Compact(_));
     let mut doc1 = format!(
         " {}",
         api::doc(fp.function, plan.floating(), choice.chosen.forward)
@@ -304,10 +306,12 @@ fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (Str
     .flatten()
     .collect::<Vec<_>>()
     .join(", ");
-    if compact {
+    if let Kernel::Compact(c) = fp.kernel {
         let doc2 = format!(
-            " Compact form: loops over the model's constant tables (RBDA), {methods}; not \
-             traced (its `OP_COUNTS` entry counts 0)."
+            " Compact form: loops over the model's constant tables (RBDA), {methods}, the \
+             kernels of `kanegen_runtime::compact`: {} mul, {} add, {} div, {} sqrt, {} sincos \
+             (traced: every operation the loops execute).",
+            c.mul, c.add, c.div, c.sqrt, c.sincos
         );
         return (doc1, doc2);
     }
@@ -331,7 +335,8 @@ fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (Str
     (doc1, doc2)
 }
 
-/// The `OP_COUNTS` entries (one per emitted function, a compact one's with 0 operations) and
+/// The `OP_COUNTS` entries (one per emitted function, a compact one's its kernel's traced
+/// counts) and
 /// the `CANDIDATES` entries (one per traced candidate).
 fn op_count_entries(
     plan: &Plan,
@@ -371,12 +376,16 @@ fn op_count_entries(
         .iter()
         .zip(fmas)
         .map(|(fp, k)| {
-            let untraced = choose::Candidate {
+            let kernel = |counts| choose::Candidate {
                 methods: fp.choice.chosen,
                 frames: fp.choice.frames,
-                counts: kanegen_trace::Counts::default(),
+                counts,
             };
-            entry(fp, fp.choice.candidate().unwrap_or(&untraced), *k)
+            match (fp.kernel, fp.choice.candidate()) {
+                (Kernel::Compact(counts), _) => entry(fp, &kernel(counts), 0),
+                (Kernel::Unrolled, Some(chosen)) => entry(fp, chosen, *k),
+                (Kernel::Unrolled, None) => entry(fp, &kernel(Counts::default()), *k),
+            }
         })
         .collect();
     let all = plan

@@ -25,7 +25,7 @@ use kanegen_dynamics::regroup::RegroupReport;
 use kanegen_dynamics::MassMatrixMethod;
 use kanegen_model::canonical::CanonicalReport;
 use kanegen_model::{BaseKind, Model, Validation};
-use kanegen_trace::{Arg, Function, Traced};
+use kanegen_trace::{Arg, Counts, Function, Traced};
 
 /// Joints of the first prefix traced for the form decision: random chains of 16 joints already
 /// emit about twice [`compact::AUTO_LIMIT`] in `M + c` (8,401 operations in canonical frames).
@@ -36,8 +36,9 @@ pub const FIRST_PREFIX: usize = 16;
 pub enum Kernel {
     /// Straight-line code from the chosen candidate's traced graph.
     Unrolled,
-    /// The compact form's loops ([`compact::body`]); not traced.
-    Compact,
+    /// The compact form's loops ([`compact::body`]): a kernel of `kanegen_runtime::compact`,
+    /// with its traced counts ([`compact::counts`]).
+    Compact(Counts),
 }
 
 /// One generated function.
@@ -108,7 +109,11 @@ impl Plan {
             if f == Function::MassMatrix {
                 mass = choice.chosen.mass_matrix;
             }
-            functions.push(function_plan(&model, f, choice, graph.is_some()));
+            let kernel = match &graph {
+                Some(_) => Kernel::Unrolled,
+                None => Kernel::Compact(compact::kernel_counts(&model, opts, f)?),
+            };
+            functions.push(function_plan(&model, f, choice, kernel));
             graphs.push(graph);
         }
         check_names(&functions)?;
@@ -359,9 +364,8 @@ fn prefix(model: &Model, joints: usize) -> Option<Model> {
     .ok()
 }
 
-/// The plan of `f`: its name, arguments and shape, with its choice; `unrolled`: whether its
-/// body is straight-line code.
-fn function_plan(model: &Model, f: Function, choice: Choice, unrolled: bool) -> FunctionPlan {
+/// The plan of `f`: its name, arguments and shape, with its choice and kernel.
+fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> FunctionPlan {
     let floating = model.base_kind() == BaseKind::FreeFloating;
     let n = model.dof();
     FunctionPlan {
@@ -374,11 +378,7 @@ fn function_plan(model: &Model, f: Function, choice: Choice, unrolled: bool) -> 
             .collect(),
         shape: api::shape(f, n, floating),
         choice,
-        kernel: if unrolled {
-            Kernel::Unrolled
-        } else {
-            Kernel::Compact
-        },
+        kernel,
     }
 }
 

@@ -66,19 +66,23 @@ fn compact_source_loops_without_allocation_or_panics() {
         ] {
             assert!(!body.contains(word), "`{word}` in the compact source");
         }
-        assert!(body.contains("for i in 0..") && body.contains("const CX_INERTIA"));
-        // f64: the loops call the type's own sine–cosine, the runtime's table sine–cosine
-        // (libm's beyond its range).
+        // The tables are data; the loops are the runtime's kernels, called once per function.
+        assert!(body.contains("const CX: kanegen_runtime::compact::Tables<"));
+        assert!(
+            !body.contains("fn cx_") && !body.contains("RBDA Table"),
+            "no algorithm is pasted into the type"
+        );
+        // f64: the kernels call the type's own sine–cosine (libm's beyond its range).
         if float == Float::F32 {
-            assert!(body.contains("libm::sincosf("));
-        } else {
-            assert!(body.contains("Self::sincos(q[j])") && body.contains("::sincos::sincos_n"));
-        }
-        if float == Float::F32 {
+            assert!(body.contains("libm::sincosf"));
             assert!(!body.contains("f64"), "f32 code names no f64");
+        } else {
+            assert!(body.contains("Self::sincos") && body.contains("::sincos::sincos_n"));
         }
-        // Straight-line bodies are `let` chains; compact ones call the loops.
-        assert!(src.contains("Self::cx_crba(&Self::cx_transforms(q), &Self::CX_INERTIA)"));
+        // Straight-line bodies are `let` chains; compact ones call the kernels.
+        assert!(src
+            .replace([' ', '\n'], "")
+            .contains("kanegen_runtime::compact::mass_matrix(&Self::CX,Self::CX.inertia,q,"));
         assert!(src.contains("Compact form: loops over the model's constant tables"));
     }
 }
@@ -124,7 +128,8 @@ fn auto_picks_compact_for_large_models_only() {
     ] {
         assert!(ops(&sixteen, name) <= LINEAR_AUTO_LIMIT);
         assert!(traced_ops(&chain_default(64), f) > LINEAR_AUTO_LIMIT);
-        // A body in loops is not traced: no candidate, 0 operations in `OP_COUNTS`.
+        // A body in loops has no unrolled candidate traced (its `OP_COUNTS` entry is its
+        // kernel's traced count, `compact_kernels.rs`).
         assert_eq!(ops(&big, name), 0);
         assert!(untraced(&big, name));
         assert!(
@@ -300,7 +305,9 @@ fn unsupported_models_stay_unrolled() {
     let mut o = compact_opts();
     o.runtime_payload = true;
     let src = generate_file(&chain(3, 5), &o).unwrap();
-    assert!(src.contains("Self::cx_crba(&Self::cx_transforms(q), &Self::cx_inertia(payload))"));
+    assert!(src.replace([' ', '\n'], "").contains(
+        "kanegen_runtime::compact::mass_matrix(&Self::CX,&kanegen_runtime::compact::with_payload::<_,"
+    ));
     let mut o = Options::new("Arm");
     o.form = Form::Unrolled;
     let g = generate_items(&chain_default(64), &o).unwrap();

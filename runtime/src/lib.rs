@@ -7,6 +7,7 @@
 //!
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
+//! - [`compact`]: the compact form's kernels (CRBA, RNEA, ABA as loops over a model's tables).
 //! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
 //!   midpoint rule) over slices with caller-provided scratch, for the simulator and `scene!`.
 //! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
@@ -21,6 +22,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod compact;
 pub mod fma;
 pub mod inertia;
 pub mod ldlt;

@@ -1,0 +1,140 @@
+//! The operation counts of a compact type's functions: the runtime kernels
+//! (`kanegen_runtime::compact`) run on the tracer [`Sym`], with every number of the tables, the
+//! payload and the arguments a symbolic *input* (so no constant folding hides a multiplication
+//! that the loops really do), counted under [`Convention::Paper`]: every operation the kernel
+//! executes, which is what the compiled loops execute (their tables are read from memory).
+//!
+//! The kernels' cores take slices of any length with caller-provided scratch, so one instance on
+//! `Sym` traces a model of any number of joints, its storage in `Vec`s. Each function is traced
+//! as its const-`N` entry point composes it: the joint transforms
+//! (`kanegen_runtime::compact::spatial::transforms`), then the CRBA, the RNEA or the ABA
+//! (`codegen/tests/compact_kernels.rs` counts the entry points themselves with a counting `f64`
+//! and compares).
+
+use crate::compact::tables::Numbers;
+use kanegen_runtime::compact::{self as k, Articulated, Bodies, Motions, Rates, Tables, Transform};
+use kanegen_runtime::Scalar;
+use kanegen_trace::sym::{Convention, Counts, Sym, Tracer};
+use kanegen_trace::Function;
+
+/// The traced counts of the kernel that the compact body of `f` calls on a model with tables
+/// `t` (`payload`: the last body's inertia built from a runtime payload per call), or `None`
+/// for a function without a compact body.
+#[must_use]
+pub fn counts(t: &Numbers, f: Function, payload: bool) -> Option<Counts> {
+    let tr = Tracer::new();
+    let n = t.parent.len();
+    let x = || tr.input("x");
+    let v3 = || -> [Sym; 3] { core::array::from_fn(|_| x()) };
+    let m3 = || -> [[Sym; 3]; 3] { core::array::from_fn(|_| v3()) };
+    let each = |make: &dyn Fn() -> [[Sym; 3]; 3]| (0..n).map(|_| make()).collect::<Vec<_>>();
+    let (a, b, c) = (each(&m3), each(&m3), each(&m3));
+    let (l, slide): (Vec<_>, Vec<_>) = (0..n).map(|_| (v3(), v3())).unzip();
+    let s: Vec<[Sym; 6]> = (0..n).map(|_| core::array::from_fn(|_| x())).collect();
+    let mut inertia: Vec<[Sym; 10]> = (0..n).map(|_| core::array::from_fn(|_| x())).collect();
+    if payload {
+        if let Some(last) = inertia.last_mut() {
+            *last = k::payload_inertia(x(), &v3(), &m3());
+        }
+    }
+    let ancestor: Option<Vec<bool>> = t.ancestor.as_ref().map(|rows| rows.concat());
+    let tables = Tables {
+        parent: &t.parent,
+        revolute: &t.revolute,
+        a: &a,
+        b: &b,
+        c: &c,
+        l: &l,
+        slide: &slide,
+        s: &s,
+        inertia: &inertia,
+        ancestor: ancestor.as_deref(),
+        a0: core::array::from_fn(|_| x()),
+    };
+    let joints = || -> Vec<Sym> { (0..n).map(|_| x()).collect() };
+    let q = joints();
+    let out = trace_kernel(&tables, f, &q, &mut || joints(), &x)?;
+    Some(tr.finish(&out).counts(Convention::Paper))
+}
+
+/// The outputs of `f`'s kernel on `tables` at `q`, as its entry point computes them
+/// (`arg`: a fresh vector of joint inputs, `x`: a fresh input), its scratch in `Vec`s.
+fn trace_kernel(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    q: &[Sym],
+    arg: &mut dyn FnMut() -> Vec<Sym>,
+    x: &dyn Fn() -> Sym,
+) -> Option<Vec<Sym>> {
+    let n = q.len();
+    let zero = Sym::zero();
+    let identity = Transform {
+        e: [[zero; 3]; 3],
+        r: [zero; 3],
+    };
+    let (mut xs, mut x0) = (vec![identity; n], vec![identity; n]);
+    let (mut s0, mut i0) = (vec![[zero; 6]; n], vec![[zero; 10]; n]);
+    let mut b = Bodies {
+        x: &mut xs,
+        x0: &mut x0,
+        s0: &mut s0,
+        i0: &mut i0,
+    };
+    let inertia = tables.inertia;
+    let mut m = vec![[[zero; 6]; 3]; n];
+    let mut out = vec![zero; n];
+    let mut rnea = |b: &Bodies<'_, Sym>, motions: Motions<'_, Sym>| {
+        k::rnea::rnea(tables, b.x, inertia, motions, &mut m, &mut out);
+        out.clone()
+    };
+    let sincos = |a: Sym| a.sin_cos();
+    if !crate::compact::has_body(f) {
+        return None;
+    }
+    k::spatial::transforms(tables, q, sincos, b.x);
+    let (qd, qdd) = (arg(), arg());
+    let (velocity, rates) = (
+        Motions::velocity(&qd),
+        Motions {
+            qd: Some(&qd),
+            qdd: Some(&qdd),
+        },
+    );
+    let rest = Motions {
+        qd: None,
+        qdd: None,
+    };
+    Some(match f {
+        Function::MassMatrix => crba(tables, &mut b),
+        Function::NonlinearEffects => rnea(&b, velocity),
+        Function::Gravity => rnea(&b, rest),
+        Function::InverseDynamics => rnea(&b, rates),
+        Function::MassMatrixAndNonlinearEffects => {
+            let h = crba(tables, &mut b);
+            [h, rnea(&b, velocity)].concat()
+        }
+        _ => {
+            let f_ext: Option<Vec<[Sym; 6]>> = (f == Function::ForwardDynamicsWithWrenches)
+                .then(|| (0..n).map(|_| core::array::from_fn(|_| x())).collect());
+            let tau = arg();
+            let rates = Rates {
+                qd: &qd,
+                tau: &tau,
+                f_ext: f_ext.as_deref(),
+            };
+            let mut bodies = vec![Articulated::zero(); n];
+            let mut qdd = vec![zero; n];
+            k::aba::aba(tables, inertia, rates, &mut b, &mut bodies, &mut qdd);
+            qdd
+        }
+    })
+}
+
+/// The CRBA's `H` (rows first) on the joint transforms of `b`.
+fn crba(tables: &Tables<'_, Sym>, b: &mut Bodies<'_, Sym>) -> Vec<Sym> {
+    let n = b.x.len();
+    let zero = Sym::zero();
+    let (mut st, mut h) = (vec![zero; 6 * n], vec![zero; n * n]);
+    k::crba::crba(tables, tables.inertia, b, &mut st, &mut h);
+    h
+}

@@ -1,0 +1,385 @@
+//! The compact form's runtime kernels (`kanegen_runtime::compact`) on the tables the generator
+//! emits ([`kanegen_codegen::compact::tables::numbers`]): in f64 they agree with the
+//! interpreted algorithms of `kanegen_dynamics` on random chains and trees with prismatic
+//! joints (regrouped or not, with and without gravity, a runtime payload, external wrenches);
+//! and the operation counts a compact type reports (`OP_COUNTS`) are what the kernels execute,
+//! counted independently of the tracer by a scalar that counts its own operations.
+
+use kanegen_codegen::compact::kernel_counts;
+use kanegen_codegen::compact::tables::{numbers, Numbers};
+use kanegen_codegen::{generate_items, Form, Options};
+use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::metrics::rel_err;
+use kanegen_dynamics::{ExternalWrench, LoadFrame, Loads, Methods, Params};
+use kanegen_model::random::{random_chain, random_tree, random_vec, rng, ChainSpec};
+use kanegen_model::Model;
+use kanegen_runtime::compact::{self as k, Tables};
+use kanegen_runtime::Scalar;
+use kanegen_trace::Function;
+use std::cell::Cell;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+const G: [f64; 3] = [0.3, -1.2, -9.81];
+
+fn spec(n: usize) -> ChainSpec {
+    ChainSpec {
+        n,
+        prismatic_fraction: 0.3,
+        ..Default::default()
+    }
+}
+
+/// The kernels' tables of `t` in scalar `S`, in `Vec`s ([`Owned::tables`]).
+struct Owned<S> {
+    a: Vec<[[S; 3]; 3]>,
+    b: Vec<[[S; 3]; 3]>,
+    c: Vec<[[S; 3]; 3]>,
+    l: Vec<[S; 3]>,
+    slide: Vec<[S; 3]>,
+    s: Vec<[S; 6]>,
+    inertia: Vec<[S; 10]>,
+    ancestor: Option<Vec<bool>>,
+    a0: [S; 6],
+}
+
+impl<S: Scalar + Copy> Owned<S> {
+    fn new(t: &Numbers, s: impl Fn(f64) -> S) -> Self {
+        let m3 = |m: &[[f64; 3]; 3]| m.map(|r| r.map(&s));
+        Owned {
+            a: t.a.iter().map(m3).collect(),
+            b: t.b.iter().map(m3).collect(),
+            c: t.c.iter().map(m3).collect(),
+            l: t.l.iter().map(|v| v.map(&s)).collect(),
+            slide: t.slide.iter().map(|v| v.map(&s)).collect(),
+            s: t.s.iter().map(|v| v.map(&s)).collect(),
+            inertia: t.inertia.iter().map(|v| v.map(&s)).collect(),
+            ancestor: t.ancestor.as_ref().map(|rows| rows.concat()),
+            a0: t.a0.map(&s),
+        }
+    }
+
+    fn tables<'a>(&'a self, t: &'a Numbers) -> Tables<'a, S> {
+        Tables {
+            parent: &t.parent,
+            revolute: &t.revolute,
+            a: &self.a,
+            b: &self.b,
+            c: &self.c,
+            l: &self.l,
+            slide: &self.slide,
+            s: &self.s,
+            inertia: &self.inertia,
+            ancestor: self.ancestor.as_deref(),
+            a0: self.a0,
+        }
+    }
+}
+
+fn arr<const N: usize>(v: Vec<f64>) -> [f64; N] {
+    core::array::from_fn(|i| v[i])
+}
+
+fn close(what: &str, x: &[f64], y: &[f64], tol: f64) {
+    let e = rel_err(x, y);
+    assert!(e < tol, "{what}: relative error {e:e}\n{x:?}\n{y:?}");
+}
+
+const PAYLOAD: (f64, [f64; 3], [[f64; 3]; 3]) = (
+    7.5,
+    [0.1, -0.2, 0.3],
+    [[0.4, 0.01, -0.02], [0.01, 0.5, 0.03], [-0.02, 0.03, 0.6]],
+);
+
+/// Every kernel against the interpreted algorithms (`Methods::SPATIAL`, RBDA's CRBA and RNEA;
+/// forward dynamics by LDLᵀ on them) for one model and options.
+fn agree<const N: usize>(model: &Model, opts: &Options) {
+    let numbers = numbers(model, opts);
+    let owned = Owned::new(&numbers, |x| x);
+    let t = owned.tables(&numbers);
+    let inertia: [[f64; 10]; N] = if opts.runtime_payload {
+        k::with_payload(t.inertia, PAYLOAD.0, &PAYLOAD.1, &PAYLOAD.2)
+    } else {
+        core::array::from_fn(|j| t.inertia[j])
+    };
+    let mut p = Params::<f64>::new(model);
+    if let (true, Some(last)) = (opts.runtime_payload, p.joints.last_mut()) {
+        last.set_inertial(PAYLOAD.0, Vec3(PAYLOAD.1), Mat3(PAYLOAD.2));
+    }
+    let alg = Methods::SPATIAL;
+    let sc = |x: f64| x.sin_cos();
+    for seed in 0..5 {
+        let mut r = rng(seed);
+        let q: [f64; N] = arr(random_vec(&mut r, N, 2.0));
+        let qd: [f64; N] = arr(random_vec(&mut r, N, 1.0));
+        let qdd: [f64; N] = arr(random_vec(&mut r, N, 1.0));
+        let tau: [f64; N] = arr(random_vec(&mut r, N, 20.0));
+        let f_ext: [[f64; 6]; N] = core::array::from_fn(|_| arr(random_vec(&mut r, 6, 3.0)));
+        let loads = Loads {
+            gravity: opts.gravity.map(|g| Vec3::new(g[0], g[1], g[2])),
+            ..Loads::default()
+        };
+        let m = k::mass_matrix(&t, &inertia, &q, sc);
+        let mi = alg.mass_matrix.mass_matrix(&p, &q);
+        close("M", m.as_flattened(), &mi.concat(), 1e-12);
+        let c = k::nonlinear_effects(&t, &inertia, &q, &qd, sc);
+        let ci: Vec<f64> = alg
+            .bias
+            .bias(&p, &q, &qd, &loads)
+            .iter()
+            .map(|b| -b)
+            .collect();
+        close("c", &c, &ci, 1e-12);
+        assert_eq!(
+            k::mass_matrix_and_nonlinear_effects(&t, &inertia, &q, &qd, sc),
+            (m, c),
+            "M + c in one call"
+        );
+        let g = k::gravity(&t, &inertia, &q, sc);
+        let gi: Vec<f64> = alg
+            .bias
+            .bias(&p, &q, &[0.0; N], &loads)
+            .iter()
+            .map(|b| -b)
+            .collect();
+        close("g", &g, &gi, 1e-12);
+        let id = k::inverse_dynamics(&t, &inertia, &q, &qd, &qdd, sc);
+        close(
+            "ID",
+            &id,
+            &alg.inverse_dynamics(&p, &q, &qd, &qdd, &loads),
+            1e-12,
+        );
+        let fd = k::forward_dynamics(&t, &inertia, &q, &qd, &tau, sc);
+        let with_tau = Loads {
+            tau: Some(tau.to_vec()),
+            ..loads.clone()
+        };
+        close(
+            "FD",
+            &fd,
+            &alg.forward_dynamics(&p, &q, &qd, &with_tau),
+            1e-10,
+        );
+        let fw = k::forward_dynamics_with_wrenches(&t, &inertia, &q, &qd, &tau, &f_ext, sc);
+        let wrenches = Loads {
+            external: f_ext
+                .iter()
+                .enumerate()
+                .map(|(body, e)| ExternalWrench {
+                    body,
+                    frame: LoadFrame::Body,
+                    force: Vec3::new(e[0], e[1], e[2]),
+                    moment: Vec3::new(e[3], e[4], e[5]),
+                })
+                .collect(),
+            ..with_tau
+        };
+        close(
+            "FD with wrenches",
+            &fw,
+            &alg.forward_dynamics(&p, &q, &qd, &wrenches),
+            1e-10,
+        );
+        assert!(rel_err(&fw, &fd) > 1e-6, "the wrenches matter");
+    }
+}
+
+#[test]
+fn kernels_agree_with_the_interpreted_algorithms() {
+    let chain = random_chain(&spec(6), 31);
+    let tree = random_tree(&spec(9), 32);
+    assert!(!tree.is_chain());
+    for (regroup, gravity, runtime_payload) in [
+        (true, Some(G), false),
+        (false, None, false),
+        (true, Some(G), true),
+        (false, None, true),
+    ] {
+        let mut o = Options::new("Arm");
+        o.regroup = regroup;
+        o.gravity = gravity;
+        o.runtime_payload = runtime_payload;
+        agree::<6>(&chain, &o);
+        agree::<9>(&tree, &o);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Operation counts.
+
+thread_local! {
+    /// `[mul, add, div, sincos]` since the last [`take`].
+    static OPS: Cell<[u64; 4]> = const { Cell::new([0; 4]) };
+}
+
+fn bump(k: usize) {
+    OPS.with(|c| {
+        let mut v = c.get();
+        v[k] += 1;
+        c.set(v);
+    });
+}
+
+fn take() -> [u64; 4] {
+    OPS.with(|c| c.replace([0; 4]))
+}
+
+/// An `f64` that counts the operations done on it (sign changes free, as in the tracer's
+/// conventions).
+#[derive(Clone, Copy, Debug)]
+struct Counted(f64);
+
+macro_rules! counted_op {
+    ($tr:ident, $f:ident, $op:tt, $k:expr) => {
+        impl $tr for Counted {
+            type Output = Counted;
+            fn $f(self, o: Counted) -> Counted {
+                bump($k);
+                Counted(self.0 $op o.0)
+            }
+        }
+    };
+}
+counted_op!(Add, add, +, 1);
+counted_op!(Sub, sub, -, 1);
+counted_op!(Mul, mul, *, 0);
+counted_op!(Div, div, /, 2);
+
+impl Neg for Counted {
+    type Output = Counted;
+    fn neg(self) -> Counted {
+        Counted(-self.0)
+    }
+}
+
+impl Scalar for Counted {
+    fn constant(x: f64) -> Self {
+        Counted(x)
+    }
+    fn sin(self) -> Self {
+        bump(3);
+        Counted(self.0.sin())
+    }
+    fn cos(self) -> Self {
+        bump(3);
+        Counted(self.0.cos())
+    }
+    fn sqrt(self) -> Self {
+        Counted(self.0.sqrt())
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        bump(3);
+        let (s, c) = self.0.sin_cos();
+        (Counted(s), Counted(c))
+    }
+}
+
+/// The operations each compact function's kernel executes, counted by running it on
+/// [`Counted`].
+fn counted<const N: usize>(t: &Numbers, f: Function, payload: bool) -> [u64; 4] {
+    let owned = Owned::new(t, Counted);
+    let t = owned.tables(t);
+    let x = |k: usize| Counted(0.1 + 0.01 * k as f64);
+    let v: [Counted; N] = core::array::from_fn(x);
+    let sc = |a: Counted| a.sin_cos();
+    take();
+    let inertia: [[Counted; 10]; N] = if payload {
+        k::with_payload(t.inertia, x(1), &[x(2), x(3), x(4)], &[[x(5); 3]; 3])
+    } else {
+        core::array::from_fn(|j| t.inertia[j])
+    };
+    match f {
+        Function::MassMatrix => _ = k::mass_matrix(&t, &inertia, &v, sc),
+        Function::NonlinearEffects => _ = k::nonlinear_effects(&t, &inertia, &v, &v, sc),
+        Function::Gravity => _ = k::gravity(&t, &inertia, &v, sc),
+        Function::InverseDynamics => _ = k::inverse_dynamics(&t, &inertia, &v, &v, &v, sc),
+        Function::MassMatrixAndNonlinearEffects => {
+            _ = k::mass_matrix_and_nonlinear_effects(&t, &inertia, &v, &v, sc);
+        }
+        Function::ForwardDynamics => _ = k::forward_dynamics(&t, &inertia, &v, &v, &v, sc),
+        Function::ForwardDynamicsWithWrenches => {
+            let f_ext = [[x(6); 6]; N];
+            _ = k::forward_dynamics_with_wrenches(&t, &inertia, &v, &v, &v, &f_ext, sc);
+        }
+        _ => unreachable!("{f:?} has no kernel"),
+    }
+    take()
+}
+
+const KERNELS: [Function; 7] = [
+    Function::MassMatrix,
+    Function::NonlinearEffects,
+    Function::Gravity,
+    Function::InverseDynamics,
+    Function::MassMatrixAndNonlinearEffects,
+    Function::ForwardDynamics,
+    Function::ForwardDynamicsWithWrenches,
+];
+
+/// A compact type's `OP_COUNTS` entry of a kernel function is the tracer's count of that kernel
+/// (`kernel_counts`), and that count is what the kernel executes ([`Counted`]); a kernel
+/// changed without the counts following fails here.
+fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
+    let t = numbers(model, opts);
+    let items = generate_items(model, opts).unwrap().items.to_string();
+    for f in KERNELS {
+        if f == Function::Gravity && opts.gravity.is_none() {
+            continue; // no `gravity` function in space
+        }
+        let c = kernel_counts(model, opts, f).expect("a kernel function");
+        let ran = counted::<N>(&t, f, opts.runtime_payload);
+        assert_eq!(
+            [c.mul, c.add, c.div, c.sincos],
+            ran,
+            "{f:?} of {}",
+            model.name()
+        );
+        assert!(c.mul > 0 && c.add > 0);
+        // The generated type reports them.
+        let entry = format!(
+            "function : \"{}\" , mass_matrix_method : {}",
+            f.name(),
+            if f.uses_mass_matrix() && !f.is_forward_dynamics() {
+                "Some (\"crba\")"
+            } else {
+                "None"
+            }
+        );
+        let at = items
+            .find(&entry)
+            .unwrap_or_else(|| panic!("no `{entry}` in OP_COUNTS"));
+        let end = at + items[at..].find('}').unwrap();
+        let reported = items[at..end].replace(' ', "");
+        assert!(
+            reported.contains(&format!(
+                "mul:{}u64,add:{}u64,div:{}u64",
+                c.mul, c.add, c.div
+            )),
+            "{reported}"
+        );
+    }
+}
+
+#[test]
+fn op_counts_of_compact_types_are_what_the_kernels_execute() {
+    let mut o = Options::new("Arm");
+    o.form = Form::Compact;
+    o.gravity = Some(G);
+    counts_follow::<5>(&random_chain(&spec(5), 41), &o);
+    counts_follow::<7>(&random_tree(&spec(7), 42), &o);
+    o.runtime_payload = true;
+    o.gravity = None;
+    counts_follow::<7>(&random_tree(&spec(7), 43), &o);
+}
+
+/// The counts follow the kernels above 64 joints too (the kernels are traced for any number of
+/// joints), on a chain and a tree.
+#[test]
+fn op_counts_of_large_compact_types_are_what_the_kernels_execute() {
+    let mut o = Options::new("Arm");
+    o.form = Form::Compact;
+    o.gravity = Some(G);
+    counts_follow::<70>(&random_chain(&spec(70), 44), &o);
+    o.runtime_payload = true;
+    counts_follow::<66>(&random_tree(&spec(66), 45), &o);
+}

@@ -1,0 +1,303 @@
+//! Forward dynamics by the articulated-body algorithm (RBDA Table 7.1), with and without
+//! external wrenches.
+
+use super::spatial::{add, axpy, crf, crm, dot, inertia_mul, scale, sub, transforms, world};
+use super::tables::{Bodies, BodyStore, Tables};
+use crate::scalar::Scalar;
+
+/// `q̈ = M(q)⁻¹ (τ − c(q, q̇))`: [`aba`] without external wrenches.
+#[inline(always)]
+pub fn forward_dynamics<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    tau: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    articulated(
+        t,
+        inertia,
+        q,
+        Rates {
+            qd,
+            tau,
+            f_ext: None,
+        },
+        sincos,
+    )
+}
+
+/// [`forward_dynamics`] with `f_ext[i] = [force; moment]` on body `i`, in its frame at its
+/// origin: [`aba`].
+#[inline(always)]
+pub fn forward_dynamics_with_wrenches<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    tau: &[S; N],
+    f_ext: &[[S; 6]; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    let rates = Rates {
+        qd,
+        tau,
+        f_ext: Some(f_ext),
+    };
+    articulated(t, inertia, q, rates, sincos)
+}
+
+/// [`aba`] on the joint transforms of `q`, on stack storage of `N` joints.
+#[inline]
+fn articulated<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    rates: Rates<'_, S>,
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut bodies = [Articulated::zero(); N];
+    let mut qdd = [S::zero(); N];
+    transforms(t, q, sincos, b.x);
+    aba(t, inertia, rates, &mut b, &mut bodies, &mut qdd);
+    qdd
+}
+
+/// What the articulated-body algorithm runs at besides `q`: `q̇`, `τ`, and the external
+/// wrenches, `f_ext[i] = [force; moment]` in body `i`'s frame at its origin (`None`: no
+/// wrenches, nothing computed for them). One entry per joint.
+#[derive(Clone, Copy, Debug)]
+pub struct Rates<'a, S> {
+    /// `q̇`.
+    pub qd: &'a [S],
+    /// `τ`.
+    pub tau: &'a [S],
+    /// The external wrenches.
+    pub f_ext: Option<&'a [[S; 6]]>,
+}
+
+/// One body's quantities in the articulated-body algorithm (RBDA Table 7.1): the kernels'
+/// scratch, one per joint.
+#[derive(Clone, Copy, Debug)]
+pub struct Articulated<S> {
+    /// `v_i`.
+    v: [S; 6],
+    /// `c_i = v_i ×ₘ S_i q̇_i`.
+    c: [S; 6],
+    /// `I^A_i`, 21 upper-triangle entries by rows ([`SYM`]).
+    ia: [S; 21],
+    /// `p^A_i`.
+    pa: [S; 6],
+    /// `U_i = I^A_i S_i`.
+    ui: [S; 6],
+    /// `D_i = S_iᵀ U_i`.
+    d: S,
+    /// `u_i = τ_i − S_iᵀ p^A_i`.
+    u: S,
+    /// `a_i`.
+    a: [S; 6],
+}
+
+impl<S: Scalar + Copy> Articulated<S> {
+    /// All zero (`D_i = 1`).
+    #[inline(always)]
+    #[must_use]
+    pub fn zero() -> Self {
+        let zero = S::zero();
+        Articulated {
+            v: [zero; 6],
+            c: [zero; 6],
+            ia: [zero; 21],
+            pa: [zero; 6],
+            ui: [zero; 6],
+            d: S::one(),
+            u: zero,
+            a: [zero; 6],
+        }
+    }
+}
+
+/// Where entry `(r, c)` of a symmetric 6×6 matrix is kept among its 21 upper-triangle entries,
+/// by rows.
+const SYM: [[usize; 6]; 6] = {
+    let mut k = [[0; 6]; 6];
+    let mut r = 0;
+    while r < 6 {
+        let mut c = 0;
+        while c < 6 {
+            let (a, b) = if r < c { (r, c) } else { (c, r) };
+            k[r][c] = a * 6 - a * (a + 1) / 2 + b;
+            c += 1;
+        }
+        r += 1;
+    }
+    k
+};
+
+/// `M v` of a symmetric 6×6 `M` kept as its 21 upper-triangle entries ([`SYM`]).
+#[inline(always)]
+fn sym_times<S: Scalar + Copy>(m: &[S; 21], v: &[S; 6]) -> [S; 6] {
+    core::array::from_fn(|r| {
+        let row = &SYM[r];
+        m[row[0]] * v[0]
+            + m[row[1]] * v[1]
+            + m[row[2]] * v[2]
+            + m[row[3]] * v[3]
+            + m[row[4]] * v[4]
+            + m[row[5]] * v[5]
+    })
+}
+
+/// `M − w uᵀ` of a packed symmetric `M` (for `w uᵀ` symmetric: `w = u / D`).
+#[inline(always)]
+fn sym_minus_outer<S: Scalar + Copy>(m: &[S; 21], w: &[S; 6], u: &[S; 6]) -> [S; 21] {
+    let mut out = *m;
+    let mut k = 0;
+    for (r, wr) in w.iter().enumerate() {
+        for uc in &u[r..] {
+            out[k] = m[k] - *wr * *uc;
+            k += 1;
+        }
+    }
+    out
+}
+
+/// The articulated-body algorithm (RBDA Table 7.1) in base coordinates (RBDA §7.3's "any
+/// coordinate system", as Pinocchio's), so that no transform is needed between bodies, on the
+/// joint transforms `b.x`, into `qdd`: the bodies carried to the base ([`world`]), velocities
+/// and bias terms outwards ([`outward`]), articulated inertias inwards ([`inward`]),
+/// accelerations outwards from `a₀` ([`Tables::a0`], [`accelerations`]). `bodies`: scratch, one
+/// per joint.
+#[inline(always)]
+pub fn aba<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    rates: Rates<'_, S>,
+    b: &mut Bodies<'_, S>,
+    bodies: &mut [Articulated<S>],
+    qdd: &mut [S],
+) {
+    world(t, inertia, b);
+    outward(t, b, rates, bodies);
+    inward(t, b.s0, rates.tau, bodies);
+    accelerations(t, b.s0, bodies, qdd);
+}
+
+/// RBDA Table 7.1, third pass: `a' = a_λ + c_i`, `q̈_i = (u_i − U_iᵀ a') / D_i`,
+/// `a_i = a' + S_i q̈_i`.
+#[inline(always)]
+fn accelerations<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    s0: &[[S; 6]],
+    bodies: &mut [Articulated<S>],
+    qdd: &mut [S],
+) {
+    for i in 0..bodies.len() {
+        let ap = match t
+            .parent
+            .get(i)
+            .copied()
+            .flatten()
+            .and_then(|l| bodies.get(l))
+        {
+            Some(p) => p.a,
+            None => t.a0,
+        };
+        let (Some(s), Some(qddi)) = (s0.get(i), qdd.get_mut(i)) else {
+            continue;
+        };
+        let o = &mut bodies[i];
+        let a = add(&ap, &o.c);
+        *qddi = (o.u - dot(&o.ui, &a)) / o.d;
+        o.a = axpy(&a, *qddi, s);
+    }
+}
+
+/// RBDA Table 7.1, first pass (base coordinates): `v_i = v_λ + S_i q̇_i`,
+/// `c_i = v_i ×ₘ S_i q̇_i`, `I^A_i = I_i`, `p^A_i = v_i ×* I_i v_i − f^x_i`.
+#[inline(always)]
+fn outward<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    b: &Bodies<'_, S>,
+    rates: Rates<'_, S>,
+    bodies: &mut [Articulated<S>],
+) {
+    let zero = S::zero();
+    for i in 0..bodies.len() {
+        let vp = match t
+            .parent
+            .get(i)
+            .copied()
+            .flatten()
+            .and_then(|l| bodies.get(l))
+        {
+            Some(p) => p.v,
+            None => [zero; 6],
+        };
+        let (Some(s), Some(k), Some(x0), Some(&qd)) =
+            (b.s0.get(i), b.i0.get(i), b.x0.get(i), rates.qd.get(i))
+        else {
+            continue;
+        };
+        let o = &mut bodies[i];
+        let vj = scale(qd, s);
+        o.v = add(&vp, &vj);
+        o.c = crm(&o.v, &vj);
+        // I = [Ī h̃; h̃ᵀ m1] (RBDA eq. (2.63)), upper triangle by rows.
+        #[rustfmt::skip]
+        let ia = [
+            k[4], k[5], k[6], zero, -k[3], k[2],
+            k[7], k[8], k[3], zero, -k[1],
+            k[9], -k[2], k[1], zero,
+            k[0], zero, zero,
+            k[0], zero,
+            k[0],
+        ];
+        o.ia = ia;
+        let iv = inertia_mul(k, &o.v);
+        let p = crf(&o.v, &iv);
+        o.pa = match rates.f_ext.and_then(|f| f.get(i)) {
+            Some(e) => sub(&p, &x0.apply_tr(&[e[3], e[4], e[5], e[0], e[1], e[2]])),
+            None => p,
+        };
+    }
+}
+
+/// RBDA Table 7.1, second pass (base coordinates, leaves first): `U_i = I^A_i S_i`,
+/// `D_i = S_iᵀ U_i`, `u_i = τ_i − S_iᵀ p^A_i`, `I^A_λ += I^A_i − U_i U_iᵀ / D_i`,
+/// `p^A_λ += p^A_i + (I^A_i − U_i U_iᵀ / D_i) c_i + U_i u_i / D_i`.
+#[inline(always)]
+fn inward<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    s0: &[[S; 6]],
+    tau: &[S],
+    bodies: &mut [Articulated<S>],
+) {
+    for i in (0..bodies.len()).rev() {
+        let (Some(s), Some(&taui)) = (s0.get(i), tau.get(i)) else {
+            continue;
+        };
+        let o = &mut bodies[i];
+        let ui = sym_times(&o.ia, s);
+        o.d = dot(s, &ui);
+        o.u = taui - dot(s, &o.pa);
+        o.ui = ui;
+        if let Some(l) = t.parent.get(i).copied().flatten() {
+            let o = &bodies[i];
+            let dinv = S::one() / o.d;
+            let w = scale(dinv, &ui);
+            let m = sym_minus_outer(&o.ia, &w, &ui);
+            let p = axpy(&o.pa, o.u, &w);
+            let p = add(&p, &sym_times(&m, &o.c));
+            if let Some(parent) = bodies.get_mut(l) {
+                for (a, b) in parent.ia.iter_mut().zip(m) {
+                    *a = *a + b;
+                }
+                parent.pa = add(&parent.pa, &p);
+            }
+        }
+    }
+}

@@ -1,0 +1,147 @@
+//! Inverse dynamics, nonlinear effects and gravity by the recursive Newton–Euler algorithm
+//! (RBDA Table 5.1).
+
+use super::spatial::{add, axpy, crf, crm, dot, inertia_mul, scale, transforms, Transform};
+use super::tables::{BodyStore, Tables};
+use crate::scalar::Scalar;
+
+/// The joint rates the recursive Newton–Euler algorithm runs at: `q̇` and `q̈`, each `None` for
+/// zero (and nothing computed for it).
+#[derive(Clone, Copy, Debug)]
+pub struct Motions<'a, S> {
+    /// `q̇`.
+    pub qd: Option<&'a [S]>,
+    /// `q̈`.
+    pub qdd: Option<&'a [S]>,
+}
+
+impl<'a, S> Motions<'a, S> {
+    /// `q̇` alone (`q̈ = 0`).
+    #[inline(always)]
+    #[must_use]
+    pub fn velocity(qd: &'a [S]) -> Self {
+        Motions {
+            qd: Some(qd),
+            qdd: None,
+        }
+    }
+}
+
+/// [`rnea`] on the joint transforms of `q` at `motions`, on stack storage of `N` joints.
+#[inline]
+fn newton_euler<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    motions: Motions<'_, S>,
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let b = store.bodies();
+    let mut m = [[[zero; 6]; 3]; N];
+    let mut tau = [zero; N];
+    transforms(t, q, sincos, b.x);
+    rnea(t, b.x, inertia, motions, &mut m, &mut tau);
+    tau
+}
+
+/// `c(q, q̇)`, the nonlinear effects (Coriolis, centrifugal and gravity): [`rnea`] at `q̈ = 0`.
+#[inline(always)]
+pub fn nonlinear_effects<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    newton_euler(t, inertia, q, Motions::velocity(qd), sincos)
+}
+
+/// `g(q)`, the gravity torques: [`rnea`] at `q̇ = 0`, `q̈ = 0`.
+#[inline(always)]
+pub fn gravity<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    let motions = Motions {
+        qd: None,
+        qdd: None,
+    };
+    newton_euler(t, inertia, q, motions, sincos)
+}
+
+/// `τ = M(q) q̈ + c(q, q̇)`: [`rnea`].
+#[inline(always)]
+pub fn inverse_dynamics<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    qdd: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; N] {
+    let motions = Motions {
+        qd: Some(qd),
+        qdd: Some(qdd),
+    };
+    newton_euler(t, inertia, q, motions, sincos)
+}
+
+/// The recursive Newton–Euler algorithm (RBDA Table 5.1) on the joint transforms `x`, into
+/// `tau`: forward `v_i = Xup_i v_λ(i) + S_i q̇_i`, `a_i = Xup_i a_λ(i) + S_i q̈_i + v_i ×ₘ S_i q̇_i`,
+/// `f_i = I_i a_i + v_i ×* I_i v_i`, from `a₀` ([`Tables::a0`], RBDA §5.3); backward
+/// `τ_i = S_iᵀ f_i`, `f_λ(i) += Xup_iᵀ f_i`. `m`: scratch of `[v_i, a_i, f_i]` per joint.
+#[inline(always)]
+pub fn rnea<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    x: &[Transform<S>],
+    inertia: &[[S; 10]],
+    motions: Motions<'_, S>,
+    m: &mut [[[S; 6]; 3]],
+    tau: &mut [S],
+) {
+    let zero = S::zero();
+    let n = x.len().min(m.len());
+    for i in 0..n {
+        let (vp, ap) = match t.parent.get(i).copied().flatten().and_then(|l| m.get(l)) {
+            Some([vp, ap, _]) => (*vp, *ap),
+            None => ([zero; 6], t.a0),
+        };
+        let (Some(s), Some(ii)) = (t.s.get(i), inertia.get(i)) else {
+            continue;
+        };
+        // RBDA Table 5.1: a_i = Xup_i a_λ(i) + S_i q̈_i + v_i ×ₘ S_i q̇_i.
+        let mut ai = x[i].apply(&ap);
+        if let Some(&qdd) = motions.qdd.and_then(|qdd| qdd.get(i)) {
+            ai = axpy(&ai, qdd, s);
+        }
+        let [v, a, f] = &mut m[i];
+        if let Some(&qd) = motions.qd.and_then(|qd| qd.get(i)) {
+            let vj = scale(qd, s);
+            *v = add(&x[i].apply(&vp), &vj);
+            ai = add(&ai, &crm(v, &vj));
+        }
+        *a = ai;
+        // f_i = I_i a_i + v_i ×* I_i v_i.
+        *f = inertia_mul(ii, a);
+        if motions.qd.is_some() {
+            let iv = inertia_mul(ii, v);
+            *f = add(f, &crf(v, &iv));
+        }
+    }
+    for i in (0..n).rev() {
+        let fi = m[i][2];
+        if let (Some(s), Some(taui)) = (t.s.get(i), tau.get_mut(i)) {
+            *taui = dot(s, &fi);
+        }
+        if let Some(l) = t.parent.get(i).copied().flatten() {
+            let carried = x[i].apply_tr(&fi);
+            if let Some([_, _, fl]) = m.get_mut(l) {
+                *fl = add(fl, &carried);
+            }
+        }
+    }
+}
