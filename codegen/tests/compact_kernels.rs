@@ -123,8 +123,8 @@ fn agree<const N: usize>(model: &Model, opts: &Options) {
         close("M", m.as_flattened(), &mi.concat(), 1e-12);
         let c = k::nonlinear_effects(&t, &inertia, &q, &qd, sc);
         let ci: Vec<f64> = alg
-            .bias
-            .bias(&p, &q, &qd, &loads)
+            .nonlinear_effects
+            .tau_minus_c(&p, &q, &qd, &loads)
             .iter()
             .map(|b| -b)
             .collect();
@@ -136,8 +136,8 @@ fn agree<const N: usize>(model: &Model, opts: &Options) {
         );
         let g = k::gravity(&t, &inertia, &q, sc);
         let gi: Vec<f64> = alg
-            .bias
-            .bias(&p, &q, &[0.0; N], &loads)
+            .nonlinear_effects
+            .tau_minus_c(&p, &q, &[0.0; N], &loads)
             .iter()
             .map(|b| -b)
             .collect();

@@ -76,8 +76,12 @@ fn reduced(model: &Model, q: &[f64], qd: &[f64], g: Option<[f64; 3]>) -> (Vec<Ve
         &coupling.full_rates(qd),
         &loads,
     );
-    let c: Vec<f64> = coupling.reduce_vector(&d.b, 0).iter().map(|x| -x).collect();
-    (coupling.reduce_matrix(&d.a, 0), c)
+    let c: Vec<f64> = coupling
+        .reduce_vector(&d.tau_minus_c, 0)
+        .iter()
+        .map(|x| -x)
+        .collect();
+    (coupling.reduce_matrix(&d.mass_matrix, 0), c)
 }
 
 fn quad(m: &[Vec<f64>], x: &[f64]) -> f64 {
@@ -115,7 +119,7 @@ fn kinetic_energy_of_the_reduced_model_is_the_full_models() {
         &c.full_rates(&QD),
         &Loads::default(),
     );
-    let t_full = 0.5 * quad(&full.a, &c.full_rates(&QD));
+    let t_full = 0.5 * quad(&full.mass_matrix, &c.full_rates(&QD));
     let t = 0.5 * quad(&mr, &QD);
     assert!((t - t_full).abs() < 1e-13 * t_full, "{t} vs {t_full}");
     // M is symmetric positive definite (two independent coordinates moving mass).
@@ -213,7 +217,7 @@ fn gravity_is_the_gradient_of_the_potential_and_power_balances() {
         &coupling.full_rates(&QD),
         &loads,
     );
-    let b = coupling.reduce_vector(&d.b, 0);
+    let b = coupling.reduce_vector(&d.tau_minus_c, 0);
     let (_, c0) = reduced(&m, &Q, &QD, None);
     for i in 0..2 {
         assert!(
