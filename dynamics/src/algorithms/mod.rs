@@ -19,6 +19,7 @@
 //! | [`frames`] | placements and Jacobians of frames on bodies, the generalized Jacobian |
 //! | [`momentum`] | total momentum and kinetic energy of a free-floating system |
 //! | [`floating`] | a free-floating base: the dispatch, and the inertial-frame algorithms on six virtual joints |
+//! | [`derivatives`] | `∂τ/∂q`, `∂τ/∂q̇`, `∂q̈/∂q`, `∂q̈/∂q̇`, `M⁻¹` (Carpentier & Mansard, RSS 2018) |
 //! | [`methods`] | the choice of mass-matrix and nonlinear-effects method, and the fixed-base dispatch |
 //!
 //! **Trees.** `crba`, `rnea`, `newton_euler`, `aba`, `frames` and `momentum` take any kinematic tree
@@ -34,6 +35,7 @@
 pub mod aba;
 pub mod crba;
 pub mod crba_inertial;
+pub mod derivatives;
 pub mod floating;
 pub mod frames;
 pub mod kane_direct;
