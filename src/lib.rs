@@ -28,8 +28,10 @@ extern crate std;
 /// `M(q) q̈ + c(q, q̇) = τ`: `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
 /// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)`,
 /// `forward_dynamics_with_wrenches(q, qd, tau, f_ext)`, `mass_matrix_and_nonlinear_effects(q, qd)`,
-/// `gravity(q)` with gravity, and each named frame's `<frame>_placement(q)` and
-/// `<frame>_jacobian(q)`. With `base = "free-floating"` (or a model whose base is free-floating)
+/// `gravity(q)` with gravity, each named frame's `<frame>_placement(q)` and
+/// `<frame>_jacobian(q)`, and the derivatives `inverse_dynamics_derivatives(q, qd, qdd)`
+/// (`(∂τ/∂q, ∂τ/∂q̇)`), `forward_dynamics_derivatives(q, qd, tau)` (`(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)`)
+/// and `mass_matrix_inverse(q)` (unrolled form up to 24 speeds; `docs/limits.md`). With `base = "free-floating"` (or a model whose base is free-floating)
 /// the arguments are Pinocchio's free-flyer `q` (`NQ = 7 + N`: base position, quaternion
 /// `[x, y, z, w]`, joints) and `v` (`NV = 6 + N`: base linear and angular velocity in base
 /// coordinates, joint rates), and `momentum(q, v)`, `base_reaction(q, v, a)` and each frame's

@@ -13,11 +13,18 @@
 //! | `forward_dynamics_with_wrenches(q, qd, tau, f_ext)` | the same with a wrench on every body |
 //! | `mass_matrix_and_nonlinear_effects(q, qd)` | `(M, c)` sharing sines, cosines and kinematics |
 //! | `<frame>_placement(q)`, `<frame>_jacobian(q)` | each named frame's pose and geometric Jacobian |
+//! | `inverse_dynamics_derivatives(q, qd, qdd)` | `(∂τ/∂q, ∂τ/∂q̇)`, Carpentier & Mansard's RNEA derivatives (unrolled form only) |
+//! | `forward_dynamics_derivatives(q, qd, tau)` | `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` (unrolled form only) |
+//! | `mass_matrix_inverse(q)` | `M(q)⁻¹`, symmetric (unrolled form only) |
+//!
+//! The derivatives are Pinocchio's layouts: row `i` = output `i`, column `j` = `∂/∂` input `j`.
 //!
 //! Free-floating base (Pinocchio's free-flyer layout: `q = [p₀, quaternion x y z w, joints]`
 //! (`7 + N`), `v = [v_b, ω_b, q̇]` (`6 + N`, base coordinates), `a = v̇`): the same functions on
 //! `(q, v)` with `6 + N` speeds, `inverse_dynamics` returning the base wrench then the drives,
-//! and `momentum(q, v)`, `base_reaction(q, v, a)`, `<frame>_generalized_jacobian(q)`.
+//! and `momentum(q, v)`, `base_reaction(q, v, a)`, `<frame>_generalized_jacobian(q)`; the
+//! derivatives' base columns of `∂/∂q` are in the tangent space (`6 + N`, Pinocchio's
+//! `integrate(q, δv)`).
 
 use crate::emit::Shape;
 use crate::options::Options;
@@ -41,6 +48,9 @@ pub fn functions(model: &Model, opts: &Options) -> Vec<Function> {
         Function::ForwardDynamicsWithWrenches,
         Function::Momentum,
         Function::BaseReaction,
+        Function::InverseDynamicsDerivatives,
+        Function::ForwardDynamicsDerivatives,
+        Function::MassMatrixInverse,
     ]
     .into_iter()
     .filter(|f| *f != Function::Gravity || opts.gravity.is_some())
@@ -90,13 +100,25 @@ pub fn fn_name(f: Function, model: &Model) -> String {
 pub fn shape(f: Function, n: usize, floating: bool) -> Shape {
     let nv = n + if floating { 6 } else { 0 };
     match f {
-        Function::MassMatrix => Shape::SymMatrix(nv),
+        Function::MassMatrix | Function::MassMatrixInverse => Shape::SymMatrix(nv),
+        Function::InverseDynamicsDerivatives => Shape::Matrices(2, nv),
+        Function::ForwardDynamicsDerivatives => Shape::Matrices(3, nv),
         Function::MassMatrixAndNonlinearEffects => Shape::SymMatrixAndVector(nv),
         Function::Momentum | Function::BaseReaction => Shape::Vector(6),
         Function::FramePlacement(_) => Shape::Placement,
         Function::FrameJacobian(_) => Shape::Matrix(6, nv),
         Function::GeneralizedJacobian(_) => Shape::Matrix(6, n),
         _ => Shape::Vector(nv),
+    }
+}
+
+/// How the derivatives' columns of `∂/∂q` read on a free-floating base.
+fn tangent(floating: bool) -> &'static str {
+    if floating {
+        "; the base columns of `∂/∂q` are in the tangent space: `q` moved by Pinocchio's \
+         `integrate(q, δv)`"
+    } else {
+        ""
     }
 }
 
@@ -166,6 +188,25 @@ pub fn doc(f: Function, floating: bool, forward: ForwardMethod) -> String {
             .into(),
         Function::GeneralizedForces => {
             "The paper's generalized forces `b = Q − h` of `A q̈ = b` (`b = τ − c`).".into()
+        }
+        Function::InverseDynamicsDerivatives => format!(
+            "`(∂τ/∂q, ∂τ/∂{v})` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's \
+             `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`{tangent}.",
+            v = if floating { "v" } else { "q̇" },
+            tangent = tangent(floating),
+        ),
+        Function::ForwardDynamicsDerivatives => format!(
+            "`(∂{speeds}/∂q, ∂{speeds}/∂{v}, M⁻¹)` of forward dynamics at the drives `tau` \
+             (`−M⁻¹ ∂τ/∂x` at `{speeds} = FD(q, {v}, τ)`; Pinocchio's `computeABADerivatives`): \
+             row `i` = output `i`, column `j` = `∂/∂` speed `j`{tangent}.",
+            speeds = if floating { "v̇" } else { "q̈" },
+            v = if floating { "v" } else { "q̇" },
+            tangent = tangent(floating),
+        ),
+        Function::MassMatrixInverse => {
+            "The inverse of the joint-space inertia matrix, `M(q)⁻¹` (symmetric, both triangles \
+             written), from the LDLᵀ factors of `M`."
+                .into()
         }
     }
 }

@@ -134,6 +134,9 @@ pub enum Shape {
     SymMatrixAndVector(usize),
     /// A `rows × cols` matrix, row-major (`[[f; cols]; rows]`).
     Matrix(usize, usize),
+    /// `k` square `n × n` matrices one after the other, each row-major, returned as a tuple of
+    /// `k` `[[f; n]; n]` (the derivatives).
+    Matrices(usize, usize),
     /// A placement: origin (3) then rotation matrix (9, row-major), returned as
     /// `([f; 3], [[f; 3]; 3])`.
     Placement,
@@ -669,6 +672,13 @@ fn result_tokens(out: &[TokenStream], shape: Shape) -> TokenStream {
         Shape::Matrix(_, cols) => {
             let rows = out.chunks(cols).map(|r| quote!([#(#r),*]));
             quote!([#(#rows),*])
+        }
+        Shape::Matrices(_, n) => {
+            let mats = out.chunks(n * n).map(|m| {
+                let rows = m.chunks(n).map(|r| quote!([#(#r),*]));
+                quote!([#(#rows),*])
+            });
+            quote!((#(#mats),*))
         }
         Shape::Placement => {
             let p = &out[..3];

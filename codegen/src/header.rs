@@ -56,6 +56,14 @@ fn form_line(plan: &Plan) -> String {
             compact::LINEAR_AUTO_LIMIT
         ));
     }
+    let missing = plan.not_generated();
+    if !missing.is_empty() {
+        line.push_str(&format!(
+            " Not generated: {} (generated in the unrolled form up to {} speeds; docs/limits.md).",
+            missing.join(", "),
+            crate::plan::DERIVATIVES_MAX_NV
+        ));
+    }
     line
 }
 

@@ -266,6 +266,11 @@ fn return_type(shape: Shape, fl: &TokenStream) -> TokenStream {
             let (r, c) = (lit(r), lit(c));
             quote!([[#fl; #c]; #r])
         }
+        Shape::Matrices(k, n) => {
+            let n = lit(n);
+            let mats = (0..k).map(|_| quote!([[#fl; #n]; #n]));
+            quote!((#(#mats),*))
+        }
         Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
     }
 }
@@ -820,7 +825,11 @@ mod tests {
             // The helpers `Self::mul_add`, `Self::sincos` and `Self::sincos_n` are not
             // generated functions.
             fns.retain(|name, _| name != "mul_add" && !name.starts_with("sincos"));
-            assert_eq!(fns.len(), 7, "all functions, gravity included");
+            assert_eq!(
+                fns.len(),
+                10,
+                "all functions, gravity and derivatives included"
+            );
             if fuse != Fuse::None {
                 assert!(fns.values().all(|c| c.fma > 0), "every function fuses");
             } else {

@@ -77,6 +77,24 @@ pub struct Plan {
     pub functions: Vec<FunctionPlan>,
 }
 
+/// The most speeds (`N`, or `6 + N` free-floating) the derivative functions are generated for:
+/// straight-line, `forward_dynamics_derivatives` is O(NV³) (`M⁻¹` times two `NV × NV`
+/// matrices), some 10⁵ operations at 32 speeds, which is what the compact form exists to avoid.
+pub const DERIVATIVES_MAX_NV: usize = 24;
+
+/// Whether the derivative functions are generated for `model` in the form `decision`: in the
+/// unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds.
+#[must_use]
+pub fn derivatives_generated(model: &Model, decision: &Decision) -> bool {
+    let nv = model.dof()
+        + if model.base_kind() == BaseKind::FreeFloating {
+            6
+        } else {
+            0
+        };
+    decision.form != Form::Compact && nv <= DERIVATIVES_MAX_NV
+}
+
 /// The traced graph of each function of a [`Plan`] with an unrolled body (`None` for a compact
 /// one), in the plan's order.
 pub type Graphs = Vec<Option<Traced>>;
@@ -99,6 +117,9 @@ impl Plan {
         let mut graphs = Vec::new();
         let mut mass = MassMatrixMethod::Crba;
         for f in api::functions(&model, opts) {
+            if f.is_derivative() && !derivatives_generated(&model, &decision) {
+                continue; // `Plan::not_generated` names them
+            }
             let (choice, graph) = match decided.iter().position(|(c, _)| c.function == f) {
                 Some(k) => {
                     let (choice, graph) = decided.swap_remove(k);
@@ -126,6 +147,21 @@ impl Plan {
             functions,
         };
         Ok((plan, graphs))
+    }
+
+    /// The functions not generated, as the header names them (`` `name` ``): the derivatives
+    /// in the compact form, which has no kernel for them, and above [`DERIVATIVES_MAX_NV`]
+    /// speeds (see [`derivatives_generated`]). Empty when they are generated.
+    #[must_use]
+    pub fn not_generated(&self) -> Vec<String> {
+        if derivatives_generated(&self.model, &self.decision) {
+            return Vec::new();
+        }
+        Function::ALL
+            .into_iter()
+            .filter(|f| f.is_derivative())
+            .map(|f| format!("`{}`", f.name()))
+            .collect()
     }
 
     /// Whether the base is free-floating.

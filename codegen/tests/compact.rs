@@ -311,9 +311,12 @@ fn unsupported_models_stay_unrolled() {
     let mut o = Options::new("Arm");
     o.form = Form::Unrolled;
     let g = generate_items(&chain_default(64), &o).unwrap();
+    // 64 speeds: the derivatives are not generated, and the form line says so.
     assert_eq!(
         form_line(&g.header),
-        "Form: unrolled straight-line code (asked for)."
+        "Form: unrolled straight-line code (asked for). Not generated: \
+         `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` \
+         (generated in the unrolled form up to 24 speeds; docs/limits.md)."
     );
 }
 

@@ -10,7 +10,7 @@
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4091 (`mass_matrix` 268, `nonlinear_effects` 308, `inverse_dynamics` 323, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 14884 (`mass_matrix` 268, `nonlinear_effects` 308, `inverse_dynamics` 323, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426, `inverse_dynamics_derivatives` 1976, `forward_dynamics_derivatives` 7654, `mass_matrix_inverse` 1163), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -91,6 +91,12 @@
 //! | `base_reaction` | — | `kane-direct` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
 //! | `base_reaction` | — | `rnea` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
 //! | `base_reaction` | — | `newton-euler` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
+//! | `inverse_dynamics_derivatives` * | — | — | — | model | 3467 | 3707 | 0 | 0 | 7 | 7174 |
+//! | `inverse_dynamics_derivatives` | — | — | — | canonical | 3468 | 3707 | 0 | 0 | 7 | 7175 |
+//! | `forward_dynamics_derivatives` * | — | — | — | model | 10508 | 9929 | 22 | 0 | 7 | 20437 |
+//! | `forward_dynamics_derivatives` | — | — | — | canonical | 10529 | 9936 | 22 | 0 | 7 | 20465 |
+//! | `mass_matrix_inverse` * | — | — | — | model | 1573 | 1387 | 10 | 0 | 7 | 2960 |
+//! | `mass_matrix_inverse` | — | — | — | canonical | 1584 | 1391 | 10 | 0 | 7 | 2975 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -154,7 +160,7 @@ impl FreeFloating7 {
     /// Length of `v`: base linear and angular velocity (base frame), joint rates.
     pub const NV: usize = 13;
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 8] = [
+    pub const OP_COUNTS: [OpCount; 11] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
@@ -258,6 +264,45 @@ impl FreeFloating7 {
             sqrt: 0u64,
             sincos: 7u64,
             fma: 426u64,
+        },
+        OpCount {
+            function: "inverse_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 3467u64,
+            add: 3707u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 1976u64,
+        },
+        OpCount {
+            function: "forward_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 10508u64,
+            add: 9929u64,
+            div: 22u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 7654u64,
+        },
+        OpCount {
+            function: "mass_matrix_inverse",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 1573u64,
+            add: 1387u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 1163u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -1220,6 +1265,84 @@ impl FreeFloating7 {
             mul: 688u64,
             add: 566u64,
             div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 3467u64,
+            add: 3707u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 3468u64,
+            add: 3707u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 10508u64,
+            add: 9929u64,
+            div: 22u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 10529u64,
+            add: 9936u64,
+            div: 22u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_inverse",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 1573u64,
+            add: 1387u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_inverse",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 1584u64,
+            add: 1391u64,
+            div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -8670,6 +8793,18902 @@ impl FreeFloating7 {
             + Self::mul_add(-0.65, x234, 0.75 * x235));
         let x243 = -x237;
         [x238, x239, x240, x241, x242, x243]
+    }
+    /// `(∂τ/∂q, ∂τ/∂v)` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`; the base columns of `∂/∂q` are in the tangent space: `q` moved by Pinocchio's `integrate(q, δv)`.
+    ///
+    /// : 3467 mul, 3707 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 1976 fused where the target has FMA.
+    #[must_use]
+    pub fn inverse_dynamics_derivatives(
+        q: &[f64; 14],
+        v: &[f64; 13],
+        a: &[f64; 13],
+    ) -> ([[f64; 13]; 13], [[f64; 13]; 13]) {
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = v[5] * 117.61766249359756;
+        let x8 = v[3] * 117.61766249359758;
+        let x9 = 180.9502499901501 * v[1];
+        let x10 = 180.9502499901501 * v[0];
+        let x11 = 110.5455 * v[2];
+        let x12 = 110.5455 * v[1];
+        let x13 = Self::mul_add(1394.5960312283303, v[3], -x7) - x9;
+        let x14 = Self::mul_add(1466.4506062283303, v[4], x10 - x11);
+        let x15 = Self::mul_add(-1271.854575, v[5], x8) - x12;
+        let x16 = 1170.07 * v[0];
+        let x17 = 1170.07 * v[1];
+        let x18 = 1170.07 * v[2];
+        let x19 = 180.9502499901501 * v[4];
+        let x20 = 180.9502499901501 * v[3];
+        let x21 = 110.5455 * v[5];
+        let x22 = 110.5455 * v[4];
+        let x23 = x16 + x19;
+        let x24 = x17 - (x20 - x21);
+        let x25 = x18 - x22;
+        let x26 = v[4] * 117.61766249359758;
+        let x27 = 1394.5960312283303 * v[5];
+        let x28 = 180.9502499901501 * v[2];
+        let x29 = Self::mul_add(1394.5960312283303, v[4], x10);
+        let x30 = v[4] * 117.61766249359756;
+        let x31 = Self::mul_add(1466.4506062283303, v[5], x12);
+        let x32 = Self::mul_add(-1271.854575, v[4], x11);
+        let x33 = x17 + x21;
+        let x34 = 110.5455 * v[0];
+        let x35 = x28 + x34;
+        let x36 = Self::mul_add(-1466.4506062283303, v[3], x9);
+        let x37 = 1271.854575 * v[3];
+        let x38 = x17 - x20;
+        let x39 = 1170.07 * v[5];
+        let x40 = 1170.07 * v[4];
+        let x41 = -x40;
+        let x42 = -x39;
+        let x43 = 1170.07 * v[3];
+        let x44 = -x43;
+        let x45 = 48.0240000085309 * c_q7;
+        let x46 = 48.0240000085309 * s_q7;
+        let x47 = s_q7 * 0.07309;
+        let x48 = c_q7 * 0.07309;
+        let x49 = Self::mul_add(130.43769025763282, s_q7, x48);
+        let x50 = Self::mul_add(-130.43769025763282, c_q7, x47);
+        let x51 = Self::mul_add(s_q7, x49, c_q7 * x47);
+        let x52 = 0.65 * x46;
+        let x53 = 0.65 * x45;
+        let x54 = Self::mul_add(
+            0.75,
+            x45,
+            Self::mul_add(0.1132, s_q7, c_q7 * 16.80768997608804),
+        );
+        let x55 = Self::mul_add(-s_q7, x50, c_q7 * x48) + x52;
+        let x56 = Self::mul_add(
+            0.75,
+            x46,
+            Self::mul_add(-0.1132, c_q7, s_q7 * 16.80768997608804),
+        );
+        let x57 = Self::mul_add(-c_q7, x49, s_q7 * x47) - x52;
+        let x58 = x53 - (Self::mul_add(c_q7, x50, s_q7 * x48) - x53);
+        let x59 = x53 + (132.47349025763282 + x53);
+        let x60 = v[5] + v[6];
+        let x61 = Self::mul_add(-0.65, v[6], v[1]);
+        let x62 = a[5] + a[6];
+        let x63 = 0.65 * v[3];
+        let x64 = Self::mul_add(0.65, x60, x61);
+        let x65 = Self::mul_add(v[4], v[6], a[3]);
+        let x66 = Self::mul_add(-v[3], v[6], a[4]);
+        let x67 = Self::mul_add(v[6], x64, a[0]);
+        let x68 = Self::mul_add(-v[0], v[6], Self::mul_add(-0.65, a[6], a[1]));
+        let x69 = Self::mul_add(-v[6], x63, a[2]);
+        let x70 = Self::mul_add(0.65, v[5], v[1]);
+        let x71 = Self::mul_add(v[3], v[3], v[4] * v[4]);
+        let x72 = v[0] * v[3];
+        let x73 = Self::mul_add(v[3], v[5], a[4]);
+        let x74 = Self::mul_add(-v[4], v[5], a[3]);
+        let x75 = Self::mul_add(0.65, a[5], a[1])
+            + Self::mul_add(v[2], v[3], Self::mul_add(-v[4], x63, v[0] * v[5]));
+        let x76 = a[0] - Self::mul_add(v[2], v[4], Self::mul_add(v[3], x63, v[5] * x70));
+        let x77 = Self::mul_add(
+            0.65,
+            a[3],
+            Self::mul_add(v[4], x70, x72) + Self::mul_add(v[1], v[4], x72),
+        );
+        let x78 = v[4] + v[4];
+        let x79 = v[3] + v[3];
+        let x80 = x64 + x70;
+        let x81 = v[0] + v[0];
+        let x82 = x63 + x63;
+        let x83 = v[4] * x57;
+        let x84 = x54 * x60;
+        let x85 = v[3] * x55;
+        let x86 = x56 * x60;
+        let x87 = v[3] * x54;
+        let x88 = v[4] * x56;
+        let x89 = v[2] * x46;
+        let x90 = v[2] * x45;
+        let x91 = v[0] * x46;
+        let x92 = x45 * x61;
+        let x93 = Self::mul_add(v[3], x51, x83) - x84 + x89;
+        let x94 = Self::mul_add(-v[4], x58, x85) + x86 + x90;
+        let x95 = Self::mul_add(-x59, x60, x87 + x88) + (x91 - x92);
+        let x96 = x46 * x60;
+        let x97 = x45 * x60;
+        let x98 = v[3] * x46;
+        let x99 = v[4] * x45;
+        let x100 = x98 - x99;
+        let x101 = Self::mul_add(
+            x46,
+            x69,
+            Self::mul_add(-x54, x62, Self::mul_add(x57, x66, x51 * x65)),
+        );
+        let x102 = Self::mul_add(
+            x45,
+            x69,
+            Self::mul_add(x56, x62, Self::mul_add(-x58, x66, x55 * x65)),
+        );
+        let x103 = x55 * x60;
+        let x104 = v[4] * x54;
+        let x105 = v[4] * x51;
+        let x106 = x46 * x61;
+        let x107 = x91 - Self::mul_add(x51, x60, x87);
+        let x108 = x57 * x60;
+        let x109 = x92 + Self::mul_add(x58, x60, x88);
+        let x110 = x90 - Self::mul_add(v[4], x59, x86);
+        let x111 = x97 + x97;
+        let x112 = v[3] * x56;
+        let x113 = v[3] * x58;
+        let x114 = v[0] * x45;
+        let x115 = x89 + Self::mul_add(v[3], x59, x84);
+        let x116 = x96 + x96;
+        let x117 = x104 - x112 + (x106 + x114);
+        let x118 = 0.00000000020510342851533115 * c_q8;
+        let x119 = 0.00000000020510342851533115 * s_q8;
+        let x120 = Self::mul_add(s_q7, s_q8, c_q7 * x118);
+        let x121 = Self::mul_add(-c_q7, s_q8, s_q7 * x118);
+        let x122 = Self::mul_add(-s_q7, c_q8, c_q7 * x119);
+        let x123 = Self::mul_add(c_q7, c_q8, s_q7 * x119);
+        let x124 = s_q7 * 1.1;
+        let x125 = Self::mul_add(c_q7, 1.1, 0.00000000013331722853496525);
+        let x126 = 0.65 * s_q7;
+        let x127 = Self::mul_add(
+            x122,
+            -12.701650001451807,
+            x120 * 0.000000008530897668050218,
+        );
+        let x128 = Self::mul_add(
+            x123,
+            -12.701650001451807,
+            x121 * 0.000000008530897668050218,
+        );
+        let x129 = Self::mul_add(
+            s_q8,
+            -12.701650001451807,
+            c_q8 * 0.000000008530897668050218,
+        );
+        let x130 = Self::mul_add(
+            c_q7,
+            0.002139996587640933,
+            x122 * 0.0000000234896432582596,
+        );
+        let x131 = Self::mul_add(
+            5.080660024070366,
+            c_q7,
+            Self::mul_add(x122, -111.7548902508081, x120 * 0.0000000234896432582596),
+        );
+        let x132 = Self::mul_add(
+            113.3918902508081,
+            c_q7,
+            Self::mul_add(5.080660024070365, x122, x120 * 0.002139996587640933),
+        );
+        let x133 = Self::mul_add(
+            s_q7,
+            0.002139996587640933,
+            x123 * 0.0000000234896432582596,
+        );
+        let x134 = Self::mul_add(
+            5.080660024070366,
+            s_q7,
+            Self::mul_add(x123, -111.7548902508081, x121 * 0.0000000234896432582596),
+        );
+        let x135 = Self::mul_add(
+            113.3918902508081,
+            s_q7,
+            Self::mul_add(5.080660024070365, x123, x121 * 0.002139996587640933),
+        );
+        let x136 = Self::mul_add(
+            s_q8,
+            0.0000000234896432582596,
+            -0.00000000000043892063713626467,
+        );
+        let x137 = Self::mul_add(
+            s_q8,
+            -111.7548902508081,
+            c_q8 * 0.0000000234896432582596,
+        ) + -0.000000001042060790057617;
+        let x138 = Self::mul_add(5.080660024070365, s_q8, c_q8 * 0.002139996587640933)
+            + -0.000000023257065456274896;
+        let x139 = 1.1 * x129;
+        let x140 = 1.1 * x127;
+        let x141 = 0.65 * x128;
+        let x142 = 0.65 * x127;
+        let x143 = x139 + x142;
+        let x144 = 1.1 * x128;
+        let x145 = 0.65 * x129;
+        let x146 = Self::mul_add(c_q7, x135, Self::mul_add(x122, x134, x120 * x133))
+            - x141;
+        let x147 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x135,
+            Self::mul_add(s_q8, x134, c_q8 * x133),
+        ) - x144;
+        let x148 = x139
+            + (Self::mul_add(c_q7, x132, Self::mul_add(x122, x131, x120 * x130)) + x139);
+        let x149 = Self::mul_add(s_q7, x132, Self::mul_add(x123, x131, x121 * x130))
+            - x141;
+        let x150 = x145
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x132,
+                Self::mul_add(s_q8, x131, c_q8 * x130),
+            ) - x140);
+        let x151 = x143
+            + (Self::mul_add(s_q7, x135, Self::mul_add(x123, x134, x121 * x133)) + x143);
+        let x152 = x140
+            - (Self::mul_add(c_q7, x138, Self::mul_add(x122, x137, x120 * x136)) - x145);
+        let x153 = Self::mul_add(s_q7, x138, Self::mul_add(x123, x137, x121 * x136))
+            - x144;
+        let x154 = x142
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x138,
+                Self::mul_add(s_q8, x137, c_q8 * x136),
+            ) + x142);
+        let x155 = Self::mul_add(v[7], c_q7, v[3]);
+        let x156 = Self::mul_add(v[7], s_q7, v[4]);
+        let x157 = Self::mul_add(-0.00000000020510342851533115, v[7], x60);
+        let x158 = Self::mul_add(-v[7], x124, v[0]);
+        let x159 = Self::mul_add(v[7], x125, x61);
+        let x160 = Self::mul_add(v[7], x126, v[2]);
+        let x161 = Self::mul_add(0.00000000020510342851533115, x156, s_q7 * x157);
+        let x162 = Self::mul_add(0.00000000020510342851533115, x155, c_q7 * x157);
+        let x163 = Self::mul_add(-s_q7, x155, c_q7 * x156);
+        let x164 = Self::mul_add(-x126, x156, x125 * x157)
+            + Self::mul_add(0.00000000020510342851533115, x159, s_q7 * x160);
+        let x165 = Self::mul_add(x126, x155, x124 * x157)
+            - Self::mul_add(0.00000000020510342851533115, x158, c_q7 * x160);
+        let x166 = Self::mul_add(x125, x155, x124 * x156)
+            - Self::mul_add(-s_q7, x158, c_q7 * x159);
+        let x167 = Self::mul_add(-v[7], x161, Self::mul_add(a[7], c_q7, x65));
+        let x168 = Self::mul_add(v[7], x162, Self::mul_add(a[7], s_q7, x66));
+        let x169 = Self::mul_add(
+            -v[7],
+            x163,
+            Self::mul_add(-0.00000000020510342851533115, a[7], x62),
+        );
+        let x170 = Self::mul_add(-v[7], x164, Self::mul_add(-a[7], x124, x67));
+        let x171 = Self::mul_add(-v[7], x165, Self::mul_add(a[7], x125, x68));
+        let x172 = Self::mul_add(v[7], x166, Self::mul_add(a[7], x126, x69));
+        let x173 = Self::mul_add(0.00000000020510342851533115, v[4], s_q7 * x60);
+        let x174 = Self::mul_add(0.00000000020510342851533115, v[3], c_q7 * x60);
+        let x175 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x176 = Self::mul_add(-v[4], x126, x60 * x125)
+            + Self::mul_add(0.00000000020510342851533115, x61, v[2] * s_q7);
+        let x177 = Self::mul_add(v[3], x126, x60 * x124)
+            - Self::mul_add(0.00000000020510342851533115, v[0], v[2] * c_q7);
+        let x178 = Self::mul_add(v[3], x125, v[4] * x124)
+            - Self::mul_add(-v[0], s_q7, c_q7 * x61);
+        let x179 = Self::mul_add(0.00000000020510342851533115, x66, s_q7 * x62)
+            + Self::mul_add(v[4], x175, x60 * x174);
+        let x180 = Self::mul_add(0.00000000020510342851533115, x65, c_q7 * x62)
+            - Self::mul_add(-v[3], x175, x60 * x173);
+        let x181 = Self::mul_add(-s_q7, x65, c_q7 * x66)
+            - Self::mul_add(v[3], x174, v[4] * x173);
+        let x182 = Self::mul_add(-x66, x126, x62 * x125)
+            + Self::mul_add(0.00000000020510342851533115, x68, s_q7 * x69)
+            - (Self::mul_add(v[4], x178, x60 * x177)
+                - Self::mul_add(x61, x175, v[2] * x174));
+        let x183 = Self::mul_add(x65, x126, x62 * x124)
+            - Self::mul_add(0.00000000020510342851533115, x67, c_q7 * x69)
+            + (Self::mul_add(v[3], x178, x60 * x176)
+                + Self::mul_add(-v[0], x175, v[2] * x173));
+        let x184 = Self::mul_add(x65, x125, x66 * x124)
+            - Self::mul_add(-s_q7, x67, c_q7 * x68)
+            + (Self::mul_add(-v[3], x177, v[4] * x176)
+                + Self::mul_add(v[0], x174, x61 * x173));
+        let x185 = x161 + x173;
+        let x186 = x162 + x174;
+        let x187 = x163 + x175;
+        let x188 = x164 + x176;
+        let x189 = x165 + x177;
+        let x190 = x166 + x178;
+        let x191 = x149 * x156;
+        let x192 = x150 * x157;
+        let x193 = x146 * x155;
+        let x194 = x147 * x157;
+        let x195 = x152 * x155;
+        let x196 = x153 * x156;
+        let x197 = x129 * x159;
+        let x198 = x128 * x160;
+        let x199 = x129 * x158;
+        let x200 = x127 * x160;
+        let x201 = x128 * x158;
+        let x202 = x127 * x159;
+        let x203 = Self::mul_add(x148, x155, x191) - x192 - (x197 - x198);
+        let x204 = Self::mul_add(x151, x156, x193) + x194 + (x199 - x200);
+        let x205 = Self::mul_add(-x154, x157, x195 - x196) + (x201 - x202);
+        let x206 = x129 * x156;
+        let x207 = x128 * x157;
+        let x208 = x206 - x207;
+        let x209 = x129 * x155;
+        let x210 = x127 * x157;
+        let x211 = x209 - x210;
+        let x212 = x128 * x155;
+        let x213 = x127 * x156;
+        let x214 = x212 - x213;
+        let x215 = x146 * x157;
+        let x216 = x152 * x156;
+        let x217 = x148 * x157;
+        let x218 = x148 * x156;
+        let x219 = x129 * x160;
+        let x220 = x128 * x159;
+        let x221 = x219 + x220;
+        let x222 = x149 * x157;
+        let x223 = x150 * x156;
+        let x224 = x151 * x157;
+        let x225 = x154 * x156;
+        let x226 = x153 * x155;
+        let x227 = x151 * x155;
+        let x228 = x127 * x158;
+        let x229 = x219 + x228;
+        let x230 = x147 * x155;
+        let x231 = x154 * x155;
+        let x232 = x220 + x228;
+        let x233 = 0.00000000020510342851533115 * c_q9;
+        let x234 = 0.00000000020510342851533115 * s_q9;
+        let x235 = x233 - x234;
+        let x236 = x233 + x234;
+        let x237 = Self::mul_add(-c_q7, c_q9, Self::mul_add(-x122, x235, x120 * s_q9));
+        let x238 = Self::mul_add(-s_q7, c_q9, Self::mul_add(-x123, x235, x121 * s_q9));
+        let x239 = x233 + Self::mul_add(-s_q8, x235, c_q8 * s_q9);
+        let x240 = Self::mul_add(c_q7, s_q9, Self::mul_add(x122, x236, x120 * c_q9));
+        let x241 = Self::mul_add(s_q7, s_q9, Self::mul_add(x123, x236, x121 * c_q9));
+        let x242 = x234 - Self::mul_add(s_q8, x236, c_q8 * c_q9);
+        let x243 = Self::mul_add(
+            -0.00000000020510342851533115,
+            c_q7,
+            Self::mul_add(-0.00000000020510342851533115, x120, x122),
+        );
+        let x244 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q7,
+            Self::mul_add(-0.00000000020510342851533115, x121, x123),
+        );
+        let x245 = s_q8 - x118 + 0.000000000000000000042067416388743556;
+        let x246 = Self::mul_add(0.4, s_q7, 0.275 * x123);
+        let x247 = 0.65 + Self::mul_add(0.4, c_q7, 0.275 * x122);
+        let x248 = 1.1 + Self::mul_add(0.275, s_q8, -0.00000000008204137140613246);
+        let x249 = Self::mul_add(-x245, x246, x244 * x248);
+        let x250 = Self::mul_add(-x245, x247, x243 * x248);
+        let x251 = Self::mul_add(-x244, x247, x243 * x246);
+        let x252 = x240 * 81.53205;
+        let x253 = x241 * 81.53205;
+        let x254 = x242 * 81.53205;
+        let x255 = x243 * 0.00214;
+        let x256 = Self::mul_add(x243, -36.18604050126307, x240 * 63.36336825000001);
+        let x257 = Self::mul_add(
+            69.99836825,
+            x243,
+            Self::mul_add(x240, 36.18604050126307, x237 * 0.00214),
+        );
+        let x258 = x244 * 0.00214;
+        let x259 = Self::mul_add(x244, -36.18604050126307, x241 * 63.36336825000001);
+        let x260 = Self::mul_add(
+            69.99836825,
+            x244,
+            Self::mul_add(x241, 36.18604050126307, x238 * 0.00214),
+        );
+        let x261 = x245 * 0.00214;
+        let x262 = Self::mul_add(x245, 36.18604050126307, x242 * 63.36336825000001);
+        let x263 = Self::mul_add(
+            69.99836825,
+            x245,
+            Self::mul_add(x242, -36.18604050126307, x239 * 0.00214),
+        );
+        let x264 = x248 * x254;
+        let x265 = x246 * x253;
+        let x266 = x264 - x265;
+        let x267 = x246 * x252;
+        let x268 = x248 * x252;
+        let x269 = x247 * x253;
+        let x270 = x247 * x252;
+        let x271 = x264 - x270;
+        let x272 = x248 * x253;
+        let x273 = x247 * x254;
+        let x274 = x246 * x254;
+        let x275 = x265 + x270;
+        let x276 = x266
+            - (Self::mul_add(x243, x257, Self::mul_add(-x240, x256, x237 * x255))
+                - x266);
+        let x277 = x269
+            - (Self::mul_add(x244, x257, Self::mul_add(-x241, x256, x238 * x255))
+                - x267);
+        let x278 = x273
+            + (Self::mul_add(x245, x257, Self::mul_add(x242, x256, x239 * x255)) - x268);
+        let x279 = x267
+            - (Self::mul_add(x243, x260, Self::mul_add(-x240, x259, x237 * x258))
+                - x269);
+        let x280 = x271
+            - (Self::mul_add(x244, x260, Self::mul_add(-x241, x259, x238 * x258))
+                - x271);
+        let x281 = x274
+            + (Self::mul_add(x245, x260, Self::mul_add(x242, x259, x239 * x258)) - x272);
+        let x282 = x268
+            - (Self::mul_add(x243, x263, Self::mul_add(x240, x262, x237 * x261)) + x273);
+        let x283 = x272
+            - (Self::mul_add(x244, x263, Self::mul_add(x241, x262, x238 * x261)) + x274);
+        let x284 = x275
+            + (Self::mul_add(x245, x263, Self::mul_add(-x242, x262, x239 * x261))
+                + x275);
+        let x285 = Self::mul_add(v[8], x243, x155);
+        let x286 = Self::mul_add(v[8], x244, x156);
+        let x287 = Self::mul_add(v[8], x245, x157);
+        let x288 = Self::mul_add(-v[8], x249, x158);
+        let x289 = Self::mul_add(v[8], x250, x159);
+        let x290 = Self::mul_add(-v[8], x251, x160);
+        let x291 = Self::mul_add(-x245, x286, x244 * x287);
+        let x292 = Self::mul_add(-x245, x285, x243 * x287);
+        let x293 = Self::mul_add(-x244, x285, x243 * x286);
+        let x294 = Self::mul_add(-x245, x289, x244 * x290);
+        let x295 = Self::mul_add(-x245, x288, x243 * x290);
+        let x296 = Self::mul_add(-x244, x288, x243 * x289);
+        let x297 = Self::mul_add(x251, x286, x250 * x287) + x294;
+        let x298 = Self::mul_add(-x251, x285, x249 * x287) - x295;
+        let x299 = Self::mul_add(x250, x285, x249 * x286) - x296;
+        let x300 = Self::mul_add(-v[8], x291, Self::mul_add(a[8], x243, x167));
+        let x301 = Self::mul_add(v[8], x292, Self::mul_add(a[8], x244, x168));
+        let x302 = Self::mul_add(-v[8], x293, Self::mul_add(a[8], x245, x169));
+        let x303 = Self::mul_add(-v[8], x297, Self::mul_add(-a[8], x249, x170));
+        let x304 = Self::mul_add(-v[8], x298, Self::mul_add(a[8], x250, x171));
+        let x305 = Self::mul_add(v[8], x299, Self::mul_add(-a[8], x251, x172));
+        let x306 = Self::mul_add(-x156, x245, x157 * x244);
+        let x307 = Self::mul_add(-x155, x245, x157 * x243);
+        let x308 = Self::mul_add(-x155, x244, x156 * x243);
+        let x309 = Self::mul_add(x156, x251, x157 * x250)
+            + Self::mul_add(-x159, x245, x160 * x244);
+        let x310 = Self::mul_add(-x155, x251, x157 * x249)
+            - Self::mul_add(-x158, x245, x160 * x243);
+        let x311 = Self::mul_add(x155, x250, x156 * x249)
+            - Self::mul_add(-x158, x244, x159 * x243);
+        let x312 = Self::mul_add(-x168, x245, x169 * x244)
+            + Self::mul_add(x156, x308, x157 * x307);
+        let x313 = Self::mul_add(-x167, x245, x169 * x243)
+            - Self::mul_add(-x155, x308, x157 * x306);
+        let x314 = Self::mul_add(-x167, x244, x168 * x243)
+            - Self::mul_add(x155, x307, x156 * x306);
+        let x315 = Self::mul_add(x168, x251, x169 * x250)
+            + Self::mul_add(-x171, x245, x172 * x244)
+            - (Self::mul_add(x156, x311, x157 * x310)
+                - Self::mul_add(x159, x308, x160 * x307));
+        let x316 = Self::mul_add(-x167, x251, x169 * x249)
+            - Self::mul_add(-x170, x245, x172 * x243)
+            + (Self::mul_add(x155, x311, x157 * x309)
+                + Self::mul_add(-x158, x308, x160 * x306));
+        let x317 = Self::mul_add(x167, x250, x168 * x249)
+            - Self::mul_add(-x170, x244, x171 * x243)
+            + (Self::mul_add(-x155, x310, x156 * x309)
+                + Self::mul_add(x158, x307, x159 * x306));
+        let x318 = x291 + x306;
+        let x319 = x292 + x307;
+        let x320 = x293 + x308;
+        let x321 = x297 + x309;
+        let x322 = x298 + x310;
+        let x323 = x299 + x311;
+        let x324 = x277 * x286;
+        let x325 = x278 * x287;
+        let x326 = x279 * x285;
+        let x327 = x281 * x287;
+        let x328 = x282 * x285;
+        let x329 = x283 * x286;
+        let x330 = x254 * x289;
+        let x331 = x253 * x290;
+        let x332 = x254 * x288;
+        let x333 = x252 * x290;
+        let x334 = x253 * x288;
+        let x335 = x252 * x289;
+        let x336 = Self::mul_add(x276, x285, x324) - x325 - (x330 + x331);
+        let x337 = Self::mul_add(x280, x286, x326) - x327 + (x332 + x333);
+        let x338 = Self::mul_add(-x284, x287, x328 + x329) + (x334 - x335);
+        let x339 = x254 * x286;
+        let x340 = x253 * x287;
+        let x341 = x339 + x340;
+        let x342 = x254 * x285;
+        let x343 = x252 * x287;
+        let x344 = x342 + x343;
+        let x345 = x253 * x285;
+        let x346 = x252 * x286;
+        let x347 = x345 - x346;
+        let x348 = x279 * x287;
+        let x349 = x282 * x286;
+        let x350 = x276 * x287;
+        let x351 = x276 * x286;
+        let x352 = x254 * x290;
+        let x353 = x253 * x289;
+        let x354 = x352 - x353;
+        let x355 = x277 * x287;
+        let x356 = x278 * x286;
+        let x357 = x280 * x287;
+        let x358 = x284 * x286;
+        let x359 = x283 * x285;
+        let x360 = x280 * x285;
+        let x361 = x252 * x288;
+        let x362 = x352 - x361;
+        let x363 = x281 * x285;
+        let x364 = x284 * x285;
+        let x365 = x353 + x361;
+        let x366 = Self::mul_add(x240, s_q10, x237 * c_q10);
+        let x367 = Self::mul_add(x241, s_q10, x238 * c_q10);
+        let x368 = Self::mul_add(-x242, s_q10, x239 * c_q10);
+        let x369 = Self::mul_add(-x240, c_q10, x237 * s_q10);
+        let x370 = Self::mul_add(-x241, c_q10, x238 * s_q10);
+        let x371 = Self::mul_add(x242, c_q10, x239 * s_q10);
+        let x372 = Self::mul_add(x240, 0.87, x247);
+        let x373 = Self::mul_add(x241, 0.87, x246);
+        let x374 = Self::mul_add(x242, -0.87, x248);
+        let x375 = Self::mul_add(-x245, x373, x244 * x374);
+        let x376 = Self::mul_add(-x245, x372, x243 * x374);
+        let x377 = Self::mul_add(-x244, x372, x243 * x373);
+        let x378 = x369 * 45.1584;
+        let x379 = x370 * 45.1584;
+        let x380 = x371 * 45.1584;
+        let x381 = x243 * 0.6328;
+        let x382 = Self::mul_add(x243, 24.351642000914637, x369 * 24.4950615);
+        let x383 = Self::mul_add(
+            28.2393615,
+            x243,
+            Self::mul_add(x369, -24.35164200091464, x366 * 0.6328),
+        );
+        let x384 = x244 * 0.6328;
+        let x385 = Self::mul_add(x244, 24.351642000914637, x370 * 24.4950615);
+        let x386 = Self::mul_add(
+            28.2393615,
+            x244,
+            Self::mul_add(x370, -24.35164200091464, x367 * 0.6328),
+        );
+        let x387 = x245 * 0.6328;
+        let x388 = Self::mul_add(x245, 24.351642000914637, x371 * 24.4950615);
+        let x389 = Self::mul_add(
+            28.2393615,
+            x245,
+            Self::mul_add(x371, -24.35164200091464, x368 * 0.6328),
+        );
+        let x390 = x374 * x380;
+        let x391 = x373 * x379;
+        let x392 = x390 + x391;
+        let x393 = x373 * x378;
+        let x394 = x374 * x378;
+        let x395 = x372 * x379;
+        let x396 = x372 * x378;
+        let x397 = x390 + x396;
+        let x398 = x374 * x379;
+        let x399 = x372 * x380;
+        let x400 = x373 * x380;
+        let x401 = x391 + x396;
+        let x402 = x392
+            - (Self::mul_add(x243, x383, Self::mul_add(-x369, x382, x366 * x381))
+                - x392);
+        let x403 = x395
+            + (Self::mul_add(x244, x383, Self::mul_add(-x370, x382, x367 * x381))
+                + x393);
+        let x404 = x399
+            + (Self::mul_add(x245, x383, Self::mul_add(-x371, x382, x368 * x381))
+                + x394);
+        let x405 = x393
+            + (Self::mul_add(x243, x386, Self::mul_add(-x369, x385, x366 * x384))
+                + x395);
+        let x406 = x397
+            - (Self::mul_add(x244, x386, Self::mul_add(-x370, x385, x367 * x384))
+                - x397);
+        let x407 = x400
+            + (Self::mul_add(x245, x386, Self::mul_add(-x371, x385, x368 * x384))
+                + x398);
+        let x408 = x394
+            + (Self::mul_add(x243, x389, Self::mul_add(-x369, x388, x366 * x387))
+                + x399);
+        let x409 = x398
+            + (Self::mul_add(x244, x389, Self::mul_add(-x370, x388, x367 * x387))
+                + x400);
+        let x410 = x401
+            - (Self::mul_add(x245, x389, Self::mul_add(-x371, x388, x368 * x387))
+                - x401);
+        let x411 = Self::mul_add(v[9], x243, x285);
+        let x412 = Self::mul_add(v[9], x244, x286);
+        let x413 = Self::mul_add(v[9], x245, x287);
+        let x414 = Self::mul_add(-v[9], x375, x288);
+        let x415 = Self::mul_add(v[9], x376, x289);
+        let x416 = Self::mul_add(-v[9], x377, x290);
+        let x417 = Self::mul_add(-x245, x412, x244 * x413);
+        let x418 = Self::mul_add(-x245, x411, x243 * x413);
+        let x419 = Self::mul_add(-x244, x411, x243 * x412);
+        let x420 = Self::mul_add(-x245, x415, x244 * x416);
+        let x421 = Self::mul_add(-x245, x414, x243 * x416);
+        let x422 = Self::mul_add(-x244, x414, x243 * x415);
+        let x423 = Self::mul_add(x377, x412, x376 * x413) + x420;
+        let x424 = Self::mul_add(-x377, x411, x375 * x413) - x421;
+        let x425 = Self::mul_add(x376, x411, x375 * x412) - x422;
+        let x426 = Self::mul_add(-v[9], x417, Self::mul_add(a[9], x243, x300));
+        let x427 = Self::mul_add(v[9], x418, Self::mul_add(a[9], x244, x301));
+        let x428 = Self::mul_add(-v[9], x419, Self::mul_add(a[9], x245, x302));
+        let x429 = Self::mul_add(-v[9], x423, Self::mul_add(-a[9], x375, x303));
+        let x430 = Self::mul_add(-v[9], x424, Self::mul_add(a[9], x376, x304));
+        let x431 = Self::mul_add(v[9], x425, Self::mul_add(-a[9], x377, x305));
+        let x432 = x294 + Self::mul_add(x286, x377, x287 * x376);
+        let x433 = x295 - Self::mul_add(-x285, x377, x287 * x375);
+        let x434 = x296 - Self::mul_add(x285, x376, x286 * x375);
+        let x435 = Self::mul_add(-x245, x301, x244 * x302)
+            + Self::mul_add(x286, x293, x287 * x292);
+        let x436 = Self::mul_add(-x245, x300, x243 * x302)
+            - Self::mul_add(-x285, x293, x287 * x291);
+        let x437 = Self::mul_add(-x244, x300, x243 * x301)
+            - Self::mul_add(x285, x292, x286 * x291);
+        let x438 = Self::mul_add(x301, x377, x302 * x376)
+            + Self::mul_add(-x245, x304, x244 * x305)
+            + (Self::mul_add(x286, x434, x287 * x433)
+                + Self::mul_add(x289, x293, x290 * x292));
+        let x439 = Self::mul_add(-x300, x377, x302 * x375)
+            - Self::mul_add(-x245, x303, x243 * x305)
+            + (Self::mul_add(-x285, x434, x287 * x432)
+                + Self::mul_add(-x288, x293, x290 * x291));
+        let x440 = Self::mul_add(x300, x376, x301 * x375)
+            - Self::mul_add(-x244, x303, x243 * x304)
+            + (Self::mul_add(x285, x433, x286 * x432)
+                + Self::mul_add(x288, x292, x289 * x291));
+        let x441 = x291 + x417;
+        let x442 = x292 + x418;
+        let x443 = x293 + x419;
+        let x444 = x423 + x432;
+        let x445 = x424 - x433;
+        let x446 = x425 - x434;
+        let x447 = x403 * x412;
+        let x448 = x404 * x413;
+        let x449 = x405 * x411;
+        let x450 = x407 * x413;
+        let x451 = x408 * x411;
+        let x452 = x409 * x412;
+        let x453 = x380 * x415;
+        let x454 = x379 * x416;
+        let x455 = x380 * x414;
+        let x456 = x378 * x416;
+        let x457 = x379 * x414;
+        let x458 = x378 * x415;
+        let x459 = Self::mul_add(x402, x411, -x447) - x448 - (x453 - x454);
+        let x460 = Self::mul_add(-x406, x412, x449) + x450 - (x455 - x456);
+        let x461 = Self::mul_add(-x410, x413, x451 + x452) + (x457 - x458);
+        let x462 = x380 * x412;
+        let x463 = x379 * x413;
+        let x464 = x462 - x463;
+        let x465 = x380 * x411;
+        let x466 = x378 * x413;
+        let x467 = x465 - x466;
+        let x468 = x379 * x411;
+        let x469 = x378 * x412;
+        let x470 = x468 - x469;
+        let x471 = x405 * x413;
+        let x472 = x408 * x412;
+        let x473 = x402 * x413;
+        let x474 = x402 * x412;
+        let x475 = x380 * x416;
+        let x476 = x379 * x415;
+        let x477 = x475 + x476;
+        let x478 = x403 * x413;
+        let x479 = x404 * x412;
+        let x480 = x406 * x413;
+        let x481 = x410 * x412;
+        let x482 = x409 * x411;
+        let x483 = x406 * x411;
+        let x484 = x378 * x414;
+        let x485 = x475 + x484;
+        let x486 = x407 * x411;
+        let x487 = x410 * x411;
+        let x488 = x476 + x484;
+        let x489 = Self::mul_add(-x369, s_q11, x366 * c_q11);
+        let x490 = Self::mul_add(-x370, s_q11, x367 * c_q11);
+        let x491 = Self::mul_add(-x371, s_q11, x368 * c_q11);
+        let x492 = Self::mul_add(x369, c_q11, x366 * s_q11);
+        let x493 = Self::mul_add(x370, c_q11, x367 * s_q11);
+        let x494 = Self::mul_add(x371, c_q11, x368 * s_q11);
+        let x495 = x372 - Self::mul_add(0.275, x243, x369 * 0.63);
+        let x496 = x373 - Self::mul_add(0.275, x244, x370 * 0.63);
+        let x497 = x374 - Self::mul_add(0.275, x245, x371 * 0.63);
+        let x498 = Self::mul_add(-x245, x496, x244 * x497);
+        let x499 = Self::mul_add(-x245, x495, x243 * x497);
+        let x500 = Self::mul_add(-x244, x495, x243 * x496);
+        let x501 = 7.078399999258757 * x492;
+        let x502 = 7.078399999258757 * x493;
+        let x503 = 7.078399999258757 * x494;
+        let x504 = 0.01675 * x243;
+        let x505 = Self::mul_add(-2.5482240016099564, x243, x492 * 9.142025249762803);
+        let x506 = Self::mul_add(
+            -9.223235249762805,
+            x243,
+            Self::mul_add(-2.5482240016099564, x492, 0.01675 * x489),
+        );
+        let x507 = 0.01675 * x244;
+        let x508 = Self::mul_add(-2.5482240016099564, x244, x493 * 9.142025249762803);
+        let x509 = Self::mul_add(
+            -9.223235249762805,
+            x244,
+            Self::mul_add(-2.5482240016099564, x493, 0.01675 * x490),
+        );
+        let x510 = 0.01675 * x245;
+        let x511 = Self::mul_add(-2.5482240016099564, x245, x494 * 9.142025249762803);
+        let x512 = Self::mul_add(
+            -9.223235249762805,
+            x245,
+            Self::mul_add(-2.5482240016099564, x494, 0.01675 * x491),
+        );
+        let x513 = x497 * x503;
+        let x514 = x496 * x502;
+        let x515 = x513 + x514;
+        let x516 = x496 * x501;
+        let x517 = x497 * x501;
+        let x518 = x495 * x502;
+        let x519 = x495 * x501;
+        let x520 = x513 + x519;
+        let x521 = x497 * x502;
+        let x522 = x495 * x503;
+        let x523 = x496 * x503;
+        let x524 = x514 + x519;
+        let x525 = x515
+            - (Self::mul_add(x243, x506, Self::mul_add(x492, x505, x489 * x504)) - x515);
+        let x526 = x518
+            + (Self::mul_add(x244, x506, Self::mul_add(x493, x505, x490 * x504)) + x516);
+        let x527 = x522
+            + (Self::mul_add(x245, x506, Self::mul_add(x494, x505, x491 * x504)) + x517);
+        let x528 = x516
+            + (Self::mul_add(x243, x509, Self::mul_add(x492, x508, x489 * x507)) + x518);
+        let x529 = x520
+            - (Self::mul_add(x244, x509, Self::mul_add(x493, x508, x490 * x507)) - x520);
+        let x530 = x523
+            + (Self::mul_add(x245, x509, Self::mul_add(x494, x508, x491 * x507)) + x521);
+        let x531 = x517
+            + (Self::mul_add(x243, x512, Self::mul_add(x492, x511, x489 * x510)) + x522);
+        let x532 = x521
+            + (Self::mul_add(x244, x512, Self::mul_add(x493, x511, x490 * x510)) + x523);
+        let x533 = x524
+            - (Self::mul_add(x245, x512, Self::mul_add(x494, x511, x491 * x510)) - x524);
+        let x534 = Self::mul_add(v[10], x243, x411);
+        let x535 = Self::mul_add(v[10], x244, x412);
+        let x536 = Self::mul_add(v[10], x245, x413);
+        let x537 = Self::mul_add(-v[10], x498, x414);
+        let x538 = Self::mul_add(v[10], x499, x415);
+        let x539 = Self::mul_add(-v[10], x500, x416);
+        let x540 = Self::mul_add(-x245, x535, x244 * x536);
+        let x541 = Self::mul_add(-x245, x534, x243 * x536);
+        let x542 = Self::mul_add(-x244, x534, x243 * x535);
+        let x543 = Self::mul_add(x500, x535, x499 * x536)
+            + Self::mul_add(-x245, x538, x244 * x539);
+        let x544 = Self::mul_add(-x500, x534, x498 * x536)
+            - Self::mul_add(-x245, x537, x243 * x539);
+        let x545 = Self::mul_add(x499, x534, x498 * x535)
+            - Self::mul_add(-x244, x537, x243 * x538);
+        let x546 = Self::mul_add(-v[10], x540, Self::mul_add(a[10], x243, x426));
+        let x547 = Self::mul_add(v[10], x541, Self::mul_add(a[10], x244, x427));
+        let x548 = Self::mul_add(-v[10], x542, Self::mul_add(a[10], x245, x428));
+        let x549 = Self::mul_add(-v[10], x543, Self::mul_add(-a[10], x498, x429));
+        let x550 = Self::mul_add(-v[10], x544, Self::mul_add(a[10], x499, x430));
+        let x551 = Self::mul_add(v[10], x545, Self::mul_add(-a[10], x500, x431));
+        let x552 = x420 + Self::mul_add(x412, x500, x413 * x499);
+        let x553 = x421 - Self::mul_add(-x411, x500, x413 * x498);
+        let x554 = x422 - Self::mul_add(x411, x499, x412 * x498);
+        let x555 = Self::mul_add(-x245, x427, x244 * x428)
+            + Self::mul_add(x412, x419, x413 * x418);
+        let x556 = Self::mul_add(-x245, x426, x243 * x428)
+            - Self::mul_add(-x411, x419, x413 * x417);
+        let x557 = Self::mul_add(-x244, x426, x243 * x427)
+            - Self::mul_add(x411, x418, x412 * x417);
+        let x558 = Self::mul_add(x427, x500, x428 * x499)
+            + Self::mul_add(-x245, x430, x244 * x431)
+            + (Self::mul_add(x412, x554, x413 * x553)
+                + Self::mul_add(x415, x419, x416 * x418));
+        let x559 = Self::mul_add(-x426, x500, x428 * x498)
+            - Self::mul_add(-x245, x429, x243 * x431)
+            + (Self::mul_add(-x411, x554, x413 * x552)
+                + Self::mul_add(-x414, x419, x416 * x417));
+        let x560 = Self::mul_add(x426, x499, x427 * x498)
+            - Self::mul_add(-x244, x429, x243 * x430)
+            + (Self::mul_add(x411, x553, x412 * x552)
+                + Self::mul_add(x414, x418, x415 * x417));
+        let x561 = x417 + x540;
+        let x562 = x418 + x541;
+        let x563 = x419 + x542;
+        let x564 = x543 + x552;
+        let x565 = x544 - x553;
+        let x566 = x545 - x554;
+        let x567 = x526 * x535;
+        let x568 = x527 * x536;
+        let x569 = x528 * x534;
+        let x570 = x530 * x536;
+        let x571 = x531 * x534;
+        let x572 = x532 * x535;
+        let x573 = x503 * x538;
+        let x574 = x502 * x539;
+        let x575 = x503 * x537;
+        let x576 = x501 * x539;
+        let x577 = x502 * x537;
+        let x578 = x501 * x538;
+        let x579 = Self::mul_add(x525, x534, -x567) - x568 - (x573 - x574);
+        let x580 = Self::mul_add(-x529, x535, x569) + x570 - (x575 - x576);
+        let x581 = Self::mul_add(-x533, x536, x571 + x572) + (x577 - x578);
+        let x582 = x503 * x535;
+        let x583 = x502 * x536;
+        let x584 = x582 - x583;
+        let x585 = x503 * x534;
+        let x586 = x501 * x536;
+        let x587 = x585 - x586;
+        let x588 = x502 * x534;
+        let x589 = x501 * x535;
+        let x590 = x588 - x589;
+        let x591 = x528 * x536;
+        let x592 = x531 * x535;
+        let x593 = x525 * x536;
+        let x594 = x525 * x535;
+        let x595 = x503 * x539;
+        let x596 = x502 * x538;
+        let x597 = x595 + x596;
+        let x598 = x526 * x536;
+        let x599 = x527 * x535;
+        let x600 = x529 * x536;
+        let x601 = x533 * x535;
+        let x602 = x532 * x534;
+        let x603 = x529 * x534;
+        let x604 = x501 * x537;
+        let x605 = x595 + x604;
+        let x606 = x530 * x534;
+        let x607 = x533 * x534;
+        let x608 = x596 + x604;
+        let x609 = 0.00000000020510342851533115 * s_q12;
+        let x610 = 0.00000000020510342851533115 * c_q12;
+        let x611 = Self::mul_add(x243, s_q12, Self::mul_add(x492, x609, x489 * c_q12));
+        let x612 = Self::mul_add(x244, s_q12, Self::mul_add(x493, x609, x490 * c_q12));
+        let x613 = Self::mul_add(x245, s_q12, Self::mul_add(x494, x609, x491 * c_q12));
+        let x614 = Self::mul_add(-x243, c_q12, Self::mul_add(-x492, x610, x489 * s_q12));
+        let x615 = Self::mul_add(-x244, c_q12, Self::mul_add(-x493, x610, x490 * s_q12));
+        let x616 = Self::mul_add(-x245, c_q12, Self::mul_add(-x494, x610, x491 * s_q12));
+        let x617 = Self::mul_add(-0.00000000020510342851533115, x243, x492);
+        let x618 = Self::mul_add(-0.00000000020510342851533115, x244, x493);
+        let x619 = Self::mul_add(-0.00000000020510342851533115, x245, x494);
+        let x620 = Self::mul_add(x243, -0.36, x495);
+        let x621 = Self::mul_add(x244, -0.36, x496);
+        let x622 = Self::mul_add(x245, -0.36, x497);
+        let x623 = Self::mul_add(-x619, x621, x618 * x622);
+        let x624 = Self::mul_add(-x619, x620, x617 * x622);
+        let x625 = Self::mul_add(-x618, x620, x617 * x621);
+        let x626 = Self::mul_add(-17.135250000000003, x614, 3.6140000000000003 * x611);
+        let x627 = Self::mul_add(-17.135250000000003, x615, 3.6140000000000003 * x612);
+        let x628 = Self::mul_add(-17.135250000000003, x616, 3.6140000000000003 * x613);
+        let x629 = Self::mul_add(x617, 0.809539999555672, x614 * 1.9877000000000002);
+        let x630 = Self::mul_add(
+            x617,
+            -2.7416399995923166,
+            Self::mul_add(x614, -5.252920330000002, x611 * 1.9877000000000002),
+        );
+        let x631 = Self::mul_add(
+            9.740442170000001,
+            x617,
+            Self::mul_add(x614, -2.741639999592316, x611 * 0.809539999555672),
+        );
+        let x632 = Self::mul_add(x618, 0.809539999555672, x615 * 1.9877000000000002);
+        let x633 = Self::mul_add(
+            x618,
+            -2.7416399995923166,
+            Self::mul_add(x615, -5.252920330000002, x612 * 1.9877000000000002),
+        );
+        let x634 = Self::mul_add(
+            9.740442170000001,
+            x618,
+            Self::mul_add(x615, -2.741639999592316, x612 * 0.809539999555672),
+        );
+        let x635 = Self::mul_add(x619, 0.809539999555672, x616 * 1.9877000000000002);
+        let x636 = Self::mul_add(
+            x619,
+            -2.7416399995923166,
+            Self::mul_add(x616, -5.252920330000002, x613 * 1.9877000000000002),
+        );
+        let x637 = Self::mul_add(
+            9.740442170000001,
+            x619,
+            Self::mul_add(x616, -2.741639999592316, x613 * 0.809539999555672),
+        );
+        let x638 = x622 * x628;
+        let x639 = x621 * x627;
+        let x640 = x638 + x639;
+        let x641 = x621 * x626;
+        let x642 = x622 * x626;
+        let x643 = x620 * x627;
+        let x644 = x620 * x626;
+        let x645 = x638 + x644;
+        let x646 = x622 * x627;
+        let x647 = x620 * x628;
+        let x648 = x621 * x628;
+        let x649 = x639 + x644;
+        let x650 = x640
+            - (Self::mul_add(x617, x631, Self::mul_add(x614, x630, x611 * x629)) - x640);
+        let x651 = x643
+            + (Self::mul_add(x618, x631, Self::mul_add(x615, x630, x612 * x629)) + x641);
+        let x652 = x647
+            + (Self::mul_add(x619, x631, Self::mul_add(x616, x630, x613 * x629)) + x642);
+        let x653 = x641
+            + (Self::mul_add(x617, x634, Self::mul_add(x614, x633, x611 * x632)) + x643);
+        let x654 = x645
+            - (Self::mul_add(x618, x634, Self::mul_add(x615, x633, x612 * x632)) - x645);
+        let x655 = x648
+            + (Self::mul_add(x619, x634, Self::mul_add(x616, x633, x613 * x632)) + x646);
+        let x656 = x642
+            + (Self::mul_add(x617, x637, Self::mul_add(x614, x636, x611 * x635)) + x647);
+        let x657 = x646
+            + (Self::mul_add(x618, x637, Self::mul_add(x615, x636, x612 * x635)) + x648);
+        let x658 = x649
+            - (Self::mul_add(x619, x637, Self::mul_add(x616, x636, x613 * x635)) - x649);
+        let x659 = Self::mul_add(v[11], x617, x534);
+        let x660 = Self::mul_add(v[11], x618, x535);
+        let x661 = Self::mul_add(v[11], x619, x536);
+        let x662 = Self::mul_add(-v[11], x623, x537);
+        let x663 = Self::mul_add(v[11], x624, x538);
+        let x664 = Self::mul_add(-v[11], x625, x539);
+        let x665 = Self::mul_add(-x619, x660, x618 * x661);
+        let x666 = Self::mul_add(-x619, x659, x617 * x661);
+        let x667 = Self::mul_add(-x618, x659, x617 * x660);
+        let x668 = Self::mul_add(x625, x660, x624 * x661)
+            + Self::mul_add(-x619, x663, x618 * x664);
+        let x669 = Self::mul_add(-x625, x659, x623 * x661)
+            - Self::mul_add(-x619, x662, x617 * x664);
+        let x670 = Self::mul_add(x624, x659, x623 * x660)
+            - Self::mul_add(-x618, x662, x617 * x663);
+        let x671 = Self::mul_add(-v[11], x665, Self::mul_add(a[11], x617, x546));
+        let x672 = Self::mul_add(v[11], x666, Self::mul_add(a[11], x618, x547));
+        let x673 = Self::mul_add(-v[11], x667, Self::mul_add(a[11], x619, x548));
+        let x674 = Self::mul_add(-v[11], x668, Self::mul_add(-a[11], x623, x549));
+        let x675 = Self::mul_add(-v[11], x669, Self::mul_add(a[11], x624, x550));
+        let x676 = Self::mul_add(v[11], x670, Self::mul_add(-a[11], x625, x551));
+        let x677 = Self::mul_add(-x535, x619, x536 * x618);
+        let x678 = Self::mul_add(-x534, x619, x536 * x617);
+        let x679 = Self::mul_add(-x534, x618, x535 * x617);
+        let x680 = Self::mul_add(x535, x625, x536 * x624)
+            + Self::mul_add(-x538, x619, x539 * x618);
+        let x681 = Self::mul_add(-x534, x625, x536 * x623)
+            - Self::mul_add(-x537, x619, x539 * x617);
+        let x682 = Self::mul_add(x534, x624, x535 * x623)
+            - Self::mul_add(-x537, x618, x538 * x617);
+        let x683 = Self::mul_add(-x547, x619, x548 * x618)
+            + Self::mul_add(x535, x679, x536 * x678);
+        let x684 = Self::mul_add(-x546, x619, x548 * x617)
+            - Self::mul_add(-x534, x679, x536 * x677);
+        let x685 = Self::mul_add(-x546, x618, x547 * x617)
+            - Self::mul_add(x534, x678, x535 * x677);
+        let x686 = Self::mul_add(x547, x625, x548 * x624)
+            + Self::mul_add(-x550, x619, x551 * x618)
+            - (Self::mul_add(x535, x682, x536 * x681)
+                - Self::mul_add(x538, x679, x539 * x678));
+        let x687 = Self::mul_add(-x546, x625, x548 * x623)
+            - Self::mul_add(-x549, x619, x551 * x617)
+            + (Self::mul_add(x534, x682, x536 * x680)
+                + Self::mul_add(-x537, x679, x539 * x677));
+        let x688 = Self::mul_add(x546, x624, x547 * x623)
+            - Self::mul_add(-x549, x618, x550 * x617)
+            + (Self::mul_add(-x534, x681, x535 * x680)
+                + Self::mul_add(x537, x678, x538 * x677));
+        let x689 = x665 + x677;
+        let x690 = x666 + x678;
+        let x691 = x667 + x679;
+        let x692 = x668 + x680;
+        let x693 = x669 + x681;
+        let x694 = x670 + x682;
+        let x695 = x651 * x660;
+        let x696 = x652 * x661;
+        let x697 = x653 * x659;
+        let x698 = x655 * x661;
+        let x699 = x656 * x659;
+        let x700 = x657 * x660;
+        let x701 = x628 * x663;
+        let x702 = x627 * x664;
+        let x703 = x628 * x662;
+        let x704 = x626 * x664;
+        let x705 = x627 * x662;
+        let x706 = x626 * x663;
+        let x707 = Self::mul_add(x650, x659, -x695) - x696 - (x701 - x702);
+        let x708 = Self::mul_add(-x654, x660, x697) + x698 - (x703 - x704);
+        let x709 = Self::mul_add(-x658, x661, x699 + x700) + (x705 - x706);
+        let x710 = x628 * x660;
+        let x711 = x627 * x661;
+        let x712 = x710 - x711;
+        let x713 = x628 * x659;
+        let x714 = x626 * x661;
+        let x715 = x713 - x714;
+        let x716 = x627 * x659;
+        let x717 = x626 * x660;
+        let x718 = x716 - x717;
+        let x719 = x653 * x661;
+        let x720 = x656 * x660;
+        let x721 = x650 * x661;
+        let x722 = x650 * x660;
+        let x723 = x628 * x664;
+        let x724 = x627 * x663;
+        let x725 = x723 + x724;
+        let x726 = x651 * x661;
+        let x727 = x652 * x660;
+        let x728 = x654 * x661;
+        let x729 = x658 * x660;
+        let x730 = x657 * x659;
+        let x731 = x654 * x659;
+        let x732 = x626 * x662;
+        let x733 = x723 + x732;
+        let x734 = x655 * x659;
+        let x735 = x658 * x659;
+        let x736 = x724 + x732;
+        let x737 = 0.00000000020510342851533115 * c_q13;
+        let x738 = 0.00000000020510342851533115 * s_q13;
+        let x739 = Self::mul_add(-x617, c_q13, Self::mul_add(x614, s_q13, x611 * x737));
+        let x740 = Self::mul_add(-x618, c_q13, Self::mul_add(x615, s_q13, x612 * x737));
+        let x741 = Self::mul_add(-x619, c_q13, Self::mul_add(x616, s_q13, x613 * x737));
+        let x742 = Self::mul_add(-x617, s_q13, Self::mul_add(-x614, c_q13, x611 * x738));
+        let x743 = Self::mul_add(-x618, s_q13, Self::mul_add(-x615, c_q13, x612 * x738));
+        let x744 = Self::mul_add(-x619, s_q13, Self::mul_add(-x616, c_q13, x613 * x738));
+        let x745 = Self::mul_add(0.00000000020510342851533115, x617, x611);
+        let x746 = Self::mul_add(0.00000000020510342851533115, x618, x612);
+        let x747 = Self::mul_add(0.00000000020510342851533115, x619, x613);
+        let x748 = x620 + Self::mul_add(0.16, x617, 0.55 * x614);
+        let x749 = x621 + Self::mul_add(0.16, x618, 0.55 * x615);
+        let x750 = x622 + Self::mul_add(0.16, x619, 0.55 * x616);
+        let x751 = Self::mul_add(-x747, x749, x746 * x750);
+        let x752 = Self::mul_add(-x747, x748, x745 * x750);
+        let x753 = Self::mul_add(-x746, x748, x745 * x749);
+        let x754 = 4.806620000000001 * x742;
+        let x755 = 4.806620000000001 * x743;
+        let x756 = 4.806620000000001 * x744;
+        let x757 = Self::mul_add(x745, -0.0145, 0.000781 * x742);
+        let x758 = Self::mul_add(
+            x745,
+            0.9614610000000001,
+            Self::mul_add(x742, 1.2025609200000003, 0.000781 * x739),
+        );
+        let x759 = Self::mul_add(
+            1.4135609200000003,
+            x745,
+            Self::mul_add(x742, -0.9614610000000001, x739 * 0.0145),
+        );
+        let x760 = Self::mul_add(x746, -0.0145, 0.000781 * x743);
+        let x761 = Self::mul_add(
+            x746,
+            0.9614610000000001,
+            Self::mul_add(x743, 1.2025609200000003, 0.000781 * x740),
+        );
+        let x762 = Self::mul_add(
+            1.4135609200000003,
+            x746,
+            Self::mul_add(x743, -0.9614610000000001, x740 * 0.0145),
+        );
+        let x763 = Self::mul_add(x747, -0.0145, 0.000781 * x744);
+        let x764 = Self::mul_add(
+            x747,
+            0.9614610000000001,
+            Self::mul_add(x744, 1.2025609200000003, 0.000781 * x741),
+        );
+        let x765 = Self::mul_add(
+            1.4135609200000003,
+            x747,
+            Self::mul_add(x744, -0.9614610000000001, x741 * 0.0145),
+        );
+        let x766 = x750 * x756;
+        let x767 = x749 * x755;
+        let x768 = x766 + x767;
+        let x769 = x749 * x754;
+        let x770 = x750 * x754;
+        let x771 = x748 * x755;
+        let x772 = x748 * x754;
+        let x773 = x766 + x772;
+        let x774 = x750 * x755;
+        let x775 = x748 * x756;
+        let x776 = x749 * x756;
+        let x777 = x767 + x772;
+        let x778 = x768
+            + (Self::mul_add(-x745, x759, Self::mul_add(x742, x758, x739 * x757))
+                + x768);
+        let x779 = x771
+            - (Self::mul_add(-x746, x759, Self::mul_add(x743, x758, x740 * x757))
+                - x769);
+        let x780 = x775
+            - (Self::mul_add(-x747, x759, Self::mul_add(x744, x758, x741 * x757))
+                - x770);
+        let x781 = x769
+            - (Self::mul_add(-x745, x762, Self::mul_add(x742, x761, x739 * x760))
+                - x771);
+        let x782 = x773
+            + (Self::mul_add(-x746, x762, Self::mul_add(x743, x761, x740 * x760))
+                + x773);
+        let x783 = x776
+            - (Self::mul_add(-x747, x762, Self::mul_add(x744, x761, x741 * x760))
+                - x774);
+        let x784 = x770
+            - (Self::mul_add(-x745, x765, Self::mul_add(x742, x764, x739 * x763))
+                - x775);
+        let x785 = x774
+            - (Self::mul_add(-x746, x765, Self::mul_add(x743, x764, x740 * x763))
+                - x776);
+        let x786 = x777
+            + (Self::mul_add(-x747, x765, Self::mul_add(x744, x764, x741 * x763))
+                + x777);
+        let x787 = Self::mul_add(-v[12], x745, x659);
+        let x788 = Self::mul_add(-v[12], x746, x660);
+        let x789 = Self::mul_add(-v[12], x747, x661);
+        let x790 = Self::mul_add(v[12], x751, x662);
+        let x791 = Self::mul_add(-v[12], x752, x663);
+        let x792 = Self::mul_add(v[12], x753, x664);
+        let x793 = Self::mul_add(-x747, x788, x746 * x789);
+        let x794 = Self::mul_add(-x747, x787, x745 * x789);
+        let x795 = Self::mul_add(-x746, x787, x745 * x788);
+        let x796 = Self::mul_add(x753, x788, x752 * x789)
+            + Self::mul_add(-x747, x791, x746 * x792);
+        let x797 = Self::mul_add(-x753, x787, x751 * x789)
+            - Self::mul_add(-x747, x790, x745 * x792);
+        let x798 = Self::mul_add(x752, x787, x751 * x788)
+            - Self::mul_add(-x746, x790, x745 * x791);
+        let x799 = Self::mul_add(v[12], x793, Self::mul_add(-a[12], x745, x671));
+        let x800 = Self::mul_add(-v[12], x794, Self::mul_add(-a[12], x746, x672));
+        let x801 = Self::mul_add(v[12], x795, Self::mul_add(-a[12], x747, x673));
+        let x802 = Self::mul_add(v[12], x796, Self::mul_add(a[12], x751, x674));
+        let x803 = Self::mul_add(v[12], x797, Self::mul_add(-a[12], x752, x675));
+        let x804 = Self::mul_add(-v[12], x798, Self::mul_add(a[12], x753, x676));
+        let x805 = Self::mul_add(-x660, x747, x661 * x746);
+        let x806 = Self::mul_add(-x659, x747, x661 * x745);
+        let x807 = Self::mul_add(-x659, x746, x660 * x745);
+        let x808 = Self::mul_add(x660, x753, x661 * x752)
+            + Self::mul_add(-x663, x747, x664 * x746);
+        let x809 = Self::mul_add(-x659, x753, x661 * x751)
+            - Self::mul_add(-x662, x747, x664 * x745);
+        let x810 = Self::mul_add(x659, x752, x660 * x751)
+            - Self::mul_add(-x662, x746, x663 * x745);
+        let x811 = Self::mul_add(-x672, x747, x673 * x746)
+            + Self::mul_add(x660, x807, x661 * x806);
+        let x812 = Self::mul_add(-x671, x747, x673 * x745)
+            - Self::mul_add(-x659, x807, x661 * x805);
+        let x813 = Self::mul_add(-x671, x746, x672 * x745)
+            - Self::mul_add(x659, x806, x660 * x805);
+        let x814 = Self::mul_add(x672, x753, x673 * x752)
+            + Self::mul_add(-x675, x747, x676 * x746)
+            - (Self::mul_add(x660, x810, x661 * x809)
+                - Self::mul_add(x663, x807, x664 * x806));
+        let x815 = Self::mul_add(-x671, x753, x673 * x751)
+            - Self::mul_add(-x674, x747, x676 * x745)
+            + (Self::mul_add(x659, x810, x661 * x808)
+                + Self::mul_add(-x662, x807, x664 * x805));
+        let x816 = Self::mul_add(x671, x752, x672 * x751)
+            - Self::mul_add(-x674, x746, x675 * x745)
+            + (Self::mul_add(-x659, x809, x660 * x808)
+                + Self::mul_add(x662, x806, x663 * x805));
+        let x817 = x793 + x805;
+        let x818 = x794 + x806;
+        let x819 = x795 + x807;
+        let x820 = x796 + x808;
+        let x821 = x797 + x809;
+        let x822 = x798 + x810;
+        let x823 = x779 * x788;
+        let x824 = x780 * x789;
+        let x825 = x781 * x787;
+        let x826 = x783 * x789;
+        let x827 = x784 * x787;
+        let x828 = x785 * x788;
+        let x829 = x756 * x791;
+        let x830 = x755 * x792;
+        let x831 = x756 * x790;
+        let x832 = x754 * x792;
+        let x833 = x755 * x790;
+        let x834 = x754 * x791;
+        let x835 = Self::mul_add(x778, x787, -x823) - x824 - (x829 - x830);
+        let x836 = Self::mul_add(-x782, x788, x825) + x826 - (x831 - x832);
+        let x837 = Self::mul_add(-x786, x789, x827 + x828) + (x833 - x834);
+        let x838 = x756 * x788;
+        let x839 = x755 * x789;
+        let x840 = x838 - x839;
+        let x841 = x756 * x787;
+        let x842 = x754 * x789;
+        let x843 = x841 - x842;
+        let x844 = x755 * x787;
+        let x845 = x754 * x788;
+        let x846 = x844 - x845;
+        let x847 = Self::mul_add(-x780, x801, Self::mul_add(-x779, x800, x778 * x799))
+            - Self::mul_add(-x755, x804, x756 * x803)
+            + (Self::mul_add(-x788, x837, x789 * x836)
+                + Self::mul_add(x791, x846, x792 * x843));
+        let x848 = Self::mul_add(x783, x801, Self::mul_add(-x782, x800, x781 * x799))
+            - Self::mul_add(-x754, x804, x756 * x802)
+            - (Self::mul_add(x787, x837, x789 * x835)
+                + Self::mul_add(-x790, x846, x792 * x840));
+        let x849 = Self::mul_add(-x786, x801, Self::mul_add(x785, x800, x784 * x799))
+            + Self::mul_add(-x754, x803, x755 * x802)
+            + (Self::mul_add(x787, x836, x788 * x835)
+                + Self::mul_add(x790, x843, x791 * x840));
+        let x850 = Self::mul_add(-x755, x801, x756 * x800)
+            + Self::mul_add(x788, x846, x789 * x843);
+        let x851 = Self::mul_add(-x754, x801, x756 * x799)
+            - Self::mul_add(-x787, x846, x789 * x840);
+        let x852 = Self::mul_add(-x754, x800, x755 * x799)
+            - Self::mul_add(x787, x843, x788 * x840);
+        let x853 = x781 * x789;
+        let x854 = x784 * x788;
+        let x855 = x778 * x789;
+        let x856 = x778 * x788;
+        let x857 = x756 * x792;
+        let x858 = x755 * x791;
+        let x859 = x857 + x858;
+        let x860 = x779 * x789;
+        let x861 = x780 * x788;
+        let x862 = x782 * x789;
+        let x863 = x786 * x788;
+        let x864 = x853 - x854 + x859 + (x859 + (x860 - x861));
+        let x865 = x837 - (x833 - (x827 + x855))
+            - (x834 + Self::mul_add(x783, x788, x862));
+        let x866 = x836 + (x831 + (x825 + x856))
+            + (x832 - Self::mul_add(x785, x789, x863));
+        let x867 = x845 - (x844 + x846);
+        let x868 = x842 - (x841 + x843);
+        let x869 = x785 * x787;
+        let x870 = x782 * x787;
+        let x871 = x754 * x790;
+        let x872 = x857 + x871;
+        let x873 = x783 * x787;
+        let x874 = x786 * x787;
+        let x875 = x837 + (x834 + (x828 + x862))
+            + (x833 - Self::mul_add(x780, x787, x855));
+        let x876 = x860 - x869 - x872 - (x872 - (x853 - x873));
+        let x877 = x835 + (x829 - (x823 + x870))
+            + (x830 + Self::mul_add(x784, x789, x874));
+        let x878 = x844 - (x845 - x846);
+        let x879 = x839 - (x838 + x840);
+        let x880 = x858 + x871;
+        let x881 = x836 - (x832 - (x826 + x863))
+            - (x831 + Self::mul_add(x779, x787, x856));
+        let x882 = x835 - (x830 + (x824 + x874))
+            - (x829 - Self::mul_add(x781, x788, x870));
+        let x883 = x861 - x873 + x880 + (x880 + (x854 - x869));
+        let x884 = x841 - (x842 - x843);
+        let x885 = x838 - (x839 - x840);
+        let x886 = x845 - (x844 - x846);
+        let x887 = x842 - (x841 - x843);
+        let x888 = x844 - (x845 + x846);
+        let x889 = x839 - (x838 - x840);
+        let x890 = x841 - (x842 + x843);
+        let x891 = x838 - (x839 + x840);
+        let x892 = Self::mul_add(-x747, x780, Self::mul_add(-x746, x779, x745 * x778))
+            - Self::mul_add(x753, x755, x752 * x756);
+        let x893 = Self::mul_add(x747, x783, Self::mul_add(-x746, x782, x745 * x781))
+            + Self::mul_add(-x753, x754, x751 * x756);
+        let x894 = Self::mul_add(-x747, x786, Self::mul_add(x746, x785, x745 * x784))
+            - Self::mul_add(x752, x754, x751 * x755);
+        let x895 = Self::mul_add(-x747, x755, x746 * x756);
+        let x896 = Self::mul_add(-x747, x754, x745 * x756);
+        let x897 = Self::mul_add(-x746, x754, x745 * x755);
+        let x898 = x745 * x864;
+        let x899 = Self::mul_add(
+            x752,
+            x867,
+            Self::mul_add(-x747, x866, Self::mul_add(x746, x865, x898)),
+        );
+        let x900 = Self::mul_add(-x753, x868, x899);
+        let x901 = x746 * x876;
+        let x902 = Self::mul_add(
+            x751,
+            x878,
+            Self::mul_add(x747, x877, Self::mul_add(x745, x875, x901)),
+        );
+        let x903 = Self::mul_add(x753, x879, x902);
+        let x904 = x747 * x883;
+        let x905 = Self::mul_add(
+            x752,
+            x885,
+            Self::mul_add(-x751, x884, Self::mul_add(x746, x882, x745 * x881) + x904),
+        );
+        let x906 = Self::mul_add(x747, x887, x746 * x886);
+        let x907 = Self::mul_add(x747, x889, x745 * x888);
+        let x908 = Self::mul_add(x746, x891, x745 * x890);
+        let x909 = Self::mul_add(
+            -x809,
+            x888,
+            Self::mul_add(x807, x881, Self::mul_add(x806, x875, x805 * x864)),
+        );
+        let x910 = Self::mul_add(
+            -x808,
+            x886,
+            Self::mul_add(x807, x882, Self::mul_add(x806, x876, x805 * x865)),
+        );
+        let x911 = Self::mul_add(
+            x808,
+            x887,
+            Self::mul_add(-x807, x883, Self::mul_add(-x806, x877, x805 * x866)),
+        );
+        let x912 = Self::mul_add(-x746, x849, x747 * x848)
+            - Self::mul_add(-x752, x852, x753 * x851)
+            - (Self::mul_add(-x780, x813, Self::mul_add(x779, x812, x778 * x811))
+                - Self::mul_add(x755, x816, x756 * x815))
+            - Self::mul_add(x810, x890, x909);
+        let x913 = Self::mul_add(x745, x849, x747 * x847)
+            - Self::mul_add(-x751, x852, x753 * x850)
+            + (Self::mul_add(x783, x813, Self::mul_add(x782, x812, x781 * x811))
+                - Self::mul_add(x754, x816, x756 * x814))
+            - Self::mul_add(x810, x891, x910);
+        let x914 = Self::mul_add(x745, x848, x746 * x847)
+            + Self::mul_add(-x751, x851, x752 * x850)
+            - (Self::mul_add(-x786, x813, Self::mul_add(-x785, x812, x784 * x811))
+                + Self::mul_add(-x754, x815, x755 * x814))
+            - Self::mul_add(x809, x889, x911);
+        let x915 = -x914;
+        let x916 = Self::mul_add(x746, x852, x747 * x851)
+            + Self::mul_add(x755, x813, x756 * x812)
+            + Self::mul_add(-x807, x884, x806 * x878);
+        let x917 = Self::mul_add(-x745, x852, x747 * x850)
+            + Self::mul_add(-x754, x813, x756 * x811)
+            - Self::mul_add(x807, x885, x805 * x867);
+        let x918 = Self::mul_add(x745, x851, x746 * x850)
+            + Self::mul_add(x754, x812, x755 * x811)
+            + Self::mul_add(-x806, x879, x805 * x868);
+        let x919 = -x918;
+        let x920 = Self::mul_add(
+            -x752,
+            x888,
+            Self::mul_add(x747, x881, Self::mul_add(-x746, x875, x898)),
+        );
+        let x921 = Self::mul_add(
+            -x751,
+            x886,
+            Self::mul_add(-x747, x882, Self::mul_add(-x745, x865, x901)),
+        );
+        let x922 = Self::mul_add(
+            -x752,
+            x889,
+            Self::mul_add(x751, x887, x904 - Self::mul_add(x746, x877, x745 * x866)),
+        );
+        let x923 = Self::mul_add(-x780, x819, Self::mul_add(x779, x818, x778 * x817))
+            - Self::mul_add(x755, x822, x756 * x821) - Self::mul_add(x753, x890, x920);
+        let x924 = -x923;
+        let x925 = Self::mul_add(x783, x819, Self::mul_add(x782, x818, x781 * x817))
+            - Self::mul_add(x754, x822, x756 * x820) - Self::mul_add(-x753, x891, x921);
+        let x926 = Self::mul_add(-x786, x819, Self::mul_add(-x785, x818, x784 * x817))
+            + Self::mul_add(-x754, x821, x755 * x820) + x922;
+        let x927 = Self::mul_add(x755, x819, x756 * x818)
+            + Self::mul_add(x747, x884, x746 * x878);
+        let x928 = Self::mul_add(-x754, x819, x756 * x817)
+            + Self::mul_add(x747, x885, x745 * x867);
+        let x929 = Self::mul_add(x754, x818, x755 * x817)
+            - Self::mul_add(x746, x879, x745 * x868);
+        let x930 = -x929;
+        let x931 = -Self::mul_add(0.65, x917, x914);
+        let x932 = Self::mul_add(-0.65, x928, x926);
+        let x933 = Self::mul_add(
+            0.00000000020510342851533115,
+            x914,
+            Self::mul_add(s_q7, x913, c_q7 * x912),
+        ) - Self::mul_add(x126, x918, Self::mul_add(-x125, x917, x124 * x916));
+        let x934 = -(Self::mul_add(
+            0.00000000020510342851533115,
+            x926,
+            Self::mul_add(-s_q7, x925, c_q7 * x923),
+        ) + Self::mul_add(x126, x929, Self::mul_add(-x125, x928, x124 * x927)));
+        let x935 = Self::mul_add(-x245, x914, Self::mul_add(x244, x913, x243 * x912));
+        let x936 = x935
+            - Self::mul_add(-x251, x918, Self::mul_add(-x250, x917, x249 * x916));
+        let x937 = Self::mul_add(-x245, x926, Self::mul_add(-x244, x925, x243 * x923));
+        let x938 = -(x937
+            + Self::mul_add(-x251, x929, Self::mul_add(-x250, x928, x249 * x927)));
+        let x939 = x935
+            - Self::mul_add(-x377, x918, Self::mul_add(-x376, x917, x375 * x916));
+        let x940 = -(x937
+            + Self::mul_add(-x377, x929, Self::mul_add(-x376, x928, x375 * x927)));
+        let x941 = x935
+            - Self::mul_add(-x500, x918, Self::mul_add(-x499, x917, x498 * x916));
+        let x942 = -(x937
+            + Self::mul_add(-x500, x929, Self::mul_add(-x499, x928, x498 * x927)));
+        let x943 = Self::mul_add(-x619, x914, Self::mul_add(x618, x913, x617 * x912))
+            - Self::mul_add(-x625, x918, Self::mul_add(-x624, x917, x623 * x916));
+        let x944 = -(Self::mul_add(-x619, x926, Self::mul_add(-x618, x925, x617 * x923))
+            + Self::mul_add(-x625, x929, Self::mul_add(-x624, x928, x623 * x927)));
+        let x945 = Self::mul_add(-x813, x894, Self::mul_add(x812, x893, x811 * x892))
+            + Self::mul_add(-x816, x897, Self::mul_add(-x815, x896, x814 * x895))
+            + (Self::mul_add(x807, x905, Self::mul_add(x806, x903, x805 * x900))
+                - Self::mul_add(-x810, x908, Self::mul_add(x809, x907, x808 * x906)));
+        let x946 = Self::mul_add(-x819, x894, Self::mul_add(x818, x893, x817 * x892))
+            + Self::mul_add(-x822, x897, Self::mul_add(-x821, x896, x820 * x895))
+            - (Self::mul_add(x747, x905, Self::mul_add(-x746, x903, x745 * x900))
+                + Self::mul_add(x753, x908, Self::mul_add(-x752, x907, x751 * x906)));
+        let x947 = x626 + x754;
+        let x948 = x627 + x755;
+        let x949 = x628 + x756;
+        let x950 = x650 + x778;
+        let x951 = x651 + x779;
+        let x952 = x652 + x780;
+        let x953 = x653 + x781;
+        let x954 = x654 + x782;
+        let x955 = x655 + x783;
+        let x956 = x656 + x784;
+        let x957 = x657 + x785;
+        let x958 = x658 + x786;
+        let x959 = x719 - x720 + x725 + (x725 + (x726 - x727)) + x864;
+        let x960 = x709 + (x706 + (x700 + x728))
+            + (x705 - Self::mul_add(x652, x659, x721)) + x875;
+        let x961 = x708 - (x704 - (x698 + x729))
+            - (x703 + Self::mul_add(x651, x659, x722)) + x881;
+        let x962 = x716 - (x717 + x718) + x888;
+        let x963 = x713 - (x714 + x715) + x890;
+        let x964 = x709 - (x705 - (x699 + x721))
+            - (x706 + Self::mul_add(x655, x660, x728)) + x865;
+        let x965 = x726 - x730 - x733 - (x733 - (x719 - x734)) + x876;
+        let x966 = x707 - (x702 + (x696 + x735))
+            - (x701 - Self::mul_add(x653, x660, x731)) + x882;
+        let x967 = x717 - (x716 - x718) + x886;
+        let x968 = x710 - (x711 + x712) + x891;
+        let x969 = x708 + (x703 + (x697 + x722))
+            + (x704 - Self::mul_add(x657, x661, x729)) + x866;
+        let x970 = x707 + (x701 - (x695 + x731))
+            + (x702 + Self::mul_add(x656, x661, x735)) + x877;
+        let x971 = x727 - x734 + x736 + (x736 + (x720 - x730)) + x883;
+        let x972 = x714 - (x713 - x715) + x887;
+        let x973 = x711 - (x710 - x712) + x889;
+        let x974 = x716 - (x717 - x718) + x878;
+        let x975 = x713 - (x714 - x715) + x884;
+        let x976 = x717 - (x716 + x718) + x867;
+        let x977 = x710 - (x711 - x712) + x885;
+        let x978 = x714 - (x713 + x715) + x868;
+        let x979 = x711 - (x710 + x712) + x879;
+        let x980 = Self::mul_add(-x652, x673, Self::mul_add(-x651, x672, x650 * x671))
+            - Self::mul_add(-x627, x676, x628 * x675)
+            + (Self::mul_add(-x660, x709, x661 * x708)
+                + Self::mul_add(x663, x718, x664 * x715)) + x847;
+        let x981 = Self::mul_add(x655, x673, Self::mul_add(-x654, x672, x653 * x671))
+            - Self::mul_add(-x626, x676, x628 * x674)
+            - (Self::mul_add(x659, x709, x661 * x707)
+                + Self::mul_add(-x662, x718, x664 * x712)) + x848;
+        let x982 = Self::mul_add(-x658, x673, Self::mul_add(x657, x672, x656 * x671))
+            + Self::mul_add(-x626, x675, x627 * x674)
+            + (Self::mul_add(x659, x708, x660 * x707)
+                + Self::mul_add(x662, x715, x663 * x712)) + x849;
+        let x983 = Self::mul_add(-x627, x673, x628 * x672)
+            + Self::mul_add(x660, x718, x661 * x715) + x850;
+        let x984 = Self::mul_add(-x626, x673, x628 * x671)
+            - Self::mul_add(-x659, x718, x661 * x712) + x851;
+        let x985 = Self::mul_add(-x626, x672, x627 * x671)
+            - Self::mul_add(x659, x715, x660 * x712) + x852;
+        let x986 = Self::mul_add(-x619, x952, Self::mul_add(-x618, x951, x617 * x950))
+            - Self::mul_add(x625, x948, x624 * x949);
+        let x987 = Self::mul_add(x619, x955, Self::mul_add(-x618, x954, x617 * x953))
+            + Self::mul_add(-x625, x947, x623 * x949);
+        let x988 = Self::mul_add(-x619, x958, Self::mul_add(x618, x957, x617 * x956))
+            - Self::mul_add(x624, x947, x623 * x948);
+        let x989 = Self::mul_add(-x619, x948, x618 * x949);
+        let x990 = Self::mul_add(-x619, x947, x617 * x949);
+        let x991 = Self::mul_add(-x618, x947, x617 * x948);
+        let x992 = x617 * x959;
+        let x993 = Self::mul_add(
+            x624,
+            x976,
+            Self::mul_add(-x619, x969, Self::mul_add(x618, x964, x992)),
+        );
+        let x994 = Self::mul_add(-x625, x978, x993);
+        let x995 = x618 * x965;
+        let x996 = Self::mul_add(
+            x623,
+            x974,
+            Self::mul_add(x619, x970, Self::mul_add(x617, x960, x995)),
+        );
+        let x997 = Self::mul_add(x625, x979, x996);
+        let x998 = x619 * x971;
+        let x999 = Self::mul_add(
+            x624,
+            x977,
+            Self::mul_add(-x623, x975, Self::mul_add(x618, x966, x617 * x961) + x998),
+        );
+        let x1000 = Self::mul_add(x619, x972, x618 * x967);
+        let x1001 = Self::mul_add(x619, x973, x617 * x962);
+        let x1002 = Self::mul_add(x618, x968, x617 * x963);
+        let x1003 = Self::mul_add(
+            -x681,
+            x962,
+            Self::mul_add(x679, x961, Self::mul_add(x678, x960, x677 * x959)),
+        );
+        let x1004 = Self::mul_add(
+            -x680,
+            x967,
+            Self::mul_add(x679, x966, Self::mul_add(x678, x965, x677 * x964)),
+        );
+        let x1005 = Self::mul_add(
+            x680,
+            x972,
+            Self::mul_add(-x679, x971, Self::mul_add(-x678, x970, x677 * x969)),
+        );
+        let x1006 = Self::mul_add(-x618, x982, x619 * x981)
+            - Self::mul_add(-x624, x985, x625 * x984)
+            - (Self::mul_add(-x685, x952, Self::mul_add(x684, x951, x683 * x950))
+                - Self::mul_add(x688, x948, x687 * x949))
+            - Self::mul_add(x682, x963, x1003);
+        let x1007 = -x1006;
+        let x1008 = Self::mul_add(x617, x982, x619 * x980)
+            - Self::mul_add(-x623, x985, x625 * x983)
+            + (Self::mul_add(x685, x955, Self::mul_add(x684, x954, x683 * x953))
+                - Self::mul_add(x688, x947, x686 * x949))
+            - Self::mul_add(x682, x968, x1004);
+        let x1009 = -x1008;
+        let x1010 = Self::mul_add(x617, x981, x618 * x980)
+            + Self::mul_add(-x623, x984, x624 * x983)
+            - (Self::mul_add(-x685, x958, Self::mul_add(-x684, x957, x683 * x956))
+                + Self::mul_add(-x687, x947, x686 * x948))
+            - Self::mul_add(x681, x973, x1005);
+        let x1011 = Self::mul_add(x618, x985, x619 * x984)
+            + Self::mul_add(x685, x948, x684 * x949)
+            + Self::mul_add(-x679, x975, x678 * x974);
+        let x1012 = -x1011;
+        let x1013 = Self::mul_add(-x617, x985, x619 * x983)
+            + Self::mul_add(-x685, x947, x683 * x949)
+            - Self::mul_add(x679, x977, x677 * x976);
+        let x1014 = -x1013;
+        let x1015 = Self::mul_add(x617, x984, x618 * x983)
+            + Self::mul_add(x684, x947, x683 * x948)
+            + Self::mul_add(-x678, x979, x677 * x978);
+        let x1016 = Self::mul_add(
+            -x624,
+            x962,
+            Self::mul_add(x619, x961, Self::mul_add(-x618, x960, x992)),
+        );
+        let x1017 = Self::mul_add(
+            -x623,
+            x967,
+            Self::mul_add(-x619, x966, Self::mul_add(-x617, x964, x995)),
+        );
+        let x1018 = Self::mul_add(
+            -x624,
+            x973,
+            Self::mul_add(x623, x972, x998 - Self::mul_add(x618, x970, x617 * x969)),
+        );
+        let x1019 = Self::mul_add(-x691, x952, Self::mul_add(x690, x951, x689 * x950))
+            - Self::mul_add(x694, x948, x693 * x949) - Self::mul_add(x625, x963, x1016);
+        let x1020 = Self::mul_add(x691, x955, Self::mul_add(x690, x954, x689 * x953))
+            - Self::mul_add(x694, x947, x692 * x949) - Self::mul_add(-x625, x968, x1017);
+        let x1021 = -x1020;
+        let x1022 = Self::mul_add(-x691, x958, Self::mul_add(-x690, x957, x689 * x956))
+            + Self::mul_add(-x693, x947, x692 * x948) + x1018;
+        let x1023 = -x1022;
+        let x1024 = Self::mul_add(x691, x948, x690 * x949)
+            + Self::mul_add(x619, x975, x618 * x974);
+        let x1025 = -x1024;
+        let x1026 = Self::mul_add(-x691, x947, x689 * x949)
+            + Self::mul_add(x619, x977, x617 * x976);
+        let x1027 = -x1026;
+        let x1028 = Self::mul_add(x690, x947, x689 * x948)
+            - Self::mul_add(x618, x979, x617 * x978);
+        let x1029 = Self::mul_add(0.65, x1013, x1010);
+        let x1030 = -Self::mul_add(-0.65, x1026, x1022);
+        let x1031 = -(Self::mul_add(
+            0.00000000020510342851533115,
+            x1010,
+            Self::mul_add(s_q7, x1008, c_q7 * x1006),
+        ) - Self::mul_add(x126, x1015, Self::mul_add(-x125, x1013, x124 * x1011)));
+        let x1032 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1022,
+            Self::mul_add(-s_q7, x1020, c_q7 * x1019),
+        ) + Self::mul_add(x126, x1028, Self::mul_add(-x125, x1026, x124 * x1024));
+        let x1033 = Self::mul_add(
+            -x245,
+            x1010,
+            Self::mul_add(x244, x1008, x243 * x1006),
+        );
+        let x1034 = -(x1033
+            - Self::mul_add(-x251, x1015, Self::mul_add(-x250, x1013, x249 * x1011)));
+        let x1035 = Self::mul_add(
+            -x245,
+            x1022,
+            Self::mul_add(-x244, x1020, x243 * x1019),
+        );
+        let x1036 = x1035
+            + Self::mul_add(-x251, x1028, Self::mul_add(-x250, x1026, x249 * x1024));
+        let x1037 = -(x1033
+            - Self::mul_add(-x377, x1015, Self::mul_add(-x376, x1013, x375 * x1011)));
+        let x1038 = x1035
+            + Self::mul_add(-x377, x1028, Self::mul_add(-x376, x1026, x375 * x1024));
+        let x1039 = -(x1033
+            - Self::mul_add(-x500, x1015, Self::mul_add(-x499, x1013, x498 * x1011)));
+        let x1040 = x1035
+            + Self::mul_add(-x500, x1028, Self::mul_add(-x499, x1026, x498 * x1024));
+        let x1041 = Self::mul_add(-x685, x988, Self::mul_add(x684, x987, x683 * x986))
+            + Self::mul_add(-x688, x991, Self::mul_add(-x687, x990, x686 * x989))
+            + (Self::mul_add(x679, x999, Self::mul_add(x678, x997, x677 * x994))
+                - Self::mul_add(-x682, x1002, Self::mul_add(x681, x1001, x680 * x1000)));
+        let x1042 = Self::mul_add(-x691, x988, Self::mul_add(x690, x987, x689 * x986))
+            + Self::mul_add(-x694, x991, Self::mul_add(-x693, x990, x692 * x989))
+            - (Self::mul_add(x619, x999, Self::mul_add(-x618, x997, x617 * x994))
+                + Self::mul_add(x625, x1002, Self::mul_add(-x624, x1001, x623 * x1000)));
+        let x1043 = -(Self::mul_add(-x685, x894, Self::mul_add(x684, x893, x683 * x892))
+            + Self::mul_add(-x688, x897, Self::mul_add(-x687, x896, x686 * x895))
+            + (Self::mul_add(x679, x905, Self::mul_add(x678, x903, x677 * x900))
+                - Self::mul_add(-x682, x908, Self::mul_add(x681, x907, x680 * x906))));
+        let x1044 = -(Self::mul_add(-x691, x894, Self::mul_add(x690, x893, x689 * x892))
+            + Self::mul_add(-x694, x897, Self::mul_add(-x693, x896, x692 * x895))
+            - (Self::mul_add(x619, x905, Self::mul_add(-x618, x903, x617 * x900))
+                + Self::mul_add(x625, x908, Self::mul_add(-x624, x907, x623 * x906))));
+        let x1045 = x501 - x947;
+        let x1046 = x502 - x948;
+        let x1047 = x503 - x949;
+        let x1048 = x525 - x950;
+        let x1049 = x526 - x951;
+        let x1050 = x527 - x952;
+        let x1051 = x528 - x953;
+        let x1052 = x529 - x954;
+        let x1053 = x530 - x955;
+        let x1054 = x531 - x956;
+        let x1055 = x532 - x957;
+        let x1056 = x533 - x958;
+        let x1057 = x591 - x592 + x597 + (x597 + (x598 - x599)) - x959;
+        let x1058 = x581 + (x578 + (x572 + x600))
+            + (x577 - Self::mul_add(x527, x534, x593)) - x960;
+        let x1059 = x580 - (x576 - (x570 + x601))
+            - (x575 + Self::mul_add(x526, x534, x594)) - x961;
+        let x1060 = x588 - (x589 + x590) - x962;
+        let x1061 = x585 - (x586 + x587) - x963;
+        let x1062 = x581 - (x577 - (x571 + x593))
+            - (x578 + Self::mul_add(x530, x535, x600)) - x964;
+        let x1063 = x598 - x602 - x605 - (x605 - (x591 - x606)) - x965;
+        let x1064 = x579 - (x574 + (x568 + x607))
+            - (x573 - Self::mul_add(x528, x535, x603)) - x966;
+        let x1065 = x589 - (x588 - x590) - x967;
+        let x1066 = x582 - (x583 + x584) - x968;
+        let x1067 = x580 + (x575 + (x569 + x594))
+            + (x576 - Self::mul_add(x532, x536, x601)) - x969;
+        let x1068 = x579 + (x573 - (x567 + x603))
+            + (x574 + Self::mul_add(x531, x536, x607)) - x970;
+        let x1069 = x599 - x606 + x608 + (x608 + (x592 - x602)) - x971;
+        let x1070 = x586 - (x585 - x587) - x972;
+        let x1071 = x583 - (x582 - x584) - x973;
+        let x1072 = x588 - (x589 - x590) - x974;
+        let x1073 = x585 - (x586 - x587) - x975;
+        let x1074 = x589 - (x588 + x590) - x976;
+        let x1075 = x582 - (x583 - x584) - x977;
+        let x1076 = x586 - (x585 + x587) - x978;
+        let x1077 = x583 - (x582 + x584) - x979;
+        let x1078 = Self::mul_add(-x527, x548, Self::mul_add(-x526, x547, x525 * x546))
+            - Self::mul_add(-x502, x551, x503 * x550)
+            + (Self::mul_add(-x535, x581, x536 * x580)
+                + Self::mul_add(x538, x590, x539 * x587)) - x980;
+        let x1079 = Self::mul_add(x530, x548, Self::mul_add(-x529, x547, x528 * x546))
+            - Self::mul_add(-x501, x551, x503 * x549)
+            - (Self::mul_add(x534, x581, x536 * x579)
+                + Self::mul_add(-x537, x590, x539 * x584)) - x981;
+        let x1080 = Self::mul_add(-x533, x548, Self::mul_add(x532, x547, x531 * x546))
+            + Self::mul_add(-x501, x550, x502 * x549)
+            + (Self::mul_add(x534, x580, x535 * x579)
+                + Self::mul_add(x537, x587, x538 * x584)) - x982;
+        let x1081 = Self::mul_add(-x502, x548, x503 * x547)
+            + Self::mul_add(x535, x590, x536 * x587) - x983;
+        let x1082 = Self::mul_add(-x501, x548, x503 * x546)
+            - Self::mul_add(-x534, x590, x536 * x584) - x984;
+        let x1083 = Self::mul_add(-x501, x547, x502 * x546)
+            - Self::mul_add(x534, x587, x535 * x584) - x985;
+        let x1084 = Self::mul_add(
+            -x245,
+            x1050,
+            Self::mul_add(-x244, x1049, x243 * x1048),
+        ) - Self::mul_add(x500, x1046, x499 * x1047);
+        let x1085 = Self::mul_add(x245, x1053, Self::mul_add(-x244, x1052, x243 * x1051))
+            + Self::mul_add(-x500, x1045, x498 * x1047);
+        let x1086 = Self::mul_add(-x245, x1056, Self::mul_add(x244, x1055, x243 * x1054))
+            - Self::mul_add(x499, x1045, x498 * x1046);
+        let x1087 = Self::mul_add(-x245, x1046, x244 * x1047);
+        let x1088 = Self::mul_add(-x245, x1045, x243 * x1047);
+        let x1089 = Self::mul_add(-x244, x1045, x243 * x1046);
+        let x1090 = x243 * x1057;
+        let x1091 = Self::mul_add(
+            x499,
+            x1074,
+            Self::mul_add(-x245, x1067, Self::mul_add(x244, x1062, x1090)),
+        );
+        let x1092 = Self::mul_add(-x500, x1076, x1091);
+        let x1093 = x244 * x1063;
+        let x1094 = Self::mul_add(
+            x498,
+            x1072,
+            Self::mul_add(x245, x1068, Self::mul_add(x243, x1058, x1093)),
+        );
+        let x1095 = Self::mul_add(x500, x1077, x1094);
+        let x1096 = x245 * x1069;
+        let x1097 = Self::mul_add(
+            x499,
+            x1075,
+            Self::mul_add(-x498, x1073, Self::mul_add(x244, x1064, x243 * x1059) + x1096),
+        );
+        let x1098 = Self::mul_add(x245, x1070, x244 * x1065);
+        let x1099 = Self::mul_add(x245, x1071, x243 * x1060);
+        let x1100 = Self::mul_add(x244, x1066, x243 * x1061);
+        let x1101 = Self::mul_add(
+            x553,
+            x1060,
+            Self::mul_add(x419, x1059, Self::mul_add(x418, x1058, x417 * x1057)),
+        );
+        let x1102 = Self::mul_add(
+            -x552,
+            x1065,
+            Self::mul_add(x419, x1064, Self::mul_add(x418, x1063, x417 * x1062)),
+        );
+        let x1103 = Self::mul_add(
+            x552,
+            x1070,
+            Self::mul_add(-x419, x1069, Self::mul_add(-x418, x1068, x417 * x1067)),
+        );
+        let x1104 = Self::mul_add(-x244, x1080, x245 * x1079)
+            - Self::mul_add(-x499, x1083, x500 * x1082)
+            - (Self::mul_add(-x557, x1050, Self::mul_add(x556, x1049, x555 * x1048))
+                - Self::mul_add(x560, x1046, x559 * x1047))
+            - Self::mul_add(-x554, x1061, x1101);
+        let x1105 = Self::mul_add(x243, x1080, x245 * x1078)
+            - Self::mul_add(-x498, x1083, x500 * x1081)
+            + (Self::mul_add(x557, x1053, Self::mul_add(x556, x1052, x555 * x1051))
+                - Self::mul_add(x560, x1045, x558 * x1047))
+            - Self::mul_add(-x554, x1066, x1102);
+        let x1106 = Self::mul_add(x243, x1079, x244 * x1078)
+            + Self::mul_add(-x498, x1082, x499 * x1081)
+            - (Self::mul_add(-x557, x1056, Self::mul_add(-x556, x1055, x555 * x1054))
+                + Self::mul_add(-x559, x1045, x558 * x1046))
+            - Self::mul_add(-x553, x1071, x1103);
+        let x1107 = -x1106;
+        let x1108 = Self::mul_add(x244, x1083, x245 * x1082)
+            + Self::mul_add(x557, x1046, x556 * x1047)
+            + Self::mul_add(-x419, x1073, x418 * x1072);
+        let x1109 = Self::mul_add(-x243, x1083, x245 * x1081)
+            + Self::mul_add(-x557, x1045, x555 * x1047)
+            - Self::mul_add(x419, x1075, x417 * x1074);
+        let x1110 = Self::mul_add(x243, x1082, x244 * x1081)
+            + Self::mul_add(x556, x1045, x555 * x1046)
+            + Self::mul_add(-x418, x1077, x417 * x1076);
+        let x1111 = -x1110;
+        let x1112 = Self::mul_add(
+            -x499,
+            x1060,
+            Self::mul_add(x245, x1059, Self::mul_add(-x244, x1058, x1090)),
+        );
+        let x1113 = Self::mul_add(
+            -x498,
+            x1065,
+            Self::mul_add(-x245, x1064, Self::mul_add(-x243, x1062, x1093)),
+        );
+        let x1114 = Self::mul_add(
+            -x499,
+            x1071,
+            Self::mul_add(x498, x1070, x1096 - Self::mul_add(x244, x1068, x243 * x1067)),
+        );
+        let x1115 = Self::mul_add(-x563, x1050, Self::mul_add(x562, x1049, x561 * x1048))
+            - Self::mul_add(x566, x1046, x565 * x1047)
+            - Self::mul_add(x500, x1061, x1112);
+        let x1116 = -x1115;
+        let x1117 = Self::mul_add(x563, x1053, Self::mul_add(x562, x1052, x561 * x1051))
+            - Self::mul_add(x566, x1045, x564 * x1047)
+            - Self::mul_add(-x500, x1066, x1113);
+        let x1118 = Self::mul_add(
+            -x563,
+            x1056,
+            Self::mul_add(-x562, x1055, x561 * x1054),
+        ) + Self::mul_add(-x565, x1045, x564 * x1046) + x1114;
+        let x1119 = Self::mul_add(x563, x1046, x562 * x1047)
+            + Self::mul_add(x245, x1073, x244 * x1072);
+        let x1120 = Self::mul_add(-x563, x1045, x561 * x1047)
+            + Self::mul_add(x245, x1075, x243 * x1074);
+        let x1121 = Self::mul_add(x562, x1045, x561 * x1046)
+            - Self::mul_add(x244, x1077, x243 * x1076);
+        let x1122 = -x1121;
+        let x1123 = -Self::mul_add(0.65, x1109, x1106);
+        let x1124 = Self::mul_add(-0.65, x1120, x1118);
+        let x1125 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1106,
+            Self::mul_add(s_q7, x1105, c_q7 * x1104),
+        ) - Self::mul_add(x126, x1110, Self::mul_add(-x125, x1109, x124 * x1108));
+        let x1126 = -(Self::mul_add(
+            0.00000000020510342851533115,
+            x1118,
+            Self::mul_add(-s_q7, x1117, c_q7 * x1115),
+        ) + Self::mul_add(x126, x1121, Self::mul_add(-x125, x1120, x124 * x1119)));
+        let x1127 = Self::mul_add(
+            -x245,
+            x1106,
+            Self::mul_add(x244, x1105, x243 * x1104),
+        );
+        let x1128 = x1127
+            - Self::mul_add(-x251, x1110, Self::mul_add(-x250, x1109, x249 * x1108));
+        let x1129 = Self::mul_add(
+            -x245,
+            x1118,
+            Self::mul_add(-x244, x1117, x243 * x1115),
+        );
+        let x1130 = -(x1129
+            + Self::mul_add(-x251, x1121, Self::mul_add(-x250, x1120, x249 * x1119)));
+        let x1131 = x1127
+            - Self::mul_add(-x377, x1110, Self::mul_add(-x376, x1109, x375 * x1108));
+        let x1132 = -(x1129
+            + Self::mul_add(-x377, x1121, Self::mul_add(-x376, x1120, x375 * x1119)));
+        let x1133 = -(Self::mul_add(
+            -x557,
+            x1086,
+            Self::mul_add(x556, x1085, x555 * x1084),
+        ) + Self::mul_add(-x560, x1089, Self::mul_add(-x559, x1088, x558 * x1087))
+            + (Self::mul_add(x419, x1097, Self::mul_add(x418, x1095, x417 * x1092))
+                - Self::mul_add(
+                    x554,
+                    x1100,
+                    Self::mul_add(-x553, x1099, x552 * x1098),
+                )));
+        let x1134 = Self::mul_add(
+            x245,
+            x1097,
+            Self::mul_add(-x244, x1095, x243 * x1092),
+        );
+        let x1135 = -(Self::mul_add(
+            -x563,
+            x1086,
+            Self::mul_add(x562, x1085, x561 * x1084),
+        ) + Self::mul_add(-x566, x1089, Self::mul_add(-x565, x1088, x564 * x1087))
+            - (x1134
+                + Self::mul_add(
+                    x500,
+                    x1100,
+                    Self::mul_add(-x499, x1099, x498 * x1098),
+                )));
+        let x1136 = Self::mul_add(-x557, x988, Self::mul_add(x556, x987, x555 * x986))
+            + Self::mul_add(-x560, x991, Self::mul_add(-x559, x990, x558 * x989))
+            + (Self::mul_add(x419, x999, Self::mul_add(x418, x997, x417 * x994))
+                - Self::mul_add(x554, x1002, Self::mul_add(-x553, x1001, x552 * x1000)));
+        let x1137 = Self::mul_add(x245, x999, Self::mul_add(-x244, x997, x243 * x994));
+        let x1138 = Self::mul_add(-x563, x988, Self::mul_add(x562, x987, x561 * x986))
+            + Self::mul_add(-x566, x991, Self::mul_add(-x565, x990, x564 * x989))
+            - (x1137
+                + Self::mul_add(x500, x1002, Self::mul_add(-x499, x1001, x498 * x1000)));
+        let x1139 = -(Self::mul_add(-x557, x894, Self::mul_add(x556, x893, x555 * x892))
+            + Self::mul_add(-x560, x897, Self::mul_add(-x559, x896, x558 * x895))
+            + (Self::mul_add(x419, x905, Self::mul_add(x418, x903, x417 * x900))
+                - Self::mul_add(x554, x908, Self::mul_add(-x553, x907, x552 * x906))));
+        let x1140 = Self::mul_add(x245, x905, Self::mul_add(-x244, x903, x243 * x900));
+        let x1141 = -(Self::mul_add(-x563, x894, Self::mul_add(x562, x893, x561 * x892))
+            + Self::mul_add(-x566, x897, Self::mul_add(-x565, x896, x564 * x895))
+            - (x1140
+                + Self::mul_add(x500, x908, Self::mul_add(-x499, x907, x498 * x906))));
+        let x1142 = x378 - x1045;
+        let x1143 = x379 - x1046;
+        let x1144 = x380 - x1047;
+        let x1145 = x402 - x1048;
+        let x1146 = x403 - x1049;
+        let x1147 = x404 - x1050;
+        let x1148 = x405 - x1051;
+        let x1149 = x406 - x1052;
+        let x1150 = x407 - x1053;
+        let x1151 = x408 - x1054;
+        let x1152 = x409 - x1055;
+        let x1153 = x410 - x1056;
+        let x1154 = x471 - x472 + x477 + (x477 + (x478 - x479)) - x1057;
+        let x1155 = x461 + (x458 + (x452 + x480))
+            + (x457 - Self::mul_add(x404, x411, x473)) - x1058;
+        let x1156 = x460 - (x456 - (x450 + x481))
+            - (x455 + Self::mul_add(x403, x411, x474)) - x1059;
+        let x1157 = x468 - (x469 + x470) - x1060;
+        let x1158 = x465 - (x466 + x467) - x1061;
+        let x1159 = x461 - (x457 - (x451 + x473))
+            - (x458 + Self::mul_add(x407, x412, x480)) - x1062;
+        let x1160 = x478 - x482 - x485 - (x485 - (x471 - x486)) - x1063;
+        let x1161 = x459 - (x454 + (x448 + x487))
+            - (x453 - Self::mul_add(x405, x412, x483)) - x1064;
+        let x1162 = x469 - (x468 - x470) - x1065;
+        let x1163 = x462 - (x463 + x464) - x1066;
+        let x1164 = x460 + (x455 + (x449 + x474))
+            + (x456 - Self::mul_add(x409, x413, x481)) - x1067;
+        let x1165 = x459 + (x453 - (x447 + x483))
+            + (x454 + Self::mul_add(x408, x413, x487)) - x1068;
+        let x1166 = x479 - x486 + x488 + (x488 + (x472 - x482)) - x1069;
+        let x1167 = x466 - (x465 - x467) - x1070;
+        let x1168 = x463 - (x462 - x464) - x1071;
+        let x1169 = x468 - (x469 - x470) - x1072;
+        let x1170 = x465 - (x466 - x467) - x1073;
+        let x1171 = x469 - (x468 + x470) - x1074;
+        let x1172 = x462 - (x463 - x464) - x1075;
+        let x1173 = x466 - (x465 + x467) - x1076;
+        let x1174 = x463 - (x462 + x464) - x1077;
+        let x1175 = Self::mul_add(-x404, x428, Self::mul_add(-x403, x427, x402 * x426))
+            - Self::mul_add(-x379, x431, x380 * x430)
+            + (Self::mul_add(-x412, x461, x413 * x460)
+                + Self::mul_add(x415, x470, x416 * x467)) - x1078;
+        let x1176 = Self::mul_add(x407, x428, Self::mul_add(-x406, x427, x405 * x426))
+            - Self::mul_add(-x378, x431, x380 * x429)
+            - (Self::mul_add(x411, x461, x413 * x459)
+                + Self::mul_add(-x414, x470, x416 * x464)) - x1079;
+        let x1177 = Self::mul_add(-x410, x428, Self::mul_add(x409, x427, x408 * x426))
+            + Self::mul_add(-x378, x430, x379 * x429)
+            + (Self::mul_add(x411, x460, x412 * x459)
+                + Self::mul_add(x414, x467, x415 * x464)) - x1080;
+        let x1178 = Self::mul_add(-x379, x428, x380 * x427)
+            + Self::mul_add(x412, x470, x413 * x467) - x1081;
+        let x1179 = Self::mul_add(-x378, x428, x380 * x426)
+            - Self::mul_add(-x411, x470, x413 * x464) - x1082;
+        let x1180 = Self::mul_add(-x378, x427, x379 * x426)
+            - Self::mul_add(x411, x467, x412 * x464) - x1083;
+        let x1181 = Self::mul_add(
+            -x245,
+            x1147,
+            Self::mul_add(-x244, x1146, x243 * x1145),
+        ) - Self::mul_add(x377, x1143, x376 * x1144);
+        let x1182 = Self::mul_add(x245, x1150, Self::mul_add(-x244, x1149, x243 * x1148))
+            + Self::mul_add(-x377, x1142, x375 * x1144);
+        let x1183 = Self::mul_add(-x245, x1153, Self::mul_add(x244, x1152, x243 * x1151))
+            - Self::mul_add(x376, x1142, x375 * x1143);
+        let x1184 = Self::mul_add(-x245, x1143, x244 * x1144);
+        let x1185 = Self::mul_add(-x245, x1142, x243 * x1144);
+        let x1186 = Self::mul_add(-x244, x1142, x243 * x1143);
+        let x1187 = x243 * x1154;
+        let x1188 = Self::mul_add(
+            x376,
+            x1171,
+            Self::mul_add(-x245, x1164, Self::mul_add(x244, x1159, x1187)),
+        );
+        let x1189 = Self::mul_add(-x377, x1173, x1188);
+        let x1190 = x244 * x1160;
+        let x1191 = Self::mul_add(
+            x375,
+            x1169,
+            Self::mul_add(x245, x1165, Self::mul_add(x243, x1155, x1190)),
+        );
+        let x1192 = Self::mul_add(x377, x1174, x1191);
+        let x1193 = x245 * x1166;
+        let x1194 = Self::mul_add(
+            x376,
+            x1172,
+            Self::mul_add(-x375, x1170, Self::mul_add(x244, x1161, x243 * x1156) + x1193),
+        );
+        let x1195 = Self::mul_add(x245, x1167, x244 * x1162);
+        let x1196 = Self::mul_add(x245, x1168, x243 * x1157);
+        let x1197 = Self::mul_add(x244, x1163, x243 * x1158);
+        let x1198 = Self::mul_add(
+            x433,
+            x1157,
+            Self::mul_add(x293, x1156, Self::mul_add(x292, x1155, x291 * x1154)),
+        );
+        let x1199 = Self::mul_add(
+            -x432,
+            x1162,
+            Self::mul_add(x293, x1161, Self::mul_add(x292, x1160, x291 * x1159)),
+        );
+        let x1200 = Self::mul_add(
+            x432,
+            x1167,
+            Self::mul_add(-x293, x1166, Self::mul_add(-x292, x1165, x291 * x1164)),
+        );
+        let x1201 = Self::mul_add(-x244, x1177, x245 * x1176)
+            - Self::mul_add(-x376, x1180, x377 * x1179)
+            - (Self::mul_add(-x437, x1147, Self::mul_add(x436, x1146, x435 * x1145))
+                - Self::mul_add(x440, x1143, x439 * x1144))
+            - Self::mul_add(-x434, x1158, x1198);
+        let x1202 = -x1201;
+        let x1203 = Self::mul_add(x243, x1177, x245 * x1175)
+            - Self::mul_add(-x375, x1180, x377 * x1178)
+            + (Self::mul_add(x437, x1150, Self::mul_add(x436, x1149, x435 * x1148))
+                - Self::mul_add(x440, x1142, x438 * x1144))
+            - Self::mul_add(-x434, x1163, x1199);
+        let x1204 = -x1203;
+        let x1205 = Self::mul_add(x243, x1176, x244 * x1175)
+            + Self::mul_add(-x375, x1179, x376 * x1178)
+            - (Self::mul_add(-x437, x1153, Self::mul_add(-x436, x1152, x435 * x1151))
+                + Self::mul_add(-x439, x1142, x438 * x1143))
+            - Self::mul_add(-x433, x1168, x1200);
+        let x1206 = Self::mul_add(x244, x1180, x245 * x1179)
+            + Self::mul_add(x437, x1143, x436 * x1144)
+            + Self::mul_add(-x293, x1170, x292 * x1169);
+        let x1207 = -x1206;
+        let x1208 = Self::mul_add(-x243, x1180, x245 * x1178)
+            + Self::mul_add(-x437, x1142, x435 * x1144)
+            - Self::mul_add(x293, x1172, x291 * x1171);
+        let x1209 = -x1208;
+        let x1210 = Self::mul_add(x243, x1179, x244 * x1178)
+            + Self::mul_add(x436, x1142, x435 * x1143)
+            + Self::mul_add(-x292, x1174, x291 * x1173);
+        let x1211 = Self::mul_add(
+            -x376,
+            x1157,
+            Self::mul_add(x245, x1156, Self::mul_add(-x244, x1155, x1187)),
+        );
+        let x1212 = Self::mul_add(
+            -x375,
+            x1162,
+            Self::mul_add(-x245, x1161, Self::mul_add(-x243, x1159, x1190)),
+        );
+        let x1213 = Self::mul_add(
+            -x376,
+            x1168,
+            Self::mul_add(x375, x1167, x1193 - Self::mul_add(x244, x1165, x243 * x1164)),
+        );
+        let x1214 = Self::mul_add(-x443, x1147, Self::mul_add(x442, x1146, x441 * x1145))
+            - Self::mul_add(x446, x1143, x445 * x1144)
+            - Self::mul_add(x377, x1158, x1211);
+        let x1215 = Self::mul_add(x443, x1150, Self::mul_add(x442, x1149, x441 * x1148))
+            - Self::mul_add(x446, x1142, x444 * x1144)
+            - Self::mul_add(-x377, x1163, x1212);
+        let x1216 = -x1215;
+        let x1217 = Self::mul_add(
+            -x443,
+            x1153,
+            Self::mul_add(-x442, x1152, x441 * x1151),
+        ) + Self::mul_add(-x445, x1142, x444 * x1143) + x1213;
+        let x1218 = -x1217;
+        let x1219 = Self::mul_add(x443, x1143, x442 * x1144)
+            + Self::mul_add(x245, x1170, x244 * x1169);
+        let x1220 = -x1219;
+        let x1221 = Self::mul_add(-x443, x1142, x441 * x1144)
+            + Self::mul_add(x245, x1172, x243 * x1171);
+        let x1222 = -x1221;
+        let x1223 = Self::mul_add(x442, x1142, x441 * x1143)
+            - Self::mul_add(x244, x1174, x243 * x1173);
+        let x1224 = Self::mul_add(0.65, x1208, x1205);
+        let x1225 = -Self::mul_add(-0.65, x1221, x1217);
+        let x1226 = -(Self::mul_add(
+            0.00000000020510342851533115,
+            x1205,
+            Self::mul_add(s_q7, x1203, c_q7 * x1201),
+        ) - Self::mul_add(x126, x1210, Self::mul_add(-x125, x1208, x124 * x1206)));
+        let x1227 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1217,
+            Self::mul_add(-s_q7, x1215, c_q7 * x1214),
+        ) + Self::mul_add(x126, x1223, Self::mul_add(-x125, x1221, x124 * x1219));
+        let x1228 = -(Self::mul_add(
+            -x245,
+            x1205,
+            Self::mul_add(x244, x1203, x243 * x1201),
+        ) - Self::mul_add(-x251, x1210, Self::mul_add(-x250, x1208, x249 * x1206)));
+        let x1229 = Self::mul_add(
+            -x245,
+            x1217,
+            Self::mul_add(-x244, x1215, x243 * x1214),
+        ) + Self::mul_add(-x251, x1223, Self::mul_add(-x250, x1221, x249 * x1219));
+        let x1230 = Self::mul_add(-x437, x1183, Self::mul_add(x436, x1182, x435 * x1181))
+            + Self::mul_add(-x440, x1186, Self::mul_add(-x439, x1185, x438 * x1184))
+            + (Self::mul_add(x293, x1194, Self::mul_add(x292, x1192, x291 * x1189))
+                - Self::mul_add(x434, x1197, Self::mul_add(-x433, x1196, x432 * x1195)));
+        let x1231 = Self::mul_add(
+            x245,
+            x1194,
+            Self::mul_add(-x244, x1192, x243 * x1189),
+        );
+        let x1232 = Self::mul_add(-x443, x1183, Self::mul_add(x442, x1182, x441 * x1181))
+            + Self::mul_add(-x446, x1186, Self::mul_add(-x445, x1185, x444 * x1184))
+            - (x1231
+                + Self::mul_add(x377, x1197, Self::mul_add(-x376, x1196, x375 * x1195)));
+        let x1233 = -(Self::mul_add(
+            -x437,
+            x1086,
+            Self::mul_add(x436, x1085, x435 * x1084),
+        ) + Self::mul_add(-x440, x1089, Self::mul_add(-x439, x1088, x438 * x1087))
+            + (Self::mul_add(x293, x1097, Self::mul_add(x292, x1095, x291 * x1092))
+                - Self::mul_add(
+                    x434,
+                    x1100,
+                    Self::mul_add(-x433, x1099, x432 * x1098),
+                )));
+        let x1234 = -(Self::mul_add(
+            -x443,
+            x1086,
+            Self::mul_add(x442, x1085, x441 * x1084),
+        ) + Self::mul_add(-x446, x1089, Self::mul_add(-x445, x1088, x444 * x1087))
+            - (x1134
+                + Self::mul_add(
+                    x377,
+                    x1100,
+                    Self::mul_add(-x376, x1099, x375 * x1098),
+                )));
+        let x1235 = Self::mul_add(-x437, x988, Self::mul_add(x436, x987, x435 * x986))
+            + Self::mul_add(-x440, x991, Self::mul_add(-x439, x990, x438 * x989))
+            + (Self::mul_add(x293, x999, Self::mul_add(x292, x997, x291 * x994))
+                - Self::mul_add(x434, x1002, Self::mul_add(-x433, x1001, x432 * x1000)));
+        let x1236 = Self::mul_add(-x443, x988, Self::mul_add(x442, x987, x441 * x986))
+            + Self::mul_add(-x446, x991, Self::mul_add(-x445, x990, x444 * x989))
+            - (x1137
+                + Self::mul_add(x377, x1002, Self::mul_add(-x376, x1001, x375 * x1000)));
+        let x1237 = -(Self::mul_add(-x437, x894, Self::mul_add(x436, x893, x435 * x892))
+            + Self::mul_add(-x440, x897, Self::mul_add(-x439, x896, x438 * x895))
+            + (Self::mul_add(x293, x905, Self::mul_add(x292, x903, x291 * x900))
+                - Self::mul_add(x434, x908, Self::mul_add(-x433, x907, x432 * x906))));
+        let x1238 = -(Self::mul_add(-x443, x894, Self::mul_add(x442, x893, x441 * x892))
+            + Self::mul_add(-x446, x897, Self::mul_add(-x445, x896, x444 * x895))
+            - (x1140
+                + Self::mul_add(x377, x908, Self::mul_add(-x376, x907, x375 * x906))));
+        let x1239 = x252 - x1142;
+        let x1240 = x253 - x1143;
+        let x1241 = x254 + x1144;
+        let x1242 = x276 + x1145;
+        let x1243 = x277 - x1146;
+        let x1244 = x278 + x1147;
+        let x1245 = x279 - x1148;
+        let x1246 = x280 + x1149;
+        let x1247 = x281 + x1150;
+        let x1248 = x282 - x1151;
+        let x1249 = x283 - x1152;
+        let x1250 = x284 - x1153;
+        let x1251 = x348 - x349 - x354 - (x354 - (x355 + x356)) - x1154;
+        let x1252 = x338 + (x335 + (x329 - x357))
+            + (x334 + Self::mul_add(x278, x285, x350)) - x1155;
+        let x1253 = x337 - (x333 + (x327 - x358))
+            + (x332 + Self::mul_add(-x277, x285, x351)) - x1156;
+        let x1254 = x345 - (x346 + x347) - x1157;
+        let x1255 = x342 + (x343 - x344) + x1158;
+        let x1256 = x338 - (x334 - (x328 - x350))
+            - (x335 - Self::mul_add(x281, x286, x357)) - x1159;
+        let x1257 = x355 - x359 + x362 + (x362 + (x348 + x363)) - x1160;
+        let x1258 = x336 + (x331 - (x325 - x364))
+            - (x330 - Self::mul_add(-x279, x286, x360)) + x1161;
+        let x1259 = x346 - (x345 - x347) - x1162;
+        let x1260 = x339 + (x340 - x341) + x1163;
+        let x1261 = x337 - (x332 - (x326 - x351))
+            + (x333 - Self::mul_add(x283, x287, x358)) - x1164;
+        let x1262 = x336 + (x330 + (x324 - x360))
+            - (x331 + Self::mul_add(x282, x287, x364)) + x1165;
+        let x1263 = x356 - x363 - x365 - (x365 + (x349 - x359)) + x1166;
+        let x1264 = x343 + (x342 - x344) - x1167;
+        let x1265 = x340 + (x339 - x341) - x1168;
+        let x1266 = x345 - (x346 - x347) - x1169;
+        let x1267 = x342 + (x343 + x344) + x1170;
+        let x1268 = x346 - (x345 + x347) - x1171;
+        let x1269 = x339 + (x340 + x341) + x1172;
+        let x1270 = x343 + (x342 + x344) - x1173;
+        let x1271 = x340 + (x339 + x341) - x1174;
+        let x1272 = Self::mul_add(-x278, x302, Self::mul_add(x277, x301, x276 * x300))
+            - Self::mul_add(x253, x305, x254 * x304)
+            - (Self::mul_add(-x286, x338, x287 * x337)
+                - Self::mul_add(-x289, x347, x290 * x344)) + x1175;
+        let x1273 = Self::mul_add(-x281, x302, Self::mul_add(x280, x301, x279 * x300))
+            + Self::mul_add(x252, x305, x254 * x303)
+            + (Self::mul_add(-x285, x338, x287 * x336)
+                + Self::mul_add(x288, x347, x290 * x341)) - x1176;
+        let x1274 = Self::mul_add(-x284, x302, Self::mul_add(x283, x301, x282 * x300))
+            + Self::mul_add(-x252, x304, x253 * x303)
+            - (Self::mul_add(-x285, x337, x286 * x336)
+                + Self::mul_add(x288, x344, x289 * x341)) - x1177;
+        let x1275 = Self::mul_add(x253, x302, x254 * x301)
+            + Self::mul_add(-x286, x347, x287 * x344) + x1178;
+        let x1276 = Self::mul_add(x252, x302, x254 * x300)
+            - Self::mul_add(x285, x347, x287 * x341) + x1179;
+        let x1277 = Self::mul_add(-x252, x301, x253 * x300)
+            + Self::mul_add(x285, x344, x286 * x341) - x1180;
+        let x1278 = Self::mul_add(-x245, x1244, Self::mul_add(x244, x1243, x243 * x1242))
+            - Self::mul_add(-x251, x1240, x250 * x1241);
+        let x1279 = Self::mul_add(-x245, x1247, Self::mul_add(x244, x1246, x243 * x1245))
+            - Self::mul_add(x251, x1239, x249 * x1241);
+        let x1280 = Self::mul_add(-x245, x1250, Self::mul_add(x244, x1249, x243 * x1248))
+            - Self::mul_add(x250, x1239, x249 * x1240);
+        let x1281 = Self::mul_add(x245, x1240, x244 * x1241);
+        let x1282 = Self::mul_add(x245, x1239, x243 * x1241);
+        let x1283 = Self::mul_add(-x244, x1239, x243 * x1240);
+        let x1284 = x243 * x1251;
+        let x1285 = Self::mul_add(
+            x250,
+            x1268,
+            Self::mul_add(-x245, x1261, Self::mul_add(x244, x1256, x1284)),
+        );
+        let x1286 = Self::mul_add(-x251, x1270, x1285);
+        let x1287 = x244 * x1257;
+        let x1288 = Self::mul_add(
+            x249,
+            x1266,
+            Self::mul_add(-x245, x1262, Self::mul_add(x243, x1252, x1287)),
+        );
+        let x1289 = Self::mul_add(x251, x1271, x1288);
+        let x1290 = x245 * x1263;
+        let x1291 = Self::mul_add(
+            -x250,
+            x1269,
+            Self::mul_add(x249, x1267, Self::mul_add(-x244, x1258, x243 * x1253) - x1290),
+        );
+        let x1292 = Self::mul_add(x245, x1264, x244 * x1259);
+        let x1293 = Self::mul_add(x245, x1265, x243 * x1254);
+        let x1294 = Self::mul_add(x244, x1260, x243 * x1255);
+        let x1295 = Self::mul_add(
+            -x310,
+            x1254,
+            Self::mul_add(x308, x1253, Self::mul_add(x307, x1252, x306 * x1251)),
+        );
+        let x1296 = Self::mul_add(
+            -x309,
+            x1259,
+            Self::mul_add(-x308, x1258, Self::mul_add(x307, x1257, x306 * x1256)),
+        );
+        let x1297 = Self::mul_add(
+            x309,
+            x1264,
+            Self::mul_add(x308, x1263, Self::mul_add(x307, x1262, x306 * x1261)),
+        );
+        let x1298 = Self::mul_add(-x244, x1274, x245 * x1273)
+            + Self::mul_add(x250, x1277, x251 * x1276)
+            + (Self::mul_add(-x314, x1244, Self::mul_add(-x313, x1243, x312 * x1242))
+                - Self::mul_add(-x317, x1240, x316 * x1241))
+            - Self::mul_add(-x311, x1255, x1295);
+        let x1299 = Self::mul_add(-x243, x1274, x245 * x1272)
+            - Self::mul_add(x249, x1277, x251 * x1275)
+            - (Self::mul_add(-x314, x1247, Self::mul_add(-x313, x1246, x312 * x1245))
+                + Self::mul_add(-x317, x1239, x315 * x1241))
+            + Self::mul_add(-x311, x1260, x1296);
+        let x1300 = -x1299;
+        let x1301 = Self::mul_add(-x243, x1273, x244 * x1272)
+            + Self::mul_add(-x249, x1276, x250 * x1275)
+            + (Self::mul_add(-x314, x1250, Self::mul_add(-x313, x1249, x312 * x1248))
+                + Self::mul_add(-x316, x1239, x315 * x1240))
+            + Self::mul_add(x310, x1265, x1297);
+        let x1302 = Self::mul_add(-x244, x1277, x245 * x1276)
+            + Self::mul_add(-x314, x1240, x313 * x1241)
+            - Self::mul_add(x308, x1267, x307 * x1266);
+        let x1303 = -x1302;
+        let x1304 = Self::mul_add(x243, x1277, x245 * x1275)
+            + Self::mul_add(x314, x1239, x312 * x1241)
+            + Self::mul_add(-x308, x1269, x306 * x1268);
+        let x1305 = -x1304;
+        let x1306 = Self::mul_add(x243, x1276, x244 * x1275)
+            - Self::mul_add(x313, x1239, x312 * x1240)
+            - Self::mul_add(-x307, x1271, x306 * x1270);
+        let x1307 = Self::mul_add(
+            -x250,
+            x1254,
+            Self::mul_add(x245, x1253, Self::mul_add(-x244, x1252, x1284)),
+        );
+        let x1308 = Self::mul_add(
+            -x249,
+            x1259,
+            Self::mul_add(x245, x1258, Self::mul_add(-x243, x1256, x1287)),
+        );
+        let x1309 = Self::mul_add(
+            x250,
+            x1265,
+            Self::mul_add(
+                -x249,
+                x1264,
+                x1290 + Self::mul_add(-x244, x1262, x243 * x1261),
+            ),
+        );
+        let x1310 = Self::mul_add(
+            -x320,
+            x1244,
+            Self::mul_add(-x319, x1243, x318 * x1242),
+        ) - Self::mul_add(-x323, x1240, x322 * x1241)
+            + Self::mul_add(-x251, x1255, x1307);
+        let x1311 = Self::mul_add(
+            -x320,
+            x1247,
+            Self::mul_add(-x319, x1246, x318 * x1245),
+        ) + Self::mul_add(-x323, x1239, x321 * x1241)
+            - Self::mul_add(x251, x1260, x1308);
+        let x1312 = Self::mul_add(
+            -x320,
+            x1250,
+            Self::mul_add(-x319, x1249, x318 * x1248),
+        ) + Self::mul_add(-x322, x1239, x321 * x1240) - x1309;
+        let x1313 = Self::mul_add(-x320, x1240, x319 * x1241)
+            - Self::mul_add(-x245, x1267, x244 * x1266);
+        let x1314 = -x1313;
+        let x1315 = Self::mul_add(x320, x1239, x318 * x1241)
+            - Self::mul_add(-x245, x1269, x243 * x1268);
+        let x1316 = -x1315;
+        let x1317 = Self::mul_add(x319, x1239, x318 * x1240)
+            - Self::mul_add(x244, x1271, x243 * x1270);
+        let x1318 = -x1317;
+        let x1319 = Self::mul_add(0.65, x1304, x1301);
+        let x1320 = Self::mul_add(0.65, x1315, x1312);
+        let x1321 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x1301,
+            Self::mul_add(-s_q7, x1299, c_q7 * x1298),
+        ) + Self::mul_add(x126, x1306, Self::mul_add(-x125, x1304, x124 * x1302));
+        let x1322 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x1312,
+            Self::mul_add(s_q7, x1311, c_q7 * x1310),
+        ) + Self::mul_add(-x126, x1317, Self::mul_add(-x125, x1315, x124 * x1313));
+        let x1323 = Self::mul_add(x314, x1280, Self::mul_add(-x313, x1279, x312 * x1278))
+            + Self::mul_add(x317, x1283, Self::mul_add(-x316, x1282, x315 * x1281))
+            - (Self::mul_add(x308, x1291, Self::mul_add(x307, x1289, x306 * x1286))
+                - Self::mul_add(x311, x1294, Self::mul_add(x310, x1293, x309 * x1292)));
+        let x1324 = Self::mul_add(x320, x1280, Self::mul_add(-x319, x1279, x318 * x1278))
+            + Self::mul_add(x323, x1283, Self::mul_add(-x322, x1282, x321 * x1281))
+            + (Self::mul_add(x245, x1291, Self::mul_add(-x244, x1289, x243 * x1286))
+                + Self::mul_add(
+                    -x251,
+                    x1294,
+                    Self::mul_add(-x250, x1293, x249 * x1292),
+                ));
+        let x1325 = Self::mul_add(-x314, x1183, Self::mul_add(x313, x1182, x312 * x1181))
+            + Self::mul_add(-x317, x1186, Self::mul_add(-x316, x1185, x315 * x1184))
+            + (Self::mul_add(x308, x1194, Self::mul_add(x307, x1192, x306 * x1189))
+                - Self::mul_add(-x311, x1197, Self::mul_add(x310, x1196, x309 * x1195)));
+        let x1326 = Self::mul_add(-x320, x1183, Self::mul_add(x319, x1182, x318 * x1181))
+            + Self::mul_add(-x323, x1186, Self::mul_add(-x322, x1185, x321 * x1184))
+            - (x1231
+                + Self::mul_add(x251, x1197, Self::mul_add(-x250, x1196, x249 * x1195)));
+        let x1327 = -(Self::mul_add(
+            -x314,
+            x1086,
+            Self::mul_add(x313, x1085, x312 * x1084),
+        ) + Self::mul_add(-x317, x1089, Self::mul_add(-x316, x1088, x315 * x1087))
+            + (Self::mul_add(x308, x1097, Self::mul_add(x307, x1095, x306 * x1092))
+                - Self::mul_add(
+                    -x311,
+                    x1100,
+                    Self::mul_add(x310, x1099, x309 * x1098),
+                )));
+        let x1328 = -(Self::mul_add(
+            -x320,
+            x1086,
+            Self::mul_add(x319, x1085, x318 * x1084),
+        ) + Self::mul_add(-x323, x1089, Self::mul_add(-x322, x1088, x321 * x1087))
+            - (x1134
+                + Self::mul_add(
+                    x251,
+                    x1100,
+                    Self::mul_add(-x250, x1099, x249 * x1098),
+                )));
+        let x1329 = Self::mul_add(-x314, x988, Self::mul_add(x313, x987, x312 * x986))
+            + Self::mul_add(-x317, x991, Self::mul_add(-x316, x990, x315 * x989))
+            + (Self::mul_add(x308, x999, Self::mul_add(x307, x997, x306 * x994))
+                - Self::mul_add(-x311, x1002, Self::mul_add(x310, x1001, x309 * x1000)));
+        let x1330 = Self::mul_add(-x320, x988, Self::mul_add(x319, x987, x318 * x986))
+            + Self::mul_add(-x323, x991, Self::mul_add(-x322, x990, x321 * x989))
+            - (x1137
+                + Self::mul_add(x251, x1002, Self::mul_add(-x250, x1001, x249 * x1000)));
+        let x1331 = -(Self::mul_add(-x314, x894, Self::mul_add(x313, x893, x312 * x892))
+            + Self::mul_add(-x317, x897, Self::mul_add(-x316, x896, x315 * x895))
+            + (Self::mul_add(x308, x905, Self::mul_add(x307, x903, x306 * x900))
+                - Self::mul_add(-x311, x908, Self::mul_add(x310, x907, x309 * x906))));
+        let x1332 = -(Self::mul_add(-x320, x894, Self::mul_add(x319, x893, x318 * x892))
+            + Self::mul_add(-x323, x897, Self::mul_add(-x322, x896, x321 * x895))
+            - (x1140
+                + Self::mul_add(x251, x908, Self::mul_add(-x250, x907, x249 * x906))));
+        let x1333 = x127 + x1239;
+        let x1334 = x128 + x1240;
+        let x1335 = x129 - x1241;
+        let x1336 = x148 - x1242;
+        let x1337 = x149 - x1243;
+        let x1338 = x150 - x1244;
+        let x1339 = x146 - x1245;
+        let x1340 = x151 - x1246;
+        let x1341 = x147 + x1247;
+        let x1342 = x152 + x1248;
+        let x1343 = x153 - x1249;
+        let x1344 = x154 + x1250;
+        let x1345 = x215 + x216 - x221 - (x221 - (x222 + x223)) - x1251;
+        let x1346 = x205 + (x202 - (x196 - x224))
+            + (x201 - Self::mul_add(x150, x155, x217)) + x1252;
+        let x1347 = x204 + (x200 + (x194 - x225))
+            + (x199 + Self::mul_add(-x149, x155, x218)) - x1253;
+        let x1348 = x212 - (x213 + x214) + x1254;
+        let x1349 = x209 - (x210 + x211) - x1255;
+        let x1350 = x205 - (x201 - (x195 + x217))
+            - (x202 + Self::mul_add(-x147, x156, x224)) + x1256;
+        let x1351 = x222 - x226 + x229 + (x229 + (x215 - x230)) - x1257;
+        let x1352 = x203 - (x198 + (x192 + x231))
+            - (x197 - Self::mul_add(-x146, x156, x227)) - x1258;
+        let x1353 = x213 - (x212 - x214) + x1259;
+        let x1354 = x206 - (x207 + x208) - x1260;
+        let x1355 = x204 - (x199 - (x193 - x218))
+            - (x200 + Self::mul_add(x153, x157, -x225)) - x1261;
+        let x1356 = x203 + (x197 + (x191 - x227))
+            + (x198 + Self::mul_add(x152, x157, x231)) - x1262;
+        let x1357 = x223 + x230 + x232 + (x232 + (x216 + x226)) - x1263;
+        let x1358 = x210 - (x209 - x211) + x1264;
+        let x1359 = x207 - (x206 - x208) + x1265;
+        let x1360 = x212 - (x213 - x214) + x1266;
+        let x1361 = x209 - (x210 - x211) - x1267;
+        let x1362 = x213 - (x212 + x214) + x1268;
+        let x1363 = x206 - (x207 - x208) - x1269;
+        let x1364 = x210 - (x209 + x211) + x1270;
+        let x1365 = x207 - (x206 + x208) + x1271;
+        let x1366 = Self::mul_add(-x150, x169, Self::mul_add(x149, x168, x148 * x167))
+            - Self::mul_add(-x128, x172, x129 * x171)
+            - (Self::mul_add(x156, x205, x157 * x204)
+                - Self::mul_add(x159, x214, x160 * x211)) - x1272;
+        let x1367 = Self::mul_add(x147, x169, Self::mul_add(x151, x168, x146 * x167))
+            + Self::mul_add(-x127, x172, x129 * x170)
+            + (Self::mul_add(x155, x205, x157 * x203)
+                + Self::mul_add(-x158, x214, x160 * x208)) - x1273;
+        let x1368 = Self::mul_add(-x154, x169, Self::mul_add(-x153, x168, x152 * x167))
+            + Self::mul_add(-x127, x171, x128 * x170)
+            + (Self::mul_add(-x155, x204, x156 * x203)
+                + Self::mul_add(x158, x211, x159 * x208)) + x1274;
+        let x1369 = Self::mul_add(-x128, x169, x129 * x168)
+            + Self::mul_add(x156, x214, x157 * x211) - x1275;
+        let x1370 = Self::mul_add(-x127, x169, x129 * x167)
+            - Self::mul_add(-x155, x214, x157 * x208) - x1276;
+        let x1371 = Self::mul_add(-x127, x168, x128 * x167)
+            - Self::mul_add(x155, x211, x156 * x208) + x1277;
+        let x1372 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1338,
+            Self::mul_add(s_q7, x1337, c_q7 * x1336),
+        ) - Self::mul_add(-x126, x1334, x125 * x1335);
+        let x1373 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x1341,
+            Self::mul_add(s_q7, x1340, c_q7 * x1339),
+        ) - Self::mul_add(x126, x1333, x124 * x1335);
+        let x1374 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1344,
+            Self::mul_add(-s_q7, x1343, c_q7 * x1342),
+        ) - Self::mul_add(x125, x1333, x124 * x1334);
+        let x1375 = Self::mul_add(0.00000000020510342851533115, x1334, s_q7 * x1335);
+        let x1376 = Self::mul_add(0.00000000020510342851533115, x1333, c_q7 * x1335);
+        let x1377 = Self::mul_add(-s_q7, x1333, c_q7 * x1334);
+        let x1378 = c_q7 * x1345;
+        let x1379 = Self::mul_add(
+            -x125,
+            x1362,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x1355,
+                Self::mul_add(-s_q7, x1350, x1378),
+            ),
+        );
+        let x1380 = Self::mul_add(-x126, x1364, x1379);
+        let x1381 = s_q7 * x1351;
+        let x1382 = Self::mul_add(
+            x124,
+            x1360,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x1356,
+                Self::mul_add(c_q7, x1346, -x1381),
+            ),
+        );
+        let x1383 = Self::mul_add(-x126, x1365, x1382);
+        let x1384 = 0.00000000020510342851533115 * x1357;
+        let x1385 = Self::mul_add(
+            -x125,
+            x1363,
+            Self::mul_add(x124, x1361, Self::mul_add(-s_q7, x1352, c_q7 * x1347) + x1384),
+        );
+        let x1386 = Self::mul_add(-0.00000000020510342851533115, x1358, s_q7 * x1353);
+        let x1387 = Self::mul_add(-0.00000000020510342851533115, x1359, c_q7 * x1348);
+        let x1388 = Self::mul_add(s_q7, x1354, c_q7 * x1349);
+        let x1389 = Self::mul_add(
+            x177,
+            x1348,
+            Self::mul_add(x175, x1347, Self::mul_add(-x174, x1346, x173 * x1345)),
+        );
+        let x1390 = Self::mul_add(
+            -x176,
+            x1353,
+            Self::mul_add(x175, x1352, Self::mul_add(-x174, x1351, x173 * x1350)),
+        );
+        let x1391 = Self::mul_add(
+            -x176,
+            x1358,
+            Self::mul_add(x175, x1357, Self::mul_add(x174, x1356, x173 * x1355)),
+        );
+        let x1392 = Self::mul_add(-s_q7, x1368, 0.00000000020510342851533115 * x1367)
+            + Self::mul_add(x125, x1371, x126 * x1370)
+            - (Self::mul_add(-x181, x1338, Self::mul_add(-x180, x1337, x179 * x1336))
+                - Self::mul_add(x184, x1334, x183 * x1335))
+            + Self::mul_add(-x178, x1349, x1389);
+        let x1393 = -(Self::mul_add(-c_q7, x1368, 0.00000000020510342851533115 * x1366)
+            - Self::mul_add(x124, x1371, x126 * x1369)
+            + (Self::mul_add(x181, x1341, Self::mul_add(-x180, x1340, x179 * x1339))
+                + Self::mul_add(x184, x1333, x182 * x1335))
+            + Self::mul_add(x178, x1354, x1390));
+        let x1394 = Self::mul_add(-c_q7, x1367, s_q7 * x1366)
+            + Self::mul_add(-x124, x1370, x125 * x1369)
+            - (Self::mul_add(-x181, x1344, Self::mul_add(x180, x1343, x179 * x1342))
+                + Self::mul_add(-x183, x1333, x182 * x1334))
+            + Self::mul_add(-x177, x1359, x1391);
+        let x1395 = -x1394;
+        let x1396 = -(Self::mul_add(-s_q7, x1371, 0.00000000020510342851533115 * x1370)
+            - Self::mul_add(x181, x1334, x180 * x1335)
+            - Self::mul_add(-x175, x1361, x174 * x1360));
+        let x1397 = Self::mul_add(c_q7, x1371, 0.00000000020510342851533115 * x1369)
+            - Self::mul_add(-x181, x1333, x179 * x1335)
+            + Self::mul_add(x175, x1363, x173 * x1362);
+        let x1398 = -x1397;
+        let x1399 = -(Self::mul_add(c_q7, x1370, s_q7 * x1369)
+            + Self::mul_add(x180, x1333, x179 * x1334)
+            + Self::mul_add(-x174, x1365, x173 * x1364));
+        let x1400 = Self::mul_add(
+            x125,
+            x1348,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x1347,
+                Self::mul_add(s_q7, x1346, x1378),
+            ),
+        );
+        let x1401 = Self::mul_add(
+            x124,
+            x1353,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x1352,
+                Self::mul_add(c_q7, x1350, x1381),
+            ),
+        );
+        let x1402 = Self::mul_add(
+            x125,
+            x1359,
+            Self::mul_add(
+                -x124,
+                x1358,
+                x1384 - Self::mul_add(-s_q7, x1356, c_q7 * x1355),
+            ),
+        );
+        let x1403 = -(Self::mul_add(
+            -x187,
+            x1338,
+            Self::mul_add(-x186, x1337, x185 * x1336),
+        ) - Self::mul_add(x190, x1334, x189 * x1335)
+            + Self::mul_add(x126, x1349, x1400));
+        let x1404 = -(Self::mul_add(
+            x187,
+            x1341,
+            Self::mul_add(-x186, x1340, x185 * x1339),
+        ) + Self::mul_add(x190, x1333, x188 * x1335)
+            - Self::mul_add(-x126, x1354, x1401));
+        let x1405 = Self::mul_add(-x187, x1344, Self::mul_add(x186, x1343, x185 * x1342))
+            + Self::mul_add(-x189, x1333, x188 * x1334) - x1402;
+        let x1406 = Self::mul_add(x187, x1334, x186 * x1335)
+            + Self::mul_add(-0.00000000020510342851533115, x1361, s_q7 * x1360);
+        let x1407 = Self::mul_add(-x187, x1333, x185 * x1335)
+            + Self::mul_add(-0.00000000020510342851533115, x1363, c_q7 * x1362);
+        let x1408 = -(Self::mul_add(x186, x1333, x185 * x1334)
+            - Self::mul_add(s_q7, x1365, c_q7 * x1364));
+        let x1409 = -Self::mul_add(-0.65, x1397, x1394);
+        let x1410 = Self::mul_add(-0.65, x1407, x1405);
+        let x1411 = -(Self::mul_add(
+            -x181,
+            x1374,
+            Self::mul_add(-x180, x1373, x179 * x1372),
+        ) + Self::mul_add(-x184, x1377, Self::mul_add(-x183, x1376, x182 * x1375))
+            - (Self::mul_add(x175, x1385, Self::mul_add(-x174, x1383, x173 * x1380))
+                + Self::mul_add(
+                    -x178,
+                    x1388,
+                    Self::mul_add(x177, x1387, x176 * x1386),
+                )));
+        let x1412 = -(Self::mul_add(
+            -x187,
+            x1374,
+            Self::mul_add(-x186, x1373, x185 * x1372),
+        ) + Self::mul_add(-x190, x1377, Self::mul_add(-x189, x1376, x188 * x1375))
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1385,
+                Self::mul_add(s_q7, x1383, c_q7 * x1380),
+            ) - Self::mul_add(-x126, x1388, Self::mul_add(-x125, x1387, x124 * x1386))));
+        let x1413 = Self::mul_add(x181, x1280, Self::mul_add(-x180, x1279, x179 * x1278))
+            + Self::mul_add(x184, x1283, Self::mul_add(-x183, x1282, x182 * x1281))
+            - (Self::mul_add(x175, x1291, Self::mul_add(x174, x1289, x173 * x1286))
+                - Self::mul_add(x178, x1294, Self::mul_add(x177, x1293, x176 * x1292)));
+        let x1414 = Self::mul_add(x187, x1280, Self::mul_add(-x186, x1279, x185 * x1278))
+            + Self::mul_add(x190, x1283, Self::mul_add(-x189, x1282, x188 * x1281))
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1291,
+                Self::mul_add(-s_q7, x1289, c_q7 * x1286),
+            ) + Self::mul_add(x126, x1294, Self::mul_add(-x125, x1293, x124 * x1292)));
+        let x1415 = Self::mul_add(-x181, x1183, Self::mul_add(x180, x1182, x179 * x1181))
+            + Self::mul_add(-x184, x1186, Self::mul_add(-x183, x1185, x182 * x1184))
+            + (Self::mul_add(x175, x1194, Self::mul_add(x174, x1192, x173 * x1189))
+                - Self::mul_add(-x178, x1197, Self::mul_add(x177, x1196, x176 * x1195)));
+        let x1416 = Self::mul_add(-x187, x1183, Self::mul_add(x186, x1182, x185 * x1181))
+            + Self::mul_add(-x190, x1186, Self::mul_add(-x189, x1185, x188 * x1184))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1194,
+                Self::mul_add(-s_q7, x1192, c_q7 * x1189),
+            ) + Self::mul_add(-x126, x1197, Self::mul_add(-x125, x1196, x124 * x1195)));
+        let x1417 = -(Self::mul_add(
+            -x181,
+            x1086,
+            Self::mul_add(x180, x1085, x179 * x1084),
+        ) + Self::mul_add(-x184, x1089, Self::mul_add(-x183, x1088, x182 * x1087))
+            + (Self::mul_add(x175, x1097, Self::mul_add(x174, x1095, x173 * x1092))
+                - Self::mul_add(
+                    -x178,
+                    x1100,
+                    Self::mul_add(x177, x1099, x176 * x1098),
+                )));
+        let x1418 = -(Self::mul_add(
+            -x187,
+            x1086,
+            Self::mul_add(x186, x1085, x185 * x1084),
+        ) + Self::mul_add(-x190, x1089, Self::mul_add(-x189, x1088, x188 * x1087))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1097,
+                Self::mul_add(-s_q7, x1095, c_q7 * x1092),
+            ) + Self::mul_add(-x126, x1100, Self::mul_add(-x125, x1099, x124 * x1098))));
+        let x1419 = Self::mul_add(-x181, x988, Self::mul_add(x180, x987, x179 * x986))
+            + Self::mul_add(-x184, x991, Self::mul_add(-x183, x990, x182 * x989))
+            + (Self::mul_add(x175, x999, Self::mul_add(x174, x997, x173 * x994))
+                - Self::mul_add(-x178, x1002, Self::mul_add(x177, x1001, x176 * x1000)));
+        let x1420 = Self::mul_add(-x187, x988, Self::mul_add(x186, x987, x185 * x986))
+            + Self::mul_add(-x190, x991, Self::mul_add(-x189, x990, x188 * x989))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x999,
+                Self::mul_add(-s_q7, x997, c_q7 * x994),
+            ) + Self::mul_add(-x126, x1002, Self::mul_add(-x125, x1001, x124 * x1000)));
+        let x1421 = -(Self::mul_add(-x181, x894, Self::mul_add(x180, x893, x179 * x892))
+            + Self::mul_add(-x184, x897, Self::mul_add(-x183, x896, x182 * x895))
+            + (Self::mul_add(x175, x905, Self::mul_add(x174, x903, x173 * x900))
+                - Self::mul_add(-x178, x908, Self::mul_add(x177, x907, x176 * x906))));
+        let x1422 = -(Self::mul_add(-x187, x894, Self::mul_add(x186, x893, x185 * x892))
+            + Self::mul_add(-x190, x897, Self::mul_add(-x189, x896, x188 * x895))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x905,
+                Self::mul_add(-s_q7, x903, c_q7 * x900),
+            ) + Self::mul_add(-x126, x908, Self::mul_add(-x125, x907, x124 * x906))));
+        let x1423 = x45 + x1333;
+        let x1424 = x46 + x1334;
+        let x1425 = x51 + x1336;
+        let x1426 = x57 + x1337;
+        let x1427 = x54 + x1338;
+        let x1428 = x55 - x1339;
+        let x1429 = x58 + x1340;
+        let x1430 = x56 - x1341;
+        let x1431 = x54 + x1342;
+        let x1432 = x56 - x1343;
+        let x1433 = x59 + x1344;
+        let x1434 = x103 - x104 + x106 + (x106 - (x104 + x108)) - x1345;
+        let x1435 = x107 + (x95 + x109) + x1346;
+        let x1436 = x94 - x110 - Self::mul_add(-v[3], x57, x105) - x1347;
+        let x1437 = x98 - (x99 + x100) + x1348;
+        let x1438 = x95 - x107 - x109 + x1350;
+        let x1439 = x108 + x112 + x114 + (x114 - (x103 - x112)) + x1351;
+        let x1440 = x93 - x115 + Self::mul_add(v[4], x55, x113) + x1352;
+        let x1441 = x99 - (x98 - x100) + x1353;
+        let x1442 = x94 + (x85 + x105) + x110 - x1355;
+        let x1443 = x93 + (x83 - x113) + x115 + x1356;
+        let x1444 = x117 + x117 + x1357;
+        let x1445 = x98 - (x99 - x100) + x1360;
+        let x1446 = x111 - x1361;
+        let x1447 = x99 - (x98 + x100) + x1362;
+        let x1448 = x116 - x1363;
+        let x1449 = x111 + x1364;
+        let x1450 = x116 + x1365;
+        let x1451 = Self::mul_add(x46, x62, Self::mul_add(-v[4], x100, x60 * x97))
+            - x1369;
+        let x1452 = Self::mul_add(-0.65, x1335, x1427);
+        let x1453 = Self::mul_add(-0.65, x1423, x1433);
+        let x1454 = Self::mul_add(0.65, x1447, x1442);
+        let x1455 = Self::mul_add(0.65, x1448, x1444);
+        let x1456 = Self::mul_add(x76, x1423, x75 * x1424);
+        let x1457 = Self::mul_add(
+            0.65,
+            x1451,
+            Self::mul_add(x71, x1433, Self::mul_add(-x74, x1432, x73 * x1431)) + x1456,
+        );
+        let x1458 = Self::mul_add(
+            x63,
+            x1349,
+            Self::mul_add(v[0], x1437, Self::mul_add(v[3], x1435, v[4] * x1434)),
+        );
+        let x1459 = Self::mul_add(
+            x63,
+            x1354,
+            Self::mul_add(-x70, x1441, Self::mul_add(-v[3], x1439, v[4] * x1438)),
+        );
+        let x1460 = v[3] * x1443;
+        let x1461 = x70 * x1358;
+        let x1462 = v[0] * x1359;
+        let x1463 = Self::mul_add(
+            -0.65,
+            Self::mul_add(-x45, x66, x46 * x65) + Self::mul_add(v[3], x97, v[4] * x96)
+                + x1371,
+            x102
+                - (Self::mul_add(v[3], x95, x60 * x93)
+                    - Self::mul_add(v[0], x100, v[2] * x96)) - x1367,
+        )
+            + (Self::mul_add(x71, x1427, Self::mul_add(-x74, x1426, x73 * x1425))
+                + Self::mul_add(-x77, x1424, x76 * x1335)) + x1458;
+        let x1464 = x101
+            + (Self::mul_add(-v[4], x95, x60 * x94)
+                - Self::mul_add(-x61, x100, v[2] * x97)) + x1366
+            - (Self::mul_add(-x71, x1430, Self::mul_add(x74, x1429, x73 * x1428))
+                - Self::mul_add(x77, x1423, x75 * x1335)) + x1459;
+        let x1465 = -(x1457 + (Self::mul_add(v[4], x1442, -x1460) + x1461 - x1462));
+        let x1466 = Self::mul_add(
+            v[3],
+            x1445,
+            Self::mul_add(x45, x62, -Self::mul_add(v[3], x100, x60 * x96)) - x1370
+                + Self::mul_add(-x71, x1424, x74 * x1335),
+        );
+        let x1467 = -x1466;
+        let x1468 = -Self::mul_add(
+            -v[4],
+            x1447,
+            x1451 + Self::mul_add(x71, x1423, x73 * x1335),
+        );
+        let x1469 = Self::mul_add(x74, x1423, x73 * x1424)
+            + Self::mul_add(-v[3], x1450, v[4] * x1449);
+        let x1470 = Self::mul_add(x81, x1423, x80 * x1424);
+        let x1471 = Self::mul_add(x79, x1423, x78 * x1424);
+        let x1472 = 0.65 * x1359;
+        let x1473 = Self::mul_add(-x79, x1426, x78 * x1425)
+            + Self::mul_add(-x82, x1424, x81 * x1335)
+            + Self::mul_add(0.65, x1437, x1436);
+        let x1474 = x1440
+            - (Self::mul_add(x79, x1429, x78 * x1428)
+                - Self::mul_add(x82, x1423, x80 * x1335));
+        let x1475 = -(Self::mul_add(-x79, x1432, x78 * x1431) + x1470 - (x1444 + x1472));
+        let x1476 = -Self::mul_add(x79, x1335, x1446);
+        let x1477 = -Self::mul_add(x78, x1335, x1448);
+        let x1478 = -(x1456
+            + Self::mul_add(x71, x1453, Self::mul_add(-x74, x1430, x73 * x1452))
+            - (Self::mul_add(-v[4], x1454, x1460) - (x1461 - x1462)));
+        let x1479 = -(x1470 + Self::mul_add(-x79, x1430, x78 * x1452) - (x1455 + x1472));
+        let x1480 = Self::mul_add(x71, x1374, Self::mul_add(-x74, x1373, x73 * x1372))
+            + Self::mul_add(-x77, x1377, Self::mul_add(x76, x1376, x75 * x1375))
+            - (Self::mul_add(-v[3], x1383, v[4] * x1380)
+                + Self::mul_add(-x63, x1388, Self::mul_add(-v[0], x1387, x70 * x1386)));
+        let x1481 = Self::mul_add(-x79, x1373, x78 * x1372)
+            + Self::mul_add(-x82, x1377, Self::mul_add(x81, x1376, x80 * x1375))
+            - Self::mul_add(-0.65, x1387, x1385);
+        let x1482 = -(Self::mul_add(-x71, x1280, Self::mul_add(-x74, x1279, x73 * x1278))
+            + Self::mul_add(x77, x1283, Self::mul_add(x76, x1282, x75 * x1281))
+            - (Self::mul_add(v[3], x1289, v[4] * x1286)
+                - Self::mul_add(x63, x1294, Self::mul_add(-v[0], x1293, x70 * x1292))));
+        let x1483 = -(Self::mul_add(-x79, x1279, x78 * x1278)
+            + Self::mul_add(x82, x1283, Self::mul_add(x81, x1282, x80 * x1281))
+            - Self::mul_add(0.65, x1293, x1291));
+        let x1484 = -(Self::mul_add(x71, x1183, Self::mul_add(x74, x1182, x73 * x1181))
+            + Self::mul_add(-x77, x1186, Self::mul_add(x76, x1185, x75 * x1184))
+            + (Self::mul_add(v[3], x1192, v[4] * x1189)
+                - Self::mul_add(-x63, x1197, Self::mul_add(-v[0], x1196, x70 * x1195))));
+        let x1485 = -(Self::mul_add(x79, x1182, x78 * x1181)
+            + Self::mul_add(-x82, x1186, Self::mul_add(x81, x1185, x80 * x1184))
+            + Self::mul_add(0.65, x1196, x1194));
+        let x1486 = Self::mul_add(x71, x1086, Self::mul_add(x74, x1085, x73 * x1084))
+            + Self::mul_add(-x77, x1089, Self::mul_add(x76, x1088, x75 * x1087))
+            + (Self::mul_add(v[3], x1095, v[4] * x1092)
+                - Self::mul_add(-x63, x1100, Self::mul_add(-v[0], x1099, x70 * x1098)));
+        let x1487 = Self::mul_add(x79, x1085, x78 * x1084)
+            + Self::mul_add(-x82, x1089, Self::mul_add(x81, x1088, x80 * x1087))
+            + Self::mul_add(0.65, x1099, x1097);
+        let x1488 = -(Self::mul_add(x71, x988, Self::mul_add(x74, x987, x73 * x986))
+            + Self::mul_add(-x77, x991, Self::mul_add(x76, x990, x75 * x989))
+            + (Self::mul_add(v[3], x997, v[4] * x994)
+                - Self::mul_add(-x63, x1002, Self::mul_add(-v[0], x1001, x70 * x1000))));
+        let x1489 = -(Self::mul_add(x79, x987, x78 * x986)
+            + Self::mul_add(-x82, x991, Self::mul_add(x81, x990, x80 * x989))
+            + Self::mul_add(0.65, x1001, x999));
+        let x1490 = Self::mul_add(x71, x894, Self::mul_add(x74, x893, x73 * x892))
+            + Self::mul_add(-x77, x897, Self::mul_add(x76, x896, x75 * x895))
+            + (Self::mul_add(v[3], x903, v[4] * x900)
+                - Self::mul_add(-x63, x908, Self::mul_add(-v[0], x907, x70 * x906)));
+        let x1491 = Self::mul_add(x79, x893, x78 * x892)
+            + Self::mul_add(-x82, x897, Self::mul_add(x81, x896, x80 * x895))
+            + Self::mul_add(0.65, x907, x905);
+        let x1492 = 110.5455 + x1423;
+        let x1493 = 180.9502499901501 + x1335;
+        let x1494 = 1394.5960312283303 + x1425;
+        let x1495 = -117.61766249359756 - x1427;
+        let x1496 = 1466.4506062283303 + x1429;
+        let x1497 = -117.61766249359758 - x1431;
+        let x1498 = 1271.854575 + x1433;
+        let x1499 = v[5] * x1493;
+        let x1500 = v[4] * x1424;
+        let x1501 = x1499 + x1500;
+        let x1502 = -x1501;
+        let x1503 = v[4] * x1492;
+        let x1504 = v[5] * x1492;
+        let x1505 = -(x22 - (x18 - x25) + x1441 - x1503);
+        let x1506 = -(x21 - (x24 - x38) + x1358 - x1504);
+        let x1507 = -Self::mul_add(-v[5], x1423, x1358);
+        let x1508 = -(x1386 + Self::mul_add(v[4], x1377, v[5] * x1376));
+        let x1509 = -(x1292 - Self::mul_add(-v[4], x1283, v[5] * x1282));
+        let x1510 = x1195 + Self::mul_add(v[4], x1186, v[5] * x1185);
+        let x1511 = -(x1098 + Self::mul_add(v[4], x1089, v[5] * x1088));
+        let x1512 = x1000 + Self::mul_add(v[4], x991, v[5] * x990);
+        let x1513 = -(x906 + Self::mul_add(v[4], x897, v[5] * x896));
+        let x1514 = v[3] * x1424;
+        let x1515 = v[3] * x1492;
+        let x1516 = x1499 + x1515;
+        let x1517 = -x1516;
+        let x1518 = v[5] * x1424;
+        let x1519 = -(x1437 - x1514);
+        let x1520 = -(x1359 - x1518);
+        let x1521 = -(x1387 + Self::mul_add(-v[3], x1377, v[5] * x1375));
+        let x1522 = -(x1293 - Self::mul_add(v[3], x1283, v[5] * x1281));
+        let x1523 = x1196 + Self::mul_add(-v[3], x1186, v[5] * x1184);
+        let x1524 = -(x1099 + Self::mul_add(-v[3], x1089, v[5] * x1087));
+        let x1525 = x1001 + Self::mul_add(-v[3], x991, v[5] * x989);
+        let x1526 = -(x907 + Self::mul_add(-v[3], x897, v[5] * x895));
+        let x1527 = v[3] * x1493;
+        let x1528 = v[4] * x1493;
+        let x1529 = x1500 + x1515;
+        let x1530 = -x1529;
+        let x1531 = -(x20 + (x24 - x33) + x1349 - x1527);
+        let x1532 = -(x19 + (x16 - x23) + x1354 - x1528);
+        let x1533 = -Self::mul_add(v[3], x1423, x1500);
+        let x1534 = -(x1388 - Self::mul_add(v[3], x1376, v[4] * x1375));
+        let x1535 = x1294 - Self::mul_add(v[3], x1282, v[4] * x1281);
+        let x1536 = x1197 - Self::mul_add(v[3], x1185, v[4] * x1184);
+        let x1537 = -(x1100 - Self::mul_add(v[3], x1088, v[4] * x1087));
+        let x1538 = x1002 - Self::mul_add(v[3], x990, v[4] * x989);
+        let x1539 = -(x908 - Self::mul_add(v[3], x896, v[4] * x895));
+        let x1540 = v[2] * x1493;
+        let x1541 = v[1] * x1424;
+        let x1542 = -(x25 + x25 - x1447 - (x18 - x1503));
+        let x1543 = -(x20 - x24 - x33 - x1449 + (x17 + x1504));
+        let x1544 = -(x26 - x28 - (x28 - x30) - x1434
+            + (x1540 + x1541 + Self::mul_add(v[4], x1497, v[5] * x1428)));
+        let x1545 = x15 + (x8 + x27) - x31 + x1438
+            + Self::mul_add(v[1], x1492, Self::mul_add(v[4], x1432, v[5] * x1496));
+        let x1546 = v[5] * x1430;
+        let x1547 = x14 - x29 - x32 - x1442
+            + Self::mul_add(v[2], x1492, -Self::mul_add(v[4], x1498, x1546));
+        let x1548 = -(x1454
+            + Self::mul_add(-v[2], x1423, Self::mul_add(v[4], x1453, x1546)));
+        let x1549 = -(x1380
+            - (Self::mul_add(v[4], x1374, v[5] * x1373)
+                - Self::mul_add(v[1], x1377, v[2] * x1376)));
+        let x1550 = x1286
+            - (Self::mul_add(-v[4], x1280, v[5] * x1279)
+                - Self::mul_add(-v[1], x1283, v[2] * x1282));
+        let x1551 = -(x1189
+            - (Self::mul_add(-v[4], x1183, v[5] * x1182)
+                + Self::mul_add(v[1], x1186, v[2] * x1185)));
+        let x1552 = x1092
+            - (Self::mul_add(-v[4], x1086, v[5] * x1085)
+                + Self::mul_add(v[1], x1089, v[2] * x1088));
+        let x1553 = -(x994
+            - (Self::mul_add(-v[4], x988, v[5] * x987)
+                + Self::mul_add(v[1], x991, v[2] * x990)));
+        let x1554 = x900
+            - (Self::mul_add(-v[4], x894, v[5] * x893)
+                + Self::mul_add(v[1], x897, v[2] * x896));
+        let x1555 = v[3] * x1430;
+        let x1556 = v[0] * x1492;
+        let x1557 = v[2] * x1424;
+        let x1558 = x18 - (x22 - x25) + x1445 - (x18 + x1514);
+        let x1559 = -(x16 + (x19 + x23) - x1450 - (x16 - x1518));
+        let x1560 = -(x15 + x31 - Self::mul_add(v[3], 117.61766249359756, x27) + x1435
+            - Self::mul_add(v[0], x1424, -Self::mul_add(-v[3], x1497, v[5] * x1494)));
+        let x1561 = x35 + x35 + x1439
+            - (x1540 + x1556 + Self::mul_add(v[3], x1432, v[5] * x1426));
+        let x1562 = -(x13 + x36 + Self::mul_add(v[5], 117.61766249359758, x37) + x1443
+            - (x1557 + Self::mul_add(-v[5], x1495, v[3] * x1498)));
+        let x1563 = -(x1443 - (x1557 + Self::mul_add(v[3], x1453, v[5] * x1452)));
+        let x1564 = -(x1383
+            + (Self::mul_add(v[3], x1374, v[5] * x1372)
+                + Self::mul_add(-v[0], x1377, v[2] * x1375)));
+        let x1565 = -(x1289
+            - (Self::mul_add(-v[3], x1280, v[5] * x1278)
+                + Self::mul_add(v[0], x1283, v[2] * x1281)));
+        let x1566 = x1192
+            + (Self::mul_add(v[3], x1183, v[5] * x1181)
+                + Self::mul_add(-v[0], x1186, v[2] * x1184));
+        let x1567 = -(x1095
+            + (Self::mul_add(v[3], x1086, v[5] * x1084)
+                + Self::mul_add(-v[0], x1089, v[2] * x1087)));
+        let x1568 = x997
+            + (Self::mul_add(v[3], x988, v[5] * x986)
+                + Self::mul_add(-v[0], x991, v[2] * x989));
+        let x1569 = -(x903
+            + (Self::mul_add(v[3], x894, v[5] * x892)
+                + Self::mul_add(-v[0], x897, v[2] * x895)));
+        let x1570 = -(x21 + x24 + x38 + x1446 - (x17 - x1527));
+        let x1571 = x23 + x23 - x1448 - (x16 + x1528);
+        let x1572 = -(x29 + (x14 + x32) - x1436
+            - Self::mul_add(v[0], x1493, Self::mul_add(v[3], x1428, v[4] * x1494)));
+        let x1573 = -(x36 - (x13 - (x7 + x37)) - x1440
+            - Self::mul_add(v[1], x1493, -Self::mul_add(-v[4], x1426, v[3] * x1496)));
+        let x1574 = x30 + x34 + (x26 + x34) + x1444
+            - (x1541 + x1556 - Self::mul_add(v[4], x1495, x1555));
+        let x1575 = x1455
+            + (Self::mul_add(-v[4], x1452, x1555) - Self::mul_add(v[0], x1423, x1541));
+        let x1576 = -(x1385
+            - (Self::mul_add(-v[3], x1373, v[4] * x1372)
+                + Self::mul_add(v[0], x1376, v[1] * x1375)));
+        let x1577 = x1291
+            - (Self::mul_add(-v[3], x1279, v[4] * x1278)
+                + Self::mul_add(v[0], x1282, v[1] * x1281));
+        let x1578 = -(x1194
+            + (Self::mul_add(v[3], x1182, v[4] * x1181)
+                + Self::mul_add(v[0], x1185, v[1] * x1184)));
+        let x1579 = x1097
+            + (Self::mul_add(v[3], x1085, v[4] * x1084)
+                + Self::mul_add(v[0], x1088, v[1] * x1087));
+        let x1580 = -(x999
+            + (Self::mul_add(v[3], x987, v[4] * x986)
+                + Self::mul_add(v[0], x990, v[1] * x989)));
+        let x1581 = x905
+            + (Self::mul_add(v[3], x893, v[4] * x892)
+                + Self::mul_add(v[0], x896, v[1] * x895));
+        (
+            [
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1467,
+                    x1396,
+                    x1303,
+                    x1207,
+                    x1108,
+                    x1012,
+                    x916,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1468,
+                    x1398,
+                    x1305,
+                    x1209,
+                    x1109,
+                    x1014,
+                    x917,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1469,
+                    x1399,
+                    x1306,
+                    x1210,
+                    x1111,
+                    x1015,
+                    x919,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1463,
+                    x1392,
+                    x1298,
+                    x1202,
+                    x1104,
+                    x1007,
+                    x912,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1464,
+                    x1393,
+                    x1300,
+                    x1204,
+                    x1105,
+                    x1009,
+                    x913,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1465,
+                    x1395,
+                    x1301,
+                    x1205,
+                    x1107,
+                    x1010,
+                    x915,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1478,
+                    x1409,
+                    x1319,
+                    x1224,
+                    x1123,
+                    x1029,
+                    x931,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1480,
+                    x1411,
+                    x1321,
+                    x1226,
+                    x1125,
+                    x1031,
+                    x933,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1482,
+                    x1413,
+                    x1323,
+                    x1228,
+                    x1128,
+                    x1034,
+                    x936,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1484,
+                    x1415,
+                    x1325,
+                    x1230,
+                    x1131,
+                    x1037,
+                    x939,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1486,
+                    x1417,
+                    x1327,
+                    x1233,
+                    x1133,
+                    x1039,
+                    x941,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1488,
+                    x1419,
+                    x1329,
+                    x1235,
+                    x1136,
+                    x1041,
+                    x943,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x1490,
+                    x1421,
+                    x1331,
+                    x1237,
+                    x1139,
+                    x1043,
+                    x945,
+                ],
+            ],
+            [
+                [
+                    0.0,
+                    x42,
+                    x40,
+                    x1501,
+                    x1558,
+                    x1570,
+                    x1476,
+                    x1406,
+                    x1314,
+                    x1220,
+                    x1119,
+                    x1025,
+                    x927,
+                ],
+                [
+                    x39,
+                    0.0,
+                    x44,
+                    x1542,
+                    x1516,
+                    x1571,
+                    x1477,
+                    x1407,
+                    x1316,
+                    x1222,
+                    x1120,
+                    x1027,
+                    x928,
+                ],
+                [
+                    x41,
+                    x43,
+                    0.0,
+                    x1543,
+                    x1559,
+                    x1529,
+                    x1471,
+                    x1408,
+                    x1318,
+                    x1223,
+                    x1122,
+                    x1028,
+                    x930,
+                ],
+                [
+                    x1502,
+                    x1519,
+                    x1531,
+                    x1544,
+                    x1560,
+                    x1572,
+                    x1473,
+                    x1403,
+                    x1310,
+                    x1214,
+                    x1116,
+                    x1019,
+                    x924,
+                ],
+                [
+                    x1505,
+                    x1517,
+                    x1532,
+                    x1545,
+                    x1561,
+                    x1573,
+                    x1474,
+                    x1404,
+                    x1311,
+                    x1216,
+                    x1117,
+                    x1021,
+                    x925,
+                ],
+                [
+                    x1506,
+                    x1520,
+                    x1530,
+                    x1547,
+                    x1562,
+                    x1574,
+                    x1475,
+                    x1405,
+                    x1312,
+                    x1218,
+                    x1118,
+                    x1023,
+                    x926,
+                ],
+                [
+                    x1507,
+                    x1520,
+                    x1533,
+                    x1548,
+                    x1563,
+                    x1575,
+                    x1479,
+                    x1410,
+                    x1320,
+                    x1225,
+                    x1124,
+                    x1030,
+                    x932,
+                ],
+                [
+                    x1508,
+                    x1521,
+                    x1534,
+                    x1549,
+                    x1564,
+                    x1576,
+                    x1481,
+                    x1412,
+                    x1322,
+                    x1227,
+                    x1126,
+                    x1032,
+                    x934,
+                ],
+                [
+                    x1509,
+                    x1522,
+                    x1535,
+                    x1550,
+                    x1565,
+                    x1577,
+                    x1483,
+                    x1414,
+                    x1324,
+                    x1229,
+                    x1130,
+                    x1036,
+                    x938,
+                ],
+                [
+                    x1510,
+                    x1523,
+                    x1536,
+                    x1551,
+                    x1566,
+                    x1578,
+                    x1485,
+                    x1416,
+                    x1326,
+                    x1232,
+                    x1132,
+                    x1038,
+                    x940,
+                ],
+                [
+                    x1511,
+                    x1524,
+                    x1537,
+                    x1552,
+                    x1567,
+                    x1579,
+                    x1487,
+                    x1418,
+                    x1328,
+                    x1234,
+                    x1135,
+                    x1040,
+                    x942,
+                ],
+                [
+                    x1512,
+                    x1525,
+                    x1538,
+                    x1553,
+                    x1568,
+                    x1580,
+                    x1489,
+                    x1420,
+                    x1330,
+                    x1236,
+                    x1138,
+                    x1042,
+                    x944,
+                ],
+                [
+                    x1513,
+                    x1526,
+                    x1539,
+                    x1554,
+                    x1569,
+                    x1581,
+                    x1491,
+                    x1422,
+                    x1332,
+                    x1238,
+                    x1141,
+                    x1044,
+                    x946,
+                ],
+            ],
+        )
+    }
+    /// `(∂v̇/∂q, ∂v̇/∂v, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `v̇ = FD(q, v, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`; the base columns of `∂/∂q` are in the tangent space: `q` moved by Pinocchio's `integrate(q, δv)`.
+    ///
+    /// : 10508 mul, 9929 add, 22 div, 0 sqrt, 7 sincos (emitted), of which 7654 fused where the target has FMA.
+    #[must_use]
+    pub fn forward_dynamics_derivatives(
+        q: &[f64; 14],
+        v: &[f64; 13],
+        tau: &[f64; 7],
+    ) -> ([[f64; 13]; 13], [[f64; 13]; 13], [[f64; 13]; 13]) {
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = v[5] * 117.61766249359756;
+        let x8 = v[3] * 117.61766249359758;
+        let x9 = 180.9502499901501 * v[1];
+        let x10 = 180.9502499901501 * v[0];
+        let x11 = 110.5455 * v[2];
+        let x12 = 110.5455 * v[1];
+        let x13 = Self::mul_add(1394.5960312283303, v[3], -x7) - x9;
+        let x14 = Self::mul_add(1466.4506062283303, v[4], x10 - x11);
+        let x15 = Self::mul_add(-1271.854575, v[5], x8) - x12;
+        let x16 = 1170.07 * v[0];
+        let x17 = 1170.07 * v[1];
+        let x18 = 1170.07 * v[2];
+        let x19 = 180.9502499901501 * v[4];
+        let x20 = 180.9502499901501 * v[3];
+        let x21 = 110.5455 * v[5];
+        let x22 = 110.5455 * v[4];
+        let x23 = x16 + x19;
+        let x24 = x17 - (x20 - x21);
+        let x25 = x18 - x22;
+        let x26 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x27 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x28 = 0.65 * v[5];
+        let x29 = Self::mul_add(0.75, v[4], v[0]);
+        let x30 = v[1] - Self::mul_add(0.75, v[3], -x28);
+        let x31 = Self::mul_add(-0.65, v[4], v[2]);
+        let x32 = Self::mul_add(s_q7, x30, c_q7 * x29);
+        let x33 = Self::mul_add(-c_q7, x30, s_q7 * x29);
+        let x34 = v[6] * x27;
+        let x35 = v[6] * x26;
+        let x36 = v[6] * x33;
+        let x37 = v[6] * x32;
+        let x38 = v[5] + v[6];
+        let x39 = Self::mul_add(x38, -16.80768997608804, x27 * 0.07309);
+        let x40 = Self::mul_add(
+            48.0240000085309,
+            x31,
+            Self::mul_add(
+                -0.1132,
+                x38,
+                Self::mul_add(130.43769025763282, x27, x26 * 0.07309),
+            ),
+        );
+        let x41 = Self::mul_add(
+            48.0240000085309,
+            x33,
+            Self::mul_add(
+                -132.47349025763282,
+                x38,
+                Self::mul_add(0.1132, x27, x26 * 16.80768997608804),
+            ),
+        );
+        let x42 = 48.0240000085309 * x38;
+        let x43 = 48.0240000085309 * x27;
+        let x44 = 0.00000000020510342851533115 * c_q8;
+        let x45 = 0.00000000020510342851533115 * s_q8;
+        let x46 = Self::mul_add(x38, c_q8, Self::mul_add(x27, s_q8, x26 * x44));
+        let x47 = Self::mul_add(x38, s_q8, Self::mul_add(-x27, c_q8, x26 * x45));
+        let x48 = Self::mul_add(-0.35, x27, x32);
+        let x49 = Self::mul_add(0.35, x26, x33);
+        let x50 = Self::mul_add(x31, c_q8, Self::mul_add(s_q8, x49, x44 * x48));
+        let x51 = Self::mul_add(x31, s_q8, Self::mul_add(-c_q8, x49, x45 * x48));
+        let x52 = Self::mul_add(-0.00000000020510342851533115, x31, x48);
+        let x53 = v[7] * x47;
+        let x54 = v[7] * x46;
+        let x55 = v[7] * x51;
+        let x56 = v[7] * x50;
+        let x57 = v[7] + Self::mul_add(-0.00000000020510342851533115, x38, x26);
+        let x58 = Self::mul_add(
+            x52,
+            12.701650001451807,
+            Self::mul_add(x57, 0.002139996587640933, x47 * 0.0000000234896432582596),
+        );
+        let x59 = Self::mul_add(
+            x52,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x57,
+                Self::mul_add(x47, -111.7548902508081, x46 * 0.0000000234896432582596),
+            ),
+        );
+        let x60 = Self::mul_add(
+            113.3918902508081,
+            x57,
+            Self::mul_add(5.080660024070366, x47, x46 * 0.002139996587640933),
+        ) - Self::mul_add(x51, 0.000000008530897668050218, x50 * 12.701650001451807);
+        let x61 = x57 * 12.701650001451807;
+        let x62 = x57 * 0.000000008530897668050218;
+        let x63 = Self::mul_add(
+            x47,
+            0.000000008530897668050218,
+            x46 * 12.701650001451807,
+        );
+        let x64 = 0.00000000020510342851533115 * c_q9;
+        let x65 = 0.00000000020510342851533115 * s_q9;
+        let x66 = x64 - x65;
+        let x67 = x64 + x65;
+        let x68 = Self::mul_add(-x57, c_q9, Self::mul_add(-x47, x66, x46 * s_q9));
+        let x69 = Self::mul_add(x57, s_q9, Self::mul_add(x47, x67, x46 * c_q9));
+        let x70 = x50 - Self::mul_add(-0.275, x57, 0.4 * x47);
+        let x71 = Self::mul_add(0.4, x46, x51);
+        let x72 = Self::mul_add(-0.275, x46, x52);
+        let x73 = Self::mul_add(-c_q9, x72, Self::mul_add(-x66, x71, s_q9 * x70));
+        let x74 = Self::mul_add(s_q9, x72, Self::mul_add(x67, x71, c_q9 * x70));
+        let x75 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x72,
+            Self::mul_add(-0.00000000020510342851533115, x70, x71),
+        );
+        let x76 = v[8] * x69;
+        let x77 = v[8] * x68;
+        let x78 = v[8] * x74;
+        let x79 = v[8] * x73;
+        let x80 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x57,
+                Self::mul_add(-0.00000000020510342851533115, x46, x47),
+            );
+        let x81 = Self::mul_add(x80, -36.18604050126307, x69 * 63.36336825000001);
+        let x82 = Self::mul_add(x75, 81.53205, x80 * 0.00214);
+        let x83 = Self::mul_add(
+            x73,
+            -81.53205,
+            Self::mul_add(
+                69.99836825,
+                x80,
+                Self::mul_add(x69, 36.18604050126307, x68 * 0.00214),
+            ),
+        );
+        let x84 = x80 * 81.53205;
+        let x85 = x68 * 81.53205;
+        let x86 = Self::mul_add(x69, s_q10, x68 * c_q10);
+        let x87 = Self::mul_add(-x69, c_q10, x68 * s_q10);
+        let x88 = Self::mul_add(x80, -0.87, x73);
+        let x89 = Self::mul_add(x68, 0.87, x75);
+        let x90 = Self::mul_add(x74, s_q10, c_q10 * x88);
+        let x91 = Self::mul_add(-x74, c_q10, s_q10 * x88);
+        let x92 = v[9] * x87;
+        let x93 = v[9] * x86;
+        let x94 = v[9] * x91;
+        let x95 = v[9] * x90;
+        let x96 = v[9] + x80;
+        let x97 = Self::mul_add(x96, 24.35164200091464, x87 * 24.4950615);
+        let x98 = Self::mul_add(x89, 45.1584, x96 * 0.6328);
+        let x99 = Self::mul_add(
+            x90,
+            -45.1584,
+            Self::mul_add(
+                28.2393615,
+                x96,
+                Self::mul_add(x87, -24.351642000914637, x86 * 0.6328),
+            ),
+        );
+        let x100 = x96 * 45.1584;
+        let x101 = x86 * 45.1584;
+        let x102 = Self::mul_add(-x87, s_q11, x86 * c_q11);
+        let x103 = Self::mul_add(x87, c_q11, x86 * s_q11);
+        let x104 = x90 + Self::mul_add(x96, -0.63, 0.275 * x87);
+        let x105 = Self::mul_add(-0.275, x86, x91);
+        let x106 = Self::mul_add(x86, 0.63, x89);
+        let x107 = Self::mul_add(-s_q11, x105, c_q11 * x104);
+        let x108 = Self::mul_add(c_q11, x105, s_q11 * x104);
+        let x109 = v[10] * x103;
+        let x110 = v[10] * x102;
+        let x111 = v[10] * x108;
+        let x112 = v[10] * x107;
+        let x113 = v[10] + x96;
+        let x114 = Self::mul_add(-2.5482240016099564, x113, x103 * 9.142025249762803);
+        let x115 = Self::mul_add(7.078399999258757, x106, 0.01675 * x113);
+        let x116 = Self::mul_add(
+            -7.078399999258757,
+            x107,
+            Self::mul_add(
+                -9.223235249762805,
+                x113,
+                Self::mul_add(-2.5482240016099564, x103, 0.01675 * x102),
+            ),
+        );
+        let x117 = 7.078399999258757 * x113;
+        let x118 = 7.078399999258757 * x102;
+        let x119 = 0.00000000020510342851533115 * s_q12;
+        let x120 = 0.00000000020510342851533115 * c_q12;
+        let x121 = Self::mul_add(x113, s_q12, Self::mul_add(x103, x119, x102 * c_q12));
+        let x122 = Self::mul_add(-x113, c_q12, Self::mul_add(-x103, x120, x102 * s_q12));
+        let x123 = Self::mul_add(x103, 0.36, x107);
+        let x124 = Self::mul_add(x102, -0.36, x108);
+        let x125 = Self::mul_add(x106, s_q12, Self::mul_add(x119, x124, c_q12 * x123));
+        let x126 = Self::mul_add(-x106, c_q12, Self::mul_add(-x120, x124, s_q12 * x123));
+        let x127 = Self::mul_add(-0.00000000020510342851533115, x106, x124);
+        let x128 = v[11] * x122;
+        let x129 = v[11] * x121;
+        let x130 = v[11] * x126;
+        let x131 = v[11] * x125;
+        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x113, x103);
+        let x133 = Self::mul_add(
+            -17.135250000000003,
+            x127,
+            Self::mul_add(x132, 0.809539999555672, x122 * 1.9877000000000002),
+        );
+        let x134 = Self::mul_add(
+            -3.6140000000000003,
+            x127,
+            Self::mul_add(
+                x132,
+                -2.741639999592316,
+                Self::mul_add(x122, -5.252920330000002, x121 * 1.9877000000000002),
+            ),
+        );
+        let x135 = Self::mul_add(
+            9.740442170000001,
+            x132,
+            Self::mul_add(x122, -2.7416399995923166, x121 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x126, 17.135250000000003 * x125);
+        let x136 = 17.135250000000003 * x132;
+        let x137 = 3.6140000000000003 * x132;
+        let x138 = Self::mul_add(3.6140000000000003, x122, 17.135250000000003 * x121);
+        let x139 = 0.00000000020510342851533115 * c_q13;
+        let x140 = 0.00000000020510342851533115 * s_q13;
+        let x141 = Self::mul_add(-x132, c_q13, Self::mul_add(x122, s_q13, x121 * x139));
+        let x142 = Self::mul_add(-x132, s_q13, Self::mul_add(-x122, c_q13, x121 * x140));
+        let x143 = x125 - Self::mul_add(-0.55, x132, 0.16 * x122);
+        let x144 = Self::mul_add(0.16, x121, x126);
+        let x145 = Self::mul_add(-0.55, x121, x127);
+        let x146 = Self::mul_add(-c_q13, x145, Self::mul_add(s_q13, x144, x139 * x143));
+        let x147 = Self::mul_add(-s_q13, x145, Self::mul_add(-c_q13, x144, x140 * x143));
+        let x148 = Self::mul_add(0.00000000020510342851533115, x145, x143);
+        let x149 = v[12] * x142;
+        let x150 = v[12] * x141;
+        let x151 = v[12] * x147;
+        let x152 = v[12] - Self::mul_add(0.00000000020510342851533115, x132, x121);
+        let x153 = Self::mul_add(
+            x152,
+            -0.9614610000000001,
+            Self::mul_add(x142, 1.2025609200000003, 0.000781 * x141),
+        );
+        let x154 = Self::mul_add(
+            4.806620000000001,
+            x148,
+            Self::mul_add(x152, 0.0145, 0.000781 * x142),
+        );
+        let x155 = Self::mul_add(
+            4.806620000000001,
+            x146,
+            Self::mul_add(
+                -1.4135609200000003,
+                x152,
+                Self::mul_add(x142, -0.9614610000000001, x141 * 0.0145),
+            ),
+        );
+        let x156 = 4.806620000000001 * x152;
+        let x157 = 4.806620000000001 * x141;
+        let x158 = Self::mul_add(x147, x156, Self::mul_add(-x141, x153, x142 * x154));
+        let x159 = Self::mul_add(x141, x157, x152 * x156);
+        let x160 = tau[6] + x158;
+        let x161 = Self::mul_add(
+            x142,
+            x157,
+            -Self::mul_add(
+                x151,
+                16.344251950881606,
+                Self::mul_add(x150, 3.2693162398830324, x149 * 0.049305260929256585),
+            ),
+        );
+        let x162 = Self::mul_add(4.806620000000001, x149, x142 * x156);
+        let x163 = Self::mul_add(
+            x160,
+            0.010257782169020348,
+            Self::mul_add(x147, x157, Self::mul_add(-x142, x155, x152 * x153))
+                - Self::mul_add(
+                    x151,
+                    0.049305260929256585,
+                    Self::mul_add(
+                        x150,
+                        0.009081457502008472,
+                        x149 * 0.00014873784145079505,
+                    ),
+                ),
+        );
+        let x164 = Self::mul_add(
+            x160,
+            0.6801694828971361,
+            Self::mul_add(-x141, x155, x152 * x154)
+                - Self::mul_add(-x146, x157, x148 * x156)
+                - Self::mul_add(
+                    x151,
+                    3.2693162398830324,
+                    Self::mul_add(x150, 1.8565173511957638, x149 * 0.009081457502008472),
+                ),
+        );
+        let x165 = x158 - x160;
+        let x166 = Self::mul_add(x160, 3.4003628227073506, x161);
+        let x167 = c_q13 * 0.009081457502008472;
+        let x168 = Self::mul_add(s_q13, 0.00014873784145079505, x167);
+        let x169 = s_q13 * 0.009081457502008472;
+        let x170 = Self::mul_add(c_q13, 0.00014873784145079505, -x169);
+        let x171 = Self::mul_add(c_q13, 1.8565173511957638, x169);
+        let x172 = Self::mul_add(s_q13, -1.8565173511957638, x167);
+        let x173 = Self::mul_add(x139, 0.049305260929256585, 4.806620000000001);
+        let x174 = s_q13 * 0.049305260929256585;
+        let x175 = Self::mul_add(
+            c_q13,
+            0.049305260929256585,
+            -0.0000000009858542415703612,
+        );
+        let x176 = x139 * 3.2693162398830324;
+        let x177 = s_q13 * 3.2693162398830324;
+        let x178 = c_q13 * 3.2693162398830324;
+        let x179 = Self::mul_add(-x140, x176, x139 * x173);
+        let x180 = Self::mul_add(-x140, x177, x139 * x174);
+        let x181 = Self::mul_add(-x140, x178, x139 * x175);
+        let x182 = Self::mul_add(c_q13, x176, s_q13 * x173);
+        let x183 = Self::mul_add(-s_q13, x176, c_q13 * x173);
+        let x184 = s_q13 * 16.344251950881606;
+        let x185 = c_q13 * 16.344251950881606;
+        let x186 = x139 * (x139 * 16.344251950881606);
+        let x187 = x139 * x184;
+        let x188 = x139 * x185;
+        let x189 = s_q13 * x184;
+        let x190 = s_q13 * x185;
+        let x191 = c_q13 * x185;
+        let x192 = 0.16 * x187;
+        let x193 = 0.55 * x188;
+        let x194 = x180 + Self::mul_add(0.55, x190, 0.16 * x189);
+        let x195 = x181 + Self::mul_add(0.55, x191, 0.16 * x190);
+        let x196 = Self::mul_add(-0.16, x186, x182);
+        let x197 = Self::mul_add(c_q13, x177, s_q13 * x174) - x192;
+        let x198 = Self::mul_add(-0.16, x188, Self::mul_add(c_q13, x178, s_q13 * x175));
+        let x199 = Self::mul_add(-0.55, x186, x183);
+        let x200 = Self::mul_add(-0.55, x187, Self::mul_add(-s_q13, x177, c_q13 * x174));
+        let x201 = Self::mul_add(-s_q13, x178, c_q13 * x175) - x193;
+        let x202 = Self::mul_add(
+            0.16,
+            x182,
+            -Self::mul_add(-0.16, x196, Self::mul_add(c_q13, x171, s_q13 * x168)),
+        );
+        let x203 = Self::mul_add(
+            0.55,
+            x182,
+            -Self::mul_add(-0.16, x199, Self::mul_add(c_q13, x172, s_q13 * x170)),
+        );
+        let x204 = Self::mul_add(
+            0.55,
+            x183,
+            -Self::mul_add(-0.55, x199, Self::mul_add(-s_q13, x172, c_q13 * x170)),
+        );
+        let x205 = x162 - Self::mul_add(-x140, x159, x139 * x166);
+        let x206 = Self::mul_add(c_q13, x159, s_q13 * x166);
+        let x207 = Self::mul_add(
+            0.00000000020510342851533115,
+            x162,
+            Self::mul_add(-s_q13, x159, c_q13 * x166),
+        );
+        let x208 = Self::mul_add(
+            0.55,
+            x205,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x165,
+                Self::mul_add(-s_q13, x164, c_q13 * x163),
+            ),
+        );
+        let x209 = -0.809539999555672
+            + Self::mul_add(
+                0.55,
+                x179,
+                -(Self::mul_add(-x140, x172, x139 * x170)
+                    + Self::mul_add(0.55, x201, 0.16 * x200)),
+            );
+        let x210 = -2.741639999592316 - x203;
+        let x211 = 9.740442170000001 + x204;
+        let x212 = -17.135250000000003 - x199;
+        let x213 = 3.6140000000000003 + x200;
+        let x214 = Self::mul_add(-x121, x134, x122 * x133)
+            + Self::mul_add(-x125, x137, x126 * x136) + x208;
+        let x215 = 1.0 / x211;
+        let x216 = tau[5] - x214;
+        let x217 = x209 * x215;
+        let x218 = x210 * x215;
+        let x219 = x212 * x215;
+        let x220 = x213 * x215;
+        let x221 = x201 * x215;
+        let x222 = Self::mul_add(
+            x209,
+            x217,
+            Self::mul_add(0.55, x181, 0.16 * x180)
+                + (Self::mul_add(
+                    -x140,
+                    Self::mul_add(
+                        x140,
+                        -1.8565173511957638,
+                        x139 * 0.009081457502008472,
+                    ),
+                    x139
+                        * Self::mul_add(
+                            x140,
+                            -0.009081457502008472,
+                            x139 * 0.00014873784145079505,
+                        ),
+                ) + Self::mul_add(0.55, x195, 0.16 * x194)),
+        );
+        let x223 = Self::mul_add(
+            -x209,
+            x218,
+            -1.9877000000000002
+                - Self::mul_add(
+                    0.16,
+                    x179,
+                    -(Self::mul_add(-x140, x171, x139 * x168)
+                        + Self::mul_add(0.55, x198, 0.16 * x197)),
+                ),
+        );
+        let x224 = Self::mul_add(-x210, x218, -5.252920330000002 + x202);
+        let x225 = Self::mul_add(x209, x219, x179 + (x192 + x193));
+        let x226 = Self::mul_add(-x209, x220, x194);
+        let x227 = Self::mul_add(x209, x221, 17.135250000000003 - x195);
+        let x228 = Self::mul_add(-x210, x219, x196);
+        let x229 = Self::mul_add(x210, x220, x197);
+        let x230 = Self::mul_add(x210, x221, -3.6140000000000003 + x198);
+        let x231 = Self::mul_add(x212, x219, x186);
+        let x232 = Self::mul_add(-x212, x220, x187);
+        let x233 = Self::mul_add(-x212, x221, x188);
+        let x234 = Self::mul_add(x213, x220, x189);
+        let x235 = Self::mul_add(x213, x221, x190);
+        let x236 = Self::mul_add(x201, x221, x191);
+        let x237 = Self::mul_add(
+            -x216,
+            x217,
+            Self::mul_add(-x122, x135, x132 * x134)
+                + Self::mul_add(x126, x138, x127 * x137)
+                + (x165 - Self::mul_add(-x140, x164, x139 * x163)
+                    - Self::mul_add(0.55, x207, 0.16 * x206))
+                + (Self::mul_add(-x129, x223, x128 * x222)
+                    + Self::mul_add(-x131, x226, x130 * x225)),
+        );
+        let x238 = Self::mul_add(
+            -x216,
+            x218,
+            Self::mul_add(-x121, x135, x132 * x133)
+                + Self::mul_add(x125, x138, x127 * x136)
+                + Self::mul_add(0.16, x205, Self::mul_add(c_q13, x164, s_q13 * x163))
+                - (Self::mul_add(x129, x224, x128 * x223)
+                    + Self::mul_add(-x131, x229, x130 * x228)),
+        );
+        let x239 = Self::mul_add(x216, x211 * x215, x214);
+        let x240 = Self::mul_add(
+            -x216,
+            x219,
+            Self::mul_add(x122, x138, x132 * x137) + x205
+                + (Self::mul_add(-x129, x228, x128 * x225)
+                    + Self::mul_add(-x131, x232, x130 * x231)),
+        );
+        let x241 = Self::mul_add(
+            -x216,
+            x220,
+            Self::mul_add(x121, x138, x132 * x136) + x206
+                - (Self::mul_add(-x129, x229, x128 * x226)
+                    + Self::mul_add(-x131, x234, x130 * x232)),
+        );
+        let x242 = Self::mul_add(
+            -x216,
+            x221,
+            Self::mul_add(-x121, x137, x122 * x136) + x207
+                + (Self::mul_add(x129, x230, x128 * x227)
+                    - Self::mul_add(-x131, x235, x130 * x233)),
+        );
+        let x243 = s_q12 * x223;
+        let x244 = Self::mul_add(-x120, x223, x119 * x222);
+        let x245 = c_q12 * x223;
+        let x246 = Self::mul_add(s_q12, x222, -x245);
+        let x247 = Self::mul_add(x120, x224, x119 * x223);
+        let x248 = Self::mul_add(c_q12, x224, x243);
+        let x249 = Self::mul_add(s_q12, x226, c_q12 * x225);
+        let x250 = x227 + Self::mul_add(-x120, x226, x119 * x225);
+        let x251 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x227,
+            Self::mul_add(-c_q12, x226, s_q12 * x225),
+        );
+        let x252 = Self::mul_add(s_q12, x229, c_q12 * x228);
+        let x253 = x230 - Self::mul_add(-x120, x229, x119 * x228);
+        let x254 = Self::mul_add(
+            0.00000000020510342851533115,
+            x230,
+            Self::mul_add(-c_q12, x229, s_q12 * x228),
+        );
+        let x255 = Self::mul_add(s_q12, x252, c_q12 * x249);
+        let x256 = Self::mul_add(-s_q12, x253, c_q12 * x250);
+        let x257 = Self::mul_add(-x120, x252, x119 * x249);
+        let x258 = Self::mul_add(-c_q12, x252, s_q12 * x249);
+        let x259 = Self::mul_add(c_q12, x253, s_q12 * x250);
+        let x260 = Self::mul_add(-c_q12, x254, s_q12 * x251);
+        let x261 = s_q12 * x232;
+        let x262 = x233 - Self::mul_add(-x120, x232, x119 * x231);
+        let x263 = c_q12 * x232;
+        let x264 = Self::mul_add(
+            0.00000000020510342851533115,
+            x233,
+            Self::mul_add(s_q12, x231, -x263),
+        );
+        let x265 = x235 - Self::mul_add(-x120, x234, x119 * x232);
+        let x266 = Self::mul_add(
+            0.00000000020510342851533115,
+            x235,
+            Self::mul_add(-c_q12, x234, x261),
+        );
+        let x267 = Self::mul_add(
+            0.00000000020510342851533115,
+            x236,
+            Self::mul_add(-c_q12, x235, s_q12 * x233),
+        );
+        let x268 = Self::mul_add(
+            s_q12,
+            Self::mul_add(s_q12, x234, x263),
+            c_q12 * Self::mul_add(c_q12, x231, x261),
+        );
+        let x269 = Self::mul_add(s_q12, x265, c_q12 * x262);
+        let x270 = Self::mul_add(s_q12, x266, c_q12 * x264);
+        let x271 = x236 - Self::mul_add(-x120, x235, x119 * x233)
+            - Self::mul_add(-x120, x265, x119 * x262);
+        let x272 = x267 - Self::mul_add(-x120, x266, x119 * x264);
+        let x273 = 0.36 * x269;
+        let x274 = Self::mul_add(-0.36, x271, x256);
+        let x275 = Self::mul_add(0.36, x268, x257);
+        let x276 = Self::mul_add(x120, x253, x119 * x250) - x273;
+        let x277 = Self::mul_add(
+            -0.36,
+            x274,
+            Self::mul_add(
+                s_q12,
+                Self::mul_add(-s_q12, x224, x245),
+                c_q12 * Self::mul_add(c_q12, x222, x243),
+            ),
+        );
+        let x278 = Self::mul_add(
+            0.36,
+            x255,
+            Self::mul_add(-0.36, x276, Self::mul_add(s_q12, x247, c_q12 * x244)),
+        );
+        let x279 = Self::mul_add(
+            0.36,
+            x257,
+            Self::mul_add(0.36, x275, Self::mul_add(-x120, x247, x119 * x244)),
+        );
+        let x280 = Self::mul_add(-s_q12, x241, c_q12 * x240);
+        let x281 = x242 + Self::mul_add(x120, x241, x119 * x240);
+        let x282 = 0.01675
+            + Self::mul_add(-0.36, x259, Self::mul_add(s_q12, x248, c_q12 * x246));
+        let x283 = 2.5482240016099564
+            - Self::mul_add(0.36, x258, Self::mul_add(-x120, x248, x119 * x246));
+        let x284 = 9.223235249762805 - Self::mul_add(-c_q12, x248, s_q12 * x246);
+        let x285 = -7.078399999258757 + x258;
+        let x286 = Self::mul_add(-x108, x117, Self::mul_add(-x102, x114, x103 * x115))
+            - Self::mul_add(
+                -0.00000000020510342851533115,
+                x239,
+                Self::mul_add(c_q12, x238, s_q12 * x237),
+            );
+        let x287 = Self::mul_add(
+            x103,
+            x117,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x242,
+                Self::mul_add(c_q12, x241, s_q12 * x240),
+            ),
+        );
+        let x288 = 1.0 / x284;
+        let x289 = tau[4] + x286;
+        let x290 = x282 * x288;
+        let x291 = x283 * x288;
+        let x292 = x285 * x288;
+        let x293 = x259 * x288;
+        let x294 = x260 * x288;
+        let x295 = Self::mul_add(-x282, x290, Self::mul_add(0.36, x256, -x277));
+        let x296 = Self::mul_add(-x282, x291, x278);
+        let x297 = Self::mul_add(-x283, x291, -9.142025249762803 - x279);
+        let x298 = Self::mul_add(x282, x292, x255 + x273);
+        let x299 = Self::mul_add(x282, x293, x274);
+        let x300 = Self::mul_add(
+            x282,
+            x294,
+            7.078399999258757
+                + Self::mul_add(0.36, x272, Self::mul_add(s_q12, x254, c_q12 * x251)),
+        );
+        let x301 = Self::mul_add(-x283, x292, x275);
+        let x302 = Self::mul_add(-x283, x293, x276);
+        let x303 = Self::mul_add(
+            -x283,
+            x294,
+            Self::mul_add(0.36, x270, Self::mul_add(-x120, x254, x119 * x251)),
+        );
+        let x304 = Self::mul_add(x285, x292, x268);
+        let x305 = Self::mul_add(-x285, x293, x269);
+        let x306 = Self::mul_add(x285, x294, x270);
+        let x307 = Self::mul_add(x259, x293, x271);
+        let x308 = Self::mul_add(-x259, x294, x272);
+        let x309 = Self::mul_add(
+            x260,
+            x294,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x267,
+                Self::mul_add(-c_q12, x266, s_q12 * x264),
+            ),
+        );
+        let x310 = Self::mul_add(
+            x289,
+            x290,
+            Self::mul_add(-x108, x118, Self::mul_add(-x103, x116, x113 * x114))
+                - Self::mul_add(-0.36, x281, Self::mul_add(-s_q12, x238, c_q12 * x237))
+                + (Self::mul_add(x110, x296, x109 * x295)
+                    - Self::mul_add(-x112, x299, x111 * x298)),
+        );
+        let x311 = Self::mul_add(
+            x289,
+            x291,
+            Self::mul_add(-x102, x116, x113 * x115)
+                - Self::mul_add(x107, x118, x106 * x117)
+                + Self::mul_add(
+                    0.36,
+                    x280,
+                    x239 + Self::mul_add(x120, x238, x119 * x237),
+                )
+                + (Self::mul_add(x110, x297, x109 * x296)
+                    + Self::mul_add(-x112, x302, x111 * x301)),
+        );
+        let x312 = Self::mul_add(
+            -x289,
+            x292,
+            Self::mul_add(x103, x118, x280)
+                + (Self::mul_add(-x110, x301, x109 * x298)
+                    + Self::mul_add(x112, x305, x111 * x304)),
+        );
+        let x313 = Self::mul_add(
+            x289,
+            x293,
+            Self::mul_add(x102, x118, x113 * x117) - x281
+                - (Self::mul_add(-x110, x302, x109 * x299)
+                    - Self::mul_add(x112, x307, x111 * x305)),
+        );
+        let x314 = Self::mul_add(
+            -x289,
+            x294,
+            x287
+                + (Self::mul_add(-x110, x303, x109 * x300)
+                    + Self::mul_add(x112, x308, x111 * x306)),
+        );
+        let x315 = s_q11 * x296;
+        let x316 = c_q11 * x296;
+        let x317 = Self::mul_add(s_q11, x295, x316);
+        let x318 = Self::mul_add(c_q11, x297, x315);
+        let x319 = Self::mul_add(s_q11, x299, c_q11 * x298);
+        let x320 = Self::mul_add(-c_q11, x299, s_q11 * x298);
+        let x321 = Self::mul_add(s_q11, x302, c_q11 * x301);
+        let x322 = Self::mul_add(-c_q11, x302, s_q11 * x301);
+        let x323 = Self::mul_add(s_q11, x321, c_q11 * x319);
+        let x324 = Self::mul_add(s_q11, x322, c_q11 * x320);
+        let x325 = Self::mul_add(s_q11, x303, c_q11 * x300);
+        let x326 = Self::mul_add(-c_q11, x321, s_q11 * x319);
+        let x327 = s_q11 * x305;
+        let x328 = c_q11 * x305;
+        let x329 = Self::mul_add(s_q11, x304, x328);
+        let x330 = Self::mul_add(c_q11, x307, x327);
+        let x331 = Self::mul_add(-s_q11, x308, c_q11 * x306);
+        let x332 = Self::mul_add(c_q11, x308, s_q11 * x306);
+        let x333 = Self::mul_add(
+            -s_q11,
+            Self::mul_add(-s_q11, x307, x328),
+            c_q11 * Self::mul_add(c_q11, x304, -x327),
+        );
+        let x334 = Self::mul_add(-s_q11, x330, c_q11 * x329);
+        let x335 = Self::mul_add(c_q11, x330, s_q11 * x329);
+        let x336 = 0.275 * x334;
+        let x337 = 0.63 * x331;
+        let x338 = 0.63 * x333;
+        let x339 = 0.63 * x334;
+        let x340 = x324 + Self::mul_add(0.63, x332, 0.275 * x335);
+        let x341 = x325 + Self::mul_add(0.63, x309, 0.275 * x332);
+        let x342 = Self::mul_add(-0.275, x333, x326);
+        let x343 = Self::mul_add(-c_q11, x322, s_q11 * x320) - x336;
+        let x344 = Self::mul_add(
+            -0.275,
+            x331,
+            Self::mul_add(-c_q11, x303, s_q11 * x300),
+        );
+        let x345 = Self::mul_add(
+            0.275,
+            x326,
+            Self::mul_add(0.275, x342, Self::mul_add(c_q11, x318, s_q11 * x317)),
+        );
+        let x346 = Self::mul_add(-s_q11, x313, c_q11 * x312);
+        let x347 = Self::mul_add(c_q11, x313, s_q11 * x312);
+        let x348 = -0.6328
+            - Self::mul_add(0.63, x323, Self::mul_add(0.63, x337, 0.275 * x339));
+        let x349 = -24.35164200091464 + Self::mul_add(-0.63, x326, 0.275 * x338);
+        let x350 = Self::mul_add(-0.63, x338, 28.2393615);
+        let x351 = 45.1584 - x338;
+        let x352 = Self::mul_add(-x91, x100, Self::mul_add(x86, x97, x87 * x98))
+            - Self::mul_add(0.63, x346, Self::mul_add(-x289, x284 * x288, x286));
+        let x353 = 1.0 / x350;
+        let x354 = tau[3] - x352;
+        let x355 = x348 * x353;
+        let x356 = x349 * x353;
+        let x357 = x351 * x353;
+        let x358 = x339 * x353;
+        let x359 = x337 * x353;
+        let x360 = Self::mul_add(
+            x348,
+            x355,
+            Self::mul_add(0.63, x325, 0.275 * x324)
+                - (Self::mul_add(
+                    -s_q11,
+                    Self::mul_add(-s_q11, x297, x316),
+                    c_q11 * Self::mul_add(c_q11, x295, -x315),
+                ) - Self::mul_add(0.63, x341, 0.275 * x340)),
+        );
+        let x361 = Self::mul_add(
+            -x348,
+            x356,
+            Self::mul_add(
+                0.275,
+                x323,
+                Self::mul_add(-s_q11, x318, c_q11 * x317)
+                    - Self::mul_add(0.63, x344, 0.275 * x343),
+            ),
+        );
+        let x362 = Self::mul_add(-x349, x356, -24.4950615 + x345);
+        let x363 = Self::mul_add(x348, x357, x323 + (x336 + x337));
+        let x364 = Self::mul_add(-x348, x358, x340);
+        let x365 = Self::mul_add(-x348, x359, -45.1584 + x341);
+        let x366 = Self::mul_add(x349, x357, x342);
+        let x367 = Self::mul_add(-x349, x358, x343);
+        let x368 = Self::mul_add(-x349, x359, x344);
+        let x369 = Self::mul_add(x351, x357, x333);
+        let x370 = Self::mul_add(-x351, x358, x334);
+        let x371 = Self::mul_add(-x351, x359, x331);
+        let x372 = Self::mul_add(x339, x358, x335);
+        let x373 = Self::mul_add(x339, x359, x332);
+        let x374 = Self::mul_add(x337, x359, x309);
+        let x375 = Self::mul_add(
+            x354,
+            x355,
+            Self::mul_add(x91, x101, Self::mul_add(x87, x99, x96 * x97))
+                + (Self::mul_add(-s_q11, x311, c_q11 * x310)
+                    - Self::mul_add(0.63, x314, 0.275 * x347))
+                - (Self::mul_add(-x93, x361, x92 * x360)
+                    + Self::mul_add(x95, x364, x94 * x363)),
+        );
+        let x376 = Self::mul_add(
+            -x354,
+            x356,
+            Self::mul_add(-x86, x99, x96 * x98) - Self::mul_add(x90, x101, x89 * x100)
+                - Self::mul_add(0.275, x346, Self::mul_add(c_q11, x311, s_q11 * x310))
+                - (Self::mul_add(x93, x362, x92 * x361)
+                    - Self::mul_add(x95, x367, x94 * x366)),
+        );
+        let x377 = Self::mul_add(
+            x354,
+            x357,
+            Self::mul_add(x87, x101, -x346)
+                - (Self::mul_add(x93, x366, x92 * x363)
+                    + Self::mul_add(x95, x370, x94 * x369)),
+        );
+        let x378 = Self::mul_add(
+            -x354,
+            x358,
+            Self::mul_add(x86, x101, x96 * x100) - x347
+                - (Self::mul_add(x93, x367, x92 * x364)
+                    + Self::mul_add(x95, x372, x94 * x370)),
+        );
+        let x379 = Self::mul_add(
+            -x354,
+            x359,
+            Self::mul_add(x87, x100, -x314)
+                - (Self::mul_add(x93, x368, x92 * x365)
+                    + Self::mul_add(x95, x373, x94 * x371)),
+        );
+        let x380 = s_q10 * x361;
+        let x381 = c_q10 * x361;
+        let x382 = Self::mul_add(s_q10, x360, -x381);
+        let x383 = Self::mul_add(c_q10, x362, x380);
+        let x384 = Self::mul_add(-s_q10, x364, c_q10 * x363);
+        let x385 = Self::mul_add(c_q10, x364, s_q10 * x363);
+        let x386 = Self::mul_add(-s_q10, x367, c_q10 * x366);
+        let x387 = Self::mul_add(c_q10, x367, s_q10 * x366);
+        let x388 = Self::mul_add(-s_q10, x386, c_q10 * x384);
+        let x389 = Self::mul_add(-s_q10, x368, c_q10 * x365);
+        let x390 = Self::mul_add(c_q10, x386, s_q10 * x384);
+        let x391 = Self::mul_add(c_q10, x368, s_q10 * x365);
+        let x392 = s_q10 * x370;
+        let x393 = c_q10 * x370;
+        let x394 = Self::mul_add(s_q10, x369, x393);
+        let x395 = Self::mul_add(c_q10, x372, x392);
+        let x396 = Self::mul_add(-s_q10, x373, c_q10 * x371);
+        let x397 = Self::mul_add(c_q10, x373, s_q10 * x371);
+        let x398 = Self::mul_add(
+            -s_q10,
+            Self::mul_add(-s_q10, x372, x393),
+            c_q10 * Self::mul_add(c_q10, x369, -x392),
+        );
+        let x399 = Self::mul_add(-s_q10, x395, c_q10 * x394);
+        let x400 = 0.87 * x396;
+        let x401 = 0.87 * x398;
+        let x402 = 0.87 * x399;
+        let x403 = Self::mul_add(0.87, x374, x389);
+        let x404 = Self::mul_add(
+            0.87,
+            x403,
+            Self::mul_add(
+                s_q10,
+                Self::mul_add(-s_q10, x362, x381),
+                c_q10 * Self::mul_add(c_q10, x360, x380),
+            ),
+        );
+        let x405 = Self::mul_add(-s_q10, x378, c_q10 * x377);
+        let x406 = -0.00214 - Self::mul_add(0.87, x388, 0.87 * x400);
+        let x407 = Self::mul_add(-0.87, x390, -36.18604050126307);
+        let x408 = Self::mul_add(-0.87, x401, 69.99836825);
+        let x409 = 81.53205 - x401;
+        let x410 = Self::mul_add(-x74, x84, Self::mul_add(x68, x81, x69 * x82))
+            - Self::mul_add(0.87, x405, Self::mul_add(x354, x350 * x353, x352));
+        let x411 = 1.0 / x408;
+        let x412 = tau[2] + x410;
+        let x413 = x406 * x411;
+        let x414 = x407 * x411;
+        let x415 = x409 * x411;
+        let x416 = x402 * x411;
+        let x417 = x400 * x411;
+        let x418 = Self::mul_add(x406, x413, Self::mul_add(0.87, x389, x404));
+        let x419 = Self::mul_add(
+            x406,
+            x414,
+            Self::mul_add(0.87, x391, Self::mul_add(s_q10, x383, c_q10 * x382)),
+        );
+        let x420 = Self::mul_add(
+            -x407,
+            x414,
+            -63.36336825000001 - Self::mul_add(-c_q10, x383, s_q10 * x382),
+        );
+        let x421 = Self::mul_add(x406, x415, x388 + x400);
+        let x422 = Self::mul_add(
+            -x406,
+            x416,
+            Self::mul_add(0.87, x397, Self::mul_add(-s_q10, x387, c_q10 * x385)),
+        );
+        let x423 = Self::mul_add(-x406, x417, -81.53205 + x403);
+        let x424 = Self::mul_add(x407, x415, x390);
+        let x425 = Self::mul_add(-x407, x416, Self::mul_add(c_q10, x387, s_q10 * x385));
+        let x426 = Self::mul_add(-x407, x417, x391);
+        let x427 = Self::mul_add(x409, x415, x398);
+        let x428 = Self::mul_add(-x409, x416, x399);
+        let x429 = Self::mul_add(-x409, x417, x396);
+        let x430 = Self::mul_add(x402, x416, Self::mul_add(c_q10, x395, s_q10 * x394));
+        let x431 = Self::mul_add(x402, x417, x397);
+        let x432 = Self::mul_add(x400, x417, x374);
+        let x433 = Self::mul_add(
+            -x412,
+            x413,
+            Self::mul_add(x74, x85, Self::mul_add(x69, x83, x80 * x81))
+                - Self::mul_add(0.87, x379, Self::mul_add(s_q10, x376, c_q10 * x375))
+                - (Self::mul_add(-x77, x419, x76 * x418)
+                    + Self::mul_add(-x79, x422, x78 * x421)),
+        );
+        let x434 = Self::mul_add(
+            -x412,
+            x414,
+            Self::mul_add(-x68, x83, x80 * x82) - Self::mul_add(x73, x85, x75 * x84)
+                - Self::mul_add(-c_q10, x376, s_q10 * x375)
+                - (Self::mul_add(x77, x420, x76 * x419)
+                    + Self::mul_add(-x79, x425, x78 * x424)),
+        );
+        let x435 = Self::mul_add(-x412, x408 * x411, x410);
+        let x436 = Self::mul_add(
+            -x412,
+            x415,
+            Self::mul_add(x69, x85, -x405)
+                - (Self::mul_add(-x77, x424, x76 * x421)
+                    + Self::mul_add(-x79, x428, x78 * x427)),
+        );
+        let x437 = Self::mul_add(
+            -x412,
+            x416,
+            Self::mul_add(x68, x85, x80 * x84) + Self::mul_add(c_q10, x378, s_q10 * x377)
+                + (Self::mul_add(-x77, x425, x76 * x422)
+                    + Self::mul_add(-x79, x430, x78 * x428)),
+        );
+        let x438 = Self::mul_add(
+            x412,
+            x417,
+            Self::mul_add(x69, x84, -x379)
+                - (Self::mul_add(-x77, x426, x76 * x423)
+                    + Self::mul_add(-x79, x431, x78 * x429)),
+        );
+        let x439 = c_q9 * x419;
+        let x440 = Self::mul_add(-x67, x419, x66 * x418);
+        let x441 = s_q9 * x419;
+        let x442 = Self::mul_add(c_q9, x418, -x441);
+        let x443 = Self::mul_add(x67, x420, x66 * x419);
+        let x444 = Self::mul_add(s_q9, x420, x439);
+        let x445 = 0.00000000020510342851533115 * x423;
+        let x446 = Self::mul_add(c_q9, x422, s_q9 * x421) - x445;
+        let x447 = x423 - Self::mul_add(-x67, x422, x66 * x421);
+        let x448 = x445 + Self::mul_add(-s_q9, x422, c_q9 * x421);
+        let x449 = 0.00000000020510342851533115 * x426;
+        let x450 = Self::mul_add(c_q9, x425, s_q9 * x424) - x449;
+        let x451 = x426 - Self::mul_add(-x67, x425, x66 * x424);
+        let x452 = x449 + Self::mul_add(-s_q9, x425, c_q9 * x424);
+        let x453 = Self::mul_add(c_q9, x450, s_q9 * x446);
+        let x454 = Self::mul_add(c_q9, x451, s_q9 * x447);
+        let x455 = Self::mul_add(c_q9, x452, s_q9 * x448);
+        let x456 = Self::mul_add(-x67, x450, x66 * x446);
+        let x457 = Self::mul_add(-s_q9, x450, c_q9 * x446);
+        let x458 = c_q9 * x428;
+        let x459 = 0.00000000020510342851533115 * x429;
+        let x460 = x429 - Self::mul_add(-x67, x428, x66 * x427);
+        let x461 = s_q9 * x428;
+        let x462 = x459 + Self::mul_add(c_q9, x427, -x461);
+        let x463 = 0.00000000020510342851533115 * x431;
+        let x464 = x431 - Self::mul_add(-x67, x430, x66 * x428);
+        let x465 = x463 + Self::mul_add(-s_q9, x430, x458);
+        let x466 = 0.00000000020510342851533115 * x432;
+        let x467 = x432 - Self::mul_add(-x67, x431, x66 * x429);
+        let x468 = x466 + Self::mul_add(-s_q9, x431, c_q9 * x429);
+        let x469 = Self::mul_add(
+            -0.00000000020510342851533115,
+            Self::mul_add(c_q9, x431, s_q9 * x429) - x466,
+            Self::mul_add(
+                c_q9,
+                Self::mul_add(c_q9, x430, x461) - x463,
+                s_q9 * (Self::mul_add(s_q9, x427, x458) - x459),
+            ),
+        );
+        let x470 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x467,
+            Self::mul_add(c_q9, x464, s_q9 * x460),
+        );
+        let x471 = 0.00000000020510342851533115 * x468;
+        let x472 = Self::mul_add(c_q9, x465, s_q9 * x462) - x471;
+        let x473 = x467 - Self::mul_add(-x67, x464, x66 * x460);
+        let x474 = x468 - Self::mul_add(-x67, x465, x66 * x462);
+        let x475 = x471 + Self::mul_add(-s_q9, x465, c_q9 * x462);
+        let x476 = 0.4 * x470;
+        let x477 = 0.275 * x472;
+        let x478 = x454 + Self::mul_add(0.275, x474, 0.4 * x473);
+        let x479 = x455 + Self::mul_add(0.275, x475, 0.4 * x474);
+        let x480 = Self::mul_add(0.4, x469, x456);
+        let x481 = Self::mul_add(-x67, x451, x66 * x447) + x476;
+        let x482 = Self::mul_add(0.4, x472, Self::mul_add(-x67, x452, x66 * x448));
+        let x483 = Self::mul_add(-0.275, x469, x457);
+        let x484 = Self::mul_add(-0.275, x470, Self::mul_add(-s_q9, x451, c_q9 * x447));
+        let x485 = Self::mul_add(-s_q9, x452, c_q9 * x448) - x477;
+        let x486 = Self::mul_add(
+            0.4,
+            x456,
+            Self::mul_add(0.4, x480, Self::mul_add(-x67, x443, x66 * x440)),
+        );
+        let x487 = Self::mul_add(
+            0.275,
+            x456,
+            -Self::mul_add(0.4, x483, Self::mul_add(-x67, x444, x66 * x442)),
+        );
+        let x488 = Self::mul_add(
+            0.275,
+            x457,
+            -Self::mul_add(-0.275, x483, Self::mul_add(-s_q9, x444, c_q9 * x442)),
+        );
+        let x489 = 0.00000000020510342851533115 * x438;
+        let x490 = Self::mul_add(-c_q9, x437, s_q9 * x436) - x489;
+        let x491 = x438 - Self::mul_add(x67, x437, x66 * x436);
+        let x492 = x489 + Self::mul_add(s_q9, x437, c_q9 * x436);
+        let x493 = 0.00000000020510342851533115 * x435;
+        let x494 = -0.002139996587640933
+            + Self::mul_add(
+                0.275,
+                x453,
+                -(Self::mul_add(c_q9, x444, s_q9 * x442)
+                    + Self::mul_add(0.275, x485, 0.4 * x484)),
+            );
+        let x495 = 5.080660024070365 + x487;
+        let x496 = 113.3918902508081 + x488;
+        let x497 = 12.701650001451807 - x483;
+        let x498 = -0.000000008530897668050218 + x484;
+        let x499 = Self::mul_add(-x46, x59, x47 * x58)
+            - Self::mul_add(-x50, x62, x51 * x61)
+            + Self::mul_add(0.275, x490, x493 - Self::mul_add(-s_q9, x434, c_q9 * x433));
+        let x500 = 1.0 / x496;
+        let x501 = tau[1] - x499;
+        let x502 = x494 * x500;
+        let x503 = x495 * x500;
+        let x504 = x497 * x500;
+        let x505 = x498 * x500;
+        let x506 = x485 * x500;
+        let x507 = Self::mul_add(
+            x494,
+            x502,
+            Self::mul_add(0.275, x455, 0.4 * x454)
+                + (Self::mul_add(
+                    c_q9,
+                    Self::mul_add(-c_q9, x420, x441),
+                    s_q9 * Self::mul_add(s_q9, x418, x439),
+                ) + Self::mul_add(0.275, x479, 0.4 * x478)),
+        );
+        let x508 = Self::mul_add(
+            -x494,
+            x503,
+            -0.0000000234896432582596
+                - Self::mul_add(
+                    0.4,
+                    x453,
+                    Self::mul_add(c_q9, x443, s_q9 * x440)
+                        + Self::mul_add(0.275, x482, 0.4 * x481),
+                ),
+        );
+        let x509 = Self::mul_add(-x495, x503, -111.7548902508081 - x486);
+        let x510 = Self::mul_add(x494, x504, x453 + (x476 + x477));
+        let x511 = Self::mul_add(-x494, x505, x478);
+        let x512 = Self::mul_add(x494, x506, -12.701650001451807 - x479);
+        let x513 = Self::mul_add(x495, x504, x480);
+        let x514 = Self::mul_add(-x495, x505, x481);
+        let x515 = Self::mul_add(x495, x506, 0.000000008530897668050218 - x482);
+        let x516 = Self::mul_add(x497, x504, x469);
+        let x517 = Self::mul_add(-x497, x505, x470);
+        let x518 = Self::mul_add(-x497, x506, x472);
+        let x519 = Self::mul_add(x498, x505, x473);
+        let x520 = Self::mul_add(x498, x506, x474);
+        let x521 = Self::mul_add(x485, x506, x475);
+        let x522 = Self::mul_add(
+            -x501,
+            x502,
+            Self::mul_add(-x47, x60, x57 * x59) - Self::mul_add(x51, x63, x52 * x62)
+                + (Self::mul_add(c_q9, x434, s_q9 * x433) + x493
+                    + Self::mul_add(0.275, x492, 0.4 * x491))
+                + (Self::mul_add(-x54, x508, x53 * x507)
+                    + Self::mul_add(-x56, x511, x55 * x510)),
+        );
+        let x523 = Self::mul_add(
+            -x501,
+            x503,
+            Self::mul_add(-x46, x60, x57 * x58) - Self::mul_add(x50, x63, x52 * x61)
+                + Self::mul_add(0.4, x490, x435 + Self::mul_add(-x67, x434, x66 * x433))
+                - (Self::mul_add(x54, x509, x53 * x508)
+                    - Self::mul_add(-x56, x514, x55 * x513)),
+        );
+        let x524 = Self::mul_add(x501, x496 * x500, x499);
+        let x525 = Self::mul_add(
+            x501,
+            x504,
+            Self::mul_add(x47, x63, x57 * x62) - x490
+                - (Self::mul_add(x54, x513, x53 * x510)
+                    + Self::mul_add(-x56, x517, x55 * x516)),
+        );
+        let x526 = Self::mul_add(
+            x501,
+            x505,
+            Self::mul_add(x46, x63, x57 * x61) + x491
+                + (Self::mul_add(x54, x514, x53 * x511)
+                    + Self::mul_add(-x56, x519, x55 * x517)),
+        );
+        let x527 = Self::mul_add(
+            x501,
+            x506,
+            Self::mul_add(-x46, x62, x47 * x61) + x492
+                - (Self::mul_add(x54, x515, x53 * x512)
+                    - Self::mul_add(-x56, x520, x55 * x518)),
+        );
+        let x528 = c_q8 * x508;
+        let x529 = Self::mul_add(s_q8, x507, -x528);
+        let x530 = s_q8 * x508;
+        let x531 = Self::mul_add(c_q8, x507, x530);
+        let x532 = Self::mul_add(c_q8, x509, x530);
+        let x533 = Self::mul_add(-s_q8, x509, x528);
+        let x534 = x512 + Self::mul_add(x45, x511, x44 * x510);
+        let x535 = Self::mul_add(-c_q8, x511, s_q8 * x510);
+        let x536 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x512,
+            Self::mul_add(s_q8, x511, c_q8 * x510),
+        );
+        let x537 = x515 + Self::mul_add(x45, x514, x44 * x513);
+        let x538 = Self::mul_add(-c_q8, x514, s_q8 * x513);
+        let x539 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x515,
+            Self::mul_add(s_q8, x514, c_q8 * x513),
+        );
+        let x540 = Self::mul_add(-x45, x537, x44 * x534);
+        let x541 = Self::mul_add(-x45, x538, x44 * x535);
+        let x542 = Self::mul_add(c_q8, x537, s_q8 * x534);
+        let x543 = Self::mul_add(-s_q8, x537, c_q8 * x534);
+        let x544 = Self::mul_add(-s_q8, x538, c_q8 * x535);
+        let x545 = Self::mul_add(-s_q8, x539, c_q8 * x536);
+        let x546 = c_q8 * x517;
+        let x547 = Self::mul_add(s_q8, x516, -x546);
+        let x548 = s_q8 * x517;
+        let x549 = Self::mul_add(
+            0.00000000020510342851533115,
+            x518,
+            Self::mul_add(c_q8, x516, x548),
+        );
+        let x550 = Self::mul_add(-c_q8, x519, x548);
+        let x551 = Self::mul_add(
+            0.00000000020510342851533115,
+            x520,
+            Self::mul_add(s_q8, x519, x546),
+        );
+        let x552 = Self::mul_add(
+            0.00000000020510342851533115,
+            x521,
+            Self::mul_add(s_q8, x520, c_q8 * x518),
+        );
+        let x553 = x521 - Self::mul_add(x45, x520, x44 * x518)
+            - Self::mul_add(
+                x45,
+                x520 - Self::mul_add(x45, x519, x44 * x517),
+                x44 * (x518 - Self::mul_add(x45, x517, x44 * x516)),
+            );
+        let x554 = Self::mul_add(-c_q8, x520, s_q8 * x518)
+            - Self::mul_add(x45, x550, x44 * x547);
+        let x555 = x552 - Self::mul_add(x45, x551, x44 * x549);
+        let x556 = Self::mul_add(-c_q8, x550, s_q8 * x547);
+        let x557 = Self::mul_add(-c_q8, x551, s_q8 * x549);
+        let x558 = 0.35 * x554;
+        let x559 = Self::mul_add(0.35, x556, x541);
+        let x560 = Self::mul_add(-0.35, x553, x542);
+        let x561 = Self::mul_add(c_q8, x538, s_q8 * x535) + x558;
+        let x562 = Self::mul_add(
+            0.35,
+            x559,
+            Self::mul_add(
+                x45,
+                Self::mul_add(-x45, x509, x44 * x508),
+                x44 * Self::mul_add(x45, x508, x44 * x507),
+            ),
+        );
+        let x563 = Self::mul_add(
+            0.35,
+            x540,
+            -Self::mul_add(0.35, x561, Self::mul_add(x45, x532, x44 * x529)),
+        );
+        let x564 = Self::mul_add(
+            0.35,
+            x542,
+            -Self::mul_add(-0.35, x560, Self::mul_add(-c_q8, x532, s_q8 * x529)),
+        );
+        let x565 = x527 + Self::mul_add(-x45, x526, x44 * x525);
+        let x566 = Self::mul_add(c_q8, x526, s_q8 * x525);
+        let x567 = -16.80768997608804
+            - Self::mul_add(0.35, x544, Self::mul_add(x45, x533, x44 * x531));
+        let x568 = 0.1132
+            + Self::mul_add(-0.35, x543, Self::mul_add(-c_q8, x533, s_q8 * x531));
+        let x569 = 132.47349025763282 - Self::mul_add(s_q8, x533, c_q8 * x531);
+        let x570 = 48.0240000085309 + x544;
+        let x571 = Self::mul_add(x32, x42, Self::mul_add(-x26, x40, x27 * x39))
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x524,
+                Self::mul_add(-s_q8, x523, c_q8 * x522),
+            );
+        let x572 = Self::mul_add(
+            x26,
+            x42,
+            -Self::mul_add(
+                -0.00000000020510342851533115,
+                x527,
+                Self::mul_add(-s_q8, x526, c_q8 * x525),
+            ),
+        );
+        let x573 = 1.0 / x569;
+        let x574 = tau[0] - x571;
+        let x575 = x567 * x573;
+        let x576 = x568 * x573;
+        let x577 = x543 * x573;
+        let x578 = x570 * x573;
+        let x579 = x545 * x573;
+        let x580 = Self::mul_add(x567, x575, Self::mul_add(0.35, x541, x562));
+        let x581 = Self::mul_add(-x567, x576, -0.07309 - x563);
+        let x582 = Self::mul_add(-x568, x576, 130.43769025763282 + x564);
+        let x583 = Self::mul_add(-x567, x577, x540 - x558);
+        let x584 = Self::mul_add(-x567, x578, x559);
+        let x585 = Self::mul_add(
+            -x567,
+            x579,
+            Self::mul_add(0.35, x557, Self::mul_add(-x45, x539, x44 * x536)),
+        );
+        let x586 = Self::mul_add(x568, x577, x560);
+        let x587 = Self::mul_add(x568, x578, x561);
+        let x588 = Self::mul_add(
+            x568,
+            x579,
+            -48.0240000085309
+                + Self::mul_add(0.35, x555, Self::mul_add(c_q8, x539, s_q8 * x536)),
+        );
+        let x589 = Self::mul_add(x543, x577, x553);
+        let x590 = Self::mul_add(-x543, x578, x554);
+        let x591 = Self::mul_add(-x543, x579, x555);
+        let x592 = Self::mul_add(x570, x578, x556);
+        let x593 = Self::mul_add(x570, x579, x557);
+        let x594 = Self::mul_add(
+            x545,
+            x579,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x552,
+                Self::mul_add(s_q8, x551, c_q8 * x549),
+            ),
+        );
+        let x595 = Self::mul_add(
+            x574,
+            x575,
+            Self::mul_add(x27, x41, x38 * x40) - Self::mul_add(x33, x43, x31 * x42)
+                + Self::mul_add(
+                    -0.35,
+                    x566,
+                    x524 + Self::mul_add(-x45, x523, x44 * x522),
+                )
+                + (Self::mul_add(-x35, x581, x34 * x580)
+                    + Self::mul_add(-x37, x584, x36 * x583)),
+        );
+        let x596 = Self::mul_add(
+            x574,
+            x576,
+            Self::mul_add(-x32, x43, Self::mul_add(x26, x41, x38 * x39))
+                - Self::mul_add(0.35, x565, Self::mul_add(c_q8, x523, s_q8 * x522))
+                - (Self::mul_add(x35, x582, x34 * x581)
+                    + Self::mul_add(-x37, x587, x36 * x586)),
+        );
+        let x597 = Self::mul_add(
+            x574,
+            x577,
+            Self::mul_add(x27, x43, x38 * x42) + x565
+                - (Self::mul_add(-x35, x586, x34 * x583)
+                    + Self::mul_add(x37, x590, x36 * x589)),
+        );
+        let x598 = Self::mul_add(
+            -x574,
+            x578,
+            Self::mul_add(x26, x43, -x566)
+                + (Self::mul_add(-x35, x587, x34 * x584)
+                    - Self::mul_add(x37, x592, x36 * x590)),
+        );
+        let x599 = Self::mul_add(
+            -x574,
+            x579,
+            x572
+                + (Self::mul_add(-x35, x588, x34 * x585)
+                    - Self::mul_add(x37, x593, x36 * x591)),
+        );
+        let x600 = s_q7 * x581;
+        let x601 = c_q7 * x581;
+        let x602 = Self::mul_add(s_q7, x580, -x601);
+        let x603 = Self::mul_add(c_q7, x582, x600);
+        let x604 = Self::mul_add(s_q7, x584, c_q7 * x583);
+        let x605 = Self::mul_add(-c_q7, x584, s_q7 * x583);
+        let x606 = Self::mul_add(s_q7, x587, c_q7 * x586);
+        let x607 = Self::mul_add(-c_q7, x587, s_q7 * x586);
+        let x608 = Self::mul_add(s_q7, x606, c_q7 * x604);
+        let x609 = Self::mul_add(s_q7, x607, c_q7 * x605);
+        let x610 = Self::mul_add(s_q7, x588, c_q7 * x585);
+        let x611 = Self::mul_add(-c_q7, x606, s_q7 * x604);
+        let x612 = Self::mul_add(-c_q7, x607, s_q7 * x605);
+        let x613 = Self::mul_add(-c_q7, x588, s_q7 * x585);
+        let x614 = s_q7 * x590;
+        let x615 = c_q7 * x590;
+        let x616 = Self::mul_add(s_q7, x589, x615);
+        let x617 = Self::mul_add(c_q7, x592, x614);
+        let x618 = Self::mul_add(-s_q7, x593, c_q7 * x591);
+        let x619 = Self::mul_add(c_q7, x593, s_q7 * x591);
+        let x620 = Self::mul_add(
+            -s_q7,
+            Self::mul_add(-s_q7, x592, x615),
+            c_q7 * Self::mul_add(c_q7, x589, -x614),
+        );
+        let x621 = Self::mul_add(-s_q7, x617, c_q7 * x616);
+        let x622 = Self::mul_add(c_q7, x617, s_q7 * x616);
+        let x623 = 0.75 * x621;
+        let x624 = 0.65 * x621;
+        let x625 = 0.65 * x619;
+        let x626 = 0.65 * x622;
+        let x627 = x608 - x623;
+        let x628 = Self::mul_add(-0.75, x622, x609);
+        let x629 = x611 + Self::mul_add(0.65, x618, 0.75 * x620);
+        let x630 = x612 + (x623 + x625);
+        let x631 = x613 - Self::mul_add(0.65, x594, 0.75 * x618);
+        let x632 = Self::mul_add(
+            -0.75,
+            x628,
+            Self::mul_add(
+                s_q7,
+                Self::mul_add(-s_q7, x582, x601),
+                c_q7 * Self::mul_add(c_q7, x580, x600),
+            ),
+        );
+        let x633 = Self::mul_add(-s_q7, x598, c_q7 * x597);
+        let x634 = Self::mul_add(c_q7, x598, s_q7 * x597);
+        let x635 = 180.9502499901501 - x629;
+        let x636 = Self::mul_add(-v[4], x25, v[5] * x24) + x633;
+        let x637 = 1.0 / (1170.07 - x620);
+        let x638 = x621 * x637;
+        let x639 = x618 * x637;
+        let x640 = x627 * x637;
+        let x641 = x635 * x637;
+        let x642 = x624 * x637;
+        let x643 = 1.0 / Self::mul_add(-x621, x638, 1170.07 - x622);
+        let x644 = Self::mul_add(x621, x639, x619);
+        let x645 = x643 * x644;
+        let x646 = Self::mul_add(-x621, x640, -180.9502499901501 - x628);
+        let x647 = x643 * x646;
+        let x648 = Self::mul_add(-x621, x641, x630);
+        let x649 = x643 * x648;
+        let x650 = Self::mul_add(-x621, x642, 110.5455 - x626);
+        let x651 = x643 * x650;
+        let x652 = 1.0
+            / Self::mul_add(-x644, x645, Self::mul_add(-x618, x639, 1170.07 - x594));
+        let x653 = Self::mul_add(
+            x644,
+            x647,
+            Self::mul_add(-x618, x640, Self::mul_add(0.75, x619, x610)),
+        );
+        let x654 = x652 * x653;
+        let x655 = Self::mul_add(
+            x644,
+            x649,
+            Self::mul_add(-x618, x641, -110.5455 - x631),
+        );
+        let x656 = x652 * x655;
+        let x657 = Self::mul_add(-x644, x651, Self::mul_add(x618, x642, x625));
+        let x658 = x652 * x657;
+        let x659 = Self::mul_add(
+            -x646,
+            x647,
+            Self::mul_add(
+                -x627,
+                x640,
+                1394.5960312283303 + Self::mul_add(0.75, x609, -x632),
+            ),
+        );
+        let x660 = 1.0 / Self::mul_add(-x653, x654, x659);
+        let x661 = Self::mul_add(
+            -x627,
+            x641,
+            Self::mul_add(-0.65, x610, 0.75 * x608)
+                + Self::mul_add(-0.75, x630, Self::mul_add(s_q7, x603, c_q7 * x602)),
+        );
+        let x662 = Self::mul_add(-x653, x656, Self::mul_add(-x646, x649, x661));
+        let x663 = x660 * x662;
+        let x664 = Self::mul_add(
+            -x646,
+            x651,
+            Self::mul_add(
+                -x627,
+                x642,
+                -117.61766249359756 + Self::mul_add(-0.65, x609, 0.75 * x626),
+            ),
+        );
+        let x665 = Self::mul_add(x653, x658, x664);
+        let x666 = x660 * x665;
+        let x667 = Self::mul_add(
+            -x648,
+            x649,
+            Self::mul_add(
+                -x635,
+                x641,
+                1466.4506062283303
+                    - (Self::mul_add(-0.65, x613, 0.75 * x611)
+                        + (Self::mul_add(-c_q7, x603, s_q7 * x602)
+                            + Self::mul_add(-0.65, x631, 0.75 * x629))),
+            ),
+        );
+        let x668 = 1.0 / Self::mul_add(-x662, x663, Self::mul_add(-x655, x656, x667));
+        let x669 = Self::mul_add(
+            -x635,
+            x642,
+            Self::mul_add(0.65, x612, Self::mul_add(0.65, x625, 0.75 * x624)),
+        );
+        let x670 = Self::mul_add(
+            -x662,
+            x666,
+            Self::mul_add(x655, x658, Self::mul_add(-x648, x651, x669)),
+        );
+        let x671 = x668 * x670;
+        let x672 = Self::mul_add(
+            -x650,
+            x651,
+            Self::mul_add(-x624, x642, Self::mul_add(-0.65, x626, 1271.854575)),
+        );
+        let x673 = Self::mul_add(
+            -x670,
+            x671,
+            Self::mul_add(-x665, x666, Self::mul_add(-x657, x658, x672)),
+        );
+        let x674 = 1.0 / x673;
+        let x675 = Self::mul_add(
+            -x636,
+            x638,
+            Self::mul_add(-v[3], x25, v[5] * x23) - x634,
+        );
+        let x676 = Self::mul_add(
+            x645,
+            x675,
+            Self::mul_add(-x636, x639, Self::mul_add(-v[3], x24, v[4] * x23) - x599),
+        );
+        let x677 = Self::mul_add(
+            x636,
+            x640,
+            Self::mul_add(v[4], x15, v[5] * x14) + Self::mul_add(-v[1], x25, v[2] * x24)
+                - Self::mul_add(0.75, x634, Self::mul_add(-s_q7, x596, c_q7 * x595)),
+        );
+        let x678 = Self::mul_add(x654, x676, Self::mul_add(x647, x675, x677));
+        let x679 = Self::mul_add(
+            x649,
+            x675,
+            Self::mul_add(
+                x636,
+                x641,
+                Self::mul_add(v[3], x15, v[5] * x13)
+                    + Self::mul_add(-v[0], x25, v[2] * x23)
+                    + (Self::mul_add(c_q7, x596, s_q7 * x595)
+                        - Self::mul_add(0.65, x599, 0.75 * x633)),
+            ),
+        );
+        let x680 = Self::mul_add(-x663, x678, Self::mul_add(x656, x676, x679));
+        let x681 = Self::mul_add(
+            x636,
+            x642,
+            Self::mul_add(-v[3], x14, v[4] * x13) + Self::mul_add(-v[0], x24, v[1] * x23)
+                - Self::mul_add(-0.65, x634, Self::mul_add(x574, x569 * x573, x571)),
+        );
+        let x682 = Self::mul_add(
+            -x666,
+            x678,
+            Self::mul_add(-x658, x676, Self::mul_add(x651, x675, x681)),
+        );
+        let x683 = x674 * Self::mul_add(-x671, x680, x682);
+        let x684 = Self::mul_add(-x671, x683, x668 * x680);
+        let x685 = Self::mul_add(-x666, x683, Self::mul_add(-x663, x684, x660 * x678));
+        let x686 = Self::mul_add(
+            -x658,
+            x683,
+            Self::mul_add(x656, x684, Self::mul_add(x654, x685, x652 * x676)),
+        );
+        let x687 = Self::mul_add(
+            x649,
+            x684,
+            Self::mul_add(x647, x685, Self::mul_add(x645, x686, x643 * x675)),
+        );
+        let x688 = Self::mul_add(x651, x683, x687);
+        let x689 = Self::mul_add(
+            x640,
+            x685,
+            Self::mul_add(-x639, x686, Self::mul_add(-x638, x688, x636 * x637)),
+        );
+        let x690 = Self::mul_add(x642, x683, Self::mul_add(x641, x684, x689));
+        let x691 = 0.65 * x683;
+        let x692 = Self::mul_add(-0.75, x684, x690);
+        let x693 = x688 + Self::mul_add(0.75, x685, -x691);
+        let x694 = Self::mul_add(0.65, x684, x686);
+        let x695 = x34 - Self::mul_add(-s_q7, x684, c_q7 * x685);
+        let x696 = x35 + Self::mul_add(c_q7, x684, s_q7 * x685);
+        let x697 = x36 - Self::mul_add(-s_q7, x693, c_q7 * x692);
+        let x698 = x37 + Self::mul_add(c_q7, x693, s_q7 * x692);
+        let x699 = x573
+            * (x574
+                + (Self::mul_add(-x569, x683, Self::mul_add(x568, x696, x567 * x695))
+                    - Self::mul_add(
+                        -x545,
+                        x694,
+                        Self::mul_add(-x570, x698, x543 * x697),
+                    )));
+        let x700 = x683 + x699;
+        let x701 = Self::mul_add(0.00000000020510342851533115, x700, x695);
+        let x702 = Self::mul_add(0.35, x696, x697);
+        let x703 = Self::mul_add(-0.35, x695, x698);
+        let x704 = Self::mul_add(0.00000000020510342851533115, x694, x702);
+        let x705 = x53
+            + Self::mul_add(-c_q8, x700, Self::mul_add(-s_q8, x696, x44 * x695));
+        let x706 = x54
+            - Self::mul_add(-s_q8, x700, Self::mul_add(c_q8, x696, x45 * x695));
+        let x707 = x55
+            + Self::mul_add(-c_q8, x694, Self::mul_add(-s_q8, x703, x44 * x702));
+        let x708 = x56
+            - Self::mul_add(-s_q8, x694, Self::mul_add(c_q8, x703, x45 * x702));
+        let x709 = x500
+            * (x501
+                - (Self::mul_add(-x496, x701, Self::mul_add(x495, x706, x494 * x705))
+                    + Self::mul_add(
+                        x485,
+                        x704,
+                        Self::mul_add(x498, x708, x497 * x707),
+                    )));
+        let x710 = x701 - x709;
+        let x711 = Self::mul_add(
+            0.00000000020510342851533115,
+            x710,
+            Self::mul_add(0.00000000020510342851533115, x705, x706),
+        );
+        let x712 = x707 + Self::mul_add(0.275, x710, 0.4 * x706);
+        let x713 = Self::mul_add(-0.4, x705, x708);
+        let x714 = Self::mul_add(-0.275, x705, x704);
+        let x715 = Self::mul_add(
+            0.00000000020510342851533115,
+            x714,
+            Self::mul_add(0.00000000020510342851533115, x712, x713),
+        );
+        let x716 = x76
+            - Self::mul_add(-c_q9, x710, Self::mul_add(x66, x706, s_q9 * x705));
+        let x717 = x77
+            + Self::mul_add(s_q9, x710, Self::mul_add(-x67, x706, c_q9 * x705));
+        let x718 = x78
+            - Self::mul_add(-c_q9, x714, Self::mul_add(x66, x713, s_q9 * x712));
+        let x719 = x79
+            + Self::mul_add(s_q9, x714, Self::mul_add(-x67, x713, c_q9 * x712));
+        let x720 = x411
+            * (x412
+                + (Self::mul_add(-x408, x711, Self::mul_add(-x407, x717, x406 * x716))
+                    + Self::mul_add(
+                        -x400,
+                        x715,
+                        Self::mul_add(x402, x719, x409 * x718),
+                    )));
+        let x721 = x711 + x720;
+        let x722 = Self::mul_add(-0.87, x721, x718);
+        let x723 = Self::mul_add(0.87, x716, x715);
+        let x724 = x92 - Self::mul_add(-s_q10, x717, c_q10 * x716);
+        let x725 = x93 + Self::mul_add(c_q10, x717, s_q10 * x716);
+        let x726 = x94 - Self::mul_add(-s_q10, x719, c_q10 * x722);
+        let x727 = x95 + Self::mul_add(c_q10, x719, s_q10 * x722);
+        let x728 = x353
+            * (x354
+                - (Self::mul_add(x350, x721, Self::mul_add(x349, x725, x348 * x724))
+                    + Self::mul_add(
+                        x337,
+                        x723,
+                        Self::mul_add(-x339, x727, x351 * x726),
+                    )));
+        let x729 = x721 + x728;
+        let x730 = x726 - Self::mul_add(-0.63, x729, 0.275 * x725);
+        let x731 = Self::mul_add(0.275, x724, x727);
+        let x732 = Self::mul_add(-0.63, x724, x723);
+        let x733 = x109 + Self::mul_add(s_q11, x725, c_q11 * x724);
+        let x734 = x110 - Self::mul_add(-c_q11, x725, s_q11 * x724);
+        let x735 = x111 + Self::mul_add(s_q11, x731, c_q11 * x730);
+        let x736 = x112 - Self::mul_add(-c_q11, x731, s_q11 * x730);
+        let x737 = x288
+            * (x289
+                - (Self::mul_add(x284, x729, Self::mul_add(x283, x734, x282 * x733))
+                    + Self::mul_add(
+                        -x260,
+                        x732,
+                        Self::mul_add(-x259, x736, x285 * x735),
+                    )));
+        let x738 = x729 + x737;
+        let x739 = Self::mul_add(-0.00000000020510342851533115, x738, x734);
+        let x740 = Self::mul_add(-0.36, x734, x735);
+        let x741 = Self::mul_add(0.36, x733, x736);
+        let x742 = Self::mul_add(-0.00000000020510342851533115, x732, x741);
+        let x743 = x128
+            + Self::mul_add(-s_q12, x738, Self::mul_add(-x119, x734, c_q12 * x733));
+        let x744 = x129
+            - Self::mul_add(c_q12, x738, Self::mul_add(x120, x734, s_q12 * x733));
+        let x745 = x130
+            + Self::mul_add(-s_q12, x732, Self::mul_add(-x119, x741, c_q12 * x740));
+        let x746 = x131
+            - Self::mul_add(c_q12, x732, Self::mul_add(x120, x741, s_q12 * x740));
+        let x747 = x215
+            * (x216
+                - (Self::mul_add(x211, x739, Self::mul_add(x210, x744, x209 * x743))
+                    + Self::mul_add(
+                        -x201,
+                        x742,
+                        Self::mul_add(x213, x746, x212 * x745),
+                    )));
+        let x748 = x739 + x747;
+        let x749 = Self::mul_add(
+            c_q13,
+            Self::mul_add(0.55, x743, x742),
+            Self::mul_add(
+                -s_q13,
+                Self::mul_add(-0.16, x743, x746),
+                x139 * (x745 + Self::mul_add(-0.55, x748, 0.16 * x744)),
+            ),
+        );
+        let x750 = Self::mul_add(
+            0.9614610000000001,
+            x150 - Self::mul_add(s_q13, x748, Self::mul_add(c_q13, x744, x140 * x743)),
+            0.0145
+                * (x149
+                    + Self::mul_add(
+                        c_q13,
+                        x748,
+                        Self::mul_add(-s_q13, x744, x139 * x743),
+                    )),
+        );
+        let x751 = Self::mul_add(
+            4.806620000000001,
+            x151 + x749,
+            Self::mul_add(
+                1.4135609200000003,
+                Self::mul_add(-0.00000000020510342851533115, x748, x743),
+                x750,
+            ),
+        );
+        let x752 = 0.707433253035886 * (x160 - x751);
+        let x753 = v[4] * 117.61766249359758;
+        let x754 = 1394.5960312283303 * v[5];
+        let x755 = 180.9502499901501 * v[2];
+        let x756 = Self::mul_add(1394.5960312283303, v[4], x10);
+        let x757 = v[4] * 117.61766249359756;
+        let x758 = Self::mul_add(1466.4506062283303, v[5], x12);
+        let x759 = Self::mul_add(-1271.854575, v[4], x11);
+        let x760 = x17 + x21;
+        let x761 = 110.5455 * v[0];
+        let x762 = x755 + x761;
+        let x763 = Self::mul_add(-1466.4506062283303, v[3], x9);
+        let x764 = 1271.854575 * v[3];
+        let x765 = x17 - x20;
+        let x766 = 1170.07 * v[5];
+        let x767 = 1170.07 * v[4];
+        let x768 = 1170.07 * v[3];
+        let x769 = 48.0240000085309 * c_q7;
+        let x770 = 48.0240000085309 * s_q7;
+        let x771 = s_q7 * 0.07309;
+        let x772 = c_q7 * 0.07309;
+        let x773 = Self::mul_add(130.43769025763282, s_q7, x772);
+        let x774 = Self::mul_add(-130.43769025763282, c_q7, x771);
+        let x775 = Self::mul_add(s_q7, x773, c_q7 * x771);
+        let x776 = 0.65 * x770;
+        let x777 = 0.65 * x769;
+        let x778 = Self::mul_add(
+            0.75,
+            x769,
+            Self::mul_add(0.1132, s_q7, c_q7 * 16.80768997608804),
+        );
+        let x779 = Self::mul_add(-s_q7, x774, c_q7 * x772) + x776;
+        let x780 = Self::mul_add(
+            0.75,
+            x770,
+            Self::mul_add(-0.1132, c_q7, s_q7 * 16.80768997608804),
+        );
+        let x781 = Self::mul_add(-c_q7, x773, s_q7 * x771) - x776;
+        let x782 = x777 - (Self::mul_add(c_q7, x774, s_q7 * x772) - x777);
+        let x783 = x777 + (132.47349025763282 + x777);
+        let x784 = Self::mul_add(-0.65, v[6], v[1]);
+        let x785 = 0.65 * v[3];
+        let x786 = Self::mul_add(0.65, x38, x784);
+        let x787 = Self::mul_add(v[4], v[6], x685);
+        let x788 = Self::mul_add(v[3], v[6], x684);
+        let x789 = Self::mul_add(v[6], x786, x690);
+        let x790 = Self::mul_add(v[0], v[6], Self::mul_add(0.65, x699, x688));
+        let x791 = Self::mul_add(-v[6], x785, x686);
+        let x792 = v[1] + x28;
+        let x793 = Self::mul_add(v[3], v[3], v[4] * v[4]);
+        let x794 = v[0] * v[3];
+        let x795 = Self::mul_add(-v[3], v[5], x684);
+        let x796 = Self::mul_add(-v[4], v[5], x685);
+        let x797 = x688 - x691
+            - Self::mul_add(v[2], v[3], Self::mul_add(-v[4], x785, v[0] * v[5]));
+        let x798 = x690
+            - Self::mul_add(v[2], v[4], Self::mul_add(v[3], x785, v[5] * x792));
+        let x799 = Self::mul_add(
+            0.65,
+            x685,
+            Self::mul_add(v[4], x792, x794) + Self::mul_add(v[1], v[4], x794),
+        );
+        let x800 = v[4] + v[4];
+        let x801 = v[3] + v[3];
+        let x802 = x786 + x792;
+        let x803 = v[0] + v[0];
+        let x804 = x785 + x785;
+        let x805 = v[4] * x781;
+        let x806 = x38 * x778;
+        let x807 = v[3] * x779;
+        let x808 = x38 * x780;
+        let x809 = v[3] * x778;
+        let x810 = v[4] * x780;
+        let x811 = v[2] * x770;
+        let x812 = v[2] * x769;
+        let x813 = v[0] * x770;
+        let x814 = x769 * x784;
+        let x815 = Self::mul_add(v[3], x775, x805) - x806 + x811;
+        let x816 = Self::mul_add(-v[4], x782, x807) + x808 + x812;
+        let x817 = Self::mul_add(-x38, x783, x809 + x810) + (x813 - x814);
+        let x818 = x38 * x770;
+        let x819 = x38 * x769;
+        let x820 = v[3] * x770;
+        let x821 = v[4] * x769;
+        let x822 = x820 - x821;
+        let x823 = Self::mul_add(
+            x770,
+            x791,
+            Self::mul_add(-x700, x778, Self::mul_add(-x781, x788, x775 * x787)),
+        );
+        let x824 = Self::mul_add(
+            x769,
+            x791,
+            Self::mul_add(x700, x780, Self::mul_add(x782, x788, x779 * x787)),
+        );
+        let x825 = x38 * x779;
+        let x826 = v[4] * x778;
+        let x827 = v[4] * x775;
+        let x828 = x770 * x784;
+        let x829 = x813 - Self::mul_add(x38, x775, x809);
+        let x830 = x38 * x781;
+        let x831 = x814 + Self::mul_add(x38, x782, x810);
+        let x832 = x812 - Self::mul_add(v[4], x783, x808);
+        let x833 = x819 + x819;
+        let x834 = v[3] * x780;
+        let x835 = v[3] * x782;
+        let x836 = v[0] * x769;
+        let x837 = x811 + Self::mul_add(v[3], x783, x806);
+        let x838 = x818 + x818;
+        let x839 = x826 - x834 + (x828 + x836);
+        let x840 = Self::mul_add(s_q7, s_q8, c_q7 * x44);
+        let x841 = Self::mul_add(-c_q7, s_q8, s_q7 * x44);
+        let x842 = Self::mul_add(-s_q7, c_q8, c_q7 * x45);
+        let x843 = Self::mul_add(c_q7, c_q8, s_q7 * x45);
+        let x844 = s_q7 * 1.1;
+        let x845 = Self::mul_add(c_q7, 1.1, 0.00000000013331722853496525);
+        let x846 = 0.65 * s_q7;
+        let x847 = Self::mul_add(
+            -12.701650001451807,
+            x842,
+            0.000000008530897668050218 * x840,
+        );
+        let x848 = Self::mul_add(
+            -12.701650001451807,
+            x843,
+            0.000000008530897668050218 * x841,
+        );
+        let x849 = Self::mul_add(
+            s_q8,
+            -12.701650001451807,
+            c_q8 * 0.000000008530897668050218,
+        );
+        let x850 = Self::mul_add(
+            c_q7,
+            0.002139996587640933,
+            0.0000000234896432582596 * x842,
+        );
+        let x851 = Self::mul_add(
+            5.080660024070366,
+            c_q7,
+            Self::mul_add(-111.7548902508081, x842, 0.0000000234896432582596 * x840),
+        );
+        let x852 = Self::mul_add(
+            113.3918902508081,
+            c_q7,
+            Self::mul_add(5.080660024070365, x842, 0.002139996587640933 * x840),
+        );
+        let x853 = Self::mul_add(
+            s_q7,
+            0.002139996587640933,
+            0.0000000234896432582596 * x843,
+        );
+        let x854 = Self::mul_add(
+            5.080660024070366,
+            s_q7,
+            Self::mul_add(-111.7548902508081, x843, 0.0000000234896432582596 * x841),
+        );
+        let x855 = Self::mul_add(
+            113.3918902508081,
+            s_q7,
+            Self::mul_add(5.080660024070365, x843, 0.002139996587640933 * x841),
+        );
+        let x856 = Self::mul_add(
+            s_q8,
+            0.0000000234896432582596,
+            -0.00000000000043892063713626467,
+        );
+        let x857 = Self::mul_add(
+            s_q8,
+            -111.7548902508081,
+            c_q8 * 0.0000000234896432582596,
+        ) + -0.000000001042060790057617;
+        let x858 = Self::mul_add(5.080660024070365, s_q8, c_q8 * 0.002139996587640933)
+            + -0.000000023257065456274896;
+        let x859 = 1.1 * x849;
+        let x860 = 1.1 * x847;
+        let x861 = 0.65 * x848;
+        let x862 = 0.65 * x847;
+        let x863 = x859 + x862;
+        let x864 = 1.1 * x848;
+        let x865 = 0.65 * x849;
+        let x866 = Self::mul_add(c_q7, x855, Self::mul_add(x842, x854, x840 * x853))
+            - x861;
+        let x867 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x855,
+            Self::mul_add(s_q8, x854, c_q8 * x853),
+        ) - x864;
+        let x868 = x859
+            + (Self::mul_add(c_q7, x852, Self::mul_add(x842, x851, x840 * x850)) + x859);
+        let x869 = Self::mul_add(s_q7, x852, Self::mul_add(x843, x851, x841 * x850))
+            - x861;
+        let x870 = x865
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x852,
+                Self::mul_add(s_q8, x851, c_q8 * x850),
+            ) - x860);
+        let x871 = x863
+            + (Self::mul_add(s_q7, x855, Self::mul_add(x843, x854, x841 * x853)) + x863);
+        let x872 = x860
+            - (Self::mul_add(c_q7, x858, Self::mul_add(x842, x857, x840 * x856)) - x865);
+        let x873 = Self::mul_add(s_q7, x858, Self::mul_add(x843, x857, x841 * x856))
+            - x864;
+        let x874 = x862
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x858,
+                Self::mul_add(s_q8, x857, c_q8 * x856),
+            ) + x862);
+        let x875 = Self::mul_add(v[7], c_q7, v[3]);
+        let x876 = Self::mul_add(v[7], s_q7, v[4]);
+        let x877 = Self::mul_add(-0.00000000020510342851533115, v[7], x38);
+        let x878 = Self::mul_add(-v[7], x844, v[0]);
+        let x879 = Self::mul_add(v[7], x845, x784);
+        let x880 = Self::mul_add(v[7], x846, v[2]);
+        let x881 = Self::mul_add(0.00000000020510342851533115, x876, s_q7 * x877);
+        let x882 = Self::mul_add(0.00000000020510342851533115, x875, c_q7 * x877);
+        let x883 = Self::mul_add(-s_q7, x875, c_q7 * x876);
+        let x884 = Self::mul_add(-x846, x876, x845 * x877)
+            + Self::mul_add(0.00000000020510342851533115, x879, s_q7 * x880);
+        let x885 = Self::mul_add(x846, x875, x844 * x877)
+            - Self::mul_add(0.00000000020510342851533115, x878, c_q7 * x880);
+        let x886 = Self::mul_add(x845, x875, x844 * x876)
+            - Self::mul_add(-s_q7, x878, c_q7 * x879);
+        let x887 = Self::mul_add(-v[7], x881, Self::mul_add(c_q7, x709, x787));
+        let x888 = Self::mul_add(-v[7], x882, Self::mul_add(-s_q7, x709, x788));
+        let x889 = Self::mul_add(
+            -v[7],
+            x883,
+            Self::mul_add(-0.00000000020510342851533115, x709, x700),
+        );
+        let x890 = Self::mul_add(-v[7], x884, Self::mul_add(-x709, x844, x789));
+        let x891 = Self::mul_add(v[7], x885, Self::mul_add(-x709, x845, x790));
+        let x892 = Self::mul_add(v[7], x886, Self::mul_add(x709, x846, x791));
+        let x893 = Self::mul_add(0.00000000020510342851533115, v[4], s_q7 * x38);
+        let x894 = Self::mul_add(0.00000000020510342851533115, v[3], c_q7 * x38);
+        let x895 = Self::mul_add(-v[4], x846, x38 * x845)
+            + Self::mul_add(0.00000000020510342851533115, x784, v[2] * s_q7);
+        let x896 = Self::mul_add(v[3], x846, x38 * x844)
+            - Self::mul_add(0.00000000020510342851533115, v[0], v[2] * c_q7);
+        let x897 = Self::mul_add(v[3], x845, v[4] * x844)
+            - Self::mul_add(-v[0], s_q7, c_q7 * x784);
+        let x898 = Self::mul_add(-0.00000000020510342851533115, x788, s_q7 * x700)
+            + Self::mul_add(-v[4], x27, x38 * x894);
+        let x899 = Self::mul_add(0.00000000020510342851533115, x787, c_q7 * x700)
+            - Self::mul_add(v[3], x27, x38 * x893);
+        let x900 = Self::mul_add(s_q7, x787, c_q7 * x788)
+            + Self::mul_add(v[3], x894, v[4] * x893);
+        let x901 = Self::mul_add(x788, x846, x700 * x845)
+            + Self::mul_add(-0.00000000020510342851533115, x790, s_q7 * x791)
+            - (Self::mul_add(v[4], x897, x38 * x896)
+                - Self::mul_add(-x27, x784, v[2] * x894));
+        let x902 = Self::mul_add(x787, x846, x700 * x844)
+            - Self::mul_add(0.00000000020510342851533115, x789, c_q7 * x791)
+            + (Self::mul_add(v[3], x897, x38 * x895)
+                + Self::mul_add(v[0], x27, v[2] * x893));
+        let x903 = Self::mul_add(-x787, x845, x788 * x844)
+            - Self::mul_add(s_q7, x789, c_q7 * x790)
+            - (Self::mul_add(-v[3], x896, v[4] * x895)
+                + Self::mul_add(v[0], x894, x784 * x893));
+        let x904 = x881 + x893;
+        let x905 = x882 + x894;
+        let x906 = x27 - x883;
+        let x907 = x884 + x895;
+        let x908 = x885 + x896;
+        let x909 = x886 + x897;
+        let x910 = x869 * x876;
+        let x911 = x870 * x877;
+        let x912 = x866 * x875;
+        let x913 = x867 * x877;
+        let x914 = x872 * x875;
+        let x915 = x873 * x876;
+        let x916 = x849 * x879;
+        let x917 = x848 * x880;
+        let x918 = x849 * x878;
+        let x919 = x847 * x880;
+        let x920 = x848 * x878;
+        let x921 = x847 * x879;
+        let x922 = Self::mul_add(x868, x875, x910) - x911 - (x916 - x917);
+        let x923 = Self::mul_add(x871, x876, x912) + x913 + (x918 - x919);
+        let x924 = Self::mul_add(-x874, x877, x914 - x915) + (x920 - x921);
+        let x925 = x849 * x876;
+        let x926 = x848 * x877;
+        let x927 = x925 - x926;
+        let x928 = x849 * x875;
+        let x929 = x847 * x877;
+        let x930 = x928 - x929;
+        let x931 = x848 * x875;
+        let x932 = x847 * x876;
+        let x933 = x931 - x932;
+        let x934 = x866 * x877;
+        let x935 = x872 * x876;
+        let x936 = x868 * x877;
+        let x937 = x868 * x876;
+        let x938 = x849 * x880;
+        let x939 = x848 * x879;
+        let x940 = x938 + x939;
+        let x941 = x869 * x877;
+        let x942 = x870 * x876;
+        let x943 = x871 * x877;
+        let x944 = x874 * x876;
+        let x945 = x873 * x875;
+        let x946 = x871 * x875;
+        let x947 = x847 * x878;
+        let x948 = x938 + x947;
+        let x949 = x867 * x875;
+        let x950 = x874 * x875;
+        let x951 = x939 + x947;
+        let x952 = Self::mul_add(-c_q7, c_q9, Self::mul_add(-x66, x842, s_q9 * x840));
+        let x953 = Self::mul_add(-s_q7, c_q9, Self::mul_add(-x66, x843, s_q9 * x841));
+        let x954 = x64 + Self::mul_add(-s_q8, x66, c_q8 * s_q9);
+        let x955 = Self::mul_add(c_q7, s_q9, Self::mul_add(x67, x842, c_q9 * x840));
+        let x956 = Self::mul_add(s_q7, s_q9, Self::mul_add(x67, x843, c_q9 * x841));
+        let x957 = x65 - Self::mul_add(s_q8, x67, c_q8 * c_q9);
+        let x958 = Self::mul_add(
+            -0.00000000020510342851533115,
+            c_q7,
+            Self::mul_add(-0.00000000020510342851533115, x840, x842),
+        );
+        let x959 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q7,
+            Self::mul_add(-0.00000000020510342851533115, x841, x843),
+        );
+        let x960 = s_q8 - x44 + 0.000000000000000000042067416388743556;
+        let x961 = Self::mul_add(0.4, s_q7, 0.275 * x843);
+        let x962 = 0.65 + Self::mul_add(0.4, c_q7, 0.275 * x842);
+        let x963 = 1.1 + Self::mul_add(0.275, s_q8, -0.00000000008204137140613246);
+        let x964 = Self::mul_add(-x960, x961, x959 * x963);
+        let x965 = Self::mul_add(-x960, x962, x958 * x963);
+        let x966 = Self::mul_add(-x959, x962, x958 * x961);
+        let x967 = 81.53205 * x955;
+        let x968 = 81.53205 * x956;
+        let x969 = 81.53205 * x957;
+        let x970 = 0.00214 * x958;
+        let x971 = Self::mul_add(-36.18604050126307, x958, 63.36336825000001 * x955);
+        let x972 = Self::mul_add(
+            69.99836825,
+            x958,
+            Self::mul_add(36.18604050126307, x955, 0.00214 * x952),
+        );
+        let x973 = 0.00214 * x959;
+        let x974 = Self::mul_add(-36.18604050126307, x959, 63.36336825000001 * x956);
+        let x975 = Self::mul_add(
+            69.99836825,
+            x959,
+            Self::mul_add(36.18604050126307, x956, 0.00214 * x953),
+        );
+        let x976 = 0.00214 * x960;
+        let x977 = Self::mul_add(36.18604050126307, x960, 63.36336825000001 * x957);
+        let x978 = Self::mul_add(
+            69.99836825,
+            x960,
+            Self::mul_add(-36.18604050126307, x957, 0.00214 * x954),
+        );
+        let x979 = x963 * x969;
+        let x980 = x961 * x968;
+        let x981 = x979 - x980;
+        let x982 = x961 * x967;
+        let x983 = x963 * x967;
+        let x984 = x962 * x968;
+        let x985 = x962 * x967;
+        let x986 = x979 - x985;
+        let x987 = x963 * x968;
+        let x988 = x962 * x969;
+        let x989 = x961 * x969;
+        let x990 = x980 + x985;
+        let x991 = x981
+            - (Self::mul_add(x958, x972, Self::mul_add(-x955, x971, x952 * x970))
+                - x981);
+        let x992 = x984
+            - (Self::mul_add(x959, x972, Self::mul_add(-x956, x971, x953 * x970))
+                - x982);
+        let x993 = x988
+            + (Self::mul_add(x960, x972, Self::mul_add(x957, x971, x954 * x970)) - x983);
+        let x994 = x982
+            - (Self::mul_add(x958, x975, Self::mul_add(-x955, x974, x952 * x973))
+                - x984);
+        let x995 = x986
+            - (Self::mul_add(x959, x975, Self::mul_add(-x956, x974, x953 * x973))
+                - x986);
+        let x996 = x989
+            + (Self::mul_add(x960, x975, Self::mul_add(x957, x974, x954 * x973)) - x987);
+        let x997 = x983
+            - (Self::mul_add(x958, x978, Self::mul_add(x955, x977, x952 * x976)) + x988);
+        let x998 = x987
+            - (Self::mul_add(x959, x978, Self::mul_add(x956, x977, x953 * x976)) + x989);
+        let x999 = x990
+            + (Self::mul_add(x960, x978, Self::mul_add(-x957, x977, x954 * x976))
+                + x990);
+        let x1000 = Self::mul_add(v[8], x958, x875);
+        let x1001 = Self::mul_add(v[8], x959, x876);
+        let x1002 = Self::mul_add(v[8], x960, x877);
+        let x1003 = Self::mul_add(-v[8], x964, x878);
+        let x1004 = Self::mul_add(v[8], x965, x879);
+        let x1005 = Self::mul_add(-v[8], x966, x880);
+        let x1006 = Self::mul_add(-x960, x1001, x959 * x1002);
+        let x1007 = Self::mul_add(-x960, x1000, x958 * x1002);
+        let x1008 = Self::mul_add(-x959, x1000, x958 * x1001);
+        let x1009 = Self::mul_add(-x960, x1004, x959 * x1005);
+        let x1010 = Self::mul_add(-x960, x1003, x958 * x1005);
+        let x1011 = Self::mul_add(-x959, x1003, x958 * x1004);
+        let x1012 = Self::mul_add(x966, x1001, x965 * x1002) + x1009;
+        let x1013 = Self::mul_add(-x966, x1000, x964 * x1002) - x1010;
+        let x1014 = Self::mul_add(x965, x1000, x964 * x1001) - x1011;
+        let x1015 = Self::mul_add(-v[8], x1006, Self::mul_add(x720, x958, x887));
+        let x1016 = Self::mul_add(-v[8], x1007, Self::mul_add(-x720, x959, x888));
+        let x1017 = Self::mul_add(-v[8], x1008, Self::mul_add(x720, x960, x889));
+        let x1018 = Self::mul_add(-v[8], x1012, Self::mul_add(-x720, x964, x890));
+        let x1019 = Self::mul_add(v[8], x1013, Self::mul_add(-x720, x965, x891));
+        let x1020 = Self::mul_add(v[8], x1014, Self::mul_add(-x720, x966, x892));
+        let x1021 = Self::mul_add(-x876, x960, x877 * x959);
+        let x1022 = Self::mul_add(-x875, x960, x877 * x958);
+        let x1023 = Self::mul_add(-x875, x959, x876 * x958);
+        let x1024 = Self::mul_add(x876, x966, x877 * x965)
+            + Self::mul_add(-x879, x960, x880 * x959);
+        let x1025 = Self::mul_add(-x875, x966, x877 * x964)
+            - Self::mul_add(-x878, x960, x880 * x958);
+        let x1026 = Self::mul_add(x875, x965, x876 * x964)
+            - Self::mul_add(-x878, x959, x879 * x958);
+        let x1027 = Self::mul_add(x888, x960, x889 * x959)
+            + Self::mul_add(x876, x1023, x877 * x1022);
+        let x1028 = Self::mul_add(-x887, x960, x889 * x958)
+            - Self::mul_add(-x875, x1023, x877 * x1021);
+        let x1029 = Self::mul_add(x887, x959, x888 * x958)
+            + Self::mul_add(x875, x1022, x876 * x1021);
+        let x1030 = Self::mul_add(-x888, x966, x889 * x965)
+            + Self::mul_add(x891, x960, x892 * x959)
+            - (Self::mul_add(x876, x1026, x877 * x1025)
+                - Self::mul_add(x879, x1023, x880 * x1022));
+        let x1031 = Self::mul_add(-x887, x966, x889 * x964)
+            - Self::mul_add(-x890, x960, x892 * x958)
+            + (Self::mul_add(x875, x1026, x877 * x1024)
+                + Self::mul_add(-x878, x1023, x880 * x1021));
+        let x1032 = Self::mul_add(-x887, x965, x888 * x964)
+            - Self::mul_add(x890, x959, x891 * x958)
+            - (Self::mul_add(-x875, x1025, x876 * x1024)
+                + Self::mul_add(x878, x1022, x879 * x1021));
+        let x1033 = x1006 + x1021;
+        let x1034 = x1007 + x1022;
+        let x1035 = x1008 + x1023;
+        let x1036 = x1012 + x1024;
+        let x1037 = x1013 + x1025;
+        let x1038 = x1014 + x1026;
+        let x1039 = x992 * x1001;
+        let x1040 = x993 * x1002;
+        let x1041 = x994 * x1000;
+        let x1042 = x996 * x1002;
+        let x1043 = x997 * x1000;
+        let x1044 = x998 * x1001;
+        let x1045 = x969 * x1004;
+        let x1046 = x968 * x1005;
+        let x1047 = x969 * x1003;
+        let x1048 = x967 * x1005;
+        let x1049 = x968 * x1003;
+        let x1050 = x967 * x1004;
+        let x1051 = Self::mul_add(x991, x1000, x1039) - x1040 - (x1045 + x1046);
+        let x1052 = Self::mul_add(x995, x1001, x1041) - x1042 + (x1047 + x1048);
+        let x1053 = Self::mul_add(-x999, x1002, x1043 + x1044) + (x1049 - x1050);
+        let x1054 = x969 * x1001;
+        let x1055 = x968 * x1002;
+        let x1056 = x1054 + x1055;
+        let x1057 = x969 * x1000;
+        let x1058 = x967 * x1002;
+        let x1059 = x1057 + x1058;
+        let x1060 = x968 * x1000;
+        let x1061 = x967 * x1001;
+        let x1062 = x1060 - x1061;
+        let x1063 = x994 * x1002;
+        let x1064 = x997 * x1001;
+        let x1065 = x991 * x1002;
+        let x1066 = x991 * x1001;
+        let x1067 = x969 * x1005;
+        let x1068 = x968 * x1004;
+        let x1069 = x1067 - x1068;
+        let x1070 = x992 * x1002;
+        let x1071 = x993 * x1001;
+        let x1072 = x995 * x1002;
+        let x1073 = x999 * x1001;
+        let x1074 = x998 * x1000;
+        let x1075 = x995 * x1000;
+        let x1076 = x967 * x1003;
+        let x1077 = x1067 - x1076;
+        let x1078 = x996 * x1000;
+        let x1079 = x999 * x1000;
+        let x1080 = x1068 + x1076;
+        let x1081 = Self::mul_add(s_q10, x955, c_q10 * x952);
+        let x1082 = Self::mul_add(s_q10, x956, c_q10 * x953);
+        let x1083 = Self::mul_add(-s_q10, x957, c_q10 * x954);
+        let x1084 = Self::mul_add(-c_q10, x955, s_q10 * x952);
+        let x1085 = Self::mul_add(-c_q10, x956, s_q10 * x953);
+        let x1086 = Self::mul_add(c_q10, x957, s_q10 * x954);
+        let x1087 = Self::mul_add(0.87, x955, x962);
+        let x1088 = Self::mul_add(0.87, x956, x961);
+        let x1089 = Self::mul_add(-0.87, x957, x963);
+        let x1090 = Self::mul_add(-x960, x1088, x959 * x1089);
+        let x1091 = Self::mul_add(-x960, x1087, x958 * x1089);
+        let x1092 = Self::mul_add(-x959, x1087, x958 * x1088);
+        let x1093 = 45.1584 * x1084;
+        let x1094 = 45.1584 * x1085;
+        let x1095 = 45.1584 * x1086;
+        let x1096 = 0.6328 * x958;
+        let x1097 = Self::mul_add(24.351642000914637, x958, 24.4950615 * x1084);
+        let x1098 = Self::mul_add(
+            28.2393615,
+            x958,
+            Self::mul_add(-24.35164200091464, x1084, 0.6328 * x1081),
+        );
+        let x1099 = 0.6328 * x959;
+        let x1100 = Self::mul_add(24.351642000914637, x959, 24.4950615 * x1085);
+        let x1101 = Self::mul_add(
+            28.2393615,
+            x959,
+            Self::mul_add(-24.35164200091464, x1085, 0.6328 * x1082),
+        );
+        let x1102 = 0.6328 * x960;
+        let x1103 = Self::mul_add(24.351642000914637, x960, 24.4950615 * x1086);
+        let x1104 = Self::mul_add(
+            28.2393615,
+            x960,
+            Self::mul_add(-24.35164200091464, x1086, 0.6328 * x1083),
+        );
+        let x1105 = x1089 * x1095;
+        let x1106 = x1088 * x1094;
+        let x1107 = x1105 + x1106;
+        let x1108 = x1088 * x1093;
+        let x1109 = x1089 * x1093;
+        let x1110 = x1087 * x1094;
+        let x1111 = x1087 * x1093;
+        let x1112 = x1105 + x1111;
+        let x1113 = x1089 * x1094;
+        let x1114 = x1087 * x1095;
+        let x1115 = x1088 * x1095;
+        let x1116 = x1106 + x1111;
+        let x1117 = x1107
+            - (Self::mul_add(x958, x1098, Self::mul_add(-x1084, x1097, x1081 * x1096))
+                - x1107);
+        let x1118 = x1110
+            + (Self::mul_add(x959, x1098, Self::mul_add(-x1085, x1097, x1082 * x1096))
+                + x1108);
+        let x1119 = x1114
+            + (Self::mul_add(x960, x1098, Self::mul_add(-x1086, x1097, x1083 * x1096))
+                + x1109);
+        let x1120 = x1108
+            + (Self::mul_add(x958, x1101, Self::mul_add(-x1084, x1100, x1081 * x1099))
+                + x1110);
+        let x1121 = x1112
+            - (Self::mul_add(x959, x1101, Self::mul_add(-x1085, x1100, x1082 * x1099))
+                - x1112);
+        let x1122 = x1115
+            + (Self::mul_add(x960, x1101, Self::mul_add(-x1086, x1100, x1083 * x1099))
+                + x1113);
+        let x1123 = x1109
+            + (Self::mul_add(x958, x1104, Self::mul_add(-x1084, x1103, x1081 * x1102))
+                + x1114);
+        let x1124 = x1113
+            + (Self::mul_add(x959, x1104, Self::mul_add(-x1085, x1103, x1082 * x1102))
+                + x1115);
+        let x1125 = x1116
+            - (Self::mul_add(x960, x1104, Self::mul_add(-x1086, x1103, x1083 * x1102))
+                - x1116);
+        let x1126 = Self::mul_add(v[9], x958, x1000);
+        let x1127 = Self::mul_add(v[9], x959, x1001);
+        let x1128 = Self::mul_add(v[9], x960, x1002);
+        let x1129 = Self::mul_add(-v[9], x1090, x1003);
+        let x1130 = Self::mul_add(v[9], x1091, x1004);
+        let x1131 = Self::mul_add(-v[9], x1092, x1005);
+        let x1132 = Self::mul_add(-x960, x1127, x959 * x1128);
+        let x1133 = Self::mul_add(-x960, x1126, x958 * x1128);
+        let x1134 = Self::mul_add(-x959, x1126, x958 * x1127);
+        let x1135 = Self::mul_add(-x960, x1130, x959 * x1131);
+        let x1136 = Self::mul_add(-x960, x1129, x958 * x1131);
+        let x1137 = Self::mul_add(-x959, x1129, x958 * x1130);
+        let x1138 = Self::mul_add(x1092, x1127, x1091 * x1128) + x1135;
+        let x1139 = Self::mul_add(-x1092, x1126, x1090 * x1128) - x1136;
+        let x1140 = Self::mul_add(x1091, x1126, x1090 * x1127) - x1137;
+        let x1141 = Self::mul_add(-v[9], x1132, Self::mul_add(x728, x958, x1015));
+        let x1142 = Self::mul_add(-v[9], x1133, Self::mul_add(-x728, x959, x1016));
+        let x1143 = Self::mul_add(-v[9], x1134, Self::mul_add(x728, x960, x1017));
+        let x1144 = Self::mul_add(-v[9], x1138, Self::mul_add(-x728, x1090, x1018));
+        let x1145 = Self::mul_add(v[9], x1139, Self::mul_add(-x728, x1091, x1019));
+        let x1146 = Self::mul_add(v[9], x1140, Self::mul_add(-x728, x1092, x1020));
+        let x1147 = x1009 + Self::mul_add(x1001, x1092, x1002 * x1091);
+        let x1148 = x1010 - Self::mul_add(-x1000, x1092, x1002 * x1090);
+        let x1149 = x1011 - Self::mul_add(x1000, x1091, x1001 * x1090);
+        let x1150 = Self::mul_add(x960, x1016, x959 * x1017)
+            + Self::mul_add(x1001, x1008, x1002 * x1007);
+        let x1151 = Self::mul_add(-x960, x1015, x958 * x1017)
+            - Self::mul_add(-x1000, x1008, x1002 * x1006);
+        let x1152 = Self::mul_add(x959, x1015, x958 * x1016)
+            + Self::mul_add(x1000, x1007, x1001 * x1006);
+        let x1153 = Self::mul_add(-x1016, x1092, x1017 * x1091)
+            + Self::mul_add(x960, x1019, x959 * x1020)
+            + (Self::mul_add(x1001, x1149, x1002 * x1148)
+                + Self::mul_add(x1004, x1008, x1005 * x1007));
+        let x1154 = Self::mul_add(-x1015, x1092, x1017 * x1090)
+            - Self::mul_add(-x960, x1018, x958 * x1020)
+            + (Self::mul_add(-x1000, x1149, x1002 * x1147)
+                + Self::mul_add(-x1003, x1008, x1005 * x1006));
+        let x1155 = Self::mul_add(-x1015, x1091, x1016 * x1090)
+            - Self::mul_add(x959, x1018, x958 * x1019)
+            - (Self::mul_add(x1000, x1148, x1001 * x1147)
+                + Self::mul_add(x1003, x1007, x1004 * x1006));
+        let x1156 = x1006 + x1132;
+        let x1157 = x1007 + x1133;
+        let x1158 = x1008 + x1134;
+        let x1159 = x1138 + x1147;
+        let x1160 = x1139 - x1148;
+        let x1161 = x1140 - x1149;
+        let x1162 = x1118 * x1127;
+        let x1163 = x1119 * x1128;
+        let x1164 = x1120 * x1126;
+        let x1165 = x1122 * x1128;
+        let x1166 = x1123 * x1126;
+        let x1167 = x1124 * x1127;
+        let x1168 = x1095 * x1130;
+        let x1169 = x1094 * x1131;
+        let x1170 = x1095 * x1129;
+        let x1171 = x1093 * x1131;
+        let x1172 = x1094 * x1129;
+        let x1173 = x1093 * x1130;
+        let x1174 = Self::mul_add(x1117, x1126, -x1162) - x1163 - (x1168 - x1169);
+        let x1175 = Self::mul_add(-x1121, x1127, x1164) + x1165 - (x1170 - x1171);
+        let x1176 = Self::mul_add(-x1125, x1128, x1166 + x1167) + (x1172 - x1173);
+        let x1177 = x1095 * x1127;
+        let x1178 = x1094 * x1128;
+        let x1179 = x1177 - x1178;
+        let x1180 = x1095 * x1126;
+        let x1181 = x1093 * x1128;
+        let x1182 = x1180 - x1181;
+        let x1183 = x1094 * x1126;
+        let x1184 = x1093 * x1127;
+        let x1185 = x1183 - x1184;
+        let x1186 = x1120 * x1128;
+        let x1187 = x1123 * x1127;
+        let x1188 = x1117 * x1128;
+        let x1189 = x1117 * x1127;
+        let x1190 = x1095 * x1131;
+        let x1191 = x1094 * x1130;
+        let x1192 = x1190 + x1191;
+        let x1193 = x1118 * x1128;
+        let x1194 = x1119 * x1127;
+        let x1195 = x1121 * x1128;
+        let x1196 = x1125 * x1127;
+        let x1197 = x1124 * x1126;
+        let x1198 = x1121 * x1126;
+        let x1199 = x1093 * x1129;
+        let x1200 = x1190 + x1199;
+        let x1201 = x1122 * x1126;
+        let x1202 = x1125 * x1126;
+        let x1203 = x1191 + x1199;
+        let x1204 = Self::mul_add(-s_q11, x1084, c_q11 * x1081);
+        let x1205 = Self::mul_add(-s_q11, x1085, c_q11 * x1082);
+        let x1206 = Self::mul_add(-s_q11, x1086, c_q11 * x1083);
+        let x1207 = Self::mul_add(c_q11, x1084, s_q11 * x1081);
+        let x1208 = Self::mul_add(c_q11, x1085, s_q11 * x1082);
+        let x1209 = Self::mul_add(c_q11, x1086, s_q11 * x1083);
+        let x1210 = x1087 - Self::mul_add(0.275, x958, 0.63 * x1084);
+        let x1211 = x1088 - Self::mul_add(0.275, x959, 0.63 * x1085);
+        let x1212 = x1089 - Self::mul_add(0.275, x960, 0.63 * x1086);
+        let x1213 = Self::mul_add(-x960, x1211, x959 * x1212);
+        let x1214 = Self::mul_add(-x960, x1210, x958 * x1212);
+        let x1215 = Self::mul_add(-x959, x1210, x958 * x1211);
+        let x1216 = 7.078399999258757 * x1207;
+        let x1217 = 7.078399999258757 * x1208;
+        let x1218 = 7.078399999258757 * x1209;
+        let x1219 = 0.01675 * x958;
+        let x1220 = Self::mul_add(-2.5482240016099564, x958, 9.142025249762803 * x1207);
+        let x1221 = Self::mul_add(
+            -9.223235249762805,
+            x958,
+            Self::mul_add(-2.5482240016099564, x1207, 0.01675 * x1204),
+        );
+        let x1222 = 0.01675 * x959;
+        let x1223 = Self::mul_add(-2.5482240016099564, x959, 9.142025249762803 * x1208);
+        let x1224 = Self::mul_add(
+            -9.223235249762805,
+            x959,
+            Self::mul_add(-2.5482240016099564, x1208, 0.01675 * x1205),
+        );
+        let x1225 = 0.01675 * x960;
+        let x1226 = Self::mul_add(-2.5482240016099564, x960, 9.142025249762803 * x1209);
+        let x1227 = Self::mul_add(
+            -9.223235249762805,
+            x960,
+            Self::mul_add(-2.5482240016099564, x1209, 0.01675 * x1206),
+        );
+        let x1228 = x1212 * x1218;
+        let x1229 = x1211 * x1217;
+        let x1230 = x1228 + x1229;
+        let x1231 = x1211 * x1216;
+        let x1232 = x1212 * x1216;
+        let x1233 = x1210 * x1217;
+        let x1234 = x1210 * x1216;
+        let x1235 = x1228 + x1234;
+        let x1236 = x1212 * x1217;
+        let x1237 = x1210 * x1218;
+        let x1238 = x1211 * x1218;
+        let x1239 = x1229 + x1234;
+        let x1240 = x1230
+            - (Self::mul_add(x958, x1221, Self::mul_add(x1207, x1220, x1204 * x1219))
+                - x1230);
+        let x1241 = x1233
+            + (Self::mul_add(x959, x1221, Self::mul_add(x1208, x1220, x1205 * x1219))
+                + x1231);
+        let x1242 = x1237
+            + (Self::mul_add(x960, x1221, Self::mul_add(x1209, x1220, x1206 * x1219))
+                + x1232);
+        let x1243 = x1231
+            + (Self::mul_add(x958, x1224, Self::mul_add(x1207, x1223, x1204 * x1222))
+                + x1233);
+        let x1244 = x1235
+            - (Self::mul_add(x959, x1224, Self::mul_add(x1208, x1223, x1205 * x1222))
+                - x1235);
+        let x1245 = x1238
+            + (Self::mul_add(x960, x1224, Self::mul_add(x1209, x1223, x1206 * x1222))
+                + x1236);
+        let x1246 = x1232
+            + (Self::mul_add(x958, x1227, Self::mul_add(x1207, x1226, x1204 * x1225))
+                + x1237);
+        let x1247 = x1236
+            + (Self::mul_add(x959, x1227, Self::mul_add(x1208, x1226, x1205 * x1225))
+                + x1238);
+        let x1248 = x1239
+            - (Self::mul_add(x960, x1227, Self::mul_add(x1209, x1226, x1206 * x1225))
+                - x1239);
+        let x1249 = Self::mul_add(v[10], x958, x1126);
+        let x1250 = Self::mul_add(v[10], x959, x1127);
+        let x1251 = Self::mul_add(v[10], x960, x1128);
+        let x1252 = Self::mul_add(-v[10], x1213, x1129);
+        let x1253 = Self::mul_add(v[10], x1214, x1130);
+        let x1254 = Self::mul_add(-v[10], x1215, x1131);
+        let x1255 = Self::mul_add(-x960, x1250, x959 * x1251);
+        let x1256 = Self::mul_add(-x960, x1249, x958 * x1251);
+        let x1257 = Self::mul_add(-x959, x1249, x958 * x1250);
+        let x1258 = Self::mul_add(x1215, x1250, x1214 * x1251)
+            + Self::mul_add(-x960, x1253, x959 * x1254);
+        let x1259 = Self::mul_add(-x1215, x1249, x1213 * x1251)
+            - Self::mul_add(-x960, x1252, x958 * x1254);
+        let x1260 = Self::mul_add(x1214, x1249, x1213 * x1250)
+            - Self::mul_add(-x959, x1252, x958 * x1253);
+        let x1261 = Self::mul_add(-v[10], x1255, Self::mul_add(x737, x958, x1141));
+        let x1262 = Self::mul_add(-v[10], x1256, Self::mul_add(-x737, x959, x1142));
+        let x1263 = Self::mul_add(-v[10], x1257, Self::mul_add(x737, x960, x1143));
+        let x1264 = Self::mul_add(-v[10], x1258, Self::mul_add(-x737, x1213, x1144));
+        let x1265 = Self::mul_add(v[10], x1259, Self::mul_add(-x737, x1214, x1145));
+        let x1266 = Self::mul_add(v[10], x1260, Self::mul_add(-x737, x1215, x1146));
+        let x1267 = x1135 + Self::mul_add(x1127, x1215, x1128 * x1214);
+        let x1268 = x1136 - Self::mul_add(-x1126, x1215, x1128 * x1213);
+        let x1269 = x1137 - Self::mul_add(x1126, x1214, x1127 * x1213);
+        let x1270 = Self::mul_add(x960, x1142, x959 * x1143)
+            + Self::mul_add(x1127, x1134, x1128 * x1133);
+        let x1271 = Self::mul_add(-x960, x1141, x958 * x1143)
+            - Self::mul_add(-x1126, x1134, x1128 * x1132);
+        let x1272 = Self::mul_add(x959, x1141, x958 * x1142)
+            + Self::mul_add(x1126, x1133, x1127 * x1132);
+        let x1273 = Self::mul_add(-x1142, x1215, x1143 * x1214)
+            + Self::mul_add(x960, x1145, x959 * x1146)
+            + (Self::mul_add(x1127, x1269, x1128 * x1268)
+                + Self::mul_add(x1130, x1134, x1131 * x1133));
+        let x1274 = Self::mul_add(-x1141, x1215, x1143 * x1213)
+            - Self::mul_add(-x960, x1144, x958 * x1146)
+            + (Self::mul_add(-x1126, x1269, x1128 * x1267)
+                + Self::mul_add(-x1129, x1134, x1131 * x1132));
+        let x1275 = Self::mul_add(-x1141, x1214, x1142 * x1213)
+            - Self::mul_add(x959, x1144, x958 * x1145)
+            - (Self::mul_add(x1126, x1268, x1127 * x1267)
+                + Self::mul_add(x1129, x1133, x1130 * x1132));
+        let x1276 = x1132 + x1255;
+        let x1277 = x1133 + x1256;
+        let x1278 = x1134 + x1257;
+        let x1279 = x1258 + x1267;
+        let x1280 = x1259 - x1268;
+        let x1281 = x1260 - x1269;
+        let x1282 = x1241 * x1250;
+        let x1283 = x1242 * x1251;
+        let x1284 = x1243 * x1249;
+        let x1285 = x1245 * x1251;
+        let x1286 = x1246 * x1249;
+        let x1287 = x1247 * x1250;
+        let x1288 = x1218 * x1253;
+        let x1289 = x1217 * x1254;
+        let x1290 = x1218 * x1252;
+        let x1291 = x1216 * x1254;
+        let x1292 = x1217 * x1252;
+        let x1293 = x1216 * x1253;
+        let x1294 = Self::mul_add(x1240, x1249, -x1282) - x1283 - (x1288 - x1289);
+        let x1295 = Self::mul_add(-x1244, x1250, x1284) + x1285 - (x1290 - x1291);
+        let x1296 = Self::mul_add(-x1248, x1251, x1286 + x1287) + (x1292 - x1293);
+        let x1297 = x1218 * x1250;
+        let x1298 = x1217 * x1251;
+        let x1299 = x1297 - x1298;
+        let x1300 = x1218 * x1249;
+        let x1301 = x1216 * x1251;
+        let x1302 = x1300 - x1301;
+        let x1303 = x1217 * x1249;
+        let x1304 = x1216 * x1250;
+        let x1305 = x1303 - x1304;
+        let x1306 = x1243 * x1251;
+        let x1307 = x1246 * x1250;
+        let x1308 = x1240 * x1251;
+        let x1309 = x1240 * x1250;
+        let x1310 = x1218 * x1254;
+        let x1311 = x1217 * x1253;
+        let x1312 = x1310 + x1311;
+        let x1313 = x1241 * x1251;
+        let x1314 = x1242 * x1250;
+        let x1315 = x1244 * x1251;
+        let x1316 = x1248 * x1250;
+        let x1317 = x1247 * x1249;
+        let x1318 = x1244 * x1249;
+        let x1319 = x1216 * x1252;
+        let x1320 = x1310 + x1319;
+        let x1321 = x1245 * x1249;
+        let x1322 = x1248 * x1249;
+        let x1323 = x1311 + x1319;
+        let x1324 = Self::mul_add(
+            s_q12,
+            x958,
+            Self::mul_add(x119, x1207, c_q12 * x1204),
+        );
+        let x1325 = Self::mul_add(
+            s_q12,
+            x959,
+            Self::mul_add(x119, x1208, c_q12 * x1205),
+        );
+        let x1326 = Self::mul_add(
+            s_q12,
+            x960,
+            Self::mul_add(x119, x1209, c_q12 * x1206),
+        );
+        let x1327 = Self::mul_add(
+            -c_q12,
+            x958,
+            Self::mul_add(-x120, x1207, s_q12 * x1204),
+        );
+        let x1328 = Self::mul_add(
+            -c_q12,
+            x959,
+            Self::mul_add(-x120, x1208, s_q12 * x1205),
+        );
+        let x1329 = Self::mul_add(
+            -c_q12,
+            x960,
+            Self::mul_add(-x120, x1209, s_q12 * x1206),
+        );
+        let x1330 = Self::mul_add(-0.00000000020510342851533115, x958, x1207);
+        let x1331 = Self::mul_add(-0.00000000020510342851533115, x959, x1208);
+        let x1332 = Self::mul_add(-0.00000000020510342851533115, x960, x1209);
+        let x1333 = Self::mul_add(-0.36, x958, x1210);
+        let x1334 = Self::mul_add(-0.36, x959, x1211);
+        let x1335 = Self::mul_add(-0.36, x960, x1212);
+        let x1336 = Self::mul_add(-x1332, x1334, x1331 * x1335);
+        let x1337 = Self::mul_add(-x1332, x1333, x1330 * x1335);
+        let x1338 = Self::mul_add(-x1331, x1333, x1330 * x1334);
+        let x1339 = Self::mul_add(
+            -17.135250000000003,
+            x1327,
+            3.6140000000000003 * x1324,
+        );
+        let x1340 = Self::mul_add(
+            -17.135250000000003,
+            x1328,
+            3.6140000000000003 * x1325,
+        );
+        let x1341 = Self::mul_add(
+            -17.135250000000003,
+            x1329,
+            3.6140000000000003 * x1326,
+        );
+        let x1342 = Self::mul_add(0.809539999555672, x1330, 1.9877000000000002 * x1327);
+        let x1343 = Self::mul_add(
+            -2.7416399995923166,
+            x1330,
+            Self::mul_add(-5.252920330000002, x1327, 1.9877000000000002 * x1324),
+        );
+        let x1344 = Self::mul_add(
+            9.740442170000001,
+            x1330,
+            Self::mul_add(-2.741639999592316, x1327, 0.809539999555672 * x1324),
+        );
+        let x1345 = Self::mul_add(0.809539999555672, x1331, 1.9877000000000002 * x1328);
+        let x1346 = Self::mul_add(
+            -2.7416399995923166,
+            x1331,
+            Self::mul_add(-5.252920330000002, x1328, 1.9877000000000002 * x1325),
+        );
+        let x1347 = Self::mul_add(
+            9.740442170000001,
+            x1331,
+            Self::mul_add(-2.741639999592316, x1328, 0.809539999555672 * x1325),
+        );
+        let x1348 = Self::mul_add(0.809539999555672, x1332, 1.9877000000000002 * x1329);
+        let x1349 = Self::mul_add(
+            -2.7416399995923166,
+            x1332,
+            Self::mul_add(-5.252920330000002, x1329, 1.9877000000000002 * x1326),
+        );
+        let x1350 = Self::mul_add(
+            9.740442170000001,
+            x1332,
+            Self::mul_add(-2.741639999592316, x1329, 0.809539999555672 * x1326),
+        );
+        let x1351 = x1335 * x1341;
+        let x1352 = x1334 * x1340;
+        let x1353 = x1351 + x1352;
+        let x1354 = x1334 * x1339;
+        let x1355 = x1335 * x1339;
+        let x1356 = x1333 * x1340;
+        let x1357 = x1333 * x1339;
+        let x1358 = x1351 + x1357;
+        let x1359 = x1335 * x1340;
+        let x1360 = x1333 * x1341;
+        let x1361 = x1334 * x1341;
+        let x1362 = x1352 + x1357;
+        let x1363 = x1353
+            - (Self::mul_add(x1330, x1344, Self::mul_add(x1327, x1343, x1324 * x1342))
+                - x1353);
+        let x1364 = x1356
+            + (Self::mul_add(x1331, x1344, Self::mul_add(x1328, x1343, x1325 * x1342))
+                + x1354);
+        let x1365 = x1360
+            + (Self::mul_add(x1332, x1344, Self::mul_add(x1329, x1343, x1326 * x1342))
+                + x1355);
+        let x1366 = x1354
+            + (Self::mul_add(x1330, x1347, Self::mul_add(x1327, x1346, x1324 * x1345))
+                + x1356);
+        let x1367 = x1358
+            - (Self::mul_add(x1331, x1347, Self::mul_add(x1328, x1346, x1325 * x1345))
+                - x1358);
+        let x1368 = x1361
+            + (Self::mul_add(x1332, x1347, Self::mul_add(x1329, x1346, x1326 * x1345))
+                + x1359);
+        let x1369 = x1355
+            + (Self::mul_add(x1330, x1350, Self::mul_add(x1327, x1349, x1324 * x1348))
+                + x1360);
+        let x1370 = x1359
+            + (Self::mul_add(x1331, x1350, Self::mul_add(x1328, x1349, x1325 * x1348))
+                + x1361);
+        let x1371 = x1362
+            - (Self::mul_add(x1332, x1350, Self::mul_add(x1329, x1349, x1326 * x1348))
+                - x1362);
+        let x1372 = Self::mul_add(v[11], x1330, x1249);
+        let x1373 = Self::mul_add(v[11], x1331, x1250);
+        let x1374 = Self::mul_add(v[11], x1332, x1251);
+        let x1375 = Self::mul_add(-v[11], x1336, x1252);
+        let x1376 = Self::mul_add(v[11], x1337, x1253);
+        let x1377 = Self::mul_add(-v[11], x1338, x1254);
+        let x1378 = Self::mul_add(-x1332, x1373, x1331 * x1374);
+        let x1379 = Self::mul_add(-x1332, x1372, x1330 * x1374);
+        let x1380 = Self::mul_add(-x1331, x1372, x1330 * x1373);
+        let x1381 = Self::mul_add(x1338, x1373, x1337 * x1374)
+            + Self::mul_add(-x1332, x1376, x1331 * x1377);
+        let x1382 = Self::mul_add(-x1338, x1372, x1336 * x1374)
+            - Self::mul_add(-x1332, x1375, x1330 * x1377);
+        let x1383 = Self::mul_add(x1337, x1372, x1336 * x1373)
+            - Self::mul_add(-x1331, x1375, x1330 * x1376);
+        let x1384 = Self::mul_add(-v[11], x1378, Self::mul_add(x747, x1330, x1261));
+        let x1385 = Self::mul_add(-v[11], x1379, Self::mul_add(-x747, x1331, x1262));
+        let x1386 = Self::mul_add(-v[11], x1380, Self::mul_add(x747, x1332, x1263));
+        let x1387 = Self::mul_add(-v[11], x1381, Self::mul_add(-x747, x1336, x1264));
+        let x1388 = Self::mul_add(v[11], x1382, Self::mul_add(-x747, x1337, x1265));
+        let x1389 = Self::mul_add(v[11], x1383, Self::mul_add(-x747, x1338, x1266));
+        let x1390 = Self::mul_add(-x1250, x1332, x1251 * x1331);
+        let x1391 = Self::mul_add(-x1249, x1332, x1251 * x1330);
+        let x1392 = Self::mul_add(-x1249, x1331, x1250 * x1330);
+        let x1393 = Self::mul_add(x1250, x1338, x1251 * x1337)
+            + Self::mul_add(-x1253, x1332, x1254 * x1331);
+        let x1394 = Self::mul_add(-x1249, x1338, x1251 * x1336)
+            - Self::mul_add(-x1252, x1332, x1254 * x1330);
+        let x1395 = Self::mul_add(x1249, x1337, x1250 * x1336)
+            - Self::mul_add(-x1252, x1331, x1253 * x1330);
+        let x1396 = Self::mul_add(x1262, x1332, x1263 * x1331)
+            + Self::mul_add(x1250, x1392, x1251 * x1391);
+        let x1397 = Self::mul_add(-x1261, x1332, x1263 * x1330)
+            - Self::mul_add(-x1249, x1392, x1251 * x1390);
+        let x1398 = Self::mul_add(x1261, x1331, x1262 * x1330)
+            + Self::mul_add(x1249, x1391, x1250 * x1390);
+        let x1399 = Self::mul_add(-x1262, x1338, x1263 * x1337)
+            + Self::mul_add(x1265, x1332, x1266 * x1331)
+            - (Self::mul_add(x1250, x1395, x1251 * x1394)
+                - Self::mul_add(x1253, x1392, x1254 * x1391));
+        let x1400 = Self::mul_add(-x1261, x1338, x1263 * x1336)
+            - Self::mul_add(-x1264, x1332, x1266 * x1330)
+            + (Self::mul_add(x1249, x1395, x1251 * x1393)
+                + Self::mul_add(-x1252, x1392, x1254 * x1390));
+        let x1401 = Self::mul_add(-x1261, x1337, x1262 * x1336)
+            - Self::mul_add(x1264, x1331, x1265 * x1330)
+            - (Self::mul_add(-x1249, x1394, x1250 * x1393)
+                + Self::mul_add(x1252, x1391, x1253 * x1390));
+        let x1402 = x1378 + x1390;
+        let x1403 = x1379 + x1391;
+        let x1404 = x1380 + x1392;
+        let x1405 = x1381 + x1393;
+        let x1406 = x1382 + x1394;
+        let x1407 = x1383 + x1395;
+        let x1408 = x1364 * x1373;
+        let x1409 = x1365 * x1374;
+        let x1410 = x1366 * x1372;
+        let x1411 = x1368 * x1374;
+        let x1412 = x1369 * x1372;
+        let x1413 = x1370 * x1373;
+        let x1414 = x1341 * x1376;
+        let x1415 = x1340 * x1377;
+        let x1416 = x1341 * x1375;
+        let x1417 = x1339 * x1377;
+        let x1418 = x1340 * x1375;
+        let x1419 = x1339 * x1376;
+        let x1420 = Self::mul_add(x1363, x1372, -x1408) - x1409 - (x1414 - x1415);
+        let x1421 = Self::mul_add(-x1367, x1373, x1410) + x1411 - (x1416 - x1417);
+        let x1422 = Self::mul_add(-x1371, x1374, x1412 + x1413) + (x1418 - x1419);
+        let x1423 = x1341 * x1373;
+        let x1424 = x1340 * x1374;
+        let x1425 = x1423 - x1424;
+        let x1426 = x1341 * x1372;
+        let x1427 = x1339 * x1374;
+        let x1428 = x1426 - x1427;
+        let x1429 = x1340 * x1372;
+        let x1430 = x1339 * x1373;
+        let x1431 = x1429 - x1430;
+        let x1432 = x1366 * x1374;
+        let x1433 = x1369 * x1373;
+        let x1434 = x1363 * x1374;
+        let x1435 = x1363 * x1373;
+        let x1436 = x1341 * x1377;
+        let x1437 = x1340 * x1376;
+        let x1438 = x1436 + x1437;
+        let x1439 = x1364 * x1374;
+        let x1440 = x1365 * x1373;
+        let x1441 = x1367 * x1374;
+        let x1442 = x1371 * x1373;
+        let x1443 = x1370 * x1372;
+        let x1444 = x1367 * x1372;
+        let x1445 = x1339 * x1375;
+        let x1446 = x1436 + x1445;
+        let x1447 = x1368 * x1372;
+        let x1448 = x1371 * x1372;
+        let x1449 = x1437 + x1445;
+        let x1450 = Self::mul_add(
+            -c_q13,
+            x1330,
+            Self::mul_add(s_q13, x1327, x139 * x1324),
+        );
+        let x1451 = Self::mul_add(
+            -c_q13,
+            x1331,
+            Self::mul_add(s_q13, x1328, x139 * x1325),
+        );
+        let x1452 = Self::mul_add(
+            -c_q13,
+            x1332,
+            Self::mul_add(s_q13, x1329, x139 * x1326),
+        );
+        let x1453 = Self::mul_add(
+            -s_q13,
+            x1330,
+            Self::mul_add(-c_q13, x1327, x140 * x1324),
+        );
+        let x1454 = Self::mul_add(
+            -s_q13,
+            x1331,
+            Self::mul_add(-c_q13, x1328, x140 * x1325),
+        );
+        let x1455 = Self::mul_add(
+            -s_q13,
+            x1332,
+            Self::mul_add(-c_q13, x1329, x140 * x1326),
+        );
+        let x1456 = Self::mul_add(0.00000000020510342851533115, x1330, x1324);
+        let x1457 = Self::mul_add(0.00000000020510342851533115, x1331, x1325);
+        let x1458 = Self::mul_add(0.00000000020510342851533115, x1332, x1326);
+        let x1459 = x1333 + Self::mul_add(0.16, x1330, 0.55 * x1327);
+        let x1460 = x1334 + Self::mul_add(0.16, x1331, 0.55 * x1328);
+        let x1461 = x1335 + Self::mul_add(0.16, x1332, 0.55 * x1329);
+        let x1462 = Self::mul_add(-x1458, x1460, x1457 * x1461);
+        let x1463 = Self::mul_add(-x1458, x1459, x1456 * x1461);
+        let x1464 = Self::mul_add(-x1457, x1459, x1456 * x1460);
+        let x1465 = 4.806620000000001 * x1453;
+        let x1466 = 4.806620000000001 * x1454;
+        let x1467 = 4.806620000000001 * x1455;
+        let x1468 = Self::mul_add(-0.0145, x1456, 0.000781 * x1453);
+        let x1469 = Self::mul_add(
+            0.9614610000000001,
+            x1456,
+            Self::mul_add(1.2025609200000003, x1453, 0.000781 * x1450),
+        );
+        let x1470 = Self::mul_add(
+            1.4135609200000003,
+            x1456,
+            Self::mul_add(-0.9614610000000001, x1453, 0.0145 * x1450),
+        );
+        let x1471 = Self::mul_add(-0.0145, x1457, 0.000781 * x1454);
+        let x1472 = Self::mul_add(
+            0.9614610000000001,
+            x1457,
+            Self::mul_add(1.2025609200000003, x1454, 0.000781 * x1451),
+        );
+        let x1473 = Self::mul_add(
+            1.4135609200000003,
+            x1457,
+            Self::mul_add(-0.9614610000000001, x1454, 0.0145 * x1451),
+        );
+        let x1474 = Self::mul_add(-0.0145, x1458, 0.000781 * x1455);
+        let x1475 = Self::mul_add(
+            0.9614610000000001,
+            x1458,
+            Self::mul_add(1.2025609200000003, x1455, 0.000781 * x1452),
+        );
+        let x1476 = Self::mul_add(
+            1.4135609200000003,
+            x1458,
+            Self::mul_add(-0.9614610000000001, x1455, 0.0145 * x1452),
+        );
+        let x1477 = x1461 * x1467;
+        let x1478 = x1460 * x1466;
+        let x1479 = x1477 + x1478;
+        let x1480 = x1460 * x1465;
+        let x1481 = x1461 * x1465;
+        let x1482 = x1459 * x1466;
+        let x1483 = x1459 * x1465;
+        let x1484 = x1477 + x1483;
+        let x1485 = x1461 * x1466;
+        let x1486 = x1459 * x1467;
+        let x1487 = x1460 * x1467;
+        let x1488 = x1478 + x1483;
+        let x1489 = x1479
+            + (Self::mul_add(-x1456, x1470, Self::mul_add(x1453, x1469, x1450 * x1468))
+                + x1479);
+        let x1490 = x1482
+            - (Self::mul_add(-x1457, x1470, Self::mul_add(x1454, x1469, x1451 * x1468))
+                - x1480);
+        let x1491 = x1486
+            - (Self::mul_add(-x1458, x1470, Self::mul_add(x1455, x1469, x1452 * x1468))
+                - x1481);
+        let x1492 = x1480
+            - (Self::mul_add(-x1456, x1473, Self::mul_add(x1453, x1472, x1450 * x1471))
+                - x1482);
+        let x1493 = x1484
+            + (Self::mul_add(-x1457, x1473, Self::mul_add(x1454, x1472, x1451 * x1471))
+                + x1484);
+        let x1494 = x1487
+            - (Self::mul_add(-x1458, x1473, Self::mul_add(x1455, x1472, x1452 * x1471))
+                - x1485);
+        let x1495 = x1481
+            - (Self::mul_add(-x1456, x1476, Self::mul_add(x1453, x1475, x1450 * x1474))
+                - x1486);
+        let x1496 = x1485
+            - (Self::mul_add(-x1457, x1476, Self::mul_add(x1454, x1475, x1451 * x1474))
+                - x1487);
+        let x1497 = x1488
+            + (Self::mul_add(-x1458, x1476, Self::mul_add(x1455, x1475, x1452 * x1474))
+                + x1488);
+        let x1498 = Self::mul_add(-v[12], x1456, x1372);
+        let x1499 = Self::mul_add(-v[12], x1457, x1373);
+        let x1500 = Self::mul_add(-v[12], x1458, x1374);
+        let x1501 = Self::mul_add(v[12], x1462, x1375);
+        let x1502 = Self::mul_add(-v[12], x1463, x1376);
+        let x1503 = Self::mul_add(v[12], x1464, x1377);
+        let x1504 = Self::mul_add(-x1458, x1499, x1457 * x1500);
+        let x1505 = Self::mul_add(-x1458, x1498, x1456 * x1500);
+        let x1506 = Self::mul_add(-x1457, x1498, x1456 * x1499);
+        let x1507 = Self::mul_add(x1464, x1499, x1463 * x1500)
+            + Self::mul_add(-x1458, x1502, x1457 * x1503);
+        let x1508 = Self::mul_add(-x1464, x1498, x1462 * x1500)
+            - Self::mul_add(-x1458, x1501, x1456 * x1503);
+        let x1509 = Self::mul_add(x1463, x1498, x1462 * x1499)
+            - Self::mul_add(-x1457, x1501, x1456 * x1502);
+        let x1510 = Self::mul_add(v[12], x1504, Self::mul_add(-x752, x1456, x1384));
+        let x1511 = Self::mul_add(v[12], x1505, Self::mul_add(x752, x1457, x1385));
+        let x1512 = Self::mul_add(v[12], x1506, Self::mul_add(-x752, x1458, x1386));
+        let x1513 = Self::mul_add(v[12], x1507, Self::mul_add(x752, x1462, x1387));
+        let x1514 = Self::mul_add(-v[12], x1508, Self::mul_add(x752, x1463, x1388));
+        let x1515 = Self::mul_add(-v[12], x1509, Self::mul_add(x752, x1464, x1389));
+        let x1516 = Self::mul_add(-x1373, x1458, x1374 * x1457);
+        let x1517 = Self::mul_add(-x1372, x1458, x1374 * x1456);
+        let x1518 = Self::mul_add(-x1372, x1457, x1373 * x1456);
+        let x1519 = Self::mul_add(x1373, x1464, x1374 * x1463)
+            + Self::mul_add(-x1376, x1458, x1377 * x1457);
+        let x1520 = Self::mul_add(-x1372, x1464, x1374 * x1462)
+            - Self::mul_add(-x1375, x1458, x1377 * x1456);
+        let x1521 = Self::mul_add(x1372, x1463, x1373 * x1462)
+            - Self::mul_add(-x1375, x1457, x1376 * x1456);
+        let x1522 = Self::mul_add(x1385, x1458, x1386 * x1457)
+            + Self::mul_add(x1373, x1518, x1374 * x1517);
+        let x1523 = Self::mul_add(-x1384, x1458, x1386 * x1456)
+            - Self::mul_add(-x1372, x1518, x1374 * x1516);
+        let x1524 = Self::mul_add(x1384, x1457, x1385 * x1456)
+            + Self::mul_add(x1372, x1517, x1373 * x1516);
+        let x1525 = Self::mul_add(-x1385, x1464, x1386 * x1463)
+            + Self::mul_add(x1388, x1458, x1389 * x1457)
+            - (Self::mul_add(x1373, x1521, x1374 * x1520)
+                - Self::mul_add(x1376, x1518, x1377 * x1517));
+        let x1526 = Self::mul_add(-x1384, x1464, x1386 * x1462)
+            - Self::mul_add(-x1387, x1458, x1389 * x1456)
+            + (Self::mul_add(x1372, x1521, x1374 * x1519)
+                + Self::mul_add(-x1375, x1518, x1377 * x1516));
+        let x1527 = Self::mul_add(-x1384, x1463, x1385 * x1462)
+            - Self::mul_add(x1387, x1457, x1388 * x1456)
+            - (Self::mul_add(-x1372, x1520, x1373 * x1519)
+                + Self::mul_add(x1375, x1517, x1376 * x1516));
+        let x1528 = x1504 + x1516;
+        let x1529 = x1505 + x1517;
+        let x1530 = x1506 + x1518;
+        let x1531 = x1507 + x1519;
+        let x1532 = x1508 + x1520;
+        let x1533 = x1509 + x1521;
+        let x1534 = x1490 * x1499;
+        let x1535 = x1491 * x1500;
+        let x1536 = x1492 * x1498;
+        let x1537 = x1494 * x1500;
+        let x1538 = x1495 * x1498;
+        let x1539 = x1496 * x1499;
+        let x1540 = x1467 * x1502;
+        let x1541 = x1466 * x1503;
+        let x1542 = x1467 * x1501;
+        let x1543 = x1465 * x1503;
+        let x1544 = x1466 * x1501;
+        let x1545 = x1465 * x1502;
+        let x1546 = Self::mul_add(x1489, x1498, -x1534) - x1535 - (x1540 - x1541);
+        let x1547 = Self::mul_add(-x1493, x1499, x1536) + x1537 - (x1542 - x1543);
+        let x1548 = Self::mul_add(-x1497, x1500, x1538 + x1539) + (x1544 - x1545);
+        let x1549 = x1467 * x1499;
+        let x1550 = x1466 * x1500;
+        let x1551 = x1549 - x1550;
+        let x1552 = x1467 * x1498;
+        let x1553 = x1465 * x1500;
+        let x1554 = x1552 - x1553;
+        let x1555 = x1466 * x1498;
+        let x1556 = x1465 * x1499;
+        let x1557 = x1555 - x1556;
+        let x1558 = Self::mul_add(
+            -x1491,
+            x1512,
+            Self::mul_add(x1490, x1511, x1489 * x1510),
+        ) + Self::mul_add(x1466, x1515, x1467 * x1514)
+            + (Self::mul_add(-x1499, x1548, x1500 * x1547)
+                + Self::mul_add(x1502, x1557, x1503 * x1554));
+        let x1559 = Self::mul_add(
+            x1494,
+            x1512,
+            Self::mul_add(x1493, x1511, x1492 * x1510),
+        ) - Self::mul_add(-x1465, x1515, x1467 * x1513)
+            - (Self::mul_add(x1498, x1548, x1500 * x1546)
+                + Self::mul_add(-x1501, x1557, x1503 * x1551));
+        let x1560 = Self::mul_add(
+            -x1497,
+            x1512,
+            Self::mul_add(-x1496, x1511, x1495 * x1510),
+        ) + Self::mul_add(x1465, x1514, x1466 * x1513)
+            + (Self::mul_add(x1498, x1547, x1499 * x1546)
+                + Self::mul_add(x1501, x1554, x1502 * x1551));
+        let x1561 = Self::mul_add(x1466, x1512, x1467 * x1511)
+            - Self::mul_add(x1499, x1557, x1500 * x1554);
+        let x1562 = Self::mul_add(-x1465, x1512, x1467 * x1510)
+            - Self::mul_add(-x1498, x1557, x1500 * x1551);
+        let x1563 = Self::mul_add(x1465, x1511, x1466 * x1510)
+            - Self::mul_add(x1498, x1554, x1499 * x1551);
+        let x1564 = x1492 * x1500;
+        let x1565 = x1495 * x1499;
+        let x1566 = x1489 * x1500;
+        let x1567 = x1489 * x1499;
+        let x1568 = x1467 * x1503;
+        let x1569 = x1466 * x1502;
+        let x1570 = x1568 + x1569;
+        let x1571 = x1490 * x1500;
+        let x1572 = x1491 * x1499;
+        let x1573 = x1493 * x1500;
+        let x1574 = x1497 * x1499;
+        let x1575 = x1564 - x1565 + x1570 + (x1570 + (x1571 - x1572));
+        let x1576 = x1548 - (x1544 - (x1538 + x1566))
+            - (x1545 + Self::mul_add(x1494, x1499, x1573));
+        let x1577 = x1547 + (x1542 + (x1536 + x1567))
+            + (x1543 - Self::mul_add(x1496, x1500, x1574));
+        let x1578 = x1556 - (x1555 + x1557);
+        let x1579 = x1553 - (x1552 + x1554);
+        let x1580 = x1496 * x1498;
+        let x1581 = x1493 * x1498;
+        let x1582 = x1465 * x1501;
+        let x1583 = x1568 + x1582;
+        let x1584 = x1494 * x1498;
+        let x1585 = x1497 * x1498;
+        let x1586 = x1548 + (x1545 + (x1539 + x1573))
+            + (x1544 - Self::mul_add(x1491, x1498, x1566));
+        let x1587 = x1571 - x1580 - x1583 - (x1583 - (x1564 - x1584));
+        let x1588 = x1546 + (x1540 - (x1534 + x1581))
+            + (x1541 + Self::mul_add(x1495, x1500, x1585));
+        let x1589 = x1555 - (x1556 - x1557);
+        let x1590 = x1550 - (x1549 + x1551);
+        let x1591 = x1569 + x1582;
+        let x1592 = x1547 - (x1543 - (x1537 + x1574))
+            - (x1542 + Self::mul_add(x1490, x1498, x1567));
+        let x1593 = x1546 - (x1541 + (x1535 + x1585))
+            - (x1540 - Self::mul_add(x1492, x1499, x1581));
+        let x1594 = x1572 - x1584 + x1591 + (x1591 + (x1565 - x1580));
+        let x1595 = x1552 - (x1553 - x1554);
+        let x1596 = x1549 - (x1550 - x1551);
+        let x1597 = x1556 - (x1555 - x1557);
+        let x1598 = x1553 - (x1552 - x1554);
+        let x1599 = x1555 - (x1556 + x1557);
+        let x1600 = x1550 - (x1549 - x1551);
+        let x1601 = x1552 - (x1553 + x1554);
+        let x1602 = x1549 - (x1550 + x1551);
+        let x1603 = Self::mul_add(
+            -x1458,
+            x1491,
+            Self::mul_add(-x1457, x1490, x1456 * x1489),
+        ) - Self::mul_add(x1464, x1466, x1463 * x1467);
+        let x1604 = Self::mul_add(
+            x1458,
+            x1494,
+            Self::mul_add(-x1457, x1493, x1456 * x1492),
+        ) + Self::mul_add(-x1464, x1465, x1462 * x1467);
+        let x1605 = Self::mul_add(
+            -x1458,
+            x1497,
+            Self::mul_add(x1457, x1496, x1456 * x1495),
+        ) - Self::mul_add(x1463, x1465, x1462 * x1466);
+        let x1606 = Self::mul_add(-x1458, x1466, x1457 * x1467);
+        let x1607 = Self::mul_add(-x1458, x1465, x1456 * x1467);
+        let x1608 = Self::mul_add(-x1457, x1465, x1456 * x1466);
+        let x1609 = x1456 * x1575;
+        let x1610 = Self::mul_add(
+            x1463,
+            x1578,
+            Self::mul_add(-x1458, x1577, Self::mul_add(x1457, x1576, x1609)),
+        );
+        let x1611 = Self::mul_add(-x1464, x1579, x1610);
+        let x1612 = x1457 * x1587;
+        let x1613 = Self::mul_add(
+            x1462,
+            x1589,
+            Self::mul_add(x1458, x1588, Self::mul_add(x1456, x1586, x1612)),
+        );
+        let x1614 = Self::mul_add(x1464, x1590, x1613);
+        let x1615 = x1458 * x1594;
+        let x1616 = Self::mul_add(
+            x1463,
+            x1596,
+            Self::mul_add(
+                -x1462,
+                x1595,
+                Self::mul_add(x1457, x1593, x1456 * x1592) + x1615,
+            ),
+        );
+        let x1617 = Self::mul_add(x1458, x1598, x1457 * x1597);
+        let x1618 = Self::mul_add(x1458, x1600, x1456 * x1599);
+        let x1619 = Self::mul_add(x1457, x1602, x1456 * x1601);
+        let x1620 = Self::mul_add(
+            -x1520,
+            x1599,
+            Self::mul_add(x1518, x1592, Self::mul_add(x1517, x1586, x1516 * x1575)),
+        );
+        let x1621 = Self::mul_add(
+            -x1519,
+            x1597,
+            Self::mul_add(x1518, x1593, Self::mul_add(x1517, x1587, x1516 * x1576)),
+        );
+        let x1622 = Self::mul_add(
+            x1519,
+            x1598,
+            Self::mul_add(-x1518, x1594, Self::mul_add(-x1517, x1588, x1516 * x1577)),
+        );
+        let x1623 = Self::mul_add(-x1457, x1560, x1458 * x1559)
+            - Self::mul_add(-x1463, x1563, x1464 * x1562)
+            - (Self::mul_add(x1491, x1524, Self::mul_add(x1490, x1523, x1489 * x1522))
+                - Self::mul_add(-x1466, x1527, x1467 * x1526))
+            - Self::mul_add(x1521, x1601, x1620);
+        let x1624 = Self::mul_add(x1456, x1560, x1458 * x1558)
+            + Self::mul_add(x1462, x1563, x1464 * x1561)
+            + (Self::mul_add(-x1494, x1524, Self::mul_add(x1493, x1523, x1492 * x1522))
+                - Self::mul_add(-x1465, x1527, x1467 * x1525))
+            - Self::mul_add(x1521, x1602, x1621);
+        let x1625 = Self::mul_add(x1456, x1559, x1457 * x1558)
+            - Self::mul_add(x1462, x1562, x1463 * x1561)
+            - (Self::mul_add(x1497, x1524, Self::mul_add(-x1496, x1523, x1495 * x1522))
+                + Self::mul_add(-x1465, x1526, x1466 * x1525))
+            - Self::mul_add(x1520, x1600, x1622);
+        let x1626 = Self::mul_add(x1457, x1563, x1458 * x1562)
+            + Self::mul_add(-x1466, x1524, x1467 * x1523)
+            + Self::mul_add(-x1518, x1595, x1517 * x1589);
+        let x1627 = Self::mul_add(x1456, x1563, x1458 * x1561)
+            - Self::mul_add(x1465, x1524, x1467 * x1522)
+            + Self::mul_add(x1518, x1596, x1516 * x1578);
+        let x1628 = Self::mul_add(-x1456, x1562, x1457 * x1561)
+            - Self::mul_add(x1465, x1523, x1466 * x1522)
+            - Self::mul_add(-x1517, x1590, x1516 * x1579);
+        let x1629 = Self::mul_add(
+            -x1463,
+            x1599,
+            Self::mul_add(x1458, x1592, Self::mul_add(-x1457, x1586, x1609)),
+        );
+        let x1630 = Self::mul_add(
+            -x1462,
+            x1597,
+            Self::mul_add(-x1458, x1593, Self::mul_add(-x1456, x1576, x1612)),
+        );
+        let x1631 = Self::mul_add(
+            -x1463,
+            x1600,
+            Self::mul_add(
+                x1462,
+                x1598,
+                x1615 - Self::mul_add(x1457, x1588, x1456 * x1577),
+            ),
+        );
+        let x1632 = Self::mul_add(
+            -x1491,
+            x1530,
+            Self::mul_add(x1490, x1529, x1489 * x1528),
+        ) - Self::mul_add(x1466, x1533, x1467 * x1532)
+            - Self::mul_add(x1464, x1601, x1629);
+        let x1633 = Self::mul_add(
+            x1494,
+            x1530,
+            Self::mul_add(x1493, x1529, x1492 * x1528),
+        ) - Self::mul_add(x1465, x1533, x1467 * x1531)
+            - Self::mul_add(-x1464, x1602, x1630);
+        let x1634 = Self::mul_add(
+            -x1497,
+            x1530,
+            Self::mul_add(-x1496, x1529, x1495 * x1528),
+        ) + Self::mul_add(-x1465, x1532, x1466 * x1531) + x1631;
+        let x1635 = Self::mul_add(x1466, x1530, x1467 * x1529)
+            + Self::mul_add(x1458, x1595, x1457 * x1589);
+        let x1636 = Self::mul_add(-x1465, x1530, x1467 * x1528)
+            + Self::mul_add(x1458, x1596, x1456 * x1578);
+        let x1637 = Self::mul_add(x1465, x1529, x1466 * x1528)
+            - Self::mul_add(x1457, x1590, x1456 * x1579);
+        let x1638 = Self::mul_add(-0.65, x1627, x1625);
+        let x1639 = Self::mul_add(-0.65, x1636, x1634);
+        let x1640 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1625,
+            Self::mul_add(s_q7, x1624, c_q7 * x1623),
+        ) - Self::mul_add(-x846, x1628, Self::mul_add(x845, x1627, x844 * x1626));
+        let x1641 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1634,
+            Self::mul_add(-s_q7, x1633, c_q7 * x1632),
+        ) + Self::mul_add(x846, x1637, Self::mul_add(-x845, x1636, x844 * x1635));
+        let x1642 = Self::mul_add(
+            -x960,
+            x1625,
+            Self::mul_add(x959, x1624, x958 * x1623),
+        );
+        let x1643 = x1642
+            - Self::mul_add(x966, x1628, Self::mul_add(x965, x1627, x964 * x1626));
+        let x1644 = Self::mul_add(
+            -x960,
+            x1634,
+            Self::mul_add(-x959, x1633, x958 * x1632),
+        );
+        let x1645 = x1644
+            + Self::mul_add(-x966, x1637, Self::mul_add(-x965, x1636, x964 * x1635));
+        let x1646 = x1642
+            - Self::mul_add(x1092, x1628, Self::mul_add(x1091, x1627, x1090 * x1626));
+        let x1647 = x1644
+            + Self::mul_add(-x1092, x1637, Self::mul_add(-x1091, x1636, x1090 * x1635));
+        let x1648 = x1642
+            - Self::mul_add(x1215, x1628, Self::mul_add(x1214, x1627, x1213 * x1626));
+        let x1649 = x1644
+            + Self::mul_add(-x1215, x1637, Self::mul_add(-x1214, x1636, x1213 * x1635));
+        let x1650 = Self::mul_add(
+            -x1332,
+            x1625,
+            Self::mul_add(x1331, x1624, x1330 * x1623),
+        ) - Self::mul_add(x1338, x1628, Self::mul_add(x1337, x1627, x1336 * x1626));
+        let x1651 = Self::mul_add(
+            -x1332,
+            x1634,
+            Self::mul_add(-x1331, x1633, x1330 * x1632),
+        ) + Self::mul_add(-x1338, x1637, Self::mul_add(-x1337, x1636, x1336 * x1635));
+        let x1652 = Self::mul_add(
+            x1524,
+            x1605,
+            Self::mul_add(x1523, x1604, x1522 * x1603),
+        ) + Self::mul_add(x1527, x1608, Self::mul_add(-x1526, x1607, x1525 * x1606))
+            + (Self::mul_add(x1518, x1616, Self::mul_add(x1517, x1614, x1516 * x1611))
+                - Self::mul_add(
+                    -x1521,
+                    x1619,
+                    Self::mul_add(x1520, x1618, x1519 * x1617),
+                ));
+        let x1653 = Self::mul_add(
+            -x1530,
+            x1605,
+            Self::mul_add(x1529, x1604, x1528 * x1603),
+        ) + Self::mul_add(-x1533, x1608, Self::mul_add(-x1532, x1607, x1531 * x1606))
+            - (Self::mul_add(x1458, x1616, Self::mul_add(-x1457, x1614, x1456 * x1611))
+                + Self::mul_add(
+                    x1464,
+                    x1619,
+                    Self::mul_add(-x1463, x1618, x1462 * x1617),
+                ));
+        let x1654 = x1339 + x1465;
+        let x1655 = x1340 + x1466;
+        let x1656 = x1341 + x1467;
+        let x1657 = x1363 + x1489;
+        let x1658 = x1364 + x1490;
+        let x1659 = x1365 + x1491;
+        let x1660 = x1366 + x1492;
+        let x1661 = x1367 + x1493;
+        let x1662 = x1368 + x1494;
+        let x1663 = x1369 + x1495;
+        let x1664 = x1370 + x1496;
+        let x1665 = x1371 + x1497;
+        let x1666 = x1432 - x1433 + x1438 + (x1438 + (x1439 - x1440)) + x1575;
+        let x1667 = x1422 + (x1419 + (x1413 + x1441))
+            + (x1418 - Self::mul_add(x1365, x1372, x1434)) + x1586;
+        let x1668 = x1421 - (x1417 - (x1411 + x1442))
+            - (x1416 + Self::mul_add(x1364, x1372, x1435)) + x1592;
+        let x1669 = x1429 - (x1430 + x1431) + x1599;
+        let x1670 = x1426 - (x1427 + x1428) + x1601;
+        let x1671 = x1422 - (x1418 - (x1412 + x1434))
+            - (x1419 + Self::mul_add(x1368, x1373, x1441)) + x1576;
+        let x1672 = x1439 - x1443 - x1446 - (x1446 - (x1432 - x1447)) + x1587;
+        let x1673 = x1420 - (x1415 + (x1409 + x1448))
+            - (x1414 - Self::mul_add(x1366, x1373, x1444)) + x1593;
+        let x1674 = x1430 - (x1429 - x1431) + x1597;
+        let x1675 = x1423 - (x1424 + x1425) + x1602;
+        let x1676 = x1421 + (x1416 + (x1410 + x1435))
+            + (x1417 - Self::mul_add(x1370, x1374, x1442)) + x1577;
+        let x1677 = x1420 + (x1414 - (x1408 + x1444))
+            + (x1415 + Self::mul_add(x1369, x1374, x1448)) + x1588;
+        let x1678 = x1440 - x1447 + x1449 + (x1449 + (x1433 - x1443)) + x1594;
+        let x1679 = x1427 - (x1426 - x1428) + x1598;
+        let x1680 = x1424 - (x1423 - x1425) + x1600;
+        let x1681 = x1429 - (x1430 - x1431) + x1589;
+        let x1682 = x1426 - (x1427 - x1428) + x1595;
+        let x1683 = x1430 - (x1429 + x1431) + x1578;
+        let x1684 = x1423 - (x1424 - x1425) + x1596;
+        let x1685 = x1427 - (x1426 + x1428) + x1579;
+        let x1686 = x1424 - (x1423 + x1425) + x1590;
+        let x1687 = Self::mul_add(
+            -x1365,
+            x1386,
+            Self::mul_add(x1364, x1385, x1363 * x1384),
+        ) + Self::mul_add(x1340, x1389, x1341 * x1388)
+            + (Self::mul_add(-x1373, x1422, x1374 * x1421)
+                + Self::mul_add(x1376, x1431, x1377 * x1428)) + x1558;
+        let x1688 = Self::mul_add(
+            x1368,
+            x1386,
+            Self::mul_add(x1367, x1385, x1366 * x1384),
+        ) - Self::mul_add(-x1339, x1389, x1341 * x1387)
+            - (Self::mul_add(x1372, x1422, x1374 * x1420)
+                + Self::mul_add(-x1375, x1431, x1377 * x1425)) + x1559;
+        let x1689 = Self::mul_add(
+            -x1371,
+            x1386,
+            Self::mul_add(-x1370, x1385, x1369 * x1384),
+        ) + Self::mul_add(x1339, x1388, x1340 * x1387)
+            + (Self::mul_add(x1372, x1421, x1373 * x1420)
+                + Self::mul_add(x1375, x1428, x1376 * x1425)) + x1560;
+        let x1690 = Self::mul_add(x1340, x1386, x1341 * x1385)
+            - Self::mul_add(x1373, x1431, x1374 * x1428) + x1561;
+        let x1691 = Self::mul_add(-x1339, x1386, x1341 * x1384)
+            - Self::mul_add(-x1372, x1431, x1374 * x1425) + x1562;
+        let x1692 = Self::mul_add(x1339, x1385, x1340 * x1384)
+            - Self::mul_add(x1372, x1428, x1373 * x1425) + x1563;
+        let x1693 = Self::mul_add(
+            -x1332,
+            x1659,
+            Self::mul_add(-x1331, x1658, x1330 * x1657),
+        ) - Self::mul_add(x1338, x1655, x1337 * x1656);
+        let x1694 = Self::mul_add(
+            x1332,
+            x1662,
+            Self::mul_add(-x1331, x1661, x1330 * x1660),
+        ) + Self::mul_add(-x1338, x1654, x1336 * x1656);
+        let x1695 = Self::mul_add(
+            -x1332,
+            x1665,
+            Self::mul_add(x1331, x1664, x1330 * x1663),
+        ) - Self::mul_add(x1337, x1654, x1336 * x1655);
+        let x1696 = Self::mul_add(-x1332, x1655, x1331 * x1656);
+        let x1697 = Self::mul_add(-x1332, x1654, x1330 * x1656);
+        let x1698 = Self::mul_add(-x1331, x1654, x1330 * x1655);
+        let x1699 = x1330 * x1666;
+        let x1700 = Self::mul_add(
+            x1337,
+            x1683,
+            Self::mul_add(-x1332, x1676, Self::mul_add(x1331, x1671, x1699)),
+        );
+        let x1701 = Self::mul_add(-x1338, x1685, x1700);
+        let x1702 = x1331 * x1672;
+        let x1703 = Self::mul_add(
+            x1336,
+            x1681,
+            Self::mul_add(x1332, x1677, Self::mul_add(x1330, x1667, x1702)),
+        );
+        let x1704 = Self::mul_add(x1338, x1686, x1703);
+        let x1705 = x1332 * x1678;
+        let x1706 = Self::mul_add(
+            x1337,
+            x1684,
+            Self::mul_add(
+                -x1336,
+                x1682,
+                Self::mul_add(x1331, x1673, x1330 * x1668) + x1705,
+            ),
+        );
+        let x1707 = Self::mul_add(x1332, x1679, x1331 * x1674);
+        let x1708 = Self::mul_add(x1332, x1680, x1330 * x1669);
+        let x1709 = Self::mul_add(x1331, x1675, x1330 * x1670);
+        let x1710 = Self::mul_add(
+            -x1394,
+            x1669,
+            Self::mul_add(x1392, x1668, Self::mul_add(x1391, x1667, x1390 * x1666)),
+        );
+        let x1711 = Self::mul_add(
+            -x1393,
+            x1674,
+            Self::mul_add(x1392, x1673, Self::mul_add(x1391, x1672, x1390 * x1671)),
+        );
+        let x1712 = Self::mul_add(
+            x1393,
+            x1679,
+            Self::mul_add(-x1392, x1678, Self::mul_add(-x1391, x1677, x1390 * x1676)),
+        );
+        let x1713 = Self::mul_add(-x1331, x1689, x1332 * x1688)
+            - Self::mul_add(-x1337, x1692, x1338 * x1691)
+            - (Self::mul_add(x1398, x1659, Self::mul_add(x1397, x1658, x1396 * x1657))
+                - Self::mul_add(-x1401, x1655, x1400 * x1656))
+            - Self::mul_add(x1395, x1670, x1710);
+        let x1714 = Self::mul_add(x1330, x1689, x1332 * x1687)
+            + Self::mul_add(x1336, x1692, x1338 * x1690)
+            + (Self::mul_add(-x1398, x1662, Self::mul_add(x1397, x1661, x1396 * x1660))
+                - Self::mul_add(-x1401, x1654, x1399 * x1656))
+            - Self::mul_add(x1395, x1675, x1711);
+        let x1715 = Self::mul_add(x1330, x1688, x1331 * x1687)
+            - Self::mul_add(x1336, x1691, x1337 * x1690)
+            - (Self::mul_add(x1398, x1665, Self::mul_add(-x1397, x1664, x1396 * x1663))
+                + Self::mul_add(-x1400, x1654, x1399 * x1655))
+            - Self::mul_add(x1394, x1680, x1712);
+        let x1716 = Self::mul_add(x1331, x1692, x1332 * x1691)
+            + Self::mul_add(-x1398, x1655, x1397 * x1656)
+            + Self::mul_add(-x1392, x1682, x1391 * x1681);
+        let x1717 = Self::mul_add(x1330, x1692, x1332 * x1690)
+            - Self::mul_add(x1398, x1654, x1396 * x1656)
+            + Self::mul_add(x1392, x1684, x1390 * x1683);
+        let x1718 = Self::mul_add(-x1330, x1691, x1331 * x1690)
+            - Self::mul_add(x1397, x1654, x1396 * x1655)
+            - Self::mul_add(-x1391, x1686, x1390 * x1685);
+        let x1719 = Self::mul_add(
+            -x1337,
+            x1669,
+            Self::mul_add(x1332, x1668, Self::mul_add(-x1331, x1667, x1699)),
+        );
+        let x1720 = Self::mul_add(
+            -x1336,
+            x1674,
+            Self::mul_add(-x1332, x1673, Self::mul_add(-x1330, x1671, x1702)),
+        );
+        let x1721 = Self::mul_add(
+            -x1337,
+            x1680,
+            Self::mul_add(
+                x1336,
+                x1679,
+                x1705 - Self::mul_add(x1331, x1677, x1330 * x1676),
+            ),
+        );
+        let x1722 = Self::mul_add(
+            -x1404,
+            x1659,
+            Self::mul_add(x1403, x1658, x1402 * x1657),
+        ) - Self::mul_add(x1407, x1655, x1406 * x1656)
+            - Self::mul_add(x1338, x1670, x1719);
+        let x1723 = Self::mul_add(
+            x1404,
+            x1662,
+            Self::mul_add(x1403, x1661, x1402 * x1660),
+        ) - Self::mul_add(x1407, x1654, x1405 * x1656)
+            - Self::mul_add(-x1338, x1675, x1720);
+        let x1724 = Self::mul_add(
+            -x1404,
+            x1665,
+            Self::mul_add(-x1403, x1664, x1402 * x1663),
+        ) + Self::mul_add(-x1406, x1654, x1405 * x1655) + x1721;
+        let x1725 = Self::mul_add(x1404, x1655, x1403 * x1656)
+            + Self::mul_add(x1332, x1682, x1331 * x1681);
+        let x1726 = Self::mul_add(-x1404, x1654, x1402 * x1656)
+            + Self::mul_add(x1332, x1684, x1330 * x1683);
+        let x1727 = Self::mul_add(x1403, x1654, x1402 * x1655)
+            - Self::mul_add(x1331, x1686, x1330 * x1685);
+        let x1728 = Self::mul_add(-0.65, x1717, x1715);
+        let x1729 = Self::mul_add(-0.65, x1726, x1724);
+        let x1730 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1715,
+            Self::mul_add(s_q7, x1714, c_q7 * x1713),
+        ) - Self::mul_add(-x846, x1718, Self::mul_add(x845, x1717, x844 * x1716));
+        let x1731 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1724,
+            Self::mul_add(-s_q7, x1723, c_q7 * x1722),
+        ) + Self::mul_add(x846, x1727, Self::mul_add(-x845, x1726, x844 * x1725));
+        let x1732 = Self::mul_add(
+            -x960,
+            x1715,
+            Self::mul_add(x959, x1714, x958 * x1713),
+        );
+        let x1733 = x1732
+            - Self::mul_add(x966, x1718, Self::mul_add(x965, x1717, x964 * x1716));
+        let x1734 = Self::mul_add(
+            -x960,
+            x1724,
+            Self::mul_add(-x959, x1723, x958 * x1722),
+        );
+        let x1735 = x1734
+            + Self::mul_add(-x966, x1727, Self::mul_add(-x965, x1726, x964 * x1725));
+        let x1736 = x1732
+            - Self::mul_add(x1092, x1718, Self::mul_add(x1091, x1717, x1090 * x1716));
+        let x1737 = x1734
+            + Self::mul_add(-x1092, x1727, Self::mul_add(-x1091, x1726, x1090 * x1725));
+        let x1738 = x1732
+            - Self::mul_add(x1215, x1718, Self::mul_add(x1214, x1717, x1213 * x1716));
+        let x1739 = x1734
+            + Self::mul_add(-x1215, x1727, Self::mul_add(-x1214, x1726, x1213 * x1725));
+        let x1740 = Self::mul_add(
+            x1398,
+            x1695,
+            Self::mul_add(x1397, x1694, x1396 * x1693),
+        ) + Self::mul_add(x1401, x1698, Self::mul_add(-x1400, x1697, x1399 * x1696))
+            + (Self::mul_add(x1392, x1706, Self::mul_add(x1391, x1704, x1390 * x1701))
+                - Self::mul_add(
+                    -x1395,
+                    x1709,
+                    Self::mul_add(x1394, x1708, x1393 * x1707),
+                ));
+        let x1741 = Self::mul_add(
+            -x1404,
+            x1695,
+            Self::mul_add(x1403, x1694, x1402 * x1693),
+        ) + Self::mul_add(-x1407, x1698, Self::mul_add(-x1406, x1697, x1405 * x1696))
+            - (Self::mul_add(x1332, x1706, Self::mul_add(-x1331, x1704, x1330 * x1701))
+                + Self::mul_add(
+                    x1338,
+                    x1709,
+                    Self::mul_add(-x1337, x1708, x1336 * x1707),
+                ));
+        let x1742 = Self::mul_add(
+            x1398,
+            x1605,
+            Self::mul_add(x1397, x1604, x1396 * x1603),
+        ) + Self::mul_add(x1401, x1608, Self::mul_add(-x1400, x1607, x1399 * x1606))
+            + (Self::mul_add(x1392, x1616, Self::mul_add(x1391, x1614, x1390 * x1611))
+                - Self::mul_add(
+                    -x1395,
+                    x1619,
+                    Self::mul_add(x1394, x1618, x1393 * x1617),
+                ));
+        let x1743 = Self::mul_add(
+            -x1404,
+            x1605,
+            Self::mul_add(x1403, x1604, x1402 * x1603),
+        ) + Self::mul_add(-x1407, x1608, Self::mul_add(-x1406, x1607, x1405 * x1606))
+            - (Self::mul_add(x1332, x1616, Self::mul_add(-x1331, x1614, x1330 * x1611))
+                + Self::mul_add(
+                    x1338,
+                    x1619,
+                    Self::mul_add(-x1337, x1618, x1336 * x1617),
+                ));
+        let x1744 = x1216 - x1654;
+        let x1745 = x1217 - x1655;
+        let x1746 = x1218 - x1656;
+        let x1747 = x1240 - x1657;
+        let x1748 = x1241 - x1658;
+        let x1749 = x1242 - x1659;
+        let x1750 = x1243 - x1660;
+        let x1751 = x1244 - x1661;
+        let x1752 = x1245 - x1662;
+        let x1753 = x1246 - x1663;
+        let x1754 = x1247 - x1664;
+        let x1755 = x1248 - x1665;
+        let x1756 = x1306 - x1307 + x1312 + (x1312 + (x1313 - x1314)) - x1666;
+        let x1757 = x1296 + (x1293 + (x1287 + x1315))
+            + (x1292 - Self::mul_add(x1242, x1249, x1308)) - x1667;
+        let x1758 = x1295 - (x1291 - (x1285 + x1316))
+            - (x1290 + Self::mul_add(x1241, x1249, x1309)) - x1668;
+        let x1759 = x1303 - (x1304 + x1305) - x1669;
+        let x1760 = x1300 - (x1301 + x1302) - x1670;
+        let x1761 = x1296 - (x1292 - (x1286 + x1308))
+            - (x1293 + Self::mul_add(x1245, x1250, x1315)) - x1671;
+        let x1762 = x1313 - x1317 - x1320 - (x1320 - (x1306 - x1321)) - x1672;
+        let x1763 = x1294 - (x1289 + (x1283 + x1322))
+            - (x1288 - Self::mul_add(x1243, x1250, x1318)) - x1673;
+        let x1764 = x1304 - (x1303 - x1305) - x1674;
+        let x1765 = x1297 - (x1298 + x1299) - x1675;
+        let x1766 = x1295 + (x1290 + (x1284 + x1309))
+            + (x1291 - Self::mul_add(x1247, x1251, x1316)) - x1676;
+        let x1767 = x1294 + (x1288 - (x1282 + x1318))
+            + (x1289 + Self::mul_add(x1246, x1251, x1322)) - x1677;
+        let x1768 = x1314 - x1321 + x1323 + (x1323 + (x1307 - x1317)) - x1678;
+        let x1769 = x1301 - (x1300 - x1302) - x1679;
+        let x1770 = x1298 - (x1297 - x1299) - x1680;
+        let x1771 = x1303 - (x1304 - x1305) - x1681;
+        let x1772 = x1300 - (x1301 - x1302) - x1682;
+        let x1773 = x1304 - (x1303 + x1305) - x1683;
+        let x1774 = x1297 - (x1298 - x1299) - x1684;
+        let x1775 = x1301 - (x1300 + x1302) - x1685;
+        let x1776 = x1298 - (x1297 + x1299) - x1686;
+        let x1777 = Self::mul_add(
+            -x1242,
+            x1263,
+            Self::mul_add(x1241, x1262, x1240 * x1261),
+        ) + Self::mul_add(x1217, x1266, x1218 * x1265)
+            + (Self::mul_add(-x1250, x1296, x1251 * x1295)
+                + Self::mul_add(x1253, x1305, x1254 * x1302)) - x1687;
+        let x1778 = Self::mul_add(
+            x1245,
+            x1263,
+            Self::mul_add(x1244, x1262, x1243 * x1261),
+        ) - Self::mul_add(-x1216, x1266, x1218 * x1264)
+            - (Self::mul_add(x1249, x1296, x1251 * x1294)
+                + Self::mul_add(-x1252, x1305, x1254 * x1299)) - x1688;
+        let x1779 = Self::mul_add(
+            -x1248,
+            x1263,
+            Self::mul_add(-x1247, x1262, x1246 * x1261),
+        ) + Self::mul_add(x1216, x1265, x1217 * x1264)
+            + (Self::mul_add(x1249, x1295, x1250 * x1294)
+                + Self::mul_add(x1252, x1302, x1253 * x1299)) - x1689;
+        let x1780 = Self::mul_add(x1217, x1263, x1218 * x1262)
+            - Self::mul_add(x1250, x1305, x1251 * x1302) - x1690;
+        let x1781 = Self::mul_add(-x1216, x1263, x1218 * x1261)
+            - Self::mul_add(-x1249, x1305, x1251 * x1299) - x1691;
+        let x1782 = Self::mul_add(x1216, x1262, x1217 * x1261)
+            - Self::mul_add(x1249, x1302, x1250 * x1299) - x1692;
+        let x1783 = Self::mul_add(
+            -x960,
+            x1749,
+            Self::mul_add(-x959, x1748, x958 * x1747),
+        ) - Self::mul_add(x1215, x1745, x1214 * x1746);
+        let x1784 = Self::mul_add(x960, x1752, Self::mul_add(-x959, x1751, x958 * x1750))
+            + Self::mul_add(-x1215, x1744, x1213 * x1746);
+        let x1785 = Self::mul_add(-x960, x1755, Self::mul_add(x959, x1754, x958 * x1753))
+            - Self::mul_add(x1214, x1744, x1213 * x1745);
+        let x1786 = Self::mul_add(-x960, x1745, x959 * x1746);
+        let x1787 = Self::mul_add(-x960, x1744, x958 * x1746);
+        let x1788 = Self::mul_add(-x959, x1744, x958 * x1745);
+        let x1789 = x958 * x1756;
+        let x1790 = Self::mul_add(
+            x1214,
+            x1773,
+            Self::mul_add(-x960, x1766, Self::mul_add(x959, x1761, x1789)),
+        );
+        let x1791 = Self::mul_add(-x1215, x1775, x1790);
+        let x1792 = x959 * x1762;
+        let x1793 = Self::mul_add(
+            x1213,
+            x1771,
+            Self::mul_add(x960, x1767, Self::mul_add(x958, x1757, x1792)),
+        );
+        let x1794 = Self::mul_add(x1215, x1776, x1793);
+        let x1795 = x960 * x1768;
+        let x1796 = Self::mul_add(
+            x1214,
+            x1774,
+            Self::mul_add(
+                -x1213,
+                x1772,
+                Self::mul_add(x959, x1763, x958 * x1758) + x1795,
+            ),
+        );
+        let x1797 = Self::mul_add(x960, x1769, x959 * x1764);
+        let x1798 = Self::mul_add(x960, x1770, x958 * x1759);
+        let x1799 = Self::mul_add(x959, x1765, x958 * x1760);
+        let x1800 = Self::mul_add(
+            x1268,
+            x1759,
+            Self::mul_add(x1134, x1758, Self::mul_add(x1133, x1757, x1132 * x1756)),
+        );
+        let x1801 = Self::mul_add(
+            -x1267,
+            x1764,
+            Self::mul_add(x1134, x1763, Self::mul_add(x1133, x1762, x1132 * x1761)),
+        );
+        let x1802 = Self::mul_add(
+            x1267,
+            x1769,
+            Self::mul_add(-x1134, x1768, Self::mul_add(-x1133, x1767, x1132 * x1766)),
+        );
+        let x1803 = Self::mul_add(-x959, x1779, x960 * x1778)
+            - Self::mul_add(-x1214, x1782, x1215 * x1781)
+            - (Self::mul_add(x1272, x1749, Self::mul_add(x1271, x1748, x1270 * x1747))
+                - Self::mul_add(-x1275, x1745, x1274 * x1746))
+            - Self::mul_add(-x1269, x1760, x1800);
+        let x1804 = Self::mul_add(x958, x1779, x960 * x1777)
+            + Self::mul_add(x1213, x1782, x1215 * x1780)
+            + (Self::mul_add(-x1272, x1752, Self::mul_add(x1271, x1751, x1270 * x1750))
+                - Self::mul_add(-x1275, x1744, x1273 * x1746))
+            - Self::mul_add(-x1269, x1765, x1801);
+        let x1805 = Self::mul_add(x958, x1778, x959 * x1777)
+            - Self::mul_add(x1213, x1781, x1214 * x1780)
+            - (Self::mul_add(x1272, x1755, Self::mul_add(-x1271, x1754, x1270 * x1753))
+                + Self::mul_add(-x1274, x1744, x1273 * x1745))
+            - Self::mul_add(-x1268, x1770, x1802);
+        let x1806 = Self::mul_add(x959, x1782, x960 * x1781)
+            + Self::mul_add(-x1272, x1745, x1271 * x1746)
+            + Self::mul_add(-x1134, x1772, x1133 * x1771);
+        let x1807 = Self::mul_add(x958, x1782, x960 * x1780)
+            - Self::mul_add(x1272, x1744, x1270 * x1746)
+            + Self::mul_add(x1134, x1774, x1132 * x1773);
+        let x1808 = Self::mul_add(-x958, x1781, x959 * x1780)
+            - Self::mul_add(x1271, x1744, x1270 * x1745)
+            - Self::mul_add(-x1133, x1776, x1132 * x1775);
+        let x1809 = Self::mul_add(
+            -x1214,
+            x1759,
+            Self::mul_add(x960, x1758, Self::mul_add(-x959, x1757, x1789)),
+        );
+        let x1810 = Self::mul_add(
+            -x1213,
+            x1764,
+            Self::mul_add(-x960, x1763, Self::mul_add(-x958, x1761, x1792)),
+        );
+        let x1811 = Self::mul_add(
+            -x1214,
+            x1770,
+            Self::mul_add(x1213, x1769, x1795 - Self::mul_add(x959, x1767, x958 * x1766)),
+        );
+        let x1812 = Self::mul_add(
+            -x1278,
+            x1749,
+            Self::mul_add(x1277, x1748, x1276 * x1747),
+        ) - Self::mul_add(x1281, x1745, x1280 * x1746)
+            - Self::mul_add(x1215, x1760, x1809);
+        let x1813 = Self::mul_add(
+            x1278,
+            x1752,
+            Self::mul_add(x1277, x1751, x1276 * x1750),
+        ) - Self::mul_add(x1281, x1744, x1279 * x1746)
+            - Self::mul_add(-x1215, x1765, x1810);
+        let x1814 = Self::mul_add(
+            -x1278,
+            x1755,
+            Self::mul_add(-x1277, x1754, x1276 * x1753),
+        ) + Self::mul_add(-x1280, x1744, x1279 * x1745) + x1811;
+        let x1815 = Self::mul_add(x1278, x1745, x1277 * x1746)
+            + Self::mul_add(x960, x1772, x959 * x1771);
+        let x1816 = Self::mul_add(-x1278, x1744, x1276 * x1746)
+            + Self::mul_add(x960, x1774, x958 * x1773);
+        let x1817 = Self::mul_add(x1277, x1744, x1276 * x1745)
+            - Self::mul_add(x959, x1776, x958 * x1775);
+        let x1818 = Self::mul_add(-0.65, x1807, x1805);
+        let x1819 = Self::mul_add(-0.65, x1816, x1814);
+        let x1820 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1805,
+            Self::mul_add(s_q7, x1804, c_q7 * x1803),
+        ) - Self::mul_add(-x846, x1808, Self::mul_add(x845, x1807, x844 * x1806));
+        let x1821 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1814,
+            Self::mul_add(-s_q7, x1813, c_q7 * x1812),
+        ) + Self::mul_add(x846, x1817, Self::mul_add(-x845, x1816, x844 * x1815));
+        let x1822 = Self::mul_add(
+            -x960,
+            x1805,
+            Self::mul_add(x959, x1804, x958 * x1803),
+        );
+        let x1823 = x1822
+            - Self::mul_add(x966, x1808, Self::mul_add(x965, x1807, x964 * x1806));
+        let x1824 = Self::mul_add(
+            -x960,
+            x1814,
+            Self::mul_add(-x959, x1813, x958 * x1812),
+        );
+        let x1825 = x1824
+            + Self::mul_add(-x966, x1817, Self::mul_add(-x965, x1816, x964 * x1815));
+        let x1826 = x1822
+            - Self::mul_add(x1092, x1808, Self::mul_add(x1091, x1807, x1090 * x1806));
+        let x1827 = x1824
+            + Self::mul_add(-x1092, x1817, Self::mul_add(-x1091, x1816, x1090 * x1815));
+        let x1828 = Self::mul_add(
+            x1272,
+            x1785,
+            Self::mul_add(x1271, x1784, x1270 * x1783),
+        ) + Self::mul_add(x1275, x1788, Self::mul_add(-x1274, x1787, x1273 * x1786))
+            + (Self::mul_add(x1134, x1796, Self::mul_add(x1133, x1794, x1132 * x1791))
+                - Self::mul_add(
+                    x1269,
+                    x1799,
+                    Self::mul_add(-x1268, x1798, x1267 * x1797),
+                ));
+        let x1829 = Self::mul_add(
+            x960,
+            x1796,
+            Self::mul_add(-x959, x1794, x958 * x1791),
+        );
+        let x1830 = Self::mul_add(
+            -x1278,
+            x1785,
+            Self::mul_add(x1277, x1784, x1276 * x1783),
+        ) + Self::mul_add(-x1281, x1788, Self::mul_add(-x1280, x1787, x1279 * x1786))
+            - (x1829
+                + Self::mul_add(
+                    x1215,
+                    x1799,
+                    Self::mul_add(-x1214, x1798, x1213 * x1797),
+                ));
+        let x1831 = Self::mul_add(
+            x1272,
+            x1695,
+            Self::mul_add(x1271, x1694, x1270 * x1693),
+        ) + Self::mul_add(x1275, x1698, Self::mul_add(-x1274, x1697, x1273 * x1696))
+            + (Self::mul_add(x1134, x1706, Self::mul_add(x1133, x1704, x1132 * x1701))
+                - Self::mul_add(
+                    x1269,
+                    x1709,
+                    Self::mul_add(-x1268, x1708, x1267 * x1707),
+                ));
+        let x1832 = Self::mul_add(
+            x960,
+            x1706,
+            Self::mul_add(-x959, x1704, x958 * x1701),
+        );
+        let x1833 = Self::mul_add(
+            -x1278,
+            x1695,
+            Self::mul_add(x1277, x1694, x1276 * x1693),
+        ) + Self::mul_add(-x1281, x1698, Self::mul_add(-x1280, x1697, x1279 * x1696))
+            - (x1832
+                + Self::mul_add(
+                    x1215,
+                    x1709,
+                    Self::mul_add(-x1214, x1708, x1213 * x1707),
+                ));
+        let x1834 = Self::mul_add(
+            x1272,
+            x1605,
+            Self::mul_add(x1271, x1604, x1270 * x1603),
+        ) + Self::mul_add(x1275, x1608, Self::mul_add(-x1274, x1607, x1273 * x1606))
+            + (Self::mul_add(x1134, x1616, Self::mul_add(x1133, x1614, x1132 * x1611))
+                - Self::mul_add(
+                    x1269,
+                    x1619,
+                    Self::mul_add(-x1268, x1618, x1267 * x1617),
+                ));
+        let x1835 = Self::mul_add(
+            x960,
+            x1616,
+            Self::mul_add(-x959, x1614, x958 * x1611),
+        );
+        let x1836 = Self::mul_add(
+            -x1278,
+            x1605,
+            Self::mul_add(x1277, x1604, x1276 * x1603),
+        ) + Self::mul_add(-x1281, x1608, Self::mul_add(-x1280, x1607, x1279 * x1606))
+            - (x1835
+                + Self::mul_add(
+                    x1215,
+                    x1619,
+                    Self::mul_add(-x1214, x1618, x1213 * x1617),
+                ));
+        let x1837 = x1093 - x1744;
+        let x1838 = x1094 - x1745;
+        let x1839 = x1095 - x1746;
+        let x1840 = x1117 - x1747;
+        let x1841 = x1118 - x1748;
+        let x1842 = x1119 - x1749;
+        let x1843 = x1120 - x1750;
+        let x1844 = x1121 - x1751;
+        let x1845 = x1122 - x1752;
+        let x1846 = x1123 - x1753;
+        let x1847 = x1124 - x1754;
+        let x1848 = x1125 - x1755;
+        let x1849 = x1186 - x1187 + x1192 + (x1192 + (x1193 - x1194)) - x1756;
+        let x1850 = x1176 + (x1173 + (x1167 + x1195))
+            + (x1172 - Self::mul_add(x1119, x1126, x1188)) - x1757;
+        let x1851 = x1175 - (x1171 - (x1165 + x1196))
+            - (x1170 + Self::mul_add(x1118, x1126, x1189)) - x1758;
+        let x1852 = x1183 - (x1184 + x1185) - x1759;
+        let x1853 = x1180 - (x1181 + x1182) - x1760;
+        let x1854 = x1176 - (x1172 - (x1166 + x1188))
+            - (x1173 + Self::mul_add(x1122, x1127, x1195)) - x1761;
+        let x1855 = x1193 - x1197 - x1200 - (x1200 - (x1186 - x1201)) - x1762;
+        let x1856 = x1174 - (x1169 + (x1163 + x1202))
+            - (x1168 - Self::mul_add(x1120, x1127, x1198)) - x1763;
+        let x1857 = x1184 - (x1183 - x1185) - x1764;
+        let x1858 = x1177 - (x1178 + x1179) - x1765;
+        let x1859 = x1175 + (x1170 + (x1164 + x1189))
+            + (x1171 - Self::mul_add(x1124, x1128, x1196)) - x1766;
+        let x1860 = x1174 + (x1168 - (x1162 + x1198))
+            + (x1169 + Self::mul_add(x1123, x1128, x1202)) - x1767;
+        let x1861 = x1194 - x1201 + x1203 + (x1203 + (x1187 - x1197)) - x1768;
+        let x1862 = x1181 - (x1180 - x1182) - x1769;
+        let x1863 = x1178 - (x1177 - x1179) - x1770;
+        let x1864 = x1183 - (x1184 - x1185) - x1771;
+        let x1865 = x1180 - (x1181 - x1182) - x1772;
+        let x1866 = x1184 - (x1183 + x1185) - x1773;
+        let x1867 = x1177 - (x1178 - x1179) - x1774;
+        let x1868 = x1181 - (x1180 + x1182) - x1775;
+        let x1869 = x1178 - (x1177 + x1179) - x1776;
+        let x1870 = Self::mul_add(
+            -x1119,
+            x1143,
+            Self::mul_add(x1118, x1142, x1117 * x1141),
+        ) + Self::mul_add(x1094, x1146, x1095 * x1145)
+            + (Self::mul_add(-x1127, x1176, x1128 * x1175)
+                + Self::mul_add(x1130, x1185, x1131 * x1182)) - x1777;
+        let x1871 = Self::mul_add(
+            x1122,
+            x1143,
+            Self::mul_add(x1121, x1142, x1120 * x1141),
+        ) - Self::mul_add(-x1093, x1146, x1095 * x1144)
+            - (Self::mul_add(x1126, x1176, x1128 * x1174)
+                + Self::mul_add(-x1129, x1185, x1131 * x1179)) - x1778;
+        let x1872 = Self::mul_add(
+            -x1125,
+            x1143,
+            Self::mul_add(-x1124, x1142, x1123 * x1141),
+        ) + Self::mul_add(x1093, x1145, x1094 * x1144)
+            + (Self::mul_add(x1126, x1175, x1127 * x1174)
+                + Self::mul_add(x1129, x1182, x1130 * x1179)) - x1779;
+        let x1873 = Self::mul_add(x1094, x1143, x1095 * x1142)
+            - Self::mul_add(x1127, x1185, x1128 * x1182) - x1780;
+        let x1874 = Self::mul_add(-x1093, x1143, x1095 * x1141)
+            - Self::mul_add(-x1126, x1185, x1128 * x1179) - x1781;
+        let x1875 = Self::mul_add(x1093, x1142, x1094 * x1141)
+            - Self::mul_add(x1126, x1182, x1127 * x1179) - x1782;
+        let x1876 = Self::mul_add(
+            -x960,
+            x1842,
+            Self::mul_add(-x959, x1841, x958 * x1840),
+        ) - Self::mul_add(x1092, x1838, x1091 * x1839);
+        let x1877 = Self::mul_add(x960, x1845, Self::mul_add(-x959, x1844, x958 * x1843))
+            + Self::mul_add(-x1092, x1837, x1090 * x1839);
+        let x1878 = Self::mul_add(-x960, x1848, Self::mul_add(x959, x1847, x958 * x1846))
+            - Self::mul_add(x1091, x1837, x1090 * x1838);
+        let x1879 = Self::mul_add(-x960, x1838, x959 * x1839);
+        let x1880 = Self::mul_add(-x960, x1837, x958 * x1839);
+        let x1881 = Self::mul_add(-x959, x1837, x958 * x1838);
+        let x1882 = x958 * x1849;
+        let x1883 = Self::mul_add(
+            x1091,
+            x1866,
+            Self::mul_add(-x960, x1859, Self::mul_add(x959, x1854, x1882)),
+        );
+        let x1884 = Self::mul_add(-x1092, x1868, x1883);
+        let x1885 = x959 * x1855;
+        let x1886 = Self::mul_add(
+            x1090,
+            x1864,
+            Self::mul_add(x960, x1860, Self::mul_add(x958, x1850, x1885)),
+        );
+        let x1887 = Self::mul_add(x1092, x1869, x1886);
+        let x1888 = x960 * x1861;
+        let x1889 = Self::mul_add(
+            x1091,
+            x1867,
+            Self::mul_add(
+                -x1090,
+                x1865,
+                Self::mul_add(x959, x1856, x958 * x1851) + x1888,
+            ),
+        );
+        let x1890 = Self::mul_add(x960, x1862, x959 * x1857);
+        let x1891 = Self::mul_add(x960, x1863, x958 * x1852);
+        let x1892 = Self::mul_add(x959, x1858, x958 * x1853);
+        let x1893 = Self::mul_add(
+            x1148,
+            x1852,
+            Self::mul_add(x1008, x1851, Self::mul_add(x1007, x1850, x1006 * x1849)),
+        );
+        let x1894 = Self::mul_add(
+            -x1147,
+            x1857,
+            Self::mul_add(x1008, x1856, Self::mul_add(x1007, x1855, x1006 * x1854)),
+        );
+        let x1895 = Self::mul_add(
+            x1147,
+            x1862,
+            Self::mul_add(-x1008, x1861, Self::mul_add(-x1007, x1860, x1006 * x1859)),
+        );
+        let x1896 = Self::mul_add(-x959, x1872, x960 * x1871)
+            - Self::mul_add(-x1091, x1875, x1092 * x1874)
+            - (Self::mul_add(x1152, x1842, Self::mul_add(x1151, x1841, x1150 * x1840))
+                - Self::mul_add(-x1155, x1838, x1154 * x1839))
+            - Self::mul_add(-x1149, x1853, x1893);
+        let x1897 = Self::mul_add(x958, x1872, x960 * x1870)
+            + Self::mul_add(x1090, x1875, x1092 * x1873)
+            + (Self::mul_add(-x1152, x1845, Self::mul_add(x1151, x1844, x1150 * x1843))
+                - Self::mul_add(-x1155, x1837, x1153 * x1839))
+            - Self::mul_add(-x1149, x1858, x1894);
+        let x1898 = Self::mul_add(x958, x1871, x959 * x1870)
+            - Self::mul_add(x1090, x1874, x1091 * x1873)
+            - (Self::mul_add(x1152, x1848, Self::mul_add(-x1151, x1847, x1150 * x1846))
+                + Self::mul_add(-x1154, x1837, x1153 * x1838))
+            - Self::mul_add(-x1148, x1863, x1895);
+        let x1899 = Self::mul_add(x959, x1875, x960 * x1874)
+            + Self::mul_add(-x1152, x1838, x1151 * x1839)
+            + Self::mul_add(-x1008, x1865, x1007 * x1864);
+        let x1900 = Self::mul_add(x958, x1875, x960 * x1873)
+            - Self::mul_add(x1152, x1837, x1150 * x1839)
+            + Self::mul_add(x1008, x1867, x1006 * x1866);
+        let x1901 = Self::mul_add(-x958, x1874, x959 * x1873)
+            - Self::mul_add(x1151, x1837, x1150 * x1838)
+            - Self::mul_add(-x1007, x1869, x1006 * x1868);
+        let x1902 = Self::mul_add(
+            -x1091,
+            x1852,
+            Self::mul_add(x960, x1851, Self::mul_add(-x959, x1850, x1882)),
+        );
+        let x1903 = Self::mul_add(
+            -x1090,
+            x1857,
+            Self::mul_add(-x960, x1856, Self::mul_add(-x958, x1854, x1885)),
+        );
+        let x1904 = Self::mul_add(
+            -x1091,
+            x1863,
+            Self::mul_add(x1090, x1862, x1888 - Self::mul_add(x959, x1860, x958 * x1859)),
+        );
+        let x1905 = Self::mul_add(
+            -x1158,
+            x1842,
+            Self::mul_add(x1157, x1841, x1156 * x1840),
+        ) - Self::mul_add(x1161, x1838, x1160 * x1839)
+            - Self::mul_add(x1092, x1853, x1902);
+        let x1906 = Self::mul_add(
+            x1158,
+            x1845,
+            Self::mul_add(x1157, x1844, x1156 * x1843),
+        ) - Self::mul_add(x1161, x1837, x1159 * x1839)
+            - Self::mul_add(-x1092, x1858, x1903);
+        let x1907 = Self::mul_add(
+            -x1158,
+            x1848,
+            Self::mul_add(-x1157, x1847, x1156 * x1846),
+        ) + Self::mul_add(-x1160, x1837, x1159 * x1838) + x1904;
+        let x1908 = Self::mul_add(x1158, x1838, x1157 * x1839)
+            + Self::mul_add(x960, x1865, x959 * x1864);
+        let x1909 = Self::mul_add(-x1158, x1837, x1156 * x1839)
+            + Self::mul_add(x960, x1867, x958 * x1866);
+        let x1910 = Self::mul_add(x1157, x1837, x1156 * x1838)
+            - Self::mul_add(x959, x1869, x958 * x1868);
+        let x1911 = Self::mul_add(-0.65, x1900, x1898);
+        let x1912 = Self::mul_add(-0.65, x1909, x1907);
+        let x1913 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1898,
+            Self::mul_add(s_q7, x1897, c_q7 * x1896),
+        ) - Self::mul_add(-x846, x1901, Self::mul_add(x845, x1900, x844 * x1899));
+        let x1914 = Self::mul_add(
+            0.00000000020510342851533115,
+            x1907,
+            Self::mul_add(-s_q7, x1906, c_q7 * x1905),
+        ) + Self::mul_add(x846, x1910, Self::mul_add(-x845, x1909, x844 * x1908));
+        let x1915 = Self::mul_add(-x960, x1898, Self::mul_add(x959, x1897, x958 * x1896))
+            - Self::mul_add(x966, x1901, Self::mul_add(x965, x1900, x964 * x1899));
+        let x1916 = Self::mul_add(
+            -x960,
+            x1907,
+            Self::mul_add(-x959, x1906, x958 * x1905),
+        ) + Self::mul_add(-x966, x1910, Self::mul_add(-x965, x1909, x964 * x1908));
+        let x1917 = Self::mul_add(
+            x1152,
+            x1878,
+            Self::mul_add(x1151, x1877, x1150 * x1876),
+        ) + Self::mul_add(x1155, x1881, Self::mul_add(-x1154, x1880, x1153 * x1879))
+            + (Self::mul_add(x1008, x1889, Self::mul_add(x1007, x1887, x1006 * x1884))
+                - Self::mul_add(
+                    x1149,
+                    x1892,
+                    Self::mul_add(-x1148, x1891, x1147 * x1890),
+                ));
+        let x1918 = Self::mul_add(
+            x960,
+            x1889,
+            Self::mul_add(-x959, x1887, x958 * x1884),
+        );
+        let x1919 = Self::mul_add(
+            -x1158,
+            x1878,
+            Self::mul_add(x1157, x1877, x1156 * x1876),
+        ) + Self::mul_add(-x1161, x1881, Self::mul_add(-x1160, x1880, x1159 * x1879))
+            - (x1918
+                + Self::mul_add(
+                    x1092,
+                    x1892,
+                    Self::mul_add(-x1091, x1891, x1090 * x1890),
+                ));
+        let x1920 = Self::mul_add(
+            x1152,
+            x1785,
+            Self::mul_add(x1151, x1784, x1150 * x1783),
+        ) + Self::mul_add(x1155, x1788, Self::mul_add(-x1154, x1787, x1153 * x1786))
+            + (Self::mul_add(x1008, x1796, Self::mul_add(x1007, x1794, x1006 * x1791))
+                - Self::mul_add(
+                    x1149,
+                    x1799,
+                    Self::mul_add(-x1148, x1798, x1147 * x1797),
+                ));
+        let x1921 = Self::mul_add(
+            -x1158,
+            x1785,
+            Self::mul_add(x1157, x1784, x1156 * x1783),
+        ) + Self::mul_add(-x1161, x1788, Self::mul_add(-x1160, x1787, x1159 * x1786))
+            - (x1829
+                + Self::mul_add(
+                    x1092,
+                    x1799,
+                    Self::mul_add(-x1091, x1798, x1090 * x1797),
+                ));
+        let x1922 = Self::mul_add(
+            x1152,
+            x1695,
+            Self::mul_add(x1151, x1694, x1150 * x1693),
+        ) + Self::mul_add(x1155, x1698, Self::mul_add(-x1154, x1697, x1153 * x1696))
+            + (Self::mul_add(x1008, x1706, Self::mul_add(x1007, x1704, x1006 * x1701))
+                - Self::mul_add(
+                    x1149,
+                    x1709,
+                    Self::mul_add(-x1148, x1708, x1147 * x1707),
+                ));
+        let x1923 = Self::mul_add(
+            -x1158,
+            x1695,
+            Self::mul_add(x1157, x1694, x1156 * x1693),
+        ) + Self::mul_add(-x1161, x1698, Self::mul_add(-x1160, x1697, x1159 * x1696))
+            - (x1832
+                + Self::mul_add(
+                    x1092,
+                    x1709,
+                    Self::mul_add(-x1091, x1708, x1090 * x1707),
+                ));
+        let x1924 = Self::mul_add(
+            x1152,
+            x1605,
+            Self::mul_add(x1151, x1604, x1150 * x1603),
+        ) + Self::mul_add(x1155, x1608, Self::mul_add(-x1154, x1607, x1153 * x1606))
+            + (Self::mul_add(x1008, x1616, Self::mul_add(x1007, x1614, x1006 * x1611))
+                - Self::mul_add(
+                    x1149,
+                    x1619,
+                    Self::mul_add(-x1148, x1618, x1147 * x1617),
+                ));
+        let x1925 = Self::mul_add(
+            -x1158,
+            x1605,
+            Self::mul_add(x1157, x1604, x1156 * x1603),
+        ) + Self::mul_add(-x1161, x1608, Self::mul_add(-x1160, x1607, x1159 * x1606))
+            - (x1835
+                + Self::mul_add(
+                    x1092,
+                    x1619,
+                    Self::mul_add(-x1091, x1618, x1090 * x1617),
+                ));
+        let x1926 = x967 - x1837;
+        let x1927 = x968 - x1838;
+        let x1928 = x969 + x1839;
+        let x1929 = x991 + x1840;
+        let x1930 = x992 - x1841;
+        let x1931 = x993 + x1842;
+        let x1932 = x994 - x1843;
+        let x1933 = x995 + x1844;
+        let x1934 = x996 + x1845;
+        let x1935 = x997 - x1846;
+        let x1936 = x998 - x1847;
+        let x1937 = x999 - x1848;
+        let x1938 = x1063 - x1064 - x1069 - (x1069 - (x1070 + x1071)) - x1849;
+        let x1939 = x1053 + (x1050 + (x1044 - x1072))
+            + (x1049 + Self::mul_add(x993, x1000, x1065)) - x1850;
+        let x1940 = x1052 - (x1048 + (x1042 - x1073))
+            + (x1047 + Self::mul_add(-x992, x1000, x1066)) - x1851;
+        let x1941 = x1060 - (x1061 + x1062) - x1852;
+        let x1942 = x1057 + (x1058 - x1059) + x1853;
+        let x1943 = x1053 - (x1049 - (x1043 - x1065))
+            - (x1050 - Self::mul_add(x996, x1001, x1072)) - x1854;
+        let x1944 = x1070 - x1074 + x1077 + (x1077 + (x1063 + x1078)) - x1855;
+        let x1945 = x1051 + (x1046 - (x1040 - x1079))
+            - (x1045 - Self::mul_add(-x994, x1001, x1075)) + x1856;
+        let x1946 = x1061 - (x1060 - x1062) - x1857;
+        let x1947 = x1054 + (x1055 - x1056) + x1858;
+        let x1948 = x1052 - (x1047 - (x1041 - x1066))
+            + (x1048 - Self::mul_add(x998, x1002, x1073)) - x1859;
+        let x1949 = x1051 + (x1045 + (x1039 - x1075))
+            - (x1046 + Self::mul_add(x997, x1002, x1079)) + x1860;
+        let x1950 = x1071 - x1078 - x1080 - (x1080 + (x1064 - x1074)) + x1861;
+        let x1951 = x1058 + (x1057 - x1059) - x1862;
+        let x1952 = x1055 + (x1054 - x1056) - x1863;
+        let x1953 = x1060 - (x1061 - x1062) - x1864;
+        let x1954 = x1057 + (x1058 + x1059) + x1865;
+        let x1955 = x1061 - (x1060 + x1062) - x1866;
+        let x1956 = x1054 + (x1055 + x1056) + x1867;
+        let x1957 = x1058 + (x1057 + x1059) - x1868;
+        let x1958 = x1055 + (x1054 + x1056) - x1869;
+        let x1959 = Self::mul_add(
+            -x993,
+            x1017,
+            Self::mul_add(-x992, x1016, x991 * x1015),
+        ) + Self::mul_add(-x968, x1020, x969 * x1019)
+            - (Self::mul_add(-x1001, x1053, x1002 * x1052)
+                - Self::mul_add(-x1004, x1062, x1005 * x1059)) + x1870;
+        let x1960 = Self::mul_add(
+            -x996,
+            x1017,
+            Self::mul_add(-x995, x1016, x994 * x1015),
+        ) + Self::mul_add(x967, x1020, x969 * x1018)
+            + (Self::mul_add(-x1000, x1053, x1002 * x1051)
+                + Self::mul_add(x1003, x1062, x1005 * x1056)) - x1871;
+        let x1961 = Self::mul_add(
+            -x999,
+            x1017,
+            Self::mul_add(-x998, x1016, x997 * x1015),
+        ) + Self::mul_add(x967, x1019, x968 * x1018)
+            - (Self::mul_add(-x1000, x1052, x1001 * x1051)
+                + Self::mul_add(x1003, x1059, x1004 * x1056)) - x1872;
+        let x1962 = Self::mul_add(-x968, x1017, x969 * x1016)
+            - Self::mul_add(-x1001, x1062, x1002 * x1059) + x1873;
+        let x1963 = Self::mul_add(x967, x1017, x969 * x1015)
+            - Self::mul_add(x1000, x1062, x1002 * x1056) + x1874;
+        let x1964 = Self::mul_add(x967, x1016, x968 * x1015)
+            + Self::mul_add(x1000, x1059, x1001 * x1056) - x1875;
+        let x1965 = Self::mul_add(-x960, x1931, Self::mul_add(x959, x1930, x958 * x1929))
+            - Self::mul_add(-x966, x1927, x965 * x1928);
+        let x1966 = Self::mul_add(-x960, x1934, Self::mul_add(x959, x1933, x958 * x1932))
+            - Self::mul_add(x966, x1926, x964 * x1928);
+        let x1967 = Self::mul_add(-x960, x1937, Self::mul_add(x959, x1936, x958 * x1935))
+            - Self::mul_add(x965, x1926, x964 * x1927);
+        let x1968 = Self::mul_add(x960, x1927, x959 * x1928);
+        let x1969 = Self::mul_add(x960, x1926, x958 * x1928);
+        let x1970 = Self::mul_add(-x959, x1926, x958 * x1927);
+        let x1971 = x958 * x1938;
+        let x1972 = Self::mul_add(
+            x965,
+            x1955,
+            Self::mul_add(-x960, x1948, Self::mul_add(x959, x1943, x1971)),
+        );
+        let x1973 = Self::mul_add(-x966, x1957, x1972);
+        let x1974 = x959 * x1944;
+        let x1975 = Self::mul_add(
+            x964,
+            x1953,
+            Self::mul_add(-x960, x1949, Self::mul_add(x958, x1939, x1974)),
+        );
+        let x1976 = Self::mul_add(x966, x1958, x1975);
+        let x1977 = x960 * x1950;
+        let x1978 = Self::mul_add(
+            -x965,
+            x1956,
+            Self::mul_add(x964, x1954, Self::mul_add(-x959, x1945, x958 * x1940) - x1977),
+        );
+        let x1979 = Self::mul_add(x960, x1951, x959 * x1946);
+        let x1980 = Self::mul_add(x960, x1952, x958 * x1941);
+        let x1981 = Self::mul_add(x959, x1947, x958 * x1942);
+        let x1982 = Self::mul_add(
+            -x1025,
+            x1941,
+            Self::mul_add(x1023, x1940, Self::mul_add(x1022, x1939, x1021 * x1938)),
+        );
+        let x1983 = Self::mul_add(
+            -x1024,
+            x1946,
+            Self::mul_add(-x1023, x1945, Self::mul_add(x1022, x1944, x1021 * x1943)),
+        );
+        let x1984 = Self::mul_add(
+            x1024,
+            x1951,
+            Self::mul_add(x1023, x1950, Self::mul_add(x1022, x1949, x1021 * x1948)),
+        );
+        let x1985 = Self::mul_add(-x959, x1961, x960 * x1960)
+            + Self::mul_add(x965, x1964, x966 * x1963)
+            + (Self::mul_add(x1029, x1931, Self::mul_add(-x1028, x1930, x1027 * x1929))
+                - Self::mul_add(x1032, x1927, x1031 * x1928))
+            - Self::mul_add(-x1026, x1942, x1982);
+        let x1986 = Self::mul_add(-x958, x1961, x960 * x1959)
+            + Self::mul_add(-x964, x1964, x966 * x1962)
+            - (Self::mul_add(x1029, x1934, Self::mul_add(-x1028, x1933, x1027 * x1932))
+                + Self::mul_add(x1032, x1926, x1030 * x1928))
+            + Self::mul_add(-x1026, x1947, x1983);
+        let x1987 = Self::mul_add(-x958, x1960, x959 * x1959)
+            - Self::mul_add(x964, x1963, x965 * x1962)
+            + (Self::mul_add(x1029, x1937, Self::mul_add(-x1028, x1936, x1027 * x1935))
+                + Self::mul_add(-x1031, x1926, x1030 * x1927))
+            + Self::mul_add(x1025, x1952, x1984);
+        let x1988 = Self::mul_add(-x959, x1964, x960 * x1963)
+            + Self::mul_add(x1029, x1927, x1028 * x1928)
+            - Self::mul_add(x1023, x1954, x1022 * x1953);
+        let x1989 = Self::mul_add(-x958, x1964, x960 * x1962)
+            - Self::mul_add(-x1029, x1926, x1027 * x1928)
+            - Self::mul_add(-x1023, x1956, x1021 * x1955);
+        let x1990 = Self::mul_add(-x958, x1963, x959 * x1962)
+            + Self::mul_add(x1028, x1926, x1027 * x1927)
+            + Self::mul_add(-x1022, x1958, x1021 * x1957);
+        let x1991 = Self::mul_add(
+            -x965,
+            x1941,
+            Self::mul_add(x960, x1940, Self::mul_add(-x959, x1939, x1971)),
+        );
+        let x1992 = Self::mul_add(
+            -x964,
+            x1946,
+            Self::mul_add(x960, x1945, Self::mul_add(-x958, x1943, x1974)),
+        );
+        let x1993 = Self::mul_add(
+            x965,
+            x1952,
+            Self::mul_add(
+                -x964,
+                x1951,
+                x1977 + Self::mul_add(-x959, x1949, x958 * x1948),
+            ),
+        );
+        let x1994 = Self::mul_add(
+            -x1035,
+            x1931,
+            Self::mul_add(-x1034, x1930, x1033 * x1929),
+        ) - Self::mul_add(-x1038, x1927, x1037 * x1928)
+            + Self::mul_add(-x966, x1942, x1991);
+        let x1995 = Self::mul_add(
+            -x1035,
+            x1934,
+            Self::mul_add(-x1034, x1933, x1033 * x1932),
+        ) + Self::mul_add(-x1038, x1926, x1036 * x1928)
+            - Self::mul_add(x966, x1947, x1992);
+        let x1996 = Self::mul_add(
+            -x1035,
+            x1937,
+            Self::mul_add(-x1034, x1936, x1033 * x1935),
+        ) + Self::mul_add(-x1037, x1926, x1036 * x1927) - x1993;
+        let x1997 = Self::mul_add(-x1035, x1927, x1034 * x1928)
+            - Self::mul_add(-x960, x1954, x959 * x1953);
+        let x1998 = Self::mul_add(x1035, x1926, x1033 * x1928)
+            - Self::mul_add(-x960, x1956, x958 * x1955);
+        let x1999 = Self::mul_add(x1034, x1926, x1033 * x1927)
+            - Self::mul_add(x959, x1958, x958 * x1957);
+        let x2000 = Self::mul_add(-0.65, x1989, x1987);
+        let x2001 = Self::mul_add(0.65, x1998, x1996);
+        let x2002 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x1987,
+            Self::mul_add(-s_q7, x1986, c_q7 * x1985),
+        ) + Self::mul_add(-x846, x1990, Self::mul_add(x845, x1989, x844 * x1988));
+        let x2003 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x1996,
+            Self::mul_add(s_q7, x1995, c_q7 * x1994),
+        ) + Self::mul_add(-x846, x1999, Self::mul_add(-x845, x1998, x844 * x1997));
+        let x2004 = Self::mul_add(
+            -x1029,
+            x1967,
+            Self::mul_add(-x1028, x1966, x1027 * x1965),
+        ) + Self::mul_add(-x1032, x1970, Self::mul_add(-x1031, x1969, x1030 * x1968))
+            - (Self::mul_add(x1023, x1978, Self::mul_add(x1022, x1976, x1021 * x1973))
+                - Self::mul_add(
+                    x1026,
+                    x1981,
+                    Self::mul_add(x1025, x1980, x1024 * x1979),
+                ));
+        let x2005 = Self::mul_add(
+            x1035,
+            x1967,
+            Self::mul_add(-x1034, x1966, x1033 * x1965),
+        ) + Self::mul_add(x1038, x1970, Self::mul_add(-x1037, x1969, x1036 * x1968))
+            + (Self::mul_add(x960, x1978, Self::mul_add(-x959, x1976, x958 * x1973))
+                + Self::mul_add(
+                    -x966,
+                    x1981,
+                    Self::mul_add(-x965, x1980, x964 * x1979),
+                ));
+        let x2006 = Self::mul_add(
+            x1029,
+            x1878,
+            Self::mul_add(x1028, x1877, x1027 * x1876),
+        ) + Self::mul_add(x1032, x1881, Self::mul_add(-x1031, x1880, x1030 * x1879))
+            + (Self::mul_add(x1023, x1889, Self::mul_add(x1022, x1887, x1021 * x1884))
+                - Self::mul_add(
+                    -x1026,
+                    x1892,
+                    Self::mul_add(x1025, x1891, x1024 * x1890),
+                ));
+        let x2007 = Self::mul_add(
+            -x1035,
+            x1878,
+            Self::mul_add(x1034, x1877, x1033 * x1876),
+        ) + Self::mul_add(-x1038, x1881, Self::mul_add(-x1037, x1880, x1036 * x1879))
+            - (x1918
+                + Self::mul_add(x966, x1892, Self::mul_add(-x965, x1891, x964 * x1890)));
+        let x2008 = Self::mul_add(
+            x1029,
+            x1785,
+            Self::mul_add(x1028, x1784, x1027 * x1783),
+        ) + Self::mul_add(x1032, x1788, Self::mul_add(-x1031, x1787, x1030 * x1786))
+            + (Self::mul_add(x1023, x1796, Self::mul_add(x1022, x1794, x1021 * x1791))
+                - Self::mul_add(
+                    -x1026,
+                    x1799,
+                    Self::mul_add(x1025, x1798, x1024 * x1797),
+                ));
+        let x2009 = Self::mul_add(
+            -x1035,
+            x1785,
+            Self::mul_add(x1034, x1784, x1033 * x1783),
+        ) + Self::mul_add(-x1038, x1788, Self::mul_add(-x1037, x1787, x1036 * x1786))
+            - (x1829
+                + Self::mul_add(x966, x1799, Self::mul_add(-x965, x1798, x964 * x1797)));
+        let x2010 = Self::mul_add(
+            x1029,
+            x1695,
+            Self::mul_add(x1028, x1694, x1027 * x1693),
+        ) + Self::mul_add(x1032, x1698, Self::mul_add(-x1031, x1697, x1030 * x1696))
+            + (Self::mul_add(x1023, x1706, Self::mul_add(x1022, x1704, x1021 * x1701))
+                - Self::mul_add(
+                    -x1026,
+                    x1709,
+                    Self::mul_add(x1025, x1708, x1024 * x1707),
+                ));
+        let x2011 = Self::mul_add(
+            -x1035,
+            x1695,
+            Self::mul_add(x1034, x1694, x1033 * x1693),
+        ) + Self::mul_add(-x1038, x1698, Self::mul_add(-x1037, x1697, x1036 * x1696))
+            - (x1832
+                + Self::mul_add(x966, x1709, Self::mul_add(-x965, x1708, x964 * x1707)));
+        let x2012 = Self::mul_add(
+            x1029,
+            x1605,
+            Self::mul_add(x1028, x1604, x1027 * x1603),
+        ) + Self::mul_add(x1032, x1608, Self::mul_add(-x1031, x1607, x1030 * x1606))
+            + (Self::mul_add(x1023, x1616, Self::mul_add(x1022, x1614, x1021 * x1611))
+                - Self::mul_add(
+                    -x1026,
+                    x1619,
+                    Self::mul_add(x1025, x1618, x1024 * x1617),
+                ));
+        let x2013 = Self::mul_add(
+            -x1035,
+            x1605,
+            Self::mul_add(x1034, x1604, x1033 * x1603),
+        ) + Self::mul_add(-x1038, x1608, Self::mul_add(-x1037, x1607, x1036 * x1606))
+            - (x1835
+                + Self::mul_add(x966, x1619, Self::mul_add(-x965, x1618, x964 * x1617)));
+        let x2014 = x847 + x1926;
+        let x2015 = x848 + x1927;
+        let x2016 = x849 - x1928;
+        let x2017 = x868 - x1929;
+        let x2018 = x869 - x1930;
+        let x2019 = x870 - x1931;
+        let x2020 = x866 - x1932;
+        let x2021 = x871 - x1933;
+        let x2022 = x867 + x1934;
+        let x2023 = x872 + x1935;
+        let x2024 = x873 - x1936;
+        let x2025 = x874 + x1937;
+        let x2026 = x934 + x935 - x940 - (x940 - (x941 + x942)) - x1938;
+        let x2027 = x924 + (x921 - (x915 - x943))
+            + (x920 - Self::mul_add(x870, x875, x936)) + x1939;
+        let x2028 = x923 + (x919 + (x913 - x944))
+            + (x918 + Self::mul_add(-x869, x875, x937)) - x1940;
+        let x2029 = x931 - (x932 + x933) + x1941;
+        let x2030 = x928 - (x929 + x930) - x1942;
+        let x2031 = x924 - (x920 - (x914 + x936))
+            - (x921 + Self::mul_add(-x867, x876, x943)) + x1943;
+        let x2032 = x941 - x945 + x948 + (x948 + (x934 - x949)) - x1944;
+        let x2033 = x922 - (x917 + (x911 + x950))
+            - (x916 - Self::mul_add(-x866, x876, x946)) - x1945;
+        let x2034 = x932 - (x931 - x933) + x1946;
+        let x2035 = x925 - (x926 + x927) - x1947;
+        let x2036 = x923 - (x918 - (x912 - x937))
+            - (x919 + Self::mul_add(x873, x877, -x944)) - x1948;
+        let x2037 = x922 + (x916 + (x910 - x946))
+            + (x917 + Self::mul_add(x872, x877, x950)) - x1949;
+        let x2038 = x942 + x949 + x951 + (x951 + (x935 + x945)) - x1950;
+        let x2039 = x929 - (x928 - x930) + x1951;
+        let x2040 = x926 - (x925 - x927) + x1952;
+        let x2041 = x931 - (x932 - x933) + x1953;
+        let x2042 = x928 - (x929 - x930) - x1954;
+        let x2043 = x932 - (x931 + x933) + x1955;
+        let x2044 = x925 - (x926 - x927) - x1956;
+        let x2045 = x929 - (x928 + x930) + x1957;
+        let x2046 = x926 - (x925 + x927) + x1958;
+        let x2047 = Self::mul_add(-x870, x889, Self::mul_add(-x869, x888, x868 * x887))
+            + Self::mul_add(x848, x892, x849 * x891)
+            - (Self::mul_add(x876, x924, x877 * x923)
+                - Self::mul_add(x879, x933, x880 * x930)) - x1959;
+        let x2048 = Self::mul_add(x867, x889, Self::mul_add(-x871, x888, x866 * x887))
+            + Self::mul_add(-x847, x892, x849 * x890)
+            + (Self::mul_add(x875, x924, x877 * x922)
+                + Self::mul_add(-x878, x933, x880 * x927)) - x1960;
+        let x2049 = Self::mul_add(-x874, x889, Self::mul_add(x873, x888, x872 * x887))
+            + Self::mul_add(x847, x891, x848 * x890)
+            + (Self::mul_add(-x875, x923, x876 * x922)
+                + Self::mul_add(x878, x930, x879 * x927)) + x1961;
+        let x2050 = Self::mul_add(x848, x889, x849 * x888)
+            - Self::mul_add(x876, x933, x877 * x930) - x1962;
+        let x2051 = Self::mul_add(-x847, x889, x849 * x887)
+            - Self::mul_add(-x875, x933, x877 * x927) - x1963;
+        let x2052 = Self::mul_add(x847, x888, x848 * x887)
+            - Self::mul_add(x875, x930, x876 * x927) + x1964;
+        let x2053 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2019,
+            Self::mul_add(s_q7, x2018, c_q7 * x2017),
+        ) - Self::mul_add(-x846, x2015, x845 * x2016);
+        let x2054 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2022,
+            Self::mul_add(s_q7, x2021, c_q7 * x2020),
+        ) - Self::mul_add(x846, x2014, x844 * x2016);
+        let x2055 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2025,
+            Self::mul_add(-s_q7, x2024, c_q7 * x2023),
+        ) - Self::mul_add(x845, x2014, x844 * x2015);
+        let x2056 = Self::mul_add(0.00000000020510342851533115, x2015, s_q7 * x2016);
+        let x2057 = Self::mul_add(0.00000000020510342851533115, x2014, c_q7 * x2016);
+        let x2058 = Self::mul_add(-s_q7, x2014, c_q7 * x2015);
+        let x2059 = c_q7 * x2026;
+        let x2060 = Self::mul_add(
+            -x845,
+            x2043,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2036,
+                Self::mul_add(-s_q7, x2031, x2059),
+            ),
+        );
+        let x2061 = Self::mul_add(-x846, x2045, x2060);
+        let x2062 = s_q7 * x2032;
+        let x2063 = Self::mul_add(
+            x844,
+            x2041,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x2037,
+                Self::mul_add(c_q7, x2027, -x2062),
+            ),
+        );
+        let x2064 = Self::mul_add(-x846, x2046, x2063);
+        let x2065 = 0.00000000020510342851533115 * x2038;
+        let x2066 = Self::mul_add(
+            -x845,
+            x2044,
+            Self::mul_add(x844, x2042, Self::mul_add(-s_q7, x2033, c_q7 * x2028) + x2065),
+        );
+        let x2067 = Self::mul_add(-0.00000000020510342851533115, x2039, s_q7 * x2034);
+        let x2068 = Self::mul_add(-0.00000000020510342851533115, x2040, c_q7 * x2029);
+        let x2069 = Self::mul_add(s_q7, x2035, c_q7 * x2030);
+        let x2070 = Self::mul_add(
+            x896,
+            x2029,
+            Self::mul_add(-x27, x2028, Self::mul_add(-x894, x2027, x893 * x2026)),
+        );
+        let x2071 = Self::mul_add(
+            -x895,
+            x2034,
+            Self::mul_add(-x27, x2033, Self::mul_add(-x894, x2032, x893 * x2031)),
+        );
+        let x2072 = Self::mul_add(
+            -x895,
+            x2039,
+            Self::mul_add(-x27, x2038, Self::mul_add(x894, x2037, x893 * x2036)),
+        );
+        let x2073 = Self::mul_add(-s_q7, x2049, 0.00000000020510342851533115 * x2048)
+            + Self::mul_add(x845, x2052, x846 * x2051)
+            - (Self::mul_add(x900, x2019, Self::mul_add(-x899, x2018, x898 * x2017))
+                - Self::mul_add(-x903, x2015, x902 * x2016))
+            + Self::mul_add(-x897, x2030, x2070);
+        let x2074 = Self::mul_add(-c_q7, x2049, 0.00000000020510342851533115 * x2047)
+            + Self::mul_add(-x844, x2052, x846 * x2050)
+            + (Self::mul_add(-x900, x2022, Self::mul_add(-x899, x2021, x898 * x2020))
+                + Self::mul_add(-x903, x2014, x901 * x2016))
+            + Self::mul_add(x897, x2035, x2071);
+        let x2075 = Self::mul_add(-c_q7, x2048, s_q7 * x2047)
+            - Self::mul_add(x844, x2051, x845 * x2050)
+            - (Self::mul_add(x900, x2025, Self::mul_add(x899, x2024, x898 * x2023))
+                + Self::mul_add(-x902, x2014, x901 * x2015))
+            + Self::mul_add(-x896, x2040, x2072);
+        let x2076 = Self::mul_add(-s_q7, x2052, 0.00000000020510342851533115 * x2051)
+            - Self::mul_add(-x900, x2015, x899 * x2016)
+            - Self::mul_add(x27, x2042, x894 * x2041);
+        let x2077 = Self::mul_add(-c_q7, x2052, 0.00000000020510342851533115 * x2050)
+            + Self::mul_add(x900, x2014, x898 * x2016)
+            - Self::mul_add(-x27, x2044, x893 * x2043);
+        let x2078 = Self::mul_add(-c_q7, x2051, s_q7 * x2050)
+            - Self::mul_add(x899, x2014, x898 * x2015)
+            - Self::mul_add(-x894, x2046, x893 * x2045);
+        let x2079 = Self::mul_add(
+            x845,
+            x2029,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x2028,
+                Self::mul_add(s_q7, x2027, x2059),
+            ),
+        );
+        let x2080 = Self::mul_add(
+            x844,
+            x2034,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x2033,
+                Self::mul_add(c_q7, x2031, x2062),
+            ),
+        );
+        let x2081 = Self::mul_add(
+            x845,
+            x2040,
+            Self::mul_add(
+                -x844,
+                x2039,
+                x2065 - Self::mul_add(-s_q7, x2037, c_q7 * x2036),
+            ),
+        );
+        let x2082 = Self::mul_add(x906, x2019, Self::mul_add(-x905, x2018, x904 * x2017))
+            - Self::mul_add(x909, x2015, x908 * x2016)
+            + Self::mul_add(x846, x2030, x2079);
+        let x2083 = Self::mul_add(
+            -x906,
+            x2022,
+            Self::mul_add(-x905, x2021, x904 * x2020),
+        ) + Self::mul_add(x909, x2014, x907 * x2016)
+            - Self::mul_add(-x846, x2035, x2080);
+        let x2084 = Self::mul_add(x906, x2025, Self::mul_add(x905, x2024, x904 * x2023))
+            + Self::mul_add(-x908, x2014, x907 * x2015) - x2081;
+        let x2085 = Self::mul_add(-x906, x2015, x905 * x2016)
+            + Self::mul_add(-0.00000000020510342851533115, x2042, s_q7 * x2041);
+        let x2086 = Self::mul_add(x906, x2014, x904 * x2016)
+            + Self::mul_add(-0.00000000020510342851533115, x2044, c_q7 * x2043);
+        let x2087 = Self::mul_add(x905, x2014, x904 * x2015)
+            - Self::mul_add(s_q7, x2046, c_q7 * x2045);
+        let x2088 = Self::mul_add(0.65, x2077, x2075);
+        let x2089 = Self::mul_add(-0.65, x2086, x2084);
+        let x2090 = Self::mul_add(x900, x2055, Self::mul_add(-x899, x2054, x898 * x2053))
+            + Self::mul_add(x903, x2058, Self::mul_add(-x902, x2057, x901 * x2056))
+            - (Self::mul_add(-x27, x2066, Self::mul_add(-x894, x2064, x893 * x2061))
+                + Self::mul_add(-x897, x2069, Self::mul_add(x896, x2068, x895 * x2067)));
+        let x2091 = Self::mul_add(x906, x2055, Self::mul_add(-x905, x2054, x904 * x2053))
+            + Self::mul_add(-x909, x2058, Self::mul_add(-x908, x2057, x907 * x2056))
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x2066,
+                Self::mul_add(s_q7, x2064, c_q7 * x2061),
+            ) - Self::mul_add(-x846, x2069, Self::mul_add(-x845, x2068, x844 * x2067)));
+        let x2092 = Self::mul_add(
+            -x900,
+            x1967,
+            Self::mul_add(-x899, x1966, x898 * x1965),
+        ) + Self::mul_add(-x903, x1970, Self::mul_add(-x902, x1969, x901 * x1968))
+            - (Self::mul_add(-x27, x1978, Self::mul_add(x894, x1976, x893 * x1973))
+                - Self::mul_add(x897, x1981, Self::mul_add(x896, x1980, x895 * x1979)));
+        let x2093 = Self::mul_add(
+            -x906,
+            x1967,
+            Self::mul_add(-x905, x1966, x904 * x1965),
+        ) + Self::mul_add(x909, x1970, Self::mul_add(-x908, x1969, x907 * x1968))
+            + (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1978,
+                Self::mul_add(-s_q7, x1976, c_q7 * x1973),
+            ) + Self::mul_add(x846, x1981, Self::mul_add(-x845, x1980, x844 * x1979)));
+        let x2094 = Self::mul_add(x900, x1878, Self::mul_add(x899, x1877, x898 * x1876))
+            + Self::mul_add(x903, x1881, Self::mul_add(-x902, x1880, x901 * x1879))
+            + (Self::mul_add(-x27, x1889, Self::mul_add(x894, x1887, x893 * x1884))
+                - Self::mul_add(-x897, x1892, Self::mul_add(x896, x1891, x895 * x1890)));
+        let x2095 = Self::mul_add(x906, x1878, Self::mul_add(x905, x1877, x904 * x1876))
+            + Self::mul_add(-x909, x1881, Self::mul_add(-x908, x1880, x907 * x1879))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1889,
+                Self::mul_add(-s_q7, x1887, c_q7 * x1884),
+            ) + Self::mul_add(-x846, x1892, Self::mul_add(-x845, x1891, x844 * x1890)));
+        let x2096 = Self::mul_add(x900, x1785, Self::mul_add(x899, x1784, x898 * x1783))
+            + Self::mul_add(x903, x1788, Self::mul_add(-x902, x1787, x901 * x1786))
+            + (Self::mul_add(-x27, x1796, Self::mul_add(x894, x1794, x893 * x1791))
+                - Self::mul_add(-x897, x1799, Self::mul_add(x896, x1798, x895 * x1797)));
+        let x2097 = Self::mul_add(x906, x1785, Self::mul_add(x905, x1784, x904 * x1783))
+            + Self::mul_add(-x909, x1788, Self::mul_add(-x908, x1787, x907 * x1786))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1796,
+                Self::mul_add(-s_q7, x1794, c_q7 * x1791),
+            ) + Self::mul_add(-x846, x1799, Self::mul_add(-x845, x1798, x844 * x1797)));
+        let x2098 = Self::mul_add(x900, x1695, Self::mul_add(x899, x1694, x898 * x1693))
+            + Self::mul_add(x903, x1698, Self::mul_add(-x902, x1697, x901 * x1696))
+            + (Self::mul_add(-x27, x1706, Self::mul_add(x894, x1704, x893 * x1701))
+                - Self::mul_add(-x897, x1709, Self::mul_add(x896, x1708, x895 * x1707)));
+        let x2099 = Self::mul_add(x906, x1695, Self::mul_add(x905, x1694, x904 * x1693))
+            + Self::mul_add(-x909, x1698, Self::mul_add(-x908, x1697, x907 * x1696))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1706,
+                Self::mul_add(-s_q7, x1704, c_q7 * x1701),
+            ) + Self::mul_add(-x846, x1709, Self::mul_add(-x845, x1708, x844 * x1707)));
+        let x2100 = Self::mul_add(x900, x1605, Self::mul_add(x899, x1604, x898 * x1603))
+            + Self::mul_add(x903, x1608, Self::mul_add(-x902, x1607, x901 * x1606))
+            + (Self::mul_add(-x27, x1616, Self::mul_add(x894, x1614, x893 * x1611))
+                - Self::mul_add(-x897, x1619, Self::mul_add(x896, x1618, x895 * x1617)));
+        let x2101 = Self::mul_add(x906, x1605, Self::mul_add(x905, x1604, x904 * x1603))
+            + Self::mul_add(-x909, x1608, Self::mul_add(-x908, x1607, x907 * x1606))
+            - (Self::mul_add(
+                -0.00000000020510342851533115,
+                x1616,
+                Self::mul_add(-s_q7, x1614, c_q7 * x1611),
+            ) + Self::mul_add(-x846, x1619, Self::mul_add(-x845, x1618, x844 * x1617)));
+        let x2102 = x769 + x2014;
+        let x2103 = x770 + x2015;
+        let x2104 = x775 + x2017;
+        let x2105 = x781 + x2018;
+        let x2106 = x778 + x2019;
+        let x2107 = x779 - x2020;
+        let x2108 = x782 + x2021;
+        let x2109 = x780 - x2022;
+        let x2110 = x778 + x2023;
+        let x2111 = x780 - x2024;
+        let x2112 = x783 + x2025;
+        let x2113 = x825 - x826 + x828 + (x828 - (x826 + x830)) - x2026;
+        let x2114 = x829 + (x817 + x831) + x2027;
+        let x2115 = x816 - x832 - Self::mul_add(-v[3], x781, x827) - x2028;
+        let x2116 = x820 - (x821 + x822) + x2029;
+        let x2117 = x817 - x829 - x831 + x2031;
+        let x2118 = x830 + x834 + x836 + (x836 - (x825 - x834)) + x2032;
+        let x2119 = x815 - x837 + Self::mul_add(v[4], x779, x835) + x2033;
+        let x2120 = x821 - (x820 - x822) + x2034;
+        let x2121 = x816 + (x807 + x827) + x832 - x2036;
+        let x2122 = x815 + (x805 - x835) + x837 + x2037;
+        let x2123 = x839 + x839 + x2038;
+        let x2124 = x820 - (x821 - x822) + x2041;
+        let x2125 = x833 - x2042;
+        let x2126 = x821 - (x820 + x822) + x2043;
+        let x2127 = x838 - x2044;
+        let x2128 = x833 + x2045;
+        let x2129 = x838 + x2046;
+        let x2130 = Self::mul_add(x700, x770, Self::mul_add(-v[4], x822, x38 * x819))
+            + x2050;
+        let x2131 = Self::mul_add(-0.65, x2016, x2106);
+        let x2132 = Self::mul_add(-0.65, x2102, x2112);
+        let x2133 = Self::mul_add(0.65, x2126, x2121);
+        let x2134 = Self::mul_add(0.65, x2127, x2123);
+        let x2135 = Self::mul_add(-x798, x2102, x797 * x2103);
+        let x2136 = Self::mul_add(
+            0.65,
+            x2130,
+            -(Self::mul_add(-x793, x2112, Self::mul_add(x796, x2111, x795 * x2110))
+                + x2135),
+        );
+        let x2137 = Self::mul_add(
+            x785,
+            x2030,
+            Self::mul_add(v[0], x2116, Self::mul_add(v[3], x2114, v[4] * x2113)),
+        );
+        let x2138 = Self::mul_add(
+            x785,
+            x2035,
+            Self::mul_add(-x792, x2120, Self::mul_add(-v[3], x2118, v[4] * x2117)),
+        );
+        let x2139 = v[3] * x2122;
+        let x2140 = x792 * x2039;
+        let x2141 = v[0] * x2040;
+        let x2142 = Self::mul_add(
+            -0.65,
+            Self::mul_add(x769, x788, x770 * x787)
+                + Self::mul_add(v[3], x819, v[4] * x818) + x2052,
+            x824
+                - (Self::mul_add(v[3], x817, x38 * x815)
+                    - Self::mul_add(v[0], x822, v[2] * x818)) - x2048,
+        )
+            - (Self::mul_add(-x793, x2106, Self::mul_add(x796, x2105, x795 * x2104))
+                - Self::mul_add(-x799, x2103, x798 * x2016)) + x2137;
+        let x2143 = x823
+            + (Self::mul_add(-v[4], x817, x38 * x816)
+                - Self::mul_add(-x784, x822, v[2] * x819)) + x2047
+            + (Self::mul_add(x793, x2109, Self::mul_add(-x796, x2108, x795 * x2107))
+                - Self::mul_add(-x799, x2102, x797 * x2016)) + x2138;
+        let x2144 = x2136 + (Self::mul_add(v[4], x2121, -x2139) + x2140 - x2141);
+        let x2145 = Self::mul_add(
+            v[3],
+            x2124,
+            Self::mul_add(x700, x769, -Self::mul_add(v[3], x822, x38 * x818)) - x2051
+                + Self::mul_add(-x793, x2103, x796 * x2016),
+        );
+        let x2146 = Self::mul_add(
+            -v[4],
+            x2126,
+            x2130 - Self::mul_add(-x793, x2102, x795 * x2016),
+        );
+        let x2147 = Self::mul_add(-x796, x2102, x795 * x2103)
+            - Self::mul_add(-v[3], x2129, v[4] * x2128);
+        let x2148 = Self::mul_add(x803, x2102, x802 * x2103);
+        let x2149 = Self::mul_add(x801, x2102, x800 * x2103);
+        let x2150 = 0.65 * x2040;
+        let x2151 = Self::mul_add(-x801, x2105, x800 * x2104)
+            + Self::mul_add(-x804, x2103, x803 * x2016)
+            + Self::mul_add(0.65, x2116, x2115);
+        let x2152 = x2119
+            - (Self::mul_add(x801, x2108, x800 * x2107)
+                - Self::mul_add(x804, x2102, x802 * x2016));
+        let x2153 = Self::mul_add(-x801, x2111, x800 * x2110) + x2148 - (x2123 + x2150);
+        let x2154 = Self::mul_add(x801, x2016, x2125);
+        let x2155 = Self::mul_add(x800, x2016, x2127);
+        let x2156 = x2135
+            + Self::mul_add(-x793, x2132, Self::mul_add(x796, x2109, x795 * x2131))
+            + (Self::mul_add(-v[4], x2133, x2139) - (x2140 - x2141));
+        let x2157 = x2148 + Self::mul_add(-x801, x2109, x800 * x2131) - (x2134 + x2150);
+        let x2158 = Self::mul_add(-x793, x2055, Self::mul_add(x796, x2054, x795 * x2053))
+            + Self::mul_add(x799, x2058, Self::mul_add(-x798, x2057, x797 * x2056))
+            + (Self::mul_add(-v[3], x2064, v[4] * x2061)
+                + Self::mul_add(
+                    -x785,
+                    x2069,
+                    Self::mul_add(-v[0], x2068, x792 * x2067),
+                ));
+        let x2159 = Self::mul_add(-x801, x2054, x800 * x2053)
+            + Self::mul_add(-x804, x2058, Self::mul_add(x803, x2057, x802 * x2056))
+            - Self::mul_add(-0.65, x2068, x2066);
+        let x2160 = Self::mul_add(x793, x1967, Self::mul_add(x796, x1966, x795 * x1965))
+            + Self::mul_add(-x799, x1970, Self::mul_add(-x798, x1969, x797 * x1968))
+            + (Self::mul_add(v[3], x1976, v[4] * x1973)
+                - Self::mul_add(x785, x1981, Self::mul_add(-v[0], x1980, x792 * x1979)));
+        let x2161 = Self::mul_add(-x801, x1966, x800 * x1965)
+            + Self::mul_add(x804, x1970, Self::mul_add(x803, x1969, x802 * x1968))
+            - Self::mul_add(0.65, x1980, x1978);
+        let x2162 = Self::mul_add(
+            -x793,
+            x1878,
+            Self::mul_add(-x796, x1877, x795 * x1876),
+        ) + Self::mul_add(x799, x1881, Self::mul_add(-x798, x1880, x797 * x1879))
+            - (Self::mul_add(v[3], x1887, v[4] * x1884)
+                - Self::mul_add(
+                    -x785,
+                    x1892,
+                    Self::mul_add(-v[0], x1891, x792 * x1890),
+                ));
+        let x2163 = Self::mul_add(x801, x1877, x800 * x1876)
+            + Self::mul_add(-x804, x1881, Self::mul_add(x803, x1880, x802 * x1879))
+            + Self::mul_add(0.65, x1891, x1889);
+        let x2164 = Self::mul_add(
+            -x793,
+            x1785,
+            Self::mul_add(-x796, x1784, x795 * x1783),
+        ) + Self::mul_add(x799, x1788, Self::mul_add(-x798, x1787, x797 * x1786))
+            - (Self::mul_add(v[3], x1794, v[4] * x1791)
+                - Self::mul_add(
+                    -x785,
+                    x1799,
+                    Self::mul_add(-v[0], x1798, x792 * x1797),
+                ));
+        let x2165 = Self::mul_add(x801, x1784, x800 * x1783)
+            + Self::mul_add(-x804, x1788, Self::mul_add(x803, x1787, x802 * x1786))
+            + Self::mul_add(0.65, x1798, x1796);
+        let x2166 = Self::mul_add(
+            -x793,
+            x1695,
+            Self::mul_add(-x796, x1694, x795 * x1693),
+        ) + Self::mul_add(x799, x1698, Self::mul_add(-x798, x1697, x797 * x1696))
+            - (Self::mul_add(v[3], x1704, v[4] * x1701)
+                - Self::mul_add(
+                    -x785,
+                    x1709,
+                    Self::mul_add(-v[0], x1708, x792 * x1707),
+                ));
+        let x2167 = Self::mul_add(x801, x1694, x800 * x1693)
+            + Self::mul_add(-x804, x1698, Self::mul_add(x803, x1697, x802 * x1696))
+            + Self::mul_add(0.65, x1708, x1706);
+        let x2168 = Self::mul_add(
+            -x793,
+            x1605,
+            Self::mul_add(-x796, x1604, x795 * x1603),
+        ) + Self::mul_add(x799, x1608, Self::mul_add(-x798, x1607, x797 * x1606))
+            - (Self::mul_add(v[3], x1614, v[4] * x1611)
+                - Self::mul_add(
+                    -x785,
+                    x1619,
+                    Self::mul_add(-v[0], x1618, x792 * x1617),
+                ));
+        let x2169 = Self::mul_add(x801, x1604, x800 * x1603)
+            + Self::mul_add(-x804, x1608, Self::mul_add(x803, x1607, x802 * x1606))
+            + Self::mul_add(0.65, x1618, x1616);
+        let x2170 = 110.5455 + x2102;
+        let x2171 = 180.9502499901501 + x2016;
+        let x2172 = 1394.5960312283303 + x2104;
+        let x2173 = -117.61766249359756 - x2106;
+        let x2174 = 1466.4506062283303 + x2108;
+        let x2175 = -117.61766249359758 - x2110;
+        let x2176 = 1271.854575 + x2112;
+        let x2177 = v[5] * x2171;
+        let x2178 = v[4] * x2103;
+        let x2179 = x2177 + x2178;
+        let x2180 = v[4] * x2170;
+        let x2181 = v[5] * x2170;
+        let x2182 = x22 - (x18 - x25) + x2120 - x2180;
+        let x2183 = x21 - (x24 - x765) + x2039 - x2181;
+        let x2184 = Self::mul_add(-v[5], x2102, x2039);
+        let x2185 = x2067 + Self::mul_add(v[4], x2058, v[5] * x2057);
+        let x2186 = x1979 - Self::mul_add(-v[4], x1970, v[5] * x1969);
+        let x2187 = x1890 + Self::mul_add(v[4], x1881, v[5] * x1880);
+        let x2188 = x1797 + Self::mul_add(v[4], x1788, v[5] * x1787);
+        let x2189 = x1707 + Self::mul_add(v[4], x1698, v[5] * x1697);
+        let x2190 = x1617 + Self::mul_add(v[4], x1608, v[5] * x1607);
+        let x2191 = v[3] * x2103;
+        let x2192 = v[3] * x2170;
+        let x2193 = x2177 + x2192;
+        let x2194 = v[5] * x2103;
+        let x2195 = x2116 - x2191;
+        let x2196 = x2040 - x2194;
+        let x2197 = x2068 + Self::mul_add(-v[3], x2058, v[5] * x2056);
+        let x2198 = x1980 - Self::mul_add(v[3], x1970, v[5] * x1968);
+        let x2199 = x1891 + Self::mul_add(-v[3], x1881, v[5] * x1879);
+        let x2200 = x1798 + Self::mul_add(-v[3], x1788, v[5] * x1786);
+        let x2201 = x1708 + Self::mul_add(-v[3], x1698, v[5] * x1696);
+        let x2202 = x1618 + Self::mul_add(-v[3], x1608, v[5] * x1606);
+        let x2203 = v[3] * x2171;
+        let x2204 = v[4] * x2171;
+        let x2205 = x2178 + x2192;
+        let x2206 = x20 + (x24 - x760) + x2030 - x2203;
+        let x2207 = x19 + (x16 - x23) + x2035 - x2204;
+        let x2208 = Self::mul_add(v[3], x2102, x2178);
+        let x2209 = x2069 - Self::mul_add(v[3], x2057, v[4] * x2056);
+        let x2210 = x1981 - Self::mul_add(v[3], x1969, v[4] * x1968);
+        let x2211 = x1892 - Self::mul_add(v[3], x1880, v[4] * x1879);
+        let x2212 = x1799 - Self::mul_add(v[3], x1787, v[4] * x1786);
+        let x2213 = x1709 - Self::mul_add(v[3], x1697, v[4] * x1696);
+        let x2214 = x1619 - Self::mul_add(v[3], x1607, v[4] * x1606);
+        let x2215 = v[2] * x2171;
+        let x2216 = v[1] * x2103;
+        let x2217 = x25 + x25 - x2126 - (x18 - x2180);
+        let x2218 = x20 - x24 - x760 - x2128 + (x17 + x2181);
+        let x2219 = x753 - x755 - (x755 - x757) - x2113
+            + (x2215 + x2216 + Self::mul_add(v[4], x2175, v[5] * x2107));
+        let x2220 = x15 + (x8 + x754) - x758 + x2117
+            + Self::mul_add(v[1], x2170, Self::mul_add(v[4], x2111, v[5] * x2174));
+        let x2221 = v[5] * x2109;
+        let x2222 = x14 - x756 - x759 - x2121
+            + Self::mul_add(v[2], x2170, -Self::mul_add(v[4], x2176, x2221));
+        let x2223 = x2133
+            + Self::mul_add(-v[2], x2102, Self::mul_add(v[4], x2132, x2221));
+        let x2224 = x2061
+            - (Self::mul_add(v[4], x2055, v[5] * x2054)
+                - Self::mul_add(v[1], x2058, v[2] * x2057));
+        let x2225 = x1973
+            - (Self::mul_add(-v[4], x1967, v[5] * x1966)
+                - Self::mul_add(-v[1], x1970, v[2] * x1969));
+        let x2226 = x1884
+            - (Self::mul_add(-v[4], x1878, v[5] * x1877)
+                + Self::mul_add(v[1], x1881, v[2] * x1880));
+        let x2227 = x1791
+            - (Self::mul_add(-v[4], x1785, v[5] * x1784)
+                + Self::mul_add(v[1], x1788, v[2] * x1787));
+        let x2228 = x1701
+            - (Self::mul_add(-v[4], x1695, v[5] * x1694)
+                + Self::mul_add(v[1], x1698, v[2] * x1697));
+        let x2229 = x1611
+            - (Self::mul_add(-v[4], x1605, v[5] * x1604)
+                + Self::mul_add(v[1], x1608, v[2] * x1607));
+        let x2230 = v[3] * x2109;
+        let x2231 = v[0] * x2170;
+        let x2232 = v[2] * x2103;
+        let x2233 = x18 - (x22 - x25) + x2124 - (x18 + x2191);
+        let x2234 = x16 + (x19 + x23) - x2129 - (x16 - x2194);
+        let x2235 = x15 + x758 - Self::mul_add(v[3], 117.61766249359756, x754) + x2114
+            - Self::mul_add(v[0], x2103, -Self::mul_add(-v[3], x2175, v[5] * x2172));
+        let x2236 = x762 + x762 + x2118
+            - (x2215 + x2231 + Self::mul_add(v[3], x2111, v[5] * x2105));
+        let x2237 = x13 + x763 + Self::mul_add(v[5], 117.61766249359758, x764) + x2122
+            - (x2232 + Self::mul_add(-v[5], x2173, v[3] * x2176));
+        let x2238 = x2122 - (x2232 + Self::mul_add(v[3], x2132, v[5] * x2131));
+        let x2239 = x2064
+            + (Self::mul_add(v[3], x2055, v[5] * x2053)
+                + Self::mul_add(-v[0], x2058, v[2] * x2056));
+        let x2240 = x1976
+            - (Self::mul_add(-v[3], x1967, v[5] * x1965)
+                + Self::mul_add(v[0], x1970, v[2] * x1968));
+        let x2241 = x1887
+            + (Self::mul_add(v[3], x1878, v[5] * x1876)
+                + Self::mul_add(-v[0], x1881, v[2] * x1879));
+        let x2242 = x1794
+            + (Self::mul_add(v[3], x1785, v[5] * x1783)
+                + Self::mul_add(-v[0], x1788, v[2] * x1786));
+        let x2243 = x1704
+            + (Self::mul_add(v[3], x1695, v[5] * x1693)
+                + Self::mul_add(-v[0], x1698, v[2] * x1696));
+        let x2244 = x1614
+            + (Self::mul_add(v[3], x1605, v[5] * x1603)
+                + Self::mul_add(-v[0], x1608, v[2] * x1606));
+        let x2245 = x21 + x24 + x765 + x2125 - (x17 - x2203);
+        let x2246 = x23 + x23 - x2127 - (x16 + x2204);
+        let x2247 = x756 + (x14 + x759) - x2115
+            - Self::mul_add(v[0], x2171, Self::mul_add(v[3], x2107, v[4] * x2172));
+        let x2248 = x763 - (x13 - (x7 + x764)) - x2119
+            - Self::mul_add(v[1], x2171, -Self::mul_add(-v[4], x2105, v[3] * x2174));
+        let x2249 = x757 + x761 + (x753 + x761) + x2123
+            - (x2216 + x2231 - Self::mul_add(v[4], x2173, x2230));
+        let x2250 = x2134
+            + (Self::mul_add(-v[4], x2131, x2230) - Self::mul_add(v[0], x2102, x2216));
+        let x2251 = x2066
+            - (Self::mul_add(-v[3], x2054, v[4] * x2053)
+                + Self::mul_add(v[0], x2057, v[1] * x2056));
+        let x2252 = x1978
+            - (Self::mul_add(-v[3], x1966, v[4] * x1965)
+                + Self::mul_add(v[0], x1969, v[1] * x1968));
+        let x2253 = x1889
+            + (Self::mul_add(v[3], x1877, v[4] * x1876)
+                + Self::mul_add(v[0], x1880, v[1] * x1879));
+        let x2254 = x1796
+            + (Self::mul_add(v[3], x1784, v[4] * x1783)
+                + Self::mul_add(v[0], x1787, v[1] * x1786));
+        let x2255 = x1706
+            + (Self::mul_add(v[3], x1694, v[4] * x1693)
+                + Self::mul_add(v[0], x1697, v[1] * x1696));
+        let x2256 = x1616
+            + (Self::mul_add(v[3], x1604, v[4] * x1603)
+                + Self::mul_add(v[0], x1607, v[1] * x1606));
+        let x2257 = 4.806620000000001 * x140;
+        let x2258 = 4.806620000000001 * c_q13;
+        let x2259 = 4.806620000000001 * s_q13;
+        let x2260 = Self::mul_add(0.000781, x140, -0.0145);
+        let x2261 = -0.9614610000000001
+            - Self::mul_add(x140, 1.2025609200000003, 0.000781 * x139);
+        let x2262 = 1.4135609200000003
+            + Self::mul_add(x140, -0.9614610000000001, x139 * 0.0145);
+        let x2263 = 0.000781 * c_q13;
+        let x2264 = 0.000781 * s_q13;
+        let x2265 = Self::mul_add(c_q13, -1.2025609200000003, x2264);
+        let x2266 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x2267 = x2264 + 0.000000000002973999713472302;
+        let x2268 = Self::mul_add(s_q13, 1.2025609200000003, x2263)
+            - 0.00000000019719894748377882;
+        let x2269 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
+            + -0.0000000002899261911072858;
+        let x2270 = 0.16 * x2259;
+        let x2271 = 0.55 * x2258;
+        let x2272 = x2270 + x2271;
+        let x2273 = 0.55 * x2257;
+        let x2274 = 0.16 * x2257;
+        let x2275 = 0.16 * x2258;
+        let x2276 = 0.55 * x2259;
+        let x2277 = x2272 + (x2262 - Self::mul_add(-x140, x2261, x139 * x2260) + x2272);
+        let x2278 = 3.6140000000000003 + x2257;
+        let x2279 = 17.135250000000003 + x2258;
+        let x2280 = -1.9877000000000002
+            + (Self::mul_add(c_q13, x2261, s_q13 * x2260) - x2273);
+        let x2281 = -0.809539999555672
+            - (Self::mul_add(
+                0.00000000020510342851533115,
+                x2262,
+                Self::mul_add(-s_q13, x2261, c_q13 * x2260),
+            ) + x2274);
+        let x2282 = -1.9877000000000002
+            - (x2266 + Self::mul_add(-x140, x2265, x139 * x2263) + x2273);
+        let x2283 = -5.252920330000002
+            + (x2270 + (Self::mul_add(c_q13, x2265, s_q13 * x2263) + x2270));
+        let x2284 = -2.741639999592316
+            - (x2276
+                + (Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x2266,
+                    Self::mul_add(-s_q13, x2265, c_q13 * x2263),
+                ) + x2275));
+        let x2285 = -0.809539999555672
+            + (x2269 - Self::mul_add(x140, x2268, x139 * x2267) - x2274);
+        let x2286 = -2.7416399995923166
+            - (x2275 - (Self::mul_add(-c_q13, x2268, s_q13 * x2267) - x2276));
+        let x2287 = 9.740442170000001
+            + (x2271
+                - (Self::mul_add(
+                    0.00000000020510342851533115,
+                    x2269,
+                    Self::mul_add(s_q13, x2268, c_q13 * x2267),
+                ) - x2271));
+        let x2288 = Self::mul_add(-s_q12, x2279, c_q12 * x2278);
+        let x2289 = x2259 - Self::mul_add(x120, x2279, x119 * x2278);
+        let x2290 = Self::mul_add(c_q12, x2279, s_q12 * x2278);
+        let x2291 = Self::mul_add(0.00000000020510342851533115, x2259, x2290);
+        let x2292 = Self::mul_add(-s_q12, x2282, c_q12 * x2277);
+        let x2293 = Self::mul_add(-s_q12, x2283, c_q12 * x2280);
+        let x2294 = Self::mul_add(-s_q12, x2284, c_q12 * x2281);
+        let x2295 = x2285 - Self::mul_add(x120, x2282, x119 * x2277);
+        let x2296 = x2286 - Self::mul_add(x120, x2283, x119 * x2280);
+        let x2297 = x2287 - Self::mul_add(x120, x2284, x119 * x2281);
+        let x2298 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2287,
+            Self::mul_add(c_q12, x2284, s_q12 * x2281),
+        );
+        let x2299 = x2294 - Self::mul_add(x120, x2293, x119 * x2292);
+        let x2300 = Self::mul_add(
+            c_q12,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2286,
+                Self::mul_add(c_q12, x2283, s_q12 * x2280),
+            ),
+            s_q12
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x2285,
+                    Self::mul_add(c_q12, x2282, s_q12 * x2277),
+                ),
+        );
+        let x2301 = 0.36 * x2291;
+        let x2302 = Self::mul_add(
+            -0.36,
+            x2288,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2294,
+                Self::mul_add(c_q12, x2293, s_q12 * x2292),
+            ),
+        );
+        let x2303 = Self::mul_add(
+            -0.36,
+            x2289,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2297,
+                Self::mul_add(c_q12, x2296, s_q12 * x2295),
+            ),
+        );
+        let x2304 = x2301 + (Self::mul_add(-s_q12, x2293, c_q12 * x2292) + x2301);
+        let x2305 = 7.078399999258757 + x2289;
+        let x2306 = 0.01675 - x2302;
+        let x2307 = -9.142025249762803
+            + (x2301 + (x2297 - Self::mul_add(x120, x2296, x119 * x2295) + x2301));
+        let x2308 = 2.5482240016099564 - x2303;
+        let x2309 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x2298, x2300);
+        let x2310 = s_q11 * s_q11;
+        let x2311 = s_q11 * c_q11;
+        let x2312 = x2304 - x2307;
+        let x2313 = x2299 + x2299;
+        let x2314 = Self::mul_add(x2311, x2313, x2310 * x2312);
+        let x2315 = Self::mul_add(-s_q11, x2305, c_q11 * x2288);
+        let x2316 = Self::mul_add(c_q11, x2305, s_q11 * x2288);
+        let x2317 = 0.275 * x2291;
+        let x2318 = 0.63 * x2316;
+        let x2319 = x2317 - x2318;
+        let x2320 = Self::mul_add(
+            0.63,
+            x2315,
+            x2299 + Self::mul_add(-x2310, x2313, x2311 * x2312),
+        );
+        let x2321 = Self::mul_add(
+            0.275,
+            x2315,
+            Self::mul_add(-s_q11, x2308, c_q11 * x2306),
+        );
+        let x2322 = Self::mul_add(
+            0.275,
+            x2316,
+            Self::mul_add(c_q11, x2308, s_q11 * x2306),
+        );
+        let x2323 = x2309 - x2318;
+        let x2324 = x2319 + (x2304 - x2314 + x2319);
+        let x2325 = -45.1584 + x2316;
+        let x2326 = -0.6328 + x2321;
+        let x2327 = -24.4950615 + (x2317 + (x2307 + x2314 + x2317));
+        let x2328 = -24.35164200091464 - Self::mul_add(0.63, x2291, -x2322);
+        let x2329 = 28.2393615 - (x2318 - x2323);
+        let x2330 = s_q10 * s_q10;
+        let x2331 = s_q10 * c_q10;
+        let x2332 = x2324 - x2327;
+        let x2333 = x2320 + x2320;
+        let x2334 = Self::mul_add(x2331, x2333, x2330 * x2332);
+        let x2335 = Self::mul_add(-s_q10, x2328, c_q10 * x2326);
+        let x2336 = Self::mul_add(c_q10, x2328, s_q10 * x2326);
+        let x2337 = c_q10 * x2315;
+        let x2338 = Self::mul_add(-s_q10, x2325, x2337);
+        let x2339 = s_q10 * x2315;
+        let x2340 = Self::mul_add(c_q10, x2325, x2339);
+        let x2341 = 0.87 * x2340;
+        let x2342 = Self::mul_add(
+            0.87,
+            x2338,
+            x2320 + Self::mul_add(-x2330, x2333, x2331 * x2332),
+        );
+        let x2343 = x2329 - x2341;
+        let x2344 = x2341 - (x2324 - x2334 - x2341);
+        let x2345 = -81.53205 + x2340;
+        let x2346 = -0.00214 + x2335;
+        let x2347 = -63.36336825000001 + (x2327 + x2334);
+        let x2348 = -36.18604050126307 + Self::mul_add(-0.87, x2291, x2336);
+        let x2349 = 69.99836825 - (x2341 - x2343);
+        let x2350 = s_q9 * x2338;
+        let x2351 = Self::mul_add(c_q9, x2345, x2350);
+        let x2352 = 0.00000000020510342851533115 * x2291;
+        let x2353 = x2351 - x2352;
+        let x2354 = x2291 - Self::mul_add(-x67, x2345, x66 * x2338);
+        let x2355 = c_q9 * x2338;
+        let x2356 = Self::mul_add(-s_q9, x2345, x2355);
+        let x2357 = x2352 + x2356;
+        let x2358 = c_q9 * x2342;
+        let x2359 = 0.00000000020510342851533115 * x2346;
+        let x2360 = Self::mul_add(s_q9, x2344, -x2358) - x2359;
+        let x2361 = s_q9 * x2342;
+        let x2362 = 0.00000000020510342851533115 * x2348;
+        let x2363 = Self::mul_add(c_q9, x2347, x2361) + x2362;
+        let x2364 = 0.00000000020510342851533115 * x2349;
+        let x2365 = Self::mul_add(c_q9, x2348, s_q9 * x2346) + x2364;
+        let x2366 = x2346 - Self::mul_add(x67, x2342, x66 * x2344);
+        let x2367 = x2348 + Self::mul_add(-x67, x2347, x66 * x2342);
+        let x2368 = x2349 + Self::mul_add(-x67, x2348, x66 * x2346);
+        let x2369 = x2359 + Self::mul_add(c_q9, x2344, x2361);
+        let x2370 = x2362 - Self::mul_add(-s_q9, x2347, x2358);
+        let x2371 = x2364 - Self::mul_add(-s_q9, x2348, c_q9 * x2346);
+        let x2372 = 0.00000000020510342851533115 * x2365;
+        let x2373 = 0.00000000020510342851533115 * x2368;
+        let x2374 = 0.00000000020510342851533115 * x2371;
+        let x2375 = 0.4 * x2357;
+        let x2376 = 0.275 * x2354;
+        let x2377 = x2375 - x2376;
+        let x2378 = 0.275 * x2353;
+        let x2379 = 0.4 * x2353;
+        let x2380 = 0.4 * x2354;
+        let x2381 = 0.275 * x2357;
+        let x2382 = x2377 - (Self::mul_add(-c_q9, x2363, s_q9 * x2360) - x2372 - x2377);
+        let x2383 = -0.000000008530897668050218 + x2353;
+        let x2384 = -12.701650001451807 - x2354;
+        let x2385 = -0.0000000234896432582596
+            + (x2365 - Self::mul_add(x67, x2363, x66 * x2360) - x2378);
+        let x2386 = -0.002139996587640933
+            - (x2372 + Self::mul_add(s_q9, x2363, c_q9 * x2360) + x2379);
+        let x2387 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x2367, s_q9 * x2366) + x2373 - x2378);
+        let x2388 = -111.7548902508081
+            + (x2375 + (x2368 + Self::mul_add(-x67, x2367, x66 * x2366) + x2375));
+        let x2389 = 5.080660024070365
+            - (x2381 + (x2373 - Self::mul_add(-s_q9, x2367, c_q9 * x2366) - x2380));
+        let x2390 = -0.002139996587640933
+            - (Self::mul_add(c_q9, x2370, s_q9 * x2369) + x2374 + x2379);
+        let x2391 = 5.080660024070366
+            + (x2380 - (x2371 + Self::mul_add(-x67, x2370, x66 * x2369) + x2381));
+        let x2392 = 113.3918902508081
+            - (x2376 - (x2374 - Self::mul_add(-s_q9, x2370, c_q9 * x2369) - x2376));
+        let x2393 = x2357 - Self::mul_add(-x45, x2384, x44 * x2383);
+        let x2394 = Self::mul_add(c_q8, x2384, s_q8 * x2383);
+        let x2395 = Self::mul_add(-s_q8, x2384, c_q8 * x2383);
+        let x2396 = Self::mul_add(0.00000000020510342851533115, x2357, x2395);
+        let x2397 = x2390 - Self::mul_add(-x45, x2387, x44 * x2382);
+        let x2398 = x2391 - Self::mul_add(-x45, x2388, x44 * x2385);
+        let x2399 = x2392 - Self::mul_add(-x45, x2389, x44 * x2386);
+        let x2400 = Self::mul_add(c_q8, x2387, s_q8 * x2382);
+        let x2401 = Self::mul_add(c_q8, x2388, s_q8 * x2385);
+        let x2402 = Self::mul_add(c_q8, x2389, s_q8 * x2386);
+        let x2403 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2392,
+            Self::mul_add(-s_q8, x2389, c_q8 * x2386),
+        );
+        let x2404 = Self::mul_add(
+            -s_q8,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2391,
+                Self::mul_add(-s_q8, x2388, c_q8 * x2385),
+            ),
+            c_q8
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x2390,
+                    Self::mul_add(-s_q8, x2387, c_q8 * x2382),
+                ),
+        );
+        let x2405 = 0.35 * x2396;
+        let x2406 = Self::mul_add(
+            0.35,
+            x2393,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2399,
+                Self::mul_add(-s_q8, x2398, c_q8 * x2397),
+            ),
+        );
+        let x2407 = Self::mul_add(
+            0.35,
+            x2394,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x2402,
+                Self::mul_add(-s_q8, x2401, c_q8 * x2400),
+            ),
+        );
+        let x2408 = x2405 - (x2399 - Self::mul_add(-x45, x2398, x44 * x2397) - x2405);
+        let x2409 = 48.0240000085309 + x2393;
+        let x2410 = -0.07309 + Self::mul_add(c_q8, x2398, s_q8 * x2397);
+        let x2411 = -16.80768997608804 - x2406;
+        let x2412 = 130.43769025763282
+            - (x2405 - (Self::mul_add(c_q8, x2401, s_q8 * x2400) - x2405));
+        let x2413 = 0.1132 - x2407;
+        let x2414 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x2403, x2404);
+        let x2415 = s_q7 * s_q7;
+        let x2416 = s_q7 * c_q7;
+        let x2417 = x2408 + x2412;
+        let x2418 = x2410 + x2410;
+        let x2419 = Self::mul_add(-x2416, x2418, x2415 * x2417);
+        let x2420 = Self::mul_add(-s_q7, x2394, c_q7 * x2409);
+        let x2421 = Self::mul_add(c_q7, x2394, s_q7 * x2409);
+        let x2422 = 0.75 * x2396;
+        let x2423 = 0.65 * x2420;
+        let x2424 = x2422 - x2423;
+        let x2425 = Self::mul_add(
+            -0.75,
+            x2420,
+            Self::mul_add(-s_q7, x2413, c_q7 * x2411),
+        );
+        let x2426 = x2414 + x2423;
+        let x2427 = 110.5455 + x2420;
+        let x2428 = 180.9502499901501 - x2396;
+        let x2429 = Self::mul_add(x45, x2383, x44 * x2384);
+        let x2430 = Self::mul_add(-0.35, x2395, x2399);
+        let x2431 = Self::mul_add(0.35, x2429, x2402);
+        let x2432 = Self::mul_add(-s_q7, x2395, c_q7 * x2429);
+        let x2433 = Self::mul_add(c_q7, x2395, s_q7 * x2429);
+        let x2434 = x67 * x2338;
+        let x2435 = Self::mul_add(x66, x2345, x2434);
+        let x2436 = x2365 + Self::mul_add(-0.275, x2351, 0.4 * x2435);
+        let x2437 = Self::mul_add(0.4, x2356, x2368);
+        let x2438 = Self::mul_add(0.275, x2356, x2371);
+        let x2439 = x2351 + Self::mul_add(x45, x2435, x44 * x2356);
+        let x2440 = Self::mul_add(-c_q8, x2435, s_q8 * x2356);
+        let x2441 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2351,
+            Self::mul_add(s_q8, x2435, c_q8 * x2356),
+        );
+        let x2442 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2438,
+            Self::mul_add(-s_q8, x2437, c_q8 * x2436),
+        );
+        let x2443 = Self::mul_add(
+            0.35,
+            x2440,
+            x2438 + Self::mul_add(-x45, x2437, x44 * x2436),
+        );
+        let x2444 = Self::mul_add(
+            -0.35,
+            x2439,
+            Self::mul_add(c_q8, x2437, s_q8 * x2436),
+        );
+        let x2445 = Self::mul_add(s_q7, x2440, c_q7 * x2439);
+        let x2446 = Self::mul_add(-c_q7, x2440, s_q7 * x2439);
+        let x2447 = Self::mul_add(-s_q9, x2340, x2355);
+        let x2448 = Self::mul_add(x66, x2340, x2434);
+        let x2449 = Self::mul_add(c_q9, x2340, x2350);
+        let x2450 = 0.00000000020510342851533115 * x2343;
+        let x2451 = Self::mul_add(c_q9, x2336, s_q9 * x2335) + x2450
+            + Self::mul_add(-0.275, x2449, 0.4 * x2448);
+        let x2452 = Self::mul_add(
+            0.4,
+            x2447,
+            x2343 + Self::mul_add(-x67, x2336, x66 * x2335),
+        );
+        let x2453 = Self::mul_add(
+            0.275,
+            x2447,
+            x2450 - Self::mul_add(-s_q9, x2336, c_q9 * x2335),
+        );
+        let x2454 = x2449 + Self::mul_add(x45, x2448, x44 * x2447);
+        let x2455 = Self::mul_add(-c_q8, x2448, s_q8 * x2447);
+        let x2456 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2449,
+            Self::mul_add(s_q8, x2448, c_q8 * x2447),
+        );
+        let x2457 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2453,
+            Self::mul_add(-s_q8, x2452, c_q8 * x2451),
+        );
+        let x2458 = Self::mul_add(
+            0.35,
+            x2455,
+            x2453 + Self::mul_add(-x45, x2452, x44 * x2451),
+        );
+        let x2459 = Self::mul_add(
+            -0.35,
+            x2454,
+            Self::mul_add(c_q8, x2452, s_q8 * x2451),
+        );
+        let x2460 = Self::mul_add(s_q7, x2455, c_q7 * x2454);
+        let x2461 = Self::mul_add(-c_q7, x2455, s_q7 * x2454);
+        let x2462 = Self::mul_add(c_q10, x2316, x2339);
+        let x2463 = Self::mul_add(-s_q10, x2316, x2337);
+        let x2464 = Self::mul_add(-s_q10, x2322, c_q10 * x2321);
+        let x2465 = Self::mul_add(c_q10, x2322, s_q10 * x2321);
+        let x2466 = Self::mul_add(-0.87, x2462, x2323);
+        let x2467 = Self::mul_add(-c_q9, x2463, s_q9 * x2462);
+        let x2468 = Self::mul_add(x67, x2463, x66 * x2462);
+        let x2469 = Self::mul_add(s_q9, x2463, c_q9 * x2462);
+        let x2470 = 0.00000000020510342851533115 * x2466;
+        let x2471 = Self::mul_add(c_q9, x2465, s_q9 * x2464) + x2470
+            + Self::mul_add(-0.275, x2469, 0.4 * x2468);
+        let x2472 = Self::mul_add(
+            -0.4,
+            x2467,
+            x2466 + Self::mul_add(-x67, x2465, x66 * x2464),
+        );
+        let x2473 = Self::mul_add(
+            -0.275,
+            x2467,
+            x2470 - Self::mul_add(-s_q9, x2465, c_q9 * x2464),
+        );
+        let x2474 = x2469 - Self::mul_add(-x45, x2468, x44 * x2467);
+        let x2475 = Self::mul_add(c_q8, x2468, s_q8 * x2467);
+        let x2476 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2469,
+            Self::mul_add(-s_q8, x2468, c_q8 * x2467),
+        );
+        let x2477 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2473,
+            Self::mul_add(-s_q8, x2472, c_q8 * x2471),
+        );
+        let x2478 = Self::mul_add(
+            -0.35,
+            x2475,
+            x2473 + Self::mul_add(-x45, x2472, x44 * x2471),
+        );
+        let x2479 = Self::mul_add(
+            -0.35,
+            x2474,
+            Self::mul_add(c_q8, x2472, s_q8 * x2471),
+        );
+        let x2480 = Self::mul_add(-s_q7, x2475, c_q7 * x2474);
+        let x2481 = Self::mul_add(c_q7, x2475, s_q7 * x2474);
+        let x2482 = Self::mul_add(-x120, x2278, x119 * x2279);
+        let x2483 = Self::mul_add(0.36, x2482, x2294);
+        let x2484 = Self::mul_add(0.36, x2290, x2297);
+        let x2485 = Self::mul_add(s_q11, x2482, c_q11 * x2290);
+        let x2486 = Self::mul_add(-c_q11, x2482, s_q11 * x2290);
+        let x2487 = Self::mul_add(-s_q11, x2484, c_q11 * x2483)
+            - Self::mul_add(-0.63, x2288, 0.275 * x2486);
+        let x2488 = Self::mul_add(
+            0.275,
+            x2485,
+            Self::mul_add(c_q11, x2484, s_q11 * x2483),
+        );
+        let x2489 = Self::mul_add(0.63, x2485, x2298);
+        let x2490 = Self::mul_add(-s_q10, x2486, c_q10 * x2485);
+        let x2491 = Self::mul_add(c_q10, x2486, s_q10 * x2485);
+        let x2492 = Self::mul_add(c_q10, x2488, s_q10 * x2487);
+        let x2493 = Self::mul_add(
+            0.87,
+            x2288,
+            Self::mul_add(-s_q10, x2488, c_q10 * x2487),
+        );
+        let x2494 = Self::mul_add(0.87, x2490, x2489);
+        let x2495 = 0.00000000020510342851533115 * x2288;
+        let x2496 = Self::mul_add(c_q9, x2491, s_q9 * x2490) + x2495;
+        let x2497 = x2288 + Self::mul_add(-x67, x2491, x66 * x2490);
+        let x2498 = x2495 - Self::mul_add(-s_q9, x2491, c_q9 * x2490);
+        let x2499 = 0.00000000020510342851533115 * x2494;
+        let x2500 = Self::mul_add(c_q9, x2492, s_q9 * x2493) - x2499
+            + Self::mul_add(0.275, x2498, 0.4 * x2497);
+        let x2501 = Self::mul_add(
+            0.4,
+            x2496,
+            x2494 - Self::mul_add(-x67, x2492, x66 * x2493),
+        );
+        let x2502 = Self::mul_add(
+            0.275,
+            x2496,
+            x2499 + Self::mul_add(-s_q9, x2492, c_q9 * x2493),
+        );
+        let x2503 = x2498 + Self::mul_add(-x45, x2497, x44 * x2496);
+        let x2504 = Self::mul_add(c_q8, x2497, s_q8 * x2496);
+        let x2505 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x2498,
+            Self::mul_add(-s_q8, x2497, c_q8 * x2496),
+        );
+        let x2506 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2502,
+            Self::mul_add(s_q8, x2501, c_q8 * x2500),
+        );
+        let x2507 = Self::mul_add(
+            0.35,
+            x2504,
+            x2502 - Self::mul_add(x45, x2501, x44 * x2500),
+        );
+        let x2508 = Self::mul_add(
+            0.35,
+            x2503,
+            Self::mul_add(-c_q8, x2501, s_q8 * x2500),
+        );
+        let x2509 = Self::mul_add(s_q7, x2504, c_q7 * x2503);
+        let x2510 = Self::mul_add(-c_q7, x2504, s_q7 * x2503);
+        let x2511 = 4.806620000000001 * x139;
+        let x2512 = x2262 + x2272;
+        let x2513 = Self::mul_add(-0.16, x2511, x2266);
+        let x2514 = Self::mul_add(-0.55, x2511, x2269);
+        let x2515 = Self::mul_add(s_q12, x2259, c_q12 * x2511);
+        let x2516 = x2258 - Self::mul_add(-x120, x2259, x119 * x2511);
+        let x2517 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2258,
+            Self::mul_add(-c_q12, x2259, s_q12 * x2511),
+        );
+        let x2518 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2514,
+            Self::mul_add(-c_q12, x2513, s_q12 * x2512),
+        );
+        let x2519 = Self::mul_add(
+            0.36,
+            x2516,
+            Self::mul_add(s_q12, x2513, c_q12 * x2512),
+        );
+        let x2520 = Self::mul_add(
+            -0.36,
+            x2515,
+            x2514 - Self::mul_add(-x120, x2513, x119 * x2512),
+        );
+        let x2521 = Self::mul_add(-s_q11, x2516, c_q11 * x2515);
+        let x2522 = Self::mul_add(c_q11, x2516, s_q11 * x2515);
+        let x2523 = Self::mul_add(-s_q11, x2520, c_q11 * x2519)
+            + Self::mul_add(0.63, x2517, 0.275 * x2522);
+        let x2524 = Self::mul_add(
+            -0.275,
+            x2521,
+            Self::mul_add(c_q11, x2520, s_q11 * x2519),
+        );
+        let x2525 = Self::mul_add(-0.63, x2521, x2518);
+        let x2526 = Self::mul_add(-s_q10, x2522, c_q10 * x2521);
+        let x2527 = Self::mul_add(c_q10, x2522, s_q10 * x2521);
+        let x2528 = Self::mul_add(c_q10, x2524, s_q10 * x2523);
+        let x2529 = Self::mul_add(
+            0.87,
+            x2517,
+            Self::mul_add(-s_q10, x2524, c_q10 * x2523),
+        );
+        let x2530 = Self::mul_add(-0.87, x2526, x2525);
+        let x2531 = 0.00000000020510342851533115 * x2517;
+        let x2532 = Self::mul_add(c_q9, x2527, s_q9 * x2526) - x2531;
+        let x2533 = x2517 - Self::mul_add(-x67, x2527, x66 * x2526);
+        let x2534 = x2531 + Self::mul_add(-s_q9, x2527, c_q9 * x2526);
+        let x2535 = 0.00000000020510342851533115 * x2530;
+        let x2536 = Self::mul_add(c_q9, x2528, s_q9 * x2529) - x2535
+            + Self::mul_add(0.275, x2534, 0.4 * x2533);
+        let x2537 = Self::mul_add(
+            -0.4,
+            x2532,
+            x2530 - Self::mul_add(-x67, x2528, x66 * x2529),
+        );
+        let x2538 = Self::mul_add(
+            -0.275,
+            x2532,
+            x2535 + Self::mul_add(-s_q9, x2528, c_q9 * x2529),
+        );
+        let x2539 = x2534 - Self::mul_add(x45, x2533, x44 * x2532);
+        let x2540 = Self::mul_add(-c_q8, x2533, s_q8 * x2532);
+        let x2541 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2534,
+            Self::mul_add(s_q8, x2533, c_q8 * x2532),
+        );
+        let x2542 = Self::mul_add(
+            0.00000000020510342851533115,
+            x2538,
+            Self::mul_add(s_q8, x2537, c_q8 * x2536),
+        );
+        let x2543 = Self::mul_add(
+            -0.35,
+            x2540,
+            x2538 - Self::mul_add(x45, x2537, x44 * x2536),
+        );
+        let x2544 = Self::mul_add(
+            0.35,
+            x2539,
+            Self::mul_add(-c_q8, x2537, s_q8 * x2536),
+        );
+        let x2545 = Self::mul_add(-s_q7, x2540, c_q7 * x2539);
+        let x2546 = Self::mul_add(c_q7, x2540, s_q7 * x2539);
+        let x2547 = x2428 * 0.0008546497218115156;
+        let x2548 = x2421 * 0.0008546497218115156;
+        let x2549 = x2432 * 0.0008546497218115156;
+        let x2550 = x2445 * 0.0008546497218115156;
+        let x2551 = x2460 * 0.0008546497218115156;
+        let x2552 = x2480 * 0.0008546497218115156;
+        let x2553 = x2509 * 0.0008546497218115156;
+        let x2554 = x2545 * 0.0008546497218115156;
+        let x2555 = x2427 * 0.0008546497218115156;
+        let x2556 = x2420 * 0.0008546497218115156;
+        let x2557 = x2433 * 0.0008546497218115156;
+        let x2558 = x2446 * 0.0008546497218115156;
+        let x2559 = x2461 * 0.0008546497218115156;
+        let x2560 = x2481 * 0.0008546497218115156;
+        let x2561 = x2510 * 0.0008546497218115156;
+        let x2562 = x2546 * 0.0008546497218115156;
+        let x2563 = x2394 * 0.0008546497218115156;
+        let x2564 = x2441 * 0.0008546497218115156;
+        let x2565 = x2456 * 0.0008546497218115156;
+        let x2566 = x2476 * 0.0008546497218115156;
+        let x2567 = x2505 * 0.0008546497218115156;
+        let x2568 = x2541 * 0.0008546497218115156;
+        let x2569 = x2428 * x2547;
+        let x2570 = x2421 * x2548;
+        let x2571 = 1.0
+            / (1394.5960312283303 - (x2422 + (x2408 - x2419 + x2422)) - x2569 - x2570);
+        let x2572 = Self::mul_add(
+            x2421,
+            x2555,
+            Self::mul_add(
+                -0.65,
+                x2421,
+                x2410 - Self::mul_add(x2415, x2418, x2416 * x2417),
+            ),
+        );
+        let x2573 = x2571 * x2572;
+        let x2574 = Self::mul_add(
+            x2428,
+            x2555,
+            -117.61766249359756 + Self::mul_add(0.65, x2396, x2425),
+        );
+        let x2575 = x2571 * x2574;
+        let x2576 = Self::mul_add(x2428, x2556, x2425);
+        let x2577 = x2571 * x2576;
+        let x2578 = Self::mul_add(
+            x2428,
+            x2557,
+            Self::mul_add(-0.75, x2433, Self::mul_add(-s_q7, x2431, c_q7 * x2430)),
+        );
+        let x2579 = Self::mul_add(-x2421, x2563, x2578);
+        let x2580 = x2571 * x2579;
+        let x2581 = Self::mul_add(
+            x2428,
+            x2558,
+            Self::mul_add(-0.75, x2446, Self::mul_add(s_q7, x2444, c_q7 * x2443)),
+        );
+        let x2582 = Self::mul_add(-x2421, x2564, x2581);
+        let x2583 = x2571 * x2582;
+        let x2584 = Self::mul_add(
+            x2428,
+            x2559,
+            Self::mul_add(-0.75, x2461, Self::mul_add(s_q7, x2459, c_q7 * x2458)),
+        );
+        let x2585 = Self::mul_add(-x2421, x2565, x2584);
+        let x2586 = x2571 * x2585;
+        let x2587 = Self::mul_add(
+            x2428,
+            x2560,
+            Self::mul_add(-0.75, x2481, Self::mul_add(s_q7, x2479, c_q7 * x2478)),
+        );
+        let x2588 = Self::mul_add(x2421, x2566, x2587);
+        let x2589 = x2571 * x2588;
+        let x2590 = Self::mul_add(
+            x2428,
+            x2561,
+            Self::mul_add(-0.75, x2510, Self::mul_add(-s_q7, x2508, c_q7 * x2507)),
+        );
+        let x2591 = Self::mul_add(-x2421, x2567, x2590);
+        let x2592 = x2571 * x2591;
+        let x2593 = Self::mul_add(
+            x2428,
+            x2562,
+            Self::mul_add(-0.75, x2546, Self::mul_add(-s_q7, x2544, c_q7 * x2543)),
+        );
+        let x2594 = Self::mul_add(x2421, x2568, x2593);
+        let x2595 = x2571 * x2594;
+        let x2596 = x2427 * x2555;
+        let x2597 = 1.0
+            / Self::mul_add(
+                -x2572,
+                x2573,
+                1466.4506062283303 - (x2424 - (x2412 - x2419 - x2424)) - x2569 - x2596,
+            );
+        let x2598 = Self::mul_add(
+            x2428,
+            x2548,
+            Self::mul_add(-0.75, x2421, Self::mul_add(c_q7, x2413, s_q7 * x2411)),
+        );
+        let x2599 = Self::mul_add(-x2572, x2575, x2598);
+        let x2600 = x2597 * x2599;
+        let x2601 = Self::mul_add(-x2572, x2577, x2598);
+        let x2602 = x2597 * x2601;
+        let x2603 = Self::mul_add(
+            x2427,
+            x2563,
+            Self::mul_add(
+                -x2428,
+                x2549,
+                Self::mul_add(c_q7, x2431, s_q7 * x2430)
+                    + Self::mul_add(-0.65, x2394, 0.75 * x2432),
+            ),
+        );
+        let x2604 = Self::mul_add(-x2572, x2580, x2603);
+        let x2605 = x2597 * x2604;
+        let x2606 = Self::mul_add(
+            x2427,
+            x2564,
+            Self::mul_add(
+                -x2428,
+                x2550,
+                Self::mul_add(-c_q7, x2444, s_q7 * x2443)
+                    + Self::mul_add(-0.65, x2441, 0.75 * x2445),
+            ),
+        );
+        let x2607 = Self::mul_add(-x2572, x2583, x2606);
+        let x2608 = x2597 * x2607;
+        let x2609 = Self::mul_add(
+            x2427,
+            x2565,
+            Self::mul_add(
+                -x2428,
+                x2551,
+                Self::mul_add(-c_q7, x2459, s_q7 * x2458)
+                    + Self::mul_add(-0.65, x2456, 0.75 * x2460),
+            ),
+        );
+        let x2610 = Self::mul_add(-x2572, x2586, x2609);
+        let x2611 = x2597 * x2610;
+        let x2612 = Self::mul_add(
+            -x2427,
+            x2566,
+            Self::mul_add(
+                -x2428,
+                x2552,
+                Self::mul_add(-c_q7, x2479, s_q7 * x2478)
+                    + Self::mul_add(0.65, x2476, 0.75 * x2480),
+            ),
+        );
+        let x2613 = Self::mul_add(-x2572, x2589, x2612);
+        let x2614 = x2597 * x2613;
+        let x2615 = Self::mul_add(
+            x2427,
+            x2567,
+            Self::mul_add(
+                -x2428,
+                x2553,
+                Self::mul_add(c_q7, x2508, s_q7 * x2507)
+                    + Self::mul_add(-0.65, x2505, 0.75 * x2509),
+            ),
+        );
+        let x2616 = Self::mul_add(-x2572, x2592, x2615);
+        let x2617 = x2597 * x2616;
+        let x2618 = Self::mul_add(
+            -x2427,
+            x2568,
+            Self::mul_add(
+                -x2428,
+                x2554,
+                Self::mul_add(c_q7, x2544, s_q7 * x2543)
+                    + Self::mul_add(0.65, x2541, 0.75 * x2545),
+            ),
+        );
+        let x2619 = Self::mul_add(-x2572, x2595, x2618);
+        let x2620 = x2597 * x2619;
+        let x2621 = 1.0
+            / Self::mul_add(
+                x2599,
+                x2600,
+                Self::mul_add(
+                    x2574,
+                    x2575,
+                    x2596 - (1271.854575 + (x2423 + x2426) - x2570),
+                ),
+            );
+        let x2622 = Self::mul_add(
+            -x2599,
+            x2602,
+            Self::mul_add(-x2574, x2577, Self::mul_add(-x2427, x2556, x2426 - x2570)),
+        );
+        let x2623 = x2621 * x2622;
+        let x2624 = x2421 * x2549;
+        let x2625 = Self::mul_add(
+            x2574,
+            x2580,
+            Self::mul_add(x2427, x2557, Self::mul_add(-0.65, x2433, x2403) - x2624),
+        );
+        let x2626 = Self::mul_add(x2599, x2605, x2625);
+        let x2627 = x2621 * x2626;
+        let x2628 = x2421 * x2550;
+        let x2629 = Self::mul_add(
+            -x2574,
+            x2583,
+            Self::mul_add(-x2427, x2558, Self::mul_add(0.65, x2446, x2442) + x2628),
+        );
+        let x2630 = Self::mul_add(-x2599, x2608, x2629);
+        let x2631 = x2621 * x2630;
+        let x2632 = x2421 * x2551;
+        let x2633 = Self::mul_add(
+            -x2574,
+            x2586,
+            Self::mul_add(-x2427, x2559, Self::mul_add(0.65, x2461, x2457) + x2632),
+        );
+        let x2634 = Self::mul_add(-x2599, x2611, x2633);
+        let x2635 = x2621 * x2634;
+        let x2636 = x2421 * x2552;
+        let x2637 = Self::mul_add(
+            -x2574,
+            x2589,
+            Self::mul_add(-x2427, x2560, Self::mul_add(0.65, x2481, x2477) + x2636),
+        );
+        let x2638 = Self::mul_add(-x2599, x2614, x2637);
+        let x2639 = x2621 * x2638;
+        let x2640 = x2421 * x2553;
+        let x2641 = Self::mul_add(
+            x2574,
+            x2592,
+            Self::mul_add(x2427, x2561, Self::mul_add(-0.65, x2510, x2506) - x2640),
+        );
+        let x2642 = Self::mul_add(x2599, x2617, x2641);
+        let x2643 = x2621 * x2642;
+        let x2644 = x2421 * x2554;
+        let x2645 = Self::mul_add(
+            x2574,
+            x2595,
+            Self::mul_add(x2427, x2562, Self::mul_add(-0.65, x2546, x2542) - x2644),
+        );
+        let x2646 = Self::mul_add(x2599, x2620, x2645);
+        let x2647 = x2621 * x2646;
+        let x2648 = Self::mul_add(
+            -x2601,
+            x2602,
+            Self::mul_add(-x2576, x2577, Self::mul_add(-x2420, x2556, x2414 - x2570)),
+        );
+        let x2649 = 1.0 / Self::mul_add(x2622, x2623, x2648);
+        let x2650 = Self::mul_add(
+            x2601,
+            x2605,
+            Self::mul_add(x2576, x2580, Self::mul_add(x2420, x2557, x2403 - x2624)),
+        );
+        let x2651 = Self::mul_add(x2622, x2627, x2650);
+        let x2652 = x2649 * x2651;
+        let x2653 = Self::mul_add(
+            -x2601,
+            x2608,
+            Self::mul_add(-x2576, x2583, Self::mul_add(-x2420, x2558, x2442 + x2628)),
+        );
+        let x2654 = Self::mul_add(x2622, x2631, x2653);
+        let x2655 = x2649 * x2654;
+        let x2656 = Self::mul_add(
+            -x2601,
+            x2611,
+            Self::mul_add(-x2576, x2586, Self::mul_add(-x2420, x2559, x2457 + x2632)),
+        );
+        let x2657 = Self::mul_add(x2622, x2635, x2656);
+        let x2658 = x2649 * x2657;
+        let x2659 = Self::mul_add(
+            -x2601,
+            x2614,
+            Self::mul_add(-x2576, x2589, Self::mul_add(-x2420, x2560, x2477 + x2636)),
+        );
+        let x2660 = Self::mul_add(x2622, x2639, x2659);
+        let x2661 = x2649 * x2660;
+        let x2662 = Self::mul_add(
+            x2601,
+            x2617,
+            Self::mul_add(x2576, x2592, Self::mul_add(x2420, x2561, x2506 - x2640)),
+        );
+        let x2663 = Self::mul_add(x2622, x2643, x2662);
+        let x2664 = x2649 * x2663;
+        let x2665 = Self::mul_add(
+            x2601,
+            x2620,
+            Self::mul_add(x2576, x2595, Self::mul_add(x2420, x2562, x2542 - x2644)),
+        );
+        let x2666 = Self::mul_add(x2622, x2647, x2665);
+        let x2667 = x2649 * x2666;
+        let x2668 = Self::mul_add(
+            -x2394,
+            x2563,
+            Self::mul_add(-x2433, x2557, Self::mul_add(-x2432, x2549, x2392)),
+        );
+        let x2669 = Self::mul_add(
+            x2626,
+            x2627,
+            Self::mul_add(-x2604, x2605, Self::mul_add(-x2579, x2580, x2668)),
+        );
+        let x2670 = 1.0 / Self::mul_add(-x2651, x2652, x2669);
+        let x2671 = Self::mul_add(
+            -x2394,
+            x2564,
+            Self::mul_add(-x2433, x2558, Self::mul_add(-x2432, x2550, x2438)),
+        );
+        let x2672 = Self::mul_add(
+            -x2626,
+            x2631,
+            Self::mul_add(-x2604, x2608, Self::mul_add(-x2579, x2583, x2671)),
+        );
+        let x2673 = Self::mul_add(x2651, x2655, x2672);
+        let x2674 = x2670 * x2673;
+        let x2675 = Self::mul_add(
+            -x2394,
+            x2565,
+            Self::mul_add(-x2433, x2559, Self::mul_add(-x2432, x2551, x2453)),
+        );
+        let x2676 = Self::mul_add(
+            -x2626,
+            x2635,
+            Self::mul_add(-x2604, x2611, Self::mul_add(-x2579, x2586, x2675)),
+        );
+        let x2677 = Self::mul_add(x2651, x2658, x2676);
+        let x2678 = x2670 * x2677;
+        let x2679 = Self::mul_add(
+            x2394,
+            x2566,
+            Self::mul_add(-x2433, x2560, Self::mul_add(-x2432, x2552, x2473)),
+        );
+        let x2680 = Self::mul_add(
+            -x2626,
+            x2639,
+            Self::mul_add(-x2604, x2614, Self::mul_add(-x2579, x2589, x2679)),
+        );
+        let x2681 = Self::mul_add(x2651, x2661, x2680);
+        let x2682 = x2670 * x2681;
+        let x2683 = Self::mul_add(
+            -x2394,
+            x2567,
+            Self::mul_add(-x2433, x2561, Self::mul_add(-x2432, x2553, x2502)),
+        );
+        let x2684 = Self::mul_add(
+            x2626,
+            x2643,
+            Self::mul_add(-x2604, x2617, Self::mul_add(-x2579, x2592, x2683)),
+        );
+        let x2685 = Self::mul_add(-x2651, x2664, x2684);
+        let x2686 = x2670 * x2685;
+        let x2687 = Self::mul_add(
+            x2394,
+            x2568,
+            Self::mul_add(-x2433, x2562, Self::mul_add(-x2432, x2554, x2538)),
+        );
+        let x2688 = Self::mul_add(
+            x2626,
+            x2647,
+            Self::mul_add(-x2604, x2620, Self::mul_add(-x2579, x2595, x2687)),
+        );
+        let x2689 = Self::mul_add(-x2651, x2667, x2688);
+        let x2690 = x2670 * x2689;
+        let x2691 = Self::mul_add(
+            -x2441,
+            x2564,
+            Self::mul_add(-x2446, x2558, Self::mul_add(-x2445, x2550, x2349)),
+        );
+        let x2692 = Self::mul_add(
+            x2630,
+            x2631,
+            Self::mul_add(-x2607, x2608, Self::mul_add(-x2582, x2583, x2691)),
+        );
+        let x2693 = 1.0
+            / Self::mul_add(-x2673, x2674, Self::mul_add(-x2654, x2655, x2692));
+        let x2694 = Self::mul_add(
+            -x2441,
+            x2565,
+            Self::mul_add(-x2446, x2559, Self::mul_add(-x2445, x2551, x2343)),
+        );
+        let x2695 = Self::mul_add(
+            x2630,
+            x2635,
+            Self::mul_add(-x2607, x2611, Self::mul_add(-x2582, x2586, x2694)),
+        );
+        let x2696 = Self::mul_add(-x2673, x2678, Self::mul_add(-x2654, x2658, x2695));
+        let x2697 = x2693 * x2696;
+        let x2698 = Self::mul_add(
+            x2441,
+            x2566,
+            Self::mul_add(-x2446, x2560, Self::mul_add(-x2445, x2552, x2466)),
+        );
+        let x2699 = Self::mul_add(
+            x2630,
+            x2639,
+            Self::mul_add(-x2607, x2614, Self::mul_add(-x2582, x2589, x2698)),
+        );
+        let x2700 = Self::mul_add(-x2673, x2682, Self::mul_add(-x2654, x2661, x2699));
+        let x2701 = x2693 * x2700;
+        let x2702 = Self::mul_add(
+            -x2441,
+            x2567,
+            Self::mul_add(-x2446, x2561, Self::mul_add(-x2445, x2553, x2494)),
+        );
+        let x2703 = Self::mul_add(
+            -x2630,
+            x2643,
+            Self::mul_add(-x2607, x2617, Self::mul_add(-x2582, x2592, x2702)),
+        );
+        let x2704 = Self::mul_add(-x2673, x2686, Self::mul_add(x2654, x2664, x2703));
+        let x2705 = x2693 * x2704;
+        let x2706 = Self::mul_add(
+            x2441,
+            x2568,
+            Self::mul_add(-x2446, x2562, Self::mul_add(-x2445, x2554, x2530)),
+        );
+        let x2707 = Self::mul_add(
+            -x2630,
+            x2647,
+            Self::mul_add(-x2607, x2620, Self::mul_add(-x2582, x2595, x2706)),
+        );
+        let x2708 = Self::mul_add(-x2673, x2690, Self::mul_add(x2654, x2667, x2707));
+        let x2709 = x2693 * x2708;
+        let x2710 = Self::mul_add(
+            -x2456,
+            x2565,
+            Self::mul_add(-x2461, x2559, Self::mul_add(-x2460, x2551, x2329)),
+        );
+        let x2711 = Self::mul_add(
+            x2634,
+            x2635,
+            Self::mul_add(-x2610, x2611, Self::mul_add(-x2585, x2586, x2710)),
+        );
+        let x2712 = Self::mul_add(
+            -x2696,
+            x2697,
+            Self::mul_add(-x2677, x2678, Self::mul_add(-x2657, x2658, x2711)),
+        );
+        let x2713 = 1.0 / x2712;
+        let x2714 = Self::mul_add(
+            x2456,
+            x2566,
+            Self::mul_add(-x2461, x2560, Self::mul_add(-x2460, x2552, x2323)),
+        );
+        let x2715 = Self::mul_add(
+            x2634,
+            x2639,
+            Self::mul_add(-x2610, x2614, Self::mul_add(-x2585, x2589, x2714)),
+        );
+        let x2716 = Self::mul_add(
+            -x2696,
+            x2701,
+            Self::mul_add(-x2677, x2682, Self::mul_add(-x2657, x2661, x2715)),
+        );
+        let x2717 = x2713 * x2716;
+        let x2718 = Self::mul_add(
+            -x2456,
+            x2567,
+            Self::mul_add(-x2461, x2561, Self::mul_add(-x2460, x2553, x2489)),
+        );
+        let x2719 = Self::mul_add(
+            -x2634,
+            x2643,
+            Self::mul_add(-x2610, x2617, Self::mul_add(-x2585, x2592, x2718)),
+        );
+        let x2720 = Self::mul_add(
+            -x2696,
+            x2705,
+            Self::mul_add(-x2677, x2686, Self::mul_add(x2657, x2664, x2719)),
+        );
+        let x2721 = x2713 * x2720;
+        let x2722 = Self::mul_add(
+            x2456,
+            x2568,
+            Self::mul_add(-x2461, x2562, Self::mul_add(-x2460, x2554, x2525)),
+        );
+        let x2723 = Self::mul_add(
+            -x2634,
+            x2647,
+            Self::mul_add(-x2610, x2620, Self::mul_add(-x2585, x2595, x2722)),
+        );
+        let x2724 = Self::mul_add(
+            -x2696,
+            x2709,
+            Self::mul_add(-x2677, x2690, Self::mul_add(x2657, x2667, x2723)),
+        );
+        let x2725 = x2713 * x2724;
+        let x2726 = Self::mul_add(
+            -x2476,
+            x2566,
+            Self::mul_add(-x2481, x2560, Self::mul_add(-x2480, x2552, x2309)),
+        );
+        let x2727 = Self::mul_add(
+            x2638,
+            x2639,
+            Self::mul_add(-x2613, x2614, Self::mul_add(-x2588, x2589, x2726)),
+        );
+        let x2728 = Self::mul_add(
+            -x2700,
+            x2701,
+            Self::mul_add(-x2681, x2682, Self::mul_add(-x2660, x2661, x2727)),
+        );
+        let x2729 = 1.0 / Self::mul_add(-x2716, x2717, x2728);
+        let x2730 = Self::mul_add(
+            x2476,
+            x2567,
+            Self::mul_add(-x2481, x2561, Self::mul_add(-x2480, x2553, x2298)),
+        );
+        let x2731 = Self::mul_add(
+            -x2638,
+            x2643,
+            Self::mul_add(-x2613, x2617, Self::mul_add(-x2588, x2592, x2730)),
+        );
+        let x2732 = Self::mul_add(
+            -x2700,
+            x2705,
+            Self::mul_add(-x2681, x2686, Self::mul_add(x2660, x2664, x2731)),
+        );
+        let x2733 = Self::mul_add(-x2716, x2721, x2732);
+        let x2734 = x2729 * x2733;
+        let x2735 = Self::mul_add(
+            -x2476,
+            x2568,
+            Self::mul_add(-x2481, x2562, Self::mul_add(-x2480, x2554, x2518)),
+        );
+        let x2736 = Self::mul_add(
+            -x2638,
+            x2647,
+            Self::mul_add(-x2613, x2620, Self::mul_add(-x2588, x2595, x2735)),
+        );
+        let x2737 = Self::mul_add(
+            -x2700,
+            x2709,
+            Self::mul_add(-x2681, x2690, Self::mul_add(x2660, x2667, x2736)),
+        );
+        let x2738 = Self::mul_add(-x2716, x2725, x2737);
+        let x2739 = x2729 * x2738;
+        let x2740 = Self::mul_add(
+            -x2505,
+            x2567,
+            Self::mul_add(-x2510, x2561, Self::mul_add(-x2509, x2553, x2287)),
+        );
+        let x2741 = Self::mul_add(
+            x2642,
+            x2643,
+            Self::mul_add(-x2616, x2617, Self::mul_add(-x2591, x2592, x2740)),
+        );
+        let x2742 = Self::mul_add(
+            -x2704,
+            x2705,
+            Self::mul_add(-x2685, x2686, Self::mul_add(-x2663, x2664, x2741)),
+        );
+        let x2743 = 1.0
+            / Self::mul_add(-x2733, x2734, Self::mul_add(-x2720, x2721, x2742));
+        let x2744 = Self::mul_add(
+            x2505,
+            x2568,
+            Self::mul_add(-x2510, x2562, Self::mul_add(-x2509, x2554, x2514)),
+        );
+        let x2745 = Self::mul_add(
+            x2642,
+            x2647,
+            Self::mul_add(-x2616, x2620, Self::mul_add(-x2591, x2595, x2744)),
+        );
+        let x2746 = Self::mul_add(
+            -x2704,
+            x2709,
+            Self::mul_add(-x2685, x2690, Self::mul_add(-x2663, x2667, x2745)),
+        );
+        let x2747 = Self::mul_add(-x2733, x2739, Self::mul_add(-x2720, x2725, x2746));
+        let x2748 = x2743 * x2747;
+        let x2749 = Self::mul_add(
+            -x2541,
+            x2568,
+            Self::mul_add(
+                -x2546,
+                x2562,
+                Self::mul_add(-x2545, x2554, 1.4135609200000003),
+            ),
+        );
+        let x2750 = Self::mul_add(
+            x2646,
+            x2647,
+            Self::mul_add(-x2619, x2620, Self::mul_add(-x2594, x2595, x2749)),
+        );
+        let x2751 = Self::mul_add(
+            -x2708,
+            x2709,
+            Self::mul_add(-x2689, x2690, Self::mul_add(-x2666, x2667, x2750)),
+        );
+        let x2752 = Self::mul_add(
+            -x2747,
+            x2748,
+            Self::mul_add(-x2738, x2739, Self::mul_add(-x2724, x2725, x2751)),
+        );
+        let x2753 = 1.0 / x2752;
+        let x2754 = Self::mul_add(x2547, x2600, x2548);
+        let x2755 = Self::mul_add(x2623, x2754, Self::mul_add(x2547, x2602, x2548));
+        let x2756 = Self::mul_add(
+            -x2652,
+            x2755,
+            Self::mul_add(x2627, x2754, Self::mul_add(-x2547, x2605, x2549)),
+        );
+        let x2757 = Self::mul_add(
+            x2655,
+            x2755,
+            Self::mul_add(-x2631, x2754, Self::mul_add(-x2547, x2608, x2550)),
+        );
+        let x2758 = Self::mul_add(-x2674, x2756, x2757);
+        let x2759 = Self::mul_add(
+            x2658,
+            x2755,
+            Self::mul_add(-x2635, x2754, Self::mul_add(-x2547, x2611, x2551)),
+        );
+        let x2760 = Self::mul_add(-x2697, x2758, Self::mul_add(-x2678, x2756, x2759));
+        let x2761 = Self::mul_add(
+            x2661,
+            x2755,
+            Self::mul_add(-x2639, x2754, Self::mul_add(-x2547, x2614, x2552)),
+        );
+        let x2762 = Self::mul_add(
+            -x2717,
+            x2760,
+            Self::mul_add(-x2701, x2758, Self::mul_add(-x2682, x2756, x2761)),
+        );
+        let x2763 = Self::mul_add(
+            -x2664,
+            x2755,
+            Self::mul_add(x2643, x2754, Self::mul_add(-x2547, x2617, x2553)),
+        );
+        let x2764 = Self::mul_add(
+            -x2721,
+            x2760,
+            Self::mul_add(-x2705, x2758, Self::mul_add(-x2686, x2756, x2763)),
+        );
+        let x2765 = Self::mul_add(-x2734, x2762, x2764);
+        let x2766 = Self::mul_add(
+            -x2667,
+            x2755,
+            Self::mul_add(x2647, x2754, Self::mul_add(-x2547, x2620, x2554)),
+        );
+        let x2767 = Self::mul_add(
+            -x2725,
+            x2760,
+            Self::mul_add(-x2709, x2758, Self::mul_add(-x2690, x2756, x2766)),
+        );
+        let x2768 = x2753
+            * Self::mul_add(-x2748, x2765, Self::mul_add(-x2739, x2762, x2767));
+        let x2769 = -x2768;
+        let x2770 = Self::mul_add(-x2748, x2768, x2743 * x2765);
+        let x2771 = -x2770;
+        let x2772 = Self::mul_add(
+            -x2739,
+            x2768,
+            Self::mul_add(-x2734, x2770, x2729 * x2762),
+        );
+        let x2773 = Self::mul_add(
+            -x2725,
+            x2768,
+            Self::mul_add(-x2721, x2770, Self::mul_add(-x2717, x2772, x2713 * x2760)),
+        );
+        let x2774 = Self::mul_add(
+            -x2705,
+            x2770,
+            Self::mul_add(-x2701, x2772, Self::mul_add(-x2697, x2773, x2693 * x2758)),
+        );
+        let x2775 = Self::mul_add(-x2709, x2768, x2774);
+        let x2776 = Self::mul_add(
+            -x2682,
+            x2772,
+            Self::mul_add(-x2678, x2773, Self::mul_add(-x2674, x2775, x2670 * x2756)),
+        );
+        let x2777 = Self::mul_add(-x2690, x2768, Self::mul_add(-x2686, x2770, x2776));
+        let x2778 = -x2777;
+        let x2779 = Self::mul_add(
+            x2658,
+            x2773,
+            Self::mul_add(x2655, x2775, Self::mul_add(-x2652, x2777, x2649 * x2755)),
+        );
+        let x2780 = Self::mul_add(
+            -x2667,
+            x2768,
+            Self::mul_add(-x2664, x2770, Self::mul_add(x2661, x2772, x2779)),
+        );
+        let x2781 = Self::mul_add(
+            x2631,
+            x2775,
+            Self::mul_add(-x2627, x2777, Self::mul_add(-x2623, x2780, x2621 * x2754)),
+        );
+        let x2782 = Self::mul_add(
+            -x2643,
+            x2770,
+            Self::mul_add(x2639, x2772, Self::mul_add(x2635, x2773, x2781)),
+        );
+        let x2783 = Self::mul_add(-x2647, x2768, x2782);
+        let x2784 = -x2783;
+        let x2785 = Self::mul_add(
+            -x2605,
+            x2777,
+            Self::mul_add(x2602, x2780, Self::mul_add(-x2600, x2783, x2547 * x2597)),
+        );
+        let x2786 = Self::mul_add(
+            -x2614,
+            x2772,
+            Self::mul_add(-x2611, x2773, Self::mul_add(-x2608, x2775, x2785)),
+        );
+        let x2787 = Self::mul_add(-x2620, x2768, Self::mul_add(-x2617, x2770, x2786));
+        let x2788 = -x2787;
+        let x2789 = Self::mul_add(
+            x2580,
+            x2777,
+            Self::mul_add(-x2577, x2780, Self::mul_add(x2575, x2783, x2573 * x2787)),
+        );
+        let x2790 = Self::mul_add(
+            x2589,
+            x2772,
+            Self::mul_add(x2586, x2773, Self::mul_add(x2583, x2775, x2789)),
+        );
+        let x2791 = Self::mul_add(x2595, x2768, Self::mul_add(x2592, x2770, x2790));
+        let x2792 = Self::mul_add(
+            -x2564,
+            x2775,
+            Self::mul_add(-x2563, x2777, Self::mul_add(x2555, x2787, x2548 * x2791)),
+        );
+        let x2793 = Self::mul_add(
+            -x2567,
+            x2770,
+            Self::mul_add(x2566, x2772, Self::mul_add(-x2565, x2773, x2792)),
+        );
+        let x2794 = Self::mul_add(x2568, x2768, x2793);
+        let x2795 = -x2794;
+        let x2796 = Self::mul_add(
+            x2557,
+            x2777,
+            Self::mul_add(-x2556, x2780, Self::mul_add(x2555, x2783, x2547 * x2791)),
+        );
+        let x2797 = Self::mul_add(
+            x2560,
+            x2772,
+            Self::mul_add(x2559, x2773, Self::mul_add(x2558, x2775, x2796)),
+        );
+        let x2798 = Self::mul_add(x2562, x2768, Self::mul_add(x2561, x2770, x2797));
+        let x2799 = Self::mul_add(
+            x2548,
+            x2780,
+            Self::mul_add(
+                -x2548,
+                x2783,
+                Self::mul_add(x2547, x2787, 0.0008546497218115156),
+            ),
+        );
+        let x2800 = Self::mul_add(
+            x2551,
+            x2773,
+            Self::mul_add(x2550, x2775, Self::mul_add(x2549, x2777, x2799)),
+        );
+        let x2801 = Self::mul_add(
+            x2554,
+            x2768,
+            Self::mul_add(x2553, x2770, Self::mul_add(x2552, x2772, x2800)),
+        );
+        let x2802 = x2547 * x2573;
+        let x2803 = Self::mul_add(-x2600, x2802, Self::mul_add(x2547, x2575, x2555));
+        let x2804 = Self::mul_add(
+            x2623,
+            x2803,
+            Self::mul_add(-x2602, x2802, Self::mul_add(x2547, x2577, x2556)),
+        );
+        let x2805 = Self::mul_add(
+            -x2627,
+            x2803,
+            Self::mul_add(-x2605, x2802, Self::mul_add(x2547, x2580, x2557)),
+        );
+        let x2806 = Self::mul_add(x2652, x2804, x2805);
+        let x2807 = Self::mul_add(
+            x2631,
+            x2803,
+            Self::mul_add(-x2608, x2802, Self::mul_add(x2547, x2583, x2558)),
+        );
+        let x2808 = Self::mul_add(-x2674, x2806, Self::mul_add(-x2655, x2804, x2807));
+        let x2809 = Self::mul_add(
+            x2635,
+            x2803,
+            Self::mul_add(-x2611, x2802, Self::mul_add(x2547, x2586, x2559)),
+        );
+        let x2810 = Self::mul_add(
+            -x2697,
+            x2808,
+            Self::mul_add(-x2678, x2806, Self::mul_add(-x2658, x2804, x2809)),
+        );
+        let x2811 = Self::mul_add(
+            x2639,
+            x2803,
+            Self::mul_add(-x2614, x2802, Self::mul_add(x2547, x2589, x2560)),
+        );
+        let x2812 = Self::mul_add(
+            -x2701,
+            x2808,
+            Self::mul_add(-x2682, x2806, Self::mul_add(-x2661, x2804, x2811)),
+        );
+        let x2813 = Self::mul_add(-x2717, x2810, x2812);
+        let x2814 = Self::mul_add(
+            -x2643,
+            x2803,
+            Self::mul_add(-x2617, x2802, Self::mul_add(x2547, x2592, x2561)),
+        );
+        let x2815 = Self::mul_add(
+            -x2705,
+            x2808,
+            Self::mul_add(-x2686, x2806, Self::mul_add(x2664, x2804, x2814)),
+        );
+        let x2816 = Self::mul_add(-x2734, x2813, Self::mul_add(-x2721, x2810, x2815));
+        let x2817 = Self::mul_add(
+            -x2647,
+            x2803,
+            Self::mul_add(-x2620, x2802, Self::mul_add(x2547, x2595, x2562)),
+        );
+        let x2818 = Self::mul_add(
+            -x2709,
+            x2808,
+            Self::mul_add(-x2690, x2806, Self::mul_add(x2667, x2804, x2817)),
+        );
+        let x2819 = Self::mul_add(
+            -x2748,
+            x2816,
+            Self::mul_add(-x2739, x2813, Self::mul_add(-x2725, x2810, x2818)),
+        );
+        let x2820 = x2753 * x2819;
+        let x2821 = -x2820;
+        let x2822 = Self::mul_add(-x2748, x2820, x2743 * x2816);
+        let x2823 = -x2822;
+        let x2824 = Self::mul_add(
+            -x2739,
+            x2820,
+            Self::mul_add(-x2734, x2822, x2729 * x2813),
+        );
+        let x2825 = Self::mul_add(
+            -x2725,
+            x2820,
+            Self::mul_add(-x2721, x2822, Self::mul_add(-x2717, x2824, x2713 * x2810)),
+        );
+        let x2826 = Self::mul_add(
+            -x2705,
+            x2822,
+            Self::mul_add(-x2701, x2824, Self::mul_add(-x2697, x2825, x2693 * x2808)),
+        );
+        let x2827 = Self::mul_add(-x2709, x2820, x2826);
+        let x2828 = Self::mul_add(
+            -x2682,
+            x2824,
+            Self::mul_add(-x2678, x2825, Self::mul_add(-x2674, x2827, x2670 * x2806)),
+        );
+        let x2829 = Self::mul_add(-x2690, x2820, Self::mul_add(-x2686, x2822, x2828));
+        let x2830 = -x2829;
+        let x2831 = Self::mul_add(
+            -x2658,
+            x2825,
+            Self::mul_add(-x2655, x2827, Self::mul_add(x2652, x2829, x2649 * x2804)),
+        );
+        let x2832 = Self::mul_add(
+            x2667,
+            x2820,
+            Self::mul_add(x2664, x2822, Self::mul_add(-x2661, x2824, x2831)),
+        );
+        let x2833 = -x2832;
+        let x2834 = Self::mul_add(
+            -x2631,
+            x2827,
+            Self::mul_add(x2627, x2829, Self::mul_add(-x2623, x2832, x2621 * x2803)),
+        );
+        let x2835 = Self::mul_add(
+            x2643,
+            x2822,
+            Self::mul_add(-x2639, x2824, Self::mul_add(-x2635, x2825, x2834)),
+        );
+        let x2836 = Self::mul_add(x2647, x2820, x2835);
+        let x2837 = Self::mul_add(
+            -x2605,
+            x2829,
+            Self::mul_add(-x2602, x2832, Self::mul_add(x2600, x2836, x2597 * x2802)),
+        );
+        let x2838 = Self::mul_add(
+            -x2614,
+            x2824,
+            Self::mul_add(-x2611, x2825, Self::mul_add(-x2608, x2827, x2837)),
+        );
+        let x2839 = Self::mul_add(-x2620, x2820, Self::mul_add(-x2617, x2822, x2838));
+        let x2840 = -x2839;
+        let x2841 = Self::mul_add(
+            x2577,
+            x2832,
+            Self::mul_add(-x2575, x2836, Self::mul_add(x2573, x2839, x2547 * x2571)),
+        );
+        let x2842 = Self::mul_add(
+            x2586,
+            x2825,
+            Self::mul_add(x2583, x2827, Self::mul_add(x2580, x2829, x2841)),
+        );
+        let x2843 = Self::mul_add(
+            x2595,
+            x2820,
+            Self::mul_add(x2592, x2822, Self::mul_add(x2589, x2824, x2842)),
+        );
+        let x2844 = Self::mul_add(
+            -x2564,
+            x2827,
+            Self::mul_add(-x2563, x2829, Self::mul_add(x2555, x2839, x2548 * x2843)),
+        );
+        let x2845 = Self::mul_add(
+            -x2567,
+            x2822,
+            Self::mul_add(x2566, x2824, Self::mul_add(-x2565, x2825, x2844)),
+        );
+        let x2846 = Self::mul_add(x2568, x2820, x2845);
+        let x2847 = -x2846;
+        let x2848 = Self::mul_add(
+            x2556,
+            x2832,
+            Self::mul_add(
+                -x2555,
+                x2836,
+                Self::mul_add(x2547, x2843, 0.0008546497218115156),
+            ),
+        );
+        let x2849 = Self::mul_add(
+            x2559,
+            x2825,
+            Self::mul_add(x2558, x2827, Self::mul_add(x2557, x2829, x2848)),
+        );
+        let x2850 = Self::mul_add(
+            x2562,
+            x2820,
+            Self::mul_add(x2561, x2822, Self::mul_add(x2560, x2824, x2849)),
+        );
+        let x2851 = Self::mul_add(
+            x2549,
+            x2829,
+            Self::mul_add(-x2548, x2832, Self::mul_add(x2548, x2836, x2547 * x2839)),
+        );
+        let x2852 = Self::mul_add(
+            x2552,
+            x2824,
+            Self::mul_add(x2551, x2825, Self::mul_add(x2550, x2827, x2851)),
+        );
+        let x2853 = Self::mul_add(x2554, x2820, Self::mul_add(x2553, x2822, x2852));
+        let x2854 = Self::mul_add(x2548, x2573, x2555);
+        let x2855 = Self::mul_add(-x2600, x2854, x2548 * x2575);
+        let x2856 = Self::mul_add(
+            x2623,
+            x2855,
+            Self::mul_add(-x2602, x2854, x2548 * x2577),
+        );
+        let x2857 = Self::mul_add(
+            x2627,
+            x2855,
+            Self::mul_add(x2605, x2854, Self::mul_add(-x2548, x2580, x2563)),
+        );
+        let x2858 = Self::mul_add(-x2652, x2856, x2857);
+        let x2859 = Self::mul_add(
+            -x2631,
+            x2855,
+            Self::mul_add(x2608, x2854, Self::mul_add(-x2548, x2583, x2564)),
+        );
+        let x2860 = Self::mul_add(-x2674, x2858, Self::mul_add(x2655, x2856, x2859));
+        let x2861 = Self::mul_add(
+            -x2635,
+            x2855,
+            Self::mul_add(x2611, x2854, Self::mul_add(-x2548, x2586, x2565)),
+        );
+        let x2862 = Self::mul_add(
+            -x2697,
+            x2860,
+            Self::mul_add(-x2678, x2858, Self::mul_add(x2658, x2856, x2861)),
+        );
+        let x2863 = Self::mul_add(
+            x2639,
+            x2855,
+            Self::mul_add(-x2614, x2854, Self::mul_add(x2548, x2589, x2566)),
+        );
+        let x2864 = Self::mul_add(
+            x2701,
+            x2860,
+            Self::mul_add(x2682, x2858, Self::mul_add(-x2661, x2856, x2863)),
+        );
+        let x2865 = Self::mul_add(x2717, x2862, x2864);
+        let x2866 = Self::mul_add(
+            x2643,
+            x2855,
+            Self::mul_add(x2617, x2854, Self::mul_add(-x2548, x2592, x2567)),
+        );
+        let x2867 = Self::mul_add(
+            -x2705,
+            x2860,
+            Self::mul_add(-x2686, x2858, Self::mul_add(-x2664, x2856, x2866)),
+        );
+        let x2868 = Self::mul_add(x2734, x2865, Self::mul_add(-x2721, x2862, x2867));
+        let x2869 = Self::mul_add(
+            -x2647,
+            x2855,
+            Self::mul_add(-x2620, x2854, Self::mul_add(x2548, x2595, x2568)),
+        );
+        let x2870 = Self::mul_add(
+            x2709,
+            x2860,
+            Self::mul_add(x2690, x2858, Self::mul_add(x2667, x2856, x2869)),
+        );
+        let x2871 = Self::mul_add(
+            x2748,
+            x2868,
+            Self::mul_add(-x2739, x2865, Self::mul_add(x2725, x2862, x2870)),
+        );
+        let x2872 = x2753 * x2871;
+        let x2873 = Self::mul_add(x2748, x2872, x2743 * x2868);
+        let x2874 = -x2873;
+        let x2875 = Self::mul_add(
+            -x2739,
+            x2872,
+            Self::mul_add(x2734, x2873, x2729 * x2865),
+        );
+        let x2876 = -x2875;
+        let x2877 = Self::mul_add(
+            x2725,
+            x2872,
+            Self::mul_add(-x2721, x2873, Self::mul_add(x2717, x2875, x2713 * x2862)),
+        );
+        let x2878 = Self::mul_add(
+            -x2705,
+            x2873,
+            Self::mul_add(x2701, x2875, Self::mul_add(-x2697, x2877, x2693 * x2860)),
+        );
+        let x2879 = Self::mul_add(x2709, x2872, x2878);
+        let x2880 = Self::mul_add(
+            x2682,
+            x2875,
+            Self::mul_add(-x2678, x2877, Self::mul_add(-x2674, x2879, x2670 * x2858)),
+        );
+        let x2881 = Self::mul_add(x2690, x2872, Self::mul_add(-x2686, x2873, x2880));
+        let x2882 = -x2881;
+        let x2883 = Self::mul_add(
+            x2658,
+            x2877,
+            Self::mul_add(x2655, x2879, Self::mul_add(-x2652, x2881, x2649 * x2856)),
+        );
+        let x2884 = Self::mul_add(
+            x2667,
+            x2872,
+            Self::mul_add(-x2664, x2873, Self::mul_add(-x2661, x2875, x2883)),
+        );
+        let x2885 = Self::mul_add(
+            x2631,
+            x2879,
+            Self::mul_add(-x2627, x2881, Self::mul_add(-x2623, x2884, x2621 * x2855)),
+        );
+        let x2886 = Self::mul_add(
+            -x2643,
+            x2873,
+            Self::mul_add(-x2639, x2875, Self::mul_add(x2635, x2877, x2885)),
+        );
+        let x2887 = Self::mul_add(x2647, x2872, x2886);
+        let x2888 = -x2887;
+        let x2889 = Self::mul_add(
+            x2605,
+            x2881,
+            Self::mul_add(-x2602, x2884, Self::mul_add(x2600, x2887, x2597 * x2854)),
+        );
+        let x2890 = Self::mul_add(
+            -x2614,
+            x2875,
+            Self::mul_add(x2611, x2877, Self::mul_add(x2608, x2879, x2889)),
+        );
+        let x2891 = Self::mul_add(-x2620, x2872, Self::mul_add(x2617, x2873, x2890));
+        let x2892 = Self::mul_add(
+            x2577,
+            x2884,
+            Self::mul_add(-x2575, x2887, Self::mul_add(x2573, x2891, x2548 * x2571)),
+        );
+        let x2893 = Self::mul_add(
+            -x2586,
+            x2877,
+            Self::mul_add(-x2583, x2879, Self::mul_add(-x2580, x2881, x2892)),
+        );
+        let x2894 = Self::mul_add(
+            x2595,
+            x2872,
+            Self::mul_add(-x2592, x2873, Self::mul_add(x2589, x2875, x2893)),
+        );
+        let x2895 = -x2894;
+        let x2896 = Self::mul_add(
+            x2563,
+            x2881,
+            Self::mul_add(
+                x2555,
+                x2891,
+                Self::mul_add(x2548, x2894, 0.0008546497218115156),
+            ),
+        );
+        let x2897 = Self::mul_add(
+            x2566,
+            x2875,
+            Self::mul_add(x2565, x2877, Self::mul_add(x2564, x2879, x2896)),
+        );
+        let x2898 = Self::mul_add(x2568, x2872, Self::mul_add(x2567, x2873, x2897));
+        let x2899 = Self::mul_add(
+            -x2557,
+            x2881,
+            Self::mul_add(x2556, x2884, Self::mul_add(-x2555, x2887, x2547 * x2894)),
+        );
+        let x2900 = Self::mul_add(
+            x2560,
+            x2875,
+            Self::mul_add(-x2559, x2877, Self::mul_add(-x2558, x2879, x2899)),
+        );
+        let x2901 = Self::mul_add(x2562, x2872, Self::mul_add(-x2561, x2873, x2900));
+        let x2902 = -x2901;
+        let x2903 = Self::mul_add(
+            -x2549,
+            x2881,
+            Self::mul_add(-x2548, x2884, Self::mul_add(x2548, x2887, x2547 * x2891)),
+        );
+        let x2904 = Self::mul_add(
+            x2552,
+            x2875,
+            Self::mul_add(-x2551, x2877, Self::mul_add(-x2550, x2879, x2903)),
+        );
+        let x2905 = Self::mul_add(x2554, x2872, Self::mul_add(-x2553, x2873, x2904));
+        let x2906 = -x2905;
+        let x2907 = Self::mul_add(-x2573, x2600, x2575);
+        let x2908 = Self::mul_add(x2623, x2907, Self::mul_add(-x2573, x2602, x2577));
+        let x2909 = Self::mul_add(
+            x2652,
+            x2908,
+            Self::mul_add(-x2627, x2907, Self::mul_add(-x2573, x2605, x2580)),
+        );
+        let x2910 = Self::mul_add(
+            -x2655,
+            x2908,
+            Self::mul_add(x2631, x2907, Self::mul_add(-x2573, x2608, x2583)),
+        );
+        let x2911 = Self::mul_add(-x2674, x2909, x2910);
+        let x2912 = Self::mul_add(
+            -x2658,
+            x2908,
+            Self::mul_add(x2635, x2907, Self::mul_add(-x2573, x2611, x2586)),
+        );
+        let x2913 = Self::mul_add(-x2697, x2911, Self::mul_add(-x2678, x2909, x2912));
+        let x2914 = Self::mul_add(
+            -x2661,
+            x2908,
+            Self::mul_add(x2639, x2907, Self::mul_add(-x2573, x2614, x2589)),
+        );
+        let x2915 = Self::mul_add(
+            -x2717,
+            x2913,
+            Self::mul_add(-x2701, x2911, Self::mul_add(-x2682, x2909, x2914)),
+        );
+        let x2916 = Self::mul_add(
+            x2664,
+            x2908,
+            Self::mul_add(-x2643, x2907, Self::mul_add(-x2573, x2617, x2592)),
+        );
+        let x2917 = Self::mul_add(
+            -x2721,
+            x2913,
+            Self::mul_add(-x2705, x2911, Self::mul_add(-x2686, x2909, x2916)),
+        );
+        let x2918 = Self::mul_add(-x2734, x2915, x2917);
+        let x2919 = Self::mul_add(
+            x2667,
+            x2908,
+            Self::mul_add(-x2647, x2907, Self::mul_add(-x2573, x2620, x2595)),
+        );
+        let x2920 = Self::mul_add(
+            -x2725,
+            x2913,
+            Self::mul_add(-x2709, x2911, Self::mul_add(-x2690, x2909, x2919)),
+        );
+        let x2921 = x2753
+            * Self::mul_add(-x2748, x2918, Self::mul_add(-x2739, x2915, x2920));
+        let x2922 = -x2921;
+        let x2923 = Self::mul_add(-x2748, x2921, x2743 * x2918);
+        let x2924 = -x2923;
+        let x2925 = Self::mul_add(
+            -x2739,
+            x2921,
+            Self::mul_add(-x2734, x2923, x2729 * x2915),
+        );
+        let x2926 = Self::mul_add(
+            -x2725,
+            x2921,
+            Self::mul_add(-x2721, x2923, Self::mul_add(-x2717, x2925, x2713 * x2913)),
+        );
+        let x2927 = Self::mul_add(
+            -x2705,
+            x2923,
+            Self::mul_add(-x2701, x2925, Self::mul_add(-x2697, x2926, x2693 * x2911)),
+        );
+        let x2928 = Self::mul_add(-x2709, x2921, x2927);
+        let x2929 = Self::mul_add(
+            -x2682,
+            x2925,
+            Self::mul_add(-x2678, x2926, Self::mul_add(-x2674, x2928, x2670 * x2909)),
+        );
+        let x2930 = Self::mul_add(-x2690, x2921, Self::mul_add(-x2686, x2923, x2929));
+        let x2931 = -x2930;
+        let x2932 = Self::mul_add(
+            -x2658,
+            x2926,
+            Self::mul_add(-x2655, x2928, Self::mul_add(x2652, x2930, x2649 * x2908)),
+        );
+        let x2933 = Self::mul_add(
+            x2667,
+            x2921,
+            Self::mul_add(x2664, x2923, Self::mul_add(-x2661, x2925, x2932)),
+        );
+        let x2934 = -x2933;
+        let x2935 = Self::mul_add(
+            -x2631,
+            x2928,
+            Self::mul_add(x2627, x2930, Self::mul_add(-x2623, x2933, x2621 * x2907)),
+        );
+        let x2936 = Self::mul_add(
+            x2643,
+            x2923,
+            Self::mul_add(-x2639, x2925, Self::mul_add(-x2635, x2926, x2935)),
+        );
+        let x2937 = Self::mul_add(x2647, x2921, x2936);
+        let x2938 = Self::mul_add(
+            -x2605,
+            x2930,
+            Self::mul_add(-x2602, x2933, Self::mul_add(x2600, x2937, x2573 * x2597)),
+        );
+        let x2939 = Self::mul_add(
+            -x2614,
+            x2925,
+            Self::mul_add(-x2611, x2926, Self::mul_add(-x2608, x2928, x2938)),
+        );
+        let x2940 = Self::mul_add(-x2620, x2921, Self::mul_add(-x2617, x2923, x2939));
+        let x2941 = -x2940;
+        let x2942 = Self::mul_add(
+            x2577,
+            x2933,
+            Self::mul_add(-x2575, x2937, Self::mul_add(x2573, x2940, x2571)),
+        );
+        let x2943 = Self::mul_add(
+            x2586,
+            x2926,
+            Self::mul_add(x2583, x2928, Self::mul_add(x2580, x2930, x2942)),
+        );
+        let x2944 = Self::mul_add(
+            x2595,
+            x2921,
+            Self::mul_add(x2592, x2923, Self::mul_add(x2589, x2925, x2943)),
+        );
+        let x2945 = Self::mul_add(
+            -x2564,
+            x2928,
+            Self::mul_add(-x2563, x2930, Self::mul_add(x2555, x2940, x2548 * x2944)),
+        );
+        let x2946 = Self::mul_add(
+            -x2567,
+            x2923,
+            Self::mul_add(x2566, x2925, Self::mul_add(-x2565, x2926, x2945)),
+        );
+        let x2947 = Self::mul_add(x2568, x2921, x2946);
+        let x2948 = -x2947;
+        let x2949 = Self::mul_add(
+            x2557,
+            x2930,
+            Self::mul_add(x2556, x2933, Self::mul_add(-x2555, x2937, x2547 * x2944)),
+        );
+        let x2950 = Self::mul_add(
+            x2560,
+            x2925,
+            Self::mul_add(x2559, x2926, Self::mul_add(x2558, x2928, x2949)),
+        );
+        let x2951 = Self::mul_add(x2562, x2921, Self::mul_add(x2561, x2923, x2950));
+        let x2952 = Self::mul_add(
+            x2549,
+            x2930,
+            Self::mul_add(-x2548, x2933, Self::mul_add(x2548, x2937, x2547 * x2940)),
+        );
+        let x2953 = Self::mul_add(
+            x2552,
+            x2925,
+            Self::mul_add(x2551, x2926, Self::mul_add(x2550, x2928, x2952)),
+        );
+        let x2954 = Self::mul_add(x2554, x2921, Self::mul_add(x2553, x2923, x2953));
+        let x2955 = Self::mul_add(x2600, x2623, x2602);
+        let x2956 = Self::mul_add(x2652, x2955, Self::mul_add(-x2600, x2627, x2605));
+        let x2957 = Self::mul_add(
+            -x2674,
+            x2956,
+            Self::mul_add(-x2655, x2955, Self::mul_add(x2600, x2631, x2608)),
+        );
+        let x2958 = Self::mul_add(
+            -x2678,
+            x2956,
+            Self::mul_add(-x2658, x2955, Self::mul_add(x2600, x2635, x2611)),
+        );
+        let x2959 = Self::mul_add(-x2697, x2957, x2958);
+        let x2960 = Self::mul_add(
+            -x2682,
+            x2956,
+            Self::mul_add(-x2661, x2955, Self::mul_add(x2600, x2639, x2614)),
+        );
+        let x2961 = Self::mul_add(-x2717, x2959, Self::mul_add(-x2701, x2957, x2960));
+        let x2962 = Self::mul_add(
+            -x2686,
+            x2956,
+            Self::mul_add(x2664, x2955, Self::mul_add(-x2600, x2643, x2617)),
+        );
+        let x2963 = Self::mul_add(
+            -x2734,
+            x2961,
+            Self::mul_add(-x2721, x2959, Self::mul_add(-x2705, x2957, x2962)),
+        );
+        let x2964 = Self::mul_add(
+            -x2690,
+            x2956,
+            Self::mul_add(x2667, x2955, Self::mul_add(-x2600, x2647, x2620)),
+        );
+        let x2965 = Self::mul_add(
+            -x2739,
+            x2961,
+            Self::mul_add(-x2725, x2959, Self::mul_add(-x2709, x2957, x2964)),
+        );
+        let x2966 = x2753 * Self::mul_add(-x2748, x2963, x2965);
+        let x2967 = -x2966;
+        let x2968 = Self::mul_add(-x2748, x2966, x2743 * x2963);
+        let x2969 = -x2968;
+        let x2970 = Self::mul_add(
+            -x2739,
+            x2966,
+            Self::mul_add(-x2734, x2968, x2729 * x2961),
+        );
+        let x2971 = Self::mul_add(
+            -x2725,
+            x2966,
+            Self::mul_add(-x2721, x2968, Self::mul_add(-x2717, x2970, x2713 * x2959)),
+        );
+        let x2972 = Self::mul_add(
+            -x2705,
+            x2968,
+            Self::mul_add(-x2701, x2970, Self::mul_add(-x2697, x2971, x2693 * x2957)),
+        );
+        let x2973 = Self::mul_add(-x2709, x2966, x2972);
+        let x2974 = Self::mul_add(
+            -x2682,
+            x2970,
+            Self::mul_add(-x2678, x2971, Self::mul_add(-x2674, x2973, x2670 * x2956)),
+        );
+        let x2975 = Self::mul_add(-x2690, x2966, Self::mul_add(-x2686, x2968, x2974));
+        let x2976 = -x2975;
+        let x2977 = Self::mul_add(
+            -x2658,
+            x2971,
+            Self::mul_add(-x2655, x2973, Self::mul_add(x2652, x2975, x2649 * x2955)),
+        );
+        let x2978 = Self::mul_add(
+            x2667,
+            x2966,
+            Self::mul_add(x2664, x2968, Self::mul_add(-x2661, x2970, x2977)),
+        );
+        let x2979 = -x2978;
+        let x2980 = Self::mul_add(
+            -x2631,
+            x2973,
+            Self::mul_add(x2627, x2975, Self::mul_add(-x2623, x2978, x2600 * x2621)),
+        );
+        let x2981 = Self::mul_add(
+            x2643,
+            x2968,
+            Self::mul_add(-x2639, x2970, Self::mul_add(-x2635, x2971, x2980)),
+        );
+        let x2982 = Self::mul_add(x2647, x2966, x2981);
+        let x2983 = Self::mul_add(
+            x2605,
+            x2975,
+            Self::mul_add(x2602, x2978, Self::mul_add(-x2600, x2982, x2597)),
+        );
+        let x2984 = Self::mul_add(
+            x2614,
+            x2970,
+            Self::mul_add(x2611, x2971, Self::mul_add(x2608, x2973, x2983)),
+        );
+        let x2985 = Self::mul_add(x2620, x2966, Self::mul_add(x2617, x2968, x2984));
+        let x2986 = Self::mul_add(
+            -x2580,
+            x2975,
+            Self::mul_add(-x2577, x2978, Self::mul_add(x2575, x2982, x2573 * x2985)),
+        );
+        let x2987 = Self::mul_add(
+            -x2589,
+            x2970,
+            Self::mul_add(-x2586, x2971, Self::mul_add(-x2583, x2973, x2986)),
+        );
+        let x2988 = Self::mul_add(-x2595, x2966, Self::mul_add(-x2592, x2968, x2987));
+        let x2989 = -x2988;
+        let x2990 = Self::mul_add(
+            x2564,
+            x2973,
+            Self::mul_add(x2563, x2975, Self::mul_add(x2555, x2985, x2548 * x2988)),
+        );
+        let x2991 = Self::mul_add(
+            x2567,
+            x2968,
+            Self::mul_add(-x2566, x2970, Self::mul_add(x2565, x2971, x2990)),
+        );
+        let x2992 = Self::mul_add(-x2568, x2966, x2991);
+        let x2993 = Self::mul_add(
+            -x2557,
+            x2975,
+            Self::mul_add(-x2556, x2978, Self::mul_add(x2555, x2982, x2547 * x2988)),
+        );
+        let x2994 = Self::mul_add(
+            -x2560,
+            x2970,
+            Self::mul_add(-x2559, x2971, Self::mul_add(-x2558, x2973, x2993)),
+        );
+        let x2995 = Self::mul_add(-x2562, x2966, Self::mul_add(-x2561, x2968, x2994));
+        let x2996 = -x2995;
+        let x2997 = Self::mul_add(
+            -x2549,
+            x2975,
+            Self::mul_add(x2548, x2978, Self::mul_add(-x2548, x2982, x2547 * x2985)),
+        );
+        let x2998 = Self::mul_add(
+            -x2552,
+            x2970,
+            Self::mul_add(-x2551, x2971, Self::mul_add(-x2550, x2973, x2997)),
+        );
+        let x2999 = Self::mul_add(-x2554, x2966, Self::mul_add(-x2553, x2968, x2998));
+        let x3000 = -x2999;
+        let x3001 = Self::mul_add(-x2623, x2652, x2627);
+        let x3002 = Self::mul_add(x2674, x3001, Self::mul_add(-x2623, x2655, x2631));
+        let x3003 = Self::mul_add(
+            -x2697,
+            x3002,
+            Self::mul_add(x2678, x3001, Self::mul_add(-x2623, x2658, x2635)),
+        );
+        let x3004 = Self::mul_add(
+            -x2701,
+            x3002,
+            Self::mul_add(x2682, x3001, Self::mul_add(-x2623, x2661, x2639)),
+        );
+        let x3005 = Self::mul_add(-x2717, x3003, x3004);
+        let x3006 = Self::mul_add(
+            x2705,
+            x3002,
+            Self::mul_add(-x2686, x3001, Self::mul_add(-x2623, x2664, x2643)),
+        );
+        let x3007 = Self::mul_add(x2734, x3005, Self::mul_add(x2721, x3003, x3006));
+        let x3008 = Self::mul_add(
+            x2709,
+            x3002,
+            Self::mul_add(-x2690, x3001, Self::mul_add(-x2623, x2667, x2647)),
+        );
+        let x3009 = Self::mul_add(
+            -x2748,
+            x3007,
+            Self::mul_add(x2739, x3005, Self::mul_add(x2725, x3003, x3008)),
+        );
+        let x3010 = x2753 * x3009;
+        let x3011 = -x3010;
+        let x3012 = Self::mul_add(-x2748, x3010, x2743 * x3007);
+        let x3013 = -x3012;
+        let x3014 = Self::mul_add(
+            x2739,
+            x3010,
+            Self::mul_add(x2734, x3012, x2729 * x3005),
+        );
+        let x3015 = -x3014;
+        let x3016 = Self::mul_add(
+            x2725,
+            x3010,
+            Self::mul_add(x2721, x3012, Self::mul_add(-x2717, x3014, x2713 * x3003)),
+        );
+        let x3017 = -x3016;
+        let x3018 = Self::mul_add(
+            x2705,
+            x3012,
+            Self::mul_add(-x2701, x3014, Self::mul_add(-x2697, x3016, x2693 * x3002)),
+        );
+        let x3019 = Self::mul_add(x2709, x3010, x3018);
+        let x3020 = -x3019;
+        let x3021 = Self::mul_add(
+            x2682,
+            x3014,
+            Self::mul_add(x2678, x3016, Self::mul_add(x2674, x3019, x2670 * x3001)),
+        );
+        let x3022 = Self::mul_add(-x2690, x3010, Self::mul_add(-x2686, x3012, x3021));
+        let x3023 = -x3022;
+        let x3024 = Self::mul_add(
+            -x2658,
+            x3016,
+            Self::mul_add(-x2655, x3019, Self::mul_add(-x2652, x3022, x2623 * x2649)),
+        );
+        let x3025 = Self::mul_add(
+            -x2667,
+            x3010,
+            Self::mul_add(-x2664, x3012, Self::mul_add(-x2661, x3014, x3024)),
+        );
+        let x3026 = Self::mul_add(
+            -x2631,
+            x3019,
+            Self::mul_add(-x2627, x3022, Self::mul_add(-x2623, x3025, x2621)),
+        );
+        let x3027 = Self::mul_add(
+            -x2643,
+            x3012,
+            Self::mul_add(-x2639, x3014, Self::mul_add(-x2635, x3016, x3026)),
+        );
+        let x3028 = Self::mul_add(-x2647, x3010, x3027);
+        let x3029 = -x3028;
+        let x3030 = Self::mul_add(
+            -x2608,
+            x3019,
+            Self::mul_add(x2605, x3022, Self::mul_add(-x2602, x3025, x2600 * x3028)),
+        );
+        let x3031 = Self::mul_add(
+            x2617,
+            x3012,
+            Self::mul_add(-x2614, x3014, Self::mul_add(-x2611, x3016, x3030)),
+        );
+        let x3032 = Self::mul_add(x2620, x3010, x3031);
+        let x3033 = Self::mul_add(
+            -x2580,
+            x3022,
+            Self::mul_add(x2577, x3025, Self::mul_add(-x2575, x3028, x2573 * x3032)),
+        );
+        let x3034 = Self::mul_add(
+            x2589,
+            x3014,
+            Self::mul_add(x2586, x3016, Self::mul_add(x2583, x3019, x3033)),
+        );
+        let x3035 = Self::mul_add(-x2595, x3010, Self::mul_add(-x2592, x3012, x3034));
+        let x3036 = -x3035;
+        let x3037 = Self::mul_add(
+            -x2564,
+            x3019,
+            Self::mul_add(x2563, x3022, Self::mul_add(x2555, x3032, x2548 * x3035)),
+        );
+        let x3038 = Self::mul_add(
+            x2567,
+            x3012,
+            Self::mul_add(x2566, x3014, Self::mul_add(-x2565, x3016, x3037)),
+        );
+        let x3039 = Self::mul_add(-x2568, x3010, x3038);
+        let x3040 = Self::mul_add(
+            -x2557,
+            x3022,
+            Self::mul_add(x2556, x3025, Self::mul_add(-x2555, x3028, x2547 * x3035)),
+        );
+        let x3041 = Self::mul_add(
+            x2560,
+            x3014,
+            Self::mul_add(x2559, x3016, Self::mul_add(x2558, x3019, x3040)),
+        );
+        let x3042 = Self::mul_add(-x2562, x3010, Self::mul_add(-x2561, x3012, x3041));
+        let x3043 = -x3042;
+        let x3044 = Self::mul_add(
+            -x2549,
+            x3022,
+            Self::mul_add(-x2548, x3025, Self::mul_add(x2548, x3028, x2547 * x3032)),
+        );
+        let x3045 = Self::mul_add(
+            x2552,
+            x3014,
+            Self::mul_add(x2551, x3016, Self::mul_add(x2550, x3019, x3044)),
+        );
+        let x3046 = Self::mul_add(-x2554, x3010, Self::mul_add(-x2553, x3012, x3045));
+        let x3047 = -x3046;
+        let x3048 = Self::mul_add(x2652, x2674, x2655);
+        let x3049 = Self::mul_add(-x2697, x3048, Self::mul_add(x2652, x2678, x2658));
+        let x3050 = Self::mul_add(
+            -x2717,
+            x3049,
+            Self::mul_add(-x2701, x3048, Self::mul_add(x2652, x2682, x2661)),
+        );
+        let x3051 = Self::mul_add(
+            x2721,
+            x3049,
+            Self::mul_add(x2705, x3048, Self::mul_add(-x2652, x2686, x2664)),
+        );
+        let x3052 = Self::mul_add(x2734, x3050, x3051);
+        let x3053 = Self::mul_add(
+            x2725,
+            x3049,
+            Self::mul_add(x2709, x3048, Self::mul_add(-x2652, x2690, x2667)),
+        );
+        let x3054 = x2753
+            * Self::mul_add(-x2748, x3052, Self::mul_add(x2739, x3050, x3053));
+        let x3055 = Self::mul_add(-x2748, x3054, x2743 * x3052);
+        let x3056 = Self::mul_add(
+            x2739,
+            x3054,
+            Self::mul_add(x2734, x3055, x2729 * x3050),
+        );
+        let x3057 = Self::mul_add(
+            x2725,
+            x3054,
+            Self::mul_add(x2721, x3055, Self::mul_add(-x2717, x3056, x2713 * x3049)),
+        );
+        let x3058 = Self::mul_add(
+            x2705,
+            x3055,
+            Self::mul_add(-x2701, x3056, Self::mul_add(-x2697, x3057, x2693 * x3048)),
+        );
+        let x3059 = Self::mul_add(x2709, x3054, x3058);
+        let x3060 = Self::mul_add(
+            x2682,
+            x3056,
+            Self::mul_add(x2678, x3057, Self::mul_add(x2674, x3059, x2652 * x2670)),
+        );
+        let x3061 = Self::mul_add(-x2690, x3054, Self::mul_add(-x2686, x3055, x3060));
+        let x3062 = Self::mul_add(
+            x2658,
+            x3057,
+            Self::mul_add(x2655, x3059, Self::mul_add(x2652, x3061, x2649)),
+        );
+        let x3063 = Self::mul_add(
+            x2667,
+            x3054,
+            Self::mul_add(x2664, x3055, Self::mul_add(x2661, x3056, x3062)),
+        );
+        let x3064 = Self::mul_add(
+            -x2635,
+            x3057,
+            Self::mul_add(-x2631, x3059, Self::mul_add(-x2627, x3061, x2623 * x3063)),
+        );
+        let x3065 = Self::mul_add(
+            -x2647,
+            x3054,
+            Self::mul_add(-x2643, x3055, Self::mul_add(-x2639, x3056, x3064)),
+        );
+        let x3066 = Self::mul_add(
+            -x2608,
+            x3059,
+            Self::mul_add(x2605, x3061, Self::mul_add(x2602, x3063, x2600 * x3065)),
+        );
+        let x3067 = Self::mul_add(
+            x2617,
+            x3055,
+            Self::mul_add(-x2614, x3056, Self::mul_add(-x2611, x3057, x3066)),
+        );
+        let x3068 = Self::mul_add(x2620, x3054, x3067);
+        let x3069 = -x3068;
+        let x3070 = Self::mul_add(
+            -x2580,
+            x3061,
+            Self::mul_add(-x2577, x3063, Self::mul_add(-x2575, x3065, x2573 * x3068)),
+        );
+        let x3071 = Self::mul_add(
+            x2589,
+            x3056,
+            Self::mul_add(x2586, x3057, Self::mul_add(x2583, x3059, x3070)),
+        );
+        let x3072 = Self::mul_add(-x2595, x3054, Self::mul_add(-x2592, x3055, x3071));
+        let x3073 = Self::mul_add(
+            -x2564,
+            x3059,
+            Self::mul_add(x2563, x3061, Self::mul_add(x2555, x3068, x2548 * x3072)),
+        );
+        let x3074 = Self::mul_add(
+            x2567,
+            x3055,
+            Self::mul_add(x2566, x3056, Self::mul_add(-x2565, x3057, x3073)),
+        );
+        let x3075 = Self::mul_add(-x2568, x3054, x3074);
+        let x3076 = -x3075;
+        let x3077 = Self::mul_add(
+            -x2557,
+            x3061,
+            Self::mul_add(-x2556, x3063, Self::mul_add(-x2555, x3065, x2547 * x3072)),
+        );
+        let x3078 = Self::mul_add(
+            x2560,
+            x3056,
+            Self::mul_add(x2559, x3057, Self::mul_add(x2558, x3059, x3077)),
+        );
+        let x3079 = Self::mul_add(-x2562, x3054, Self::mul_add(-x2561, x3055, x3078));
+        let x3080 = Self::mul_add(
+            -x2549,
+            x3061,
+            Self::mul_add(x2548, x3063, Self::mul_add(x2548, x3065, x2547 * x3068)),
+        );
+        let x3081 = Self::mul_add(
+            x2552,
+            x3056,
+            Self::mul_add(x2551, x3057, Self::mul_add(x2550, x3059, x3080)),
+        );
+        let x3082 = Self::mul_add(-x2554, x3054, Self::mul_add(-x2553, x3055, x3081));
+        let x3083 = Self::mul_add(-x2674, x2697, x2678);
+        let x3084 = Self::mul_add(-x2717, x3083, Self::mul_add(-x2674, x2701, x2682));
+        let x3085 = Self::mul_add(
+            -x2734,
+            x3084,
+            Self::mul_add(-x2721, x3083, Self::mul_add(-x2674, x2705, x2686)),
+        );
+        let x3086 = Self::mul_add(
+            -x2739,
+            x3084,
+            Self::mul_add(-x2725, x3083, Self::mul_add(-x2674, x2709, x2690)),
+        );
+        let x3087 = x2753 * Self::mul_add(-x2748, x3085, x3086);
+        let x3088 = -x3087;
+        let x3089 = Self::mul_add(-x2748, x3087, x2743 * x3085);
+        let x3090 = -x3089;
+        let x3091 = Self::mul_add(
+            -x2739,
+            x3087,
+            Self::mul_add(-x2734, x3089, x2729 * x3084),
+        );
+        let x3092 = Self::mul_add(
+            -x2725,
+            x3087,
+            Self::mul_add(-x2721, x3089, Self::mul_add(-x2717, x3091, x2713 * x3083)),
+        );
+        let x3093 = Self::mul_add(
+            -x2705,
+            x3089,
+            Self::mul_add(-x2701, x3091, Self::mul_add(-x2697, x3092, x2674 * x2693)),
+        );
+        let x3094 = Self::mul_add(-x2709, x3087, x3093);
+        let x3095 = Self::mul_add(
+            x2682,
+            x3091,
+            Self::mul_add(x2678, x3092, Self::mul_add(x2674, x3094, x2670)),
+        );
+        let x3096 = Self::mul_add(x2690, x3087, Self::mul_add(x2686, x3089, x3095));
+        let x3097 = Self::mul_add(
+            x2661,
+            x3091,
+            Self::mul_add(x2658, x3092, Self::mul_add(x2655, x3094, x2652 * x3096)),
+        );
+        let x3098 = Self::mul_add(-x2667, x3087, Self::mul_add(-x2664, x3089, x3097));
+        let x3099 = Self::mul_add(
+            -x2635,
+            x3092,
+            Self::mul_add(-x2631, x3094, Self::mul_add(-x2627, x3096, x2623 * x3098)),
+        );
+        let x3100 = Self::mul_add(
+            x2647,
+            x3087,
+            Self::mul_add(x2643, x3089, Self::mul_add(-x2639, x3091, x3099)),
+        );
+        let x3101 = Self::mul_add(
+            -x2608,
+            x3094,
+            Self::mul_add(x2605, x3096, Self::mul_add(x2602, x3098, x2600 * x3100)),
+        );
+        let x3102 = Self::mul_add(
+            -x2617,
+            x3089,
+            Self::mul_add(-x2614, x3091, Self::mul_add(-x2611, x3092, x3101)),
+        );
+        let x3103 = Self::mul_add(-x2620, x3087, x3102);
+        let x3104 = -x3103;
+        let x3105 = Self::mul_add(
+            -x2580,
+            x3096,
+            Self::mul_add(-x2577, x3098, Self::mul_add(-x2575, x3100, x2573 * x3103)),
+        );
+        let x3106 = Self::mul_add(
+            x2589,
+            x3091,
+            Self::mul_add(x2586, x3092, Self::mul_add(x2583, x3094, x3105)),
+        );
+        let x3107 = Self::mul_add(x2595, x3087, Self::mul_add(x2592, x3089, x3106));
+        let x3108 = Self::mul_add(
+            -x2564,
+            x3094,
+            Self::mul_add(x2563, x3096, Self::mul_add(x2555, x3103, x2548 * x3107)),
+        );
+        let x3109 = Self::mul_add(
+            -x2567,
+            x3089,
+            Self::mul_add(x2566, x3091, Self::mul_add(-x2565, x3092, x3108)),
+        );
+        let x3110 = Self::mul_add(x2568, x3087, x3109);
+        let x3111 = -x3110;
+        let x3112 = Self::mul_add(
+            -x2557,
+            x3096,
+            Self::mul_add(-x2556, x3098, Self::mul_add(-x2555, x3100, x2547 * x3107)),
+        );
+        let x3113 = Self::mul_add(
+            x2560,
+            x3091,
+            Self::mul_add(x2559, x3092, Self::mul_add(x2558, x3094, x3112)),
+        );
+        let x3114 = Self::mul_add(x2562, x3087, Self::mul_add(x2561, x3089, x3113));
+        let x3115 = Self::mul_add(
+            -x2549,
+            x3096,
+            Self::mul_add(x2548, x3098, Self::mul_add(x2548, x3100, x2547 * x3103)),
+        );
+        let x3116 = Self::mul_add(
+            x2552,
+            x3091,
+            Self::mul_add(x2551, x3092, Self::mul_add(x2550, x3094, x3115)),
+        );
+        let x3117 = Self::mul_add(x2554, x3087, Self::mul_add(x2553, x3089, x3116));
+        let x3118 = Self::mul_add(-x2697, x2717, x2701);
+        let x3119 = Self::mul_add(-x2734, x3118, Self::mul_add(-x2697, x2721, x2705));
+        let x3120 = Self::mul_add(
+            -x2748,
+            x3119,
+            Self::mul_add(-x2739, x3118, Self::mul_add(-x2697, x2725, x2709)),
+        );
+        let x3121 = x2753 * x3120;
+        let x3122 = Self::mul_add(-x2748, x3121, x2743 * x3119);
+        let x3123 = Self::mul_add(
+            -x2739,
+            x3121,
+            Self::mul_add(-x2734, x3122, x2729 * x3118),
+        );
+        let x3124 = -x3123;
+        let x3125 = Self::mul_add(
+            -x2725,
+            x3121,
+            Self::mul_add(-x2721, x3122, Self::mul_add(-x2717, x3123, x2697 * x2713)),
+        );
+        let x3126 = -x3125;
+        let x3127 = Self::mul_add(
+            x2705,
+            x3122,
+            Self::mul_add(x2701, x3123, Self::mul_add(x2697, x3125, x2693)),
+        );
+        let x3128 = Self::mul_add(x2709, x3121, x3127);
+        let x3129 = Self::mul_add(
+            -x2686,
+            x3122,
+            Self::mul_add(-x2682, x3123, Self::mul_add(-x2678, x3125, x2674 * x3128)),
+        );
+        let x3130 = Self::mul_add(-x2690, x3121, x3129);
+        let x3131 = Self::mul_add(
+            -x2661,
+            x3123,
+            Self::mul_add(-x2658, x3125, Self::mul_add(x2655, x3128, x2652 * x3130)),
+        );
+        let x3132 = Self::mul_add(x2667, x3121, Self::mul_add(x2664, x3122, x3131));
+        let x3133 = Self::mul_add(
+            x2635,
+            x3125,
+            Self::mul_add(-x2631, x3128, Self::mul_add(-x2627, x3130, x2623 * x3132)),
+        );
+        let x3134 = Self::mul_add(
+            -x2647,
+            x3121,
+            Self::mul_add(-x2643, x3122, Self::mul_add(x2639, x3123, x3133)),
+        );
+        let x3135 = Self::mul_add(
+            -x2608,
+            x3128,
+            Self::mul_add(x2605, x3130, Self::mul_add(x2602, x3132, x2600 * x3134)),
+        );
+        let x3136 = Self::mul_add(
+            x2617,
+            x3122,
+            Self::mul_add(x2614, x3123, Self::mul_add(x2611, x3125, x3135)),
+        );
+        let x3137 = Self::mul_add(x2620, x3121, x3136);
+        let x3138 = -x3137;
+        let x3139 = Self::mul_add(
+            -x2580,
+            x3130,
+            Self::mul_add(-x2577, x3132, Self::mul_add(-x2575, x3134, x2573 * x3137)),
+        );
+        let x3140 = Self::mul_add(
+            -x2589,
+            x3123,
+            Self::mul_add(-x2586, x3125, Self::mul_add(x2583, x3128, x3139)),
+        );
+        let x3141 = Self::mul_add(-x2595, x3121, Self::mul_add(-x2592, x3122, x3140));
+        let x3142 = Self::mul_add(
+            -x2564,
+            x3128,
+            Self::mul_add(x2563, x3130, Self::mul_add(x2555, x3137, x2548 * x3141)),
+        );
+        let x3143 = Self::mul_add(
+            x2567,
+            x3122,
+            Self::mul_add(-x2566, x3123, Self::mul_add(x2565, x3125, x3142)),
+        );
+        let x3144 = Self::mul_add(-x2568, x3121, x3143);
+        let x3145 = -x3144;
+        let x3146 = Self::mul_add(
+            -x2557,
+            x3130,
+            Self::mul_add(-x2556, x3132, Self::mul_add(-x2555, x3134, x2547 * x3141)),
+        );
+        let x3147 = Self::mul_add(
+            -x2560,
+            x3123,
+            Self::mul_add(-x2559, x3125, Self::mul_add(x2558, x3128, x3146)),
+        );
+        let x3148 = Self::mul_add(-x2562, x3121, Self::mul_add(-x2561, x3122, x3147));
+        let x3149 = Self::mul_add(
+            -x2549,
+            x3130,
+            Self::mul_add(x2548, x3132, Self::mul_add(x2548, x3134, x2547 * x3137)),
+        );
+        let x3150 = Self::mul_add(
+            -x2552,
+            x3123,
+            Self::mul_add(-x2551, x3125, Self::mul_add(x2550, x3128, x3149)),
+        );
+        let x3151 = Self::mul_add(-x2554, x3121, Self::mul_add(-x2553, x3122, x3150));
+        let x3152 = Self::mul_add(-x2717, x2734, x2721);
+        let x3153 = x2753
+            * Self::mul_add(-x2748, x3152, Self::mul_add(-x2717, x2739, x2725));
+        let x3154 = Self::mul_add(-x2748, x3153, x2743 * x3152);
+        let x3155 = Self::mul_add(
+            -x2739,
+            x3153,
+            Self::mul_add(-x2734, x3154, x2717 * x2729),
+        );
+        let x3156 = -x3155;
+        let x3157 = Self::mul_add(
+            x2725,
+            x3153,
+            Self::mul_add(x2721, x3154, Self::mul_add(x2717, x3155, x2713)),
+        );
+        let x3158 = Self::mul_add(
+            -x2709,
+            x3153,
+            Self::mul_add(-x2705, x3154, Self::mul_add(-x2701, x3155, x2697 * x3157)),
+        );
+        let x3159 = -x3158;
+        let x3160 = Self::mul_add(
+            x2686,
+            x3154,
+            Self::mul_add(x2682, x3155, Self::mul_add(-x2678, x3157, x2674 * x3158)),
+        );
+        let x3161 = Self::mul_add(x2690, x3153, x3160);
+        let x3162 = -x3161;
+        let x3163 = Self::mul_add(
+            x2661,
+            x3155,
+            Self::mul_add(-x2658, x3157, Self::mul_add(x2655, x3158, x2652 * x3161)),
+        );
+        let x3164 = Self::mul_add(-x2667, x3153, Self::mul_add(-x2664, x3154, x3163));
+        let x3165 = -x3164;
+        let x3166 = Self::mul_add(
+            x2635,
+            x3157,
+            Self::mul_add(-x2631, x3158, Self::mul_add(-x2627, x3161, x2623 * x3164)),
+        );
+        let x3167 = Self::mul_add(
+            x2647,
+            x3153,
+            Self::mul_add(x2643, x3154, Self::mul_add(-x2639, x3155, x3166)),
+        );
+        let x3168 = -x3167;
+        let x3169 = Self::mul_add(
+            -x2608,
+            x3158,
+            Self::mul_add(x2605, x3161, Self::mul_add(x2602, x3164, x2600 * x3167)),
+        );
+        let x3170 = Self::mul_add(
+            -x2617,
+            x3154,
+            Self::mul_add(-x2614, x3155, Self::mul_add(x2611, x3157, x3169)),
+        );
+        let x3171 = Self::mul_add(-x2620, x3153, x3170);
+        let x3172 = Self::mul_add(
+            -x2580,
+            x3161,
+            Self::mul_add(-x2577, x3164, Self::mul_add(-x2575, x3167, x2573 * x3171)),
+        );
+        let x3173 = Self::mul_add(
+            x2589,
+            x3155,
+            Self::mul_add(-x2586, x3157, Self::mul_add(x2583, x3158, x3172)),
+        );
+        let x3174 = Self::mul_add(x2595, x3153, Self::mul_add(x2592, x3154, x3173));
+        let x3175 = -x3174;
+        let x3176 = Self::mul_add(
+            -x2564,
+            x3158,
+            Self::mul_add(x2563, x3161, Self::mul_add(x2555, x3171, x2548 * x3174)),
+        );
+        let x3177 = Self::mul_add(
+            -x2567,
+            x3154,
+            Self::mul_add(x2566, x3155, Self::mul_add(x2565, x3157, x3176)),
+        );
+        let x3178 = Self::mul_add(x2568, x3153, x3177);
+        let x3179 = Self::mul_add(
+            -x2557,
+            x3161,
+            Self::mul_add(-x2556, x3164, Self::mul_add(-x2555, x3167, x2547 * x3174)),
+        );
+        let x3180 = Self::mul_add(
+            x2560,
+            x3155,
+            Self::mul_add(-x2559, x3157, Self::mul_add(x2558, x3158, x3179)),
+        );
+        let x3181 = Self::mul_add(x2562, x3153, Self::mul_add(x2561, x3154, x3180));
+        let x3182 = -x3181;
+        let x3183 = Self::mul_add(
+            -x2549,
+            x3161,
+            Self::mul_add(x2548, x3164, Self::mul_add(x2548, x3167, x2547 * x3171)),
+        );
+        let x3184 = Self::mul_add(
+            x2552,
+            x3155,
+            Self::mul_add(-x2551, x3157, Self::mul_add(x2550, x3158, x3183)),
+        );
+        let x3185 = Self::mul_add(x2554, x3153, Self::mul_add(x2553, x3154, x3184));
+        let x3186 = -x3185;
+        let x3187 = x2753 * Self::mul_add(-x2734, x2748, x2739);
+        let x3188 = Self::mul_add(-x2748, x3187, x2734 * x2743);
+        let x3189 = Self::mul_add(x2739, x3187, Self::mul_add(x2734, x3188, x2729));
+        let x3190 = Self::mul_add(
+            -x2725,
+            x3187,
+            Self::mul_add(-x2721, x3188, x2717 * x3189),
+        );
+        let x3191 = -x3190;
+        let x3192 = Self::mul_add(
+            x2709,
+            x3187,
+            Self::mul_add(x2705, x3188, Self::mul_add(-x2701, x3189, x2697 * x3190)),
+        );
+        let x3193 = Self::mul_add(
+            -x2686,
+            x3188,
+            Self::mul_add(x2682, x3189, Self::mul_add(-x2678, x3190, x2674 * x3192)),
+        );
+        let x3194 = Self::mul_add(-x2690, x3187, x3193);
+        let x3195 = Self::mul_add(
+            x2661,
+            x3189,
+            Self::mul_add(-x2658, x3190, Self::mul_add(x2655, x3192, x2652 * x3194)),
+        );
+        let x3196 = Self::mul_add(x2667, x3187, Self::mul_add(x2664, x3188, x3195));
+        let x3197 = Self::mul_add(
+            x2635,
+            x3190,
+            Self::mul_add(-x2631, x3192, Self::mul_add(-x2627, x3194, x2623 * x3196)),
+        );
+        let x3198 = Self::mul_add(
+            -x2647,
+            x3187,
+            Self::mul_add(-x2643, x3188, Self::mul_add(-x2639, x3189, x3197)),
+        );
+        let x3199 = Self::mul_add(
+            -x2608,
+            x3192,
+            Self::mul_add(x2605, x3194, Self::mul_add(x2602, x3196, x2600 * x3198)),
+        );
+        let x3200 = Self::mul_add(
+            x2617,
+            x3188,
+            Self::mul_add(-x2614, x3189, Self::mul_add(x2611, x3190, x3199)),
+        );
+        let x3201 = Self::mul_add(x2620, x3187, x3200);
+        let x3202 = -x3201;
+        let x3203 = Self::mul_add(
+            -x2580,
+            x3194,
+            Self::mul_add(-x2577, x3196, Self::mul_add(-x2575, x3198, x2573 * x3201)),
+        );
+        let x3204 = Self::mul_add(
+            x2589,
+            x3189,
+            Self::mul_add(-x2586, x3190, Self::mul_add(x2583, x3192, x3203)),
+        );
+        let x3205 = Self::mul_add(-x2595, x3187, Self::mul_add(-x2592, x3188, x3204));
+        let x3206 = Self::mul_add(
+            -x2564,
+            x3192,
+            Self::mul_add(x2563, x3194, Self::mul_add(x2555, x3201, x2548 * x3205)),
+        );
+        let x3207 = Self::mul_add(
+            x2567,
+            x3188,
+            Self::mul_add(x2566, x3189, Self::mul_add(x2565, x3190, x3206)),
+        );
+        let x3208 = Self::mul_add(-x2568, x3187, x3207);
+        let x3209 = -x3208;
+        let x3210 = Self::mul_add(
+            -x2557,
+            x3194,
+            Self::mul_add(-x2556, x3196, Self::mul_add(-x2555, x3198, x2547 * x3205)),
+        );
+        let x3211 = Self::mul_add(
+            x2560,
+            x3189,
+            Self::mul_add(-x2559, x3190, Self::mul_add(x2558, x3192, x3210)),
+        );
+        let x3212 = Self::mul_add(-x2562, x3187, Self::mul_add(-x2561, x3188, x3211));
+        let x3213 = Self::mul_add(
+            -x2549,
+            x3194,
+            Self::mul_add(x2548, x3196, Self::mul_add(x2548, x3198, x2547 * x3201)),
+        );
+        let x3214 = Self::mul_add(
+            x2552,
+            x3189,
+            Self::mul_add(-x2551, x3190, Self::mul_add(x2550, x3192, x3213)),
+        );
+        let x3215 = Self::mul_add(-x2554, x3187, Self::mul_add(-x2553, x3188, x3214));
+        let x3216 = x2748 * x2753;
+        let x3217 = -x3216;
+        let x3218 = Self::mul_add(x2748, x3216, x2743);
+        let x3219 = Self::mul_add(-x2739, x3216, x2734 * x3218);
+        let x3220 = Self::mul_add(
+            x2725,
+            x3216,
+            Self::mul_add(-x2721, x3218, x2717 * x3219),
+        );
+        let x3221 = -x3220;
+        let x3222 = Self::mul_add(
+            -x2709,
+            x3216,
+            Self::mul_add(x2705, x3218, Self::mul_add(-x2701, x3219, x2697 * x3220)),
+        );
+        let x3223 = Self::mul_add(
+            -x2686,
+            x3218,
+            Self::mul_add(x2682, x3219, Self::mul_add(-x2678, x3220, x2674 * x3222)),
+        );
+        let x3224 = Self::mul_add(x2690, x3216, x3223);
+        let x3225 = Self::mul_add(
+            x2661,
+            x3219,
+            Self::mul_add(-x2658, x3220, Self::mul_add(x2655, x3222, x2652 * x3224)),
+        );
+        let x3226 = Self::mul_add(-x2667, x3216, Self::mul_add(x2664, x3218, x3225));
+        let x3227 = Self::mul_add(
+            x2635,
+            x3220,
+            Self::mul_add(-x2631, x3222, Self::mul_add(-x2627, x3224, x2623 * x3226)),
+        );
+        let x3228 = Self::mul_add(
+            x2647,
+            x3216,
+            Self::mul_add(-x2643, x3218, Self::mul_add(-x2639, x3219, x3227)),
+        );
+        let x3229 = Self::mul_add(
+            -x2608,
+            x3222,
+            Self::mul_add(x2605, x3224, Self::mul_add(x2602, x3226, x2600 * x3228)),
+        );
+        let x3230 = Self::mul_add(
+            x2617,
+            x3218,
+            Self::mul_add(-x2614, x3219, Self::mul_add(x2611, x3220, x3229)),
+        );
+        let x3231 = Self::mul_add(-x2620, x3216, x3230);
+        let x3232 = -x3231;
+        let x3233 = Self::mul_add(
+            -x2580,
+            x3224,
+            Self::mul_add(-x2577, x3226, Self::mul_add(-x2575, x3228, x2573 * x3231)),
+        );
+        let x3234 = Self::mul_add(
+            x2589,
+            x3219,
+            Self::mul_add(-x2586, x3220, Self::mul_add(x2583, x3222, x3233)),
+        );
+        let x3235 = Self::mul_add(x2595, x3216, Self::mul_add(-x2592, x3218, x3234));
+        let x3236 = Self::mul_add(
+            -x2564,
+            x3222,
+            Self::mul_add(x2563, x3224, Self::mul_add(x2555, x3231, x2548 * x3235)),
+        );
+        let x3237 = Self::mul_add(
+            x2567,
+            x3218,
+            Self::mul_add(x2566, x3219, Self::mul_add(x2565, x3220, x3236)),
+        );
+        let x3238 = Self::mul_add(x2568, x3216, x3237);
+        let x3239 = -x3238;
+        let x3240 = Self::mul_add(
+            -x2557,
+            x3224,
+            Self::mul_add(-x2556, x3226, Self::mul_add(-x2555, x3228, x2547 * x3235)),
+        );
+        let x3241 = Self::mul_add(
+            x2560,
+            x3219,
+            Self::mul_add(-x2559, x3220, Self::mul_add(x2558, x3222, x3240)),
+        );
+        let x3242 = Self::mul_add(x2562, x3216, Self::mul_add(-x2561, x3218, x3241));
+        let x3243 = Self::mul_add(
+            -x2549,
+            x3224,
+            Self::mul_add(x2548, x3226, Self::mul_add(x2548, x3228, x2547 * x3231)),
+        );
+        let x3244 = Self::mul_add(
+            x2552,
+            x3219,
+            Self::mul_add(-x2551, x3220, Self::mul_add(x2550, x3222, x3243)),
+        );
+        let x3245 = Self::mul_add(x2554, x3216, Self::mul_add(-x2553, x3218, x3244));
+        let x3246 = Self::mul_add(-x2739, x2753, x2734 * x3216);
+        let x3247 = -x3246;
+        let x3248 = Self::mul_add(
+            x2725,
+            x2753,
+            Self::mul_add(-x2721, x3216, x2717 * x3246),
+        );
+        let x3249 = Self::mul_add(
+            -x2709,
+            x2753,
+            Self::mul_add(x2705, x3216, Self::mul_add(-x2701, x3246, x2697 * x3248)),
+        );
+        let x3250 = -x3249;
+        let x3251 = Self::mul_add(
+            -x2686,
+            x3216,
+            Self::mul_add(x2682, x3246, Self::mul_add(-x2678, x3248, x2674 * x3249)),
+        );
+        let x3252 = Self::mul_add(x2690, x2753, x3251);
+        let x3253 = -x3252;
+        let x3254 = Self::mul_add(
+            x2661,
+            x3246,
+            Self::mul_add(-x2658, x3248, Self::mul_add(x2655, x3249, x2652 * x3252)),
+        );
+        let x3255 = Self::mul_add(-x2667, x2753, Self::mul_add(x2664, x3216, x3254));
+        let x3256 = -x3255;
+        let x3257 = Self::mul_add(
+            x2635,
+            x3248,
+            Self::mul_add(-x2631, x3249, Self::mul_add(-x2627, x3252, x2623 * x3255)),
+        );
+        let x3258 = Self::mul_add(
+            x2647,
+            x2753,
+            Self::mul_add(-x2643, x3216, Self::mul_add(-x2639, x3246, x3257)),
+        );
+        let x3259 = -x3258;
+        let x3260 = Self::mul_add(
+            -x2608,
+            x3249,
+            Self::mul_add(x2605, x3252, Self::mul_add(x2602, x3255, x2600 * x3258)),
+        );
+        let x3261 = Self::mul_add(
+            x2617,
+            x3216,
+            Self::mul_add(-x2614, x3246, Self::mul_add(x2611, x3248, x3260)),
+        );
+        let x3262 = Self::mul_add(-x2620, x2753, x3261);
+        let x3263 = Self::mul_add(
+            -x2580,
+            x3252,
+            Self::mul_add(-x2577, x3255, Self::mul_add(-x2575, x3258, x2573 * x3262)),
+        );
+        let x3264 = Self::mul_add(
+            x2589,
+            x3246,
+            Self::mul_add(-x2586, x3248, Self::mul_add(x2583, x3249, x3263)),
+        );
+        let x3265 = Self::mul_add(x2595, x2753, Self::mul_add(-x2592, x3216, x3264));
+        let x3266 = -x3265;
+        let x3267 = Self::mul_add(
+            -x2564,
+            x3249,
+            Self::mul_add(x2563, x3252, Self::mul_add(x2555, x3262, x2548 * x3265)),
+        );
+        let x3268 = Self::mul_add(
+            x2567,
+            x3216,
+            Self::mul_add(x2566, x3246, Self::mul_add(x2565, x3248, x3267)),
+        );
+        let x3269 = Self::mul_add(x2568, x2753, x3268);
+        let x3270 = Self::mul_add(
+            -x2557,
+            x3252,
+            Self::mul_add(-x2556, x3255, Self::mul_add(-x2555, x3258, x2547 * x3265)),
+        );
+        let x3271 = Self::mul_add(
+            x2560,
+            x3246,
+            Self::mul_add(-x2559, x3248, Self::mul_add(x2558, x3249, x3270)),
+        );
+        let x3272 = Self::mul_add(x2562, x2753, Self::mul_add(-x2561, x3216, x3271));
+        let x3273 = -x3272;
+        let x3274 = Self::mul_add(
+            -x2549,
+            x3252,
+            Self::mul_add(x2548, x3255, Self::mul_add(x2548, x3258, x2547 * x3262)),
+        );
+        let x3275 = Self::mul_add(
+            x2552,
+            x3246,
+            Self::mul_add(-x2551, x3248, Self::mul_add(x2550, x3249, x3274)),
+        );
+        let x3276 = Self::mul_add(x2554, x2753, Self::mul_add(-x2553, x3216, x3275));
+        let x3277 = -x3276;
+        let x3278 = Self::mul_add(
+            -x2142,
+            x2791,
+            Self::mul_add(-x2147, x2794, Self::mul_add(x2146, x2798, x2145 * x2801)),
+        );
+        let x3279 = Self::mul_add(
+            -x2156,
+            x2780,
+            Self::mul_add(-x2144, x2783, Self::mul_add(x2143, x2787, x3278)),
+        );
+        let x3280 = Self::mul_add(
+            -x2162,
+            x2773,
+            Self::mul_add(-x2160, x2775, Self::mul_add(-x2158, x2777, x3279)),
+        );
+        let x3281 = Self::mul_add(
+            -x2168,
+            x2768,
+            Self::mul_add(x2166, x2770, Self::mul_add(x2164, x2772, x3280)),
+        );
+        let x3282 = Self::mul_add(
+            -x2073,
+            x2791,
+            Self::mul_add(x2078, x2794, Self::mul_add(-x2077, x2798, x2076 * x2801)),
+        );
+        let x3283 = Self::mul_add(
+            x2088,
+            x2780,
+            Self::mul_add(-x2075, x2783, Self::mul_add(-x2074, x2787, x3282)),
+        );
+        let x3284 = Self::mul_add(
+            -x2094,
+            x2773,
+            Self::mul_add(-x2092, x2775, Self::mul_add(-x2090, x2777, x3283)),
+        );
+        let x3285 = Self::mul_add(
+            -x2100,
+            x2768,
+            Self::mul_add(x2098, x2770, Self::mul_add(x2096, x2772, x3284)),
+        );
+        let x3286 = Self::mul_add(
+            -x1985,
+            x2791,
+            Self::mul_add(-x1990, x2794, Self::mul_add(-x1989, x2798, x1988 * x2801)),
+        );
+        let x3287 = Self::mul_add(
+            -x2000,
+            x2780,
+            Self::mul_add(x1987, x2783, Self::mul_add(-x1986, x2787, x3286)),
+        );
+        let x3288 = Self::mul_add(
+            -x2006,
+            x2773,
+            Self::mul_add(-x2004, x2775, Self::mul_add(x2002, x2777, x3287)),
+        );
+        let x3289 = Self::mul_add(
+            -x2012,
+            x2768,
+            Self::mul_add(x2010, x2770, Self::mul_add(x2008, x2772, x3288)),
+        );
+        let x3290 = Self::mul_add(
+            x1896,
+            x2791,
+            Self::mul_add(-x1901, x2794, Self::mul_add(-x1900, x2798, x1899 * x2801)),
+        );
+        let x3291 = Self::mul_add(
+            -x1911,
+            x2780,
+            Self::mul_add(x1898, x2783, Self::mul_add(-x1897, x2787, x3290)),
+        );
+        let x3292 = Self::mul_add(
+            -x1917,
+            x2773,
+            Self::mul_add(x1915, x2775, Self::mul_add(-x1913, x2777, x3291)),
+        );
+        let x3293 = Self::mul_add(
+            -x1924,
+            x2768,
+            Self::mul_add(x1922, x2770, Self::mul_add(x1920, x2772, x3292)),
+        );
+        let x3294 = Self::mul_add(
+            x1803,
+            x2791,
+            Self::mul_add(-x1808, x2794, Self::mul_add(-x1807, x2798, x1806 * x2801)),
+        );
+        let x3295 = Self::mul_add(
+            -x1818,
+            x2780,
+            Self::mul_add(x1805, x2783, Self::mul_add(-x1804, x2787, x3294)),
+        );
+        let x3296 = Self::mul_add(
+            x1826,
+            x2773,
+            Self::mul_add(x1823, x2775, Self::mul_add(-x1820, x2777, x3295)),
+        );
+        let x3297 = Self::mul_add(
+            x1834,
+            x2768,
+            Self::mul_add(-x1831, x2770, Self::mul_add(-x1828, x2772, x3296)),
+        );
+        let x3298 = -x3297;
+        let x3299 = Self::mul_add(
+            x1713,
+            x2791,
+            Self::mul_add(-x1718, x2794, Self::mul_add(-x1717, x2798, x1716 * x2801)),
+        );
+        let x3300 = Self::mul_add(
+            -x1728,
+            x2780,
+            Self::mul_add(x1715, x2783, Self::mul_add(-x1714, x2787, x3299)),
+        );
+        let x3301 = Self::mul_add(
+            x1736,
+            x2773,
+            Self::mul_add(x1733, x2775, Self::mul_add(-x1730, x2777, x3300)),
+        );
+        let x3302 = Self::mul_add(
+            -x1742,
+            x2768,
+            Self::mul_add(x1740, x2770, Self::mul_add(x1738, x2772, x3301)),
+        );
+        let x3303 = Self::mul_add(
+            x1623,
+            x2791,
+            Self::mul_add(-x1628, x2794, Self::mul_add(-x1627, x2798, x1626 * x2801)),
+        );
+        let x3304 = Self::mul_add(
+            -x1638,
+            x2780,
+            Self::mul_add(x1625, x2783, Self::mul_add(-x1624, x2787, x3303)),
+        );
+        let x3305 = Self::mul_add(
+            x1646,
+            x2773,
+            Self::mul_add(x1643, x2775, Self::mul_add(-x1640, x2777, x3304)),
+        );
+        let x3306 = Self::mul_add(
+            -x1652,
+            x2768,
+            Self::mul_add(-x1650, x2770, Self::mul_add(x1648, x2772, x3305)),
+        );
+        let x3307 = -x3306;
+        let x3308 = Self::mul_add(
+            -x2142,
+            x2843,
+            Self::mul_add(-x2147, x2846, Self::mul_add(x2146, x2850, x2145 * x2853)),
+        );
+        let x3309 = Self::mul_add(
+            x2156,
+            x2832,
+            Self::mul_add(x2144, x2836, Self::mul_add(x2143, x2839, x3308)),
+        );
+        let x3310 = Self::mul_add(
+            -x2162,
+            x2825,
+            Self::mul_add(-x2160, x2827, Self::mul_add(-x2158, x2829, x3309)),
+        );
+        let x3311 = Self::mul_add(
+            -x2168,
+            x2820,
+            Self::mul_add(x2166, x2822, Self::mul_add(x2164, x2824, x3310)),
+        );
+        let x3312 = Self::mul_add(
+            -x2073,
+            x2843,
+            Self::mul_add(x2078, x2846, Self::mul_add(-x2077, x2850, x2076 * x2853)),
+        );
+        let x3313 = Self::mul_add(
+            -x2088,
+            x2832,
+            Self::mul_add(x2075, x2836, Self::mul_add(-x2074, x2839, x3312)),
+        );
+        let x3314 = Self::mul_add(
+            -x2094,
+            x2825,
+            Self::mul_add(-x2092, x2827, Self::mul_add(-x2090, x2829, x3313)),
+        );
+        let x3315 = Self::mul_add(
+            -x2100,
+            x2820,
+            Self::mul_add(x2098, x2822, Self::mul_add(x2096, x2824, x3314)),
+        );
+        let x3316 = Self::mul_add(
+            -x1985,
+            x2843,
+            Self::mul_add(-x1990, x2846, Self::mul_add(-x1989, x2850, x1988 * x2853)),
+        );
+        let x3317 = Self::mul_add(
+            x2000,
+            x2832,
+            Self::mul_add(-x1987, x2836, Self::mul_add(-x1986, x2839, x3316)),
+        );
+        let x3318 = Self::mul_add(
+            -x2006,
+            x2825,
+            Self::mul_add(-x2004, x2827, Self::mul_add(x2002, x2829, x3317)),
+        );
+        let x3319 = Self::mul_add(
+            -x2012,
+            x2820,
+            Self::mul_add(x2010, x2822, Self::mul_add(x2008, x2824, x3318)),
+        );
+        let x3320 = Self::mul_add(
+            x1896,
+            x2843,
+            Self::mul_add(-x1901, x2846, Self::mul_add(-x1900, x2850, x1899 * x2853)),
+        );
+        let x3321 = Self::mul_add(
+            x1911,
+            x2832,
+            Self::mul_add(-x1898, x2836, Self::mul_add(-x1897, x2839, x3320)),
+        );
+        let x3322 = Self::mul_add(
+            -x1917,
+            x2825,
+            Self::mul_add(x1915, x2827, Self::mul_add(-x1913, x2829, x3321)),
+        );
+        let x3323 = Self::mul_add(
+            -x1924,
+            x2820,
+            Self::mul_add(x1922, x2822, Self::mul_add(x1920, x2824, x3322)),
+        );
+        let x3324 = Self::mul_add(
+            x1803,
+            x2843,
+            Self::mul_add(-x1808, x2846, Self::mul_add(-x1807, x2850, x1806 * x2853)),
+        );
+        let x3325 = Self::mul_add(
+            x1818,
+            x2832,
+            Self::mul_add(-x1805, x2836, Self::mul_add(-x1804, x2839, x3324)),
+        );
+        let x3326 = Self::mul_add(
+            x1826,
+            x2825,
+            Self::mul_add(x1823, x2827, Self::mul_add(-x1820, x2829, x3325)),
+        );
+        let x3327 = Self::mul_add(
+            x1834,
+            x2820,
+            Self::mul_add(-x1831, x2822, Self::mul_add(-x1828, x2824, x3326)),
+        );
+        let x3328 = -x3327;
+        let x3329 = Self::mul_add(
+            x1713,
+            x2843,
+            Self::mul_add(-x1718, x2846, Self::mul_add(-x1717, x2850, x1716 * x2853)),
+        );
+        let x3330 = Self::mul_add(
+            x1728,
+            x2832,
+            Self::mul_add(-x1715, x2836, Self::mul_add(-x1714, x2839, x3329)),
+        );
+        let x3331 = Self::mul_add(
+            x1736,
+            x2825,
+            Self::mul_add(x1733, x2827, Self::mul_add(-x1730, x2829, x3330)),
+        );
+        let x3332 = Self::mul_add(
+            -x1742,
+            x2820,
+            Self::mul_add(x1740, x2822, Self::mul_add(x1738, x2824, x3331)),
+        );
+        let x3333 = Self::mul_add(
+            x1623,
+            x2843,
+            Self::mul_add(-x1628, x2846, Self::mul_add(-x1627, x2850, x1626 * x2853)),
+        );
+        let x3334 = Self::mul_add(
+            x1638,
+            x2832,
+            Self::mul_add(-x1625, x2836, Self::mul_add(-x1624, x2839, x3333)),
+        );
+        let x3335 = Self::mul_add(
+            x1646,
+            x2825,
+            Self::mul_add(x1643, x2827, Self::mul_add(-x1640, x2829, x3334)),
+        );
+        let x3336 = Self::mul_add(
+            -x1652,
+            x2820,
+            Self::mul_add(-x1650, x2822, Self::mul_add(x1648, x2824, x3335)),
+        );
+        let x3337 = -x3336;
+        let x3338 = Self::mul_add(
+            -x2142,
+            x2894,
+            Self::mul_add(-x2147, x2898, Self::mul_add(x2146, x2901, x2145 * x2905)),
+        );
+        let x3339 = Self::mul_add(
+            x2156,
+            x2884,
+            Self::mul_add(x2144, x2887, Self::mul_add(x2143, x2891, x3338)),
+        );
+        let x3340 = Self::mul_add(
+            x2162,
+            x2877,
+            Self::mul_add(x2160, x2879, Self::mul_add(x2158, x2881, x3339)),
+        );
+        let x3341 = Self::mul_add(
+            -x2168,
+            x2872,
+            Self::mul_add(-x2166, x2873, Self::mul_add(x2164, x2875, x3340)),
+        );
+        let x3342 = -x3341;
+        let x3343 = Self::mul_add(
+            -x2073,
+            x2894,
+            Self::mul_add(x2078, x2898, Self::mul_add(-x2077, x2901, x2076 * x2905)),
+        );
+        let x3344 = Self::mul_add(
+            -x2088,
+            x2884,
+            Self::mul_add(x2075, x2887, Self::mul_add(-x2074, x2891, x3343)),
+        );
+        let x3345 = Self::mul_add(
+            x2094,
+            x2877,
+            Self::mul_add(x2092, x2879, Self::mul_add(x2090, x2881, x3344)),
+        );
+        let x3346 = Self::mul_add(
+            -x2100,
+            x2872,
+            Self::mul_add(-x2098, x2873, Self::mul_add(x2096, x2875, x3345)),
+        );
+        let x3347 = -x3346;
+        let x3348 = Self::mul_add(
+            -x1985,
+            x2894,
+            Self::mul_add(-x1990, x2898, Self::mul_add(-x1989, x2901, x1988 * x2905)),
+        );
+        let x3349 = Self::mul_add(
+            x2000,
+            x2884,
+            Self::mul_add(-x1987, x2887, Self::mul_add(-x1986, x2891, x3348)),
+        );
+        let x3350 = Self::mul_add(
+            x2006,
+            x2877,
+            Self::mul_add(x2004, x2879, Self::mul_add(-x2002, x2881, x3349)),
+        );
+        let x3351 = Self::mul_add(
+            -x2012,
+            x2872,
+            Self::mul_add(-x2010, x2873, Self::mul_add(x2008, x2875, x3350)),
+        );
+        let x3352 = -x3351;
+        let x3353 = Self::mul_add(
+            x1896,
+            x2894,
+            Self::mul_add(-x1901, x2898, Self::mul_add(-x1900, x2901, x1899 * x2905)),
+        );
+        let x3354 = Self::mul_add(
+            x1911,
+            x2884,
+            Self::mul_add(-x1898, x2887, Self::mul_add(-x1897, x2891, x3353)),
+        );
+        let x3355 = Self::mul_add(
+            x1917,
+            x2877,
+            Self::mul_add(-x1915, x2879, Self::mul_add(x1913, x2881, x3354)),
+        );
+        let x3356 = Self::mul_add(
+            -x1924,
+            x2872,
+            Self::mul_add(-x1922, x2873, Self::mul_add(x1920, x2875, x3355)),
+        );
+        let x3357 = -x3356;
+        let x3358 = Self::mul_add(
+            x1803,
+            x2894,
+            Self::mul_add(-x1808, x2898, Self::mul_add(-x1807, x2901, x1806 * x2905)),
+        );
+        let x3359 = Self::mul_add(
+            x1818,
+            x2884,
+            Self::mul_add(-x1805, x2887, Self::mul_add(-x1804, x2891, x3358)),
+        );
+        let x3360 = Self::mul_add(
+            -x1826,
+            x2877,
+            Self::mul_add(-x1823, x2879, Self::mul_add(x1820, x2881, x3359)),
+        );
+        let x3361 = Self::mul_add(
+            x1834,
+            x2872,
+            Self::mul_add(x1831, x2873, Self::mul_add(-x1828, x2875, x3360)),
+        );
+        let x3362 = Self::mul_add(
+            x1713,
+            x2894,
+            Self::mul_add(-x1718, x2898, Self::mul_add(-x1717, x2901, x1716 * x2905)),
+        );
+        let x3363 = Self::mul_add(
+            x1728,
+            x2884,
+            Self::mul_add(-x1715, x2887, Self::mul_add(-x1714, x2891, x3362)),
+        );
+        let x3364 = Self::mul_add(
+            -x1736,
+            x2877,
+            Self::mul_add(-x1733, x2879, Self::mul_add(x1730, x2881, x3363)),
+        );
+        let x3365 = Self::mul_add(
+            -x1742,
+            x2872,
+            Self::mul_add(-x1740, x2873, Self::mul_add(x1738, x2875, x3364)),
+        );
+        let x3366 = -x3365;
+        let x3367 = Self::mul_add(
+            x1623,
+            x2894,
+            Self::mul_add(-x1628, x2898, Self::mul_add(-x1627, x2901, x1626 * x2905)),
+        );
+        let x3368 = Self::mul_add(
+            x1638,
+            x2884,
+            Self::mul_add(-x1625, x2887, Self::mul_add(-x1624, x2891, x3367)),
+        );
+        let x3369 = Self::mul_add(
+            -x1646,
+            x2877,
+            Self::mul_add(-x1643, x2879, Self::mul_add(x1640, x2881, x3368)),
+        );
+        let x3370 = Self::mul_add(
+            -x1652,
+            x2872,
+            Self::mul_add(x1650, x2873, Self::mul_add(x1648, x2875, x3369)),
+        );
+        let x3371 = Self::mul_add(
+            -x2142,
+            x2944,
+            Self::mul_add(-x2147, x2947, Self::mul_add(x2146, x2951, x2145 * x2954)),
+        );
+        let x3372 = Self::mul_add(
+            x2156,
+            x2933,
+            Self::mul_add(x2144, x2937, Self::mul_add(x2143, x2940, x3371)),
+        );
+        let x3373 = Self::mul_add(
+            -x2162,
+            x2926,
+            Self::mul_add(-x2160, x2928, Self::mul_add(-x2158, x2930, x3372)),
+        );
+        let x3374 = Self::mul_add(
+            -x2168,
+            x2921,
+            Self::mul_add(x2166, x2923, Self::mul_add(x2164, x2925, x3373)),
+        );
+        let x3375 = Self::mul_add(
+            -x2073,
+            x2944,
+            Self::mul_add(x2078, x2947, Self::mul_add(-x2077, x2951, x2076 * x2954)),
+        );
+        let x3376 = Self::mul_add(
+            -x2088,
+            x2933,
+            Self::mul_add(x2075, x2937, Self::mul_add(-x2074, x2940, x3375)),
+        );
+        let x3377 = Self::mul_add(
+            -x2094,
+            x2926,
+            Self::mul_add(-x2092, x2928, Self::mul_add(-x2090, x2930, x3376)),
+        );
+        let x3378 = Self::mul_add(
+            -x2100,
+            x2921,
+            Self::mul_add(x2098, x2923, Self::mul_add(x2096, x2925, x3377)),
+        );
+        let x3379 = Self::mul_add(
+            -x1985,
+            x2944,
+            Self::mul_add(-x1990, x2947, Self::mul_add(-x1989, x2951, x1988 * x2954)),
+        );
+        let x3380 = Self::mul_add(
+            x2000,
+            x2933,
+            Self::mul_add(-x1987, x2937, Self::mul_add(-x1986, x2940, x3379)),
+        );
+        let x3381 = Self::mul_add(
+            -x2006,
+            x2926,
+            Self::mul_add(-x2004, x2928, Self::mul_add(x2002, x2930, x3380)),
+        );
+        let x3382 = Self::mul_add(
+            -x2012,
+            x2921,
+            Self::mul_add(x2010, x2923, Self::mul_add(x2008, x2925, x3381)),
+        );
+        let x3383 = Self::mul_add(
+            x1896,
+            x2944,
+            Self::mul_add(-x1901, x2947, Self::mul_add(-x1900, x2951, x1899 * x2954)),
+        );
+        let x3384 = Self::mul_add(
+            x1911,
+            x2933,
+            Self::mul_add(-x1898, x2937, Self::mul_add(-x1897, x2940, x3383)),
+        );
+        let x3385 = Self::mul_add(
+            -x1917,
+            x2926,
+            Self::mul_add(x1915, x2928, Self::mul_add(-x1913, x2930, x3384)),
+        );
+        let x3386 = Self::mul_add(
+            -x1924,
+            x2921,
+            Self::mul_add(x1922, x2923, Self::mul_add(x1920, x2925, x3385)),
+        );
+        let x3387 = Self::mul_add(
+            x1803,
+            x2944,
+            Self::mul_add(-x1808, x2947, Self::mul_add(-x1807, x2951, x1806 * x2954)),
+        );
+        let x3388 = Self::mul_add(
+            x1818,
+            x2933,
+            Self::mul_add(-x1805, x2937, Self::mul_add(-x1804, x2940, x3387)),
+        );
+        let x3389 = Self::mul_add(
+            x1826,
+            x2926,
+            Self::mul_add(x1823, x2928, Self::mul_add(-x1820, x2930, x3388)),
+        );
+        let x3390 = Self::mul_add(
+            x1834,
+            x2921,
+            Self::mul_add(-x1831, x2923, Self::mul_add(-x1828, x2925, x3389)),
+        );
+        let x3391 = -x3390;
+        let x3392 = Self::mul_add(
+            x1713,
+            x2944,
+            Self::mul_add(-x1718, x2947, Self::mul_add(-x1717, x2951, x1716 * x2954)),
+        );
+        let x3393 = Self::mul_add(
+            x1728,
+            x2933,
+            Self::mul_add(-x1715, x2937, Self::mul_add(-x1714, x2940, x3392)),
+        );
+        let x3394 = Self::mul_add(
+            x1736,
+            x2926,
+            Self::mul_add(x1733, x2928, Self::mul_add(-x1730, x2930, x3393)),
+        );
+        let x3395 = Self::mul_add(
+            -x1742,
+            x2921,
+            Self::mul_add(x1740, x2923, Self::mul_add(x1738, x2925, x3394)),
+        );
+        let x3396 = Self::mul_add(
+            x1623,
+            x2944,
+            Self::mul_add(-x1628, x2947, Self::mul_add(-x1627, x2951, x1626 * x2954)),
+        );
+        let x3397 = Self::mul_add(
+            x1638,
+            x2933,
+            Self::mul_add(-x1625, x2937, Self::mul_add(-x1624, x2940, x3396)),
+        );
+        let x3398 = Self::mul_add(
+            x1646,
+            x2926,
+            Self::mul_add(x1643, x2928, Self::mul_add(-x1640, x2930, x3397)),
+        );
+        let x3399 = Self::mul_add(
+            -x1652,
+            x2921,
+            Self::mul_add(-x1650, x2923, Self::mul_add(x1648, x2925, x3398)),
+        );
+        let x3400 = -x3399;
+        let x3401 = Self::mul_add(
+            -x2142,
+            x2988,
+            Self::mul_add(-x2147, x2992, Self::mul_add(x2146, x2995, x2145 * x2999)),
+        );
+        let x3402 = Self::mul_add(
+            -x2156,
+            x2978,
+            Self::mul_add(-x2144, x2982, Self::mul_add(x2143, x2985, x3401)),
+        );
+        let x3403 = Self::mul_add(
+            x2162,
+            x2971,
+            Self::mul_add(x2160, x2973, Self::mul_add(x2158, x2975, x3402)),
+        );
+        let x3404 = Self::mul_add(
+            x2168,
+            x2966,
+            Self::mul_add(-x2166, x2968, Self::mul_add(-x2164, x2970, x3403)),
+        );
+        let x3405 = -x3404;
+        let x3406 = Self::mul_add(
+            -x2073,
+            x2988,
+            Self::mul_add(x2078, x2992, Self::mul_add(-x2077, x2995, x2076 * x2999)),
+        );
+        let x3407 = Self::mul_add(
+            x2088,
+            x2978,
+            Self::mul_add(-x2075, x2982, Self::mul_add(-x2074, x2985, x3406)),
+        );
+        let x3408 = Self::mul_add(
+            x2094,
+            x2971,
+            Self::mul_add(x2092, x2973, Self::mul_add(x2090, x2975, x3407)),
+        );
+        let x3409 = Self::mul_add(
+            x2100,
+            x2966,
+            Self::mul_add(-x2098, x2968, Self::mul_add(-x2096, x2970, x3408)),
+        );
+        let x3410 = -x3409;
+        let x3411 = Self::mul_add(
+            -x1985,
+            x2988,
+            Self::mul_add(-x1990, x2992, Self::mul_add(-x1989, x2995, x1988 * x2999)),
+        );
+        let x3412 = Self::mul_add(
+            -x2000,
+            x2978,
+            Self::mul_add(x1987, x2982, Self::mul_add(-x1986, x2985, x3411)),
+        );
+        let x3413 = Self::mul_add(
+            x2006,
+            x2971,
+            Self::mul_add(x2004, x2973, Self::mul_add(-x2002, x2975, x3412)),
+        );
+        let x3414 = Self::mul_add(
+            x2012,
+            x2966,
+            Self::mul_add(-x2010, x2968, Self::mul_add(-x2008, x2970, x3413)),
+        );
+        let x3415 = -x3414;
+        let x3416 = Self::mul_add(
+            x1896,
+            x2988,
+            Self::mul_add(-x1901, x2992, Self::mul_add(-x1900, x2995, x1899 * x2999)),
+        );
+        let x3417 = Self::mul_add(
+            -x1911,
+            x2978,
+            Self::mul_add(x1898, x2982, Self::mul_add(-x1897, x2985, x3416)),
+        );
+        let x3418 = Self::mul_add(
+            x1917,
+            x2971,
+            Self::mul_add(-x1915, x2973, Self::mul_add(x1913, x2975, x3417)),
+        );
+        let x3419 = Self::mul_add(
+            x1924,
+            x2966,
+            Self::mul_add(-x1922, x2968, Self::mul_add(-x1920, x2970, x3418)),
+        );
+        let x3420 = -x3419;
+        let x3421 = Self::mul_add(
+            x1803,
+            x2988,
+            Self::mul_add(-x1808, x2992, Self::mul_add(-x1807, x2995, x1806 * x2999)),
+        );
+        let x3422 = Self::mul_add(
+            -x1818,
+            x2978,
+            Self::mul_add(x1805, x2982, Self::mul_add(-x1804, x2985, x3421)),
+        );
+        let x3423 = Self::mul_add(
+            -x1826,
+            x2971,
+            Self::mul_add(-x1823, x2973, Self::mul_add(x1820, x2975, x3422)),
+        );
+        let x3424 = Self::mul_add(
+            -x1834,
+            x2966,
+            Self::mul_add(x1831, x2968, Self::mul_add(x1828, x2970, x3423)),
+        );
+        let x3425 = Self::mul_add(
+            x1713,
+            x2988,
+            Self::mul_add(-x1718, x2992, Self::mul_add(-x1717, x2995, x1716 * x2999)),
+        );
+        let x3426 = Self::mul_add(
+            -x1728,
+            x2978,
+            Self::mul_add(x1715, x2982, Self::mul_add(-x1714, x2985, x3425)),
+        );
+        let x3427 = Self::mul_add(
+            -x1736,
+            x2971,
+            Self::mul_add(-x1733, x2973, Self::mul_add(x1730, x2975, x3426)),
+        );
+        let x3428 = Self::mul_add(
+            x1742,
+            x2966,
+            Self::mul_add(-x1740, x2968, Self::mul_add(-x1738, x2970, x3427)),
+        );
+        let x3429 = -x3428;
+        let x3430 = Self::mul_add(
+            x1623,
+            x2988,
+            Self::mul_add(-x1628, x2992, Self::mul_add(-x1627, x2995, x1626 * x2999)),
+        );
+        let x3431 = Self::mul_add(
+            -x1638,
+            x2978,
+            Self::mul_add(x1625, x2982, Self::mul_add(-x1624, x2985, x3430)),
+        );
+        let x3432 = Self::mul_add(
+            -x1646,
+            x2971,
+            Self::mul_add(-x1643, x2973, Self::mul_add(x1640, x2975, x3431)),
+        );
+        let x3433 = Self::mul_add(
+            x1652,
+            x2966,
+            Self::mul_add(x1650, x2968, Self::mul_add(-x1648, x2970, x3432)),
+        );
+        let x3434 = Self::mul_add(
+            -x2142,
+            x3035,
+            Self::mul_add(-x2147, x3039, Self::mul_add(x2146, x3042, x2145 * x3046)),
+        );
+        let x3435 = Self::mul_add(
+            x2156,
+            x3025,
+            Self::mul_add(x2144, x3028, Self::mul_add(x2143, x3032, x3434)),
+        );
+        let x3436 = Self::mul_add(
+            -x2162,
+            x3016,
+            Self::mul_add(-x2160, x3019, Self::mul_add(x2158, x3022, x3435)),
+        );
+        let x3437 = Self::mul_add(
+            x2168,
+            x3010,
+            Self::mul_add(-x2166, x3012, Self::mul_add(x2164, x3014, x3436)),
+        );
+        let x3438 = -x3437;
+        let x3439 = Self::mul_add(
+            -x2073,
+            x3035,
+            Self::mul_add(x2078, x3039, Self::mul_add(-x2077, x3042, x2076 * x3046)),
+        );
+        let x3440 = Self::mul_add(
+            -x2088,
+            x3025,
+            Self::mul_add(x2075, x3028, Self::mul_add(-x2074, x3032, x3439)),
+        );
+        let x3441 = Self::mul_add(
+            -x2094,
+            x3016,
+            Self::mul_add(-x2092, x3019, Self::mul_add(x2090, x3022, x3440)),
+        );
+        let x3442 = Self::mul_add(
+            x2100,
+            x3010,
+            Self::mul_add(-x2098, x3012, Self::mul_add(x2096, x3014, x3441)),
+        );
+        let x3443 = -x3442;
+        let x3444 = Self::mul_add(
+            -x1985,
+            x3035,
+            Self::mul_add(-x1990, x3039, Self::mul_add(-x1989, x3042, x1988 * x3046)),
+        );
+        let x3445 = Self::mul_add(
+            x2000,
+            x3025,
+            Self::mul_add(-x1987, x3028, Self::mul_add(-x1986, x3032, x3444)),
+        );
+        let x3446 = Self::mul_add(
+            -x2006,
+            x3016,
+            Self::mul_add(-x2004, x3019, Self::mul_add(-x2002, x3022, x3445)),
+        );
+        let x3447 = Self::mul_add(
+            x2012,
+            x3010,
+            Self::mul_add(-x2010, x3012, Self::mul_add(x2008, x3014, x3446)),
+        );
+        let x3448 = -x3447;
+        let x3449 = Self::mul_add(
+            x1896,
+            x3035,
+            Self::mul_add(-x1901, x3039, Self::mul_add(-x1900, x3042, x1899 * x3046)),
+        );
+        let x3450 = Self::mul_add(
+            x1911,
+            x3025,
+            Self::mul_add(-x1898, x3028, Self::mul_add(-x1897, x3032, x3449)),
+        );
+        let x3451 = Self::mul_add(
+            -x1917,
+            x3016,
+            Self::mul_add(x1915, x3019, Self::mul_add(x1913, x3022, x3450)),
+        );
+        let x3452 = Self::mul_add(
+            x1924,
+            x3010,
+            Self::mul_add(-x1922, x3012, Self::mul_add(x1920, x3014, x3451)),
+        );
+        let x3453 = -x3452;
+        let x3454 = Self::mul_add(
+            x1803,
+            x3035,
+            Self::mul_add(-x1808, x3039, Self::mul_add(-x1807, x3042, x1806 * x3046)),
+        );
+        let x3455 = Self::mul_add(
+            x1818,
+            x3025,
+            Self::mul_add(-x1805, x3028, Self::mul_add(-x1804, x3032, x3454)),
+        );
+        let x3456 = Self::mul_add(
+            x1826,
+            x3016,
+            Self::mul_add(x1823, x3019, Self::mul_add(x1820, x3022, x3455)),
+        );
+        let x3457 = Self::mul_add(
+            -x1834,
+            x3010,
+            Self::mul_add(x1831, x3012, Self::mul_add(-x1828, x3014, x3456)),
+        );
+        let x3458 = Self::mul_add(
+            x1713,
+            x3035,
+            Self::mul_add(-x1718, x3039, Self::mul_add(-x1717, x3042, x1716 * x3046)),
+        );
+        let x3459 = Self::mul_add(
+            x1728,
+            x3025,
+            Self::mul_add(-x1715, x3028, Self::mul_add(-x1714, x3032, x3458)),
+        );
+        let x3460 = Self::mul_add(
+            x1736,
+            x3016,
+            Self::mul_add(x1733, x3019, Self::mul_add(x1730, x3022, x3459)),
+        );
+        let x3461 = Self::mul_add(
+            x1742,
+            x3010,
+            Self::mul_add(-x1740, x3012, Self::mul_add(x1738, x3014, x3460)),
+        );
+        let x3462 = -x3461;
+        let x3463 = Self::mul_add(
+            x1623,
+            x3035,
+            Self::mul_add(-x1628, x3039, Self::mul_add(-x1627, x3042, x1626 * x3046)),
+        );
+        let x3464 = Self::mul_add(
+            x1638,
+            x3025,
+            Self::mul_add(-x1625, x3028, Self::mul_add(-x1624, x3032, x3463)),
+        );
+        let x3465 = Self::mul_add(
+            x1646,
+            x3016,
+            Self::mul_add(x1643, x3019, Self::mul_add(x1640, x3022, x3464)),
+        );
+        let x3466 = Self::mul_add(
+            x1652,
+            x3010,
+            Self::mul_add(x1650, x3012, Self::mul_add(x1648, x3014, x3465)),
+        );
+        let x3467 = Self::mul_add(
+            -x2142,
+            x3072,
+            Self::mul_add(-x2147, x3075, Self::mul_add(x2146, x3079, x2145 * x3082)),
+        );
+        let x3468 = Self::mul_add(
+            -x2156,
+            x3063,
+            Self::mul_add(x2144, x3065, Self::mul_add(x2143, x3068, x3467)),
+        );
+        let x3469 = Self::mul_add(
+            -x2162,
+            x3057,
+            Self::mul_add(-x2160, x3059, Self::mul_add(x2158, x3061, x3468)),
+        );
+        let x3470 = Self::mul_add(
+            x2168,
+            x3054,
+            Self::mul_add(-x2166, x3055, Self::mul_add(x2164, x3056, x3469)),
+        );
+        let x3471 = Self::mul_add(
+            -x2073,
+            x3072,
+            Self::mul_add(x2078, x3075, Self::mul_add(-x2077, x3079, x2076 * x3082)),
+        );
+        let x3472 = Self::mul_add(
+            x2088,
+            x3063,
+            Self::mul_add(x2075, x3065, Self::mul_add(-x2074, x3068, x3471)),
+        );
+        let x3473 = Self::mul_add(
+            -x2094,
+            x3057,
+            Self::mul_add(-x2092, x3059, Self::mul_add(x2090, x3061, x3472)),
+        );
+        let x3474 = Self::mul_add(
+            x2100,
+            x3054,
+            Self::mul_add(-x2098, x3055, Self::mul_add(x2096, x3056, x3473)),
+        );
+        let x3475 = Self::mul_add(
+            -x1985,
+            x3072,
+            Self::mul_add(-x1990, x3075, Self::mul_add(-x1989, x3079, x1988 * x3082)),
+        );
+        let x3476 = Self::mul_add(
+            -x2000,
+            x3063,
+            Self::mul_add(-x1987, x3065, Self::mul_add(-x1986, x3068, x3475)),
+        );
+        let x3477 = Self::mul_add(
+            -x2006,
+            x3057,
+            Self::mul_add(-x2004, x3059, Self::mul_add(-x2002, x3061, x3476)),
+        );
+        let x3478 = Self::mul_add(
+            x2012,
+            x3054,
+            Self::mul_add(-x2010, x3055, Self::mul_add(x2008, x3056, x3477)),
+        );
+        let x3479 = Self::mul_add(
+            x1896,
+            x3072,
+            Self::mul_add(-x1901, x3075, Self::mul_add(-x1900, x3079, x1899 * x3082)),
+        );
+        let x3480 = Self::mul_add(
+            -x1911,
+            x3063,
+            Self::mul_add(-x1898, x3065, Self::mul_add(-x1897, x3068, x3479)),
+        );
+        let x3481 = Self::mul_add(
+            -x1917,
+            x3057,
+            Self::mul_add(x1915, x3059, Self::mul_add(x1913, x3061, x3480)),
+        );
+        let x3482 = Self::mul_add(
+            x1924,
+            x3054,
+            Self::mul_add(-x1922, x3055, Self::mul_add(x1920, x3056, x3481)),
+        );
+        let x3483 = Self::mul_add(
+            x1803,
+            x3072,
+            Self::mul_add(-x1808, x3075, Self::mul_add(-x1807, x3079, x1806 * x3082)),
+        );
+        let x3484 = Self::mul_add(
+            -x1818,
+            x3063,
+            Self::mul_add(-x1805, x3065, Self::mul_add(-x1804, x3068, x3483)),
+        );
+        let x3485 = Self::mul_add(
+            x1826,
+            x3057,
+            Self::mul_add(x1823, x3059, Self::mul_add(x1820, x3061, x3484)),
+        );
+        let x3486 = Self::mul_add(
+            -x1834,
+            x3054,
+            Self::mul_add(x1831, x3055, Self::mul_add(-x1828, x3056, x3485)),
+        );
+        let x3487 = -x3486;
+        let x3488 = Self::mul_add(
+            x1713,
+            x3072,
+            Self::mul_add(-x1718, x3075, Self::mul_add(-x1717, x3079, x1716 * x3082)),
+        );
+        let x3489 = Self::mul_add(
+            -x1728,
+            x3063,
+            Self::mul_add(-x1715, x3065, Self::mul_add(-x1714, x3068, x3488)),
+        );
+        let x3490 = Self::mul_add(
+            x1736,
+            x3057,
+            Self::mul_add(x1733, x3059, Self::mul_add(x1730, x3061, x3489)),
+        );
+        let x3491 = Self::mul_add(
+            x1742,
+            x3054,
+            Self::mul_add(-x1740, x3055, Self::mul_add(x1738, x3056, x3490)),
+        );
+        let x3492 = Self::mul_add(
+            x1623,
+            x3072,
+            Self::mul_add(-x1628, x3075, Self::mul_add(-x1627, x3079, x1626 * x3082)),
+        );
+        let x3493 = Self::mul_add(
+            -x1638,
+            x3063,
+            Self::mul_add(-x1625, x3065, Self::mul_add(-x1624, x3068, x3492)),
+        );
+        let x3494 = Self::mul_add(
+            x1646,
+            x3057,
+            Self::mul_add(x1643, x3059, Self::mul_add(x1640, x3061, x3493)),
+        );
+        let x3495 = Self::mul_add(
+            x1652,
+            x3054,
+            Self::mul_add(x1650, x3055, Self::mul_add(x1648, x3056, x3494)),
+        );
+        let x3496 = -x3495;
+        let x3497 = Self::mul_add(
+            -x2142,
+            x3107,
+            Self::mul_add(-x2147, x3110, Self::mul_add(x2146, x3114, x2145 * x3117)),
+        );
+        let x3498 = Self::mul_add(
+            -x2156,
+            x3098,
+            Self::mul_add(x2144, x3100, Self::mul_add(x2143, x3103, x3497)),
+        );
+        let x3499 = Self::mul_add(
+            -x2162,
+            x3092,
+            Self::mul_add(-x2160, x3094, Self::mul_add(x2158, x3096, x3498)),
+        );
+        let x3500 = Self::mul_add(
+            -x2168,
+            x3087,
+            Self::mul_add(x2166, x3089, Self::mul_add(x2164, x3091, x3499)),
+        );
+        let x3501 = Self::mul_add(
+            -x2073,
+            x3107,
+            Self::mul_add(x2078, x3110, Self::mul_add(-x2077, x3114, x2076 * x3117)),
+        );
+        let x3502 = Self::mul_add(
+            x2088,
+            x3098,
+            Self::mul_add(x2075, x3100, Self::mul_add(-x2074, x3103, x3501)),
+        );
+        let x3503 = Self::mul_add(
+            -x2094,
+            x3092,
+            Self::mul_add(-x2092, x3094, Self::mul_add(x2090, x3096, x3502)),
+        );
+        let x3504 = Self::mul_add(
+            -x2100,
+            x3087,
+            Self::mul_add(x2098, x3089, Self::mul_add(x2096, x3091, x3503)),
+        );
+        let x3505 = Self::mul_add(
+            -x1985,
+            x3107,
+            Self::mul_add(-x1990, x3110, Self::mul_add(-x1989, x3114, x1988 * x3117)),
+        );
+        let x3506 = Self::mul_add(
+            -x2000,
+            x3098,
+            Self::mul_add(-x1987, x3100, Self::mul_add(-x1986, x3103, x3505)),
+        );
+        let x3507 = Self::mul_add(
+            -x2006,
+            x3092,
+            Self::mul_add(-x2004, x3094, Self::mul_add(-x2002, x3096, x3506)),
+        );
+        let x3508 = Self::mul_add(
+            -x2012,
+            x3087,
+            Self::mul_add(x2010, x3089, Self::mul_add(x2008, x3091, x3507)),
+        );
+        let x3509 = Self::mul_add(
+            x1896,
+            x3107,
+            Self::mul_add(-x1901, x3110, Self::mul_add(-x1900, x3114, x1899 * x3117)),
+        );
+        let x3510 = Self::mul_add(
+            -x1911,
+            x3098,
+            Self::mul_add(-x1898, x3100, Self::mul_add(-x1897, x3103, x3509)),
+        );
+        let x3511 = Self::mul_add(
+            -x1917,
+            x3092,
+            Self::mul_add(x1915, x3094, Self::mul_add(x1913, x3096, x3510)),
+        );
+        let x3512 = Self::mul_add(
+            -x1924,
+            x3087,
+            Self::mul_add(x1922, x3089, Self::mul_add(x1920, x3091, x3511)),
+        );
+        let x3513 = Self::mul_add(
+            x1803,
+            x3107,
+            Self::mul_add(-x1808, x3110, Self::mul_add(-x1807, x3114, x1806 * x3117)),
+        );
+        let x3514 = Self::mul_add(
+            -x1818,
+            x3098,
+            Self::mul_add(-x1805, x3100, Self::mul_add(-x1804, x3103, x3513)),
+        );
+        let x3515 = Self::mul_add(
+            x1826,
+            x3092,
+            Self::mul_add(x1823, x3094, Self::mul_add(x1820, x3096, x3514)),
+        );
+        let x3516 = Self::mul_add(
+            x1834,
+            x3087,
+            Self::mul_add(-x1831, x3089, Self::mul_add(-x1828, x3091, x3515)),
+        );
+        let x3517 = -x3516;
+        let x3518 = Self::mul_add(
+            x1713,
+            x3107,
+            Self::mul_add(-x1718, x3110, Self::mul_add(-x1717, x3114, x1716 * x3117)),
+        );
+        let x3519 = Self::mul_add(
+            -x1728,
+            x3098,
+            Self::mul_add(-x1715, x3100, Self::mul_add(-x1714, x3103, x3518)),
+        );
+        let x3520 = Self::mul_add(
+            x1736,
+            x3092,
+            Self::mul_add(x1733, x3094, Self::mul_add(x1730, x3096, x3519)),
+        );
+        let x3521 = Self::mul_add(
+            -x1742,
+            x3087,
+            Self::mul_add(x1740, x3089, Self::mul_add(x1738, x3091, x3520)),
+        );
+        let x3522 = Self::mul_add(
+            x1623,
+            x3107,
+            Self::mul_add(-x1628, x3110, Self::mul_add(-x1627, x3114, x1626 * x3117)),
+        );
+        let x3523 = Self::mul_add(
+            -x1638,
+            x3098,
+            Self::mul_add(-x1625, x3100, Self::mul_add(-x1624, x3103, x3522)),
+        );
+        let x3524 = Self::mul_add(
+            x1646,
+            x3092,
+            Self::mul_add(x1643, x3094, Self::mul_add(x1640, x3096, x3523)),
+        );
+        let x3525 = Self::mul_add(
+            -x1652,
+            x3087,
+            Self::mul_add(-x1650, x3089, Self::mul_add(x1648, x3091, x3524)),
+        );
+        let x3526 = -x3525;
+        let x3527 = Self::mul_add(
+            -x2142,
+            x3141,
+            Self::mul_add(-x2147, x3144, Self::mul_add(x2146, x3148, x2145 * x3151)),
+        );
+        let x3528 = Self::mul_add(
+            -x2156,
+            x3132,
+            Self::mul_add(x2144, x3134, Self::mul_add(x2143, x3137, x3527)),
+        );
+        let x3529 = Self::mul_add(
+            x2162,
+            x3125,
+            Self::mul_add(-x2160, x3128, Self::mul_add(x2158, x3130, x3528)),
+        );
+        let x3530 = Self::mul_add(
+            x2168,
+            x3121,
+            Self::mul_add(-x2166, x3122, Self::mul_add(-x2164, x3123, x3529)),
+        );
+        let x3531 = Self::mul_add(
+            -x2073,
+            x3141,
+            Self::mul_add(x2078, x3144, Self::mul_add(-x2077, x3148, x2076 * x3151)),
+        );
+        let x3532 = Self::mul_add(
+            x2088,
+            x3132,
+            Self::mul_add(x2075, x3134, Self::mul_add(-x2074, x3137, x3531)),
+        );
+        let x3533 = Self::mul_add(
+            x2094,
+            x3125,
+            Self::mul_add(-x2092, x3128, Self::mul_add(x2090, x3130, x3532)),
+        );
+        let x3534 = Self::mul_add(
+            x2100,
+            x3121,
+            Self::mul_add(-x2098, x3122, Self::mul_add(-x2096, x3123, x3533)),
+        );
+        let x3535 = Self::mul_add(
+            -x1985,
+            x3141,
+            Self::mul_add(-x1990, x3144, Self::mul_add(-x1989, x3148, x1988 * x3151)),
+        );
+        let x3536 = Self::mul_add(
+            -x2000,
+            x3132,
+            Self::mul_add(-x1987, x3134, Self::mul_add(-x1986, x3137, x3535)),
+        );
+        let x3537 = Self::mul_add(
+            x2006,
+            x3125,
+            Self::mul_add(-x2004, x3128, Self::mul_add(-x2002, x3130, x3536)),
+        );
+        let x3538 = Self::mul_add(
+            x2012,
+            x3121,
+            Self::mul_add(-x2010, x3122, Self::mul_add(-x2008, x3123, x3537)),
+        );
+        let x3539 = Self::mul_add(
+            x1896,
+            x3141,
+            Self::mul_add(-x1901, x3144, Self::mul_add(-x1900, x3148, x1899 * x3151)),
+        );
+        let x3540 = Self::mul_add(
+            -x1911,
+            x3132,
+            Self::mul_add(-x1898, x3134, Self::mul_add(-x1897, x3137, x3539)),
+        );
+        let x3541 = Self::mul_add(
+            x1917,
+            x3125,
+            Self::mul_add(x1915, x3128, Self::mul_add(x1913, x3130, x3540)),
+        );
+        let x3542 = Self::mul_add(
+            x1924,
+            x3121,
+            Self::mul_add(-x1922, x3122, Self::mul_add(-x1920, x3123, x3541)),
+        );
+        let x3543 = Self::mul_add(
+            x1803,
+            x3141,
+            Self::mul_add(-x1808, x3144, Self::mul_add(-x1807, x3148, x1806 * x3151)),
+        );
+        let x3544 = Self::mul_add(
+            -x1818,
+            x3132,
+            Self::mul_add(-x1805, x3134, Self::mul_add(-x1804, x3137, x3543)),
+        );
+        let x3545 = Self::mul_add(
+            -x1826,
+            x3125,
+            Self::mul_add(x1823, x3128, Self::mul_add(x1820, x3130, x3544)),
+        );
+        let x3546 = Self::mul_add(
+            -x1834,
+            x3121,
+            Self::mul_add(x1831, x3122, Self::mul_add(x1828, x3123, x3545)),
+        );
+        let x3547 = -x3546;
+        let x3548 = Self::mul_add(
+            x1713,
+            x3141,
+            Self::mul_add(-x1718, x3144, Self::mul_add(-x1717, x3148, x1716 * x3151)),
+        );
+        let x3549 = Self::mul_add(
+            -x1728,
+            x3132,
+            Self::mul_add(-x1715, x3134, Self::mul_add(-x1714, x3137, x3548)),
+        );
+        let x3550 = Self::mul_add(
+            -x1736,
+            x3125,
+            Self::mul_add(x1733, x3128, Self::mul_add(x1730, x3130, x3549)),
+        );
+        let x3551 = Self::mul_add(
+            x1742,
+            x3121,
+            Self::mul_add(-x1740, x3122, Self::mul_add(-x1738, x3123, x3550)),
+        );
+        let x3552 = Self::mul_add(
+            x1623,
+            x3141,
+            Self::mul_add(-x1628, x3144, Self::mul_add(-x1627, x3148, x1626 * x3151)),
+        );
+        let x3553 = Self::mul_add(
+            -x1638,
+            x3132,
+            Self::mul_add(-x1625, x3134, Self::mul_add(-x1624, x3137, x3552)),
+        );
+        let x3554 = Self::mul_add(
+            -x1646,
+            x3125,
+            Self::mul_add(x1643, x3128, Self::mul_add(x1640, x3130, x3553)),
+        );
+        let x3555 = Self::mul_add(
+            x1652,
+            x3121,
+            Self::mul_add(x1650, x3122, Self::mul_add(-x1648, x3123, x3554)),
+        );
+        let x3556 = -x3555;
+        let x3557 = Self::mul_add(
+            -x2142,
+            x3174,
+            Self::mul_add(-x2147, x3178, Self::mul_add(x2146, x3181, x2145 * x3185)),
+        );
+        let x3558 = Self::mul_add(
+            -x2156,
+            x3164,
+            Self::mul_add(x2144, x3167, Self::mul_add(x2143, x3171, x3557)),
+        );
+        let x3559 = Self::mul_add(
+            x2162,
+            x3157,
+            Self::mul_add(-x2160, x3158, Self::mul_add(x2158, x3161, x3558)),
+        );
+        let x3560 = Self::mul_add(
+            -x2168,
+            x3153,
+            Self::mul_add(x2166, x3154, Self::mul_add(x2164, x3155, x3559)),
+        );
+        let x3561 = -x3560;
+        let x3562 = Self::mul_add(
+            -x2073,
+            x3174,
+            Self::mul_add(x2078, x3178, Self::mul_add(-x2077, x3181, x2076 * x3185)),
+        );
+        let x3563 = Self::mul_add(
+            x2088,
+            x3164,
+            Self::mul_add(x2075, x3167, Self::mul_add(-x2074, x3171, x3562)),
+        );
+        let x3564 = Self::mul_add(
+            x2094,
+            x3157,
+            Self::mul_add(-x2092, x3158, Self::mul_add(x2090, x3161, x3563)),
+        );
+        let x3565 = Self::mul_add(
+            -x2100,
+            x3153,
+            Self::mul_add(x2098, x3154, Self::mul_add(x2096, x3155, x3564)),
+        );
+        let x3566 = -x3565;
+        let x3567 = Self::mul_add(
+            -x1985,
+            x3174,
+            Self::mul_add(-x1990, x3178, Self::mul_add(-x1989, x3181, x1988 * x3185)),
+        );
+        let x3568 = Self::mul_add(
+            -x2000,
+            x3164,
+            Self::mul_add(-x1987, x3167, Self::mul_add(-x1986, x3171, x3567)),
+        );
+        let x3569 = Self::mul_add(
+            x2006,
+            x3157,
+            Self::mul_add(-x2004, x3158, Self::mul_add(-x2002, x3161, x3568)),
+        );
+        let x3570 = Self::mul_add(
+            -x2012,
+            x3153,
+            Self::mul_add(x2010, x3154, Self::mul_add(x2008, x3155, x3569)),
+        );
+        let x3571 = -x3570;
+        let x3572 = Self::mul_add(
+            x1896,
+            x3174,
+            Self::mul_add(-x1901, x3178, Self::mul_add(-x1900, x3181, x1899 * x3185)),
+        );
+        let x3573 = Self::mul_add(
+            -x1911,
+            x3164,
+            Self::mul_add(-x1898, x3167, Self::mul_add(-x1897, x3171, x3572)),
+        );
+        let x3574 = Self::mul_add(
+            x1917,
+            x3157,
+            Self::mul_add(x1915, x3158, Self::mul_add(x1913, x3161, x3573)),
+        );
+        let x3575 = Self::mul_add(
+            -x1924,
+            x3153,
+            Self::mul_add(x1922, x3154, Self::mul_add(x1920, x3155, x3574)),
+        );
+        let x3576 = -x3575;
+        let x3577 = Self::mul_add(
+            x1803,
+            x3174,
+            Self::mul_add(-x1808, x3178, Self::mul_add(-x1807, x3181, x1806 * x3185)),
+        );
+        let x3578 = Self::mul_add(
+            -x1818,
+            x3164,
+            Self::mul_add(-x1805, x3167, Self::mul_add(-x1804, x3171, x3577)),
+        );
+        let x3579 = Self::mul_add(
+            -x1826,
+            x3157,
+            Self::mul_add(x1823, x3158, Self::mul_add(x1820, x3161, x3578)),
+        );
+        let x3580 = Self::mul_add(
+            x1834,
+            x3153,
+            Self::mul_add(-x1831, x3154, Self::mul_add(-x1828, x3155, x3579)),
+        );
+        let x3581 = Self::mul_add(
+            x1713,
+            x3174,
+            Self::mul_add(-x1718, x3178, Self::mul_add(-x1717, x3181, x1716 * x3185)),
+        );
+        let x3582 = Self::mul_add(
+            -x1728,
+            x3164,
+            Self::mul_add(-x1715, x3167, Self::mul_add(-x1714, x3171, x3581)),
+        );
+        let x3583 = Self::mul_add(
+            -x1736,
+            x3157,
+            Self::mul_add(x1733, x3158, Self::mul_add(x1730, x3161, x3582)),
+        );
+        let x3584 = Self::mul_add(
+            -x1742,
+            x3153,
+            Self::mul_add(x1740, x3154, Self::mul_add(x1738, x3155, x3583)),
+        );
+        let x3585 = -x3584;
+        let x3586 = Self::mul_add(
+            x1623,
+            x3174,
+            Self::mul_add(-x1628, x3178, Self::mul_add(-x1627, x3181, x1626 * x3185)),
+        );
+        let x3587 = Self::mul_add(
+            -x1638,
+            x3164,
+            Self::mul_add(-x1625, x3167, Self::mul_add(-x1624, x3171, x3586)),
+        );
+        let x3588 = Self::mul_add(
+            -x1646,
+            x3157,
+            Self::mul_add(x1643, x3158, Self::mul_add(x1640, x3161, x3587)),
+        );
+        let x3589 = Self::mul_add(
+            -x1652,
+            x3153,
+            Self::mul_add(-x1650, x3154, Self::mul_add(x1648, x3155, x3588)),
+        );
+        let x3590 = Self::mul_add(
+            -x2142,
+            x3205,
+            Self::mul_add(-x2147, x3208, Self::mul_add(x2146, x3212, x2145 * x3215)),
+        );
+        let x3591 = Self::mul_add(
+            -x2156,
+            x3196,
+            Self::mul_add(x2144, x3198, Self::mul_add(x2143, x3201, x3590)),
+        );
+        let x3592 = Self::mul_add(
+            x2162,
+            x3190,
+            Self::mul_add(-x2160, x3192, Self::mul_add(x2158, x3194, x3591)),
+        );
+        let x3593 = Self::mul_add(
+            x2168,
+            x3187,
+            Self::mul_add(-x2166, x3188, Self::mul_add(x2164, x3189, x3592)),
+        );
+        let x3594 = Self::mul_add(
+            -x2073,
+            x3205,
+            Self::mul_add(x2078, x3208, Self::mul_add(-x2077, x3212, x2076 * x3215)),
+        );
+        let x3595 = Self::mul_add(
+            x2088,
+            x3196,
+            Self::mul_add(x2075, x3198, Self::mul_add(-x2074, x3201, x3594)),
+        );
+        let x3596 = Self::mul_add(
+            x2094,
+            x3190,
+            Self::mul_add(-x2092, x3192, Self::mul_add(x2090, x3194, x3595)),
+        );
+        let x3597 = Self::mul_add(
+            x2100,
+            x3187,
+            Self::mul_add(-x2098, x3188, Self::mul_add(x2096, x3189, x3596)),
+        );
+        let x3598 = Self::mul_add(
+            -x1985,
+            x3205,
+            Self::mul_add(-x1990, x3208, Self::mul_add(-x1989, x3212, x1988 * x3215)),
+        );
+        let x3599 = Self::mul_add(
+            -x2000,
+            x3196,
+            Self::mul_add(-x1987, x3198, Self::mul_add(-x1986, x3201, x3598)),
+        );
+        let x3600 = Self::mul_add(
+            x2006,
+            x3190,
+            Self::mul_add(-x2004, x3192, Self::mul_add(-x2002, x3194, x3599)),
+        );
+        let x3601 = Self::mul_add(
+            x2012,
+            x3187,
+            Self::mul_add(-x2010, x3188, Self::mul_add(x2008, x3189, x3600)),
+        );
+        let x3602 = Self::mul_add(
+            x1896,
+            x3205,
+            Self::mul_add(-x1901, x3208, Self::mul_add(-x1900, x3212, x1899 * x3215)),
+        );
+        let x3603 = Self::mul_add(
+            -x1911,
+            x3196,
+            Self::mul_add(-x1898, x3198, Self::mul_add(-x1897, x3201, x3602)),
+        );
+        let x3604 = Self::mul_add(
+            x1917,
+            x3190,
+            Self::mul_add(x1915, x3192, Self::mul_add(x1913, x3194, x3603)),
+        );
+        let x3605 = Self::mul_add(
+            x1924,
+            x3187,
+            Self::mul_add(-x1922, x3188, Self::mul_add(x1920, x3189, x3604)),
+        );
+        let x3606 = Self::mul_add(
+            x1803,
+            x3205,
+            Self::mul_add(-x1808, x3208, Self::mul_add(-x1807, x3212, x1806 * x3215)),
+        );
+        let x3607 = Self::mul_add(
+            -x1818,
+            x3196,
+            Self::mul_add(-x1805, x3198, Self::mul_add(-x1804, x3201, x3606)),
+        );
+        let x3608 = Self::mul_add(
+            -x1826,
+            x3190,
+            Self::mul_add(x1823, x3192, Self::mul_add(x1820, x3194, x3607)),
+        );
+        let x3609 = Self::mul_add(
+            -x1834,
+            x3187,
+            Self::mul_add(x1831, x3188, Self::mul_add(-x1828, x3189, x3608)),
+        );
+        let x3610 = -x3609;
+        let x3611 = Self::mul_add(
+            x1713,
+            x3205,
+            Self::mul_add(-x1718, x3208, Self::mul_add(-x1717, x3212, x1716 * x3215)),
+        );
+        let x3612 = Self::mul_add(
+            -x1728,
+            x3196,
+            Self::mul_add(-x1715, x3198, Self::mul_add(-x1714, x3201, x3611)),
+        );
+        let x3613 = Self::mul_add(
+            -x1736,
+            x3190,
+            Self::mul_add(x1733, x3192, Self::mul_add(x1730, x3194, x3612)),
+        );
+        let x3614 = Self::mul_add(
+            x1742,
+            x3187,
+            Self::mul_add(-x1740, x3188, Self::mul_add(x1738, x3189, x3613)),
+        );
+        let x3615 = Self::mul_add(
+            x1623,
+            x3205,
+            Self::mul_add(-x1628, x3208, Self::mul_add(-x1627, x3212, x1626 * x3215)),
+        );
+        let x3616 = Self::mul_add(
+            -x1638,
+            x3196,
+            Self::mul_add(-x1625, x3198, Self::mul_add(-x1624, x3201, x3615)),
+        );
+        let x3617 = Self::mul_add(
+            -x1646,
+            x3190,
+            Self::mul_add(x1643, x3192, Self::mul_add(x1640, x3194, x3616)),
+        );
+        let x3618 = Self::mul_add(
+            x1652,
+            x3187,
+            Self::mul_add(x1650, x3188, Self::mul_add(x1648, x3189, x3617)),
+        );
+        let x3619 = -x3618;
+        let x3620 = Self::mul_add(
+            -x2142,
+            x3235,
+            Self::mul_add(-x2147, x3238, Self::mul_add(x2146, x3242, x2145 * x3245)),
+        );
+        let x3621 = Self::mul_add(
+            -x2156,
+            x3226,
+            Self::mul_add(x2144, x3228, Self::mul_add(x2143, x3231, x3620)),
+        );
+        let x3622 = Self::mul_add(
+            x2162,
+            x3220,
+            Self::mul_add(-x2160, x3222, Self::mul_add(x2158, x3224, x3621)),
+        );
+        let x3623 = Self::mul_add(
+            -x2168,
+            x3216,
+            Self::mul_add(-x2166, x3218, Self::mul_add(x2164, x3219, x3622)),
+        );
+        let x3624 = Self::mul_add(
+            -x2073,
+            x3235,
+            Self::mul_add(x2078, x3238, Self::mul_add(-x2077, x3242, x2076 * x3245)),
+        );
+        let x3625 = Self::mul_add(
+            x2088,
+            x3226,
+            Self::mul_add(x2075, x3228, Self::mul_add(-x2074, x3231, x3624)),
+        );
+        let x3626 = Self::mul_add(
+            x2094,
+            x3220,
+            Self::mul_add(-x2092, x3222, Self::mul_add(x2090, x3224, x3625)),
+        );
+        let x3627 = Self::mul_add(
+            -x2100,
+            x3216,
+            Self::mul_add(-x2098, x3218, Self::mul_add(x2096, x3219, x3626)),
+        );
+        let x3628 = Self::mul_add(
+            -x1985,
+            x3235,
+            Self::mul_add(-x1990, x3238, Self::mul_add(-x1989, x3242, x1988 * x3245)),
+        );
+        let x3629 = Self::mul_add(
+            -x2000,
+            x3226,
+            Self::mul_add(-x1987, x3228, Self::mul_add(-x1986, x3231, x3628)),
+        );
+        let x3630 = Self::mul_add(
+            x2006,
+            x3220,
+            Self::mul_add(-x2004, x3222, Self::mul_add(-x2002, x3224, x3629)),
+        );
+        let x3631 = Self::mul_add(
+            -x2012,
+            x3216,
+            Self::mul_add(-x2010, x3218, Self::mul_add(x2008, x3219, x3630)),
+        );
+        let x3632 = Self::mul_add(
+            x1896,
+            x3235,
+            Self::mul_add(-x1901, x3238, Self::mul_add(-x1900, x3242, x1899 * x3245)),
+        );
+        let x3633 = Self::mul_add(
+            -x1911,
+            x3226,
+            Self::mul_add(-x1898, x3228, Self::mul_add(-x1897, x3231, x3632)),
+        );
+        let x3634 = Self::mul_add(
+            x1917,
+            x3220,
+            Self::mul_add(x1915, x3222, Self::mul_add(x1913, x3224, x3633)),
+        );
+        let x3635 = Self::mul_add(
+            -x1924,
+            x3216,
+            Self::mul_add(-x1922, x3218, Self::mul_add(x1920, x3219, x3634)),
+        );
+        let x3636 = Self::mul_add(
+            x1803,
+            x3235,
+            Self::mul_add(-x1808, x3238, Self::mul_add(-x1807, x3242, x1806 * x3245)),
+        );
+        let x3637 = Self::mul_add(
+            -x1818,
+            x3226,
+            Self::mul_add(-x1805, x3228, Self::mul_add(-x1804, x3231, x3636)),
+        );
+        let x3638 = Self::mul_add(
+            -x1826,
+            x3220,
+            Self::mul_add(x1823, x3222, Self::mul_add(x1820, x3224, x3637)),
+        );
+        let x3639 = Self::mul_add(
+            x1834,
+            x3216,
+            Self::mul_add(x1831, x3218, Self::mul_add(-x1828, x3219, x3638)),
+        );
+        let x3640 = -x3639;
+        let x3641 = Self::mul_add(
+            x1713,
+            x3235,
+            Self::mul_add(-x1718, x3238, Self::mul_add(-x1717, x3242, x1716 * x3245)),
+        );
+        let x3642 = Self::mul_add(
+            -x1728,
+            x3226,
+            Self::mul_add(-x1715, x3228, Self::mul_add(-x1714, x3231, x3641)),
+        );
+        let x3643 = Self::mul_add(
+            -x1736,
+            x3220,
+            Self::mul_add(x1733, x3222, Self::mul_add(x1730, x3224, x3642)),
+        );
+        let x3644 = Self::mul_add(
+            -x1742,
+            x3216,
+            Self::mul_add(-x1740, x3218, Self::mul_add(x1738, x3219, x3643)),
+        );
+        let x3645 = Self::mul_add(
+            x1623,
+            x3235,
+            Self::mul_add(-x1628, x3238, Self::mul_add(-x1627, x3242, x1626 * x3245)),
+        );
+        let x3646 = Self::mul_add(
+            -x1638,
+            x3226,
+            Self::mul_add(-x1625, x3228, Self::mul_add(-x1624, x3231, x3645)),
+        );
+        let x3647 = Self::mul_add(
+            -x1646,
+            x3220,
+            Self::mul_add(x1643, x3222, Self::mul_add(x1640, x3224, x3646)),
+        );
+        let x3648 = Self::mul_add(
+            -x1652,
+            x3216,
+            Self::mul_add(x1650, x3218, Self::mul_add(x1648, x3219, x3647)),
+        );
+        let x3649 = -x3648;
+        let x3650 = Self::mul_add(
+            -x2142,
+            x3265,
+            Self::mul_add(-x2147, x3269, Self::mul_add(x2146, x3272, x2145 * x3276)),
+        );
+        let x3651 = Self::mul_add(
+            -x2156,
+            x3255,
+            Self::mul_add(x2144, x3258, Self::mul_add(x2143, x3262, x3650)),
+        );
+        let x3652 = Self::mul_add(
+            x2162,
+            x3248,
+            Self::mul_add(-x2160, x3249, Self::mul_add(x2158, x3252, x3651)),
+        );
+        let x3653 = Self::mul_add(
+            -x2168,
+            x2753,
+            Self::mul_add(-x2166, x3216, Self::mul_add(x2164, x3246, x3652)),
+        );
+        let x3654 = -x3653;
+        let x3655 = Self::mul_add(
+            -x2073,
+            x3265,
+            Self::mul_add(x2078, x3269, Self::mul_add(-x2077, x3272, x2076 * x3276)),
+        );
+        let x3656 = Self::mul_add(
+            x2088,
+            x3255,
+            Self::mul_add(x2075, x3258, Self::mul_add(-x2074, x3262, x3655)),
+        );
+        let x3657 = Self::mul_add(
+            x2094,
+            x3248,
+            Self::mul_add(-x2092, x3249, Self::mul_add(x2090, x3252, x3656)),
+        );
+        let x3658 = Self::mul_add(
+            -x2100,
+            x2753,
+            Self::mul_add(-x2098, x3216, Self::mul_add(x2096, x3246, x3657)),
+        );
+        let x3659 = -x3658;
+        let x3660 = Self::mul_add(
+            -x1985,
+            x3265,
+            Self::mul_add(-x1990, x3269, Self::mul_add(-x1989, x3272, x1988 * x3276)),
+        );
+        let x3661 = Self::mul_add(
+            -x2000,
+            x3255,
+            Self::mul_add(-x1987, x3258, Self::mul_add(-x1986, x3262, x3660)),
+        );
+        let x3662 = Self::mul_add(
+            x2006,
+            x3248,
+            Self::mul_add(-x2004, x3249, Self::mul_add(-x2002, x3252, x3661)),
+        );
+        let x3663 = Self::mul_add(
+            -x2012,
+            x2753,
+            Self::mul_add(-x2010, x3216, Self::mul_add(x2008, x3246, x3662)),
+        );
+        let x3664 = -x3663;
+        let x3665 = Self::mul_add(
+            x1896,
+            x3265,
+            Self::mul_add(-x1901, x3269, Self::mul_add(-x1900, x3272, x1899 * x3276)),
+        );
+        let x3666 = Self::mul_add(
+            -x1911,
+            x3255,
+            Self::mul_add(-x1898, x3258, Self::mul_add(-x1897, x3262, x3665)),
+        );
+        let x3667 = Self::mul_add(
+            x1917,
+            x3248,
+            Self::mul_add(x1915, x3249, Self::mul_add(x1913, x3252, x3666)),
+        );
+        let x3668 = Self::mul_add(
+            -x1924,
+            x2753,
+            Self::mul_add(-x1922, x3216, Self::mul_add(x1920, x3246, x3667)),
+        );
+        let x3669 = -x3668;
+        let x3670 = Self::mul_add(
+            x1803,
+            x3265,
+            Self::mul_add(-x1808, x3269, Self::mul_add(-x1807, x3272, x1806 * x3276)),
+        );
+        let x3671 = Self::mul_add(
+            -x1818,
+            x3255,
+            Self::mul_add(-x1805, x3258, Self::mul_add(-x1804, x3262, x3670)),
+        );
+        let x3672 = Self::mul_add(
+            -x1826,
+            x3248,
+            Self::mul_add(x1823, x3249, Self::mul_add(x1820, x3252, x3671)),
+        );
+        let x3673 = Self::mul_add(
+            x1834,
+            x2753,
+            Self::mul_add(x1831, x3216, Self::mul_add(-x1828, x3246, x3672)),
+        );
+        let x3674 = Self::mul_add(
+            x1713,
+            x3265,
+            Self::mul_add(-x1718, x3269, Self::mul_add(-x1717, x3272, x1716 * x3276)),
+        );
+        let x3675 = Self::mul_add(
+            -x1728,
+            x3255,
+            Self::mul_add(-x1715, x3258, Self::mul_add(-x1714, x3262, x3674)),
+        );
+        let x3676 = Self::mul_add(
+            -x1736,
+            x3248,
+            Self::mul_add(x1733, x3249, Self::mul_add(x1730, x3252, x3675)),
+        );
+        let x3677 = Self::mul_add(
+            -x1742,
+            x2753,
+            Self::mul_add(-x1740, x3216, Self::mul_add(x1738, x3246, x3676)),
+        );
+        let x3678 = -x3677;
+        let x3679 = Self::mul_add(
+            x1623,
+            x3265,
+            Self::mul_add(-x1628, x3269, Self::mul_add(-x1627, x3272, x1626 * x3276)),
+        );
+        let x3680 = Self::mul_add(
+            -x1638,
+            x3255,
+            Self::mul_add(-x1625, x3258, Self::mul_add(-x1624, x3262, x3679)),
+        );
+        let x3681 = Self::mul_add(
+            -x1646,
+            x3248,
+            Self::mul_add(x1643, x3249, Self::mul_add(x1640, x3252, x3680)),
+        );
+        let x3682 = Self::mul_add(
+            -x1652,
+            x2753,
+            Self::mul_add(x1650, x3216, Self::mul_add(x1648, x3246, x3681)),
+        );
+        let x3683 = Self::mul_add(
+            x2182,
+            x2787,
+            Self::mul_add(-x2179, x2791, Self::mul_add(x767, x2794, x766 * x2798)),
+        );
+        let x3684 = Self::mul_add(
+            x2185,
+            x2777,
+            Self::mul_add(-x2184, x2780, Self::mul_add(x2183, x2783, x3683)),
+        );
+        let x3685 = Self::mul_add(
+            -x2188,
+            x2772,
+            Self::mul_add(x2187, x2773, Self::mul_add(-x2186, x2775, x3684)),
+        );
+        let x3686 = -Self::mul_add(x2190, x2768, Self::mul_add(-x2189, x2770, x3685));
+        let x3687 = Self::mul_add(
+            -x2193,
+            x2787,
+            Self::mul_add(x2195, x2791, Self::mul_add(x768, x2794, x766 * x2801)),
+        );
+        let x3688 = Self::mul_add(
+            -x2197,
+            x2777,
+            Self::mul_add(x2196, x2780, Self::mul_add(-x2196, x2783, x3687)),
+        );
+        let x3689 = Self::mul_add(
+            x2200,
+            x2772,
+            Self::mul_add(-x2199, x2773, Self::mul_add(x2198, x2775, x3688)),
+        );
+        let x3690 = Self::mul_add(-x2202, x2768, Self::mul_add(x2201, x2770, x3689));
+        let x3691 = Self::mul_add(
+            x2207,
+            x2787,
+            Self::mul_add(-x2206, x2791, Self::mul_add(-x768, x2798, x767 * x2801)),
+        );
+        let x3692 = Self::mul_add(
+            x2209,
+            x2777,
+            Self::mul_add(-x2208, x2780, Self::mul_add(x2205, x2783, x3691)),
+        );
+        let x3693 = Self::mul_add(
+            -x2212,
+            x2772,
+            Self::mul_add(x2211, x2773, Self::mul_add(x2210, x2775, x3692)),
+        );
+        let x3694 = -Self::mul_add(x2214, x2768, Self::mul_add(-x2213, x2770, x3693));
+        let x3695 = Self::mul_add(
+            -x2219,
+            x2791,
+            Self::mul_add(x2218, x2794, Self::mul_add(-x2217, x2798, x2179 * x2801)),
+        );
+        let x3696 = Self::mul_add(
+            -x2223,
+            x2780,
+            Self::mul_add(-x2222, x2783, Self::mul_add(-x2220, x2787, x3695)),
+        );
+        let x3697 = Self::mul_add(
+            -x2226,
+            x2773,
+            Self::mul_add(x2225, x2775, Self::mul_add(x2224, x2777, x3696)),
+        );
+        let x3698 = Self::mul_add(
+            -x2229,
+            x2768,
+            Self::mul_add(x2228, x2770, Self::mul_add(x2227, x2772, x3697)),
+        );
+        let x3699 = -x3698;
+        let x3700 = Self::mul_add(
+            -x2235,
+            x2791,
+            Self::mul_add(x2234, x2794, Self::mul_add(x2193, x2798, x2233 * x2801)),
+        );
+        let x3701 = Self::mul_add(
+            -x2238,
+            x2780,
+            Self::mul_add(x2237, x2783, Self::mul_add(-x2236, x2787, x3700)),
+        );
+        let x3702 = Self::mul_add(
+            x2241,
+            x2773,
+            Self::mul_add(-x2240, x2775, Self::mul_add(x2239, x2777, x3701)),
+        );
+        let x3703 = Self::mul_add(
+            x2244,
+            x2768,
+            Self::mul_add(-x2243, x2770, Self::mul_add(-x2242, x2772, x3702)),
+        );
+        let x3704 = -x3703;
+        let x3705 = Self::mul_add(
+            x2247,
+            x2791,
+            Self::mul_add(x2205, x2794, Self::mul_add(-x2246, x2798, x2245 * x2801)),
+        );
+        let x3706 = Self::mul_add(
+            -x2250,
+            x2780,
+            Self::mul_add(x2249, x2783, Self::mul_add(-x2248, x2787, x3705)),
+        );
+        let x3707 = Self::mul_add(
+            x2253,
+            x2773,
+            Self::mul_add(-x2252, x2775, Self::mul_add(-x2251, x2777, x3706)),
+        );
+        let x3708 = Self::mul_add(
+            x2256,
+            x2768,
+            Self::mul_add(-x2255, x2770, Self::mul_add(-x2254, x2772, x3707)),
+        );
+        let x3709 = Self::mul_add(
+            -x2151,
+            x2791,
+            Self::mul_add(x2149, x2794, Self::mul_add(x2155, x2798, x2154 * x2801)),
+        );
+        let x3710 = Self::mul_add(
+            x2157,
+            x2780,
+            Self::mul_add(-x2153, x2783, Self::mul_add(x2152, x2787, x3709)),
+        );
+        let x3711 = Self::mul_add(
+            x2163,
+            x2773,
+            Self::mul_add(x2161, x2775, Self::mul_add(x2159, x2777, x3710)),
+        );
+        let x3712 = Self::mul_add(
+            x2169,
+            x2768,
+            Self::mul_add(-x2167, x2770, Self::mul_add(-x2165, x2772, x3711)),
+        );
+        let x3713 = Self::mul_add(
+            -x2082,
+            x2791,
+            Self::mul_add(x2087, x2794, Self::mul_add(x2086, x2798, x2085 * x2801)),
+        );
+        let x3714 = Self::mul_add(
+            x2089,
+            x2780,
+            Self::mul_add(-x2084, x2783, Self::mul_add(x2083, x2787, x3713)),
+        );
+        let x3715 = Self::mul_add(
+            x2095,
+            x2773,
+            Self::mul_add(x2093, x2775, Self::mul_add(x2091, x2777, x3714)),
+        );
+        let x3716 = Self::mul_add(
+            x2101,
+            x2768,
+            Self::mul_add(-x2099, x2770, Self::mul_add(-x2097, x2772, x3715)),
+        );
+        let x3717 = -x3716;
+        let x3718 = Self::mul_add(
+            -x1994,
+            x2791,
+            Self::mul_add(-x1999, x2794, Self::mul_add(x1998, x2798, x1997 * x2801)),
+        );
+        let x3719 = Self::mul_add(
+            -x2001,
+            x2780,
+            Self::mul_add(x1996, x2783, Self::mul_add(x1995, x2787, x3718)),
+        );
+        let x3720 = Self::mul_add(
+            -x2007,
+            x2773,
+            Self::mul_add(-x2005, x2775, Self::mul_add(x2003, x2777, x3719)),
+        );
+        let x3721 = Self::mul_add(
+            -x2013,
+            x2768,
+            Self::mul_add(x2011, x2770, Self::mul_add(x2009, x2772, x3720)),
+        );
+        let x3722 = Self::mul_add(
+            -x1905,
+            x2791,
+            Self::mul_add(x1910, x2794, Self::mul_add(x1909, x2798, x1908 * x2801)),
+        );
+        let x3723 = Self::mul_add(
+            x1912,
+            x2780,
+            Self::mul_add(-x1907, x2783, Self::mul_add(-x1906, x2787, x3722)),
+        );
+        let x3724 = Self::mul_add(
+            -x1919,
+            x2773,
+            Self::mul_add(-x1916, x2775, Self::mul_add(x1914, x2777, x3723)),
+        );
+        let x3725 = Self::mul_add(
+            -x1925,
+            x2768,
+            Self::mul_add(x1923, x2770, Self::mul_add(x1921, x2772, x3724)),
+        );
+        let x3726 = Self::mul_add(
+            -x1812,
+            x2791,
+            Self::mul_add(x1817, x2794, Self::mul_add(x1816, x2798, x1815 * x2801)),
+        );
+        let x3727 = Self::mul_add(
+            x1819,
+            x2780,
+            Self::mul_add(-x1814, x2783, Self::mul_add(-x1813, x2787, x3726)),
+        );
+        let x3728 = Self::mul_add(
+            -x1827,
+            x2773,
+            Self::mul_add(-x1825, x2775, Self::mul_add(x1821, x2777, x3727)),
+        );
+        let x3729 = Self::mul_add(
+            x1836,
+            x2768,
+            Self::mul_add(-x1833, x2770, Self::mul_add(-x1830, x2772, x3728)),
+        );
+        let x3730 = -x3729;
+        let x3731 = Self::mul_add(
+            -x1722,
+            x2791,
+            Self::mul_add(x1727, x2794, Self::mul_add(x1726, x2798, x1725 * x2801)),
+        );
+        let x3732 = Self::mul_add(
+            x1729,
+            x2780,
+            Self::mul_add(-x1724, x2783, Self::mul_add(-x1723, x2787, x3731)),
+        );
+        let x3733 = Self::mul_add(
+            -x1737,
+            x2773,
+            Self::mul_add(-x1735, x2775, Self::mul_add(x1731, x2777, x3732)),
+        );
+        let x3734 = Self::mul_add(
+            -x1743,
+            x2768,
+            Self::mul_add(x1741, x2770, Self::mul_add(-x1739, x2772, x3733)),
+        );
+        let x3735 = Self::mul_add(
+            -x1632,
+            x2791,
+            Self::mul_add(x1637, x2794, Self::mul_add(x1636, x2798, x1635 * x2801)),
+        );
+        let x3736 = Self::mul_add(
+            x1639,
+            x2780,
+            Self::mul_add(-x1634, x2783, Self::mul_add(-x1633, x2787, x3735)),
+        );
+        let x3737 = Self::mul_add(
+            -x1647,
+            x2773,
+            Self::mul_add(-x1645, x2775, Self::mul_add(x1641, x2777, x3736)),
+        );
+        let x3738 = Self::mul_add(
+            -x1653,
+            x2768,
+            Self::mul_add(x1651, x2770, Self::mul_add(-x1649, x2772, x3737)),
+        );
+        let x3739 = -x3738;
+        let x3740 = Self::mul_add(
+            x2182,
+            x2839,
+            Self::mul_add(-x2179, x2843, Self::mul_add(x767, x2846, x766 * x2850)),
+        );
+        let x3741 = Self::mul_add(
+            x2185,
+            x2829,
+            Self::mul_add(x2184, x2832, Self::mul_add(-x2183, x2836, x3740)),
+        );
+        let x3742 = Self::mul_add(
+            -x2188,
+            x2824,
+            Self::mul_add(x2187, x2825, Self::mul_add(-x2186, x2827, x3741)),
+        );
+        let x3743 = -Self::mul_add(x2190, x2820, Self::mul_add(-x2189, x2822, x3742));
+        let x3744 = Self::mul_add(
+            -x2193,
+            x2839,
+            Self::mul_add(x2195, x2843, Self::mul_add(x768, x2846, x766 * x2853)),
+        );
+        let x3745 = Self::mul_add(
+            -x2197,
+            x2829,
+            Self::mul_add(-x2196, x2832, Self::mul_add(x2196, x2836, x3744)),
+        );
+        let x3746 = Self::mul_add(
+            x2200,
+            x2824,
+            Self::mul_add(-x2199, x2825, Self::mul_add(x2198, x2827, x3745)),
+        );
+        let x3747 = Self::mul_add(-x2202, x2820, Self::mul_add(x2201, x2822, x3746));
+        let x3748 = Self::mul_add(
+            x2207,
+            x2839,
+            Self::mul_add(-x2206, x2843, Self::mul_add(-x768, x2850, x767 * x2853)),
+        );
+        let x3749 = Self::mul_add(
+            x2209,
+            x2829,
+            Self::mul_add(x2208, x2832, Self::mul_add(-x2205, x2836, x3748)),
+        );
+        let x3750 = Self::mul_add(
+            -x2212,
+            x2824,
+            Self::mul_add(x2211, x2825, Self::mul_add(x2210, x2827, x3749)),
+        );
+        let x3751 = -Self::mul_add(x2214, x2820, Self::mul_add(-x2213, x2822, x3750));
+        let x3752 = Self::mul_add(
+            -x2219,
+            x2843,
+            Self::mul_add(x2218, x2846, Self::mul_add(-x2217, x2850, x2179 * x2853)),
+        );
+        let x3753 = Self::mul_add(
+            x2223,
+            x2832,
+            Self::mul_add(x2222, x2836, Self::mul_add(-x2220, x2839, x3752)),
+        );
+        let x3754 = Self::mul_add(
+            -x2226,
+            x2825,
+            Self::mul_add(x2225, x2827, Self::mul_add(x2224, x2829, x3753)),
+        );
+        let x3755 = Self::mul_add(
+            -x2229,
+            x2820,
+            Self::mul_add(x2228, x2822, Self::mul_add(x2227, x2824, x3754)),
+        );
+        let x3756 = -x3755;
+        let x3757 = Self::mul_add(
+            -x2235,
+            x2843,
+            Self::mul_add(x2234, x2846, Self::mul_add(x2193, x2850, x2233 * x2853)),
+        );
+        let x3758 = Self::mul_add(
+            x2238,
+            x2832,
+            Self::mul_add(-x2237, x2836, Self::mul_add(-x2236, x2839, x3757)),
+        );
+        let x3759 = Self::mul_add(
+            x2241,
+            x2825,
+            Self::mul_add(-x2240, x2827, Self::mul_add(x2239, x2829, x3758)),
+        );
+        let x3760 = Self::mul_add(
+            x2244,
+            x2820,
+            Self::mul_add(-x2243, x2822, Self::mul_add(-x2242, x2824, x3759)),
+        );
+        let x3761 = -x3760;
+        let x3762 = Self::mul_add(
+            x2247,
+            x2843,
+            Self::mul_add(x2205, x2846, Self::mul_add(-x2246, x2850, x2245 * x2853)),
+        );
+        let x3763 = Self::mul_add(
+            x2250,
+            x2832,
+            Self::mul_add(-x2249, x2836, Self::mul_add(-x2248, x2839, x3762)),
+        );
+        let x3764 = Self::mul_add(
+            x2253,
+            x2825,
+            Self::mul_add(-x2252, x2827, Self::mul_add(-x2251, x2829, x3763)),
+        );
+        let x3765 = Self::mul_add(
+            x2256,
+            x2820,
+            Self::mul_add(-x2255, x2822, Self::mul_add(-x2254, x2824, x3764)),
+        );
+        let x3766 = Self::mul_add(
+            -x2151,
+            x2843,
+            Self::mul_add(x2149, x2846, Self::mul_add(x2155, x2850, x2154 * x2853)),
+        );
+        let x3767 = Self::mul_add(
+            -x2157,
+            x2832,
+            Self::mul_add(x2153, x2836, Self::mul_add(x2152, x2839, x3766)),
+        );
+        let x3768 = Self::mul_add(
+            x2163,
+            x2825,
+            Self::mul_add(x2161, x2827, Self::mul_add(x2159, x2829, x3767)),
+        );
+        let x3769 = Self::mul_add(
+            x2169,
+            x2820,
+            Self::mul_add(-x2167, x2822, Self::mul_add(-x2165, x2824, x3768)),
+        );
+        let x3770 = Self::mul_add(
+            -x2082,
+            x2843,
+            Self::mul_add(x2087, x2846, Self::mul_add(x2086, x2850, x2085 * x2853)),
+        );
+        let x3771 = Self::mul_add(
+            -x2089,
+            x2832,
+            Self::mul_add(x2084, x2836, Self::mul_add(x2083, x2839, x3770)),
+        );
+        let x3772 = Self::mul_add(
+            x2095,
+            x2825,
+            Self::mul_add(x2093, x2827, Self::mul_add(x2091, x2829, x3771)),
+        );
+        let x3773 = Self::mul_add(
+            x2101,
+            x2820,
+            Self::mul_add(-x2099, x2822, Self::mul_add(-x2097, x2824, x3772)),
+        );
+        let x3774 = -x3773;
+        let x3775 = Self::mul_add(
+            -x1994,
+            x2843,
+            Self::mul_add(-x1999, x2846, Self::mul_add(x1998, x2850, x1997 * x2853)),
+        );
+        let x3776 = Self::mul_add(
+            x2001,
+            x2832,
+            Self::mul_add(-x1996, x2836, Self::mul_add(x1995, x2839, x3775)),
+        );
+        let x3777 = Self::mul_add(
+            -x2007,
+            x2825,
+            Self::mul_add(-x2005, x2827, Self::mul_add(x2003, x2829, x3776)),
+        );
+        let x3778 = Self::mul_add(
+            -x2013,
+            x2820,
+            Self::mul_add(x2011, x2822, Self::mul_add(x2009, x2824, x3777)),
+        );
+        let x3779 = Self::mul_add(
+            -x1905,
+            x2843,
+            Self::mul_add(x1910, x2846, Self::mul_add(x1909, x2850, x1908 * x2853)),
+        );
+        let x3780 = Self::mul_add(
+            -x1912,
+            x2832,
+            Self::mul_add(x1907, x2836, Self::mul_add(-x1906, x2839, x3779)),
+        );
+        let x3781 = Self::mul_add(
+            -x1919,
+            x2825,
+            Self::mul_add(-x1916, x2827, Self::mul_add(x1914, x2829, x3780)),
+        );
+        let x3782 = Self::mul_add(
+            -x1925,
+            x2820,
+            Self::mul_add(x1923, x2822, Self::mul_add(x1921, x2824, x3781)),
+        );
+        let x3783 = Self::mul_add(
+            -x1812,
+            x2843,
+            Self::mul_add(x1817, x2846, Self::mul_add(x1816, x2850, x1815 * x2853)),
+        );
+        let x3784 = Self::mul_add(
+            -x1819,
+            x2832,
+            Self::mul_add(x1814, x2836, Self::mul_add(-x1813, x2839, x3783)),
+        );
+        let x3785 = Self::mul_add(
+            -x1827,
+            x2825,
+            Self::mul_add(-x1825, x2827, Self::mul_add(x1821, x2829, x3784)),
+        );
+        let x3786 = Self::mul_add(
+            x1836,
+            x2820,
+            Self::mul_add(-x1833, x2822, Self::mul_add(-x1830, x2824, x3785)),
+        );
+        let x3787 = -x3786;
+        let x3788 = Self::mul_add(
+            -x1722,
+            x2843,
+            Self::mul_add(x1727, x2846, Self::mul_add(x1726, x2850, x1725 * x2853)),
+        );
+        let x3789 = Self::mul_add(
+            -x1729,
+            x2832,
+            Self::mul_add(x1724, x2836, Self::mul_add(-x1723, x2839, x3788)),
+        );
+        let x3790 = Self::mul_add(
+            -x1737,
+            x2825,
+            Self::mul_add(-x1735, x2827, Self::mul_add(x1731, x2829, x3789)),
+        );
+        let x3791 = Self::mul_add(
+            -x1743,
+            x2820,
+            Self::mul_add(x1741, x2822, Self::mul_add(-x1739, x2824, x3790)),
+        );
+        let x3792 = Self::mul_add(
+            -x1632,
+            x2843,
+            Self::mul_add(x1637, x2846, Self::mul_add(x1636, x2850, x1635 * x2853)),
+        );
+        let x3793 = Self::mul_add(
+            -x1639,
+            x2832,
+            Self::mul_add(x1634, x2836, Self::mul_add(-x1633, x2839, x3792)),
+        );
+        let x3794 = Self::mul_add(
+            -x1647,
+            x2825,
+            Self::mul_add(-x1645, x2827, Self::mul_add(x1641, x2829, x3793)),
+        );
+        let x3795 = Self::mul_add(
+            -x1653,
+            x2820,
+            Self::mul_add(x1651, x2822, Self::mul_add(-x1649, x2824, x3794)),
+        );
+        let x3796 = -x3795;
+        let x3797 = Self::mul_add(
+            x2182,
+            x2891,
+            Self::mul_add(-x2179, x2894, Self::mul_add(x767, x2898, x766 * x2901)),
+        );
+        let x3798 = Self::mul_add(
+            -x2185,
+            x2881,
+            Self::mul_add(x2184, x2884, Self::mul_add(-x2183, x2887, x3797)),
+        );
+        let x3799 = Self::mul_add(
+            -x2188,
+            x2875,
+            Self::mul_add(-x2187, x2877, Self::mul_add(x2186, x2879, x3798)),
+        );
+        let x3800 = Self::mul_add(x2190, x2872, Self::mul_add(x2189, x2873, x3799));
+        let x3801 = Self::mul_add(
+            -x2193,
+            x2891,
+            Self::mul_add(x2195, x2894, Self::mul_add(x768, x2898, x766 * x2905)),
+        );
+        let x3802 = Self::mul_add(
+            x2197,
+            x2881,
+            Self::mul_add(-x2196, x2884, Self::mul_add(x2196, x2887, x3801)),
+        );
+        let x3803 = Self::mul_add(
+            x2200,
+            x2875,
+            Self::mul_add(x2199, x2877, Self::mul_add(-x2198, x2879, x3802)),
+        );
+        let x3804 = -Self::mul_add(-x2202, x2872, Self::mul_add(-x2201, x2873, x3803));
+        let x3805 = Self::mul_add(
+            x2207,
+            x2891,
+            Self::mul_add(-x2206, x2894, Self::mul_add(-x768, x2901, x767 * x2905)),
+        );
+        let x3806 = Self::mul_add(
+            -x2209,
+            x2881,
+            Self::mul_add(x2208, x2884, Self::mul_add(-x2205, x2887, x3805)),
+        );
+        let x3807 = Self::mul_add(
+            -x2212,
+            x2875,
+            Self::mul_add(-x2211, x2877, Self::mul_add(-x2210, x2879, x3806)),
+        );
+        let x3808 = Self::mul_add(x2214, x2872, Self::mul_add(x2213, x2873, x3807));
+        let x3809 = Self::mul_add(
+            -x2219,
+            x2894,
+            Self::mul_add(x2218, x2898, Self::mul_add(-x2217, x2901, x2179 * x2905)),
+        );
+        let x3810 = Self::mul_add(
+            x2223,
+            x2884,
+            Self::mul_add(x2222, x2887, Self::mul_add(-x2220, x2891, x3809)),
+        );
+        let x3811 = Self::mul_add(
+            x2226,
+            x2877,
+            Self::mul_add(-x2225, x2879, Self::mul_add(-x2224, x2881, x3810)),
+        );
+        let x3812 = Self::mul_add(
+            -x2229,
+            x2872,
+            Self::mul_add(-x2228, x2873, Self::mul_add(x2227, x2875, x3811)),
+        );
+        let x3813 = Self::mul_add(
+            -x2235,
+            x2894,
+            Self::mul_add(x2234, x2898, Self::mul_add(x2193, x2901, x2233 * x2905)),
+        );
+        let x3814 = Self::mul_add(
+            x2238,
+            x2884,
+            Self::mul_add(-x2237, x2887, Self::mul_add(-x2236, x2891, x3813)),
+        );
+        let x3815 = Self::mul_add(
+            -x2241,
+            x2877,
+            Self::mul_add(x2240, x2879, Self::mul_add(-x2239, x2881, x3814)),
+        );
+        let x3816 = Self::mul_add(
+            x2244,
+            x2872,
+            Self::mul_add(x2243, x2873, Self::mul_add(-x2242, x2875, x3815)),
+        );
+        let x3817 = Self::mul_add(
+            x2247,
+            x2894,
+            Self::mul_add(x2205, x2898, Self::mul_add(-x2246, x2901, x2245 * x2905)),
+        );
+        let x3818 = Self::mul_add(
+            x2250,
+            x2884,
+            Self::mul_add(-x2249, x2887, Self::mul_add(-x2248, x2891, x3817)),
+        );
+        let x3819 = Self::mul_add(
+            -x2253,
+            x2877,
+            Self::mul_add(x2252, x2879, Self::mul_add(x2251, x2881, x3818)),
+        );
+        let x3820 = Self::mul_add(
+            x2256,
+            x2872,
+            Self::mul_add(x2255, x2873, Self::mul_add(-x2254, x2875, x3819)),
+        );
+        let x3821 = -x3820;
+        let x3822 = Self::mul_add(
+            -x2151,
+            x2894,
+            Self::mul_add(x2149, x2898, Self::mul_add(x2155, x2901, x2154 * x2905)),
+        );
+        let x3823 = Self::mul_add(
+            -x2157,
+            x2884,
+            Self::mul_add(x2153, x2887, Self::mul_add(x2152, x2891, x3822)),
+        );
+        let x3824 = Self::mul_add(
+            -x2163,
+            x2877,
+            Self::mul_add(-x2161, x2879, Self::mul_add(-x2159, x2881, x3823)),
+        );
+        let x3825 = Self::mul_add(
+            x2169,
+            x2872,
+            Self::mul_add(x2167, x2873, Self::mul_add(-x2165, x2875, x3824)),
+        );
+        let x3826 = -x3825;
+        let x3827 = Self::mul_add(
+            -x2082,
+            x2894,
+            Self::mul_add(x2087, x2898, Self::mul_add(x2086, x2901, x2085 * x2905)),
+        );
+        let x3828 = Self::mul_add(
+            -x2089,
+            x2884,
+            Self::mul_add(x2084, x2887, Self::mul_add(x2083, x2891, x3827)),
+        );
+        let x3829 = Self::mul_add(
+            -x2095,
+            x2877,
+            Self::mul_add(-x2093, x2879, Self::mul_add(-x2091, x2881, x3828)),
+        );
+        let x3830 = Self::mul_add(
+            x2101,
+            x2872,
+            Self::mul_add(x2099, x2873, Self::mul_add(-x2097, x2875, x3829)),
+        );
+        let x3831 = Self::mul_add(
+            -x1994,
+            x2894,
+            Self::mul_add(-x1999, x2898, Self::mul_add(x1998, x2901, x1997 * x2905)),
+        );
+        let x3832 = Self::mul_add(
+            x2001,
+            x2884,
+            Self::mul_add(-x1996, x2887, Self::mul_add(x1995, x2891, x3831)),
+        );
+        let x3833 = Self::mul_add(
+            x2007,
+            x2877,
+            Self::mul_add(x2005, x2879, Self::mul_add(-x2003, x2881, x3832)),
+        );
+        let x3834 = Self::mul_add(
+            -x2013,
+            x2872,
+            Self::mul_add(-x2011, x2873, Self::mul_add(x2009, x2875, x3833)),
+        );
+        let x3835 = -x3834;
+        let x3836 = Self::mul_add(
+            -x1905,
+            x2894,
+            Self::mul_add(x1910, x2898, Self::mul_add(x1909, x2901, x1908 * x2905)),
+        );
+        let x3837 = Self::mul_add(
+            -x1912,
+            x2884,
+            Self::mul_add(x1907, x2887, Self::mul_add(-x1906, x2891, x3836)),
+        );
+        let x3838 = Self::mul_add(
+            x1919,
+            x2877,
+            Self::mul_add(x1916, x2879, Self::mul_add(-x1914, x2881, x3837)),
+        );
+        let x3839 = Self::mul_add(
+            -x1925,
+            x2872,
+            Self::mul_add(-x1923, x2873, Self::mul_add(x1921, x2875, x3838)),
+        );
+        let x3840 = -x3839;
+        let x3841 = Self::mul_add(
+            -x1812,
+            x2894,
+            Self::mul_add(x1817, x2898, Self::mul_add(x1816, x2901, x1815 * x2905)),
+        );
+        let x3842 = Self::mul_add(
+            -x1819,
+            x2884,
+            Self::mul_add(x1814, x2887, Self::mul_add(-x1813, x2891, x3841)),
+        );
+        let x3843 = Self::mul_add(
+            x1827,
+            x2877,
+            Self::mul_add(x1825, x2879, Self::mul_add(-x1821, x2881, x3842)),
+        );
+        let x3844 = Self::mul_add(
+            x1836,
+            x2872,
+            Self::mul_add(x1833, x2873, Self::mul_add(-x1830, x2875, x3843)),
+        );
+        let x3845 = Self::mul_add(
+            -x1722,
+            x2894,
+            Self::mul_add(x1727, x2898, Self::mul_add(x1726, x2901, x1725 * x2905)),
+        );
+        let x3846 = Self::mul_add(
+            -x1729,
+            x2884,
+            Self::mul_add(x1724, x2887, Self::mul_add(-x1723, x2891, x3845)),
+        );
+        let x3847 = Self::mul_add(
+            x1737,
+            x2877,
+            Self::mul_add(x1735, x2879, Self::mul_add(-x1731, x2881, x3846)),
+        );
+        let x3848 = Self::mul_add(
+            -x1743,
+            x2872,
+            Self::mul_add(-x1741, x2873, Self::mul_add(-x1739, x2875, x3847)),
+        );
+        let x3849 = -x3848;
+        let x3850 = Self::mul_add(
+            -x1632,
+            x2894,
+            Self::mul_add(x1637, x2898, Self::mul_add(x1636, x2901, x1635 * x2905)),
+        );
+        let x3851 = Self::mul_add(
+            -x1639,
+            x2884,
+            Self::mul_add(x1634, x2887, Self::mul_add(-x1633, x2891, x3850)),
+        );
+        let x3852 = Self::mul_add(
+            x1647,
+            x2877,
+            Self::mul_add(x1645, x2879, Self::mul_add(-x1641, x2881, x3851)),
+        );
+        let x3853 = Self::mul_add(
+            -x1653,
+            x2872,
+            Self::mul_add(-x1651, x2873, Self::mul_add(-x1649, x2875, x3852)),
+        );
+        let x3854 = Self::mul_add(
+            x2182,
+            x2940,
+            Self::mul_add(-x2179, x2944, Self::mul_add(x767, x2947, x766 * x2951)),
+        );
+        let x3855 = Self::mul_add(
+            x2185,
+            x2930,
+            Self::mul_add(x2184, x2933, Self::mul_add(-x2183, x2937, x3854)),
+        );
+        let x3856 = Self::mul_add(
+            -x2188,
+            x2925,
+            Self::mul_add(x2187, x2926, Self::mul_add(-x2186, x2928, x3855)),
+        );
+        let x3857 = -Self::mul_add(x2190, x2921, Self::mul_add(-x2189, x2923, x3856));
+        let x3858 = Self::mul_add(
+            -x2193,
+            x2940,
+            Self::mul_add(x2195, x2944, Self::mul_add(x768, x2947, x766 * x2954)),
+        );
+        let x3859 = Self::mul_add(
+            -x2197,
+            x2930,
+            Self::mul_add(-x2196, x2933, Self::mul_add(x2196, x2937, x3858)),
+        );
+        let x3860 = Self::mul_add(
+            x2200,
+            x2925,
+            Self::mul_add(-x2199, x2926, Self::mul_add(x2198, x2928, x3859)),
+        );
+        let x3861 = Self::mul_add(-x2202, x2921, Self::mul_add(x2201, x2923, x3860));
+        let x3862 = Self::mul_add(
+            x2207,
+            x2940,
+            Self::mul_add(-x2206, x2944, Self::mul_add(-x768, x2951, x767 * x2954)),
+        );
+        let x3863 = Self::mul_add(
+            x2209,
+            x2930,
+            Self::mul_add(x2208, x2933, Self::mul_add(-x2205, x2937, x3862)),
+        );
+        let x3864 = Self::mul_add(
+            -x2212,
+            x2925,
+            Self::mul_add(x2211, x2926, Self::mul_add(x2210, x2928, x3863)),
+        );
+        let x3865 = -Self::mul_add(x2214, x2921, Self::mul_add(-x2213, x2923, x3864));
+        let x3866 = Self::mul_add(
+            -x2219,
+            x2944,
+            Self::mul_add(x2218, x2947, Self::mul_add(-x2217, x2951, x2179 * x2954)),
+        );
+        let x3867 = Self::mul_add(
+            x2223,
+            x2933,
+            Self::mul_add(x2222, x2937, Self::mul_add(-x2220, x2940, x3866)),
+        );
+        let x3868 = Self::mul_add(
+            -x2226,
+            x2926,
+            Self::mul_add(x2225, x2928, Self::mul_add(x2224, x2930, x3867)),
+        );
+        let x3869 = Self::mul_add(
+            -x2229,
+            x2921,
+            Self::mul_add(x2228, x2923, Self::mul_add(x2227, x2925, x3868)),
+        );
+        let x3870 = -x3869;
+        let x3871 = Self::mul_add(
+            -x2235,
+            x2944,
+            Self::mul_add(x2234, x2947, Self::mul_add(x2193, x2951, x2233 * x2954)),
+        );
+        let x3872 = Self::mul_add(
+            x2238,
+            x2933,
+            Self::mul_add(-x2237, x2937, Self::mul_add(-x2236, x2940, x3871)),
+        );
+        let x3873 = Self::mul_add(
+            x2241,
+            x2926,
+            Self::mul_add(-x2240, x2928, Self::mul_add(x2239, x2930, x3872)),
+        );
+        let x3874 = Self::mul_add(
+            x2244,
+            x2921,
+            Self::mul_add(-x2243, x2923, Self::mul_add(-x2242, x2925, x3873)),
+        );
+        let x3875 = -x3874;
+        let x3876 = Self::mul_add(
+            x2247,
+            x2944,
+            Self::mul_add(x2205, x2947, Self::mul_add(-x2246, x2951, x2245 * x2954)),
+        );
+        let x3877 = Self::mul_add(
+            x2250,
+            x2933,
+            Self::mul_add(-x2249, x2937, Self::mul_add(-x2248, x2940, x3876)),
+        );
+        let x3878 = Self::mul_add(
+            x2253,
+            x2926,
+            Self::mul_add(-x2252, x2928, Self::mul_add(-x2251, x2930, x3877)),
+        );
+        let x3879 = Self::mul_add(
+            x2256,
+            x2921,
+            Self::mul_add(-x2255, x2923, Self::mul_add(-x2254, x2925, x3878)),
+        );
+        let x3880 = Self::mul_add(
+            -x2151,
+            x2944,
+            Self::mul_add(x2149, x2947, Self::mul_add(x2155, x2951, x2154 * x2954)),
+        );
+        let x3881 = Self::mul_add(
+            -x2157,
+            x2933,
+            Self::mul_add(x2153, x2937, Self::mul_add(x2152, x2940, x3880)),
+        );
+        let x3882 = Self::mul_add(
+            x2163,
+            x2926,
+            Self::mul_add(x2161, x2928, Self::mul_add(x2159, x2930, x3881)),
+        );
+        let x3883 = Self::mul_add(
+            x2169,
+            x2921,
+            Self::mul_add(-x2167, x2923, Self::mul_add(-x2165, x2925, x3882)),
+        );
+        let x3884 = Self::mul_add(
+            -x2082,
+            x2944,
+            Self::mul_add(x2087, x2947, Self::mul_add(x2086, x2951, x2085 * x2954)),
+        );
+        let x3885 = Self::mul_add(
+            -x2089,
+            x2933,
+            Self::mul_add(x2084, x2937, Self::mul_add(x2083, x2940, x3884)),
+        );
+        let x3886 = Self::mul_add(
+            x2095,
+            x2926,
+            Self::mul_add(x2093, x2928, Self::mul_add(x2091, x2930, x3885)),
+        );
+        let x3887 = Self::mul_add(
+            x2101,
+            x2921,
+            Self::mul_add(-x2099, x2923, Self::mul_add(-x2097, x2925, x3886)),
+        );
+        let x3888 = -x3887;
+        let x3889 = Self::mul_add(
+            -x1994,
+            x2944,
+            Self::mul_add(-x1999, x2947, Self::mul_add(x1998, x2951, x1997 * x2954)),
+        );
+        let x3890 = Self::mul_add(
+            x2001,
+            x2933,
+            Self::mul_add(-x1996, x2937, Self::mul_add(x1995, x2940, x3889)),
+        );
+        let x3891 = Self::mul_add(
+            -x2007,
+            x2926,
+            Self::mul_add(-x2005, x2928, Self::mul_add(x2003, x2930, x3890)),
+        );
+        let x3892 = Self::mul_add(
+            -x2013,
+            x2921,
+            Self::mul_add(x2011, x2923, Self::mul_add(x2009, x2925, x3891)),
+        );
+        let x3893 = Self::mul_add(
+            -x1905,
+            x2944,
+            Self::mul_add(x1910, x2947, Self::mul_add(x1909, x2951, x1908 * x2954)),
+        );
+        let x3894 = Self::mul_add(
+            -x1912,
+            x2933,
+            Self::mul_add(x1907, x2937, Self::mul_add(-x1906, x2940, x3893)),
+        );
+        let x3895 = Self::mul_add(
+            -x1919,
+            x2926,
+            Self::mul_add(-x1916, x2928, Self::mul_add(x1914, x2930, x3894)),
+        );
+        let x3896 = Self::mul_add(
+            -x1925,
+            x2921,
+            Self::mul_add(x1923, x2923, Self::mul_add(x1921, x2925, x3895)),
+        );
+        let x3897 = Self::mul_add(
+            -x1812,
+            x2944,
+            Self::mul_add(x1817, x2947, Self::mul_add(x1816, x2951, x1815 * x2954)),
+        );
+        let x3898 = Self::mul_add(
+            -x1819,
+            x2933,
+            Self::mul_add(x1814, x2937, Self::mul_add(-x1813, x2940, x3897)),
+        );
+        let x3899 = Self::mul_add(
+            -x1827,
+            x2926,
+            Self::mul_add(-x1825, x2928, Self::mul_add(x1821, x2930, x3898)),
+        );
+        let x3900 = Self::mul_add(
+            x1836,
+            x2921,
+            Self::mul_add(-x1833, x2923, Self::mul_add(-x1830, x2925, x3899)),
+        );
+        let x3901 = -x3900;
+        let x3902 = Self::mul_add(
+            -x1722,
+            x2944,
+            Self::mul_add(x1727, x2947, Self::mul_add(x1726, x2951, x1725 * x2954)),
+        );
+        let x3903 = Self::mul_add(
+            -x1729,
+            x2933,
+            Self::mul_add(x1724, x2937, Self::mul_add(-x1723, x2940, x3902)),
+        );
+        let x3904 = Self::mul_add(
+            -x1737,
+            x2926,
+            Self::mul_add(-x1735, x2928, Self::mul_add(x1731, x2930, x3903)),
+        );
+        let x3905 = Self::mul_add(
+            -x1743,
+            x2921,
+            Self::mul_add(x1741, x2923, Self::mul_add(-x1739, x2925, x3904)),
+        );
+        let x3906 = Self::mul_add(
+            -x1632,
+            x2944,
+            Self::mul_add(x1637, x2947, Self::mul_add(x1636, x2951, x1635 * x2954)),
+        );
+        let x3907 = Self::mul_add(
+            -x1639,
+            x2933,
+            Self::mul_add(x1634, x2937, Self::mul_add(-x1633, x2940, x3906)),
+        );
+        let x3908 = Self::mul_add(
+            -x1647,
+            x2926,
+            Self::mul_add(-x1645, x2928, Self::mul_add(x1641, x2930, x3907)),
+        );
+        let x3909 = Self::mul_add(
+            -x1653,
+            x2921,
+            Self::mul_add(x1651, x2923, Self::mul_add(-x1649, x2925, x3908)),
+        );
+        let x3910 = -x3909;
+        let x3911 = Self::mul_add(
+            x2182,
+            x2985,
+            Self::mul_add(-x2179, x2988, Self::mul_add(x767, x2992, x766 * x2995)),
+        );
+        let x3912 = Self::mul_add(
+            -x2185,
+            x2975,
+            Self::mul_add(-x2184, x2978, Self::mul_add(x2183, x2982, x3911)),
+        );
+        let x3913 = Self::mul_add(
+            x2188,
+            x2970,
+            Self::mul_add(-x2187, x2971, Self::mul_add(x2186, x2973, x3912)),
+        );
+        let x3914 = Self::mul_add(-x2190, x2966, Self::mul_add(x2189, x2968, x3913));
+        let x3915 = Self::mul_add(
+            -x2193,
+            x2985,
+            Self::mul_add(x2195, x2988, Self::mul_add(x768, x2992, x766 * x2999)),
+        );
+        let x3916 = Self::mul_add(
+            x2197,
+            x2975,
+            Self::mul_add(x2196, x2978, Self::mul_add(-x2196, x2982, x3915)),
+        );
+        let x3917 = Self::mul_add(
+            -x2200,
+            x2970,
+            Self::mul_add(x2199, x2971, Self::mul_add(-x2198, x2973, x3916)),
+        );
+        let x3918 = -Self::mul_add(x2202, x2966, Self::mul_add(-x2201, x2968, x3917));
+        let x3919 = Self::mul_add(
+            x2207,
+            x2985,
+            Self::mul_add(-x2206, x2988, Self::mul_add(-x768, x2995, x767 * x2999)),
+        );
+        let x3920 = Self::mul_add(
+            -x2209,
+            x2975,
+            Self::mul_add(-x2208, x2978, Self::mul_add(x2205, x2982, x3919)),
+        );
+        let x3921 = Self::mul_add(
+            x2212,
+            x2970,
+            Self::mul_add(-x2211, x2971, Self::mul_add(-x2210, x2973, x3920)),
+        );
+        let x3922 = Self::mul_add(-x2214, x2966, Self::mul_add(x2213, x2968, x3921));
+        let x3923 = Self::mul_add(
+            -x2219,
+            x2988,
+            Self::mul_add(x2218, x2992, Self::mul_add(-x2217, x2995, x2179 * x2999)),
+        );
+        let x3924 = Self::mul_add(
+            -x2223,
+            x2978,
+            Self::mul_add(-x2222, x2982, Self::mul_add(-x2220, x2985, x3923)),
+        );
+        let x3925 = Self::mul_add(
+            x2226,
+            x2971,
+            Self::mul_add(-x2225, x2973, Self::mul_add(-x2224, x2975, x3924)),
+        );
+        let x3926 = Self::mul_add(
+            x2229,
+            x2966,
+            Self::mul_add(-x2228, x2968, Self::mul_add(-x2227, x2970, x3925)),
+        );
+        let x3927 = Self::mul_add(
+            -x2235,
+            x2988,
+            Self::mul_add(x2234, x2992, Self::mul_add(x2193, x2995, x2233 * x2999)),
+        );
+        let x3928 = Self::mul_add(
+            -x2238,
+            x2978,
+            Self::mul_add(x2237, x2982, Self::mul_add(-x2236, x2985, x3927)),
+        );
+        let x3929 = Self::mul_add(
+            -x2241,
+            x2971,
+            Self::mul_add(x2240, x2973, Self::mul_add(-x2239, x2975, x3928)),
+        );
+        let x3930 = Self::mul_add(
+            -x2244,
+            x2966,
+            Self::mul_add(x2243, x2968, Self::mul_add(x2242, x2970, x3929)),
+        );
+        let x3931 = Self::mul_add(
+            x2247,
+            x2988,
+            Self::mul_add(x2205, x2992, Self::mul_add(-x2246, x2995, x2245 * x2999)),
+        );
+        let x3932 = Self::mul_add(
+            -x2250,
+            x2978,
+            Self::mul_add(x2249, x2982, Self::mul_add(-x2248, x2985, x3931)),
+        );
+        let x3933 = Self::mul_add(
+            -x2253,
+            x2971,
+            Self::mul_add(x2252, x2973, Self::mul_add(x2251, x2975, x3932)),
+        );
+        let x3934 = Self::mul_add(
+            -x2256,
+            x2966,
+            Self::mul_add(x2255, x2968, Self::mul_add(x2254, x2970, x3933)),
+        );
+        let x3935 = -x3934;
+        let x3936 = Self::mul_add(
+            -x2151,
+            x2988,
+            Self::mul_add(x2149, x2992, Self::mul_add(x2155, x2995, x2154 * x2999)),
+        );
+        let x3937 = Self::mul_add(
+            x2157,
+            x2978,
+            Self::mul_add(-x2153, x2982, Self::mul_add(x2152, x2985, x3936)),
+        );
+        let x3938 = Self::mul_add(
+            -x2163,
+            x2971,
+            Self::mul_add(-x2161, x2973, Self::mul_add(-x2159, x2975, x3937)),
+        );
+        let x3939 = Self::mul_add(
+            -x2169,
+            x2966,
+            Self::mul_add(x2167, x2968, Self::mul_add(x2165, x2970, x3938)),
+        );
+        let x3940 = -x3939;
+        let x3941 = Self::mul_add(
+            -x2082,
+            x2988,
+            Self::mul_add(x2087, x2992, Self::mul_add(x2086, x2995, x2085 * x2999)),
+        );
+        let x3942 = Self::mul_add(
+            x2089,
+            x2978,
+            Self::mul_add(-x2084, x2982, Self::mul_add(x2083, x2985, x3941)),
+        );
+        let x3943 = Self::mul_add(
+            -x2095,
+            x2971,
+            Self::mul_add(-x2093, x2973, Self::mul_add(-x2091, x2975, x3942)),
+        );
+        let x3944 = Self::mul_add(
+            -x2101,
+            x2966,
+            Self::mul_add(x2099, x2968, Self::mul_add(x2097, x2970, x3943)),
+        );
+        let x3945 = Self::mul_add(
+            -x1994,
+            x2988,
+            Self::mul_add(-x1999, x2992, Self::mul_add(x1998, x2995, x1997 * x2999)),
+        );
+        let x3946 = Self::mul_add(
+            -x2001,
+            x2978,
+            Self::mul_add(x1996, x2982, Self::mul_add(x1995, x2985, x3945)),
+        );
+        let x3947 = Self::mul_add(
+            x2007,
+            x2971,
+            Self::mul_add(x2005, x2973, Self::mul_add(-x2003, x2975, x3946)),
+        );
+        let x3948 = Self::mul_add(
+            x2013,
+            x2966,
+            Self::mul_add(-x2011, x2968, Self::mul_add(-x2009, x2970, x3947)),
+        );
+        let x3949 = -x3948;
+        let x3950 = Self::mul_add(
+            -x1905,
+            x2988,
+            Self::mul_add(x1910, x2992, Self::mul_add(x1909, x2995, x1908 * x2999)),
+        );
+        let x3951 = Self::mul_add(
+            x1912,
+            x2978,
+            Self::mul_add(-x1907, x2982, Self::mul_add(-x1906, x2985, x3950)),
+        );
+        let x3952 = Self::mul_add(
+            x1919,
+            x2971,
+            Self::mul_add(x1916, x2973, Self::mul_add(-x1914, x2975, x3951)),
+        );
+        let x3953 = Self::mul_add(
+            x1925,
+            x2966,
+            Self::mul_add(-x1923, x2968, Self::mul_add(-x1921, x2970, x3952)),
+        );
+        let x3954 = -x3953;
+        let x3955 = Self::mul_add(
+            -x1812,
+            x2988,
+            Self::mul_add(x1817, x2992, Self::mul_add(x1816, x2995, x1815 * x2999)),
+        );
+        let x3956 = Self::mul_add(
+            x1819,
+            x2978,
+            Self::mul_add(-x1814, x2982, Self::mul_add(-x1813, x2985, x3955)),
+        );
+        let x3957 = Self::mul_add(
+            x1827,
+            x2971,
+            Self::mul_add(x1825, x2973, Self::mul_add(-x1821, x2975, x3956)),
+        );
+        let x3958 = Self::mul_add(
+            -x1836,
+            x2966,
+            Self::mul_add(x1833, x2968, Self::mul_add(x1830, x2970, x3957)),
+        );
+        let x3959 = Self::mul_add(
+            -x1722,
+            x2988,
+            Self::mul_add(x1727, x2992, Self::mul_add(x1726, x2995, x1725 * x2999)),
+        );
+        let x3960 = Self::mul_add(
+            x1729,
+            x2978,
+            Self::mul_add(-x1724, x2982, Self::mul_add(-x1723, x2985, x3959)),
+        );
+        let x3961 = Self::mul_add(
+            x1737,
+            x2971,
+            Self::mul_add(x1735, x2973, Self::mul_add(-x1731, x2975, x3960)),
+        );
+        let x3962 = Self::mul_add(
+            x1743,
+            x2966,
+            Self::mul_add(-x1741, x2968, Self::mul_add(x1739, x2970, x3961)),
+        );
+        let x3963 = -x3962;
+        let x3964 = Self::mul_add(
+            -x1632,
+            x2988,
+            Self::mul_add(x1637, x2992, Self::mul_add(x1636, x2995, x1635 * x2999)),
+        );
+        let x3965 = Self::mul_add(
+            x1639,
+            x2978,
+            Self::mul_add(-x1634, x2982, Self::mul_add(-x1633, x2985, x3964)),
+        );
+        let x3966 = Self::mul_add(
+            x1647,
+            x2971,
+            Self::mul_add(x1645, x2973, Self::mul_add(-x1641, x2975, x3965)),
+        );
+        let x3967 = Self::mul_add(
+            x1653,
+            x2966,
+            Self::mul_add(-x1651, x2968, Self::mul_add(x1649, x2970, x3966)),
+        );
+        let x3968 = Self::mul_add(
+            x2182,
+            x3032,
+            Self::mul_add(-x2179, x3035, Self::mul_add(x767, x3039, x766 * x3042)),
+        );
+        let x3969 = Self::mul_add(
+            -x2185,
+            x3022,
+            Self::mul_add(x2184, x3025, Self::mul_add(-x2183, x3028, x3968)),
+        );
+        let x3970 = Self::mul_add(
+            -x2188,
+            x3014,
+            Self::mul_add(x2187, x3016, Self::mul_add(-x2186, x3019, x3969)),
+        );
+        let x3971 = Self::mul_add(-x2190, x3010, Self::mul_add(x2189, x3012, x3970));
+        let x3972 = Self::mul_add(
+            -x2193,
+            x3032,
+            Self::mul_add(x2195, x3035, Self::mul_add(x768, x3039, x766 * x3046)),
+        );
+        let x3973 = Self::mul_add(
+            x2197,
+            x3022,
+            Self::mul_add(-x2196, x3025, Self::mul_add(x2196, x3028, x3972)),
+        );
+        let x3974 = Self::mul_add(
+            x2200,
+            x3014,
+            Self::mul_add(-x2199, x3016, Self::mul_add(x2198, x3019, x3973)),
+        );
+        let x3975 = -Self::mul_add(x2202, x3010, Self::mul_add(-x2201, x3012, x3974));
+        let x3976 = Self::mul_add(
+            x2207,
+            x3032,
+            Self::mul_add(-x2206, x3035, Self::mul_add(-x768, x3042, x767 * x3046)),
+        );
+        let x3977 = Self::mul_add(
+            -x2209,
+            x3022,
+            Self::mul_add(x2208, x3025, Self::mul_add(-x2205, x3028, x3976)),
+        );
+        let x3978 = Self::mul_add(
+            -x2212,
+            x3014,
+            Self::mul_add(x2211, x3016, Self::mul_add(x2210, x3019, x3977)),
+        );
+        let x3979 = Self::mul_add(-x2214, x3010, Self::mul_add(x2213, x3012, x3978));
+        let x3980 = Self::mul_add(
+            -x2219,
+            x3035,
+            Self::mul_add(x2218, x3039, Self::mul_add(-x2217, x3042, x2179 * x3046)),
+        );
+        let x3981 = Self::mul_add(
+            x2223,
+            x3025,
+            Self::mul_add(x2222, x3028, Self::mul_add(-x2220, x3032, x3980)),
+        );
+        let x3982 = Self::mul_add(
+            -x2226,
+            x3016,
+            Self::mul_add(x2225, x3019, Self::mul_add(-x2224, x3022, x3981)),
+        );
+        let x3983 = Self::mul_add(
+            x2229,
+            x3010,
+            Self::mul_add(-x2228, x3012, Self::mul_add(x2227, x3014, x3982)),
+        );
+        let x3984 = Self::mul_add(
+            -x2235,
+            x3035,
+            Self::mul_add(x2234, x3039, Self::mul_add(x2193, x3042, x2233 * x3046)),
+        );
+        let x3985 = Self::mul_add(
+            x2238,
+            x3025,
+            Self::mul_add(-x2237, x3028, Self::mul_add(-x2236, x3032, x3984)),
+        );
+        let x3986 = Self::mul_add(
+            x2241,
+            x3016,
+            Self::mul_add(-x2240, x3019, Self::mul_add(-x2239, x3022, x3985)),
+        );
+        let x3987 = Self::mul_add(
+            -x2244,
+            x3010,
+            Self::mul_add(x2243, x3012, Self::mul_add(-x2242, x3014, x3986)),
+        );
+        let x3988 = Self::mul_add(
+            x2247,
+            x3035,
+            Self::mul_add(x2205, x3039, Self::mul_add(-x2246, x3042, x2245 * x3046)),
+        );
+        let x3989 = Self::mul_add(
+            x2250,
+            x3025,
+            Self::mul_add(-x2249, x3028, Self::mul_add(-x2248, x3032, x3988)),
+        );
+        let x3990 = Self::mul_add(
+            x2253,
+            x3016,
+            Self::mul_add(-x2252, x3019, Self::mul_add(x2251, x3022, x3989)),
+        );
+        let x3991 = Self::mul_add(
+            -x2256,
+            x3010,
+            Self::mul_add(x2255, x3012, Self::mul_add(-x2254, x3014, x3990)),
+        );
+        let x3992 = -x3991;
+        let x3993 = Self::mul_add(
+            -x2151,
+            x3035,
+            Self::mul_add(x2149, x3039, Self::mul_add(x2155, x3042, x2154 * x3046)),
+        );
+        let x3994 = Self::mul_add(
+            -x2157,
+            x3025,
+            Self::mul_add(x2153, x3028, Self::mul_add(x2152, x3032, x3993)),
+        );
+        let x3995 = Self::mul_add(
+            x2163,
+            x3016,
+            Self::mul_add(x2161, x3019, Self::mul_add(-x2159, x3022, x3994)),
+        );
+        let x3996 = Self::mul_add(
+            -x2169,
+            x3010,
+            Self::mul_add(x2167, x3012, Self::mul_add(-x2165, x3014, x3995)),
+        );
+        let x3997 = -x3996;
+        let x3998 = Self::mul_add(
+            -x2082,
+            x3035,
+            Self::mul_add(x2087, x3039, Self::mul_add(x2086, x3042, x2085 * x3046)),
+        );
+        let x3999 = Self::mul_add(
+            -x2089,
+            x3025,
+            Self::mul_add(x2084, x3028, Self::mul_add(x2083, x3032, x3998)),
+        );
+        let x4000 = Self::mul_add(
+            x2095,
+            x3016,
+            Self::mul_add(x2093, x3019, Self::mul_add(-x2091, x3022, x3999)),
+        );
+        let x4001 = Self::mul_add(
+            -x2101,
+            x3010,
+            Self::mul_add(x2099, x3012, Self::mul_add(-x2097, x3014, x4000)),
+        );
+        let x4002 = Self::mul_add(
+            -x1994,
+            x3035,
+            Self::mul_add(-x1999, x3039, Self::mul_add(x1998, x3042, x1997 * x3046)),
+        );
+        let x4003 = Self::mul_add(
+            x2001,
+            x3025,
+            Self::mul_add(-x1996, x3028, Self::mul_add(x1995, x3032, x4002)),
+        );
+        let x4004 = Self::mul_add(
+            -x2007,
+            x3016,
+            Self::mul_add(-x2005, x3019, Self::mul_add(-x2003, x3022, x4003)),
+        );
+        let x4005 = Self::mul_add(
+            x2013,
+            x3010,
+            Self::mul_add(-x2011, x3012, Self::mul_add(x2009, x3014, x4004)),
+        );
+        let x4006 = -x4005;
+        let x4007 = Self::mul_add(
+            -x1905,
+            x3035,
+            Self::mul_add(x1910, x3039, Self::mul_add(x1909, x3042, x1908 * x3046)),
+        );
+        let x4008 = Self::mul_add(
+            -x1912,
+            x3025,
+            Self::mul_add(x1907, x3028, Self::mul_add(-x1906, x3032, x4007)),
+        );
+        let x4009 = Self::mul_add(
+            -x1919,
+            x3016,
+            Self::mul_add(-x1916, x3019, Self::mul_add(-x1914, x3022, x4008)),
+        );
+        let x4010 = Self::mul_add(
+            x1925,
+            x3010,
+            Self::mul_add(-x1923, x3012, Self::mul_add(x1921, x3014, x4009)),
+        );
+        let x4011 = -x4010;
+        let x4012 = Self::mul_add(
+            -x1812,
+            x3035,
+            Self::mul_add(x1817, x3039, Self::mul_add(x1816, x3042, x1815 * x3046)),
+        );
+        let x4013 = Self::mul_add(
+            -x1819,
+            x3025,
+            Self::mul_add(x1814, x3028, Self::mul_add(-x1813, x3032, x4012)),
+        );
+        let x4014 = Self::mul_add(
+            -x1827,
+            x3016,
+            Self::mul_add(-x1825, x3019, Self::mul_add(-x1821, x3022, x4013)),
+        );
+        let x4015 = Self::mul_add(
+            -x1836,
+            x3010,
+            Self::mul_add(x1833, x3012, Self::mul_add(-x1830, x3014, x4014)),
+        );
+        let x4016 = Self::mul_add(
+            -x1722,
+            x3035,
+            Self::mul_add(x1727, x3039, Self::mul_add(x1726, x3042, x1725 * x3046)),
+        );
+        let x4017 = Self::mul_add(
+            -x1729,
+            x3025,
+            Self::mul_add(x1724, x3028, Self::mul_add(-x1723, x3032, x4016)),
+        );
+        let x4018 = Self::mul_add(
+            -x1737,
+            x3016,
+            Self::mul_add(-x1735, x3019, Self::mul_add(-x1731, x3022, x4017)),
+        );
+        let x4019 = Self::mul_add(
+            x1743,
+            x3010,
+            Self::mul_add(-x1741, x3012, Self::mul_add(-x1739, x3014, x4018)),
+        );
+        let x4020 = -x4019;
+        let x4021 = Self::mul_add(
+            -x1632,
+            x3035,
+            Self::mul_add(x1637, x3039, Self::mul_add(x1636, x3042, x1635 * x3046)),
+        );
+        let x4022 = Self::mul_add(
+            -x1639,
+            x3025,
+            Self::mul_add(x1634, x3028, Self::mul_add(-x1633, x3032, x4021)),
+        );
+        let x4023 = Self::mul_add(
+            -x1647,
+            x3016,
+            Self::mul_add(-x1645, x3019, Self::mul_add(-x1641, x3022, x4022)),
+        );
+        let x4024 = Self::mul_add(
+            x1653,
+            x3010,
+            Self::mul_add(-x1651, x3012, Self::mul_add(-x1649, x3014, x4023)),
+        );
+        let x4025 = Self::mul_add(
+            x2182,
+            x3068,
+            Self::mul_add(-x2179, x3072, Self::mul_add(x767, x3075, x766 * x3079)),
+        );
+        let x4026 = Self::mul_add(
+            -x2185,
+            x3061,
+            Self::mul_add(-x2184, x3063, Self::mul_add(-x2183, x3065, x4025)),
+        );
+        let x4027 = Self::mul_add(
+            -x2188,
+            x3056,
+            Self::mul_add(x2187, x3057, Self::mul_add(-x2186, x3059, x4026)),
+        );
+        let x4028 = -Self::mul_add(-x2190, x3054, Self::mul_add(x2189, x3055, x4027));
+        let x4029 = Self::mul_add(
+            -x2193,
+            x3068,
+            Self::mul_add(x2195, x3072, Self::mul_add(x768, x3075, x766 * x3082)),
+        );
+        let x4030 = Self::mul_add(
+            x2197,
+            x3061,
+            Self::mul_add(x2196, x3063, Self::mul_add(x2196, x3065, x4029)),
+        );
+        let x4031 = Self::mul_add(
+            x2200,
+            x3056,
+            Self::mul_add(-x2199, x3057, Self::mul_add(x2198, x3059, x4030)),
+        );
+        let x4032 = Self::mul_add(x2202, x3054, Self::mul_add(-x2201, x3055, x4031));
+        let x4033 = Self::mul_add(
+            x2207,
+            x3068,
+            Self::mul_add(-x2206, x3072, Self::mul_add(-x768, x3079, x767 * x3082)),
+        );
+        let x4034 = Self::mul_add(
+            -x2209,
+            x3061,
+            Self::mul_add(-x2208, x3063, Self::mul_add(-x2205, x3065, x4033)),
+        );
+        let x4035 = Self::mul_add(
+            -x2212,
+            x3056,
+            Self::mul_add(x2211, x3057, Self::mul_add(x2210, x3059, x4034)),
+        );
+        let x4036 = -Self::mul_add(-x2214, x3054, Self::mul_add(x2213, x3055, x4035));
+        let x4037 = Self::mul_add(
+            -x2219,
+            x3072,
+            Self::mul_add(x2218, x3075, Self::mul_add(-x2217, x3079, x2179 * x3082)),
+        );
+        let x4038 = Self::mul_add(
+            -x2223,
+            x3063,
+            Self::mul_add(x2222, x3065, Self::mul_add(-x2220, x3068, x4037)),
+        );
+        let x4039 = Self::mul_add(
+            -x2226,
+            x3057,
+            Self::mul_add(x2225, x3059, Self::mul_add(-x2224, x3061, x4038)),
+        );
+        let x4040 = Self::mul_add(
+            x2229,
+            x3054,
+            Self::mul_add(-x2228, x3055, Self::mul_add(x2227, x3056, x4039)),
+        );
+        let x4041 = -x4040;
+        let x4042 = Self::mul_add(
+            -x2235,
+            x3072,
+            Self::mul_add(x2234, x3075, Self::mul_add(x2193, x3079, x2233 * x3082)),
+        );
+        let x4043 = Self::mul_add(
+            -x2238,
+            x3063,
+            Self::mul_add(-x2237, x3065, Self::mul_add(-x2236, x3068, x4042)),
+        );
+        let x4044 = Self::mul_add(
+            x2241,
+            x3057,
+            Self::mul_add(-x2240, x3059, Self::mul_add(-x2239, x3061, x4043)),
+        );
+        let x4045 = Self::mul_add(
+            -x2244,
+            x3054,
+            Self::mul_add(x2243, x3055, Self::mul_add(-x2242, x3056, x4044)),
+        );
+        let x4046 = -x4045;
+        let x4047 = Self::mul_add(
+            x2247,
+            x3072,
+            Self::mul_add(x2205, x3075, Self::mul_add(-x2246, x3079, x2245 * x3082)),
+        );
+        let x4048 = Self::mul_add(
+            -x2250,
+            x3063,
+            Self::mul_add(-x2249, x3065, Self::mul_add(-x2248, x3068, x4047)),
+        );
+        let x4049 = Self::mul_add(
+            x2253,
+            x3057,
+            Self::mul_add(-x2252, x3059, Self::mul_add(x2251, x3061, x4048)),
+        );
+        let x4050 = Self::mul_add(
+            -x2256,
+            x3054,
+            Self::mul_add(x2255, x3055, Self::mul_add(-x2254, x3056, x4049)),
+        );
+        let x4051 = Self::mul_add(
+            -x2151,
+            x3072,
+            Self::mul_add(x2149, x3075, Self::mul_add(x2155, x3079, x2154 * x3082)),
+        );
+        let x4052 = Self::mul_add(
+            x2157,
+            x3063,
+            Self::mul_add(x2153, x3065, Self::mul_add(x2152, x3068, x4051)),
+        );
+        let x4053 = Self::mul_add(
+            x2163,
+            x3057,
+            Self::mul_add(x2161, x3059, Self::mul_add(-x2159, x3061, x4052)),
+        );
+        let x4054 = Self::mul_add(
+            -x2169,
+            x3054,
+            Self::mul_add(x2167, x3055, Self::mul_add(-x2165, x3056, x4053)),
+        );
+        let x4055 = Self::mul_add(
+            -x2082,
+            x3072,
+            Self::mul_add(x2087, x3075, Self::mul_add(x2086, x3079, x2085 * x3082)),
+        );
+        let x4056 = Self::mul_add(
+            x2089,
+            x3063,
+            Self::mul_add(x2084, x3065, Self::mul_add(x2083, x3068, x4055)),
+        );
+        let x4057 = Self::mul_add(
+            x2095,
+            x3057,
+            Self::mul_add(x2093, x3059, Self::mul_add(-x2091, x3061, x4056)),
+        );
+        let x4058 = Self::mul_add(
+            -x2101,
+            x3054,
+            Self::mul_add(x2099, x3055, Self::mul_add(-x2097, x3056, x4057)),
+        );
+        let x4059 = -x4058;
+        let x4060 = Self::mul_add(
+            -x1994,
+            x3072,
+            Self::mul_add(-x1999, x3075, Self::mul_add(x1998, x3079, x1997 * x3082)),
+        );
+        let x4061 = Self::mul_add(
+            -x2001,
+            x3063,
+            Self::mul_add(-x1996, x3065, Self::mul_add(x1995, x3068, x4060)),
+        );
+        let x4062 = Self::mul_add(
+            -x2007,
+            x3057,
+            Self::mul_add(-x2005, x3059, Self::mul_add(-x2003, x3061, x4061)),
+        );
+        let x4063 = Self::mul_add(
+            x2013,
+            x3054,
+            Self::mul_add(-x2011, x3055, Self::mul_add(x2009, x3056, x4062)),
+        );
+        let x4064 = Self::mul_add(
+            -x1905,
+            x3072,
+            Self::mul_add(x1910, x3075, Self::mul_add(x1909, x3079, x1908 * x3082)),
+        );
+        let x4065 = Self::mul_add(
+            x1912,
+            x3063,
+            Self::mul_add(x1907, x3065, Self::mul_add(-x1906, x3068, x4064)),
+        );
+        let x4066 = Self::mul_add(
+            -x1919,
+            x3057,
+            Self::mul_add(-x1916, x3059, Self::mul_add(-x1914, x3061, x4065)),
+        );
+        let x4067 = Self::mul_add(
+            x1925,
+            x3054,
+            Self::mul_add(-x1923, x3055, Self::mul_add(x1921, x3056, x4066)),
+        );
+        let x4068 = Self::mul_add(
+            -x1812,
+            x3072,
+            Self::mul_add(x1817, x3075, Self::mul_add(x1816, x3079, x1815 * x3082)),
+        );
+        let x4069 = Self::mul_add(
+            x1819,
+            x3063,
+            Self::mul_add(x1814, x3065, Self::mul_add(-x1813, x3068, x4068)),
+        );
+        let x4070 = Self::mul_add(
+            -x1827,
+            x3057,
+            Self::mul_add(-x1825, x3059, Self::mul_add(-x1821, x3061, x4069)),
+        );
+        let x4071 = Self::mul_add(
+            -x1836,
+            x3054,
+            Self::mul_add(x1833, x3055, Self::mul_add(-x1830, x3056, x4070)),
+        );
+        let x4072 = -x4071;
+        let x4073 = Self::mul_add(
+            -x1722,
+            x3072,
+            Self::mul_add(x1727, x3075, Self::mul_add(x1726, x3079, x1725 * x3082)),
+        );
+        let x4074 = Self::mul_add(
+            x1729,
+            x3063,
+            Self::mul_add(x1724, x3065, Self::mul_add(-x1723, x3068, x4073)),
+        );
+        let x4075 = Self::mul_add(
+            -x1737,
+            x3057,
+            Self::mul_add(-x1735, x3059, Self::mul_add(-x1731, x3061, x4074)),
+        );
+        let x4076 = Self::mul_add(
+            x1743,
+            x3054,
+            Self::mul_add(-x1741, x3055, Self::mul_add(-x1739, x3056, x4075)),
+        );
+        let x4077 = Self::mul_add(
+            -x1632,
+            x3072,
+            Self::mul_add(x1637, x3075, Self::mul_add(x1636, x3079, x1635 * x3082)),
+        );
+        let x4078 = Self::mul_add(
+            x1639,
+            x3063,
+            Self::mul_add(x1634, x3065, Self::mul_add(-x1633, x3068, x4077)),
+        );
+        let x4079 = Self::mul_add(
+            -x1647,
+            x3057,
+            Self::mul_add(-x1645, x3059, Self::mul_add(-x1641, x3061, x4078)),
+        );
+        let x4080 = Self::mul_add(
+            x1653,
+            x3054,
+            Self::mul_add(-x1651, x3055, Self::mul_add(-x1649, x3056, x4079)),
+        );
+        let x4081 = -x4080;
+        let x4082 = Self::mul_add(
+            x2182,
+            x3103,
+            Self::mul_add(-x2179, x3107, Self::mul_add(x767, x3110, x766 * x3114)),
+        );
+        let x4083 = Self::mul_add(
+            -x2185,
+            x3096,
+            Self::mul_add(-x2184, x3098, Self::mul_add(-x2183, x3100, x4082)),
+        );
+        let x4084 = Self::mul_add(
+            -x2188,
+            x3091,
+            Self::mul_add(x2187, x3092, Self::mul_add(-x2186, x3094, x4083)),
+        );
+        let x4085 = -Self::mul_add(x2190, x3087, Self::mul_add(-x2189, x3089, x4084));
+        let x4086 = Self::mul_add(
+            -x2193,
+            x3103,
+            Self::mul_add(x2195, x3107, Self::mul_add(x768, x3110, x766 * x3117)),
+        );
+        let x4087 = Self::mul_add(
+            x2197,
+            x3096,
+            Self::mul_add(x2196, x3098, Self::mul_add(x2196, x3100, x4086)),
+        );
+        let x4088 = Self::mul_add(
+            x2200,
+            x3091,
+            Self::mul_add(-x2199, x3092, Self::mul_add(x2198, x3094, x4087)),
+        );
+        let x4089 = Self::mul_add(-x2202, x3087, Self::mul_add(x2201, x3089, x4088));
+        let x4090 = Self::mul_add(
+            x2207,
+            x3103,
+            Self::mul_add(-x2206, x3107, Self::mul_add(-x768, x3114, x767 * x3117)),
+        );
+        let x4091 = Self::mul_add(
+            -x2209,
+            x3096,
+            Self::mul_add(-x2208, x3098, Self::mul_add(-x2205, x3100, x4090)),
+        );
+        let x4092 = Self::mul_add(
+            -x2212,
+            x3091,
+            Self::mul_add(x2211, x3092, Self::mul_add(x2210, x3094, x4091)),
+        );
+        let x4093 = -Self::mul_add(x2214, x3087, Self::mul_add(-x2213, x3089, x4092));
+        let x4094 = Self::mul_add(
+            -x2219,
+            x3107,
+            Self::mul_add(x2218, x3110, Self::mul_add(-x2217, x3114, x2179 * x3117)),
+        );
+        let x4095 = Self::mul_add(
+            -x2223,
+            x3098,
+            Self::mul_add(x2222, x3100, Self::mul_add(-x2220, x3103, x4094)),
+        );
+        let x4096 = Self::mul_add(
+            -x2226,
+            x3092,
+            Self::mul_add(x2225, x3094, Self::mul_add(-x2224, x3096, x4095)),
+        );
+        let x4097 = Self::mul_add(
+            -x2229,
+            x3087,
+            Self::mul_add(x2228, x3089, Self::mul_add(x2227, x3091, x4096)),
+        );
+        let x4098 = -x4097;
+        let x4099 = Self::mul_add(
+            -x2235,
+            x3107,
+            Self::mul_add(x2234, x3110, Self::mul_add(x2193, x3114, x2233 * x3117)),
+        );
+        let x4100 = Self::mul_add(
+            -x2238,
+            x3098,
+            Self::mul_add(-x2237, x3100, Self::mul_add(-x2236, x3103, x4099)),
+        );
+        let x4101 = Self::mul_add(
+            x2241,
+            x3092,
+            Self::mul_add(-x2240, x3094, Self::mul_add(-x2239, x3096, x4100)),
+        );
+        let x4102 = Self::mul_add(
+            x2244,
+            x3087,
+            Self::mul_add(-x2243, x3089, Self::mul_add(-x2242, x3091, x4101)),
+        );
+        let x4103 = -x4102;
+        let x4104 = Self::mul_add(
+            x2247,
+            x3107,
+            Self::mul_add(x2205, x3110, Self::mul_add(-x2246, x3114, x2245 * x3117)),
+        );
+        let x4105 = Self::mul_add(
+            -x2250,
+            x3098,
+            Self::mul_add(-x2249, x3100, Self::mul_add(-x2248, x3103, x4104)),
+        );
+        let x4106 = Self::mul_add(
+            x2253,
+            x3092,
+            Self::mul_add(-x2252, x3094, Self::mul_add(x2251, x3096, x4105)),
+        );
+        let x4107 = Self::mul_add(
+            x2256,
+            x3087,
+            Self::mul_add(-x2255, x3089, Self::mul_add(-x2254, x3091, x4106)),
+        );
+        let x4108 = Self::mul_add(
+            -x2151,
+            x3107,
+            Self::mul_add(x2149, x3110, Self::mul_add(x2155, x3114, x2154 * x3117)),
+        );
+        let x4109 = Self::mul_add(
+            x2157,
+            x3098,
+            Self::mul_add(x2153, x3100, Self::mul_add(x2152, x3103, x4108)),
+        );
+        let x4110 = Self::mul_add(
+            x2163,
+            x3092,
+            Self::mul_add(x2161, x3094, Self::mul_add(-x2159, x3096, x4109)),
+        );
+        let x4111 = Self::mul_add(
+            x2169,
+            x3087,
+            Self::mul_add(-x2167, x3089, Self::mul_add(-x2165, x3091, x4110)),
+        );
+        let x4112 = Self::mul_add(
+            -x2082,
+            x3107,
+            Self::mul_add(x2087, x3110, Self::mul_add(x2086, x3114, x2085 * x3117)),
+        );
+        let x4113 = Self::mul_add(
+            x2089,
+            x3098,
+            Self::mul_add(x2084, x3100, Self::mul_add(x2083, x3103, x4112)),
+        );
+        let x4114 = Self::mul_add(
+            x2095,
+            x3092,
+            Self::mul_add(x2093, x3094, Self::mul_add(-x2091, x3096, x4113)),
+        );
+        let x4115 = Self::mul_add(
+            x2101,
+            x3087,
+            Self::mul_add(-x2099, x3089, Self::mul_add(-x2097, x3091, x4114)),
+        );
+        let x4116 = -x4115;
+        let x4117 = Self::mul_add(
+            -x1994,
+            x3107,
+            Self::mul_add(-x1999, x3110, Self::mul_add(x1998, x3114, x1997 * x3117)),
+        );
+        let x4118 = Self::mul_add(
+            -x2001,
+            x3098,
+            Self::mul_add(-x1996, x3100, Self::mul_add(x1995, x3103, x4117)),
+        );
+        let x4119 = Self::mul_add(
+            -x2007,
+            x3092,
+            Self::mul_add(-x2005, x3094, Self::mul_add(-x2003, x3096, x4118)),
+        );
+        let x4120 = Self::mul_add(
+            -x2013,
+            x3087,
+            Self::mul_add(x2011, x3089, Self::mul_add(x2009, x3091, x4119)),
+        );
+        let x4121 = Self::mul_add(
+            -x1905,
+            x3107,
+            Self::mul_add(x1910, x3110, Self::mul_add(x1909, x3114, x1908 * x3117)),
+        );
+        let x4122 = Self::mul_add(
+            x1912,
+            x3098,
+            Self::mul_add(x1907, x3100, Self::mul_add(-x1906, x3103, x4121)),
+        );
+        let x4123 = Self::mul_add(
+            -x1919,
+            x3092,
+            Self::mul_add(-x1916, x3094, Self::mul_add(-x1914, x3096, x4122)),
+        );
+        let x4124 = Self::mul_add(
+            -x1925,
+            x3087,
+            Self::mul_add(x1923, x3089, Self::mul_add(x1921, x3091, x4123)),
+        );
+        let x4125 = Self::mul_add(
+            -x1812,
+            x3107,
+            Self::mul_add(x1817, x3110, Self::mul_add(x1816, x3114, x1815 * x3117)),
+        );
+        let x4126 = Self::mul_add(
+            x1819,
+            x3098,
+            Self::mul_add(x1814, x3100, Self::mul_add(-x1813, x3103, x4125)),
+        );
+        let x4127 = Self::mul_add(
+            -x1827,
+            x3092,
+            Self::mul_add(-x1825, x3094, Self::mul_add(-x1821, x3096, x4126)),
+        );
+        let x4128 = Self::mul_add(
+            x1836,
+            x3087,
+            Self::mul_add(-x1833, x3089, Self::mul_add(-x1830, x3091, x4127)),
+        );
+        let x4129 = -x4128;
+        let x4130 = Self::mul_add(
+            -x1722,
+            x3107,
+            Self::mul_add(x1727, x3110, Self::mul_add(x1726, x3114, x1725 * x3117)),
+        );
+        let x4131 = Self::mul_add(
+            x1729,
+            x3098,
+            Self::mul_add(x1724, x3100, Self::mul_add(-x1723, x3103, x4130)),
+        );
+        let x4132 = Self::mul_add(
+            -x1737,
+            x3092,
+            Self::mul_add(-x1735, x3094, Self::mul_add(-x1731, x3096, x4131)),
+        );
+        let x4133 = Self::mul_add(
+            -x1743,
+            x3087,
+            Self::mul_add(x1741, x3089, Self::mul_add(-x1739, x3091, x4132)),
+        );
+        let x4134 = Self::mul_add(
+            -x1632,
+            x3107,
+            Self::mul_add(x1637, x3110, Self::mul_add(x1636, x3114, x1635 * x3117)),
+        );
+        let x4135 = Self::mul_add(
+            x1639,
+            x3098,
+            Self::mul_add(x1634, x3100, Self::mul_add(-x1633, x3103, x4134)),
+        );
+        let x4136 = Self::mul_add(
+            -x1647,
+            x3092,
+            Self::mul_add(-x1645, x3094, Self::mul_add(-x1641, x3096, x4135)),
+        );
+        let x4137 = Self::mul_add(
+            -x1653,
+            x3087,
+            Self::mul_add(x1651, x3089, Self::mul_add(-x1649, x3091, x4136)),
+        );
+        let x4138 = -x4137;
+        let x4139 = Self::mul_add(
+            x2182,
+            x3137,
+            Self::mul_add(-x2179, x3141, Self::mul_add(x767, x3144, x766 * x3148)),
+        );
+        let x4140 = Self::mul_add(
+            -x2185,
+            x3130,
+            Self::mul_add(-x2184, x3132, Self::mul_add(-x2183, x3134, x4139)),
+        );
+        let x4141 = Self::mul_add(
+            x2188,
+            x3123,
+            Self::mul_add(-x2187, x3125, Self::mul_add(-x2186, x3128, x4140)),
+        );
+        let x4142 = -Self::mul_add(-x2190, x3121, Self::mul_add(x2189, x3122, x4141));
+        let x4143 = Self::mul_add(
+            -x2193,
+            x3137,
+            Self::mul_add(x2195, x3141, Self::mul_add(x768, x3144, x766 * x3151)),
+        );
+        let x4144 = Self::mul_add(
+            x2197,
+            x3130,
+            Self::mul_add(x2196, x3132, Self::mul_add(x2196, x3134, x4143)),
+        );
+        let x4145 = Self::mul_add(
+            -x2200,
+            x3123,
+            Self::mul_add(x2199, x3125, Self::mul_add(x2198, x3128, x4144)),
+        );
+        let x4146 = Self::mul_add(x2202, x3121, Self::mul_add(-x2201, x3122, x4145));
+        let x4147 = Self::mul_add(
+            x2207,
+            x3137,
+            Self::mul_add(-x2206, x3141, Self::mul_add(-x768, x3148, x767 * x3151)),
+        );
+        let x4148 = Self::mul_add(
+            -x2209,
+            x3130,
+            Self::mul_add(-x2208, x3132, Self::mul_add(-x2205, x3134, x4147)),
+        );
+        let x4149 = Self::mul_add(
+            x2212,
+            x3123,
+            Self::mul_add(-x2211, x3125, Self::mul_add(x2210, x3128, x4148)),
+        );
+        let x4150 = -Self::mul_add(-x2214, x3121, Self::mul_add(x2213, x3122, x4149));
+        let x4151 = Self::mul_add(
+            -x2219,
+            x3141,
+            Self::mul_add(x2218, x3144, Self::mul_add(-x2217, x3148, x2179 * x3151)),
+        );
+        let x4152 = Self::mul_add(
+            -x2223,
+            x3132,
+            Self::mul_add(x2222, x3134, Self::mul_add(-x2220, x3137, x4151)),
+        );
+        let x4153 = Self::mul_add(
+            x2226,
+            x3125,
+            Self::mul_add(x2225, x3128, Self::mul_add(-x2224, x3130, x4152)),
+        );
+        let x4154 = Self::mul_add(
+            x2229,
+            x3121,
+            Self::mul_add(-x2228, x3122, Self::mul_add(-x2227, x3123, x4153)),
+        );
+        let x4155 = -x4154;
+        let x4156 = Self::mul_add(
+            -x2235,
+            x3141,
+            Self::mul_add(x2234, x3144, Self::mul_add(x2193, x3148, x2233 * x3151)),
+        );
+        let x4157 = Self::mul_add(
+            -x2238,
+            x3132,
+            Self::mul_add(-x2237, x3134, Self::mul_add(-x2236, x3137, x4156)),
+        );
+        let x4158 = Self::mul_add(
+            -x2241,
+            x3125,
+            Self::mul_add(-x2240, x3128, Self::mul_add(-x2239, x3130, x4157)),
+        );
+        let x4159 = Self::mul_add(
+            -x2244,
+            x3121,
+            Self::mul_add(x2243, x3122, Self::mul_add(x2242, x3123, x4158)),
+        );
+        let x4160 = -x4159;
+        let x4161 = Self::mul_add(
+            x2247,
+            x3141,
+            Self::mul_add(x2205, x3144, Self::mul_add(-x2246, x3148, x2245 * x3151)),
+        );
+        let x4162 = Self::mul_add(
+            -x2250,
+            x3132,
+            Self::mul_add(-x2249, x3134, Self::mul_add(-x2248, x3137, x4161)),
+        );
+        let x4163 = Self::mul_add(
+            -x2253,
+            x3125,
+            Self::mul_add(-x2252, x3128, Self::mul_add(x2251, x3130, x4162)),
+        );
+        let x4164 = Self::mul_add(
+            -x2256,
+            x3121,
+            Self::mul_add(x2255, x3122, Self::mul_add(x2254, x3123, x4163)),
+        );
+        let x4165 = Self::mul_add(
+            -x2151,
+            x3141,
+            Self::mul_add(x2149, x3144, Self::mul_add(x2155, x3148, x2154 * x3151)),
+        );
+        let x4166 = Self::mul_add(
+            x2157,
+            x3132,
+            Self::mul_add(x2153, x3134, Self::mul_add(x2152, x3137, x4165)),
+        );
+        let x4167 = Self::mul_add(
+            -x2163,
+            x3125,
+            Self::mul_add(x2161, x3128, Self::mul_add(-x2159, x3130, x4166)),
+        );
+        let x4168 = Self::mul_add(
+            -x2169,
+            x3121,
+            Self::mul_add(x2167, x3122, Self::mul_add(x2165, x3123, x4167)),
+        );
+        let x4169 = Self::mul_add(
+            -x2082,
+            x3141,
+            Self::mul_add(x2087, x3144, Self::mul_add(x2086, x3148, x2085 * x3151)),
+        );
+        let x4170 = Self::mul_add(
+            x2089,
+            x3132,
+            Self::mul_add(x2084, x3134, Self::mul_add(x2083, x3137, x4169)),
+        );
+        let x4171 = Self::mul_add(
+            -x2095,
+            x3125,
+            Self::mul_add(x2093, x3128, Self::mul_add(-x2091, x3130, x4170)),
+        );
+        let x4172 = Self::mul_add(
+            -x2101,
+            x3121,
+            Self::mul_add(x2099, x3122, Self::mul_add(x2097, x3123, x4171)),
+        );
+        let x4173 = -x4172;
+        let x4174 = Self::mul_add(
+            -x1994,
+            x3141,
+            Self::mul_add(-x1999, x3144, Self::mul_add(x1998, x3148, x1997 * x3151)),
+        );
+        let x4175 = Self::mul_add(
+            -x2001,
+            x3132,
+            Self::mul_add(-x1996, x3134, Self::mul_add(x1995, x3137, x4174)),
+        );
+        let x4176 = Self::mul_add(
+            x2007,
+            x3125,
+            Self::mul_add(-x2005, x3128, Self::mul_add(-x2003, x3130, x4175)),
+        );
+        let x4177 = Self::mul_add(
+            x2013,
+            x3121,
+            Self::mul_add(-x2011, x3122, Self::mul_add(-x2009, x3123, x4176)),
+        );
+        let x4178 = Self::mul_add(
+            -x1905,
+            x3141,
+            Self::mul_add(x1910, x3144, Self::mul_add(x1909, x3148, x1908 * x3151)),
+        );
+        let x4179 = Self::mul_add(
+            x1912,
+            x3132,
+            Self::mul_add(x1907, x3134, Self::mul_add(-x1906, x3137, x4178)),
+        );
+        let x4180 = Self::mul_add(
+            x1919,
+            x3125,
+            Self::mul_add(-x1916, x3128, Self::mul_add(-x1914, x3130, x4179)),
+        );
+        let x4181 = Self::mul_add(
+            x1925,
+            x3121,
+            Self::mul_add(-x1923, x3122, Self::mul_add(-x1921, x3123, x4180)),
+        );
+        let x4182 = Self::mul_add(
+            -x1812,
+            x3141,
+            Self::mul_add(x1817, x3144, Self::mul_add(x1816, x3148, x1815 * x3151)),
+        );
+        let x4183 = Self::mul_add(
+            x1819,
+            x3132,
+            Self::mul_add(x1814, x3134, Self::mul_add(-x1813, x3137, x4182)),
+        );
+        let x4184 = Self::mul_add(
+            x1827,
+            x3125,
+            Self::mul_add(-x1825, x3128, Self::mul_add(-x1821, x3130, x4183)),
+        );
+        let x4185 = Self::mul_add(
+            -x1836,
+            x3121,
+            Self::mul_add(x1833, x3122, Self::mul_add(x1830, x3123, x4184)),
+        );
+        let x4186 = -x4185;
+        let x4187 = Self::mul_add(
+            -x1722,
+            x3141,
+            Self::mul_add(x1727, x3144, Self::mul_add(x1726, x3148, x1725 * x3151)),
+        );
+        let x4188 = Self::mul_add(
+            x1729,
+            x3132,
+            Self::mul_add(x1724, x3134, Self::mul_add(-x1723, x3137, x4187)),
+        );
+        let x4189 = Self::mul_add(
+            x1737,
+            x3125,
+            Self::mul_add(-x1735, x3128, Self::mul_add(-x1731, x3130, x4188)),
+        );
+        let x4190 = Self::mul_add(
+            x1743,
+            x3121,
+            Self::mul_add(-x1741, x3122, Self::mul_add(x1739, x3123, x4189)),
+        );
+        let x4191 = Self::mul_add(
+            -x1632,
+            x3141,
+            Self::mul_add(x1637, x3144, Self::mul_add(x1636, x3148, x1635 * x3151)),
+        );
+        let x4192 = Self::mul_add(
+            x1639,
+            x3132,
+            Self::mul_add(x1634, x3134, Self::mul_add(-x1633, x3137, x4191)),
+        );
+        let x4193 = Self::mul_add(
+            x1647,
+            x3125,
+            Self::mul_add(-x1645, x3128, Self::mul_add(-x1641, x3130, x4192)),
+        );
+        let x4194 = Self::mul_add(
+            x1653,
+            x3121,
+            Self::mul_add(-x1651, x3122, Self::mul_add(x1649, x3123, x4193)),
+        );
+        let x4195 = -x4194;
+        let x4196 = Self::mul_add(
+            x2182,
+            x3171,
+            Self::mul_add(-x2179, x3174, Self::mul_add(x767, x3178, x766 * x3181)),
+        );
+        let x4197 = Self::mul_add(
+            -x2185,
+            x3161,
+            Self::mul_add(-x2184, x3164, Self::mul_add(-x2183, x3167, x4196)),
+        );
+        let x4198 = Self::mul_add(
+            -x2188,
+            x3155,
+            Self::mul_add(-x2187, x3157, Self::mul_add(-x2186, x3158, x4197)),
+        );
+        let x4199 = Self::mul_add(x2190, x3153, Self::mul_add(-x2189, x3154, x4198));
+        let x4200 = Self::mul_add(
+            -x2193,
+            x3171,
+            Self::mul_add(x2195, x3174, Self::mul_add(x768, x3178, x766 * x3185)),
+        );
+        let x4201 = Self::mul_add(
+            x2197,
+            x3161,
+            Self::mul_add(x2196, x3164, Self::mul_add(x2196, x3167, x4200)),
+        );
+        let x4202 = Self::mul_add(
+            x2200,
+            x3155,
+            Self::mul_add(x2199, x3157, Self::mul_add(x2198, x3158, x4201)),
+        );
+        let x4203 = -Self::mul_add(-x2202, x3153, Self::mul_add(x2201, x3154, x4202));
+        let x4204 = Self::mul_add(
+            x2207,
+            x3171,
+            Self::mul_add(-x2206, x3174, Self::mul_add(-x768, x3181, x767 * x3185)),
+        );
+        let x4205 = Self::mul_add(
+            -x2209,
+            x3161,
+            Self::mul_add(-x2208, x3164, Self::mul_add(-x2205, x3167, x4204)),
+        );
+        let x4206 = Self::mul_add(
+            -x2212,
+            x3155,
+            Self::mul_add(-x2211, x3157, Self::mul_add(x2210, x3158, x4205)),
+        );
+        let x4207 = Self::mul_add(x2214, x3153, Self::mul_add(-x2213, x3154, x4206));
+        let x4208 = Self::mul_add(
+            -x2219,
+            x3174,
+            Self::mul_add(x2218, x3178, Self::mul_add(-x2217, x3181, x2179 * x3185)),
+        );
+        let x4209 = Self::mul_add(
+            -x2223,
+            x3164,
+            Self::mul_add(x2222, x3167, Self::mul_add(-x2220, x3171, x4208)),
+        );
+        let x4210 = Self::mul_add(
+            x2226,
+            x3157,
+            Self::mul_add(x2225, x3158, Self::mul_add(-x2224, x3161, x4209)),
+        );
+        let x4211 = Self::mul_add(
+            -x2229,
+            x3153,
+            Self::mul_add(x2228, x3154, Self::mul_add(x2227, x3155, x4210)),
+        );
+        let x4212 = Self::mul_add(
+            -x2235,
+            x3174,
+            Self::mul_add(x2234, x3178, Self::mul_add(x2193, x3181, x2233 * x3185)),
+        );
+        let x4213 = Self::mul_add(
+            -x2238,
+            x3164,
+            Self::mul_add(-x2237, x3167, Self::mul_add(-x2236, x3171, x4212)),
+        );
+        let x4214 = Self::mul_add(
+            -x2241,
+            x3157,
+            Self::mul_add(-x2240, x3158, Self::mul_add(-x2239, x3161, x4213)),
+        );
+        let x4215 = Self::mul_add(
+            x2244,
+            x3153,
+            Self::mul_add(-x2243, x3154, Self::mul_add(-x2242, x3155, x4214)),
+        );
+        let x4216 = Self::mul_add(
+            x2247,
+            x3174,
+            Self::mul_add(x2205, x3178, Self::mul_add(-x2246, x3181, x2245 * x3185)),
+        );
+        let x4217 = Self::mul_add(
+            -x2250,
+            x3164,
+            Self::mul_add(-x2249, x3167, Self::mul_add(-x2248, x3171, x4216)),
+        );
+        let x4218 = Self::mul_add(
+            -x2253,
+            x3157,
+            Self::mul_add(-x2252, x3158, Self::mul_add(x2251, x3161, x4217)),
+        );
+        let x4219 = Self::mul_add(
+            x2256,
+            x3153,
+            Self::mul_add(-x2255, x3154, Self::mul_add(-x2254, x3155, x4218)),
+        );
+        let x4220 = -x4219;
+        let x4221 = Self::mul_add(
+            -x2151,
+            x3174,
+            Self::mul_add(x2149, x3178, Self::mul_add(x2155, x3181, x2154 * x3185)),
+        );
+        let x4222 = Self::mul_add(
+            x2157,
+            x3164,
+            Self::mul_add(x2153, x3167, Self::mul_add(x2152, x3171, x4221)),
+        );
+        let x4223 = Self::mul_add(
+            -x2163,
+            x3157,
+            Self::mul_add(x2161, x3158, Self::mul_add(-x2159, x3161, x4222)),
+        );
+        let x4224 = Self::mul_add(
+            x2169,
+            x3153,
+            Self::mul_add(-x2167, x3154, Self::mul_add(-x2165, x3155, x4223)),
+        );
+        let x4225 = -x4224;
+        let x4226 = Self::mul_add(
+            -x2082,
+            x3174,
+            Self::mul_add(x2087, x3178, Self::mul_add(x2086, x3181, x2085 * x3185)),
+        );
+        let x4227 = Self::mul_add(
+            x2089,
+            x3164,
+            Self::mul_add(x2084, x3167, Self::mul_add(x2083, x3171, x4226)),
+        );
+        let x4228 = Self::mul_add(
+            -x2095,
+            x3157,
+            Self::mul_add(x2093, x3158, Self::mul_add(-x2091, x3161, x4227)),
+        );
+        let x4229 = Self::mul_add(
+            x2101,
+            x3153,
+            Self::mul_add(-x2099, x3154, Self::mul_add(-x2097, x3155, x4228)),
+        );
+        let x4230 = Self::mul_add(
+            -x1994,
+            x3174,
+            Self::mul_add(-x1999, x3178, Self::mul_add(x1998, x3181, x1997 * x3185)),
+        );
+        let x4231 = Self::mul_add(
+            -x2001,
+            x3164,
+            Self::mul_add(-x1996, x3167, Self::mul_add(x1995, x3171, x4230)),
+        );
+        let x4232 = Self::mul_add(
+            x2007,
+            x3157,
+            Self::mul_add(-x2005, x3158, Self::mul_add(-x2003, x3161, x4231)),
+        );
+        let x4233 = Self::mul_add(
+            -x2013,
+            x3153,
+            Self::mul_add(x2011, x3154, Self::mul_add(x2009, x3155, x4232)),
+        );
+        let x4234 = -x4233;
+        let x4235 = Self::mul_add(
+            -x1905,
+            x3174,
+            Self::mul_add(x1910, x3178, Self::mul_add(x1909, x3181, x1908 * x3185)),
+        );
+        let x4236 = Self::mul_add(
+            x1912,
+            x3164,
+            Self::mul_add(x1907, x3167, Self::mul_add(-x1906, x3171, x4235)),
+        );
+        let x4237 = Self::mul_add(
+            x1919,
+            x3157,
+            Self::mul_add(-x1916, x3158, Self::mul_add(-x1914, x3161, x4236)),
+        );
+        let x4238 = Self::mul_add(
+            -x1925,
+            x3153,
+            Self::mul_add(x1923, x3154, Self::mul_add(x1921, x3155, x4237)),
+        );
+        let x4239 = -x4238;
+        let x4240 = Self::mul_add(
+            -x1812,
+            x3174,
+            Self::mul_add(x1817, x3178, Self::mul_add(x1816, x3181, x1815 * x3185)),
+        );
+        let x4241 = Self::mul_add(
+            x1819,
+            x3164,
+            Self::mul_add(x1814, x3167, Self::mul_add(-x1813, x3171, x4240)),
+        );
+        let x4242 = Self::mul_add(
+            x1827,
+            x3157,
+            Self::mul_add(-x1825, x3158, Self::mul_add(-x1821, x3161, x4241)),
+        );
+        let x4243 = Self::mul_add(
+            x1836,
+            x3153,
+            Self::mul_add(-x1833, x3154, Self::mul_add(-x1830, x3155, x4242)),
+        );
+        let x4244 = Self::mul_add(
+            -x1722,
+            x3174,
+            Self::mul_add(x1727, x3178, Self::mul_add(x1726, x3181, x1725 * x3185)),
+        );
+        let x4245 = Self::mul_add(
+            x1729,
+            x3164,
+            Self::mul_add(x1724, x3167, Self::mul_add(-x1723, x3171, x4244)),
+        );
+        let x4246 = Self::mul_add(
+            x1737,
+            x3157,
+            Self::mul_add(-x1735, x3158, Self::mul_add(-x1731, x3161, x4245)),
+        );
+        let x4247 = Self::mul_add(
+            -x1743,
+            x3153,
+            Self::mul_add(x1741, x3154, Self::mul_add(-x1739, x3155, x4246)),
+        );
+        let x4248 = -x4247;
+        let x4249 = Self::mul_add(
+            -x1632,
+            x3174,
+            Self::mul_add(x1637, x3178, Self::mul_add(x1636, x3181, x1635 * x3185)),
+        );
+        let x4250 = Self::mul_add(
+            x1639,
+            x3164,
+            Self::mul_add(x1634, x3167, Self::mul_add(-x1633, x3171, x4249)),
+        );
+        let x4251 = Self::mul_add(
+            x1647,
+            x3157,
+            Self::mul_add(-x1645, x3158, Self::mul_add(-x1641, x3161, x4250)),
+        );
+        let x4252 = Self::mul_add(
+            -x1653,
+            x3153,
+            Self::mul_add(x1651, x3154, Self::mul_add(-x1649, x3155, x4251)),
+        );
+        let x4253 = Self::mul_add(
+            x2182,
+            x3201,
+            Self::mul_add(-x2179, x3205, Self::mul_add(x767, x3208, x766 * x3212)),
+        );
+        let x4254 = Self::mul_add(
+            -x2185,
+            x3194,
+            Self::mul_add(-x2184, x3196, Self::mul_add(-x2183, x3198, x4253)),
+        );
+        let x4255 = Self::mul_add(
+            -x2188,
+            x3189,
+            Self::mul_add(-x2187, x3190, Self::mul_add(-x2186, x3192, x4254)),
+        );
+        let x4256 = -Self::mul_add(-x2190, x3187, Self::mul_add(x2189, x3188, x4255));
+        let x4257 = Self::mul_add(
+            -x2193,
+            x3201,
+            Self::mul_add(x2195, x3205, Self::mul_add(x768, x3208, x766 * x3215)),
+        );
+        let x4258 = Self::mul_add(
+            x2197,
+            x3194,
+            Self::mul_add(x2196, x3196, Self::mul_add(x2196, x3198, x4257)),
+        );
+        let x4259 = Self::mul_add(
+            x2200,
+            x3189,
+            Self::mul_add(x2199, x3190, Self::mul_add(x2198, x3192, x4258)),
+        );
+        let x4260 = Self::mul_add(x2202, x3187, Self::mul_add(-x2201, x3188, x4259));
+        let x4261 = Self::mul_add(
+            x2207,
+            x3201,
+            Self::mul_add(-x2206, x3205, Self::mul_add(-x768, x3212, x767 * x3215)),
+        );
+        let x4262 = Self::mul_add(
+            -x2209,
+            x3194,
+            Self::mul_add(-x2208, x3196, Self::mul_add(-x2205, x3198, x4261)),
+        );
+        let x4263 = Self::mul_add(
+            -x2212,
+            x3189,
+            Self::mul_add(-x2211, x3190, Self::mul_add(x2210, x3192, x4262)),
+        );
+        let x4264 = -Self::mul_add(-x2214, x3187, Self::mul_add(x2213, x3188, x4263));
+        let x4265 = Self::mul_add(
+            -x2219,
+            x3205,
+            Self::mul_add(x2218, x3208, Self::mul_add(-x2217, x3212, x2179 * x3215)),
+        );
+        let x4266 = Self::mul_add(
+            -x2223,
+            x3196,
+            Self::mul_add(x2222, x3198, Self::mul_add(-x2220, x3201, x4265)),
+        );
+        let x4267 = Self::mul_add(
+            x2226,
+            x3190,
+            Self::mul_add(x2225, x3192, Self::mul_add(-x2224, x3194, x4266)),
+        );
+        let x4268 = Self::mul_add(
+            x2229,
+            x3187,
+            Self::mul_add(-x2228, x3188, Self::mul_add(x2227, x3189, x4267)),
+        );
+        let x4269 = -x4268;
+        let x4270 = Self::mul_add(
+            -x2235,
+            x3205,
+            Self::mul_add(x2234, x3208, Self::mul_add(x2193, x3212, x2233 * x3215)),
+        );
+        let x4271 = Self::mul_add(
+            -x2238,
+            x3196,
+            Self::mul_add(-x2237, x3198, Self::mul_add(-x2236, x3201, x4270)),
+        );
+        let x4272 = Self::mul_add(
+            -x2241,
+            x3190,
+            Self::mul_add(-x2240, x3192, Self::mul_add(-x2239, x3194, x4271)),
+        );
+        let x4273 = Self::mul_add(
+            -x2244,
+            x3187,
+            Self::mul_add(x2243, x3188, Self::mul_add(-x2242, x3189, x4272)),
+        );
+        let x4274 = -x4273;
+        let x4275 = Self::mul_add(
+            x2247,
+            x3205,
+            Self::mul_add(x2205, x3208, Self::mul_add(-x2246, x3212, x2245 * x3215)),
+        );
+        let x4276 = Self::mul_add(
+            -x2250,
+            x3196,
+            Self::mul_add(-x2249, x3198, Self::mul_add(-x2248, x3201, x4275)),
+        );
+        let x4277 = Self::mul_add(
+            -x2253,
+            x3190,
+            Self::mul_add(-x2252, x3192, Self::mul_add(x2251, x3194, x4276)),
+        );
+        let x4278 = Self::mul_add(
+            -x2256,
+            x3187,
+            Self::mul_add(x2255, x3188, Self::mul_add(-x2254, x3189, x4277)),
+        );
+        let x4279 = Self::mul_add(
+            -x2151,
+            x3205,
+            Self::mul_add(x2149, x3208, Self::mul_add(x2155, x3212, x2154 * x3215)),
+        );
+        let x4280 = Self::mul_add(
+            x2157,
+            x3196,
+            Self::mul_add(x2153, x3198, Self::mul_add(x2152, x3201, x4279)),
+        );
+        let x4281 = Self::mul_add(
+            -x2163,
+            x3190,
+            Self::mul_add(x2161, x3192, Self::mul_add(-x2159, x3194, x4280)),
+        );
+        let x4282 = Self::mul_add(
+            -x2169,
+            x3187,
+            Self::mul_add(x2167, x3188, Self::mul_add(-x2165, x3189, x4281)),
+        );
+        let x4283 = Self::mul_add(
+            -x2082,
+            x3205,
+            Self::mul_add(x2087, x3208, Self::mul_add(x2086, x3212, x2085 * x3215)),
+        );
+        let x4284 = Self::mul_add(
+            x2089,
+            x3196,
+            Self::mul_add(x2084, x3198, Self::mul_add(x2083, x3201, x4283)),
+        );
+        let x4285 = Self::mul_add(
+            -x2095,
+            x3190,
+            Self::mul_add(x2093, x3192, Self::mul_add(-x2091, x3194, x4284)),
+        );
+        let x4286 = Self::mul_add(
+            -x2101,
+            x3187,
+            Self::mul_add(x2099, x3188, Self::mul_add(-x2097, x3189, x4285)),
+        );
+        let x4287 = -x4286;
+        let x4288 = Self::mul_add(
+            -x1994,
+            x3205,
+            Self::mul_add(-x1999, x3208, Self::mul_add(x1998, x3212, x1997 * x3215)),
+        );
+        let x4289 = Self::mul_add(
+            -x2001,
+            x3196,
+            Self::mul_add(-x1996, x3198, Self::mul_add(x1995, x3201, x4288)),
+        );
+        let x4290 = Self::mul_add(
+            x2007,
+            x3190,
+            Self::mul_add(-x2005, x3192, Self::mul_add(-x2003, x3194, x4289)),
+        );
+        let x4291 = Self::mul_add(
+            x2013,
+            x3187,
+            Self::mul_add(-x2011, x3188, Self::mul_add(x2009, x3189, x4290)),
+        );
+        let x4292 = Self::mul_add(
+            -x1905,
+            x3205,
+            Self::mul_add(x1910, x3208, Self::mul_add(x1909, x3212, x1908 * x3215)),
+        );
+        let x4293 = Self::mul_add(
+            x1912,
+            x3196,
+            Self::mul_add(x1907, x3198, Self::mul_add(-x1906, x3201, x4292)),
+        );
+        let x4294 = Self::mul_add(
+            x1919,
+            x3190,
+            Self::mul_add(-x1916, x3192, Self::mul_add(-x1914, x3194, x4293)),
+        );
+        let x4295 = Self::mul_add(
+            x1925,
+            x3187,
+            Self::mul_add(-x1923, x3188, Self::mul_add(x1921, x3189, x4294)),
+        );
+        let x4296 = Self::mul_add(
+            -x1812,
+            x3205,
+            Self::mul_add(x1817, x3208, Self::mul_add(x1816, x3212, x1815 * x3215)),
+        );
+        let x4297 = Self::mul_add(
+            x1819,
+            x3196,
+            Self::mul_add(x1814, x3198, Self::mul_add(-x1813, x3201, x4296)),
+        );
+        let x4298 = Self::mul_add(
+            x1827,
+            x3190,
+            Self::mul_add(-x1825, x3192, Self::mul_add(-x1821, x3194, x4297)),
+        );
+        let x4299 = Self::mul_add(
+            -x1836,
+            x3187,
+            Self::mul_add(x1833, x3188, Self::mul_add(-x1830, x3189, x4298)),
+        );
+        let x4300 = -x4299;
+        let x4301 = Self::mul_add(
+            -x1722,
+            x3205,
+            Self::mul_add(x1727, x3208, Self::mul_add(x1726, x3212, x1725 * x3215)),
+        );
+        let x4302 = Self::mul_add(
+            x1729,
+            x3196,
+            Self::mul_add(x1724, x3198, Self::mul_add(-x1723, x3201, x4301)),
+        );
+        let x4303 = Self::mul_add(
+            x1737,
+            x3190,
+            Self::mul_add(-x1735, x3192, Self::mul_add(-x1731, x3194, x4302)),
+        );
+        let x4304 = Self::mul_add(
+            x1743,
+            x3187,
+            Self::mul_add(-x1741, x3188, Self::mul_add(-x1739, x3189, x4303)),
+        );
+        let x4305 = Self::mul_add(
+            -x1632,
+            x3205,
+            Self::mul_add(x1637, x3208, Self::mul_add(x1636, x3212, x1635 * x3215)),
+        );
+        let x4306 = Self::mul_add(
+            x1639,
+            x3196,
+            Self::mul_add(x1634, x3198, Self::mul_add(-x1633, x3201, x4305)),
+        );
+        let x4307 = Self::mul_add(
+            x1647,
+            x3190,
+            Self::mul_add(-x1645, x3192, Self::mul_add(-x1641, x3194, x4306)),
+        );
+        let x4308 = Self::mul_add(
+            x1653,
+            x3187,
+            Self::mul_add(-x1651, x3188, Self::mul_add(-x1649, x3189, x4307)),
+        );
+        let x4309 = -x4308;
+        let x4310 = Self::mul_add(
+            x2182,
+            x3231,
+            Self::mul_add(-x2179, x3235, Self::mul_add(x767, x3238, x766 * x3242)),
+        );
+        let x4311 = Self::mul_add(
+            -x2185,
+            x3224,
+            Self::mul_add(-x2184, x3226, Self::mul_add(-x2183, x3228, x4310)),
+        );
+        let x4312 = Self::mul_add(
+            -x2188,
+            x3219,
+            Self::mul_add(-x2187, x3220, Self::mul_add(-x2186, x3222, x4311)),
+        );
+        let x4313 = -Self::mul_add(x2190, x3216, Self::mul_add(x2189, x3218, x4312));
+        let x4314 = Self::mul_add(
+            -x2193,
+            x3231,
+            Self::mul_add(x2195, x3235, Self::mul_add(x768, x3238, x766 * x3245)),
+        );
+        let x4315 = Self::mul_add(
+            x2197,
+            x3224,
+            Self::mul_add(x2196, x3226, Self::mul_add(x2196, x3228, x4314)),
+        );
+        let x4316 = Self::mul_add(
+            x2200,
+            x3219,
+            Self::mul_add(x2199, x3220, Self::mul_add(x2198, x3222, x4315)),
+        );
+        let x4317 = Self::mul_add(-x2202, x3216, Self::mul_add(-x2201, x3218, x4316));
+        let x4318 = Self::mul_add(
+            x2207,
+            x3231,
+            Self::mul_add(-x2206, x3235, Self::mul_add(-x768, x3242, x767 * x3245)),
+        );
+        let x4319 = Self::mul_add(
+            -x2209,
+            x3224,
+            Self::mul_add(-x2208, x3226, Self::mul_add(-x2205, x3228, x4318)),
+        );
+        let x4320 = Self::mul_add(
+            -x2212,
+            x3219,
+            Self::mul_add(-x2211, x3220, Self::mul_add(x2210, x3222, x4319)),
+        );
+        let x4321 = -Self::mul_add(x2214, x3216, Self::mul_add(x2213, x3218, x4320));
+        let x4322 = Self::mul_add(
+            -x2219,
+            x3235,
+            Self::mul_add(x2218, x3238, Self::mul_add(-x2217, x3242, x2179 * x3245)),
+        );
+        let x4323 = Self::mul_add(
+            -x2223,
+            x3226,
+            Self::mul_add(x2222, x3228, Self::mul_add(-x2220, x3231, x4322)),
+        );
+        let x4324 = Self::mul_add(
+            x2226,
+            x3220,
+            Self::mul_add(x2225, x3222, Self::mul_add(-x2224, x3224, x4323)),
+        );
+        let x4325 = Self::mul_add(
+            -x2229,
+            x3216,
+            Self::mul_add(-x2228, x3218, Self::mul_add(x2227, x3219, x4324)),
+        );
+        let x4326 = -x4325;
+        let x4327 = Self::mul_add(
+            -x2235,
+            x3235,
+            Self::mul_add(x2234, x3238, Self::mul_add(x2193, x3242, x2233 * x3245)),
+        );
+        let x4328 = Self::mul_add(
+            -x2238,
+            x3226,
+            Self::mul_add(-x2237, x3228, Self::mul_add(-x2236, x3231, x4327)),
+        );
+        let x4329 = Self::mul_add(
+            -x2241,
+            x3220,
+            Self::mul_add(-x2240, x3222, Self::mul_add(-x2239, x3224, x4328)),
+        );
+        let x4330 = Self::mul_add(
+            x2244,
+            x3216,
+            Self::mul_add(x2243, x3218, Self::mul_add(-x2242, x3219, x4329)),
+        );
+        let x4331 = -x4330;
+        let x4332 = Self::mul_add(
+            x2247,
+            x3235,
+            Self::mul_add(x2205, x3238, Self::mul_add(-x2246, x3242, x2245 * x3245)),
+        );
+        let x4333 = Self::mul_add(
+            -x2250,
+            x3226,
+            Self::mul_add(-x2249, x3228, Self::mul_add(-x2248, x3231, x4332)),
+        );
+        let x4334 = Self::mul_add(
+            -x2253,
+            x3220,
+            Self::mul_add(-x2252, x3222, Self::mul_add(x2251, x3224, x4333)),
+        );
+        let x4335 = Self::mul_add(
+            x2256,
+            x3216,
+            Self::mul_add(x2255, x3218, Self::mul_add(-x2254, x3219, x4334)),
+        );
+        let x4336 = Self::mul_add(
+            -x2151,
+            x3235,
+            Self::mul_add(x2149, x3238, Self::mul_add(x2155, x3242, x2154 * x3245)),
+        );
+        let x4337 = Self::mul_add(
+            x2157,
+            x3226,
+            Self::mul_add(x2153, x3228, Self::mul_add(x2152, x3231, x4336)),
+        );
+        let x4338 = Self::mul_add(
+            -x2163,
+            x3220,
+            Self::mul_add(x2161, x3222, Self::mul_add(-x2159, x3224, x4337)),
+        );
+        let x4339 = Self::mul_add(
+            x2169,
+            x3216,
+            Self::mul_add(x2167, x3218, Self::mul_add(-x2165, x3219, x4338)),
+        );
+        let x4340 = Self::mul_add(
+            -x2082,
+            x3235,
+            Self::mul_add(x2087, x3238, Self::mul_add(x2086, x3242, x2085 * x3245)),
+        );
+        let x4341 = Self::mul_add(
+            x2089,
+            x3226,
+            Self::mul_add(x2084, x3228, Self::mul_add(x2083, x3231, x4340)),
+        );
+        let x4342 = Self::mul_add(
+            -x2095,
+            x3220,
+            Self::mul_add(x2093, x3222, Self::mul_add(-x2091, x3224, x4341)),
+        );
+        let x4343 = Self::mul_add(
+            x2101,
+            x3216,
+            Self::mul_add(x2099, x3218, Self::mul_add(-x2097, x3219, x4342)),
+        );
+        let x4344 = -x4343;
+        let x4345 = Self::mul_add(
+            -x1994,
+            x3235,
+            Self::mul_add(-x1999, x3238, Self::mul_add(x1998, x3242, x1997 * x3245)),
+        );
+        let x4346 = Self::mul_add(
+            -x2001,
+            x3226,
+            Self::mul_add(-x1996, x3228, Self::mul_add(x1995, x3231, x4345)),
+        );
+        let x4347 = Self::mul_add(
+            x2007,
+            x3220,
+            Self::mul_add(-x2005, x3222, Self::mul_add(-x2003, x3224, x4346)),
+        );
+        let x4348 = Self::mul_add(
+            -x2013,
+            x3216,
+            Self::mul_add(-x2011, x3218, Self::mul_add(x2009, x3219, x4347)),
+        );
+        let x4349 = Self::mul_add(
+            -x1905,
+            x3235,
+            Self::mul_add(x1910, x3238, Self::mul_add(x1909, x3242, x1908 * x3245)),
+        );
+        let x4350 = Self::mul_add(
+            x1912,
+            x3226,
+            Self::mul_add(x1907, x3228, Self::mul_add(-x1906, x3231, x4349)),
+        );
+        let x4351 = Self::mul_add(
+            x1919,
+            x3220,
+            Self::mul_add(-x1916, x3222, Self::mul_add(-x1914, x3224, x4350)),
+        );
+        let x4352 = Self::mul_add(
+            -x1925,
+            x3216,
+            Self::mul_add(-x1923, x3218, Self::mul_add(x1921, x3219, x4351)),
+        );
+        let x4353 = Self::mul_add(
+            -x1812,
+            x3235,
+            Self::mul_add(x1817, x3238, Self::mul_add(x1816, x3242, x1815 * x3245)),
+        );
+        let x4354 = Self::mul_add(
+            x1819,
+            x3226,
+            Self::mul_add(x1814, x3228, Self::mul_add(-x1813, x3231, x4353)),
+        );
+        let x4355 = Self::mul_add(
+            x1827,
+            x3220,
+            Self::mul_add(-x1825, x3222, Self::mul_add(-x1821, x3224, x4354)),
+        );
+        let x4356 = Self::mul_add(
+            x1836,
+            x3216,
+            Self::mul_add(x1833, x3218, Self::mul_add(-x1830, x3219, x4355)),
+        );
+        let x4357 = -x4356;
+        let x4358 = Self::mul_add(
+            -x1722,
+            x3235,
+            Self::mul_add(x1727, x3238, Self::mul_add(x1726, x3242, x1725 * x3245)),
+        );
+        let x4359 = Self::mul_add(
+            x1729,
+            x3226,
+            Self::mul_add(x1724, x3228, Self::mul_add(-x1723, x3231, x4358)),
+        );
+        let x4360 = Self::mul_add(
+            x1737,
+            x3220,
+            Self::mul_add(-x1735, x3222, Self::mul_add(-x1731, x3224, x4359)),
+        );
+        let x4361 = Self::mul_add(
+            -x1743,
+            x3216,
+            Self::mul_add(-x1741, x3218, Self::mul_add(-x1739, x3219, x4360)),
+        );
+        let x4362 = Self::mul_add(
+            -x1632,
+            x3235,
+            Self::mul_add(x1637, x3238, Self::mul_add(x1636, x3242, x1635 * x3245)),
+        );
+        let x4363 = Self::mul_add(
+            x1639,
+            x3226,
+            Self::mul_add(x1634, x3228, Self::mul_add(-x1633, x3231, x4362)),
+        );
+        let x4364 = Self::mul_add(
+            x1647,
+            x3220,
+            Self::mul_add(-x1645, x3222, Self::mul_add(-x1641, x3224, x4363)),
+        );
+        let x4365 = Self::mul_add(
+            -x1653,
+            x3216,
+            Self::mul_add(-x1651, x3218, Self::mul_add(-x1649, x3219, x4364)),
+        );
+        let x4366 = -x4365;
+        let x4367 = Self::mul_add(
+            x2182,
+            x3262,
+            Self::mul_add(-x2179, x3265, Self::mul_add(x767, x3269, x766 * x3272)),
+        );
+        let x4368 = Self::mul_add(
+            -x2185,
+            x3252,
+            Self::mul_add(-x2184, x3255, Self::mul_add(-x2183, x3258, x4367)),
+        );
+        let x4369 = Self::mul_add(
+            -x2188,
+            x3246,
+            Self::mul_add(-x2187, x3248, Self::mul_add(-x2186, x3249, x4368)),
+        );
+        let x4370 = Self::mul_add(x2190, x2753, Self::mul_add(x2189, x3216, x4369));
+        let x4371 = Self::mul_add(
+            -x2193,
+            x3262,
+            Self::mul_add(x2195, x3265, Self::mul_add(x768, x3269, x766 * x3276)),
+        );
+        let x4372 = Self::mul_add(
+            x2197,
+            x3252,
+            Self::mul_add(x2196, x3255, Self::mul_add(x2196, x3258, x4371)),
+        );
+        let x4373 = Self::mul_add(
+            x2200,
+            x3246,
+            Self::mul_add(x2199, x3248, Self::mul_add(x2198, x3249, x4372)),
+        );
+        let x4374 = -Self::mul_add(-x2202, x2753, Self::mul_add(-x2201, x3216, x4373));
+        let x4375 = Self::mul_add(
+            x2207,
+            x3262,
+            Self::mul_add(-x2206, x3265, Self::mul_add(-x768, x3272, x767 * x3276)),
+        );
+        let x4376 = Self::mul_add(
+            -x2209,
+            x3252,
+            Self::mul_add(-x2208, x3255, Self::mul_add(-x2205, x3258, x4375)),
+        );
+        let x4377 = Self::mul_add(
+            -x2212,
+            x3246,
+            Self::mul_add(-x2211, x3248, Self::mul_add(x2210, x3249, x4376)),
+        );
+        let x4378 = Self::mul_add(x2214, x2753, Self::mul_add(x2213, x3216, x4377));
+        let x4379 = Self::mul_add(
+            -x2219,
+            x3265,
+            Self::mul_add(x2218, x3269, Self::mul_add(-x2217, x3272, x2179 * x3276)),
+        );
+        let x4380 = Self::mul_add(
+            -x2223,
+            x3255,
+            Self::mul_add(x2222, x3258, Self::mul_add(-x2220, x3262, x4379)),
+        );
+        let x4381 = Self::mul_add(
+            x2226,
+            x3248,
+            Self::mul_add(x2225, x3249, Self::mul_add(-x2224, x3252, x4380)),
+        );
+        let x4382 = Self::mul_add(
+            -x2229,
+            x2753,
+            Self::mul_add(-x2228, x3216, Self::mul_add(x2227, x3246, x4381)),
+        );
+        let x4383 = Self::mul_add(
+            -x2235,
+            x3265,
+            Self::mul_add(x2234, x3269, Self::mul_add(x2193, x3272, x2233 * x3276)),
+        );
+        let x4384 = Self::mul_add(
+            -x2238,
+            x3255,
+            Self::mul_add(-x2237, x3258, Self::mul_add(-x2236, x3262, x4383)),
+        );
+        let x4385 = Self::mul_add(
+            -x2241,
+            x3248,
+            Self::mul_add(-x2240, x3249, Self::mul_add(-x2239, x3252, x4384)),
+        );
+        let x4386 = Self::mul_add(
+            x2244,
+            x2753,
+            Self::mul_add(x2243, x3216, Self::mul_add(-x2242, x3246, x4385)),
+        );
+        let x4387 = Self::mul_add(
+            x2247,
+            x3265,
+            Self::mul_add(x2205, x3269, Self::mul_add(-x2246, x3272, x2245 * x3276)),
+        );
+        let x4388 = Self::mul_add(
+            -x2250,
+            x3255,
+            Self::mul_add(-x2249, x3258, Self::mul_add(-x2248, x3262, x4387)),
+        );
+        let x4389 = Self::mul_add(
+            -x2253,
+            x3248,
+            Self::mul_add(-x2252, x3249, Self::mul_add(x2251, x3252, x4388)),
+        );
+        let x4390 = Self::mul_add(
+            x2256,
+            x2753,
+            Self::mul_add(x2255, x3216, Self::mul_add(-x2254, x3246, x4389)),
+        );
+        let x4391 = -x4390;
+        let x4392 = Self::mul_add(
+            -x2151,
+            x3265,
+            Self::mul_add(x2149, x3269, Self::mul_add(x2155, x3272, x2154 * x3276)),
+        );
+        let x4393 = Self::mul_add(
+            x2157,
+            x3255,
+            Self::mul_add(x2153, x3258, Self::mul_add(x2152, x3262, x4392)),
+        );
+        let x4394 = Self::mul_add(
+            -x2163,
+            x3248,
+            Self::mul_add(x2161, x3249, Self::mul_add(-x2159, x3252, x4393)),
+        );
+        let x4395 = Self::mul_add(
+            x2169,
+            x2753,
+            Self::mul_add(x2167, x3216, Self::mul_add(-x2165, x3246, x4394)),
+        );
+        let x4396 = -x4395;
+        let x4397 = Self::mul_add(
+            -x2082,
+            x3265,
+            Self::mul_add(x2087, x3269, Self::mul_add(x2086, x3272, x2085 * x3276)),
+        );
+        let x4398 = Self::mul_add(
+            x2089,
+            x3255,
+            Self::mul_add(x2084, x3258, Self::mul_add(x2083, x3262, x4397)),
+        );
+        let x4399 = Self::mul_add(
+            -x2095,
+            x3248,
+            Self::mul_add(x2093, x3249, Self::mul_add(-x2091, x3252, x4398)),
+        );
+        let x4400 = Self::mul_add(
+            x2101,
+            x2753,
+            Self::mul_add(x2099, x3216, Self::mul_add(-x2097, x3246, x4399)),
+        );
+        let x4401 = Self::mul_add(
+            -x1994,
+            x3265,
+            Self::mul_add(-x1999, x3269, Self::mul_add(x1998, x3272, x1997 * x3276)),
+        );
+        let x4402 = Self::mul_add(
+            -x2001,
+            x3255,
+            Self::mul_add(-x1996, x3258, Self::mul_add(x1995, x3262, x4401)),
+        );
+        let x4403 = Self::mul_add(
+            x2007,
+            x3248,
+            Self::mul_add(-x2005, x3249, Self::mul_add(-x2003, x3252, x4402)),
+        );
+        let x4404 = Self::mul_add(
+            -x2013,
+            x2753,
+            Self::mul_add(-x2011, x3216, Self::mul_add(x2009, x3246, x4403)),
+        );
+        let x4405 = -x4404;
+        let x4406 = Self::mul_add(
+            -x1905,
+            x3265,
+            Self::mul_add(x1910, x3269, Self::mul_add(x1909, x3272, x1908 * x3276)),
+        );
+        let x4407 = Self::mul_add(
+            x1912,
+            x3255,
+            Self::mul_add(x1907, x3258, Self::mul_add(-x1906, x3262, x4406)),
+        );
+        let x4408 = Self::mul_add(
+            x1919,
+            x3248,
+            Self::mul_add(-x1916, x3249, Self::mul_add(-x1914, x3252, x4407)),
+        );
+        let x4409 = Self::mul_add(
+            -x1925,
+            x2753,
+            Self::mul_add(-x1923, x3216, Self::mul_add(x1921, x3246, x4408)),
+        );
+        let x4410 = -x4409;
+        let x4411 = Self::mul_add(
+            -x1812,
+            x3265,
+            Self::mul_add(x1817, x3269, Self::mul_add(x1816, x3272, x1815 * x3276)),
+        );
+        let x4412 = Self::mul_add(
+            x1819,
+            x3255,
+            Self::mul_add(x1814, x3258, Self::mul_add(-x1813, x3262, x4411)),
+        );
+        let x4413 = Self::mul_add(
+            x1827,
+            x3248,
+            Self::mul_add(-x1825, x3249, Self::mul_add(-x1821, x3252, x4412)),
+        );
+        let x4414 = Self::mul_add(
+            x1836,
+            x2753,
+            Self::mul_add(x1833, x3216, Self::mul_add(-x1830, x3246, x4413)),
+        );
+        let x4415 = Self::mul_add(
+            -x1722,
+            x3265,
+            Self::mul_add(x1727, x3269, Self::mul_add(x1726, x3272, x1725 * x3276)),
+        );
+        let x4416 = Self::mul_add(
+            x1729,
+            x3255,
+            Self::mul_add(x1724, x3258, Self::mul_add(-x1723, x3262, x4415)),
+        );
+        let x4417 = Self::mul_add(
+            x1737,
+            x3248,
+            Self::mul_add(-x1735, x3249, Self::mul_add(-x1731, x3252, x4416)),
+        );
+        let x4418 = Self::mul_add(
+            -x1743,
+            x2753,
+            Self::mul_add(-x1741, x3216, Self::mul_add(-x1739, x3246, x4417)),
+        );
+        let x4419 = -x4418;
+        let x4420 = Self::mul_add(
+            -x1632,
+            x3265,
+            Self::mul_add(x1637, x3269, Self::mul_add(x1636, x3272, x1635 * x3276)),
+        );
+        let x4421 = Self::mul_add(
+            x1639,
+            x3255,
+            Self::mul_add(x1634, x3258, Self::mul_add(-x1633, x3262, x4420)),
+        );
+        let x4422 = Self::mul_add(
+            x1647,
+            x3248,
+            Self::mul_add(-x1645, x3249, Self::mul_add(-x1641, x3252, x4421)),
+        );
+        let x4423 = Self::mul_add(
+            -x1653,
+            x2753,
+            Self::mul_add(-x1651, x3216, Self::mul_add(-x1649, x3246, x4422)),
+        );
+        (
+            [
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3281,
+                    x3285,
+                    x3289,
+                    x3293,
+                    x3298,
+                    x3302,
+                    x3307,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3311,
+                    x3315,
+                    x3319,
+                    x3323,
+                    x3328,
+                    x3332,
+                    x3337,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3342,
+                    x3347,
+                    x3352,
+                    x3357,
+                    x3361,
+                    x3366,
+                    x3370,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3374,
+                    x3378,
+                    x3382,
+                    x3386,
+                    x3391,
+                    x3395,
+                    x3400,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3405,
+                    x3410,
+                    x3415,
+                    x3420,
+                    x3424,
+                    x3429,
+                    x3433,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3438,
+                    x3443,
+                    x3448,
+                    x3453,
+                    x3457,
+                    x3462,
+                    x3466,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3470,
+                    x3474,
+                    x3478,
+                    x3482,
+                    x3487,
+                    x3491,
+                    x3496,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3500,
+                    x3504,
+                    x3508,
+                    x3512,
+                    x3517,
+                    x3521,
+                    x3526,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3530,
+                    x3534,
+                    x3538,
+                    x3542,
+                    x3547,
+                    x3551,
+                    x3556,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3561,
+                    x3566,
+                    x3571,
+                    x3576,
+                    x3580,
+                    x3585,
+                    x3589,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3593,
+                    x3597,
+                    x3601,
+                    x3605,
+                    x3610,
+                    x3614,
+                    x3619,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3623,
+                    x3627,
+                    x3631,
+                    x3635,
+                    x3640,
+                    x3644,
+                    x3649,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x3654,
+                    x3659,
+                    x3664,
+                    x3669,
+                    x3673,
+                    x3678,
+                    x3682,
+                ],
+            ],
+            [
+                [
+                    x3686,
+                    x3690,
+                    x3694,
+                    x3699,
+                    x3704,
+                    x3708,
+                    x3712,
+                    x3717,
+                    x3721,
+                    x3725,
+                    x3730,
+                    x3734,
+                    x3739,
+                ],
+                [
+                    x3743,
+                    x3747,
+                    x3751,
+                    x3756,
+                    x3761,
+                    x3765,
+                    x3769,
+                    x3774,
+                    x3778,
+                    x3782,
+                    x3787,
+                    x3791,
+                    x3796,
+                ],
+                [
+                    x3800,
+                    x3804,
+                    x3808,
+                    x3812,
+                    x3816,
+                    x3821,
+                    x3826,
+                    x3830,
+                    x3835,
+                    x3840,
+                    x3844,
+                    x3849,
+                    x3853,
+                ],
+                [
+                    x3857,
+                    x3861,
+                    x3865,
+                    x3870,
+                    x3875,
+                    x3879,
+                    x3883,
+                    x3888,
+                    x3892,
+                    x3896,
+                    x3901,
+                    x3905,
+                    x3910,
+                ],
+                [
+                    x3914,
+                    x3918,
+                    x3922,
+                    x3926,
+                    x3930,
+                    x3935,
+                    x3940,
+                    x3944,
+                    x3949,
+                    x3954,
+                    x3958,
+                    x3963,
+                    x3967,
+                ],
+                [
+                    x3971,
+                    x3975,
+                    x3979,
+                    x3983,
+                    x3987,
+                    x3992,
+                    x3997,
+                    x4001,
+                    x4006,
+                    x4011,
+                    x4015,
+                    x4020,
+                    x4024,
+                ],
+                [
+                    x4028,
+                    x4032,
+                    x4036,
+                    x4041,
+                    x4046,
+                    x4050,
+                    x4054,
+                    x4059,
+                    x4063,
+                    x4067,
+                    x4072,
+                    x4076,
+                    x4081,
+                ],
+                [
+                    x4085,
+                    x4089,
+                    x4093,
+                    x4098,
+                    x4103,
+                    x4107,
+                    x4111,
+                    x4116,
+                    x4120,
+                    x4124,
+                    x4129,
+                    x4133,
+                    x4138,
+                ],
+                [
+                    x4142,
+                    x4146,
+                    x4150,
+                    x4155,
+                    x4160,
+                    x4164,
+                    x4168,
+                    x4173,
+                    x4177,
+                    x4181,
+                    x4186,
+                    x4190,
+                    x4195,
+                ],
+                [
+                    x4199,
+                    x4203,
+                    x4207,
+                    x4211,
+                    x4215,
+                    x4220,
+                    x4225,
+                    x4229,
+                    x4234,
+                    x4239,
+                    x4243,
+                    x4248,
+                    x4252,
+                ],
+                [
+                    x4256,
+                    x4260,
+                    x4264,
+                    x4269,
+                    x4274,
+                    x4278,
+                    x4282,
+                    x4287,
+                    x4291,
+                    x4295,
+                    x4300,
+                    x4304,
+                    x4309,
+                ],
+                [
+                    x4313,
+                    x4317,
+                    x4321,
+                    x4326,
+                    x4331,
+                    x4335,
+                    x4339,
+                    x4344,
+                    x4348,
+                    x4352,
+                    x4357,
+                    x4361,
+                    x4366,
+                ],
+                [
+                    x4370,
+                    x4374,
+                    x4378,
+                    x4382,
+                    x4386,
+                    x4391,
+                    x4396,
+                    x4400,
+                    x4405,
+                    x4410,
+                    x4414,
+                    x4419,
+                    x4423,
+                ],
+            ],
+            [
+                [
+                    x2801,
+                    x2798,
+                    x2795,
+                    x2791,
+                    x2788,
+                    x2784,
+                    x2780,
+                    x2778,
+                    x2775,
+                    x2773,
+                    x2772,
+                    x2771,
+                    x2769,
+                ],
+                [
+                    x2853,
+                    x2850,
+                    x2847,
+                    x2843,
+                    x2840,
+                    x2836,
+                    x2833,
+                    x2830,
+                    x2827,
+                    x2825,
+                    x2824,
+                    x2823,
+                    x2821,
+                ],
+                [
+                    x2906,
+                    x2902,
+                    x2898,
+                    x2895,
+                    x2891,
+                    x2888,
+                    x2884,
+                    x2882,
+                    x2879,
+                    x2877,
+                    x2876,
+                    x2874,
+                    x2872,
+                ],
+                [
+                    x2954,
+                    x2951,
+                    x2948,
+                    x2944,
+                    x2941,
+                    x2937,
+                    x2934,
+                    x2931,
+                    x2928,
+                    x2926,
+                    x2925,
+                    x2924,
+                    x2922,
+                ],
+                [
+                    x3000,
+                    x2996,
+                    x2992,
+                    x2989,
+                    x2985,
+                    x2982,
+                    x2979,
+                    x2976,
+                    x2973,
+                    x2971,
+                    x2970,
+                    x2969,
+                    x2967,
+                ],
+                [
+                    x3047,
+                    x3043,
+                    x3039,
+                    x3036,
+                    x3032,
+                    x3029,
+                    x3025,
+                    x3023,
+                    x3020,
+                    x3017,
+                    x3015,
+                    x3013,
+                    x3011,
+                ],
+                [
+                    x3082,
+                    x3079,
+                    x3076,
+                    x3072,
+                    x3069,
+                    x3065,
+                    x3063,
+                    x3061,
+                    x3059,
+                    x3057,
+                    x3056,
+                    x3055,
+                    x3054,
+                ],
+                [
+                    x3117,
+                    x3114,
+                    x3111,
+                    x3107,
+                    x3104,
+                    x3100,
+                    x3098,
+                    x3096,
+                    x3094,
+                    x3092,
+                    x3091,
+                    x3090,
+                    x3088,
+                ],
+                [
+                    x3151,
+                    x3148,
+                    x3145,
+                    x3141,
+                    x3138,
+                    x3134,
+                    x3132,
+                    x3130,
+                    x3128,
+                    x3126,
+                    x3124,
+                    x3122,
+                    x3121,
+                ],
+                [
+                    x3186,
+                    x3182,
+                    x3178,
+                    x3175,
+                    x3171,
+                    x3168,
+                    x3165,
+                    x3162,
+                    x3159,
+                    x3157,
+                    x3156,
+                    x3154,
+                    x3153,
+                ],
+                [
+                    x3215,
+                    x3212,
+                    x3209,
+                    x3205,
+                    x3202,
+                    x3198,
+                    x3196,
+                    x3194,
+                    x3192,
+                    x3191,
+                    x3189,
+                    x3188,
+                    x3187,
+                ],
+                [
+                    x3245,
+                    x3242,
+                    x3239,
+                    x3235,
+                    x3232,
+                    x3228,
+                    x3226,
+                    x3224,
+                    x3222,
+                    x3221,
+                    x3219,
+                    x3218,
+                    x3217,
+                ],
+                [
+                    x3277,
+                    x3273,
+                    x3269,
+                    x3266,
+                    x3262,
+                    x3259,
+                    x3256,
+                    x3253,
+                    x3250,
+                    x3248,
+                    x3247,
+                    x3217,
+                    x2753,
+                ],
+            ],
+        )
+    }
+    /// The inverse of the joint-space inertia matrix, `M(q)⁻¹` (symmetric, both triangles written), from the LDLᵀ factors of `M`.
+    ///
+    /// : 1573 mul, 1387 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1163 fused where the target has FMA.
+    #[must_use]
+    pub fn mass_matrix_inverse(q: &[f64; 14]) -> [[f64; 13]; 13] {
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = 0.00000000020510342851533115 * c_q8;
+        let x8 = 0.00000000020510342851533115 * s_q8;
+        let x9 = 0.00000000020510342851533115 * c_q9;
+        let x10 = 0.00000000020510342851533115 * s_q9;
+        let x11 = x9 - x10;
+        let x12 = x9 + x10;
+        let x13 = 0.00000000020510342851533115 * s_q12;
+        let x14 = 0.00000000020510342851533115 * c_q12;
+        let x15 = 0.00000000020510342851533115 * c_q13;
+        let x16 = 0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = Self::mul_add(0.000781, x16, -0.0145);
+        let x21 = -0.9614610000000001
+            - Self::mul_add(x16, 1.2025609200000003, 0.000781 * x15);
+        let x22 = 1.4135609200000003
+            + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
+        let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = Self::mul_add(s_q13, 1.2025609200000003, x23)
+            - 0.00000000019719894748377882;
+        let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
+            + -0.0000000002899261911072858;
+        let x30 = 0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = x30 + x31;
+        let x33 = 0.55 * x17;
+        let x34 = 0.16 * x17;
+        let x35 = 0.16 * x18;
+        let x36 = 0.55 * x19;
+        let x37 = x32 + (x22 - Self::mul_add(-x16, x21, x15 * x20) + x32);
+        let x38 = 3.6140000000000003 + x17;
+        let x39 = 17.135250000000003 + x18;
+        let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
+        let x41 = -0.809539999555672
+            - (Self::mul_add(
+                0.00000000020510342851533115,
+                x22,
+                Self::mul_add(-s_q13, x21, c_q13 * x20),
+            ) + x34);
+        let x42 = -1.9877000000000002
+            - (x26 + Self::mul_add(-x16, x25, x15 * x23) + x33);
+        let x43 = -5.252920330000002
+            + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
+        let x44 = -2.741639999592316
+            - (x36
+                + (Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x26,
+                    Self::mul_add(-s_q13, x25, c_q13 * x23),
+                ) + x35));
+        let x45 = -0.809539999555672 + (x29 - Self::mul_add(x16, x28, x15 * x27) - x34);
+        let x46 = -2.7416399995923166
+            - (x35 - (Self::mul_add(-c_q13, x28, s_q13 * x27) - x36));
+        let x47 = 9.740442170000001
+            + (x31
+                - (Self::mul_add(
+                    0.00000000020510342851533115,
+                    x29,
+                    Self::mul_add(s_q13, x28, c_q13 * x27),
+                ) - x31));
+        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
+        let x49 = x19 - Self::mul_add(x14, x39, x13 * x38);
+        let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
+        let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
+        let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
+        let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
+        let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
+        let x55 = x45 - Self::mul_add(x14, x42, x13 * x37);
+        let x56 = x46 - Self::mul_add(x14, x43, x13 * x40);
+        let x57 = x47 - Self::mul_add(x14, x44, x13 * x41);
+        let x58 = Self::mul_add(
+            0.00000000020510342851533115,
+            x47,
+            Self::mul_add(c_q12, x44, s_q12 * x41),
+        );
+        let x59 = x54 - Self::mul_add(x14, x53, x13 * x52);
+        let x60 = Self::mul_add(
+            c_q12,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x46,
+                Self::mul_add(c_q12, x43, s_q12 * x40),
+            ),
+            s_q12
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x45,
+                    Self::mul_add(c_q12, x42, s_q12 * x37),
+                ),
+        );
+        let x61 = x51 * 0.36;
+        let x62 = Self::mul_add(
+            x48,
+            -0.36,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x54,
+                Self::mul_add(c_q12, x53, s_q12 * x52),
+            ),
+        );
+        let x63 = Self::mul_add(
+            x49,
+            -0.36,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x57,
+                Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x64 = x61 + (Self::mul_add(-s_q12, x53, c_q12 * x52) + x61);
+        let x65 = 7.078399999258757 + x49;
+        let x66 = 0.01675 - x62;
+        let x67 = -9.142025249762803
+            + (x61 + (x57 - Self::mul_add(x14, x56, x13 * x55) + x61));
+        let x68 = 2.5482240016099564 - x63;
+        let x69 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x58, x60);
+        let x70 = s_q11 * s_q11;
+        let x71 = s_q11 * c_q11;
+        let x72 = x64 - x67;
+        let x73 = x59 + x59;
+        let x74 = Self::mul_add(x71, x73, x70 * x72);
+        let x75 = Self::mul_add(-s_q11, x65, c_q11 * x48);
+        let x76 = Self::mul_add(c_q11, x65, s_q11 * x48);
+        let x77 = 0.275 * x51;
+        let x78 = x76 * 0.63;
+        let x79 = x77 - x78;
+        let x80 = Self::mul_add(x75, 0.63, x59 + Self::mul_add(-x70, x73, x71 * x72));
+        let x81 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x68, c_q11 * x66));
+        let x82 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x68, s_q11 * x66));
+        let x83 = x69 - x78;
+        let x84 = x79 + (x64 - x74 + x79);
+        let x85 = -45.1584 + x76;
+        let x86 = -0.6328 + x81;
+        let x87 = -24.4950615 + (x77 + (x67 + x74 + x77));
+        let x88 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x82);
+        let x89 = 28.2393615 - (x78 - x83);
+        let x90 = s_q10 * s_q10;
+        let x91 = s_q10 * c_q10;
+        let x92 = x84 - x87;
+        let x93 = x80 + x80;
+        let x94 = Self::mul_add(x91, x93, x90 * x92);
+        let x95 = Self::mul_add(-s_q10, x88, c_q10 * x86);
+        let x96 = Self::mul_add(c_q10, x88, s_q10 * x86);
+        let x97 = c_q10 * x75;
+        let x98 = Self::mul_add(-s_q10, x85, x97);
+        let x99 = s_q10 * x75;
+        let x100 = Self::mul_add(c_q10, x85, x99);
+        let x101 = x100 * 0.87;
+        let x102 = Self::mul_add(x98, 0.87, x80 + Self::mul_add(-x90, x93, x91 * x92));
+        let x103 = x89 - x101;
+        let x104 = x101 - (x84 - x94 - x101);
+        let x105 = -81.53205 + x100;
+        let x106 = -0.00214 + x95;
+        let x107 = -63.36336825000001 + (x87 + x94);
+        let x108 = -36.18604050126307 + Self::mul_add(x51, -0.87, x96);
+        let x109 = 69.99836825 - (x101 - x103);
+        let x110 = s_q9 * x98;
+        let x111 = Self::mul_add(c_q9, x105, x110);
+        let x112 = 0.00000000020510342851533115 * x51;
+        let x113 = x111 - x112;
+        let x114 = x51 - Self::mul_add(-x12, x105, x11 * x98);
+        let x115 = c_q9 * x98;
+        let x116 = Self::mul_add(-s_q9, x105, x115);
+        let x117 = x112 + x116;
+        let x118 = c_q9 * x102;
+        let x119 = 0.00000000020510342851533115 * x106;
+        let x120 = Self::mul_add(s_q9, x104, -x118) - x119;
+        let x121 = s_q9 * x102;
+        let x122 = 0.00000000020510342851533115 * x108;
+        let x123 = Self::mul_add(c_q9, x107, x121) + x122;
+        let x124 = 0.00000000020510342851533115 * x109;
+        let x125 = Self::mul_add(c_q9, x108, s_q9 * x106) + x124;
+        let x126 = x106 - Self::mul_add(x12, x102, x11 * x104);
+        let x127 = x108 + Self::mul_add(-x12, x107, x11 * x102);
+        let x128 = x109 + Self::mul_add(-x12, x108, x11 * x106);
+        let x129 = x119 + Self::mul_add(c_q9, x104, x121);
+        let x130 = x122 - Self::mul_add(-s_q9, x107, x118);
+        let x131 = x124 - Self::mul_add(-s_q9, x108, c_q9 * x106);
+        let x132 = 0.00000000020510342851533115 * x125;
+        let x133 = 0.00000000020510342851533115 * x128;
+        let x134 = 0.00000000020510342851533115 * x131;
+        let x135 = 0.4 * x117;
+        let x136 = 0.275 * x114;
+        let x137 = x135 - x136;
+        let x138 = 0.275 * x113;
+        let x139 = 0.4 * x113;
+        let x140 = 0.4 * x114;
+        let x141 = 0.275 * x117;
+        let x142 = x137 - (Self::mul_add(-c_q9, x123, s_q9 * x120) - x132 - x137);
+        let x143 = -0.000000008530897668050218 + x113;
+        let x144 = -12.701650001451807 - x114;
+        let x145 = -0.0000000234896432582596
+            + (x125 - Self::mul_add(x12, x123, x11 * x120) - x138);
+        let x146 = -0.002139996587640933
+            - (x132 + Self::mul_add(s_q9, x123, c_q9 * x120) + x139);
+        let x147 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x127, s_q9 * x126) + x133 - x138);
+        let x148 = -111.7548902508081
+            + (x135 + (x128 + Self::mul_add(-x12, x127, x11 * x126) + x135));
+        let x149 = 5.080660024070365
+            - (x141 + (x133 - Self::mul_add(-s_q9, x127, c_q9 * x126) - x140));
+        let x150 = -0.002139996587640933
+            - (Self::mul_add(c_q9, x130, s_q9 * x129) + x134 + x139);
+        let x151 = 5.080660024070366
+            + (x140 - (x131 + Self::mul_add(-x12, x130, x11 * x129) + x141));
+        let x152 = 113.3918902508081
+            - (x136 - (x134 - Self::mul_add(-s_q9, x130, c_q9 * x129) - x136));
+        let x153 = x117 - Self::mul_add(-x8, x144, x7 * x143);
+        let x154 = Self::mul_add(c_q8, x144, s_q8 * x143);
+        let x155 = Self::mul_add(-s_q8, x144, c_q8 * x143);
+        let x156 = Self::mul_add(0.00000000020510342851533115, x117, x155);
+        let x157 = x150 - Self::mul_add(-x8, x147, x7 * x142);
+        let x158 = x151 - Self::mul_add(-x8, x148, x7 * x145);
+        let x159 = x152 - Self::mul_add(-x8, x149, x7 * x146);
+        let x160 = Self::mul_add(c_q8, x147, s_q8 * x142);
+        let x161 = Self::mul_add(c_q8, x148, s_q8 * x145);
+        let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
+        let x163 = Self::mul_add(
+            0.00000000020510342851533115,
+            x152,
+            Self::mul_add(-s_q8, x149, c_q8 * x146),
+        );
+        let x164 = Self::mul_add(
+            -s_q8,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x151,
+                Self::mul_add(-s_q8, x148, c_q8 * x145),
+            ),
+            c_q8
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x150,
+                    Self::mul_add(-s_q8, x147, c_q8 * x142),
+                ),
+        );
+        let x165 = 0.35 * x156;
+        let x166 = Self::mul_add(
+            0.35,
+            x153,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x159,
+                Self::mul_add(-s_q8, x158, c_q8 * x157),
+            ),
+        );
+        let x167 = Self::mul_add(
+            0.35,
+            x154,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x162,
+                Self::mul_add(-s_q8, x161, c_q8 * x160),
+            ),
+        );
+        let x168 = x165 - (x159 - Self::mul_add(-x8, x158, x7 * x157) - x165);
+        let x169 = 48.0240000085309 + x153;
+        let x170 = -0.07309 + Self::mul_add(c_q8, x158, s_q8 * x157);
+        let x171 = -16.80768997608804 - x166;
+        let x172 = 130.43769025763282
+            - (x165 - (Self::mul_add(c_q8, x161, s_q8 * x160) - x165));
+        let x173 = 0.1132 - x167;
+        let x174 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x163, x164);
+        let x175 = s_q7 * s_q7;
+        let x176 = s_q7 * c_q7;
+        let x177 = x168 + x172;
+        let x178 = x170 + x170;
+        let x179 = Self::mul_add(-x176, x178, x175 * x177);
+        let x180 = Self::mul_add(-s_q7, x154, c_q7 * x169);
+        let x181 = Self::mul_add(c_q7, x154, s_q7 * x169);
+        let x182 = 0.75 * x156;
+        let x183 = 0.65 * x180;
+        let x184 = x182 - x183;
+        let x185 = Self::mul_add(-0.75, x180, Self::mul_add(-s_q7, x173, c_q7 * x171));
+        let x186 = x174 + x183;
+        let x187 = 110.5455 + x180;
+        let x188 = 180.9502499901501 - x156;
+        let x189 = Self::mul_add(x8, x143, x7 * x144);
+        let x190 = Self::mul_add(-0.35, x155, x159);
+        let x191 = Self::mul_add(0.35, x189, x162);
+        let x192 = Self::mul_add(-s_q7, x155, c_q7 * x189);
+        let x193 = Self::mul_add(c_q7, x155, s_q7 * x189);
+        let x194 = x12 * x98;
+        let x195 = Self::mul_add(x11, x105, x194);
+        let x196 = x125 + Self::mul_add(-0.275, x111, 0.4 * x195);
+        let x197 = Self::mul_add(0.4, x116, x128);
+        let x198 = Self::mul_add(0.275, x116, x131);
+        let x199 = x111 + Self::mul_add(x8, x195, x7 * x116);
+        let x200 = Self::mul_add(-c_q8, x195, s_q8 * x116);
+        let x201 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x111,
+            Self::mul_add(s_q8, x195, c_q8 * x116),
+        );
+        let x202 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x198,
+            Self::mul_add(-s_q8, x197, c_q8 * x196),
+        );
+        let x203 = Self::mul_add(0.35, x200, x198 + Self::mul_add(-x8, x197, x7 * x196));
+        let x204 = Self::mul_add(-0.35, x199, Self::mul_add(c_q8, x197, s_q8 * x196));
+        let x205 = Self::mul_add(s_q7, x200, c_q7 * x199);
+        let x206 = Self::mul_add(-c_q7, x200, s_q7 * x199);
+        let x207 = Self::mul_add(-s_q9, x100, x115);
+        let x208 = Self::mul_add(x11, x100, x194);
+        let x209 = Self::mul_add(c_q9, x100, x110);
+        let x210 = 0.00000000020510342851533115 * x103;
+        let x211 = Self::mul_add(c_q9, x96, s_q9 * x95) + x210
+            + Self::mul_add(-0.275, x209, 0.4 * x208);
+        let x212 = Self::mul_add(0.4, x207, x103 + Self::mul_add(-x12, x96, x11 * x95));
+        let x213 = Self::mul_add(
+            0.275,
+            x207,
+            x210 - Self::mul_add(-s_q9, x96, c_q9 * x95),
+        );
+        let x214 = x209 + Self::mul_add(x8, x208, x7 * x207);
+        let x215 = Self::mul_add(-c_q8, x208, s_q8 * x207);
+        let x216 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x209,
+            Self::mul_add(s_q8, x208, c_q8 * x207),
+        );
+        let x217 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x213,
+            Self::mul_add(-s_q8, x212, c_q8 * x211),
+        );
+        let x218 = Self::mul_add(0.35, x215, x213 + Self::mul_add(-x8, x212, x7 * x211));
+        let x219 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x212, s_q8 * x211));
+        let x220 = Self::mul_add(s_q7, x215, c_q7 * x214);
+        let x221 = Self::mul_add(-c_q7, x215, s_q7 * x214);
+        let x222 = Self::mul_add(c_q10, x76, x99);
+        let x223 = Self::mul_add(-s_q10, x76, x97);
+        let x224 = Self::mul_add(-s_q10, x82, c_q10 * x81);
+        let x225 = Self::mul_add(c_q10, x82, s_q10 * x81);
+        let x226 = Self::mul_add(-0.87, x222, x83);
+        let x227 = Self::mul_add(-c_q9, x223, s_q9 * x222);
+        let x228 = Self::mul_add(x12, x223, x11 * x222);
+        let x229 = Self::mul_add(s_q9, x223, c_q9 * x222);
+        let x230 = 0.00000000020510342851533115 * x226;
+        let x231 = Self::mul_add(c_q9, x225, s_q9 * x224) + x230
+            + Self::mul_add(-0.275, x229, 0.4 * x228);
+        let x232 = Self::mul_add(
+            -0.4,
+            x227,
+            x226 + Self::mul_add(-x12, x225, x11 * x224),
+        );
+        let x233 = Self::mul_add(
+            -0.275,
+            x227,
+            x230 - Self::mul_add(-s_q9, x225, c_q9 * x224),
+        );
+        let x234 = x229 - Self::mul_add(-x8, x228, x7 * x227);
+        let x235 = Self::mul_add(c_q8, x228, s_q8 * x227);
+        let x236 = Self::mul_add(
+            0.00000000020510342851533115,
+            x229,
+            Self::mul_add(-s_q8, x228, c_q8 * x227),
+        );
+        let x237 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x233,
+            Self::mul_add(-s_q8, x232, c_q8 * x231),
+        );
+        let x238 = Self::mul_add(
+            -0.35,
+            x235,
+            x233 + Self::mul_add(-x8, x232, x7 * x231),
+        );
+        let x239 = Self::mul_add(-0.35, x234, Self::mul_add(c_q8, x232, s_q8 * x231));
+        let x240 = Self::mul_add(-s_q7, x235, c_q7 * x234);
+        let x241 = Self::mul_add(c_q7, x235, s_q7 * x234);
+        let x242 = Self::mul_add(-x14, x38, x13 * x39);
+        let x243 = Self::mul_add(0.36, x242, x54);
+        let x244 = Self::mul_add(x50, 0.36, x57);
+        let x245 = Self::mul_add(s_q11, x242, c_q11 * x50);
+        let x246 = Self::mul_add(-c_q11, x242, s_q11 * x50);
+        let x247 = Self::mul_add(-s_q11, x244, c_q11 * x243)
+            - Self::mul_add(x48, -0.63, 0.275 * x246);
+        let x248 = Self::mul_add(0.275, x245, Self::mul_add(c_q11, x244, s_q11 * x243));
+        let x249 = Self::mul_add(0.63, x245, x58);
+        let x250 = Self::mul_add(-s_q10, x246, c_q10 * x245);
+        let x251 = Self::mul_add(c_q10, x246, s_q10 * x245);
+        let x252 = Self::mul_add(c_q10, x248, s_q10 * x247);
+        let x253 = Self::mul_add(x48, 0.87, Self::mul_add(-s_q10, x248, c_q10 * x247));
+        let x254 = Self::mul_add(0.87, x250, x249);
+        let x255 = 0.00000000020510342851533115 * x48;
+        let x256 = Self::mul_add(c_q9, x251, s_q9 * x250) + x255;
+        let x257 = x48 + Self::mul_add(-x12, x251, x11 * x250);
+        let x258 = x255 - Self::mul_add(-s_q9, x251, c_q9 * x250);
+        let x259 = 0.00000000020510342851533115 * x254;
+        let x260 = Self::mul_add(c_q9, x252, s_q9 * x253) - x259
+            + Self::mul_add(0.275, x258, 0.4 * x257);
+        let x261 = Self::mul_add(
+            0.4,
+            x256,
+            x254 - Self::mul_add(-x12, x252, x11 * x253),
+        );
+        let x262 = Self::mul_add(
+            0.275,
+            x256,
+            x259 + Self::mul_add(-s_q9, x252, c_q9 * x253),
+        );
+        let x263 = x258 + Self::mul_add(-x8, x257, x7 * x256);
+        let x264 = Self::mul_add(c_q8, x257, s_q8 * x256);
+        let x265 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x258,
+            Self::mul_add(-s_q8, x257, c_q8 * x256),
+        );
+        let x266 = Self::mul_add(
+            0.00000000020510342851533115,
+            x262,
+            Self::mul_add(s_q8, x261, c_q8 * x260),
+        );
+        let x267 = Self::mul_add(0.35, x264, x262 - Self::mul_add(x8, x261, x7 * x260));
+        let x268 = Self::mul_add(0.35, x263, Self::mul_add(-c_q8, x261, s_q8 * x260));
+        let x269 = Self::mul_add(s_q7, x264, c_q7 * x263);
+        let x270 = Self::mul_add(-c_q7, x264, s_q7 * x263);
+        let x271 = 4.806620000000001 * x15;
+        let x272 = x22 + x32;
+        let x273 = Self::mul_add(-0.16, x271, x26);
+        let x274 = Self::mul_add(-0.55, x271, x29);
+        let x275 = Self::mul_add(s_q12, x19, c_q12 * x271);
+        let x276 = x18 - Self::mul_add(-x14, x19, x13 * x271);
+        let x277 = Self::mul_add(
+            0.00000000020510342851533115,
+            x18,
+            Self::mul_add(-c_q12, x19, s_q12 * x271),
+        );
+        let x278 = Self::mul_add(
+            0.00000000020510342851533115,
+            x274,
+            Self::mul_add(-c_q12, x273, s_q12 * x272),
+        );
+        let x279 = Self::mul_add(0.36, x276, Self::mul_add(s_q12, x273, c_q12 * x272));
+        let x280 = Self::mul_add(
+            -0.36,
+            x275,
+            x274 - Self::mul_add(-x14, x273, x13 * x272),
+        );
+        let x281 = Self::mul_add(-s_q11, x276, c_q11 * x275);
+        let x282 = Self::mul_add(c_q11, x276, s_q11 * x275);
+        let x283 = Self::mul_add(-s_q11, x280, c_q11 * x279)
+            + Self::mul_add(0.63, x277, 0.275 * x282);
+        let x284 = Self::mul_add(-0.275, x281, Self::mul_add(c_q11, x280, s_q11 * x279));
+        let x285 = Self::mul_add(-0.63, x281, x278);
+        let x286 = Self::mul_add(-s_q10, x282, c_q10 * x281);
+        let x287 = Self::mul_add(c_q10, x282, s_q10 * x281);
+        let x288 = Self::mul_add(c_q10, x284, s_q10 * x283);
+        let x289 = Self::mul_add(0.87, x277, Self::mul_add(-s_q10, x284, c_q10 * x283));
+        let x290 = Self::mul_add(-0.87, x286, x285);
+        let x291 = 0.00000000020510342851533115 * x277;
+        let x292 = Self::mul_add(c_q9, x287, s_q9 * x286) - x291;
+        let x293 = x277 - Self::mul_add(-x12, x287, x11 * x286);
+        let x294 = x291 + Self::mul_add(-s_q9, x287, c_q9 * x286);
+        let x295 = 0.00000000020510342851533115 * x290;
+        let x296 = Self::mul_add(c_q9, x288, s_q9 * x289) - x295
+            + Self::mul_add(0.275, x294, 0.4 * x293);
+        let x297 = Self::mul_add(
+            -0.4,
+            x292,
+            x290 - Self::mul_add(-x12, x288, x11 * x289),
+        );
+        let x298 = Self::mul_add(
+            -0.275,
+            x292,
+            x295 + Self::mul_add(-s_q9, x288, c_q9 * x289),
+        );
+        let x299 = x294 - Self::mul_add(x8, x293, x7 * x292);
+        let x300 = Self::mul_add(-c_q8, x293, s_q8 * x292);
+        let x301 = Self::mul_add(
+            0.00000000020510342851533115,
+            x294,
+            Self::mul_add(s_q8, x293, c_q8 * x292),
+        );
+        let x302 = Self::mul_add(
+            0.00000000020510342851533115,
+            x298,
+            Self::mul_add(s_q8, x297, c_q8 * x296),
+        );
+        let x303 = Self::mul_add(-0.35, x300, x298 - Self::mul_add(x8, x297, x7 * x296));
+        let x304 = Self::mul_add(0.35, x299, Self::mul_add(-c_q8, x297, s_q8 * x296));
+        let x305 = Self::mul_add(-s_q7, x300, c_q7 * x299);
+        let x306 = Self::mul_add(c_q7, x300, s_q7 * x299);
+        let x307 = x188 * 0.0008546497218115156;
+        let x308 = x181 * 0.0008546497218115156;
+        let x309 = x192 * 0.0008546497218115156;
+        let x310 = x205 * 0.0008546497218115156;
+        let x311 = x220 * 0.0008546497218115156;
+        let x312 = x240 * 0.0008546497218115156;
+        let x313 = x269 * 0.0008546497218115156;
+        let x314 = x305 * 0.0008546497218115156;
+        let x315 = x187 * 0.0008546497218115156;
+        let x316 = x180 * 0.0008546497218115156;
+        let x317 = x193 * 0.0008546497218115156;
+        let x318 = x206 * 0.0008546497218115156;
+        let x319 = x221 * 0.0008546497218115156;
+        let x320 = x241 * 0.0008546497218115156;
+        let x321 = x270 * 0.0008546497218115156;
+        let x322 = x306 * 0.0008546497218115156;
+        let x323 = x154 * 0.0008546497218115156;
+        let x324 = x201 * 0.0008546497218115156;
+        let x325 = x216 * 0.0008546497218115156;
+        let x326 = x236 * 0.0008546497218115156;
+        let x327 = x265 * 0.0008546497218115156;
+        let x328 = x301 * 0.0008546497218115156;
+        let x329 = x188 * x307;
+        let x330 = x181 * x308;
+        let x331 = 1.0
+            / (1394.5960312283303 - (x182 + (x168 - x179 + x182)) - x329 - x330);
+        let x332 = Self::mul_add(
+            x181,
+            x315,
+            Self::mul_add(-0.65, x181, x170 - Self::mul_add(x175, x178, x176 * x177)),
+        );
+        let x333 = x331 * x332;
+        let x334 = Self::mul_add(
+            x188,
+            x315,
+            -117.61766249359756 + Self::mul_add(0.65, x156, x185),
+        );
+        let x335 = x331 * x334;
+        let x336 = Self::mul_add(x188, x316, x185);
+        let x337 = x331 * x336;
+        let x338 = Self::mul_add(
+            x188,
+            x317,
+            Self::mul_add(-0.75, x193, Self::mul_add(-s_q7, x191, c_q7 * x190)),
+        );
+        let x339 = Self::mul_add(-x181, x323, x338);
+        let x340 = x331 * x339;
+        let x341 = Self::mul_add(
+            x188,
+            x318,
+            Self::mul_add(-0.75, x206, Self::mul_add(s_q7, x204, c_q7 * x203)),
+        );
+        let x342 = Self::mul_add(-x181, x324, x341);
+        let x343 = x331 * x342;
+        let x344 = Self::mul_add(
+            x188,
+            x319,
+            Self::mul_add(-0.75, x221, Self::mul_add(s_q7, x219, c_q7 * x218)),
+        );
+        let x345 = Self::mul_add(-x181, x325, x344);
+        let x346 = x331 * x345;
+        let x347 = Self::mul_add(
+            x188,
+            x320,
+            Self::mul_add(-0.75, x241, Self::mul_add(s_q7, x239, c_q7 * x238)),
+        );
+        let x348 = Self::mul_add(x181, x326, x347);
+        let x349 = x331 * x348;
+        let x350 = Self::mul_add(
+            x188,
+            x321,
+            Self::mul_add(-0.75, x270, Self::mul_add(-s_q7, x268, c_q7 * x267)),
+        );
+        let x351 = Self::mul_add(-x181, x327, x350);
+        let x352 = x331 * x351;
+        let x353 = Self::mul_add(
+            x188,
+            x322,
+            Self::mul_add(-0.75, x306, Self::mul_add(-s_q7, x304, c_q7 * x303)),
+        );
+        let x354 = Self::mul_add(x181, x328, x353);
+        let x355 = x331 * x354;
+        let x356 = x187 * x315;
+        let x357 = 1.0
+            / Self::mul_add(
+                -x332,
+                x333,
+                1466.4506062283303 - (x184 - (x172 - x179 - x184)) - x329 - x356,
+            );
+        let x358 = Self::mul_add(
+            x188,
+            x308,
+            Self::mul_add(-0.75, x181, Self::mul_add(c_q7, x173, s_q7 * x171)),
+        );
+        let x359 = Self::mul_add(-x332, x335, x358);
+        let x360 = x357 * x359;
+        let x361 = Self::mul_add(-x332, x337, x358);
+        let x362 = x357 * x361;
+        let x363 = Self::mul_add(
+            x187,
+            x323,
+            Self::mul_add(
+                -x188,
+                x309,
+                Self::mul_add(c_q7, x191, s_q7 * x190)
+                    + Self::mul_add(-0.65, x154, 0.75 * x192),
+            ),
+        );
+        let x364 = Self::mul_add(-x332, x340, x363);
+        let x365 = x357 * x364;
+        let x366 = Self::mul_add(
+            x187,
+            x324,
+            Self::mul_add(
+                -x188,
+                x310,
+                Self::mul_add(-c_q7, x204, s_q7 * x203)
+                    + Self::mul_add(-0.65, x201, 0.75 * x205),
+            ),
+        );
+        let x367 = Self::mul_add(-x332, x343, x366);
+        let x368 = x357 * x367;
+        let x369 = Self::mul_add(
+            x187,
+            x325,
+            Self::mul_add(
+                -x188,
+                x311,
+                Self::mul_add(-c_q7, x219, s_q7 * x218)
+                    + Self::mul_add(-0.65, x216, 0.75 * x220),
+            ),
+        );
+        let x370 = Self::mul_add(-x332, x346, x369);
+        let x371 = x357 * x370;
+        let x372 = Self::mul_add(
+            -x187,
+            x326,
+            Self::mul_add(
+                -x188,
+                x312,
+                Self::mul_add(-c_q7, x239, s_q7 * x238)
+                    + Self::mul_add(0.65, x236, 0.75 * x240),
+            ),
+        );
+        let x373 = Self::mul_add(-x332, x349, x372);
+        let x374 = x357 * x373;
+        let x375 = Self::mul_add(
+            x187,
+            x327,
+            Self::mul_add(
+                -x188,
+                x313,
+                Self::mul_add(c_q7, x268, s_q7 * x267)
+                    + Self::mul_add(-0.65, x265, 0.75 * x269),
+            ),
+        );
+        let x376 = Self::mul_add(-x332, x352, x375);
+        let x377 = x357 * x376;
+        let x378 = Self::mul_add(
+            -x187,
+            x328,
+            Self::mul_add(
+                -x188,
+                x314,
+                Self::mul_add(c_q7, x304, s_q7 * x303)
+                    + Self::mul_add(0.65, x301, 0.75 * x305),
+            ),
+        );
+        let x379 = Self::mul_add(-x332, x355, x378);
+        let x380 = x357 * x379;
+        let x381 = 1.0
+            / Self::mul_add(
+                x359,
+                x360,
+                Self::mul_add(x334, x335, x356 - (1271.854575 + (x183 + x186) - x330)),
+            );
+        let x382 = Self::mul_add(
+            -x359,
+            x362,
+            Self::mul_add(-x334, x337, Self::mul_add(-x187, x316, x186 - x330)),
+        );
+        let x383 = x381 * x382;
+        let x384 = x181 * x309;
+        let x385 = Self::mul_add(
+            x334,
+            x340,
+            Self::mul_add(x187, x317, Self::mul_add(-0.65, x193, x163) - x384),
+        );
+        let x386 = Self::mul_add(x359, x365, x385);
+        let x387 = x381 * x386;
+        let x388 = x181 * x310;
+        let x389 = Self::mul_add(
+            -x334,
+            x343,
+            Self::mul_add(-x187, x318, Self::mul_add(0.65, x206, x202) + x388),
+        );
+        let x390 = Self::mul_add(-x359, x368, x389);
+        let x391 = x381 * x390;
+        let x392 = x181 * x311;
+        let x393 = Self::mul_add(
+            -x334,
+            x346,
+            Self::mul_add(-x187, x319, Self::mul_add(0.65, x221, x217) + x392),
+        );
+        let x394 = Self::mul_add(-x359, x371, x393);
+        let x395 = x381 * x394;
+        let x396 = x181 * x312;
+        let x397 = Self::mul_add(
+            -x334,
+            x349,
+            Self::mul_add(-x187, x320, Self::mul_add(0.65, x241, x237) + x396),
+        );
+        let x398 = Self::mul_add(-x359, x374, x397);
+        let x399 = x381 * x398;
+        let x400 = x181 * x313;
+        let x401 = Self::mul_add(
+            x334,
+            x352,
+            Self::mul_add(x187, x321, Self::mul_add(-0.65, x270, x266) - x400),
+        );
+        let x402 = Self::mul_add(x359, x377, x401);
+        let x403 = x381 * x402;
+        let x404 = x181 * x314;
+        let x405 = Self::mul_add(
+            x334,
+            x355,
+            Self::mul_add(x187, x322, Self::mul_add(-0.65, x306, x302) - x404),
+        );
+        let x406 = Self::mul_add(x359, x380, x405);
+        let x407 = x381 * x406;
+        let x408 = Self::mul_add(
+            -x361,
+            x362,
+            Self::mul_add(-x336, x337, Self::mul_add(-x180, x316, x174 - x330)),
+        );
+        let x409 = 1.0 / Self::mul_add(x382, x383, x408);
+        let x410 = Self::mul_add(
+            x361,
+            x365,
+            Self::mul_add(x336, x340, Self::mul_add(x180, x317, x163 - x384)),
+        );
+        let x411 = Self::mul_add(x382, x387, x410);
+        let x412 = x409 * x411;
+        let x413 = Self::mul_add(
+            -x361,
+            x368,
+            Self::mul_add(-x336, x343, Self::mul_add(-x180, x318, x202 + x388)),
+        );
+        let x414 = Self::mul_add(x382, x391, x413);
+        let x415 = x409 * x414;
+        let x416 = Self::mul_add(
+            -x361,
+            x371,
+            Self::mul_add(-x336, x346, Self::mul_add(-x180, x319, x217 + x392)),
+        );
+        let x417 = Self::mul_add(x382, x395, x416);
+        let x418 = x409 * x417;
+        let x419 = Self::mul_add(
+            -x361,
+            x374,
+            Self::mul_add(-x336, x349, Self::mul_add(-x180, x320, x237 + x396)),
+        );
+        let x420 = Self::mul_add(x382, x399, x419);
+        let x421 = x409 * x420;
+        let x422 = Self::mul_add(
+            x361,
+            x377,
+            Self::mul_add(x336, x352, Self::mul_add(x180, x321, x266 - x400)),
+        );
+        let x423 = Self::mul_add(x382, x403, x422);
+        let x424 = x409 * x423;
+        let x425 = Self::mul_add(
+            x361,
+            x380,
+            Self::mul_add(x336, x355, Self::mul_add(x180, x322, x302 - x404)),
+        );
+        let x426 = Self::mul_add(x382, x407, x425);
+        let x427 = x409 * x426;
+        let x428 = Self::mul_add(
+            -x154,
+            x323,
+            Self::mul_add(-x193, x317, Self::mul_add(-x192, x309, x152)),
+        );
+        let x429 = Self::mul_add(
+            x386,
+            x387,
+            Self::mul_add(-x364, x365, Self::mul_add(-x339, x340, x428)),
+        );
+        let x430 = 1.0 / Self::mul_add(-x411, x412, x429);
+        let x431 = Self::mul_add(
+            -x154,
+            x324,
+            Self::mul_add(-x193, x318, Self::mul_add(-x192, x310, x198)),
+        );
+        let x432 = Self::mul_add(
+            -x386,
+            x391,
+            Self::mul_add(-x364, x368, Self::mul_add(-x339, x343, x431)),
+        );
+        let x433 = Self::mul_add(x411, x415, x432);
+        let x434 = x430 * x433;
+        let x435 = Self::mul_add(
+            -x154,
+            x325,
+            Self::mul_add(-x193, x319, Self::mul_add(-x192, x311, x213)),
+        );
+        let x436 = Self::mul_add(
+            -x386,
+            x395,
+            Self::mul_add(-x364, x371, Self::mul_add(-x339, x346, x435)),
+        );
+        let x437 = Self::mul_add(x411, x418, x436);
+        let x438 = x430 * x437;
+        let x439 = Self::mul_add(
+            x154,
+            x326,
+            Self::mul_add(-x193, x320, Self::mul_add(-x192, x312, x233)),
+        );
+        let x440 = Self::mul_add(
+            -x386,
+            x399,
+            Self::mul_add(-x364, x374, Self::mul_add(-x339, x349, x439)),
+        );
+        let x441 = Self::mul_add(x411, x421, x440);
+        let x442 = x430 * x441;
+        let x443 = Self::mul_add(
+            -x154,
+            x327,
+            Self::mul_add(-x193, x321, Self::mul_add(-x192, x313, x262)),
+        );
+        let x444 = Self::mul_add(
+            x386,
+            x403,
+            Self::mul_add(-x364, x377, Self::mul_add(-x339, x352, x443)),
+        );
+        let x445 = Self::mul_add(-x411, x424, x444);
+        let x446 = x430 * x445;
+        let x447 = Self::mul_add(
+            x154,
+            x328,
+            Self::mul_add(-x193, x322, Self::mul_add(-x192, x314, x298)),
+        );
+        let x448 = Self::mul_add(
+            x386,
+            x407,
+            Self::mul_add(-x364, x380, Self::mul_add(-x339, x355, x447)),
+        );
+        let x449 = Self::mul_add(-x411, x427, x448);
+        let x450 = x430 * x449;
+        let x451 = Self::mul_add(
+            -x201,
+            x324,
+            Self::mul_add(-x206, x318, Self::mul_add(-x205, x310, x109)),
+        );
+        let x452 = Self::mul_add(
+            x390,
+            x391,
+            Self::mul_add(-x367, x368, Self::mul_add(-x342, x343, x451)),
+        );
+        let x453 = 1.0 / Self::mul_add(-x433, x434, Self::mul_add(-x414, x415, x452));
+        let x454 = Self::mul_add(
+            -x201,
+            x325,
+            Self::mul_add(-x206, x319, Self::mul_add(-x205, x311, x103)),
+        );
+        let x455 = Self::mul_add(
+            x390,
+            x395,
+            Self::mul_add(-x367, x371, Self::mul_add(-x342, x346, x454)),
+        );
+        let x456 = Self::mul_add(-x433, x438, Self::mul_add(-x414, x418, x455));
+        let x457 = x453 * x456;
+        let x458 = Self::mul_add(
+            x201,
+            x326,
+            Self::mul_add(-x206, x320, Self::mul_add(-x205, x312, x226)),
+        );
+        let x459 = Self::mul_add(
+            x390,
+            x399,
+            Self::mul_add(-x367, x374, Self::mul_add(-x342, x349, x458)),
+        );
+        let x460 = Self::mul_add(-x433, x442, Self::mul_add(-x414, x421, x459));
+        let x461 = x453 * x460;
+        let x462 = Self::mul_add(
+            -x201,
+            x327,
+            Self::mul_add(-x206, x321, Self::mul_add(-x205, x313, x254)),
+        );
+        let x463 = Self::mul_add(
+            -x390,
+            x403,
+            Self::mul_add(-x367, x377, Self::mul_add(-x342, x352, x462)),
+        );
+        let x464 = Self::mul_add(-x433, x446, Self::mul_add(x414, x424, x463));
+        let x465 = x453 * x464;
+        let x466 = Self::mul_add(
+            x201,
+            x328,
+            Self::mul_add(-x206, x322, Self::mul_add(-x205, x314, x290)),
+        );
+        let x467 = Self::mul_add(
+            -x390,
+            x407,
+            Self::mul_add(-x367, x380, Self::mul_add(-x342, x355, x466)),
+        );
+        let x468 = Self::mul_add(-x433, x450, Self::mul_add(x414, x427, x467));
+        let x469 = x453 * x468;
+        let x470 = Self::mul_add(
+            -x216,
+            x325,
+            Self::mul_add(-x221, x319, Self::mul_add(-x220, x311, x89)),
+        );
+        let x471 = Self::mul_add(
+            x394,
+            x395,
+            Self::mul_add(-x370, x371, Self::mul_add(-x345, x346, x470)),
+        );
+        let x472 = Self::mul_add(
+            -x456,
+            x457,
+            Self::mul_add(-x437, x438, Self::mul_add(-x417, x418, x471)),
+        );
+        let x473 = 1.0 / x472;
+        let x474 = Self::mul_add(
+            x216,
+            x326,
+            Self::mul_add(-x221, x320, Self::mul_add(-x220, x312, x83)),
+        );
+        let x475 = Self::mul_add(
+            x394,
+            x399,
+            Self::mul_add(-x370, x374, Self::mul_add(-x345, x349, x474)),
+        );
+        let x476 = Self::mul_add(
+            -x456,
+            x461,
+            Self::mul_add(-x437, x442, Self::mul_add(-x417, x421, x475)),
+        );
+        let x477 = x473 * x476;
+        let x478 = Self::mul_add(
+            -x216,
+            x327,
+            Self::mul_add(-x221, x321, Self::mul_add(-x220, x313, x249)),
+        );
+        let x479 = Self::mul_add(
+            -x394,
+            x403,
+            Self::mul_add(-x370, x377, Self::mul_add(-x345, x352, x478)),
+        );
+        let x480 = Self::mul_add(
+            -x456,
+            x465,
+            Self::mul_add(-x437, x446, Self::mul_add(x417, x424, x479)),
+        );
+        let x481 = x473 * x480;
+        let x482 = Self::mul_add(
+            x216,
+            x328,
+            Self::mul_add(-x221, x322, Self::mul_add(-x220, x314, x285)),
+        );
+        let x483 = Self::mul_add(
+            -x394,
+            x407,
+            Self::mul_add(-x370, x380, Self::mul_add(-x345, x355, x482)),
+        );
+        let x484 = Self::mul_add(
+            -x456,
+            x469,
+            Self::mul_add(-x437, x450, Self::mul_add(x417, x427, x483)),
+        );
+        let x485 = x473 * x484;
+        let x486 = Self::mul_add(
+            -x236,
+            x326,
+            Self::mul_add(-x241, x320, Self::mul_add(-x240, x312, x69)),
+        );
+        let x487 = Self::mul_add(
+            x398,
+            x399,
+            Self::mul_add(-x373, x374, Self::mul_add(-x348, x349, x486)),
+        );
+        let x488 = Self::mul_add(
+            -x460,
+            x461,
+            Self::mul_add(-x441, x442, Self::mul_add(-x420, x421, x487)),
+        );
+        let x489 = 1.0 / Self::mul_add(-x476, x477, x488);
+        let x490 = Self::mul_add(
+            x236,
+            x327,
+            Self::mul_add(-x241, x321, Self::mul_add(-x240, x313, x58)),
+        );
+        let x491 = Self::mul_add(
+            -x398,
+            x403,
+            Self::mul_add(-x373, x377, Self::mul_add(-x348, x352, x490)),
+        );
+        let x492 = Self::mul_add(
+            -x460,
+            x465,
+            Self::mul_add(-x441, x446, Self::mul_add(x420, x424, x491)),
+        );
+        let x493 = Self::mul_add(-x476, x481, x492);
+        let x494 = x489 * x493;
+        let x495 = Self::mul_add(
+            -x236,
+            x328,
+            Self::mul_add(-x241, x322, Self::mul_add(-x240, x314, x278)),
+        );
+        let x496 = Self::mul_add(
+            -x398,
+            x407,
+            Self::mul_add(-x373, x380, Self::mul_add(-x348, x355, x495)),
+        );
+        let x497 = Self::mul_add(
+            -x460,
+            x469,
+            Self::mul_add(-x441, x450, Self::mul_add(x420, x427, x496)),
+        );
+        let x498 = Self::mul_add(-x476, x485, x497);
+        let x499 = x489 * x498;
+        let x500 = Self::mul_add(
+            -x265,
+            x327,
+            Self::mul_add(-x270, x321, Self::mul_add(-x269, x313, x47)),
+        );
+        let x501 = Self::mul_add(
+            x402,
+            x403,
+            Self::mul_add(-x376, x377, Self::mul_add(-x351, x352, x500)),
+        );
+        let x502 = Self::mul_add(
+            -x464,
+            x465,
+            Self::mul_add(-x445, x446, Self::mul_add(-x423, x424, x501)),
+        );
+        let x503 = 1.0 / Self::mul_add(-x493, x494, Self::mul_add(-x480, x481, x502));
+        let x504 = Self::mul_add(
+            x265,
+            x328,
+            Self::mul_add(-x270, x322, Self::mul_add(-x269, x314, x274)),
+        );
+        let x505 = Self::mul_add(
+            x402,
+            x407,
+            Self::mul_add(-x376, x380, Self::mul_add(-x351, x355, x504)),
+        );
+        let x506 = Self::mul_add(
+            -x464,
+            x469,
+            Self::mul_add(-x445, x450, Self::mul_add(-x423, x427, x505)),
+        );
+        let x507 = Self::mul_add(-x493, x499, Self::mul_add(-x480, x485, x506));
+        let x508 = x503 * x507;
+        let x509 = Self::mul_add(
+            -x301,
+            x328,
+            Self::mul_add(-x306, x322, Self::mul_add(-x305, x314, 1.4135609200000003)),
+        );
+        let x510 = Self::mul_add(
+            x406,
+            x407,
+            Self::mul_add(-x379, x380, Self::mul_add(-x354, x355, x509)),
+        );
+        let x511 = Self::mul_add(
+            -x468,
+            x469,
+            Self::mul_add(-x449, x450, Self::mul_add(-x426, x427, x510)),
+        );
+        let x512 = Self::mul_add(
+            -x507,
+            x508,
+            Self::mul_add(-x498, x499, Self::mul_add(-x484, x485, x511)),
+        );
+        let x513 = 1.0 / x512;
+        let x514 = Self::mul_add(x307, x360, x308);
+        let x515 = Self::mul_add(x383, x514, Self::mul_add(x307, x362, x308));
+        let x516 = Self::mul_add(
+            -x412,
+            x515,
+            Self::mul_add(x387, x514, Self::mul_add(-x307, x365, x309)),
+        );
+        let x517 = Self::mul_add(
+            x415,
+            x515,
+            Self::mul_add(-x391, x514, Self::mul_add(-x307, x368, x310)),
+        );
+        let x518 = Self::mul_add(-x434, x516, x517);
+        let x519 = Self::mul_add(
+            x418,
+            x515,
+            Self::mul_add(-x395, x514, Self::mul_add(-x307, x371, x311)),
+        );
+        let x520 = Self::mul_add(-x457, x518, Self::mul_add(-x438, x516, x519));
+        let x521 = Self::mul_add(
+            x421,
+            x515,
+            Self::mul_add(-x399, x514, Self::mul_add(-x307, x374, x312)),
+        );
+        let x522 = Self::mul_add(
+            -x477,
+            x520,
+            Self::mul_add(-x461, x518, Self::mul_add(-x442, x516, x521)),
+        );
+        let x523 = Self::mul_add(
+            -x424,
+            x515,
+            Self::mul_add(x403, x514, Self::mul_add(-x307, x377, x313)),
+        );
+        let x524 = Self::mul_add(
+            -x481,
+            x520,
+            Self::mul_add(-x465, x518, Self::mul_add(-x446, x516, x523)),
+        );
+        let x525 = Self::mul_add(-x494, x522, x524);
+        let x526 = Self::mul_add(
+            -x427,
+            x515,
+            Self::mul_add(x407, x514, Self::mul_add(-x307, x380, x314)),
+        );
+        let x527 = Self::mul_add(
+            -x485,
+            x520,
+            Self::mul_add(-x469, x518, Self::mul_add(-x450, x516, x526)),
+        );
+        let x528 = x513 * Self::mul_add(-x508, x525, Self::mul_add(-x499, x522, x527));
+        let x529 = -x528;
+        let x530 = Self::mul_add(-x508, x528, x503 * x525);
+        let x531 = -x530;
+        let x532 = Self::mul_add(-x499, x528, Self::mul_add(-x494, x530, x489 * x522));
+        let x533 = Self::mul_add(
+            -x485,
+            x528,
+            Self::mul_add(-x481, x530, Self::mul_add(-x477, x532, x473 * x520)),
+        );
+        let x534 = Self::mul_add(
+            -x465,
+            x530,
+            Self::mul_add(-x461, x532, Self::mul_add(-x457, x533, x453 * x518)),
+        );
+        let x535 = Self::mul_add(-x469, x528, x534);
+        let x536 = Self::mul_add(
+            -x442,
+            x532,
+            Self::mul_add(-x438, x533, Self::mul_add(-x434, x535, x430 * x516)),
+        );
+        let x537 = Self::mul_add(-x450, x528, Self::mul_add(-x446, x530, x536));
+        let x538 = -x537;
+        let x539 = Self::mul_add(
+            x418,
+            x533,
+            Self::mul_add(x415, x535, Self::mul_add(-x412, x537, x409 * x515)),
+        );
+        let x540 = Self::mul_add(
+            -x427,
+            x528,
+            Self::mul_add(-x424, x530, Self::mul_add(x421, x532, x539)),
+        );
+        let x541 = Self::mul_add(
+            x391,
+            x535,
+            Self::mul_add(-x387, x537, Self::mul_add(-x383, x540, x381 * x514)),
+        );
+        let x542 = Self::mul_add(
+            -x403,
+            x530,
+            Self::mul_add(x399, x532, Self::mul_add(x395, x533, x541)),
+        );
+        let x543 = Self::mul_add(-x407, x528, x542);
+        let x544 = -x543;
+        let x545 = Self::mul_add(
+            -x365,
+            x537,
+            Self::mul_add(x362, x540, Self::mul_add(-x360, x543, x307 * x357)),
+        );
+        let x546 = Self::mul_add(
+            -x374,
+            x532,
+            Self::mul_add(-x371, x533, Self::mul_add(-x368, x535, x545)),
+        );
+        let x547 = Self::mul_add(-x380, x528, Self::mul_add(-x377, x530, x546));
+        let x548 = -x547;
+        let x549 = Self::mul_add(
+            x340,
+            x537,
+            Self::mul_add(-x337, x540, Self::mul_add(x335, x543, x333 * x547)),
+        );
+        let x550 = Self::mul_add(
+            x349,
+            x532,
+            Self::mul_add(x346, x533, Self::mul_add(x343, x535, x549)),
+        );
+        let x551 = Self::mul_add(x355, x528, Self::mul_add(x352, x530, x550));
+        let x552 = Self::mul_add(
+            -x324,
+            x535,
+            Self::mul_add(-x323, x537, Self::mul_add(x315, x547, x308 * x551)),
+        );
+        let x553 = Self::mul_add(
+            -x327,
+            x530,
+            Self::mul_add(x326, x532, Self::mul_add(-x325, x533, x552)),
+        );
+        let x554 = -Self::mul_add(x328, x528, x553);
+        let x555 = Self::mul_add(
+            x317,
+            x537,
+            Self::mul_add(-x316, x540, Self::mul_add(x315, x543, x307 * x551)),
+        );
+        let x556 = Self::mul_add(
+            x320,
+            x532,
+            Self::mul_add(x319, x533, Self::mul_add(x318, x535, x555)),
+        );
+        let x557 = Self::mul_add(x322, x528, Self::mul_add(x321, x530, x556));
+        let x558 = Self::mul_add(
+            x308,
+            x540,
+            Self::mul_add(-x308, x543, Self::mul_add(x307, x547, 0.0008546497218115156)),
+        );
+        let x559 = Self::mul_add(
+            x311,
+            x533,
+            Self::mul_add(x310, x535, Self::mul_add(x309, x537, x558)),
+        );
+        let x560 = Self::mul_add(
+            x314,
+            x528,
+            Self::mul_add(x313, x530, Self::mul_add(x312, x532, x559)),
+        );
+        let x561 = x307 * x333;
+        let x562 = Self::mul_add(-x360, x561, Self::mul_add(x307, x335, x315));
+        let x563 = Self::mul_add(
+            x383,
+            x562,
+            Self::mul_add(-x362, x561, Self::mul_add(x307, x337, x316)),
+        );
+        let x564 = Self::mul_add(
+            -x387,
+            x562,
+            Self::mul_add(-x365, x561, Self::mul_add(x307, x340, x317)),
+        );
+        let x565 = Self::mul_add(x412, x563, x564);
+        let x566 = Self::mul_add(
+            x391,
+            x562,
+            Self::mul_add(-x368, x561, Self::mul_add(x307, x343, x318)),
+        );
+        let x567 = Self::mul_add(-x434, x565, Self::mul_add(-x415, x563, x566));
+        let x568 = Self::mul_add(
+            x395,
+            x562,
+            Self::mul_add(-x371, x561, Self::mul_add(x307, x346, x319)),
+        );
+        let x569 = Self::mul_add(
+            -x457,
+            x567,
+            Self::mul_add(-x438, x565, Self::mul_add(-x418, x563, x568)),
+        );
+        let x570 = Self::mul_add(
+            x399,
+            x562,
+            Self::mul_add(-x374, x561, Self::mul_add(x307, x349, x320)),
+        );
+        let x571 = Self::mul_add(
+            -x461,
+            x567,
+            Self::mul_add(-x442, x565, Self::mul_add(-x421, x563, x570)),
+        );
+        let x572 = Self::mul_add(-x477, x569, x571);
+        let x573 = Self::mul_add(
+            -x403,
+            x562,
+            Self::mul_add(-x377, x561, Self::mul_add(x307, x352, x321)),
+        );
+        let x574 = Self::mul_add(
+            -x465,
+            x567,
+            Self::mul_add(-x446, x565, Self::mul_add(x424, x563, x573)),
+        );
+        let x575 = Self::mul_add(-x494, x572, Self::mul_add(-x481, x569, x574));
+        let x576 = Self::mul_add(
+            -x407,
+            x562,
+            Self::mul_add(-x380, x561, Self::mul_add(x307, x355, x322)),
+        );
+        let x577 = Self::mul_add(
+            -x469,
+            x567,
+            Self::mul_add(-x450, x565, Self::mul_add(x427, x563, x576)),
+        );
+        let x578 = Self::mul_add(
+            -x508,
+            x575,
+            Self::mul_add(-x499, x572, Self::mul_add(-x485, x569, x577)),
+        );
+        let x579 = x513 * x578;
+        let x580 = -x579;
+        let x581 = Self::mul_add(-x508, x579, x503 * x575);
+        let x582 = -x581;
+        let x583 = Self::mul_add(-x499, x579, Self::mul_add(-x494, x581, x489 * x572));
+        let x584 = Self::mul_add(
+            -x485,
+            x579,
+            Self::mul_add(-x481, x581, Self::mul_add(-x477, x583, x473 * x569)),
+        );
+        let x585 = Self::mul_add(
+            -x465,
+            x581,
+            Self::mul_add(-x461, x583, Self::mul_add(-x457, x584, x453 * x567)),
+        );
+        let x586 = Self::mul_add(-x469, x579, x585);
+        let x587 = Self::mul_add(
+            -x442,
+            x583,
+            Self::mul_add(-x438, x584, Self::mul_add(-x434, x586, x430 * x565)),
+        );
+        let x588 = Self::mul_add(-x450, x579, Self::mul_add(-x446, x581, x587));
+        let x589 = -x588;
+        let x590 = Self::mul_add(
+            -x418,
+            x584,
+            Self::mul_add(-x415, x586, Self::mul_add(x412, x588, x409 * x563)),
+        );
+        let x591 = Self::mul_add(
+            x427,
+            x579,
+            Self::mul_add(x424, x581, Self::mul_add(-x421, x583, x590)),
+        );
+        let x592 = -x591;
+        let x593 = Self::mul_add(
+            -x391,
+            x586,
+            Self::mul_add(x387, x588, Self::mul_add(-x383, x591, x381 * x562)),
+        );
+        let x594 = Self::mul_add(
+            x403,
+            x581,
+            Self::mul_add(-x399, x583, Self::mul_add(-x395, x584, x593)),
+        );
+        let x595 = Self::mul_add(x407, x579, x594);
+        let x596 = Self::mul_add(
+            -x365,
+            x588,
+            Self::mul_add(-x362, x591, Self::mul_add(x360, x595, x357 * x561)),
+        );
+        let x597 = Self::mul_add(
+            -x374,
+            x583,
+            Self::mul_add(-x371, x584, Self::mul_add(-x368, x586, x596)),
+        );
+        let x598 = Self::mul_add(-x380, x579, Self::mul_add(-x377, x581, x597));
+        let x599 = -x598;
+        let x600 = Self::mul_add(
+            x337,
+            x591,
+            Self::mul_add(-x335, x595, Self::mul_add(x333, x598, x307 * x331)),
+        );
+        let x601 = Self::mul_add(
+            x346,
+            x584,
+            Self::mul_add(x343, x586, Self::mul_add(x340, x588, x600)),
+        );
+        let x602 = Self::mul_add(
+            x355,
+            x579,
+            Self::mul_add(x352, x581, Self::mul_add(x349, x583, x601)),
+        );
+        let x603 = Self::mul_add(
+            -x324,
+            x586,
+            Self::mul_add(-x323, x588, Self::mul_add(x315, x598, x308 * x602)),
+        );
+        let x604 = Self::mul_add(
+            -x327,
+            x581,
+            Self::mul_add(x326, x583, Self::mul_add(-x325, x584, x603)),
+        );
+        let x605 = -Self::mul_add(x328, x579, x604);
+        let x606 = Self::mul_add(
+            x316,
+            x591,
+            Self::mul_add(-x315, x595, Self::mul_add(x307, x602, 0.0008546497218115156)),
+        );
+        let x607 = Self::mul_add(
+            x319,
+            x584,
+            Self::mul_add(x318, x586, Self::mul_add(x317, x588, x606)),
+        );
+        let x608 = Self::mul_add(
+            x322,
+            x579,
+            Self::mul_add(x321, x581, Self::mul_add(x320, x583, x607)),
+        );
+        let x609 = Self::mul_add(x308, x333, x315);
+        let x610 = Self::mul_add(-x360, x609, x308 * x335);
+        let x611 = Self::mul_add(x383, x610, Self::mul_add(-x362, x609, x308 * x337));
+        let x612 = Self::mul_add(
+            x387,
+            x610,
+            Self::mul_add(x365, x609, Self::mul_add(-x308, x340, x323)),
+        );
+        let x613 = Self::mul_add(-x412, x611, x612);
+        let x614 = Self::mul_add(
+            -x391,
+            x610,
+            Self::mul_add(x368, x609, Self::mul_add(-x308, x343, x324)),
+        );
+        let x615 = Self::mul_add(-x434, x613, Self::mul_add(x415, x611, x614));
+        let x616 = Self::mul_add(
+            -x395,
+            x610,
+            Self::mul_add(x371, x609, Self::mul_add(-x308, x346, x325)),
+        );
+        let x617 = Self::mul_add(
+            -x457,
+            x615,
+            Self::mul_add(-x438, x613, Self::mul_add(x418, x611, x616)),
+        );
+        let x618 = Self::mul_add(
+            x399,
+            x610,
+            Self::mul_add(-x374, x609, Self::mul_add(x308, x349, x326)),
+        );
+        let x619 = Self::mul_add(
+            x461,
+            x615,
+            Self::mul_add(x442, x613, Self::mul_add(-x421, x611, x618)),
+        );
+        let x620 = Self::mul_add(x477, x617, x619);
+        let x621 = Self::mul_add(
+            x403,
+            x610,
+            Self::mul_add(x377, x609, Self::mul_add(-x308, x352, x327)),
+        );
+        let x622 = Self::mul_add(
+            -x465,
+            x615,
+            Self::mul_add(-x446, x613, Self::mul_add(-x424, x611, x621)),
+        );
+        let x623 = Self::mul_add(x494, x620, Self::mul_add(-x481, x617, x622));
+        let x624 = Self::mul_add(
+            -x407,
+            x610,
+            Self::mul_add(-x380, x609, Self::mul_add(x308, x355, x328)),
+        );
+        let x625 = Self::mul_add(
+            x469,
+            x615,
+            Self::mul_add(x450, x613, Self::mul_add(x427, x611, x624)),
+        );
+        let x626 = Self::mul_add(
+            x508,
+            x623,
+            Self::mul_add(-x499, x620, Self::mul_add(x485, x617, x625)),
+        );
+        let x627 = x513 * x626;
+        let x628 = Self::mul_add(x508, x627, x503 * x623);
+        let x629 = -x628;
+        let x630 = Self::mul_add(-x499, x627, Self::mul_add(x494, x628, x489 * x620));
+        let x631 = -x630;
+        let x632 = Self::mul_add(
+            x485,
+            x627,
+            Self::mul_add(-x481, x628, Self::mul_add(x477, x630, x473 * x617)),
+        );
+        let x633 = Self::mul_add(
+            -x465,
+            x628,
+            Self::mul_add(x461, x630, Self::mul_add(-x457, x632, x453 * x615)),
+        );
+        let x634 = Self::mul_add(x469, x627, x633);
+        let x635 = Self::mul_add(
+            x442,
+            x630,
+            Self::mul_add(-x438, x632, Self::mul_add(-x434, x634, x430 * x613)),
+        );
+        let x636 = Self::mul_add(x450, x627, Self::mul_add(-x446, x628, x635));
+        let x637 = -x636;
+        let x638 = Self::mul_add(
+            x418,
+            x632,
+            Self::mul_add(x415, x634, Self::mul_add(-x412, x636, x409 * x611)),
+        );
+        let x639 = Self::mul_add(
+            x427,
+            x627,
+            Self::mul_add(-x424, x628, Self::mul_add(-x421, x630, x638)),
+        );
+        let x640 = Self::mul_add(
+            x391,
+            x634,
+            Self::mul_add(-x387, x636, Self::mul_add(-x383, x639, x381 * x610)),
+        );
+        let x641 = Self::mul_add(
+            -x403,
+            x628,
+            Self::mul_add(-x399, x630, Self::mul_add(x395, x632, x640)),
+        );
+        let x642 = Self::mul_add(x407, x627, x641);
+        let x643 = -x642;
+        let x644 = Self::mul_add(
+            x365,
+            x636,
+            Self::mul_add(-x362, x639, Self::mul_add(x360, x642, x357 * x609)),
+        );
+        let x645 = Self::mul_add(
+            -x374,
+            x630,
+            Self::mul_add(x371, x632, Self::mul_add(x368, x634, x644)),
+        );
+        let x646 = Self::mul_add(-x380, x627, Self::mul_add(x377, x628, x645));
+        let x647 = Self::mul_add(
+            x337,
+            x639,
+            Self::mul_add(-x335, x642, Self::mul_add(x333, x646, x308 * x331)),
+        );
+        let x648 = Self::mul_add(
+            -x346,
+            x632,
+            Self::mul_add(-x343, x634, Self::mul_add(-x340, x636, x647)),
+        );
+        let x649 = Self::mul_add(
+            x355,
+            x627,
+            Self::mul_add(-x352, x628, Self::mul_add(x349, x630, x648)),
+        );
+        let x650 = -x649;
+        let x651 = Self::mul_add(
+            x323,
+            x636,
+            Self::mul_add(x315, x646, Self::mul_add(x308, x649, 0.0008546497218115156)),
+        );
+        let x652 = Self::mul_add(
+            x326,
+            x630,
+            Self::mul_add(x325, x632, Self::mul_add(x324, x634, x651)),
+        );
+        let x653 = Self::mul_add(x328, x627, Self::mul_add(x327, x628, x652));
+        let x654 = Self::mul_add(-x333, x360, x335);
+        let x655 = Self::mul_add(x383, x654, Self::mul_add(-x333, x362, x337));
+        let x656 = Self::mul_add(
+            x412,
+            x655,
+            Self::mul_add(-x387, x654, Self::mul_add(-x333, x365, x340)),
+        );
+        let x657 = Self::mul_add(
+            -x415,
+            x655,
+            Self::mul_add(x391, x654, Self::mul_add(-x333, x368, x343)),
+        );
+        let x658 = Self::mul_add(-x434, x656, x657);
+        let x659 = Self::mul_add(
+            -x418,
+            x655,
+            Self::mul_add(x395, x654, Self::mul_add(-x333, x371, x346)),
+        );
+        let x660 = Self::mul_add(-x457, x658, Self::mul_add(-x438, x656, x659));
+        let x661 = Self::mul_add(
+            -x421,
+            x655,
+            Self::mul_add(x399, x654, Self::mul_add(-x333, x374, x349)),
+        );
+        let x662 = Self::mul_add(
+            -x477,
+            x660,
+            Self::mul_add(-x461, x658, Self::mul_add(-x442, x656, x661)),
+        );
+        let x663 = Self::mul_add(
+            x424,
+            x655,
+            Self::mul_add(-x403, x654, Self::mul_add(-x333, x377, x352)),
+        );
+        let x664 = Self::mul_add(
+            -x481,
+            x660,
+            Self::mul_add(-x465, x658, Self::mul_add(-x446, x656, x663)),
+        );
+        let x665 = Self::mul_add(-x494, x662, x664);
+        let x666 = Self::mul_add(
+            x427,
+            x655,
+            Self::mul_add(-x407, x654, Self::mul_add(-x333, x380, x355)),
+        );
+        let x667 = Self::mul_add(
+            -x485,
+            x660,
+            Self::mul_add(-x469, x658, Self::mul_add(-x450, x656, x666)),
+        );
+        let x668 = x513 * Self::mul_add(-x508, x665, Self::mul_add(-x499, x662, x667));
+        let x669 = -x668;
+        let x670 = Self::mul_add(-x508, x668, x503 * x665);
+        let x671 = -x670;
+        let x672 = Self::mul_add(-x499, x668, Self::mul_add(-x494, x670, x489 * x662));
+        let x673 = Self::mul_add(
+            -x485,
+            x668,
+            Self::mul_add(-x481, x670, Self::mul_add(-x477, x672, x473 * x660)),
+        );
+        let x674 = Self::mul_add(
+            -x465,
+            x670,
+            Self::mul_add(-x461, x672, Self::mul_add(-x457, x673, x453 * x658)),
+        );
+        let x675 = Self::mul_add(-x469, x668, x674);
+        let x676 = Self::mul_add(
+            -x442,
+            x672,
+            Self::mul_add(-x438, x673, Self::mul_add(-x434, x675, x430 * x656)),
+        );
+        let x677 = Self::mul_add(-x450, x668, Self::mul_add(-x446, x670, x676));
+        let x678 = -x677;
+        let x679 = Self::mul_add(
+            -x418,
+            x673,
+            Self::mul_add(-x415, x675, Self::mul_add(x412, x677, x409 * x655)),
+        );
+        let x680 = Self::mul_add(
+            x427,
+            x668,
+            Self::mul_add(x424, x670, Self::mul_add(-x421, x672, x679)),
+        );
+        let x681 = -x680;
+        let x682 = Self::mul_add(
+            -x391,
+            x675,
+            Self::mul_add(x387, x677, Self::mul_add(-x383, x680, x381 * x654)),
+        );
+        let x683 = Self::mul_add(
+            x403,
+            x670,
+            Self::mul_add(-x399, x672, Self::mul_add(-x395, x673, x682)),
+        );
+        let x684 = Self::mul_add(x407, x668, x683);
+        let x685 = Self::mul_add(
+            -x365,
+            x677,
+            Self::mul_add(-x362, x680, Self::mul_add(x360, x684, x333 * x357)),
+        );
+        let x686 = Self::mul_add(
+            -x374,
+            x672,
+            Self::mul_add(-x371, x673, Self::mul_add(-x368, x675, x685)),
+        );
+        let x687 = Self::mul_add(-x380, x668, Self::mul_add(-x377, x670, x686));
+        let x688 = -x687;
+        let x689 = Self::mul_add(
+            x337,
+            x680,
+            Self::mul_add(-x335, x684, Self::mul_add(x333, x687, x331)),
+        );
+        let x690 = Self::mul_add(
+            x346,
+            x673,
+            Self::mul_add(x343, x675, Self::mul_add(x340, x677, x689)),
+        );
+        let x691 = Self::mul_add(
+            x355,
+            x668,
+            Self::mul_add(x352, x670, Self::mul_add(x349, x672, x690)),
+        );
+        let x692 = Self::mul_add(x360, x383, x362);
+        let x693 = Self::mul_add(x412, x692, Self::mul_add(-x360, x387, x365));
+        let x694 = Self::mul_add(
+            -x434,
+            x693,
+            Self::mul_add(-x415, x692, Self::mul_add(x360, x391, x368)),
+        );
+        let x695 = Self::mul_add(
+            -x438,
+            x693,
+            Self::mul_add(-x418, x692, Self::mul_add(x360, x395, x371)),
+        );
+        let x696 = Self::mul_add(-x457, x694, x695);
+        let x697 = Self::mul_add(
+            -x442,
+            x693,
+            Self::mul_add(-x421, x692, Self::mul_add(x360, x399, x374)),
+        );
+        let x698 = Self::mul_add(-x477, x696, Self::mul_add(-x461, x694, x697));
+        let x699 = Self::mul_add(
+            -x446,
+            x693,
+            Self::mul_add(x424, x692, Self::mul_add(-x360, x403, x377)),
+        );
+        let x700 = Self::mul_add(
+            -x494,
+            x698,
+            Self::mul_add(-x481, x696, Self::mul_add(-x465, x694, x699)),
+        );
+        let x701 = Self::mul_add(
+            -x450,
+            x693,
+            Self::mul_add(x427, x692, Self::mul_add(-x360, x407, x380)),
+        );
+        let x702 = Self::mul_add(
+            -x499,
+            x698,
+            Self::mul_add(-x485, x696, Self::mul_add(-x469, x694, x701)),
+        );
+        let x703 = x513 * Self::mul_add(-x508, x700, x702);
+        let x704 = -x703;
+        let x705 = Self::mul_add(-x508, x703, x503 * x700);
+        let x706 = -x705;
+        let x707 = Self::mul_add(-x499, x703, Self::mul_add(-x494, x705, x489 * x698));
+        let x708 = Self::mul_add(
+            -x485,
+            x703,
+            Self::mul_add(-x481, x705, Self::mul_add(-x477, x707, x473 * x696)),
+        );
+        let x709 = Self::mul_add(
+            -x465,
+            x705,
+            Self::mul_add(-x461, x707, Self::mul_add(-x457, x708, x453 * x694)),
+        );
+        let x710 = Self::mul_add(-x469, x703, x709);
+        let x711 = Self::mul_add(
+            -x442,
+            x707,
+            Self::mul_add(-x438, x708, Self::mul_add(-x434, x710, x430 * x693)),
+        );
+        let x712 = Self::mul_add(-x450, x703, Self::mul_add(-x446, x705, x711));
+        let x713 = -x712;
+        let x714 = Self::mul_add(
+            -x418,
+            x708,
+            Self::mul_add(-x415, x710, Self::mul_add(x412, x712, x409 * x692)),
+        );
+        let x715 = Self::mul_add(
+            x427,
+            x703,
+            Self::mul_add(x424, x705, Self::mul_add(-x421, x707, x714)),
+        );
+        let x716 = -x715;
+        let x717 = Self::mul_add(
+            -x391,
+            x710,
+            Self::mul_add(x387, x712, Self::mul_add(-x383, x715, x360 * x381)),
+        );
+        let x718 = Self::mul_add(
+            x403,
+            x705,
+            Self::mul_add(-x399, x707, Self::mul_add(-x395, x708, x717)),
+        );
+        let x719 = Self::mul_add(x407, x703, x718);
+        let x720 = Self::mul_add(
+            x365,
+            x712,
+            Self::mul_add(x362, x715, Self::mul_add(-x360, x719, x357)),
+        );
+        let x721 = Self::mul_add(
+            x374,
+            x707,
+            Self::mul_add(x371, x708, Self::mul_add(x368, x710, x720)),
+        );
+        let x722 = Self::mul_add(x380, x703, Self::mul_add(x377, x705, x721));
+        let x723 = Self::mul_add(-x383, x412, x387);
+        let x724 = Self::mul_add(x434, x723, Self::mul_add(-x383, x415, x391));
+        let x725 = Self::mul_add(
+            -x457,
+            x724,
+            Self::mul_add(x438, x723, Self::mul_add(-x383, x418, x395)),
+        );
+        let x726 = Self::mul_add(
+            -x461,
+            x724,
+            Self::mul_add(x442, x723, Self::mul_add(-x383, x421, x399)),
+        );
+        let x727 = Self::mul_add(-x477, x725, x726);
+        let x728 = Self::mul_add(
+            x465,
+            x724,
+            Self::mul_add(-x446, x723, Self::mul_add(-x383, x424, x403)),
+        );
+        let x729 = Self::mul_add(x494, x727, Self::mul_add(x481, x725, x728));
+        let x730 = Self::mul_add(
+            x469,
+            x724,
+            Self::mul_add(-x450, x723, Self::mul_add(-x383, x427, x407)),
+        );
+        let x731 = Self::mul_add(
+            -x508,
+            x729,
+            Self::mul_add(x499, x727, Self::mul_add(x485, x725, x730)),
+        );
+        let x732 = x513 * x731;
+        let x733 = -x732;
+        let x734 = Self::mul_add(-x508, x732, x503 * x729);
+        let x735 = -x734;
+        let x736 = Self::mul_add(x499, x732, Self::mul_add(x494, x734, x489 * x727));
+        let x737 = -x736;
+        let x738 = Self::mul_add(
+            x485,
+            x732,
+            Self::mul_add(x481, x734, Self::mul_add(-x477, x736, x473 * x725)),
+        );
+        let x739 = -x738;
+        let x740 = Self::mul_add(
+            x465,
+            x734,
+            Self::mul_add(-x461, x736, Self::mul_add(-x457, x738, x453 * x724)),
+        );
+        let x741 = Self::mul_add(x469, x732, x740);
+        let x742 = -x741;
+        let x743 = Self::mul_add(
+            x442,
+            x736,
+            Self::mul_add(x438, x738, Self::mul_add(x434, x741, x430 * x723)),
+        );
+        let x744 = Self::mul_add(-x450, x732, Self::mul_add(-x446, x734, x743));
+        let x745 = -x744;
+        let x746 = Self::mul_add(
+            -x418,
+            x738,
+            Self::mul_add(-x415, x741, Self::mul_add(-x412, x744, x383 * x409)),
+        );
+        let x747 = Self::mul_add(
+            -x427,
+            x732,
+            Self::mul_add(-x424, x734, Self::mul_add(-x421, x736, x746)),
+        );
+        let x748 = Self::mul_add(
+            -x391,
+            x741,
+            Self::mul_add(-x387, x744, Self::mul_add(-x383, x747, x381)),
+        );
+        let x749 = Self::mul_add(
+            -x403,
+            x734,
+            Self::mul_add(-x399, x736, Self::mul_add(-x395, x738, x748)),
+        );
+        let x750 = -Self::mul_add(-x407, x732, x749);
+        let x751 = Self::mul_add(x412, x434, x415);
+        let x752 = Self::mul_add(-x457, x751, Self::mul_add(x412, x438, x418));
+        let x753 = Self::mul_add(
+            -x477,
+            x752,
+            Self::mul_add(-x461, x751, Self::mul_add(x412, x442, x421)),
+        );
+        let x754 = Self::mul_add(
+            x481,
+            x752,
+            Self::mul_add(x465, x751, Self::mul_add(-x412, x446, x424)),
+        );
+        let x755 = Self::mul_add(x494, x753, x754);
+        let x756 = Self::mul_add(
+            x485,
+            x752,
+            Self::mul_add(x469, x751, Self::mul_add(-x412, x450, x427)),
+        );
+        let x757 = x513 * Self::mul_add(-x508, x755, Self::mul_add(x499, x753, x756));
+        let x758 = Self::mul_add(-x508, x757, x503 * x755);
+        let x759 = Self::mul_add(x499, x757, Self::mul_add(x494, x758, x489 * x753));
+        let x760 = Self::mul_add(
+            x485,
+            x757,
+            Self::mul_add(x481, x758, Self::mul_add(-x477, x759, x473 * x752)),
+        );
+        let x761 = Self::mul_add(
+            x465,
+            x758,
+            Self::mul_add(-x461, x759, Self::mul_add(-x457, x760, x453 * x751)),
+        );
+        let x762 = Self::mul_add(x469, x757, x761);
+        let x763 = Self::mul_add(
+            x442,
+            x759,
+            Self::mul_add(x438, x760, Self::mul_add(x434, x762, x412 * x430)),
+        );
+        let x764 = Self::mul_add(-x450, x757, Self::mul_add(-x446, x758, x763));
+        let x765 = Self::mul_add(
+            x418,
+            x760,
+            Self::mul_add(x415, x762, Self::mul_add(x412, x764, x409)),
+        );
+        let x766 = Self::mul_add(
+            x427,
+            x757,
+            Self::mul_add(x424, x758, Self::mul_add(x421, x759, x765)),
+        );
+        let x767 = Self::mul_add(-x434, x457, x438);
+        let x768 = Self::mul_add(-x477, x767, Self::mul_add(-x434, x461, x442));
+        let x769 = Self::mul_add(
+            -x494,
+            x768,
+            Self::mul_add(-x481, x767, Self::mul_add(-x434, x465, x446)),
+        );
+        let x770 = Self::mul_add(
+            -x499,
+            x768,
+            Self::mul_add(-x485, x767, Self::mul_add(-x434, x469, x450)),
+        );
+        let x771 = x513 * Self::mul_add(-x508, x769, x770);
+        let x772 = -x771;
+        let x773 = Self::mul_add(-x508, x771, x503 * x769);
+        let x774 = -x773;
+        let x775 = Self::mul_add(-x499, x771, Self::mul_add(-x494, x773, x489 * x768));
+        let x776 = Self::mul_add(
+            -x485,
+            x771,
+            Self::mul_add(-x481, x773, Self::mul_add(-x477, x775, x473 * x767)),
+        );
+        let x777 = Self::mul_add(
+            -x465,
+            x773,
+            Self::mul_add(-x461, x775, Self::mul_add(-x457, x776, x434 * x453)),
+        );
+        let x778 = Self::mul_add(-x469, x771, x777);
+        let x779 = Self::mul_add(
+            x442,
+            x775,
+            Self::mul_add(x438, x776, Self::mul_add(x434, x778, x430)),
+        );
+        let x780 = Self::mul_add(x450, x771, Self::mul_add(x446, x773, x779));
+        let x781 = Self::mul_add(-x457, x477, x461);
+        let x782 = Self::mul_add(-x494, x781, Self::mul_add(-x457, x481, x465));
+        let x783 = Self::mul_add(
+            -x508,
+            x782,
+            Self::mul_add(-x499, x781, Self::mul_add(-x457, x485, x469)),
+        );
+        let x784 = x513 * x783;
+        let x785 = Self::mul_add(-x508, x784, x503 * x782);
+        let x786 = Self::mul_add(-x499, x784, Self::mul_add(-x494, x785, x489 * x781));
+        let x787 = -x786;
+        let x788 = Self::mul_add(
+            -x485,
+            x784,
+            Self::mul_add(-x481, x785, Self::mul_add(-x477, x786, x457 * x473)),
+        );
+        let x789 = -x788;
+        let x790 = Self::mul_add(
+            x465,
+            x785,
+            Self::mul_add(x461, x786, Self::mul_add(x457, x788, x453)),
+        );
+        let x791 = Self::mul_add(x469, x784, x790);
+        let x792 = Self::mul_add(-x477, x494, x481);
+        let x793 = x513 * Self::mul_add(-x508, x792, Self::mul_add(-x477, x499, x485));
+        let x794 = Self::mul_add(-x508, x793, x503 * x792);
+        let x795 = Self::mul_add(-x499, x793, Self::mul_add(-x494, x794, x477 * x489));
+        let x796 = -x795;
+        let x797 = Self::mul_add(
+            x485,
+            x793,
+            Self::mul_add(x481, x794, Self::mul_add(x477, x795, x473)),
+        );
+        let x798 = x513 * Self::mul_add(-x494, x508, x499);
+        let x799 = Self::mul_add(-x508, x798, x494 * x503);
+        let x800 = Self::mul_add(x499, x798, Self::mul_add(x494, x799, x489));
+        let x801 = x508 * x513;
+        let x802 = -x801;
+        let x803 = Self::mul_add(x508, x801, x503);
+        [
+            [
+                x560,
+                x557,
+                x554,
+                x551,
+                x548,
+                x544,
+                x540,
+                x538,
+                x535,
+                x533,
+                x532,
+                x531,
+                x529,
+            ],
+            [
+                x557,
+                x608,
+                x605,
+                x602,
+                x599,
+                x595,
+                x592,
+                x589,
+                x586,
+                x584,
+                x583,
+                x582,
+                x580,
+            ],
+            [
+                x554,
+                x605,
+                x653,
+                x650,
+                x646,
+                x643,
+                x639,
+                x637,
+                x634,
+                x632,
+                x631,
+                x629,
+                x627,
+            ],
+            [
+                x551,
+                x602,
+                x650,
+                x691,
+                x688,
+                x684,
+                x681,
+                x678,
+                x675,
+                x673,
+                x672,
+                x671,
+                x669,
+            ],
+            [
+                x548,
+                x599,
+                x646,
+                x688,
+                x722,
+                x719,
+                x716,
+                x713,
+                x710,
+                x708,
+                x707,
+                x706,
+                x704,
+            ],
+            [
+                x544,
+                x595,
+                x643,
+                x684,
+                x719,
+                x750,
+                x747,
+                x745,
+                x742,
+                x739,
+                x737,
+                x735,
+                x733,
+            ],
+            [
+                x540,
+                x592,
+                x639,
+                x681,
+                x716,
+                x747,
+                x766,
+                x764,
+                x762,
+                x760,
+                x759,
+                x758,
+                x757,
+            ],
+            [
+                x538,
+                x589,
+                x637,
+                x678,
+                x713,
+                x745,
+                x764,
+                x780,
+                x778,
+                x776,
+                x775,
+                x774,
+                x772,
+            ],
+            [
+                x535,
+                x586,
+                x634,
+                x675,
+                x710,
+                x742,
+                x762,
+                x778,
+                x791,
+                x789,
+                x787,
+                x785,
+                x784,
+            ],
+            [
+                x533,
+                x584,
+                x632,
+                x673,
+                x708,
+                x739,
+                x760,
+                x776,
+                x789,
+                x797,
+                x796,
+                x794,
+                x793,
+            ],
+            [
+                x532,
+                x583,
+                x631,
+                x672,
+                x707,
+                x737,
+                x759,
+                x775,
+                x787,
+                x796,
+                x800,
+                x799,
+                x798,
+            ],
+            [
+                x531,
+                x582,
+                x629,
+                x671,
+                x706,
+                x735,
+                x758,
+                x774,
+                x785,
+                x794,
+                x799,
+                x803,
+                x802,
+            ],
+            [
+                x529,
+                x580,
+                x627,
+                x669,
+                x704,
+                x733,
+                x757,
+                x772,
+                x784,
+                x793,
+                x798,
+                x802,
+                x513,
+            ],
+        ]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

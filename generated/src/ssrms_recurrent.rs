@@ -10,7 +10,7 @@
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, nonlinear-effects or forward method; without it each takes the cheapest candidate.
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 6760 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732, `inverse_dynamics_derivatives` 1098, `forward_dynamics_derivatives` 2200, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -23,6 +23,9 @@
 //! | `forward_dynamics` * | `recurrent` | `recurrent` | `ldlt` | model | 1138 | 1072 | 7 | 0 | 7 | 2210 |
 //! | `mass_matrix_and_nonlinear_effects` * | `recurrent` | `recurrent` | — | model | 1012 | 967 | 0 | 0 | 7 | 1979 |
 //! | `forward_dynamics_with_wrenches` * | `recurrent` | `recurrent` | `ldlt` | model | 1242 | 1177 | 7 | 0 | 7 | 2419 |
+//! | `inverse_dynamics_derivatives` * | — | — | — | model | 2033 | 2091 | 0 | 0 | 6 | 4124 |
+//! | `forward_dynamics_derivatives` * | — | — | — | model | 3606 | 3331 | 12 | 0 | 7 | 6937 |
+//! | `mass_matrix_inverse` * | — | — | — | model | 309 | 242 | 7 | 0 | 5 | 551 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsRecurrent;
@@ -82,7 +85,7 @@ impl SsrmsRecurrent {
     /// Named frames, in the model's order (one `<frame>_…` function family each).
     pub const FRAMES: [&'static str; 0] = [];
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 6] = [
+    pub const OP_COUNTS: [OpCount; 9] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
@@ -160,6 +163,45 @@ impl SsrmsRecurrent {
             sqrt: 0u64,
             sincos: 7u64,
             fma: 732u64,
+        },
+        OpCount {
+            function: "inverse_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 2033u64,
+            add: 2091u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 1098u64,
+        },
+        OpCount {
+            function: "forward_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 3606u64,
+            add: 3331u64,
+            div: 12u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 2200u64,
+        },
+        OpCount {
+            function: "mass_matrix_inverse",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 309u64,
+            add: 242u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 201u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -240,6 +282,45 @@ impl SsrmsRecurrent {
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 2033u64,
+            add: 2091u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_derivatives",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 3606u64,
+            add: 3331u64,
+            div: 12u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_inverse",
+            mass_matrix_method: None,
+            nonlinear_effects_method: None,
+            forward_method: None,
+            frames: "model",
+            mul: 309u64,
+            add: 242u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 5u64,
             fma: 0u64,
         },
     ];
@@ -6302,6 +6383,5450 @@ impl SsrmsRecurrent {
             Self::mul_add(-x604, x667, Self::mul_add(x603, x668, x674)),
         );
         [x675, x673, x671, x669, x668, x667, x666]
+    }
+    /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`.
+    ///
+    /// : 2033 mul, 2091 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 1098 fused where the target has FMA.
+    #[must_use]
+    pub fn inverse_dynamics_derivatives(
+        q: &[f64; 7],
+        qd: &[f64; 7],
+        qdd: &[f64; 7],
+    ) -> ([[f64; 7]; 7], [[f64; 7]; 7]) {
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5)] = Self::sincos_n([q[0], q[1], q[2], q[3], q[4], q[5]]);
+        let x6 = c_q0 * s_q1;
+        let x7 = s_q0 * s_q1;
+        let x8 = c_q0 * c_q1;
+        let x9 = s_q0 * c_q1;
+        let x10 = 0.7026 * s_q0;
+        let x11 = 0.7026 * c_q0;
+        let x12 = Self::mul_add(-c_q0, x10, s_q0 * x11);
+        let x13 = 1.3589 * c_q0;
+        let x14 = 1.3589 * s_q0;
+        let x15 = s_q1 * 1145.5438279999998;
+        let x16 = x8 * 1145.5438279999998;
+        let x17 = x9 * 1145.5438279999998;
+        let x18 = s_q1 * 65693.9112265768;
+        let x19 = x8 * 65693.9112265768;
+        let x20 = 65697.3302265768 * s_q0;
+        let x21 = x9 * 65693.9112265768;
+        let x22 = 65697.3302265768 * c_q0;
+        let x23 = x11 * x17;
+        let x24 = x10 * x16;
+        let x25 = x23 - x24;
+        let x26 = x10 * x15;
+        let x27 = x11 * x15;
+        let x28 = 1.3589 * x16;
+        let x29 = 1.3589 * x15;
+        let x30 = x23 - x29;
+        let x31 = x11 * x16;
+        let x32 = 1.3589 * x17;
+        let x33 = x10 * x17;
+        let x34 = x24 + x29;
+        let x35 = x25 + Self::mul_add(s_q1, x18, x25);
+        let x36 = x28 + Self::mul_add(x8, x18, x26);
+        let x37 = x32 + Self::mul_add(x9, x18, -x27);
+        let x38 = x26 + Self::mul_add(s_q1, x19, x28);
+        let x39 = x30 + (Self::mul_add(-s_q0, x20, x8 * x19) + x30);
+        let x40 = x33 + (Self::mul_add(c_q0, x20, x9 * x19) - x31);
+        let x41 = x27 - Self::mul_add(s_q1, x21, x32);
+        let x42 = x31 - (Self::mul_add(s_q0, x22, x8 * x21) + x33);
+        let x43 = x34 - (Self::mul_add(-c_q0, x22, x9 * x21) - x34);
+        let x44 = qd[1] * s_q0;
+        let x45 = qd[1] * c_q0;
+        let x46 = qd[1] * x12;
+        let x47 = qd[1] * x13;
+        let x48 = qd[1] * x14;
+        let x49 = Self::mul_add(-c_q0, x44, s_q0 * x45);
+        let x50 = qd[0] * c_q0;
+        let x51 = qd[0] * s_q0;
+        let x52 = qd[0] * x14;
+        let x53 = qd[0] * x13;
+        let x54 = Self::mul_add(x14, x44, x13 * x45)
+            - Self::mul_add(c_q0, x47, s_q0 * x48);
+        let x55 = Self::mul_add(-c_q0, x46, Self::mul_add(x12, x45, x52));
+        let x56 = Self::mul_add(-s_q0, x46, Self::mul_add(x12, x44, -x53));
+        let x57 = Self::mul_add(qd[1], x49, qdd[0]);
+        let x58 = Self::mul_add(qd[1], x50, qdd[1] * s_q0);
+        let x59 = Self::mul_add(-qd[1], x51, qdd[1] * c_q0);
+        let x60 = Self::mul_add(qd[1], x54, qdd[1] * x12);
+        let x61 = Self::mul_add(-qd[1], x55, qdd[1] * x13);
+        let x62 = Self::mul_add(-qd[1], x56, qdd[1] * x14);
+        let x63 = Self::mul_add(-qd[0], x51, qdd[0] * c_q0);
+        let x64 = Self::mul_add(qd[0], x50, qdd[0] * s_q0);
+        let x65 = Self::mul_add(qd[0], x53, qdd[0] * x14);
+        let x66 = Self::mul_add(-qd[0], x52, qdd[0] * x13);
+        let x67 = x50 + x50;
+        let x68 = x51 + x51;
+        let x69 = x52 + x55;
+        let x70 = x53 - x56;
+        let x71 = x36 * x44;
+        let x72 = x37 * x45;
+        let x73 = qd[0] * x38;
+        let x74 = x40 * x45;
+        let x75 = qd[0] * x41;
+        let x76 = x42 * x44;
+        let x77 = x17 * x47;
+        let x78 = x16 * x48;
+        let x79 = x17 * x46;
+        let x80 = x15 * x48;
+        let x81 = x16 * x46;
+        let x82 = x15 * x47;
+        let x83 = Self::mul_add(qd[0], x35, x71) - x72 + (x77 - x78);
+        let x84 = Self::mul_add(x39, x44, x73) - x74 - (x79 - x80);
+        let x85 = Self::mul_add(-x43, x45, x75 + x76) - (x81 - x82);
+        let x86 = x17 * x44;
+        let x87 = x16 * x45;
+        let x88 = x86 + x87;
+        let x89 = qd[0] * x17;
+        let x90 = x15 * x45;
+        let x91 = x89 + x90;
+        let x92 = qd[0] * x16;
+        let x93 = x15 * x44;
+        let x94 = x92 - x93;
+        let x95 = x38 * x45;
+        let x96 = x41 * x44;
+        let x97 = x35 * x45;
+        let x98 = x35 * x44;
+        let x99 = x17 * x48;
+        let x100 = x16 * x47;
+        let x101 = x99 + x100;
+        let x102 = x36 * x45;
+        let x103 = x37 * x44;
+        let x104 = x39 * x45;
+        let x105 = x43 * x44;
+        let x106 = qd[0] * x42;
+        let x107 = qd[0] * x39;
+        let x108 = x15 * x46;
+        let x109 = x99 + x108;
+        let x110 = qd[0] * x40;
+        let x111 = qd[0] * x43;
+        let x112 = x100 + x108;
+        let x113 = c_q1 * c_q2;
+        let x114 = Self::mul_add(s_q0, s_q2, x6 * c_q2);
+        let x115 = Self::mul_add(-c_q0, s_q2, x7 * c_q2);
+        let x116 = c_q1 * s_q2;
+        let x117 = Self::mul_add(-s_q0, c_q2, x6 * s_q2);
+        let x118 = Self::mul_add(c_q0, c_q2, x7 * s_q2);
+        let x119 = Self::mul_add(s_q1, 0.5692, 1.3589);
+        let x120 = Self::mul_add(x8, 0.5692, x10);
+        let x121 = Self::mul_add(x9, -0.5692, x11);
+        let x122 = Self::mul_add(x9, x120, x8 * x121);
+        let x123 = Self::mul_add(x9, x119, s_q1 * x121);
+        let x124 = Self::mul_add(-x8, x119, s_q1 * x120);
+        let x125 = 5224.5702 * x113;
+        let x126 = 5224.5702 * x114;
+        let x127 = 5224.5702 * x115;
+        let x128 = Self::mul_add(3946.1881206800003, s_q1, x113 * 39234.47412200001);
+        let x129 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x113);
+        let x130 = Self::mul_add(-3946.1881206800003, x8, x114 * 39234.47412200001);
+        let x131 = Self::mul_add(39241.404122, x8, 3946.18812068 * x114);
+        let x132 = Self::mul_add(-3946.1881206800003, x9, x115 * 39234.47412200001);
+        let x133 = Self::mul_add(39241.404122, x9, 3946.18812068 * x115);
+        let x134 = x121 * x127;
+        let x135 = x120 * x126;
+        let x136 = x134 - x135;
+        let x137 = x120 * x125;
+        let x138 = x121 * x125;
+        let x139 = x119 * x126;
+        let x140 = x119 * x125;
+        let x141 = x134 + x140;
+        let x142 = x121 * x126;
+        let x143 = x119 * x127;
+        let x144 = x120 * x127;
+        let x145 = x135 - x140;
+        let x146 = x136 - (Self::mul_add(s_q1, x129, x113 * x128) - x136);
+        let x147 = x139 + (Self::mul_add(-x8, x129, x114 * x128) - x137);
+        let x148 = x143 + (Self::mul_add(-x9, x129, x115 * x128) + x138);
+        let x149 = x137 - (Self::mul_add(s_q1, x131, x113 * x130) + x139);
+        let x150 = x141 - (Self::mul_add(-x8, x131, x114 * x130) - x141);
+        let x151 = x144 - (Self::mul_add(-x9, x131, x115 * x130) + x142);
+        let x152 = x138 + (Self::mul_add(s_q1, x133, x113 * x132) + x143);
+        let x153 = x142 + (Self::mul_add(-x8, x133, x114 * x132) - x144);
+        let x154 = x145 + (Self::mul_add(-x9, x133, x115 * x132) + x145);
+        let x155 = Self::mul_add(-qd[2], s_q1, qd[0]);
+        let x156 = Self::mul_add(-qd[2], x8, x44);
+        let x157 = Self::mul_add(qd[2], x9, x45);
+        let x158 = Self::mul_add(-qd[2], x122, x46);
+        let x159 = Self::mul_add(qd[2], x123, x47);
+        let x160 = Self::mul_add(qd[2], x124, x48);
+        let x161 = Self::mul_add(x9, x156, x8 * x157);
+        let x162 = Self::mul_add(x9, x155, s_q1 * x157);
+        let x163 = Self::mul_add(-x8, x155, s_q1 * x156);
+        let x164 = Self::mul_add(-x9, x159, x8 * x160);
+        let x165 = Self::mul_add(-x9, x158, s_q1 * x160);
+        let x166 = Self::mul_add(-x8, x158, s_q1 * x159);
+        let x167 = Self::mul_add(x124, x156, x123 * x157) + x164;
+        let x168 = Self::mul_add(-x124, x155, x122 * x157) - x165;
+        let x169 = Self::mul_add(x123, x155, x122 * x156) + x166;
+        let x170 = Self::mul_add(-qd[2], x161, Self::mul_add(-qdd[2], s_q1, x57));
+        let x171 = Self::mul_add(qd[2], x162, Self::mul_add(-qdd[2], x8, x58));
+        let x172 = Self::mul_add(-qd[2], x163, Self::mul_add(qdd[2], x9, x59));
+        let x173 = Self::mul_add(qd[2], x167, Self::mul_add(-qdd[2], x122, x60));
+        let x174 = Self::mul_add(qd[2], x168, Self::mul_add(qdd[2], x123, x61));
+        let x175 = Self::mul_add(qd[2], x169, Self::mul_add(qdd[2], x124, x62));
+        let x176 = Self::mul_add(x9, x44, x8 * x45);
+        let x177 = Self::mul_add(qd[0], x9, s_q1 * x45);
+        let x178 = Self::mul_add(-qd[0], x8, s_q1 * x44);
+        let x179 = Self::mul_add(x44, x124, x45 * x123)
+            + Self::mul_add(-x9, x47, x8 * x48);
+        let x180 = Self::mul_add(-qd[0], x124, x45 * x122)
+            - Self::mul_add(-x9, x46, s_q1 * x48);
+        let x181 = Self::mul_add(qd[0], x123, x44 * x122)
+            + Self::mul_add(-x8, x46, s_q1 * x47);
+        let x182 = Self::mul_add(x9, x58, x8 * x59)
+            - Self::mul_add(x44, x178, x45 * x177);
+        let x183 = Self::mul_add(x9, x57, s_q1 * x59)
+            + Self::mul_add(-qd[0], x178, x45 * x176);
+        let x184 = Self::mul_add(-x8, x57, s_q1 * x58)
+            + Self::mul_add(qd[0], x177, x44 * x176);
+        let x185 = Self::mul_add(x58, x124, x59 * x123)
+            + Self::mul_add(-x9, x61, x8 * x62)
+            + (Self::mul_add(x44, x181, x45 * x180)
+                - Self::mul_add(-x47, x178, x48 * x177));
+        let x186 = Self::mul_add(-x57, x124, x59 * x122)
+            - Self::mul_add(-x9, x60, s_q1 * x62)
+            - (Self::mul_add(qd[0], x181, x45 * x179)
+                + Self::mul_add(x46, x178, x48 * x176));
+        let x187 = Self::mul_add(x57, x123, x58 * x122)
+            + Self::mul_add(-x8, x60, s_q1 * x61)
+            - (Self::mul_add(-qd[0], x180, x44 * x179)
+                - Self::mul_add(x46, x177, x47 * x176));
+        let x188 = x161 + x176;
+        let x189 = x162 + x177;
+        let x190 = x163 + x178;
+        let x191 = x167 + x179;
+        let x192 = x168 + x180;
+        let x193 = x169 + x181;
+        let x194 = x147 * x156;
+        let x195 = x148 * x157;
+        let x196 = x149 * x155;
+        let x197 = x151 * x157;
+        let x198 = x152 * x155;
+        let x199 = x153 * x156;
+        let x200 = x127 * x159;
+        let x201 = x126 * x160;
+        let x202 = x127 * x158;
+        let x203 = x125 * x160;
+        let x204 = x126 * x158;
+        let x205 = x125 * x159;
+        let x206 = Self::mul_add(x146, x155, x194) - x195 + (x200 - x201);
+        let x207 = Self::mul_add(-x150, x156, x196) + x197 + (x202 + x203);
+        let x208 = Self::mul_add(x154, x157, x198 - x199) + (x204 + x205);
+        let x209 = x127 * x156;
+        let x210 = x126 * x157;
+        let x211 = x209 + x210;
+        let x212 = x127 * x155;
+        let x213 = x125 * x157;
+        let x214 = x212 - x213;
+        let x215 = x126 * x155;
+        let x216 = x125 * x156;
+        let x217 = x215 + x216;
+        let x218 = x149 * x157;
+        let x219 = x152 * x156;
+        let x220 = x146 * x157;
+        let x221 = x146 * x156;
+        let x222 = x127 * x160;
+        let x223 = x126 * x159;
+        let x224 = x222 + x223;
+        let x225 = x147 * x157;
+        let x226 = x148 * x156;
+        let x227 = x150 * x157;
+        let x228 = x154 * x156;
+        let x229 = x153 * x155;
+        let x230 = x150 * x155;
+        let x231 = x125 * x158;
+        let x232 = x222 - x231;
+        let x233 = x151 * x155;
+        let x234 = x154 * x155;
+        let x235 = x223 - x231;
+        let x236 = Self::mul_add(-x116, s_q3, x113 * c_q3);
+        let x237 = Self::mul_add(-x117, s_q3, x114 * c_q3);
+        let x238 = Self::mul_add(-x118, s_q3, x115 * c_q3);
+        let x239 = Self::mul_add(x116, c_q3, x113 * s_q3);
+        let x240 = Self::mul_add(x117, c_q3, x114 * s_q3);
+        let x241 = Self::mul_add(x118, c_q3, x115 * s_q3);
+        let x242 = x119 + Self::mul_add(s_q1, 0.475, 7.11 * x113);
+        let x243 = x120 - Self::mul_add(x8, -0.475, 7.11 * x114);
+        let x244 = x121 + Self::mul_add(x9, -0.475, 7.11 * x115);
+        let x245 = Self::mul_add(x9, x243, x8 * x244);
+        let x246 = Self::mul_add(x9, x242, s_q1 * x244);
+        let x247 = Self::mul_add(-x8, x242, s_q1 * x243);
+        let x248 = 3239.4582 * x236;
+        let x249 = 3239.4582 * x237;
+        let x250 = 3239.4582 * x238;
+        let x251 = Self::mul_add(1375.0472756800002, s_q1, x236 * 24989.305802);
+        let x252 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x236);
+        let x253 = Self::mul_add(-1375.0472756800002, x8, x237 * 24989.305802);
+        let x254 = Self::mul_add(24998.827802, x8, 1375.0472756800002 * x237);
+        let x255 = Self::mul_add(-1375.0472756800002, x9, x238 * 24989.305802);
+        let x256 = Self::mul_add(24998.827802, x9, 1375.0472756800002 * x238);
+        let x257 = x244 * x250;
+        let x258 = x243 * x249;
+        let x259 = x257 - x258;
+        let x260 = x243 * x248;
+        let x261 = x244 * x248;
+        let x262 = x242 * x249;
+        let x263 = x242 * x248;
+        let x264 = x257 + x263;
+        let x265 = x244 * x249;
+        let x266 = x242 * x250;
+        let x267 = x243 * x250;
+        let x268 = x258 - x263;
+        let x269 = x259 - (Self::mul_add(s_q1, x252, x236 * x251) - x259);
+        let x270 = x262 + (Self::mul_add(-x8, x252, x237 * x251) - x260);
+        let x271 = x266 + (Self::mul_add(-x9, x252, x238 * x251) + x261);
+        let x272 = x260 - (Self::mul_add(s_q1, x254, x236 * x253) + x262);
+        let x273 = x264 - (Self::mul_add(-x8, x254, x237 * x253) - x264);
+        let x274 = x267 - (Self::mul_add(-x9, x254, x238 * x253) + x265);
+        let x275 = x261 + (Self::mul_add(s_q1, x256, x236 * x255) + x266);
+        let x276 = x265 + (Self::mul_add(-x8, x256, x237 * x255) - x267);
+        let x277 = x268 + (Self::mul_add(-x9, x256, x238 * x255) + x268);
+        let x278 = Self::mul_add(-qd[3], s_q1, x155);
+        let x279 = Self::mul_add(-qd[3], x8, x156);
+        let x280 = Self::mul_add(qd[3], x9, x157);
+        let x281 = Self::mul_add(-qd[3], x245, x158);
+        let x282 = Self::mul_add(qd[3], x246, x159);
+        let x283 = Self::mul_add(qd[3], x247, x160);
+        let x284 = Self::mul_add(x9, x279, x8 * x280);
+        let x285 = Self::mul_add(x9, x278, s_q1 * x280);
+        let x286 = Self::mul_add(-x8, x278, s_q1 * x279);
+        let x287 = Self::mul_add(-x9, x282, x8 * x283);
+        let x288 = Self::mul_add(-x9, x281, s_q1 * x283);
+        let x289 = Self::mul_add(-x8, x281, s_q1 * x282);
+        let x290 = Self::mul_add(x247, x279, x246 * x280) + x287;
+        let x291 = Self::mul_add(-x247, x278, x245 * x280) - x288;
+        let x292 = Self::mul_add(x246, x278, x245 * x279) + x289;
+        let x293 = Self::mul_add(-qd[3], x284, Self::mul_add(-qdd[3], s_q1, x170));
+        let x294 = Self::mul_add(qd[3], x285, Self::mul_add(-qdd[3], x8, x171));
+        let x295 = Self::mul_add(-qd[3], x286, Self::mul_add(qdd[3], x9, x172));
+        let x296 = Self::mul_add(qd[3], x290, Self::mul_add(-qdd[3], x245, x173));
+        let x297 = Self::mul_add(qd[3], x291, Self::mul_add(qdd[3], x246, x174));
+        let x298 = Self::mul_add(qd[3], x292, Self::mul_add(qdd[3], x247, x175));
+        let x299 = x164 + Self::mul_add(x156, x247, x157 * x246);
+        let x300 = x165 - Self::mul_add(-x155, x247, x157 * x245);
+        let x301 = x166 + Self::mul_add(x155, x246, x156 * x245);
+        let x302 = Self::mul_add(x9, x171, x8 * x172)
+            - Self::mul_add(x156, x163, x157 * x162);
+        let x303 = Self::mul_add(x9, x170, s_q1 * x172)
+            + Self::mul_add(-x155, x163, x157 * x161);
+        let x304 = Self::mul_add(-x8, x170, s_q1 * x171)
+            + Self::mul_add(x155, x162, x156 * x161);
+        let x305 = Self::mul_add(x171, x247, x172 * x246)
+            + Self::mul_add(-x9, x174, x8 * x175)
+            - (Self::mul_add(-x156, x301, x157 * x300)
+                + Self::mul_add(-x159, x163, x160 * x162));
+        let x306 = Self::mul_add(-x170, x247, x172 * x245)
+            - Self::mul_add(-x9, x173, s_q1 * x175)
+            - (Self::mul_add(x155, x301, x157 * x299)
+                + Self::mul_add(x158, x163, x160 * x161));
+        let x307 = Self::mul_add(x170, x246, x171 * x245)
+            + Self::mul_add(-x8, x173, s_q1 * x174)
+            - (Self::mul_add(x155, x300, x156 * x299)
+                - Self::mul_add(x158, x162, x159 * x161));
+        let x308 = x161 + x284;
+        let x309 = x162 + x285;
+        let x310 = x163 + x286;
+        let x311 = x290 + x299;
+        let x312 = x291 - x300;
+        let x313 = x292 + x301;
+        let x314 = x270 * x279;
+        let x315 = x271 * x280;
+        let x316 = x272 * x278;
+        let x317 = x274 * x280;
+        let x318 = x275 * x278;
+        let x319 = x276 * x279;
+        let x320 = x250 * x282;
+        let x321 = x249 * x283;
+        let x322 = x250 * x281;
+        let x323 = x248 * x283;
+        let x324 = x249 * x281;
+        let x325 = x248 * x282;
+        let x326 = Self::mul_add(x269, x278, x314) - x315 + (x320 - x321);
+        let x327 = Self::mul_add(-x273, x279, x316) + x317 + (x322 + x323);
+        let x328 = Self::mul_add(x277, x280, x318 - x319) + (x324 + x325);
+        let x329 = x250 * x279;
+        let x330 = x249 * x280;
+        let x331 = x329 + x330;
+        let x332 = x250 * x278;
+        let x333 = x248 * x280;
+        let x334 = x332 - x333;
+        let x335 = x249 * x278;
+        let x336 = x248 * x279;
+        let x337 = x335 + x336;
+        let x338 = x272 * x280;
+        let x339 = x275 * x279;
+        let x340 = x269 * x280;
+        let x341 = x269 * x279;
+        let x342 = x250 * x283;
+        let x343 = x249 * x282;
+        let x344 = x342 + x343;
+        let x345 = x270 * x280;
+        let x346 = x271 * x279;
+        let x347 = x273 * x280;
+        let x348 = x277 * x279;
+        let x349 = x276 * x278;
+        let x350 = x273 * x278;
+        let x351 = x248 * x281;
+        let x352 = x342 - x351;
+        let x353 = x274 * x278;
+        let x354 = x277 * x278;
+        let x355 = x343 - x351;
+        let x356 = Self::mul_add(-x239, s_q4, x236 * c_q4);
+        let x357 = Self::mul_add(-x240, s_q4, x237 * c_q4);
+        let x358 = Self::mul_add(-x241, s_q4, x238 * c_q4);
+        let x359 = Self::mul_add(x239, c_q4, x236 * s_q4);
+        let x360 = Self::mul_add(x240, c_q4, x237 * s_q4);
+        let x361 = Self::mul_add(x241, c_q4, x238 * s_q4);
+        let x362 = Self::mul_add(7.11, x236, x242);
+        let x363 = Self::mul_add(-7.11, x237, x243);
+        let x364 = Self::mul_add(7.11, x238, x244);
+        let x365 = Self::mul_add(x9, x363, x8 * x364);
+        let x366 = Self::mul_add(x9, x362, s_q1 * x364);
+        let x367 = Self::mul_add(-x8, x362, s_q1 * x363);
+        let x368 = x359 * 171.195516;
+        let x369 = x360 * 171.195516;
+        let x370 = x361 * 171.195516;
+        let x371 = 132.6783695416 * x356;
+        let x372 = Self::mul_add(x359, 97.44448770720001, 135.4729695416 * s_q1);
+        let x373 = s_q1 * 97.44448770720001;
+        let x374 = 132.6783695416 * x357;
+        let x375 = Self::mul_add(x360, -97.44448770720001, 135.4729695416 * x8);
+        let x376 = x8 * 97.44448770720001;
+        let x377 = 132.6783695416 * x358;
+        let x378 = Self::mul_add(x361, -97.44448770720001, 135.4729695416 * x9);
+        let x379 = x9 * 97.44448770720001;
+        let x380 = x364 * x370;
+        let x381 = x363 * x369;
+        let x382 = x380 - x381;
+        let x383 = x363 * x368;
+        let x384 = x364 * x368;
+        let x385 = x362 * x369;
+        let x386 = x362 * x368;
+        let x387 = x380 + x386;
+        let x388 = x364 * x369;
+        let x389 = x362 * x370;
+        let x390 = x363 * x370;
+        let x391 = x381 - x386;
+        let x392 = x382
+            - (Self::mul_add(x359, x373, Self::mul_add(s_q1, x372, x356 * x371)) - x382);
+        let x393 = x385
+            + (Self::mul_add(x360, x373, Self::mul_add(-x8, x372, x357 * x371)) - x383);
+        let x394 = x389
+            + (Self::mul_add(x361, x373, Self::mul_add(-x9, x372, x358 * x371)) + x384);
+        let x395 = x383
+            - (Self::mul_add(-x359, x376, Self::mul_add(-s_q1, x375, x356 * x374))
+                + x385);
+        let x396 = x387
+            - (Self::mul_add(-x360, x376, Self::mul_add(x8, x375, x357 * x374)) - x387);
+        let x397 = x390
+            - (Self::mul_add(-x361, x376, Self::mul_add(x9, x375, x358 * x374)) + x388);
+        let x398 = x384
+            + (Self::mul_add(-x359, x379, Self::mul_add(-s_q1, x378, x356 * x377))
+                + x389);
+        let x399 = x388
+            + (Self::mul_add(-x360, x379, Self::mul_add(x8, x378, x357 * x377)) - x390);
+        let x400 = x391
+            + (Self::mul_add(-x361, x379, Self::mul_add(x9, x378, x358 * x377)) + x391);
+        let x401 = Self::mul_add(-qd[4], s_q1, x278);
+        let x402 = Self::mul_add(-qd[4], x8, x279);
+        let x403 = Self::mul_add(qd[4], x9, x280);
+        let x404 = Self::mul_add(-qd[4], x365, x281);
+        let x405 = Self::mul_add(qd[4], x366, x282);
+        let x406 = Self::mul_add(qd[4], x367, x283);
+        let x407 = Self::mul_add(x9, x402, x8 * x403);
+        let x408 = Self::mul_add(x9, x401, s_q1 * x403);
+        let x409 = Self::mul_add(-x8, x401, s_q1 * x402);
+        let x410 = Self::mul_add(x367, x402, x366 * x403)
+            + Self::mul_add(-x9, x405, x8 * x406);
+        let x411 = Self::mul_add(-x367, x401, x365 * x403)
+            - Self::mul_add(-x9, x404, s_q1 * x406);
+        let x412 = Self::mul_add(x366, x401, x365 * x402)
+            + Self::mul_add(-x8, x404, s_q1 * x405);
+        let x413 = Self::mul_add(-qd[4], x407, Self::mul_add(-qdd[4], s_q1, x293));
+        let x414 = Self::mul_add(qd[4], x408, Self::mul_add(-qdd[4], x8, x294));
+        let x415 = Self::mul_add(-qd[4], x409, Self::mul_add(qdd[4], x9, x295));
+        let x416 = Self::mul_add(qd[4], x410, Self::mul_add(-qdd[4], x365, x296));
+        let x417 = Self::mul_add(qd[4], x411, Self::mul_add(qdd[4], x366, x297));
+        let x418 = Self::mul_add(qd[4], x412, Self::mul_add(qdd[4], x367, x298));
+        let x419 = x287 + Self::mul_add(x279, x367, x280 * x366);
+        let x420 = x288 - Self::mul_add(-x278, x367, x280 * x365);
+        let x421 = x289 + Self::mul_add(x278, x366, x279 * x365);
+        let x422 = Self::mul_add(x9, x294, x8 * x295)
+            - Self::mul_add(x279, x286, x280 * x285);
+        let x423 = Self::mul_add(x9, x293, s_q1 * x295)
+            + Self::mul_add(-x278, x286, x280 * x284);
+        let x424 = Self::mul_add(-x8, x293, s_q1 * x294)
+            + Self::mul_add(x278, x285, x279 * x284);
+        let x425 = Self::mul_add(x294, x367, x295 * x366)
+            + Self::mul_add(-x9, x297, x8 * x298)
+            - (Self::mul_add(-x279, x421, x280 * x420)
+                + Self::mul_add(-x282, x286, x283 * x285));
+        let x426 = Self::mul_add(-x293, x367, x295 * x365)
+            - Self::mul_add(-x9, x296, s_q1 * x298)
+            - (Self::mul_add(x278, x421, x280 * x419)
+                + Self::mul_add(x281, x286, x283 * x284));
+        let x427 = Self::mul_add(x293, x366, x294 * x365)
+            + Self::mul_add(-x8, x296, s_q1 * x297)
+            - (Self::mul_add(x278, x420, x279 * x419)
+                - Self::mul_add(x281, x285, x282 * x284));
+        let x428 = x284 + x407;
+        let x429 = x285 + x408;
+        let x430 = x286 + x409;
+        let x431 = x410 + x419;
+        let x432 = x411 - x420;
+        let x433 = x412 + x421;
+        let x434 = x393 * x402;
+        let x435 = x394 * x403;
+        let x436 = x395 * x401;
+        let x437 = x397 * x403;
+        let x438 = x398 * x401;
+        let x439 = x399 * x402;
+        let x440 = x370 * x405;
+        let x441 = x369 * x406;
+        let x442 = x370 * x404;
+        let x443 = x368 * x406;
+        let x444 = x369 * x404;
+        let x445 = x368 * x405;
+        let x446 = Self::mul_add(x392, x401, x434) - x435 + (x440 - x441);
+        let x447 = Self::mul_add(-x396, x402, x436) + x437 + (x442 + x443);
+        let x448 = Self::mul_add(x400, x403, x438 - x439) + (x444 + x445);
+        let x449 = x370 * x402;
+        let x450 = x369 * x403;
+        let x451 = x449 + x450;
+        let x452 = x370 * x401;
+        let x453 = x368 * x403;
+        let x454 = x452 - x453;
+        let x455 = x369 * x401;
+        let x456 = x368 * x402;
+        let x457 = x455 + x456;
+        let x458 = Self::mul_add(x369, x415, x370 * x414)
+            - Self::mul_add(-x402, x457, x403 * x454);
+        let x459 = Self::mul_add(-x368, x415, x370 * x413)
+            + Self::mul_add(x401, x457, x403 * x451);
+        let x460 = Self::mul_add(x368, x414, x369 * x413)
+            - Self::mul_add(x401, x454, x402 * x451);
+        let x461 = x395 * x403;
+        let x462 = x398 * x402;
+        let x463 = x392 * x403;
+        let x464 = x392 * x402;
+        let x465 = x370 * x406;
+        let x466 = x369 * x405;
+        let x467 = x465 + x466;
+        let x468 = x393 * x403;
+        let x469 = x394 * x402;
+        let x470 = x396 * x403;
+        let x471 = x400 * x402;
+        let x472 = x456 + (x455 + x457);
+        let x473 = x453 - (x452 + x454);
+        let x474 = x399 * x401;
+        let x475 = x396 * x401;
+        let x476 = x368 * x404;
+        let x477 = x465 - x476;
+        let x478 = x397 * x401;
+        let x479 = x400 * x401;
+        let x480 = x455 + (x456 + x457);
+        let x481 = x450 + (x449 + x451);
+        let x482 = x466 - x476;
+        let x483 = x452 - (x453 - x454);
+        let x484 = x449 + (x450 + x451);
+        let x485 = x456 + (x455 - x457);
+        let x486 = x453 - (x452 - x454);
+        let x487 = x455 + (x456 - x457);
+        let x488 = x450 + (x449 - x451);
+        let x489 = x452 - (x453 + x454);
+        let x490 = x449 + (x450 - x451);
+        let x491 = Self::mul_add(-s_q1, s_q5, x356 * c_q5);
+        let x492 = Self::mul_add(x8, s_q5, x357 * c_q5);
+        let x493 = Self::mul_add(x9, s_q5, x358 * c_q5);
+        let x494 = Self::mul_add(s_q1, c_q5, x356 * s_q5);
+        let x495 = Self::mul_add(-x8, c_q5, x357 * s_q5);
+        let x496 = Self::mul_add(-x9, c_q5, x358 * s_q5);
+        let x497 = 44.41 * x494;
+        let x498 = 47.471 * x359;
+        let x499 = 44.41 * x495;
+        let x500 = 47.471 * x360;
+        let x501 = 44.41 * x496;
+        let x502 = 47.471 * x361;
+        let x503 = Self::mul_add(x359, x498, x494 * x497);
+        let x504 = Self::mul_add(x360, x498, x495 * x497);
+        let x505 = Self::mul_add(x361, x498, x496 * x497);
+        let x506 = Self::mul_add(x359, x500, x494 * x499);
+        let x507 = Self::mul_add(x360, x500, x495 * x499);
+        let x508 = Self::mul_add(x361, x500, x496 * x499);
+        let x509 = Self::mul_add(x359, x502, x494 * x501);
+        let x510 = Self::mul_add(x360, x502, x495 * x501);
+        let x511 = Self::mul_add(x361, x502, x496 * x501);
+        let x512 = Self::mul_add(qd[5], x359, x401);
+        let x513 = Self::mul_add(-qd[5], x360, x402);
+        let x514 = Self::mul_add(qd[5], x361, x403);
+        let x515 = Self::mul_add(x361, x513, x360 * x514);
+        let x516 = Self::mul_add(-x361, x512, x359 * x514);
+        let x517 = Self::mul_add(x360, x512, x359 * x513);
+        let x518 = Self::mul_add(-qd[5], x515, Self::mul_add(qdd[5], x359, x413));
+        let x519 = Self::mul_add(-qd[5], x516, Self::mul_add(-qdd[5], x360, x414));
+        let x520 = Self::mul_add(qd[5], x517, Self::mul_add(qdd[5], x361, x415));
+        let x521 = Self::mul_add(x361, x402, x360 * x403);
+        let x522 = Self::mul_add(-x361, x401, x359 * x403);
+        let x523 = Self::mul_add(x360, x401, x359 * x402);
+        let x524 = Self::mul_add(x361, x414, x360 * x415)
+            + Self::mul_add(x402, x523, x403 * x522);
+        let x525 = Self::mul_add(-x361, x413, x359 * x415)
+            - Self::mul_add(x401, x523, x403 * x521);
+        let x526 = Self::mul_add(x360, x413, x359 * x414)
+            - Self::mul_add(-x401, x522, x402 * x521);
+        let x527 = x515 + x521;
+        let x528 = x516 + x522;
+        let x529 = x517 + x523;
+        let x530 = x504 * x513;
+        let x531 = x505 * x514;
+        let x532 = Self::mul_add(x503, x512, -x530) + x531;
+        let x533 = x506 * x512;
+        let x534 = x508 * x514;
+        let x535 = Self::mul_add(-x507, x513, x533) + x534;
+        let x536 = x509 * x512;
+        let x537 = x510 * x513;
+        let x538 = Self::mul_add(x511, x514, x536 - x537);
+        let x539 = x506 * x514;
+        let x540 = x509 * x513;
+        let x541 = x503 * x514;
+        let x542 = x503 * x513;
+        let x543 = x504 * x514;
+        let x544 = x505 * x513;
+        let x545 = x507 * x514;
+        let x546 = x511 * x513;
+        let x547 = x510 * x512;
+        let x548 = x507 * x512;
+        let x549 = x508 * x512;
+        let x550 = x511 * x512;
+        let x551 = 9.336 * x491;
+        let x552 = 9.336 * x492;
+        let x553 = 9.336 * x493;
+        let x554 = x491 * x551;
+        let x555 = x492 * x551;
+        let x556 = x493 * x551;
+        let x557 = x491 * x552;
+        let x558 = x492 * x552;
+        let x559 = x493 * x552;
+        let x560 = x491 * x553;
+        let x561 = x492 * x553;
+        let x562 = x493 * x553;
+        let x563 = Self::mul_add(qd[6], x491, x512);
+        let x564 = Self::mul_add(-qd[6], x492, x513);
+        let x565 = Self::mul_add(qd[6], x493, x514);
+        let x566 = Self::mul_add(x493, x564, x492 * x565);
+        let x567 = Self::mul_add(-x493, x563, x491 * x565);
+        let x568 = Self::mul_add(x492, x563, x491 * x564);
+        let x569 = Self::mul_add(-qd[6], x566, Self::mul_add(qdd[6], x491, x518));
+        let x570 = Self::mul_add(-qd[6], x567, Self::mul_add(-qdd[6], x492, x519));
+        let x571 = Self::mul_add(qd[6], x568, Self::mul_add(qdd[6], x493, x520));
+        let x572 = Self::mul_add(x493, x513, x492 * x514);
+        let x573 = Self::mul_add(-x493, x512, x491 * x514);
+        let x574 = Self::mul_add(x492, x512, x491 * x513);
+        let x575 = Self::mul_add(x493, x519, x492 * x520)
+            + Self::mul_add(x513, x574, x514 * x573);
+        let x576 = Self::mul_add(-x493, x518, x491 * x520)
+            - Self::mul_add(x512, x574, x514 * x572);
+        let x577 = Self::mul_add(x492, x518, x491 * x519)
+            - Self::mul_add(-x512, x573, x513 * x572);
+        let x578 = x566 + x572;
+        let x579 = x567 + x573;
+        let x580 = x568 + x574;
+        let x581 = x555 * x564;
+        let x582 = x556 * x565;
+        let x583 = Self::mul_add(x554, x563, -x581) + x582;
+        let x584 = x557 * x563;
+        let x585 = x559 * x565;
+        let x586 = Self::mul_add(-x558, x564, x584) + x585;
+        let x587 = x560 * x563;
+        let x588 = x561 * x564;
+        let x589 = Self::mul_add(x562, x565, x587 - x588);
+        let x590 = Self::mul_add(x556, x571, Self::mul_add(-x555, x570, x554 * x569))
+            - Self::mul_add(x564, x589, x565 * x586);
+        let x591 = Self::mul_add(x559, x571, Self::mul_add(-x558, x570, x557 * x569))
+            + Self::mul_add(-x563, x589, x565 * x583);
+        let x592 = Self::mul_add(x562, x571, Self::mul_add(-x561, x570, x560 * x569))
+            + Self::mul_add(x563, x586, x564 * x583);
+        let x593 = x557 * x565;
+        let x594 = x560 * x564;
+        let x595 = x554 * x565;
+        let x596 = x554 * x564;
+        let x597 = x555 * x565;
+        let x598 = x556 * x564;
+        let x599 = x558 * x565;
+        let x600 = x562 * x564;
+        let x601 = x593 + x594 + (x597 + x598);
+        let x602 = x589 + (x587 - x595) + Self::mul_add(x559, x564, x599);
+        let x603 = x586 + (x584 + x596) - Self::mul_add(x561, x565, x600);
+        let x604 = x561 * x563;
+        let x605 = x558 * x563;
+        let x606 = x559 * x563;
+        let x607 = x562 * x563;
+        let x608 = x589 - (x588 + x599) + Self::mul_add(-x556, x563, x595);
+        let x609 = x597 - x604 + (x593 - x606);
+        let x610 = x583 - (x581 + x605) - Self::mul_add(x560, x565, -x607);
+        let x611 = x586 + (x585 + x600) - Self::mul_add(x555, x563, x596);
+        let x612 = x583 + (x582 - x607) + Self::mul_add(x557, x564, x605);
+        let x613 = x598 + x606 + (x594 + x604);
+        let x614 = Self::mul_add(x493, x556, Self::mul_add(x492, x555, x491 * x554));
+        let x615 = Self::mul_add(x493, x559, Self::mul_add(x492, x558, x491 * x557));
+        let x616 = Self::mul_add(x493, x562, Self::mul_add(x492, x561, x491 * x560));
+        let x617 = x491 * x601;
+        let x618 = Self::mul_add(-x493, x603, Self::mul_add(x492, x602, x617));
+        let x619 = -x618;
+        let x620 = x492 * x609;
+        let x621 = Self::mul_add(-x493, x610, Self::mul_add(x491, x608, x620));
+        let x622 = x493 * x613;
+        let x623 = Self::mul_add(-x492, x612, x491 * x611) - x622;
+        let x624 = Self::mul_add(-x492, x592, x493 * x591)
+            + Self::mul_add(-x556, x577, Self::mul_add(-x555, x576, x554 * x575))
+            - Self::mul_add(-x574, x611, Self::mul_add(x573, x608, x572 * x601));
+        let x625 = -x624;
+        let x626 = Self::mul_add(-x491, x592, x493 * x590)
+            - Self::mul_add(-x559, x577, Self::mul_add(-x558, x576, x557 * x575))
+            + Self::mul_add(x574, x612, Self::mul_add(x573, x609, x572 * x602));
+        let x627 = Self::mul_add(-x491, x591, x492 * x590)
+            + Self::mul_add(-x562, x577, Self::mul_add(-x561, x576, x560 * x575))
+            + Self::mul_add(-x574, x613, Self::mul_add(x573, x610, x572 * x603));
+        let x628 = Self::mul_add(-x556, x580, Self::mul_add(-x555, x579, x554 * x578))
+            + Self::mul_add(x493, x611, Self::mul_add(-x492, x608, x617));
+        let x629 = -x628;
+        let x630 = Self::mul_add(-x559, x580, Self::mul_add(-x558, x579, x557 * x578))
+            - Self::mul_add(x493, x612, Self::mul_add(-x491, x602, x620));
+        let x631 = Self::mul_add(-x562, x580, Self::mul_add(-x561, x579, x560 * x578))
+            - (x622 + Self::mul_add(-x492, x610, x491 * x603));
+        let x632 = -Self::mul_add(c_q0, x627, s_q0 * x626);
+        let x633 = Self::mul_add(-c_q0, x631, s_q0 * x630);
+        let x634 = Self::mul_add(-x9, x627, Self::mul_add(x8, x626, s_q1 * x624));
+        let x635 = Self::mul_add(-x9, x631, Self::mul_add(-x8, x630, s_q1 * x628));
+        let x636 = -Self::mul_add(x361, x627, Self::mul_add(-x360, x626, x359 * x624));
+        let x637 = -Self::mul_add(x361, x631, Self::mul_add(x360, x630, x359 * x628));
+        let x638 = -(Self::mul_add(-x577, x616, Self::mul_add(-x576, x615, x575 * x614))
+            - Self::mul_add(-x574, x623, Self::mul_add(x573, x621, x572 * x618)));
+        let x639 = -(Self::mul_add(-x580, x616, Self::mul_add(-x579, x615, x578 * x614))
+            + Self::mul_add(x493, x623, Self::mul_add(-x492, x621, x491 * x618)));
+        let x640 = x503 + x554;
+        let x641 = x504 + x555;
+        let x642 = x505 + x556;
+        let x643 = x506 + x557;
+        let x644 = x507 + x558;
+        let x645 = x508 + x559;
+        let x646 = x509 + x560;
+        let x647 = x510 + x561;
+        let x648 = x511 + x562;
+        let x649 = x539 + x540 + (x543 + x544) + x601;
+        let x650 = x538 - (x537 + x545) + Self::mul_add(-x505, x512, x541) + x608;
+        let x651 = x535 + (x534 + x546) - Self::mul_add(x504, x512, x542) + x611;
+        let x652 = x538 + (x536 - x541) + Self::mul_add(x508, x513, x545) + x602;
+        let x653 = x543 - x547 + (x539 - x549) + x609;
+        let x654 = x532 + (x531 - x550) + Self::mul_add(x506, x513, x548) + x612;
+        let x655 = x535 + (x533 + x542) - Self::mul_add(x510, x514, x546) + x603;
+        let x656 = x532 - (x530 + x548) - Self::mul_add(x509, x514, -x550) + x610;
+        let x657 = x544 + x549 + (x540 + x547) + x613;
+        let x658 = Self::mul_add(x505, x520, Self::mul_add(-x504, x519, x503 * x518))
+            - Self::mul_add(x513, x538, x514 * x535) + x590;
+        let x659 = Self::mul_add(x508, x520, Self::mul_add(-x507, x519, x506 * x518))
+            + Self::mul_add(-x512, x538, x514 * x532) + x591;
+        let x660 = Self::mul_add(x511, x520, Self::mul_add(-x510, x519, x509 * x518))
+            + Self::mul_add(x512, x535, x513 * x532) + x592;
+        let x661 = Self::mul_add(x361, x642, Self::mul_add(x360, x641, x359 * x640));
+        let x662 = Self::mul_add(x361, x645, Self::mul_add(x360, x644, x359 * x643));
+        let x663 = Self::mul_add(x361, x648, Self::mul_add(x360, x647, x359 * x646));
+        let x664 = x359 * x649;
+        let x665 = Self::mul_add(-x361, x655, Self::mul_add(x360, x652, x664));
+        let x666 = -x665;
+        let x667 = x360 * x653;
+        let x668 = Self::mul_add(-x361, x656, Self::mul_add(x359, x650, x667));
+        let x669 = x361 * x657;
+        let x670 = Self::mul_add(-x360, x654, x359 * x651) - x669;
+        let x671 = Self::mul_add(-x360, x660, x361 * x659)
+            + Self::mul_add(-x526, x642, Self::mul_add(-x525, x641, x524 * x640))
+            - Self::mul_add(-x523, x651, Self::mul_add(x522, x650, x521 * x649));
+        let x672 = -x671;
+        let x673 = Self::mul_add(-x359, x660, x361 * x658)
+            - Self::mul_add(-x526, x645, Self::mul_add(-x525, x644, x524 * x643))
+            + Self::mul_add(x523, x654, Self::mul_add(x522, x653, x521 * x652));
+        let x674 = Self::mul_add(-x359, x659, x360 * x658)
+            + Self::mul_add(-x526, x648, Self::mul_add(-x525, x647, x524 * x646))
+            + Self::mul_add(-x523, x657, Self::mul_add(x522, x656, x521 * x655));
+        let x675 = Self::mul_add(-x529, x642, Self::mul_add(-x528, x641, x527 * x640))
+            + Self::mul_add(x361, x651, Self::mul_add(-x360, x650, x664));
+        let x676 = -x675;
+        let x677 = Self::mul_add(-x529, x645, Self::mul_add(-x528, x644, x527 * x643))
+            - Self::mul_add(x361, x654, Self::mul_add(-x359, x652, x667));
+        let x678 = Self::mul_add(-x529, x648, Self::mul_add(-x528, x647, x527 * x646))
+            - (x669 + Self::mul_add(-x360, x656, x359 * x655));
+        let x679 = -Self::mul_add(c_q0, x674, s_q0 * x673);
+        let x680 = Self::mul_add(-c_q0, x678, s_q0 * x677);
+        let x681 = Self::mul_add(-x9, x674, Self::mul_add(x8, x673, s_q1 * x671));
+        let x682 = Self::mul_add(-x9, x678, Self::mul_add(-x8, x677, s_q1 * x675));
+        let x683 = -(Self::mul_add(-x526, x663, Self::mul_add(-x525, x662, x524 * x661))
+            - Self::mul_add(-x523, x670, Self::mul_add(x522, x668, x521 * x665)));
+        let x684 = -(Self::mul_add(-x529, x663, Self::mul_add(-x528, x662, x527 * x661))
+            + Self::mul_add(x361, x670, Self::mul_add(-x360, x668, x359 * x665)));
+        let x685 = -(Self::mul_add(-x526, x616, Self::mul_add(-x525, x615, x524 * x614))
+            - Self::mul_add(-x523, x623, Self::mul_add(x522, x621, x521 * x618)));
+        let x686 = -(Self::mul_add(-x529, x616, Self::mul_add(-x528, x615, x527 * x614))
+            + Self::mul_add(x361, x623, Self::mul_add(-x360, x621, x359 * x618)));
+        let x687 = x392 - x640;
+        let x688 = x393 + x641;
+        let x689 = x394 + x642;
+        let x690 = x395 - x643;
+        let x691 = x396 - x644;
+        let x692 = x397 - x645;
+        let x693 = x398 + x646;
+        let x694 = x399 + x647;
+        let x695 = x400 + x648;
+        let x696 = x461 - x462 + x467 + (x467 - (x468 + x469)) - x649;
+        let x697 = x448 - (x445 + (x439 - x470))
+            + (x444 - Self::mul_add(x394, x401, x463)) + x650;
+        let x698 = x447 - (x443 - (x437 - x471))
+            + (x442 - Self::mul_add(-x393, x401, x464)) - x651;
+        let x699 = x448 - (x444 - (x438 + x463))
+            + (x445 - Self::mul_add(x397, x402, x470)) + x652;
+        let x700 = x468 - x474 + x477 + (x477 - (x461 - x478)) + x653;
+        let x701 = x446 + (x441 - (x435 - x479))
+            + (x440 + Self::mul_add(x395, x402, x475)) - x654;
+        let x702 = x447 - (x442 - (x436 + x464))
+            + (x443 + Self::mul_add(x399, x403, x471)) - x655;
+        let x703 = x446 - (x440 - (x434 - x475))
+            - (x441 - Self::mul_add(x398, x403, -x479)) - x656;
+        let x704 = x469 - x478 + x482 + (x482 + (x462 + x474)) + x657;
+        let x705 = Self::mul_add(-x394, x415, Self::mul_add(x393, x414, x392 * x413))
+            + Self::mul_add(-x369, x418, x370 * x417)
+            - (Self::mul_add(-x402, x448, x403 * x447)
+                + Self::mul_add(x405, x457, x406 * x454)) - x658;
+        let x706 = Self::mul_add(x397, x415, Self::mul_add(-x396, x414, x395 * x413))
+            + Self::mul_add(x368, x418, x370 * x416)
+            + (Self::mul_add(x401, x448, x403 * x446)
+                + Self::mul_add(-x404, x457, x406 * x451)) - x659;
+        let x707 = Self::mul_add(x400, x415, Self::mul_add(-x399, x414, x398 * x413))
+            + Self::mul_add(x368, x417, x369 * x416)
+            - (Self::mul_add(x401, x447, x402 * x446)
+                - Self::mul_add(x404, x454, x405 * x451)) + x660;
+        let x708 = Self::mul_add(x9, x689, Self::mul_add(x8, x688, s_q1 * x687))
+            - Self::mul_add(-x367, x369, x366 * x370);
+        let x709 = Self::mul_add(-x9, x692, Self::mul_add(-x8, x691, s_q1 * x690))
+            + Self::mul_add(-x367, x368, x365 * x370);
+        let x710 = Self::mul_add(-x9, x695, Self::mul_add(-x8, x694, s_q1 * x693))
+            + Self::mul_add(-x366, x368, x365 * x369);
+        let x711 = Self::mul_add(-x9, x369, x8 * x370);
+        let x712 = Self::mul_add(x9, x368, s_q1 * x370);
+        let x713 = Self::mul_add(x8, x368, s_q1 * x369);
+        let x714 = s_q1 * x696;
+        let x715 = Self::mul_add(
+            x366,
+            x472,
+            Self::mul_add(x9, x702, Self::mul_add(x8, x699, x714)),
+        );
+        let x716 = Self::mul_add(-x367, x473, x715);
+        let x717 = -x716;
+        let x718 = x8 * x700;
+        let x719 = Self::mul_add(
+            -x365,
+            x480,
+            Self::mul_add(-x9, x703, Self::mul_add(s_q1, x697, -x718)),
+        );
+        let x720 = Self::mul_add(-x367, x481, x719);
+        let x721 = x9 * x704;
+        let x722 = Self::mul_add(
+            x366,
+            x484,
+            Self::mul_add(-x365, x483, Self::mul_add(x8, x701, s_q1 * x698) - x721),
+        );
+        let x723 = Self::mul_add(-x9, x486, x8 * x485);
+        let x724 = Self::mul_add(-x9, x488, s_q1 * x487);
+        let x725 = Self::mul_add(x8, x490, s_q1 * x489);
+        let x726 = Self::mul_add(
+            -x420,
+            x487,
+            Self::mul_add(x286, x698, Self::mul_add(x285, x697, x284 * x696)),
+        );
+        let x727 = Self::mul_add(
+            -x419,
+            x485,
+            Self::mul_add(x286, x701, Self::mul_add(-x285, x700, x284 * x699)),
+        );
+        let x728 = Self::mul_add(
+            x419,
+            x486,
+            Self::mul_add(-x286, x704, Self::mul_add(-x285, x703, x284 * x702)),
+        );
+        let x729 = Self::mul_add(x8, x707, x9 * x706)
+            + Self::mul_add(x366, x460, x367 * x459)
+            + (Self::mul_add(-x424, x689, Self::mul_add(-x423, x688, x422 * x687))
+                - Self::mul_add(-x369, x427, x370 * x426))
+            - Self::mul_add(x421, x489, x726);
+        let x730 = Self::mul_add(-s_q1, x707, x9 * x705)
+            + Self::mul_add(x365, x460, x367 * x458)
+            - (Self::mul_add(x424, x692, Self::mul_add(x423, x691, x422 * x690))
+                - Self::mul_add(x368, x427, x370 * x425))
+            - Self::mul_add(x421, x490, x727);
+        let x731 = Self::mul_add(s_q1, x706, x8 * x705)
+            + Self::mul_add(-x365, x459, x366 * x458)
+            - (Self::mul_add(x424, x695, Self::mul_add(x423, x694, x422 * x693))
+                - Self::mul_add(x368, x426, x369 * x425))
+            + Self::mul_add(x420, x488, x728);
+        let x732 = Self::mul_add(x8, x460, x9 * x459)
+            - Self::mul_add(-x369, x424, x370 * x423)
+            - Self::mul_add(x286, x483, x285 * x480);
+        let x733 = Self::mul_add(-s_q1, x460, x9 * x458)
+            - Self::mul_add(-x368, x424, x370 * x422)
+            - Self::mul_add(x286, x484, x284 * x472);
+        let x734 = Self::mul_add(s_q1, x459, x8 * x458)
+            - Self::mul_add(-x368, x423, x369 * x422)
+            - Self::mul_add(x285, x481, x284 * x473);
+        let x735 = Self::mul_add(
+            x366,
+            x487,
+            Self::mul_add(-x9, x698, Self::mul_add(-x8, x697, x714)),
+        );
+        let x736 = Self::mul_add(
+            x365,
+            x485,
+            Self::mul_add(-x9, x701, Self::mul_add(s_q1, x699, x718)),
+        );
+        let x737 = Self::mul_add(
+            -x366,
+            x488,
+            Self::mul_add(-x365, x486, x721 + Self::mul_add(x8, x703, s_q1 * x702)),
+        );
+        let x738 = Self::mul_add(-x430, x689, Self::mul_add(-x429, x688, x428 * x687))
+            - Self::mul_add(-x369, x433, x370 * x432) - Self::mul_add(x367, x489, x735);
+        let x739 = Self::mul_add(x430, x692, Self::mul_add(x429, x691, x428 * x690))
+            - Self::mul_add(x368, x433, x370 * x431) + Self::mul_add(x367, x490, x736);
+        let x740 = Self::mul_add(x430, x695, Self::mul_add(x429, x694, x428 * x693))
+            - Self::mul_add(x368, x432, x369 * x431) - x737;
+        let x741 = Self::mul_add(-x369, x430, x370 * x429)
+            - Self::mul_add(x9, x483, x8 * x480);
+        let x742 = Self::mul_add(-x368, x430, x370 * x428)
+            + Self::mul_add(-x9, x484, s_q1 * x472);
+        let x743 = Self::mul_add(-x368, x429, x369 * x428)
+            + Self::mul_add(-x8, x481, s_q1 * x473);
+        let x744 = Self::mul_add(c_q0, x731, s_q0 * x730)
+            - Self::mul_add(-x14, x734, Self::mul_add(x13, x733, x12 * x732));
+        let x745 = -(Self::mul_add(c_q0, x740, s_q0 * x739)
+            - Self::mul_add(-x14, x743, Self::mul_add(x13, x742, x12 * x741)));
+        let x746 = Self::mul_add(-x9, x731, Self::mul_add(x8, x730, s_q1 * x729));
+        let x747 = -(x746
+            - Self::mul_add(x124, x734, Self::mul_add(-x123, x733, x122 * x732)));
+        let x748 = Self::mul_add(x9, x740, Self::mul_add(-x8, x739, s_q1 * x738));
+        let x749 = -(x748
+            + Self::mul_add(x124, x743, Self::mul_add(-x123, x742, x122 * x741)));
+        let x750 = -(x746
+            - Self::mul_add(x247, x734, Self::mul_add(-x246, x733, x245 * x732)));
+        let x751 = -(x748
+            + Self::mul_add(x247, x743, Self::mul_add(-x246, x742, x245 * x741)));
+        let x752 = -(Self::mul_add(-x424, x710, Self::mul_add(x423, x709, x422 * x708))
+            + Self::mul_add(x427, x713, Self::mul_add(-x426, x712, x425 * x711))
+            - (Self::mul_add(x286, x722, Self::mul_add(x285, x720, x284 * x716))
+                - Self::mul_add(-x421, x725, Self::mul_add(x420, x724, x419 * x723))));
+        let x753 = Self::mul_add(-x9, x722, Self::mul_add(-x8, x720, s_q1 * x716));
+        let x754 = -(Self::mul_add(-x430, x710, Self::mul_add(x429, x709, x428 * x708))
+            + Self::mul_add(x433, x713, Self::mul_add(-x432, x712, x431 * x711))
+            - (x753
+                + Self::mul_add(x367, x725, Self::mul_add(x366, x724, x365 * x723))));
+        let x755 = -(Self::mul_add(x424, x663, Self::mul_add(x423, x662, x422 * x661))
+            - Self::mul_add(x286, x670, Self::mul_add(-x285, x668, x284 * x665)));
+        let x756 = Self::mul_add(-x9, x670, Self::mul_add(x8, x668, s_q1 * x665));
+        let x757 = -(Self::mul_add(x430, x663, Self::mul_add(x429, x662, x428 * x661))
+            - x756);
+        let x758 = -(Self::mul_add(x424, x616, Self::mul_add(x423, x615, x422 * x614))
+            - Self::mul_add(x286, x623, Self::mul_add(-x285, x621, x284 * x618)));
+        let x759 = Self::mul_add(-x9, x623, Self::mul_add(x8, x621, s_q1 * x618));
+        let x760 = -(Self::mul_add(x430, x616, Self::mul_add(x429, x615, x428 * x614))
+            - x759);
+        let x761 = x248 - x368;
+        let x762 = x249 - x369;
+        let x763 = x250 - x370;
+        let x764 = x269 - x687;
+        let x765 = x270 - x688;
+        let x766 = x271 - x689;
+        let x767 = x272 - x690;
+        let x768 = x273 - x691;
+        let x769 = x274 - x692;
+        let x770 = x275 - x693;
+        let x771 = x276 - x694;
+        let x772 = x277 - x695;
+        let x773 = x338 - x339 + x344 + (x344 - (x345 + x346)) - x696;
+        let x774 = x328 - (x325 + (x319 - x347))
+            + (x324 - Self::mul_add(x271, x278, x340)) - x697;
+        let x775 = x327 - (x323 - (x317 - x348))
+            + (x322 - Self::mul_add(-x270, x278, x341)) - x698;
+        let x776 = x335 + (x336 - x337) - x487;
+        let x777 = x332 - (x333 + x334) - x489;
+        let x778 = x328 - (x324 - (x318 + x340))
+            + (x325 - Self::mul_add(x274, x279, x347)) - x699;
+        let x779 = x345 - x349 + x352 + (x352 - (x338 - x353)) - x700;
+        let x780 = x326 + (x321 - (x315 - x354))
+            + (x320 + Self::mul_add(x272, x279, x350)) - x701;
+        let x781 = x336 + (x335 - x337) - x485;
+        let x782 = x329 + (x330 - x331) - x490;
+        let x783 = x327 - (x322 - (x316 + x341))
+            + (x323 + Self::mul_add(x276, x280, x348)) - x702;
+        let x784 = x326 - (x320 - (x314 - x350))
+            - (x321 - Self::mul_add(x275, x280, -x354)) - x703;
+        let x785 = x346 - x353 + x355 + (x355 + (x339 + x349)) - x704;
+        let x786 = x333 - (x332 - x334) - x486;
+        let x787 = x330 + (x329 - x331) - x488;
+        let x788 = x335 + (x336 + x337) - x480;
+        let x789 = x332 - (x333 - x334) - x483;
+        let x790 = x336 + (x335 + x337) - x472;
+        let x791 = x329 + (x330 + x331) - x484;
+        let x792 = x333 - (x332 + x334) - x473;
+        let x793 = x330 + (x329 + x331) - x481;
+        let x794 = Self::mul_add(-x271, x295, Self::mul_add(x270, x294, x269 * x293))
+            + Self::mul_add(-x249, x298, x250 * x297)
+            - (Self::mul_add(-x279, x328, x280 * x327)
+                + Self::mul_add(x282, x337, x283 * x334)) - x705;
+        let x795 = Self::mul_add(x274, x295, Self::mul_add(-x273, x294, x272 * x293))
+            + Self::mul_add(x248, x298, x250 * x296)
+            + (Self::mul_add(x278, x328, x280 * x326)
+                + Self::mul_add(-x281, x337, x283 * x331)) - x706;
+        let x796 = Self::mul_add(x277, x295, Self::mul_add(-x276, x294, x275 * x293))
+            + Self::mul_add(x248, x297, x249 * x296)
+            - (Self::mul_add(x278, x327, x279 * x326)
+                - Self::mul_add(x281, x334, x282 * x331)) - x707;
+        let x797 = Self::mul_add(x249, x295, x250 * x294)
+            - Self::mul_add(-x279, x337, x280 * x334) - x458;
+        let x798 = Self::mul_add(-x248, x295, x250 * x293)
+            + Self::mul_add(x278, x337, x280 * x331) - x459;
+        let x799 = Self::mul_add(x248, x294, x249 * x293)
+            - Self::mul_add(x278, x334, x279 * x331) - x460;
+        let x800 = Self::mul_add(x9, x766, Self::mul_add(x8, x765, s_q1 * x764))
+            - Self::mul_add(-x247, x762, x246 * x763);
+        let x801 = Self::mul_add(-x9, x769, Self::mul_add(-x8, x768, s_q1 * x767))
+            + Self::mul_add(-x247, x761, x245 * x763);
+        let x802 = Self::mul_add(-x9, x772, Self::mul_add(-x8, x771, s_q1 * x770))
+            + Self::mul_add(-x246, x761, x245 * x762);
+        let x803 = Self::mul_add(-x9, x762, x8 * x763);
+        let x804 = Self::mul_add(x9, x761, s_q1 * x763);
+        let x805 = Self::mul_add(x8, x761, s_q1 * x762);
+        let x806 = s_q1 * x773;
+        let x807 = Self::mul_add(
+            x246,
+            x790,
+            Self::mul_add(x9, x783, Self::mul_add(x8, x778, x806)),
+        );
+        let x808 = Self::mul_add(-x247, x792, x807);
+        let x809 = x8 * x779;
+        let x810 = Self::mul_add(
+            -x245,
+            x788,
+            Self::mul_add(-x9, x784, Self::mul_add(s_q1, x774, -x809)),
+        );
+        let x811 = Self::mul_add(-x247, x793, x810);
+        let x812 = x9 * x785;
+        let x813 = Self::mul_add(
+            x246,
+            x791,
+            Self::mul_add(-x245, x789, Self::mul_add(x8, x780, s_q1 * x775) - x812),
+        );
+        let x814 = Self::mul_add(-x9, x786, x8 * x781);
+        let x815 = Self::mul_add(-x9, x787, s_q1 * x776);
+        let x816 = Self::mul_add(x8, x782, s_q1 * x777);
+        let x817 = Self::mul_add(
+            -x300,
+            x776,
+            Self::mul_add(x163, x775, Self::mul_add(x162, x774, x161 * x773)),
+        );
+        let x818 = Self::mul_add(
+            -x299,
+            x781,
+            Self::mul_add(x163, x780, Self::mul_add(-x162, x779, x161 * x778)),
+        );
+        let x819 = Self::mul_add(
+            x299,
+            x786,
+            Self::mul_add(-x163, x785, Self::mul_add(-x162, x784, x161 * x783)),
+        );
+        let x820 = Self::mul_add(x8, x796, x9 * x795)
+            + Self::mul_add(x246, x799, x247 * x798)
+            + (Self::mul_add(-x304, x766, Self::mul_add(-x303, x765, x302 * x764))
+                - Self::mul_add(-x307, x762, x306 * x763))
+            - Self::mul_add(x301, x777, x817);
+        let x821 = -x820;
+        let x822 = Self::mul_add(-s_q1, x796, x9 * x794)
+            + Self::mul_add(x245, x799, x247 * x797)
+            - (Self::mul_add(x304, x769, Self::mul_add(x303, x768, x302 * x767))
+                - Self::mul_add(x307, x761, x305 * x763))
+            - Self::mul_add(x301, x782, x818);
+        let x823 = Self::mul_add(s_q1, x795, x8 * x794)
+            + Self::mul_add(-x245, x798, x246 * x797)
+            - (Self::mul_add(x304, x772, Self::mul_add(x303, x771, x302 * x770))
+                - Self::mul_add(x306, x761, x305 * x762))
+            + Self::mul_add(x300, x787, x819);
+        let x824 = Self::mul_add(x8, x799, x9 * x798)
+            - Self::mul_add(-x304, x762, x303 * x763)
+            - Self::mul_add(x163, x789, x162 * x788);
+        let x825 = Self::mul_add(-s_q1, x799, x9 * x797)
+            - Self::mul_add(-x304, x761, x302 * x763)
+            - Self::mul_add(x163, x791, x161 * x790);
+        let x826 = Self::mul_add(s_q1, x798, x8 * x797)
+            - Self::mul_add(-x303, x761, x302 * x762)
+            - Self::mul_add(x162, x793, x161 * x792);
+        let x827 = Self::mul_add(
+            x246,
+            x776,
+            Self::mul_add(-x9, x775, Self::mul_add(-x8, x774, x806)),
+        );
+        let x828 = Self::mul_add(
+            x245,
+            x781,
+            Self::mul_add(-x9, x780, Self::mul_add(s_q1, x778, x809)),
+        );
+        let x829 = Self::mul_add(
+            -x246,
+            x787,
+            Self::mul_add(-x245, x786, x812 + Self::mul_add(x8, x784, s_q1 * x783)),
+        );
+        let x830 = Self::mul_add(-x310, x766, Self::mul_add(-x309, x765, x308 * x764))
+            - Self::mul_add(-x313, x762, x312 * x763) - Self::mul_add(x247, x777, x827);
+        let x831 = -x830;
+        let x832 = Self::mul_add(x310, x769, Self::mul_add(x309, x768, x308 * x767))
+            - Self::mul_add(x313, x761, x311 * x763) + Self::mul_add(x247, x782, x828);
+        let x833 = Self::mul_add(x310, x772, Self::mul_add(x309, x771, x308 * x770))
+            - Self::mul_add(x312, x761, x311 * x762) - x829;
+        let x834 = Self::mul_add(-x310, x762, x309 * x763)
+            - Self::mul_add(x9, x789, x8 * x788);
+        let x835 = Self::mul_add(-x310, x761, x308 * x763)
+            + Self::mul_add(-x9, x791, s_q1 * x790);
+        let x836 = Self::mul_add(-x309, x761, x308 * x762)
+            + Self::mul_add(-x8, x793, s_q1 * x792);
+        let x837 = -(Self::mul_add(c_q0, x823, s_q0 * x822)
+            - Self::mul_add(-x14, x826, Self::mul_add(x13, x825, x12 * x824)));
+        let x838 = Self::mul_add(c_q0, x833, s_q0 * x832)
+            - Self::mul_add(-x14, x836, Self::mul_add(x13, x835, x12 * x834));
+        let x839 = Self::mul_add(-x9, x823, Self::mul_add(x8, x822, s_q1 * x820))
+            - Self::mul_add(x124, x826, Self::mul_add(-x123, x825, x122 * x824));
+        let x840 = Self::mul_add(x9, x833, Self::mul_add(-x8, x832, s_q1 * x830))
+            + Self::mul_add(x124, x836, Self::mul_add(-x123, x835, x122 * x834));
+        let x841 = Self::mul_add(-x304, x802, Self::mul_add(x303, x801, x302 * x800))
+            + Self::mul_add(x307, x805, Self::mul_add(-x306, x804, x305 * x803))
+            - (Self::mul_add(x163, x813, Self::mul_add(x162, x811, x161 * x808))
+                - Self::mul_add(-x301, x816, Self::mul_add(x300, x815, x299 * x814)));
+        let x842 = Self::mul_add(-x9, x813, Self::mul_add(-x8, x811, s_q1 * x808));
+        let x843 = Self::mul_add(-x310, x802, Self::mul_add(x309, x801, x308 * x800))
+            + Self::mul_add(x313, x805, Self::mul_add(-x312, x804, x311 * x803))
+            - (x842 + Self::mul_add(x247, x816, Self::mul_add(x246, x815, x245 * x814)));
+        let x844 = -(Self::mul_add(-x304, x710, Self::mul_add(x303, x709, x302 * x708))
+            + Self::mul_add(x307, x713, Self::mul_add(-x306, x712, x305 * x711))
+            - (Self::mul_add(x163, x722, Self::mul_add(x162, x720, x161 * x716))
+                - Self::mul_add(-x301, x725, Self::mul_add(x300, x724, x299 * x723))));
+        let x845 = -(Self::mul_add(-x310, x710, Self::mul_add(x309, x709, x308 * x708))
+            + Self::mul_add(x313, x713, Self::mul_add(-x312, x712, x311 * x711))
+            - (x753
+                + Self::mul_add(x247, x725, Self::mul_add(x246, x724, x245 * x723))));
+        let x846 = -(Self::mul_add(x304, x663, Self::mul_add(x303, x662, x302 * x661))
+            - Self::mul_add(x163, x670, Self::mul_add(-x162, x668, x161 * x665)));
+        let x847 = x756
+            - Self::mul_add(x310, x663, Self::mul_add(x309, x662, x308 * x661));
+        let x848 = -(Self::mul_add(x304, x616, Self::mul_add(x303, x615, x302 * x614))
+            - Self::mul_add(x163, x623, Self::mul_add(-x162, x621, x161 * x618)));
+        let x849 = x759
+            - Self::mul_add(x310, x616, Self::mul_add(x309, x615, x308 * x614));
+        let x850 = x125 + x761;
+        let x851 = x126 + x762;
+        let x852 = x127 + x763;
+        let x853 = x146 + x764;
+        let x854 = x147 + x765;
+        let x855 = x148 + x766;
+        let x856 = x149 + x767;
+        let x857 = x150 + x768;
+        let x858 = x151 + x769;
+        let x859 = x152 + x770;
+        let x860 = x153 + x771;
+        let x861 = x154 + x772;
+        let x862 = x218 - x219 + x224 + (x224 - (x225 + x226)) + x773;
+        let x863 = x208 - (x205 + (x199 - x227))
+            + (x204 - Self::mul_add(x148, x155, x220)) + x774;
+        let x864 = x207 - (x203 - (x197 - x228))
+            + (x202 - Self::mul_add(-x147, x155, x221)) + x775;
+        let x865 = x215 + (x216 - x217) + x776;
+        let x866 = x212 - (x213 + x214) + x777;
+        let x867 = x208 - (x204 - (x198 + x220))
+            + (x205 - Self::mul_add(x151, x156, x227)) + x778;
+        let x868 = x225 - x229 + x232 + (x232 - (x218 - x233)) + x779;
+        let x869 = x206 + (x201 - (x195 - x234))
+            + (x200 + Self::mul_add(x149, x156, x230)) + x780;
+        let x870 = x216 + (x215 - x217) + x781;
+        let x871 = x209 + (x210 - x211) + x782;
+        let x872 = x207 - (x202 - (x196 + x221))
+            + (x203 + Self::mul_add(x153, x157, x228)) + x783;
+        let x873 = x206 - (x200 - (x194 - x230))
+            - (x201 - Self::mul_add(x152, x157, -x234)) + x784;
+        let x874 = x226 - x233 + x235 + (x235 + (x219 + x229)) + x785;
+        let x875 = x213 - (x212 - x214) + x786;
+        let x876 = x210 + (x209 - x211) + x787;
+        let x877 = x215 + (x216 + x217) + x788;
+        let x878 = x212 - (x213 - x214) + x789;
+        let x879 = x216 + (x215 + x217) + x790;
+        let x880 = x209 + (x210 + x211) + x791;
+        let x881 = x213 - (x212 + x214) + x792;
+        let x882 = x210 + (x209 + x211) + x793;
+        let x883 = Self::mul_add(-x148, x172, Self::mul_add(x147, x171, x146 * x170))
+            + Self::mul_add(-x126, x175, x127 * x174)
+            - (Self::mul_add(-x156, x208, x157 * x207)
+                + Self::mul_add(x159, x217, x160 * x214)) + x794;
+        let x884 = Self::mul_add(x151, x172, Self::mul_add(-x150, x171, x149 * x170))
+            + Self::mul_add(x125, x175, x127 * x173)
+            + (Self::mul_add(x155, x208, x157 * x206)
+                + Self::mul_add(-x158, x217, x160 * x211)) + x795;
+        let x885 = Self::mul_add(x154, x172, Self::mul_add(-x153, x171, x152 * x170))
+            + Self::mul_add(x125, x174, x126 * x173)
+            - (Self::mul_add(x155, x207, x156 * x206)
+                - Self::mul_add(x158, x214, x159 * x211)) + x796;
+        let x886 = Self::mul_add(x126, x172, x127 * x171)
+            - Self::mul_add(-x156, x217, x157 * x214) + x797;
+        let x887 = Self::mul_add(-x125, x172, x127 * x170)
+            + Self::mul_add(x155, x217, x157 * x211) + x798;
+        let x888 = Self::mul_add(x125, x171, x126 * x170)
+            - Self::mul_add(x155, x214, x156 * x211) + x799;
+        let x889 = Self::mul_add(x9, x855, Self::mul_add(x8, x854, s_q1 * x853))
+            - Self::mul_add(-x124, x851, x123 * x852);
+        let x890 = Self::mul_add(-x9, x858, Self::mul_add(-x8, x857, s_q1 * x856))
+            + Self::mul_add(-x124, x850, x122 * x852);
+        let x891 = Self::mul_add(-x9, x861, Self::mul_add(-x8, x860, s_q1 * x859))
+            + Self::mul_add(-x123, x850, x122 * x851);
+        let x892 = Self::mul_add(-x9, x851, x8 * x852);
+        let x893 = Self::mul_add(x9, x850, s_q1 * x852);
+        let x894 = Self::mul_add(x8, x850, s_q1 * x851);
+        let x895 = s_q1 * x862;
+        let x896 = Self::mul_add(
+            x123,
+            x879,
+            Self::mul_add(x9, x872, Self::mul_add(x8, x867, x895)),
+        );
+        let x897 = Self::mul_add(-x124, x881, x896);
+        let x898 = x8 * x868;
+        let x899 = Self::mul_add(
+            -x122,
+            x877,
+            Self::mul_add(-x9, x873, Self::mul_add(s_q1, x863, -x898)),
+        );
+        let x900 = Self::mul_add(-x124, x882, x899);
+        let x901 = x9 * x874;
+        let x902 = Self::mul_add(
+            x123,
+            x880,
+            Self::mul_add(-x122, x878, Self::mul_add(x8, x869, s_q1 * x864) - x901),
+        );
+        let x903 = Self::mul_add(-x9, x875, x8 * x870);
+        let x904 = Self::mul_add(-x9, x876, s_q1 * x865);
+        let x905 = Self::mul_add(x8, x871, s_q1 * x866);
+        let x906 = Self::mul_add(
+            x180,
+            x865,
+            Self::mul_add(x178, x864, Self::mul_add(x177, x863, x176 * x862)),
+        );
+        let x907 = Self::mul_add(
+            -x179,
+            x870,
+            Self::mul_add(x178, x869, Self::mul_add(-x177, x868, x176 * x867)),
+        );
+        let x908 = Self::mul_add(
+            x179,
+            x875,
+            Self::mul_add(-x178, x874, Self::mul_add(-x177, x873, x176 * x872)),
+        );
+        let x909 = -(Self::mul_add(x8, x885, x9 * x884)
+            + Self::mul_add(x123, x888, x124 * x887)
+            + (Self::mul_add(-x184, x855, Self::mul_add(-x183, x854, x182 * x853))
+                - Self::mul_add(-x187, x851, x186 * x852))
+            - Self::mul_add(x181, x866, x906));
+        let x910 = Self::mul_add(
+            x123,
+            x865,
+            Self::mul_add(-x9, x864, Self::mul_add(-x8, x863, x895)),
+        );
+        let x911 = Self::mul_add(
+            x122,
+            x870,
+            Self::mul_add(-x9, x869, Self::mul_add(s_q1, x867, x898)),
+        );
+        let x912 = Self::mul_add(
+            -x123,
+            x876,
+            Self::mul_add(-x122, x875, x901 + Self::mul_add(x8, x873, s_q1 * x872)),
+        );
+        let x913 = -(Self::mul_add(-x190, x855, Self::mul_add(-x189, x854, x188 * x853))
+            - Self::mul_add(-x193, x851, x192 * x852) - Self::mul_add(x124, x866, x910));
+        let x914 = Self::mul_add(
+            c_q0,
+            Self::mul_add(s_q1, x884, x8 * x883)
+                + Self::mul_add(-x122, x887, x123 * x886)
+                - (Self::mul_add(x184, x861, Self::mul_add(x183, x860, x182 * x859))
+                    - Self::mul_add(x186, x850, x185 * x851))
+                + Self::mul_add(-x180, x876, x908),
+            s_q0
+                * (Self::mul_add(-s_q1, x885, x9 * x883)
+                    + Self::mul_add(x122, x888, x124 * x886)
+                    - (Self::mul_add(x184, x858, Self::mul_add(x183, x857, x182 * x856))
+                        - Self::mul_add(x187, x850, x185 * x852))
+                    - Self::mul_add(x181, x871, x907)),
+        );
+        let x915 = Self::mul_add(
+            -x14,
+            Self::mul_add(s_q1, x887, x8 * x886)
+                - Self::mul_add(-x183, x850, x182 * x851)
+                - Self::mul_add(x177, x882, x176 * x881),
+            Self::mul_add(
+                x13,
+                Self::mul_add(-s_q1, x888, x9 * x886)
+                    - Self::mul_add(-x184, x850, x182 * x852)
+                    - Self::mul_add(x178, x880, x176 * x879),
+                x12
+                    * (Self::mul_add(x8, x888, x9 * x887)
+                        - Self::mul_add(-x184, x851, x183 * x852)
+                        - Self::mul_add(x178, x878, x177 * x877)),
+            ),
+        );
+        let x916 = -(x914 - x915);
+        let x917 = Self::mul_add(
+            c_q0,
+            Self::mul_add(x190, x861, Self::mul_add(x189, x860, x188 * x859))
+                - Self::mul_add(x192, x850, x191 * x851) - x912,
+            s_q0
+                * (Self::mul_add(x190, x858, Self::mul_add(x189, x857, x188 * x856))
+                    - Self::mul_add(x193, x850, x191 * x852)
+                    + Self::mul_add(x124, x871, x911)),
+        );
+        let x918 = Self::mul_add(
+            -x14,
+            Self::mul_add(-x189, x850, x188 * x851)
+                + Self::mul_add(-x8, x882, s_q1 * x881),
+            Self::mul_add(
+                x13,
+                Self::mul_add(-x190, x850, x188 * x852)
+                    + Self::mul_add(-x9, x880, s_q1 * x879),
+                x12
+                    * (Self::mul_add(-x190, x851, x189 * x852)
+                        - Self::mul_add(x9, x878, x8 * x877)),
+            ),
+        );
+        let x919 = x917 - x918;
+        let x920 = Self::mul_add(-x184, x891, Self::mul_add(x183, x890, x182 * x889))
+            + Self::mul_add(x187, x894, Self::mul_add(-x186, x893, x185 * x892))
+            - (Self::mul_add(x178, x902, Self::mul_add(x177, x900, x176 * x897))
+                - Self::mul_add(-x181, x905, Self::mul_add(-x180, x904, x179 * x903)));
+        let x921 = Self::mul_add(-x190, x891, Self::mul_add(x189, x890, x188 * x889))
+            + Self::mul_add(x193, x894, Self::mul_add(-x192, x893, x191 * x892))
+            - (Self::mul_add(-x9, x902, Self::mul_add(-x8, x900, s_q1 * x897))
+                + Self::mul_add(x124, x905, Self::mul_add(x123, x904, x122 * x903)));
+        let x922 = Self::mul_add(-x184, x802, Self::mul_add(x183, x801, x182 * x800))
+            + Self::mul_add(x187, x805, Self::mul_add(-x186, x804, x185 * x803))
+            - (Self::mul_add(x178, x813, Self::mul_add(x177, x811, x176 * x808))
+                - Self::mul_add(-x181, x816, Self::mul_add(-x180, x815, x179 * x814)));
+        let x923 = Self::mul_add(-x190, x802, Self::mul_add(x189, x801, x188 * x800))
+            + Self::mul_add(x193, x805, Self::mul_add(-x192, x804, x191 * x803))
+            - (x842 + Self::mul_add(x124, x816, Self::mul_add(x123, x815, x122 * x814)));
+        let x924 = -(Self::mul_add(-x184, x710, Self::mul_add(x183, x709, x182 * x708))
+            + Self::mul_add(x187, x713, Self::mul_add(-x186, x712, x185 * x711))
+            - (Self::mul_add(x178, x722, Self::mul_add(x177, x720, x176 * x716))
+                - Self::mul_add(-x181, x725, Self::mul_add(-x180, x724, x179 * x723))));
+        let x925 = -(Self::mul_add(-x190, x710, Self::mul_add(x189, x709, x188 * x708))
+            + Self::mul_add(x193, x713, Self::mul_add(-x192, x712, x191 * x711))
+            - (x753
+                + Self::mul_add(x124, x725, Self::mul_add(x123, x724, x122 * x723))));
+        let x926 = -(Self::mul_add(x184, x663, Self::mul_add(x183, x662, x182 * x661))
+            - Self::mul_add(x178, x670, Self::mul_add(-x177, x668, x176 * x665)));
+        let x927 = x756
+            - Self::mul_add(x190, x663, Self::mul_add(x189, x662, x188 * x661));
+        let x928 = -(Self::mul_add(x184, x616, Self::mul_add(x183, x615, x182 * x614))
+            - Self::mul_add(x178, x623, Self::mul_add(-x177, x621, x176 * x618)));
+        let x929 = x759
+            - Self::mul_add(x190, x616, Self::mul_add(x189, x615, x188 * x614));
+        let x930 = x15 + x850;
+        let x931 = x16 - x851;
+        let x932 = x17 - x852;
+        let x933 = x36 - x854;
+        let x934 = x37 - x855;
+        let x935 = -(x95 - x96 - x101 - (x101 - (x102 + x103)) + x862);
+        let x936 = x85 - (x82 - (x76 - x104)) - (x81 - Self::mul_add(qd[0], x37, x97))
+            + x863;
+        let x937 = x84 - (x80 + (x74 - x105)) - (x79 - Self::mul_add(-qd[0], x36, x98))
+            + x864;
+        let x938 = x92 - (x93 + x94) - x865;
+        let x939 = x89 + (x90 - x91) - x866;
+        let x940 = Self::mul_add(-c_q0, x40 - x858, s_q0 * (x39 - x857))
+            - Self::mul_add(-x14, x930, x12 * x932);
+        let x941 = Self::mul_add(-c_q0, x43 - x861, s_q0 * (x42 - x860))
+            - Self::mul_add(-x13, x930, x12 * x931);
+        let x942 = c_q0 * x930;
+        let x943 = s_q0 * x930;
+        let x944 = Self::mul_add(
+            -x13,
+            x93 - (x92 + x94) + x879,
+            Self::mul_add(
+                -c_q0,
+                x84 + (x79 + (x73 - x98)) + (x80 - Self::mul_add(x42, x45, x105)) + x872,
+                s_q0
+                    * (x85 + (x81 + (x75 - x97)) + (x82 + Self::mul_add(x40, x44, x104))
+                        + x867),
+            ),
+        );
+        let x945 = -Self::mul_add(x14, x90 + (x89 + x91) + x881, x944);
+        let x946 = Self::mul_add(
+            x12,
+            x92 - (x93 - x94) - x877,
+            Self::mul_add(
+                -c_q0,
+                x83 - (x77 - (x71 - x107)) - (x78 + Self::mul_add(x41, x45, x111))
+                    - x873,
+                s_q0 * (x102 - x106 + x109 + (x109 + (x95 + x110)) - x868),
+            ),
+        );
+        let x947 = Self::mul_add(-x14, x87 + (x86 + x88) - x882, x946);
+        let x948 = Self::mul_add(
+            -x12,
+            x89 + (x90 + x91) - x878,
+            Self::mul_add(
+                c_q0,
+                x103 - x110 + x112 + (x112 - (x96 - x106)) - x874,
+                s_q0
+                    * (x83 + (x78 - (x72 - x111))
+                        + (x77 + Self::mul_add(-x38, x44, x107)) - x869),
+            ),
+        );
+        let x949 = Self::mul_add(-x13, x86 + (x87 + x88) - x880, x948);
+        let x950 = c_q0 * (x87 + (x86 - x88) - x876);
+        let x951 = s_q0 * (x86 + (x87 - x88) - x871);
+        let x952 = Self::mul_add(
+            -s_q0,
+            Self::mul_add(-x43, x59, Self::mul_add(x42, x58, x41 * x57))
+                - Self::mul_add(-x15, x61, x16 * x60)
+                + (Self::mul_add(-qd[0], x84, x44 * x83)
+                    - Self::mul_add(x46, x91, x47 * x88)) + x885,
+            c_q0
+                * (Self::mul_add(-x40, x59, Self::mul_add(x39, x58, x38 * x57))
+                    - Self::mul_add(-x15, x62, x17 * x60)
+                    - (Self::mul_add(-qd[0], x85, x45 * x83)
+                        + Self::mul_add(-x46, x94, x48 * x88)) + x884),
+        );
+        let x953 = Self::mul_add(
+            -x53,
+            x939,
+            Self::mul_add(x52, x938, Self::mul_add(x51, x937, x50 * x936)),
+        );
+        let x954 = -(x952
+            - Self::mul_add(
+                x13,
+                Self::mul_add(-x15, x58, x16 * x57)
+                    - Self::mul_add(qd[0], x91, x44 * x88) - x888,
+                x14
+                    * (Self::mul_add(x15, x59, x17 * x57)
+                        + Self::mul_add(qd[0], x94, x45 * x88) - x887),
+            )
+            + (Self::mul_add(x64, x934, x63 * x933)
+                - Self::mul_add(x66, x931, x65 * x932)) - x953);
+        let x955 = Self::mul_add(
+            -x14,
+            x939,
+            Self::mul_add(-x13, x938, Self::mul_add(-c_q0, x937, s_q0 * x936)),
+        );
+        let x956 = -(Self::mul_add(
+            x68,
+            x934,
+            Self::mul_add(x67, x933, x49 * (x35 - x853)),
+        ) - Self::mul_add(x70, x931, x69 * x932) - x955);
+        let x957 = -(Self::mul_add(-x64, x941, x63 * x940)
+            - Self::mul_add(-x66, x943, x65 * x942)
+            - (Self::mul_add(-x51, x949, x50 * x947)
+                + Self::mul_add(-x53, x951, x52 * x950)));
+        let x958 = Self::mul_add(
+            -x68,
+            x941,
+            Self::mul_add(
+                x67,
+                x940,
+                x49
+                    * (Self::mul_add(-c_q0, x934, s_q0 * x933)
+                        + Self::mul_add(-x14, x931, x13 * x932)),
+            ),
+        );
+        let x959 = Self::mul_add(
+            -x70,
+            x943,
+            Self::mul_add(x69, x942, x54 * Self::mul_add(c_q0, x931, s_q0 * x932)),
+        );
+        let x960 = Self::mul_add(
+            x14,
+            x951,
+            Self::mul_add(
+                x13,
+                x950,
+                x12
+                    * Self::mul_add(
+                        c_q0,
+                        x90 + (x89 - x91) + x875,
+                        s_q0 * (x93 - (x92 - x94) + x870),
+                    ),
+            ),
+        );
+        let x961 = -(x958 - x959 - (Self::mul_add(c_q0, x949, s_q0 * x947) - x960));
+        let x962 = Self::mul_add(-x64, x891, x63 * x890)
+            + Self::mul_add(x66, x894, x65 * x893)
+            - (Self::mul_add(x51, x902, x50 * x900)
+                - Self::mul_add(-x53, x905, x52 * x904));
+        let x963 = -(Self::mul_add(x68, x891, Self::mul_add(-x67, x890, x49 * x889))
+            - Self::mul_add(x70, x894, Self::mul_add(x69, x893, x54 * x892))
+            + (Self::mul_add(-c_q0, x902, s_q0 * x900)
+                - Self::mul_add(-x14, x905, Self::mul_add(-x13, x904, x12 * x903))));
+        let x964 = Self::mul_add(-x64, x802, x63 * x801)
+            + Self::mul_add(x66, x805, x65 * x804)
+            - (Self::mul_add(x51, x813, x50 * x811)
+                - Self::mul_add(-x53, x816, x52 * x815));
+        let x965 = -(Self::mul_add(x68, x802, Self::mul_add(-x67, x801, x49 * x800))
+            - Self::mul_add(x70, x805, Self::mul_add(x69, x804, x54 * x803))
+            + (Self::mul_add(-c_q0, x813, s_q0 * x811)
+                - Self::mul_add(-x14, x816, Self::mul_add(-x13, x815, x12 * x814))));
+        let x966 = -(Self::mul_add(-x64, x710, x63 * x709)
+            + Self::mul_add(x66, x713, x65 * x712)
+            - (Self::mul_add(x51, x722, x50 * x720)
+                - Self::mul_add(-x53, x725, x52 * x724)));
+        let x967 = Self::mul_add(x68, x710, Self::mul_add(-x67, x709, x49 * x708))
+            - Self::mul_add(x70, x713, Self::mul_add(x69, x712, x54 * x711))
+            + (Self::mul_add(-c_q0, x722, s_q0 * x720)
+                - Self::mul_add(-x14, x725, Self::mul_add(-x13, x724, x12 * x723)));
+        let x968 = -(Self::mul_add(x64, x663, x63 * x662)
+            + Self::mul_add(-x51, x670, x50 * x668));
+        let x969 = Self::mul_add(-x68, x663, Self::mul_add(-x67, x662, x49 * x661))
+            - Self::mul_add(c_q0, x670, s_q0 * x668);
+        let x970 = -(Self::mul_add(x64, x616, x63 * x615)
+            + Self::mul_add(-x51, x623, x50 * x621));
+        let x971 = Self::mul_add(-x68, x616, Self::mul_add(-x67, x615, x49 * x614))
+            - Self::mul_add(c_q0, x623, s_q0 * x621);
+        (
+            [
+                [0.0, x954, x909, x821, x729, x672, x625],
+                [0.0, x957, x916, x837, x744, x679, x632],
+                [0.0, x962, x920, x839, x747, x681, x634],
+                [0.0, x964, x922, x841, x750, x681, x634],
+                [0.0, x966, x924, x844, x752, x681, x634],
+                [0.0, x968, x926, x846, x755, x683, x636],
+                [0.0, x970, x928, x848, x758, x685, x638],
+            ],
+            [
+                [x935, x956, x913, x831, x738, x676, x629],
+                [x945, x961, x919, x838, x745, x680, x633],
+                [x897, x963, x921, x840, x749, x682, x635],
+                [x808, x965, x923, x843, x751, x682, x635],
+                [x717, x967, x925, x845, x754, x682, x635],
+                [x666, x969, x927, x847, x757, x684, x637],
+                [x619, x971, x929, x849, x760, x686, x639],
+            ],
+        )
+    }
+    /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`.
+    ///
+    /// : 3606 mul, 3331 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 2200 fused where the target has FMA.
+    #[must_use]
+    pub fn forward_dynamics_derivatives(
+        q: &[f64; 7],
+        qd: &[f64; 7],
+        tau: &[f64; 7],
+    ) -> ([[f64; 7]; 7], [[f64; 7]; 7], [[f64; 7]; 7]) {
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = qd[0] * c_q1;
+        let x8 = qd[0] * s_q1;
+        let x9 = 0.7026 * qd[0];
+        let x10 = s_q1 * x9;
+        let x11 = c_q1 * x9;
+        let x12 = qd[1] * x8;
+        let x13 = qd[1] * x7;
+        let x14 = qd[1] * x11;
+        let x15 = qd[1] * x10;
+        let x16 = x8 * 65693.9112265768;
+        let x17 = Self::mul_add(x10, -1145.5438279999998, 65697.3302265768 * qd[1]);
+        let x18 = qd[1] * 1145.5438279999998;
+        let x19 = x7 * 1145.5438279999998;
+        let x20 = Self::mul_add(-qd[1], s_q2, x7 * c_q2);
+        let x21 = Self::mul_add(qd[1], c_q2, x7 * s_q2);
+        let x22 = x7 * 0.5692;
+        let x23 = Self::mul_add(qd[1], -0.5692, x10);
+        let x24 = Self::mul_add(-s_q2, x22, c_q2 * x23);
+        let x25 = Self::mul_add(c_q2, x22, s_q2 * x23);
+        let x26 = qd[2] * x21;
+        let x27 = qd[2] * x20;
+        let x28 = qd[2] * x25;
+        let x29 = qd[2] * x24;
+        let x30 = qd[2] - x8;
+        let x31 = Self::mul_add(-3946.18812068, x30, x20 * 39234.47412200001);
+        let x32 = 5224.5702 * x11;
+        let x33 = Self::mul_add(
+            5224.5702,
+            x25,
+            Self::mul_add(39241.404122, x30, 3946.1881206800003 * x20),
+        );
+        let x34 = 5224.5702 * x21;
+        let x35 = 5224.5702 * x30;
+        let x36 = Self::mul_add(-x21, s_q3, x20 * c_q3);
+        let x37 = Self::mul_add(x21, c_q3, x20 * s_q3);
+        let x38 = Self::mul_add(x21, -0.475, x24);
+        let x39 = Self::mul_add(-7.11, x21, x11);
+        let x40 = x25 + Self::mul_add(7.11, x30, x20 * 0.475);
+        let x41 = Self::mul_add(-s_q3, x40, c_q3 * x38);
+        let x42 = Self::mul_add(c_q3, x40, s_q3 * x38);
+        let x43 = qd[3] * x37;
+        let x44 = qd[3] * x36;
+        let x45 = qd[3] * x42;
+        let x46 = qd[3] * x41;
+        let x47 = qd[3] + x30;
+        let x48 = Self::mul_add(-1375.0472756800002, x47, x36 * 24989.305802);
+        let x49 = 3239.4582 * x39;
+        let x50 = Self::mul_add(
+            3239.4582,
+            x42,
+            Self::mul_add(24998.827802, x47, 1375.0472756800002 * x36),
+        );
+        let x51 = 3239.4582 * x37;
+        let x52 = 3239.4582 * x47;
+        let x53 = Self::mul_add(-x37, s_q4, x36 * c_q4);
+        let x54 = Self::mul_add(x37, c_q4, x36 * s_q4);
+        let x55 = Self::mul_add(-7.11, x37, x39);
+        let x56 = Self::mul_add(7.11, x47, x42);
+        let x57 = Self::mul_add(-s_q4, x56, x41 * c_q4);
+        let x58 = Self::mul_add(c_q4, x56, x41 * s_q4);
+        let x59 = qd[4] * x54;
+        let x60 = qd[4] * x53;
+        let x61 = qd[4] * x58;
+        let x62 = qd[4] + x47;
+        let x63 = x62 * 97.44448770720001;
+        let x64 = Self::mul_add(x55, -171.195516, 132.6783695416 * x53);
+        let x65 = Self::mul_add(
+            x57,
+            171.195516,
+            Self::mul_add(x54, -97.44448770720001, 135.4729695416 * x62),
+        );
+        let x66 = x62 * 171.195516;
+        let x67 = x53 * 171.195516;
+        let x68 = Self::mul_add(x53, x67, x62 * x66);
+        let x69 = Self::mul_add(x62, s_q5, x53 * c_q5);
+        let x70 = Self::mul_add(-x62, c_q5, x53 * s_q5);
+        let x71 = qd[5] + x54;
+        let x72 = 44.41 * x70;
+        let x73 = 47.471 * x71;
+        let x74 = 9.336 * (qd[6] + x69);
+        let x75 = Self::mul_add(x71, c_q6, x70 * s_q6) * x74;
+        let x76 = Self::mul_add(-x71, s_q6, x70 * c_q6) * x74;
+        let x77 = tau[6] + Self::mul_add(-x70, x73, x71 * x72);
+        let x78 = Self::mul_add(x69, x72, -Self::mul_add(c_q6, x76, s_q6 * x75));
+        let x79 = tau[5] + x78;
+        let x80 = Self::mul_add(
+            44.41,
+            qd[5] * x69,
+            Self::mul_add(x69, x73, -Self::mul_add(-s_q6, x76, c_q6 * x75)),
+        );
+        let x81 = 44.41 * c_q5;
+        let x82 = s_q5 * x81;
+        let x83 = Self::mul_add(c_q5, x81, 135.4729695416);
+        let x84 = Self::mul_add(x58, x66, Self::mul_add(x53, x63, x54 * x64))
+            + Self::mul_add(-c_q5, x80, s_q5 * x77);
+        let x85 = 1.0 / x83;
+        let x86 = tau[4] - x84;
+        let x87 = x82 * x85;
+        let x88 = 97.44448770720001 * x85;
+        let x89 = 171.195516 * x85;
+        let x90 = Self::mul_add(
+            -x82,
+            x87,
+            Self::mul_add(s_q5, 44.41 * s_q5, 132.6783695416),
+        );
+        let x91 = x82 * x88;
+        let x92 = 97.44448770720001 * x88;
+        let x93 = x82 * x89;
+        let x94 = 97.44448770720001 * x89;
+        let x95 = 171.195516 * x89;
+        let x96 = Self::mul_add(
+            x54,
+            x67,
+            -Self::mul_add(-x61, x95, Self::mul_add(-x60, x94, x59 * x93)),
+        );
+        let x97 = Self::mul_add(x59, 171.195516, x54 * x66);
+        let x98 = Self::mul_add(
+            x86,
+            x87,
+            Self::mul_add(-x58, x67, Self::mul_add(x62, x63, x54 * x65))
+                - Self::mul_add(s_q5, x80, c_q5 * x77)
+                + Self::mul_add(x61, x93, Self::mul_add(x60, x91, x59 * x90)),
+        );
+        let x99 = Self::mul_add(
+            x86,
+            x88,
+            Self::mul_add(-x53, x65, x62 * x64) + Self::mul_add(x57, x67, x55 * x66)
+                + (x78 - x79)
+                - Self::mul_add(-x61, x94, Self::mul_add(-x60, x92, x59 * x91)),
+        );
+        let x100 = Self::mul_add(x86, x89, x96);
+        let x101 = s_q4 * x91;
+        let x102 = c_q4 * x91;
+        let x103 = Self::mul_add(s_q4, x90, x102);
+        let x104 = Self::mul_add(-c_q4, x92, x101);
+        let x105 = c_q4 * x93;
+        let x106 = s_q4 * x93;
+        let x107 = c_q4 * x94;
+        let x108 = s_q4 * x94;
+        let x109 = c_q4 * 171.195516;
+        let x110 = Self::mul_add(s_q4, x108, c_q4 * x106);
+        let x111 = s_q4 * 171.195516;
+        let x112 = Self::mul_add(-c_q4, x108, s_q4 * x106);
+        let x113 = s_q4 * x95;
+        let x114 = c_q4 * x113;
+        let x115 = s_q4 * x113;
+        let x116 = 7.11 * x114;
+        let x117 = 7.11 * x115;
+        let x118 = 7.11 * x109;
+        let x119 = 7.11 * x112;
+        let x120 = 7.11 * x111;
+        let x121 = Self::mul_add(c_q4, x68, s_q4 * x100);
+        let x122 = Self::mul_add(-7.11, x110, 1375.0472756800002);
+        let x123 = Self::mul_add(-7.11, x117, 24998.827802);
+        let x124 = -3239.4582 + x117;
+        let x125 = 3239.4582 - x111;
+        let x126 = Self::mul_add(x41, x52, Self::mul_add(-x36, x49, x37 * x48))
+            - Self::mul_add(-7.11, x121, Self::mul_add(x86, x83 * x85, x84));
+        let x127 = 1.0 / x123;
+        let x128 = tau[3] + x126;
+        let x129 = x122 * x127;
+        let x130 = x119 * x127;
+        let x131 = x116 * x127;
+        let x132 = x124 * x127;
+        let x133 = Self::mul_add(
+            -x122,
+            x129,
+            -24989.305802
+                + Self::mul_add(
+                    -s_q4,
+                    Self::mul_add(s_q4, x92, x102),
+                    c_q4 * Self::mul_add(c_q4, x90, -x101),
+                ),
+        );
+        let x134 = Self::mul_add(
+            x122,
+            x130,
+            Self::mul_add(-s_q4, x104, c_q4 * x103) - x118,
+        );
+        let x135 = Self::mul_add(
+            x119,
+            x130,
+            x120 - (Self::mul_add(c_q4, x104, s_q4 * x103) - x120),
+        );
+        let x136 = Self::mul_add(-x122, x131, Self::mul_add(s_q4, x107, c_q4 * x105));
+        let x137 = Self::mul_add(-x122, x132, x110);
+        let x138 = Self::mul_add(x119, x131, Self::mul_add(-c_q4, x107, s_q4 * x105));
+        let x139 = Self::mul_add(x119, x132, x112);
+        let x140 = Self::mul_add(x116, x131, c_q4 * (c_q4 * x95));
+        let x141 = Self::mul_add(x116, x132, x114);
+        let x142 = Self::mul_add(x124, x132, x115);
+        let x143 = Self::mul_add(x36, x52, -x97) - Self::mul_add(-x44, x125, x43 * x109);
+        let x144 = Self::mul_add(
+            -x128,
+            x129,
+            Self::mul_add(x47, x49, x37 * x50) - Self::mul_add(x39, x52, x42 * x51)
+                + Self::mul_add(s_q4, x99, c_q4 * x98)
+                + (Self::mul_add(x44, x134, x43 * x133)
+                    + Self::mul_add(x46, x137, x45 * x136)),
+        );
+        let x145 = Self::mul_add(
+            x128,
+            x130,
+            Self::mul_add(-x41, x51, Self::mul_add(x36, x50, x47 * x48))
+                + Self::mul_add(-7.11, x97, Self::mul_add(-c_q4, x99, s_q4 * x98))
+                + (Self::mul_add(-x44, x135, x43 * x134)
+                    + Self::mul_add(x46, x139, x45 * x138)),
+        );
+        let x146 = Self::mul_add(
+            x128,
+            x131,
+            Self::mul_add(x47, x52, x37 * x51) + Self::mul_add(-s_q4, x68, c_q4 * x100)
+                - (Self::mul_add(x44, x138, x43 * x136)
+                    - Self::mul_add(x46, x141, x45 * x140)),
+        );
+        let x147 = Self::mul_add(
+            x128,
+            x132,
+            Self::mul_add(x36, x51, x121)
+                - (Self::mul_add(x44, x139, x43 * x137)
+                    - Self::mul_add(x46, x142, x45 * x141)),
+        );
+        let x148 = s_q3 * x134;
+        let x149 = c_q3 * x134;
+        let x150 = Self::mul_add(s_q3, x133, x149);
+        let x151 = Self::mul_add(-c_q3, x135, x148);
+        let x152 = Self::mul_add(-s_q3, x137, c_q3 * x136);
+        let x153 = Self::mul_add(c_q3, x137, s_q3 * x136);
+        let x154 = Self::mul_add(-s_q3, x139, c_q3 * x138);
+        let x155 = Self::mul_add(c_q3, x139, s_q3 * x138);
+        let x156 = Self::mul_add(-s_q3, x154, c_q3 * x152);
+        let x157 = c_q3 * x109;
+        let x158 = Self::mul_add(s_q3, x125, x157);
+        let x159 = Self::mul_add(-s_q3, x155, c_q3 * x153);
+        let x160 = Self::mul_add(c_q3, x154, s_q3 * x152);
+        let x161 = s_q3 * x109;
+        let x162 = Self::mul_add(-c_q3, x125, x161);
+        let x163 = s_q3 * x141;
+        let x164 = c_q3 * x141;
+        let x165 = Self::mul_add(s_q3, x140, x164);
+        let x166 = Self::mul_add(c_q3, x142, x163);
+        let x167 = Self::mul_add(
+            -s_q3,
+            Self::mul_add(-s_q3, x142, x164),
+            c_q3 * Self::mul_add(c_q3, x140, -x163),
+        );
+        let x168 = Self::mul_add(-s_q3, x166, c_q3 * x165);
+        let x169 = Self::mul_add(c_q3, x166, s_q3 * x165);
+        let x170 = 0.475 * x168;
+        let x171 = 7.11 * x168;
+        let x172 = 7.11 * x169;
+        let x173 = Self::mul_add(0.475, x169, x159);
+        let x174 = Self::mul_add(-0.475, x167, x160);
+        let x175 = Self::mul_add(c_q3, x155, s_q3 * x153) - x170;
+        let x176 = 7.11 * x158;
+        let x177 = 7.11 * x175;
+        let x178 = 7.11 * x162;
+        let x179 = Self::mul_add(
+            -0.475,
+            x173,
+            Self::mul_add(
+                -s_q3,
+                Self::mul_add(s_q3, x135, x149),
+                c_q3 * Self::mul_add(c_q3, x133, -x148),
+            ),
+        );
+        let x180 = Self::mul_add(-s_q3, x147, c_q3 * x146);
+        let x181 = Self::mul_add(c_q3, x147, s_q3 * x146);
+        let x182 = 3946.18812068 - Self::mul_add(7.11, x159, 0.475 * x172);
+        let x183 = Self::mul_add(-7.11, x172, 39241.404122);
+        let x184 = -5224.5702 + x172;
+        let x185 = 5224.5702 - x162;
+        let x186 = Self::mul_add(x24, x35, Self::mul_add(-x20, x32, x21 * x31))
+            + Self::mul_add(7.11, x181, Self::mul_add(-x128, x123 * x127, x126));
+        let x187 = 1.0 / x183;
+        let x188 = tau[2] + x186;
+        let x189 = x182 * x187;
+        let x190 = x177 * x187;
+        let x191 = x171 * x187;
+        let x192 = x184 * x187;
+        let x193 = Self::mul_add(
+            -x182,
+            x189,
+            -39234.47412200001 - Self::mul_add(0.475, x159, -x179),
+        );
+        let x194 = Self::mul_add(
+            -x182,
+            x190,
+            Self::mul_add(-0.475, x156, x176)
+                - Self::mul_add(-0.475, x175, Self::mul_add(-s_q3, x151, c_q3 * x150)),
+        );
+        let x195 = Self::mul_add(
+            x177,
+            x190,
+            Self::mul_add(-0.475, x160, x178)
+                - (Self::mul_add(c_q3, x151, s_q3 * x150)
+                    + Self::mul_add(0.475, x174, -x178)),
+        );
+        let x196 = Self::mul_add(-x182, x191, x156 + x170);
+        let x197 = Self::mul_add(-x182, x192, x173);
+        let x198 = Self::mul_add(x177, x191, x174);
+        let x199 = Self::mul_add(x177, x192, x175);
+        let x200 = Self::mul_add(x171, x191, x167);
+        let x201 = Self::mul_add(x171, x192, x168);
+        let x202 = Self::mul_add(x184, x192, x169);
+        let x203 = Self::mul_add(
+            -x188,
+            x189,
+            Self::mul_add(x30, x32, x21 * x33) - Self::mul_add(x11, x35, x25 * x34)
+                + Self::mul_add(0.475, x181, Self::mul_add(-s_q3, x145, c_q3 * x144))
+                + (Self::mul_add(-x27, x194, x26 * x193)
+                    + Self::mul_add(x29, x197, x28 * x196)),
+        );
+        let x204 = Self::mul_add(
+            x188,
+            x190,
+            Self::mul_add(-x24, x34, Self::mul_add(x20, x33, x30 * x31))
+                + (Self::mul_add(c_q3, x145, s_q3 * x144)
+                    - Self::mul_add(-7.11, x143, 0.475 * x180))
+                - (Self::mul_add(x27, x195, x26 * x194)
+                    - Self::mul_add(x29, x199, x28 * x198)),
+        );
+        let x205 = Self::mul_add(
+            x188,
+            x191,
+            Self::mul_add(x30, x35, x21 * x34) + x180
+                - (Self::mul_add(x27, x198, x26 * x196)
+                    - Self::mul_add(x29, x201, x28 * x200)),
+        );
+        let x206 = Self::mul_add(
+            x188,
+            x192,
+            Self::mul_add(x20, x34, x181)
+                - (Self::mul_add(x27, x199, x26 * x197)
+                    - Self::mul_add(x29, x202, x28 * x201)),
+        );
+        let x207 = s_q2 * x194;
+        let x208 = c_q2 * x194;
+        let x209 = Self::mul_add(s_q2, x193, -x208);
+        let x210 = Self::mul_add(c_q2, x195, x207);
+        let x211 = Self::mul_add(-s_q2, x197, c_q2 * x196);
+        let x212 = Self::mul_add(c_q2, x197, s_q2 * x196);
+        let x213 = Self::mul_add(-s_q2, x199, c_q2 * x198);
+        let x214 = Self::mul_add(c_q2, x199, s_q2 * x198);
+        let x215 = Self::mul_add(-s_q2, x213, c_q2 * x211);
+        let x216 = c_q2 * x158;
+        let x217 = Self::mul_add(s_q2, x185, x216);
+        let x218 = Self::mul_add(-s_q2, x214, c_q2 * x212);
+        let x219 = Self::mul_add(c_q2, x213, s_q2 * x211);
+        let x220 = s_q2 * x158;
+        let x221 = Self::mul_add(-c_q2, x185, x220);
+        let x222 = s_q2 * x201;
+        let x223 = c_q2 * x201;
+        let x224 = Self::mul_add(s_q2, x200, x223);
+        let x225 = Self::mul_add(c_q2, x202, x222);
+        let x226 = Self::mul_add(
+            -s_q2,
+            Self::mul_add(-s_q2, x202, x223),
+            c_q2 * Self::mul_add(c_q2, x200, -x222),
+        );
+        let x227 = 0.5692 * Self::mul_add(-s_q2, x225, c_q2 * x224);
+        let x228 = Self::mul_add(-0.5692, x226, x219);
+        let x229 = Self::mul_add(
+            -0.5692,
+            Self::mul_add(0.5692, Self::mul_add(c_q2, x225, s_q2 * x224), x218),
+            Self::mul_add(
+                s_q2,
+                Self::mul_add(-s_q2, x195, x208),
+                c_q2 * Self::mul_add(c_q2, x193, x207),
+            ),
+        );
+        let x230 = Self::mul_add(
+            0.5692,
+            x215,
+            Self::mul_add(
+                -0.5692,
+                Self::mul_add(c_q2, x214, s_q2 * x212) - x227,
+                Self::mul_add(s_q2, x210, c_q2 * x209),
+            ),
+        );
+        let x231 = Self::mul_add(
+            0.5692,
+            x219,
+            Self::mul_add(0.5692, x228, Self::mul_add(-c_q2, x210, s_q2 * x209)),
+        );
+        let x232 = Self::mul_add(-s_q2, x206, c_q2 * x205);
+        let x233 = 1145.5438279999998 + x228;
+        let x234 = 1.0 / (65697.3302265768 + x231);
+        let x235 = tau[1]
+            - (Self::mul_add(x11, x18, x7 * x16)
+                + Self::mul_add(-0.5692, x232, Self::mul_add(c_q2, x204, s_q2 * x203)));
+        let x236 = x230 * x234;
+        let x237 = x233 * x234;
+        let x238 = x221 * x234;
+        let x239 = Self::mul_add(x230, x236, Self::mul_add(0.5692, x218, -x229));
+        let x240 = Self::mul_add(-x230, x237, x215 + x227);
+        let x241 = Self::mul_add(-x230, x238, x217);
+        let x242 = Self::mul_add(x233, x237, x226);
+        let x243 = x233 * x238;
+        let x244 = x221 * x238;
+        let x245 = Self::mul_add(
+            x235,
+            x236,
+            Self::mul_add(-x11, x19, Self::mul_add(x8, x17, qd[1] * x16))
+                + Self::mul_add(
+                    0.5692,
+                    Self::mul_add(c_q2, x206, s_q2 * x205),
+                    Self::mul_add(-s_q2, x204, c_q2 * x203),
+                ) - Self::mul_add(x12, x239, Self::mul_add(x15, x241, x14 * x240)),
+        );
+        let x246 = Self::mul_add(
+            x235,
+            x237,
+            Self::mul_add(x8, x19, -x232)
+                + Self::mul_add(x12, x240, Self::mul_add(x15, x243, x14 * x242)),
+        );
+        let x247 = Self::mul_add(
+            -x235,
+            x238,
+            Self::mul_add(x7, x19, qd[1] * x18)
+                + (Self::mul_add(x20, x35, x143) - Self::mul_add(-x27, x185, x26 * x158))
+                - Self::mul_add(x12, x241, Self::mul_add(x15, x244, x14 * x243)),
+        );
+        let x248 = s_q1 * 65693.9112265768;
+        let x249 = s_q1 * x248;
+        let x250 = c_q1 * Self::mul_add(-c_q1, x241, s_q1 * x240);
+        let x251 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(
+                -c_q1,
+                Self::mul_add(-c_q1, x244, s_q1 * x243),
+                s_q1 * Self::mul_add(-c_q1, x243, s_q1 * x242),
+            ),
+            x250,
+        );
+        let x252 = Self::mul_add(
+            0.7026,
+            x250,
+            -Self::mul_add(-0.7026, x251, Self::mul_add(c_q1, c_q1 * x239, x249)),
+        );
+        let x253 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
+                x13,
+                -65693.9112265768,
+                Self::mul_add(x10, x19, x7 * x17)
+                    + Self::mul_add(-x188, x183 * x187, x186),
+            ),
+            c_q1 * x245,
+        );
+        let x254 = 1.0 / (66279.65991417361 + x252);
+        let x255 = x254
+            * (tau[0]
+                + Self::mul_add(0.7026, Self::mul_add(c_q1, x247, s_q1 * x246), x253));
+        let x256 = 0.7026 * x255;
+        let x257 = Self::mul_add(-c_q1, x255, x12);
+        let x258 = Self::mul_add(s_q1, x255, x13);
+        let x259 = Self::mul_add(s_q1, x256, x14);
+        let x260 = Self::mul_add(
+            x230,
+            x257,
+            -Self::mul_add(x221, Self::mul_add(-c_q1, x256, x15), x233 * x259),
+        );
+        let x261 = x234 * (x235 - x260);
+        let x262 = 0.5692 * x257;
+        let x263 = Self::mul_add(-0.5692, x261, x259);
+        let x264 = x26 + Self::mul_add(s_q2, x261, c_q2 * x257);
+        let x265 = x27 - Self::mul_add(-c_q2, x261, s_q2 * x257);
+        let x266 = x28 - Self::mul_add(s_q2, x262, c_q2 * x263);
+        let x267 = x29 + Self::mul_add(-c_q2, x262, s_q2 * x263);
+        let x268 = x187
+            * (x188
+                + (Self::mul_add(-x177, x265, Self::mul_add(x183, x258, x182 * x264))
+                    + Self::mul_add(x184, x267, x171 * x266)));
+        let x269 = x258 - x268;
+        let x270 = Self::mul_add(0.475, x265, x266);
+        let x271 = x267 - Self::mul_add(7.11, x269, 0.475 * x264);
+        let x272 = x43 + Self::mul_add(s_q3, x265, c_q3 * x264);
+        let x273 = x44 - Self::mul_add(-c_q3, x265, s_q3 * x264);
+        let x274 = x45 + Self::mul_add(s_q3, x271, c_q3 * x270);
+        let x275 = x46 - Self::mul_add(-c_q3, x271, s_q3 * x270);
+        let x276 = x127
+            * (x128
+                + (Self::mul_add(-x119, x273, Self::mul_add(x123, x269, x122 * x272))
+                    + Self::mul_add(x124, x275, x116 * x274)));
+        let x277 = x269 - x276;
+        let x278 = x59 + Self::mul_add(s_q4, x273, c_q4 * x272);
+        let x279 = x60 - Self::mul_add(-c_q4, x273, s_q4 * x272);
+        let x280 = Self::mul_add(
+            -171.195516,
+            x61 + Self::mul_add(s_q4, Self::mul_add(-7.11, x277, x275), c_q4 * x274),
+            Self::mul_add(
+                -97.44448770720001,
+                x279,
+                Self::mul_add(-x83, x277, x82 * x278),
+            ),
+        );
+        let x281 = x85 * (x86 - x280);
+        let x282 = 0.02106549261654484 * Self::mul_add(-47.471, x279, x79);
+        let x283 = Self::mul_add(
+            9.336,
+            Self::mul_add(qd[5], x70, Self::mul_add(s_q5, x277 - x281, c_q5 * x278)),
+            tau[6],
+        );
+        let x284 = 0.10711225364181662 * x283;
+        let x285 = c_q0 * s_q1;
+        let x286 = s_q0 * s_q1;
+        let x287 = c_q0 * c_q1;
+        let x288 = s_q0 * c_q1;
+        let x289 = 0.7026 * s_q0;
+        let x290 = 0.7026 * c_q0;
+        let x291 = Self::mul_add(-c_q0, x289, s_q0 * x290);
+        let x292 = 1.3589 * c_q0;
+        let x293 = 1.3589 * s_q0;
+        let x294 = s_q1 * 1145.5438279999998;
+        let x295 = 1145.5438279999998 * x287;
+        let x296 = 1145.5438279999998 * x288;
+        let x297 = 65693.9112265768 * x287;
+        let x298 = 65697.3302265768 * s_q0;
+        let x299 = 65693.9112265768 * x288;
+        let x300 = 65697.3302265768 * c_q0;
+        let x301 = x290 * x296;
+        let x302 = x289 * x295;
+        let x303 = x301 - x302;
+        let x304 = x289 * x294;
+        let x305 = x290 * x294;
+        let x306 = 1.3589 * x295;
+        let x307 = 1.3589 * x294;
+        let x308 = x301 - x307;
+        let x309 = x290 * x295;
+        let x310 = 1.3589 * x296;
+        let x311 = x289 * x296;
+        let x312 = x302 + x307;
+        let x313 = x303 + (x249 + x303);
+        let x314 = x306 + Self::mul_add(x248, x287, x304);
+        let x315 = x310 + Self::mul_add(x248, x288, -x305);
+        let x316 = x304 + Self::mul_add(s_q1, x297, x306);
+        let x317 = x308 + (Self::mul_add(-s_q0, x298, x287 * x297) + x308);
+        let x318 = x311 + (Self::mul_add(c_q0, x298, x288 * x297) - x309);
+        let x319 = x305 - Self::mul_add(s_q1, x299, x310);
+        let x320 = x309 - (Self::mul_add(s_q0, x300, x287 * x299) + x311);
+        let x321 = x312 - (Self::mul_add(-c_q0, x300, x288 * x299) - x312);
+        let x322 = qd[1] * s_q0;
+        let x323 = qd[1] * c_q0;
+        let x324 = qd[1] * x291;
+        let x325 = qd[1] * x292;
+        let x326 = qd[1] * x293;
+        let x327 = Self::mul_add(-c_q0, x322, s_q0 * x323);
+        let x328 = qd[0] * c_q0;
+        let x329 = qd[0] * s_q0;
+        let x330 = qd[0] * x293;
+        let x331 = qd[0] * x292;
+        let x332 = Self::mul_add(x293, x322, x292 * x323)
+            - Self::mul_add(c_q0, x325, s_q0 * x326);
+        let x333 = Self::mul_add(-c_q0, x324, Self::mul_add(x291, x323, x330));
+        let x334 = Self::mul_add(-s_q0, x324, Self::mul_add(x291, x322, -x331));
+        let x335 = Self::mul_add(qd[1], x327, x255);
+        let x336 = Self::mul_add(qd[1], x328, s_q0 * x261);
+        let x337 = Self::mul_add(-qd[1], x329, c_q0 * x261);
+        let x338 = Self::mul_add(qd[1], x332, x261 * x291);
+        let x339 = Self::mul_add(-qd[1], x333, x261 * x292);
+        let x340 = Self::mul_add(-qd[1], x334, x261 * x293);
+        let x341 = Self::mul_add(-qd[0], x329, c_q0 * x255);
+        let x342 = Self::mul_add(qd[0], x328, s_q0 * x255);
+        let x343 = Self::mul_add(qd[0], x331, x255 * x293);
+        let x344 = Self::mul_add(-qd[0], x330, x255 * x292);
+        let x345 = x328 + x328;
+        let x346 = x329 + x329;
+        let x347 = x330 + x333;
+        let x348 = x331 - x334;
+        let x349 = x314 * x322;
+        let x350 = x315 * x323;
+        let x351 = qd[0] * x316;
+        let x352 = x318 * x323;
+        let x353 = qd[0] * x319;
+        let x354 = x320 * x322;
+        let x355 = x296 * x325;
+        let x356 = x295 * x326;
+        let x357 = x296 * x324;
+        let x358 = x294 * x326;
+        let x359 = x295 * x324;
+        let x360 = x294 * x325;
+        let x361 = Self::mul_add(qd[0], x313, x349) - x350 + (x355 - x356);
+        let x362 = Self::mul_add(x317, x322, x351) - x352 - (x357 - x358);
+        let x363 = Self::mul_add(-x321, x323, x353 + x354) - (x359 - x360);
+        let x364 = x296 * x322;
+        let x365 = x295 * x323;
+        let x366 = x364 + x365;
+        let x367 = qd[0] * x296;
+        let x368 = x294 * x323;
+        let x369 = x367 + x368;
+        let x370 = qd[0] * x295;
+        let x371 = x294 * x322;
+        let x372 = x370 - x371;
+        let x373 = x316 * x323;
+        let x374 = x319 * x322;
+        let x375 = x313 * x323;
+        let x376 = x313 * x322;
+        let x377 = x296 * x326;
+        let x378 = x295 * x325;
+        let x379 = x377 + x378;
+        let x380 = x314 * x323;
+        let x381 = x315 * x322;
+        let x382 = x317 * x323;
+        let x383 = x321 * x322;
+        let x384 = qd[0] * x320;
+        let x385 = qd[0] * x317;
+        let x386 = x294 * x324;
+        let x387 = x377 + x386;
+        let x388 = qd[0] * x318;
+        let x389 = qd[0] * x321;
+        let x390 = x378 + x386;
+        let x391 = c_q1 * c_q2;
+        let x392 = Self::mul_add(s_q0, s_q2, c_q2 * x285);
+        let x393 = Self::mul_add(-c_q0, s_q2, c_q2 * x286);
+        let x394 = c_q1 * s_q2;
+        let x395 = Self::mul_add(-s_q0, c_q2, s_q2 * x285);
+        let x396 = Self::mul_add(c_q0, c_q2, s_q2 * x286);
+        let x397 = Self::mul_add(s_q1, 0.5692, 1.3589);
+        let x398 = Self::mul_add(0.5692, x287, x289);
+        let x399 = Self::mul_add(-0.5692, x288, x290);
+        let x400 = Self::mul_add(x288, x398, x287 * x399);
+        let x401 = Self::mul_add(x288, x397, s_q1 * x399);
+        let x402 = Self::mul_add(-x287, x397, s_q1 * x398);
+        let x403 = 5224.5702 * x391;
+        let x404 = 5224.5702 * x392;
+        let x405 = 5224.5702 * x393;
+        let x406 = Self::mul_add(3946.1881206800003, s_q1, 39234.47412200001 * x391);
+        let x407 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x391);
+        let x408 = Self::mul_add(-3946.1881206800003, x287, 39234.47412200001 * x392);
+        let x409 = Self::mul_add(39241.404122, x287, 3946.18812068 * x392);
+        let x410 = Self::mul_add(-3946.1881206800003, x288, 39234.47412200001 * x393);
+        let x411 = Self::mul_add(39241.404122, x288, 3946.18812068 * x393);
+        let x412 = x399 * x405;
+        let x413 = x398 * x404;
+        let x414 = x412 - x413;
+        let x415 = x398 * x403;
+        let x416 = x399 * x403;
+        let x417 = x397 * x404;
+        let x418 = x397 * x403;
+        let x419 = x412 + x418;
+        let x420 = x399 * x404;
+        let x421 = x397 * x405;
+        let x422 = x398 * x405;
+        let x423 = x413 - x418;
+        let x424 = x414 - (Self::mul_add(s_q1, x407, x391 * x406) - x414);
+        let x425 = x417 + (Self::mul_add(-x287, x407, x392 * x406) - x415);
+        let x426 = x421 + (Self::mul_add(-x288, x407, x393 * x406) + x416);
+        let x427 = x415 - (Self::mul_add(s_q1, x409, x391 * x408) + x417);
+        let x428 = x419 - (Self::mul_add(-x287, x409, x392 * x408) - x419);
+        let x429 = x422 - (Self::mul_add(-x288, x409, x393 * x408) + x420);
+        let x430 = x416 + (Self::mul_add(s_q1, x411, x391 * x410) + x421);
+        let x431 = x420 + (Self::mul_add(-x287, x411, x392 * x410) - x422);
+        let x432 = x423 + (Self::mul_add(-x288, x411, x393 * x410) + x423);
+        let x433 = Self::mul_add(-qd[2], s_q1, qd[0]);
+        let x434 = Self::mul_add(-qd[2], x287, x322);
+        let x435 = Self::mul_add(qd[2], x288, x323);
+        let x436 = Self::mul_add(-qd[2], x400, x324);
+        let x437 = Self::mul_add(qd[2], x401, x325);
+        let x438 = Self::mul_add(qd[2], x402, x326);
+        let x439 = Self::mul_add(x288, x434, x287 * x435);
+        let x440 = Self::mul_add(x288, x433, s_q1 * x435);
+        let x441 = Self::mul_add(-x287, x433, s_q1 * x434);
+        let x442 = Self::mul_add(-x288, x437, x287 * x438);
+        let x443 = Self::mul_add(-x288, x436, s_q1 * x438);
+        let x444 = Self::mul_add(-x287, x436, s_q1 * x437);
+        let x445 = Self::mul_add(x402, x434, x401 * x435) + x442;
+        let x446 = Self::mul_add(-x402, x433, x400 * x435) - x443;
+        let x447 = Self::mul_add(x401, x433, x400 * x434) + x444;
+        let x448 = Self::mul_add(-qd[2], x439, Self::mul_add(-s_q1, x268, x335));
+        let x449 = Self::mul_add(qd[2], x440, Self::mul_add(-x268, x287, x336));
+        let x450 = Self::mul_add(-qd[2], x441, Self::mul_add(x268, x288, x337));
+        let x451 = Self::mul_add(qd[2], x445, Self::mul_add(-x268, x400, x338));
+        let x452 = Self::mul_add(qd[2], x446, Self::mul_add(x268, x401, x339));
+        let x453 = Self::mul_add(qd[2], x447, Self::mul_add(x268, x402, x340));
+        let x454 = Self::mul_add(x288, x322, x287 * x323);
+        let x455 = Self::mul_add(qd[0], x288, s_q1 * x323);
+        let x456 = Self::mul_add(-qd[0], x287, s_q1 * x322);
+        let x457 = Self::mul_add(x322, x402, x323 * x401)
+            + Self::mul_add(-x288, x325, x287 * x326);
+        let x458 = Self::mul_add(-qd[0], x402, x323 * x400)
+            - Self::mul_add(-x288, x324, s_q1 * x326);
+        let x459 = Self::mul_add(qd[0], x401, x322 * x400)
+            + Self::mul_add(-x287, x324, s_q1 * x325);
+        let x460 = Self::mul_add(x288, x336, x287 * x337)
+            - Self::mul_add(x322, x456, x323 * x455);
+        let x461 = Self::mul_add(x288, x335, s_q1 * x337)
+            + Self::mul_add(-qd[0], x456, x323 * x454);
+        let x462 = Self::mul_add(-x287, x335, s_q1 * x336)
+            + Self::mul_add(qd[0], x455, x322 * x454);
+        let x463 = Self::mul_add(x336, x402, x337 * x401)
+            + Self::mul_add(-x288, x339, x287 * x340)
+            + (Self::mul_add(x322, x459, x323 * x458)
+                - Self::mul_add(-x325, x456, x326 * x455));
+        let x464 = Self::mul_add(-x335, x402, x337 * x400)
+            - Self::mul_add(-x288, x338, s_q1 * x340)
+            - (Self::mul_add(qd[0], x459, x323 * x457)
+                + Self::mul_add(x324, x456, x326 * x454));
+        let x465 = Self::mul_add(x335, x401, x336 * x400)
+            + Self::mul_add(-x287, x338, s_q1 * x339)
+            - (Self::mul_add(-qd[0], x458, x322 * x457)
+                - Self::mul_add(x324, x455, x325 * x454));
+        let x466 = x439 + x454;
+        let x467 = x440 + x455;
+        let x468 = x441 + x456;
+        let x469 = x445 + x457;
+        let x470 = x446 + x458;
+        let x471 = x447 + x459;
+        let x472 = x425 * x434;
+        let x473 = x426 * x435;
+        let x474 = x427 * x433;
+        let x475 = x429 * x435;
+        let x476 = x430 * x433;
+        let x477 = x431 * x434;
+        let x478 = x405 * x437;
+        let x479 = x404 * x438;
+        let x480 = x405 * x436;
+        let x481 = x403 * x438;
+        let x482 = x404 * x436;
+        let x483 = x403 * x437;
+        let x484 = Self::mul_add(x424, x433, x472) - x473 + (x478 - x479);
+        let x485 = Self::mul_add(-x428, x434, x474) + x475 + (x480 + x481);
+        let x486 = Self::mul_add(x432, x435, x476 - x477) + (x482 + x483);
+        let x487 = x405 * x434;
+        let x488 = x404 * x435;
+        let x489 = x487 + x488;
+        let x490 = x405 * x433;
+        let x491 = x403 * x435;
+        let x492 = x490 - x491;
+        let x493 = x404 * x433;
+        let x494 = x403 * x434;
+        let x495 = x493 + x494;
+        let x496 = x427 * x435;
+        let x497 = x430 * x434;
+        let x498 = x424 * x435;
+        let x499 = x424 * x434;
+        let x500 = x405 * x438;
+        let x501 = x404 * x437;
+        let x502 = x500 + x501;
+        let x503 = x425 * x435;
+        let x504 = x426 * x434;
+        let x505 = x428 * x435;
+        let x506 = x432 * x434;
+        let x507 = x431 * x433;
+        let x508 = x428 * x433;
+        let x509 = x403 * x436;
+        let x510 = x500 - x509;
+        let x511 = x429 * x433;
+        let x512 = x432 * x433;
+        let x513 = x501 - x509;
+        let x514 = Self::mul_add(-s_q3, x394, c_q3 * x391);
+        let x515 = Self::mul_add(-s_q3, x395, c_q3 * x392);
+        let x516 = Self::mul_add(-s_q3, x396, c_q3 * x393);
+        let x517 = Self::mul_add(c_q3, x394, s_q3 * x391);
+        let x518 = Self::mul_add(c_q3, x395, s_q3 * x392);
+        let x519 = Self::mul_add(c_q3, x396, s_q3 * x393);
+        let x520 = x397 + Self::mul_add(s_q1, 0.475, 7.11 * x391);
+        let x521 = x398 - Self::mul_add(-0.475, x287, 7.11 * x392);
+        let x522 = x399 + Self::mul_add(-0.475, x288, 7.11 * x393);
+        let x523 = Self::mul_add(x288, x521, x287 * x522);
+        let x524 = Self::mul_add(x288, x520, s_q1 * x522);
+        let x525 = Self::mul_add(-x287, x520, s_q1 * x521);
+        let x526 = 3239.4582 * x514;
+        let x527 = 3239.4582 * x515;
+        let x528 = 3239.4582 * x516;
+        let x529 = Self::mul_add(1375.0472756800002, s_q1, 24989.305802 * x514);
+        let x530 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x514);
+        let x531 = Self::mul_add(-1375.0472756800002, x287, 24989.305802 * x515);
+        let x532 = Self::mul_add(24998.827802, x287, 1375.0472756800002 * x515);
+        let x533 = Self::mul_add(-1375.0472756800002, x288, 24989.305802 * x516);
+        let x534 = Self::mul_add(24998.827802, x288, 1375.0472756800002 * x516);
+        let x535 = x522 * x528;
+        let x536 = x521 * x527;
+        let x537 = x535 - x536;
+        let x538 = x521 * x526;
+        let x539 = x522 * x526;
+        let x540 = x520 * x527;
+        let x541 = x520 * x526;
+        let x542 = x535 + x541;
+        let x543 = x522 * x527;
+        let x544 = x520 * x528;
+        let x545 = x521 * x528;
+        let x546 = x536 - x541;
+        let x547 = x537 - (Self::mul_add(s_q1, x530, x514 * x529) - x537);
+        let x548 = x540 + (Self::mul_add(-x287, x530, x515 * x529) - x538);
+        let x549 = x544 + (Self::mul_add(-x288, x530, x516 * x529) + x539);
+        let x550 = x538 - (Self::mul_add(s_q1, x532, x514 * x531) + x540);
+        let x551 = x542 - (Self::mul_add(-x287, x532, x515 * x531) - x542);
+        let x552 = x545 - (Self::mul_add(-x288, x532, x516 * x531) + x543);
+        let x553 = x539 + (Self::mul_add(s_q1, x534, x514 * x533) + x544);
+        let x554 = x543 + (Self::mul_add(-x287, x534, x515 * x533) - x545);
+        let x555 = x546 + (Self::mul_add(-x288, x534, x516 * x533) + x546);
+        let x556 = Self::mul_add(-qd[3], s_q1, x433);
+        let x557 = Self::mul_add(-qd[3], x287, x434);
+        let x558 = Self::mul_add(qd[3], x288, x435);
+        let x559 = Self::mul_add(-qd[3], x523, x436);
+        let x560 = Self::mul_add(qd[3], x524, x437);
+        let x561 = Self::mul_add(qd[3], x525, x438);
+        let x562 = Self::mul_add(x288, x557, x287 * x558);
+        let x563 = Self::mul_add(x288, x556, s_q1 * x558);
+        let x564 = Self::mul_add(-x287, x556, s_q1 * x557);
+        let x565 = Self::mul_add(-x288, x560, x287 * x561);
+        let x566 = Self::mul_add(-x288, x559, s_q1 * x561);
+        let x567 = Self::mul_add(-x287, x559, s_q1 * x560);
+        let x568 = Self::mul_add(x525, x557, x524 * x558) + x565;
+        let x569 = Self::mul_add(-x525, x556, x523 * x558) - x566;
+        let x570 = Self::mul_add(x524, x556, x523 * x557) + x567;
+        let x571 = Self::mul_add(-qd[3], x562, Self::mul_add(-s_q1, x276, x448));
+        let x572 = Self::mul_add(qd[3], x563, Self::mul_add(-x276, x287, x449));
+        let x573 = Self::mul_add(-qd[3], x564, Self::mul_add(x276, x288, x450));
+        let x574 = Self::mul_add(qd[3], x568, Self::mul_add(-x276, x523, x451));
+        let x575 = Self::mul_add(qd[3], x569, Self::mul_add(x276, x524, x452));
+        let x576 = Self::mul_add(qd[3], x570, Self::mul_add(x276, x525, x453));
+        let x577 = x442 + Self::mul_add(x434, x525, x435 * x524);
+        let x578 = x443 - Self::mul_add(-x433, x525, x435 * x523);
+        let x579 = x444 + Self::mul_add(x433, x524, x434 * x523);
+        let x580 = Self::mul_add(x288, x449, x287 * x450)
+            - Self::mul_add(x434, x441, x435 * x440);
+        let x581 = Self::mul_add(x288, x448, s_q1 * x450)
+            + Self::mul_add(-x433, x441, x435 * x439);
+        let x582 = Self::mul_add(-x287, x448, s_q1 * x449)
+            + Self::mul_add(x433, x440, x434 * x439);
+        let x583 = Self::mul_add(x449, x525, x450 * x524)
+            + Self::mul_add(-x288, x452, x287 * x453)
+            - (Self::mul_add(-x434, x579, x435 * x578)
+                + Self::mul_add(-x437, x441, x438 * x440));
+        let x584 = Self::mul_add(-x448, x525, x450 * x523)
+            - Self::mul_add(-x288, x451, s_q1 * x453)
+            - (Self::mul_add(x433, x579, x435 * x577)
+                + Self::mul_add(x436, x441, x438 * x439));
+        let x585 = Self::mul_add(x448, x524, x449 * x523)
+            + Self::mul_add(-x287, x451, s_q1 * x452)
+            - (Self::mul_add(x433, x578, x434 * x577)
+                - Self::mul_add(x436, x440, x437 * x439));
+        let x586 = x439 + x562;
+        let x587 = x440 + x563;
+        let x588 = x441 + x564;
+        let x589 = x568 + x577;
+        let x590 = x569 - x578;
+        let x591 = x570 + x579;
+        let x592 = x548 * x557;
+        let x593 = x549 * x558;
+        let x594 = x550 * x556;
+        let x595 = x552 * x558;
+        let x596 = x553 * x556;
+        let x597 = x554 * x557;
+        let x598 = x528 * x560;
+        let x599 = x527 * x561;
+        let x600 = x528 * x559;
+        let x601 = x526 * x561;
+        let x602 = x527 * x559;
+        let x603 = x526 * x560;
+        let x604 = Self::mul_add(x547, x556, x592) - x593 + (x598 - x599);
+        let x605 = Self::mul_add(-x551, x557, x594) + x595 + (x600 + x601);
+        let x606 = Self::mul_add(x555, x558, x596 - x597) + (x602 + x603);
+        let x607 = x528 * x557;
+        let x608 = x527 * x558;
+        let x609 = x607 + x608;
+        let x610 = x528 * x556;
+        let x611 = x526 * x558;
+        let x612 = x610 - x611;
+        let x613 = x527 * x556;
+        let x614 = x526 * x557;
+        let x615 = x613 + x614;
+        let x616 = x550 * x558;
+        let x617 = x553 * x557;
+        let x618 = x547 * x558;
+        let x619 = x547 * x557;
+        let x620 = x528 * x561;
+        let x621 = x527 * x560;
+        let x622 = x620 + x621;
+        let x623 = x548 * x558;
+        let x624 = x549 * x557;
+        let x625 = x551 * x558;
+        let x626 = x555 * x557;
+        let x627 = x554 * x556;
+        let x628 = x551 * x556;
+        let x629 = x526 * x559;
+        let x630 = x620 - x629;
+        let x631 = x552 * x556;
+        let x632 = x555 * x556;
+        let x633 = x621 - x629;
+        let x634 = Self::mul_add(-s_q4, x517, c_q4 * x514);
+        let x635 = Self::mul_add(-s_q4, x518, c_q4 * x515);
+        let x636 = Self::mul_add(-s_q4, x519, c_q4 * x516);
+        let x637 = Self::mul_add(c_q4, x517, s_q4 * x514);
+        let x638 = Self::mul_add(c_q4, x518, s_q4 * x515);
+        let x639 = Self::mul_add(c_q4, x519, s_q4 * x516);
+        let x640 = Self::mul_add(7.11, x514, x520);
+        let x641 = Self::mul_add(-7.11, x515, x521);
+        let x642 = Self::mul_add(7.11, x516, x522);
+        let x643 = Self::mul_add(x288, x641, x287 * x642);
+        let x644 = Self::mul_add(x288, x640, s_q1 * x642);
+        let x645 = Self::mul_add(-x287, x640, s_q1 * x641);
+        let x646 = 171.195516 * x637;
+        let x647 = 171.195516 * x638;
+        let x648 = 171.195516 * x639;
+        let x649 = 132.6783695416 * x634;
+        let x650 = Self::mul_add(97.44448770720001, x637, 135.4729695416 * s_q1);
+        let x651 = s_q1 * 97.44448770720001;
+        let x652 = 132.6783695416 * x635;
+        let x653 = Self::mul_add(-97.44448770720001, x638, 135.4729695416 * x287);
+        let x654 = 97.44448770720001 * x287;
+        let x655 = 132.6783695416 * x636;
+        let x656 = Self::mul_add(-97.44448770720001, x639, 135.4729695416 * x288);
+        let x657 = 97.44448770720001 * x288;
+        let x658 = x642 * x648;
+        let x659 = x641 * x647;
+        let x660 = x658 - x659;
+        let x661 = x641 * x646;
+        let x662 = x642 * x646;
+        let x663 = x640 * x647;
+        let x664 = x640 * x646;
+        let x665 = x658 + x664;
+        let x666 = x642 * x647;
+        let x667 = x640 * x648;
+        let x668 = x641 * x648;
+        let x669 = x659 - x664;
+        let x670 = x660
+            - (Self::mul_add(x637, x651, Self::mul_add(s_q1, x650, x634 * x649)) - x660);
+        let x671 = x663
+            + (Self::mul_add(x638, x651, Self::mul_add(-x287, x650, x635 * x649))
+                - x661);
+        let x672 = x667
+            + (Self::mul_add(x639, x651, Self::mul_add(-x288, x650, x636 * x649))
+                + x662);
+        let x673 = x661
+            - (Self::mul_add(-x637, x654, Self::mul_add(-s_q1, x653, x634 * x652))
+                + x663);
+        let x674 = x665
+            - (Self::mul_add(-x638, x654, Self::mul_add(x287, x653, x635 * x652))
+                - x665);
+        let x675 = x668
+            - (Self::mul_add(-x639, x654, Self::mul_add(x288, x653, x636 * x652))
+                + x666);
+        let x676 = x662
+            + (Self::mul_add(-x637, x657, Self::mul_add(-s_q1, x656, x634 * x655))
+                + x667);
+        let x677 = x666
+            + (Self::mul_add(-x638, x657, Self::mul_add(x287, x656, x635 * x655))
+                - x668);
+        let x678 = x669
+            + (Self::mul_add(-x639, x657, Self::mul_add(x288, x656, x636 * x655))
+                + x669);
+        let x679 = Self::mul_add(-qd[4], s_q1, x556);
+        let x680 = Self::mul_add(-qd[4], x287, x557);
+        let x681 = Self::mul_add(qd[4], x288, x558);
+        let x682 = Self::mul_add(-qd[4], x643, x559);
+        let x683 = Self::mul_add(qd[4], x644, x560);
+        let x684 = Self::mul_add(qd[4], x645, x561);
+        let x685 = Self::mul_add(x288, x680, x287 * x681);
+        let x686 = Self::mul_add(x288, x679, s_q1 * x681);
+        let x687 = Self::mul_add(-x287, x679, s_q1 * x680);
+        let x688 = Self::mul_add(x645, x680, x644 * x681)
+            + Self::mul_add(-x288, x683, x287 * x684);
+        let x689 = Self::mul_add(-x645, x679, x643 * x681)
+            - Self::mul_add(-x288, x682, s_q1 * x684);
+        let x690 = Self::mul_add(x644, x679, x643 * x680)
+            + Self::mul_add(-x287, x682, s_q1 * x683);
+        let x691 = Self::mul_add(-qd[4], x685, Self::mul_add(-s_q1, x281, x571));
+        let x692 = Self::mul_add(qd[4], x686, Self::mul_add(-x281, x287, x572));
+        let x693 = Self::mul_add(-qd[4], x687, Self::mul_add(x281, x288, x573));
+        let x694 = Self::mul_add(qd[4], x688, Self::mul_add(-x281, x643, x574));
+        let x695 = Self::mul_add(qd[4], x689, Self::mul_add(x281, x644, x575));
+        let x696 = Self::mul_add(qd[4], x690, Self::mul_add(x281, x645, x576));
+        let x697 = x565 + Self::mul_add(x557, x645, x558 * x644);
+        let x698 = x566 - Self::mul_add(-x556, x645, x558 * x643);
+        let x699 = x567 + Self::mul_add(x556, x644, x557 * x643);
+        let x700 = Self::mul_add(x288, x572, x287 * x573)
+            - Self::mul_add(x557, x564, x558 * x563);
+        let x701 = Self::mul_add(x288, x571, s_q1 * x573)
+            + Self::mul_add(-x556, x564, x558 * x562);
+        let x702 = Self::mul_add(-x287, x571, s_q1 * x572)
+            + Self::mul_add(x556, x563, x557 * x562);
+        let x703 = Self::mul_add(x572, x645, x573 * x644)
+            + Self::mul_add(-x288, x575, x287 * x576)
+            - (Self::mul_add(-x557, x699, x558 * x698)
+                + Self::mul_add(-x560, x564, x561 * x563));
+        let x704 = Self::mul_add(-x571, x645, x573 * x643)
+            - Self::mul_add(-x288, x574, s_q1 * x576)
+            - (Self::mul_add(x556, x699, x558 * x697)
+                + Self::mul_add(x559, x564, x561 * x562));
+        let x705 = Self::mul_add(x571, x644, x572 * x643)
+            + Self::mul_add(-x287, x574, s_q1 * x575)
+            - (Self::mul_add(x556, x698, x557 * x697)
+                - Self::mul_add(x559, x563, x560 * x562));
+        let x706 = x562 + x685;
+        let x707 = x563 + x686;
+        let x708 = x564 + x687;
+        let x709 = x688 + x697;
+        let x710 = x689 - x698;
+        let x711 = x690 + x699;
+        let x712 = x671 * x680;
+        let x713 = x672 * x681;
+        let x714 = x673 * x679;
+        let x715 = x675 * x681;
+        let x716 = x676 * x679;
+        let x717 = x677 * x680;
+        let x718 = x648 * x683;
+        let x719 = x647 * x684;
+        let x720 = x648 * x682;
+        let x721 = x646 * x684;
+        let x722 = x647 * x682;
+        let x723 = x646 * x683;
+        let x724 = Self::mul_add(x670, x679, x712) - x713 + (x718 - x719);
+        let x725 = Self::mul_add(-x674, x680, x714) + x715 + (x720 + x721);
+        let x726 = Self::mul_add(x678, x681, x716 - x717) + (x722 + x723);
+        let x727 = x648 * x680;
+        let x728 = x647 * x681;
+        let x729 = x727 + x728;
+        let x730 = x648 * x679;
+        let x731 = x646 * x681;
+        let x732 = x730 - x731;
+        let x733 = x647 * x679;
+        let x734 = x646 * x680;
+        let x735 = x733 + x734;
+        let x736 = Self::mul_add(x647, x693, x648 * x692)
+            - Self::mul_add(-x680, x735, x681 * x732);
+        let x737 = Self::mul_add(-x646, x693, x648 * x691)
+            + Self::mul_add(x679, x735, x681 * x729);
+        let x738 = Self::mul_add(x646, x692, x647 * x691)
+            - Self::mul_add(x679, x732, x680 * x729);
+        let x739 = x673 * x681;
+        let x740 = x676 * x680;
+        let x741 = x670 * x681;
+        let x742 = x670 * x680;
+        let x743 = x648 * x684;
+        let x744 = x647 * x683;
+        let x745 = x743 + x744;
+        let x746 = x671 * x681;
+        let x747 = x672 * x680;
+        let x748 = x674 * x681;
+        let x749 = x678 * x680;
+        let x750 = x734 + (x733 + x735);
+        let x751 = x731 - (x730 + x732);
+        let x752 = x677 * x679;
+        let x753 = x674 * x679;
+        let x754 = x646 * x682;
+        let x755 = x743 - x754;
+        let x756 = x675 * x679;
+        let x757 = x678 * x679;
+        let x758 = x733 + (x734 + x735);
+        let x759 = x728 + (x727 + x729);
+        let x760 = x744 - x754;
+        let x761 = x730 - (x731 - x732);
+        let x762 = x727 + (x728 + x729);
+        let x763 = x734 + (x733 - x735);
+        let x764 = x731 - (x730 - x732);
+        let x765 = x733 + (x734 - x735);
+        let x766 = x728 + (x727 - x729);
+        let x767 = x730 - (x731 + x732);
+        let x768 = x727 + (x728 - x729);
+        let x769 = Self::mul_add(-s_q1, s_q5, c_q5 * x634);
+        let x770 = Self::mul_add(s_q5, x287, c_q5 * x635);
+        let x771 = Self::mul_add(s_q5, x288, c_q5 * x636);
+        let x772 = Self::mul_add(s_q1, c_q5, s_q5 * x634);
+        let x773 = Self::mul_add(-c_q5, x287, s_q5 * x635);
+        let x774 = Self::mul_add(-c_q5, x288, s_q5 * x636);
+        let x775 = 44.41 * x772;
+        let x776 = 47.471 * x637;
+        let x777 = 44.41 * x773;
+        let x778 = 47.471 * x638;
+        let x779 = 44.41 * x774;
+        let x780 = 47.471 * x639;
+        let x781 = Self::mul_add(x637, x776, x772 * x775);
+        let x782 = Self::mul_add(x638, x776, x773 * x775);
+        let x783 = Self::mul_add(x639, x776, x774 * x775);
+        let x784 = Self::mul_add(x637, x778, x772 * x777);
+        let x785 = Self::mul_add(x638, x778, x773 * x777);
+        let x786 = Self::mul_add(x639, x778, x774 * x777);
+        let x787 = Self::mul_add(x637, x780, x772 * x779);
+        let x788 = Self::mul_add(x638, x780, x773 * x779);
+        let x789 = Self::mul_add(x639, x780, x774 * x779);
+        let x790 = Self::mul_add(qd[5], x637, x679);
+        let x791 = Self::mul_add(-qd[5], x638, x680);
+        let x792 = Self::mul_add(qd[5], x639, x681);
+        let x793 = Self::mul_add(x639, x791, x638 * x792);
+        let x794 = Self::mul_add(-x639, x790, x637 * x792);
+        let x795 = Self::mul_add(x638, x790, x637 * x791);
+        let x796 = Self::mul_add(-qd[5], x793, Self::mul_add(x282, x637, x691));
+        let x797 = Self::mul_add(-qd[5], x794, Self::mul_add(-x282, x638, x692));
+        let x798 = Self::mul_add(qd[5], x795, Self::mul_add(x282, x639, x693));
+        let x799 = Self::mul_add(x639, x680, x638 * x681);
+        let x800 = Self::mul_add(-x639, x679, x637 * x681);
+        let x801 = Self::mul_add(x638, x679, x637 * x680);
+        let x802 = Self::mul_add(x639, x692, x638 * x693)
+            + Self::mul_add(x680, x801, x681 * x800);
+        let x803 = Self::mul_add(-x639, x691, x637 * x693)
+            - Self::mul_add(x679, x801, x681 * x799);
+        let x804 = Self::mul_add(x638, x691, x637 * x692)
+            - Self::mul_add(-x679, x800, x680 * x799);
+        let x805 = x793 + x799;
+        let x806 = x794 + x800;
+        let x807 = x795 + x801;
+        let x808 = x782 * x791;
+        let x809 = x783 * x792;
+        let x810 = Self::mul_add(x781, x790, -x808) + x809;
+        let x811 = x784 * x790;
+        let x812 = x786 * x792;
+        let x813 = Self::mul_add(-x785, x791, x811) + x812;
+        let x814 = x787 * x790;
+        let x815 = x788 * x791;
+        let x816 = Self::mul_add(x789, x792, x814 - x815);
+        let x817 = x784 * x792;
+        let x818 = x787 * x791;
+        let x819 = x781 * x792;
+        let x820 = x781 * x791;
+        let x821 = x782 * x792;
+        let x822 = x783 * x791;
+        let x823 = x785 * x792;
+        let x824 = x789 * x791;
+        let x825 = x788 * x790;
+        let x826 = x785 * x790;
+        let x827 = x786 * x790;
+        let x828 = x789 * x790;
+        let x829 = 9.336 * x769;
+        let x830 = 9.336 * x770;
+        let x831 = 9.336 * x771;
+        let x832 = x769 * x829;
+        let x833 = x770 * x829;
+        let x834 = x771 * x829;
+        let x835 = x769 * x830;
+        let x836 = x770 * x830;
+        let x837 = x771 * x830;
+        let x838 = x769 * x831;
+        let x839 = x770 * x831;
+        let x840 = x771 * x831;
+        let x841 = Self::mul_add(qd[6], x769, x790);
+        let x842 = Self::mul_add(-qd[6], x770, x791);
+        let x843 = Self::mul_add(qd[6], x771, x792);
+        let x844 = Self::mul_add(x771, x842, x770 * x843);
+        let x845 = Self::mul_add(-x771, x841, x769 * x843);
+        let x846 = Self::mul_add(x770, x841, x769 * x842);
+        let x847 = Self::mul_add(-qd[6], x844, Self::mul_add(x284, x769, x796));
+        let x848 = Self::mul_add(-qd[6], x845, Self::mul_add(-x284, x770, x797));
+        let x849 = Self::mul_add(qd[6], x846, Self::mul_add(x284, x771, x798));
+        let x850 = Self::mul_add(x771, x791, x770 * x792);
+        let x851 = Self::mul_add(-x771, x790, x769 * x792);
+        let x852 = Self::mul_add(x770, x790, x769 * x791);
+        let x853 = Self::mul_add(x771, x797, x770 * x798)
+            + Self::mul_add(x791, x852, x792 * x851);
+        let x854 = Self::mul_add(-x771, x796, x769 * x798)
+            - Self::mul_add(x790, x852, x792 * x850);
+        let x855 = Self::mul_add(x770, x796, x769 * x797)
+            - Self::mul_add(-x790, x851, x791 * x850);
+        let x856 = x844 + x850;
+        let x857 = x845 + x851;
+        let x858 = x846 + x852;
+        let x859 = x833 * x842;
+        let x860 = x834 * x843;
+        let x861 = Self::mul_add(x832, x841, -x859) + x860;
+        let x862 = x835 * x841;
+        let x863 = x837 * x843;
+        let x864 = Self::mul_add(-x836, x842, x862) + x863;
+        let x865 = x838 * x841;
+        let x866 = x839 * x842;
+        let x867 = Self::mul_add(x840, x843, x865 - x866);
+        let x868 = Self::mul_add(x834, x849, Self::mul_add(-x833, x848, x832 * x847))
+            - Self::mul_add(x842, x867, x843 * x864);
+        let x869 = Self::mul_add(x837, x849, Self::mul_add(-x836, x848, x835 * x847))
+            + Self::mul_add(-x841, x867, x843 * x861);
+        let x870 = Self::mul_add(x840, x849, Self::mul_add(-x839, x848, x838 * x847))
+            + Self::mul_add(x841, x864, x842 * x861);
+        let x871 = x835 * x843;
+        let x872 = x838 * x842;
+        let x873 = x832 * x843;
+        let x874 = x832 * x842;
+        let x875 = x833 * x843;
+        let x876 = x834 * x842;
+        let x877 = x836 * x843;
+        let x878 = x840 * x842;
+        let x879 = x871 + x872 + (x875 + x876);
+        let x880 = x867 + (x865 - x873) + Self::mul_add(x837, x842, x877);
+        let x881 = x864 + (x862 + x874) - Self::mul_add(x839, x843, x878);
+        let x882 = x839 * x841;
+        let x883 = x836 * x841;
+        let x884 = x837 * x841;
+        let x885 = x840 * x841;
+        let x886 = x867 - (x866 + x877) + Self::mul_add(-x834, x841, x873);
+        let x887 = x875 - x882 + (x871 - x884);
+        let x888 = x861 - (x859 + x883) - Self::mul_add(x838, x843, -x885);
+        let x889 = x864 + (x863 + x878) - Self::mul_add(x833, x841, x874);
+        let x890 = x861 + (x860 - x885) + Self::mul_add(x835, x842, x883);
+        let x891 = x876 + x884 + (x872 + x882);
+        let x892 = Self::mul_add(x771, x834, Self::mul_add(x770, x833, x769 * x832));
+        let x893 = Self::mul_add(x771, x837, Self::mul_add(x770, x836, x769 * x835));
+        let x894 = Self::mul_add(x771, x840, Self::mul_add(x770, x839, x769 * x838));
+        let x895 = x769 * x879;
+        let x896 = Self::mul_add(-x771, x881, Self::mul_add(x770, x880, x895));
+        let x897 = x770 * x887;
+        let x898 = Self::mul_add(-x771, x888, Self::mul_add(x769, x886, x897));
+        let x899 = x771 * x891;
+        let x900 = Self::mul_add(-x770, x890, x769 * x889) - x899;
+        let x901 = Self::mul_add(-x770, x870, x771 * x869)
+            + Self::mul_add(-x834, x855, Self::mul_add(-x833, x854, x832 * x853))
+            - Self::mul_add(-x852, x889, Self::mul_add(x851, x886, x850 * x879));
+        let x902 = Self::mul_add(-x769, x870, x771 * x868)
+            - Self::mul_add(-x837, x855, Self::mul_add(-x836, x854, x835 * x853))
+            + Self::mul_add(x852, x890, Self::mul_add(x851, x887, x850 * x880));
+        let x903 = Self::mul_add(-x769, x869, x770 * x868)
+            + Self::mul_add(-x840, x855, Self::mul_add(-x839, x854, x838 * x853))
+            + Self::mul_add(-x852, x891, Self::mul_add(x851, x888, x850 * x881));
+        let x904 = Self::mul_add(-x834, x858, Self::mul_add(-x833, x857, x832 * x856))
+            + Self::mul_add(x771, x889, Self::mul_add(-x770, x886, x895));
+        let x905 = Self::mul_add(-x837, x858, Self::mul_add(-x836, x857, x835 * x856))
+            - Self::mul_add(x771, x890, Self::mul_add(-x769, x880, x897));
+        let x906 = Self::mul_add(-x840, x858, Self::mul_add(-x839, x857, x838 * x856))
+            - (x899 + Self::mul_add(-x770, x888, x769 * x881));
+        let x907 = Self::mul_add(c_q0, x903, s_q0 * x902);
+        let x908 = Self::mul_add(-c_q0, x906, s_q0 * x905);
+        let x909 = Self::mul_add(-x288, x903, Self::mul_add(x287, x902, s_q1 * x901));
+        let x910 = Self::mul_add(-x288, x906, Self::mul_add(-x287, x905, s_q1 * x904));
+        let x911 = Self::mul_add(x639, x903, Self::mul_add(-x638, x902, x637 * x901));
+        let x912 = Self::mul_add(x639, x906, Self::mul_add(x638, x905, x637 * x904));
+        let x913 = Self::mul_add(-x855, x894, Self::mul_add(-x854, x893, x853 * x892))
+            - Self::mul_add(-x852, x900, Self::mul_add(x851, x898, x850 * x896));
+        let x914 = Self::mul_add(-x858, x894, Self::mul_add(-x857, x893, x856 * x892))
+            + Self::mul_add(x771, x900, Self::mul_add(-x770, x898, x769 * x896));
+        let x915 = x781 + x832;
+        let x916 = x782 + x833;
+        let x917 = x783 + x834;
+        let x918 = x784 + x835;
+        let x919 = x785 + x836;
+        let x920 = x786 + x837;
+        let x921 = x787 + x838;
+        let x922 = x788 + x839;
+        let x923 = x789 + x840;
+        let x924 = x817 + x818 + (x821 + x822) + x879;
+        let x925 = x816 - (x815 + x823) + Self::mul_add(-x783, x790, x819) + x886;
+        let x926 = x813 + (x812 + x824) - Self::mul_add(x782, x790, x820) + x889;
+        let x927 = x816 + (x814 - x819) + Self::mul_add(x786, x791, x823) + x880;
+        let x928 = x821 - x825 + (x817 - x827) + x887;
+        let x929 = x810 + (x809 - x828) + Self::mul_add(x784, x791, x826) + x890;
+        let x930 = x813 + (x811 + x820) - Self::mul_add(x788, x792, x824) + x881;
+        let x931 = x810 - (x808 + x826) - Self::mul_add(x787, x792, -x828) + x888;
+        let x932 = x822 + x827 + (x818 + x825) + x891;
+        let x933 = Self::mul_add(x783, x798, Self::mul_add(-x782, x797, x781 * x796))
+            - Self::mul_add(x791, x816, x792 * x813) + x868;
+        let x934 = Self::mul_add(x786, x798, Self::mul_add(-x785, x797, x784 * x796))
+            + Self::mul_add(-x790, x816, x792 * x810) + x869;
+        let x935 = Self::mul_add(x789, x798, Self::mul_add(-x788, x797, x787 * x796))
+            + Self::mul_add(x790, x813, x791 * x810) + x870;
+        let x936 = Self::mul_add(x639, x917, Self::mul_add(x638, x916, x637 * x915));
+        let x937 = Self::mul_add(x639, x920, Self::mul_add(x638, x919, x637 * x918));
+        let x938 = Self::mul_add(x639, x923, Self::mul_add(x638, x922, x637 * x921));
+        let x939 = x637 * x924;
+        let x940 = Self::mul_add(-x639, x930, Self::mul_add(x638, x927, x939));
+        let x941 = x638 * x928;
+        let x942 = Self::mul_add(-x639, x931, Self::mul_add(x637, x925, x941));
+        let x943 = x639 * x932;
+        let x944 = Self::mul_add(-x638, x929, x637 * x926) - x943;
+        let x945 = Self::mul_add(-x638, x935, x639 * x934)
+            + Self::mul_add(-x804, x917, Self::mul_add(-x803, x916, x802 * x915))
+            - Self::mul_add(-x801, x926, Self::mul_add(x800, x925, x799 * x924));
+        let x946 = Self::mul_add(-x637, x935, x639 * x933)
+            - Self::mul_add(-x804, x920, Self::mul_add(-x803, x919, x802 * x918))
+            + Self::mul_add(x801, x929, Self::mul_add(x800, x928, x799 * x927));
+        let x947 = Self::mul_add(-x637, x934, x638 * x933)
+            + Self::mul_add(-x804, x923, Self::mul_add(-x803, x922, x802 * x921))
+            + Self::mul_add(-x801, x932, Self::mul_add(x800, x931, x799 * x930));
+        let x948 = Self::mul_add(-x807, x917, Self::mul_add(-x806, x916, x805 * x915))
+            + Self::mul_add(x639, x926, Self::mul_add(-x638, x925, x939));
+        let x949 = Self::mul_add(-x807, x920, Self::mul_add(-x806, x919, x805 * x918))
+            - Self::mul_add(x639, x929, Self::mul_add(-x637, x927, x941));
+        let x950 = Self::mul_add(-x807, x923, Self::mul_add(-x806, x922, x805 * x921))
+            - (x943 + Self::mul_add(-x638, x931, x637 * x930));
+        let x951 = Self::mul_add(c_q0, x947, s_q0 * x946);
+        let x952 = Self::mul_add(-c_q0, x950, s_q0 * x949);
+        let x953 = Self::mul_add(-x288, x947, Self::mul_add(x287, x946, s_q1 * x945));
+        let x954 = Self::mul_add(-x288, x950, Self::mul_add(-x287, x949, s_q1 * x948));
+        let x955 = Self::mul_add(-x804, x938, Self::mul_add(-x803, x937, x802 * x936))
+            - Self::mul_add(-x801, x944, Self::mul_add(x800, x942, x799 * x940));
+        let x956 = Self::mul_add(-x807, x938, Self::mul_add(-x806, x937, x805 * x936))
+            + Self::mul_add(x639, x944, Self::mul_add(-x638, x942, x637 * x940));
+        let x957 = Self::mul_add(-x804, x894, Self::mul_add(-x803, x893, x802 * x892))
+            - Self::mul_add(-x801, x900, Self::mul_add(x800, x898, x799 * x896));
+        let x958 = Self::mul_add(-x807, x894, Self::mul_add(-x806, x893, x805 * x892))
+            + Self::mul_add(x639, x900, Self::mul_add(-x638, x898, x637 * x896));
+        let x959 = x670 - x915;
+        let x960 = x671 + x916;
+        let x961 = x672 + x917;
+        let x962 = x673 - x918;
+        let x963 = x674 - x919;
+        let x964 = x675 - x920;
+        let x965 = x676 + x921;
+        let x966 = x677 + x922;
+        let x967 = x678 + x923;
+        let x968 = x739 - x740 + x745 + (x745 - (x746 + x747)) - x924;
+        let x969 = x726 - (x723 + (x717 - x748))
+            + (x722 - Self::mul_add(x672, x679, x741)) + x925;
+        let x970 = x725 - (x721 - (x715 - x749))
+            + (x720 - Self::mul_add(-x671, x679, x742)) - x926;
+        let x971 = x726 - (x722 - (x716 + x741))
+            + (x723 - Self::mul_add(x675, x680, x748)) + x927;
+        let x972 = x746 - x752 + x755 + (x755 - (x739 - x756)) + x928;
+        let x973 = x724 + (x719 - (x713 - x757))
+            + (x718 + Self::mul_add(x673, x680, x753)) - x929;
+        let x974 = x725 - (x720 - (x714 + x742))
+            + (x721 + Self::mul_add(x677, x681, x749)) - x930;
+        let x975 = x724 - (x718 - (x712 - x753))
+            - (x719 - Self::mul_add(x676, x681, -x757)) - x931;
+        let x976 = x747 - x756 + x760 + (x760 + (x740 + x752)) + x932;
+        let x977 = Self::mul_add(-x672, x693, Self::mul_add(x671, x692, x670 * x691))
+            + Self::mul_add(-x647, x696, x648 * x695)
+            - (Self::mul_add(-x680, x726, x681 * x725)
+                + Self::mul_add(x683, x735, x684 * x732)) - x933;
+        let x978 = Self::mul_add(x675, x693, Self::mul_add(-x674, x692, x673 * x691))
+            + Self::mul_add(x646, x696, x648 * x694)
+            + (Self::mul_add(x679, x726, x681 * x724)
+                + Self::mul_add(-x682, x735, x684 * x729)) - x934;
+        let x979 = Self::mul_add(x678, x693, Self::mul_add(-x677, x692, x676 * x691))
+            + Self::mul_add(x646, x695, x647 * x694)
+            - (Self::mul_add(x679, x725, x680 * x724)
+                - Self::mul_add(x682, x732, x683 * x729)) + x935;
+        let x980 = Self::mul_add(x288, x961, Self::mul_add(x287, x960, s_q1 * x959))
+            - Self::mul_add(-x645, x647, x644 * x648);
+        let x981 = Self::mul_add(-x288, x964, Self::mul_add(-x287, x963, s_q1 * x962))
+            + Self::mul_add(-x645, x646, x643 * x648);
+        let x982 = Self::mul_add(-x288, x967, Self::mul_add(-x287, x966, s_q1 * x965))
+            + Self::mul_add(-x644, x646, x643 * x647);
+        let x983 = Self::mul_add(-x288, x647, x287 * x648);
+        let x984 = Self::mul_add(x288, x646, s_q1 * x648);
+        let x985 = Self::mul_add(x287, x646, s_q1 * x647);
+        let x986 = s_q1 * x968;
+        let x987 = Self::mul_add(
+            x644,
+            x750,
+            Self::mul_add(x288, x974, Self::mul_add(x287, x971, x986)),
+        );
+        let x988 = Self::mul_add(-x645, x751, x987);
+        let x989 = x287 * x972;
+        let x990 = Self::mul_add(
+            -x643,
+            x758,
+            Self::mul_add(-x288, x975, Self::mul_add(s_q1, x969, -x989)),
+        );
+        let x991 = Self::mul_add(-x645, x759, x990);
+        let x992 = x288 * x976;
+        let x993 = Self::mul_add(
+            x644,
+            x762,
+            Self::mul_add(-x643, x761, Self::mul_add(x287, x973, s_q1 * x970) - x992),
+        );
+        let x994 = Self::mul_add(-x288, x764, x287 * x763);
+        let x995 = Self::mul_add(-x288, x766, s_q1 * x765);
+        let x996 = Self::mul_add(x287, x768, s_q1 * x767);
+        let x997 = Self::mul_add(
+            -x698,
+            x765,
+            Self::mul_add(x564, x970, Self::mul_add(x563, x969, x562 * x968)),
+        );
+        let x998 = Self::mul_add(
+            -x697,
+            x763,
+            Self::mul_add(x564, x973, Self::mul_add(-x563, x972, x562 * x971)),
+        );
+        let x999 = Self::mul_add(
+            x697,
+            x764,
+            Self::mul_add(-x564, x976, Self::mul_add(-x563, x975, x562 * x974)),
+        );
+        let x1000 = Self::mul_add(x287, x979, x288 * x978)
+            + Self::mul_add(x644, x738, x645 * x737)
+            + (Self::mul_add(-x702, x961, Self::mul_add(-x701, x960, x700 * x959))
+                - Self::mul_add(-x647, x705, x648 * x704))
+            - Self::mul_add(x699, x767, x997);
+        let x1001 = Self::mul_add(-s_q1, x979, x288 * x977)
+            + Self::mul_add(x643, x738, x645 * x736)
+            - (Self::mul_add(x702, x964, Self::mul_add(x701, x963, x700 * x962))
+                - Self::mul_add(x646, x705, x648 * x703))
+            - Self::mul_add(x699, x768, x998);
+        let x1002 = Self::mul_add(s_q1, x978, x287 * x977)
+            + Self::mul_add(-x643, x737, x644 * x736)
+            - (Self::mul_add(x702, x967, Self::mul_add(x701, x966, x700 * x965))
+                - Self::mul_add(x646, x704, x647 * x703))
+            + Self::mul_add(x698, x766, x999);
+        let x1003 = Self::mul_add(x287, x738, x288 * x737)
+            - Self::mul_add(-x647, x702, x648 * x701)
+            - Self::mul_add(x564, x761, x563 * x758);
+        let x1004 = Self::mul_add(-s_q1, x738, x288 * x736)
+            - Self::mul_add(-x646, x702, x648 * x700)
+            - Self::mul_add(x564, x762, x562 * x750);
+        let x1005 = Self::mul_add(s_q1, x737, x287 * x736)
+            - Self::mul_add(-x646, x701, x647 * x700)
+            - Self::mul_add(x563, x759, x562 * x751);
+        let x1006 = Self::mul_add(
+            x644,
+            x765,
+            Self::mul_add(-x288, x970, Self::mul_add(-x287, x969, x986)),
+        );
+        let x1007 = Self::mul_add(
+            x643,
+            x763,
+            Self::mul_add(-x288, x973, Self::mul_add(s_q1, x971, x989)),
+        );
+        let x1008 = Self::mul_add(
+            -x644,
+            x766,
+            Self::mul_add(-x643, x764, x992 + Self::mul_add(x287, x975, s_q1 * x974)),
+        );
+        let x1009 = Self::mul_add(-x708, x961, Self::mul_add(-x707, x960, x706 * x959))
+            - Self::mul_add(-x647, x711, x648 * x710) - Self::mul_add(x645, x767, x1006);
+        let x1010 = Self::mul_add(x708, x964, Self::mul_add(x707, x963, x706 * x962))
+            - Self::mul_add(x646, x711, x648 * x709) + Self::mul_add(x645, x768, x1007);
+        let x1011 = Self::mul_add(x708, x967, Self::mul_add(x707, x966, x706 * x965))
+            - Self::mul_add(x646, x710, x647 * x709) - x1008;
+        let x1012 = Self::mul_add(-x647, x708, x648 * x707)
+            - Self::mul_add(x288, x761, x287 * x758);
+        let x1013 = Self::mul_add(-x646, x708, x648 * x706)
+            + Self::mul_add(-x288, x762, s_q1 * x750);
+        let x1014 = Self::mul_add(-x646, x707, x647 * x706)
+            + Self::mul_add(-x287, x759, s_q1 * x751);
+        let x1015 = Self::mul_add(c_q0, x1002, s_q0 * x1001)
+            - Self::mul_add(-x293, x1005, Self::mul_add(x292, x1004, x291 * x1003));
+        let x1016 = Self::mul_add(c_q0, x1011, s_q0 * x1010)
+            - Self::mul_add(-x293, x1014, Self::mul_add(x292, x1013, x291 * x1012));
+        let x1017 = Self::mul_add(
+            -x288,
+            x1002,
+            Self::mul_add(x287, x1001, s_q1 * x1000),
+        );
+        let x1018 = x1017
+            - Self::mul_add(x402, x1005, Self::mul_add(-x401, x1004, x400 * x1003));
+        let x1019 = Self::mul_add(
+            x288,
+            x1011,
+            Self::mul_add(-x287, x1010, s_q1 * x1009),
+        );
+        let x1020 = x1019
+            + Self::mul_add(x402, x1014, Self::mul_add(-x401, x1013, x400 * x1012));
+        let x1021 = x1017
+            - Self::mul_add(x525, x1005, Self::mul_add(-x524, x1004, x523 * x1003));
+        let x1022 = x1019
+            + Self::mul_add(x525, x1014, Self::mul_add(-x524, x1013, x523 * x1012));
+        let x1023 = Self::mul_add(-x702, x982, Self::mul_add(x701, x981, x700 * x980))
+            + Self::mul_add(x705, x985, Self::mul_add(-x704, x984, x703 * x983))
+            - (Self::mul_add(x564, x993, Self::mul_add(x563, x991, x562 * x988))
+                - Self::mul_add(-x699, x996, Self::mul_add(x698, x995, x697 * x994)));
+        let x1024 = Self::mul_add(-x288, x993, Self::mul_add(-x287, x991, s_q1 * x988));
+        let x1025 = Self::mul_add(-x708, x982, Self::mul_add(x707, x981, x706 * x980))
+            + Self::mul_add(x711, x985, Self::mul_add(-x710, x984, x709 * x983))
+            - (x1024
+                + Self::mul_add(x645, x996, Self::mul_add(x644, x995, x643 * x994)));
+        let x1026 = Self::mul_add(x702, x938, Self::mul_add(x701, x937, x700 * x936))
+            - Self::mul_add(x564, x944, Self::mul_add(-x563, x942, x562 * x940));
+        let x1027 = Self::mul_add(-x288, x944, Self::mul_add(x287, x942, s_q1 * x940));
+        let x1028 = Self::mul_add(x708, x938, Self::mul_add(x707, x937, x706 * x936))
+            - x1027;
+        let x1029 = Self::mul_add(x702, x894, Self::mul_add(x701, x893, x700 * x892))
+            - Self::mul_add(x564, x900, Self::mul_add(-x563, x898, x562 * x896));
+        let x1030 = Self::mul_add(-x288, x900, Self::mul_add(x287, x898, s_q1 * x896));
+        let x1031 = Self::mul_add(x708, x894, Self::mul_add(x707, x893, x706 * x892))
+            - x1030;
+        let x1032 = x526 - x646;
+        let x1033 = x527 - x647;
+        let x1034 = x528 - x648;
+        let x1035 = x547 - x959;
+        let x1036 = x548 - x960;
+        let x1037 = x549 - x961;
+        let x1038 = x550 - x962;
+        let x1039 = x551 - x963;
+        let x1040 = x552 - x964;
+        let x1041 = x553 - x965;
+        let x1042 = x554 - x966;
+        let x1043 = x555 - x967;
+        let x1044 = x616 - x617 + x622 + (x622 - (x623 + x624)) - x968;
+        let x1045 = x606 - (x603 + (x597 - x625))
+            + (x602 - Self::mul_add(x549, x556, x618)) - x969;
+        let x1046 = x605 - (x601 - (x595 - x626))
+            + (x600 - Self::mul_add(-x548, x556, x619)) - x970;
+        let x1047 = x613 + (x614 - x615) - x765;
+        let x1048 = x610 - (x611 + x612) - x767;
+        let x1049 = x606 - (x602 - (x596 + x618))
+            + (x603 - Self::mul_add(x552, x557, x625)) - x971;
+        let x1050 = x623 - x627 + x630 + (x630 - (x616 - x631)) - x972;
+        let x1051 = x604 + (x599 - (x593 - x632))
+            + (x598 + Self::mul_add(x550, x557, x628)) - x973;
+        let x1052 = x614 + (x613 - x615) - x763;
+        let x1053 = x607 + (x608 - x609) - x768;
+        let x1054 = x605 - (x600 - (x594 + x619))
+            + (x601 + Self::mul_add(x554, x558, x626)) - x974;
+        let x1055 = x604 - (x598 - (x592 - x628))
+            - (x599 - Self::mul_add(x553, x558, -x632)) - x975;
+        let x1056 = x624 - x631 + x633 + (x633 + (x617 + x627)) - x976;
+        let x1057 = x611 - (x610 - x612) - x764;
+        let x1058 = x608 + (x607 - x609) - x766;
+        let x1059 = x613 + (x614 + x615) - x758;
+        let x1060 = x610 - (x611 - x612) - x761;
+        let x1061 = x614 + (x613 + x615) - x750;
+        let x1062 = x607 + (x608 + x609) - x762;
+        let x1063 = x611 - (x610 + x612) - x751;
+        let x1064 = x608 + (x607 + x609) - x759;
+        let x1065 = Self::mul_add(-x549, x573, Self::mul_add(x548, x572, x547 * x571))
+            + Self::mul_add(-x527, x576, x528 * x575)
+            - (Self::mul_add(-x557, x606, x558 * x605)
+                + Self::mul_add(x560, x615, x561 * x612)) - x977;
+        let x1066 = Self::mul_add(x552, x573, Self::mul_add(-x551, x572, x550 * x571))
+            + Self::mul_add(x526, x576, x528 * x574)
+            + (Self::mul_add(x556, x606, x558 * x604)
+                + Self::mul_add(-x559, x615, x561 * x609)) - x978;
+        let x1067 = Self::mul_add(x555, x573, Self::mul_add(-x554, x572, x553 * x571))
+            + Self::mul_add(x526, x575, x527 * x574)
+            - (Self::mul_add(x556, x605, x557 * x604)
+                - Self::mul_add(x559, x612, x560 * x609)) - x979;
+        let x1068 = Self::mul_add(x527, x573, x528 * x572)
+            - Self::mul_add(-x557, x615, x558 * x612) - x736;
+        let x1069 = Self::mul_add(-x526, x573, x528 * x571)
+            + Self::mul_add(x556, x615, x558 * x609) - x737;
+        let x1070 = Self::mul_add(x526, x572, x527 * x571)
+            - Self::mul_add(x556, x612, x557 * x609) - x738;
+        let x1071 = Self::mul_add(x288, x1037, Self::mul_add(x287, x1036, s_q1 * x1035))
+            - Self::mul_add(-x525, x1033, x524 * x1034);
+        let x1072 = Self::mul_add(
+            -x288,
+            x1040,
+            Self::mul_add(-x287, x1039, s_q1 * x1038),
+        ) + Self::mul_add(-x525, x1032, x523 * x1034);
+        let x1073 = Self::mul_add(
+            -x288,
+            x1043,
+            Self::mul_add(-x287, x1042, s_q1 * x1041),
+        ) + Self::mul_add(-x524, x1032, x523 * x1033);
+        let x1074 = Self::mul_add(-x288, x1033, x287 * x1034);
+        let x1075 = Self::mul_add(x288, x1032, s_q1 * x1034);
+        let x1076 = Self::mul_add(x287, x1032, s_q1 * x1033);
+        let x1077 = s_q1 * x1044;
+        let x1078 = Self::mul_add(
+            x524,
+            x1061,
+            Self::mul_add(x288, x1054, Self::mul_add(x287, x1049, x1077)),
+        );
+        let x1079 = Self::mul_add(-x525, x1063, x1078);
+        let x1080 = x287 * x1050;
+        let x1081 = Self::mul_add(
+            -x523,
+            x1059,
+            Self::mul_add(-x288, x1055, Self::mul_add(s_q1, x1045, -x1080)),
+        );
+        let x1082 = Self::mul_add(-x525, x1064, x1081);
+        let x1083 = x288 * x1056;
+        let x1084 = Self::mul_add(
+            x524,
+            x1062,
+            Self::mul_add(-x523, x1060, Self::mul_add(x287, x1051, s_q1 * x1046) - x1083),
+        );
+        let x1085 = Self::mul_add(-x288, x1057, x287 * x1052);
+        let x1086 = Self::mul_add(-x288, x1058, s_q1 * x1047);
+        let x1087 = Self::mul_add(x287, x1053, s_q1 * x1048);
+        let x1088 = Self::mul_add(
+            -x578,
+            x1047,
+            Self::mul_add(x441, x1046, Self::mul_add(x440, x1045, x439 * x1044)),
+        );
+        let x1089 = Self::mul_add(
+            -x577,
+            x1052,
+            Self::mul_add(x441, x1051, Self::mul_add(-x440, x1050, x439 * x1049)),
+        );
+        let x1090 = Self::mul_add(
+            x577,
+            x1057,
+            Self::mul_add(-x441, x1056, Self::mul_add(-x440, x1055, x439 * x1054)),
+        );
+        let x1091 = Self::mul_add(x287, x1067, x288 * x1066)
+            + Self::mul_add(x524, x1070, x525 * x1069)
+            + (Self::mul_add(-x582, x1037, Self::mul_add(-x581, x1036, x580 * x1035))
+                - Self::mul_add(-x585, x1033, x584 * x1034))
+            - Self::mul_add(x579, x1048, x1088);
+        let x1092 = Self::mul_add(-s_q1, x1067, x288 * x1065)
+            + Self::mul_add(x523, x1070, x525 * x1068)
+            - (Self::mul_add(x582, x1040, Self::mul_add(x581, x1039, x580 * x1038))
+                - Self::mul_add(x585, x1032, x583 * x1034))
+            - Self::mul_add(x579, x1053, x1089);
+        let x1093 = Self::mul_add(s_q1, x1066, x287 * x1065)
+            + Self::mul_add(-x523, x1069, x524 * x1068)
+            - (Self::mul_add(x582, x1043, Self::mul_add(x581, x1042, x580 * x1041))
+                - Self::mul_add(x584, x1032, x583 * x1033))
+            + Self::mul_add(x578, x1058, x1090);
+        let x1094 = Self::mul_add(x287, x1070, x288 * x1069)
+            - Self::mul_add(-x582, x1033, x581 * x1034)
+            - Self::mul_add(x441, x1060, x440 * x1059);
+        let x1095 = Self::mul_add(-s_q1, x1070, x288 * x1068)
+            - Self::mul_add(-x582, x1032, x580 * x1034)
+            - Self::mul_add(x441, x1062, x439 * x1061);
+        let x1096 = Self::mul_add(s_q1, x1069, x287 * x1068)
+            - Self::mul_add(-x581, x1032, x580 * x1033)
+            - Self::mul_add(x440, x1064, x439 * x1063);
+        let x1097 = Self::mul_add(
+            x524,
+            x1047,
+            Self::mul_add(-x288, x1046, Self::mul_add(-x287, x1045, x1077)),
+        );
+        let x1098 = Self::mul_add(
+            x523,
+            x1052,
+            Self::mul_add(-x288, x1051, Self::mul_add(s_q1, x1049, x1080)),
+        );
+        let x1099 = Self::mul_add(
+            -x524,
+            x1058,
+            Self::mul_add(-x523, x1057, x1083 + Self::mul_add(x287, x1055, s_q1 * x1054)),
+        );
+        let x1100 = Self::mul_add(
+            -x588,
+            x1037,
+            Self::mul_add(-x587, x1036, x586 * x1035),
+        ) - Self::mul_add(-x591, x1033, x590 * x1034)
+            - Self::mul_add(x525, x1048, x1097);
+        let x1101 = Self::mul_add(x588, x1040, Self::mul_add(x587, x1039, x586 * x1038))
+            - Self::mul_add(x591, x1032, x589 * x1034)
+            + Self::mul_add(x525, x1053, x1098);
+        let x1102 = Self::mul_add(x588, x1043, Self::mul_add(x587, x1042, x586 * x1041))
+            - Self::mul_add(x590, x1032, x589 * x1033) - x1099;
+        let x1103 = Self::mul_add(-x588, x1033, x587 * x1034)
+            - Self::mul_add(x288, x1060, x287 * x1059);
+        let x1104 = Self::mul_add(-x588, x1032, x586 * x1034)
+            + Self::mul_add(-x288, x1062, s_q1 * x1061);
+        let x1105 = Self::mul_add(-x587, x1032, x586 * x1033)
+            + Self::mul_add(-x287, x1064, s_q1 * x1063);
+        let x1106 = Self::mul_add(c_q0, x1093, s_q0 * x1092)
+            - Self::mul_add(-x293, x1096, Self::mul_add(x292, x1095, x291 * x1094));
+        let x1107 = Self::mul_add(c_q0, x1102, s_q0 * x1101)
+            - Self::mul_add(-x293, x1105, Self::mul_add(x292, x1104, x291 * x1103));
+        let x1108 = Self::mul_add(-x288, x1093, Self::mul_add(x287, x1092, s_q1 * x1091))
+            - Self::mul_add(x402, x1096, Self::mul_add(-x401, x1095, x400 * x1094));
+        let x1109 = Self::mul_add(x288, x1102, Self::mul_add(-x287, x1101, s_q1 * x1100))
+            + Self::mul_add(x402, x1105, Self::mul_add(-x401, x1104, x400 * x1103));
+        let x1110 = Self::mul_add(-x582, x1073, Self::mul_add(x581, x1072, x580 * x1071))
+            + Self::mul_add(x585, x1076, Self::mul_add(-x584, x1075, x583 * x1074))
+            - (Self::mul_add(x441, x1084, Self::mul_add(x440, x1082, x439 * x1079))
+                - Self::mul_add(-x579, x1087, Self::mul_add(x578, x1086, x577 * x1085)));
+        let x1111 = Self::mul_add(
+            -x288,
+            x1084,
+            Self::mul_add(-x287, x1082, s_q1 * x1079),
+        );
+        let x1112 = Self::mul_add(-x588, x1073, Self::mul_add(x587, x1072, x586 * x1071))
+            + Self::mul_add(x591, x1076, Self::mul_add(-x590, x1075, x589 * x1074))
+            - (x1111
+                + Self::mul_add(x525, x1087, Self::mul_add(x524, x1086, x523 * x1085)));
+        let x1113 = Self::mul_add(-x582, x982, Self::mul_add(x581, x981, x580 * x980))
+            + Self::mul_add(x585, x985, Self::mul_add(-x584, x984, x583 * x983))
+            - (Self::mul_add(x441, x993, Self::mul_add(x440, x991, x439 * x988))
+                - Self::mul_add(-x579, x996, Self::mul_add(x578, x995, x577 * x994)));
+        let x1114 = Self::mul_add(-x588, x982, Self::mul_add(x587, x981, x586 * x980))
+            + Self::mul_add(x591, x985, Self::mul_add(-x590, x984, x589 * x983))
+            - (x1024
+                + Self::mul_add(x525, x996, Self::mul_add(x524, x995, x523 * x994)));
+        let x1115 = Self::mul_add(x582, x938, Self::mul_add(x581, x937, x580 * x936))
+            - Self::mul_add(x441, x944, Self::mul_add(-x440, x942, x439 * x940));
+        let x1116 = x1027
+            - Self::mul_add(x588, x938, Self::mul_add(x587, x937, x586 * x936));
+        let x1117 = Self::mul_add(x582, x894, Self::mul_add(x581, x893, x580 * x892))
+            - Self::mul_add(x441, x900, Self::mul_add(-x440, x898, x439 * x896));
+        let x1118 = x1030
+            - Self::mul_add(x588, x894, Self::mul_add(x587, x893, x586 * x892));
+        let x1119 = x403 + x1032;
+        let x1120 = x404 + x1033;
+        let x1121 = x405 + x1034;
+        let x1122 = x424 + x1035;
+        let x1123 = x425 + x1036;
+        let x1124 = x426 + x1037;
+        let x1125 = x427 + x1038;
+        let x1126 = x428 + x1039;
+        let x1127 = x429 + x1040;
+        let x1128 = x430 + x1041;
+        let x1129 = x431 + x1042;
+        let x1130 = x432 + x1043;
+        let x1131 = x496 - x497 + x502 + (x502 - (x503 + x504)) + x1044;
+        let x1132 = x486 - (x483 + (x477 - x505))
+            + (x482 - Self::mul_add(x426, x433, x498)) + x1045;
+        let x1133 = x485 - (x481 - (x475 - x506))
+            + (x480 - Self::mul_add(-x425, x433, x499)) + x1046;
+        let x1134 = x493 + (x494 - x495) + x1047;
+        let x1135 = x490 - (x491 + x492) + x1048;
+        let x1136 = x486 - (x482 - (x476 + x498))
+            + (x483 - Self::mul_add(x429, x434, x505)) + x1049;
+        let x1137 = x503 - x507 + x510 + (x510 - (x496 - x511)) + x1050;
+        let x1138 = x484 + (x479 - (x473 - x512))
+            + (x478 + Self::mul_add(x427, x434, x508)) + x1051;
+        let x1139 = x494 + (x493 - x495) + x1052;
+        let x1140 = x487 + (x488 - x489) + x1053;
+        let x1141 = x485 - (x480 - (x474 + x499))
+            + (x481 + Self::mul_add(x431, x435, x506)) + x1054;
+        let x1142 = x484 - (x478 - (x472 - x508))
+            - (x479 - Self::mul_add(x430, x435, -x512)) + x1055;
+        let x1143 = x504 - x511 + x513 + (x513 + (x497 + x507)) + x1056;
+        let x1144 = x491 - (x490 - x492) + x1057;
+        let x1145 = x488 + (x487 - x489) + x1058;
+        let x1146 = x493 + (x494 + x495) + x1059;
+        let x1147 = x490 - (x491 - x492) + x1060;
+        let x1148 = x494 + (x493 + x495) + x1061;
+        let x1149 = x487 + (x488 + x489) + x1062;
+        let x1150 = x491 - (x490 + x492) + x1063;
+        let x1151 = x488 + (x487 + x489) + x1064;
+        let x1152 = Self::mul_add(-x426, x450, Self::mul_add(x425, x449, x424 * x448))
+            + Self::mul_add(-x404, x453, x405 * x452)
+            - (Self::mul_add(-x434, x486, x435 * x485)
+                + Self::mul_add(x437, x495, x438 * x492)) + x1065;
+        let x1153 = Self::mul_add(x429, x450, Self::mul_add(-x428, x449, x427 * x448))
+            + Self::mul_add(x403, x453, x405 * x451)
+            + (Self::mul_add(x433, x486, x435 * x484)
+                + Self::mul_add(-x436, x495, x438 * x489)) + x1066;
+        let x1154 = Self::mul_add(x432, x450, Self::mul_add(-x431, x449, x430 * x448))
+            + Self::mul_add(x403, x452, x404 * x451)
+            - (Self::mul_add(x433, x485, x434 * x484)
+                - Self::mul_add(x436, x492, x437 * x489)) + x1067;
+        let x1155 = Self::mul_add(x404, x450, x405 * x449)
+            - Self::mul_add(-x434, x495, x435 * x492) + x1068;
+        let x1156 = Self::mul_add(-x403, x450, x405 * x448)
+            + Self::mul_add(x433, x495, x435 * x489) + x1069;
+        let x1157 = Self::mul_add(x403, x449, x404 * x448)
+            - Self::mul_add(x433, x492, x434 * x489) + x1070;
+        let x1158 = Self::mul_add(x288, x1124, Self::mul_add(x287, x1123, s_q1 * x1122))
+            - Self::mul_add(-x402, x1120, x401 * x1121);
+        let x1159 = Self::mul_add(
+            -x288,
+            x1127,
+            Self::mul_add(-x287, x1126, s_q1 * x1125),
+        ) + Self::mul_add(-x402, x1119, x400 * x1121);
+        let x1160 = Self::mul_add(
+            -x288,
+            x1130,
+            Self::mul_add(-x287, x1129, s_q1 * x1128),
+        ) + Self::mul_add(-x401, x1119, x400 * x1120);
+        let x1161 = Self::mul_add(-x288, x1120, x287 * x1121);
+        let x1162 = Self::mul_add(x288, x1119, s_q1 * x1121);
+        let x1163 = Self::mul_add(x287, x1119, s_q1 * x1120);
+        let x1164 = s_q1 * x1131;
+        let x1165 = Self::mul_add(
+            x401,
+            x1148,
+            Self::mul_add(x288, x1141, Self::mul_add(x287, x1136, x1164)),
+        );
+        let x1166 = Self::mul_add(-x402, x1150, x1165);
+        let x1167 = x287 * x1137;
+        let x1168 = Self::mul_add(
+            -x400,
+            x1146,
+            Self::mul_add(-x288, x1142, Self::mul_add(s_q1, x1132, -x1167)),
+        );
+        let x1169 = Self::mul_add(-x402, x1151, x1168);
+        let x1170 = x288 * x1143;
+        let x1171 = Self::mul_add(
+            x401,
+            x1149,
+            Self::mul_add(-x400, x1147, Self::mul_add(x287, x1138, s_q1 * x1133) - x1170),
+        );
+        let x1172 = Self::mul_add(-x288, x1144, x287 * x1139);
+        let x1173 = Self::mul_add(-x288, x1145, s_q1 * x1134);
+        let x1174 = Self::mul_add(x287, x1140, s_q1 * x1135);
+        let x1175 = Self::mul_add(
+            x458,
+            x1134,
+            Self::mul_add(x456, x1133, Self::mul_add(x455, x1132, x454 * x1131)),
+        );
+        let x1176 = Self::mul_add(
+            -x457,
+            x1139,
+            Self::mul_add(x456, x1138, Self::mul_add(-x455, x1137, x454 * x1136)),
+        );
+        let x1177 = Self::mul_add(
+            x457,
+            x1144,
+            Self::mul_add(-x456, x1143, Self::mul_add(-x455, x1142, x454 * x1141)),
+        );
+        let x1178 = Self::mul_add(x287, x1154, x288 * x1153)
+            + Self::mul_add(x401, x1157, x402 * x1156)
+            + (Self::mul_add(-x462, x1124, Self::mul_add(-x461, x1123, x460 * x1122))
+                - Self::mul_add(-x465, x1120, x464 * x1121))
+            - Self::mul_add(x459, x1135, x1175);
+        let x1179 = Self::mul_add(
+            x401,
+            x1134,
+            Self::mul_add(-x288, x1133, Self::mul_add(-x287, x1132, x1164)),
+        );
+        let x1180 = Self::mul_add(
+            x400,
+            x1139,
+            Self::mul_add(-x288, x1138, Self::mul_add(s_q1, x1136, x1167)),
+        );
+        let x1181 = Self::mul_add(
+            -x401,
+            x1145,
+            Self::mul_add(-x400, x1144, x1170 + Self::mul_add(x287, x1142, s_q1 * x1141)),
+        );
+        let x1182 = Self::mul_add(
+            -x468,
+            x1124,
+            Self::mul_add(-x467, x1123, x466 * x1122),
+        ) - Self::mul_add(-x471, x1120, x470 * x1121)
+            - Self::mul_add(x402, x1135, x1179);
+        let x1183 = Self::mul_add(
+            c_q0,
+            Self::mul_add(s_q1, x1153, x287 * x1152)
+                + Self::mul_add(-x400, x1156, x401 * x1155)
+                - (Self::mul_add(x462, x1130, Self::mul_add(x461, x1129, x460 * x1128))
+                    - Self::mul_add(x464, x1119, x463 * x1120))
+                + Self::mul_add(-x458, x1145, x1177),
+            s_q0
+                * (Self::mul_add(-s_q1, x1154, x288 * x1152)
+                    + Self::mul_add(x400, x1157, x402 * x1155)
+                    - (Self::mul_add(
+                        x462,
+                        x1127,
+                        Self::mul_add(x461, x1126, x460 * x1125),
+                    ) - Self::mul_add(x465, x1119, x463 * x1121))
+                    - Self::mul_add(x459, x1140, x1176)),
+        );
+        let x1184 = Self::mul_add(
+            -x293,
+            Self::mul_add(s_q1, x1156, x287 * x1155)
+                - Self::mul_add(-x461, x1119, x460 * x1120)
+                - Self::mul_add(x455, x1151, x454 * x1150),
+            Self::mul_add(
+                x292,
+                Self::mul_add(-s_q1, x1157, x288 * x1155)
+                    - Self::mul_add(-x462, x1119, x460 * x1121)
+                    - Self::mul_add(x456, x1149, x454 * x1148),
+                x291
+                    * (Self::mul_add(x287, x1157, x288 * x1156)
+                        - Self::mul_add(-x462, x1120, x461 * x1121)
+                        - Self::mul_add(x456, x1147, x455 * x1146)),
+            ),
+        );
+        let x1185 = x1183 - x1184;
+        let x1186 = Self::mul_add(
+            c_q0,
+            Self::mul_add(x468, x1130, Self::mul_add(x467, x1129, x466 * x1128))
+                - Self::mul_add(x470, x1119, x469 * x1120) - x1181,
+            s_q0
+                * (Self::mul_add(x468, x1127, Self::mul_add(x467, x1126, x466 * x1125))
+                    - Self::mul_add(x471, x1119, x469 * x1121)
+                    + Self::mul_add(x402, x1140, x1180)),
+        );
+        let x1187 = Self::mul_add(
+            -x293,
+            Self::mul_add(-x467, x1119, x466 * x1120)
+                + Self::mul_add(-x287, x1151, s_q1 * x1150),
+            Self::mul_add(
+                x292,
+                Self::mul_add(-x468, x1119, x466 * x1121)
+                    + Self::mul_add(-x288, x1149, s_q1 * x1148),
+                x291
+                    * (Self::mul_add(-x468, x1120, x467 * x1121)
+                        - Self::mul_add(x288, x1147, x287 * x1146)),
+            ),
+        );
+        let x1188 = x1186 - x1187;
+        let x1189 = Self::mul_add(-x462, x1160, Self::mul_add(x461, x1159, x460 * x1158))
+            + Self::mul_add(x465, x1163, Self::mul_add(-x464, x1162, x463 * x1161))
+            - (Self::mul_add(x456, x1171, Self::mul_add(x455, x1169, x454 * x1166))
+                - Self::mul_add(
+                    -x459,
+                    x1174,
+                    Self::mul_add(-x458, x1173, x457 * x1172),
+                ));
+        let x1190 = Self::mul_add(-x468, x1160, Self::mul_add(x467, x1159, x466 * x1158))
+            + Self::mul_add(x471, x1163, Self::mul_add(-x470, x1162, x469 * x1161))
+            - (Self::mul_add(-x288, x1171, Self::mul_add(-x287, x1169, s_q1 * x1166))
+                + Self::mul_add(x402, x1174, Self::mul_add(x401, x1173, x400 * x1172)));
+        let x1191 = Self::mul_add(-x462, x1073, Self::mul_add(x461, x1072, x460 * x1071))
+            + Self::mul_add(x465, x1076, Self::mul_add(-x464, x1075, x463 * x1074))
+            - (Self::mul_add(x456, x1084, Self::mul_add(x455, x1082, x454 * x1079))
+                - Self::mul_add(
+                    -x459,
+                    x1087,
+                    Self::mul_add(-x458, x1086, x457 * x1085),
+                ));
+        let x1192 = Self::mul_add(-x468, x1073, Self::mul_add(x467, x1072, x466 * x1071))
+            + Self::mul_add(x471, x1076, Self::mul_add(-x470, x1075, x469 * x1074))
+            - (x1111
+                + Self::mul_add(x402, x1087, Self::mul_add(x401, x1086, x400 * x1085)));
+        let x1193 = Self::mul_add(-x462, x982, Self::mul_add(x461, x981, x460 * x980))
+            + Self::mul_add(x465, x985, Self::mul_add(-x464, x984, x463 * x983))
+            - (Self::mul_add(x456, x993, Self::mul_add(x455, x991, x454 * x988))
+                - Self::mul_add(-x459, x996, Self::mul_add(-x458, x995, x457 * x994)));
+        let x1194 = Self::mul_add(-x468, x982, Self::mul_add(x467, x981, x466 * x980))
+            + Self::mul_add(x471, x985, Self::mul_add(-x470, x984, x469 * x983))
+            - (x1024
+                + Self::mul_add(x402, x996, Self::mul_add(x401, x995, x400 * x994)));
+        let x1195 = Self::mul_add(x462, x938, Self::mul_add(x461, x937, x460 * x936))
+            - Self::mul_add(x456, x944, Self::mul_add(-x455, x942, x454 * x940));
+        let x1196 = x1027
+            - Self::mul_add(x468, x938, Self::mul_add(x467, x937, x466 * x936));
+        let x1197 = Self::mul_add(x462, x894, Self::mul_add(x461, x893, x460 * x892))
+            - Self::mul_add(x456, x900, Self::mul_add(-x455, x898, x454 * x896));
+        let x1198 = x1030
+            - Self::mul_add(x468, x894, Self::mul_add(x467, x893, x466 * x892));
+        let x1199 = x294 + x1119;
+        let x1200 = x295 - x1120;
+        let x1201 = x296 - x1121;
+        let x1202 = x314 - x1123;
+        let x1203 = x315 - x1124;
+        let x1204 = x373 - x374 - x379 - (x379 - (x380 + x381)) + x1131;
+        let x1205 = x363 - (x360 - (x354 - x382))
+            - (x359 - Self::mul_add(qd[0], x315, x375)) + x1132;
+        let x1206 = x362 - (x358 + (x352 - x383))
+            - (x357 - Self::mul_add(-qd[0], x314, x376)) + x1133;
+        let x1207 = x370 - (x371 + x372) - x1134;
+        let x1208 = x367 + (x368 - x369) - x1135;
+        let x1209 = Self::mul_add(-c_q0, x318 - x1127, s_q0 * (x317 - x1126))
+            - Self::mul_add(-x293, x1199, x291 * x1201);
+        let x1210 = Self::mul_add(-c_q0, x321 - x1130, s_q0 * (x320 - x1129))
+            - Self::mul_add(-x292, x1199, x291 * x1200);
+        let x1211 = c_q0 * x1199;
+        let x1212 = s_q0 * x1199;
+        let x1213 = Self::mul_add(
+            -x292,
+            x371 - (x370 + x372) + x1148,
+            Self::mul_add(
+                -c_q0,
+                x362 + (x357 + (x351 - x376)) + (x358 - Self::mul_add(x320, x323, x383))
+                    + x1141,
+                s_q0
+                    * (x363 + (x359 + (x353 - x375))
+                        + (x360 + Self::mul_add(x318, x322, x382)) + x1136),
+            ),
+        );
+        let x1214 = Self::mul_add(x293, x368 + (x367 + x369) + x1150, x1213);
+        let x1215 = Self::mul_add(
+            x291,
+            x370 - (x371 - x372) - x1146,
+            Self::mul_add(
+                -c_q0,
+                x361 - (x355 - (x349 - x385)) - (x356 + Self::mul_add(x319, x323, x389))
+                    - x1142,
+                s_q0 * (x380 - x384 + x387 + (x387 + (x373 + x388)) - x1137),
+            ),
+        );
+        let x1216 = Self::mul_add(-x293, x365 + (x364 + x366) - x1151, x1215);
+        let x1217 = Self::mul_add(
+            -x291,
+            x367 + (x368 + x369) - x1147,
+            Self::mul_add(
+                c_q0,
+                x381 - x388 + x390 + (x390 - (x374 - x384)) - x1143,
+                s_q0
+                    * (x361 + (x356 - (x350 - x389))
+                        + (x355 + Self::mul_add(-x316, x322, x385)) - x1138),
+            ),
+        );
+        let x1218 = Self::mul_add(-x292, x364 + (x365 + x366) - x1149, x1217);
+        let x1219 = c_q0 * (x365 + (x364 - x366) - x1145);
+        let x1220 = s_q0 * (x364 + (x365 - x366) - x1140);
+        let x1221 = Self::mul_add(
+            -s_q0,
+            Self::mul_add(-x321, x337, Self::mul_add(x320, x336, x319 * x335))
+                - Self::mul_add(-x294, x339, x295 * x338)
+                + (Self::mul_add(-qd[0], x362, x322 * x361)
+                    - Self::mul_add(x324, x369, x325 * x366)) + x1154,
+            c_q0
+                * (Self::mul_add(-x318, x337, Self::mul_add(x317, x336, x316 * x335))
+                    - Self::mul_add(-x294, x340, x296 * x338)
+                    - (Self::mul_add(-qd[0], x363, x323 * x361)
+                        + Self::mul_add(-x324, x372, x326 * x366)) + x1153),
+        );
+        let x1222 = Self::mul_add(
+            -x331,
+            x1208,
+            Self::mul_add(x330, x1207, Self::mul_add(x329, x1206, x328 * x1205)),
+        );
+        let x1223 = x1221
+            - Self::mul_add(
+                x292,
+                Self::mul_add(-x294, x336, x295 * x335)
+                    - Self::mul_add(qd[0], x369, x322 * x366) - x1157,
+                x293
+                    * (Self::mul_add(x294, x337, x296 * x335)
+                        + Self::mul_add(qd[0], x372, x323 * x366) - x1156),
+            )
+            + (Self::mul_add(x342, x1203, x341 * x1202)
+                - Self::mul_add(x344, x1200, x343 * x1201)) - x1222;
+        let x1224 = Self::mul_add(
+            -x293,
+            x1208,
+            Self::mul_add(-x292, x1207, Self::mul_add(-c_q0, x1206, s_q0 * x1205)),
+        );
+        let x1225 = Self::mul_add(
+            x346,
+            x1203,
+            Self::mul_add(x345, x1202, x327 * (x313 - x1122)),
+        ) - Self::mul_add(x348, x1200, x347 * x1201) - x1224;
+        let x1226 = Self::mul_add(-x342, x1210, x341 * x1209)
+            - Self::mul_add(-x344, x1212, x343 * x1211)
+            - (Self::mul_add(-x329, x1218, x328 * x1216)
+                + Self::mul_add(-x331, x1220, x330 * x1219));
+        let x1227 = Self::mul_add(
+            -x346,
+            x1210,
+            Self::mul_add(
+                x345,
+                x1209,
+                x327
+                    * (Self::mul_add(-c_q0, x1203, s_q0 * x1202)
+                        + Self::mul_add(-x293, x1200, x292 * x1201)),
+            ),
+        );
+        let x1228 = Self::mul_add(
+            -x348,
+            x1212,
+            Self::mul_add(x347, x1211, x332 * Self::mul_add(c_q0, x1200, s_q0 * x1201)),
+        );
+        let x1229 = Self::mul_add(
+            x293,
+            x1220,
+            Self::mul_add(
+                x292,
+                x1219,
+                x291
+                    * Self::mul_add(
+                        c_q0,
+                        x368 + (x367 - x369) + x1144,
+                        s_q0 * (x371 - (x370 - x372) + x1139),
+                    ),
+            ),
+        );
+        let x1230 = x1227 - x1228 - (Self::mul_add(c_q0, x1218, s_q0 * x1216) - x1229);
+        let x1231 = Self::mul_add(-x342, x1160, x341 * x1159)
+            + Self::mul_add(x344, x1163, x343 * x1162)
+            - (Self::mul_add(x329, x1171, x328 * x1169)
+                - Self::mul_add(-x331, x1174, x330 * x1173));
+        let x1232 = Self::mul_add(x346, x1160, Self::mul_add(-x345, x1159, x327 * x1158))
+            - Self::mul_add(x348, x1163, Self::mul_add(x347, x1162, x332 * x1161))
+            + (Self::mul_add(-c_q0, x1171, s_q0 * x1169)
+                - Self::mul_add(
+                    -x293,
+                    x1174,
+                    Self::mul_add(-x292, x1173, x291 * x1172),
+                ));
+        let x1233 = Self::mul_add(-x342, x1073, x341 * x1072)
+            + Self::mul_add(x344, x1076, x343 * x1075)
+            - (Self::mul_add(x329, x1084, x328 * x1082)
+                - Self::mul_add(-x331, x1087, x330 * x1086));
+        let x1234 = Self::mul_add(x346, x1073, Self::mul_add(-x345, x1072, x327 * x1071))
+            - Self::mul_add(x348, x1076, Self::mul_add(x347, x1075, x332 * x1074))
+            + (Self::mul_add(-c_q0, x1084, s_q0 * x1082)
+                - Self::mul_add(
+                    -x293,
+                    x1087,
+                    Self::mul_add(-x292, x1086, x291 * x1085),
+                ));
+        let x1235 = Self::mul_add(-x342, x982, x341 * x981)
+            + Self::mul_add(x344, x985, x343 * x984)
+            - (Self::mul_add(x329, x993, x328 * x991)
+                - Self::mul_add(-x331, x996, x330 * x995));
+        let x1236 = Self::mul_add(x346, x982, Self::mul_add(-x345, x981, x327 * x980))
+            - Self::mul_add(x348, x985, Self::mul_add(x347, x984, x332 * x983))
+            + (Self::mul_add(-c_q0, x993, s_q0 * x991)
+                - Self::mul_add(-x293, x996, Self::mul_add(-x292, x995, x291 * x994)));
+        let x1237 = Self::mul_add(x342, x938, x341 * x937)
+            + Self::mul_add(-x329, x944, x328 * x942);
+        let x1238 = Self::mul_add(-x346, x938, Self::mul_add(-x345, x937, x327 * x936))
+            - Self::mul_add(c_q0, x944, s_q0 * x942);
+        let x1239 = Self::mul_add(x342, x894, x341 * x893)
+            + Self::mul_add(-x329, x900, x328 * x898);
+        let x1240 = Self::mul_add(-x346, x894, Self::mul_add(-x345, x893, x327 * x892))
+            - Self::mul_add(c_q0, x900, s_q0 * x898);
+        let x1241 = s_q5 * s_q5 * 35.074;
+        let x1242 = s_q5 * c_q5 * 35.074;
+        let x1243 = 132.6783695416 + (9.336 + x1241);
+        let x1244 = 135.4729695416 + (44.41 - x1241);
+        let x1245 = 47.471 - x1243;
+        let x1246 = s_q4 * s_q4 * x1245;
+        let x1247 = Self::mul_add(-s_q4, x1242, c_q4 * 97.44448770720001);
+        let x1248 = Self::mul_add(c_q4, x1242, s_q4 * 97.44448770720001);
+        let x1249 = x120 - x1244;
+        let x1250 = Self::mul_add(s_q4 * c_q4, x1245, x118);
+        let x1251 = x120 + (x120 - (47.471 - x1246));
+        let x1252 = -24989.305802 + (x1243 + x1246);
+        let x1253 = 1375.0472756800002 - x1248;
+        let x1254 = 24998.827802 - (x120 + x1249);
+        let x1255 = s_q3 * s_q3;
+        let x1256 = s_q3 * c_q3;
+        let x1257 = x1251 + x1252;
+        let x1258 = x1250 + x1250;
+        let x1259 = Self::mul_add(-x1256, x1258, x1255 * x1257);
+        let x1260 = c_q3 * x1247;
+        let x1261 = s_q3 * x1247;
+        let x1262 = Self::mul_add(0.475, x162, Self::mul_add(-c_q3, x1253, x1261));
+        let x1263 = x178 - x1254;
+        let x1264 = x176 + (x1250 - Self::mul_add(x1255, x1258, x1256 * x1257));
+        let x1265 = Self::mul_add(0.475, x158, Self::mul_add(s_q3, x1253, x1260));
+        let x1266 = x178 + (x178 + (x1251 - x1259));
+        let x1267 = -39234.47412200001 + (x1252 - x1259);
+        let x1268 = 3946.18812068 - x1262;
+        let x1269 = 39241.404122 - (x178 + x1263);
+        let x1270 = s_q2 * s_q2;
+        let x1271 = s_q2 * c_q2;
+        let x1272 = x1266 + x1267;
+        let x1273 = x1264 + x1264;
+        let x1274 = Self::mul_add(-x1271, x1273, x1270 * x1272);
+        let x1275 = x1267 - x1274;
+        let x1276 = c_q2 * x1265;
+        let x1277 = s_q2 * x1265;
+        let x1278 = Self::mul_add(0.5692, x221, Self::mul_add(-c_q2, x1268, x1277));
+        let x1279 = Self::mul_add(0.5692, x217, Self::mul_add(s_q2, x1268, x1276));
+        let x1280 = 0.7026 * x217;
+        let x1281 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(-c_q1, x221, x294),
+            Self::mul_add(
+                s_q1,
+                x1279,
+                c_q1 * (x1264 - Self::mul_add(x1270, x1273, x1271 * x1272)),
+            ),
+        );
+        let x1282 = Self::mul_add(
+            -0.7026,
+            s_q1 * x217,
+            Self::mul_add(s_q1, x1269, c_q1 * x1278),
+        );
+        let x1283 = Self::mul_add(-s_q2, x162, x216);
+        let x1284 = Self::mul_add(
+            -s_q1,
+            x1263,
+            c_q1
+                * Self::mul_add(
+                    0.5692,
+                    Self::mul_add(c_q2, x162, x220),
+                    Self::mul_add(c_q2, x1262, x1277),
+                ),
+        );
+        let x1285 = Self::mul_add(-0.7026, s_q1 * x1283, x1284);
+        let x1286 = Self::mul_add(-s_q3, x111, x157);
+        let x1287 = Self::mul_add(c_q3, x111, x161);
+        let x1288 = Self::mul_add(0.475, x1287, Self::mul_add(c_q3, x1248, x1261));
+        let x1289 = Self::mul_add(7.11, x1287, x1249);
+        let x1290 = Self::mul_add(0.475, x1286, Self::mul_add(-s_q3, x1248, x1260));
+        let x1291 = Self::mul_add(-s_q2, x1287, c_q2 * x1286);
+        let x1292 = Self::mul_add(
+            -s_q1,
+            x1289,
+            c_q1
+                * Self::mul_add(
+                    0.5692,
+                    Self::mul_add(c_q2, x1287, s_q2 * x1286),
+                    Self::mul_add(s_q2, x1290, c_q2 * x1288),
+                ),
+        );
+        let x1293 = Self::mul_add(-0.7026, s_q1 * x1291, x1292);
+        let x1294 = 47.471 * s_q4;
+        let x1295 = 47.471 * c_q4;
+        let x1296 = Self::mul_add(s_q3, x1295, c_q3 * x1294);
+        let x1297 = Self::mul_add(-c_q3, x1295, s_q3 * x1294);
+        let x1298 = c_q1 * Self::mul_add(-s_q2, x1297, c_q2 * x1296);
+        let x1299 = 9.336 * c_q5;
+        let x1300 = 9.336 * s_q5;
+        let x1301 = c_q4 * x1299;
+        let x1302 = s_q4 * x1299;
+        let x1303 = Self::mul_add(-s_q3, x1302, c_q3 * x1301);
+        let x1304 = Self::mul_add(c_q3, x1302, s_q3 * x1301);
+        let x1305 = Self::mul_add(
+            -s_q1,
+            x1300,
+            c_q1 * Self::mul_add(-s_q2, x1304, c_q2 * x1303),
+        );
+        let x1306 = 1.0
+            / (66279.65991417361
+                - (x1280
+                    - (x1275
+                        - Self::mul_add(
+                            -(s_q1 * c_q1),
+                            x1278 + x1278,
+                            s_q1 * s_q1 * (x1275 - (-65693.9112265768 + x1269)),
+                        ) - x1280)));
+        let x1307 = x1281 * x1306;
+        let x1308 = x1282 * x1306;
+        let x1309 = x1285 * x1306;
+        let x1310 = x1293 * x1306;
+        let x1311 = x1298 * x1306;
+        let x1312 = x1305 * x1306;
+        let x1313 = 1.0
+            / Self::mul_add(-x1281, x1307, 65697.3302265768 - (x1266 - x1274));
+        let x1314 = Self::mul_add(-x1281, x1308, x1279);
+        let x1315 = x1313 * x1314;
+        let x1316 = Self::mul_add(
+            -x1281,
+            x1309,
+            Self::mul_add(0.5692, x1283, Self::mul_add(-s_q2, x1262, x1276)),
+        );
+        let x1317 = x1313 * x1316;
+        let x1318 = Self::mul_add(
+            x1281,
+            x1310,
+            Self::mul_add(-0.5692, x1291, Self::mul_add(-c_q2, x1290, s_q2 * x1288)),
+        );
+        let x1319 = x1313 * x1318;
+        let x1320 = Self::mul_add(
+            x1281,
+            x1311,
+            Self::mul_add(c_q2, x1297, s_q2 * x1296),
+        );
+        let x1321 = x1313 * x1320;
+        let x1322 = Self::mul_add(
+            x1281,
+            x1312,
+            Self::mul_add(c_q2, x1304, s_q2 * x1303),
+        );
+        let x1323 = x1313 * x1322;
+        let x1324 = 1.0
+            / Self::mul_add(-x1314, x1315, Self::mul_add(-x1282, x1308, x1269));
+        let x1325 = Self::mul_add(x1314, x1317, Self::mul_add(x1282, x1309, x1263));
+        let x1326 = x1324 * x1325;
+        let x1327 = Self::mul_add(-x1314, x1319, Self::mul_add(x1282, x1310, x1289));
+        let x1328 = x1324 * x1327;
+        let x1329 = Self::mul_add(-x1314, x1321, x1282 * x1311);
+        let x1330 = x1324 * x1329;
+        let x1331 = Self::mul_add(-x1314, x1323, Self::mul_add(x1282, x1312, x1300));
+        let x1332 = x1324 * x1331;
+        let x1333 = Self::mul_add(
+            -x1325,
+            x1326,
+            Self::mul_add(-x1316, x1317, Self::mul_add(-x1285, x1309, x1254)),
+        );
+        let x1334 = 1.0 / x1333;
+        let x1335 = Self::mul_add(
+            x1325,
+            x1328,
+            Self::mul_add(-x1316, x1319, Self::mul_add(x1285, x1310, x1249)),
+        );
+        let x1336 = x1334 * x1335;
+        let x1337 = Self::mul_add(
+            x1325,
+            x1330,
+            Self::mul_add(-x1316, x1321, x1285 * x1311),
+        );
+        let x1338 = x1334 * x1337;
+        let x1339 = Self::mul_add(
+            x1325,
+            x1332,
+            Self::mul_add(-x1316, x1323, Self::mul_add(x1285, x1312, x1300)),
+        );
+        let x1340 = x1334 * x1339;
+        let x1341 = Self::mul_add(
+            -x1327,
+            x1328,
+            Self::mul_add(-x1318, x1319, Self::mul_add(-x1293, x1310, x1244)),
+        );
+        let x1342 = 1.0 / Self::mul_add(-x1335, x1336, x1341);
+        let x1343 = Self::mul_add(
+            x1335,
+            x1338,
+            Self::mul_add(x1327, x1330, Self::mul_add(x1318, x1321, x1293 * x1311)),
+        );
+        let x1344 = x1342 * x1343;
+        let x1345 = Self::mul_add(
+            x1327,
+            x1332,
+            Self::mul_add(x1318, x1323, Self::mul_add(x1293, x1312, x1300)),
+        );
+        let x1346 = Self::mul_add(x1335, x1340, x1345);
+        let x1347 = x1342 * x1346;
+        let x1348 = Self::mul_add(
+            -x1329,
+            x1330,
+            Self::mul_add(-x1320, x1321, Self::mul_add(-x1298, x1311, 47.471)),
+        );
+        let x1349 = 1.0
+            / Self::mul_add(-x1343, x1344, Self::mul_add(-x1337, x1338, x1348));
+        let x1350 = Self::mul_add(
+            x1337,
+            x1340,
+            Self::mul_add(x1329, x1332, Self::mul_add(x1320, x1323, x1298 * x1312)),
+        );
+        let x1351 = Self::mul_add(x1343, x1347, x1350);
+        let x1352 = x1349 * x1351;
+        let x1353 = Self::mul_add(
+            -x1331,
+            x1332,
+            Self::mul_add(-x1322, x1323, Self::mul_add(-x1305, x1312, 9.336)),
+        );
+        let x1354 = Self::mul_add(
+            -x1351,
+            x1352,
+            Self::mul_add(-x1346, x1347, Self::mul_add(-x1339, x1340, x1353)),
+        );
+        let x1355 = 1.0 / x1354;
+        let x1356 = Self::mul_add(-x1307, x1315, x1308);
+        let x1357 = Self::mul_add(x1326, x1356, Self::mul_add(-x1307, x1317, x1309));
+        let x1358 = Self::mul_add(
+            x1336,
+            x1357,
+            Self::mul_add(x1328, x1356, Self::mul_add(x1307, x1319, x1310)),
+        );
+        let x1359 = Self::mul_add(
+            x1338,
+            x1357,
+            Self::mul_add(x1330, x1356, Self::mul_add(x1307, x1321, x1311)),
+        );
+        let x1360 = Self::mul_add(x1344, x1358, x1359);
+        let x1361 = Self::mul_add(
+            x1340,
+            x1357,
+            Self::mul_add(x1332, x1356, Self::mul_add(x1307, x1323, x1312)),
+        );
+        let x1362 = x1355
+            * Self::mul_add(x1352, x1360, Self::mul_add(x1347, x1358, x1361));
+        let x1363 = -x1362;
+        let x1364 = Self::mul_add(x1352, x1362, x1349 * x1360);
+        let x1365 = -x1364;
+        let x1366 = Self::mul_add(
+            x1347,
+            x1362,
+            Self::mul_add(x1344, x1364, x1342 * x1358),
+        );
+        let x1367 = Self::mul_add(
+            x1340,
+            x1362,
+            Self::mul_add(x1338, x1364, Self::mul_add(x1336, x1366, x1334 * x1357)),
+        );
+        let x1368 = Self::mul_add(
+            x1330,
+            x1364,
+            Self::mul_add(x1328, x1366, Self::mul_add(x1326, x1367, x1324 * x1356)),
+        );
+        let x1369 = Self::mul_add(x1332, x1362, x1368);
+        let x1370 = Self::mul_add(
+            x1319,
+            x1366,
+            Self::mul_add(-x1317, x1367, Self::mul_add(-x1315, x1369, x1307 * x1313)),
+        );
+        let x1371 = Self::mul_add(x1323, x1362, Self::mul_add(x1321, x1364, x1370));
+        let x1372 = -x1371;
+        let x1373 = Self::mul_add(
+            x1309,
+            x1367,
+            Self::mul_add(x1308, x1369, Self::mul_add(x1307, x1371, x1306)),
+        );
+        let x1374 = Self::mul_add(
+            x1312,
+            x1362,
+            Self::mul_add(x1311, x1364, Self::mul_add(x1310, x1366, x1373)),
+        );
+        let x1375 = Self::mul_add(x1315, x1326, x1317);
+        let x1376 = Self::mul_add(-x1336, x1375, Self::mul_add(-x1315, x1328, x1319));
+        let x1377 = Self::mul_add(
+            x1344,
+            x1376,
+            Self::mul_add(-x1338, x1375, Self::mul_add(-x1315, x1330, x1321)),
+        );
+        let x1378 = Self::mul_add(
+            x1347,
+            x1376,
+            Self::mul_add(-x1340, x1375, Self::mul_add(-x1315, x1332, x1323)),
+        );
+        let x1379 = x1355 * Self::mul_add(x1352, x1377, x1378);
+        let x1380 = Self::mul_add(x1352, x1379, x1349 * x1377);
+        let x1381 = Self::mul_add(
+            x1347,
+            x1379,
+            Self::mul_add(x1344, x1380, x1342 * x1376),
+        );
+        let x1382 = -x1381;
+        let x1383 = Self::mul_add(
+            -x1340,
+            x1379,
+            Self::mul_add(-x1338, x1380, Self::mul_add(-x1336, x1381, x1334 * x1375)),
+        );
+        let x1384 = Self::mul_add(
+            -x1330,
+            x1380,
+            Self::mul_add(-x1328, x1381, Self::mul_add(x1326, x1383, x1315 * x1324)),
+        );
+        let x1385 = Self::mul_add(-x1332, x1379, x1384);
+        let x1386 = Self::mul_add(
+            x1319,
+            x1381,
+            Self::mul_add(x1317, x1383, Self::mul_add(x1315, x1385, x1313)),
+        );
+        let x1387 = Self::mul_add(x1323, x1379, Self::mul_add(x1321, x1380, x1386));
+        let x1388 = Self::mul_add(
+            x1310,
+            x1381,
+            Self::mul_add(-x1309, x1383, Self::mul_add(-x1308, x1385, x1307 * x1387)),
+        );
+        let x1389 = Self::mul_add(x1312, x1379, Self::mul_add(x1311, x1380, x1388));
+        let x1390 = -x1389;
+        let x1391 = Self::mul_add(x1326, x1336, x1328);
+        let x1392 = Self::mul_add(x1344, x1391, Self::mul_add(x1326, x1338, x1330));
+        let x1393 = Self::mul_add(
+            x1352,
+            x1392,
+            Self::mul_add(x1347, x1391, Self::mul_add(x1326, x1340, x1332)),
+        );
+        let x1394 = x1355 * x1393;
+        let x1395 = -x1394;
+        let x1396 = Self::mul_add(x1352, x1394, x1349 * x1392);
+        let x1397 = -x1396;
+        let x1398 = Self::mul_add(
+            x1347,
+            x1394,
+            Self::mul_add(x1344, x1396, x1342 * x1391),
+        );
+        let x1399 = Self::mul_add(
+            x1340,
+            x1394,
+            Self::mul_add(x1338, x1396, Self::mul_add(x1336, x1398, x1326 * x1334)),
+        );
+        let x1400 = Self::mul_add(
+            x1330,
+            x1396,
+            Self::mul_add(x1328, x1398, Self::mul_add(x1326, x1399, x1324)),
+        );
+        let x1401 = Self::mul_add(x1332, x1394, x1400);
+        let x1402 = Self::mul_add(
+            -x1321,
+            x1396,
+            Self::mul_add(-x1319, x1398, Self::mul_add(x1317, x1399, x1315 * x1401)),
+        );
+        let x1403 = Self::mul_add(-x1323, x1394, x1402);
+        let x1404 = Self::mul_add(
+            -x1310,
+            x1398,
+            Self::mul_add(-x1309, x1399, Self::mul_add(-x1308, x1401, x1307 * x1403)),
+        );
+        let x1405 = Self::mul_add(-x1312, x1394, Self::mul_add(-x1311, x1396, x1404));
+        let x1406 = -x1405;
+        let x1407 = Self::mul_add(x1336, x1344, x1338);
+        let x1408 = x1355
+            * Self::mul_add(x1352, x1407, Self::mul_add(x1336, x1347, x1340));
+        let x1409 = -x1408;
+        let x1410 = Self::mul_add(x1352, x1408, x1349 * x1407);
+        let x1411 = -x1410;
+        let x1412 = Self::mul_add(
+            x1347,
+            x1408,
+            Self::mul_add(x1344, x1410, x1336 * x1342),
+        );
+        let x1413 = Self::mul_add(
+            x1340,
+            x1408,
+            Self::mul_add(x1338, x1410, Self::mul_add(x1336, x1412, x1334)),
+        );
+        let x1414 = Self::mul_add(
+            x1332,
+            x1408,
+            Self::mul_add(x1330, x1410, Self::mul_add(x1328, x1412, x1326 * x1413)),
+        );
+        let x1415 = Self::mul_add(
+            -x1321,
+            x1410,
+            Self::mul_add(-x1319, x1412, Self::mul_add(x1317, x1413, x1315 * x1414)),
+        );
+        let x1416 = Self::mul_add(-x1323, x1408, x1415);
+        let x1417 = Self::mul_add(
+            -x1310,
+            x1412,
+            Self::mul_add(-x1309, x1413, Self::mul_add(-x1308, x1414, x1307 * x1416)),
+        );
+        let x1418 = Self::mul_add(-x1312, x1408, Self::mul_add(-x1311, x1410, x1417));
+        let x1419 = -x1418;
+        let x1420 = x1355 * Self::mul_add(x1344, x1352, x1347);
+        let x1421 = -x1420;
+        let x1422 = Self::mul_add(x1352, x1420, x1344 * x1349);
+        let x1423 = -x1422;
+        let x1424 = Self::mul_add(x1347, x1420, Self::mul_add(x1344, x1422, x1342));
+        let x1425 = Self::mul_add(
+            x1340,
+            x1420,
+            Self::mul_add(x1338, x1422, x1336 * x1424),
+        );
+        let x1426 = Self::mul_add(
+            x1332,
+            x1420,
+            Self::mul_add(x1330, x1422, Self::mul_add(x1328, x1424, x1326 * x1425)),
+        );
+        let x1427 = Self::mul_add(
+            -x1321,
+            x1422,
+            Self::mul_add(-x1319, x1424, Self::mul_add(x1317, x1425, x1315 * x1426)),
+        );
+        let x1428 = Self::mul_add(-x1323, x1420, x1427);
+        let x1429 = Self::mul_add(
+            -x1310,
+            x1424,
+            Self::mul_add(-x1309, x1425, Self::mul_add(-x1308, x1426, x1307 * x1428)),
+        );
+        let x1430 = Self::mul_add(-x1312, x1420, Self::mul_add(-x1311, x1422, x1429));
+        let x1431 = -x1430;
+        let x1432 = x1352 * x1355;
+        let x1433 = Self::mul_add(x1352, x1432, x1349);
+        let x1434 = Self::mul_add(x1347, x1432, x1344 * x1433);
+        let x1435 = -x1434;
+        let x1436 = Self::mul_add(
+            x1340,
+            x1432,
+            Self::mul_add(x1338, x1433, x1336 * x1434),
+        );
+        let x1437 = -x1436;
+        let x1438 = Self::mul_add(
+            x1332,
+            x1432,
+            Self::mul_add(x1330, x1433, Self::mul_add(x1328, x1434, x1326 * x1436)),
+        );
+        let x1439 = -x1438;
+        let x1440 = Self::mul_add(
+            -x1321,
+            x1433,
+            Self::mul_add(-x1319, x1434, Self::mul_add(x1317, x1436, x1315 * x1438)),
+        );
+        let x1441 = Self::mul_add(-x1323, x1432, x1440);
+        let x1442 = -x1441;
+        let x1443 = Self::mul_add(
+            -x1310,
+            x1434,
+            Self::mul_add(-x1309, x1436, Self::mul_add(-x1308, x1438, x1307 * x1441)),
+        );
+        let x1444 = Self::mul_add(-x1312, x1432, Self::mul_add(-x1311, x1433, x1443));
+        let x1445 = Self::mul_add(x1347, x1355, x1344 * x1432);
+        let x1446 = -x1445;
+        let x1447 = Self::mul_add(
+            x1340,
+            x1355,
+            Self::mul_add(x1338, x1432, x1336 * x1445),
+        );
+        let x1448 = -x1447;
+        let x1449 = Self::mul_add(
+            x1332,
+            x1355,
+            Self::mul_add(x1330, x1432, Self::mul_add(x1328, x1445, x1326 * x1447)),
+        );
+        let x1450 = -x1449;
+        let x1451 = Self::mul_add(
+            -x1321,
+            x1432,
+            Self::mul_add(-x1319, x1445, Self::mul_add(x1317, x1447, x1315 * x1449)),
+        );
+        let x1452 = Self::mul_add(-x1323, x1355, x1451);
+        let x1453 = -x1452;
+        let x1454 = Self::mul_add(
+            -x1310,
+            x1445,
+            Self::mul_add(-x1309, x1447, Self::mul_add(-x1308, x1449, x1307 * x1452)),
+        );
+        let x1455 = Self::mul_add(-x1312, x1355, Self::mul_add(-x1311, x1432, x1454));
+        let x1456 = Self::mul_add(
+            -x1233,
+            x1367,
+            Self::mul_add(-x1231, x1369, Self::mul_add(-x1226, x1371, x1223 * x1374)),
+        );
+        let x1457 = Self::mul_add(
+            -x1239,
+            x1362,
+            Self::mul_add(-x1237, x1364, Self::mul_add(x1235, x1366, x1456)),
+        );
+        let x1458 = Self::mul_add(
+            -x1191,
+            x1367,
+            Self::mul_add(-x1189, x1369, Self::mul_add(-x1185, x1371, x1178 * x1374)),
+        );
+        let x1459 = Self::mul_add(
+            -x1197,
+            x1362,
+            Self::mul_add(-x1195, x1364, Self::mul_add(x1193, x1366, x1458)),
+        );
+        let x1460 = Self::mul_add(
+            -x1110,
+            x1367,
+            Self::mul_add(-x1108, x1369, Self::mul_add(-x1106, x1371, x1091 * x1374)),
+        );
+        let x1461 = Self::mul_add(
+            -x1117,
+            x1362,
+            Self::mul_add(-x1115, x1364, Self::mul_add(x1113, x1366, x1460)),
+        );
+        let x1462 = Self::mul_add(
+            -x1021,
+            x1367,
+            Self::mul_add(-x1018, x1369, Self::mul_add(-x1015, x1371, x1000 * x1374)),
+        );
+        let x1463 = Self::mul_add(
+            x1029,
+            x1362,
+            Self::mul_add(x1026, x1364, Self::mul_add(-x1023, x1366, x1462)),
+        );
+        let x1464 = -x1463;
+        let x1465 = Self::mul_add(
+            -x953,
+            x1367,
+            Self::mul_add(-x953, x1369, Self::mul_add(-x951, x1371, x945 * x1374)),
+        );
+        let x1466 = Self::mul_add(
+            -x957,
+            x1362,
+            Self::mul_add(-x955, x1364, Self::mul_add(-x953, x1366, x1465)),
+        );
+        let x1467 = Self::mul_add(
+            -x909,
+            x1367,
+            Self::mul_add(-x909, x1369, Self::mul_add(-x907, x1371, x901 * x1374)),
+        );
+        let x1468 = Self::mul_add(
+            -x913,
+            x1362,
+            Self::mul_add(-x911, x1364, Self::mul_add(-x909, x1366, x1467)),
+        );
+        let x1469 = Self::mul_add(
+            x1233,
+            x1383,
+            Self::mul_add(x1231, x1385, Self::mul_add(-x1226, x1387, x1223 * x1389)),
+        );
+        let x1470 = Self::mul_add(
+            -x1239,
+            x1379,
+            Self::mul_add(-x1237, x1380, Self::mul_add(x1235, x1381, x1469)),
+        );
+        let x1471 = -x1470;
+        let x1472 = Self::mul_add(
+            x1191,
+            x1383,
+            Self::mul_add(x1189, x1385, Self::mul_add(-x1185, x1387, x1178 * x1389)),
+        );
+        let x1473 = Self::mul_add(
+            -x1197,
+            x1379,
+            Self::mul_add(-x1195, x1380, Self::mul_add(x1193, x1381, x1472)),
+        );
+        let x1474 = -x1473;
+        let x1475 = Self::mul_add(
+            x1110,
+            x1383,
+            Self::mul_add(x1108, x1385, Self::mul_add(-x1106, x1387, x1091 * x1389)),
+        );
+        let x1476 = Self::mul_add(
+            -x1117,
+            x1379,
+            Self::mul_add(-x1115, x1380, Self::mul_add(x1113, x1381, x1475)),
+        );
+        let x1477 = -x1476;
+        let x1478 = Self::mul_add(
+            x1021,
+            x1383,
+            Self::mul_add(x1018, x1385, Self::mul_add(-x1015, x1387, x1000 * x1389)),
+        );
+        let x1479 = Self::mul_add(
+            x1029,
+            x1379,
+            Self::mul_add(x1026, x1380, Self::mul_add(-x1023, x1381, x1478)),
+        );
+        let x1480 = Self::mul_add(
+            x953,
+            x1383,
+            Self::mul_add(x953, x1385, Self::mul_add(-x951, x1387, x945 * x1389)),
+        );
+        let x1481 = Self::mul_add(
+            -x957,
+            x1379,
+            Self::mul_add(-x955, x1380, Self::mul_add(-x953, x1381, x1480)),
+        );
+        let x1482 = -x1481;
+        let x1483 = Self::mul_add(
+            x909,
+            x1383,
+            Self::mul_add(x909, x1385, Self::mul_add(-x907, x1387, x901 * x1389)),
+        );
+        let x1484 = Self::mul_add(
+            -x913,
+            x1379,
+            Self::mul_add(-x911, x1380, Self::mul_add(-x909, x1381, x1483)),
+        );
+        let x1485 = -x1484;
+        let x1486 = Self::mul_add(
+            x1233,
+            x1399,
+            Self::mul_add(x1231, x1401, Self::mul_add(-x1226, x1403, x1223 * x1405)),
+        );
+        let x1487 = Self::mul_add(
+            x1239,
+            x1394,
+            Self::mul_add(x1237, x1396, Self::mul_add(-x1235, x1398, x1486)),
+        );
+        let x1488 = -x1487;
+        let x1489 = Self::mul_add(
+            x1191,
+            x1399,
+            Self::mul_add(x1189, x1401, Self::mul_add(-x1185, x1403, x1178 * x1405)),
+        );
+        let x1490 = Self::mul_add(
+            x1197,
+            x1394,
+            Self::mul_add(x1195, x1396, Self::mul_add(-x1193, x1398, x1489)),
+        );
+        let x1491 = -x1490;
+        let x1492 = Self::mul_add(
+            x1110,
+            x1399,
+            Self::mul_add(x1108, x1401, Self::mul_add(-x1106, x1403, x1091 * x1405)),
+        );
+        let x1493 = Self::mul_add(
+            x1117,
+            x1394,
+            Self::mul_add(x1115, x1396, Self::mul_add(-x1113, x1398, x1492)),
+        );
+        let x1494 = -x1493;
+        let x1495 = Self::mul_add(
+            x1021,
+            x1399,
+            Self::mul_add(x1018, x1401, Self::mul_add(-x1015, x1403, x1000 * x1405)),
+        );
+        let x1496 = Self::mul_add(
+            -x1029,
+            x1394,
+            Self::mul_add(-x1026, x1396, Self::mul_add(x1023, x1398, x1495)),
+        );
+        let x1497 = Self::mul_add(
+            x953,
+            x1399,
+            Self::mul_add(x953, x1401, Self::mul_add(-x951, x1403, x945 * x1405)),
+        );
+        let x1498 = Self::mul_add(
+            x957,
+            x1394,
+            Self::mul_add(x955, x1396, Self::mul_add(x953, x1398, x1497)),
+        );
+        let x1499 = -x1498;
+        let x1500 = Self::mul_add(
+            x909,
+            x1399,
+            Self::mul_add(x909, x1401, Self::mul_add(-x907, x1403, x901 * x1405)),
+        );
+        let x1501 = Self::mul_add(
+            x913,
+            x1394,
+            Self::mul_add(x911, x1396, Self::mul_add(x909, x1398, x1500)),
+        );
+        let x1502 = -x1501;
+        let x1503 = Self::mul_add(
+            x1233,
+            x1413,
+            Self::mul_add(x1231, x1414, Self::mul_add(-x1226, x1416, x1223 * x1418)),
+        );
+        let x1504 = Self::mul_add(
+            x1239,
+            x1408,
+            Self::mul_add(x1237, x1410, Self::mul_add(-x1235, x1412, x1503)),
+        );
+        let x1505 = -x1504;
+        let x1506 = Self::mul_add(
+            x1191,
+            x1413,
+            Self::mul_add(x1189, x1414, Self::mul_add(-x1185, x1416, x1178 * x1418)),
+        );
+        let x1507 = Self::mul_add(
+            x1197,
+            x1408,
+            Self::mul_add(x1195, x1410, Self::mul_add(-x1193, x1412, x1506)),
+        );
+        let x1508 = -x1507;
+        let x1509 = Self::mul_add(
+            x1110,
+            x1413,
+            Self::mul_add(x1108, x1414, Self::mul_add(-x1106, x1416, x1091 * x1418)),
+        );
+        let x1510 = Self::mul_add(
+            x1117,
+            x1408,
+            Self::mul_add(x1115, x1410, Self::mul_add(-x1113, x1412, x1509)),
+        );
+        let x1511 = -x1510;
+        let x1512 = Self::mul_add(
+            x1021,
+            x1413,
+            Self::mul_add(x1018, x1414, Self::mul_add(-x1015, x1416, x1000 * x1418)),
+        );
+        let x1513 = Self::mul_add(
+            -x1029,
+            x1408,
+            Self::mul_add(-x1026, x1410, Self::mul_add(x1023, x1412, x1512)),
+        );
+        let x1514 = Self::mul_add(
+            x953,
+            x1413,
+            Self::mul_add(x953, x1414, Self::mul_add(-x951, x1416, x945 * x1418)),
+        );
+        let x1515 = Self::mul_add(
+            x957,
+            x1408,
+            Self::mul_add(x955, x1410, Self::mul_add(x953, x1412, x1514)),
+        );
+        let x1516 = -x1515;
+        let x1517 = Self::mul_add(
+            x909,
+            x1413,
+            Self::mul_add(x909, x1414, Self::mul_add(-x907, x1416, x901 * x1418)),
+        );
+        let x1518 = Self::mul_add(
+            x913,
+            x1408,
+            Self::mul_add(x911, x1410, Self::mul_add(x909, x1412, x1517)),
+        );
+        let x1519 = -x1518;
+        let x1520 = Self::mul_add(
+            x1233,
+            x1425,
+            Self::mul_add(x1231, x1426, Self::mul_add(-x1226, x1428, x1223 * x1430)),
+        );
+        let x1521 = Self::mul_add(
+            x1239,
+            x1420,
+            Self::mul_add(x1237, x1422, Self::mul_add(-x1235, x1424, x1520)),
+        );
+        let x1522 = -x1521;
+        let x1523 = Self::mul_add(
+            x1191,
+            x1425,
+            Self::mul_add(x1189, x1426, Self::mul_add(-x1185, x1428, x1178 * x1430)),
+        );
+        let x1524 = Self::mul_add(
+            x1197,
+            x1420,
+            Self::mul_add(x1195, x1422, Self::mul_add(-x1193, x1424, x1523)),
+        );
+        let x1525 = -x1524;
+        let x1526 = Self::mul_add(
+            x1110,
+            x1425,
+            Self::mul_add(x1108, x1426, Self::mul_add(-x1106, x1428, x1091 * x1430)),
+        );
+        let x1527 = Self::mul_add(
+            x1117,
+            x1420,
+            Self::mul_add(x1115, x1422, Self::mul_add(-x1113, x1424, x1526)),
+        );
+        let x1528 = -x1527;
+        let x1529 = Self::mul_add(
+            x1021,
+            x1425,
+            Self::mul_add(x1018, x1426, Self::mul_add(-x1015, x1428, x1000 * x1430)),
+        );
+        let x1530 = Self::mul_add(
+            -x1029,
+            x1420,
+            Self::mul_add(-x1026, x1422, Self::mul_add(x1023, x1424, x1529)),
+        );
+        let x1531 = Self::mul_add(
+            x953,
+            x1425,
+            Self::mul_add(x953, x1426, Self::mul_add(-x951, x1428, x945 * x1430)),
+        );
+        let x1532 = Self::mul_add(
+            x957,
+            x1420,
+            Self::mul_add(x955, x1422, Self::mul_add(x953, x1424, x1531)),
+        );
+        let x1533 = -x1532;
+        let x1534 = Self::mul_add(
+            x909,
+            x1425,
+            Self::mul_add(x909, x1426, Self::mul_add(-x907, x1428, x901 * x1430)),
+        );
+        let x1535 = Self::mul_add(
+            x913,
+            x1420,
+            Self::mul_add(x911, x1422, Self::mul_add(x909, x1424, x1534)),
+        );
+        let x1536 = -x1535;
+        let x1537 = Self::mul_add(
+            x1233,
+            x1436,
+            Self::mul_add(x1231, x1438, Self::mul_add(-x1226, x1441, x1223 * x1444)),
+        );
+        let x1538 = Self::mul_add(
+            x1239,
+            x1432,
+            Self::mul_add(x1237, x1433, Self::mul_add(-x1235, x1434, x1537)),
+        );
+        let x1539 = Self::mul_add(
+            x1191,
+            x1436,
+            Self::mul_add(x1189, x1438, Self::mul_add(-x1185, x1441, x1178 * x1444)),
+        );
+        let x1540 = Self::mul_add(
+            x1197,
+            x1432,
+            Self::mul_add(x1195, x1433, Self::mul_add(-x1193, x1434, x1539)),
+        );
+        let x1541 = Self::mul_add(
+            x1110,
+            x1436,
+            Self::mul_add(x1108, x1438, Self::mul_add(-x1106, x1441, x1091 * x1444)),
+        );
+        let x1542 = Self::mul_add(
+            x1117,
+            x1432,
+            Self::mul_add(x1115, x1433, Self::mul_add(-x1113, x1434, x1541)),
+        );
+        let x1543 = Self::mul_add(
+            x1021,
+            x1436,
+            Self::mul_add(x1018, x1438, Self::mul_add(-x1015, x1441, x1000 * x1444)),
+        );
+        let x1544 = Self::mul_add(
+            -x1029,
+            x1432,
+            Self::mul_add(-x1026, x1433, Self::mul_add(x1023, x1434, x1543)),
+        );
+        let x1545 = -x1544;
+        let x1546 = Self::mul_add(
+            x953,
+            x1436,
+            Self::mul_add(x953, x1438, Self::mul_add(-x951, x1441, x945 * x1444)),
+        );
+        let x1547 = Self::mul_add(
+            x957,
+            x1432,
+            Self::mul_add(x955, x1433, Self::mul_add(x953, x1434, x1546)),
+        );
+        let x1548 = Self::mul_add(
+            x909,
+            x1436,
+            Self::mul_add(x909, x1438, Self::mul_add(-x907, x1441, x901 * x1444)),
+        );
+        let x1549 = Self::mul_add(
+            x913,
+            x1432,
+            Self::mul_add(x911, x1433, Self::mul_add(x909, x1434, x1548)),
+        );
+        let x1550 = Self::mul_add(
+            x1233,
+            x1447,
+            Self::mul_add(x1231, x1449, Self::mul_add(-x1226, x1452, x1223 * x1455)),
+        );
+        let x1551 = Self::mul_add(
+            x1239,
+            x1355,
+            Self::mul_add(x1237, x1432, Self::mul_add(-x1235, x1445, x1550)),
+        );
+        let x1552 = Self::mul_add(
+            x1191,
+            x1447,
+            Self::mul_add(x1189, x1449, Self::mul_add(-x1185, x1452, x1178 * x1455)),
+        );
+        let x1553 = Self::mul_add(
+            x1197,
+            x1355,
+            Self::mul_add(x1195, x1432, Self::mul_add(-x1193, x1445, x1552)),
+        );
+        let x1554 = Self::mul_add(
+            x1110,
+            x1447,
+            Self::mul_add(x1108, x1449, Self::mul_add(-x1106, x1452, x1091 * x1455)),
+        );
+        let x1555 = Self::mul_add(
+            x1117,
+            x1355,
+            Self::mul_add(x1115, x1432, Self::mul_add(-x1113, x1445, x1554)),
+        );
+        let x1556 = Self::mul_add(
+            x1021,
+            x1447,
+            Self::mul_add(x1018, x1449, Self::mul_add(-x1015, x1452, x1000 * x1455)),
+        );
+        let x1557 = Self::mul_add(
+            -x1029,
+            x1355,
+            Self::mul_add(-x1026, x1432, Self::mul_add(x1023, x1445, x1556)),
+        );
+        let x1558 = -x1557;
+        let x1559 = Self::mul_add(
+            x953,
+            x1447,
+            Self::mul_add(x953, x1449, Self::mul_add(-x951, x1452, x945 * x1455)),
+        );
+        let x1560 = Self::mul_add(
+            x957,
+            x1355,
+            Self::mul_add(x955, x1432, Self::mul_add(x953, x1445, x1559)),
+        );
+        let x1561 = Self::mul_add(
+            x909,
+            x1447,
+            Self::mul_add(x909, x1449, Self::mul_add(-x907, x1452, x901 * x1455)),
+        );
+        let x1562 = Self::mul_add(
+            x913,
+            x1355,
+            Self::mul_add(x911, x1432, Self::mul_add(x909, x1445, x1561)),
+        );
+        let x1563 = Self::mul_add(
+            -x1079,
+            x1367,
+            Self::mul_add(-x1166, x1369, Self::mul_add(-x1214, x1371, x1204 * x1374)),
+        );
+        let x1564 = Self::mul_add(
+            -x896,
+            x1362,
+            Self::mul_add(-x940, x1364, Self::mul_add(x988, x1366, x1563)),
+        );
+        let x1565 = Self::mul_add(
+            x1234,
+            x1367,
+            Self::mul_add(x1232, x1369, Self::mul_add(-x1230, x1371, x1225 * x1374)),
+        );
+        let x1566 = Self::mul_add(
+            x1240,
+            x1362,
+            Self::mul_add(x1238, x1364, Self::mul_add(-x1236, x1366, x1565)),
+        );
+        let x1567 = Self::mul_add(
+            -x1192,
+            x1367,
+            Self::mul_add(-x1190, x1369, Self::mul_add(x1188, x1371, x1182 * x1374)),
+        );
+        let x1568 = Self::mul_add(
+            x1198,
+            x1362,
+            Self::mul_add(x1196, x1364, Self::mul_add(x1194, x1366, x1567)),
+        );
+        let x1569 = Self::mul_add(
+            -x1112,
+            x1367,
+            Self::mul_add(-x1109, x1369, Self::mul_add(x1107, x1371, x1100 * x1374)),
+        );
+        let x1570 = Self::mul_add(
+            x1118,
+            x1362,
+            Self::mul_add(x1116, x1364, Self::mul_add(x1114, x1366, x1569)),
+        );
+        let x1571 = Self::mul_add(
+            -x1022,
+            x1367,
+            Self::mul_add(-x1020, x1369, Self::mul_add(x1016, x1371, x1009 * x1374)),
+        );
+        let x1572 = Self::mul_add(
+            x1031,
+            x1362,
+            Self::mul_add(x1028, x1364, Self::mul_add(-x1025, x1366, x1571)),
+        );
+        let x1573 = -x1572;
+        let x1574 = Self::mul_add(
+            -x954,
+            x1367,
+            Self::mul_add(-x954, x1369, Self::mul_add(x952, x1371, x948 * x1374)),
+        );
+        let x1575 = Self::mul_add(
+            -x958,
+            x1362,
+            Self::mul_add(-x956, x1364, Self::mul_add(-x954, x1366, x1574)),
+        );
+        let x1576 = Self::mul_add(
+            -x910,
+            x1367,
+            Self::mul_add(-x910, x1369, Self::mul_add(x908, x1371, x904 * x1374)),
+        );
+        let x1577 = Self::mul_add(
+            -x914,
+            x1362,
+            Self::mul_add(-x912, x1364, Self::mul_add(-x910, x1366, x1576)),
+        );
+        let x1578 = Self::mul_add(
+            x1079,
+            x1383,
+            Self::mul_add(x1166, x1385, Self::mul_add(-x1214, x1387, x1204 * x1389)),
+        );
+        let x1579 = Self::mul_add(
+            -x896,
+            x1379,
+            Self::mul_add(-x940, x1380, Self::mul_add(x988, x1381, x1578)),
+        );
+        let x1580 = -x1579;
+        let x1581 = Self::mul_add(
+            -x1234,
+            x1383,
+            Self::mul_add(-x1232, x1385, Self::mul_add(-x1230, x1387, x1225 * x1389)),
+        );
+        let x1582 = Self::mul_add(
+            x1240,
+            x1379,
+            Self::mul_add(x1238, x1380, Self::mul_add(-x1236, x1381, x1581)),
+        );
+        let x1583 = -x1582;
+        let x1584 = Self::mul_add(
+            x1192,
+            x1383,
+            Self::mul_add(x1190, x1385, Self::mul_add(x1188, x1387, x1182 * x1389)),
+        );
+        let x1585 = Self::mul_add(
+            x1198,
+            x1379,
+            Self::mul_add(x1196, x1380, Self::mul_add(x1194, x1381, x1584)),
+        );
+        let x1586 = -x1585;
+        let x1587 = Self::mul_add(
+            x1112,
+            x1383,
+            Self::mul_add(x1109, x1385, Self::mul_add(x1107, x1387, x1100 * x1389)),
+        );
+        let x1588 = Self::mul_add(
+            x1118,
+            x1379,
+            Self::mul_add(x1116, x1380, Self::mul_add(x1114, x1381, x1587)),
+        );
+        let x1589 = -x1588;
+        let x1590 = Self::mul_add(
+            x1022,
+            x1383,
+            Self::mul_add(x1020, x1385, Self::mul_add(x1016, x1387, x1009 * x1389)),
+        );
+        let x1591 = Self::mul_add(
+            x1031,
+            x1379,
+            Self::mul_add(x1028, x1380, Self::mul_add(-x1025, x1381, x1590)),
+        );
+        let x1592 = Self::mul_add(
+            x954,
+            x1383,
+            Self::mul_add(x954, x1385, Self::mul_add(x952, x1387, x948 * x1389)),
+        );
+        let x1593 = Self::mul_add(
+            -x958,
+            x1379,
+            Self::mul_add(-x956, x1380, Self::mul_add(-x954, x1381, x1592)),
+        );
+        let x1594 = -x1593;
+        let x1595 = Self::mul_add(
+            x910,
+            x1383,
+            Self::mul_add(x910, x1385, Self::mul_add(x908, x1387, x904 * x1389)),
+        );
+        let x1596 = Self::mul_add(
+            -x914,
+            x1379,
+            Self::mul_add(-x912, x1380, Self::mul_add(-x910, x1381, x1595)),
+        );
+        let x1597 = -x1596;
+        let x1598 = Self::mul_add(
+            x1079,
+            x1399,
+            Self::mul_add(x1166, x1401, Self::mul_add(-x1214, x1403, x1204 * x1405)),
+        );
+        let x1599 = Self::mul_add(
+            x896,
+            x1394,
+            Self::mul_add(x940, x1396, Self::mul_add(-x988, x1398, x1598)),
+        );
+        let x1600 = -x1599;
+        let x1601 = Self::mul_add(
+            -x1234,
+            x1399,
+            Self::mul_add(-x1232, x1401, Self::mul_add(-x1230, x1403, x1225 * x1405)),
+        );
+        let x1602 = Self::mul_add(
+            -x1240,
+            x1394,
+            Self::mul_add(-x1238, x1396, Self::mul_add(x1236, x1398, x1601)),
+        );
+        let x1603 = -x1602;
+        let x1604 = Self::mul_add(
+            x1192,
+            x1399,
+            Self::mul_add(x1190, x1401, Self::mul_add(x1188, x1403, x1182 * x1405)),
+        );
+        let x1605 = Self::mul_add(
+            -x1198,
+            x1394,
+            Self::mul_add(-x1196, x1396, Self::mul_add(-x1194, x1398, x1604)),
+        );
+        let x1606 = -x1605;
+        let x1607 = Self::mul_add(
+            x1112,
+            x1399,
+            Self::mul_add(x1109, x1401, Self::mul_add(x1107, x1403, x1100 * x1405)),
+        );
+        let x1608 = Self::mul_add(
+            -x1118,
+            x1394,
+            Self::mul_add(-x1116, x1396, Self::mul_add(-x1114, x1398, x1607)),
+        );
+        let x1609 = -x1608;
+        let x1610 = Self::mul_add(
+            x1022,
+            x1399,
+            Self::mul_add(x1020, x1401, Self::mul_add(x1016, x1403, x1009 * x1405)),
+        );
+        let x1611 = Self::mul_add(
+            -x1031,
+            x1394,
+            Self::mul_add(-x1028, x1396, Self::mul_add(x1025, x1398, x1610)),
+        );
+        let x1612 = Self::mul_add(
+            x954,
+            x1399,
+            Self::mul_add(x954, x1401, Self::mul_add(x952, x1403, x948 * x1405)),
+        );
+        let x1613 = Self::mul_add(
+            x958,
+            x1394,
+            Self::mul_add(x956, x1396, Self::mul_add(x954, x1398, x1612)),
+        );
+        let x1614 = -x1613;
+        let x1615 = Self::mul_add(
+            x910,
+            x1399,
+            Self::mul_add(x910, x1401, Self::mul_add(x908, x1403, x904 * x1405)),
+        );
+        let x1616 = Self::mul_add(
+            x914,
+            x1394,
+            Self::mul_add(x912, x1396, Self::mul_add(x910, x1398, x1615)),
+        );
+        let x1617 = -x1616;
+        let x1618 = Self::mul_add(
+            x1079,
+            x1413,
+            Self::mul_add(x1166, x1414, Self::mul_add(-x1214, x1416, x1204 * x1418)),
+        );
+        let x1619 = Self::mul_add(
+            x896,
+            x1408,
+            Self::mul_add(x940, x1410, Self::mul_add(-x988, x1412, x1618)),
+        );
+        let x1620 = -x1619;
+        let x1621 = Self::mul_add(
+            -x1234,
+            x1413,
+            Self::mul_add(-x1232, x1414, Self::mul_add(-x1230, x1416, x1225 * x1418)),
+        );
+        let x1622 = Self::mul_add(
+            -x1240,
+            x1408,
+            Self::mul_add(-x1238, x1410, Self::mul_add(x1236, x1412, x1621)),
+        );
+        let x1623 = -x1622;
+        let x1624 = Self::mul_add(
+            x1192,
+            x1413,
+            Self::mul_add(x1190, x1414, Self::mul_add(x1188, x1416, x1182 * x1418)),
+        );
+        let x1625 = Self::mul_add(
+            -x1198,
+            x1408,
+            Self::mul_add(-x1196, x1410, Self::mul_add(-x1194, x1412, x1624)),
+        );
+        let x1626 = -x1625;
+        let x1627 = Self::mul_add(
+            x1112,
+            x1413,
+            Self::mul_add(x1109, x1414, Self::mul_add(x1107, x1416, x1100 * x1418)),
+        );
+        let x1628 = Self::mul_add(
+            -x1118,
+            x1408,
+            Self::mul_add(-x1116, x1410, Self::mul_add(-x1114, x1412, x1627)),
+        );
+        let x1629 = -x1628;
+        let x1630 = Self::mul_add(
+            x1022,
+            x1413,
+            Self::mul_add(x1020, x1414, Self::mul_add(x1016, x1416, x1009 * x1418)),
+        );
+        let x1631 = Self::mul_add(
+            -x1031,
+            x1408,
+            Self::mul_add(-x1028, x1410, Self::mul_add(x1025, x1412, x1630)),
+        );
+        let x1632 = Self::mul_add(
+            x954,
+            x1413,
+            Self::mul_add(x954, x1414, Self::mul_add(x952, x1416, x948 * x1418)),
+        );
+        let x1633 = Self::mul_add(
+            x958,
+            x1408,
+            Self::mul_add(x956, x1410, Self::mul_add(x954, x1412, x1632)),
+        );
+        let x1634 = -x1633;
+        let x1635 = Self::mul_add(
+            x910,
+            x1413,
+            Self::mul_add(x910, x1414, Self::mul_add(x908, x1416, x904 * x1418)),
+        );
+        let x1636 = Self::mul_add(
+            x914,
+            x1408,
+            Self::mul_add(x912, x1410, Self::mul_add(x910, x1412, x1635)),
+        );
+        let x1637 = -x1636;
+        let x1638 = Self::mul_add(
+            x1079,
+            x1425,
+            Self::mul_add(x1166, x1426, Self::mul_add(-x1214, x1428, x1204 * x1430)),
+        );
+        let x1639 = Self::mul_add(
+            x896,
+            x1420,
+            Self::mul_add(x940, x1422, Self::mul_add(-x988, x1424, x1638)),
+        );
+        let x1640 = -x1639;
+        let x1641 = Self::mul_add(
+            -x1234,
+            x1425,
+            Self::mul_add(-x1232, x1426, Self::mul_add(-x1230, x1428, x1225 * x1430)),
+        );
+        let x1642 = Self::mul_add(
+            -x1240,
+            x1420,
+            Self::mul_add(-x1238, x1422, Self::mul_add(x1236, x1424, x1641)),
+        );
+        let x1643 = -x1642;
+        let x1644 = Self::mul_add(
+            x1192,
+            x1425,
+            Self::mul_add(x1190, x1426, Self::mul_add(x1188, x1428, x1182 * x1430)),
+        );
+        let x1645 = Self::mul_add(
+            -x1198,
+            x1420,
+            Self::mul_add(-x1196, x1422, Self::mul_add(-x1194, x1424, x1644)),
+        );
+        let x1646 = -x1645;
+        let x1647 = Self::mul_add(
+            x1112,
+            x1425,
+            Self::mul_add(x1109, x1426, Self::mul_add(x1107, x1428, x1100 * x1430)),
+        );
+        let x1648 = Self::mul_add(
+            -x1118,
+            x1420,
+            Self::mul_add(-x1116, x1422, Self::mul_add(-x1114, x1424, x1647)),
+        );
+        let x1649 = -x1648;
+        let x1650 = Self::mul_add(
+            x1022,
+            x1425,
+            Self::mul_add(x1020, x1426, Self::mul_add(x1016, x1428, x1009 * x1430)),
+        );
+        let x1651 = Self::mul_add(
+            -x1031,
+            x1420,
+            Self::mul_add(-x1028, x1422, Self::mul_add(x1025, x1424, x1650)),
+        );
+        let x1652 = Self::mul_add(
+            x954,
+            x1425,
+            Self::mul_add(x954, x1426, Self::mul_add(x952, x1428, x948 * x1430)),
+        );
+        let x1653 = Self::mul_add(
+            x958,
+            x1420,
+            Self::mul_add(x956, x1422, Self::mul_add(x954, x1424, x1652)),
+        );
+        let x1654 = -x1653;
+        let x1655 = Self::mul_add(
+            x910,
+            x1425,
+            Self::mul_add(x910, x1426, Self::mul_add(x908, x1428, x904 * x1430)),
+        );
+        let x1656 = Self::mul_add(
+            x914,
+            x1420,
+            Self::mul_add(x912, x1422, Self::mul_add(x910, x1424, x1655)),
+        );
+        let x1657 = -x1656;
+        let x1658 = Self::mul_add(
+            x1079,
+            x1436,
+            Self::mul_add(x1166, x1438, Self::mul_add(-x1214, x1441, x1204 * x1444)),
+        );
+        let x1659 = Self::mul_add(
+            x896,
+            x1432,
+            Self::mul_add(x940, x1433, Self::mul_add(-x988, x1434, x1658)),
+        );
+        let x1660 = Self::mul_add(
+            -x1234,
+            x1436,
+            Self::mul_add(-x1232, x1438, Self::mul_add(-x1230, x1441, x1225 * x1444)),
+        );
+        let x1661 = Self::mul_add(
+            -x1240,
+            x1432,
+            Self::mul_add(-x1238, x1433, Self::mul_add(x1236, x1434, x1660)),
+        );
+        let x1662 = Self::mul_add(
+            x1192,
+            x1436,
+            Self::mul_add(x1190, x1438, Self::mul_add(x1188, x1441, x1182 * x1444)),
+        );
+        let x1663 = Self::mul_add(
+            -x1198,
+            x1432,
+            Self::mul_add(-x1196, x1433, Self::mul_add(-x1194, x1434, x1662)),
+        );
+        let x1664 = Self::mul_add(
+            x1112,
+            x1436,
+            Self::mul_add(x1109, x1438, Self::mul_add(x1107, x1441, x1100 * x1444)),
+        );
+        let x1665 = Self::mul_add(
+            -x1118,
+            x1432,
+            Self::mul_add(-x1116, x1433, Self::mul_add(-x1114, x1434, x1664)),
+        );
+        let x1666 = Self::mul_add(
+            x1022,
+            x1436,
+            Self::mul_add(x1020, x1438, Self::mul_add(x1016, x1441, x1009 * x1444)),
+        );
+        let x1667 = Self::mul_add(
+            -x1031,
+            x1432,
+            Self::mul_add(-x1028, x1433, Self::mul_add(x1025, x1434, x1666)),
+        );
+        let x1668 = -x1667;
+        let x1669 = Self::mul_add(
+            x954,
+            x1436,
+            Self::mul_add(x954, x1438, Self::mul_add(x952, x1441, x948 * x1444)),
+        );
+        let x1670 = Self::mul_add(
+            x958,
+            x1432,
+            Self::mul_add(x956, x1433, Self::mul_add(x954, x1434, x1669)),
+        );
+        let x1671 = Self::mul_add(
+            x910,
+            x1436,
+            Self::mul_add(x910, x1438, Self::mul_add(x908, x1441, x904 * x1444)),
+        );
+        let x1672 = Self::mul_add(
+            x914,
+            x1432,
+            Self::mul_add(x912, x1433, Self::mul_add(x910, x1434, x1671)),
+        );
+        let x1673 = Self::mul_add(
+            x1079,
+            x1447,
+            Self::mul_add(x1166, x1449, Self::mul_add(-x1214, x1452, x1204 * x1455)),
+        );
+        let x1674 = Self::mul_add(
+            x896,
+            x1355,
+            Self::mul_add(x940, x1432, Self::mul_add(-x988, x1445, x1673)),
+        );
+        let x1675 = Self::mul_add(
+            -x1234,
+            x1447,
+            Self::mul_add(-x1232, x1449, Self::mul_add(-x1230, x1452, x1225 * x1455)),
+        );
+        let x1676 = Self::mul_add(
+            -x1240,
+            x1355,
+            Self::mul_add(-x1238, x1432, Self::mul_add(x1236, x1445, x1675)),
+        );
+        let x1677 = Self::mul_add(
+            x1192,
+            x1447,
+            Self::mul_add(x1190, x1449, Self::mul_add(x1188, x1452, x1182 * x1455)),
+        );
+        let x1678 = Self::mul_add(
+            -x1198,
+            x1355,
+            Self::mul_add(-x1196, x1432, Self::mul_add(-x1194, x1445, x1677)),
+        );
+        let x1679 = Self::mul_add(
+            x1112,
+            x1447,
+            Self::mul_add(x1109, x1449, Self::mul_add(x1107, x1452, x1100 * x1455)),
+        );
+        let x1680 = Self::mul_add(
+            -x1118,
+            x1355,
+            Self::mul_add(-x1116, x1432, Self::mul_add(-x1114, x1445, x1679)),
+        );
+        let x1681 = Self::mul_add(
+            x1022,
+            x1447,
+            Self::mul_add(x1020, x1449, Self::mul_add(x1016, x1452, x1009 * x1455)),
+        );
+        let x1682 = Self::mul_add(
+            -x1031,
+            x1355,
+            Self::mul_add(-x1028, x1432, Self::mul_add(x1025, x1445, x1681)),
+        );
+        let x1683 = -x1682;
+        let x1684 = Self::mul_add(
+            x954,
+            x1447,
+            Self::mul_add(x954, x1449, Self::mul_add(x952, x1452, x948 * x1455)),
+        );
+        let x1685 = Self::mul_add(
+            x958,
+            x1355,
+            Self::mul_add(x956, x1432, Self::mul_add(x954, x1445, x1684)),
+        );
+        let x1686 = Self::mul_add(
+            x910,
+            x1447,
+            Self::mul_add(x910, x1449, Self::mul_add(x908, x1452, x904 * x1455)),
+        );
+        let x1687 = Self::mul_add(
+            x914,
+            x1355,
+            Self::mul_add(x912, x1432, Self::mul_add(x910, x1445, x1686)),
+        );
+        (
+            [
+                [0.0, x1457, x1459, x1461, x1464, x1466, x1468],
+                [0.0, x1471, x1474, x1477, x1479, x1482, x1485],
+                [0.0, x1488, x1491, x1494, x1496, x1499, x1502],
+                [0.0, x1505, x1508, x1511, x1513, x1516, x1519],
+                [0.0, x1522, x1525, x1528, x1530, x1533, x1536],
+                [0.0, x1538, x1540, x1542, x1545, x1547, x1549],
+                [0.0, x1551, x1553, x1555, x1558, x1560, x1562],
+            ],
+            [
+                [x1564, x1566, x1568, x1570, x1573, x1575, x1577],
+                [x1580, x1583, x1586, x1589, x1591, x1594, x1597],
+                [x1600, x1603, x1606, x1609, x1611, x1614, x1617],
+                [x1620, x1623, x1626, x1629, x1631, x1634, x1637],
+                [x1640, x1643, x1646, x1649, x1651, x1654, x1657],
+                [x1659, x1661, x1663, x1665, x1668, x1670, x1672],
+                [x1674, x1676, x1678, x1680, x1683, x1685, x1687],
+            ],
+            [
+                [x1374, x1372, x1369, x1367, x1366, x1365, x1363],
+                [x1390, x1387, x1385, x1383, x1382, x1380, x1379],
+                [x1406, x1403, x1401, x1399, x1398, x1397, x1395],
+                [x1419, x1416, x1414, x1413, x1412, x1411, x1409],
+                [x1431, x1428, x1426, x1425, x1424, x1423, x1421],
+                [x1444, x1442, x1439, x1437, x1435, x1433, x1432],
+                [x1455, x1453, x1450, x1448, x1446, x1432, x1355],
+            ],
+        )
+    }
+    /// The inverse of the joint-space inertia matrix, `M(q)⁻¹` (symmetric, both triangles written), from the LDLᵀ factors of `M`.
+    ///
+    /// : 309 mul, 242 add, 7 div, 0 sqrt, 5 sincos (emitted), of which 201 fused where the target has FMA.
+    #[must_use]
+    pub fn mass_matrix_inverse(q: &[f64; 7]) -> [[f64; 7]; 7] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let x5 = s_q5 * s_q5 * 35.074;
+        let x6 = s_q5 * c_q5 * 35.074;
+        let x7 = 132.6783695416 + (9.336 + x5);
+        let x8 = 135.4729695416 + (44.41 - x5);
+        let x9 = 47.471 - x7;
+        let x10 = s_q4 * s_q4 * x9;
+        let x11 = Self::mul_add(-s_q4, x6, c_q4 * 97.44448770720001);
+        let x12 = Self::mul_add(c_q4, x6, s_q4 * 97.44448770720001);
+        let x13 = c_q4 * 171.195516;
+        let x14 = s_q4 * 171.195516;
+        let x15 = 7.11 * x14;
+        let x16 = x8 - x15;
+        let x17 = Self::mul_add(7.11, x13, s_q4 * c_q4 * x9);
+        let x18 = x15 - (47.471 - x10 - x15);
+        let x19 = 3239.4582 - x14;
+        let x20 = -24989.305802 + (x7 + x10);
+        let x21 = 1375.0472756800002 - x12;
+        let x22 = 24998.827802 - (x15 - x16);
+        let x23 = s_q3 * s_q3;
+        let x24 = s_q3 * c_q3;
+        let x25 = x18 + x20;
+        let x26 = x17 + x17;
+        let x27 = Self::mul_add(-x24, x26, x23 * x25);
+        let x28 = c_q3 * x11;
+        let x29 = s_q3 * x11;
+        let x30 = c_q3 * x13;
+        let x31 = Self::mul_add(s_q3, x19, x30);
+        let x32 = s_q3 * x13;
+        let x33 = Self::mul_add(-c_q3, x19, x32);
+        let x34 = 7.11 * x33;
+        let x35 = Self::mul_add(x33, 0.475, Self::mul_add(-c_q3, x21, x29));
+        let x36 = x22 - x34;
+        let x37 = Self::mul_add(7.11, x31, x17 - Self::mul_add(x23, x26, x24 * x25));
+        let x38 = Self::mul_add(x31, 0.475, Self::mul_add(s_q3, x21, x28));
+        let x39 = x34 + (x18 - x27 + x34);
+        let x40 = 5224.5702 - x33;
+        let x41 = -39234.47412200001 + (x20 - x27);
+        let x42 = 3946.18812068 - x35;
+        let x43 = 39241.404122 - (x34 - x36);
+        let x44 = s_q2 * s_q2;
+        let x45 = s_q2 * c_q2;
+        let x46 = x39 + x41;
+        let x47 = x37 + x37;
+        let x48 = Self::mul_add(-x45, x47, x44 * x46);
+        let x49 = x41 - x48;
+        let x50 = c_q2 * x38;
+        let x51 = s_q2 * x38;
+        let x52 = c_q2 * x31;
+        let x53 = Self::mul_add(s_q2, x40, x52);
+        let x54 = s_q2 * x31;
+        let x55 = Self::mul_add(-c_q2, x40, x54);
+        let x56 = Self::mul_add(0.5692, x55, Self::mul_add(-c_q2, x42, x51));
+        let x57 = Self::mul_add(0.5692, x53, Self::mul_add(s_q2, x42, x50));
+        let x58 = 0.7026 * x53;
+        let x59 = Self::mul_add(
+            0.7026,
+            Self::mul_add(s_q1, -1145.5438279999998, c_q1 * x55),
+            Self::mul_add(s_q1, x57, c_q1 * (x37 - Self::mul_add(x44, x47, x45 * x46))),
+        );
+        let x60 = Self::mul_add(
+            -0.7026,
+            s_q1 * x53,
+            Self::mul_add(s_q1, x43, c_q1 * x56),
+        );
+        let x61 = Self::mul_add(-s_q2, x33, x52);
+        let x62 = Self::mul_add(
+            s_q1,
+            x36,
+            c_q1
+                * Self::mul_add(
+                    0.5692,
+                    Self::mul_add(c_q2, x33, x54),
+                    Self::mul_add(c_q2, x35, x51),
+                ),
+        );
+        let x63 = Self::mul_add(-0.7026, s_q1 * x61, x62);
+        let x64 = Self::mul_add(-s_q3, x14, x30);
+        let x65 = Self::mul_add(c_q3, x14, x32);
+        let x66 = Self::mul_add(0.475, x65, Self::mul_add(c_q3, x12, x29));
+        let x67 = Self::mul_add(-7.11, x65, x16);
+        let x68 = Self::mul_add(0.475, x64, Self::mul_add(-s_q3, x12, x28));
+        let x69 = Self::mul_add(-s_q2, x65, c_q2 * x64);
+        let x70 = Self::mul_add(
+            s_q1,
+            x67,
+            c_q1
+                * Self::mul_add(
+                    0.5692,
+                    Self::mul_add(c_q2, x65, s_q2 * x64),
+                    Self::mul_add(s_q2, x68, c_q2 * x66),
+                ),
+        );
+        let x71 = Self::mul_add(-0.7026, s_q1 * x69, x70);
+        let x72 = 47.471 * s_q4;
+        let x73 = 47.471 * c_q4;
+        let x74 = Self::mul_add(s_q3, x73, c_q3 * x72);
+        let x75 = Self::mul_add(-c_q3, x73, s_q3 * x72);
+        let x76 = c_q1 * Self::mul_add(-s_q2, x75, c_q2 * x74);
+        let x77 = 9.336 * c_q5;
+        let x78 = 9.336 * s_q5;
+        let x79 = c_q4 * x77;
+        let x80 = s_q4 * x77;
+        let x81 = Self::mul_add(-s_q3, x80, c_q3 * x79);
+        let x82 = Self::mul_add(c_q3, x80, s_q3 * x79);
+        let x83 = Self::mul_add(
+            -s_q1,
+            x78,
+            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x81),
+        );
+        let x84 = 1.0
+            / (66279.65991417361
+                - (x58
+                    - (x49
+                        - Self::mul_add(
+                            -(s_q1 * c_q1),
+                            x56 + x56,
+                            s_q1 * s_q1 * (x49 - (-65693.9112265768 + x43)),
+                        ) - x58)));
+        let x85 = x59 * x84;
+        let x86 = x60 * x84;
+        let x87 = x63 * x84;
+        let x88 = x71 * x84;
+        let x89 = x76 * x84;
+        let x90 = x83 * x84;
+        let x91 = 1.0 / Self::mul_add(-x59, x85, 65697.3302265768 - (x39 - x48));
+        let x92 = Self::mul_add(-x59, x86, x57);
+        let x93 = x91 * x92;
+        let x94 = Self::mul_add(
+            -x59,
+            x87,
+            Self::mul_add(0.5692, x61, Self::mul_add(-s_q2, x35, x50)),
+        );
+        let x95 = x91 * x94;
+        let x96 = Self::mul_add(
+            x59,
+            x88,
+            Self::mul_add(-0.5692, x69, Self::mul_add(-c_q2, x68, s_q2 * x66)),
+        );
+        let x97 = x91 * x96;
+        let x98 = Self::mul_add(x59, x89, Self::mul_add(c_q2, x75, s_q2 * x74));
+        let x99 = x91 * x98;
+        let x100 = Self::mul_add(x59, x90, Self::mul_add(c_q2, x82, s_q2 * x81));
+        let x101 = x91 * x100;
+        let x102 = 1.0 / Self::mul_add(-x92, x93, Self::mul_add(-x60, x86, x43));
+        let x103 = Self::mul_add(-x92, x95, Self::mul_add(-x60, x87, x36));
+        let x104 = x102 * x103;
+        let x105 = Self::mul_add(x92, x97, Self::mul_add(-x60, x88, x67));
+        let x106 = x102 * x105;
+        let x107 = Self::mul_add(-x92, x99, x60 * x89);
+        let x108 = x102 * x107;
+        let x109 = Self::mul_add(-x92, x101, Self::mul_add(x60, x90, x78));
+        let x110 = x102 * x109;
+        let x111 = Self::mul_add(
+            -x103,
+            x104,
+            Self::mul_add(-x94, x95, Self::mul_add(-x63, x87, x22)),
+        );
+        let x112 = 1.0 / x111;
+        let x113 = Self::mul_add(
+            -x103,
+            x106,
+            Self::mul_add(x94, x97, Self::mul_add(-x63, x88, x16)),
+        );
+        let x114 = x112 * x113;
+        let x115 = Self::mul_add(-x103, x108, Self::mul_add(-x94, x99, x63 * x89));
+        let x116 = x112 * x115;
+        let x117 = Self::mul_add(
+            -x103,
+            x110,
+            Self::mul_add(-x94, x101, Self::mul_add(x63, x90, x78)),
+        );
+        let x118 = x112 * x117;
+        let x119 = Self::mul_add(
+            -x105,
+            x106,
+            Self::mul_add(-x96, x97, Self::mul_add(-x71, x88, x8)),
+        );
+        let x120 = 1.0 / Self::mul_add(-x113, x114, x119);
+        let x121 = Self::mul_add(
+            -x113,
+            x116,
+            Self::mul_add(-x105, x108, Self::mul_add(x96, x99, x71 * x89)),
+        );
+        let x122 = x120 * x121;
+        let x123 = Self::mul_add(
+            -x105,
+            x110,
+            Self::mul_add(x96, x101, Self::mul_add(x71, x90, x78)),
+        );
+        let x124 = Self::mul_add(-x113, x118, x123);
+        let x125 = x120 * x124;
+        let x126 = Self::mul_add(
+            -x107,
+            x108,
+            Self::mul_add(-x98, x99, Self::mul_add(-x76, x89, 47.471)),
+        );
+        let x127 = 1.0 / Self::mul_add(-x121, x122, Self::mul_add(-x115, x116, x126));
+        let x128 = Self::mul_add(
+            x115,
+            x118,
+            Self::mul_add(x107, x110, Self::mul_add(x98, x101, x76 * x90)),
+        );
+        let x129 = Self::mul_add(x121, x125, x128);
+        let x130 = x127 * x129;
+        let x131 = Self::mul_add(
+            -x109,
+            x110,
+            Self::mul_add(-x100, x101, Self::mul_add(-x83, x90, 9.336)),
+        );
+        let x132 = Self::mul_add(
+            -x129,
+            x130,
+            Self::mul_add(-x124, x125, Self::mul_add(-x117, x118, x131)),
+        );
+        let x133 = 1.0 / x132;
+        let x134 = Self::mul_add(-x85, x93, x86);
+        let x135 = Self::mul_add(-x104, x134, Self::mul_add(-x85, x95, x87));
+        let x136 = Self::mul_add(
+            -x114,
+            x135,
+            Self::mul_add(-x106, x134, Self::mul_add(x85, x97, x88)),
+        );
+        let x137 = Self::mul_add(
+            x116,
+            x135,
+            Self::mul_add(x108, x134, Self::mul_add(x85, x99, x89)),
+        );
+        let x138 = Self::mul_add(x122, x136, x137);
+        let x139 = Self::mul_add(
+            x118,
+            x135,
+            Self::mul_add(x110, x134, Self::mul_add(x85, x101, x90)),
+        );
+        let x140 = x133 * Self::mul_add(x130, x138, Self::mul_add(x125, x136, x139));
+        let x141 = -x140;
+        let x142 = Self::mul_add(x130, x140, x127 * x138);
+        let x143 = -x142;
+        let x144 = Self::mul_add(x125, x140, Self::mul_add(x122, x142, x120 * x136));
+        let x145 = Self::mul_add(
+            x118,
+            x140,
+            Self::mul_add(x116, x142, Self::mul_add(-x114, x144, x112 * x135)),
+        );
+        let x146 = Self::mul_add(
+            x108,
+            x142,
+            Self::mul_add(-x106, x144, Self::mul_add(-x104, x145, x102 * x134)),
+        );
+        let x147 = Self::mul_add(x110, x140, x146);
+        let x148 = Self::mul_add(
+            x97,
+            x144,
+            Self::mul_add(-x95, x145, Self::mul_add(-x93, x147, x85 * x91)),
+        );
+        let x149 = Self::mul_add(x101, x140, Self::mul_add(x99, x142, x148));
+        let x150 = -x149;
+        let x151 = Self::mul_add(
+            x87,
+            x145,
+            Self::mul_add(x86, x147, Self::mul_add(x85, x149, x84)),
+        );
+        let x152 = Self::mul_add(
+            x90,
+            x140,
+            Self::mul_add(x89, x142, Self::mul_add(x88, x144, x151)),
+        );
+        let x153 = Self::mul_add(-x93, x104, x95);
+        let x154 = Self::mul_add(x114, x153, Self::mul_add(x93, x106, x97));
+        let x155 = Self::mul_add(
+            x122,
+            x154,
+            Self::mul_add(-x116, x153, Self::mul_add(-x93, x108, x99)),
+        );
+        let x156 = Self::mul_add(
+            x125,
+            x154,
+            Self::mul_add(-x118, x153, Self::mul_add(-x93, x110, x101)),
+        );
+        let x157 = x133 * Self::mul_add(x130, x155, x156);
+        let x158 = Self::mul_add(x130, x157, x127 * x155);
+        let x159 = Self::mul_add(x125, x157, Self::mul_add(x122, x158, x120 * x154));
+        let x160 = -x159;
+        let x161 = Self::mul_add(
+            -x118,
+            x157,
+            Self::mul_add(-x116, x158, Self::mul_add(x114, x159, x112 * x153)),
+        );
+        let x162 = Self::mul_add(
+            -x108,
+            x158,
+            Self::mul_add(x106, x159, Self::mul_add(-x104, x161, x93 * x102)),
+        );
+        let x163 = Self::mul_add(-x110, x157, x162);
+        let x164 = Self::mul_add(
+            x97,
+            x159,
+            Self::mul_add(x95, x161, Self::mul_add(x93, x163, x91)),
+        );
+        let x165 = Self::mul_add(x101, x157, Self::mul_add(x99, x158, x164));
+        let x166 = Self::mul_add(-x104, x114, x106);
+        let x167 = Self::mul_add(-x122, x166, Self::mul_add(-x104, x116, x108));
+        let x168 = Self::mul_add(
+            x130,
+            x167,
+            Self::mul_add(-x125, x166, Self::mul_add(-x104, x118, x110)),
+        );
+        let x169 = x133 * x168;
+        let x170 = -x169;
+        let x171 = Self::mul_add(x130, x169, x127 * x167);
+        let x172 = -x171;
+        let x173 = Self::mul_add(-x125, x169, Self::mul_add(-x122, x171, x120 * x166));
+        let x174 = -x173;
+        let x175 = Self::mul_add(
+            -x118,
+            x169,
+            Self::mul_add(-x116, x171, Self::mul_add(-x114, x173, x104 * x112)),
+        );
+        let x176 = -x175;
+        let x177 = Self::mul_add(
+            x108,
+            x171,
+            Self::mul_add(x106, x173, Self::mul_add(x104, x175, x102)),
+        );
+        let x178 = Self::mul_add(x110, x169, x177);
+        let x179 = Self::mul_add(-x114, x122, x116);
+        let x180 = x133 * Self::mul_add(x130, x179, Self::mul_add(-x114, x125, x118));
+        let x181 = -x180;
+        let x182 = Self::mul_add(x130, x180, x127 * x179);
+        let x183 = -x182;
+        let x184 = Self::mul_add(-x125, x180, Self::mul_add(-x122, x182, x114 * x120));
+        let x185 = -x184;
+        let x186 = Self::mul_add(
+            x118,
+            x180,
+            Self::mul_add(x116, x182, Self::mul_add(x114, x184, x112)),
+        );
+        let x187 = x133 * Self::mul_add(x122, x130, x125);
+        let x188 = -x187;
+        let x189 = Self::mul_add(x130, x187, x122 * x127);
+        let x190 = -x189;
+        let x191 = Self::mul_add(x125, x187, Self::mul_add(x122, x189, x120));
+        let x192 = x130 * x133;
+        let x193 = Self::mul_add(x130, x192, x127);
+        [
+            [x152, x150, x147, x145, x144, x143, x141],
+            [x150, x165, x163, x161, x160, x158, x157],
+            [x147, x163, x178, x176, x174, x172, x170],
+            [x145, x161, x176, x186, x185, x183, x181],
+            [x144, x160, x174, x185, x191, x190, x188],
+            [x143, x158, x172, x183, x190, x193, x192],
+            [x141, x157, x170, x181, x188, x192, x133],
+        ]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -108,6 +108,30 @@ pub fn count_lines(
     Ok(lines)
 }
 
+/// The derivative functions and the name of their (one, analytical) candidate: Carpentier &
+/// Mansard's RNEA derivatives, and `M⁻¹` by LDLᵀ on the CRBA's `M`.
+pub const DERIVATIVES: [(Function, &str); 3] = [
+    (Function::InverseDynamicsDerivatives, "carpentier-mansard"),
+    (Function::ForwardDynamicsDerivatives, "carpentier-mansard"),
+    (Function::MassMatrixInverse, "crba-ldlt"),
+];
+
+/// Traces the derivative functions ([`DERIVATIVES`]) of `model` under `spec` and lists their
+/// counts under every convention.
+///
+/// # Errors
+/// As [`trace`].
+pub fn derivative_lines(model: &Model, spec: &Spec) -> Result<Vec<CountLine>, TraceError> {
+    let mut lines = Vec::new();
+    for (f, method) in DERIVATIVES {
+        let t = trace(Subject::Model(model), f, Methods::SPATIAL, spec)?;
+        for conv in Convention::ALL {
+            lines.push(CountLine::new(f.name(), method, conv, t.trace.counts(conv)));
+        }
+    }
+    Ok(lines)
+}
+
 fn diff(a: u64, b: u64) -> i64 {
     i64::try_from(a).unwrap_or(i64::MAX) - i64::try_from(b).unwrap_or(i64::MAX)
 }

@@ -24,6 +24,9 @@
 use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
+use kanegen_dynamics::algorithms::derivatives::{
+    aba as fd_derivatives, minverse, rnea as id_derivatives,
+};
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
@@ -431,6 +434,22 @@ fn floating_outputs(
         Function::GeneralizedJacobian(k) => {
             frames::generalized_jacobian(p, base, state, q, &p.frames[k]).concat()
         }
+        Function::InverseDynamicsDerivatives => {
+            let a = args.qdd.as_ref().expect("takes a");
+            let base_acc: [Sym; 6] = core::array::from_fn(|k| a[k]);
+            let g = effects.gravity.as_ref();
+            let (dq, dv) =
+                id_derivatives::floating_derivatives(p, base, state, q, qd, &base_acc, &a[6..], g);
+            [dq, dv].concat().concat()
+        }
+        Function::ForwardDynamicsDerivatives => {
+            let tau = args.arg(Arg::Tau).expect("takes tau");
+            let g = effects.gravity.as_ref();
+            let (dq, dv, minv) =
+                fd_derivatives::floating_derivatives(p, base, state, q, qd, &tau, g);
+            [dq, dv, minv].concat().concat()
+        }
+        Function::MassMatrixInverse => upper(&minverse::floating_mass_matrix_inverse(p, base, q)),
     }
 }
 
@@ -514,6 +533,18 @@ fn fixed_outputs(
             placement_outputs(x, r)
         }
         Function::FrameJacobian(k) => frames::jacobian(p, q, &p.frames[k]).concat(),
+        Function::InverseDynamicsDerivatives => {
+            let qdd = args.qdd.as_ref().expect("takes q̈");
+            let (dq, dv) = id_derivatives::derivatives(p, q, qd, qdd, effects.gravity.as_ref());
+            [dq, dv].concat().concat()
+        }
+        Function::ForwardDynamicsDerivatives => {
+            let tau = args.arg(Arg::Tau).expect("takes tau");
+            let (dq, dv, minv) =
+                fd_derivatives::derivatives(p, q, qd, &tau, effects.gravity.as_ref());
+            [dq, dv, minv].concat().concat()
+        }
+        Function::MassMatrixInverse => upper(&minverse::mass_matrix_inverse(p, q)),
         Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_) => {
             unreachable!("rejected by check: free-floating only")
         }
@@ -589,6 +620,11 @@ fn check(
         if !(w.body < n || (floating && w.body == BASE_BODY)) {
             return Err(format!("wrench[{i}] acts on body {} of {n}", w.body));
         }
+    }
+    if function.is_derivative() && (spec.damping.is_some() || !spec.wrenches.is_empty()) {
+        return Err(
+            "the derivatives take gravity and a runtime payload, not wrenches or damping".into(),
+        );
     }
     if function.floating_only() && !floating {
         return Err(format!("{} needs a free-floating base", function.name()));

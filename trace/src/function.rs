@@ -40,11 +40,19 @@ pub enum Function {
     FrameJacobian(usize),
     /// Free-floating: the generalized Jacobian (Umetani–Yoshida) of named frame `k`, `6 × N`.
     GeneralizedJacobian(usize),
+    /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics, `NV × NV` each, row-major (Pinocchio's
+    /// `computeRNEADerivatives`; free-floating: `∂/∂q` in the tangent space).
+    InverseDynamicsDerivatives,
+    /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics, `NV × NV` each, row-major (Pinocchio's
+    /// `computeABADerivatives`).
+    ForwardDynamicsDerivatives,
+    /// `M(q)⁻¹`, symmetric; outputs the upper triangle, row-major.
+    MassMatrixInverse,
 }
 
 impl Function {
     /// The functions without a frame, in emission order.
-    pub const ALL: [Function; 10] = [
+    pub const ALL: [Function; 13] = [
         Function::MassMatrix,
         Function::GeneralizedForces,
         Function::NonlinearEffects,
@@ -55,6 +63,9 @@ impl Function {
         Function::ForwardDynamicsWithWrenches,
         Function::Momentum,
         Function::BaseReaction,
+        Function::InverseDynamicsDerivatives,
+        Function::ForwardDynamicsDerivatives,
+        Function::MassMatrixInverse,
     ];
 
     /// The snake-case name (the generated function's name; a frame's functions are named
@@ -75,6 +86,9 @@ impl Function {
             Function::FramePlacement(_) => "placement",
             Function::FrameJacobian(_) => "jacobian",
             Function::GeneralizedJacobian(_) => "generalized_jacobian",
+            Function::InverseDynamicsDerivatives => "inverse_dynamics_derivatives",
+            Function::ForwardDynamicsDerivatives => "forward_dynamics_derivatives",
+            Function::MassMatrixInverse => "mass_matrix_inverse",
         }
     }
 
@@ -109,6 +123,7 @@ impl Function {
         match (self, v, a) {
             (
                 Function::MassMatrix
+                | Function::MassMatrixInverse
                 | Function::Gravity
                 | Function::FramePlacement(_)
                 | Function::FrameJacobian(_)
@@ -116,12 +131,20 @@ impl Function {
                 _,
                 _,
             ) => &[Arg::Q],
-            (Function::GeneralizedForces | Function::ForwardDynamics, Arg::V, _) => {
-                &[Arg::Q, Arg::V, Arg::Tau]
-            }
-            (Function::GeneralizedForces | Function::ForwardDynamics, _, _) => {
-                &[Arg::Q, Arg::Qd, Arg::Tau]
-            }
+            (
+                Function::GeneralizedForces
+                | Function::ForwardDynamics
+                | Function::ForwardDynamicsDerivatives,
+                Arg::V,
+                _,
+            ) => &[Arg::Q, Arg::V, Arg::Tau],
+            (
+                Function::GeneralizedForces
+                | Function::ForwardDynamics
+                | Function::ForwardDynamicsDerivatives,
+                _,
+                _,
+            ) => &[Arg::Q, Arg::Qd, Arg::Tau],
             (
                 Function::NonlinearEffects
                 | Function::MassMatrixAndNonlinearEffects
@@ -136,12 +159,20 @@ impl Function {
                 _,
                 _,
             ) => &[Arg::Q, Arg::Qd],
-            (Function::InverseDynamics | Function::BaseReaction, Arg::V, _) => {
-                &[Arg::Q, Arg::V, Arg::A]
-            }
-            (Function::InverseDynamics | Function::BaseReaction, _, _) => {
-                &[Arg::Q, Arg::Qd, Arg::Qdd]
-            }
+            (
+                Function::InverseDynamics
+                | Function::BaseReaction
+                | Function::InverseDynamicsDerivatives,
+                Arg::V,
+                _,
+            ) => &[Arg::Q, Arg::V, Arg::A],
+            (
+                Function::InverseDynamics
+                | Function::BaseReaction
+                | Function::InverseDynamicsDerivatives,
+                _,
+                _,
+            ) => &[Arg::Q, Arg::Qd, Arg::Qdd],
             (Function::ForwardDynamicsWithWrenches, Arg::V, _) => {
                 &[Arg::Q, Arg::V, Arg::Tau, Arg::FExt]
             }
@@ -163,6 +194,19 @@ impl Function {
         )
     }
 
+    /// Whether it is one of the derivative functions ([`Function::InverseDynamicsDerivatives`],
+    /// [`Function::ForwardDynamicsDerivatives`], [`Function::MassMatrixInverse`]), traced by the
+    /// analytical algorithms of `kanegen_dynamics::algorithms::derivatives`.
+    #[must_use]
+    pub fn is_derivative(self) -> bool {
+        matches!(
+            self,
+            Function::InverseDynamicsDerivatives
+                | Function::ForwardDynamicsDerivatives
+                | Function::MassMatrixInverse
+        )
+    }
+
     /// Whether it reads and writes joint-space quantities only (`q`, `q̇`, `q̈`, `τ`, `M`, `c`,
     /// `g`; on a free-floating base also the base's, in base coordinates), so it can be computed
     /// in any body frames. Not: named frames, body-frame wrenches, and the base reaction and the
@@ -177,6 +221,9 @@ impl Function {
                 | Function::InverseDynamics
                 | Function::ForwardDynamics
                 | Function::MassMatrixAndNonlinearEffects
+                | Function::InverseDynamicsDerivatives
+                | Function::ForwardDynamicsDerivatives
+                | Function::MassMatrixInverse
         )
     }
 

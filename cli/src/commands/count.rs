@@ -6,7 +6,7 @@ use kanegen_codegen::choose::candidates;
 use kanegen_dynamics::{MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::{BaseKind, Model};
 use kanegen_sim::scene::{BaseSpec, Scene};
-use kanegen_trace::count::{count_lines, effect_lines, CountLine, EffectLine};
+use kanegen_trace::count::{count_lines, derivative_lines, effect_lines, CountLine, EffectLine};
 use kanegen_trace::{Base, Function, Spec, TraceError};
 use serde::Serialize;
 use std::path::Path;
@@ -27,6 +27,11 @@ pub struct CountReport {
     /// Methods left out by the size rule ([`DIRECT_MAX_N`]); absent when none.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub omitted: Vec<String>,
+    /// The derivative functions (`inverse_dynamics_derivatives`, `forward_dynamics_derivatives`,
+    /// `mass_matrix_inverse`), their one analytical candidate per convention; absent above
+    /// `kanegen_codegen::plan::DERIVATIVES_MAX_NV` speeds, where they are not generated.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derivatives: Vec<CountLine>,
 }
 
 /// Above this many joints `count` without `--algorithm` leaves out the direct Kane sums
@@ -116,6 +121,17 @@ pub fn count_with_progress(
         counts.extend(count_lines(model, &[], &[*b], &spec)?);
         progress(mass.len() + k + 1, total);
     }
+    let nv = model.dof()
+        + if model.base_kind() == BaseKind::FreeFloating {
+            6
+        } else {
+            0
+        };
+    let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV {
+        derivative_lines(model, &spec)?
+    } else {
+        Vec::new()
+    };
     Ok(CountReport {
         model: model.name().into(),
         n: model.dof(),
@@ -123,6 +139,7 @@ pub fn count_with_progress(
         gravity: gravity.is_some(),
         counts,
         omitted,
+        derivatives,
     })
 }
 
@@ -163,6 +180,10 @@ pub fn render_text(r: &CountReport) -> String {
     write_count_table(&mut s, &r.counts);
     for o in &r.omitted {
         let _ = std::fmt::Write::write_fmt(&mut s, format_args!("\nomitted: {o}\n"));
+    }
+    if !r.derivatives.is_empty() {
+        s.push_str("\nderivatives\n");
+        write_count_table(&mut s, &r.derivatives);
     }
     s
 }
