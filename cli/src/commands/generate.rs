@@ -4,12 +4,10 @@
 use kanegen_codegen::{generate_file, Float, Options};
 use kanegen_model::{BaseKind, Model, ModelError};
 
-/// Most joints `kanegen generate` accepts without `--allow-large`. Large models take the compact
-/// form, decided from a traced prefix ([`kanegen_codegen::plan`]), so generating is quick at
-/// that size (random chain N = 1000: 0.55–3.4 s, 59 MB, 1.6 MB of code); beyond it the generated
-/// code is what grows: its functions keep O(N) arrays on the caller's stack, and its frame
-/// functions stay straight-line (6·N Jacobian entries).
-pub const MAX_N: usize = 1000;
+/// Most joints `kanegen generate` accepts without `--allow-large`
+/// ([`kanegen_codegen::MAX_JOINTS`], the bound `dynamics!` applies too; random chain N = 1000:
+/// 0.55–3.4 s, 59 MB, 1.6 MB of code).
+pub const MAX_N: usize = kanegen_codegen::MAX_JOINTS;
 
 /// `CamelCase` type name from a model name or file stem: `ssrms_nguyen_hughes_1994` →
 /// `SsrmsNguyenHughes1994`; a leading digit gets a `Model` prefix.
