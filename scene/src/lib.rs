@@ -857,8 +857,12 @@ fn parse_floating_base(b: RawBase, chain: &Model, validation: Validation) -> Res
         .map_err(|e| invalid!("base.inertia: {e}"))?;
     let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
     check_finite("base.quaternion", &quat)?;
-    let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
-    if norm < 1e-12 {
+    // Scaled by its largest entry first, so that entries near f64's range normalize instead of
+    // overflowing the sum of squares.
+    let scale = quat.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let unit_scaled = quat.map(|x| if scale > 0.0 { x / scale } else { 0.0 });
+    let norm_scaled = unit_scaled.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if scale * norm_scaled < 1e-12 {
         bail!("base.quaternion: must be non-zero");
     }
     let position = b.position.unwrap_or([0.0; 3]);
@@ -870,7 +874,7 @@ fn parse_floating_base(b: RawBase, chain: &Model, validation: Validation) -> Res
     Ok(BaseSpec::FreeFloating {
         inertial,
         position,
-        quaternion: quat.map(|x| x / norm),
+        quaternion: unit_scaled.map(|x| x / norm_scaled),
         v,
         omega,
     })
