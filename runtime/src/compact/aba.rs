@@ -183,7 +183,7 @@ const SYM: [[usize; 6]; 6] = {
 /// `M v` of a symmetric 6×6 `M` kept as its 21 upper-triangle entries ([`SYM`]).
 #[inline(always)]
 fn sym_times<S: Scalar + Copy>(m: &[S; 21], v: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| {
+    let row = |r: usize| {
         let row = &SYM[r];
         m[row[0]] * v[0]
             + m[row[1]] * v[1]
@@ -191,7 +191,8 @@ fn sym_times<S: Scalar + Copy>(m: &[S; 21], v: &[S; 6]) -> [S; 6] {
             + m[row[3]] * v[3]
             + m[row[4]] * v[4]
             + m[row[5]] * v[5]
-    })
+    };
+    [row(0), row(1), row(2), row(3), row(4), row(5)]
 }
 
 /// `M − w uᵀ` of a packed symmetric `M` (for `w uᵀ` symmetric: `w = u / D`).
