@@ -32,8 +32,8 @@ macro_rules! symmetric_into {
                 }
             }
         }
-        for i in 1..N {
-            for j in 0..i {
+        for j in 0..N {
+            for i in j + 1..N {
                 $h[j][i] = $h[i][j];
             }
         }
@@ -107,8 +107,8 @@ pub fn crba<S: Scalar + Copy>(
     for (i, (hrow, (ici, si))) in h.chunks_exact_mut(n).zip(bodies).enumerate() {
         row(t, st, i, ici, si, hrow);
     }
-    for i in 1..n {
-        for j in 0..i {
+    for j in 0..n {
+        for i in j + 1..n {
             if let Some(&hij) = h.get(i * n + j) {
                 if let Some(hji) = h.get_mut(j * n + i) {
                     *hji = hij;
