@@ -3,7 +3,8 @@
 # CasADi-generated C (Pinocchio's algorithms traced on casadi::SX) and numeric Pinocchio (C++),
 # for M(q), c(q, v), (M, c), inverse and forward dynamics, their derivatives and M⁻¹. Everything
 # from scratch: venv, pip install, random chains, model export, SX tracing, C codegen, gcc / g++,
-# cargo (one crate build per model, timed), validation against numeric Pinocchio, interleaved timing, report.
+# cargo (one crate build per model, timed), validation against numeric Pinocchio, interleaved
+# timing, report.
 # Not part of .ci/run. See benches/peers/README.md.
 #
 #   bash benches/peers/run.sh              # from the project root; results in target/peers/out/
