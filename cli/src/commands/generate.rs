@@ -38,16 +38,18 @@ pub fn generate(model: &Model, opts: &Options) -> Result<String, kanegen_codegen
 }
 
 /// [`generate`], refusing code that holds a non-finite constant (`f64::NAN`, `f64::INFINITY`):
-/// a model quantity folded into the code overflowed.
+/// a model quantity folded into the code overflowed. The joint-limit tables are exempt: an
+/// absent limit is `±∞` by design.
 ///
 /// # Errors
 /// As [`generate`], or a non-finite constant.
 pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String> {
     let code = generate(model, opts)?;
+    let checked = checked_lines(&code);
     for ty in ["f64", "f32"] {
         for c in ["NAN", "INFINITY", "NEG_INFINITY"] {
             let token = format!("{ty}::{c}");
-            if let Some(line) = code.lines().position(|l| {
+            if let Some(&(line, _)) = checked.iter().find(|(_, l)| {
                 !l.trim_start().starts_with("//")
                     && l.split(|ch: char| !(ch.is_alphanumeric() || ch == '_' || ch == ':'))
                         .any(|w| w == token)
@@ -61,6 +63,24 @@ pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String>
         }
     }
     Ok(code)
+}
+
+/// The lines of `code` (0-based number, text) outside the joint-limit tables
+/// (`pub const …_LIMIT: [..] = [..];`, where `±∞` marks an absent limit).
+fn checked_lines(code: &str) -> Vec<(usize, &str)> {
+    let mut in_table = false;
+    let mut lines = Vec::new();
+    for (i, l) in code.lines().enumerate() {
+        if !in_table && l.trim_start().starts_with("pub const ") && l.contains("_LIMIT: [") {
+            in_table = true;
+        }
+        if in_table {
+            in_table = !l.trim_end().ends_with(';');
+        } else {
+            lines.push((i, l));
+        }
+    }
+    lines
 }
 
 /// One file of the `kanegen-generated` crate.
