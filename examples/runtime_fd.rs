@@ -1,20 +1,24 @@
 //! Forward dynamics at run time, no compilation: the model read from its file, then either the
 //! articulated-body algorithm in a preallocated workspace ([`aba::forward_dynamics_in`]), the
-//! allocating [`aba::forward_dynamics`], or the model's own trace of the articulated-body
+//! allocating [`aba::forward_dynamics`], the model's own trace of the articulated-body
 //! algorithm (regrouped parameters, constants folded, common subexpressions shared: the graph
-//! the code generator emits) evaluated as a flat tape of `f64` registers. ns per call (best of 7
-//! rounds of 20000 calls), on SSRMS and the random chains of `benches/data`.
-//! Run: `cargo run --release --example runtime_fd`.
+//! the code generator emits) evaluated as a flat tape of `f64` registers, or the compact form's
+//! articulated-body kernel (`kanegen_runtime::compact::aba`) on slices, its tables built at run
+//! time. ns per call (best of 7 rounds of 20000 calls), on SSRMS and the random chains of
+//! `benches/data`. Run: `cargo run --release --example runtime_fd`.
 //!
 //! Measured (wall clock on a loaded 2-core machine, so only the ratios mean much): workspace
-//! 1501, 1433, 3747, 8340, 16273 ns for SSRMS and N = 8, 16, 32, 64; the tape 5944, 35431,
-//! 81565, 166108, 318225 ns (961 to 51987 instructions): the tape loses 4× on SSRMS and about
-//! 20× on the random chains, its per-instruction dispatch costing more than the arithmetic, so
-//! the run-time path is the workspace ABA. Its side-by-side numbers against Pinocchio are in
-//! `benches/peers` (`aba_runtime`).
+//! 2349, 2716, 5512, 11155, 21420 ns for SSRMS and N = 8, 16, 32, 64; the compact kernel 1273,
+//! 1355, 3092, 6050, 12388 ns (0.50–0.58 of the workspace's time); the tape 10794 to 482913 ns
+//! (959 to 51611 instructions), its per-instruction dispatch costing more than the arithmetic.
+//! The run-time path (`kanegen_sim`'s provider) is the workspace ABA, which also takes armature,
+//! base-frame wrenches and a free-floating base; the kernel has none of these. Its side-by-side
+//! numbers against Pinocchio are in `benches/peers` (`aba_runtime`).
 
+use kanegen::codegen::compact::tables::{numbers, Numbers};
 use kanegen::dynamics::algorithms::aba;
 use kanegen::dynamics::{Loads, Params};
+use kanegen::runtime::compact::{self as kernels, Articulated, Bodies, Rates, Tables, Transform};
 use kanegen::trace::{trace, Function, Node, Spec, Subject};
 use std::hint::black_box;
 use std::time::Instant;
@@ -131,14 +135,97 @@ impl Tape {
     }
 }
 
+/// The compact form's articulated-body kernel (`kanegen_runtime::compact::aba`) on slices: the
+/// model's tables built at run time (`kanegen_codegen`'s, unregrouped, no gravity), its scratch
+/// in `Vec`s allocated once.
+struct Kernel {
+    t: Numbers,
+    ancestor: Option<Vec<bool>>,
+    x: [Vec<Transform<f64>>; 2],
+    s0: Vec<[f64; 6]>,
+    i0: Vec<[f64; 10]>,
+    six: [Vec<[f64; 6]>; 5],
+    ia: Vec<[f64; 21]>,
+    du: [Vec<f64>; 2],
+}
+
+impl Kernel {
+    fn new(model: &kanegen::model::Model) -> Self {
+        let mut opts = kanegen::codegen::Options::new("R");
+        opts.regroup = false;
+        let t = numbers(model, &opts);
+        let n = t.parent.len();
+        let id = Transform {
+            e: [[0.0; 3]; 3],
+            r: [0.0; 3],
+        };
+        Kernel {
+            ancestor: t.ancestor.as_ref().map(|rows| rows.concat()),
+            t,
+            x: [vec![id; n], vec![id; n]],
+            s0: vec![[0.0; 6]; n],
+            i0: vec![[0.0; 10]; n],
+            six: core::array::from_fn(|_| vec![[0.0; 6]; n]),
+            ia: vec![[0.0; 21]; n],
+            du: [vec![0.0; n], vec![0.0; n]],
+        }
+    }
+
+    /// `q̈` into `qdd`: the joint transforms, then the articulated-body algorithm.
+    fn forward_dynamics(&mut self, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) {
+        let t = &self.t;
+        let tables = Tables {
+            parent: &t.parent,
+            revolute: &t.revolute,
+            a: &t.a,
+            b: &t.b,
+            c: &t.c,
+            l: &t.l,
+            slide: &t.slide,
+            s: &t.s,
+            inertia: &t.inertia,
+            ancestor: self.ancestor.as_deref(),
+            a0: t.a0,
+        };
+        let [x, x0] = &mut self.x;
+        let mut b = Bodies {
+            x,
+            x0,
+            s0: &mut self.s0,
+            i0: &mut self.i0,
+        };
+        let [v, c, pa, ui, a] = &mut self.six;
+        let [d, u] = &mut self.du;
+        let mut ab = Articulated {
+            v,
+            c,
+            ia: &mut self.ia,
+            pa,
+            ui,
+            d,
+            u,
+            a,
+        };
+        kernels::spatial::transforms(&tables, q, f64::sin_cos, b.x);
+        let rates = Rates {
+            qd,
+            tau,
+            f_ext: None,
+        };
+        kernels::aba::aba(&tables, tables.inertia, rates, &mut b, &mut ab, qdd);
+    }
+}
+
 fn main() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = vec![root.join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf")];
     for n in [8, 16, 32, 64] {
         files.push(root.join(format!("benches/data/random_n{n}.toml")));
     }
-    println!("| model | N | workspace ns | allocating ns | tape ns | tape instructions |");
-    println!("|---|---:|---:|---:|---:|---:|");
+    println!(
+        "| model | N | workspace ns | allocating ns | tape ns | tape instructions | compact kernel ns |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|");
     for f in files {
         let model = kanegen::model::io::load_model(&f).unwrap();
         let p = Params::<f64>::new(&model);
@@ -202,8 +289,18 @@ fn main() {
             tape.eval(&[black_box(q), black_box(qd), &tau], &mut out);
             out[k % n]
         });
+        // The compact kernel computes the same q̈.
+        let mut kernel = Kernel::new(&model);
+        kernel.forward_dynamics(q, qd, &tau, &mut out);
+        let err = kanegen::dynamics::metrics::rel_err(&out, &want);
+        assert!(err < 1e-10, "compact kernel vs ABA {err:e}");
+        let t_kernel = time(|k| {
+            let (q, qd) = &states[k % 16];
+            kernel.forward_dynamics(black_box(q), black_box(qd), &tau, &mut out);
+            out[k % n]
+        });
         println!(
-            "| {} | {n} | {t_ws:.0} | {t_alloc:.0} | {t_tape:.0} | {} |",
+            "| {} | {n} | {t_ws:.0} | {t_alloc:.0} | {t_tape:.0} | {} | {t_kernel:.0} |",
             model.name(),
             tape.code.len()
         );

@@ -356,3 +356,37 @@ fn count_lists_the_capture_cost() {
         .iter()
         .any(|e| e["effect"] == "rotor"));
 }
+
+/// A base quaternion with entries near f64's range normalizes (its squares would overflow) and
+/// one of zeros is an error naming the key.
+#[test]
+fn base_quaternion_normalizes_at_any_scale() {
+    let scene = |quat: &str| {
+        let text = format!(
+            "model = \"../tests/data/reference/bmsd_7dof_free_floating.urdf\"\n\
+             allow_nonphysical = true\n\
+             [base]\ntype = \"free-floating\"\nquaternion = {quat}\n\
+             [simulation]\nduration = 1.0\n"
+        );
+        Scene::parse(&text, &root().join("scenes"))
+    };
+    for (quat, want) in [
+        (
+            "[1e200, 1e200, 0.0, 0.0]",
+            [0.5f64.sqrt(), 0.5f64.sqrt(), 0.0, 0.0],
+        ),
+        ("[0.0, 0.0, -3e150, 4e150]", [0.0, 0.0, -0.6, 0.8]),
+        ("[0.0, 0.0, 0.0, 2.0]", [0.0, 0.0, 0.0, 1.0]),
+    ] {
+        let s = scene(quat).unwrap();
+        let kanegen::sim::scene::BaseSpec::FreeFloating { quaternion, .. } = s.base else {
+            panic!("{quat}: the base is free-floating");
+        };
+        assert!(
+            max_abs_diff(&quaternion, &want) < 1e-15,
+            "{quat}: {quaternion:?}"
+        );
+    }
+    let e = format!("{:#}", scene("[0.0, 0.0, 0.0, 0.0]").unwrap_err());
+    assert!(e.contains("base.quaternion"), "{e}");
+}

@@ -608,3 +608,38 @@ fn near_permutation_placements_take_the_two_step_carry() {
     assert_eq!(emitted.mul + emitted.add, near);
     check_constant_model!(XArm7, 7, "tests/data/erd/xarm7.urdf");
 }
+
+/// The generated limit constants are the URDF's `<limit>` attributes, joint by joint, read here
+/// from the file's text independently of the model reader; a model without limits gives ±∞.
+#[test]
+fn limits_are_the_urdf_limit_attributes() {
+    let text = std::fs::read_to_string("tests/data/erd/xarm7.urdf").unwrap();
+    let attr = |tag: &str, name: &str| -> f64 {
+        let start = tag.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+        let len = tag[start..].find('"').unwrap();
+        tag[start..start + len].parse().unwrap()
+    };
+    for (i, joint) in XArm7::JOINTS.iter().enumerate() {
+        let at = text
+            .find(&format!("<joint name=\"{joint}\" type="))
+            .unwrap();
+        let tag = &text[at + text[at..].find("<limit").unwrap()..];
+        let tag = &tag[..tag.find("/>").unwrap()];
+        assert_eq!(
+            XArm7::LOWER_POSITION_LIMIT[i],
+            attr(tag, "lower"),
+            "{joint}"
+        );
+        assert_eq!(
+            XArm7::UPPER_POSITION_LIMIT[i],
+            attr(tag, "upper"),
+            "{joint}"
+        );
+        assert_eq!(XArm7::VELOCITY_LIMIT[i], attr(tag, "velocity"), "{joint}");
+        assert_eq!(XArm7::EFFORT_LIMIT[i], attr(tag, "effort"), "{joint}");
+    }
+    assert!(Random5::LOWER_POSITION_LIMIT
+        .iter()
+        .all(|x| *x == f64::NEG_INFINITY));
+    assert!(Random5::EFFORT_LIMIT.iter().all(|x| *x == f64::INFINITY));
+}

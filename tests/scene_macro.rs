@@ -1,43 +1,55 @@
-//! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`), on every example scene
-//! of `scenes/` with rigid joints (`ssrms_flexible.toml`, with flexible joints and the stiff
-//! integrator, is compared in `tests/flexible.rs`) and on seven test scenes with what the
-//! examples lack
-//! (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant and tabulated body-frame
-//! wrenches on one body, constant drives; `floating_wrenches.toml`, free-floating under
-//! gravity, wrenches on the base in both frames and on two links, constant drives, damping;
-//! `floating_midpoint.toml`, a tumbling free-floating base under PD drives, implicit midpoint;
-//! `computed_torque_wrench.toml`, constant wrenches in both frames compensated by a
-//! computed-torque drive; `computed_torque_tabulated.toml`, tabulated wrenches compensated at
-//! each time by a computed-torque drive; `rotor_wrench.toml`, rotor inertia and Coulomb friction with gravity,
+//! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`). Both integrate the one
+//! right-hand side of `kanegen::runtime::scene` (`deriv`: drives, damping, Coulomb friction,
+//! wrench profiles, armature, flexible joints, the free-floating kinematics) over the same
+//! `SceneEffects`; what differs, and what these tests check, is its provider: the generated
+//! dynamics of the scene's model (forward dynamics with the wrenches as `f_ext` rows, the
+//! generated frame placements rotating inertial-frame wrenches, the generated mass matrix
+//! under the armature's LDLᵀ, the generated frame Jacobians compensating a computed-torque
+//! drive, one dynamics type a model phase and the capture impulse) against the run-time
+//! algorithms over the model's numbers (the articulated-body algorithm with the armature in it).
+//!
+//! Scenes: every example scene of `scenes/` with rigid joints (`ssrms_flexible.toml`, with
+//! flexible joints and the stiff integrator, is compared in `tests/flexible.rs`) and seven test
+//! scenes with what the examples lack (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base,
+//! constant and tabulated body-frame wrenches on one body, constant drives;
+//! `floating_wrenches.toml`, free-floating under gravity, wrenches on the base in both frames
+//! and on two links, constant drives, damping; `floating_midpoint.toml`, a tumbling
+//! free-floating base under PD drives, implicit midpoint; `computed_torque_wrench.toml`,
+//! constant wrenches in both frames compensated by a computed-torque drive;
+//! `computed_torque_tabulated.toml`, tabulated wrenches compensated at each time by a
+//! computed-torque drive; `rotor_wrench.toml`, rotor inertia and Coulomb friction with gravity,
 //! an inertial-frame and a tabulated wrench, dopri5; `floating_friction.toml`, drive friction
-//! on the tumbling free-floating arm), and the capture and rotor scenes (`scenes/capture_free_floating.toml`:
-//! a payload captured and released on the free-floating 7-dof arm, dopri5;
-//! `tests/data/scenes/capture_rotor_rk4.toml`: capture and release with rotor inertia, RK4;
-//! `tests/data/scenes/floating_rotor.toml`: rotor inertia on a free-floating base):
+//! on the tumbling free-floating arm), and the capture and rotor scenes
+//! (`scenes/capture_free_floating.toml`: a payload captured and released on the free-floating
+//! 7-dof arm, dopri5; `tests/data/scenes/capture_rotor_rk4.toml`: capture and release with
+//! rotor inertia, RK4; `tests/data/scenes/floating_rotor.toml`: rotor inertia on a
+//! free-floating base):
 //!
 //! - the compiled run samples at the same times as the interpreted one, and every state
 //!   component agrees to `|x_c − x_i| ≤ 1e-9 (1 + |x_i|)` at every sample — the same integrator
 //!   and step (RK4, midpoint) or tolerance (dopri5) on right-hand sides equal to rounding;
-//!   measured worst 9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.0e-15,
-//!   the test scenes 2.4e-14, 2.5e-15, 5.0e-16 (midpoint), 1.3e-16 (computed torque),
-//!   4.1e-14 (rotor with wrenches) and 1.6e-12 (friction, free-floating), capture 9.5e-14,
-//!   capture with rotors 2.2e-15, floating rotor 1.4e-15, the other fixed-base
-//!   scenes ≤ 3.8e-16 (`ssrms_drives`, rotor inertia and friction, 1.1e-16);
+//!   measured (release build, `-C target-cpu=native`) worst 3.9e-14 (`gravity_wrench`), 3.4e-14
+//!   (rotor with wrenches), Dextre 9.1e-15, `free_floating_7dof` 3.7e-15 (dopri5 at tolerance
+//!   1e-10), floating rotor 2.8e-15, capture 1.5e-15, capture with rotors 7.0e-16, the other
+//!   scenes ≤ 8.2e-16 (`ssrms_drives`, rotor inertia and friction, 1.9e-16);
 //! - on the free-floating 7-dof scene, the compiled run conserves linear and angular momentum
 //!   (`NameDynamics::momentum`) as the interpreted one does (its summary's drift): measured
-//!   drifts 5.6e-11 (linear) and 3.49e-10 (angular) relative, interpreted 5.6e-11 and 3.48e-10;
+//!   drifts 5.6e-11 (linear) and 3.49e-10 (angular) relative, interpreted the same;
 //! - the compiled capture impulse is the interpreted one (1e-12) and conserves the generated
-//!   `momentum` of the phases before and after (measured 8.0e-16 linear, 9.9e-16 angular,
+//!   `momentum` of the phases before and after (measured 4.5e-16 linear, 2.9e-15 angular,
 //!   bound 1e-12);
 //! - the compiled right-hand side and one RK4 step ([`SsrmsEffects::step`]) off the equilibrium
 //!   are the interpreted ones; ten midpoint steps ([`FloatingMidpoint::step`]) are the run's
 //!   state at its first output sample.
 //!
-//! The checks see a wrong effect: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves the
-//! SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
+//! The checks see a wrong provider: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves
+//! the SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
 //! inertial-frame wrench left unrotated moves `floating_wrenches` by 2.4e-2; the wrench
-//! compensation of the computed-torque drive with the wrong sign moves its scene by 9.6e-2;
-//! Coulomb friction added instead of subtracted and half the rotor inertia (both at once) move `ssrms_drives` by 9.0e-2 and `rotor_wrench` by 4.8e-1.
+//! compensation of the computed-torque drive with the wrong sign moves its scene by 9.6e-2.
+//! The effects' arithmetic is shared by both runs, so a wrong effect there (Coulomb friction
+//! added instead of subtracted, half the rotor inertia) moves both alike and is not seen here:
+//! `tests/drive_effects.rs` (the energy with rotor inertia and friction) and
+//! `tests/flexible.rs` check it against independent oracles.
 
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, Run};

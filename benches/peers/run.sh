@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # kanegen vs its peers on the same URDFs, in one run: kanegen's generated Rust (dynamics!),
 # CasADi-generated C (Pinocchio's algorithms traced on casadi::SX) and numeric Pinocchio (C++),
-# for M(q), c(q, v), (M, c), inverse and forward dynamics. Everything from scratch: venv, pip
-# install, random chains, model export, SX tracing, C codegen, gcc / g++, cargo (one crate build
-# per model, timed), validation against numeric Pinocchio, interleaved timing, report.
+# for M(q), c(q, v), (M, c), inverse and forward dynamics, their derivatives and M⁻¹. Everything
+# from scratch: venv, pip install, random chains, model export, SX tracing, C codegen, gcc / g++,
+# cargo (one crate build per model, timed), validation against numeric Pinocchio, interleaved
+# timing, report.
 # Not part of .ci/run. See benches/peers/README.md.
 #
 #   bash benches/peers/run.sh              # from the project root; results in target/peers/out/
@@ -25,6 +26,10 @@
 #                     no LLVM), to split the compile time
 #   CASADI_EXTRA=""   more CasADi variants to generate, compile and time: plain, simp
 #   WORLD=1           CasADi and Pinocchio also in Convention::WORLD (M_world, aba_world)
+#   DERIVS=1          the derivative rows (rnea_derivs, aba_derivs, minv; CasADi also rnea_jac,
+#                     aba_jac) on all three sides; the kanegen side needs a dynamics! that emits
+#                     inverse_dynamics_derivatives, forward_dynamics_derivatives and
+#                     mass_matrix_inverse. DERIVS=peers: CasADi and Pinocchio only; DERIVS=0: none
 #   CASADI_SIDE=1     0: no CasADi side (no tracing, no gcc of generated C): Pinocchio and kanegen
 #                     only, e.g. for the run-time path against numeric Pinocchio
 #   TIMING_ONLY=0     1: reuse everything an earlier complete run built in PEERS_WORK (models,
@@ -61,6 +66,14 @@ CHECK_SPLIT=${CHECK_SPLIT:-1}
 TIMING_ONLY=${TIMING_ONLY:-0}
 CASADI_EXTRA=${CASADI_EXTRA:-}
 WORLD=${WORLD:-1}
+DERIVS=${DERIVS:-1}
+case $DERIVS in
+  0) PEERS_DERIVS=0; KG_FEATURES="" ;;
+  peers) PEERS_DERIVS=1; KG_FEATURES="" ;;
+  1) PEERS_DERIVS=1; KG_FEATURES="--features derivs" ;;
+  *) echo "DERIVS=$DERIVS: 1, peers or 0" >&2; exit 1 ;;
+esac
+export PEERS_DERIVS
 CASADI_SIDE=${CASADI_SIDE:-1}
 CC=${CC:-gcc}
 CXX=${CXX:-g++}
@@ -221,7 +234,7 @@ for m in $NAMES; do
     fi
     if [ "$cst" != failed ]; then
       # shellcheck disable=SC2086
-      $CC $fl -std=c11 -Wall -DPEERS_WORLD=$WORLD -I"gen/$m/$v" -Isrc -c src/driver.c -o "$d/driver.o"
+      $CC $fl -std=c11 -Wall -DPEERS_WORLD=$WORLD -DPEERS_DERIVS=$PEERS_DERIVS -I"gen/$m/$v" -Isrc -c src/driver.c -o "$d/driver.o"
       $CC "$d/driver.o" "$d/casadi_gen.o" -lm -o "$d/driver"
       echo "casadi,$lab,$m,cc,$tc,$cst" >> $COMPILE
       CLABELS[$m]="${CLABELS[$m]} $lab"
@@ -256,6 +269,11 @@ kanegen = { path = "$KANEGEN_DIR", default-features = false }
 kanegen-dynamics = { path = "$KANEGEN_DIR/dynamics" }
 kanegen-model = { path = "$KANEGEN_DIR/model" }
 
+[features]
+# the derivative rows (DERIVS=1): the model's type has inverse_dynamics_derivatives,
+# forward_dynamics_derivatives and mass_matrix_inverse
+derivs = []
+
 [workspace]
 EOF
 cargo_env() {  # cargo_env TARGET_DIR RUSTFLAGS CMD...
@@ -276,7 +294,7 @@ kbuild() {  # kbuild KIND TARGET_DIR RUSTFLAGS: deps once, then one timed build 
   first=$(for m in $NAMES; do echo "$($VPY -c "import json; print(json.load(open('build/models/models.json'))['$m']['n'])") $m"; done | sort -n | head -n1 | cut -d' ' -f2)
   use_source "$first" default
   t0=$(now)
-  if cargo_env "$td" "$rf" cargo build --release -q > "logs/kanegen_${kind}_deps.log" 2>&1; then
+  if cargo_env "$td" "$rf" cargo build --release -q $KG_FEATURES > "logs/kanegen_${kind}_deps.log" 2>&1; then
     echo "kanegen,$kind,deps,build,$(since "$t0"),ok" >> $COMPILE
     echo "   dependencies (kanegen, kanegen-macros and the generator crates) in $(since "$t0") s"
   else
@@ -289,12 +307,12 @@ kbuild() {  # kbuild KIND TARGET_DIR RUSTFLAGS: deps once, then one timed build 
     if [ "$kind" = default ] && [ "$CHECK_SPLIT" = 1 ]; then
       use_source "$m" "$src"
       t0=$(now)
-      if cargo_env "$td" "$rf" cargo check --release -q > "logs/kanegen_${kind}_${m}_check.log" 2>&1; then st=ok; else rc=$?; st=$([ $rc = 124 ] || [ $rc = 137 ] && echo timeout || echo error); fi
+      if cargo_env "$td" "$rf" cargo check --release -q $KG_FEATURES > "logs/kanegen_${kind}_${m}_check.log" 2>&1; then st=ok; else rc=$?; st=$([ $rc = 124 ] || [ $rc = 137 ] && echo timeout || echo error); fi
       echo "kanegen,$kind,$m,check,$(since "$t0"),$st" >> $COMPILE
     fi
     use_source "$m" "$src"
     t0=$(now)
-    if cargo_env "$td" "$rf" cargo build --release -q > "logs/kanegen_${kind}_$m.log" 2>&1; then
+    if cargo_env "$td" "$rf" cargo build --release -q $KG_FEATURES > "logs/kanegen_${kind}_$m.log" 2>&1; then
       st=ok
       cp "$td/release/kanegen_peer_bench" "build/bin/kanegen_${kind}_$m"
       KBUILT[$kind.$m]=1

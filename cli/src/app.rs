@@ -4,7 +4,7 @@ use crate::commands;
 use crate::output::{print, OutputDir, OutputFile};
 use crate::progress::Progress;
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use kanegen_dynamics::Methods;
 use kanegen_model::{BaseKind, Model};
 use std::io::Write;
@@ -67,189 +67,221 @@ fn parse_scalar(s: &str) -> Result<kanegen_codegen::Float, String> {
 #[derive(Subcommand)]
 enum Command {
     /// Evaluate A(q) and b(q, q̇) at the states of a JSON file.
-    Eval {
-        /// Model file (.urdf or .toml).
-        model: PathBuf,
-        /// States file: {"states":[{"q":[…],"qd":[…],"tau":[…]}]}; free-floating: each state
-        /// also with "base": {"position", "quaternion" [x, y, z, w], "v", "omega"} (base frame).
-        #[arg(long)]
-        states: PathBuf,
-        /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-inertial (serial chains;
-        /// `crba-base` is its earlier name, still accepted), spatial
-        /// (any tree). Default: recurrent for a chain, spatial for a tree.
-        #[arg(long, value_parser = parse_algorithm)]
-        algorithm: Option<Methods>,
-        /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
-        /// root link's inertial is the free-floating base's).
-        #[arg(long, value_parser = parse_base)]
-        base: Option<BaseKind>,
-        /// Gravity X,Y,Z, m/s², in the base frame (fixed base) or the inertial frame
-        /// (free-floating base); zero unless given.
-        #[arg(long, allow_hyphen_values = true)]
-        gravity: Option<String>,
-        /// Print JSON: {"joints": [names in the order of q], "base": "fixed" | "free-floating",
-        /// "results": [{"A": [[…]], "b": […]}]}.
-        #[arg(long)]
-        json: bool,
-        /// Accept inertias that are not physically realisable (a negative principal moment, the
-        /// triangle inequality violated, rotational inertia without mass); other checks stay.
-        #[arg(long)]
-        allow_nonphysical: bool,
-    },
+    Eval(EvalArgs),
     /// The joints in the order of q (type, parent, axis, limits, mimic), the frames, the base,
     /// the total mass, and what the URDF reader ignored and merged.
-    Info {
-        /// Model file (.urdf or .toml).
-        model: PathBuf,
-        /// The base: fixed or free-floating (default: the model's).
-        #[arg(long, value_parser = parse_base)]
-        base: Option<BaseKind>,
-        /// Print JSON.
-        #[arg(long)]
-        json: bool,
-        /// Accept inertias that are not physically realisable (docs/models.md).
-        #[arg(long)]
-        allow_nonphysical: bool,
-    },
+    Info(InfoArgs),
     /// Reproduce the paper's Table 1 by tracing; print it, or write table1.md, table1.json and
     /// fig2.svg into --out.
-    Table1 {
-        /// Print the JSON report.
-        #[arg(long)]
-        json: bool,
-        /// Write table1.md, table1.json and fig2.svg into this directory.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Replace existing files in --out.
-        #[arg(long)]
-        force: bool,
-    },
+    Table1(Table1Args),
     /// Operation counts of A and b for a model, per algorithm and convention.
-    Count {
-        /// Model file (.urdf or .toml), or a scene file (.toml with a `model` key).
-        model: PathBuf,
-        /// Only the methods of this algorithm (default: every method that suits the model).
-        #[arg(long, value_parser = parse_algorithm)]
-        algorithm: Option<Methods>,
-        /// The base: fixed or free-floating (default: the model's).
-        #[arg(long, value_parser = parse_base)]
-        base: Option<BaseKind>,
-        /// Include gravity X,Y,Z in b.
-        #[arg(long, allow_hyphen_values = true)]
-        gravity: Option<String>,
-        /// Print JSON.
-        #[arg(long)]
-        json: bool,
-        /// Accept inertias that are not physically realisable (a negative principal moment, the
-        /// triangle inequality violated, rotational inertia without mass); other checks stay.
-        #[arg(long)]
-        allow_nonphysical: bool,
-    },
+    Count(CountArgs),
     /// Emit unrolled, allocation-free, no_std Rust for a model (stdout, or -o FILE).
-    Generate {
-        /// Model file (.urdf or .toml).
-        model: PathBuf,
-        /// Output file (stdout when absent); never the model file itself.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Replace an existing output file.
-        #[arg(long)]
-        force: bool,
-        /// Gravity X,Y,Z, m/s², in the base frame (fixed) or the inertial frame (free-floating);
-        /// none: space, no gravity code.
-        #[arg(long, allow_hyphen_values = true)]
-        gravity: Option<String>,
-        /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
-        /// root link's inertial is the free-floating base's).
-        #[arg(long, value_parser = parse_base)]
-        base: Option<BaseKind>,
-        /// Make the last body's mass, centre of mass and inertia a runtime `payload` argument.
-        #[arg(long)]
-        runtime_payload: bool,
-        /// Name of the generated struct (default: from the model name, in CamelCase).
-        #[arg(long)]
-        name: Option<String>,
-        /// Lock joint INDEX at VALUE (rad or m) before generating: `--lock 1=0`.
-        #[arg(long)]
-        lock: Vec<String>,
-        /// Floating-point type of the code: f64 (default) or f32.
-        #[arg(long, default_value = "f64", value_parser = parse_scalar)]
-        scalar: kanegen_codegen::Float,
-        /// Fuse each single-use product into its sum as one `libm::fma` call.
-        #[arg(long)]
-        fma: bool,
-        /// Snap float noise below TOL to exact 0 or ±1 before tracing (0: off; 1e-9 also catches
-        /// `rpy = 1.570796325`); the header says what was snapped.
-        #[arg(long, default_value_t = kanegen_model::canonical::DEFAULT_SNAP, value_name = "TOL")]
-        snap: f64,
-        /// Force one algorithm (recurrent, recurrent-r1, kane-direct, crba-inertial, spatial, aba;
-        /// crba-base is accepted for crba-inertial)
-        /// instead of the cheapest candidate per function.
-        #[arg(long, value_parser = parse_forced)]
-        algorithm: Option<Methods>,
-        /// Accept inertias that are not physically realisable (a negative principal moment, the
-        /// triangle inequality violated, rotational inertia without mass); other checks stay.
-        #[arg(long)]
-        allow_nonphysical: bool,
-        /// Generate every URDF mimic joint as an independent joint (Pinocchio's mimic=False).
-        #[arg(long)]
-        ignore_mimic: bool,
-        /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
-        /// caller's stack, and the frame functions stay straight-line).
-        #[arg(long)]
-        allow_large: bool,
-    },
+    Generate(GenerateArgs),
     /// ns per call of the generated SSRMS code against the interpreted algorithms, measured side
     /// by side in one run (report ratios: the machine is shared and noisy).
-    Bench {
-        /// Print JSON.
-        #[arg(long)]
-        json: bool,
-        /// Measurement rounds per candidate (the median is reported), 1 to 100000.
-        #[arg(long, default_value_t = 31, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-        rounds: u32,
-        /// Calls per round, 1 to 100000000.
-        #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
-        calls: u32,
-    },
+    Bench(BenchArgs),
     /// What accuracy costs in time: errors of A, b, q̈ per precision against a double-double
     /// reference with ns per call; integrators' work–precision; each scene effect's cost and
     /// trajectory change. Without inputs: the four subjects of docs/accuracy.md.
-    Accuracy {
-        /// Model (.urdf/.toml) or scene files (default: SSRMS model and three example scenes).
-        inputs: Vec<PathBuf>,
-        /// Write accuracy.md, accuracy.json and work-precision SVGs into this directory.
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Replace existing files in --out.
-        #[arg(long)]
-        force: bool,
-        /// Print JSON (one input: the report; several: {"subjects": [...]}).
-        #[arg(long)]
-        json: bool,
-        /// Accept inertias that are not physically realisable (models only; docs/models.md).
-        #[arg(long)]
-        allow_nonphysical: bool,
-    },
+    Accuracy(AccuracyArgs),
     /// Simulate a scene file (TOML, docs/scenes.md): write trajectory.csv,
     /// summary.json and SVG plots into --out, print a summary.
-    Simulate {
-        /// Scene file (.toml).
-        scene: PathBuf,
-        /// Write trajectory.csv, summary.json, joints.svg, drift.svg into this directory
-        /// (the trajectory as it is computed; Ctrl-C keeps what was computed).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Print the JSON summary to stdout (and no progress bar).
-        #[arg(long)]
-        json: bool,
-        /// Replace existing files in --out.
-        #[arg(long)]
-        force: bool,
-        /// Allow more than 1e8 steps or output samples (as `allow_long = true` in [simulation]).
-        #[arg(long)]
-        allow_long: bool,
-    },
+    Simulate(SimulateArgs),
+}
+
+// The arguments of `kanegen eval` (its help is the variant's doc).
+#[derive(Args)]
+struct EvalArgs {
+    /// Model file (.urdf or .toml).
+    model: PathBuf,
+    /// States file: {"states":[{"q":[…],"qd":[…],"tau":[…]}]}; free-floating: each state
+    /// also with "base": {"position", "quaternion" [x, y, z, w], "v", "omega"} (base frame).
+    #[arg(long)]
+    states: PathBuf,
+    /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-inertial (serial chains;
+    /// `crba-base` is its earlier name, still accepted), spatial
+    /// (any tree). Default: recurrent for a chain, spatial for a tree.
+    #[arg(long, value_parser = parse_algorithm)]
+    algorithm: Option<Methods>,
+    /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
+    /// root link's inertial is the free-floating base's).
+    #[arg(long, value_parser = parse_base)]
+    base: Option<BaseKind>,
+    /// Gravity X,Y,Z, m/s², in the base frame (fixed base) or the inertial frame
+    /// (free-floating base); zero unless given.
+    #[arg(long, allow_hyphen_values = true)]
+    gravity: Option<String>,
+    /// Print JSON: {"joints": [names in the order of q], "base": "fixed" | "free-floating",
+    /// "results": [{"A": [[…]], "b": […]}]}.
+    #[arg(long)]
+    json: bool,
+    /// Accept inertias that are not physically realisable (a negative principal moment, the
+    /// triangle inequality violated, rotational inertia without mass); other checks stay.
+    #[arg(long)]
+    allow_nonphysical: bool,
+}
+
+// The arguments of `kanegen info` (its help is the variant's doc).
+#[derive(Args)]
+struct InfoArgs {
+    /// Model file (.urdf or .toml).
+    model: PathBuf,
+    /// The base: fixed or free-floating (default: the model's).
+    #[arg(long, value_parser = parse_base)]
+    base: Option<BaseKind>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Accept inertias that are not physically realisable (docs/models.md).
+    #[arg(long)]
+    allow_nonphysical: bool,
+}
+
+// The arguments of `kanegen table1` (its help is the variant's doc).
+#[derive(Args)]
+struct Table1Args {
+    /// Print the JSON report.
+    #[arg(long)]
+    json: bool,
+    /// Write table1.md, table1.json and fig2.svg into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Replace existing files in --out.
+    #[arg(long)]
+    force: bool,
+}
+
+// The arguments of `kanegen count` (its help is the variant's doc).
+#[derive(Args)]
+struct CountArgs {
+    /// Model file (.urdf or .toml), or a scene file (.toml with a `model` key).
+    model: PathBuf,
+    /// Only the methods of this algorithm (default: every method that suits the model).
+    #[arg(long, value_parser = parse_algorithm)]
+    algorithm: Option<Methods>,
+    /// The base: fixed or free-floating (default: the model's).
+    #[arg(long, value_parser = parse_base)]
+    base: Option<BaseKind>,
+    /// Include gravity X,Y,Z in b.
+    #[arg(long, allow_hyphen_values = true)]
+    gravity: Option<String>,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Accept inertias that are not physically realisable (a negative principal moment, the
+    /// triangle inequality violated, rotational inertia without mass); other checks stay.
+    #[arg(long)]
+    allow_nonphysical: bool,
+}
+
+// The arguments of `kanegen generate` (its help is the variant's doc).
+#[derive(Args)]
+struct GenerateArgs {
+    /// Model file (.urdf or .toml).
+    model: PathBuf,
+    /// Output file (stdout when absent); never the model file itself.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Replace an existing output file.
+    #[arg(long)]
+    force: bool,
+    /// Gravity X,Y,Z, m/s², in the base frame (fixed) or the inertial frame (free-floating);
+    /// none: space, no gravity code.
+    #[arg(long, allow_hyphen_values = true)]
+    gravity: Option<String>,
+    /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
+    /// root link's inertial is the free-floating base's).
+    #[arg(long, value_parser = parse_base)]
+    base: Option<BaseKind>,
+    /// Make the last body's mass, centre of mass and inertia a runtime `payload` argument.
+    #[arg(long)]
+    runtime_payload: bool,
+    /// Name of the generated struct (default: from the model name, in CamelCase).
+    #[arg(long)]
+    name: Option<String>,
+    /// Lock joint INDEX at VALUE (rad or m) before generating: `--lock 1=0`.
+    #[arg(long)]
+    lock: Vec<String>,
+    /// Floating-point type of the code: f64 (default) or f32.
+    #[arg(long, default_value = "f64", value_parser = parse_scalar)]
+    scalar: kanegen_codegen::Float,
+    /// Fuse each single-use product into its sum as one `libm::fma` call.
+    #[arg(long)]
+    fma: bool,
+    /// Snap float noise below TOL to exact 0 or ±1 before tracing (0: off; 1e-9 also catches
+    /// `rpy = 1.570796325`); the header says what was snapped.
+    #[arg(long, default_value_t = kanegen_model::canonical::DEFAULT_SNAP, value_name = "TOL")]
+    snap: f64,
+    /// Force one algorithm (recurrent, recurrent-r1, kane-direct, crba-inertial, spatial, aba;
+    /// crba-base is accepted for crba-inertial)
+    /// instead of the cheapest candidate per function.
+    #[arg(long, value_parser = parse_forced)]
+    algorithm: Option<Methods>,
+    /// Accept inertias that are not physically realisable (a negative principal moment, the
+    /// triangle inequality violated, rotational inertia without mass); other checks stay.
+    #[arg(long)]
+    allow_nonphysical: bool,
+    /// Generate every URDF mimic joint as an independent joint (Pinocchio's mimic=False).
+    #[arg(long)]
+    ignore_mimic: bool,
+    /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
+    /// caller's stack, and the frame functions stay straight-line).
+    #[arg(long)]
+    allow_large: bool,
+}
+
+// The arguments of `kanegen bench` (its help is the variant's doc).
+#[derive(Args)]
+struct BenchArgs {
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Measurement rounds per candidate (the median is reported), 1 to 100000.
+    #[arg(long, default_value_t = 31, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    rounds: u32,
+    /// Calls per round, 1 to 100000000.
+    #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+    calls: u32,
+}
+
+// The arguments of `kanegen accuracy` (its help is the variant's doc).
+#[derive(Args)]
+struct AccuracyArgs {
+    /// Model (.urdf/.toml) or scene files (default: SSRMS model and three example scenes).
+    inputs: Vec<PathBuf>,
+    /// Write accuracy.md, accuracy.json and work-precision SVGs into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Replace existing files in --out.
+    #[arg(long)]
+    force: bool,
+    /// Print JSON (one input: the report; several: {"subjects": [...]}).
+    #[arg(long)]
+    json: bool,
+    /// Accept inertias that are not physically realisable (models only; docs/models.md).
+    #[arg(long)]
+    allow_nonphysical: bool,
+}
+
+// The arguments of `kanegen simulate` (its help is the variant's doc).
+#[derive(Args)]
+struct SimulateArgs {
+    /// Scene file (.toml).
+    scene: PathBuf,
+    /// Write trajectory.csv, summary.json, joints.svg, drift.svg into this directory
+    /// (the trajectory as it is computed; Ctrl-C keeps what was computed).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print the JSON summary to stdout (and no progress bar).
+    #[arg(long)]
+    json: bool,
+    /// Replace existing files in --out.
+    #[arg(long)]
+    force: bool,
+    /// Allow more than 1e8 steps or output samples (as `allow_long = true` in [simulation]).
+    #[arg(long)]
+    allow_long: bool,
 }
 
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<Model> {
@@ -321,331 +353,309 @@ where
 ///
 /// # Errors
 /// Any error of the command, with its context chain.
-#[allow(clippy::too_many_lines)]
 pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
-    let say = |msg: &str| {
-        let _ = writeln!(std::io::stderr(), "{msg}");
-    };
     match cli.command {
-        Command::Eval {
-            model,
-            states,
-            algorithm,
-            base,
-            gravity,
-            json: as_json,
-            allow_nonphysical,
-        } => {
-            let mut chain = load(&model, allow_nonphysical)?;
-            if let Some(kind) = base {
-                chain = chain
-                    .with_base_kind(kind)
-                    .with_context(|| format!("model `{}`: --base", model.display()))?;
-            }
-            let algorithm = checked_methods(&chain, algorithm)?;
-            let text = std::fs::read_to_string(&states)
-                .with_context(|| format!("cannot read states file `{}`", states.display()))?;
-            let g = gravity_arg(gravity)?;
-            let results = commands::eval::eval_states(&chain, &text, algorithm, g)
-                .with_context(|| format!("states file `{}`", states.display()))?;
-            if as_json {
-                let joints = commands::eval::coordinate_names(&chain);
-                let v = serde_json::json!({
-                    "joints": joints,
-                    "base": chain.base_kind().name(),
-                    "results": results
-                });
-                print(out, &format!("{v}\n"))?;
-            } else {
-                print(
-                    out,
-                    &commands::eval::render_text(&chain, algorithm, &results),
-                )?;
-            }
+        Command::Eval(a) => eval(a, out),
+        Command::Info(a) => commands::info::run(&a.model, a.base, a.allow_nonphysical, a.json, out),
+        Command::Table1(a) => table1(a, out, interactive),
+        Command::Count(a) if commands::count::is_scene_file(&a.model) => {
+            count_scene(a, out, interactive)
         }
-        Command::Info {
-            model,
-            base,
-            json: as_json,
-            allow_nonphysical,
-        } => commands::info::run(&model, base, allow_nonphysical, as_json, out)?,
-        Command::Table1 {
-            json: as_json,
-            out: dir,
-            force,
-        } => {
-            let planned = dir
-                .as_deref()
-                .map(|d| OutputDir::plan(d, &commands::table1::FILES, force, &[]))
-                .transpose()?;
-            let progress = Progress::spinner(interactive.0, "table1: tracing every algorithm");
-            let t = kanegen_trace::table1::build(&kanegen_trace::table1::trace_all());
-            progress.finish();
-            if let Some(d) = &planned {
-                commands::table1::write_planned(&t, d)?;
-                say(&format!(
-                    "wrote table1.md, table1.json, fig2.svg to {}",
-                    d.dir().display()
-                ));
-            }
-            if as_json {
-                print(out, &json(&t)?)?;
-            } else if planned.is_none() {
-                print(out, &commands::table1::render_markdown(&t)?)?;
-            }
-        }
-        Command::Count {
-            model,
-            algorithm,
-            base,
-            gravity,
-            json: as_json,
-            allow_nonphysical,
-        } => {
-            if commands::count::is_scene_file(&model) {
-                anyhow::ensure!(base.is_none(), "--base: a scene's [base] decides");
-                anyhow::ensure!(gravity.is_none(), "--gravity: a scene's [effects] decide");
-                let scene = kanegen_sim::scene::Scene::load(&model)?;
-                let algs = match algorithm {
-                    Some(a) => vec![checked_methods(&scene.model, Some(a))?],
-                    None if scene.model.is_chain() => Methods::ALL.to_vec(),
-                    None => vec![Methods::SPATIAL],
-                };
-                let progress = Progress::spinner(
-                    interactive.0,
-                    &format!(
-                        "count: tracing the scene's A and b (N = {})",
-                        scene.model.dof()
-                    ),
-                );
-                let r = commands::count::count_scene(&scene, &model.display().to_string(), &algs)?;
-                progress.finish();
-                if as_json {
-                    print(out, &json(&r)?)?;
-                } else {
-                    print(out, &commands::count::render_scene_text(&r))?;
-                }
-                return Ok(());
-            }
-            let mut chain = load(&model, allow_nonphysical)?;
-            if let Some(kind) = base {
-                chain = chain
-                    .with_base_kind(kind)
-                    .with_context(|| format!("model `{}`: --base", model.display()))?;
-            }
-            let algs = match algorithm {
-                Some(a) => vec![checked_methods(&chain, Some(a))?],
-                None => commands::count::emittable(&chain),
-            };
-            let g = gravity_arg(gravity)?;
-            let explicit = algorithm.is_some();
-            let progress = Progress::bar(interactive.0, "count: tracing");
-            let r = commands::count::count_with_progress(&chain, &algs, g, explicit, &|k, n| {
-                progress.set(k, n);
-            })?;
-            progress.finish();
-            if as_json {
-                print(out, &json(&r)?)?;
-            } else {
-                print(out, &commands::count::render_text(&r))?;
-            }
-        }
-        Command::Generate {
-            model,
-            output,
-            force,
-            gravity,
-            base,
-            runtime_payload,
-            name,
-            lock,
-            scalar,
-            fma,
-            snap,
-            algorithm,
-            allow_nonphysical,
-            ignore_mimic,
-            allow_large,
-        } => {
-            let target = output
-                .as_deref()
-                .map(|p| OutputFile::plan(p, force, std::slice::from_ref(&model)))
-                .transpose()?;
-            let mut chain = load(&model, allow_nonphysical)?;
-            if ignore_mimic {
-                chain = chain.without_mimics();
-            }
-            for l in &lock {
-                let (i, v) = l
-                    .split_once('=')
-                    .with_context(|| format!("--lock `{l}`: expected INDEX=VALUE"))?;
-                let i: usize = i.trim().parse().with_context(|| format!("--lock `{l}`"))?;
-                let v: f64 = v.trim().parse().with_context(|| format!("--lock `{l}`"))?;
-                chain = chain
-                    .lock_joint(i, v)
-                    .with_context(|| format!("--lock `{l}`"))?;
-            }
-            let n = chain.dof();
-            anyhow::ensure!(
-                allow_large || n <= commands::generate::MAX_N,
-                "`{}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
-                 on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
-                 pass --allow-large to generate it anyway",
-                model.display(),
-                commands::generate::MAX_N
-            );
-            let g = gravity_arg(gravity)?;
-            let name = name.unwrap_or_else(|| commands::generate::type_name(chain.name()));
-            let mut opts = kanegen_codegen::Options::new(name);
-            opts.gravity = g;
-            opts.base = base;
-            opts.runtime_payload = runtime_payload;
-            opts.float = scalar;
-            opts.fma = fma;
-            opts.snap = snap;
-            opts.algorithm = algorithm;
-            let progress = Progress::spinner(
-                interactive.0,
-                &format!(
-                    "generate: tracing and emitting every function of `{}` (N = {})",
-                    chain.name(),
-                    chain.dof()
-                ),
-            );
-            let code = commands::generate::generate_checked(&chain, &opts)?;
-            progress.finish();
-            match target {
-                Some(f) => f.write(code.as_bytes())?,
-                None => print(out, &code)?,
-            }
-        }
-        Command::Bench {
-            json: as_json,
-            rounds,
-            calls,
-        } => {
-            let r = commands::bench::bench_ssrms(rounds as usize, calls as usize)?;
-            if as_json {
-                print(out, &json(&r)?)?;
-            } else {
-                print(out, &commands::bench::render_text(&r))?;
-            }
-        }
-        Command::Accuracy {
-            inputs,
-            out: dir,
-            force,
-            json: as_json,
-            allow_nonphysical,
-        } => {
-            let inputs: Vec<PathBuf> = if inputs.is_empty() {
-                commands::accuracy::DEFAULT_INPUTS
-                    .iter()
-                    .map(PathBuf::from)
-                    .collect()
-            } else {
-                inputs
-            };
-            let planned = dir
-                .as_deref()
-                .map(|d| {
-                    let names = commands::accuracy::file_names(&inputs);
-                    let names: Vec<&str> = names.iter().map(String::as_str).collect();
-                    OutputDir::plan(d, &names, force, &inputs)
-                })
-                .transpose()?;
-            let opts = crate::reports::accuracy::Options { timing: true };
-            let progress = Progress::bar(interactive.0, "accuracy");
-            let reports = commands::accuracy::run_with_progress(
-                &inputs,
-                allow_nonphysical,
-                opts,
-                &|k, n| {
-                    progress.set(k, n);
-                },
-            )?;
-            progress.finish();
-            if let Some(d) = &planned {
-                commands::accuracy::write_planned(&reports, d)?;
-                say(&format!(
-                    "wrote accuracy.md, accuracy.json, work-precision SVGs to {}",
-                    d.dir().display()
-                ));
-            }
-            if as_json {
-                print(out, &json(&commands::accuracy::to_json(&reports))?)?;
-            } else if planned.is_none() {
-                print(out, &commands::accuracy::render_markdown(&reports, true)?)?;
-            }
-        }
-        Command::Simulate {
-            scene,
-            out: dir,
-            json: as_json,
-            force,
-            allow_long,
-        } => {
-            let options = kanegen_sim::scene::SceneOptions { allow_long };
-            let sc = kanegen_sim::scene::Scene::load_with(&scene, options)?;
-            let mut inputs = vec![scene.clone()];
-            if let Some(m) = std::fs::read_to_string(&scene).ok().and_then(|t| {
-                kanegen_sim::scene::Scene::model_path(&t, scene.parent().unwrap_or(Path::new(".")))
-            }) {
-                inputs.push(m);
-            }
-            let planned = dir
-                .as_deref()
-                .map(|d| OutputDir::plan(d, &commands::simulate::FILES, force, &inputs))
-                .transpose()?;
-            let pb = if as_json || !interactive.0 {
-                indicatif::ProgressBar::hidden()
-            } else {
-                indicatif::ProgressBar::new((sc.simulation.duration * 1000.0) as u64)
-            };
-            if interactive.0 {
-                STOP.store(false, Ordering::SeqCst);
-                install_ctrlc();
-            }
-            let control = kanegen_sim::simulate::Control {
-                progress: Some(&pb),
-                stop: interactive.0.then_some(&STOP),
-            };
-            let summary = commands::simulate::run(&sc, planned.as_ref(), control)?;
-            pb.finish_and_clear();
-            if as_json {
-                print(out, &json(&summary)?)?;
-            } else {
-                print(
-                    out,
-                    &format!("{}\n", commands::simulate_text::render_text(&summary)),
-                )?;
-            }
-            if let Some(d) = &planned {
-                say(&format!(
-                    "wrote trajectory.csv, summary.json, plots to {}{}",
-                    d.dir().display(),
-                    if summary.complete {
-                        ""
-                    } else {
-                        " (incomplete run)"
-                    }
-                ));
-            }
-            match summary.stopped.as_deref() {
-                None => {}
-                Some("interrupted") => return Err(Interrupted.into()),
-                Some(why) => anyhow::bail!(
-                    "the simulation stopped at t = {}: {why}{}",
-                    summary.t_end,
-                    if planned.is_some() {
-                        "; the trajectory up to there and a summary with \"complete\": false \
-                         were written"
-                    } else {
-                        ""
-                    }
-                ),
-            }
-        }
+        Command::Count(a) => count(a, out, interactive),
+        Command::Generate(a) => generate(a, out, interactive),
+        Command::Bench(a) => bench(a, out),
+        Command::Accuracy(a) => accuracy(a, out, interactive),
+        Command::Simulate(a) => simulate(a, out, interactive),
+    }
+}
+
+/// A line on stderr (what a command wrote where).
+fn say(msg: &str) {
+    let _ = writeln!(std::io::stderr(), "{msg}");
+}
+
+/// The model at `model` with the base `--base` gives (the model's own when `None`).
+fn load_with_base(model: &Path, allow_nonphysical: bool, base: Option<BaseKind>) -> Result<Model> {
+    let chain = load(model, allow_nonphysical)?;
+    match base {
+        None => Ok(chain),
+        Some(kind) => chain
+            .with_base_kind(kind)
+            .with_context(|| format!("model `{}`: --base", model.display())),
+    }
+}
+
+/// `kanegen eval`: A and b at each state of the states file, as text or JSON.
+fn eval(a: EvalArgs, out: &mut dyn Write) -> Result<()> {
+    let chain = load_with_base(&a.model, a.allow_nonphysical, a.base)?;
+    let algorithm = checked_methods(&chain, a.algorithm)?;
+    let text = std::fs::read_to_string(&a.states)
+        .with_context(|| format!("cannot read states file `{}`", a.states.display()))?;
+    let g = gravity_arg(a.gravity)?;
+    let results = commands::eval::eval_states(&chain, &text, algorithm, g)
+        .with_context(|| format!("states file `{}`", a.states.display()))?;
+    if a.json {
+        let joints = commands::eval::coordinate_names(&chain);
+        let v = serde_json::json!({
+            "joints": joints,
+            "base": chain.base_kind().name(),
+            "results": results
+        });
+        print(out, &format!("{v}\n"))
+    } else {
+        print(
+            out,
+            &commands::eval::render_text(&chain, algorithm, &results),
+        )
+    }
+}
+
+/// `kanegen table1`: the paper's Table 1 by tracing, printed or written into `--out`.
+fn table1(a: Table1Args, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let planned = a
+        .out
+        .as_deref()
+        .map(|d| OutputDir::plan(d, &commands::table1::FILES, a.force, &[]))
+        .transpose()?;
+    let progress = Progress::spinner(interactive.0, "table1: tracing every algorithm");
+    let t = kanegen_trace::table1::build(&kanegen_trace::table1::trace_all());
+    progress.finish();
+    if let Some(d) = &planned {
+        commands::table1::write_planned(&t, d)?;
+        say(&format!(
+            "wrote table1.md, table1.json, fig2.svg to {}",
+            d.dir().display()
+        ));
+    }
+    if a.json {
+        print(out, &json(&t)?)?;
+    } else if planned.is_none() {
+        print(out, &commands::table1::render_markdown(&t)?)?;
     }
     Ok(())
+}
+
+/// `kanegen count` on a scene file: the counts of the scene's A and b (its base and gravity).
+fn count_scene(a: CountArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    anyhow::ensure!(a.base.is_none(), "--base: a scene's [base] decides");
+    anyhow::ensure!(a.gravity.is_none(), "--gravity: a scene's [effects] decide");
+    let scene = kanegen_sim::scene::Scene::load(&a.model)?;
+    let algs = match a.algorithm {
+        Some(m) => vec![checked_methods(&scene.model, Some(m))?],
+        None if scene.model.is_chain() => Methods::ALL.to_vec(),
+        None => vec![Methods::SPATIAL],
+    };
+    let progress = Progress::spinner(
+        interactive.0,
+        &format!(
+            "count: tracing the scene's A and b (N = {})",
+            scene.model.dof()
+        ),
+    );
+    let r = commands::count::count_scene(&scene, &a.model.display().to_string(), &algs)?;
+    progress.finish();
+    if a.json {
+        print(out, &json(&r)?)
+    } else {
+        print(out, &commands::count::render_scene_text(&r))
+    }
+}
+
+/// `kanegen count` on a model file: the counts of each method that suits it (or the one named).
+fn count(a: CountArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let chain = load_with_base(&a.model, a.allow_nonphysical, a.base)?;
+    let algs = match a.algorithm {
+        Some(m) => vec![checked_methods(&chain, Some(m))?],
+        None => commands::count::emittable(&chain),
+    };
+    let g = gravity_arg(a.gravity)?;
+    let explicit = a.algorithm.is_some();
+    let progress = Progress::bar(interactive.0, "count: tracing");
+    let r = commands::count::count_with_progress(&chain, &algs, g, explicit, &|k, n| {
+        progress.set(k, n);
+    })?;
+    progress.finish();
+    if a.json {
+        print(out, &json(&r)?)
+    } else {
+        print(out, &commands::count::render_text(&r))
+    }
+}
+
+/// `kanegen generate`: the model (mimics ignored, joints locked as asked) emitted as Rust, to
+/// stdout or `-o`.
+fn generate(a: GenerateArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let target = a
+        .output
+        .as_deref()
+        .map(|p| OutputFile::plan(p, a.force, std::slice::from_ref(&a.model)))
+        .transpose()?;
+    let mut chain = load(&a.model, a.allow_nonphysical)?;
+    if a.ignore_mimic {
+        chain = chain.without_mimics();
+    }
+    for l in &a.lock {
+        let (i, v) = l
+            .split_once('=')
+            .with_context(|| format!("--lock `{l}`: expected INDEX=VALUE"))?;
+        let i: usize = i.trim().parse().with_context(|| format!("--lock `{l}`"))?;
+        let v: f64 = v.trim().parse().with_context(|| format!("--lock `{l}`"))?;
+        chain = chain
+            .lock_joint(i, v)
+            .with_context(|| format!("--lock `{l}`"))?;
+    }
+    let n = chain.dof();
+    anyhow::ensure!(
+        a.allow_large || n <= commands::generate::MAX_N,
+        "`{}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
+         on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
+         pass --allow-large to generate it anyway",
+        a.model.display(),
+        commands::generate::MAX_N
+    );
+    let name = a
+        .name
+        .unwrap_or_else(|| commands::generate::type_name(chain.name()));
+    let mut opts = kanegen_codegen::Options::new(name);
+    opts.gravity = gravity_arg(a.gravity)?;
+    opts.base = a.base;
+    opts.runtime_payload = a.runtime_payload;
+    opts.float = a.scalar;
+    opts.fma = a.fma;
+    opts.snap = a.snap;
+    opts.algorithm = a.algorithm;
+    let progress = Progress::spinner(
+        interactive.0,
+        &format!(
+            "generate: tracing and emitting every function of `{}` (N = {})",
+            chain.name(),
+            chain.dof()
+        ),
+    );
+    let code = commands::generate::generate_checked(&chain, &opts)?;
+    progress.finish();
+    match target {
+        Some(f) => f.write(code.as_bytes()),
+        None => print(out, &code),
+    }
+}
+
+/// `kanegen bench`: the generated SSRMS code against the interpreted algorithms.
+fn bench(a: BenchArgs, out: &mut dyn Write) -> Result<()> {
+    let r = commands::bench::bench_ssrms(a.rounds as usize, a.calls as usize)?;
+    if a.json {
+        print(out, &json(&r)?)
+    } else {
+        print(out, &commands::bench::render_text(&r))
+    }
+}
+
+/// `kanegen accuracy`: the accuracy reports of the inputs (the default subjects without any),
+/// printed or written into `--out`.
+fn accuracy(a: AccuracyArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let inputs: Vec<PathBuf> = if a.inputs.is_empty() {
+        commands::accuracy::DEFAULT_INPUTS
+            .iter()
+            .map(PathBuf::from)
+            .collect()
+    } else {
+        a.inputs
+    };
+    let planned = a
+        .out
+        .as_deref()
+        .map(|d| {
+            let names = commands::accuracy::file_names(&inputs);
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            OutputDir::plan(d, &names, a.force, &inputs)
+        })
+        .transpose()?;
+    let opts = crate::reports::accuracy::Options { timing: true };
+    let progress = Progress::bar(interactive.0, "accuracy");
+    let reports =
+        commands::accuracy::run_with_progress(&inputs, a.allow_nonphysical, opts, &|k, n| {
+            progress.set(k, n);
+        })?;
+    progress.finish();
+    if let Some(d) = &planned {
+        commands::accuracy::write_planned(&reports, d)?;
+        say(&format!(
+            "wrote accuracy.md, accuracy.json, work-precision SVGs to {}",
+            d.dir().display()
+        ));
+    }
+    if a.json {
+        print(out, &json(&commands::accuracy::to_json(&reports))?)?;
+    } else if planned.is_none() {
+        print(out, &commands::accuracy::render_markdown(&reports, true)?)?;
+    }
+    Ok(())
+}
+
+/// `kanegen simulate`: runs the scene (Ctrl-C stops it when interactive), writes its outputs
+/// into `--out`, prints its summary; an error when it stopped early.
+fn simulate(a: SimulateArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let options = kanegen_sim::scene::SceneOptions {
+        allow_long: a.allow_long,
+    };
+    let sc = kanegen_sim::scene::Scene::load_with(&a.scene, options)?;
+    let mut inputs = vec![a.scene.clone()];
+    if let Some(m) = std::fs::read_to_string(&a.scene).ok().and_then(|t| {
+        kanegen_sim::scene::Scene::model_path(&t, a.scene.parent().unwrap_or(Path::new(".")))
+    }) {
+        inputs.push(m);
+    }
+    let planned = a
+        .out
+        .as_deref()
+        .map(|d| OutputDir::plan(d, &commands::simulate::FILES, a.force, &inputs))
+        .transpose()?;
+    let pb = if a.json || !interactive.0 {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new((sc.simulation.duration * 1000.0) as u64)
+    };
+    if interactive.0 {
+        STOP.store(false, Ordering::SeqCst);
+        install_ctrlc();
+    }
+    let control = kanegen_sim::simulate::Control {
+        progress: Some(&pb),
+        stop: interactive.0.then_some(&STOP),
+    };
+    let summary = commands::simulate::run(&sc, planned.as_ref(), control)?;
+    pb.finish_and_clear();
+    if a.json {
+        print(out, &json(&summary)?)?;
+    } else {
+        print(
+            out,
+            &format!("{}\n", commands::simulate_text::render_text(&summary)),
+        )?;
+    }
+    if let Some(d) = &planned {
+        say(&format!(
+            "wrote trajectory.csv, summary.json, plots to {}{}",
+            d.dir().display(),
+            if summary.complete {
+                ""
+            } else {
+                " (incomplete run)"
+            }
+        ));
+    }
+    match summary.stopped.as_deref() {
+        None => Ok(()),
+        Some("interrupted") => Err(Interrupted.into()),
+        Some(why) => anyhow::bail!(
+            "the simulation stopped at t = {}: {why}{}",
+            summary.t_end,
+            if planned.is_some() {
+                "; the trajectory up to there and a summary with \"complete\": false \
+                 were written"
+            } else {
+                ""
+            }
+        ),
+    }
 }

@@ -65,16 +65,12 @@
 //! noisy 2-core machine), old / new time: random N = 16, 32, 64: `M` 1.08, 1.27, 1.45;
 //! `M + c` 1.04, 1.14, 1.29; forward dynamics 1.13, 1.14, 1.14.
 //!
-//! Moving the kernels from pasted tokens into `kanegen_runtime::compact` (generic over the
-//! scalar; cores over slices with caller-provided scratch, so that one instance on `Sym` traces
-//! any N, inlined into const-`N` entry points; the tables one `const` of `'static` slices) gives
-//! bit-identical results and, side by side (two crates with one `dynamics!(…, form =
-//! "compact")` per random chain, 7 alternating runs, per run the lowest of 9 rounds, median of
-//! the per-run ratios new / old), random N = 16, 32, 64: `M` 1.04, 1.11, 1.17; `M + c` 0.99,
-//! 1.03, 1.04; forward dynamics 1.04, 1.09, 1.10. With the cores left out of line (one instance
-//! for every N) they were 1.11–1.23 (`M`), 1.03–1.08 and 1.10–1.15; `H` lent to the kernel as
-//! a slice costs one copy of it into the result (`memmove` 11 % of `M`'s time at N = 64,
-//! against 3 %).
+//! The kernels live in `kanegen_runtime::compact` (generic over the scalar; cores over slices
+//! with caller-provided scratch, so that one instance on `Sym` traces any N, inlined into
+//! const-`N` entry points; the tables one `const` of `'static` slices). Side by side against the
+//! same algorithms pasted as tokens into each generated type (`tools/compact/side_by_side.sh`),
+//! their results are bit-identical and their times no longer (`docs/performance.md`, "The
+//! compact kernels against the token-template kernels").
 
 pub mod counts;
 pub mod tables;

@@ -45,7 +45,7 @@ pub mod sincos;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
-pub use options::{forced_algorithm, Error, Float, Form, Options, VERSION};
+pub use options::{forced_algorithm, Error, Float, Form, Options, MAX_JOINTS, VERSION};
 pub use plan::Plan;
 
 use kanegen_model::Model;
@@ -439,7 +439,7 @@ fn type_items(
          method; `fma`: fused multiply-adds formed, each also counted as one `mul` and one `add`).",
         opts.type_name
     );
-    let consts = type_consts(plan, fmas, op_ty);
+    let consts = type_consts(plan, opts.float, fmas, op_ty);
     let helpers = helper_items(plan, opts, fmas)?;
     Ok(quote! {
         #(#struct_docs)*
@@ -499,9 +499,9 @@ fn type_items(
     })
 }
 
-/// The type's constants: `N`, `JOINTS`, `FRAMES`, a free-floating base's `NQ` and `NV`,
-/// `OP_COUNTS` and `CANDIDATES`.
-fn type_consts(plan: &Plan, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
+/// The type's constants: `N`, `JOINTS`, `FRAMES`, the joints' limits, a free-floating base's
+/// `NQ` and `NV`, `OP_COUNTS` and `CANDIDATES`.
+fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
     let model = &plan.model;
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
@@ -522,6 +522,7 @@ fn type_consts(plan: &Plan, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
     } else {
         quote!()
     };
+    let limits = limit_consts(model.limits(), float);
     let n_fns = Literal::usize_unsuffixed(plan.functions.len());
     let (emitted, all) = op_count_entries(plan, fmas, op_ty);
     quote! {
@@ -531,11 +532,44 @@ fn type_consts(plan: &Plan, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
         pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
         /// Named frames, in the model's order (one `<frame>_…` function family each).
         pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
+        #limits
         #floating_consts
         /// Emitted operation counts of each generated function, in emission order.
         pub const OP_COUNTS: [#op_ty; #n_fns] = [#(#emitted),*];
         /// Emitted operation counts of every candidate traced (the cheapest is emitted).
         pub const CANDIDATES: &'static [#op_ty] = &[#(#all),*];
+    }
+}
+
+/// The joints' limits as the model file gives them (a URDF's `<limit>`), in the order of
+/// `JOINTS`, named as Pinocchio's `lowerPositionLimit`, `upperPositionLimit`, `velocityLimit`
+/// and `effortLimit`; a limit the file does not give is `-∞` (lower) or `+∞`.
+fn limit_consts(limits: &[kanegen_model::Limits], float: Float) -> TokenStream {
+    let ty = float.ty();
+    let n = Literal::usize_unsuffixed(limits.len());
+    let column = |pick: fn(&kanegen_model::Limits) -> Option<f64>, absent: TokenStream| {
+        let entries = limits.iter().map(|l| match pick(l) {
+            Some(x) => {
+                let x = float.suffixed(x);
+                quote!(#x)
+            }
+            None => absent.clone(),
+        });
+        quote!([#(#entries),*])
+    };
+    let lower = column(|l| l.lower, quote!(#ty::NEG_INFINITY));
+    let upper = column(|l| l.upper, quote!(#ty::INFINITY));
+    let velocity = column(|l| l.velocity, quote!(#ty::INFINITY));
+    let effort = column(|l| l.effort, quote!(#ty::INFINITY));
+    quote! {
+        /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
+        pub const LOWER_POSITION_LIMIT: [#ty; #n] = #lower;
+        /// Highest joint positions (rad or m; `+∞` where the model gives none).
+        pub const UPPER_POSITION_LIMIT: [#ty; #n] = #upper;
+        /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
+        pub const VELOCITY_LIMIT: [#ty; #n] = #velocity;
+        /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
+        pub const EFFORT_LIMIT: [#ty; #n] = #effort;
     }
 }
 

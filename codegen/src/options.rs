@@ -5,6 +5,13 @@ use kanegen_dynamics::{ForwardMethod, Methods};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
+/// Most joints a model may have for generation without an explicit override (`--allow-large`
+/// of `kanegen generate`, `allow_large = true` of `dynamics!`). Large models take the compact
+/// form, decided from a traced prefix ([`crate::plan`]), so generating is quick at that size;
+/// beyond it the generated code is what grows: its functions keep O(N) arrays on the caller's
+/// stack, and its frame functions stay straight-line (6·N Jacobian entries).
+pub const MAX_JOINTS: usize = 1000;
+
 /// Version of the generator, written into every generated header.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 

@@ -155,6 +155,32 @@ impl FreeFloating7 {
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
     pub const FRAMES: [&'static str; 0] = [];
+    /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
+    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+        -3.141592653589793f64,
+    ];
+    /// Highest joint positions (rad or m; `+∞` where the model gives none).
+    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+        3.141592653589793f64,
+        3.141592653589793f64,
+        3.141592653589793f64,
+        3.141592653589793f64,
+        3.141592653589793f64,
+        3.141592653589793f64,
+        3.141592653589793f64,
+    ];
+    /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
+    pub const VELOCITY_LIMIT: [f64; 7] = [1f64, 1f64, 1f64, 1f64, 1f64, 1f64, 1f64];
+    /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
+    pub const EFFORT_LIMIT: [f64; 7] = [
+        10000f64, 10000f64, 10000f64, 10000f64, 10000f64, 10000f64, 10000f64,
+    ];
     /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
     pub const NQ: usize = 14;
     /// Length of `v`: base linear and angular velocity (base frame), joint rates.

@@ -149,6 +149,37 @@ impl Srms {
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
     pub const FRAMES: [&'static str; 0] = [];
+    /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
+    pub const LOWER_POSITION_LIMIT: [f64; 6] = [
+        -3.0962f64,
+        0f64,
+        -2.75064f64,
+        -2.0316f64,
+        -2.0316f64,
+        -7.714f64,
+    ];
+    /// Highest joint positions (rad or m; `+∞` where the model gives none).
+    pub const UPPER_POSITION_LIMIT: [f64; 6] = [
+        3.0962f64,
+        2.485f64,
+        0f64,
+        2.0316f64,
+        2.0316f64,
+        7.714f64,
+    ];
+    /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
+    pub const VELOCITY_LIMIT: [f64; 6] = [
+        0.03997f64,
+        0.03997f64,
+        0.056f64,
+        0.0831f64,
+        0.0831f64,
+        0.0831f64,
+    ];
+    /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
+    pub const EFFORT_LIMIT: [f64; 6] = [
+        1570f64, 1570f64, 1074f64, 470f64, 470f64, 470f64,
+    ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 9] = [
         OpCount {

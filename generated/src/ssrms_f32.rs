@@ -151,6 +151,40 @@ impl SsrmsF32 {
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
     pub const FRAMES: [&'static str; 0] = [];
+    /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
+    pub const LOWER_POSITION_LIMIT: [f32; 7] = [
+        -4.71239f32,
+        -4.71239f32,
+        -4.71239f32,
+        -4.71239f32,
+        -4.71239f32,
+        -4.71239f32,
+        -4.71239f32,
+    ];
+    /// Highest joint positions (rad or m; `+∞` where the model gives none).
+    pub const UPPER_POSITION_LIMIT: [f32; 7] = [
+        4.71239f32,
+        4.71239f32,
+        4.71239f32,
+        4.71239f32,
+        4.71239f32,
+        4.71239f32,
+        4.71239f32,
+    ];
+    /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
+    pub const VELOCITY_LIMIT: [f32; 7] = [
+        0.0698132f32,
+        0.0698132f32,
+        0.0698132f32,
+        0.0698132f32,
+        0.0698132f32,
+        0.0698132f32,
+        0.0698132f32,
+    ];
+    /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
+    pub const EFFORT_LIMIT: [f32; 7] = [
+        2332f32, 2332f32, 2332f32, 2332f32, 2332f32, 2332f32, 2332f32,
+    ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 9] = [
         OpCount {

@@ -84,6 +84,40 @@ impl SsrmsRecurrent {
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
     pub const FRAMES: [&'static str; 0] = [];
+    /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
+    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+        -4.71239f64,
+        -4.71239f64,
+        -4.71239f64,
+        -4.71239f64,
+        -4.71239f64,
+        -4.71239f64,
+        -4.71239f64,
+    ];
+    /// Highest joint positions (rad or m; `+∞` where the model gives none).
+    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+        4.71239f64,
+        4.71239f64,
+        4.71239f64,
+        4.71239f64,
+        4.71239f64,
+        4.71239f64,
+        4.71239f64,
+    ];
+    /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
+    pub const VELOCITY_LIMIT: [f64; 7] = [
+        0.0698132f64,
+        0.0698132f64,
+        0.0698132f64,
+        0.0698132f64,
+        0.0698132f64,
+        0.0698132f64,
+        0.0698132f64,
+    ];
+    /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
+    pub const EFFORT_LIMIT: [f64; 7] = [
+        2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64,
+    ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 9] = [
         OpCount {

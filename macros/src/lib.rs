@@ -26,6 +26,7 @@ struct Input {
     gravity: Option<[f64; 3]>,
     base: Option<kanegen_codegen::kanegen_model::BaseKind>,
     allow_nonphysical: bool,
+    allow_large: bool,
     ignore_mimic: bool,
     runtime_payload: bool,
     float: kanegen_codegen::Float,
@@ -57,20 +58,37 @@ fn float(e: &Expr) -> syn::Result<f64> {
     }
 }
 
-impl Parse for Input {
-    fn parse(input: ParseStream) -> syn::Result<Self> {
-        let runtime: syn::Path = input.parse()?;
-        input.parse::<Token![;]>()?;
-        let name: Ident = input.parse()?;
-        input.parse::<Token![,]>()?;
-        let path: LitStr = input.parse()?;
-        let mut out = Input {
+/// The options `dynamics!` takes after the model's path, in the order its messages list them.
+const OPTIONS: &[&str] = &[
+    "gravity",
+    "base",
+    "allow_nonphysical",
+    "allow_large",
+    "ignore_mimic",
+    "runtime_payload",
+    "scalar",
+    "fma",
+    "fma_path",
+    "target_fma",
+    "regroup",
+    "canonical",
+    "libm_trig",
+    "snap",
+    "algorithm",
+    "form",
+];
+
+impl Input {
+    /// The defaults of every option.
+    fn new(runtime: syn::Path, name: Ident, path: LitStr) -> Self {
+        Input {
             runtime,
             name,
             path,
             gravity: None,
             base: None,
             allow_nonphysical: false,
+            allow_large: false,
             ignore_mimic: false,
             runtime_payload: false,
             float: kanegen_codegen::Float::F64,
@@ -83,105 +101,146 @@ impl Parse for Input {
             snap: None,
             algorithm: None,
             form: kanegen_codegen::Form::Auto,
-        };
-        let mut fma_path_key: Option<Ident> = None;
+        }
+    }
+
+    /// Parses the value of option `key` (its `=` already read) into `self`.
+    fn option(&mut self, key: &Ident, input: ParseStream) -> syn::Result<()> {
+        match key.to_string().as_str() {
+            "gravity" => self.gravity = Some(gravity(input)?),
+            "base" => self.base = Some(base(input)?),
+            "allow_nonphysical" => self.allow_nonphysical = input.parse::<LitBool>()?.value,
+            "allow_large" => self.allow_large = input.parse::<LitBool>()?.value,
+            "ignore_mimic" => self.ignore_mimic = input.parse::<LitBool>()?.value,
+            "runtime_payload" => self.runtime_payload = input.parse::<LitBool>()?.value,
+            "scalar" => self.float = scalar(input)?,
+            "fma" => self.fma = input.parse::<LitBool>()?.value,
+            "regroup" => self.regroup = input.parse::<LitBool>()?.value,
+            "canonical" => self.canonical = input.parse::<LitBool>()?.value,
+            "libm_trig" => self.libm_trig = input.parse::<LitBool>()?.value,
+            "target_fma" => self.target_fma = input.parse::<LitBool>()?.value,
+            "algorithm" => {
+                let name: LitStr = input.parse()?;
+                self.algorithm = Some(
+                    kanegen_codegen::forced_algorithm(&name.value())
+                        .map_err(|e| syn::Error::new(name.span(), e.0))?,
+                );
+            }
+            "snap" => self.snap = Some(snap(input)?),
+            "form" => self.form = form(input)?,
+            "fma_path" => self.fma_path = Some(input.parse::<syn::Path>()?),
+            other => {
+                return Err(syn::Error::new(
+                    key.span(),
+                    format!("unknown option `{other}` (expected {})", OPTIONS.join(", ")),
+                ))
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `gravity = [x, y, z]`: three finite components within the bound the CLI applies
+/// ([`kanegen_codegen::kanegen_model::bounds::GRAVITY`]).
+fn gravity(input: ParseStream) -> syn::Result<[f64; 3]> {
+    let arr: ExprArray = input.parse()?;
+    let v: Vec<f64> = arr.elems.iter().map(float).collect::<syn::Result<_>>()?;
+    let g: [f64; 3] = v
+        .try_into()
+        .map_err(|_| syn::Error::new_spanned(&arr, "gravity must have three components"))?;
+    kanegen_codegen::kanegen_model::bounds::GRAVITY
+        .check(&g)
+        .map_err(|e| syn::Error::new_spanned(&arr, format!("gravity: {e}")))?;
+    Ok(g)
+}
+
+/// `base = "fixed" | "free-floating"`.
+fn base(input: ParseStream) -> syn::Result<kanegen_codegen::kanegen_model::BaseKind> {
+    let lit: LitStr = input.parse()?;
+    kanegen_codegen::kanegen_model::BaseKind::from_name(&lit.value()).ok_or_else(|| {
+        syn::Error::new(
+            lit.span(),
+            format!(
+                "unknown base `{}`: expected \"fixed\" or \"free-floating\"",
+                lit.value()
+            ),
+        )
+    })
+}
+
+/// `scalar = f32 | f64`.
+fn scalar(input: ParseStream) -> syn::Result<kanegen_codegen::Float> {
+    let ty: Ident = input
+        .parse()
+        .map_err(|e| syn::Error::new(e.span(), "expected `f32` or `f64` (scalar = f32)"))?;
+    kanegen_codegen::Float::from_name(&ty.to_string()).ok_or_else(|| {
+        syn::Error::new(
+            ty.span(),
+            format!("unsupported scalar `{ty}`: expected `f32` or `f64`"),
+        )
+    })
+}
+
+/// `snap = x` with `x` in [0, 0.1).
+fn snap(input: ParseStream) -> syn::Result<f64> {
+    let e: Expr = input.parse()?;
+    let x = float(&e)?;
+    if !(0.0..0.1).contains(&x) {
+        return Err(syn::Error::new_spanned(
+            e,
+            format!("snap tolerance {x} is not in [0, 0.1)"),
+        ));
+    }
+    Ok(x)
+}
+
+/// `form = "auto" | "unrolled" | "compact"`.
+fn form(input: ParseStream) -> syn::Result<kanegen_codegen::Form> {
+    let lit: LitStr = input.parse()?;
+    kanegen_codegen::Form::from_name(&lit.value()).ok_or_else(|| {
+        syn::Error::new(
+            lit.span(),
+            format!(
+                "unknown form `{}`: expected \"auto\", \"unrolled\" or \"compact\"",
+                lit.value()
+            ),
+        )
+    })
+}
+
+/// The head every macro input starts with: `RUNTIME; Name, "path"`.
+fn head(input: ParseStream) -> syn::Result<(syn::Path, Ident, LitStr)> {
+    let runtime: syn::Path = input.parse()?;
+    input.parse::<Token![;]>()?;
+    let name: Ident = input.parse()?;
+    input.parse::<Token![,]>()?;
+    Ok((runtime, name, input.parse()?))
+}
+
+impl Parse for Input {
+    /// `RUNTIME; Name, "path" [, key = value]*`: each option at most once.
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let (runtime, name, path) = head(input)?;
+        let mut out = Input::new(runtime, name, path);
+        let mut seen: Vec<Ident> = Vec::new();
         while input.parse::<Option<Token![,]>>()?.is_some() {
             if input.is_empty() {
                 break;
             }
             let key: Ident = input.parse()?;
-            input.parse::<Token![=]>()?;
-            match key.to_string().as_str() {
-                "gravity" => {
-                    let arr: ExprArray = input.parse()?;
-                    let v: Vec<f64> = arr.elems.iter().map(float).collect::<syn::Result<_>>()?;
-                    let g: [f64; 3] = v.try_into().map_err(|_| {
-                        syn::Error::new_spanned(&arr, "gravity must have three components")
-                    })?;
-                    out.gravity = Some(g);
-                }
-                "base" => {
-                    let lit: LitStr = input.parse()?;
-                    out.base = Some(
-                        kanegen_codegen::kanegen_model::BaseKind::from_name(&lit.value())
-                            .ok_or_else(|| {
-                                syn::Error::new(
-                                    lit.span(),
-                                    format!(
-                                        "unknown base `{}`: expected \"fixed\" or \"free-floating\"",
-                                        lit.value()
-                                    ),
-                                )
-                            })?,
-                    );
-                }
-                "allow_nonphysical" => out.allow_nonphysical = input.parse::<LitBool>()?.value,
-                "ignore_mimic" => out.ignore_mimic = input.parse::<LitBool>()?.value,
-                "runtime_payload" => out.runtime_payload = input.parse::<LitBool>()?.value,
-                "scalar" => {
-                    let ty: Ident = input.parse().map_err(|e| {
-                        syn::Error::new(e.span(), "expected `f32` or `f64` (scalar = f32)")
-                    })?;
-                    out.float =
-                        kanegen_codegen::Float::from_name(&ty.to_string()).ok_or_else(|| {
-                            syn::Error::new(
-                                ty.span(),
-                                format!("unsupported scalar `{ty}`: expected `f32` or `f64`"),
-                            )
-                        })?;
-                }
-                "fma" => out.fma = input.parse::<LitBool>()?.value,
-                "regroup" => out.regroup = input.parse::<LitBool>()?.value,
-                "canonical" => out.canonical = input.parse::<LitBool>()?.value,
-                "libm_trig" => out.libm_trig = input.parse::<LitBool>()?.value,
-                "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
-                "algorithm" => {
-                    let name: LitStr = input.parse()?;
-                    out.algorithm = Some(
-                        kanegen_codegen::forced_algorithm(&name.value())
-                            .map_err(|e| syn::Error::new(name.span(), e.0))?,
-                    );
-                }
-                "snap" => {
-                    let e: Expr = input.parse()?;
-                    let x = float(&e)?;
-                    if !(0.0..0.1).contains(&x) {
-                        return Err(syn::Error::new_spanned(
-                            e,
-                            format!("snap tolerance {x} is not in [0, 0.1)"),
-                        ));
-                    }
-                    out.snap = Some(x);
-                }
-                "form" => {
-                    let lit: LitStr = input.parse()?;
-                    out.form = kanegen_codegen::Form::from_name(&lit.value()).ok_or_else(|| {
-                        syn::Error::new(
-                            lit.span(),
-                            format!(
-                                "unknown form `{}`: expected \"auto\", \"unrolled\" or \"compact\"",
-                                lit.value()
-                            ),
-                        )
-                    })?;
-                }
-                "fma_path" => {
-                    out.fma_path = Some(input.parse::<syn::Path>()?);
-                    fma_path_key = Some(key);
-                }
-                other => {
-                    return Err(syn::Error::new(
-                        key.span(),
-                        format!(
-                            "unknown option `{other}` (expected gravity, base, allow_nonphysical, ignore_mimic, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, canonical, libm_trig, snap, \
-                             algorithm, form)"
-                        ),
-                    ))
-                }
+            if let Some(first) = seen.iter().find(|k| **k == key) {
+                let mut e = syn::Error::new(
+                    key.span(),
+                    format!("option `{key}` is given twice: give each option once"),
+                );
+                e.combine(syn::Error::new(first.span(), "first given here"));
+                return Err(e);
             }
+            input.parse::<Token![=]>()?;
+            out.option(&key, input)?;
+            seen.push(key);
         }
-        if let (Some(key), false) = (fma_path_key, out.fma) {
+        if let (Some(key), false) = (seen.iter().find(|k| *k == "fma_path"), out.fma) {
             return Err(syn::Error::new(key.span(), "`fma_path` needs `fma = true`"));
         }
         Ok(out)
@@ -214,6 +273,15 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         .map_err(|e| e.to_string().replace(&abs, &rel))?;
     if input.ignore_mimic {
         model = model.without_mimics();
+    }
+    let n = model.dof();
+    if n > kanegen_codegen::MAX_JOINTS && !input.allow_large {
+        return Err(format!(
+            "`{rel}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
+             on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
+             `allow_large = true` generates it anyway",
+            kanegen_codegen::MAX_JOINTS
+        ));
     }
     let name = input.name.to_string();
     let mut opts = kanegen_codegen::Options::new(name.clone());
@@ -259,11 +327,7 @@ struct SceneInput {
 
 impl Parse for SceneInput {
     fn parse(input: ParseStream) -> syn::Result<Self> {
-        let runtime: syn::Path = input.parse()?;
-        input.parse::<Token![;]>()?;
-        let name: Ident = input.parse()?;
-        input.parse::<Token![,]>()?;
-        let path: LitStr = input.parse()?;
+        let (runtime, name, path) = head(input)?;
         input.parse::<Option<Token![,]>>()?;
         if !input.is_empty() {
             return Err(input.error(

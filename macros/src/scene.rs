@@ -184,6 +184,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         wrench_frames: &wrench_frames,
     };
     let provider = scene_provider::provider(scene, &shape).map_err(|e| format!("{rel}: {e}"))?;
+    let rt = &shape.rt;
     let state = state_items(scene, &layout, name, &dyn_name);
     let simulator = simulator_items(runtime, (name, rel), scene, &layout, &model_ty, &phase_tys);
     let docs = Docs::of(scene, &model, &layout, name, rel);
@@ -207,6 +208,10 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
 
         #[allow(clippy::unreadable_literal, clippy::excessive_precision)]
         #provider
+
+        impl #rt::scene::SceneModel for #model_ty {
+            const EFFECTS: #rt::scene::SceneEffects<'static> = #name::EFFECTS;
+        }
 
         #[doc = #struct_doc]
         #[doc = ""]
@@ -460,62 +465,48 @@ impl Methods {
     }
 }
 
-/// `impl Name`: the scene's constants and effects, `initial_state`, `rhs`, `step`, `run` and
-/// (with events) the event items.
-fn simulator_items(
+/// The scene's right-hand side in model phase `phase` as an `ode::System`
+/// (`kanegen_runtime::scene::SceneOde`: the one right-hand side over the provider `model_ty`
+/// and its `SceneModel::EFFECTS`, in the memory `work` of the enclosing function).
+fn system(rt: &TokenStream, model_ty: &Ident, phase: TokenStream) -> TokenStream {
+    quote! {
+        #rt::scene::SceneOde {
+            dynamics: #model_ty(#phase),
+            work: &mut work,
+        }
+    }
+}
+
+/// The body of `run`: one integration over the scene's duration, or (with events) one a
+/// segment between events with the event applied at its end.
+fn run_body(
     runtime: &syn::Path,
-    (name, rel): (&Ident, &str),
     scene: &Scene,
     l: &Layout,
     model_ty: &Ident,
-    phase_tys: &[Ident],
+    m: &Methods,
 ) -> TokenStream {
-    let sim = &scene.simulation;
     let rt = quote!(#runtime::__private::runtime);
-    let ode = quote!(#rt::ode);
-    let dim = Literal::usize_unsuffixed(l.dim);
-    let (state_ty, floating) = (&l.state_ty, l.floating);
-    let m = Methods::of(sim, &ode, &dim);
-    // The scene's right-hand side in model phase `phase` as an `ode::System` (the quaternion
-    // projected and advanced by the exponential map on a free-floating base), `work` its
-    // memory.
-    let system = |phase: TokenStream| {
-        quote! {
-            #ode::FnSystem::<#dim, _> {
-                rhs: |t: f64, x: &[f64; #dim]| {
-                    let mut dx = [0.0f64; #dim];
-                    #rt::scene::deriv(&mut #model_ty(#phase), &Self::EFFECTS, t, x, &mut dx, &mut work);
-                    dx
-                },
-                floating: #floating,
-            }
-        }
-    };
-    let step_system = system(quote!(0));
     let (run_fn, options) = (&m.run_fn, &m.options);
-    let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| quote!(#ode::#run_fn(&mut sys, #t0, #t1, &#options, &mut x, &mut scratch, #obs));
-    let run_body = if scene.events.is_empty() {
+    let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| quote!(#rt::ode::#run_fn(&mut sys, #t0, #t1, &#options, &mut x, &mut scratch, #obs));
+    if scene.events.is_empty() {
         let call = integrate(quote!(0.0), quote!(Self::DURATION), quote!(obs));
-        let sys = system(quote!(0));
+        let sys = system(&rt, model_ty, quote!(0));
         quote! {
             let mut sys = #sys;
             #call
         }
     } else {
         let call = integrate(quote!(t0), quote!(t1), quote!(&mut obs));
-        let sys = system(quote!(phase));
-        crate::scene_events::run_segments(runtime, state_ty, &sys, &call)
-    };
-    let events = crate::scene_events::event_items(
-        runtime,
-        scene,
-        state_ty,
-        &phase_tys[0],
-        phase_tys,
-        l.nv,
-        l.n,
-    );
-    let (rhs_sig, phase) = if scene.events.is_empty() {
+        let sys = system(&rt, model_ty, quote!(phase));
+        crate::scene_events::run_segments(runtime, &l.state_ty, &sys, &call)
+    }
+}
+
+/// The signature of `rhs` (`rhs_in` with the model phase as its first argument when the scene
+/// has events) and the phase it runs in.
+fn rhs_signature(scene: &Scene, state_ty: &Ident) -> (TokenStream, TokenStream) {
+    if scene.events.is_empty() {
         let sig = quote! {
             /// The right-hand side `ẋ = f(t, x)` with the scene's effects only.
             #[must_use]
@@ -530,8 +521,12 @@ fn simulator_items(
             pub fn rhs_in(phase: usize, t: f64, s: &#state_ty) -> #state_ty
         };
         (sig, quote!(phase))
-    };
-    let step_doc = match sim.integrator {
+    }
+}
+
+/// The doc of `step` for the scene's integrator.
+fn step_doc(integrator: Integrator) -> &'static str {
+    match integrator {
         Integrator::Rosenbrock => {
             " One Rodas4 step of size `h` from `(t, state)` (no step control)."
         }
@@ -542,7 +537,30 @@ fn simulator_items(
             " One fixed RK4 step of size `h` from `(t, state)`, then the projection (the \
              quaternion renormalized on a free-floating base)."
         }
-    };
+    }
+}
+
+/// `impl Name`: the scene's constants and effects, `initial_state`, `rhs`, `step`, `run` and
+/// (with events) the event items.
+fn simulator_items(
+    runtime: &syn::Path,
+    (name, rel): (&Ident, &str),
+    scene: &Scene,
+    l: &Layout,
+    model_ty: &Ident,
+    phase_tys: &[Ident],
+) -> TokenStream {
+    let rt = quote!(#runtime::__private::runtime);
+    let ode = quote!(#rt::ode);
+    let dim = Literal::usize_unsuffixed(l.dim);
+    let state_ty = &l.state_ty;
+    let m = Methods::of(&scene.simulation, &ode, &dim);
+    let step_system = system(&rt, model_ty, quote!(0));
+    let run_body = run_body(runtime, scene, l, model_ty, &m);
+    let events =
+        crate::scene_events::event_items(runtime, scene, state_ty, &phase_tys[0], phase_tys);
+    let (rhs_sig, phase) = rhs_signature(scene, state_ty);
+    let step_doc = step_doc(scene.simulation.integrator);
     let constants = constants(&rt, scene, l, rel);
     let (step_fn, run_scratch, step_scratch) = (&m.step_fn, &m.run_scratch, &m.step_scratch);
     quote! {

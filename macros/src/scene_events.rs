@@ -1,23 +1,16 @@
 //! Payload capture and release (`[[events]]`) in `kanegen::scene!`, as the interpreted
 //! simulator does them (`kanegen_sim::events`): one generated dynamics type per distinct model
 //! phase, a run integrated segment by segment between the event times, and at a capture the
-//! impulse `H' ν⁺ = H ν⁻ + J_pᵀ h_p` from the generated mass matrices of the phases before and
-//! after and the generated Jacobian and placement of a frame at the payload's centre of mass.
+//! impulse `H' ν⁺ = H ν⁻ + J_pᵀ h_p` (`kanegen_runtime::scene::capture_velocity`) over the
+//! generated mass matrices of the phases before and after and the generated Jacobian and
+//! placement of a frame at the payload's centre of mass.
 
+use crate::scene_provider::{arr, lit};
 use kanegen_codegen::kanegen_model::{BaseKind, Model};
 use kanegen_scene::{BaseSpec, EventKind, Scene};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 use syn::Ident;
-
-fn lit(x: f64) -> Literal {
-    Literal::f64_suffixed(x)
-}
-
-fn arr(v: &[f64]) -> TokenStream {
-    let v = v.iter().map(|x| lit(*x));
-    quote!([#(#v),*])
-}
 
 /// The dynamics type of each phase (phase 0 is `NameDynamics`, phase `k` follows event
 /// `k − 1`; a phase whose model is an earlier phase's reuses its type) and the items of the
@@ -102,8 +95,6 @@ pub fn event_items(
     state_ty: &Ident,
     dyn_ty: &Ident,
     phase_tys: &[Ident],
-    nv: usize,
-    n: usize,
 ) -> TokenStream {
     if scene.events.is_empty() {
         return TokenStream::new();
@@ -111,19 +102,7 @@ pub fn event_items(
     let times: Vec<f64> = scene.events.iter().map(|e| e.time).collect();
     let count = Literal::usize_unsuffixed(times.len());
     let times = arr(&times);
-    let nvl = Literal::usize_unsuffixed(nv);
-    let armature = scene.rotor.as_ref().map(|r| {
-        let refl = arr(&r.reflected);
-        let nl = Literal::usize_unsuffixed(n);
-        let off = Literal::usize_unsuffixed(nv - n);
-        quote! {
-            const ROTOR: [f64; #nl] = #refl;
-            for i in 0..#nl {
-                h[#off + i][#off + i] += ROTOR[i];
-                h_new[#off + i][#off + i] += ROTOR[i];
-            }
-        }
-    });
+    let rt = quote!(#runtime::__private::runtime);
     let arms = scene.events.iter().enumerate().map(|(k, e)| {
         let kl = Literal::usize_unsuffixed(k);
         match &e.kind {
@@ -138,41 +117,21 @@ pub fn event_items(
                 let (m, v, w) = (lit(payload.mass), arr(v), arr(omega));
                 let rows = payload.inertia.iter().map(|r| arr(r));
                 quote!(#kl => {
-                    const MASS: f64 = #m;
-                    const V: [f64; 3] = #v;
-                    const OMEGA: [f64; 3] = #w;
-                    const INERTIA: [[f64; 3]; 3] = [#(#rows),*];
-                    let mut h = #before::mass_matrix(&s.q);
-                    let mut h_new = #after::mass_matrix(&s.q);
-                    #armature
-                    // h_p = [m v_p; R I_p Rᵀ ω_p] (inertial frame).
-                    let r = #dyn_ty::#pl(&s.q).1;
-                    let wb: [f64; 3] = core::array::from_fn(|i| {
-                        r[0][i] * OMEGA[0] + r[1][i] * OMEGA[1] + r[2][i] * OMEGA[2]
-                    });
-                    let iw: [f64; 3] = core::array::from_fn(|i| {
-                        INERTIA[i][0] * wb[0] + INERTIA[i][1] * wb[1] + INERTIA[i][2] * wb[2]
-                    });
-                    let hp = [
-                        MASS * V[0],
-                        MASS * V[1],
-                        MASS * V[2],
-                        r[0][0] * iw[0] + r[0][1] * iw[1] + r[0][2] * iw[2],
-                        r[1][0] * iw[0] + r[1][1] * iw[1] + r[1][2] * iw[2],
-                        r[2][0] * iw[0] + r[2][1] * iw[1] + r[2][2] * iw[2],
-                    ];
-                    let jp = #dyn_ty::#jac(&s.q);
-                    let p: [f64; #nvl] = core::array::from_fn(|i| {
-                        let mut x = 0.0;
-                        for j in 0..#nvl {
-                            x += h[i][j] * s.v[j];
-                        }
-                        for row in 0..6 {
-                            x += jp[row][i] * hp[row];
-                        }
-                        x
-                    });
-                    s.v = #runtime::__private::runtime::ode::solve_spd(&h_new, &p).unwrap_or([f64::NAN; #nvl]);
+                    const PAYLOAD: #rt::scene::CapturedPayload = #rt::scene::CapturedPayload {
+                        mass: #m,
+                        inertia: [#(#rows),*],
+                        v: #v,
+                        omega: #w,
+                    };
+                    s.v = #rt::scene::capture_velocity(
+                        #before::mass_matrix(&s.q),
+                        #after::mass_matrix(&s.q),
+                        Self::EFFECTS.armature,
+                        &#dyn_ty::#pl(&s.q).1,
+                        &#dyn_ty::#jac(&s.q),
+                        &PAYLOAD,
+                        &s.v,
+                    );
                 })
             }
         }

@@ -152,6 +152,7 @@ pub fn provider(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
     let inverse = inverse(scene, sh)?;
     Ok(quote! {
         impl #rt::scene::SceneDynamics for #ty {
+            #[inline(always)]
             fn forward(&mut self, q: &[f64], v: &[f64], tau: &[f64], w: &[f64], acc: &mut [f64]) {
                 let (Ok(q), Ok(v), Ok(tau), Ok(w)) = (
                     <&[f64; #nql]>::try_from(q),
@@ -164,7 +165,10 @@ pub fn provider(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
                 let _ = w;
                 #f_ext
                 let a: [f64; #nvl] = #forward;
-                #rt::scene::copy_into(acc, &a);
+                match <&mut [f64; #nvl]>::try_from(&mut *acc) {
+                    Ok(acc) => *acc = a,
+                    Err(_) => acc.fill(f64::NAN),
+                }
             }
 
             fn mass_matrix(&mut self, q: &[f64], m: &mut [f64]) {

@@ -758,6 +758,484 @@ fn parse_events(
     Ok(events)
 }
 
+/// The scene's model at `model_path`: loaded, without mimic joints, its forward dynamics
+/// defined (errors name the model file).
+fn load_chain(model_path: &Path, validation: Validation) -> Result<Model> {
+    let chain = kanegen_model::io::load_model_with(model_path, validation)
+        .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
+    if chain.has_mimics() {
+        bail!(
+            "model: `{}`: mimic joints are not supported by the simulator yet",
+            model_path.display()
+        );
+    }
+    chain
+        .check_forward_dynamics()
+        .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
+    Ok(chain)
+}
+
+/// `[payload]`: its holding body (the last by default) and its validated inertial.
+fn parse_payload(
+    raw: Option<RawPayload>,
+    chain0: &Model,
+    validation: Validation,
+) -> Result<Option<(usize, Inertial)>> {
+    let Some(p) = raw else {
+        return Ok(None);
+    };
+    if !(p.mass.is_finite() && p.mass > 0.0) {
+        bail!("payload.mass: must be > 0");
+    }
+    check_bound("payload.com", &p.com, LENGTH)?;
+    let pay = Inertial {
+        mass: p.mass,
+        com: p.com,
+        inertia: p.inertia.0,
+    };
+    kanegen_model::validate_inertial_with("payload", "inertia", &pay, validation)
+        .map_err(|e| invalid!("payload.inertia: {e}"))?;
+    let holder = match &p.body {
+        None => chain0.dof() - 1,
+        Some(name) => body_index(chain0, name).ok_or_else(|| {
+            invalid!(
+                "payload.body: unknown body `{name}` (moving bodies: {})",
+                body_names(chain0)
+            )
+        })?,
+    };
+    Ok(Some((holder, pay)))
+}
+
+/// `[base]`: fixed (no other keys), or free-floating with its inertial (the model's base
+/// inertial by default), its normalized attitude and its initial position and velocity.
+fn parse_base(raw: Option<RawBase>, chain: &Model, validation: Validation) -> Result<BaseSpec> {
+    let Some(b) = raw else {
+        return Ok(BaseSpec::Fixed);
+    };
+    match b.kind.as_str() {
+        "fixed" => {
+            let given = [
+                ("mass", b.mass.is_some()),
+                ("com", b.com.is_some()),
+                ("inertia", b.inertia.is_some()),
+                ("position", b.position.is_some()),
+                ("quaternion", b.quaternion.is_some()),
+                ("v", b.v.is_some()),
+                ("omega", b.omega.is_some()),
+            ];
+            if let Some((k, _)) = given.iter().find(|(_, g)| *g) {
+                bail!("base.{k}: only for type = \"free-floating\"");
+            }
+            Ok(BaseSpec::Fixed)
+        }
+        "free-floating" => parse_floating_base(b, chain, validation),
+        other => bail!(
+            "base.type: unknown base type `{other}` (expected \"fixed\" or \"free-floating\")"
+        ),
+    }
+}
+
+/// The free-floating `[base]` of [`parse_base`].
+fn parse_floating_base(b: RawBase, chain: &Model, validation: Validation) -> Result<BaseSpec> {
+    let model = chain.base_inertial();
+    let mass = b.mass.or(model.map(|i| i.mass)).ok_or_else(|| {
+        invalid!("base.mass: the model has no base inertial; give mass, com, inertia")
+    })?;
+    let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
+    let inertia = b
+        .inertia
+        .map(|i| i.0)
+        .or(model.map(|i| i.inertia))
+        .ok_or_else(|| invalid!("base.inertia: the model has no base inertial"))?;
+    if !(mass.is_finite() && mass > 0.0) {
+        bail!("base.mass: must be > 0");
+    }
+    check_bound("base.com", &com, LENGTH)?;
+    let inertial = Inertial { mass, com, inertia };
+    kanegen_model::validate_inertial_with("base", "inertia", &inertial, validation)
+        .map_err(|e| invalid!("base.inertia: {e}"))?;
+    let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+    check_finite("base.quaternion", &quat)?;
+    // Scaled by its largest entry first, so that entries near f64's range normalize instead of
+    // overflowing the sum of squares.
+    let scale = quat.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let unit_scaled = quat.map(|x| if scale > 0.0 { x / scale } else { 0.0 });
+    let norm_scaled = unit_scaled.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if scale * norm_scaled < 1e-12 {
+        bail!("base.quaternion: must be non-zero");
+    }
+    let position = b.position.unwrap_or([0.0; 3]);
+    let v = b.v.unwrap_or([0.0; 3]);
+    let omega = b.omega.unwrap_or([0.0; 3]);
+    check_bound("base.position", &position, LENGTH)?;
+    check_bound("base.v", &v, RATE)?;
+    check_bound("base.omega", &omega, RATE)?;
+    Ok(BaseSpec::FreeFloating {
+        inertial,
+        position,
+        quaternion: unit_scaled.map(|x| x / norm_scaled),
+        v,
+        omega,
+    })
+}
+
+/// `[[effects.wrench]]`: each on a known body (the base only when it floats), in its body's
+/// or the inertial frame, with its profile.
+fn parse_wrenches(raw: Vec<RawWrench>, chain: &Model, floating: bool) -> Result<Vec<SceneWrench>> {
+    let mut wrenches = Vec::new();
+    for (k, w) in raw.into_iter().enumerate() {
+        let key = format!("effects.wrench[{k}]");
+        let body = if w.body == "base" || w.body == chain.base() {
+            if !floating {
+                bail!("{key}.body: a wrench on a fixed base has no effect");
+            }
+            BASE_BODY
+        } else {
+            body_index(chain, &w.body).ok_or_else(|| {
+                invalid!(
+                    "{key}.body: unknown body `{}` (known: base, {})",
+                    w.body,
+                    body_names(chain)
+                )
+            })?
+        };
+        let frame = match w.frame.as_str() {
+            "body" => LoadFrame::Body,
+            "inertial" => LoadFrame::Base,
+            other => bail!("{key}.frame: unknown frame `{other}` (expected body or inertial)"),
+        };
+        wrenches.push(SceneWrench {
+            body,
+            frame,
+            profile: wrench_profile(&key, w.time, w.force, w.moment)?,
+        });
+    }
+    Ok(wrenches)
+}
+
+/// `[effects.rotor]`: rotor inertias and gear ratios, `N` each, and the reflected inertia.
+fn parse_rotor(
+    raw: Option<toml::Spanned<RawRotor>>,
+    text: &str,
+    n: usize,
+) -> Result<Option<Rotor>> {
+    let Some(r) = raw else {
+        return Ok(None);
+    };
+    let line = line_of(text, r.span().start);
+    let r = r.into_inner();
+    let key = |k: &str| format!("effects.rotor.{k} (line {line})");
+    check_len(&key("inertia"), &r.inertia, n, GAIN)?;
+    check_len(&key("gear_ratio"), &r.gear_ratio, n, GAIN)?;
+    if r.inertia.iter().any(|x| *x < 0.0) {
+        bail!("{}: must be >= 0", key("inertia"));
+    }
+    if r.gear_ratio.contains(&0.0) {
+        bail!("{}: must be non-zero", key("gear_ratio"));
+    }
+    let reflected: Vec<f64> = r
+        .inertia
+        .iter()
+        .zip(&r.gear_ratio)
+        .map(|(i, g)| i * g * g)
+        .collect();
+    check_bound(&key("inertia"), &reflected, GAIN)?;
+    Ok(Some(Rotor {
+        inertia: r.inertia,
+        gear_ratio: r.gear_ratio,
+        reflected,
+    }))
+}
+
+/// `[effects.friction]`: its viscous part becomes `damping` (given once), its Coulomb part
+/// the returned friction.
+fn parse_friction(
+    raw: Option<toml::Spanned<RawFriction>>,
+    text: &str,
+    n: usize,
+    damping: &mut Option<Vec<f64>>,
+) -> Result<Option<Coulomb>> {
+    let Some(f) = raw else {
+        return Ok(None);
+    };
+    let line = line_of(text, f.span().start);
+    let f = f.into_inner();
+    let key = |k: &str| format!("effects.friction.{k} (line {line})");
+    if f.viscous.is_none() && f.coulomb.is_none() {
+        bail!("effects.friction (line {line}): give `viscous` and/or `coulomb` coefficients");
+    }
+    if let Some(b) = f.viscous {
+        if damping.is_some() {
+            bail!(
+                "{}: viscous friction is `effects.damping`; give it once",
+                key("viscous")
+            );
+        }
+        check_len(&key("viscous"), &b, n, GAIN)?;
+        if b.iter().any(|x| *x < 0.0) {
+            bail!("{}: coefficients must be >= 0", key("viscous"));
+        }
+        *damping = Some(b);
+    }
+    let Some(c) = f.coulomb else {
+        if f.v_s.is_some() {
+            bail!("{}: only with `coulomb`", key("v_s"));
+        }
+        return Ok(None);
+    };
+    check_len(&key("coulomb"), &c, n, FORCE)?;
+    if c.iter().any(|x| *x < 0.0) {
+        bail!("{}: friction torques must be >= 0", key("coulomb"));
+    }
+    let v_s = f.v_s.unwrap_or(DEFAULT_V_S);
+    if !(v_s.is_finite() && v_s > 0.0) {
+        bail!("{}: must be > 0", key("v_s"));
+    }
+    Ok(Some(Coulomb { tau_c: c, v_s }))
+}
+
+/// `[effects.flexible]`: Spong's flexible joints, on a fixed base and without `[effects.rotor]`.
+fn parse_flexible(
+    raw: Option<toml::Spanned<flexible::RawFlexible>>,
+    text: &str,
+    n: usize,
+    floating: bool,
+    rotor: bool,
+) -> Result<Option<flexible::Flexible>> {
+    let Some(f) = raw else {
+        return Ok(None);
+    };
+    let line = line_of(text, f.span().start);
+    if floating {
+        bail!(
+            "effects.flexible (line {line}): flexible joints are supported on a fixed \
+             base only"
+        );
+    }
+    if rotor {
+        bail!(
+            "effects.flexible (line {line}): `motor_inertia` and `gear_ratio` give the \
+             motor inertia of a flexible joint; `effects.rotor` (the rigid-gear \
+             model) cannot be given with it"
+        );
+    }
+    Ok(Some(flexible::Flexible::from_raw(f.into_inner(), n, line)?))
+}
+
+/// `[drives]`: the keys its type uses (and no other), validated.
+fn parse_drives(raw: Option<RawDrives>, n: usize, floating: bool) -> Result<Drives> {
+    let Some(d) = raw else {
+        return Ok(Drives::None);
+    };
+    let extra = |keys: &[(&str, bool)]| -> Result<()> {
+        if let Some((k, _)) = keys.iter().find(|(_, g)| *g) {
+            bail!("drives.{k}: not used by drives.type = \"{}\"", d.kind);
+        }
+        Ok(())
+    };
+    match d.kind.as_str() {
+        "none" => {
+            extra(&[
+                ("kp", d.kp.is_some()),
+                ("kd", d.kd.is_some()),
+                ("target", d.target.is_some()),
+                ("duration_s", d.duration_s.is_some()),
+                ("tau", d.tau.is_some()),
+            ])?;
+            Ok(Drives::None)
+        }
+        "constant" => {
+            extra(&[
+                ("kp", d.kp.is_some()),
+                ("kd", d.kd.is_some()),
+                ("target", d.target.is_some()),
+                ("duration_s", d.duration_s.is_some()),
+            ])?;
+            let tau = d
+                .tau
+                .ok_or_else(|| invalid!("drives.tau: required by type = \"constant\""))?;
+            check_len("drives.tau", &tau, n, FORCE)?;
+            Ok(Drives::Constant { tau })
+        }
+        "pd" => {
+            extra(&[("duration_s", d.duration_s.is_some()), ("tau", d.tau.is_some())])?;
+            let target = d
+                .target
+                .ok_or_else(|| invalid!("drives.target: required by type = \"pd\""))?;
+            check_len("drives.target", &target, n, POSITION)?;
+            Ok(Drives::Pd {
+                kp: gain("drives.kp", d.kp, n)?,
+                kd: gain("drives.kd", d.kd, n)?,
+                target,
+            })
+        }
+        "computed-torque" => {
+            extra(&[("tau", d.tau.is_some())])?;
+            if floating {
+                bail!("drives.type: computed-torque needs a fixed base");
+            }
+            let target = d.target.ok_or_else(|| {
+                invalid!("drives.target: required by type = \"computed-torque\"")
+            })?;
+            check_len("drives.target", &target, n, POSITION)?;
+            let duration = d.duration_s.ok_or_else(|| {
+                invalid!("drives.duration_s: required by type = \"computed-torque\"")
+            })?;
+            if !(duration.is_finite() && duration > 0.0) {
+                bail!("drives.duration_s: must be > 0");
+            }
+            Ok(Drives::ComputedTorque {
+                kp: gain("drives.kp", d.kp, n)?,
+                kd: gain("drives.kd", d.kd, n)?,
+                target,
+                duration,
+            })
+        }
+        other => bail!(
+            "drives.type: unknown drive type `{other}` (expected none, constant, pd or computed-torque)"
+        ),
+    }
+}
+
+/// `[simulation]`: the integrator and its settings, the step and sample limits, and the
+/// algorithm (the model's default, or the one named, which a tree must allow).
+fn parse_simulation(
+    s: RawSimulation,
+    chain: &Model,
+    options: SceneOptions,
+) -> Result<SimulationSpec> {
+    if !(s.duration.is_finite() && s.duration > 0.0) {
+        bail!("simulation.duration: must be > 0");
+    }
+    let integrator = match s.integrator.as_deref().unwrap_or("rk4") {
+        "rk4" => Integrator::Rk4,
+        "dopri5" => Integrator::Dopri5,
+        "midpoint" => Integrator::Midpoint,
+        "rosenbrock" => Integrator::Rosenbrock,
+        other => {
+            bail!(
+                "simulation.integrator: unknown integrator `{other}` \
+                 (expected rk4, dopri5, midpoint or rosenbrock)"
+            )
+        }
+    };
+    let step = s.step.unwrap_or(0.01);
+    if !(step.is_finite() && step > 0.0) {
+        bail!("simulation.step: must be > 0");
+    }
+    let tolerance = s.tolerance.unwrap_or(1e-8);
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        bail!("simulation.tolerance: must be > 0");
+    }
+    if tolerance < MIN_TOLERANCE {
+        bail!(
+            "simulation.tolerance: {tolerance:e} is below {MIN_TOLERANCE:e}: the error \
+             estimate would be dominated by the rounding error of the state (2.2e-16 \
+             relative) and the step size would shrink until it underflows"
+        );
+    }
+    let max_step = s.max_step.unwrap_or(s.duration);
+    if !(max_step.is_finite() && max_step > 0.0) {
+        bail!("simulation.max_step: must be > 0");
+    }
+    let output_every = s.output_every.unwrap_or(10);
+    if output_every == 0 {
+        bail!("simulation.output_every: must be >= 1");
+    }
+    let allow_long = s.allow_long || options.allow_long;
+    check_run_length(&s, integrator, step, output_every, allow_long)?;
+    let (algorithm, forward) = parse_algorithm(s.algorithm, chain)?;
+    if !integrator.is_adaptive() {
+        if s.tolerance.is_some() {
+            bail!("simulation.tolerance: only for integrator = \"dopri5\" or \"rosenbrock\"");
+        }
+        if s.max_step.is_some() {
+            bail!("simulation.max_step: only for integrator = \"dopri5\" or \"rosenbrock\"");
+        }
+    }
+    Ok(SimulationSpec {
+        duration: s.duration,
+        integrator,
+        step,
+        tolerance,
+        max_step,
+        output_every,
+        algorithm,
+        forward,
+        allow_long,
+    })
+}
+
+/// The steps (fixed-step integrators) and output samples of `[simulation]` within
+/// [`MAX_STEPS`], or [`MAX_STEPS_LONG`] when `allow_long`.
+fn check_run_length(
+    s: &RawSimulation,
+    integrator: Integrator,
+    step: f64,
+    output_every: usize,
+    allow_long: bool,
+) -> Result<()> {
+    let limit = if allow_long {
+        MAX_STEPS_LONG
+    } else {
+        MAX_STEPS
+    };
+    let hint = if allow_long {
+        ""
+    } else {
+        " (set allow_long = true in [simulation], or pass --allow-long, to run it)"
+    };
+    let samples = s.duration / (step * output_every as f64);
+    if !integrator.is_adaptive() && s.duration / step > limit {
+        bail!(
+            "simulation.step: duration / step = {:.3e} steps exceeds the limit {limit:.0e}{hint}",
+            s.duration / step
+        );
+    }
+    if samples > limit {
+        bail!(
+            "simulation.output_every: duration / (step · output_every) = {samples:.3e} output \
+             samples exceeds the limit {limit:.0e}{hint}"
+        );
+    }
+    Ok(())
+}
+
+/// `simulation.algorithm`: the algorithm and the forward method it selects (none named: the
+/// articulated-body algorithm, the recurrent methods on a chain and the spatial ones on a
+/// tree; a named one runs on LDLᵀ and must handle the model's topology).
+fn parse_algorithm(name: Option<String>, chain: &Model) -> Result<(Methods, ForwardMethod)> {
+    // The paper's algorithms handle serial chains; a tree takes the local-frame ones.
+    let forward = if name.is_some() {
+        ForwardMethod::Ldlt
+    } else {
+        ForwardMethod::Aba
+    };
+    let algorithm = match name {
+        None if chain.is_chain() => Methods::RECURRENT,
+        None => Methods::SPATIAL,
+        Some(a) => Methods::from_name(&a).ok_or_else(|| {
+            let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
+            invalid!(
+                "simulation.algorithm: unknown algorithm `{a}` (known: {})",
+                names.join(", ")
+            )
+        })?,
+    };
+    if let Some(j) = chain.first_branch() {
+        if algorithm != Methods::SPATIAL {
+            bail!(
+                "simulation.algorithm: `{algorithm}` handles serial chains only, and the \
+                 model is a tree (joint `{}` does not hang from the joint before it): use \
+                 \"spatial\"",
+                j.name
+            );
+        }
+    }
+    Ok((algorithm, forward))
+}
+
 impl Scene {
     /// Reads and validates a scene file; the model path is relative to the file's directory.
     pub fn load(path: &Path) -> Result<Scene> {
@@ -792,122 +1270,18 @@ impl Scene {
     /// [`Scene::parse`] with options.
     pub fn parse_with(text: &str, dir: &Path, options: SceneOptions) -> Result<Scene> {
         let raw: RawScene = toml::from_str(text).map_err(|e| invalid!("{e}"))?;
-        let model_path = dir.join(&raw.model);
         let validation = Validation {
             allow_nonphysical_inertia: raw.allow_nonphysical,
         };
-        let chain = kanegen_model::io::load_model_with(&model_path, validation)
-            .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
-        if chain.has_mimics() {
-            bail!(
-                "model: `{}`: mimic joints are not supported by the simulator yet",
-                model_path.display()
-            );
-        }
-        chain
-            .check_forward_dynamics()
-            .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
-        let n = chain.dof();
-
-        let chain0 = chain;
-        let static_payload = match raw.payload {
-            None => None,
-            Some(p) => {
-                if !(p.mass.is_finite() && p.mass > 0.0) {
-                    bail!("payload.mass: must be > 0");
-                }
-                check_bound("payload.com", &p.com, LENGTH)?;
-                let pay = Inertial {
-                    mass: p.mass,
-                    com: p.com,
-                    inertia: p.inertia.0,
-                };
-                kanegen_model::validate_inertial_with("payload", "inertia", &pay, validation)
-                    .map_err(|e| invalid!("payload.inertia: {e}"))?;
-                let holder = match &p.body {
-                    None => n - 1,
-                    Some(name) => body_index(&chain0, name).ok_or_else(|| {
-                        invalid!(
-                            "payload.body: unknown body `{name}` (moving bodies: {})",
-                            body_names(&chain0)
-                        )
-                    })?,
-                };
-                Some((holder, pay))
-            }
-        };
-        let attached: Vec<(usize, Inertial)> = static_payload.into_iter().collect();
+        let chain0 = load_chain(&dir.join(&raw.model), validation)?;
+        let n = chain0.dof();
+        let attached: Vec<(usize, Inertial)> = parse_payload(raw.payload, &chain0, validation)?
+            .into_iter()
+            .collect();
         let chain =
             with_payloads(&chain0, &attached, validation).map_err(|e| invalid!("payload: {e}"))?;
-
-        let base = match raw.base {
-            None => BaseSpec::Fixed,
-            Some(b) => match b.kind.as_str() {
-                "fixed" => {
-                    let given = [
-                        ("mass", b.mass.is_some()),
-                        ("com", b.com.is_some()),
-                        ("inertia", b.inertia.is_some()),
-                        ("position", b.position.is_some()),
-                        ("quaternion", b.quaternion.is_some()),
-                        ("v", b.v.is_some()),
-                        ("omega", b.omega.is_some()),
-                    ];
-                    if let Some((k, _)) = given.iter().find(|(_, g)| *g) {
-                        bail!("base.{k}: only for type = \"free-floating\"");
-                    }
-                    BaseSpec::Fixed
-                }
-                "free-floating" => {
-                    let model = chain.base_inertial();
-                    let mass = b.mass.or(model.map(|i| i.mass)).ok_or_else(|| {
-                        invalid!("base.mass: the model has no base inertial; give mass, com, inertia")
-                    })?;
-                    let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
-                    let inertia = b
-                        .inertia
-                        .map(|i| i.0)
-                        .or(model.map(|i| i.inertia))
-                        .ok_or_else(|| invalid!("base.inertia: the model has no base inertial"))?;
-                    if !(mass.is_finite() && mass > 0.0) {
-                        bail!("base.mass: must be > 0");
-                    }
-                    check_bound("base.com", &com, LENGTH)?;
-                    let inertial = Inertial { mass, com, inertia };
-                    kanegen_model::validate_inertial_with(
-                        "base",
-                        "inertia",
-                        &inertial,
-                        validation,
-                    )
-                    .map_err(|e| invalid!("base.inertia: {e}"))?;
-                    let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
-                    check_finite("base.quaternion", &quat)?;
-                    let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    if norm < 1e-12 {
-                        bail!("base.quaternion: must be non-zero");
-                    }
-                    let position = b.position.unwrap_or([0.0; 3]);
-                    let v = b.v.unwrap_or([0.0; 3]);
-                    let omega = b.omega.unwrap_or([0.0; 3]);
-                    check_bound("base.position", &position, LENGTH)?;
-                    check_bound("base.v", &v, RATE)?;
-                    check_bound("base.omega", &omega, RATE)?;
-                    BaseSpec::FreeFloating {
-                        inertial,
-                        position,
-                        quaternion: quat.map(|x| x / norm),
-                        v,
-                        omega,
-                    }
-                }
-                other => bail!(
-                    "base.type: unknown base type `{other}` (expected \"fixed\" or \"free-floating\")"
-                ),
-            },
-        };
+        let base = parse_base(raw.base, &chain, validation)?;
         let floating = matches!(base, BaseSpec::FreeFloating { .. });
-
         let e = raw.effects;
         if let Some(g) = &e.gravity {
             check_bound("effects.gravity", g, GRAVITY)?;
@@ -918,319 +1292,26 @@ impl Scene {
                 bail!("effects.damping: coefficients must be >= 0");
             }
         }
-        let mut wrenches = Vec::new();
-        for (k, w) in e.wrench.into_iter().enumerate() {
-            let key = format!("effects.wrench[{k}]");
-            let body = if w.body == "base" || w.body == chain.base() {
-                if !floating {
-                    bail!("{key}.body: a wrench on a fixed base has no effect");
-                }
-                BASE_BODY
-            } else {
-                chain
-                    .joints()
-                    .iter()
-                    .position(|j| j.body == w.body)
-                    .ok_or_else(|| {
-                        let names: Vec<&str> =
-                            chain.joints().iter().map(|j| j.body.as_str()).collect();
-                        invalid!(
-                            "{key}.body: unknown body `{}` (known: base, {})",
-                            w.body,
-                            names.join(", ")
-                        )
-                    })?
-            };
-            let frame = match w.frame.as_str() {
-                "body" => LoadFrame::Body,
-                "inertial" => LoadFrame::Base,
-                other => bail!("{key}.frame: unknown frame `{other}` (expected body or inertial)"),
-            };
-            wrenches.push(SceneWrench {
-                body,
-                frame,
-                profile: wrench_profile(&key, w.time, w.force, w.moment)?,
-            });
-        }
-
+        let wrenches = parse_wrenches(e.wrench, &chain, floating)?;
         let mut damping = e.damping;
-        let rotor = match e.rotor {
-            None => None,
-            Some(r) => {
-                let line = line_of(text, r.span().start);
-                let r = r.into_inner();
-                let key = |k: &str| format!("effects.rotor.{k} (line {line})");
-                check_len(&key("inertia"), &r.inertia, n, GAIN)?;
-                check_len(&key("gear_ratio"), &r.gear_ratio, n, GAIN)?;
-                if r.inertia.iter().any(|x| *x < 0.0) {
-                    bail!("{}: must be >= 0", key("inertia"));
-                }
-                if r.gear_ratio.contains(&0.0) {
-                    bail!("{}: must be non-zero", key("gear_ratio"));
-                }
-                let reflected: Vec<f64> = r
-                    .inertia
-                    .iter()
-                    .zip(&r.gear_ratio)
-                    .map(|(i, g)| i * g * g)
-                    .collect();
-                check_bound(&key("inertia"), &reflected, GAIN)?;
-                Some(Rotor {
-                    inertia: r.inertia,
-                    gear_ratio: r.gear_ratio,
-                    reflected,
-                })
-            }
-        };
-        let coulomb = match e.friction {
-            None => None,
-            Some(f) => {
-                let line = line_of(text, f.span().start);
-                let f = f.into_inner();
-                let key = |k: &str| format!("effects.friction.{k} (line {line})");
-                if f.viscous.is_none() && f.coulomb.is_none() {
-                    bail!(
-                        "effects.friction (line {line}): give `viscous` and/or `coulomb` coefficients"
-                    );
-                }
-                if let Some(b) = f.viscous {
-                    if damping.is_some() {
-                        bail!(
-                            "{}: viscous friction is `effects.damping`; give it once",
-                            key("viscous")
-                        );
-                    }
-                    check_len(&key("viscous"), &b, n, GAIN)?;
-                    if b.iter().any(|x| *x < 0.0) {
-                        bail!("{}: coefficients must be >= 0", key("viscous"));
-                    }
-                    damping = Some(b);
-                }
-                match f.coulomb {
-                    None => {
-                        if f.v_s.is_some() {
-                            bail!("{}: only with `coulomb`", key("v_s"));
-                        }
-                        None
-                    }
-                    Some(c) => {
-                        check_len(&key("coulomb"), &c, n, FORCE)?;
-                        if c.iter().any(|x| *x < 0.0) {
-                            bail!("{}: friction torques must be >= 0", key("coulomb"));
-                        }
-                        let v_s = f.v_s.unwrap_or(DEFAULT_V_S);
-                        if !(v_s.is_finite() && v_s > 0.0) {
-                            bail!("{}: must be > 0", key("v_s"));
-                        }
-                        Some(Coulomb { tau_c: c, v_s })
-                    }
-                }
-            }
-        };
-
-        let flexible = match e.flexible {
-            None => None,
-            Some(f) => {
-                let line = line_of(text, f.span().start);
-                if floating {
-                    bail!(
-                        "effects.flexible (line {line}): flexible joints are supported on a fixed \
-                         base only"
-                    );
-                }
-                if rotor.is_some() {
-                    bail!(
-                        "effects.flexible (line {line}): `motor_inertia` and `gear_ratio` give the \
-                         motor inertia of a flexible joint; `effects.rotor` (the rigid-gear \
-                         model) cannot be given with it"
-                    );
-                }
-                Some(flexible::Flexible::from_raw(f.into_inner(), n, line)?)
-            }
-        };
-
+        let rotor = parse_rotor(e.rotor, text, n)?;
+        let coulomb = parse_friction(e.friction, text, n, &mut damping)?;
+        let flexible = parse_flexible(e.flexible, text, n, floating, rotor.is_some())?;
         let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
         check_len("initial.q", &q0, n, POSITION)?;
         let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
         check_len("initial.qd", &qd0, n, RATE)?;
-
-        let drives = match raw.drives {
-            None => Drives::None,
-            Some(d) => {
-                let extra = |keys: &[(&str, bool)]| -> Result<()> {
-                    if let Some((k, _)) = keys.iter().find(|(_, g)| *g) {
-                        bail!("drives.{k}: not used by drives.type = \"{}\"", d.kind);
-                    }
-                    Ok(())
-                };
-                match d.kind.as_str() {
-                    "none" => {
-                        extra(&[
-                            ("kp", d.kp.is_some()),
-                            ("kd", d.kd.is_some()),
-                            ("target", d.target.is_some()),
-                            ("duration_s", d.duration_s.is_some()),
-                            ("tau", d.tau.is_some()),
-                        ])?;
-                        Drives::None
-                    }
-                    "constant" => {
-                        extra(&[
-                            ("kp", d.kp.is_some()),
-                            ("kd", d.kd.is_some()),
-                            ("target", d.target.is_some()),
-                            ("duration_s", d.duration_s.is_some()),
-                        ])?;
-                        let tau = d
-                            .tau
-                            .ok_or_else(|| invalid!("drives.tau: required by type = \"constant\""))?;
-                        check_len("drives.tau", &tau, n, FORCE)?;
-                        Drives::Constant { tau }
-                    }
-                    "pd" => {
-                        extra(&[("duration_s", d.duration_s.is_some()), ("tau", d.tau.is_some())])?;
-                        let target = d
-                            .target
-                            .ok_or_else(|| invalid!("drives.target: required by type = \"pd\""))?;
-                        check_len("drives.target", &target, n, POSITION)?;
-                        Drives::Pd {
-                            kp: gain("drives.kp", d.kp, n)?,
-                            kd: gain("drives.kd", d.kd, n)?,
-                            target,
-                        }
-                    }
-                    "computed-torque" => {
-                        extra(&[("tau", d.tau.is_some())])?;
-                        if floating {
-                            bail!("drives.type: computed-torque needs a fixed base");
-                        }
-                        let target = d.target.ok_or_else(|| {
-                            invalid!("drives.target: required by type = \"computed-torque\"")
-                        })?;
-                        check_len("drives.target", &target, n, POSITION)?;
-                        let duration = d.duration_s.ok_or_else(|| {
-                            invalid!("drives.duration_s: required by type = \"computed-torque\"")
-                        })?;
-                        if !(duration.is_finite() && duration > 0.0) {
-                            bail!("drives.duration_s: must be > 0");
-                        }
-                        Drives::ComputedTorque {
-                            kp: gain("drives.kp", d.kp, n)?,
-                            kd: gain("drives.kd", d.kd, n)?,
-                            target,
-                            duration,
-                        }
-                    }
-                    other => bail!(
-                        "drives.type: unknown drive type `{other}` (expected none, constant, pd or computed-torque)"
-                    ),
-                }
-            }
-        };
-
-        let s = raw.simulation;
-        if !(s.duration.is_finite() && s.duration > 0.0) {
-            bail!("simulation.duration: must be > 0");
-        }
-        let integrator = match s.integrator.as_deref().unwrap_or("rk4") {
-            "rk4" => Integrator::Rk4,
-            "dopri5" => Integrator::Dopri5,
-            "midpoint" => Integrator::Midpoint,
-            "rosenbrock" => Integrator::Rosenbrock,
-            other => {
-                bail!(
-                    "simulation.integrator: unknown integrator `{other}` \
-                     (expected rk4, dopri5, midpoint or rosenbrock)"
-                )
-            }
-        };
-        let step = s.step.unwrap_or(0.01);
-        if !(step.is_finite() && step > 0.0) {
-            bail!("simulation.step: must be > 0");
-        }
-        let tolerance = s.tolerance.unwrap_or(1e-8);
-        if !(tolerance.is_finite() && tolerance > 0.0) {
-            bail!("simulation.tolerance: must be > 0");
-        }
-        if tolerance < MIN_TOLERANCE {
-            bail!(
-                "simulation.tolerance: {tolerance:e} is below {MIN_TOLERANCE:e}: the error \
-                 estimate would be dominated by the rounding error of the state (2.2e-16 \
-                 relative) and the step size would shrink until it underflows"
-            );
-        }
-        let max_step = s.max_step.unwrap_or(s.duration);
-        if !(max_step.is_finite() && max_step > 0.0) {
-            bail!("simulation.max_step: must be > 0");
-        }
-        let output_every = s.output_every.unwrap_or(10);
-        if output_every == 0 {
-            bail!("simulation.output_every: must be >= 1");
-        }
-        let allow_long = s.allow_long || options.allow_long;
-        let limit = if allow_long {
-            MAX_STEPS_LONG
-        } else {
-            MAX_STEPS
-        };
-        let hint = if allow_long {
-            ""
-        } else {
-            " (set allow_long = true in [simulation], or pass --allow-long, to run it)"
-        };
-        let samples = s.duration / (step * output_every as f64);
-        if !integrator.is_adaptive() && s.duration / step > limit {
-            bail!(
-                "simulation.step: duration / step = {:.3e} steps exceeds the limit {limit:.0e}{hint}",
-                s.duration / step
-            );
-        }
-        if samples > limit {
-            bail!(
-                "simulation.output_every: duration / (step · output_every) = {samples:.3e} output \
-                 samples exceeds the limit {limit:.0e}{hint}"
-            );
-        }
-        // The paper's algorithms handle serial chains; a tree takes the local-frame ones.
-        let forward = if s.algorithm.is_some() {
-            ForwardMethod::Ldlt
-        } else {
-            ForwardMethod::Aba
-        };
-        let algorithm = match s.algorithm {
-            None if chain.is_chain() => Methods::RECURRENT,
-            None => Methods::SPATIAL,
-            Some(a) => Methods::from_name(&a).ok_or_else(|| {
-                let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
-                invalid!(
-                    "simulation.algorithm: unknown algorithm `{a}` (known: {})",
-                    names.join(", ")
-                )
-            })?,
-        };
-        if let Some(j) = chain.first_branch() {
-            if algorithm != Methods::SPATIAL {
-                bail!(
-                    "simulation.algorithm: `{algorithm}` handles serial chains only, and the \
-                     model is a tree (joint `{}` does not hang from the joint before it): use \
-                     \"spatial\"",
-                    j.name
-                );
-            }
-        }
-        if !integrator.is_adaptive() {
-            if s.tolerance.is_some() {
-                bail!("simulation.tolerance: only for integrator = \"dopri5\" or \"rosenbrock\"");
-            }
-            if s.max_step.is_some() {
-                bail!("simulation.max_step: only for integrator = \"dopri5\" or \"rosenbrock\"");
-            }
-        }
-
+        let drives = parse_drives(raw.drives, n, floating)?;
+        let simulation = parse_simulation(raw.simulation, &chain, options)?;
         let events = parse_events(
-            raw.events, text, &chain0, attached, floating, s.duration, validation,
+            raw.events,
+            text,
+            &chain0,
+            attached,
+            floating,
+            simulation.duration,
+            validation,
         )?;
-
         Ok(Scene {
             events,
             model: chain,
@@ -1244,17 +1325,7 @@ impl Scene {
             drives,
             q0,
             qd0,
-            simulation: SimulationSpec {
-                duration: s.duration,
-                integrator,
-                step,
-                tolerance,
-                max_step,
-                output_every,
-                algorithm,
-                forward,
-                allow_long,
-            },
+            simulation,
         })
     }
 

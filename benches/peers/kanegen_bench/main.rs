@@ -18,6 +18,11 @@
 //!   M_nle  mass_matrix_and_nonlinear_effects(q, qd)     (one call; CasADi's M_nle)
 //!   rnea   inverse_dynamics(q, qd, qdd = a)
 //!   aba    forward_dynamics(q, qd, tau)
+//!   rnea_derivs  inverse_dynamics_derivatives(q, qd, qdd = a) -> (dtau_dq, dtau_dv)
+//!   aba_derivs   forward_dynamics_derivatives(q, qd, tau) -> (ddq_dq, ddq_dv, minv)
+//!   minv         mass_matrix_inverse(q)
+//!          (the three derivative rows with the crate feature `derivs`, which run.sh turns on
+//!          with DERIVS=1; row i = output i, column j = input j, as Pinocchio)
 //!   sincos_n  N x libm::sincos (what the generated code calls), for scale
 //!   aba_runtime  forward dynamics on the run-time path, no compilation: the model read from
 //!          its URDF when the program starts, `aba::forward_dynamics_in` with a workspace
@@ -214,6 +219,36 @@ macro_rules! states_of {
     };
 }
 
+/// The derivative rows (crate feature `derivs`): each call's whole result goes through
+/// `black_box`; the checksum adds one entry of each returned matrix.
+#[cfg(feature = "derivs")]
+macro_rules! bench_derivatives {
+    ($ty:ident, $name:expr, $s:ident, $sfx:ident, $ctx:ident) => {{
+        const N: usize = $ty::N;
+        let k_n = $s.q.len();
+        $ctx.time($name, $sfx, "rnea_derivs", k_n, N * N, |k, e| {
+            let (dq, dv) = black_box($ty::inverse_dynamics_derivatives(
+                black_box(&$s.q[k]),
+                black_box(&$s.v[k]),
+                black_box(&$s.a[k]),
+            ));
+            dq[e / N][e % N] + dv[e / N][e % N]
+        });
+        $ctx.time($name, $sfx, "aba_derivs", k_n, N * N, |k, e| {
+            let (dq, dv, minv) = black_box($ty::forward_dynamics_derivatives(
+                black_box(&$s.q[k]),
+                black_box(&$s.v[k]),
+                black_box(&$s.tau[k]),
+            ));
+            dq[e / N][e % N] + dv[e / N][e % N] + minv[e / N][e % N]
+        });
+        $ctx.time($name, $sfx, "minv", k_n, N * N, |k, e| {
+            let m = black_box($ty::mass_matrix_inverse(black_box(&$s.q[k])));
+            m[e / N][e % N]
+        });
+    }};
+}
+
 macro_rules! bench_model {
     ($ty:ident, $name:expr, $st:ident, $suffix:expr, $ctx:expr) => {{
         let ctx: &Ctx = $ctx;
@@ -256,6 +291,8 @@ macro_rules! bench_model {
             ));
             d[e]
         });
+        #[cfg(feature = "derivs")]
+        bench_derivatives!($ty, $name, s, sfx, ctx);
         // the run-time path: the URDF read now, the workspace ABA (default and native builds)
         if sfx.is_empty() && (ctx.label == "default" || ctx.label == "native") {
             let path = format!("{}/models/{}.urdf", env!("CARGO_MANIFEST_DIR"), $name);
@@ -317,6 +354,24 @@ macro_rules! bench_model {
     }};
 }
 
+/// The derivative entries of one state's dump (crate feature `derivs`), each key led by ", ".
+#[cfg(feature = "derivs")]
+macro_rules! dump_derivatives {
+    ($ty:ident, $s:ident, $q:ident, $v:ident, $tau:ident, $a:ident) => {{
+        let (tq, tv) = $ty::inverse_dynamics_derivatives($q, $v, $a);
+        let (dq, dv, mi) = $ty::forward_dynamics_derivatives($q, $v, $tau);
+        format!(
+            ", \"rnea_derivs\": [{}], \"rnea_derivs.dtau_dv\": [{}], \"aba_derivs\": [{}], \"aba_derivs.ddq_dv\": [{}], \"aba_derivs.Minv\": [{}], \"minv\": [{}]",
+            $s.back_m(&tq).join(", "),
+            $s.back_m(&tv).join(", "),
+            $s.back_m(&dq).join(", "),
+            $s.back_m(&dv).join(", "),
+            $s.back_m(&mi).join(", "),
+            $s.back_m(&$ty::mass_matrix_inverse($q)).join(", "),
+        )
+    }};
+}
+
 macro_rules! dump_model {
     ($ty:ident, $name:expr, $st:ident, $suffix:expr, $out:expr) => {{
         let out: &mut Vec<String> = $out;
@@ -326,14 +381,19 @@ macro_rules! dump_model {
         for k in 0..s.q.len() {
             let (q, v, tau, a) = (&s.q[k], &s.v[k], &s.tau[k], &s.a[k]);
             let (m2, c2) = $ty::mass_matrix_and_nonlinear_effects(q, v);
+            #[cfg(feature = "derivs")]
+            let derivs = dump_derivatives!($ty, s, q, v, tau, a);
+            #[cfg(not(feature = "derivs"))]
+            let derivs = String::new();
             samples.push(format!(
-                "{{\"M\": [{}], \"nle\": {}, \"M_nle\": [{}], \"M_nle.nle\": {}, \"rnea\": {}, \"aba\": {}}}",
+                "{{\"M\": [{}], \"nle\": {}, \"M_nle\": [{}], \"M_nle.nle\": {}, \"rnea\": {}, \"aba\": {}{}}}",
                 s.back_m(&$ty::mass_matrix(q)).join(", "),
                 vec_json(&s.back(&$ty::nonlinear_effects(q, v))),
                 s.back_m(&m2).join(", "),
                 vec_json(&s.back(&c2)),
                 vec_json(&s.back(&$ty::inverse_dynamics(q, v, a))),
                 vec_json(&s.back(&$ty::forward_dynamics(q, v, tau))),
+                derivs,
             ));
         }
         let opt = |x: Option<&str>| x.map_or("null".to_string(), |m| format!("\"{m}\""));

@@ -5,7 +5,8 @@
  * Built once per model and label: gcc -O3 -march=native -I gen/MODEL/VARIANT, linked with
  * gen/MODEL/VARIANT/casadi_gen.o (compiled separately, as a user would: no LTO, so every
  * call goes through CasADi's standard entry point f(arg, res, iw, w, mem)).
- * -DPEERS_WORLD=1 when the generated file has M_world and aba_world.
+ * -DPEERS_WORLD=1 when the generated file has M_world and aba_world; -DPEERS_DERIVS=1 when it has
+ * rnea_derivs, rnea_jac, aba_derivs, aba_jac and minv.
  *
  * usage: driver STATES.txt LABEL MODEL time ROUNDS CALLS ROUND_US
  *        driver STATES.txt LABEL MODEL dump
@@ -33,27 +34,52 @@ typedef int (*work_t)(casadi_int *, casadi_int *, casadi_int *, casadi_int *);
 
 enum { IN_Q = 1, IN_QV = 2, IN_QVTAU = 3, IN_QVA = 4 };
 
+/* Outputs: `nmat` dense n x n matrices (column-major, as CasADi writes them), then `nvec`
+ * vectors of n. The dump names the first output after the function and the others
+ * "NAME.OUTPUT" (out[i]), as M_nle's second output is "M_nle.nle". */
+#define MAX_MAT 3
 struct func {
   const char *name;
   fn_t f;
   work_t work;
-  int in;     /* IN_*: which state vectors are the inputs */
-  int matrix; /* first output is n x n */
-  int nout;   /* outputs: 1 or 2 */
+  int in;   /* IN_*: which state vectors are the inputs */
+  int nmat; /* n x n outputs, first: 0 to MAX_MAT */
+  int nvec; /* vector outputs after them: 0 or 1 */
+  const char *out[MAX_MAT + 1]; /* output names, for the dump keys of outputs 2.. */
 };
 
 static const struct func FUNCS[] = {
-    {"M", M, M_work, IN_Q, 1, 1},
-    {"nle", nle, nle_work, IN_QV, 0, 1},
-    {"M_nle", M_nle, M_nle_work, IN_QV, 1, 2},
-    {"rnea", rnea, rnea_work, IN_QVA, 0, 1},
-    {"aba", aba, aba_work, IN_QVTAU, 0, 1},
+    {"M", M, M_work, IN_Q, 1, 0, {"M"}},
+    {"nle", nle, nle_work, IN_QV, 0, 1, {"nle"}},
+    {"M_nle", M_nle, M_nle_work, IN_QV, 1, 1, {"M", "nle"}},
+    {"rnea", rnea, rnea_work, IN_QVA, 0, 1, {"tau"}},
+    {"aba", aba, aba_work, IN_QVTAU, 0, 1, {"ddq"}},
 #if PEERS_WORLD
-    {"M_world", M_world, M_world_work, IN_Q, 1, 1},
-    {"aba_world", aba_world, aba_world_work, IN_QVTAU, 0, 1},
+    {"M_world", M_world, M_world_work, IN_Q, 1, 0, {"M"}},
+    {"aba_world", aba_world, aba_world_work, IN_QVTAU, 0, 1, {"ddq"}},
+#endif
+#if PEERS_DERIVS
+    {"rnea_derivs", rnea_derivs, rnea_derivs_work, IN_QVA, 2, 0, {"dtau_dq", "dtau_dv"}},
+    {"rnea_jac", rnea_jac, rnea_jac_work, IN_QVA, 2, 0, {"dtau_dq", "dtau_dv"}},
+    {"aba_derivs", aba_derivs, aba_derivs_work, IN_QVTAU, 3, 0, {"ddq_dq", "ddq_dv", "Minv"}},
+    {"aba_jac", aba_jac, aba_jac_work, IN_QVTAU, 3, 0, {"ddq_dq", "ddq_dv", "Minv"}},
+    {"minv", minv, minv_work, IN_Q, 1, 0, {"Minv"}},
 #endif
 };
 #define NFUNCS (sizeof(FUNCS) / sizeof(FUNCS[0]))
+
+/* Column-major dense n x n as JSON rows (without the outer brackets). */
+static void dump_matrix(const double *m, int n) {
+  for (int r = 0; r < n; ++r) {
+    printf("%s[", r ? ", " : "");
+    for (int c = 0; c < n; ++c) printf("%s%.17g", c ? ", " : "", m[c * n + r]);
+    printf("]");
+  }
+}
+
+static void dump_vector(const double *x, int n) {
+  for (int r = 0; r < n; ++r) printf("%s%.17g", r ? ", " : "", x[r]);
+}
 
 int main(int argc, char **argv) {
   if (argc < 5) {
@@ -95,31 +121,24 @@ int main(int argc, char **argv) {
       if (p == IN_QVA) args[p][k * stride + 2] = s + 3 * n;
     }
   }
-  double *out0 = malloc(sizeof(double) * (size_t)n * n), *out1 = malloc(sizeof(double) * (size_t)n);
-  casadi_real *res[4] = {out0, out1, 0, 0};
+  /* res[i]: the i-th output; the matrices first, then the vector */
+  casadi_real *res[MAX_MAT + 2] = {0};
+  for (int i = 0; i <= MAX_MAT; ++i) res[i] = malloc(sizeof(double) * (size_t)n * n);
+  double *out0 = res[0];
 
   if (!strcmp(mode, "dump")) {
     printf("{\"side\": \"casadi\", \"label\": \"%s\", \"model\": \"%s\", \"n\": %d, \"samples\": [\n", label, model, n);
     for (int k = 0; k < K; ++k) {
       printf("%s{", k ? ",\n" : "");
       for (size_t i = 0; i < NFUNCS; ++i) {
-        memset(out0, 0, sizeof(double) * n * n);
-        memset(out1, 0, sizeof(double) * n);
-        FUNCS[i].f(args[FUNCS[i].in] + k * stride, res, iw, w, 0);
-        printf("%s\"%s\": [", i ? ", " : "", FUNCS[i].name);
-        if (FUNCS[i].matrix) { /* column-major dense n x n */
-          for (int r = 0; r < n; ++r) {
-            printf("%s[", r ? ", " : "");
-            for (int c = 0; c < n; ++c) printf("%s%.17g", c ? ", " : "", out0[c * n + r]);
-            printf("]");
-          }
-        } else {
-          for (int r = 0; r < n; ++r) printf("%s%.17g", r ? ", " : "", out0[r]);
-        }
-        printf("]");
-        if (FUNCS[i].nout == 2) {
-          printf(", \"%s.nle\": [", FUNCS[i].name);
-          for (int r = 0; r < n; ++r) printf("%s%.17g", r ? ", " : "", out1[r]);
+        const struct func *F = &FUNCS[i];
+        for (int o = 0; o <= MAX_MAT; ++o) memset(res[o], 0, sizeof(double) * n * n);
+        F->f(args[F->in] + k * stride, res, iw, w, 0);
+        for (int o = 0; o < F->nmat + F->nvec; ++o) {
+          if (o) printf(", \"%s.%s\": [", F->name, F->out[o]);
+          else printf("%s\"%s\": [", i ? ", " : "", F->name);
+          if (o < F->nmat) dump_matrix(res[o], n);
+          else dump_vector(res[o], n);
           printf("]");
         }
       }
@@ -141,7 +160,7 @@ int main(int argc, char **argv) {
     const int trig = i == NFUNCS;
     fn_t f = trig ? 0 : FUNCS[i].f;
     const casadi_real **A = args[trig ? IN_Q : FUNCS[i].in];
-    const int nn = trig ? 2 * n : (FUNCS[i].matrix ? n * n : n);
+    const int nn = trig ? 2 * n : (FUNCS[i].nmat ? n * n : n);
     double chk = 0.0;
     int k = 0, e = 0;
 #define ONE_CALL()                                                                   \

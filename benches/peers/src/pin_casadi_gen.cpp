@@ -26,12 +26,22 @@
 //   aba(q,v,tau)  aba (Convention::LOCAL, default)
 //   M_world(q)    crba with Convention::WORLD, mirrored
 //   aba_world     aba with Convention::WORLD
+//   rnea_derivs(q,v,a)  computeRNEADerivatives on SX: dtau_dq, dtau_dv (row i = tau_i, column j =
+//                 input j)
+//   rnea_jac(q,v,a)     SX::jacobian of the traced rnea w.r.t. q and v (the same two matrices)
+//   aba_derivs(q,v,tau) computeABADerivatives on SX: ddq_dq, ddq_dv, Minv (Pinocchio mirrors
+//                 Minv itself there)
+//   aba_jac(q,v,tau)    SX::jacobian of the traced aba w.r.t. q, v and tau (the last is M^-1)
+//   minv(q)       computeMinverse on SX, upper triangle mirrored (Pinocchio fills only that)
+// (the PEERS_DERIVS=0 environment leaves the five derivative functions out).
 // and OUTDIR/V/counts.json with CasADi's instruction counts per function.
 #include <pinocchio/autodiff/casadi.hpp>  // must come first
 
 #include <pinocchio/multibody.hpp>
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 
 #include <casadi/casadi.hpp>
@@ -63,7 +73,8 @@ static SX to_sx(const Mat & m)
   return SX::densify(out);
 }
 
-static void symmetrize(ADData::MatrixXs & M)
+template<typename Mat>
+static void symmetrize(Mat & M)
 {
   for (Eigen::Index i = 0; i < M.rows(); ++i)
     for (Eigen::Index j = 0; j < i; ++j)
@@ -78,6 +89,36 @@ struct Spec
   std::vector<SX> out;
   std::vector<std::string> out_names;
 };
+
+// The derivative functions: Pinocchio's derivative algorithms run on SX, and CasADi's own
+// jacobians of the traced rnea and aba (dense, row i = output i, column j = input j).
+static void add_derivative_specs(
+  const ADModel & am, ADData & ad, const ADModel::ConfigVectorType & q_ad, const ADModel::TangentVectorType & v_ad,
+  const ADModel::TangentVectorType & tau_ad, const ADModel::TangentVectorType & a_ad, const SX & q, const SX & v,
+  const SX & tau, const SX & a, const SX & tau_id, const SX & ddq, std::vector<Spec> & specs)
+{
+  pinocchio::computeRNEADerivatives(am, ad, q_ad, v_ad, a_ad);
+  SX dtau_dq = to_sx(ad.dtau_dq), dtau_dv = to_sx(ad.dtau_dv);
+
+  pinocchio::computeABADerivatives(am, ad, q_ad, v_ad, tau_ad);
+  SX ddq_dq = to_sx(ad.ddq_dq), ddq_dv = to_sx(ad.ddq_dv), Minv_aba = to_sx(ad.Minv);
+
+  pinocchio::computeMinverse(am, ad, q_ad);
+  ADData::MatrixXs Minv_ad = ad.Minv;
+  symmetrize(Minv_ad);
+  SX Minv = to_sx(Minv_ad);
+
+  const std::vector<std::string> d_rnea = {"dtau_dq", "dtau_dv"}, d_aba = {"ddq_dq", "ddq_dv", "Minv"};
+  specs.push_back({"rnea_derivs", {q, v, a}, {"q", "v", "a"}, {dtau_dq, dtau_dv}, d_rnea});
+  specs.push_back({"rnea_jac", {q, v, a}, {"q", "v", "a"},
+                   {SX::densify(SX::jacobian(tau_id, q)), SX::densify(SX::jacobian(tau_id, v))}, d_rnea});
+  specs.push_back({"aba_derivs", {q, v, tau}, {"q", "v", "tau"}, {ddq_dq, ddq_dv, Minv_aba}, d_aba});
+  specs.push_back({"aba_jac", {q, v, tau}, {"q", "v", "tau"},
+                   {SX::densify(SX::jacobian(ddq, q)), SX::densify(SX::jacobian(ddq, v)),
+                    SX::densify(SX::jacobian(ddq, tau))},
+                   d_aba});
+  specs.push_back({"minv", {q}, {"q"}, {Minv}, {"Minv"}});
+}
 
 static std::string count_json(const casadi::Function & f)
 {
@@ -184,6 +225,9 @@ int main(int argc, char ** argv)
     specs.push_back({"M_world", {q}, {"q"}, {Mw}, {"M"}});
     specs.push_back({"aba_world", {q, v, tau}, {"q", "v", "tau"}, {ddqw}, {"ddq"}});
   }
+  const char * derivs_env = std::getenv("PEERS_DERIVS");
+  if (!(derivs_env && std::string(derivs_env) == "0"))
+    add_derivative_specs(am, ad, q_ad, v_ad, tau_ad, a_ad, q, v, tau, a, tau_id, ddq, specs);
 
   std::vector<std::string> variants = {"plain", "cse", "simp", "cse_noheader"};
   if (argc > 3)

@@ -21,8 +21,16 @@
 //   rnea       rnea(model, data, q, v, a)
 //   aba        aba(model, data, q, v, tau) (Convention::LOCAL, the default)
 //   aba_world  aba with Convention::WORLD
+//   rnea_derivs  computeRNEADerivatives(model, data, q, v, a): data.dtau_dq, data.dtau_dv
+//   aba_derivs computeABADerivatives(model, data, q, v, tau): data.ddq_dq, data.ddq_dv, data.Minv
+//              (this algorithm mirrors Minv itself: no mirror here)
+//   minv       computeMinverse(model, data, q), then the strictly lower triangle mirrored from
+//              the upper (Pinocchio fills the upper triangle only)
+// The environment PEERS_DERIVS=0 leaves out the three derivative functions.
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
+#include <pinocchio/algorithm/rnea-derivatives.hpp>
 #include <pinocchio/algorithm/rnea.hpp>
 #include <pinocchio/multibody.hpp>
 
@@ -45,9 +53,10 @@ struct State
   VectorXd q, v, tau, a;
 };
 
-static void mirror(pinocchio::Data & data)
+template<typename Mat>
+static void mirror(Mat & m)
 {
-  data.M.triangularView<Eigen::StrictlyLower>() = data.M.transpose().triangularView<Eigen::StrictlyLower>();
+  m.template triangularView<Eigen::StrictlyLower>() = m.transpose().template triangularView<Eigen::StrictlyLower>();
 }
 
 enum Func
@@ -59,9 +68,18 @@ enum Func
   F_RNEA,
   F_ABA,
   F_ABA_WORLD,
+  F_RNEA_DERIVS,
+  F_ABA_DERIVS,
+  F_MINV,
   F_COUNT
 };
-static const char * NAMES[F_COUNT] = {"M", "M_world", "nle", "M_nle", "rnea", "aba", "aba_world"};
+static const char * NAMES[F_COUNT] = {"M",    "M_world",     "nle",        "M_nle", "rnea",
+                                      "aba",  "aba_world",   "rnea_derivs", "aba_derivs", "minv"};
+// The functions whose timed output (the checksum's element) is n x n.
+static constexpr bool matrix_out(int f)
+{
+  return f == F_M || f == F_M_WORLD || f == F_M_NLE || f == F_RNEA_DERIVS || f == F_ABA_DERIVS || f == F_MINV;
+}
 
 // Evaluates function f at state s; returns one output element (index e, cycling). A template,
 // so that the timing loop of each function is compiled for that function alone (no switch).
@@ -72,18 +90,18 @@ static inline double call(const pinocchio::Model & model, pinocchio::Data & data
   {
   case F_M:
     pinocchio::crba(model, data, s.q, Convention::LOCAL);
-    mirror(data);
+    mirror(data.M);
     return data.M(e / n, e % n);
   case F_M_WORLD:
     pinocchio::crba(model, data, s.q, Convention::WORLD);
-    mirror(data);
+    mirror(data.M);
     return data.M(e / n, e % n);
   case F_NLE:
     pinocchio::nonLinearEffects(model, data, s.q, s.v);
     return data.nle(e);
   case F_M_NLE:
     pinocchio::crba(model, data, s.q, Convention::LOCAL);
-    mirror(data);
+    mirror(data.M);
     pinocchio::nonLinearEffects(model, data, s.q, s.v);
     return data.M(e / n, e % n) + data.nle(e % n);
   case F_RNEA:
@@ -95,13 +113,24 @@ static inline double call(const pinocchio::Model & model, pinocchio::Data & data
   case F_ABA_WORLD:
     pinocchio::aba(model, data, s.q, s.v, s.tau, Convention::WORLD);
     return data.ddq(e);
+  case F_RNEA_DERIVS:
+    pinocchio::computeRNEADerivatives(model, data, s.q, s.v, s.a);
+    return data.dtau_dq(e / n, e % n) + data.dtau_dv(e / n, e % n);
+  case F_ABA_DERIVS:
+    pinocchio::computeABADerivatives(model, data, s.q, s.v, s.tau);
+    return data.ddq_dq(e / n, e % n) + data.ddq_dv(e / n, e % n) + data.Minv(e / n, e % n);
+  case F_MINV:
+    pinocchio::computeMinverse(model, data, s.q);
+    mirror(data.Minv);
+    return data.Minv(e / n, e % n);
   default:
     return 0.0;
   }
 }
 
 typedef double (*call_t)(const pinocchio::Model &, pinocchio::Data &, const State &, int, int);
-static const call_t DUMP_CALL[F_COUNT] = {call<0>, call<1>, call<2>, call<3>, call<4>, call<5>, call<6>};
+static const call_t DUMP_CALL[F_COUNT] = {call<0>, call<1>, call<2>, call<3>, call<4>,
+                                          call<5>, call<6>, call<7>, call<8>, call<9>};
 
 template<int f>
 static void time_func(
@@ -109,7 +138,7 @@ static void time_func(
   long max_calls, double round_us, const char * label, const char * model_name)
 {
   const int K = int(S.size());
-  const int nn = (f == F_M || f == F_M_WORLD || f == F_M_NLE) ? n * n : n;
+  const int nn = matrix_out(f) ? n * n : n;
   std::vector<double> ns(rounds), wall(rounds);
   double chk = 0.0;
   int k = 0, e = 0;
@@ -146,15 +175,51 @@ static void time_func(
 typedef void (*time_t_)(
   const pinocchio::Model &, pinocchio::Data &, const std::vector<State> &, int, int, long, double, const char *,
   const char *);
-static const time_t_ TIME[F_COUNT] = {time_func<0>, time_func<1>, time_func<2>, time_func<3>,
-                                      time_func<4>, time_func<5>, time_func<6>};
+static const time_t_ TIME[F_COUNT] = {time_func<0>, time_func<1>, time_func<2>, time_func<3>, time_func<4>,
+                                      time_func<5>, time_func<6>, time_func<7>, time_func<8>, time_func<9>};
 
-static void print_vec(const VectorXd & x)
+template<typename Vec>
+static void print_vec(const Vec & x)
 {
   std::printf("[");
   for (Eigen::Index i = 0; i < x.size(); ++i)
     std::printf("%s%.17g", i ? ", " : "", x(i));
   std::printf("]");
+}
+
+// A matrix as JSON rows.
+template<typename Mat>
+static void print_mat(const Mat & m)
+{
+  std::printf("[");
+  for (Eigen::Index r = 0; r < m.rows(); ++r)
+  {
+    std::printf("%s", r ? ", " : "");
+    print_vec(m.row(r));
+  }
+  std::printf("]");
+}
+
+// The dump of one derivative function: the first output under the function's name, the others
+// as "NAME.output" (as M_nle's second output is "M_nle.nle").
+static void print_derivs(int f, const pinocchio::Data & data)
+{
+  if (f == F_RNEA_DERIVS)
+  {
+    print_mat(data.dtau_dq);
+    std::printf(", \"rnea_derivs.dtau_dv\": ");
+    print_mat(data.dtau_dv);
+  }
+  else if (f == F_ABA_DERIVS)
+  {
+    print_mat(data.ddq_dq);
+    std::printf(", \"aba_derivs.ddq_dv\": ");
+    print_mat(data.ddq_dv);
+    std::printf(", \"aba_derivs.Minv\": ");
+    print_mat(data.Minv);
+  }
+  else
+    print_mat(data.Minv);
 }
 
 int main(int argc, char ** argv)
@@ -192,6 +257,8 @@ int main(int argc, char ** argv)
     return 1;
   }
 
+  const char * derivs_env = std::getenv("PEERS_DERIVS");
+  const int f_count = derivs_env && std::string(derivs_env) == "0" ? F_RNEA_DERIVS : F_COUNT;
   if (!std::strcmp(mode, "dump"))
   {
     std::printf(
@@ -200,19 +267,15 @@ int main(int argc, char ** argv)
     for (int k = 0; k < K; ++k)
     {
       std::printf("%s{", k ? ",\n" : "");
-      for (int f = 0; f < F_COUNT; ++f)
+      for (int f = 0; f < f_count; ++f)
       {
         DUMP_CALL[f](model, data, S[k], 0, n);
         std::printf("%s\"%s\": ", f ? ", " : "", NAMES[f]);
-        if (f == F_M || f == F_M_WORLD || f == F_M_NLE)
+        if (f == F_RNEA_DERIVS || f == F_ABA_DERIVS || f == F_MINV)
+          print_derivs(f, data);
+        else if (f == F_M || f == F_M_WORLD || f == F_M_NLE)
         {
-          std::printf("[");
-          for (int r = 0; r < n; ++r)
-          {
-            std::printf("%s", r ? ", " : "");
-            print_vec(data.M.row(r).transpose());
-          }
-          std::printf("]");
+          print_mat(data.M);
           if (f == F_M_NLE)
           {
             std::printf(", \"M_nle.nle\": ");
@@ -239,7 +302,7 @@ int main(int argc, char ** argv)
   const int rounds = std::atoi(argv[6]);
   const long max_calls = std::atol(argv[7]);
   const double round_us = std::atof(argv[8]);
-  for (int fi = 0; fi < F_COUNT; ++fi)
+  for (int fi = 0; fi < f_count; ++fi)
     TIME[fi](model, data, S, n, rounds, max_calls, round_us, label, model_name);
   return 0;
 }

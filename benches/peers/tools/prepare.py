@@ -21,7 +21,10 @@ For each model NAME=PATH.urdf this writes into DIR:
                    snapped (models.json: `snapped`).
   NAME.states.txt  "K n", then one line per state: q, v, tau, a (n each)   [C / C++ drivers]
   NAME.ref.json    Pinocchio numeric (Python) at those states, gravity 0: M (crba, symmetrized),
-                   nle = nonLinearEffects, tau = rnea(q, v, a), ddq = aba(q, v, tau)
+                   nle = nonLinearEffects, tau = rnea(q, v, a), ddq = aba(q, v, tau),
+                   dtau_dq, dtau_dv = computeRNEADerivatives(q, v, a), ddq_dq, ddq_dv =
+                   computeABADerivatives(q, v, tau), Minv = computeMinverse(q) (symmetrized
+                   from its upper triangle; row i = output i, column j = input j)
   NAME.states.rs   the same states as Rust constants, in Pinocchio's joint order, with the joint
                    names (the kanegen bench maps them onto `Name::JOINTS`)
   NAME.kg_default.rs / NAME.kg_clean.rs / NAME.kg_native.rs   the body of the kanegen bench's
@@ -188,10 +191,16 @@ for spec in args.models:
         Mq = np.triu(Mq) + np.triu(Mq, 1).T
         nle = pin.nonLinearEffects(model, data, q, v).copy()
         ddq = pin.aba(model, data, q, v, tau).copy()
+        dtau_dq, dtau_dv, _ = (x.copy() for x in pin.computeRNEADerivatives(model, data, q, v, a))
+        ddq_dq, ddq_dv, _ = (x.copy() for x in pin.computeABADerivatives(model, data, q, v, tau))
+        Minv = pin.computeMinverse(model, data, q).copy()
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
         taus.append(tau)
         accs.append(a)
         refs.append({"q": q.tolist(), "v": v.tolist(), "tau": tau.tolist(), "a": a.tolist(),
-                     "M": Mq.tolist(), "nle": nle.tolist(), "ddq": ddq.tolist()})
+                     "M": Mq.tolist(), "nle": nle.tolist(), "ddq": ddq.tolist(),
+                     "dtau_dq": dtau_dq.tolist(), "dtau_dv": dtau_dv.tolist(),
+                     "ddq_dq": ddq_dq.tolist(), "ddq_dv": ddq_dv.tolist(), "Minv": Minv.tolist()})
     with open(os.path.join(args.out, f"{name}.states.txt"), "w") as f:
         f.write(f"{len(qs)} {n}\n")
         for q, v, t, a in zip(qs, vs, taus, accs):

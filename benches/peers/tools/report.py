@@ -70,7 +70,9 @@ for model in models:
             cas[(model, var)] = json.load(open(cj))["functions"]
 
 KG_FUNC = {"M": "mass_matrix", "nle": "nonlinear_effects", "M_nle": "mass_matrix_and_nonlinear_effects",
-           "rnea": "inverse_dynamics", "aba": "forward_dynamics"}
+           "rnea": "inverse_dynamics", "aba": "forward_dynamics",
+           "rnea_derivs": "inverse_dynamics_derivatives", "aba_derivs": "forward_dynamics_derivatives",
+           "minv": "mass_matrix_inverse"}
 kg = {}  # model(+sfx) -> {kanegen function: op count dict}
 for kind in ("default", "clean", "native"):
     for model in models:
@@ -82,7 +84,7 @@ for kind in ("default", "clean", "native"):
 
 
 def kg_ops(key, func):
-    o = kg.get(key, {}).get(KG_FUNC[func])
+    o = kg.get(key, {}).get(KG_FUNC.get(func))
     return None if o is None else o["mul"] + o["add"]
 
 
@@ -124,6 +126,11 @@ FUNCS = [  # (row name, common key, peer keys (LOCAL first))
     ("(M, c) one call", "M_nle", ["M_nle"]),
     ("inverse dynamics", "rnea", ["rnea"]),
     ("forward dynamics", "aba", ["aba", "aba_world"]),
+]
+DFUNCS = [  # (row name, common key, CasADi's SX-jacobian variant or None)
+    ("∂τ/∂q, ∂τ/∂v", "rnea_derivs", "rnea_jac"),
+    ("∂q̈/∂q, ∂q̈/∂v, M⁻¹", "aba_derivs", "aba_jac"),
+    ("M⁻¹", "minv", None),
 ]
 
 L = []
@@ -176,6 +183,39 @@ L.append("### Where kanegen is slower\n")
 L.extend([f"- {s}" for s in slower] or ["- nowhere in the headline table."])
 L.append("\n(Ties, within 0.5 %, are not listed. CasADi and Pinocchio at their faster convention.)")
 L.append("")
+
+# ------------------------------------------------------------------ derivatives
+R["derivatives"] = []
+if any(ns(s_, l_, m, f) for m in models for _, f, _ in DFUNCS
+       for s_, l_ in (("kanegen", "default"), ("casadi", "cse"), ("pinocchio", "hdr"))):
+    L.append("## Derivatives of the dynamics\n")
+    L.append("Pinocchio's layouts (row i = output i, column j = ∂/∂ input j). kanegen: "
+             "`inverse_dynamics_derivatives`, `forward_dynamics_derivatives` (with M⁻¹), `mass_matrix_inverse`. "
+             "CasADi: Pinocchio's `computeRNEADerivatives`, `computeABADerivatives`, `computeMinverse` traced on SX "
+             "(`derivs`), and CasADi's own `SX::jacobian` of the traced `rnea` and `aba` (`jac`; for `aba` also "
+             "w.r.t. τ, which is M⁻¹). Numeric Pinocchio: the same three algorithms on double (`computeMinverse` "
+             "+ mirror of its upper triangle). Ratios against CasADi use its faster variant.\n")
+    L.append("| model | n | function | kanegen ns | CasADi derivs ns | CasADi jac ns | Pinocchio ns "
+             "| vs CasADi | vs Pinocchio | kanegen ops | CasADi derivs ops | CasADi jac ops |")
+    L.append("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for model in models:
+        n = MODELS[model]["n"]
+        for name, key, jac in DFUNCS:
+            c_ns = {v: ns("casadi", "cse", model, f) for v, f in (("derivs", key), ("jac", jac)) if f}
+            r = {"model": model, "n": n, "function": key, "kanegen_ns": ns("kanegen", "default", model, key),
+                 "casadi_derivs_ns": c_ns.get("derivs"), "casadi_jac_ns": c_ns.get("jac"),
+                 "pinocchio_ns": ns("pinocchio", "hdr", model, key), "kanegen_ops": kg_ops(model, key),
+                 "casadi_derivs_ops": cas_ops(model, "cse", key),
+                 "casadi_jac_ops": cas_ops(model, "cse", jac) if jac else None}
+            c_best = min((x for x in c_ns.values() if x is not None), default=None)
+            r["kanegen_faster_than_casadi"] = ratio(c_best, r["kanegen_ns"])
+            r["kanegen_faster_than_pinocchio"] = ratio(r["pinocchio_ns"], r["kanegen_ns"])
+            R["derivatives"].append(r)
+            cells = [fmt_ns(r[x]) for x in ("kanegen_ns", "casadi_derivs_ns", "casadi_jac_ns", "pinocchio_ns")]
+            cells += [fmt_ratio(r[x]) for x in ("kanegen_faster_than_casadi", "kanegen_faster_than_pinocchio")]
+            cells += ["–" if r[x] is None else str(r[x]) for x in ("kanegen_ops", "casadi_derivs_ops", "casadi_jac_ops")]
+            L.append(f"| {model} | {n} | {name} | " + " | ".join(cells) + " |")
+    L.append("")
 
 # ------------------------------------------------------------------ run-time path
 R["runtime"] = []
@@ -302,6 +342,7 @@ L.append("`sincos_n`: n sincos calls on q alone (C: glibc `sincos`, which gcc al
          "sin/cos pairs; Rust: `libm::sincos`, which kanegen's code calls). Pinocchio `M_nle` = crba + "
          "nonLinearEffects (two calls); `M`, `M_world`: crba + mirror of the upper triangle.\n")
 cols = ["M", "M_world", "nle", "M_nle", "rnea", "aba", "aba_world", "aba_runtime", "sincos_n"]
+cols += [c for c in ("rnea_derivs", "rnea_jac", "aba_derivs", "aba_jac", "minv") if any(k[3] == c for k in T)]
 L.append("| model | side / label | " + " | ".join(cols) + " | spread |")
 L.append("|---|---|" + "---:|" * (len(cols) + 1))
 for model in models:
@@ -324,12 +365,15 @@ L.append("kanegen: `Name::OP_COUNTS` of each emitted function (the cheapest cand
          "OP_SQ, add = OP_ADD + OP_SUB + OP_TWICE; `n_instr` includes inputs, outputs, constants).\n")
 L.append("| model | function | kanegen method (M / bias) | kanegen mul | add | div | sincos | CasADi mul | add | sin+cos | n_instr | ops ratio CasADi / kanegen |")
 L.append("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+OP_KEYS = [f[1] for f in FUNCS] + ["rnea_derivs", "rnea_jac", "aba_derivs", "aba_jac", "minv"]
 for model in models:
-    for name, key, pk in FUNCS:
-        o = kg.get(model, {}).get(KG_FUNC[key])
+    for key in OP_KEYS:
+        o = kg.get(model, {}).get(KG_FUNC.get(key))
         c = cas.get((model, "cse"), {}).get(key)
         ko, co = kg_ops(model, key), cas_ops(model, "cse", key)
-        meth = "–" if o is None else f"{o['mass_matrix_method'] or '–'} / {o['bias_method'] or '–'}"
+        if o is None and c is None:
+            continue
+        meth = "–" if o is None else f"{o['mass_matrix_method'] or '–'} / {o['nonlinear_effects_method'] or '–'}"
         L.append(f"| {model} | {key} | {meth} | " + (" | ".join(str(o[x]) for x in ("mul", "add", "div", "sincos")) if o else "– | – | – | –")
                  + " | " + (f"{c['mul_total']} | {c['add_total']} | {c['sin'] + c['cos']} | {c['n_instructions']}" if c else "– | – | – | –")
                  + (f" | {co / ko:.2f} |" if ko and co else " | – |"))
@@ -341,7 +385,7 @@ vj = os.path.join(a.out, "dumps", "validation.json")
 if os.path.exists(vj):
     v = json.load(open(vj))
     R["validation"] = v
-    L.append(f"## Validation against numeric Pinocchio (Python pin; crba, nonLinearEffects, rnea, aba), rtol {v['rtol']:g}\n")
+    L.append(f"## Validation against numeric Pinocchio (Python pin; crba, nonLinearEffects, rnea, aba and, with DERIVS, computeRNEADerivatives, computeABADerivatives, computeMinverse), rtol {v['rtol']:g}\n")
     L.append("Worst normwise relative error max|x − x_ref| / max|x_ref| over the 20 states and all functions "
              "of a (side, label), per model.\n")
     sl = sorted({(r["side"], r["label"]) for r in v["rows"]})

@@ -4,13 +4,17 @@
 usage: validate.py REFDIR DUMPDIR [--rtol 1e-9]
 
 REFDIR/NAME.ref.json            tools/prepare.py (Python pin): M (crba, symmetrized), nle,
-                                tau = rnea(q, v, a), ddq = aba(q, v, tau)
+                                tau = rnea(q, v, a), ddq = aba(q, v, tau), dtau_dq, dtau_dv
+                                (computeRNEADerivatives), ddq_dq, ddq_dv (computeABADerivatives),
+                                Minv (computeMinverse, symmetrized)
 DUMPDIR/casadi.NAME.LABEL.json  `driver ... dump` (CasADi-generated C)
 DUMPDIR/pinocchio.NAME.LABEL.json  `pin_numeric ... dump` (numeric Pinocchio in C++)
 DUMPDIR/kanegen.LABEL.NAME.json `kanegen_bench LABEL dump` (one build: one model, its variants)
 
 Every side dumps the same keys in Pinocchio's joint order: M, nle, M_nle (+ M_nle.nle), rnea,
-aba, and CasADi / Pinocchio also M_world, aba_world.
+aba, and CasADi / Pinocchio also M_world, aba_world. With the derivatives: rnea_derivs
+(+ rnea_derivs.dtau_dv), aba_derivs (+ aba_derivs.ddq_dv, aba_derivs.Minv), minv; CasADi also
+rnea_jac and aba_jac (SX jacobians, same keys). A key absent from a dump is not checked.
 
 Error measure, per quantity: max over the states of  max|x - x_ref| / max|x_ref|
 (normwise relative: the entries of M span many orders of magnitude, and the small ones carry
@@ -33,8 +37,12 @@ p.add_argument("--rtol", type=float, default=1e-9)
 a = p.parse_args()
 
 REF_KEY = {"M": "M", "M_world": "M", "M_nle": "M", "M_nle.nle": "nle", "nle": "nle", "rnea": "tau",
-           "aba": "ddq", "aba_world": "ddq"}
-ORDER = ["M", "M_world", "nle", "M_nle", "M_nle.nle", "rnea", "aba", "aba_world"]
+           "aba": "ddq", "aba_world": "ddq", "minv": "Minv"}
+for f in ("rnea_derivs", "rnea_jac"):
+    REF_KEY.update({f: "dtau_dq", f + ".dtau_dv": "dtau_dv"})
+for f in ("aba_derivs", "aba_jac"):
+    REF_KEY.update({f: "ddq_dq", f + ".ddq_dv": "ddq_dv", f + ".Minv": "Minv"})
+ORDER = list(REF_KEY)
 
 
 def err(x, ref):
@@ -64,7 +72,7 @@ def check(side, label, model, samples):
         rows.append({"side": side, "label": label, "model": model, "quantity": key, "ref": REF_KEY[key],
                      "max_rel_err": e})
         ok = e <= a.rtol and np.isfinite(e)
-        print(f"{side:9s} {label:15s} {model:11s} {key:10s} vs {REF_KEY[key]:4s} max rel err {e:9.2e}"
+        print(f"{side:9s} {label:15s} {model:11s} {key:20s} vs {REF_KEY[key]:7s} max rel err {e:9.2e}"
               + ("" if ok else "   <-- FAIL"))
         if not ok:
             bad.append(f"{side}/{label}/{model}/{key}")

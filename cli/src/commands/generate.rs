@@ -4,12 +4,10 @@
 use kanegen_codegen::{generate_file, Float, Options};
 use kanegen_model::{BaseKind, Model, ModelError};
 
-/// Most joints `kanegen generate` accepts without `--allow-large`. Large models take the compact
-/// form, decided from a traced prefix ([`kanegen_codegen::plan`]), so generating is quick at
-/// that size (random chain N = 1000: 0.55–3.4 s, 59 MB, 1.6 MB of code); beyond it the generated
-/// code is what grows: its functions keep O(N) arrays on the caller's stack, and its frame
-/// functions stay straight-line (6·N Jacobian entries).
-pub const MAX_N: usize = 1000;
+/// Most joints `kanegen generate` accepts without `--allow-large`
+/// ([`kanegen_codegen::MAX_JOINTS`], the bound `dynamics!` applies too; random chain N = 1000:
+/// 0.55–3.4 s, 59 MB, 1.6 MB of code).
+pub const MAX_N: usize = kanegen_codegen::MAX_JOINTS;
 
 /// `CamelCase` type name from a model name or file stem: `ssrms_nguyen_hughes_1994` →
 /// `SsrmsNguyenHughes1994`; a leading digit gets a `Model` prefix.
@@ -40,16 +38,18 @@ pub fn generate(model: &Model, opts: &Options) -> Result<String, kanegen_codegen
 }
 
 /// [`generate`], refusing code that holds a non-finite constant (`f64::NAN`, `f64::INFINITY`):
-/// a model quantity folded into the code overflowed.
+/// a model quantity folded into the code overflowed. The joint-limit tables are exempt: an
+/// absent limit is `±∞` by design.
 ///
 /// # Errors
 /// As [`generate`], or a non-finite constant.
 pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String> {
     let code = generate(model, opts)?;
+    let checked = checked_lines(&code);
     for ty in ["f64", "f32"] {
         for c in ["NAN", "INFINITY", "NEG_INFINITY"] {
             let token = format!("{ty}::{c}");
-            if let Some(line) = code.lines().position(|l| {
+            if let Some(&(line, _)) = checked.iter().find(|(_, l)| {
                 !l.trim_start().starts_with("//")
                     && l.split(|ch: char| !(ch.is_alphanumeric() || ch == '_' || ch == ':'))
                         .any(|w| w == token)
@@ -63,6 +63,24 @@ pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String>
         }
     }
     Ok(code)
+}
+
+/// The lines of `code` (0-based number, text) outside the joint-limit tables
+/// (`pub const …_LIMIT: [..] = [..];`, where `±∞` marks an absent limit).
+fn checked_lines(code: &str) -> Vec<(usize, &str)> {
+    let mut in_table = false;
+    let mut lines = Vec::new();
+    for (i, l) in code.lines().enumerate() {
+        if !in_table && l.trim_start().starts_with("pub const ") && l.contains("_LIMIT: [") {
+            in_table = true;
+        }
+        if in_table {
+            in_table = !l.trim_end().ends_with(';');
+        } else {
+            lines.push((i, l));
+        }
+    }
+    lines
 }
 
 /// One file of the `kanegen-generated` crate.

@@ -122,9 +122,26 @@ fn trace_kernel(
                 tau: &tau,
                 f_ext: f_ext.as_deref(),
             };
-            let mut bodies = vec![Articulated::zero(); n];
+            let (mut v, mut c, mut pa, mut ui, mut a) = (
+                vec![[zero; 6]; n],
+                vec![[zero; 6]; n],
+                vec![[zero; 6]; n],
+                vec![[zero; 6]; n],
+                vec![[zero; 6]; n],
+            );
+            let (mut ia, mut d, mut u) = (vec![[zero; 21]; n], vec![zero; n], vec![zero; n]);
+            let mut ab = Articulated {
+                v: &mut v,
+                c: &mut c,
+                ia: &mut ia,
+                pa: &mut pa,
+                ui: &mut ui,
+                d: &mut d,
+                u: &mut u,
+                a: &mut a,
+            };
             let mut qdd = vec![zero; n];
-            k::aba::aba(tables, inertia, rates, &mut b, &mut bodies, &mut qdd);
+            k::aba::aba(tables, inertia, rates, &mut b, &mut ab, &mut qdd);
             qdd
         }
     })

@@ -59,10 +59,17 @@ fn articulated<S: Scalar + Copy, const N: usize>(
 ) -> [S; N] {
     let mut store = BodyStore::<S, N>::new();
     let mut b = store.bodies();
-    let mut bodies = [Articulated::zero(); N];
+    let mut scratch = ArticulatedStore::<S, N>::new();
     let mut qdd = [S::zero(); N];
     transforms(t, q, sincos, b.x);
-    aba(t, inertia, rates, &mut b, &mut bodies, &mut qdd);
+    aba(
+        t,
+        inertia,
+        rates,
+        &mut b,
+        &mut scratch.articulated(),
+        &mut qdd,
+    );
     qdd
 }
 
@@ -79,44 +86,80 @@ pub struct Rates<'a, S> {
     pub f_ext: Option<&'a [[S; 6]]>,
 }
 
-/// One body's quantities in the articulated-body algorithm (RBDA Table 7.1): the kernels'
-/// scratch, one per joint.
-#[derive(Clone, Copy, Debug)]
-pub struct Articulated<S> {
+/// The bodies' quantities in the articulated-body algorithm (RBDA Table 7.1), one entry per
+/// joint in each slice: the kernel's scratch (see [`ArticulatedStore`]).
+#[derive(Debug)]
+pub struct Articulated<'a, S> {
     /// `v_i`.
-    v: [S; 6],
+    pub v: &'a mut [[S; 6]],
     /// `c_i = v_i ×ₘ S_i q̇_i`.
-    c: [S; 6],
+    pub c: &'a mut [[S; 6]],
     /// `I^A_i`, 21 upper-triangle entries by rows ([`SYM`]).
-    ia: [S; 21],
+    pub ia: &'a mut [[S; 21]],
     /// `p^A_i`.
-    pa: [S; 6],
+    pub pa: &'a mut [[S; 6]],
     /// `U_i = I^A_i S_i`.
-    ui: [S; 6],
+    pub ui: &'a mut [[S; 6]],
     /// `D_i = S_iᵀ U_i`.
-    d: S,
+    pub d: &'a mut [S],
     /// `u_i = τ_i − S_iᵀ p^A_i`.
-    u: S,
+    pub u: &'a mut [S],
     /// `a_i`.
-    a: [S; 6],
+    pub a: &'a mut [[S; 6]],
 }
 
-impl<S: Scalar + Copy> Articulated<S> {
-    /// All zero (`D_i = 1`).
+/// Storage of `N` joints for [`Articulated`], on the stack: what the const-`N` entry points hand
+/// to [`aba`]. All zero (every entry is written before it is read).
+#[derive(Clone, Copy, Debug)]
+pub struct ArticulatedStore<S, const N: usize> {
+    v: [[S; 6]; N],
+    c: [[S; 6]; N],
+    ia: [[S; 21]; N],
+    pa: [[S; 6]; N],
+    ui: [[S; 6]; N],
+    d: [S; N],
+    u: [S; N],
+    a: [[S; 6]; N],
+}
+
+impl<S: Scalar + Copy, const N: usize> ArticulatedStore<S, N> {
+    /// Zeroed storage.
     #[inline(always)]
     #[must_use]
-    pub fn zero() -> Self {
+    pub fn new() -> Self {
         let zero = S::zero();
-        Articulated {
-            v: [zero; 6],
-            c: [zero; 6],
-            ia: [zero; 21],
-            pa: [zero; 6],
-            ui: [zero; 6],
-            d: S::one(),
-            u: zero,
-            a: [zero; 6],
+        ArticulatedStore {
+            v: [[zero; 6]; N],
+            c: [[zero; 6]; N],
+            ia: [[zero; 21]; N],
+            pa: [[zero; 6]; N],
+            ui: [[zero; 6]; N],
+            d: [zero; N],
+            u: [zero; N],
+            a: [[zero; 6]; N],
         }
+    }
+
+    /// The storage as the kernel's scratch.
+    #[inline(always)]
+    pub fn articulated(&mut self) -> Articulated<'_, S> {
+        Articulated {
+            v: &mut self.v,
+            c: &mut self.c,
+            ia: &mut self.ia,
+            pa: &mut self.pa,
+            ui: &mut self.ui,
+            d: &mut self.d,
+            u: &mut self.u,
+            a: &mut self.a,
+        }
+    }
+}
+
+impl<S: Scalar + Copy, const N: usize> Default for ArticulatedStore<S, N> {
+    #[inline(always)]
+    fn default() -> Self {
+        Self::new()
     }
 }
 
@@ -140,7 +183,7 @@ const SYM: [[usize; 6]; 6] = {
 /// `M v` of a symmetric 6×6 `M` kept as its 21 upper-triangle entries ([`SYM`]).
 #[inline(always)]
 fn sym_times<S: Scalar + Copy>(m: &[S; 21], v: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| {
+    let row = |r: usize| {
         let row = &SYM[r];
         m[row[0]] * v[0]
             + m[row[1]] * v[1]
@@ -148,7 +191,8 @@ fn sym_times<S: Scalar + Copy>(m: &[S; 21], v: &[S; 6]) -> [S; 6] {
             + m[row[3]] * v[3]
             + m[row[4]] * v[4]
             + m[row[5]] * v[5]
-    })
+    };
+    [row(0), row(1), row(2), row(3), row(4), row(5)]
 }
 
 /// `M − w uᵀ` of a packed symmetric `M` (for `w uᵀ` symmetric: `w = u / D`).
@@ -169,21 +213,21 @@ fn sym_minus_outer<S: Scalar + Copy>(m: &[S; 21], w: &[S; 6], u: &[S; 6]) -> [S;
 /// coordinate system", as Pinocchio's), so that no transform is needed between bodies, on the
 /// joint transforms `b.x`, into `qdd`: the bodies carried to the base ([`world`]), velocities
 /// and bias terms outwards ([`outward`]), articulated inertias inwards ([`inward`]),
-/// accelerations outwards from `a₀` ([`Tables::a0`], [`accelerations`]). `bodies`: scratch, one
-/// per joint.
+/// accelerations outwards from `a₀` ([`Tables::a0`], [`accelerations`]). `ab`: scratch, one
+/// entry per joint.
 #[inline(always)]
 pub fn aba<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
     rates: Rates<'_, S>,
     b: &mut Bodies<'_, S>,
-    bodies: &mut [Articulated<S>],
+    ab: &mut Articulated<'_, S>,
     qdd: &mut [S],
 ) {
     world(t, inertia, b);
-    outward(t, b, rates, bodies);
-    inward(t, b.s0, rates.tau, bodies);
-    accelerations(t, b.s0, bodies, qdd);
+    outward(t, b, rates, ab);
+    inward(t, b.s0, rates.tau, ab);
+    accelerations(t, b.s0, ab, qdd);
 }
 
 /// RBDA Table 7.1, third pass: `a' = a_λ + c_i`, `q̈_i = (u_i − U_iᵀ a') / D_i`,
@@ -192,27 +236,29 @@ pub fn aba<S: Scalar + Copy>(
 fn accelerations<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     s0: &[[S; 6]],
-    bodies: &mut [Articulated<S>],
+    ab: &mut Articulated<'_, S>,
     qdd: &mut [S],
 ) {
-    for i in 0..bodies.len() {
-        let ap = match t
-            .parent
-            .get(i)
-            .copied()
-            .flatten()
-            .and_then(|l| bodies.get(l))
-        {
-            Some(p) => p.a,
+    for i in 0..ab.a.len() {
+        let ap = match t.parent.get(i).copied().flatten().and_then(|l| ab.a.get(l)) {
+            Some(p) => *p,
             None => t.a0,
         };
-        let (Some(s), Some(qddi)) = (s0.get(i), qdd.get_mut(i)) else {
+        let (Some(s), Some(c), Some(ui), Some(&u), Some(&d), Some(qddi)) = (
+            s0.get(i),
+            ab.c.get(i),
+            ab.ui.get(i),
+            ab.u.get(i),
+            ab.d.get(i),
+            qdd.get_mut(i),
+        ) else {
             continue;
         };
-        let o = &mut bodies[i];
-        let a = add(&ap, &o.c);
-        *qddi = (o.u - dot(&o.ui, &a)) / o.d;
-        o.a = axpy(&a, *qddi, s);
+        let a = add(&ap, c);
+        *qddi = (u - dot(ui, &a)) / d;
+        if let Some(ai) = ab.a.get_mut(i) {
+            *ai = axpy(&a, *qddi, s);
+        }
     }
 }
 
@@ -223,18 +269,12 @@ fn outward<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     b: &Bodies<'_, S>,
     rates: Rates<'_, S>,
-    bodies: &mut [Articulated<S>],
+    ab: &mut Articulated<'_, S>,
 ) {
     let zero = S::zero();
-    for i in 0..bodies.len() {
-        let vp = match t
-            .parent
-            .get(i)
-            .copied()
-            .flatten()
-            .and_then(|l| bodies.get(l))
-        {
-            Some(p) => p.v,
+    for i in 0..ab.v.len() {
+        let vp = match t.parent.get(i).copied().flatten().and_then(|l| ab.v.get(l)) {
+            Some(p) => *p,
             None => [zero; 6],
         };
         let (Some(s), Some(k), Some(x0), Some(&qd)) =
@@ -242,13 +282,16 @@ fn outward<S: Scalar + Copy>(
         else {
             continue;
         };
-        let o = &mut bodies[i];
+        let (Some(c), Some(ia), Some(pa)) = (ab.c.get_mut(i), ab.ia.get_mut(i), ab.pa.get_mut(i))
+        else {
+            continue;
+        };
         let vj = scale(qd, s);
-        o.v = add(&vp, &vj);
-        o.c = crm(&o.v, &vj);
+        let v = add(&vp, &vj);
+        *c = crm(&v, &vj);
         // I = [Ī h̃; h̃ᵀ m1] (RBDA eq. (2.63)), upper triangle by rows.
         #[rustfmt::skip]
-        let ia = [
+        let i0 = [
             k[4], k[5], k[6], zero, -k[3], k[2],
             k[7], k[8], k[3], zero, -k[1],
             k[9], -k[2], k[1], zero,
@@ -256,13 +299,16 @@ fn outward<S: Scalar + Copy>(
             k[0], zero,
             k[0],
         ];
-        o.ia = ia;
-        let iv = inertia_mul(k, &o.v);
-        let p = crf(&o.v, &iv);
-        o.pa = match rates.f_ext.and_then(|f| f.get(i)) {
+        *ia = i0;
+        let iv = inertia_mul(k, &v);
+        let p = crf(&v, &iv);
+        *pa = match rates.f_ext.and_then(|f| f.get(i)) {
             Some(e) => sub(&p, &x0.apply_tr(&[e[3], e[4], e[5], e[0], e[1], e[2]])),
             None => p,
         };
+        if let Some(vi) = ab.v.get_mut(i) {
+            *vi = v;
+        }
     }
 }
 
@@ -274,29 +320,36 @@ fn inward<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     s0: &[[S; 6]],
     tau: &[S],
-    bodies: &mut [Articulated<S>],
+    ab: &mut Articulated<'_, S>,
 ) {
-    for i in (0..bodies.len()).rev() {
-        let (Some(s), Some(&taui)) = (s0.get(i), tau.get(i)) else {
+    for i in (0..ab.ia.len()).rev() {
+        let (Some(s), Some(&taui), Some(&ia), Some(&pa), Some(&c)) = (
+            s0.get(i),
+            tau.get(i),
+            ab.ia.get(i),
+            ab.pa.get(i),
+            ab.c.get(i),
+        ) else {
             continue;
         };
-        let o = &mut bodies[i];
-        let ui = sym_times(&o.ia, s);
-        o.d = dot(s, &ui);
-        o.u = taui - dot(s, &o.pa);
-        o.ui = ui;
+        let ui = sym_times(&ia, s);
+        let d = dot(s, &ui);
+        let u = taui - dot(s, &pa);
+        if let (Some(di), Some(uu), Some(uv)) = (ab.d.get_mut(i), ab.u.get_mut(i), ab.ui.get_mut(i))
+        {
+            (*di, *uu, *uv) = (d, u, ui);
+        }
         if let Some(l) = t.parent.get(i).copied().flatten() {
-            let o = &bodies[i];
-            let dinv = S::one() / o.d;
+            let dinv = S::one() / d;
             let w = scale(dinv, &ui);
-            let m = sym_minus_outer(&o.ia, &w, &ui);
-            let p = axpy(&o.pa, o.u, &w);
-            let p = add(&p, &sym_times(&m, &o.c));
-            if let Some(parent) = bodies.get_mut(l) {
-                for (a, b) in parent.ia.iter_mut().zip(m) {
+            let m = sym_minus_outer(&ia, &w, &ui);
+            let p = axpy(&pa, u, &w);
+            let p = add(&p, &sym_times(&m, &c));
+            if let (Some(ial), Some(pal)) = (ab.ia.get_mut(l), ab.pa.get_mut(l)) {
+                for (a, b) in ial.iter_mut().zip(m) {
                     *a = *a + b;
                 }
-                parent.pa = add(&parent.pa, &p);
+                *pal = add(pal, &p);
             }
         }
     }

@@ -41,7 +41,9 @@ pub mod rnea;
 pub mod spatial;
 pub mod tables;
 
-pub use aba::{forward_dynamics, forward_dynamics_with_wrenches, Articulated, Rates};
+pub use aba::{
+    forward_dynamics, forward_dynamics_with_wrenches, Articulated, ArticulatedStore, Rates,
+};
 pub use crba::{mass_matrix, mass_matrix_and_nonlinear_effects};
 pub use payload::{payload_inertia, with_payload};
 pub use rnea::{gravity, inverse_dynamics, nonlinear_effects, Motions};

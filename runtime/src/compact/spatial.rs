@@ -65,9 +65,11 @@ impl<S: Scalar + Copy> Transform<S> {
         let hr = rot_tr(e, &[i[1], i[2], i[3]]);
         let h = [hr[0] + m * r[0], hr[1] + m * r[1], hr[2] + m * r[2]];
         // Ī E, then the upper triangle of Eᵀ (Ī E).
-        let ie: [[S; 3]; 3] = core::array::from_fn(|a| {
-            core::array::from_fn(|b| ib[a][0] * e[0][b] + ib[a][1] * e[1][b] + ib[a][2] * e[2][b])
-        });
+        let ie_row = |a: usize| {
+            let ie = |b: usize| ib[a][0] * e[0][b] + ib[a][1] * e[1][b] + ib[a][2] * e[2][b];
+            [ie(0), ie(1), ie(2)]
+        };
+        let ie = [ie_row(0), ie_row(1), ie_row(2)];
         let d = r[0] * (hr[0] + h[0]) + r[1] * (hr[1] + h[1]) + r[2] * (hr[2] + h[2]);
         let entry = |a: usize, b: usize| {
             let eie = e[0][a] * ie[0][b] + e[1][a] * ie[1][b] + e[2][a] * ie[2][b];
@@ -103,14 +105,16 @@ pub fn cross<S: Scalar + Copy>(a: &[S; 3], b: &[S; 3]) -> [S; 3] {
 #[inline(always)]
 #[must_use]
 pub fn rot<S: Scalar + Copy>(e: &[[S; 3]; 3], v: &[S; 3]) -> [S; 3] {
-    core::array::from_fn(|r| e[r][0] * v[0] + e[r][1] * v[1] + e[r][2] * v[2])
+    let row = |r: usize| e[r][0] * v[0] + e[r][1] * v[1] + e[r][2] * v[2];
+    [row(0), row(1), row(2)]
 }
 
 /// `Eᵀ v`.
 #[inline(always)]
 #[must_use]
 pub fn rot_tr<S: Scalar + Copy>(e: &[[S; 3]; 3], v: &[S; 3]) -> [S; 3] {
-    core::array::from_fn(|c| e[0][c] * v[0] + e[1][c] * v[1] + e[2][c] * v[2])
+    let col = |c: usize| e[0][c] * v[0] + e[1][c] * v[1] + e[2][c] * v[2];
+    [col(0), col(1), col(2)]
 }
 
 /// `a ×ₘ b = [ω_a × ω_b; ω_a × v_b + v_a × ω_b]` (RBDA eq. (2.31)).
@@ -173,28 +177,32 @@ pub fn dot<S: Scalar + Copy>(a: &[S; 6], b: &[S; 6]) -> S {
 #[inline(always)]
 #[must_use]
 pub fn axpy<S: Scalar + Copy>(a: &[S; 6], k: S, b: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| a[r] + k * b[r])
+    let f = |r: usize| a[r] + k * b[r];
+    [f(0), f(1), f(2), f(3), f(4), f(5)]
 }
 
 /// `k b`.
 #[inline(always)]
 #[must_use]
 pub fn scale<S: Scalar + Copy>(k: S, b: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| k * b[r])
+    let f = |r: usize| k * b[r];
+    [f(0), f(1), f(2), f(3), f(4), f(5)]
 }
 
 /// `a + b`.
 #[inline(always)]
 #[must_use]
 pub fn add<S: Scalar + Copy>(a: &[S; 6], b: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| a[r] + b[r])
+    let f = |r: usize| a[r] + b[r];
+    [f(0), f(1), f(2), f(3), f(4), f(5)]
 }
 
 /// `a − b`.
 #[inline(always)]
 #[must_use]
 pub fn sub<S: Scalar + Copy>(a: &[S; 6], b: &[S; 6]) -> [S; 6] {
-    core::array::from_fn(|r| a[r] - b[r])
+    let f = |r: usize| a[r] - b[r];
+    [f(0), f(1), f(2), f(3), f(4), f(5)]
 }
 
 /// `Xup_j = XJ(q_j) Xtree_j` for every joint, as `E_j = A_j + cos q_j B_j + sin q_j C_j` and
@@ -257,9 +265,11 @@ pub fn world<S: Scalar + Copy>(t: &Tables<'_, S>, inertia: &[[S; 10]], w: &mut B
 #[inline(always)]
 fn compose<S: Scalar + Copy>(x: &Transform<S>, p: &Transform<S>) -> Transform<S> {
     let (e, r, el) = (&x.e, &x.r, &p.e);
-    let e0 = core::array::from_fn(|a| {
-        core::array::from_fn(|b| e[a][0] * el[0][b] + e[a][1] * el[1][b] + e[a][2] * el[2][b])
-    });
+    let row = |a: usize| {
+        let e0 = |b: usize| e[a][0] * el[0][b] + e[a][1] * el[1][b] + e[a][2] * el[2][b];
+        [e0(0), e0(1), e0(2)]
+    };
+    let e0 = [row(0), row(1), row(2)];
     let d = rot_tr(el, r);
     Transform {
         e: e0,

@@ -1,10 +1,12 @@
 //! Dense linear solves without allocation or panics: LU with partial pivoting on a row-major
-//! `d × d` slice (the iteration matrix of [`rosenbrock`](super::rosenbrock())), and LDLᵀ of a
-//! fixed-size symmetric positive definite matrix ([`solve_spd`], `scene!`'s
-//! `(M + diag(I_m n²)) q̈ = τ − c`).
+//! `d × d` slice (the iteration matrix of [`rosenbrock`](super::rosenbrock())), and the solve of
+//! a fixed-size symmetric positive definite system by the runtime's one LDLᵀ
+//! ([`crate::ldlt`]; [`solve_spd`], `scene!`'s `(M + diag(I_m n²)) q̈ = τ − c`).
 
 // Index loops over matrix entries, in the order of Golub & Van Loan, Alg. 3.4.1.
 #![allow(clippy::needless_range_loop)]
+
+use crate::ldlt::{factor_in_place, solve_in_place};
 
 /// Factors `a` (row-major `d × d`) in place into `P a = L U` by Gaussian elimination with
 /// partial pivoting (Golub & Van Loan, *Matrix Computations*, Alg. 3.4.1; `piv[k]`: the row
@@ -66,49 +68,24 @@ pub fn lu_solve(a: &[f64], piv: &[usize], b: &mut [f64], d: usize) {
     }
 }
 
-/// Solves `A x = b` for a symmetric positive definite `A` by a fixed-size LDLᵀ factorization
-/// (Golub & Van Loan, Alg. 4.1.2; only the lower triangle is read). `None` when a pivot is
-/// not positive (or not finite): `A` is not positive definite.
+/// Solves `A x = b` for a symmetric positive definite `A` of fixed size by the runtime's LDLᵀ
+/// ([`factor_in_place`], [`solve_in_place`]: Golub & Van Loan, Alg. 4.1.2; only the lower
+/// triangle is read). `None` when a pivot is not positive (or not finite): `A` is not positive
+/// definite.
 #[must_use]
 pub fn solve_spd<const N: usize>(a: &[[f64; N]; N], b: &[f64; N]) -> Option<[f64; N]> {
-    // l[i][k] for k < i; w[i][k] = L_ik D_k.
-    let mut l = [[0.0f64; N]; N];
-    let mut w = [[0.0f64; N]; N];
+    let mut l = *a;
     let mut d_inv = [0.0f64; N];
-    for j in 0..N {
-        let mut dj = a[j][j];
-        for k in 0..j {
-            dj -= l[j][k] * w[j][k];
-        }
-        // `!(dj > 0)` also catches NaN.
-        if !(dj > 0.0 && dj.is_finite()) {
-            return None;
-        }
-        let inv = 1.0 / dj;
-        d_inv[j] = inv;
-        for i in (j + 1)..N {
-            let mut s = a[i][j];
-            for k in 0..j {
-                s -= l[i][k] * w[j][k];
-            }
-            l[i][j] = s * inv;
-            w[i][j] = s;
-        }
+    factor_in_place(l.as_flattened_mut(), N, &mut d_inv).ok()?;
+    // The pivots `D_j` are left on the diagonal; `!(D_j > 0)` also catches NaN.
+    if l.iter()
+        .enumerate()
+        .any(|(j, row)| !(row[j] > 0.0 && row[j].is_finite()))
+    {
+        return None;
     }
     let mut x = *b;
-    for i in 0..N {
-        for k in 0..i {
-            x[i] -= l[i][k] * x[k];
-        }
-    }
-    for i in 0..N {
-        x[i] *= d_inv[i];
-    }
-    for i in (0..N).rev() {
-        for k in (i + 1)..N {
-            x[i] -= l[k][i] * x[k];
-        }
-    }
+    solve_in_place(l.as_flattened(), N, &d_inv, &mut x).ok()?;
     Some(x)
 }
 

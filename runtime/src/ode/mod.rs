@@ -1,7 +1,7 @@
 //! The integrators of kanegen, written once: allocation-free, panic-free and `no_std`, over a
 //! [`System`] whose state is a slice, with caller-provided [`Scratch`] memory — the interpreted
 //! simulator (`kanegen-sim`, states sized at run time, [`VecScratch`]) and the simulators that
-//! `scene!` emits (`[f64; D]` states and [`ArrayScratch`] on the stack, through [`FnSystem`])
+//! `scene!` emits ([`ArrayScratch`] on the stack, through [`crate::scene::SceneOde`])
 //! run the same code step for step.
 //!
 //! - [`rk4()`]: fixed-step classical Runge–Kutta 4 (Hairer, Nørsett & Wanner, *Solving ODEs I*,

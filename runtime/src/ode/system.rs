@@ -1,5 +1,5 @@
 //! The first-order system `ẋ = f(t, x)` the integrators advance, and its closure form for
-//! fixed-size states ([`FnSystem`], what `scene!` emits).
+//! fixed-size states ([`FnSystem`]; a scene's right-hand side is `crate::scene::SceneOde`).
 
 use super::quaternion;
 
@@ -30,8 +30,7 @@ pub trait System {
     }
 }
 
-/// The [`System`] of a right-hand side `rhs(t, &x) -> ẋ` over `[f64; D]` (the form `scene!`
-/// emits). With `floating`, the state is a free-floating one, `[p₀, quat, q, v_b, ω_b, q̇]`
+/// The [`System`] of a right-hand side `rhs(t, &x) -> ẋ` over `[f64; D]`. With `floating`, the state is a free-floating one, `[p₀, quat, q, v_b, ω_b, q̇]`
 /// (`D = 13 + 2n`): the quaternion is renormalized by [`System::project`] and advanced by the
 /// exponential map ([`quaternion::advance_floating`]).
 #[derive(Clone, Copy, Debug)]
@@ -50,12 +49,12 @@ impl<const D: usize, F: FnMut(f64, &[f64; D]) -> [f64; D]> System for FnSystem<D
     /// `rhs` on `x`; a slice of another length (which the integrators refuse before they call
     /// this) gives NaN.
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
-        match <&[f64; D]>::try_from(x) {
-            Ok(x) => dx
-                .iter_mut()
-                .zip((self.rhs)(t, x))
-                .for_each(|(d, v)| *d = v),
-            Err(_) => dx.fill(f64::NAN),
+        match (
+            <&[f64; D]>::try_from(x),
+            <&mut [f64; D]>::try_from(&mut *dx),
+        ) {
+            (Ok(x), Ok(dx)) => *dx = (self.rhs)(t, x),
+            _ => dx.fill(f64::NAN),
         }
     }
 

@@ -17,10 +17,12 @@
 //! derivative or work slice of the wrong length gives a NaN derivative.
 
 mod armature;
+mod capture;
 mod drives;
 mod floating;
 
 pub use armature::forward_with_armature;
+pub use capture::{capture_velocity, CapturedPayload};
 pub use drives::{drive_torques, quintic_reference};
 pub use floating::floating_kinematics;
 
@@ -261,6 +263,53 @@ pub fn deriv<D: SceneDynamics + ?Sized>(
         floating_kinematics(q, v, dq);
     } else {
         dq.copy_from_slice(v);
+    }
+}
+
+/// A provider whose scene's effects are known at compile time (what `scene!` emits): the
+/// right-hand side of [`SceneOde`] over it is specialized to them, every effect the scene
+/// does not name removed by the optimizer.
+pub trait SceneModel: SceneDynamics {
+    /// The scene's effects.
+    const EFFECTS: SceneEffects<'static>;
+}
+
+/// The right-hand side of a scene ([`deriv`] of [`SceneModel::EFFECTS`] over `dynamics`, in
+/// `work`) as an [`ode::System`](crate::ode::System): the integrators call [`deriv`] on their
+/// own state slices. On a free-floating base the quaternion is renormalized by
+/// [`System::project`](crate::ode::System::project) and advanced by the exponential map
+/// ([`crate::ode::quaternion::advance_floating`]).
+#[derive(Debug)]
+pub struct SceneOde<'a, D> {
+    /// The provider of the dynamics and the effects.
+    pub dynamics: D,
+    /// Work memory of [`SceneEffects::work_len`] (or more).
+    pub work: &'a mut [f64],
+}
+
+impl<D: SceneModel> crate::ode::System for SceneOde<'_, D> {
+    #[inline(always)]
+    fn dim(&self) -> usize {
+        D::EFFECTS.dim()
+    }
+
+    #[inline]
+    fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
+        deriv(&mut self.dynamics, &D::EFFECTS, t, x, dx, self.work);
+    }
+
+    fn project(&self, x: &mut [f64]) {
+        if D::EFFECTS.floating {
+            crate::ode::quaternion::normalize_quaternion(x);
+        }
+    }
+
+    fn advance(&self, x: &[f64], h: f64, at: &[f64], f: &[f64], out: &mut [f64]) {
+        if D::EFFECTS.floating {
+            crate::ode::quaternion::advance_floating(x, h, at, f, out);
+        } else {
+            crate::ode::quaternion::advance_additive(x, h, f, out);
+        }
     }
 }
 

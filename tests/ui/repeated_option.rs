@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "two_link.toml", fma = true, scalar = f32, fma = false);
+
+fn main() {}
