@@ -23,7 +23,7 @@ extern crate std;
 /// `dynamics!(Name, "path/to/model.urdf" [, base = "free-floating"] [, gravity = [x, y, z]]
 /// [, allow_nonphysical = true] [, allow_large = true] [, ignore_mimic = true] [, runtime_payload = true] [, scalar = f32] [, fma = true]
 /// [, fma_path = f64::mul_add] [, target_fma = false] [, regroup = false] [, canonical = false]
-/// [, libm_trig = true] [, snap = 1e-9] [, algorithm = "recurrent"] [, form = "compact"])` defines `pub struct Name;` with the associated constants `N`,
+/// [, libm_trig = true] [, snap = 1e-9] [, algorithm = "recurrent"] [, form = "compact"] [, derivatives = false])` defines `pub struct Name;` with the associated constants `N`,
 /// `JOINTS`, `FRAMES`, `OP_COUNTS`, `CANDIDATES` and, on `&[f64; N]` arrays, the functions of
 /// `M(q) q̈ + c(q, q̇) = τ`: `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
 /// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)`,

@@ -218,6 +218,10 @@ struct GenerateArgs {
     /// instead of the cheapest candidate per function.
     #[arg(long, value_parser = parse_forced)]
     algorithm: Option<Methods>,
+    /// Leave out the derivative functions (`inverse_dynamics_derivatives`,
+    /// `forward_dynamics_derivatives`, `mass_matrix_inverse`): a smaller file that compiles faster.
+    #[arg(long)]
+    no_derivatives: bool,
     /// Accept inertias that are not physically realisable (a negative principal moment, the
     /// triangle inequality violated, rotational inertia without mass); other checks stay.
     #[arg(long)]
@@ -524,6 +528,7 @@ fn generate(a: GenerateArgs, out: &mut dyn Write, interactive: Interactive) -> R
     opts.fma = a.fma;
     opts.snap = a.snap;
     opts.algorithm = a.algorithm;
+    opts.derivatives = !a.no_derivatives;
     let progress = Progress::spinner(
         interactive.0,
         &format!(

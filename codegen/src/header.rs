@@ -58,11 +58,15 @@ fn form_line(plan: &Plan) -> String {
     }
     let missing = plan.not_generated();
     if !missing.is_empty() {
-        line.push_str(&format!(
-            " Not generated: {} (generated in the unrolled form up to {} speeds; docs/limits.md).",
-            missing.join(", "),
-            crate::plan::DERIVATIVES_MAX_NV
-        ));
+        let why = if plan.derivatives_asked {
+            format!(
+                "generated in the unrolled form up to {} speeds; docs/limits.md",
+                crate::plan::DERIVATIVES_MAX_NV
+            )
+        } else {
+            "not asked for: `derivatives = false`, `--no-derivatives`".to_string()
+        };
+        line.push_str(&format!(" Not generated: {} ({why}).", missing.join(", ")));
     }
     line
 }

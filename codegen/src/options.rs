@@ -90,6 +90,11 @@ pub struct Options {
     /// Straight-line or compact code ([`Form`], default [`Form::Auto`]: chosen by size, see
     /// [`crate::compact`]).
     pub form: Form,
+    /// Generate the derivative functions (`inverse_dynamics_derivatives`,
+    /// `forward_dynamics_derivatives`, `mass_matrix_inverse`) where the form allows them
+    /// ([`crate::plan::derivatives_generated`]). Default `true`; `false` leaves them out to
+    /// save compile time (they are several times the size of the other functions).
+    pub derivatives: bool,
 }
 
 /// The methods `algorithm = NAME` forces ([`Options::algorithm`]).
@@ -263,6 +268,7 @@ impl Options {
             libm_trig: false,
             algorithm: None,
             form: Form::Auto,
+            derivatives: true,
         }
     }
 }

@@ -75,6 +75,8 @@ pub struct Plan {
     pub decision: Decision,
     /// The functions, in emission order.
     pub functions: Vec<FunctionPlan>,
+    /// Whether the derivative functions were asked for ([`Options::derivatives`]).
+    pub derivatives_asked: bool,
 }
 
 /// The most speeds (`N`, or `6 + N` free-floating) the derivative functions are generated for:
@@ -82,10 +84,10 @@ pub struct Plan {
 /// matrices), some 10⁵ operations at 32 speeds, which is what the compact form exists to avoid.
 pub const DERIVATIVES_MAX_NV: usize = 24;
 
-/// Whether the derivative functions are generated for `model` in the form `decision`: in the
-/// unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds.
+/// Whether the derivative functions can be generated for `model` in the form `decision`: in
+/// the unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds.
 #[must_use]
-pub fn derivatives_generated(model: &Model, decision: &Decision) -> bool {
+pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
     let nv = model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {
             6
@@ -117,7 +119,7 @@ impl Plan {
         let mut graphs = Vec::new();
         let mut mass = MassMatrixMethod::Crba;
         for f in api::functions(&model, opts) {
-            if f.is_derivative() && !derivatives_generated(&model, &decision) {
+            if f.is_derivative() && !(opts.derivatives && derivatives_fit(&model, &decision)) {
                 continue; // `Plan::not_generated` names them
             }
             let (choice, graph) = match decided.iter().position(|(c, _)| c.function == f) {
@@ -139,6 +141,7 @@ impl Plan {
         }
         check_names(&functions)?;
         let plan = Plan {
+            derivatives_asked: opts.derivatives,
             model,
             snap,
             subjects,
@@ -150,11 +153,11 @@ impl Plan {
     }
 
     /// The functions not generated, as the header names them (`` `name` ``): the derivatives
-    /// in the compact form, which has no kernel for them, and above [`DERIVATIVES_MAX_NV`]
-    /// speeds (see [`derivatives_generated`]). Empty when they are generated.
+    /// when not asked for, in the compact form, which has no kernel for them, and above
+    /// [`DERIVATIVES_MAX_NV`] speeds (see [`derivatives_fit`]). Empty when they are generated.
     #[must_use]
     pub fn not_generated(&self) -> Vec<String> {
-        if derivatives_generated(&self.model, &self.decision) {
+        if self.derivatives_asked && derivatives_fit(&self.model, &self.decision) {
             return Vec::new();
         }
         Function::ALL

@@ -39,6 +39,7 @@ struct Input {
     snap: Option<f64>,
     algorithm: Option<kanegen_codegen::kanegen_dynamics::Methods>,
     form: kanegen_codegen::Form,
+    derivatives: bool,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -76,6 +77,7 @@ const OPTIONS: &[&str] = &[
     "snap",
     "algorithm",
     "form",
+    "derivatives",
 ];
 
 impl Input {
@@ -97,6 +99,7 @@ impl Input {
             target_fma: true,
             regroup: true,
             canonical: true,
+            derivatives: true,
             libm_trig: false,
             snap: None,
             algorithm: None,
@@ -117,6 +120,7 @@ impl Input {
             "fma" => self.fma = input.parse::<LitBool>()?.value,
             "regroup" => self.regroup = input.parse::<LitBool>()?.value,
             "canonical" => self.canonical = input.parse::<LitBool>()?.value,
+            "derivatives" => self.derivatives = input.parse::<LitBool>()?.value,
             "libm_trig" => self.libm_trig = input.parse::<LitBool>()?.value,
             "target_fma" => self.target_fma = input.parse::<LitBool>()?.value,
             "algorithm" => {
@@ -299,6 +303,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.fma = input.fma;
     opts.regroup = input.regroup;
     opts.canonical = input.canonical;
+    opts.derivatives = input.derivatives;
     opts.libm_trig = input.libm_trig;
     opts.target_fma = input.target_fma;
     opts.algorithm = input.algorithm;

@@ -104,11 +104,14 @@ pub struct GeneratedFile {
     pub allow_nonphysical: bool,
     /// The forced algorithm (`--algorithm`; `None`: the cheapest per function).
     pub algorithm: Option<&'static str>,
+    /// The derivative functions (off: `--no-derivatives`). Only one file carries them: they
+    /// are several times the size of the rest, and the crate is also built with `+fma`.
+    pub derivatives: bool,
 }
 
 /// The files of `generated/src/`, each reproducible with
 /// `kanegen generate MODEL --name TYPE [--lock INDEX=VALUE] [--scalar f32] [--fma]
-/// [--base free-floating] [--allow-nonphysical] [--algorithm NAME] -o FILE`.
+/// [--base free-floating] [--allow-nonphysical] [--algorithm NAME] [--no-derivatives] -o FILE`.
 pub const GENERATED: [GeneratedFile; 7] = [
     GeneratedFile {
         file: "generated/src/ssrms.rs",
@@ -120,6 +123,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
+        derivatives: true,
     },
     GeneratedFile {
         file: "generated/src/ssrms6.rs",
@@ -131,6 +135,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
+        derivatives: false,
     },
     GeneratedFile {
         file: "generated/src/srms.rs",
@@ -142,6 +147,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
+        derivatives: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms_f32.rs",
@@ -153,6 +159,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
+        derivatives: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms_fma.rs",
@@ -164,6 +171,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
+        derivatives: false,
     },
     GeneratedFile {
         file: "generated/src/free_floating_7dof.rs",
@@ -175,6 +183,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: Some(BaseKind::FreeFloating),
         allow_nonphysical: true,
         algorithm: None,
+        derivatives: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms_recurrent.rs",
@@ -186,6 +195,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: Some("recurrent"),
+        derivatives: false,
     },
 ];
 
@@ -227,6 +237,9 @@ impl GeneratedFile {
         if let Some(a) = self.algorithm {
             c += &format!(" --algorithm {a}");
         }
+        if !self.derivatives {
+            c += " --no-derivatives";
+        }
         c + &format!(" -o {}", self.file)
     }
 
@@ -240,6 +253,7 @@ impl GeneratedFile {
         o.algorithm = self
             .algorithm
             .map(|a| kanegen_codegen::forced_algorithm(a).expect("a known algorithm"));
+        o.derivatives = self.derivatives;
         o
     }
 
