@@ -60,6 +60,7 @@ mod common;
 kanegen::scene!(SsrmsEffects, "scenes/ssrms_effects.toml");
 kanegen::scene!(SsrmsPayload, "scenes/ssrms_payload_fixed.toml");
 kanegen::scene!(Srms, "scenes/srms.toml");
+kanegen::scene!(Ur5TorqueInput, "scenes/ur5_torque_input.toml");
 kanegen::scene!(FreeFloating7, "scenes/free_floating_7dof.toml");
 kanegen::scene!(Dextre, "scenes/dextre_free_floating.toml");
 kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
@@ -127,6 +128,11 @@ agree!(
     "scenes/ssrms_payload_fixed.toml"
 );
 agree!(srms_agrees, Srms, "scenes/srms.toml");
+agree!(
+    ur5_torque_input_agrees,
+    Ur5TorqueInput,
+    "scenes/ur5_torque_input.toml"
+);
 agree!(
     free_floating_7dof_agrees,
     FreeFloating7,

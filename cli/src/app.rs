@@ -286,6 +286,12 @@ struct SimulateArgs {
     /// Allow more than 1e8 steps or output samples (as `allow_long = true` in [simulation]).
     #[arg(long)]
     allow_long: bool,
+    /// Instead of running: print the Jacobians (A, B) of one step of the scene's integrator
+    /// from its initial state (t = 0, no added torque u, the scene's step), exact for the scheme
+    /// (RK4 for rk4 and dopri5 scenes, implicit midpoint; fixed base without wrenches, rotor
+    /// inertia or flexible joints); with --json as JSON.
+    #[arg(long, conflicts_with_all = ["out", "force"])]
+    linearize: bool,
 }
 
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<Model> {
@@ -604,6 +610,15 @@ fn simulate(a: SimulateArgs, out: &mut dyn Write, interactive: Interactive) -> R
         allow_long: a.allow_long,
     };
     let sc = kanegen_sim::scene::Scene::load_with(&a.scene, options)?;
+    if a.linearize {
+        let j = commands::linearize::at_initial_state(&sc)
+            .with_context(|| format!("scene `{}`: --linearize", a.scene.display()))?;
+        return if a.json {
+            print(out, &json(&commands::linearize::to_json(&sc, &j))?)
+        } else {
+            print(out, &commands::linearize::render_text(&sc, &j))
+        };
+    }
     let mut inputs = vec![a.scene.clone()];
     if let Some(m) = std::fs::read_to_string(&a.scene).ok().and_then(|t| {
         kanegen_sim::scene::Scene::model_path(&t, a.scene.parent().unwrap_or(Path::new(".")))

@@ -67,6 +67,17 @@ pub struct Generated {
     pub fmas: Vec<u64>,
 }
 
+impl Generated {
+    /// Whether the derivative functions (`inverse_dynamics_derivatives`,
+    /// `forward_dynamics_derivatives`, `mass_matrix_inverse`) were generated.
+    #[must_use]
+    pub fn has_derivatives(&self) -> bool {
+        self.choices
+            .iter()
+            .any(|c| c.function == kanegen_trace::Function::ForwardDynamicsDerivatives)
+    }
+}
+
 /// Generates the items for `model`.
 ///
 /// # Errors

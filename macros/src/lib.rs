@@ -10,6 +10,7 @@
 
 mod scene;
 mod scene_events;
+mod scene_linearize;
 mod scene_provider;
 
 use proc_macro::TokenStream;

@@ -12,6 +12,7 @@
 //! type per model phase, a run segment by segment, and the capture impulse. A scene error is a
 //! compile error naming the key and the scene file.
 
+use crate::scene_linearize;
 use crate::scene_provider::{self, arr, lit, Shape};
 use kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
 use kanegen_codegen::kanegen_dynamics::LoadFrame;
@@ -109,14 +110,14 @@ fn base_kind(scene: &Scene) -> BaseKind {
 }
 
 /// The generated dynamics: the items of `NameDynamics` and of the types of later model phases,
-/// and the type of each phase (phase 0 first).
+/// the type of each phase (phase 0 first), and whether they carry the derivatives.
 fn dynamics(
     scene: &Scene,
     model: &Model,
     runtime: &syn::Path,
     dyn_name: &str,
     rel: &str,
-) -> Result<(TokenStream, Vec<Ident>), String> {
+) -> Result<(TokenStream, Vec<Ident>, bool), String> {
     let mut opts = kanegen_codegen::Options::new(dyn_name.to_string());
     opts.gravity = scene.gravity;
     opts.base = Some(base_kind(scene));
@@ -129,8 +130,8 @@ fn dynamics(
     let g = kanegen_codegen::generate_items(model, &opts).map_err(|e| format!("{rel}: {e}"))?;
     let (phase_tys, phase_items) =
         crate::scene_events::phase_dynamics(scene, &opts, dyn_name, rel)?;
-    let items = g.items;
-    Ok((quote!(#items #phase_items), phase_tys))
+    let (items, derivatives) = (&g.items, g.has_derivatives());
+    Ok((quote!(#items #phase_items), phase_tys, derivatives))
 }
 
 /// Sizes and names of the state of `Name`.
@@ -171,7 +172,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let scene = &src.scene;
     let (model, wrench_frames) = scene_model(scene, rel)?;
     let dyn_name = format!("{name}Dynamics");
-    let (dyn_items, phase_tys) = dynamics(scene, &model, runtime, &dyn_name, rel)?;
+    let (dyn_items, phase_tys, has_derivatives) = dynamics(scene, &model, runtime, &dyn_name, rel)?;
     let layout = Layout::of(scene, name);
     let model_ty = format_ident!("{}Model", name);
     let shape = Shape {
@@ -186,9 +187,26 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let provider = scene_provider::provider(scene, &shape).map_err(|e| format!("{rel}: {e}"))?;
     let rt = &shape.rt;
     let state = state_items(scene, &layout, name, &dyn_name);
+    let profiles = scene.wrench_profiles();
+    let linearize =
+        scene_linearize::availability(scene, &scene.effects(&profiles), has_derivatives);
+    let (derivatives, step_jacobians) = match linearize {
+        Ok(()) => (
+            scene_linearize::derivatives(&shape),
+            scene_linearize::step_jacobians(
+                rt,
+                scene,
+                &layout.state_ty,
+                &model_ty,
+                (layout.n, layout.dim),
+            ),
+        ),
+        Err(_) => (TokenStream::new(), TokenStream::new()),
+    };
     let simulator = simulator_items(runtime, (name, rel), scene, &layout, &model_ty, &phase_tys);
     let docs = Docs::of(scene, &model, &layout, name, rel);
     let (struct_doc, integrator_doc) = (docs.scene, docs.integrator);
+    let linearize_doc = scene_linearize::doc(name, &linearize);
     let scene_lit = LitStr::new(&src.abs, Span::call_site());
     let model_lit = LitStr::new(&src.model_path.display().to_string(), Span::call_site());
     let model_doc = format!(
@@ -209,6 +227,8 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         #[allow(clippy::unreadable_literal, clippy::excessive_precision)]
         #provider
 
+        #derivatives
+
         impl #rt::scene::SceneModel for #model_ty {
             const EFFECTS: #rt::scene::SceneEffects<'static> = #name::EFFECTS;
         }
@@ -216,10 +236,16 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         #[doc = #struct_doc]
         #[doc = ""]
         #[doc = #integrator_doc]
+        #[doc = ""]
+        #[doc = #linearize_doc]
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
         pub struct #name;
 
         #simulator
+
+        impl #name {
+            #step_jacobians
+        }
     })
 }
 

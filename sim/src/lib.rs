@@ -13,6 +13,7 @@
 pub mod events;
 pub use kanegen_scene::flexible;
 pub mod integrate;
+pub mod linearize;
 pub mod monitors;
 pub mod provider;
 pub use kanegen_scene as scene;

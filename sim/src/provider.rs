@@ -5,11 +5,12 @@
 
 use crate::scene::Scene;
 use kanegen_dynamics::algorithms::aba::{self, Workspace};
+use kanegen_dynamics::algorithms::derivatives;
 use kanegen_dynamics::algorithms::floating;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::{ForwardMethod, Loads, Methods, Params};
-use kanegen_runtime::scene::{forward_with_armature, SceneDynamics};
+use kanegen_runtime::scene::{forward_with_armature, SceneDerivatives, SceneDynamics};
 
 /// The state of a free-floating base from the provider's positions `q = [p₀, quat, …]` and
 /// speeds `v = [v_b, ω_b, …]`.
@@ -147,5 +148,46 @@ impl SceneDynamics for RunTimeDynamics {
         } else {
             forward_with_armature(self, q, v, tau, w, armature, acc, work);
         }
+    }
+}
+
+/// Row-major copy of an `N × N` matrix.
+fn copy_rows(src: &[Vec<f64>], dst: &mut [f64]) {
+    for (row, d) in src.iter().zip(dst.chunks_exact_mut(src.len().max(1))) {
+        d.copy_from_slice(row);
+    }
+}
+
+/// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`) on a
+/// fixed base, no external wrench (what [`kanegen_runtime::scene::linearize`] covers).
+impl SceneDerivatives for RunTimeDynamics {
+    fn forward_derivatives(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        tau: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+        minv: &mut [f64],
+    ) {
+        let g = self.loads.gravity.as_ref();
+        let (a, b, m) = derivatives::aba::derivatives(&self.params, q, v, tau, g);
+        copy_rows(&a, dq);
+        copy_rows(&b, dv);
+        copy_rows(&m, minv);
+    }
+
+    fn inverse_derivatives(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        qdd: &[f64],
+        dq: &mut [f64],
+        dv: &mut [f64],
+    ) {
+        let g = self.loads.gravity.as_ref();
+        let (a, b) = derivatives::rnea::derivatives(&self.params, q, v, qdd, g);
+        copy_rows(&a, dq);
+        copy_rows(&b, dv);
     }
 }

@@ -7,6 +7,7 @@ pub mod count_events;
 pub mod eval;
 pub mod generate;
 pub mod info;
+pub mod linearize;
 pub mod simulate;
 pub mod simulate_text;
 pub mod table1;

@@ -13,6 +13,8 @@
 //! - [`midpoint()`]: the fixed-step Lie-group implicit midpoint rule (Hairer, Lubich & Wanner,
 //!   *Geometric Numerical Integration*), with the quaternion exponential map of a free-floating
 //!   base ([`quaternion`]).
+//! - [`linearize`]: the Jacobians `(A, B)` of one RK4 or midpoint step of a system with
+//!   inputs, exact for the scheme (what MPC and iLQR linearize about).
 //! - [`profile`]: the time profiles of a scene's drives and loads ([`quintic`], [`table`]).
 //!
 //! Nothing here allocates or panics: a run that cannot go on returns a [`Stop`], with the last
@@ -22,6 +24,7 @@
 use core::ops::ControlFlow;
 
 pub mod dopri5;
+pub mod linearize;
 pub mod lu;
 pub mod midpoint;
 pub mod profile;
@@ -32,6 +35,7 @@ mod scratch;
 mod system;
 
 pub use dopri5::{dopri5, Dopri5Options};
+pub use linearize::{midpoint_step_jacobians, rk4_step_jacobians, ControlledSystem};
 pub use lu::solve_spd;
 pub use midpoint::{midpoint, midpoint_step};
 pub use profile::{quintic, table};

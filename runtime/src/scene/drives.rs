@@ -38,17 +38,8 @@ pub fn drive_torques<D: SceneDynamics + ?Sized>(
                 tau[i] = kp[i] * (target[i] - q[i]) - kd[i] * qd[i];
             }
         }
-        Drive::ComputedTorque {
-            kp,
-            kd,
-            q0,
-            target,
-            duration,
-        } => {
-            for i in 0..n {
-                let (qr, qdr, qddr) = quintic_reference(q0[i], target[i], duration, t);
-                cmd[i] = qddr + kd[i] * (qdr - qd[i]) + kp[i] * (qr - q[i]);
-            }
+        Drive::ComputedTorque { .. } => {
+            commanded_acceleration(&fx.drive, t, q, qd, cmd);
             dynamics.inverse(q, qd, cmd, w, tau);
         }
     }
@@ -61,6 +52,25 @@ pub fn drive_torques<D: SceneDynamics + ?Sized>(
         let inv = 1.0 / c.v_s;
         for i in 0..n {
             tau[i] -= c.tau_c[i] * libm::tanh(qd[i] * inv);
+        }
+    }
+}
+
+/// The commanded acceleration `q̈_cmd = q̈_d + k_d (q̇_d − q̇) + k_p (q_d − q)` of a
+/// computed-torque drive at `(t, q, q̇)` into `cmd` (nothing for another drive).
+#[inline(always)]
+pub fn commanded_acceleration(drive: &Drive<'_>, t: f64, q: &[f64], qd: &[f64], cmd: &mut [f64]) {
+    if let Drive::ComputedTorque {
+        kp,
+        kd,
+        q0,
+        target,
+        duration,
+    } = *drive
+    {
+        for i in 0..cmd.len() {
+            let (qr, qdr, qddr) = quintic_reference(q0[i], target[i], duration, t);
+            cmd[i] = qddr + kd[i] * (qdr - qd[i]) + kp[i] * (qr - q[i]);
         }
     }
 }

@@ -6,6 +6,8 @@
 //! the simulators `scene!` emits (a generated dynamics type, the effects as `const` data) call
 //! the same [`deriv`]: only the provider differs. With `const` [`SceneEffects`] the optimizer
 //! removes every effect a scene does not name from the emitted code.
+//! [`linearize`] gives the Jacobians of the same right-hand side with joint torques as its input,
+//! for the step Jacobians of MPC and iLQR.
 //!
 //! State layout (`q` positions, `v` speeds of the provider):
 //! - fixed base `[q (N), q̇ (N)]`; with flexible joints `[q (N), q̇ (N), θ (N), θ̇ (N)]`, the
@@ -20,11 +22,13 @@ mod armature;
 mod capture;
 mod drives;
 mod floating;
+pub mod linearize;
 
 pub use armature::forward_with_armature;
 pub use capture::{capture_velocity, CapturedPayload};
 pub use drives::{drive_torques, quintic_reference};
 pub use floating::floating_kinematics;
+pub use linearize::{linearizable, SceneControl, SceneDerivatives};
 
 /// The time profile of an external wrench: force and moment (N, N·m) in the frame the scene
 /// names for it (the provider applies them).
@@ -230,9 +234,25 @@ pub fn deriv<D: SceneDynamics + ?Sized>(
     dx: &mut [f64],
     work: &mut [f64],
 ) {
+    deriv_input(dynamics, fx, t, x, &[], dx, work);
+}
+
+/// [`deriv`] with the input `u`: joint torques added to the drive's (to the motors' with
+/// flexible joints); `u` of length `N`, or empty for none.
+#[inline(always)]
+pub fn deriv_input<D: SceneDynamics + ?Sized>(
+    dynamics: &mut D,
+    fx: &SceneEffects<'_>,
+    t: f64,
+    x: &[f64],
+    u: &[f64],
+    dx: &mut [f64],
+    work: &mut [f64],
+) {
     let (n, (nq, nv)) = (fx.dof, fx.sizes());
     let dim = fx.dim();
-    if x.len() != dim || dx.len() != dim || work.len() < fx.work_len() {
+    let u_ok = u.is_empty() || u.len() == n;
+    if x.len() != dim || dx.len() != dim || work.len() < fx.work_len() || !u_ok {
         dx.fill(f64::NAN);
         return;
     }
@@ -247,11 +267,13 @@ pub fn deriv<D: SceneDynamics + ?Sized>(
     match fx.flexible {
         None => {
             drive_torques(dynamics, fx, t, &q[nq - n..], &v[nv - n..], w, tau, aux);
+            add_input(tau, u);
         }
         Some(f) => {
             // Spong's model: the drives act on the motors, the springs on the links.
             let (th, thd) = motors.split_at(n);
             drive_torques(dynamics, fx, t, th, thd, w, aux, tau);
+            add_input(aux, u);
             flexible_joints(&f, q, v, th, thd, aux, tau, dmotors);
         }
     }
@@ -310,6 +332,14 @@ impl<D: SceneModel> crate::ode::System for SceneOde<'_, D> {
         } else {
             crate::ode::quaternion::advance_additive(x, h, f, out);
         }
+    }
+}
+
+/// `tau += u` (nothing for an empty `u`).
+#[inline(always)]
+fn add_input(tau: &mut [f64], u: &[f64]) {
+    for (t, ui) in tau.iter_mut().zip(u) {
+        *t += ui;
     }
 }
 

@@ -1,0 +1,187 @@
+//! What `scene!` emits for the Jacobians of one step, `x⁺ = Φ(t, x, u)` (`u` the joint torques
+//! added to the scene's drive): the provider's derivatives, forwards to the generated
+//! `forward_dynamics_derivatives` and `inverse_dynamics_derivatives` ([`derivatives`]), and
+//! `Name::step_jacobians` ([`step_jacobians`]), which calls the runtime's exact chain rule
+//! through the step (`kanegen_runtime::ode::linearize`) over the scene's right-hand side with
+//! its input (`kanegen_runtime::scene::linearize`) — the code `kanegen simulate --linearize`
+//! runs over the run-time algorithms.
+
+use crate::scene_provider::Shape;
+use kanegen_runtime::scene::{linearizable, SceneEffects};
+use kanegen_scene::{Integrator, Scene};
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
+use syn::Ident;
+
+/// Whether `scene!` emits `step_jacobians`, or why not (the sentence of the scene's doc).
+pub fn availability(
+    scene: &Scene,
+    effects: &SceneEffects<'_>,
+    has_derivatives: bool,
+) -> Result<(), String> {
+    if let Err(what) = linearizable(effects) {
+        return Err(format!("the scene has {what}"));
+    }
+    if scene.simulation.integrator == Integrator::Rosenbrock {
+        return Err("its step is a Rodas4 step".into());
+    }
+    if !has_derivatives {
+        return Err("the generated dynamics carry no derivatives (more than 24 speeds)".into());
+    }
+    Ok(())
+}
+
+/// The doc line of `Name` on its step Jacobians.
+pub fn doc(name: &Ident, available: &Result<(), String>) -> String {
+    match available {
+        Ok(()) => format!(
+            " [`{name}::step_jacobians`] gives the Jacobians `(A, B)` of one [`{name}::step`] with \
+             joint torques `u` added to the drive, exact for the scheme (the chain rule through \
+             its stages, from the generated derivatives)."
+        ),
+        Err(why) => format!(" No `step_jacobians`: {why}."),
+    }
+}
+
+/// `impl SceneDerivatives for <shape.ty>`: forwards to the generated derivative functions of
+/// the provider's phase.
+pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
+    let Shape { rt, ty, .. } = sh;
+    let (nl, nvl) = (
+        Literal::usize_unsuffixed(sh.n),
+        Literal::usize_unsuffixed(sh.nv),
+    );
+    let nan = quote!([[f64::NAN; #nvl]; #nvl]);
+    let arms = |call: &dyn Fn(&Ident) -> TokenStream, nan: &TokenStream| {
+        let arms = sh.phases.iter().enumerate().map(|(k, dy)| {
+            let (k, c) = (Literal::usize_unsuffixed(k), call(dy));
+            quote!(#k => #c,)
+        });
+        quote!(match self.0 { #(#arms)* _ => #nan })
+    };
+    let forward = arms(
+        &|dy| quote!(#dy::forward_dynamics_derivatives(q, v, tau)),
+        &quote!((#nan, #nan, #nan)),
+    );
+    let inverse = arms(
+        &|dy| quote!(#dy::inverse_dynamics_derivatives(q, v, qdd)),
+        &quote!((#nan, #nan)),
+    );
+    quote! {
+        impl #rt::scene::SceneDerivatives for #ty {
+            fn forward_derivatives(
+                &mut self,
+                q: &[f64],
+                v: &[f64],
+                tau: &[f64],
+                dq: &mut [f64],
+                dv: &mut [f64],
+                minv: &mut [f64],
+            ) {
+                let (Ok(q), Ok(v), Ok(tau)) = (
+                    <&[f64; #nl]>::try_from(q),
+                    <&[f64; #nl]>::try_from(v),
+                    <&[f64; #nl]>::try_from(tau),
+                ) else {
+                    dq.fill(f64::NAN);
+                    dv.fill(f64::NAN);
+                    return minv.fill(f64::NAN);
+                };
+                let (a, b, c) = #forward;
+                for (m, dst) in [(a, dq), (b, dv), (c, minv)] {
+                    for (row, d) in m.iter().zip(dst.chunks_exact_mut(#nvl)) {
+                        #rt::scene::copy_into(d, row);
+                    }
+                }
+            }
+
+            fn inverse_derivatives(
+                &mut self,
+                q: &[f64],
+                v: &[f64],
+                qdd: &[f64],
+                dq: &mut [f64],
+                dv: &mut [f64],
+            ) {
+                let (Ok(q), Ok(v), Ok(qdd)) = (
+                    <&[f64; #nl]>::try_from(q),
+                    <&[f64; #nl]>::try_from(v),
+                    <&[f64; #nl]>::try_from(qdd),
+                ) else {
+                    dq.fill(f64::NAN);
+                    return dv.fill(f64::NAN);
+                };
+                let (a, b) = #inverse;
+                for (m, dst) in [(a, dq), (b, dv)] {
+                    for (row, d) in m.iter().zip(dst.chunks_exact_mut(#nvl)) {
+                        #rt::scene::copy_into(d, row);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `Name::step_jacobians` (inside `impl Name`) for the scene's step scheme: RK4 (RK4 and
+/// dopri5 scenes) or the implicit midpoint rule.
+pub fn step_jacobians(
+    rt: &TokenStream,
+    scene: &Scene,
+    state_ty: &Ident,
+    model_ty: &Ident,
+    (n, dim): (usize, usize),
+) -> TokenStream {
+    let ode = quote!(#rt::ode);
+    let (nl, dl) = (Literal::usize_unsuffixed(n), Literal::usize_unsuffixed(dim));
+    let (call, scratch, scheme) = if scene.simulation.integrator == Integrator::Midpoint {
+        (
+            quote!(#ode::midpoint_step_jacobians),
+            quote!(#ode::ArrayScratch::<{ #ode::linearize::midpoint_scratch_len(#dl, #nl) }, #dl>::new()),
+            "implicit midpoint",
+        )
+    } else {
+        (
+            quote!(#ode::rk4_step_jacobians),
+            quote!(#ode::ArrayScratch::<{ #ode::linearize::rk4_scratch_len(#dl, #nl) }>::new()),
+            "RK4",
+        )
+    };
+    let doc = format!(
+        " One {scheme} step of size `h` from `(t, state)` (what [`Self::step`] takes) with the \
+         joint torques `u` added to the scene's drive, and its Jacobians `(A, B)`: \
+         `A[i][j] = ∂x⁺_i/∂x_j`, `B[i][j] = ∂x⁺_i/∂u_j` over the flat state \
+         ([`{state_ty}::to_array`]). Exact for the scheme: the chain rule through its stages \
+         (`kanegen::runtime::ode::linearize`) from the generated derivatives of forward and \
+         inverse dynamics and the drive's own. With `u = 0` the new state is `step`'s, bit for bit."
+    );
+    quote! {
+        #[doc = #doc]
+        ///
+        /// # Errors
+        /// A `kanegen::ode::Stop` when the new state is not finite (or the midpoint iterations
+        /// do not converge).
+        #[allow(clippy::type_complexity)]
+        pub fn step_jacobians(
+            t: f64,
+            state: &#state_ty,
+            u: &[f64; #nl],
+            h: f64,
+        ) -> Result<(#state_ty, [[f64; #dl]; #dl], [[f64; #nl]; #dl]), #ode::Stop> {
+            let mut x = state.to_array();
+            let mut work = [0.0f64; #rt::scene::linearize::jacobian_work_len(&Self::EFFECTS)];
+            let mut model = #model_ty(0);
+            let mut sys = #rt::scene::SceneControl {
+                dynamics: &mut model,
+                effects: &Self::EFFECTS,
+                work: &mut work,
+            };
+            let (mut a, mut b) = ([0.0f64; #dl * #dl], [0.0f64; #dl * #nl]);
+            #call(&mut sys, t, h, &mut x, u, &mut a, &mut b, &mut #scratch)?;
+            Ok((
+                #state_ty::from_array(&x),
+                core::array::from_fn(|i| core::array::from_fn(|j| a[i * #dl + j])),
+                core::array::from_fn(|i| core::array::from_fn(|j| b[i * #nl + j])),
+            ))
+        }
+    }
+}

@@ -1,0 +1,267 @@
+//! The Jacobians `(A, B)` of one step of a scene, `x⁺ = Φ(t, x, u)` with `u` the joint torques
+//! added to the scene's drive: `scene!`'s `step_jacobians` (from the generated derivatives)
+//! and the interpreted `kanegen::sim::linearize::step_jacobians` (from the run-time ones).
+//!
+//! Oracles:
+//! - central differences of the step itself (the state `step_jacobians` returns, which with
+//!   `u = 0` is [`Srms::step`]'s bit for bit), at steps `e` and `2e`: the Jacobians agree with
+//!   the differences at `e` within four times the differences' own error `|D(e) − D(2e)|` plus
+//!   a rounding floor of `1e-9 · max|J|`;
+//! - the interpreted and generated Jacobians, two independent derivative codes (run-time
+//!   Carpentier–Mansard over the model's numbers, generated straight-line code), agree to
+//!   `1e-10 · max|J|`.
+//!
+//! Scenes: `scenes/srms.toml` (dopri5, so its step is RK4; PD drives and damping, fixed base),
+//! `tests/data/scenes/linearize_ct_midpoint.toml` (UR5 under gravity, a computed-torque drive
+//! along a quintic, viscous and Coulomb friction, implicit midpoint) and
+//! `scenes/ur5_torque_input.toml` (UR5 under gravity, damping, no drive, RK4).
+
+use kanegen::sim::linearize::{scheme, step_jacobians};
+use kanegen::sim::scene::Scene;
+use kanegen::sim::system::SceneSystem;
+use std::path::Path;
+
+kanegen::scene!(Srms, "scenes/srms.toml");
+kanegen::scene!(CtMidpoint, "tests/data/scenes/linearize_ct_midpoint.toml");
+kanegen::scene!(FreeUr5, "scenes/ur5_torque_input.toml");
+
+/// One step with its Jacobians at `(x, u)`: the new state, `A` (`D × D`) and `B` (`D × N`).
+type Jac<const D: usize, const N: usize> = ([f64; D], [[f64; D]; D], [[f64; N]; D]);
+
+/// The largest entry of `A` and `B` in magnitude.
+fn scale<const D: usize, const N: usize>(j: &Jac<D, N>) -> f64 {
+    let a = j.1.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
+    j.2.iter().flatten().fold(a, |m, v| m.max(v.abs()))
+}
+
+/// `(worst |J − D(e)|, worst |D(e) − D(2e)|)` of the central differences `D` of the step over
+/// every column of `x` and `u` (`e` relative to each component).
+fn against_differences<const D: usize, const N: usize>(
+    step: impl Fn(&[f64; D], &[f64; N]) -> Jac<D, N>,
+    x: [f64; D],
+    u: [f64; N],
+) -> (f64, f64, f64) {
+    let j = step(&x, &u);
+    let (mut worst, mut own) = (0.0_f64, 0.0_f64);
+    for col in 0..D + N {
+        let diff = |e: f64| -> [f64; D] {
+            let (mut xp, mut xm, mut up, mut um) = (x, x, u, u);
+            let h = if col < D {
+                let h = e * (1.0 + x[col].abs());
+                xp[col] += h;
+                xm[col] -= h;
+                h
+            } else {
+                let h = e * (1.0 + u[col - D].abs());
+                up[col - D] += h;
+                um[col - D] -= h;
+                h
+            };
+            let (p, m) = (step(&xp, &up).0, step(&xm, &um).0);
+            core::array::from_fn(|i| (p[i] - m[i]) / (2.0 * h))
+        };
+        let (d1, d2) = (diff(1e-6), diff(2e-6));
+        for i in 0..D {
+            let exact = if col < D {
+                j.1[i][col]
+            } else {
+                j.2[i][col - D]
+            };
+            worst = worst.max((exact - d1[i]).abs());
+            own = own.max((d1[i] - d2[i]).abs());
+        }
+    }
+    (worst, own, scale(&j))
+}
+
+fn assert_matches_differences(name: &str, (worst, own, scale): (f64, f64, f64)) {
+    eprintln!("{name}: worst |J − D| {worst:.2e}, the differences' own error {own:.2e}, max|J| {scale:.2e}");
+    assert!(
+        worst <= 4.0 * own + 1e-9 * scale,
+        "{name}: {worst:e} > 4 · {own:e} + 1e-9 · {scale:e}"
+    );
+}
+
+/// The interpreted system of a scene file.
+fn interpreted(file: &str) -> Scene {
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap()
+}
+
+/// The interpreted Jacobians as fixed-size arrays.
+fn interpreted_step<const D: usize, const N: usize>(
+    scene: &Scene,
+    t: f64,
+    x: &[f64; D],
+    u: &[f64; N],
+    h: f64,
+) -> Jac<D, N> {
+    let mut sys = SceneSystem::new(scene);
+    let j = step_jacobians(&mut sys, t, x, u, h).unwrap();
+    (
+        j.state.try_into().unwrap(),
+        core::array::from_fn(|i| j.a[i].clone().try_into().unwrap()),
+        core::array::from_fn(|i| j.b[i].clone().try_into().unwrap()),
+    )
+}
+
+/// Worst `|J_generated − J_interpreted|` over `A`, `B` and the new state.
+fn worst_between<const D: usize, const N: usize>(g: &Jac<D, N>, i: &Jac<D, N>) -> f64 {
+    let a = g.1.iter().flatten().zip(i.1.iter().flatten());
+    let b = g.2.iter().flatten().zip(i.2.iter().flatten());
+    let x = g.0.iter().zip(i.0.iter());
+    a.chain(b)
+        .chain(x)
+        .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()))
+}
+
+macro_rules! scene_tests {
+    ($mod:ident, $ty:ident, $st:ident, $file:literal, $t:expr, $du:expr) => {
+        mod $mod {
+            use super::*;
+
+            /// A state off the initial one (speeds and a displacement) and an input.
+            fn point() -> (f64, [f64; $ty::DIM], [f64; $ty::N]) {
+                let x0 = $ty::initial_state().to_array();
+                let x = core::array::from_fn(|i| {
+                    x0[i] + 0.05 * ((i as f64) * 0.7).sin() + 0.1 * (i % 3) as f64
+                });
+                let u = core::array::from_fn(|i| $du * (1.0 + i as f64) * 0.3);
+                ($t, x, u)
+            }
+
+            fn step(x: &[f64; $ty::DIM], u: &[f64; $ty::N]) -> Jac<{ $ty::DIM }, { $ty::N }> {
+                let s = $st::from_array(x);
+                let (s, a, b) = $ty::step_jacobians(point().0, &s, u, $ty::STEP).unwrap();
+                (s.to_array(), a, b)
+            }
+
+            #[test]
+            fn generated_jacobians_match_central_differences() {
+                let (_, x, u) = point();
+                assert_matches_differences(stringify!($ty), against_differences(step, x, u));
+            }
+
+            #[test]
+            fn interpreted_jacobians_match_central_differences() {
+                let scene = interpreted($file);
+                let (t, x, u) = point();
+                let f = |x: &[f64; $ty::DIM], u: &[f64; $ty::N]| {
+                    interpreted_step(&scene, t, x, u, $ty::STEP)
+                };
+                assert_matches_differences(
+                    concat!(stringify!($ty), " (interpreted)"),
+                    against_differences(f, x, u),
+                );
+            }
+
+            #[test]
+            fn interpreted_and_generated_agree() {
+                let scene = interpreted($file);
+                let (t, x, u) = point();
+                let g = step(&x, &u);
+                let i = interpreted_step(&scene, t, &x, &u, $ty::STEP);
+                let w = worst_between(&g, &i);
+                eprintln!(
+                    "{}: generated vs interpreted {w:.2e} (max|J| {:.2e})",
+                    stringify!($ty),
+                    scale(&g)
+                );
+                assert!(w <= 1e-10 * scale(&g).max(1.0), "{w:e}");
+            }
+
+            /// With no input, the new state is `step`'s, bit for bit.
+            #[test]
+            fn with_no_input_the_state_is_the_step() {
+                let (t, x, _) = point();
+                let s = $st::from_array(&x);
+                let (with, _, _) = $ty::step_jacobians(t, &s, &[0.0; $ty::N], $ty::STEP).unwrap();
+                let mut plain = s;
+                $ty::step(t, &mut plain, $ty::STEP).unwrap();
+                assert_eq!(with.to_array(), plain.to_array());
+            }
+        }
+    };
+}
+
+scene_tests!(srms, Srms, SrmsState, "scenes/srms.toml", 0.0, 20.0);
+scene_tests!(
+    computed_torque_midpoint,
+    CtMidpoint,
+    CtMidpointState,
+    "tests/data/scenes/linearize_ct_midpoint.toml",
+    0.4,
+    1.5
+);
+scene_tests!(
+    free_ur5,
+    FreeUr5,
+    FreeUr5State,
+    "scenes/ur5_torque_input.toml",
+    0.0,
+    2.0
+);
+
+/// What the step Jacobians do not cover is refused, named.
+#[test]
+fn uncovered_scenes_are_refused_by_name() {
+    for (file, words) in [
+        ("scenes/free_floating_7dof.toml", "free-floating base"),
+        ("scenes/ssrms_effects.toml", "external wrenches"),
+        ("scenes/ssrms_drives.toml", "rotor inertia"),
+        ("scenes/ssrms_flexible.toml", "flexible joints"),
+    ] {
+        let scene = interpreted(file);
+        let sys = SceneSystem::new(&scene);
+        let err = scheme(&sys).unwrap_err().to_string();
+        assert!(err.contains(words), "{file}: {err}");
+    }
+}
+
+/// `kanegen simulate SCENE --linearize` with its arguments, from the project root.
+fn cli(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .args(["simulate"])
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap()
+}
+
+/// The CLI prints the generated type's Jacobians at the scene's initial state (JSON), and
+/// refuses an uncovered scene naming what it has.
+#[test]
+fn cli_linearize_prints_the_step_jacobians() {
+    let o = cli(&["scenes/srms.toml", "--linearize", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["scheme"], "rk4");
+    let s = Srms::initial_state();
+    let (next, a, b) = Srms::step_jacobians(0.0, &s, &[0.0; Srms::N], Srms::STEP).unwrap();
+    let rows =
+        |m: &serde_json::Value| -> Vec<Vec<f64>> { serde_json::from_value(m.clone()).unwrap() };
+    let (ca, cb) = (rows(&v["A"]), rows(&v["B"]));
+    let x: Vec<f64> = serde_json::from_value(v["x_next"].clone()).unwrap();
+    let mut worst = 0.0_f64;
+    for i in 0..Srms::DIM {
+        worst = worst.max((x[i] - next.to_array()[i]).abs());
+        for j in 0..Srms::DIM {
+            worst = worst.max((ca[i][j] - a[i][j]).abs());
+        }
+        for j in 0..Srms::N {
+            worst = worst.max((cb[i][j] - b[i][j]).abs());
+        }
+    }
+    assert!(worst <= 1e-12, "{worst:e}");
+    let text = cli(&["scenes/srms.toml", "--linearize"]);
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(
+        text.contains("A = ∂x⁺/∂x (12 × 12") && text.contains("qd_wrist_roll"),
+        "{text}"
+    );
+    let err = cli(&["scenes/ssrms_effects.toml", "--linearize"]);
+    let msg = String::from_utf8_lossy(&err.stderr);
+    assert!(
+        !err.status.success() && msg.contains("external wrenches"),
+        "{msg}"
+    );
+}
