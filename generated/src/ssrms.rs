@@ -10,7 +10,7 @@
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4509 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1098, `forward_dynamics_derivatives` 2200, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4403 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1098, `forward_dynamics_derivatives` 2094, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -88,8 +88,8 @@
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 566 | 433 | 5 | 0 | 6 | 999 |
 //! | `inverse_dynamics_derivatives` * | — | — | — | model | 2033 | 2091 | 0 | 0 | 6 | 4124 |
 //! | `inverse_dynamics_derivatives` | — | — | — | canonical | 2036 | 2094 | 0 | 0 | 6 | 4130 |
-//! | `forward_dynamics_derivatives` * | — | — | — | model | 3606 | 3331 | 12 | 0 | 7 | 6937 |
-//! | `forward_dynamics_derivatives` | — | — | — | canonical | 3617 | 3339 | 12 | 0 | 7 | 6956 |
+//! | `forward_dynamics_derivatives` | — | — | — | model | 3373 | 3174 | 7 | 0 | 7 | 6547 |
+//! | `forward_dynamics_derivatives` * | — | — | — | canonical | 3373 | 3173 | 7 | 0 | 7 | 6546 |
 //! | `mass_matrix_inverse` | — | — | — | model | 309 | 242 | 7 | 0 | 5 | 551 |
 //! | `mass_matrix_inverse` * | — | — | — | canonical | 309 | 240 | 7 | 0 | 5 | 549 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
@@ -282,13 +282,13 @@ impl Ssrms {
             mass_matrix_method: None,
             nonlinear_effects_method: None,
             forward_method: None,
-            frames: "model",
-            mul: 3606u64,
-            add: 3331u64,
-            div: 12u64,
+            frames: "canonical",
+            mul: 3373u64,
+            add: 3173u64,
+            div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 2200u64,
+            fma: 2094u64,
         },
         OpCount {
             function: "mass_matrix_inverse",
@@ -1235,9 +1235,9 @@ impl Ssrms {
             nonlinear_effects_method: None,
             forward_method: None,
             frames: "model",
-            mul: 3606u64,
-            add: 3331u64,
-            div: 12u64,
+            mul: 3373u64,
+            add: 3174u64,
+            div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -1248,9 +1248,9 @@ impl Ssrms {
             nonlinear_effects_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 3617u64,
-            add: 3339u64,
-            div: 12u64,
+            mul: 3373u64,
+            add: 3173u64,
+            div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -4604,7 +4604,7 @@ impl Ssrms {
     }
     /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`.
     ///
-    /// : 3606 mul, 3331 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 2200 fused where the target has FMA.
+    /// : 3373 mul, 3173 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 2094 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_derivatives(
         q: &[f64; 7],
@@ -4621,3529 +4621,3292 @@ impl Ssrms {
             q[5],
             q[6],
         ]);
-        let x7 = qd[0] * c_q1;
-        let x8 = qd[0] * s_q1;
-        let x9 = 0.7026 * qd[0];
-        let x10 = s_q1 * x9;
-        let x11 = c_q1 * x9;
-        let x12 = qd[1] * x8;
-        let x13 = qd[1] * x7;
-        let x14 = qd[1] * x11;
-        let x15 = qd[1] * x10;
-        let x16 = x8 * 65693.9112265768;
-        let x17 = Self::mul_add(x10, -1145.5438279999998, 65697.3302265768 * qd[1]);
-        let x18 = qd[1] * 1145.5438279999998;
-        let x19 = x7 * 1145.5438279999998;
-        let x20 = Self::mul_add(-qd[1], s_q2, x7 * c_q2);
-        let x21 = Self::mul_add(qd[1], c_q2, x7 * s_q2);
-        let x22 = x7 * 0.5692;
-        let x23 = Self::mul_add(qd[1], -0.5692, x10);
-        let x24 = Self::mul_add(-s_q2, x22, c_q2 * x23);
-        let x25 = Self::mul_add(c_q2, x22, s_q2 * x23);
-        let x26 = qd[2] * x21;
-        let x27 = qd[2] * x20;
-        let x28 = qd[2] * x25;
-        let x29 = qd[2] * x24;
-        let x30 = qd[2] - x8;
-        let x31 = Self::mul_add(-3946.18812068, x30, x20 * 39234.47412200001);
-        let x32 = 5224.5702 * x11;
-        let x33 = Self::mul_add(
-            5224.5702,
-            x25,
-            Self::mul_add(39241.404122, x30, 3946.1881206800003 * x20),
+        let x7 = s_q5 * s_q5 * 35.074;
+        let x8 = -35.074 + x7;
+        let x9 = s_q5 * c_q5 * 35.074;
+        let x10 = 179.8829695416 - x7;
+        let x11 = x8 - -129.6173695416;
+        let x12 = s_q4 * s_q4 * x11;
+        let x13 = x8 - x12;
+        let x14 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x9);
+        let x15 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x9);
+        let x16 = 171.195516 * s_q4;
+        let x17 = 171.195516 * c_q4;
+        let x18 = 7.11 * x16;
+        let x19 = Self::mul_add(-7.11, x17, s_q4 * c_q4 * x11);
+        let x20 = x10 - x18;
+        let x21 = 3239.4582 - x16;
+        let x22 = 1375.0472756800002 - x14;
+        let x23 = 24989.305802 - (x18 - (-129.6173695416 + x12 - x18));
+        let x24 = 24998.827802 - (x18 - x20);
+        let x25 = s_q3 * s_q3;
+        let x26 = s_q3 * c_q3;
+        let x27 = x13 - x23;
+        let x28 = x19 + x19;
+        let x29 = Self::mul_add(x26, x28, x25 * x27);
+        let x30 = x13 - x29;
+        let x31 = s_q3 * x15;
+        let x32 = c_q3 * x15;
+        let x33 = s_q3 * x17;
+        let x34 = Self::mul_add(c_q3, x21, -x33);
+        let x35 = c_q3 * x17;
+        let x36 = Self::mul_add(s_q3, x21, x35);
+        let x37 = 7.11 * x34;
+        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(c_q3, x22, x31));
+        let x39 = Self::mul_add(-7.11, x36, x19 + Self::mul_add(-x25, x28, x26 * x27));
+        let x40 = Self::mul_add(x36, 0.475, Self::mul_add(s_q3, x22, -x32));
+        let x41 = x24 + x37;
+        let x42 = 5224.5702 + x34;
+        let x43 = 3946.18812068 + x38;
+        let x44 = 39234.474122 + (x37 + (x23 + x29 + x37));
+        let x45 = 39241.404122 + (x37 + x41);
+        let x46 = s_q2 * s_q2;
+        let x47 = s_q2 * c_q2;
+        let x48 = x30 - x44;
+        let x49 = x39 + x39;
+        let x50 = Self::mul_add(x47, x49, x46 * x48);
+        let x51 = x30 - x50;
+        let x52 = s_q2 * x40;
+        let x53 = c_q2 * x40;
+        let x54 = s_q2 * x36;
+        let x55 = Self::mul_add(c_q2, x42, -x54);
+        let x56 = c_q2 * x36;
+        let x57 = Self::mul_add(s_q2, x42, x56);
+        let x58 = Self::mul_add(0.5692, x55, Self::mul_add(c_q2, x43, -x52));
+        let x59 = Self::mul_add(0.5692, x57, Self::mul_add(s_q2, x43, x53));
+        let x60 = 1145.5438279999998 * s_q1;
+        let x61 = 0.7026 * x57;
+        let x62 = Self::mul_add(
+            0.7026,
+            Self::mul_add(c_q1, x55, x60),
+            Self::mul_add(-s_q1, x59, c_q1 * (x39 + Self::mul_add(-x46, x49, x47 * x48))),
         );
-        let x34 = 5224.5702 * x21;
-        let x35 = 5224.5702 * x30;
-        let x36 = Self::mul_add(-x21, s_q3, x20 * c_q3);
-        let x37 = Self::mul_add(x21, c_q3, x20 * s_q3);
-        let x38 = Self::mul_add(x21, -0.475, x24);
-        let x39 = Self::mul_add(-7.11, x21, x11);
-        let x40 = x25 + Self::mul_add(7.11, x30, x20 * 0.475);
-        let x41 = Self::mul_add(-s_q3, x40, c_q3 * x38);
-        let x42 = Self::mul_add(c_q3, x40, s_q3 * x38);
-        let x43 = qd[3] * x37;
-        let x44 = qd[3] * x36;
-        let x45 = qd[3] * x42;
-        let x46 = qd[3] * x41;
-        let x47 = qd[3] + x30;
-        let x48 = Self::mul_add(-1375.0472756800002, x47, x36 * 24989.305802);
-        let x49 = 3239.4582 * x39;
-        let x50 = Self::mul_add(
-            3239.4582,
-            x42,
-            Self::mul_add(24998.827802, x47, 1375.0472756800002 * x36),
+        let x63 = Self::mul_add(
+            0.7026,
+            s_q1 * x57,
+            Self::mul_add(-s_q1, x45, c_q1 * x58),
         );
-        let x51 = 3239.4582 * x37;
-        let x52 = 3239.4582 * x47;
-        let x53 = Self::mul_add(-x37, s_q4, x36 * c_q4);
-        let x54 = Self::mul_add(x37, c_q4, x36 * s_q4);
-        let x55 = Self::mul_add(-7.11, x37, x39);
-        let x56 = Self::mul_add(7.11, x47, x42);
-        let x57 = Self::mul_add(-s_q4, x56, x41 * c_q4);
-        let x58 = Self::mul_add(c_q4, x56, x41 * s_q4);
-        let x59 = qd[4] * x54;
-        let x60 = qd[4] * x53;
-        let x61 = qd[4] * x58;
-        let x62 = qd[4] + x47;
-        let x63 = x62 * 97.44448770720001;
-        let x64 = Self::mul_add(x55, -171.195516, 132.6783695416 * x53);
+        let x64 = Self::mul_add(s_q2, x34, x56);
         let x65 = Self::mul_add(
-            x57,
-            171.195516,
-            Self::mul_add(x54, -97.44448770720001, 135.4729695416 * x62),
-        );
-        let x66 = x62 * 171.195516;
-        let x67 = x53 * 171.195516;
-        let x68 = Self::mul_add(x53, x67, x62 * x66);
-        let x69 = Self::mul_add(x62, s_q5, x53 * c_q5);
-        let x70 = Self::mul_add(-x62, c_q5, x53 * s_q5);
-        let x71 = qd[5] + x54;
-        let x72 = 44.41 * x70;
-        let x73 = 47.471 * x71;
-        let x74 = 9.336 * (qd[6] + x69);
-        let x75 = Self::mul_add(x71, c_q6, x70 * s_q6) * x74;
-        let x76 = Self::mul_add(-x71, s_q6, x70 * c_q6) * x74;
-        let x77 = tau[6] + Self::mul_add(-x70, x73, x71 * x72);
-        let x78 = Self::mul_add(x69, x72, -Self::mul_add(c_q6, x76, s_q6 * x75));
-        let x79 = tau[5] + x78;
-        let x80 = Self::mul_add(
-            44.41,
-            qd[5] * x69,
-            Self::mul_add(x69, x73, -Self::mul_add(-s_q6, x76, c_q6 * x75)),
-        );
-        let x81 = 44.41 * c_q5;
-        let x82 = s_q5 * x81;
-        let x83 = Self::mul_add(c_q5, x81, 135.4729695416);
-        let x84 = Self::mul_add(x58, x66, Self::mul_add(x53, x63, x54 * x64))
-            + Self::mul_add(-c_q5, x80, s_q5 * x77);
-        let x85 = 1.0 / x83;
-        let x86 = tau[4] - x84;
-        let x87 = x82 * x85;
-        let x88 = 97.44448770720001 * x85;
-        let x89 = 171.195516 * x85;
-        let x90 = Self::mul_add(
-            -x82,
-            x87,
-            Self::mul_add(s_q5, 44.41 * s_q5, 132.6783695416),
-        );
-        let x91 = x82 * x88;
-        let x92 = 97.44448770720001 * x88;
-        let x93 = x82 * x89;
-        let x94 = 97.44448770720001 * x89;
-        let x95 = 171.195516 * x89;
-        let x96 = Self::mul_add(
-            x54,
-            x67,
-            -Self::mul_add(-x61, x95, Self::mul_add(-x60, x94, x59 * x93)),
-        );
-        let x97 = Self::mul_add(x59, 171.195516, x54 * x66);
-        let x98 = Self::mul_add(
-            x86,
-            x87,
-            Self::mul_add(-x58, x67, Self::mul_add(x62, x63, x54 * x65))
-                - Self::mul_add(s_q5, x80, c_q5 * x77)
-                + Self::mul_add(x61, x93, Self::mul_add(x60, x91, x59 * x90)),
-        );
-        let x99 = Self::mul_add(
-            x86,
-            x88,
-            Self::mul_add(-x53, x65, x62 * x64) + Self::mul_add(x57, x67, x55 * x66)
-                + (x78 - x79)
-                - Self::mul_add(-x61, x94, Self::mul_add(-x60, x92, x59 * x91)),
-        );
-        let x100 = Self::mul_add(x86, x89, x96);
-        let x101 = s_q4 * x91;
-        let x102 = c_q4 * x91;
-        let x103 = Self::mul_add(s_q4, x90, x102);
-        let x104 = Self::mul_add(-c_q4, x92, x101);
-        let x105 = c_q4 * x93;
-        let x106 = s_q4 * x93;
-        let x107 = c_q4 * x94;
-        let x108 = s_q4 * x94;
-        let x109 = c_q4 * 171.195516;
-        let x110 = Self::mul_add(s_q4, x108, c_q4 * x106);
-        let x111 = s_q4 * 171.195516;
-        let x112 = Self::mul_add(-c_q4, x108, s_q4 * x106);
-        let x113 = s_q4 * x95;
-        let x114 = c_q4 * x113;
-        let x115 = s_q4 * x113;
-        let x116 = 7.11 * x114;
-        let x117 = 7.11 * x115;
-        let x118 = 7.11 * x109;
-        let x119 = 7.11 * x112;
-        let x120 = 7.11 * x111;
-        let x121 = Self::mul_add(c_q4, x68, s_q4 * x100);
-        let x122 = Self::mul_add(-7.11, x110, 1375.0472756800002);
-        let x123 = Self::mul_add(-7.11, x117, 24998.827802);
-        let x124 = -3239.4582 + x117;
-        let x125 = 3239.4582 - x111;
-        let x126 = Self::mul_add(x41, x52, Self::mul_add(-x36, x49, x37 * x48))
-            - Self::mul_add(-7.11, x121, Self::mul_add(x86, x83 * x85, x84));
-        let x127 = 1.0 / x123;
-        let x128 = tau[3] + x126;
-        let x129 = x122 * x127;
-        let x130 = x119 * x127;
-        let x131 = x116 * x127;
-        let x132 = x124 * x127;
-        let x133 = Self::mul_add(
-            -x122,
-            x129,
-            -24989.305802
-                + Self::mul_add(
-                    -s_q4,
-                    Self::mul_add(s_q4, x92, x102),
-                    c_q4 * Self::mul_add(c_q4, x90, -x101),
+            s_q1,
+            x41,
+            c_q1
+                * Self::mul_add(
+                    0.5692,
+                    Self::mul_add(-c_q2, x34, x54),
+                    Self::mul_add(-c_q2, x38, x52),
                 ),
         );
+        let x66 = Self::mul_add(-0.7026, s_q1 * x64, x65);
+        let x67 = Self::mul_add(-s_q3, x16, x35);
+        let x68 = Self::mul_add(c_q3, x16, x33);
+        let x69 = Self::mul_add(-0.475, x68, Self::mul_add(-c_q3, x14, x31));
+        let x70 = Self::mul_add(-0.475, x67, Self::mul_add(s_q3, x14, x32));
+        let x71 = Self::mul_add(-7.11, x68, x20);
+        let x72 = Self::mul_add(-s_q2, x68, c_q2 * x67);
+        let x73 = Self::mul_add(
+            -s_q1,
+            x71,
+            c_q1
+                * Self::mul_add(
+                    -0.5692,
+                    Self::mul_add(c_q2, x68, s_q2 * x67),
+                    Self::mul_add(s_q2, x70, c_q2 * x69),
+                ),
+        );
+        let x74 = Self::mul_add(0.7026, s_q1 * x72, x73);
+        let x75 = 47.471 * s_q4;
+        let x76 = 47.471 * c_q4;
+        let x77 = Self::mul_add(s_q3, x76, c_q3 * x75);
+        let x78 = Self::mul_add(-c_q3, x76, s_q3 * x75);
+        let x79 = c_q1 * Self::mul_add(-s_q2, x78, c_q2 * x77);
+        let x80 = 9.336 * c_q5;
+        let x81 = 9.336 * s_q5;
+        let x82 = c_q4 * x80;
+        let x83 = s_q4 * x80;
+        let x84 = Self::mul_add(-s_q3, x83, c_q3 * x82);
+        let x85 = Self::mul_add(c_q3, x83, s_q3 * x82);
+        let x86 = Self::mul_add(
+            -s_q1,
+            x81,
+            c_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
+        );
+        let x87 = 1.0
+            / (2232.9683597151998
+                - (x61
+                    - (x51
+                        - Self::mul_add(
+                            s_q1 * c_q1,
+                            x58 + x58,
+                            s_q1 * s_q1 * (x51 - (-1647.2196721184 + x45)),
+                        ) - x61)));
+        let x88 = x62 * x87;
+        let x89 = x63 * x87;
+        let x90 = x66 * x87;
+        let x91 = x74 * x87;
+        let x92 = x79 * x87;
+        let x93 = x86 * x87;
+        let x94 = 1.0 / Self::mul_add(-x62, x88, 1650.6386721183999 + (x44 + x50));
+        let x95 = Self::mul_add(-x62, x89, x59);
+        let x96 = x94 * x95;
+        let x97 = Self::mul_add(
+            x62,
+            x90,
+            Self::mul_add(0.5692, x64, Self::mul_add(s_q2, x38, x53)),
+        );
+        let x98 = x94 * x97;
+        let x99 = Self::mul_add(
+            -x62,
+            x91,
+            Self::mul_add(0.5692, x72, Self::mul_add(-c_q2, x70, s_q2 * x69)),
+        );
+        let x100 = x94 * x99;
+        let x101 = Self::mul_add(-x62, x92, Self::mul_add(c_q2, x78, s_q2 * x77));
+        let x102 = x94 * x101;
+        let x103 = Self::mul_add(-x62, x93, Self::mul_add(c_q2, x85, s_q2 * x84));
+        let x104 = x94 * x103;
+        let x105 = 1.0 / Self::mul_add(-x95, x96, Self::mul_add(-x63, x89, x45));
+        let x106 = Self::mul_add(-x95, x98, Self::mul_add(x63, x90, x41));
+        let x107 = x105 * x106;
+        let x108 = Self::mul_add(-x95, x100, Self::mul_add(-x63, x91, x71));
+        let x109 = x105 * x108;
+        let x110 = Self::mul_add(x95, x102, x63 * x92);
+        let x111 = x105 * x110;
+        let x112 = Self::mul_add(-x95, x104, Self::mul_add(-x63, x93, x81));
+        let x113 = x105 * x112;
+        let x114 = Self::mul_add(
+            -x106,
+            x107,
+            Self::mul_add(-x97, x98, Self::mul_add(-x66, x90, x24)),
+        );
+        let x115 = 1.0 / x114;
+        let x116 = Self::mul_add(
+            -x106,
+            x109,
+            Self::mul_add(-x97, x100, Self::mul_add(x66, x91, x20)),
+        );
+        let x117 = x115 * x116;
+        let x118 = Self::mul_add(x106, x111, Self::mul_add(-x97, x102, x66 * x92));
+        let x119 = x115 * x118;
+        let x120 = Self::mul_add(
+            -x106,
+            x113,
+            Self::mul_add(-x97, x104, Self::mul_add(x66, x93, x81)),
+        );
+        let x121 = x115 * x120;
+        let x122 = Self::mul_add(
+            -x108,
+            x109,
+            Self::mul_add(-x99, x100, Self::mul_add(-x74, x91, x10)),
+        );
+        let x123 = 1.0 / Self::mul_add(-x116, x117, x122);
+        let x124 = Self::mul_add(
+            x116,
+            x119,
+            Self::mul_add(-x108, x111, Self::mul_add(x99, x102, x74 * x92)),
+        );
+        let x125 = x123 * x124;
+        let x126 = Self::mul_add(
+            -x108,
+            x113,
+            Self::mul_add(-x99, x104, Self::mul_add(-x74, x93, x81)),
+        );
+        let x127 = Self::mul_add(-x116, x121, x126);
+        let x128 = x123 * x127;
+        let x129 = Self::mul_add(
+            -x110,
+            x111,
+            Self::mul_add(-x101, x102, Self::mul_add(-x79, x92, 47.471)),
+        );
+        let x130 = 1.0 / Self::mul_add(-x124, x125, Self::mul_add(-x118, x119, x129));
+        let x131 = Self::mul_add(
+            x118,
+            x121,
+            Self::mul_add(-x110, x113, Self::mul_add(x101, x104, x79 * x93)),
+        );
+        let x132 = Self::mul_add(-x124, x128, x131);
+        let x133 = x130 * x132;
         let x134 = Self::mul_add(
-            x122,
-            x130,
-            Self::mul_add(-s_q4, x104, c_q4 * x103) - x118,
+            -x112,
+            x113,
+            Self::mul_add(-x103, x104, Self::mul_add(-x86, x93, 9.336)),
         );
         let x135 = Self::mul_add(
+            -x132,
+            x133,
+            Self::mul_add(-x127, x128, Self::mul_add(-x120, x121, x134)),
+        );
+        let x136 = 1.0 / x135;
+        let x137 = Self::mul_add(-x88, x96, x89);
+        let x138 = Self::mul_add(x107, x137, Self::mul_add(x88, x98, x90));
+        let x139 = Self::mul_add(
+            x117,
+            x138,
+            Self::mul_add(-x109, x137, Self::mul_add(-x88, x100, x91)),
+        );
+        let x140 = Self::mul_add(
             x119,
-            x130,
-            x120 - (Self::mul_add(c_q4, x104, s_q4 * x103) - x120),
+            x138,
+            Self::mul_add(x111, x137, Self::mul_add(-x88, x102, x92)),
         );
-        let x136 = Self::mul_add(-x122, x131, Self::mul_add(s_q4, x107, c_q4 * x105));
-        let x137 = Self::mul_add(-x122, x132, x110);
-        let x138 = Self::mul_add(x119, x131, Self::mul_add(-c_q4, x107, s_q4 * x105));
-        let x139 = Self::mul_add(x119, x132, x112);
-        let x140 = Self::mul_add(x116, x131, c_q4 * (c_q4 * x95));
-        let x141 = Self::mul_add(x116, x132, x114);
-        let x142 = Self::mul_add(x124, x132, x115);
-        let x143 = Self::mul_add(x36, x52, -x97) - Self::mul_add(-x44, x125, x43 * x109);
-        let x144 = Self::mul_add(
+        let x141 = Self::mul_add(x125, x139, x140);
+        let x142 = Self::mul_add(
+            x121,
+            x138,
+            Self::mul_add(-x113, x137, Self::mul_add(-x88, x104, x93)),
+        );
+        let x143 = x136 * Self::mul_add(x133, x141, Self::mul_add(-x128, x139, x142));
+        let x144 = -x143;
+        let x145 = Self::mul_add(x133, x143, x130 * x141);
+        let x146 = -x145;
+        let x147 = Self::mul_add(-x128, x143, Self::mul_add(x125, x145, x123 * x139));
+        let x148 = -x147;
+        let x149 = Self::mul_add(
+            x121,
+            x143,
+            Self::mul_add(x119, x145, Self::mul_add(x117, x147, x115 * x138)),
+        );
+        let x150 = Self::mul_add(
+            x111,
+            x145,
+            Self::mul_add(-x109, x147, Self::mul_add(x107, x149, x105 * x137)),
+        );
+        let x151 = Self::mul_add(-x113, x143, x150);
+        let x152 = -x151;
+        let x153 = Self::mul_add(
+            -x100,
+            x147,
+            Self::mul_add(x98, x149, Self::mul_add(-x96, x151, x88 * x94)),
+        );
+        let x154 = Self::mul_add(-x104, x143, Self::mul_add(-x102, x145, x153));
+        let x155 = Self::mul_add(
+            x90,
+            x149,
+            Self::mul_add(x89, x151, Self::mul_add(x88, x154, x87)),
+        );
+        let x156 = Self::mul_add(
+            x93,
+            x143,
+            Self::mul_add(x92, x145, Self::mul_add(x91, x147, x155)),
+        );
+        let x157 = Self::mul_add(-x96, x107, x98);
+        let x158 = Self::mul_add(-x117, x157, Self::mul_add(-x96, x109, x100));
+        let x159 = Self::mul_add(
+            x125,
+            x158,
+            Self::mul_add(-x119, x157, Self::mul_add(x96, x111, x102)),
+        );
+        let x160 = Self::mul_add(
             -x128,
-            x129,
-            Self::mul_add(x47, x49, x37 * x50) - Self::mul_add(x39, x52, x42 * x51)
-                + Self::mul_add(s_q4, x99, c_q4 * x98)
-                + (Self::mul_add(x44, x134, x43 * x133)
-                    + Self::mul_add(x46, x137, x45 * x136)),
+            x158,
+            Self::mul_add(-x121, x157, Self::mul_add(-x96, x113, x104)),
         );
-        let x145 = Self::mul_add(
-            x128,
-            x130,
-            Self::mul_add(-x41, x51, Self::mul_add(x36, x50, x47 * x48))
-                + Self::mul_add(-7.11, x97, Self::mul_add(-c_q4, x99, s_q4 * x98))
-                + (Self::mul_add(-x44, x135, x43 * x134)
-                    + Self::mul_add(x46, x139, x45 * x138)),
+        let x161 = x136 * Self::mul_add(x133, x159, x160);
+        let x162 = Self::mul_add(x133, x161, x130 * x159);
+        let x163 = Self::mul_add(-x128, x161, Self::mul_add(x125, x162, x123 * x158));
+        let x164 = Self::mul_add(
+            -x121,
+            x161,
+            Self::mul_add(-x119, x162, Self::mul_add(-x117, x163, x115 * x157)),
         );
-        let x146 = Self::mul_add(
-            x128,
-            x131,
-            Self::mul_add(x47, x52, x37 * x51) + Self::mul_add(-s_q4, x68, c_q4 * x100)
-                - (Self::mul_add(x44, x138, x43 * x136)
-                    - Self::mul_add(x46, x141, x45 * x140)),
+        let x165 = Self::mul_add(
+            x111,
+            x162,
+            Self::mul_add(-x109, x163, Self::mul_add(-x107, x164, x96 * x105)),
         );
-        let x147 = Self::mul_add(
-            x128,
-            x132,
-            Self::mul_add(x36, x51, x121)
-                - (Self::mul_add(x44, x139, x43 * x137)
-                    - Self::mul_add(x46, x142, x45 * x141)),
-        );
-        let x148 = s_q3 * x134;
-        let x149 = c_q3 * x134;
-        let x150 = Self::mul_add(s_q3, x133, x149);
-        let x151 = Self::mul_add(-c_q3, x135, x148);
-        let x152 = Self::mul_add(-s_q3, x137, c_q3 * x136);
-        let x153 = Self::mul_add(c_q3, x137, s_q3 * x136);
-        let x154 = Self::mul_add(-s_q3, x139, c_q3 * x138);
-        let x155 = Self::mul_add(c_q3, x139, s_q3 * x138);
-        let x156 = Self::mul_add(-s_q3, x154, c_q3 * x152);
-        let x157 = c_q3 * x109;
-        let x158 = Self::mul_add(s_q3, x125, x157);
-        let x159 = Self::mul_add(-s_q3, x155, c_q3 * x153);
-        let x160 = Self::mul_add(c_q3, x154, s_q3 * x152);
-        let x161 = s_q3 * x109;
-        let x162 = Self::mul_add(-c_q3, x125, x161);
-        let x163 = s_q3 * x141;
-        let x164 = c_q3 * x141;
-        let x165 = Self::mul_add(s_q3, x140, x164);
-        let x166 = Self::mul_add(c_q3, x142, x163);
+        let x166 = Self::mul_add(-x113, x161, x165);
         let x167 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-s_q3, x142, x164),
-            c_q3 * Self::mul_add(c_q3, x140, -x163),
+            x100,
+            x163,
+            Self::mul_add(x98, x164, Self::mul_add(x96, x166, x94)),
         );
-        let x168 = Self::mul_add(-s_q3, x166, c_q3 * x165);
-        let x169 = Self::mul_add(c_q3, x166, s_q3 * x165);
-        let x170 = 0.475 * x168;
-        let x171 = 7.11 * x168;
-        let x172 = 7.11 * x169;
-        let x173 = Self::mul_add(0.475, x169, x159);
-        let x174 = Self::mul_add(-0.475, x167, x160);
-        let x175 = Self::mul_add(c_q3, x155, s_q3 * x153) - x170;
-        let x176 = 7.11 * x158;
-        let x177 = 7.11 * x175;
-        let x178 = 7.11 * x162;
+        let x168 = Self::mul_add(x104, x161, Self::mul_add(x102, x162, x167));
+        let x169 = Self::mul_add(
+            -x91,
+            x163,
+            Self::mul_add(x90, x164, Self::mul_add(-x89, x166, x88 * x168)),
+        );
+        let x170 = Self::mul_add(-x93, x161, Self::mul_add(-x92, x162, x169));
+        let x171 = Self::mul_add(-x107, x117, x109);
+        let x172 = Self::mul_add(-x125, x171, Self::mul_add(x107, x119, x111));
+        let x173 = Self::mul_add(
+            -x133,
+            x172,
+            Self::mul_add(-x128, x171, Self::mul_add(-x107, x121, x113)),
+        );
+        let x174 = x136 * x173;
+        let x175 = -x174;
+        let x176 = Self::mul_add(-x133, x174, x130 * x172);
+        let x177 = Self::mul_add(-x128, x174, Self::mul_add(-x125, x176, x123 * x171));
+        let x178 = -x177;
         let x179 = Self::mul_add(
-            -0.475,
-            x173,
-            Self::mul_add(
-                -s_q3,
-                Self::mul_add(s_q3, x135, x149),
-                c_q3 * Self::mul_add(c_q3, x133, -x148),
-            ),
+            -x121,
+            x174,
+            Self::mul_add(x119, x176, Self::mul_add(-x117, x177, x107 * x115)),
         );
-        let x180 = Self::mul_add(-s_q3, x147, c_q3 * x146);
-        let x181 = Self::mul_add(c_q3, x147, s_q3 * x146);
-        let x182 = 3946.18812068 - Self::mul_add(7.11, x159, 0.475 * x172);
-        let x183 = Self::mul_add(-7.11, x172, 39241.404122);
-        let x184 = -5224.5702 + x172;
-        let x185 = 5224.5702 - x162;
-        let x186 = Self::mul_add(x24, x35, Self::mul_add(-x20, x32, x21 * x31))
-            + Self::mul_add(7.11, x181, Self::mul_add(-x128, x123 * x127, x126));
-        let x187 = 1.0 / x183;
-        let x188 = tau[2] + x186;
-        let x189 = x182 * x187;
-        let x190 = x177 * x187;
-        let x191 = x171 * x187;
-        let x192 = x184 * x187;
-        let x193 = Self::mul_add(
-            -x182,
-            x189,
-            -39234.47412200001 - Self::mul_add(0.475, x159, -x179),
+        let x180 = -x179;
+        let x181 = Self::mul_add(
+            x111,
+            x176,
+            Self::mul_add(x109, x177, Self::mul_add(x107, x179, x105)),
         );
+        let x182 = Self::mul_add(x113, x174, x181);
+        let x183 = Self::mul_add(
+            x102,
+            x176,
+            Self::mul_add(-x100, x177, Self::mul_add(-x98, x179, x96 * x182)),
+        );
+        let x184 = Self::mul_add(-x104, x174, x183);
+        let x185 = Self::mul_add(
+            x91,
+            x177,
+            Self::mul_add(-x90, x179, Self::mul_add(-x89, x182, x88 * x184)),
+        );
+        let x186 = Self::mul_add(x93, x174, Self::mul_add(-x92, x176, x185));
+        let x187 = Self::mul_add(x117, x125, x119);
+        let x188 = x136 * Self::mul_add(x133, x187, Self::mul_add(-x117, x128, x121));
+        let x189 = -x188;
+        let x190 = Self::mul_add(x133, x188, x130 * x187);
+        let x191 = -x190;
+        let x192 = Self::mul_add(-x128, x188, Self::mul_add(x125, x190, x117 * x123));
+        let x193 = -x192;
         let x194 = Self::mul_add(
-            -x182,
-            x190,
-            Self::mul_add(-0.475, x156, x176)
-                - Self::mul_add(-0.475, x175, Self::mul_add(-s_q3, x151, c_q3 * x150)),
+            x121,
+            x188,
+            Self::mul_add(x119, x190, Self::mul_add(x117, x192, x115)),
         );
         let x195 = Self::mul_add(
-            x177,
+            -x113,
+            x188,
+            Self::mul_add(x111, x190, Self::mul_add(-x109, x192, x107 * x194)),
+        );
+        let x196 = -x195;
+        let x197 = Self::mul_add(
+            x102,
             x190,
-            Self::mul_add(-0.475, x160, x178)
-                - (Self::mul_add(c_q3, x151, s_q3 * x150)
-                    + Self::mul_add(0.475, x174, -x178)),
+            Self::mul_add(x100, x192, Self::mul_add(-x98, x194, x96 * x195)),
         );
-        let x196 = Self::mul_add(-x182, x191, x156 + x170);
-        let x197 = Self::mul_add(-x182, x192, x173);
-        let x198 = Self::mul_add(x177, x191, x174);
-        let x199 = Self::mul_add(x177, x192, x175);
-        let x200 = Self::mul_add(x171, x191, x167);
-        let x201 = Self::mul_add(x171, x192, x168);
-        let x202 = Self::mul_add(x184, x192, x169);
-        let x203 = Self::mul_add(
-            -x188,
-            x189,
-            Self::mul_add(x30, x32, x21 * x33) - Self::mul_add(x11, x35, x25 * x34)
-                + Self::mul_add(0.475, x181, Self::mul_add(-s_q3, x145, c_q3 * x144))
-                + (Self::mul_add(-x27, x194, x26 * x193)
-                    + Self::mul_add(x29, x197, x28 * x196)),
-        );
-        let x204 = Self::mul_add(
-            x188,
-            x190,
-            Self::mul_add(-x24, x34, Self::mul_add(x20, x33, x30 * x31))
-                + (Self::mul_add(c_q3, x145, s_q3 * x144)
-                    - Self::mul_add(-7.11, x143, 0.475 * x180))
-                - (Self::mul_add(x27, x195, x26 * x194)
-                    - Self::mul_add(x29, x199, x28 * x198)),
-        );
-        let x205 = Self::mul_add(
-            x188,
-            x191,
-            Self::mul_add(x30, x35, x21 * x34) + x180
-                - (Self::mul_add(x27, x198, x26 * x196)
-                    - Self::mul_add(x29, x201, x28 * x200)),
-        );
-        let x206 = Self::mul_add(
-            x188,
+        let x198 = Self::mul_add(x104, x188, x197);
+        let x199 = -x198;
+        let x200 = Self::mul_add(
+            -x91,
             x192,
-            Self::mul_add(x20, x34, x181)
-                - (Self::mul_add(x27, x199, x26 * x197)
-                    - Self::mul_add(x29, x202, x28 * x201)),
+            Self::mul_add(-x90, x194, Self::mul_add(-x89, x195, x88 * x198)),
         );
-        let x207 = s_q2 * x194;
-        let x208 = c_q2 * x194;
-        let x209 = Self::mul_add(s_q2, x193, -x208);
-        let x210 = Self::mul_add(c_q2, x195, x207);
-        let x211 = Self::mul_add(-s_q2, x197, c_q2 * x196);
-        let x212 = Self::mul_add(c_q2, x197, s_q2 * x196);
-        let x213 = Self::mul_add(-s_q2, x199, c_q2 * x198);
-        let x214 = Self::mul_add(c_q2, x199, s_q2 * x198);
-        let x215 = Self::mul_add(-s_q2, x213, c_q2 * x211);
-        let x216 = c_q2 * x158;
-        let x217 = Self::mul_add(s_q2, x185, x216);
-        let x218 = Self::mul_add(-s_q2, x214, c_q2 * x212);
-        let x219 = Self::mul_add(c_q2, x213, s_q2 * x211);
-        let x220 = s_q2 * x158;
-        let x221 = Self::mul_add(-c_q2, x185, x220);
-        let x222 = s_q2 * x201;
-        let x223 = c_q2 * x201;
-        let x224 = Self::mul_add(s_q2, x200, x223);
-        let x225 = Self::mul_add(c_q2, x202, x222);
-        let x226 = Self::mul_add(
-            -s_q2,
-            Self::mul_add(-s_q2, x202, x223),
-            c_q2 * Self::mul_add(c_q2, x200, -x222),
+        let x201 = Self::mul_add(-x93, x188, Self::mul_add(-x92, x190, x200));
+        let x202 = -x201;
+        let x203 = x136 * Self::mul_add(-x125, x133, x128);
+        let x204 = -x203;
+        let x205 = Self::mul_add(-x133, x203, x125 * x130);
+        let x206 = Self::mul_add(x128, x203, Self::mul_add(x125, x205, x123));
+        let x207 = Self::mul_add(-x121, x203, Self::mul_add(x119, x205, x117 * x206));
+        let x208 = -x207;
+        let x209 = Self::mul_add(
+            x113,
+            x203,
+            Self::mul_add(x111, x205, Self::mul_add(-x109, x206, x107 * x207)),
         );
-        let x227 = 0.5692 * Self::mul_add(-s_q2, x225, c_q2 * x224);
-        let x228 = Self::mul_add(-0.5692, x226, x219);
-        let x229 = Self::mul_add(
-            -0.5692,
-            Self::mul_add(0.5692, Self::mul_add(c_q2, x225, s_q2 * x224), x218),
-            Self::mul_add(
-                s_q2,
-                Self::mul_add(-s_q2, x195, x208),
-                c_q2 * Self::mul_add(c_q2, x193, x207),
-            ),
+        let x210 = Self::mul_add(
+            x102,
+            x205,
+            Self::mul_add(x100, x206, Self::mul_add(-x98, x207, x96 * x209)),
         );
-        let x230 = Self::mul_add(
-            0.5692,
+        let x211 = Self::mul_add(-x104, x203, x210);
+        let x212 = Self::mul_add(
+            -x91,
+            x206,
+            Self::mul_add(-x90, x207, Self::mul_add(-x89, x209, x88 * x211)),
+        );
+        let x213 = Self::mul_add(x93, x203, Self::mul_add(-x92, x205, x212));
+        let x214 = x133 * x136;
+        let x215 = Self::mul_add(x133, x214, x130);
+        let x216 = Self::mul_add(-x128, x214, x125 * x215);
+        let x217 = Self::mul_add(x121, x214, Self::mul_add(x119, x215, x117 * x216));
+        let x218 = -x217;
+        let x219 = Self::mul_add(
+            -x113,
+            x214,
+            Self::mul_add(x111, x215, Self::mul_add(-x109, x216, x107 * x217)),
+        );
+        let x220 = Self::mul_add(
+            x102,
             x215,
-            Self::mul_add(
-                -0.5692,
-                Self::mul_add(c_q2, x214, s_q2 * x212) - x227,
-                Self::mul_add(s_q2, x210, c_q2 * x209),
-            ),
+            Self::mul_add(x100, x216, Self::mul_add(-x98, x217, x96 * x219)),
         );
-        let x231 = Self::mul_add(
-            0.5692,
-            x219,
-            Self::mul_add(0.5692, x228, Self::mul_add(-c_q2, x210, s_q2 * x209)),
+        let x221 = Self::mul_add(x104, x214, x220);
+        let x222 = Self::mul_add(
+            -x91,
+            x216,
+            Self::mul_add(-x90, x217, Self::mul_add(-x89, x219, x88 * x221)),
         );
-        let x232 = Self::mul_add(-s_q2, x206, c_q2 * x205);
-        let x233 = 1145.5438279999998 + x228;
-        let x234 = 1.0 / (65697.3302265768 + x231);
-        let x235 = tau[1]
-            - (Self::mul_add(x11, x18, x7 * x16)
-                + Self::mul_add(-0.5692, x232, Self::mul_add(c_q2, x204, s_q2 * x203)));
-        let x236 = x230 * x234;
-        let x237 = x233 * x234;
-        let x238 = x221 * x234;
-        let x239 = Self::mul_add(x230, x236, Self::mul_add(0.5692, x218, -x229));
-        let x240 = Self::mul_add(-x230, x237, x215 + x227);
-        let x241 = Self::mul_add(-x230, x238, x217);
-        let x242 = Self::mul_add(x233, x237, x226);
-        let x243 = x233 * x238;
-        let x244 = x221 * x238;
-        let x245 = Self::mul_add(
-            x235,
-            x236,
-            Self::mul_add(-x11, x19, Self::mul_add(x8, x17, qd[1] * x16))
-                + Self::mul_add(
-                    0.5692,
-                    Self::mul_add(c_q2, x206, s_q2 * x205),
-                    Self::mul_add(-s_q2, x204, c_q2 * x203),
-                ) - Self::mul_add(x12, x239, Self::mul_add(x15, x241, x14 * x240)),
+        let x223 = Self::mul_add(-x93, x214, Self::mul_add(-x92, x215, x222));
+        let x224 = Self::mul_add(-x128, x136, x125 * x214);
+        let x225 = Self::mul_add(x121, x136, Self::mul_add(x119, x214, x117 * x224));
+        let x226 = -x225;
+        let x227 = Self::mul_add(
+            -x113,
+            x136,
+            Self::mul_add(x111, x214, Self::mul_add(-x109, x224, x107 * x225)),
         );
-        let x246 = Self::mul_add(
-            x235,
-            x237,
-            Self::mul_add(x8, x19, -x232)
-                + Self::mul_add(x12, x240, Self::mul_add(x15, x243, x14 * x242)),
+        let x228 = Self::mul_add(
+            x102,
+            x214,
+            Self::mul_add(x100, x224, Self::mul_add(-x98, x225, x96 * x227)),
         );
-        let x247 = Self::mul_add(
-            -x235,
-            x238,
-            Self::mul_add(x7, x19, qd[1] * x18)
-                + (Self::mul_add(x20, x35, x143) - Self::mul_add(-x27, x185, x26 * x158))
-                - Self::mul_add(x12, x241, Self::mul_add(x15, x244, x14 * x243)),
+        let x229 = Self::mul_add(x104, x136, x228);
+        let x230 = Self::mul_add(
+            -x91,
+            x224,
+            Self::mul_add(-x90, x225, Self::mul_add(-x89, x227, x88 * x229)),
         );
-        let x248 = s_q1 * 65693.9112265768;
-        let x249 = s_q1 * x248;
-        let x250 = c_q1 * Self::mul_add(-c_q1, x241, s_q1 * x240);
-        let x251 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(
-                -c_q1,
-                Self::mul_add(-c_q1, x244, s_q1 * x243),
-                s_q1 * Self::mul_add(-c_q1, x243, s_q1 * x242),
-            ),
+        let x231 = Self::mul_add(-x93, x136, Self::mul_add(-x92, x214, x230));
+        let x232 = qd[0] * c_q1;
+        let x233 = qd[0] * s_q1;
+        let x234 = qd[0] * 0.7026;
+        let x235 = s_q1 * x234;
+        let x236 = c_q1 * x234;
+        let x237 = qd[1] * x233;
+        let x238 = qd[1] * x232;
+        let x239 = qd[1] * x236;
+        let x240 = qd[1] * x235;
+        let x241 = x233 * 1647.2196721184;
+        let x242 = Self::mul_add(-1145.5438279999998, x235, 1650.6386721183999 * qd[1]);
+        let x243 = 1145.5438279999998 * qd[1];
+        let x244 = 1145.5438279999998 * x232;
+        let x245 = Self::mul_add(-qd[1], s_q2, c_q2 * x232);
+        let x246 = Self::mul_add(qd[1], c_q2, s_q2 * x232);
+        let x247 = 0.5692 * x232;
+        let x248 = Self::mul_add(-0.5692, qd[1], x235);
+        let x249 = Self::mul_add(-s_q2, x247, c_q2 * x248);
+        let x250 = Self::mul_add(c_q2, x247, s_q2 * x248);
+        let x251 = qd[2] - x233;
+        let x252 = 0.5692 * x237;
+        let x253 = Self::mul_add(qd[2], x246, c_q2 * x237);
+        let x254 = Self::mul_add(-qd[2], x245, s_q2 * x237);
+        let x255 = Self::mul_add(qd[2], x249, Self::mul_add(-c_q2, x252, s_q2 * x239));
+        let x256 = 3946.18812068 * x251;
+        let x257 = Self::mul_add(-5224.5702, x236, 39234.474122 * x246);
+        let x258 = Self::mul_add(
+            5224.5702,
             x250,
+            Self::mul_add(39241.404122, x251, 3946.1881206800003 * x245),
         );
-        let x252 = Self::mul_add(
-            0.7026,
-            x250,
-            -Self::mul_add(-0.7026, x251, Self::mul_add(c_q1, c_q1 * x239, x249)),
+        let x259 = 5224.5702 * x251;
+        let x260 = 5224.5702 * x246;
+        let x261 = Self::mul_add(-s_q3, x246, c_q3 * x245);
+        let x262 = Self::mul_add(c_q3, x246, s_q3 * x245);
+        let x263 = Self::mul_add(-0.475, x246, x249);
+        let x264 = x250 + Self::mul_add(7.11, x251, 0.475 * x245);
+        let x265 = Self::mul_add(-7.11, x246, x236);
+        let x266 = Self::mul_add(-s_q3, x264, c_q3 * x263);
+        let x267 = Self::mul_add(c_q3, x264, s_q3 * x263);
+        let x268 = qd[3] + x251;
+        let x269 = 7.11 * x238;
+        let x270 = Self::mul_add(
+            0.475,
+            x254,
+            Self::mul_add(-qd[2], x250, Self::mul_add(s_q2, x252, c_q2 * x239)),
         );
-        let x253 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                x13,
-                -65693.9112265768,
-                Self::mul_add(x10, x19, x7 * x17)
-                    + Self::mul_add(-x188, x183 * x187, x186),
-            ),
-            c_q1 * x245,
+        let x271 = x255 - Self::mul_add(0.475, x253, x269);
+        let x272 = Self::mul_add(-7.11, x254, x240);
+        let x273 = Self::mul_add(qd[3], x262, Self::mul_add(-s_q3, x254, c_q3 * x253));
+        let x274 = Self::mul_add(-qd[3], x261, Self::mul_add(c_q3, x254, s_q3 * x253));
+        let x275 = Self::mul_add(qd[3], x266, Self::mul_add(c_q3, x271, s_q3 * x270));
+        let x276 = 1375.0472756800002 * x268;
+        let x277 = Self::mul_add(-3239.4582, x265, 24989.305802 * x262);
+        let x278 = Self::mul_add(
+            3239.4582,
+            x267,
+            Self::mul_add(24998.827802, x268, 1375.0472756800002 * x261),
         );
-        let x254 = 1.0 / (66279.65991417361 + x252);
-        let x255 = x254
-            * (tau[0]
-                + Self::mul_add(0.7026, Self::mul_add(c_q1, x247, s_q1 * x246), x253));
-        let x256 = 0.7026 * x255;
-        let x257 = Self::mul_add(-c_q1, x255, x12);
-        let x258 = Self::mul_add(s_q1, x255, x13);
-        let x259 = Self::mul_add(s_q1, x256, x14);
-        let x260 = Self::mul_add(
-            x230,
-            x257,
-            -Self::mul_add(x221, Self::mul_add(-c_q1, x256, x15), x233 * x259),
+        let x279 = 3239.4582 * x268;
+        let x280 = 3239.4582 * x262;
+        let x281 = Self::mul_add(-s_q4, x262, c_q4 * x261);
+        let x282 = Self::mul_add(c_q4, x262, s_q4 * x261);
+        let x283 = Self::mul_add(7.11, x268, x267);
+        let x284 = Self::mul_add(-7.11, x262, x265);
+        let x285 = Self::mul_add(-s_q4, x283, c_q4 * x266);
+        let x286 = Self::mul_add(c_q4, x283, s_q4 * x266);
+        let x287 = qd[4] + x268;
+        let x288 = Self::mul_add(
+            s_q4,
+            x269 - x275,
+            c_q4 * Self::mul_add(-qd[3], x267, Self::mul_add(-s_q3, x271, c_q3 * x270)),
         );
-        let x261 = x234 * (x235 - x260);
-        let x262 = 0.5692 * x257;
-        let x263 = Self::mul_add(-0.5692, x261, x259);
-        let x264 = x26 + Self::mul_add(s_q2, x261, c_q2 * x257);
-        let x265 = x27 - Self::mul_add(-c_q2, x261, s_q2 * x257);
-        let x266 = x28 - Self::mul_add(s_q2, x262, c_q2 * x263);
-        let x267 = x29 + Self::mul_add(-c_q2, x262, s_q2 * x263);
-        let x268 = x187
-            * (x188
-                + (Self::mul_add(-x177, x265, Self::mul_add(x183, x258, x182 * x264))
-                    + Self::mul_add(x184, x267, x171 * x266)));
-        let x269 = x258 - x268;
-        let x270 = Self::mul_add(0.475, x265, x266);
-        let x271 = x267 - Self::mul_add(7.11, x269, 0.475 * x264);
-        let x272 = x43 + Self::mul_add(s_q3, x265, c_q3 * x264);
-        let x273 = x44 - Self::mul_add(-c_q3, x265, s_q3 * x264);
-        let x274 = x45 + Self::mul_add(s_q3, x271, c_q3 * x270);
-        let x275 = x46 - Self::mul_add(-c_q3, x271, s_q3 * x270);
-        let x276 = x127
-            * (x128
-                + (Self::mul_add(-x119, x273, Self::mul_add(x123, x269, x122 * x272))
-                    + Self::mul_add(x124, x275, x116 * x274)));
-        let x277 = x269 - x276;
-        let x278 = x59 + Self::mul_add(s_q4, x273, c_q4 * x272);
-        let x279 = x60 - Self::mul_add(-c_q4, x273, s_q4 * x272);
-        let x280 = Self::mul_add(
+        let x289 = Self::mul_add(qd[4], x282, Self::mul_add(-s_q4, x274, c_q4 * x273));
+        let x290 = Self::mul_add(-qd[4], x281, Self::mul_add(c_q4, x274, s_q4 * x273));
+        let x291 = Self::mul_add(97.44448770720001, x287, x282 * 177.0883695416);
+        let x292 = 171.195516 * x284;
+        let x293 = Self::mul_add(
             -171.195516,
-            x61 + Self::mul_add(s_q4, Self::mul_add(-7.11, x277, x275), c_q4 * x274),
+            x285,
+            Self::mul_add(-179.8829695416, x287, 97.44448770720001 * x282),
+        );
+        let x294 = 171.195516 * x287;
+        let x295 = 171.195516 * x281;
+        let x296 = Self::mul_add(x281, x295, x287 * x294);
+        let x297 = Self::mul_add(
+            171.195516,
+            Self::mul_add(-7.11, x274, x272),
+            -Self::mul_add(-x286, x295, Self::mul_add(-x282, x293, x287 * x291)),
+        );
+        let x298 = Self::mul_add(-x282, x295, 171.195516 * x238);
+        let x299 = Self::mul_add(x282, x294, 171.195516 * x289);
+        let x300 = Self::mul_add(-c_q5, x287, s_q5 * x281);
+        let x301 = Self::mul_add(s_q5, x287, c_q5 * x281);
+        let x302 = qd[5] + x282;
+        let x303 = Self::mul_add(qd[5], x300, Self::mul_add(s_q5, x238, c_q5 * x289));
+        let x304 = 44.41 * x301;
+        let x305 = 47.471 * x302;
+        let x306 = 9.336 * x303;
+        let x307 = 9.336 * (qd[6] + x301);
+        let x308 = Self::mul_add(c_q6, x302, s_q6 * x300) * x307;
+        let x309 = Self::mul_add(-s_q6, x302, c_q6 * x300) * x307;
+        let x310 = Self::mul_add(x301, x305, x302 * x304)
+            - Self::mul_add(-s_q6, x309, c_q6 * x308);
+        let x311 = Self::mul_add(-x300, x305, 44.41 * x303) - x306;
+        let x312 = Self::mul_add(x300, x304, 47.471 * x290)
+            - Self::mul_add(c_q6, x309, s_q6 * x308);
+        let x313 = x297 + Self::mul_add(c_q5, x311, s_q5 * x310);
+        let x314 = Self::mul_add(97.44448770720001, x238, x290 * 177.0883695416)
+            + (Self::mul_add(-x281, x293, x287 * x292)
+                - Self::mul_add(x285, x295, x284 * x294)) - x312;
+        let x315 = Self::mul_add(
+            171.195516,
+            Self::mul_add(-qd[4], x286, x288),
+            Self::mul_add(-179.8829695416, x238, 97.44448770720001 * x290),
+        ) - Self::mul_add(-x286, x294, Self::mul_add(-x281, x291, x282 * x292))
+            - Self::mul_add(-s_q5, x311, c_q5 * x310);
+        let x316 = Self::mul_add(-c_q4, x296, s_q4 * x298);
+        let x317 = Self::mul_add(
+            1375.0472756800002,
+            x238,
+            -(Self::mul_add(-x262, x278, x268 * x277)
+                + Self::mul_add(x267, x280, x265 * x279)),
+        ) - Self::mul_add(s_q4, x314, c_q4 * x313);
+        let x318 = Self::mul_add(-3239.4582, x272, 24989.305802 * x274)
+            + Self::mul_add(x266, x280, Self::mul_add(-x261, x278, x268 * x276))
+            + Self::mul_add(7.11, x299, Self::mul_add(-c_q4, x314, s_q4 * x313));
+        let x319 = Self::mul_add(
+            -3239.4582,
+            x275,
+            Self::mul_add(24998.827802, x238, 1375.0472756800002 * x273),
+        ) - Self::mul_add(-x266, x279, Self::mul_add(-x261, x277, x262 * x276))
+            - Self::mul_add(7.11, x316, x315);
+        let x320 = Self::mul_add(x262, x280, x268 * x279)
+            - Self::mul_add(s_q4, x296, c_q4 * x298);
+        let x321 = Self::mul_add(x261, x280, 3239.4582 * x238) - x316;
+        let x322 = Self::mul_add(-x261, x279, 3239.4582 * x274) + x299;
+        let x323 = Self::mul_add(-s_q3, x321, c_q3 * x320);
+        let x324 = Self::mul_add(c_q3, x321, s_q3 * x320);
+        let x325 = Self::mul_add(
+            3946.18812068,
+            x238,
+            -(Self::mul_add(-x246, x258, x251 * x257)
+                + Self::mul_add(x250, x260, x236 * x259)),
+        ) + Self::mul_add(0.475, x324, Self::mul_add(s_q3, x318, c_q3 * x317));
+        let x326 = Self::mul_add(-5224.5702, x240, 39234.474122 * x254)
+            + Self::mul_add(x249, x260, Self::mul_add(-x245, x258, x251 * x256))
+            - (Self::mul_add(-c_q3, x318, s_q3 * x317)
+                - Self::mul_add(7.11, x322, 0.475 * x323));
+        let x327 = Self::mul_add(
+            -5224.5702,
+            x255,
+            Self::mul_add(39241.404122, x238, 3946.1881206800003 * x253),
+        ) - Self::mul_add(-x249, x259, Self::mul_add(-x245, x257, x246 * x256))
+            + Self::mul_add(7.11, x324, x319);
+        let x328 = Self::mul_add(x246, x260, x251 * x259) + x323;
+        let x329 = Self::mul_add(x245, x260, 5224.5702 * x238) + x324;
+        let x330 = Self::mul_add(-s_q2, x329, c_q2 * x328);
+        let x331 = Self::mul_add(
+            s_q1,
+            Self::mul_add(x238, 1647.2196721184, -Self::mul_add(x235, x244, x232 * x242))
+                - x327,
+            c_q1
+                * (Self::mul_add(-x236, x244, Self::mul_add(x233, x242, qd[1] * x241))
+                    + Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x329, s_q2 * x328),
+                        Self::mul_add(s_q2, x326, c_q2 * x325),
+                    )),
+        );
+        let x332 = Self::mul_add(
+            0.7026,
             Self::mul_add(
-                -97.44448770720001,
-                x279,
-                Self::mul_add(-x83, x277, x82 * x278),
+                c_q1,
+                Self::mul_add(x232, x244, qd[1] * x243)
+                    - (Self::mul_add(-x245, x259, 5224.5702 * x254) + x322),
+                s_q1 * Self::mul_add(x233, x244, -x330),
             ),
+            x331,
         );
-        let x281 = x85 * (x86 - x280);
-        let x282 = 0.02106549261654484 * Self::mul_add(-47.471, x279, x79);
-        let x283 = Self::mul_add(
-            9.336,
-            Self::mul_add(qd[5], x70, Self::mul_add(s_q5, x277 - x281, c_q5 * x278)),
-            tau[6],
+        let x333 = tau[0] + x332;
+        let x334 = tau[1]
+            + (Self::mul_add(
+                1145.5438279999998,
+                x239,
+                -Self::mul_add(x236, x243, x232 * x241),
+            ) - Self::mul_add(-0.5692, x330, Self::mul_add(-c_q2, x326, s_q2 * x325)));
+        let x335 = tau[2] + x327;
+        let x336 = tau[3] + x319;
+        let x337 = tau[4] - x315;
+        let x338 = tau[5] + x312;
+        let x339 = tau[6] + x306;
+        let x340 = Self::mul_add(
+            x149,
+            x336,
+            Self::mul_add(-x151, x335, Self::mul_add(x154, x334, x156 * x333)),
         );
-        let x284 = 0.10711225364181662 * x283;
-        let x285 = c_q0 * s_q1;
-        let x286 = s_q0 * s_q1;
-        let x287 = c_q0 * c_q1;
-        let x288 = s_q0 * c_q1;
-        let x289 = 0.7026 * s_q0;
-        let x290 = 0.7026 * c_q0;
-        let x291 = Self::mul_add(-c_q0, x289, s_q0 * x290);
-        let x292 = 1.3589 * c_q0;
-        let x293 = 1.3589 * s_q0;
-        let x294 = s_q1 * 1145.5438279999998;
-        let x295 = 1145.5438279999998 * x287;
-        let x296 = 1145.5438279999998 * x288;
-        let x297 = 65693.9112265768 * x287;
-        let x298 = 65697.3302265768 * s_q0;
-        let x299 = 65693.9112265768 * x288;
-        let x300 = 65697.3302265768 * c_q0;
-        let x301 = x290 * x296;
-        let x302 = x289 * x295;
-        let x303 = x301 - x302;
-        let x304 = x289 * x294;
-        let x305 = x290 * x294;
-        let x306 = 1.3589 * x295;
-        let x307 = 1.3589 * x294;
-        let x308 = x301 - x307;
-        let x309 = x290 * x295;
-        let x310 = 1.3589 * x296;
-        let x311 = x289 * x296;
-        let x312 = x302 + x307;
-        let x313 = x303 + (x249 + x303);
-        let x314 = x306 + Self::mul_add(x248, x287, x304);
-        let x315 = x310 + Self::mul_add(x248, x288, -x305);
-        let x316 = x304 + Self::mul_add(s_q1, x297, x306);
-        let x317 = x308 + (Self::mul_add(-s_q0, x298, x287 * x297) + x308);
-        let x318 = x311 + (Self::mul_add(c_q0, x298, x288 * x297) - x309);
-        let x319 = x305 - Self::mul_add(s_q1, x299, x310);
-        let x320 = x309 - (Self::mul_add(s_q0, x300, x287 * x299) + x311);
-        let x321 = x312 - (Self::mul_add(-c_q0, x300, x288 * x299) - x312);
-        let x322 = qd[1] * s_q0;
-        let x323 = qd[1] * c_q0;
-        let x324 = qd[1] * x291;
-        let x325 = qd[1] * x292;
-        let x326 = qd[1] * x293;
-        let x327 = Self::mul_add(-c_q0, x322, s_q0 * x323);
-        let x328 = qd[0] * c_q0;
-        let x329 = qd[0] * s_q0;
-        let x330 = qd[0] * x293;
-        let x331 = qd[0] * x292;
-        let x332 = Self::mul_add(x293, x322, x292 * x323)
-            - Self::mul_add(c_q0, x325, s_q0 * x326);
-        let x333 = Self::mul_add(-c_q0, x324, Self::mul_add(x291, x323, x330));
-        let x334 = Self::mul_add(-s_q0, x324, Self::mul_add(x291, x322, -x331));
-        let x335 = Self::mul_add(qd[1], x327, x255);
-        let x336 = Self::mul_add(qd[1], x328, s_q0 * x261);
-        let x337 = Self::mul_add(-qd[1], x329, c_q0 * x261);
-        let x338 = Self::mul_add(qd[1], x332, x261 * x291);
-        let x339 = Self::mul_add(-qd[1], x333, x261 * x292);
-        let x340 = Self::mul_add(-qd[1], x334, x261 * x293);
-        let x341 = Self::mul_add(-qd[0], x329, c_q0 * x255);
-        let x342 = Self::mul_add(qd[0], x328, s_q0 * x255);
-        let x343 = Self::mul_add(qd[0], x331, x255 * x293);
-        let x344 = Self::mul_add(-qd[0], x330, x255 * x292);
-        let x345 = x328 + x328;
-        let x346 = x329 + x329;
-        let x347 = x330 + x333;
-        let x348 = x331 - x334;
-        let x349 = x314 * x322;
-        let x350 = x315 * x323;
-        let x351 = qd[0] * x316;
-        let x352 = x318 * x323;
-        let x353 = qd[0] * x319;
-        let x354 = x320 * x322;
-        let x355 = x296 * x325;
-        let x356 = x295 * x326;
-        let x357 = x296 * x324;
-        let x358 = x294 * x326;
-        let x359 = x295 * x324;
-        let x360 = x294 * x325;
-        let x361 = Self::mul_add(qd[0], x313, x349) - x350 + (x355 - x356);
-        let x362 = Self::mul_add(x317, x322, x351) - x352 - (x357 - x358);
-        let x363 = Self::mul_add(-x321, x323, x353 + x354) - (x359 - x360);
-        let x364 = x296 * x322;
-        let x365 = x295 * x323;
-        let x366 = x364 + x365;
-        let x367 = qd[0] * x296;
-        let x368 = x294 * x323;
-        let x369 = x367 + x368;
-        let x370 = qd[0] * x295;
-        let x371 = x294 * x322;
+        let x341 = Self::mul_add(
+            -x143,
+            x339,
+            Self::mul_add(-x145, x338, Self::mul_add(-x147, x337, x340)),
+        );
+        let x342 = Self::mul_add(
+            x164,
+            x336,
+            Self::mul_add(x166, x335, Self::mul_add(x168, x334, x170 * x333)),
+        );
+        let x343 = Self::mul_add(
+            x161,
+            x339,
+            Self::mul_add(x162, x338, Self::mul_add(x163, x337, x342)),
+        );
+        let x344 = Self::mul_add(
+            -x179,
+            x336,
+            Self::mul_add(x182, x335, Self::mul_add(x184, x334, x186 * x333)),
+        );
+        let x345 = Self::mul_add(
+            -x174,
+            x339,
+            Self::mul_add(x176, x338, Self::mul_add(-x177, x337, x344)),
+        );
+        let x346 = Self::mul_add(
+            -x194,
+            x336,
+            Self::mul_add(x195, x335, Self::mul_add(x198, x334, x201 * x333)),
+        );
+        let x347 = Self::mul_add(
+            x188,
+            x339,
+            Self::mul_add(x190, x338, Self::mul_add(x192, x337, x346)),
+        );
+        let x348 = Self::mul_add(
+            -x207,
+            x336,
+            Self::mul_add(x209, x335, Self::mul_add(x211, x334, x213 * x333)),
+        );
+        let x349 = Self::mul_add(
+            -x203,
+            x339,
+            Self::mul_add(x205, x338, Self::mul_add(x206, x337, x348)),
+        );
+        let x350 = Self::mul_add(
+            -x217,
+            x336,
+            Self::mul_add(x219, x335, Self::mul_add(x221, x334, x223 * x333)),
+        );
+        let x351 = Self::mul_add(
+            x214,
+            x339,
+            Self::mul_add(x215, x338, Self::mul_add(x216, x337, x350)),
+        );
+        let x352 = Self::mul_add(
+            -x225,
+            x336,
+            Self::mul_add(x227, x335, Self::mul_add(x229, x334, x231 * x333)),
+        );
+        let x353 = Self::mul_add(
+            x136,
+            x339,
+            Self::mul_add(x214, x338, Self::mul_add(x224, x337, x352)),
+        );
+        let x354 = c_q0 * s_q1;
+        let x355 = s_q0 * s_q1;
+        let x356 = c_q0 * c_q1;
+        let x357 = s_q0 * c_q1;
+        let x358 = s_q0 * 0.7026;
+        let x359 = c_q0 * 0.7026;
+        let x360 = Self::mul_add(-c_q0, x358, s_q0 * x359);
+        let x361 = 1.3589 * c_q0;
+        let x362 = 1.3589 * s_q0;
+        let x363 = 1145.5438279999998 * x356;
+        let x364 = 1145.5438279999998 * x357;
+        let x365 = s_q1 * 1647.2196721184;
+        let x366 = 1647.2196721184 * x356;
+        let x367 = 1650.6386721183999 * s_q0;
+        let x368 = 1647.2196721184 * x357;
+        let x369 = 1650.6386721183999 * c_q0;
+        let x370 = x359 * x364;
+        let x371 = x358 * x363;
         let x372 = x370 - x371;
-        let x373 = x316 * x323;
-        let x374 = x319 * x322;
-        let x375 = x313 * x323;
-        let x376 = x313 * x322;
-        let x377 = x296 * x326;
-        let x378 = x295 * x325;
-        let x379 = x377 + x378;
-        let x380 = x314 * x323;
-        let x381 = x315 * x322;
-        let x382 = x317 * x323;
-        let x383 = x321 * x322;
-        let x384 = qd[0] * x320;
-        let x385 = qd[0] * x317;
-        let x386 = x294 * x324;
-        let x387 = x377 + x386;
-        let x388 = qd[0] * x318;
-        let x389 = qd[0] * x321;
-        let x390 = x378 + x386;
-        let x391 = c_q1 * c_q2;
-        let x392 = Self::mul_add(s_q0, s_q2, c_q2 * x285);
-        let x393 = Self::mul_add(-c_q0, s_q2, c_q2 * x286);
-        let x394 = c_q1 * s_q2;
-        let x395 = Self::mul_add(-s_q0, c_q2, s_q2 * x285);
-        let x396 = Self::mul_add(c_q0, c_q2, s_q2 * x286);
-        let x397 = Self::mul_add(s_q1, 0.5692, 1.3589);
-        let x398 = Self::mul_add(0.5692, x287, x289);
-        let x399 = Self::mul_add(-0.5692, x288, x290);
-        let x400 = Self::mul_add(x288, x398, x287 * x399);
-        let x401 = Self::mul_add(x288, x397, s_q1 * x399);
-        let x402 = Self::mul_add(-x287, x397, s_q1 * x398);
-        let x403 = 5224.5702 * x391;
-        let x404 = 5224.5702 * x392;
-        let x405 = 5224.5702 * x393;
-        let x406 = Self::mul_add(3946.1881206800003, s_q1, 39234.47412200001 * x391);
-        let x407 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x391);
-        let x408 = Self::mul_add(-3946.1881206800003, x287, 39234.47412200001 * x392);
-        let x409 = Self::mul_add(39241.404122, x287, 3946.18812068 * x392);
-        let x410 = Self::mul_add(-3946.1881206800003, x288, 39234.47412200001 * x393);
-        let x411 = Self::mul_add(39241.404122, x288, 3946.18812068 * x393);
-        let x412 = x399 * x405;
-        let x413 = x398 * x404;
-        let x414 = x412 - x413;
-        let x415 = x398 * x403;
-        let x416 = x399 * x403;
-        let x417 = x397 * x404;
-        let x418 = x397 * x403;
-        let x419 = x412 + x418;
-        let x420 = x399 * x404;
-        let x421 = x397 * x405;
-        let x422 = x398 * x405;
-        let x423 = x413 - x418;
-        let x424 = x414 - (Self::mul_add(s_q1, x407, x391 * x406) - x414);
-        let x425 = x417 + (Self::mul_add(-x287, x407, x392 * x406) - x415);
-        let x426 = x421 + (Self::mul_add(-x288, x407, x393 * x406) + x416);
-        let x427 = x415 - (Self::mul_add(s_q1, x409, x391 * x408) + x417);
-        let x428 = x419 - (Self::mul_add(-x287, x409, x392 * x408) - x419);
-        let x429 = x422 - (Self::mul_add(-x288, x409, x393 * x408) + x420);
-        let x430 = x416 + (Self::mul_add(s_q1, x411, x391 * x410) + x421);
-        let x431 = x420 + (Self::mul_add(-x287, x411, x392 * x410) - x422);
-        let x432 = x423 + (Self::mul_add(-x288, x411, x393 * x410) + x423);
-        let x433 = Self::mul_add(-qd[2], s_q1, qd[0]);
-        let x434 = Self::mul_add(-qd[2], x287, x322);
-        let x435 = Self::mul_add(qd[2], x288, x323);
-        let x436 = Self::mul_add(-qd[2], x400, x324);
-        let x437 = Self::mul_add(qd[2], x401, x325);
-        let x438 = Self::mul_add(qd[2], x402, x326);
-        let x439 = Self::mul_add(x288, x434, x287 * x435);
-        let x440 = Self::mul_add(x288, x433, s_q1 * x435);
-        let x441 = Self::mul_add(-x287, x433, s_q1 * x434);
-        let x442 = Self::mul_add(-x288, x437, x287 * x438);
-        let x443 = Self::mul_add(-x288, x436, s_q1 * x438);
-        let x444 = Self::mul_add(-x287, x436, s_q1 * x437);
-        let x445 = Self::mul_add(x402, x434, x401 * x435) + x442;
-        let x446 = Self::mul_add(-x402, x433, x400 * x435) - x443;
-        let x447 = Self::mul_add(x401, x433, x400 * x434) + x444;
-        let x448 = Self::mul_add(-qd[2], x439, Self::mul_add(-s_q1, x268, x335));
-        let x449 = Self::mul_add(qd[2], x440, Self::mul_add(-x268, x287, x336));
-        let x450 = Self::mul_add(-qd[2], x441, Self::mul_add(x268, x288, x337));
-        let x451 = Self::mul_add(qd[2], x445, Self::mul_add(-x268, x400, x338));
-        let x452 = Self::mul_add(qd[2], x446, Self::mul_add(x268, x401, x339));
-        let x453 = Self::mul_add(qd[2], x447, Self::mul_add(x268, x402, x340));
-        let x454 = Self::mul_add(x288, x322, x287 * x323);
-        let x455 = Self::mul_add(qd[0], x288, s_q1 * x323);
-        let x456 = Self::mul_add(-qd[0], x287, s_q1 * x322);
-        let x457 = Self::mul_add(x322, x402, x323 * x401)
-            + Self::mul_add(-x288, x325, x287 * x326);
-        let x458 = Self::mul_add(-qd[0], x402, x323 * x400)
-            - Self::mul_add(-x288, x324, s_q1 * x326);
-        let x459 = Self::mul_add(qd[0], x401, x322 * x400)
-            + Self::mul_add(-x287, x324, s_q1 * x325);
-        let x460 = Self::mul_add(x288, x336, x287 * x337)
-            - Self::mul_add(x322, x456, x323 * x455);
-        let x461 = Self::mul_add(x288, x335, s_q1 * x337)
-            + Self::mul_add(-qd[0], x456, x323 * x454);
-        let x462 = Self::mul_add(-x287, x335, s_q1 * x336)
-            + Self::mul_add(qd[0], x455, x322 * x454);
-        let x463 = Self::mul_add(x336, x402, x337 * x401)
-            + Self::mul_add(-x288, x339, x287 * x340)
-            + (Self::mul_add(x322, x459, x323 * x458)
-                - Self::mul_add(-x325, x456, x326 * x455));
-        let x464 = Self::mul_add(-x335, x402, x337 * x400)
-            - Self::mul_add(-x288, x338, s_q1 * x340)
-            - (Self::mul_add(qd[0], x459, x323 * x457)
-                + Self::mul_add(x324, x456, x326 * x454));
-        let x465 = Self::mul_add(x335, x401, x336 * x400)
-            + Self::mul_add(-x287, x338, s_q1 * x339)
-            - (Self::mul_add(-qd[0], x458, x322 * x457)
-                - Self::mul_add(x324, x455, x325 * x454));
-        let x466 = x439 + x454;
-        let x467 = x440 + x455;
-        let x468 = x441 + x456;
-        let x469 = x445 + x457;
-        let x470 = x446 + x458;
-        let x471 = x447 + x459;
-        let x472 = x425 * x434;
-        let x473 = x426 * x435;
-        let x474 = x427 * x433;
-        let x475 = x429 * x435;
-        let x476 = x430 * x433;
-        let x477 = x431 * x434;
-        let x478 = x405 * x437;
-        let x479 = x404 * x438;
-        let x480 = x405 * x436;
-        let x481 = x403 * x438;
-        let x482 = x404 * x436;
-        let x483 = x403 * x437;
-        let x484 = Self::mul_add(x424, x433, x472) - x473 + (x478 - x479);
-        let x485 = Self::mul_add(-x428, x434, x474) + x475 + (x480 + x481);
-        let x486 = Self::mul_add(x432, x435, x476 - x477) + (x482 + x483);
-        let x487 = x405 * x434;
-        let x488 = x404 * x435;
-        let x489 = x487 + x488;
-        let x490 = x405 * x433;
-        let x491 = x403 * x435;
-        let x492 = x490 - x491;
-        let x493 = x404 * x433;
-        let x494 = x403 * x434;
-        let x495 = x493 + x494;
-        let x496 = x427 * x435;
-        let x497 = x430 * x434;
-        let x498 = x424 * x435;
-        let x499 = x424 * x434;
-        let x500 = x405 * x438;
-        let x501 = x404 * x437;
-        let x502 = x500 + x501;
-        let x503 = x425 * x435;
-        let x504 = x426 * x434;
-        let x505 = x428 * x435;
-        let x506 = x432 * x434;
-        let x507 = x431 * x433;
-        let x508 = x428 * x433;
-        let x509 = x403 * x436;
-        let x510 = x500 - x509;
-        let x511 = x429 * x433;
-        let x512 = x432 * x433;
-        let x513 = x501 - x509;
-        let x514 = Self::mul_add(-s_q3, x394, c_q3 * x391);
-        let x515 = Self::mul_add(-s_q3, x395, c_q3 * x392);
-        let x516 = Self::mul_add(-s_q3, x396, c_q3 * x393);
-        let x517 = Self::mul_add(c_q3, x394, s_q3 * x391);
-        let x518 = Self::mul_add(c_q3, x395, s_q3 * x392);
-        let x519 = Self::mul_add(c_q3, x396, s_q3 * x393);
-        let x520 = x397 + Self::mul_add(s_q1, 0.475, 7.11 * x391);
-        let x521 = x398 - Self::mul_add(-0.475, x287, 7.11 * x392);
-        let x522 = x399 + Self::mul_add(-0.475, x288, 7.11 * x393);
-        let x523 = Self::mul_add(x288, x521, x287 * x522);
-        let x524 = Self::mul_add(x288, x520, s_q1 * x522);
-        let x525 = Self::mul_add(-x287, x520, s_q1 * x521);
-        let x526 = 3239.4582 * x514;
-        let x527 = 3239.4582 * x515;
-        let x528 = 3239.4582 * x516;
-        let x529 = Self::mul_add(1375.0472756800002, s_q1, 24989.305802 * x514);
-        let x530 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x514);
-        let x531 = Self::mul_add(-1375.0472756800002, x287, 24989.305802 * x515);
-        let x532 = Self::mul_add(24998.827802, x287, 1375.0472756800002 * x515);
-        let x533 = Self::mul_add(-1375.0472756800002, x288, 24989.305802 * x516);
-        let x534 = Self::mul_add(24998.827802, x288, 1375.0472756800002 * x516);
-        let x535 = x522 * x528;
-        let x536 = x521 * x527;
-        let x537 = x535 - x536;
-        let x538 = x521 * x526;
-        let x539 = x522 * x526;
-        let x540 = x520 * x527;
-        let x541 = x520 * x526;
-        let x542 = x535 + x541;
-        let x543 = x522 * x527;
-        let x544 = x520 * x528;
-        let x545 = x521 * x528;
-        let x546 = x536 - x541;
-        let x547 = x537 - (Self::mul_add(s_q1, x530, x514 * x529) - x537);
-        let x548 = x540 + (Self::mul_add(-x287, x530, x515 * x529) - x538);
-        let x549 = x544 + (Self::mul_add(-x288, x530, x516 * x529) + x539);
-        let x550 = x538 - (Self::mul_add(s_q1, x532, x514 * x531) + x540);
-        let x551 = x542 - (Self::mul_add(-x287, x532, x515 * x531) - x542);
-        let x552 = x545 - (Self::mul_add(-x288, x532, x516 * x531) + x543);
-        let x553 = x539 + (Self::mul_add(s_q1, x534, x514 * x533) + x544);
-        let x554 = x543 + (Self::mul_add(-x287, x534, x515 * x533) - x545);
-        let x555 = x546 + (Self::mul_add(-x288, x534, x516 * x533) + x546);
-        let x556 = Self::mul_add(-qd[3], s_q1, x433);
-        let x557 = Self::mul_add(-qd[3], x287, x434);
-        let x558 = Self::mul_add(qd[3], x288, x435);
-        let x559 = Self::mul_add(-qd[3], x523, x436);
-        let x560 = Self::mul_add(qd[3], x524, x437);
-        let x561 = Self::mul_add(qd[3], x525, x438);
-        let x562 = Self::mul_add(x288, x557, x287 * x558);
-        let x563 = Self::mul_add(x288, x556, s_q1 * x558);
-        let x564 = Self::mul_add(-x287, x556, s_q1 * x557);
-        let x565 = Self::mul_add(-x288, x560, x287 * x561);
-        let x566 = Self::mul_add(-x288, x559, s_q1 * x561);
-        let x567 = Self::mul_add(-x287, x559, s_q1 * x560);
-        let x568 = Self::mul_add(x525, x557, x524 * x558) + x565;
-        let x569 = Self::mul_add(-x525, x556, x523 * x558) - x566;
-        let x570 = Self::mul_add(x524, x556, x523 * x557) + x567;
-        let x571 = Self::mul_add(-qd[3], x562, Self::mul_add(-s_q1, x276, x448));
-        let x572 = Self::mul_add(qd[3], x563, Self::mul_add(-x276, x287, x449));
-        let x573 = Self::mul_add(-qd[3], x564, Self::mul_add(x276, x288, x450));
-        let x574 = Self::mul_add(qd[3], x568, Self::mul_add(-x276, x523, x451));
-        let x575 = Self::mul_add(qd[3], x569, Self::mul_add(x276, x524, x452));
-        let x576 = Self::mul_add(qd[3], x570, Self::mul_add(x276, x525, x453));
-        let x577 = x442 + Self::mul_add(x434, x525, x435 * x524);
-        let x578 = x443 - Self::mul_add(-x433, x525, x435 * x523);
-        let x579 = x444 + Self::mul_add(x433, x524, x434 * x523);
-        let x580 = Self::mul_add(x288, x449, x287 * x450)
-            - Self::mul_add(x434, x441, x435 * x440);
-        let x581 = Self::mul_add(x288, x448, s_q1 * x450)
-            + Self::mul_add(-x433, x441, x435 * x439);
-        let x582 = Self::mul_add(-x287, x448, s_q1 * x449)
-            + Self::mul_add(x433, x440, x434 * x439);
-        let x583 = Self::mul_add(x449, x525, x450 * x524)
-            + Self::mul_add(-x288, x452, x287 * x453)
-            - (Self::mul_add(-x434, x579, x435 * x578)
-                + Self::mul_add(-x437, x441, x438 * x440));
-        let x584 = Self::mul_add(-x448, x525, x450 * x523)
-            - Self::mul_add(-x288, x451, s_q1 * x453)
-            - (Self::mul_add(x433, x579, x435 * x577)
-                + Self::mul_add(x436, x441, x438 * x439));
-        let x585 = Self::mul_add(x448, x524, x449 * x523)
-            + Self::mul_add(-x287, x451, s_q1 * x452)
-            - (Self::mul_add(x433, x578, x434 * x577)
-                - Self::mul_add(x436, x440, x437 * x439));
-        let x586 = x439 + x562;
-        let x587 = x440 + x563;
-        let x588 = x441 + x564;
-        let x589 = x568 + x577;
-        let x590 = x569 - x578;
-        let x591 = x570 + x579;
-        let x592 = x548 * x557;
-        let x593 = x549 * x558;
-        let x594 = x550 * x556;
-        let x595 = x552 * x558;
-        let x596 = x553 * x556;
-        let x597 = x554 * x557;
-        let x598 = x528 * x560;
-        let x599 = x527 * x561;
-        let x600 = x528 * x559;
-        let x601 = x526 * x561;
-        let x602 = x527 * x559;
-        let x603 = x526 * x560;
-        let x604 = Self::mul_add(x547, x556, x592) - x593 + (x598 - x599);
-        let x605 = Self::mul_add(-x551, x557, x594) + x595 + (x600 + x601);
-        let x606 = Self::mul_add(x555, x558, x596 - x597) + (x602 + x603);
-        let x607 = x528 * x557;
-        let x608 = x527 * x558;
-        let x609 = x607 + x608;
-        let x610 = x528 * x556;
-        let x611 = x526 * x558;
+        let x373 = x60 * x358;
+        let x374 = x60 * x359;
+        let x375 = 1.3589 * x363;
+        let x376 = 1.3589 * x60;
+        let x377 = x370 - x376;
+        let x378 = x359 * x363;
+        let x379 = 1.3589 * x364;
+        let x380 = x358 * x364;
+        let x381 = x371 + x376;
+        let x382 = x372 + Self::mul_add(s_q1, x365, x372);
+        let x383 = x375 + Self::mul_add(x356, x365, x373);
+        let x384 = x379 + Self::mul_add(x357, x365, -x374);
+        let x385 = x373 + Self::mul_add(s_q1, x366, x375);
+        let x386 = x377 + (Self::mul_add(-s_q0, x367, x356 * x366) + x377);
+        let x387 = x380 + (Self::mul_add(c_q0, x367, x357 * x366) - x378);
+        let x388 = x374 - Self::mul_add(s_q1, x368, x379);
+        let x389 = x378 - (Self::mul_add(s_q0, x369, x356 * x368) + x380);
+        let x390 = x381 - (Self::mul_add(-c_q0, x369, x357 * x368) - x381);
+        let x391 = qd[1] * s_q0;
+        let x392 = qd[1] * c_q0;
+        let x393 = qd[1] * x360;
+        let x394 = qd[1] * x361;
+        let x395 = qd[1] * x362;
+        let x396 = Self::mul_add(-c_q0, x391, s_q0 * x392);
+        let x397 = qd[0] * c_q0;
+        let x398 = qd[0] * s_q0;
+        let x399 = qd[0] * x362;
+        let x400 = qd[0] * x361;
+        let x401 = Self::mul_add(x362, x391, x361 * x392)
+            - Self::mul_add(c_q0, x394, s_q0 * x395);
+        let x402 = Self::mul_add(-c_q0, x393, Self::mul_add(x360, x392, x399));
+        let x403 = Self::mul_add(-s_q0, x393, Self::mul_add(x360, x391, -x400));
+        let x404 = Self::mul_add(qd[1], x396, x341);
+        let x405 = Self::mul_add(qd[1], x397, s_q0 * x343);
+        let x406 = Self::mul_add(-qd[1], x398, c_q0 * x343);
+        let x407 = Self::mul_add(qd[1], x401, x343 * x360);
+        let x408 = Self::mul_add(-qd[1], x402, x343 * x361);
+        let x409 = Self::mul_add(-qd[1], x403, x343 * x362);
+        let x410 = Self::mul_add(-qd[0], x398, c_q0 * x341);
+        let x411 = Self::mul_add(qd[0], x397, s_q0 * x341);
+        let x412 = Self::mul_add(qd[0], x400, x341 * x362);
+        let x413 = Self::mul_add(-qd[0], x399, x341 * x361);
+        let x414 = x397 + x397;
+        let x415 = x398 + x398;
+        let x416 = x399 + x402;
+        let x417 = x400 - x403;
+        let x418 = x383 * x391;
+        let x419 = x384 * x392;
+        let x420 = qd[0] * x385;
+        let x421 = x387 * x392;
+        let x422 = qd[0] * x388;
+        let x423 = x389 * x391;
+        let x424 = x364 * x394;
+        let x425 = x363 * x395;
+        let x426 = x364 * x393;
+        let x427 = x60 * x395;
+        let x428 = x363 * x393;
+        let x429 = x60 * x394;
+        let x430 = Self::mul_add(qd[0], x382, x418) - x419 + (x424 - x425);
+        let x431 = Self::mul_add(x386, x391, x420) - x421 - (x426 - x427);
+        let x432 = Self::mul_add(-x390, x392, x422 + x423) - (x428 - x429);
+        let x433 = x364 * x391;
+        let x434 = x363 * x392;
+        let x435 = x433 + x434;
+        let x436 = qd[0] * x364;
+        let x437 = x60 * x392;
+        let x438 = x436 + x437;
+        let x439 = qd[0] * x363;
+        let x440 = x60 * x391;
+        let x441 = x439 - x440;
+        let x442 = x385 * x392;
+        let x443 = x388 * x391;
+        let x444 = x382 * x392;
+        let x445 = x382 * x391;
+        let x446 = x364 * x395;
+        let x447 = x363 * x394;
+        let x448 = x446 + x447;
+        let x449 = x383 * x392;
+        let x450 = x384 * x391;
+        let x451 = x386 * x392;
+        let x452 = x390 * x391;
+        let x453 = qd[0] * x389;
+        let x454 = qd[0] * x386;
+        let x455 = x60 * x393;
+        let x456 = x446 + x455;
+        let x457 = qd[0] * x387;
+        let x458 = qd[0] * x390;
+        let x459 = x447 + x455;
+        let x460 = c_q1 * c_q2;
+        let x461 = Self::mul_add(s_q0, s_q2, c_q2 * x354);
+        let x462 = Self::mul_add(-c_q0, s_q2, c_q2 * x355);
+        let x463 = c_q1 * s_q2;
+        let x464 = Self::mul_add(-s_q0, c_q2, s_q2 * x354);
+        let x465 = Self::mul_add(c_q0, c_q2, s_q2 * x355);
+        let x466 = Self::mul_add(0.5692, s_q1, 1.3589);
+        let x467 = Self::mul_add(0.5692, x356, x358);
+        let x468 = Self::mul_add(-0.5692, x357, x359);
+        let x469 = Self::mul_add(x357, x467, x356 * x468);
+        let x470 = Self::mul_add(x357, x466, s_q1 * x468);
+        let x471 = Self::mul_add(-x356, x466, s_q1 * x467);
+        let x472 = 5224.5702 * x460;
+        let x473 = 5224.5702 * x461;
+        let x474 = 5224.5702 * x462;
+        let x475 = 3946.1881206800003 * s_q1;
+        let x476 = 39234.474122 * x463;
+        let x477 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x460);
+        let x478 = 3946.1881206800003 * x356;
+        let x479 = 39234.474122 * x464;
+        let x480 = Self::mul_add(39241.404122, x356, 3946.18812068 * x461);
+        let x481 = 3946.1881206800003 * x357;
+        let x482 = 39234.474122 * x465;
+        let x483 = Self::mul_add(39241.404122, x357, 3946.18812068 * x462);
+        let x484 = x468 * x474;
+        let x485 = x467 * x473;
+        let x486 = x484 - x485;
+        let x487 = x467 * x472;
+        let x488 = x468 * x472;
+        let x489 = x466 * x473;
+        let x490 = x466 * x472;
+        let x491 = x484 + x490;
+        let x492 = x468 * x473;
+        let x493 = x466 * x474;
+        let x494 = x467 * x474;
+        let x495 = x485 - x490;
+        let x496 = x486
+            - (Self::mul_add(s_q1, x477, Self::mul_add(-x463, x476, x460 * x475))
+                - x486);
+        let x497 = x489
+            + (Self::mul_add(-x356, x477, Self::mul_add(-x464, x476, x461 * x475))
+                - x487);
+        let x498 = x493
+            + (Self::mul_add(-x357, x477, Self::mul_add(-x465, x476, x462 * x475))
+                + x488);
+        let x499 = x487
+            + (Self::mul_add(-s_q1, x480, Self::mul_add(x463, x479, x460 * x478))
+                - x489);
+        let x500 = x491
+            + (Self::mul_add(x356, x480, Self::mul_add(x464, x479, x461 * x478)) + x491);
+        let x501 = x494
+            + (Self::mul_add(x357, x480, Self::mul_add(x465, x479, x462 * x478)) - x492);
+        let x502 = x488
+            - (Self::mul_add(-s_q1, x483, Self::mul_add(x463, x482, x460 * x481))
+                - x493);
+        let x503 = x492
+            - (Self::mul_add(x356, x483, Self::mul_add(x464, x482, x461 * x481)) + x494);
+        let x504 = x495
+            - (Self::mul_add(x357, x483, Self::mul_add(x465, x482, x462 * x481)) - x495);
+        let x505 = Self::mul_add(-qd[2], s_q1, qd[0]);
+        let x506 = Self::mul_add(-qd[2], x356, x391);
+        let x507 = Self::mul_add(qd[2], x357, x392);
+        let x508 = Self::mul_add(-qd[2], x469, x393);
+        let x509 = Self::mul_add(qd[2], x470, x394);
+        let x510 = Self::mul_add(qd[2], x471, x395);
+        let x511 = Self::mul_add(x357, x506, x356 * x507);
+        let x512 = Self::mul_add(x357, x505, s_q1 * x507);
+        let x513 = Self::mul_add(-x356, x505, s_q1 * x506);
+        let x514 = Self::mul_add(-x357, x509, x356 * x510);
+        let x515 = Self::mul_add(-x357, x508, s_q1 * x510);
+        let x516 = Self::mul_add(-x356, x508, s_q1 * x509);
+        let x517 = Self::mul_add(x471, x506, x470 * x507) + x514;
+        let x518 = Self::mul_add(-x471, x505, x469 * x507) - x515;
+        let x519 = Self::mul_add(x470, x505, x469 * x506) + x516;
+        let x520 = Self::mul_add(-qd[2], x511, Self::mul_add(-s_q1, x345, x404));
+        let x521 = Self::mul_add(qd[2], x512, Self::mul_add(-x345, x356, x405));
+        let x522 = Self::mul_add(-qd[2], x513, Self::mul_add(x345, x357, x406));
+        let x523 = Self::mul_add(qd[2], x517, Self::mul_add(-x345, x469, x407));
+        let x524 = Self::mul_add(qd[2], x518, Self::mul_add(x345, x470, x408));
+        let x525 = Self::mul_add(qd[2], x519, Self::mul_add(x345, x471, x409));
+        let x526 = Self::mul_add(x357, x391, x356 * x392);
+        let x527 = Self::mul_add(qd[0], x357, s_q1 * x392);
+        let x528 = Self::mul_add(-qd[0], x356, s_q1 * x391);
+        let x529 = Self::mul_add(x391, x471, x392 * x470)
+            + Self::mul_add(-x357, x394, x356 * x395);
+        let x530 = Self::mul_add(-qd[0], x471, x392 * x469)
+            - Self::mul_add(-x357, x393, s_q1 * x395);
+        let x531 = Self::mul_add(qd[0], x470, x391 * x469)
+            + Self::mul_add(-x356, x393, s_q1 * x394);
+        let x532 = Self::mul_add(x357, x405, x356 * x406)
+            - Self::mul_add(x391, x528, x392 * x527);
+        let x533 = Self::mul_add(x357, x404, s_q1 * x406)
+            + Self::mul_add(-qd[0], x528, x392 * x526);
+        let x534 = Self::mul_add(-x356, x404, s_q1 * x405)
+            + Self::mul_add(qd[0], x527, x391 * x526);
+        let x535 = Self::mul_add(x405, x471, x406 * x470)
+            + Self::mul_add(-x357, x408, x356 * x409)
+            + (Self::mul_add(x391, x531, x392 * x530)
+                - Self::mul_add(-x394, x528, x395 * x527));
+        let x536 = Self::mul_add(-x404, x471, x406 * x469)
+            - Self::mul_add(-x357, x407, s_q1 * x409)
+            - (Self::mul_add(qd[0], x531, x392 * x529)
+                + Self::mul_add(x393, x528, x395 * x526));
+        let x537 = Self::mul_add(x404, x470, x405 * x469)
+            + Self::mul_add(-x356, x407, s_q1 * x408)
+            - (Self::mul_add(-qd[0], x530, x391 * x529)
+                - Self::mul_add(x393, x527, x394 * x526));
+        let x538 = x511 + x526;
+        let x539 = x512 + x527;
+        let x540 = x513 + x528;
+        let x541 = x517 + x529;
+        let x542 = x518 + x530;
+        let x543 = x519 + x531;
+        let x544 = x497 * x506;
+        let x545 = x498 * x507;
+        let x546 = x499 * x505;
+        let x547 = x501 * x507;
+        let x548 = x502 * x505;
+        let x549 = x503 * x506;
+        let x550 = x474 * x509;
+        let x551 = x473 * x510;
+        let x552 = x474 * x508;
+        let x553 = x472 * x510;
+        let x554 = x473 * x508;
+        let x555 = x472 * x509;
+        let x556 = Self::mul_add(x496, x505, x544) - x545 + (x550 - x551);
+        let x557 = Self::mul_add(-x500, x506, x546) + x547 + (x552 + x553);
+        let x558 = Self::mul_add(x504, x507, x548 - x549) + (x554 + x555);
+        let x559 = x474 * x506;
+        let x560 = x473 * x507;
+        let x561 = x559 + x560;
+        let x562 = x474 * x505;
+        let x563 = x472 * x507;
+        let x564 = x562 - x563;
+        let x565 = x473 * x505;
+        let x566 = x472 * x506;
+        let x567 = x565 + x566;
+        let x568 = x499 * x507;
+        let x569 = x502 * x506;
+        let x570 = x496 * x507;
+        let x571 = x496 * x506;
+        let x572 = x474 * x510;
+        let x573 = x473 * x509;
+        let x574 = x572 + x573;
+        let x575 = x497 * x507;
+        let x576 = x498 * x506;
+        let x577 = x500 * x507;
+        let x578 = x504 * x506;
+        let x579 = x503 * x505;
+        let x580 = x500 * x505;
+        let x581 = x472 * x508;
+        let x582 = x572 - x581;
+        let x583 = x501 * x505;
+        let x584 = x504 * x505;
+        let x585 = x573 - x581;
+        let x586 = Self::mul_add(-s_q3, x463, c_q3 * x460);
+        let x587 = Self::mul_add(-s_q3, x464, c_q3 * x461);
+        let x588 = Self::mul_add(-s_q3, x465, c_q3 * x462);
+        let x589 = Self::mul_add(c_q3, x463, s_q3 * x460);
+        let x590 = Self::mul_add(c_q3, x464, s_q3 * x461);
+        let x591 = Self::mul_add(c_q3, x465, s_q3 * x462);
+        let x592 = x466 + Self::mul_add(s_q1, 0.475, 7.11 * x460);
+        let x593 = x467 - Self::mul_add(-0.475, x356, 7.11 * x461);
+        let x594 = x468 + Self::mul_add(-0.475, x357, 7.11 * x462);
+        let x595 = Self::mul_add(x357, x593, x356 * x594);
+        let x596 = Self::mul_add(x357, x592, s_q1 * x594);
+        let x597 = Self::mul_add(-x356, x592, s_q1 * x593);
+        let x598 = 3239.4582 * x586;
+        let x599 = 3239.4582 * x587;
+        let x600 = 3239.4582 * x588;
+        let x601 = 1375.0472756800002 * s_q1;
+        let x602 = 24989.305802 * x589;
+        let x603 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x586);
+        let x604 = 1375.0472756800002 * x356;
+        let x605 = 24989.305802 * x590;
+        let x606 = Self::mul_add(24998.827802, x356, 1375.0472756800002 * x587);
+        let x607 = 1375.0472756800002 * x357;
+        let x608 = 24989.305802 * x591;
+        let x609 = Self::mul_add(24998.827802, x357, 1375.0472756800002 * x588);
+        let x610 = x594 * x600;
+        let x611 = x593 * x599;
         let x612 = x610 - x611;
-        let x613 = x527 * x556;
-        let x614 = x526 * x557;
-        let x615 = x613 + x614;
-        let x616 = x550 * x558;
-        let x617 = x553 * x557;
-        let x618 = x547 * x558;
-        let x619 = x547 * x557;
-        let x620 = x528 * x561;
-        let x621 = x527 * x560;
-        let x622 = x620 + x621;
-        let x623 = x548 * x558;
-        let x624 = x549 * x557;
-        let x625 = x551 * x558;
-        let x626 = x555 * x557;
-        let x627 = x554 * x556;
-        let x628 = x551 * x556;
-        let x629 = x526 * x559;
-        let x630 = x620 - x629;
-        let x631 = x552 * x556;
-        let x632 = x555 * x556;
-        let x633 = x621 - x629;
-        let x634 = Self::mul_add(-s_q4, x517, c_q4 * x514);
-        let x635 = Self::mul_add(-s_q4, x518, c_q4 * x515);
-        let x636 = Self::mul_add(-s_q4, x519, c_q4 * x516);
-        let x637 = Self::mul_add(c_q4, x517, s_q4 * x514);
-        let x638 = Self::mul_add(c_q4, x518, s_q4 * x515);
-        let x639 = Self::mul_add(c_q4, x519, s_q4 * x516);
-        let x640 = Self::mul_add(7.11, x514, x520);
-        let x641 = Self::mul_add(-7.11, x515, x521);
-        let x642 = Self::mul_add(7.11, x516, x522);
-        let x643 = Self::mul_add(x288, x641, x287 * x642);
-        let x644 = Self::mul_add(x288, x640, s_q1 * x642);
-        let x645 = Self::mul_add(-x287, x640, s_q1 * x641);
-        let x646 = 171.195516 * x637;
-        let x647 = 171.195516 * x638;
-        let x648 = 171.195516 * x639;
-        let x649 = 132.6783695416 * x634;
-        let x650 = Self::mul_add(97.44448770720001, x637, 135.4729695416 * s_q1);
-        let x651 = s_q1 * 97.44448770720001;
-        let x652 = 132.6783695416 * x635;
-        let x653 = Self::mul_add(-97.44448770720001, x638, 135.4729695416 * x287);
-        let x654 = 97.44448770720001 * x287;
-        let x655 = 132.6783695416 * x636;
-        let x656 = Self::mul_add(-97.44448770720001, x639, 135.4729695416 * x288);
-        let x657 = 97.44448770720001 * x288;
-        let x658 = x642 * x648;
-        let x659 = x641 * x647;
-        let x660 = x658 - x659;
-        let x661 = x641 * x646;
-        let x662 = x642 * x646;
-        let x663 = x640 * x647;
-        let x664 = x640 * x646;
-        let x665 = x658 + x664;
-        let x666 = x642 * x647;
-        let x667 = x640 * x648;
-        let x668 = x641 * x648;
-        let x669 = x659 - x664;
-        let x670 = x660
-            - (Self::mul_add(x637, x651, Self::mul_add(s_q1, x650, x634 * x649)) - x660);
-        let x671 = x663
-            + (Self::mul_add(x638, x651, Self::mul_add(-x287, x650, x635 * x649))
-                - x661);
-        let x672 = x667
-            + (Self::mul_add(x639, x651, Self::mul_add(-x288, x650, x636 * x649))
-                + x662);
-        let x673 = x661
-            - (Self::mul_add(-x637, x654, Self::mul_add(-s_q1, x653, x634 * x652))
-                + x663);
-        let x674 = x665
-            - (Self::mul_add(-x638, x654, Self::mul_add(x287, x653, x635 * x652))
-                - x665);
-        let x675 = x668
-            - (Self::mul_add(-x639, x654, Self::mul_add(x288, x653, x636 * x652))
-                + x666);
-        let x676 = x662
-            + (Self::mul_add(-x637, x657, Self::mul_add(-s_q1, x656, x634 * x655))
-                + x667);
-        let x677 = x666
-            + (Self::mul_add(-x638, x657, Self::mul_add(x287, x656, x635 * x655))
-                - x668);
-        let x678 = x669
-            + (Self::mul_add(-x639, x657, Self::mul_add(x288, x656, x636 * x655))
-                + x669);
-        let x679 = Self::mul_add(-qd[4], s_q1, x556);
-        let x680 = Self::mul_add(-qd[4], x287, x557);
-        let x681 = Self::mul_add(qd[4], x288, x558);
-        let x682 = Self::mul_add(-qd[4], x643, x559);
-        let x683 = Self::mul_add(qd[4], x644, x560);
-        let x684 = Self::mul_add(qd[4], x645, x561);
-        let x685 = Self::mul_add(x288, x680, x287 * x681);
-        let x686 = Self::mul_add(x288, x679, s_q1 * x681);
-        let x687 = Self::mul_add(-x287, x679, s_q1 * x680);
-        let x688 = Self::mul_add(x645, x680, x644 * x681)
-            + Self::mul_add(-x288, x683, x287 * x684);
-        let x689 = Self::mul_add(-x645, x679, x643 * x681)
-            - Self::mul_add(-x288, x682, s_q1 * x684);
-        let x690 = Self::mul_add(x644, x679, x643 * x680)
-            + Self::mul_add(-x287, x682, s_q1 * x683);
-        let x691 = Self::mul_add(-qd[4], x685, Self::mul_add(-s_q1, x281, x571));
-        let x692 = Self::mul_add(qd[4], x686, Self::mul_add(-x281, x287, x572));
-        let x693 = Self::mul_add(-qd[4], x687, Self::mul_add(x281, x288, x573));
-        let x694 = Self::mul_add(qd[4], x688, Self::mul_add(-x281, x643, x574));
-        let x695 = Self::mul_add(qd[4], x689, Self::mul_add(x281, x644, x575));
-        let x696 = Self::mul_add(qd[4], x690, Self::mul_add(x281, x645, x576));
-        let x697 = x565 + Self::mul_add(x557, x645, x558 * x644);
-        let x698 = x566 - Self::mul_add(-x556, x645, x558 * x643);
-        let x699 = x567 + Self::mul_add(x556, x644, x557 * x643);
-        let x700 = Self::mul_add(x288, x572, x287 * x573)
-            - Self::mul_add(x557, x564, x558 * x563);
-        let x701 = Self::mul_add(x288, x571, s_q1 * x573)
-            + Self::mul_add(-x556, x564, x558 * x562);
-        let x702 = Self::mul_add(-x287, x571, s_q1 * x572)
-            + Self::mul_add(x556, x563, x557 * x562);
-        let x703 = Self::mul_add(x572, x645, x573 * x644)
-            + Self::mul_add(-x288, x575, x287 * x576)
-            - (Self::mul_add(-x557, x699, x558 * x698)
-                + Self::mul_add(-x560, x564, x561 * x563));
-        let x704 = Self::mul_add(-x571, x645, x573 * x643)
-            - Self::mul_add(-x288, x574, s_q1 * x576)
-            - (Self::mul_add(x556, x699, x558 * x697)
-                + Self::mul_add(x559, x564, x561 * x562));
-        let x705 = Self::mul_add(x571, x644, x572 * x643)
-            + Self::mul_add(-x287, x574, s_q1 * x575)
-            - (Self::mul_add(x556, x698, x557 * x697)
-                - Self::mul_add(x559, x563, x560 * x562));
-        let x706 = x562 + x685;
-        let x707 = x563 + x686;
-        let x708 = x564 + x687;
-        let x709 = x688 + x697;
-        let x710 = x689 - x698;
-        let x711 = x690 + x699;
-        let x712 = x671 * x680;
-        let x713 = x672 * x681;
-        let x714 = x673 * x679;
-        let x715 = x675 * x681;
-        let x716 = x676 * x679;
-        let x717 = x677 * x680;
-        let x718 = x648 * x683;
-        let x719 = x647 * x684;
-        let x720 = x648 * x682;
-        let x721 = x646 * x684;
-        let x722 = x647 * x682;
-        let x723 = x646 * x683;
-        let x724 = Self::mul_add(x670, x679, x712) - x713 + (x718 - x719);
-        let x725 = Self::mul_add(-x674, x680, x714) + x715 + (x720 + x721);
-        let x726 = Self::mul_add(x678, x681, x716 - x717) + (x722 + x723);
-        let x727 = x648 * x680;
-        let x728 = x647 * x681;
-        let x729 = x727 + x728;
-        let x730 = x648 * x679;
-        let x731 = x646 * x681;
-        let x732 = x730 - x731;
-        let x733 = x647 * x679;
-        let x734 = x646 * x680;
-        let x735 = x733 + x734;
-        let x736 = Self::mul_add(x647, x693, x648 * x692)
-            - Self::mul_add(-x680, x735, x681 * x732);
-        let x737 = Self::mul_add(-x646, x693, x648 * x691)
-            + Self::mul_add(x679, x735, x681 * x729);
-        let x738 = Self::mul_add(x646, x692, x647 * x691)
-            - Self::mul_add(x679, x732, x680 * x729);
-        let x739 = x673 * x681;
-        let x740 = x676 * x680;
-        let x741 = x670 * x681;
-        let x742 = x670 * x680;
-        let x743 = x648 * x684;
-        let x744 = x647 * x683;
-        let x745 = x743 + x744;
-        let x746 = x671 * x681;
-        let x747 = x672 * x680;
-        let x748 = x674 * x681;
-        let x749 = x678 * x680;
-        let x750 = x734 + (x733 + x735);
-        let x751 = x731 - (x730 + x732);
-        let x752 = x677 * x679;
-        let x753 = x674 * x679;
-        let x754 = x646 * x682;
-        let x755 = x743 - x754;
-        let x756 = x675 * x679;
-        let x757 = x678 * x679;
-        let x758 = x733 + (x734 + x735);
-        let x759 = x728 + (x727 + x729);
-        let x760 = x744 - x754;
-        let x761 = x730 - (x731 - x732);
-        let x762 = x727 + (x728 + x729);
-        let x763 = x734 + (x733 - x735);
-        let x764 = x731 - (x730 - x732);
-        let x765 = x733 + (x734 - x735);
-        let x766 = x728 + (x727 - x729);
-        let x767 = x730 - (x731 + x732);
-        let x768 = x727 + (x728 - x729);
-        let x769 = Self::mul_add(-s_q1, s_q5, c_q5 * x634);
-        let x770 = Self::mul_add(s_q5, x287, c_q5 * x635);
-        let x771 = Self::mul_add(s_q5, x288, c_q5 * x636);
-        let x772 = Self::mul_add(s_q1, c_q5, s_q5 * x634);
-        let x773 = Self::mul_add(-c_q5, x287, s_q5 * x635);
-        let x774 = Self::mul_add(-c_q5, x288, s_q5 * x636);
-        let x775 = 44.41 * x772;
-        let x776 = 47.471 * x637;
-        let x777 = 44.41 * x773;
-        let x778 = 47.471 * x638;
-        let x779 = 44.41 * x774;
-        let x780 = 47.471 * x639;
-        let x781 = Self::mul_add(x637, x776, x772 * x775);
-        let x782 = Self::mul_add(x638, x776, x773 * x775);
-        let x783 = Self::mul_add(x639, x776, x774 * x775);
-        let x784 = Self::mul_add(x637, x778, x772 * x777);
-        let x785 = Self::mul_add(x638, x778, x773 * x777);
-        let x786 = Self::mul_add(x639, x778, x774 * x777);
-        let x787 = Self::mul_add(x637, x780, x772 * x779);
-        let x788 = Self::mul_add(x638, x780, x773 * x779);
-        let x789 = Self::mul_add(x639, x780, x774 * x779);
-        let x790 = Self::mul_add(qd[5], x637, x679);
-        let x791 = Self::mul_add(-qd[5], x638, x680);
-        let x792 = Self::mul_add(qd[5], x639, x681);
-        let x793 = Self::mul_add(x639, x791, x638 * x792);
-        let x794 = Self::mul_add(-x639, x790, x637 * x792);
-        let x795 = Self::mul_add(x638, x790, x637 * x791);
-        let x796 = Self::mul_add(-qd[5], x793, Self::mul_add(x282, x637, x691));
-        let x797 = Self::mul_add(-qd[5], x794, Self::mul_add(-x282, x638, x692));
-        let x798 = Self::mul_add(qd[5], x795, Self::mul_add(x282, x639, x693));
-        let x799 = Self::mul_add(x639, x680, x638 * x681);
-        let x800 = Self::mul_add(-x639, x679, x637 * x681);
-        let x801 = Self::mul_add(x638, x679, x637 * x680);
-        let x802 = Self::mul_add(x639, x692, x638 * x693)
-            + Self::mul_add(x680, x801, x681 * x800);
-        let x803 = Self::mul_add(-x639, x691, x637 * x693)
-            - Self::mul_add(x679, x801, x681 * x799);
-        let x804 = Self::mul_add(x638, x691, x637 * x692)
-            - Self::mul_add(-x679, x800, x680 * x799);
-        let x805 = x793 + x799;
-        let x806 = x794 + x800;
-        let x807 = x795 + x801;
-        let x808 = x782 * x791;
-        let x809 = x783 * x792;
-        let x810 = Self::mul_add(x781, x790, -x808) + x809;
-        let x811 = x784 * x790;
-        let x812 = x786 * x792;
-        let x813 = Self::mul_add(-x785, x791, x811) + x812;
-        let x814 = x787 * x790;
-        let x815 = x788 * x791;
-        let x816 = Self::mul_add(x789, x792, x814 - x815);
-        let x817 = x784 * x792;
-        let x818 = x787 * x791;
-        let x819 = x781 * x792;
-        let x820 = x781 * x791;
-        let x821 = x782 * x792;
-        let x822 = x783 * x791;
-        let x823 = x785 * x792;
-        let x824 = x789 * x791;
-        let x825 = x788 * x790;
-        let x826 = x785 * x790;
-        let x827 = x786 * x790;
-        let x828 = x789 * x790;
-        let x829 = 9.336 * x769;
-        let x830 = 9.336 * x770;
-        let x831 = 9.336 * x771;
-        let x832 = x769 * x829;
-        let x833 = x770 * x829;
-        let x834 = x771 * x829;
-        let x835 = x769 * x830;
-        let x836 = x770 * x830;
-        let x837 = x771 * x830;
-        let x838 = x769 * x831;
-        let x839 = x770 * x831;
-        let x840 = x771 * x831;
-        let x841 = Self::mul_add(qd[6], x769, x790);
-        let x842 = Self::mul_add(-qd[6], x770, x791);
-        let x843 = Self::mul_add(qd[6], x771, x792);
-        let x844 = Self::mul_add(x771, x842, x770 * x843);
-        let x845 = Self::mul_add(-x771, x841, x769 * x843);
-        let x846 = Self::mul_add(x770, x841, x769 * x842);
-        let x847 = Self::mul_add(-qd[6], x844, Self::mul_add(x284, x769, x796));
-        let x848 = Self::mul_add(-qd[6], x845, Self::mul_add(-x284, x770, x797));
-        let x849 = Self::mul_add(qd[6], x846, Self::mul_add(x284, x771, x798));
-        let x850 = Self::mul_add(x771, x791, x770 * x792);
-        let x851 = Self::mul_add(-x771, x790, x769 * x792);
-        let x852 = Self::mul_add(x770, x790, x769 * x791);
-        let x853 = Self::mul_add(x771, x797, x770 * x798)
-            + Self::mul_add(x791, x852, x792 * x851);
-        let x854 = Self::mul_add(-x771, x796, x769 * x798)
-            - Self::mul_add(x790, x852, x792 * x850);
-        let x855 = Self::mul_add(x770, x796, x769 * x797)
-            - Self::mul_add(-x790, x851, x791 * x850);
-        let x856 = x844 + x850;
-        let x857 = x845 + x851;
-        let x858 = x846 + x852;
-        let x859 = x833 * x842;
-        let x860 = x834 * x843;
-        let x861 = Self::mul_add(x832, x841, -x859) + x860;
-        let x862 = x835 * x841;
-        let x863 = x837 * x843;
-        let x864 = Self::mul_add(-x836, x842, x862) + x863;
-        let x865 = x838 * x841;
-        let x866 = x839 * x842;
-        let x867 = Self::mul_add(x840, x843, x865 - x866);
-        let x868 = Self::mul_add(x834, x849, Self::mul_add(-x833, x848, x832 * x847))
-            - Self::mul_add(x842, x867, x843 * x864);
-        let x869 = Self::mul_add(x837, x849, Self::mul_add(-x836, x848, x835 * x847))
-            + Self::mul_add(-x841, x867, x843 * x861);
-        let x870 = Self::mul_add(x840, x849, Self::mul_add(-x839, x848, x838 * x847))
-            + Self::mul_add(x841, x864, x842 * x861);
-        let x871 = x835 * x843;
-        let x872 = x838 * x842;
-        let x873 = x832 * x843;
-        let x874 = x832 * x842;
-        let x875 = x833 * x843;
-        let x876 = x834 * x842;
-        let x877 = x836 * x843;
-        let x878 = x840 * x842;
-        let x879 = x871 + x872 + (x875 + x876);
-        let x880 = x867 + (x865 - x873) + Self::mul_add(x837, x842, x877);
-        let x881 = x864 + (x862 + x874) - Self::mul_add(x839, x843, x878);
-        let x882 = x839 * x841;
-        let x883 = x836 * x841;
-        let x884 = x837 * x841;
-        let x885 = x840 * x841;
-        let x886 = x867 - (x866 + x877) + Self::mul_add(-x834, x841, x873);
-        let x887 = x875 - x882 + (x871 - x884);
-        let x888 = x861 - (x859 + x883) - Self::mul_add(x838, x843, -x885);
-        let x889 = x864 + (x863 + x878) - Self::mul_add(x833, x841, x874);
-        let x890 = x861 + (x860 - x885) + Self::mul_add(x835, x842, x883);
-        let x891 = x876 + x884 + (x872 + x882);
-        let x892 = Self::mul_add(x771, x834, Self::mul_add(x770, x833, x769 * x832));
-        let x893 = Self::mul_add(x771, x837, Self::mul_add(x770, x836, x769 * x835));
-        let x894 = Self::mul_add(x771, x840, Self::mul_add(x770, x839, x769 * x838));
-        let x895 = x769 * x879;
-        let x896 = Self::mul_add(-x771, x881, Self::mul_add(x770, x880, x895));
-        let x897 = x770 * x887;
-        let x898 = Self::mul_add(-x771, x888, Self::mul_add(x769, x886, x897));
-        let x899 = x771 * x891;
-        let x900 = Self::mul_add(-x770, x890, x769 * x889) - x899;
-        let x901 = Self::mul_add(-x770, x870, x771 * x869)
-            + Self::mul_add(-x834, x855, Self::mul_add(-x833, x854, x832 * x853))
-            - Self::mul_add(-x852, x889, Self::mul_add(x851, x886, x850 * x879));
-        let x902 = Self::mul_add(-x769, x870, x771 * x868)
-            - Self::mul_add(-x837, x855, Self::mul_add(-x836, x854, x835 * x853))
-            + Self::mul_add(x852, x890, Self::mul_add(x851, x887, x850 * x880));
-        let x903 = Self::mul_add(-x769, x869, x770 * x868)
-            + Self::mul_add(-x840, x855, Self::mul_add(-x839, x854, x838 * x853))
-            + Self::mul_add(-x852, x891, Self::mul_add(x851, x888, x850 * x881));
-        let x904 = Self::mul_add(-x834, x858, Self::mul_add(-x833, x857, x832 * x856))
-            + Self::mul_add(x771, x889, Self::mul_add(-x770, x886, x895));
-        let x905 = Self::mul_add(-x837, x858, Self::mul_add(-x836, x857, x835 * x856))
-            - Self::mul_add(x771, x890, Self::mul_add(-x769, x880, x897));
-        let x906 = Self::mul_add(-x840, x858, Self::mul_add(-x839, x857, x838 * x856))
-            - (x899 + Self::mul_add(-x770, x888, x769 * x881));
-        let x907 = Self::mul_add(c_q0, x903, s_q0 * x902);
-        let x908 = Self::mul_add(-c_q0, x906, s_q0 * x905);
-        let x909 = Self::mul_add(-x288, x903, Self::mul_add(x287, x902, s_q1 * x901));
-        let x910 = Self::mul_add(-x288, x906, Self::mul_add(-x287, x905, s_q1 * x904));
-        let x911 = Self::mul_add(x639, x903, Self::mul_add(-x638, x902, x637 * x901));
-        let x912 = Self::mul_add(x639, x906, Self::mul_add(x638, x905, x637 * x904));
-        let x913 = Self::mul_add(-x855, x894, Self::mul_add(-x854, x893, x853 * x892))
-            - Self::mul_add(-x852, x900, Self::mul_add(x851, x898, x850 * x896));
-        let x914 = Self::mul_add(-x858, x894, Self::mul_add(-x857, x893, x856 * x892))
-            + Self::mul_add(x771, x900, Self::mul_add(-x770, x898, x769 * x896));
-        let x915 = x781 + x832;
-        let x916 = x782 + x833;
-        let x917 = x783 + x834;
-        let x918 = x784 + x835;
-        let x919 = x785 + x836;
-        let x920 = x786 + x837;
-        let x921 = x787 + x838;
-        let x922 = x788 + x839;
-        let x923 = x789 + x840;
-        let x924 = x817 + x818 + (x821 + x822) + x879;
-        let x925 = x816 - (x815 + x823) + Self::mul_add(-x783, x790, x819) + x886;
-        let x926 = x813 + (x812 + x824) - Self::mul_add(x782, x790, x820) + x889;
-        let x927 = x816 + (x814 - x819) + Self::mul_add(x786, x791, x823) + x880;
-        let x928 = x821 - x825 + (x817 - x827) + x887;
-        let x929 = x810 + (x809 - x828) + Self::mul_add(x784, x791, x826) + x890;
-        let x930 = x813 + (x811 + x820) - Self::mul_add(x788, x792, x824) + x881;
-        let x931 = x810 - (x808 + x826) - Self::mul_add(x787, x792, -x828) + x888;
-        let x932 = x822 + x827 + (x818 + x825) + x891;
-        let x933 = Self::mul_add(x783, x798, Self::mul_add(-x782, x797, x781 * x796))
-            - Self::mul_add(x791, x816, x792 * x813) + x868;
-        let x934 = Self::mul_add(x786, x798, Self::mul_add(-x785, x797, x784 * x796))
-            + Self::mul_add(-x790, x816, x792 * x810) + x869;
-        let x935 = Self::mul_add(x789, x798, Self::mul_add(-x788, x797, x787 * x796))
-            + Self::mul_add(x790, x813, x791 * x810) + x870;
-        let x936 = Self::mul_add(x639, x917, Self::mul_add(x638, x916, x637 * x915));
-        let x937 = Self::mul_add(x639, x920, Self::mul_add(x638, x919, x637 * x918));
-        let x938 = Self::mul_add(x639, x923, Self::mul_add(x638, x922, x637 * x921));
-        let x939 = x637 * x924;
-        let x940 = Self::mul_add(-x639, x930, Self::mul_add(x638, x927, x939));
-        let x941 = x638 * x928;
-        let x942 = Self::mul_add(-x639, x931, Self::mul_add(x637, x925, x941));
-        let x943 = x639 * x932;
-        let x944 = Self::mul_add(-x638, x929, x637 * x926) - x943;
-        let x945 = Self::mul_add(-x638, x935, x639 * x934)
-            + Self::mul_add(-x804, x917, Self::mul_add(-x803, x916, x802 * x915))
-            - Self::mul_add(-x801, x926, Self::mul_add(x800, x925, x799 * x924));
-        let x946 = Self::mul_add(-x637, x935, x639 * x933)
-            - Self::mul_add(-x804, x920, Self::mul_add(-x803, x919, x802 * x918))
-            + Self::mul_add(x801, x929, Self::mul_add(x800, x928, x799 * x927));
-        let x947 = Self::mul_add(-x637, x934, x638 * x933)
-            + Self::mul_add(-x804, x923, Self::mul_add(-x803, x922, x802 * x921))
-            + Self::mul_add(-x801, x932, Self::mul_add(x800, x931, x799 * x930));
-        let x948 = Self::mul_add(-x807, x917, Self::mul_add(-x806, x916, x805 * x915))
-            + Self::mul_add(x639, x926, Self::mul_add(-x638, x925, x939));
-        let x949 = Self::mul_add(-x807, x920, Self::mul_add(-x806, x919, x805 * x918))
-            - Self::mul_add(x639, x929, Self::mul_add(-x637, x927, x941));
-        let x950 = Self::mul_add(-x807, x923, Self::mul_add(-x806, x922, x805 * x921))
-            - (x943 + Self::mul_add(-x638, x931, x637 * x930));
-        let x951 = Self::mul_add(c_q0, x947, s_q0 * x946);
-        let x952 = Self::mul_add(-c_q0, x950, s_q0 * x949);
-        let x953 = Self::mul_add(-x288, x947, Self::mul_add(x287, x946, s_q1 * x945));
-        let x954 = Self::mul_add(-x288, x950, Self::mul_add(-x287, x949, s_q1 * x948));
-        let x955 = Self::mul_add(-x804, x938, Self::mul_add(-x803, x937, x802 * x936))
-            - Self::mul_add(-x801, x944, Self::mul_add(x800, x942, x799 * x940));
-        let x956 = Self::mul_add(-x807, x938, Self::mul_add(-x806, x937, x805 * x936))
-            + Self::mul_add(x639, x944, Self::mul_add(-x638, x942, x637 * x940));
-        let x957 = Self::mul_add(-x804, x894, Self::mul_add(-x803, x893, x802 * x892))
-            - Self::mul_add(-x801, x900, Self::mul_add(x800, x898, x799 * x896));
-        let x958 = Self::mul_add(-x807, x894, Self::mul_add(-x806, x893, x805 * x892))
-            + Self::mul_add(x639, x900, Self::mul_add(-x638, x898, x637 * x896));
-        let x959 = x670 - x915;
-        let x960 = x671 + x916;
-        let x961 = x672 + x917;
-        let x962 = x673 - x918;
-        let x963 = x674 - x919;
-        let x964 = x675 - x920;
-        let x965 = x676 + x921;
-        let x966 = x677 + x922;
-        let x967 = x678 + x923;
-        let x968 = x739 - x740 + x745 + (x745 - (x746 + x747)) - x924;
-        let x969 = x726 - (x723 + (x717 - x748))
-            + (x722 - Self::mul_add(x672, x679, x741)) + x925;
-        let x970 = x725 - (x721 - (x715 - x749))
-            + (x720 - Self::mul_add(-x671, x679, x742)) - x926;
-        let x971 = x726 - (x722 - (x716 + x741))
-            + (x723 - Self::mul_add(x675, x680, x748)) + x927;
-        let x972 = x746 - x752 + x755 + (x755 - (x739 - x756)) + x928;
-        let x973 = x724 + (x719 - (x713 - x757))
-            + (x718 + Self::mul_add(x673, x680, x753)) - x929;
-        let x974 = x725 - (x720 - (x714 + x742))
-            + (x721 + Self::mul_add(x677, x681, x749)) - x930;
-        let x975 = x724 - (x718 - (x712 - x753))
-            - (x719 - Self::mul_add(x676, x681, -x757)) - x931;
-        let x976 = x747 - x756 + x760 + (x760 + (x740 + x752)) + x932;
-        let x977 = Self::mul_add(-x672, x693, Self::mul_add(x671, x692, x670 * x691))
-            + Self::mul_add(-x647, x696, x648 * x695)
-            - (Self::mul_add(-x680, x726, x681 * x725)
-                + Self::mul_add(x683, x735, x684 * x732)) - x933;
-        let x978 = Self::mul_add(x675, x693, Self::mul_add(-x674, x692, x673 * x691))
-            + Self::mul_add(x646, x696, x648 * x694)
-            + (Self::mul_add(x679, x726, x681 * x724)
-                + Self::mul_add(-x682, x735, x684 * x729)) - x934;
-        let x979 = Self::mul_add(x678, x693, Self::mul_add(-x677, x692, x676 * x691))
-            + Self::mul_add(x646, x695, x647 * x694)
-            - (Self::mul_add(x679, x725, x680 * x724)
-                - Self::mul_add(x682, x732, x683 * x729)) + x935;
-        let x980 = Self::mul_add(x288, x961, Self::mul_add(x287, x960, s_q1 * x959))
-            - Self::mul_add(-x645, x647, x644 * x648);
-        let x981 = Self::mul_add(-x288, x964, Self::mul_add(-x287, x963, s_q1 * x962))
-            + Self::mul_add(-x645, x646, x643 * x648);
-        let x982 = Self::mul_add(-x288, x967, Self::mul_add(-x287, x966, s_q1 * x965))
-            + Self::mul_add(-x644, x646, x643 * x647);
-        let x983 = Self::mul_add(-x288, x647, x287 * x648);
-        let x984 = Self::mul_add(x288, x646, s_q1 * x648);
-        let x985 = Self::mul_add(x287, x646, s_q1 * x647);
-        let x986 = s_q1 * x968;
-        let x987 = Self::mul_add(
-            x644,
-            x750,
-            Self::mul_add(x288, x974, Self::mul_add(x287, x971, x986)),
+        let x613 = x593 * x598;
+        let x614 = x594 * x598;
+        let x615 = x592 * x599;
+        let x616 = x592 * x598;
+        let x617 = x610 + x616;
+        let x618 = x594 * x599;
+        let x619 = x592 * x600;
+        let x620 = x593 * x600;
+        let x621 = x611 - x616;
+        let x622 = x612
+            - (Self::mul_add(s_q1, x603, Self::mul_add(-x589, x602, x586 * x601))
+                - x612);
+        let x623 = x615
+            + (Self::mul_add(-x356, x603, Self::mul_add(-x590, x602, x587 * x601))
+                - x613);
+        let x624 = x619
+            + (Self::mul_add(-x357, x603, Self::mul_add(-x591, x602, x588 * x601))
+                + x614);
+        let x625 = x613
+            + (Self::mul_add(-s_q1, x606, Self::mul_add(x589, x605, x586 * x604))
+                - x615);
+        let x626 = x617
+            + (Self::mul_add(x356, x606, Self::mul_add(x590, x605, x587 * x604)) + x617);
+        let x627 = x620
+            + (Self::mul_add(x357, x606, Self::mul_add(x591, x605, x588 * x604)) - x618);
+        let x628 = x614
+            - (Self::mul_add(-s_q1, x609, Self::mul_add(x589, x608, x586 * x607))
+                - x619);
+        let x629 = x618
+            - (Self::mul_add(x356, x609, Self::mul_add(x590, x608, x587 * x607)) + x620);
+        let x630 = x621
+            - (Self::mul_add(x357, x609, Self::mul_add(x591, x608, x588 * x607)) - x621);
+        let x631 = Self::mul_add(-qd[3], s_q1, x505);
+        let x632 = Self::mul_add(-qd[3], x356, x506);
+        let x633 = Self::mul_add(qd[3], x357, x507);
+        let x634 = Self::mul_add(-qd[3], x595, x508);
+        let x635 = Self::mul_add(qd[3], x596, x509);
+        let x636 = Self::mul_add(qd[3], x597, x510);
+        let x637 = Self::mul_add(x357, x632, x356 * x633);
+        let x638 = Self::mul_add(x357, x631, s_q1 * x633);
+        let x639 = Self::mul_add(-x356, x631, s_q1 * x632);
+        let x640 = Self::mul_add(-x357, x635, x356 * x636);
+        let x641 = Self::mul_add(-x357, x634, s_q1 * x636);
+        let x642 = Self::mul_add(-x356, x634, s_q1 * x635);
+        let x643 = Self::mul_add(x597, x632, x596 * x633) + x640;
+        let x644 = Self::mul_add(-x597, x631, x595 * x633) - x641;
+        let x645 = Self::mul_add(x596, x631, x595 * x632) + x642;
+        let x646 = Self::mul_add(-qd[3], x637, Self::mul_add(s_q1, x347, x520));
+        let x647 = Self::mul_add(qd[3], x638, Self::mul_add(x347, x356, x521));
+        let x648 = Self::mul_add(-qd[3], x639, Self::mul_add(-x347, x357, x522));
+        let x649 = Self::mul_add(qd[3], x643, Self::mul_add(x347, x595, x523));
+        let x650 = Self::mul_add(qd[3], x644, Self::mul_add(-x347, x596, x524));
+        let x651 = Self::mul_add(qd[3], x645, Self::mul_add(-x347, x597, x525));
+        let x652 = x514 + Self::mul_add(x506, x597, x507 * x596);
+        let x653 = x515 - Self::mul_add(-x505, x597, x507 * x595);
+        let x654 = x516 + Self::mul_add(x505, x596, x506 * x595);
+        let x655 = Self::mul_add(x357, x521, x356 * x522)
+            - Self::mul_add(x506, x513, x507 * x512);
+        let x656 = Self::mul_add(x357, x520, s_q1 * x522)
+            + Self::mul_add(-x505, x513, x507 * x511);
+        let x657 = Self::mul_add(-x356, x520, s_q1 * x521)
+            + Self::mul_add(x505, x512, x506 * x511);
+        let x658 = Self::mul_add(x521, x597, x522 * x596)
+            + Self::mul_add(-x357, x524, x356 * x525)
+            - (Self::mul_add(-x506, x654, x507 * x653)
+                + Self::mul_add(-x509, x513, x510 * x512));
+        let x659 = Self::mul_add(-x520, x597, x522 * x595)
+            - Self::mul_add(-x357, x523, s_q1 * x525)
+            - (Self::mul_add(x505, x654, x507 * x652)
+                + Self::mul_add(x508, x513, x510 * x511));
+        let x660 = Self::mul_add(x520, x596, x521 * x595)
+            + Self::mul_add(-x356, x523, s_q1 * x524)
+            - (Self::mul_add(x505, x653, x506 * x652)
+                - Self::mul_add(x508, x512, x509 * x511));
+        let x661 = x511 + x637;
+        let x662 = x512 + x638;
+        let x663 = x513 + x639;
+        let x664 = x643 + x652;
+        let x665 = x644 - x653;
+        let x666 = x645 + x654;
+        let x667 = x623 * x632;
+        let x668 = x624 * x633;
+        let x669 = x625 * x631;
+        let x670 = x627 * x633;
+        let x671 = x628 * x631;
+        let x672 = x629 * x632;
+        let x673 = x600 * x635;
+        let x674 = x599 * x636;
+        let x675 = x600 * x634;
+        let x676 = x598 * x636;
+        let x677 = x599 * x634;
+        let x678 = x598 * x635;
+        let x679 = Self::mul_add(x622, x631, x667) - x668 + (x673 - x674);
+        let x680 = Self::mul_add(-x626, x632, x669) + x670 + (x675 + x676);
+        let x681 = Self::mul_add(x630, x633, x671 - x672) + (x677 + x678);
+        let x682 = x600 * x632;
+        let x683 = x599 * x633;
+        let x684 = x682 + x683;
+        let x685 = x600 * x631;
+        let x686 = x598 * x633;
+        let x687 = x685 - x686;
+        let x688 = x599 * x631;
+        let x689 = x598 * x632;
+        let x690 = x688 + x689;
+        let x691 = x625 * x633;
+        let x692 = x628 * x632;
+        let x693 = x622 * x633;
+        let x694 = x622 * x632;
+        let x695 = x600 * x636;
+        let x696 = x599 * x635;
+        let x697 = x695 + x696;
+        let x698 = x623 * x633;
+        let x699 = x624 * x632;
+        let x700 = x626 * x633;
+        let x701 = x630 * x632;
+        let x702 = x629 * x631;
+        let x703 = x626 * x631;
+        let x704 = x598 * x634;
+        let x705 = x695 - x704;
+        let x706 = x627 * x631;
+        let x707 = x630 * x631;
+        let x708 = x696 - x704;
+        let x709 = Self::mul_add(c_q4, x589, s_q4 * x586);
+        let x710 = Self::mul_add(c_q4, x590, s_q4 * x587);
+        let x711 = Self::mul_add(c_q4, x591, s_q4 * x588);
+        let x712 = Self::mul_add(7.11, x586, x592);
+        let x713 = Self::mul_add(-7.11, x587, x593);
+        let x714 = Self::mul_add(7.11, x588, x594);
+        let x715 = Self::mul_add(x357, x713, x356 * x714);
+        let x716 = Self::mul_add(x357, x712, s_q1 * x714);
+        let x717 = Self::mul_add(-x356, x712, s_q1 * x713);
+        let x718 = 171.195516 * x709;
+        let x719 = 171.195516 * x710;
+        let x720 = 171.195516 * x711;
+        let x721 = Self::mul_add(-97.44448770720001, s_q1, 177.0883695416 * x709);
+        let x722 = Self::mul_add(179.8829695416, s_q1, 97.44448770720001 * x709);
+        let x723 = Self::mul_add(97.44448770720001, x356, 177.0883695416 * x710);
+        let x724 = Self::mul_add(-179.8829695416, x356, 97.44448770720001 * x710);
+        let x725 = Self::mul_add(97.44448770720001, x357, 177.0883695416 * x711);
+        let x726 = Self::mul_add(-179.8829695416, x357, 97.44448770720001 * x711);
+        let x727 = x714 * x720;
+        let x728 = x713 * x719;
+        let x729 = x727 - x728;
+        let x730 = x713 * x718;
+        let x731 = x714 * x718;
+        let x732 = x712 * x719;
+        let x733 = x712 * x718;
+        let x734 = x727 + x733;
+        let x735 = x714 * x719;
+        let x736 = x712 * x720;
+        let x737 = x713 * x720;
+        let x738 = x728 - x733;
+        let x739 = x729 + (Self::mul_add(-s_q1, x722, x709 * x721) + x729);
+        let x740 = x732 - (Self::mul_add(x356, x722, x710 * x721) + x730);
+        let x741 = x736 - (Self::mul_add(x357, x722, x711 * x721) - x731);
+        let x742 = x730 + (Self::mul_add(-s_q1, x724, x709 * x723) - x732);
+        let x743 = x734 + (Self::mul_add(x356, x724, x710 * x723) + x734);
+        let x744 = x737 + (Self::mul_add(x357, x724, x711 * x723) - x735);
+        let x745 = x731 - (Self::mul_add(-s_q1, x726, x709 * x725) - x736);
+        let x746 = x735 - (Self::mul_add(x356, x726, x710 * x725) + x737);
+        let x747 = x738 - (Self::mul_add(x357, x726, x711 * x725) - x738);
+        let x748 = Self::mul_add(-qd[4], s_q1, x631);
+        let x749 = Self::mul_add(-qd[4], x356, x632);
+        let x750 = Self::mul_add(qd[4], x357, x633);
+        let x751 = Self::mul_add(-qd[4], x715, x634);
+        let x752 = Self::mul_add(qd[4], x716, x635);
+        let x753 = Self::mul_add(qd[4], x717, x636);
+        let x754 = Self::mul_add(x357, x749, x356 * x750);
+        let x755 = Self::mul_add(x357, x748, s_q1 * x750);
+        let x756 = Self::mul_add(-x356, x748, s_q1 * x749);
+        let x757 = Self::mul_add(x717, x749, x716 * x750)
+            + Self::mul_add(-x357, x752, x356 * x753);
+        let x758 = Self::mul_add(-x717, x748, x715 * x750)
+            - Self::mul_add(-x357, x751, s_q1 * x753);
+        let x759 = Self::mul_add(x716, x748, x715 * x749)
+            + Self::mul_add(-x356, x751, s_q1 * x752);
+        let x760 = Self::mul_add(-qd[4], x754, Self::mul_add(-s_q1, x349, x646));
+        let x761 = Self::mul_add(qd[4], x755, Self::mul_add(-x349, x356, x647));
+        let x762 = Self::mul_add(-qd[4], x756, Self::mul_add(x349, x357, x648));
+        let x763 = Self::mul_add(qd[4], x757, Self::mul_add(-x349, x715, x649));
+        let x764 = Self::mul_add(qd[4], x758, Self::mul_add(x349, x716, x650));
+        let x765 = Self::mul_add(qd[4], x759, Self::mul_add(x349, x717, x651));
+        let x766 = x640 + Self::mul_add(x632, x717, x633 * x716);
+        let x767 = x641 - Self::mul_add(-x631, x717, x633 * x715);
+        let x768 = x642 + Self::mul_add(x631, x716, x632 * x715);
+        let x769 = Self::mul_add(x357, x647, x356 * x648)
+            - Self::mul_add(x632, x639, x633 * x638);
+        let x770 = Self::mul_add(x357, x646, s_q1 * x648)
+            + Self::mul_add(-x631, x639, x633 * x637);
+        let x771 = Self::mul_add(-x356, x646, s_q1 * x647)
+            + Self::mul_add(x631, x638, x632 * x637);
+        let x772 = Self::mul_add(x647, x717, x648 * x716)
+            + Self::mul_add(-x357, x650, x356 * x651)
+            - (Self::mul_add(-x632, x768, x633 * x767)
+                + Self::mul_add(-x635, x639, x636 * x638));
+        let x773 = Self::mul_add(-x646, x717, x648 * x715)
+            - Self::mul_add(-x357, x649, s_q1 * x651)
+            - (Self::mul_add(x631, x768, x633 * x766)
+                + Self::mul_add(x634, x639, x636 * x637));
+        let x774 = Self::mul_add(x646, x716, x647 * x715)
+            + Self::mul_add(-x356, x649, s_q1 * x650)
+            - (Self::mul_add(x631, x767, x632 * x766)
+                - Self::mul_add(x634, x638, x635 * x637));
+        let x775 = x637 + x754;
+        let x776 = x638 + x755;
+        let x777 = x639 + x756;
+        let x778 = x757 + x766;
+        let x779 = x758 - x767;
+        let x780 = x759 + x768;
+        let x781 = x740 * x749;
+        let x782 = x741 * x750;
+        let x783 = x742 * x748;
+        let x784 = x744 * x750;
+        let x785 = x745 * x748;
+        let x786 = x746 * x749;
+        let x787 = x720 * x752;
+        let x788 = x719 * x753;
+        let x789 = x720 * x751;
+        let x790 = x718 * x753;
+        let x791 = x719 * x751;
+        let x792 = x718 * x752;
+        let x793 = Self::mul_add(x739, x748, x781) - x782 + (x787 - x788);
+        let x794 = Self::mul_add(-x743, x749, x783) + x784 + (x789 + x790);
+        let x795 = Self::mul_add(x747, x750, x785 - x786) + (x791 + x792);
+        let x796 = x720 * x749;
+        let x797 = x719 * x750;
+        let x798 = x796 + x797;
+        let x799 = x720 * x748;
+        let x800 = x718 * x750;
+        let x801 = x799 - x800;
+        let x802 = x719 * x748;
+        let x803 = x718 * x749;
+        let x804 = x802 + x803;
+        let x805 = Self::mul_add(x719, x762, x720 * x761)
+            - Self::mul_add(-x749, x804, x750 * x801);
+        let x806 = Self::mul_add(-x718, x762, x720 * x760)
+            + Self::mul_add(x748, x804, x750 * x798);
+        let x807 = Self::mul_add(x718, x761, x719 * x760)
+            - Self::mul_add(x748, x801, x749 * x798);
+        let x808 = x742 * x750;
+        let x809 = x745 * x749;
+        let x810 = x739 * x750;
+        let x811 = x739 * x749;
+        let x812 = x720 * x753;
+        let x813 = x719 * x752;
+        let x814 = x812 + x813;
+        let x815 = x740 * x750;
+        let x816 = x741 * x749;
+        let x817 = x743 * x750;
+        let x818 = x747 * x749;
+        let x819 = x803 + (x802 + x804);
+        let x820 = x800 - (x799 + x801);
+        let x821 = x746 * x748;
+        let x822 = x743 * x748;
+        let x823 = x718 * x751;
+        let x824 = x812 - x823;
+        let x825 = x744 * x748;
+        let x826 = x747 * x748;
+        let x827 = x802 + (x803 + x804);
+        let x828 = x797 + (x796 + x798);
+        let x829 = x813 - x823;
+        let x830 = x799 - (x800 - x801);
+        let x831 = x796 + (x797 + x798);
+        let x832 = x803 + (x802 - x804);
+        let x833 = x800 - (x799 - x801);
+        let x834 = x802 + (x803 - x804);
+        let x835 = x797 + (x796 - x798);
+        let x836 = x799 - (x800 + x801);
+        let x837 = x796 + (x797 - x798);
+        let x838 = Self::mul_add(
+            -s_q1,
+            s_q5,
+            c_q5 * Self::mul_add(-s_q4, x589, c_q4 * x586),
         );
-        let x988 = Self::mul_add(-x645, x751, x987);
-        let x989 = x287 * x972;
-        let x990 = Self::mul_add(
-            -x643,
-            x758,
-            Self::mul_add(-x288, x975, Self::mul_add(s_q1, x969, -x989)),
+        let x839 = Self::mul_add(
+            s_q5,
+            x356,
+            c_q5 * Self::mul_add(-s_q4, x590, c_q4 * x587),
         );
-        let x991 = Self::mul_add(-x645, x759, x990);
-        let x992 = x288 * x976;
-        let x993 = Self::mul_add(
-            x644,
-            x762,
-            Self::mul_add(-x643, x761, Self::mul_add(x287, x973, s_q1 * x970) - x992),
+        let x840 = Self::mul_add(
+            s_q5,
+            x357,
+            c_q5 * Self::mul_add(-s_q4, x591, c_q4 * x588),
         );
-        let x994 = Self::mul_add(-x288, x764, x287 * x763);
-        let x995 = Self::mul_add(-x288, x766, s_q1 * x765);
-        let x996 = Self::mul_add(x287, x768, s_q1 * x767);
-        let x997 = Self::mul_add(
-            -x698,
-            x765,
-            Self::mul_add(x564, x970, Self::mul_add(x563, x969, x562 * x968)),
-        );
-        let x998 = Self::mul_add(
-            -x697,
-            x763,
-            Self::mul_add(x564, x973, Self::mul_add(-x563, x972, x562 * x971)),
-        );
-        let x999 = Self::mul_add(
-            x697,
-            x764,
-            Self::mul_add(-x564, x976, Self::mul_add(-x563, x975, x562 * x974)),
-        );
-        let x1000 = Self::mul_add(x287, x979, x288 * x978)
-            + Self::mul_add(x644, x738, x645 * x737)
-            + (Self::mul_add(-x702, x961, Self::mul_add(-x701, x960, x700 * x959))
-                - Self::mul_add(-x647, x705, x648 * x704))
-            - Self::mul_add(x699, x767, x997);
-        let x1001 = Self::mul_add(-s_q1, x979, x288 * x977)
-            + Self::mul_add(x643, x738, x645 * x736)
-            - (Self::mul_add(x702, x964, Self::mul_add(x701, x963, x700 * x962))
-                - Self::mul_add(x646, x705, x648 * x703))
-            - Self::mul_add(x699, x768, x998);
-        let x1002 = Self::mul_add(s_q1, x978, x287 * x977)
-            + Self::mul_add(-x643, x737, x644 * x736)
-            - (Self::mul_add(x702, x967, Self::mul_add(x701, x966, x700 * x965))
-                - Self::mul_add(x646, x704, x647 * x703))
-            + Self::mul_add(x698, x766, x999);
-        let x1003 = Self::mul_add(x287, x738, x288 * x737)
-            - Self::mul_add(-x647, x702, x648 * x701)
-            - Self::mul_add(x564, x761, x563 * x758);
-        let x1004 = Self::mul_add(-s_q1, x738, x288 * x736)
-            - Self::mul_add(-x646, x702, x648 * x700)
-            - Self::mul_add(x564, x762, x562 * x750);
-        let x1005 = Self::mul_add(s_q1, x737, x287 * x736)
-            - Self::mul_add(-x646, x701, x647 * x700)
-            - Self::mul_add(x563, x759, x562 * x751);
-        let x1006 = Self::mul_add(
-            x644,
-            x765,
-            Self::mul_add(-x288, x970, Self::mul_add(-x287, x969, x986)),
-        );
-        let x1007 = Self::mul_add(
-            x643,
-            x763,
-            Self::mul_add(-x288, x973, Self::mul_add(s_q1, x971, x989)),
-        );
-        let x1008 = Self::mul_add(
-            -x644,
-            x766,
-            Self::mul_add(-x643, x764, x992 + Self::mul_add(x287, x975, s_q1 * x974)),
-        );
-        let x1009 = Self::mul_add(-x708, x961, Self::mul_add(-x707, x960, x706 * x959))
-            - Self::mul_add(-x647, x711, x648 * x710) - Self::mul_add(x645, x767, x1006);
-        let x1010 = Self::mul_add(x708, x964, Self::mul_add(x707, x963, x706 * x962))
-            - Self::mul_add(x646, x711, x648 * x709) + Self::mul_add(x645, x768, x1007);
-        let x1011 = Self::mul_add(x708, x967, Self::mul_add(x707, x966, x706 * x965))
-            - Self::mul_add(x646, x710, x647 * x709) - x1008;
-        let x1012 = Self::mul_add(-x647, x708, x648 * x707)
-            - Self::mul_add(x288, x761, x287 * x758);
-        let x1013 = Self::mul_add(-x646, x708, x648 * x706)
-            + Self::mul_add(-x288, x762, s_q1 * x750);
-        let x1014 = Self::mul_add(-x646, x707, x647 * x706)
-            + Self::mul_add(-x287, x759, s_q1 * x751);
-        let x1015 = Self::mul_add(c_q0, x1002, s_q0 * x1001)
-            - Self::mul_add(-x293, x1005, Self::mul_add(x292, x1004, x291 * x1003));
-        let x1016 = Self::mul_add(c_q0, x1011, s_q0 * x1010)
-            - Self::mul_add(-x293, x1014, Self::mul_add(x292, x1013, x291 * x1012));
-        let x1017 = Self::mul_add(
-            -x288,
-            x1002,
-            Self::mul_add(x287, x1001, s_q1 * x1000),
-        );
-        let x1018 = x1017
-            - Self::mul_add(x402, x1005, Self::mul_add(-x401, x1004, x400 * x1003));
+        let x841 = 44.41 * x838;
+        let x842 = 47.471 * x709;
+        let x843 = 44.41 * x839;
+        let x844 = 47.471 * x710;
+        let x845 = 44.41 * x840;
+        let x846 = 47.471 * x711;
+        let x847 = Self::mul_add(-x709, x842, x838 * x841);
+        let x848 = Self::mul_add(-x710, x842, x839 * x841);
+        let x849 = Self::mul_add(-x711, x842, x840 * x841);
+        let x850 = Self::mul_add(-x709, x844, x838 * x843);
+        let x851 = Self::mul_add(-x710, x844, x839 * x843);
+        let x852 = Self::mul_add(-x711, x844, x840 * x843);
+        let x853 = Self::mul_add(-x709, x846, x838 * x845);
+        let x854 = Self::mul_add(-x710, x846, x839 * x845);
+        let x855 = Self::mul_add(-x711, x846, x840 * x845);
+        let x856 = Self::mul_add(qd[5], x709, x748);
+        let x857 = Self::mul_add(-qd[5], x710, x749);
+        let x858 = Self::mul_add(qd[5], x711, x750);
+        let x859 = Self::mul_add(x711, x857, x710 * x858);
+        let x860 = Self::mul_add(-x711, x856, x709 * x858);
+        let x861 = Self::mul_add(x710, x856, x709 * x857);
+        let x862 = Self::mul_add(-qd[5], x859, Self::mul_add(x351, x709, x760));
+        let x863 = Self::mul_add(-qd[5], x860, Self::mul_add(-x351, x710, x761));
+        let x864 = Self::mul_add(qd[5], x861, Self::mul_add(x351, x711, x762));
+        let x865 = Self::mul_add(x711, x749, x710 * x750);
+        let x866 = Self::mul_add(-x711, x748, x709 * x750);
+        let x867 = Self::mul_add(x710, x748, x709 * x749);
+        let x868 = Self::mul_add(x711, x761, x710 * x762)
+            + Self::mul_add(x749, x867, x750 * x866);
+        let x869 = Self::mul_add(-x711, x760, x709 * x762)
+            - Self::mul_add(x748, x867, x750 * x865);
+        let x870 = Self::mul_add(x710, x760, x709 * x761)
+            - Self::mul_add(-x748, x866, x749 * x865);
+        let x871 = x859 + x865;
+        let x872 = x860 + x866;
+        let x873 = x861 + x867;
+        let x874 = x848 * x857;
+        let x875 = x849 * x858;
+        let x876 = Self::mul_add(x847, x856, -x874) + x875;
+        let x877 = x850 * x856;
+        let x878 = x852 * x858;
+        let x879 = Self::mul_add(-x851, x857, x877) + x878;
+        let x880 = x853 * x856;
+        let x881 = x854 * x857;
+        let x882 = Self::mul_add(x855, x858, x880 - x881);
+        let x883 = x850 * x858;
+        let x884 = x853 * x857;
+        let x885 = x847 * x858;
+        let x886 = x847 * x857;
+        let x887 = x848 * x858;
+        let x888 = x849 * x857;
+        let x889 = x851 * x858;
+        let x890 = x855 * x857;
+        let x891 = x854 * x856;
+        let x892 = x851 * x856;
+        let x893 = x852 * x856;
+        let x894 = x855 * x856;
+        let x895 = 9.336 * x838;
+        let x896 = 9.336 * x839;
+        let x897 = 9.336 * x840;
+        let x898 = x838 * x895;
+        let x899 = x839 * x895;
+        let x900 = x840 * x895;
+        let x901 = x838 * x896;
+        let x902 = x839 * x896;
+        let x903 = x840 * x896;
+        let x904 = x838 * x897;
+        let x905 = x839 * x897;
+        let x906 = x840 * x897;
+        let x907 = Self::mul_add(qd[6], x838, x856);
+        let x908 = Self::mul_add(-qd[6], x839, x857);
+        let x909 = Self::mul_add(qd[6], x840, x858);
+        let x910 = Self::mul_add(x840, x908, x839 * x909);
+        let x911 = Self::mul_add(-x840, x907, x838 * x909);
+        let x912 = Self::mul_add(x839, x907, x838 * x908);
+        let x913 = Self::mul_add(-qd[6], x910, Self::mul_add(x353, x838, x862));
+        let x914 = Self::mul_add(-qd[6], x911, Self::mul_add(-x353, x839, x863));
+        let x915 = Self::mul_add(qd[6], x912, Self::mul_add(x353, x840, x864));
+        let x916 = Self::mul_add(x840, x857, x839 * x858);
+        let x917 = Self::mul_add(-x840, x856, x838 * x858);
+        let x918 = Self::mul_add(x839, x856, x838 * x857);
+        let x919 = Self::mul_add(x840, x863, x839 * x864)
+            + Self::mul_add(x857, x918, x858 * x917);
+        let x920 = Self::mul_add(-x840, x862, x838 * x864)
+            - Self::mul_add(x856, x918, x858 * x916);
+        let x921 = Self::mul_add(x839, x862, x838 * x863)
+            - Self::mul_add(-x856, x917, x857 * x916);
+        let x922 = x910 + x916;
+        let x923 = x911 + x917;
+        let x924 = x912 + x918;
+        let x925 = x899 * x908;
+        let x926 = x900 * x909;
+        let x927 = Self::mul_add(x898, x907, -x925) + x926;
+        let x928 = x901 * x907;
+        let x929 = x903 * x909;
+        let x930 = Self::mul_add(-x902, x908, x928) + x929;
+        let x931 = x904 * x907;
+        let x932 = x905 * x908;
+        let x933 = Self::mul_add(x906, x909, x931 - x932);
+        let x934 = Self::mul_add(x900, x915, Self::mul_add(-x899, x914, x898 * x913))
+            - Self::mul_add(x908, x933, x909 * x930);
+        let x935 = Self::mul_add(x903, x915, Self::mul_add(-x902, x914, x901 * x913))
+            + Self::mul_add(-x907, x933, x909 * x927);
+        let x936 = Self::mul_add(x906, x915, Self::mul_add(-x905, x914, x904 * x913))
+            + Self::mul_add(x907, x930, x908 * x927);
+        let x937 = x901 * x909;
+        let x938 = x904 * x908;
+        let x939 = x898 * x909;
+        let x940 = x898 * x908;
+        let x941 = x899 * x909;
+        let x942 = x900 * x908;
+        let x943 = x902 * x909;
+        let x944 = x906 * x908;
+        let x945 = x937 + x938 + (x941 + x942);
+        let x946 = x933 + (x931 - x939) + Self::mul_add(x903, x908, x943);
+        let x947 = x930 + (x928 + x940) - Self::mul_add(x905, x909, x944);
+        let x948 = x905 * x907;
+        let x949 = x902 * x907;
+        let x950 = x903 * x907;
+        let x951 = x906 * x907;
+        let x952 = x933 - (x932 + x943) + Self::mul_add(-x900, x907, x939);
+        let x953 = x941 - x948 + (x937 - x950);
+        let x954 = x927 - (x925 + x949) - Self::mul_add(x904, x909, -x951);
+        let x955 = x930 + (x929 + x944) - Self::mul_add(x899, x907, x940);
+        let x956 = x927 + (x926 - x951) + Self::mul_add(x901, x908, x949);
+        let x957 = x942 + x950 + (x938 + x948);
+        let x958 = Self::mul_add(x840, x900, Self::mul_add(x839, x899, x838 * x898));
+        let x959 = Self::mul_add(x840, x903, Self::mul_add(x839, x902, x838 * x901));
+        let x960 = Self::mul_add(x840, x906, Self::mul_add(x839, x905, x838 * x904));
+        let x961 = x838 * x945;
+        let x962 = Self::mul_add(-x840, x947, Self::mul_add(x839, x946, x961));
+        let x963 = x839 * x953;
+        let x964 = Self::mul_add(-x840, x954, Self::mul_add(x838, x952, x963));
+        let x965 = x840 * x957;
+        let x966 = Self::mul_add(-x839, x956, x838 * x955) - x965;
+        let x967 = Self::mul_add(-x839, x936, x840 * x935)
+            + Self::mul_add(-x900, x921, Self::mul_add(-x899, x920, x898 * x919))
+            - Self::mul_add(-x918, x955, Self::mul_add(x917, x952, x916 * x945));
+        let x968 = Self::mul_add(-x838, x936, x840 * x934)
+            - Self::mul_add(-x903, x921, Self::mul_add(-x902, x920, x901 * x919))
+            + Self::mul_add(x918, x956, Self::mul_add(x917, x953, x916 * x946));
+        let x969 = Self::mul_add(-x838, x935, x839 * x934)
+            + Self::mul_add(-x906, x921, Self::mul_add(-x905, x920, x904 * x919))
+            + Self::mul_add(-x918, x957, Self::mul_add(x917, x954, x916 * x947));
+        let x970 = Self::mul_add(-x900, x924, Self::mul_add(-x899, x923, x898 * x922))
+            + Self::mul_add(x840, x955, Self::mul_add(-x839, x952, x961));
+        let x971 = Self::mul_add(-x903, x924, Self::mul_add(-x902, x923, x901 * x922))
+            - Self::mul_add(x840, x956, Self::mul_add(-x838, x946, x963));
+        let x972 = Self::mul_add(-x906, x924, Self::mul_add(-x905, x923, x904 * x922))
+            - (x965 + Self::mul_add(-x839, x954, x838 * x947));
+        let x973 = Self::mul_add(c_q0, x969, s_q0 * x968);
+        let x974 = Self::mul_add(-c_q0, x972, s_q0 * x971);
+        let x975 = Self::mul_add(-x357, x969, Self::mul_add(x356, x968, s_q1 * x967));
+        let x976 = Self::mul_add(-x357, x972, Self::mul_add(-x356, x971, s_q1 * x970));
+        let x977 = Self::mul_add(x711, x969, Self::mul_add(-x710, x968, x709 * x967));
+        let x978 = Self::mul_add(x711, x972, Self::mul_add(x710, x971, x709 * x970));
+        let x979 = Self::mul_add(-x921, x960, Self::mul_add(-x920, x959, x919 * x958))
+            - Self::mul_add(-x918, x966, Self::mul_add(x917, x964, x916 * x962));
+        let x980 = Self::mul_add(-x924, x960, Self::mul_add(-x923, x959, x922 * x958))
+            + Self::mul_add(x840, x966, Self::mul_add(-x839, x964, x838 * x962));
+        let x981 = x847 - x898;
+        let x982 = x848 - x899;
+        let x983 = x849 - x900;
+        let x984 = x850 - x901;
+        let x985 = x851 - x902;
+        let x986 = x852 - x903;
+        let x987 = x853 - x904;
+        let x988 = x854 - x905;
+        let x989 = x855 - x906;
+        let x990 = x883 + x884 + (x887 + x888) - x945;
+        let x991 = x882 - (x881 + x889) + Self::mul_add(-x849, x856, x885) - x952;
+        let x992 = x879 + (x878 + x890) - Self::mul_add(x848, x856, x886) - x955;
+        let x993 = x882 + (x880 - x885) + Self::mul_add(x852, x857, x889) - x946;
+        let x994 = x887 - x891 + (x883 - x893) - x953;
+        let x995 = x876 + (x875 - x894) + Self::mul_add(x850, x857, x892) - x956;
+        let x996 = x879 + (x877 + x886) - Self::mul_add(x854, x858, x890) - x947;
+        let x997 = x876 - (x874 + x892) - Self::mul_add(x853, x858, -x894) - x954;
+        let x998 = x888 + x893 + (x884 + x891) - x957;
+        let x999 = Self::mul_add(x849, x864, Self::mul_add(-x848, x863, x847 * x862))
+            - Self::mul_add(x857, x882, x858 * x879) - x934;
+        let x1000 = Self::mul_add(x852, x864, Self::mul_add(-x851, x863, x850 * x862))
+            + Self::mul_add(-x856, x882, x858 * x876) - x935;
+        let x1001 = Self::mul_add(x855, x864, Self::mul_add(-x854, x863, x853 * x862))
+            + Self::mul_add(x856, x879, x857 * x876) - x936;
+        let x1002 = Self::mul_add(x711, x983, Self::mul_add(x710, x982, x709 * x981));
+        let x1003 = Self::mul_add(x711, x986, Self::mul_add(x710, x985, x709 * x984));
+        let x1004 = Self::mul_add(x711, x989, Self::mul_add(x710, x988, x709 * x987));
+        let x1005 = x709 * x990;
+        let x1006 = Self::mul_add(-x711, x996, Self::mul_add(x710, x993, x1005));
+        let x1007 = x710 * x994;
+        let x1008 = Self::mul_add(-x711, x997, Self::mul_add(x709, x991, x1007));
+        let x1009 = x711 * x998;
+        let x1010 = Self::mul_add(-x710, x995, x709 * x992) - x1009;
+        let x1011 = Self::mul_add(-x710, x1001, x711 * x1000)
+            + Self::mul_add(-x870, x983, Self::mul_add(-x869, x982, x868 * x981))
+            - Self::mul_add(-x867, x992, Self::mul_add(x866, x991, x865 * x990));
+        let x1012 = Self::mul_add(-x709, x1001, x711 * x999)
+            - Self::mul_add(-x870, x986, Self::mul_add(-x869, x985, x868 * x984))
+            + Self::mul_add(x867, x995, Self::mul_add(x866, x994, x865 * x993));
+        let x1013 = Self::mul_add(-x709, x1000, x710 * x999)
+            + Self::mul_add(-x870, x989, Self::mul_add(-x869, x988, x868 * x987))
+            + Self::mul_add(-x867, x998, Self::mul_add(x866, x997, x865 * x996));
+        let x1014 = Self::mul_add(-x873, x983, Self::mul_add(-x872, x982, x871 * x981))
+            + Self::mul_add(x711, x992, Self::mul_add(-x710, x991, x1005));
+        let x1015 = Self::mul_add(-x873, x986, Self::mul_add(-x872, x985, x871 * x984))
+            - Self::mul_add(x711, x995, Self::mul_add(-x709, x993, x1007));
+        let x1016 = Self::mul_add(-x873, x989, Self::mul_add(-x872, x988, x871 * x987))
+            - (x1009 + Self::mul_add(-x710, x997, x709 * x996));
+        let x1017 = Self::mul_add(c_q0, x1013, s_q0 * x1012);
+        let x1018 = Self::mul_add(-c_q0, x1016, s_q0 * x1015);
         let x1019 = Self::mul_add(
-            x288,
-            x1011,
-            Self::mul_add(-x287, x1010, s_q1 * x1009),
+            -x357,
+            x1013,
+            Self::mul_add(x356, x1012, s_q1 * x1011),
         );
-        let x1020 = x1019
-            + Self::mul_add(x402, x1014, Self::mul_add(-x401, x1013, x400 * x1012));
-        let x1021 = x1017
-            - Self::mul_add(x525, x1005, Self::mul_add(-x524, x1004, x523 * x1003));
-        let x1022 = x1019
-            + Self::mul_add(x525, x1014, Self::mul_add(-x524, x1013, x523 * x1012));
-        let x1023 = Self::mul_add(-x702, x982, Self::mul_add(x701, x981, x700 * x980))
-            + Self::mul_add(x705, x985, Self::mul_add(-x704, x984, x703 * x983))
-            - (Self::mul_add(x564, x993, Self::mul_add(x563, x991, x562 * x988))
-                - Self::mul_add(-x699, x996, Self::mul_add(x698, x995, x697 * x994)));
-        let x1024 = Self::mul_add(-x288, x993, Self::mul_add(-x287, x991, s_q1 * x988));
-        let x1025 = Self::mul_add(-x708, x982, Self::mul_add(x707, x981, x706 * x980))
-            + Self::mul_add(x711, x985, Self::mul_add(-x710, x984, x709 * x983))
-            - (x1024
-                + Self::mul_add(x645, x996, Self::mul_add(x644, x995, x643 * x994)));
-        let x1026 = Self::mul_add(x702, x938, Self::mul_add(x701, x937, x700 * x936))
-            - Self::mul_add(x564, x944, Self::mul_add(-x563, x942, x562 * x940));
-        let x1027 = Self::mul_add(-x288, x944, Self::mul_add(x287, x942, s_q1 * x940));
-        let x1028 = Self::mul_add(x708, x938, Self::mul_add(x707, x937, x706 * x936))
-            - x1027;
-        let x1029 = Self::mul_add(x702, x894, Self::mul_add(x701, x893, x700 * x892))
-            - Self::mul_add(x564, x900, Self::mul_add(-x563, x898, x562 * x896));
-        let x1030 = Self::mul_add(-x288, x900, Self::mul_add(x287, x898, s_q1 * x896));
-        let x1031 = Self::mul_add(x708, x894, Self::mul_add(x707, x893, x706 * x892))
-            - x1030;
-        let x1032 = x526 - x646;
-        let x1033 = x527 - x647;
-        let x1034 = x528 - x648;
-        let x1035 = x547 - x959;
-        let x1036 = x548 - x960;
-        let x1037 = x549 - x961;
-        let x1038 = x550 - x962;
-        let x1039 = x551 - x963;
-        let x1040 = x552 - x964;
-        let x1041 = x553 - x965;
-        let x1042 = x554 - x966;
-        let x1043 = x555 - x967;
-        let x1044 = x616 - x617 + x622 + (x622 - (x623 + x624)) - x968;
-        let x1045 = x606 - (x603 + (x597 - x625))
-            + (x602 - Self::mul_add(x549, x556, x618)) - x969;
-        let x1046 = x605 - (x601 - (x595 - x626))
-            + (x600 - Self::mul_add(-x548, x556, x619)) - x970;
-        let x1047 = x613 + (x614 - x615) - x765;
-        let x1048 = x610 - (x611 + x612) - x767;
-        let x1049 = x606 - (x602 - (x596 + x618))
-            + (x603 - Self::mul_add(x552, x557, x625)) - x971;
-        let x1050 = x623 - x627 + x630 + (x630 - (x616 - x631)) - x972;
-        let x1051 = x604 + (x599 - (x593 - x632))
-            + (x598 + Self::mul_add(x550, x557, x628)) - x973;
-        let x1052 = x614 + (x613 - x615) - x763;
-        let x1053 = x607 + (x608 - x609) - x768;
-        let x1054 = x605 - (x600 - (x594 + x619))
-            + (x601 + Self::mul_add(x554, x558, x626)) - x974;
-        let x1055 = x604 - (x598 - (x592 - x628))
-            - (x599 - Self::mul_add(x553, x558, -x632)) - x975;
-        let x1056 = x624 - x631 + x633 + (x633 + (x617 + x627)) - x976;
-        let x1057 = x611 - (x610 - x612) - x764;
-        let x1058 = x608 + (x607 - x609) - x766;
-        let x1059 = x613 + (x614 + x615) - x758;
-        let x1060 = x610 - (x611 - x612) - x761;
-        let x1061 = x614 + (x613 + x615) - x750;
-        let x1062 = x607 + (x608 + x609) - x762;
-        let x1063 = x611 - (x610 + x612) - x751;
-        let x1064 = x608 + (x607 + x609) - x759;
-        let x1065 = Self::mul_add(-x549, x573, Self::mul_add(x548, x572, x547 * x571))
-            + Self::mul_add(-x527, x576, x528 * x575)
-            - (Self::mul_add(-x557, x606, x558 * x605)
-                + Self::mul_add(x560, x615, x561 * x612)) - x977;
-        let x1066 = Self::mul_add(x552, x573, Self::mul_add(-x551, x572, x550 * x571))
-            + Self::mul_add(x526, x576, x528 * x574)
-            + (Self::mul_add(x556, x606, x558 * x604)
-                + Self::mul_add(-x559, x615, x561 * x609)) - x978;
-        let x1067 = Self::mul_add(x555, x573, Self::mul_add(-x554, x572, x553 * x571))
-            + Self::mul_add(x526, x575, x527 * x574)
-            - (Self::mul_add(x556, x605, x557 * x604)
-                - Self::mul_add(x559, x612, x560 * x609)) - x979;
-        let x1068 = Self::mul_add(x527, x573, x528 * x572)
-            - Self::mul_add(-x557, x615, x558 * x612) - x736;
-        let x1069 = Self::mul_add(-x526, x573, x528 * x571)
-            + Self::mul_add(x556, x615, x558 * x609) - x737;
-        let x1070 = Self::mul_add(x526, x572, x527 * x571)
-            - Self::mul_add(x556, x612, x557 * x609) - x738;
-        let x1071 = Self::mul_add(x288, x1037, Self::mul_add(x287, x1036, s_q1 * x1035))
-            - Self::mul_add(-x525, x1033, x524 * x1034);
+        let x1020 = Self::mul_add(
+            -x357,
+            x1016,
+            Self::mul_add(-x356, x1015, s_q1 * x1014),
+        );
+        let x1021 = Self::mul_add(
+            -x870,
+            x1004,
+            Self::mul_add(-x869, x1003, x868 * x1002),
+        ) - Self::mul_add(-x867, x1010, Self::mul_add(x866, x1008, x865 * x1006));
+        let x1022 = Self::mul_add(
+            -x873,
+            x1004,
+            Self::mul_add(-x872, x1003, x871 * x1002),
+        ) + Self::mul_add(x711, x1010, Self::mul_add(-x710, x1008, x709 * x1006));
+        let x1023 = Self::mul_add(-x870, x960, Self::mul_add(-x869, x959, x868 * x958))
+            - Self::mul_add(-x867, x966, Self::mul_add(x866, x964, x865 * x962));
+        let x1024 = Self::mul_add(-x873, x960, Self::mul_add(-x872, x959, x871 * x958))
+            + Self::mul_add(x711, x966, Self::mul_add(-x710, x964, x709 * x962));
+        let x1025 = x739 + x981;
+        let x1026 = x740 - x982;
+        let x1027 = x741 - x983;
+        let x1028 = x742 + x984;
+        let x1029 = x743 + x985;
+        let x1030 = x744 + x986;
+        let x1031 = x745 - x987;
+        let x1032 = x746 - x988;
+        let x1033 = x747 - x989;
+        let x1034 = x808 - x809 + x814 + (x814 - (x815 + x816)) + x990;
+        let x1035 = x795 - (x792 + (x786 - x817))
+            + (x791 - Self::mul_add(x741, x748, x810)) - x991;
+        let x1036 = x794 - (x790 - (x784 - x818))
+            + (x789 - Self::mul_add(-x740, x748, x811)) + x992;
+        let x1037 = x795 - (x791 - (x785 + x810))
+            + (x792 - Self::mul_add(x744, x749, x817)) - x993;
+        let x1038 = x815 - x821 + x824 + (x824 - (x808 - x825)) - x994;
+        let x1039 = x793 + (x788 - (x782 - x826))
+            + (x787 + Self::mul_add(x742, x749, x822)) + x995;
+        let x1040 = x794 - (x789 - (x783 + x811))
+            + (x790 + Self::mul_add(x746, x750, x818)) + x996;
+        let x1041 = x793 - (x787 - (x781 - x822))
+            - (x788 - Self::mul_add(x745, x750, -x826)) + x997;
+        let x1042 = x816 - x825 + x829 + (x829 + (x809 + x821)) - x998;
+        let x1043 = Self::mul_add(-x741, x762, Self::mul_add(x740, x761, x739 * x760))
+            + Self::mul_add(-x719, x765, x720 * x764)
+            - (Self::mul_add(-x749, x795, x750 * x794)
+                + Self::mul_add(x752, x804, x753 * x801)) + x999;
+        let x1044 = Self::mul_add(x744, x762, Self::mul_add(-x743, x761, x742 * x760))
+            + Self::mul_add(x718, x765, x720 * x763)
+            + (Self::mul_add(x748, x795, x750 * x793)
+                + Self::mul_add(-x751, x804, x753 * x798)) + x1000;
+        let x1045 = Self::mul_add(x747, x762, Self::mul_add(-x746, x761, x745 * x760))
+            + Self::mul_add(x718, x764, x719 * x763)
+            - (Self::mul_add(x748, x794, x749 * x793)
+                - Self::mul_add(x751, x801, x752 * x798)) - x1001;
+        let x1046 = Self::mul_add(x357, x1027, Self::mul_add(x356, x1026, s_q1 * x1025))
+            - Self::mul_add(-x717, x719, x716 * x720);
+        let x1047 = Self::mul_add(
+            -x357,
+            x1030,
+            Self::mul_add(-x356, x1029, s_q1 * x1028),
+        ) + Self::mul_add(-x717, x718, x715 * x720);
+        let x1048 = Self::mul_add(
+            -x357,
+            x1033,
+            Self::mul_add(-x356, x1032, s_q1 * x1031),
+        ) + Self::mul_add(-x716, x718, x715 * x719);
+        let x1049 = Self::mul_add(-x357, x719, x356 * x720);
+        let x1050 = Self::mul_add(x357, x718, s_q1 * x720);
+        let x1051 = Self::mul_add(x356, x718, s_q1 * x719);
+        let x1052 = s_q1 * x1034;
+        let x1053 = Self::mul_add(
+            x716,
+            x819,
+            Self::mul_add(x357, x1040, Self::mul_add(x356, x1037, x1052)),
+        );
+        let x1054 = Self::mul_add(-x717, x820, x1053);
+        let x1055 = x356 * x1038;
+        let x1056 = Self::mul_add(
+            -x715,
+            x827,
+            Self::mul_add(-x357, x1041, Self::mul_add(s_q1, x1035, -x1055)),
+        );
+        let x1057 = Self::mul_add(-x717, x828, x1056);
+        let x1058 = x357 * x1042;
+        let x1059 = Self::mul_add(
+            x716,
+            x831,
+            Self::mul_add(-x715, x830, Self::mul_add(x356, x1039, s_q1 * x1036) - x1058),
+        );
+        let x1060 = Self::mul_add(-x357, x833, x356 * x832);
+        let x1061 = Self::mul_add(-x357, x835, s_q1 * x834);
+        let x1062 = Self::mul_add(x356, x837, s_q1 * x836);
+        let x1063 = Self::mul_add(
+            -x767,
+            x834,
+            Self::mul_add(x639, x1036, Self::mul_add(x638, x1035, x637 * x1034)),
+        );
+        let x1064 = Self::mul_add(
+            -x766,
+            x832,
+            Self::mul_add(x639, x1039, Self::mul_add(-x638, x1038, x637 * x1037)),
+        );
+        let x1065 = Self::mul_add(
+            x766,
+            x833,
+            Self::mul_add(-x639, x1042, Self::mul_add(-x638, x1041, x637 * x1040)),
+        );
+        let x1066 = Self::mul_add(x356, x1045, x357 * x1044)
+            + Self::mul_add(x716, x807, x717 * x806)
+            + (Self::mul_add(-x771, x1027, Self::mul_add(-x770, x1026, x769 * x1025))
+                - Self::mul_add(-x719, x774, x720 * x773))
+            - Self::mul_add(x768, x836, x1063);
+        let x1067 = Self::mul_add(-s_q1, x1045, x357 * x1043)
+            + Self::mul_add(x715, x807, x717 * x805)
+            - (Self::mul_add(x771, x1030, Self::mul_add(x770, x1029, x769 * x1028))
+                - Self::mul_add(x718, x774, x720 * x772))
+            - Self::mul_add(x768, x837, x1064);
+        let x1068 = Self::mul_add(s_q1, x1044, x356 * x1043)
+            + Self::mul_add(-x715, x806, x716 * x805)
+            - (Self::mul_add(x771, x1033, Self::mul_add(x770, x1032, x769 * x1031))
+                - Self::mul_add(x718, x773, x719 * x772))
+            + Self::mul_add(x767, x835, x1065);
+        let x1069 = Self::mul_add(x356, x807, x357 * x806)
+            - Self::mul_add(-x719, x771, x720 * x770)
+            - Self::mul_add(x639, x830, x638 * x827);
+        let x1070 = Self::mul_add(-s_q1, x807, x357 * x805)
+            - Self::mul_add(-x718, x771, x720 * x769)
+            - Self::mul_add(x639, x831, x637 * x819);
+        let x1071 = Self::mul_add(s_q1, x806, x356 * x805)
+            - Self::mul_add(-x718, x770, x719 * x769)
+            - Self::mul_add(x638, x828, x637 * x820);
         let x1072 = Self::mul_add(
-            -x288,
-            x1040,
-            Self::mul_add(-x287, x1039, s_q1 * x1038),
-        ) + Self::mul_add(-x525, x1032, x523 * x1034);
+            x716,
+            x834,
+            Self::mul_add(-x357, x1036, Self::mul_add(-x356, x1035, x1052)),
+        );
         let x1073 = Self::mul_add(
-            -x288,
-            x1043,
-            Self::mul_add(-x287, x1042, s_q1 * x1041),
-        ) + Self::mul_add(-x524, x1032, x523 * x1033);
-        let x1074 = Self::mul_add(-x288, x1033, x287 * x1034);
-        let x1075 = Self::mul_add(x288, x1032, s_q1 * x1034);
-        let x1076 = Self::mul_add(x287, x1032, s_q1 * x1033);
-        let x1077 = s_q1 * x1044;
-        let x1078 = Self::mul_add(
-            x524,
-            x1061,
-            Self::mul_add(x288, x1054, Self::mul_add(x287, x1049, x1077)),
+            x715,
+            x832,
+            Self::mul_add(-x357, x1039, Self::mul_add(s_q1, x1037, x1055)),
         );
-        let x1079 = Self::mul_add(-x525, x1063, x1078);
-        let x1080 = x287 * x1050;
-        let x1081 = Self::mul_add(
-            -x523,
-            x1059,
-            Self::mul_add(-x288, x1055, Self::mul_add(s_q1, x1045, -x1080)),
+        let x1074 = Self::mul_add(
+            -x716,
+            x835,
+            Self::mul_add(-x715, x833, x1058 + Self::mul_add(x356, x1041, s_q1 * x1040)),
         );
-        let x1082 = Self::mul_add(-x525, x1064, x1081);
-        let x1083 = x288 * x1056;
-        let x1084 = Self::mul_add(
-            x524,
-            x1062,
-            Self::mul_add(-x523, x1060, Self::mul_add(x287, x1051, s_q1 * x1046) - x1083),
+        let x1075 = Self::mul_add(
+            -x777,
+            x1027,
+            Self::mul_add(-x776, x1026, x775 * x1025),
+        ) - Self::mul_add(-x719, x780, x720 * x779) - Self::mul_add(x717, x836, x1072);
+        let x1076 = Self::mul_add(x777, x1030, Self::mul_add(x776, x1029, x775 * x1028))
+            - Self::mul_add(x718, x780, x720 * x778) + Self::mul_add(x717, x837, x1073);
+        let x1077 = Self::mul_add(x777, x1033, Self::mul_add(x776, x1032, x775 * x1031))
+            - Self::mul_add(x718, x779, x719 * x778) - x1074;
+        let x1078 = Self::mul_add(-x719, x777, x720 * x776)
+            - Self::mul_add(x357, x830, x356 * x827);
+        let x1079 = Self::mul_add(-x718, x777, x720 * x775)
+            + Self::mul_add(-x357, x831, s_q1 * x819);
+        let x1080 = Self::mul_add(-x718, x776, x719 * x775)
+            + Self::mul_add(-x356, x828, s_q1 * x820);
+        let x1081 = Self::mul_add(c_q0, x1068, s_q0 * x1067)
+            - Self::mul_add(-x362, x1071, Self::mul_add(x361, x1070, x360 * x1069));
+        let x1082 = Self::mul_add(c_q0, x1077, s_q0 * x1076)
+            - Self::mul_add(-x362, x1080, Self::mul_add(x361, x1079, x360 * x1078));
+        let x1083 = Self::mul_add(
+            -x357,
+            x1068,
+            Self::mul_add(x356, x1067, s_q1 * x1066),
         );
-        let x1085 = Self::mul_add(-x288, x1057, x287 * x1052);
-        let x1086 = Self::mul_add(-x288, x1058, s_q1 * x1047);
-        let x1087 = Self::mul_add(x287, x1053, s_q1 * x1048);
-        let x1088 = Self::mul_add(
-            -x578,
-            x1047,
-            Self::mul_add(x441, x1046, Self::mul_add(x440, x1045, x439 * x1044)),
+        let x1084 = x1083
+            - Self::mul_add(x471, x1071, Self::mul_add(-x470, x1070, x469 * x1069));
+        let x1085 = Self::mul_add(
+            x357,
+            x1077,
+            Self::mul_add(-x356, x1076, s_q1 * x1075),
         );
-        let x1089 = Self::mul_add(
-            -x577,
-            x1052,
-            Self::mul_add(x441, x1051, Self::mul_add(-x440, x1050, x439 * x1049)),
-        );
+        let x1086 = x1085
+            + Self::mul_add(x471, x1080, Self::mul_add(-x470, x1079, x469 * x1078));
+        let x1087 = x1083
+            - Self::mul_add(x597, x1071, Self::mul_add(-x596, x1070, x595 * x1069));
+        let x1088 = x1085
+            + Self::mul_add(x597, x1080, Self::mul_add(-x596, x1079, x595 * x1078));
+        let x1089 = Self::mul_add(-x771, x1048, Self::mul_add(x770, x1047, x769 * x1046))
+            + Self::mul_add(x774, x1051, Self::mul_add(-x773, x1050, x772 * x1049))
+            - (Self::mul_add(x639, x1059, Self::mul_add(x638, x1057, x637 * x1054))
+                - Self::mul_add(-x768, x1062, Self::mul_add(x767, x1061, x766 * x1060)));
         let x1090 = Self::mul_add(
-            x577,
-            x1057,
-            Self::mul_add(-x441, x1056, Self::mul_add(-x440, x1055, x439 * x1054)),
+            -x357,
+            x1059,
+            Self::mul_add(-x356, x1057, s_q1 * x1054),
         );
-        let x1091 = Self::mul_add(x287, x1067, x288 * x1066)
-            + Self::mul_add(x524, x1070, x525 * x1069)
-            + (Self::mul_add(-x582, x1037, Self::mul_add(-x581, x1036, x580 * x1035))
-                - Self::mul_add(-x585, x1033, x584 * x1034))
-            - Self::mul_add(x579, x1048, x1088);
-        let x1092 = Self::mul_add(-s_q1, x1067, x288 * x1065)
-            + Self::mul_add(x523, x1070, x525 * x1068)
-            - (Self::mul_add(x582, x1040, Self::mul_add(x581, x1039, x580 * x1038))
-                - Self::mul_add(x585, x1032, x583 * x1034))
-            - Self::mul_add(x579, x1053, x1089);
-        let x1093 = Self::mul_add(s_q1, x1066, x287 * x1065)
-            + Self::mul_add(-x523, x1069, x524 * x1068)
-            - (Self::mul_add(x582, x1043, Self::mul_add(x581, x1042, x580 * x1041))
-                - Self::mul_add(x584, x1032, x583 * x1033))
-            + Self::mul_add(x578, x1058, x1090);
-        let x1094 = Self::mul_add(x287, x1070, x288 * x1069)
-            - Self::mul_add(-x582, x1033, x581 * x1034)
-            - Self::mul_add(x441, x1060, x440 * x1059);
-        let x1095 = Self::mul_add(-s_q1, x1070, x288 * x1068)
-            - Self::mul_add(-x582, x1032, x580 * x1034)
-            - Self::mul_add(x441, x1062, x439 * x1061);
-        let x1096 = Self::mul_add(s_q1, x1069, x287 * x1068)
-            - Self::mul_add(-x581, x1032, x580 * x1033)
-            - Self::mul_add(x440, x1064, x439 * x1063);
-        let x1097 = Self::mul_add(
-            x524,
-            x1047,
-            Self::mul_add(-x288, x1046, Self::mul_add(-x287, x1045, x1077)),
+        let x1091 = Self::mul_add(-x777, x1048, Self::mul_add(x776, x1047, x775 * x1046))
+            + Self::mul_add(x780, x1051, Self::mul_add(-x779, x1050, x778 * x1049))
+            - (x1090
+                + Self::mul_add(x717, x1062, Self::mul_add(x716, x1061, x715 * x1060)));
+        let x1092 = Self::mul_add(x771, x1004, Self::mul_add(x770, x1003, x769 * x1002))
+            - Self::mul_add(x639, x1010, Self::mul_add(-x638, x1008, x637 * x1006));
+        let x1093 = Self::mul_add(
+            -x357,
+            x1010,
+            Self::mul_add(x356, x1008, s_q1 * x1006),
         );
-        let x1098 = Self::mul_add(
-            x523,
-            x1052,
-            Self::mul_add(-x288, x1051, Self::mul_add(s_q1, x1049, x1080)),
-        );
-        let x1099 = Self::mul_add(
-            -x524,
-            x1058,
-            Self::mul_add(-x523, x1057, x1083 + Self::mul_add(x287, x1055, s_q1 * x1054)),
-        );
-        let x1100 = Self::mul_add(
-            -x588,
-            x1037,
-            Self::mul_add(-x587, x1036, x586 * x1035),
-        ) - Self::mul_add(-x591, x1033, x590 * x1034)
-            - Self::mul_add(x525, x1048, x1097);
-        let x1101 = Self::mul_add(x588, x1040, Self::mul_add(x587, x1039, x586 * x1038))
-            - Self::mul_add(x591, x1032, x589 * x1034)
-            + Self::mul_add(x525, x1053, x1098);
-        let x1102 = Self::mul_add(x588, x1043, Self::mul_add(x587, x1042, x586 * x1041))
-            - Self::mul_add(x590, x1032, x589 * x1033) - x1099;
-        let x1103 = Self::mul_add(-x588, x1033, x587 * x1034)
-            - Self::mul_add(x288, x1060, x287 * x1059);
-        let x1104 = Self::mul_add(-x588, x1032, x586 * x1034)
-            + Self::mul_add(-x288, x1062, s_q1 * x1061);
-        let x1105 = Self::mul_add(-x587, x1032, x586 * x1033)
-            + Self::mul_add(-x287, x1064, s_q1 * x1063);
-        let x1106 = Self::mul_add(c_q0, x1093, s_q0 * x1092)
-            - Self::mul_add(-x293, x1096, Self::mul_add(x292, x1095, x291 * x1094));
-        let x1107 = Self::mul_add(c_q0, x1102, s_q0 * x1101)
-            - Self::mul_add(-x293, x1105, Self::mul_add(x292, x1104, x291 * x1103));
-        let x1108 = Self::mul_add(-x288, x1093, Self::mul_add(x287, x1092, s_q1 * x1091))
-            - Self::mul_add(x402, x1096, Self::mul_add(-x401, x1095, x400 * x1094));
-        let x1109 = Self::mul_add(x288, x1102, Self::mul_add(-x287, x1101, s_q1 * x1100))
-            + Self::mul_add(x402, x1105, Self::mul_add(-x401, x1104, x400 * x1103));
-        let x1110 = Self::mul_add(-x582, x1073, Self::mul_add(x581, x1072, x580 * x1071))
-            + Self::mul_add(x585, x1076, Self::mul_add(-x584, x1075, x583 * x1074))
-            - (Self::mul_add(x441, x1084, Self::mul_add(x440, x1082, x439 * x1079))
-                - Self::mul_add(-x579, x1087, Self::mul_add(x578, x1086, x577 * x1085)));
-        let x1111 = Self::mul_add(
-            -x288,
-            x1084,
-            Self::mul_add(-x287, x1082, s_q1 * x1079),
-        );
-        let x1112 = Self::mul_add(-x588, x1073, Self::mul_add(x587, x1072, x586 * x1071))
-            + Self::mul_add(x591, x1076, Self::mul_add(-x590, x1075, x589 * x1074))
-            - (x1111
-                + Self::mul_add(x525, x1087, Self::mul_add(x524, x1086, x523 * x1085)));
-        let x1113 = Self::mul_add(-x582, x982, Self::mul_add(x581, x981, x580 * x980))
-            + Self::mul_add(x585, x985, Self::mul_add(-x584, x984, x583 * x983))
-            - (Self::mul_add(x441, x993, Self::mul_add(x440, x991, x439 * x988))
-                - Self::mul_add(-x579, x996, Self::mul_add(x578, x995, x577 * x994)));
-        let x1114 = Self::mul_add(-x588, x982, Self::mul_add(x587, x981, x586 * x980))
-            + Self::mul_add(x591, x985, Self::mul_add(-x590, x984, x589 * x983))
-            - (x1024
-                + Self::mul_add(x525, x996, Self::mul_add(x524, x995, x523 * x994)));
-        let x1115 = Self::mul_add(x582, x938, Self::mul_add(x581, x937, x580 * x936))
-            - Self::mul_add(x441, x944, Self::mul_add(-x440, x942, x439 * x940));
-        let x1116 = x1027
-            - Self::mul_add(x588, x938, Self::mul_add(x587, x937, x586 * x936));
-        let x1117 = Self::mul_add(x582, x894, Self::mul_add(x581, x893, x580 * x892))
-            - Self::mul_add(x441, x900, Self::mul_add(-x440, x898, x439 * x896));
-        let x1118 = x1030
-            - Self::mul_add(x588, x894, Self::mul_add(x587, x893, x586 * x892));
-        let x1119 = x403 + x1032;
-        let x1120 = x404 + x1033;
-        let x1121 = x405 + x1034;
-        let x1122 = x424 + x1035;
-        let x1123 = x425 + x1036;
-        let x1124 = x426 + x1037;
-        let x1125 = x427 + x1038;
-        let x1126 = x428 + x1039;
-        let x1127 = x429 + x1040;
-        let x1128 = x430 + x1041;
-        let x1129 = x431 + x1042;
-        let x1130 = x432 + x1043;
-        let x1131 = x496 - x497 + x502 + (x502 - (x503 + x504)) + x1044;
-        let x1132 = x486 - (x483 + (x477 - x505))
-            + (x482 - Self::mul_add(x426, x433, x498)) + x1045;
-        let x1133 = x485 - (x481 - (x475 - x506))
-            + (x480 - Self::mul_add(-x425, x433, x499)) + x1046;
-        let x1134 = x493 + (x494 - x495) + x1047;
-        let x1135 = x490 - (x491 + x492) + x1048;
-        let x1136 = x486 - (x482 - (x476 + x498))
-            + (x483 - Self::mul_add(x429, x434, x505)) + x1049;
-        let x1137 = x503 - x507 + x510 + (x510 - (x496 - x511)) + x1050;
-        let x1138 = x484 + (x479 - (x473 - x512))
-            + (x478 + Self::mul_add(x427, x434, x508)) + x1051;
-        let x1139 = x494 + (x493 - x495) + x1052;
-        let x1140 = x487 + (x488 - x489) + x1053;
-        let x1141 = x485 - (x480 - (x474 + x499))
-            + (x481 + Self::mul_add(x431, x435, x506)) + x1054;
-        let x1142 = x484 - (x478 - (x472 - x508))
-            - (x479 - Self::mul_add(x430, x435, -x512)) + x1055;
-        let x1143 = x504 - x511 + x513 + (x513 + (x497 + x507)) + x1056;
-        let x1144 = x491 - (x490 - x492) + x1057;
-        let x1145 = x488 + (x487 - x489) + x1058;
-        let x1146 = x493 + (x494 + x495) + x1059;
-        let x1147 = x490 - (x491 - x492) + x1060;
-        let x1148 = x494 + (x493 + x495) + x1061;
-        let x1149 = x487 + (x488 + x489) + x1062;
-        let x1150 = x491 - (x490 + x492) + x1063;
-        let x1151 = x488 + (x487 + x489) + x1064;
-        let x1152 = Self::mul_add(-x426, x450, Self::mul_add(x425, x449, x424 * x448))
-            + Self::mul_add(-x404, x453, x405 * x452)
-            - (Self::mul_add(-x434, x486, x435 * x485)
-                + Self::mul_add(x437, x495, x438 * x492)) + x1065;
-        let x1153 = Self::mul_add(x429, x450, Self::mul_add(-x428, x449, x427 * x448))
-            + Self::mul_add(x403, x453, x405 * x451)
-            + (Self::mul_add(x433, x486, x435 * x484)
-                + Self::mul_add(-x436, x495, x438 * x489)) + x1066;
-        let x1154 = Self::mul_add(x432, x450, Self::mul_add(-x431, x449, x430 * x448))
-            + Self::mul_add(x403, x452, x404 * x451)
-            - (Self::mul_add(x433, x485, x434 * x484)
-                - Self::mul_add(x436, x492, x437 * x489)) + x1067;
-        let x1155 = Self::mul_add(x404, x450, x405 * x449)
-            - Self::mul_add(-x434, x495, x435 * x492) + x1068;
-        let x1156 = Self::mul_add(-x403, x450, x405 * x448)
-            + Self::mul_add(x433, x495, x435 * x489) + x1069;
-        let x1157 = Self::mul_add(x403, x449, x404 * x448)
-            - Self::mul_add(x433, x492, x434 * x489) + x1070;
-        let x1158 = Self::mul_add(x288, x1124, Self::mul_add(x287, x1123, s_q1 * x1122))
-            - Self::mul_add(-x402, x1120, x401 * x1121);
-        let x1159 = Self::mul_add(
-            -x288,
+        let x1094 = Self::mul_add(x777, x1004, Self::mul_add(x776, x1003, x775 * x1002))
+            - x1093;
+        let x1095 = Self::mul_add(x771, x960, Self::mul_add(x770, x959, x769 * x958))
+            - Self::mul_add(x639, x966, Self::mul_add(-x638, x964, x637 * x962));
+        let x1096 = Self::mul_add(-x357, x966, Self::mul_add(x356, x964, s_q1 * x962));
+        let x1097 = Self::mul_add(x777, x960, Self::mul_add(x776, x959, x775 * x958))
+            - x1096;
+        let x1098 = x598 - x718;
+        let x1099 = x599 - x719;
+        let x1100 = x600 - x720;
+        let x1101 = x622 - x1025;
+        let x1102 = x623 - x1026;
+        let x1103 = x624 - x1027;
+        let x1104 = x625 - x1028;
+        let x1105 = x626 - x1029;
+        let x1106 = x627 - x1030;
+        let x1107 = x628 - x1031;
+        let x1108 = x629 - x1032;
+        let x1109 = x630 - x1033;
+        let x1110 = x691 - x692 + x697 + (x697 - (x698 + x699)) - x1034;
+        let x1111 = x681 - (x678 + (x672 - x700))
+            + (x677 - Self::mul_add(x624, x631, x693)) - x1035;
+        let x1112 = x680 - (x676 - (x670 - x701))
+            + (x675 - Self::mul_add(-x623, x631, x694)) - x1036;
+        let x1113 = x688 + (x689 - x690) - x834;
+        let x1114 = x685 - (x686 + x687) - x836;
+        let x1115 = x681 - (x677 - (x671 + x693))
+            + (x678 - Self::mul_add(x627, x632, x700)) - x1037;
+        let x1116 = x698 - x702 + x705 + (x705 - (x691 - x706)) - x1038;
+        let x1117 = x679 + (x674 - (x668 - x707))
+            + (x673 + Self::mul_add(x625, x632, x703)) - x1039;
+        let x1118 = x689 + (x688 - x690) - x832;
+        let x1119 = x682 + (x683 - x684) - x837;
+        let x1120 = x680 - (x675 - (x669 + x694))
+            + (x676 + Self::mul_add(x629, x633, x701)) - x1040;
+        let x1121 = x679 - (x673 - (x667 - x703))
+            - (x674 - Self::mul_add(x628, x633, -x707)) - x1041;
+        let x1122 = x699 - x706 + x708 + (x708 + (x692 + x702)) - x1042;
+        let x1123 = x686 - (x685 - x687) - x833;
+        let x1124 = x683 + (x682 - x684) - x835;
+        let x1125 = x688 + (x689 + x690) - x827;
+        let x1126 = x685 - (x686 - x687) - x830;
+        let x1127 = x689 + (x688 + x690) - x819;
+        let x1128 = x682 + (x683 + x684) - x831;
+        let x1129 = x686 - (x685 + x687) - x820;
+        let x1130 = x683 + (x682 + x684) - x828;
+        let x1131 = Self::mul_add(-x624, x648, Self::mul_add(x623, x647, x622 * x646))
+            + Self::mul_add(-x599, x651, x600 * x650)
+            - (Self::mul_add(-x632, x681, x633 * x680)
+                + Self::mul_add(x635, x690, x636 * x687)) - x1043;
+        let x1132 = Self::mul_add(x627, x648, Self::mul_add(-x626, x647, x625 * x646))
+            + Self::mul_add(x598, x651, x600 * x649)
+            + (Self::mul_add(x631, x681, x633 * x679)
+                + Self::mul_add(-x634, x690, x636 * x684)) - x1044;
+        let x1133 = Self::mul_add(x630, x648, Self::mul_add(-x629, x647, x628 * x646))
+            + Self::mul_add(x598, x650, x599 * x649)
+            - (Self::mul_add(x631, x680, x632 * x679)
+                - Self::mul_add(x634, x687, x635 * x684)) - x1045;
+        let x1134 = Self::mul_add(x599, x648, x600 * x647)
+            - Self::mul_add(-x632, x690, x633 * x687) - x805;
+        let x1135 = Self::mul_add(-x598, x648, x600 * x646)
+            + Self::mul_add(x631, x690, x633 * x684) - x806;
+        let x1136 = Self::mul_add(x598, x647, x599 * x646)
+            - Self::mul_add(x631, x687, x632 * x684) - x807;
+        let x1137 = Self::mul_add(x357, x1103, Self::mul_add(x356, x1102, s_q1 * x1101))
+            - Self::mul_add(-x597, x1099, x596 * x1100);
+        let x1138 = Self::mul_add(
+            -x357,
+            x1106,
+            Self::mul_add(-x356, x1105, s_q1 * x1104),
+        ) + Self::mul_add(-x597, x1098, x595 * x1100);
+        let x1139 = Self::mul_add(
+            -x357,
+            x1109,
+            Self::mul_add(-x356, x1108, s_q1 * x1107),
+        ) + Self::mul_add(-x596, x1098, x595 * x1099);
+        let x1140 = Self::mul_add(-x357, x1099, x356 * x1100);
+        let x1141 = Self::mul_add(x357, x1098, s_q1 * x1100);
+        let x1142 = Self::mul_add(x356, x1098, s_q1 * x1099);
+        let x1143 = s_q1 * x1110;
+        let x1144 = Self::mul_add(
+            x596,
             x1127,
-            Self::mul_add(-x287, x1126, s_q1 * x1125),
-        ) + Self::mul_add(-x402, x1119, x400 * x1121);
-        let x1160 = Self::mul_add(
-            -x288,
-            x1130,
-            Self::mul_add(-x287, x1129, s_q1 * x1128),
-        ) + Self::mul_add(-x401, x1119, x400 * x1120);
-        let x1161 = Self::mul_add(-x288, x1120, x287 * x1121);
-        let x1162 = Self::mul_add(x288, x1119, s_q1 * x1121);
-        let x1163 = Self::mul_add(x287, x1119, s_q1 * x1120);
-        let x1164 = s_q1 * x1131;
+            Self::mul_add(x357, x1120, Self::mul_add(x356, x1115, x1143)),
+        );
+        let x1145 = Self::mul_add(-x597, x1129, x1144);
+        let x1146 = x356 * x1116;
+        let x1147 = Self::mul_add(
+            -x595,
+            x1125,
+            Self::mul_add(-x357, x1121, Self::mul_add(s_q1, x1111, -x1146)),
+        );
+        let x1148 = Self::mul_add(-x597, x1130, x1147);
+        let x1149 = x357 * x1122;
+        let x1150 = Self::mul_add(
+            x596,
+            x1128,
+            Self::mul_add(-x595, x1126, Self::mul_add(x356, x1117, s_q1 * x1112) - x1149),
+        );
+        let x1151 = Self::mul_add(-x357, x1123, x356 * x1118);
+        let x1152 = Self::mul_add(-x357, x1124, s_q1 * x1113);
+        let x1153 = Self::mul_add(x356, x1119, s_q1 * x1114);
+        let x1154 = Self::mul_add(
+            -x653,
+            x1113,
+            Self::mul_add(x513, x1112, Self::mul_add(x512, x1111, x511 * x1110)),
+        );
+        let x1155 = Self::mul_add(
+            -x652,
+            x1118,
+            Self::mul_add(x513, x1117, Self::mul_add(-x512, x1116, x511 * x1115)),
+        );
+        let x1156 = Self::mul_add(
+            x652,
+            x1123,
+            Self::mul_add(-x513, x1122, Self::mul_add(-x512, x1121, x511 * x1120)),
+        );
+        let x1157 = Self::mul_add(x356, x1133, x357 * x1132)
+            + Self::mul_add(x596, x1136, x597 * x1135)
+            + (Self::mul_add(-x657, x1103, Self::mul_add(-x656, x1102, x655 * x1101))
+                - Self::mul_add(-x660, x1099, x659 * x1100))
+            - Self::mul_add(x654, x1114, x1154);
+        let x1158 = Self::mul_add(-s_q1, x1133, x357 * x1131)
+            + Self::mul_add(x595, x1136, x597 * x1134)
+            - (Self::mul_add(x657, x1106, Self::mul_add(x656, x1105, x655 * x1104))
+                - Self::mul_add(x660, x1098, x658 * x1100))
+            - Self::mul_add(x654, x1119, x1155);
+        let x1159 = Self::mul_add(s_q1, x1132, x356 * x1131)
+            + Self::mul_add(-x595, x1135, x596 * x1134)
+            - (Self::mul_add(x657, x1109, Self::mul_add(x656, x1108, x655 * x1107))
+                - Self::mul_add(x659, x1098, x658 * x1099))
+            + Self::mul_add(x653, x1124, x1156);
+        let x1160 = Self::mul_add(x356, x1136, x357 * x1135)
+            - Self::mul_add(-x657, x1099, x656 * x1100)
+            - Self::mul_add(x513, x1126, x512 * x1125);
+        let x1161 = Self::mul_add(-s_q1, x1136, x357 * x1134)
+            - Self::mul_add(-x657, x1098, x655 * x1100)
+            - Self::mul_add(x513, x1128, x511 * x1127);
+        let x1162 = Self::mul_add(s_q1, x1135, x356 * x1134)
+            - Self::mul_add(-x656, x1098, x655 * x1099)
+            - Self::mul_add(x512, x1130, x511 * x1129);
+        let x1163 = Self::mul_add(
+            x596,
+            x1113,
+            Self::mul_add(-x357, x1112, Self::mul_add(-x356, x1111, x1143)),
+        );
+        let x1164 = Self::mul_add(
+            x595,
+            x1118,
+            Self::mul_add(-x357, x1117, Self::mul_add(s_q1, x1115, x1146)),
+        );
         let x1165 = Self::mul_add(
-            x401,
-            x1148,
-            Self::mul_add(x288, x1141, Self::mul_add(x287, x1136, x1164)),
-        );
-        let x1166 = Self::mul_add(-x402, x1150, x1165);
-        let x1167 = x287 * x1137;
-        let x1168 = Self::mul_add(
-            -x400,
-            x1146,
-            Self::mul_add(-x288, x1142, Self::mul_add(s_q1, x1132, -x1167)),
-        );
-        let x1169 = Self::mul_add(-x402, x1151, x1168);
-        let x1170 = x288 * x1143;
-        let x1171 = Self::mul_add(
-            x401,
-            x1149,
-            Self::mul_add(-x400, x1147, Self::mul_add(x287, x1138, s_q1 * x1133) - x1170),
-        );
-        let x1172 = Self::mul_add(-x288, x1144, x287 * x1139);
-        let x1173 = Self::mul_add(-x288, x1145, s_q1 * x1134);
-        let x1174 = Self::mul_add(x287, x1140, s_q1 * x1135);
-        let x1175 = Self::mul_add(
-            x458,
-            x1134,
-            Self::mul_add(x456, x1133, Self::mul_add(x455, x1132, x454 * x1131)),
-        );
-        let x1176 = Self::mul_add(
-            -x457,
-            x1139,
-            Self::mul_add(x456, x1138, Self::mul_add(-x455, x1137, x454 * x1136)),
-        );
-        let x1177 = Self::mul_add(
-            x457,
-            x1144,
-            Self::mul_add(-x456, x1143, Self::mul_add(-x455, x1142, x454 * x1141)),
-        );
-        let x1178 = Self::mul_add(x287, x1154, x288 * x1153)
-            + Self::mul_add(x401, x1157, x402 * x1156)
-            + (Self::mul_add(-x462, x1124, Self::mul_add(-x461, x1123, x460 * x1122))
-                - Self::mul_add(-x465, x1120, x464 * x1121))
-            - Self::mul_add(x459, x1135, x1175);
-        let x1179 = Self::mul_add(
-            x401,
-            x1134,
-            Self::mul_add(-x288, x1133, Self::mul_add(-x287, x1132, x1164)),
-        );
-        let x1180 = Self::mul_add(
-            x400,
-            x1139,
-            Self::mul_add(-x288, x1138, Self::mul_add(s_q1, x1136, x1167)),
-        );
-        let x1181 = Self::mul_add(
-            -x401,
-            x1145,
-            Self::mul_add(-x400, x1144, x1170 + Self::mul_add(x287, x1142, s_q1 * x1141)),
-        );
-        let x1182 = Self::mul_add(
-            -x468,
+            -x596,
             x1124,
-            Self::mul_add(-x467, x1123, x466 * x1122),
-        ) - Self::mul_add(-x471, x1120, x470 * x1121)
-            - Self::mul_add(x402, x1135, x1179);
-        let x1183 = Self::mul_add(
+            Self::mul_add(-x595, x1123, x1149 + Self::mul_add(x356, x1121, s_q1 * x1120)),
+        );
+        let x1166 = Self::mul_add(
+            -x663,
+            x1103,
+            Self::mul_add(-x662, x1102, x661 * x1101),
+        ) - Self::mul_add(-x666, x1099, x665 * x1100)
+            - Self::mul_add(x597, x1114, x1163);
+        let x1167 = Self::mul_add(x663, x1106, Self::mul_add(x662, x1105, x661 * x1104))
+            - Self::mul_add(x666, x1098, x664 * x1100)
+            + Self::mul_add(x597, x1119, x1164);
+        let x1168 = Self::mul_add(x663, x1109, Self::mul_add(x662, x1108, x661 * x1107))
+            - Self::mul_add(x665, x1098, x664 * x1099) - x1165;
+        let x1169 = Self::mul_add(-x663, x1099, x662 * x1100)
+            - Self::mul_add(x357, x1126, x356 * x1125);
+        let x1170 = Self::mul_add(-x663, x1098, x661 * x1100)
+            + Self::mul_add(-x357, x1128, s_q1 * x1127);
+        let x1171 = Self::mul_add(-x662, x1098, x661 * x1099)
+            + Self::mul_add(-x356, x1130, s_q1 * x1129);
+        let x1172 = Self::mul_add(c_q0, x1159, s_q0 * x1158)
+            - Self::mul_add(-x362, x1162, Self::mul_add(x361, x1161, x360 * x1160));
+        let x1173 = Self::mul_add(c_q0, x1168, s_q0 * x1167)
+            - Self::mul_add(-x362, x1171, Self::mul_add(x361, x1170, x360 * x1169));
+        let x1174 = Self::mul_add(-x357, x1159, Self::mul_add(x356, x1158, s_q1 * x1157))
+            - Self::mul_add(x471, x1162, Self::mul_add(-x470, x1161, x469 * x1160));
+        let x1175 = Self::mul_add(x357, x1168, Self::mul_add(-x356, x1167, s_q1 * x1166))
+            + Self::mul_add(x471, x1171, Self::mul_add(-x470, x1170, x469 * x1169));
+        let x1176 = Self::mul_add(-x657, x1139, Self::mul_add(x656, x1138, x655 * x1137))
+            + Self::mul_add(x660, x1142, Self::mul_add(-x659, x1141, x658 * x1140))
+            - (Self::mul_add(x513, x1150, Self::mul_add(x512, x1148, x511 * x1145))
+                - Self::mul_add(-x654, x1153, Self::mul_add(x653, x1152, x652 * x1151)));
+        let x1177 = Self::mul_add(
+            -x357,
+            x1150,
+            Self::mul_add(-x356, x1148, s_q1 * x1145),
+        );
+        let x1178 = Self::mul_add(-x663, x1139, Self::mul_add(x662, x1138, x661 * x1137))
+            + Self::mul_add(x666, x1142, Self::mul_add(-x665, x1141, x664 * x1140))
+            - (x1177
+                + Self::mul_add(x597, x1153, Self::mul_add(x596, x1152, x595 * x1151)));
+        let x1179 = Self::mul_add(-x657, x1048, Self::mul_add(x656, x1047, x655 * x1046))
+            + Self::mul_add(x660, x1051, Self::mul_add(-x659, x1050, x658 * x1049))
+            - (Self::mul_add(x513, x1059, Self::mul_add(x512, x1057, x511 * x1054))
+                - Self::mul_add(-x654, x1062, Self::mul_add(x653, x1061, x652 * x1060)));
+        let x1180 = Self::mul_add(-x663, x1048, Self::mul_add(x662, x1047, x661 * x1046))
+            + Self::mul_add(x666, x1051, Self::mul_add(-x665, x1050, x664 * x1049))
+            - (x1090
+                + Self::mul_add(x597, x1062, Self::mul_add(x596, x1061, x595 * x1060)));
+        let x1181 = Self::mul_add(x657, x1004, Self::mul_add(x656, x1003, x655 * x1002))
+            - Self::mul_add(x513, x1010, Self::mul_add(-x512, x1008, x511 * x1006));
+        let x1182 = x1093
+            - Self::mul_add(x663, x1004, Self::mul_add(x662, x1003, x661 * x1002));
+        let x1183 = Self::mul_add(x657, x960, Self::mul_add(x656, x959, x655 * x958))
+            - Self::mul_add(x513, x966, Self::mul_add(-x512, x964, x511 * x962));
+        let x1184 = x1096
+            - Self::mul_add(x663, x960, Self::mul_add(x662, x959, x661 * x958));
+        let x1185 = x472 + x1098;
+        let x1186 = x473 + x1099;
+        let x1187 = x474 + x1100;
+        let x1188 = x496 + x1101;
+        let x1189 = x497 + x1102;
+        let x1190 = x498 + x1103;
+        let x1191 = x499 + x1104;
+        let x1192 = x500 + x1105;
+        let x1193 = x501 + x1106;
+        let x1194 = x502 + x1107;
+        let x1195 = x503 + x1108;
+        let x1196 = x504 + x1109;
+        let x1197 = x568 - x569 + x574 + (x574 - (x575 + x576)) + x1110;
+        let x1198 = x558 - (x555 + (x549 - x577))
+            + (x554 - Self::mul_add(x498, x505, x570)) + x1111;
+        let x1199 = x557 - (x553 - (x547 - x578))
+            + (x552 - Self::mul_add(-x497, x505, x571)) + x1112;
+        let x1200 = x565 + (x566 - x567) + x1113;
+        let x1201 = x562 - (x563 + x564) + x1114;
+        let x1202 = x558 - (x554 - (x548 + x570))
+            + (x555 - Self::mul_add(x501, x506, x577)) + x1115;
+        let x1203 = x575 - x579 + x582 + (x582 - (x568 - x583)) + x1116;
+        let x1204 = x556 + (x551 - (x545 - x584))
+            + (x550 + Self::mul_add(x499, x506, x580)) + x1117;
+        let x1205 = x566 + (x565 - x567) + x1118;
+        let x1206 = x559 + (x560 - x561) + x1119;
+        let x1207 = x557 - (x552 - (x546 + x571))
+            + (x553 + Self::mul_add(x503, x507, x578)) + x1120;
+        let x1208 = x556 - (x550 - (x544 - x580))
+            - (x551 - Self::mul_add(x502, x507, -x584)) + x1121;
+        let x1209 = x576 - x583 + x585 + (x585 + (x569 + x579)) + x1122;
+        let x1210 = x563 - (x562 - x564) + x1123;
+        let x1211 = x560 + (x559 - x561) + x1124;
+        let x1212 = x565 + (x566 + x567) + x1125;
+        let x1213 = x562 - (x563 - x564) + x1126;
+        let x1214 = x566 + (x565 + x567) + x1127;
+        let x1215 = x559 + (x560 + x561) + x1128;
+        let x1216 = x563 - (x562 + x564) + x1129;
+        let x1217 = x560 + (x559 + x561) + x1130;
+        let x1218 = Self::mul_add(-x498, x522, Self::mul_add(x497, x521, x496 * x520))
+            + Self::mul_add(-x473, x525, x474 * x524)
+            - (Self::mul_add(-x506, x558, x507 * x557)
+                + Self::mul_add(x509, x567, x510 * x564)) + x1131;
+        let x1219 = Self::mul_add(x501, x522, Self::mul_add(-x500, x521, x499 * x520))
+            + Self::mul_add(x472, x525, x474 * x523)
+            + (Self::mul_add(x505, x558, x507 * x556)
+                + Self::mul_add(-x508, x567, x510 * x561)) + x1132;
+        let x1220 = Self::mul_add(x504, x522, Self::mul_add(-x503, x521, x502 * x520))
+            + Self::mul_add(x472, x524, x473 * x523)
+            - (Self::mul_add(x505, x557, x506 * x556)
+                - Self::mul_add(x508, x564, x509 * x561)) + x1133;
+        let x1221 = Self::mul_add(x473, x522, x474 * x521)
+            - Self::mul_add(-x506, x567, x507 * x564) + x1134;
+        let x1222 = Self::mul_add(-x472, x522, x474 * x520)
+            + Self::mul_add(x505, x567, x507 * x561) + x1135;
+        let x1223 = Self::mul_add(x472, x521, x473 * x520)
+            - Self::mul_add(x505, x564, x506 * x561) + x1136;
+        let x1224 = Self::mul_add(x357, x1190, Self::mul_add(x356, x1189, s_q1 * x1188))
+            - Self::mul_add(-x471, x1186, x470 * x1187);
+        let x1225 = Self::mul_add(
+            -x357,
+            x1193,
+            Self::mul_add(-x356, x1192, s_q1 * x1191),
+        ) + Self::mul_add(-x471, x1185, x469 * x1187);
+        let x1226 = Self::mul_add(
+            -x357,
+            x1196,
+            Self::mul_add(-x356, x1195, s_q1 * x1194),
+        ) + Self::mul_add(-x470, x1185, x469 * x1186);
+        let x1227 = Self::mul_add(-x357, x1186, x356 * x1187);
+        let x1228 = Self::mul_add(x357, x1185, s_q1 * x1187);
+        let x1229 = Self::mul_add(x356, x1185, s_q1 * x1186);
+        let x1230 = s_q1 * x1197;
+        let x1231 = Self::mul_add(
+            x470,
+            x1214,
+            Self::mul_add(x357, x1207, Self::mul_add(x356, x1202, x1230)),
+        );
+        let x1232 = Self::mul_add(-x471, x1216, x1231);
+        let x1233 = x356 * x1203;
+        let x1234 = Self::mul_add(
+            -x469,
+            x1212,
+            Self::mul_add(-x357, x1208, Self::mul_add(s_q1, x1198, -x1233)),
+        );
+        let x1235 = Self::mul_add(-x471, x1217, x1234);
+        let x1236 = x357 * x1209;
+        let x1237 = Self::mul_add(
+            x470,
+            x1215,
+            Self::mul_add(-x469, x1213, Self::mul_add(x356, x1204, s_q1 * x1199) - x1236),
+        );
+        let x1238 = Self::mul_add(-x357, x1210, x356 * x1205);
+        let x1239 = Self::mul_add(-x357, x1211, s_q1 * x1200);
+        let x1240 = Self::mul_add(x356, x1206, s_q1 * x1201);
+        let x1241 = Self::mul_add(
+            x530,
+            x1200,
+            Self::mul_add(x528, x1199, Self::mul_add(x527, x1198, x526 * x1197)),
+        );
+        let x1242 = Self::mul_add(
+            -x529,
+            x1205,
+            Self::mul_add(x528, x1204, Self::mul_add(-x527, x1203, x526 * x1202)),
+        );
+        let x1243 = Self::mul_add(
+            x529,
+            x1210,
+            Self::mul_add(-x528, x1209, Self::mul_add(-x527, x1208, x526 * x1207)),
+        );
+        let x1244 = Self::mul_add(x356, x1220, x357 * x1219)
+            + Self::mul_add(x470, x1223, x471 * x1222)
+            + (Self::mul_add(-x534, x1190, Self::mul_add(-x533, x1189, x532 * x1188))
+                - Self::mul_add(-x537, x1186, x536 * x1187))
+            - Self::mul_add(x531, x1201, x1241);
+        let x1245 = Self::mul_add(
+            x470,
+            x1200,
+            Self::mul_add(-x357, x1199, Self::mul_add(-x356, x1198, x1230)),
+        );
+        let x1246 = Self::mul_add(
+            x469,
+            x1205,
+            Self::mul_add(-x357, x1204, Self::mul_add(s_q1, x1202, x1233)),
+        );
+        let x1247 = Self::mul_add(
+            -x470,
+            x1211,
+            Self::mul_add(-x469, x1210, x1236 + Self::mul_add(x356, x1208, s_q1 * x1207)),
+        );
+        let x1248 = Self::mul_add(
+            -x540,
+            x1190,
+            Self::mul_add(-x539, x1189, x538 * x1188),
+        ) - Self::mul_add(-x543, x1186, x542 * x1187)
+            - Self::mul_add(x471, x1201, x1245);
+        let x1249 = Self::mul_add(
             c_q0,
-            Self::mul_add(s_q1, x1153, x287 * x1152)
-                + Self::mul_add(-x400, x1156, x401 * x1155)
-                - (Self::mul_add(x462, x1130, Self::mul_add(x461, x1129, x460 * x1128))
-                    - Self::mul_add(x464, x1119, x463 * x1120))
-                + Self::mul_add(-x458, x1145, x1177),
+            Self::mul_add(s_q1, x1219, x356 * x1218)
+                + Self::mul_add(-x469, x1222, x470 * x1221)
+                - (Self::mul_add(x534, x1196, Self::mul_add(x533, x1195, x532 * x1194))
+                    - Self::mul_add(x536, x1185, x535 * x1186))
+                + Self::mul_add(-x530, x1211, x1243),
             s_q0
-                * (Self::mul_add(-s_q1, x1154, x288 * x1152)
-                    + Self::mul_add(x400, x1157, x402 * x1155)
+                * (Self::mul_add(-s_q1, x1220, x357 * x1218)
+                    + Self::mul_add(x469, x1223, x471 * x1221)
                     - (Self::mul_add(
-                        x462,
-                        x1127,
-                        Self::mul_add(x461, x1126, x460 * x1125),
-                    ) - Self::mul_add(x465, x1119, x463 * x1121))
-                    - Self::mul_add(x459, x1140, x1176)),
+                        x534,
+                        x1193,
+                        Self::mul_add(x533, x1192, x532 * x1191),
+                    ) - Self::mul_add(x537, x1185, x535 * x1187))
+                    - Self::mul_add(x531, x1206, x1242)),
         );
-        let x1184 = Self::mul_add(
-            -x293,
-            Self::mul_add(s_q1, x1156, x287 * x1155)
-                - Self::mul_add(-x461, x1119, x460 * x1120)
-                - Self::mul_add(x455, x1151, x454 * x1150),
+        let x1250 = Self::mul_add(
+            -x362,
+            Self::mul_add(s_q1, x1222, x356 * x1221)
+                - Self::mul_add(-x533, x1185, x532 * x1186)
+                - Self::mul_add(x527, x1217, x526 * x1216),
             Self::mul_add(
-                x292,
-                Self::mul_add(-s_q1, x1157, x288 * x1155)
-                    - Self::mul_add(-x462, x1119, x460 * x1121)
-                    - Self::mul_add(x456, x1149, x454 * x1148),
-                x291
-                    * (Self::mul_add(x287, x1157, x288 * x1156)
-                        - Self::mul_add(-x462, x1120, x461 * x1121)
-                        - Self::mul_add(x456, x1147, x455 * x1146)),
+                x361,
+                Self::mul_add(-s_q1, x1223, x357 * x1221)
+                    - Self::mul_add(-x534, x1185, x532 * x1187)
+                    - Self::mul_add(x528, x1215, x526 * x1214),
+                x360
+                    * (Self::mul_add(x356, x1223, x357 * x1222)
+                        - Self::mul_add(-x534, x1186, x533 * x1187)
+                        - Self::mul_add(x528, x1213, x527 * x1212)),
             ),
         );
-        let x1185 = x1183 - x1184;
-        let x1186 = Self::mul_add(
+        let x1251 = x1249 - x1250;
+        let x1252 = Self::mul_add(
             c_q0,
-            Self::mul_add(x468, x1130, Self::mul_add(x467, x1129, x466 * x1128))
-                - Self::mul_add(x470, x1119, x469 * x1120) - x1181,
+            Self::mul_add(x540, x1196, Self::mul_add(x539, x1195, x538 * x1194))
+                - Self::mul_add(x542, x1185, x541 * x1186) - x1247,
             s_q0
-                * (Self::mul_add(x468, x1127, Self::mul_add(x467, x1126, x466 * x1125))
-                    - Self::mul_add(x471, x1119, x469 * x1121)
-                    + Self::mul_add(x402, x1140, x1180)),
+                * (Self::mul_add(x540, x1193, Self::mul_add(x539, x1192, x538 * x1191))
+                    - Self::mul_add(x543, x1185, x541 * x1187)
+                    + Self::mul_add(x471, x1206, x1246)),
         );
-        let x1187 = Self::mul_add(
-            -x293,
-            Self::mul_add(-x467, x1119, x466 * x1120)
-                + Self::mul_add(-x287, x1151, s_q1 * x1150),
+        let x1253 = Self::mul_add(
+            -x362,
+            Self::mul_add(-x539, x1185, x538 * x1186)
+                + Self::mul_add(-x356, x1217, s_q1 * x1216),
             Self::mul_add(
-                x292,
-                Self::mul_add(-x468, x1119, x466 * x1121)
-                    + Self::mul_add(-x288, x1149, s_q1 * x1148),
-                x291
-                    * (Self::mul_add(-x468, x1120, x467 * x1121)
-                        - Self::mul_add(x288, x1147, x287 * x1146)),
+                x361,
+                Self::mul_add(-x540, x1185, x538 * x1187)
+                    + Self::mul_add(-x357, x1215, s_q1 * x1214),
+                x360
+                    * (Self::mul_add(-x540, x1186, x539 * x1187)
+                        - Self::mul_add(x357, x1213, x356 * x1212)),
             ),
         );
-        let x1188 = x1186 - x1187;
-        let x1189 = Self::mul_add(-x462, x1160, Self::mul_add(x461, x1159, x460 * x1158))
-            + Self::mul_add(x465, x1163, Self::mul_add(-x464, x1162, x463 * x1161))
-            - (Self::mul_add(x456, x1171, Self::mul_add(x455, x1169, x454 * x1166))
+        let x1254 = x1252 - x1253;
+        let x1255 = Self::mul_add(-x534, x1226, Self::mul_add(x533, x1225, x532 * x1224))
+            + Self::mul_add(x537, x1229, Self::mul_add(-x536, x1228, x535 * x1227))
+            - (Self::mul_add(x528, x1237, Self::mul_add(x527, x1235, x526 * x1232))
                 - Self::mul_add(
-                    -x459,
-                    x1174,
-                    Self::mul_add(-x458, x1173, x457 * x1172),
+                    -x531,
+                    x1240,
+                    Self::mul_add(-x530, x1239, x529 * x1238),
                 ));
-        let x1190 = Self::mul_add(-x468, x1160, Self::mul_add(x467, x1159, x466 * x1158))
-            + Self::mul_add(x471, x1163, Self::mul_add(-x470, x1162, x469 * x1161))
-            - (Self::mul_add(-x288, x1171, Self::mul_add(-x287, x1169, s_q1 * x1166))
-                + Self::mul_add(x402, x1174, Self::mul_add(x401, x1173, x400 * x1172)));
-        let x1191 = Self::mul_add(-x462, x1073, Self::mul_add(x461, x1072, x460 * x1071))
-            + Self::mul_add(x465, x1076, Self::mul_add(-x464, x1075, x463 * x1074))
-            - (Self::mul_add(x456, x1084, Self::mul_add(x455, x1082, x454 * x1079))
+        let x1256 = Self::mul_add(-x540, x1226, Self::mul_add(x539, x1225, x538 * x1224))
+            + Self::mul_add(x543, x1229, Self::mul_add(-x542, x1228, x541 * x1227))
+            - (Self::mul_add(-x357, x1237, Self::mul_add(-x356, x1235, s_q1 * x1232))
+                + Self::mul_add(x471, x1240, Self::mul_add(x470, x1239, x469 * x1238)));
+        let x1257 = Self::mul_add(-x534, x1139, Self::mul_add(x533, x1138, x532 * x1137))
+            + Self::mul_add(x537, x1142, Self::mul_add(-x536, x1141, x535 * x1140))
+            - (Self::mul_add(x528, x1150, Self::mul_add(x527, x1148, x526 * x1145))
                 - Self::mul_add(
-                    -x459,
-                    x1087,
-                    Self::mul_add(-x458, x1086, x457 * x1085),
+                    -x531,
+                    x1153,
+                    Self::mul_add(-x530, x1152, x529 * x1151),
                 ));
-        let x1192 = Self::mul_add(-x468, x1073, Self::mul_add(x467, x1072, x466 * x1071))
-            + Self::mul_add(x471, x1076, Self::mul_add(-x470, x1075, x469 * x1074))
-            - (x1111
-                + Self::mul_add(x402, x1087, Self::mul_add(x401, x1086, x400 * x1085)));
-        let x1193 = Self::mul_add(-x462, x982, Self::mul_add(x461, x981, x460 * x980))
-            + Self::mul_add(x465, x985, Self::mul_add(-x464, x984, x463 * x983))
-            - (Self::mul_add(x456, x993, Self::mul_add(x455, x991, x454 * x988))
-                - Self::mul_add(-x459, x996, Self::mul_add(-x458, x995, x457 * x994)));
-        let x1194 = Self::mul_add(-x468, x982, Self::mul_add(x467, x981, x466 * x980))
-            + Self::mul_add(x471, x985, Self::mul_add(-x470, x984, x469 * x983))
-            - (x1024
-                + Self::mul_add(x402, x996, Self::mul_add(x401, x995, x400 * x994)));
-        let x1195 = Self::mul_add(x462, x938, Self::mul_add(x461, x937, x460 * x936))
-            - Self::mul_add(x456, x944, Self::mul_add(-x455, x942, x454 * x940));
-        let x1196 = x1027
-            - Self::mul_add(x468, x938, Self::mul_add(x467, x937, x466 * x936));
-        let x1197 = Self::mul_add(x462, x894, Self::mul_add(x461, x893, x460 * x892))
-            - Self::mul_add(x456, x900, Self::mul_add(-x455, x898, x454 * x896));
-        let x1198 = x1030
-            - Self::mul_add(x468, x894, Self::mul_add(x467, x893, x466 * x892));
-        let x1199 = x294 + x1119;
-        let x1200 = x295 - x1120;
-        let x1201 = x296 - x1121;
-        let x1202 = x314 - x1123;
-        let x1203 = x315 - x1124;
-        let x1204 = x373 - x374 - x379 - (x379 - (x380 + x381)) + x1131;
-        let x1205 = x363 - (x360 - (x354 - x382))
-            - (x359 - Self::mul_add(qd[0], x315, x375)) + x1132;
-        let x1206 = x362 - (x358 + (x352 - x383))
-            - (x357 - Self::mul_add(-qd[0], x314, x376)) + x1133;
-        let x1207 = x370 - (x371 + x372) - x1134;
-        let x1208 = x367 + (x368 - x369) - x1135;
-        let x1209 = Self::mul_add(-c_q0, x318 - x1127, s_q0 * (x317 - x1126))
-            - Self::mul_add(-x293, x1199, x291 * x1201);
-        let x1210 = Self::mul_add(-c_q0, x321 - x1130, s_q0 * (x320 - x1129))
-            - Self::mul_add(-x292, x1199, x291 * x1200);
-        let x1211 = c_q0 * x1199;
-        let x1212 = s_q0 * x1199;
-        let x1213 = Self::mul_add(
-            -x292,
-            x371 - (x370 + x372) + x1148,
+        let x1258 = Self::mul_add(-x540, x1139, Self::mul_add(x539, x1138, x538 * x1137))
+            + Self::mul_add(x543, x1142, Self::mul_add(-x542, x1141, x541 * x1140))
+            - (x1177
+                + Self::mul_add(x471, x1153, Self::mul_add(x470, x1152, x469 * x1151)));
+        let x1259 = Self::mul_add(-x534, x1048, Self::mul_add(x533, x1047, x532 * x1046))
+            + Self::mul_add(x537, x1051, Self::mul_add(-x536, x1050, x535 * x1049))
+            - (Self::mul_add(x528, x1059, Self::mul_add(x527, x1057, x526 * x1054))
+                - Self::mul_add(
+                    -x531,
+                    x1062,
+                    Self::mul_add(-x530, x1061, x529 * x1060),
+                ));
+        let x1260 = Self::mul_add(-x540, x1048, Self::mul_add(x539, x1047, x538 * x1046))
+            + Self::mul_add(x543, x1051, Self::mul_add(-x542, x1050, x541 * x1049))
+            - (x1090
+                + Self::mul_add(x471, x1062, Self::mul_add(x470, x1061, x469 * x1060)));
+        let x1261 = Self::mul_add(x534, x1004, Self::mul_add(x533, x1003, x532 * x1002))
+            - Self::mul_add(x528, x1010, Self::mul_add(-x527, x1008, x526 * x1006));
+        let x1262 = x1093
+            - Self::mul_add(x540, x1004, Self::mul_add(x539, x1003, x538 * x1002));
+        let x1263 = Self::mul_add(x534, x960, Self::mul_add(x533, x959, x532 * x958))
+            - Self::mul_add(x528, x966, Self::mul_add(-x527, x964, x526 * x962));
+        let x1264 = x1096
+            - Self::mul_add(x540, x960, Self::mul_add(x539, x959, x538 * x958));
+        let x1265 = x60 + x1185;
+        let x1266 = x363 - x1186;
+        let x1267 = x364 - x1187;
+        let x1268 = x383 - x1189;
+        let x1269 = x384 - x1190;
+        let x1270 = x442 - x443 - x448 - (x448 - (x449 + x450)) + x1197;
+        let x1271 = x432 - (x429 - (x423 - x451))
+            - (x428 - Self::mul_add(qd[0], x384, x444)) + x1198;
+        let x1272 = x431 - (x427 + (x421 - x452))
+            - (x426 - Self::mul_add(-qd[0], x383, x445)) + x1199;
+        let x1273 = x439 - (x440 + x441) - x1200;
+        let x1274 = x436 + (x437 - x438) - x1201;
+        let x1275 = Self::mul_add(-c_q0, x387 - x1193, s_q0 * (x386 - x1192))
+            - Self::mul_add(-x362, x1265, x360 * x1267);
+        let x1276 = Self::mul_add(-c_q0, x390 - x1196, s_q0 * (x389 - x1195))
+            - Self::mul_add(-x361, x1265, x360 * x1266);
+        let x1277 = c_q0 * x1265;
+        let x1278 = s_q0 * x1265;
+        let x1279 = Self::mul_add(
+            -x361,
+            x440 - (x439 + x441) + x1214,
             Self::mul_add(
                 -c_q0,
-                x362 + (x357 + (x351 - x376)) + (x358 - Self::mul_add(x320, x323, x383))
-                    + x1141,
+                x431 + (x426 + (x420 - x445)) + (x427 - Self::mul_add(x389, x392, x452))
+                    + x1207,
                 s_q0
-                    * (x363 + (x359 + (x353 - x375))
-                        + (x360 + Self::mul_add(x318, x322, x382)) + x1136),
+                    * (x432 + (x428 + (x422 - x444))
+                        + (x429 + Self::mul_add(x387, x391, x451)) + x1202),
             ),
         );
-        let x1214 = Self::mul_add(x293, x368 + (x367 + x369) + x1150, x1213);
-        let x1215 = Self::mul_add(
-            x291,
-            x370 - (x371 - x372) - x1146,
+        let x1280 = Self::mul_add(x362, x437 + (x436 + x438) + x1216, x1279);
+        let x1281 = Self::mul_add(
+            x360,
+            x439 - (x440 - x441) - x1212,
             Self::mul_add(
                 -c_q0,
-                x361 - (x355 - (x349 - x385)) - (x356 + Self::mul_add(x319, x323, x389))
-                    - x1142,
-                s_q0 * (x380 - x384 + x387 + (x387 + (x373 + x388)) - x1137),
+                x430 - (x424 - (x418 - x454)) - (x425 + Self::mul_add(x388, x392, x458))
+                    - x1208,
+                s_q0 * (x449 - x453 + x456 + (x456 + (x442 + x457)) - x1203),
             ),
         );
-        let x1216 = Self::mul_add(-x293, x365 + (x364 + x366) - x1151, x1215);
-        let x1217 = Self::mul_add(
-            -x291,
-            x367 + (x368 + x369) - x1147,
+        let x1282 = Self::mul_add(-x362, x434 + (x433 + x435) - x1217, x1281);
+        let x1283 = Self::mul_add(
+            -x360,
+            x436 + (x437 + x438) - x1213,
             Self::mul_add(
                 c_q0,
-                x381 - x388 + x390 + (x390 - (x374 - x384)) - x1143,
+                x450 - x457 + x459 + (x459 - (x443 - x453)) - x1209,
                 s_q0
-                    * (x361 + (x356 - (x350 - x389))
-                        + (x355 + Self::mul_add(-x316, x322, x385)) - x1138),
+                    * (x430 + (x425 - (x419 - x458))
+                        + (x424 + Self::mul_add(-x385, x391, x454)) - x1204),
             ),
         );
-        let x1218 = Self::mul_add(-x292, x364 + (x365 + x366) - x1149, x1217);
-        let x1219 = c_q0 * (x365 + (x364 - x366) - x1145);
-        let x1220 = s_q0 * (x364 + (x365 - x366) - x1140);
-        let x1221 = Self::mul_add(
+        let x1284 = Self::mul_add(-x361, x433 + (x434 + x435) - x1215, x1283);
+        let x1285 = c_q0 * (x434 + (x433 - x435) - x1211);
+        let x1286 = s_q0 * (x433 + (x434 - x435) - x1206);
+        let x1287 = Self::mul_add(
             -s_q0,
-            Self::mul_add(-x321, x337, Self::mul_add(x320, x336, x319 * x335))
-                - Self::mul_add(-x294, x339, x295 * x338)
-                + (Self::mul_add(-qd[0], x362, x322 * x361)
-                    - Self::mul_add(x324, x369, x325 * x366)) + x1154,
+            Self::mul_add(-x390, x406, Self::mul_add(x389, x405, x388 * x404))
+                - Self::mul_add(-x60, x408, x363 * x407)
+                + (Self::mul_add(-qd[0], x431, x391 * x430)
+                    - Self::mul_add(x393, x438, x394 * x435)) + x1220,
             c_q0
-                * (Self::mul_add(-x318, x337, Self::mul_add(x317, x336, x316 * x335))
-                    - Self::mul_add(-x294, x340, x296 * x338)
-                    - (Self::mul_add(-qd[0], x363, x323 * x361)
-                        + Self::mul_add(-x324, x372, x326 * x366)) + x1153),
+                * (Self::mul_add(-x387, x406, Self::mul_add(x386, x405, x385 * x404))
+                    - Self::mul_add(-x60, x409, x364 * x407)
+                    - (Self::mul_add(-qd[0], x432, x392 * x430)
+                        + Self::mul_add(-x393, x441, x395 * x435)) + x1219),
         );
-        let x1222 = Self::mul_add(
-            -x331,
-            x1208,
-            Self::mul_add(x330, x1207, Self::mul_add(x329, x1206, x328 * x1205)),
+        let x1288 = Self::mul_add(
+            -x400,
+            x1274,
+            Self::mul_add(x399, x1273, Self::mul_add(x398, x1272, x397 * x1271)),
         );
-        let x1223 = x1221
+        let x1289 = x1287
             - Self::mul_add(
-                x292,
-                Self::mul_add(-x294, x336, x295 * x335)
-                    - Self::mul_add(qd[0], x369, x322 * x366) - x1157,
-                x293
-                    * (Self::mul_add(x294, x337, x296 * x335)
-                        + Self::mul_add(qd[0], x372, x323 * x366) - x1156),
+                x361,
+                Self::mul_add(-x60, x405, x363 * x404)
+                    - Self::mul_add(qd[0], x438, x391 * x435) - x1223,
+                x362
+                    * (Self::mul_add(x60, x406, x364 * x404)
+                        + Self::mul_add(qd[0], x441, x392 * x435) - x1222),
             )
-            + (Self::mul_add(x342, x1203, x341 * x1202)
-                - Self::mul_add(x344, x1200, x343 * x1201)) - x1222;
-        let x1224 = Self::mul_add(
-            -x293,
-            x1208,
-            Self::mul_add(-x292, x1207, Self::mul_add(-c_q0, x1206, s_q0 * x1205)),
+            + (Self::mul_add(x411, x1269, x410 * x1268)
+                - Self::mul_add(x413, x1266, x412 * x1267)) - x1288;
+        let x1290 = Self::mul_add(
+            -x362,
+            x1274,
+            Self::mul_add(-x361, x1273, Self::mul_add(-c_q0, x1272, s_q0 * x1271)),
         );
-        let x1225 = Self::mul_add(
-            x346,
-            x1203,
-            Self::mul_add(x345, x1202, x327 * (x313 - x1122)),
-        ) - Self::mul_add(x348, x1200, x347 * x1201) - x1224;
-        let x1226 = Self::mul_add(-x342, x1210, x341 * x1209)
-            - Self::mul_add(-x344, x1212, x343 * x1211)
-            - (Self::mul_add(-x329, x1218, x328 * x1216)
-                + Self::mul_add(-x331, x1220, x330 * x1219));
-        let x1227 = Self::mul_add(
-            -x346,
-            x1210,
+        let x1291 = Self::mul_add(
+            x415,
+            x1269,
+            Self::mul_add(x414, x1268, x396 * (x382 - x1188)),
+        ) - Self::mul_add(x417, x1266, x416 * x1267) - x1290;
+        let x1292 = Self::mul_add(-x411, x1276, x410 * x1275)
+            - Self::mul_add(-x413, x1278, x412 * x1277)
+            - (Self::mul_add(-x398, x1284, x397 * x1282)
+                + Self::mul_add(-x400, x1286, x399 * x1285));
+        let x1293 = Self::mul_add(
+            -x415,
+            x1276,
             Self::mul_add(
-                x345,
-                x1209,
-                x327
-                    * (Self::mul_add(-c_q0, x1203, s_q0 * x1202)
-                        + Self::mul_add(-x293, x1200, x292 * x1201)),
+                x414,
+                x1275,
+                x396
+                    * (Self::mul_add(-c_q0, x1269, s_q0 * x1268)
+                        + Self::mul_add(-x362, x1266, x361 * x1267)),
             ),
         );
-        let x1228 = Self::mul_add(
-            -x348,
-            x1212,
-            Self::mul_add(x347, x1211, x332 * Self::mul_add(c_q0, x1200, s_q0 * x1201)),
+        let x1294 = Self::mul_add(
+            -x417,
+            x1278,
+            Self::mul_add(x416, x1277, x401 * Self::mul_add(c_q0, x1266, s_q0 * x1267)),
         );
-        let x1229 = Self::mul_add(
-            x293,
-            x1220,
+        let x1295 = Self::mul_add(
+            x362,
+            x1286,
             Self::mul_add(
-                x292,
-                x1219,
-                x291
+                x361,
+                x1285,
+                x360
                     * Self::mul_add(
                         c_q0,
-                        x368 + (x367 - x369) + x1144,
-                        s_q0 * (x371 - (x370 - x372) + x1139),
+                        x437 + (x436 - x438) + x1210,
+                        s_q0 * (x440 - (x439 - x441) + x1205),
                     ),
             ),
         );
-        let x1230 = x1227 - x1228 - (Self::mul_add(c_q0, x1218, s_q0 * x1216) - x1229);
-        let x1231 = Self::mul_add(-x342, x1160, x341 * x1159)
-            + Self::mul_add(x344, x1163, x343 * x1162)
-            - (Self::mul_add(x329, x1171, x328 * x1169)
-                - Self::mul_add(-x331, x1174, x330 * x1173));
-        let x1232 = Self::mul_add(x346, x1160, Self::mul_add(-x345, x1159, x327 * x1158))
-            - Self::mul_add(x348, x1163, Self::mul_add(x347, x1162, x332 * x1161))
-            + (Self::mul_add(-c_q0, x1171, s_q0 * x1169)
+        let x1296 = x1293 - x1294 - (Self::mul_add(c_q0, x1284, s_q0 * x1282) - x1295);
+        let x1297 = Self::mul_add(-x411, x1226, x410 * x1225)
+            + Self::mul_add(x413, x1229, x412 * x1228)
+            - (Self::mul_add(x398, x1237, x397 * x1235)
+                - Self::mul_add(-x400, x1240, x399 * x1239));
+        let x1298 = Self::mul_add(x415, x1226, Self::mul_add(-x414, x1225, x396 * x1224))
+            - Self::mul_add(x417, x1229, Self::mul_add(x416, x1228, x401 * x1227))
+            + (Self::mul_add(-c_q0, x1237, s_q0 * x1235)
                 - Self::mul_add(
-                    -x293,
-                    x1174,
-                    Self::mul_add(-x292, x1173, x291 * x1172),
+                    -x362,
+                    x1240,
+                    Self::mul_add(-x361, x1239, x360 * x1238),
                 ));
-        let x1233 = Self::mul_add(-x342, x1073, x341 * x1072)
-            + Self::mul_add(x344, x1076, x343 * x1075)
-            - (Self::mul_add(x329, x1084, x328 * x1082)
-                - Self::mul_add(-x331, x1087, x330 * x1086));
-        let x1234 = Self::mul_add(x346, x1073, Self::mul_add(-x345, x1072, x327 * x1071))
-            - Self::mul_add(x348, x1076, Self::mul_add(x347, x1075, x332 * x1074))
-            + (Self::mul_add(-c_q0, x1084, s_q0 * x1082)
+        let x1299 = Self::mul_add(-x411, x1139, x410 * x1138)
+            + Self::mul_add(x413, x1142, x412 * x1141)
+            - (Self::mul_add(x398, x1150, x397 * x1148)
+                - Self::mul_add(-x400, x1153, x399 * x1152));
+        let x1300 = Self::mul_add(x415, x1139, Self::mul_add(-x414, x1138, x396 * x1137))
+            - Self::mul_add(x417, x1142, Self::mul_add(x416, x1141, x401 * x1140))
+            + (Self::mul_add(-c_q0, x1150, s_q0 * x1148)
                 - Self::mul_add(
-                    -x293,
-                    x1087,
-                    Self::mul_add(-x292, x1086, x291 * x1085),
+                    -x362,
+                    x1153,
+                    Self::mul_add(-x361, x1152, x360 * x1151),
                 ));
-        let x1235 = Self::mul_add(-x342, x982, x341 * x981)
-            + Self::mul_add(x344, x985, x343 * x984)
-            - (Self::mul_add(x329, x993, x328 * x991)
-                - Self::mul_add(-x331, x996, x330 * x995));
-        let x1236 = Self::mul_add(x346, x982, Self::mul_add(-x345, x981, x327 * x980))
-            - Self::mul_add(x348, x985, Self::mul_add(x347, x984, x332 * x983))
-            + (Self::mul_add(-c_q0, x993, s_q0 * x991)
-                - Self::mul_add(-x293, x996, Self::mul_add(-x292, x995, x291 * x994)));
-        let x1237 = Self::mul_add(x342, x938, x341 * x937)
-            + Self::mul_add(-x329, x944, x328 * x942);
-        let x1238 = Self::mul_add(-x346, x938, Self::mul_add(-x345, x937, x327 * x936))
-            - Self::mul_add(c_q0, x944, s_q0 * x942);
-        let x1239 = Self::mul_add(x342, x894, x341 * x893)
-            + Self::mul_add(-x329, x900, x328 * x898);
-        let x1240 = Self::mul_add(-x346, x894, Self::mul_add(-x345, x893, x327 * x892))
-            - Self::mul_add(c_q0, x900, s_q0 * x898);
-        let x1241 = s_q5 * s_q5 * 35.074;
-        let x1242 = s_q5 * c_q5 * 35.074;
-        let x1243 = 132.6783695416 + (9.336 + x1241);
-        let x1244 = 135.4729695416 + (44.41 - x1241);
-        let x1245 = 47.471 - x1243;
-        let x1246 = s_q4 * s_q4 * x1245;
-        let x1247 = Self::mul_add(-s_q4, x1242, c_q4 * 97.44448770720001);
-        let x1248 = Self::mul_add(c_q4, x1242, s_q4 * 97.44448770720001);
-        let x1249 = x120 - x1244;
-        let x1250 = Self::mul_add(s_q4 * c_q4, x1245, x118);
-        let x1251 = x120 + (x120 - (47.471 - x1246));
-        let x1252 = -24989.305802 + (x1243 + x1246);
-        let x1253 = 1375.0472756800002 - x1248;
-        let x1254 = 24998.827802 - (x120 + x1249);
-        let x1255 = s_q3 * s_q3;
-        let x1256 = s_q3 * c_q3;
-        let x1257 = x1251 + x1252;
-        let x1258 = x1250 + x1250;
-        let x1259 = Self::mul_add(-x1256, x1258, x1255 * x1257);
-        let x1260 = c_q3 * x1247;
-        let x1261 = s_q3 * x1247;
-        let x1262 = Self::mul_add(0.475, x162, Self::mul_add(-c_q3, x1253, x1261));
-        let x1263 = x178 - x1254;
-        let x1264 = x176 + (x1250 - Self::mul_add(x1255, x1258, x1256 * x1257));
-        let x1265 = Self::mul_add(0.475, x158, Self::mul_add(s_q3, x1253, x1260));
-        let x1266 = x178 + (x178 + (x1251 - x1259));
-        let x1267 = -39234.47412200001 + (x1252 - x1259);
-        let x1268 = 3946.18812068 - x1262;
-        let x1269 = 39241.404122 - (x178 + x1263);
-        let x1270 = s_q2 * s_q2;
-        let x1271 = s_q2 * c_q2;
-        let x1272 = x1266 + x1267;
-        let x1273 = x1264 + x1264;
-        let x1274 = Self::mul_add(-x1271, x1273, x1270 * x1272);
-        let x1275 = x1267 - x1274;
-        let x1276 = c_q2 * x1265;
-        let x1277 = s_q2 * x1265;
-        let x1278 = Self::mul_add(0.5692, x221, Self::mul_add(-c_q2, x1268, x1277));
-        let x1279 = Self::mul_add(0.5692, x217, Self::mul_add(s_q2, x1268, x1276));
-        let x1280 = 0.7026 * x217;
-        let x1281 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(-c_q1, x221, x294),
-            Self::mul_add(
-                s_q1,
-                x1279,
-                c_q1 * (x1264 - Self::mul_add(x1270, x1273, x1271 * x1272)),
-            ),
+        let x1301 = Self::mul_add(-x411, x1048, x410 * x1047)
+            + Self::mul_add(x413, x1051, x412 * x1050)
+            - (Self::mul_add(x398, x1059, x397 * x1057)
+                - Self::mul_add(-x400, x1062, x399 * x1061));
+        let x1302 = Self::mul_add(x415, x1048, Self::mul_add(-x414, x1047, x396 * x1046))
+            - Self::mul_add(x417, x1051, Self::mul_add(x416, x1050, x401 * x1049))
+            + (Self::mul_add(-c_q0, x1059, s_q0 * x1057)
+                - Self::mul_add(
+                    -x362,
+                    x1062,
+                    Self::mul_add(-x361, x1061, x360 * x1060),
+                ));
+        let x1303 = Self::mul_add(x411, x1004, x410 * x1003)
+            + Self::mul_add(-x398, x1010, x397 * x1008);
+        let x1304 = Self::mul_add(
+            -x415,
+            x1004,
+            Self::mul_add(-x414, x1003, x396 * x1002),
+        ) - Self::mul_add(c_q0, x1010, s_q0 * x1008);
+        let x1305 = Self::mul_add(x411, x960, x410 * x959)
+            + Self::mul_add(-x398, x966, x397 * x964);
+        let x1306 = Self::mul_add(-x415, x960, Self::mul_add(-x414, x959, x396 * x958))
+            - Self::mul_add(c_q0, x966, s_q0 * x964);
+        let x1307 = Self::mul_add(
+            -x149,
+            x1299,
+            Self::mul_add(x151, x1297, Self::mul_add(x154, x1292, x156 * x1289)),
         );
-        let x1282 = Self::mul_add(
-            -0.7026,
-            s_q1 * x217,
-            Self::mul_add(s_q1, x1269, c_q1 * x1278),
+        let x1308 = Self::mul_add(
+            -x143,
+            x1305,
+            Self::mul_add(x145, x1303, Self::mul_add(-x147, x1301, x1307)),
         );
-        let x1283 = Self::mul_add(-s_q2, x162, x216);
-        let x1284 = Self::mul_add(
-            -s_q1,
+        let x1309 = Self::mul_add(
+            -x149,
+            x1257,
+            Self::mul_add(x151, x1255, Self::mul_add(x154, x1251, x156 * x1244)),
+        );
+        let x1310 = Self::mul_add(
+            -x143,
             x1263,
-            c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(c_q2, x162, x220),
-                    Self::mul_add(c_q2, x1262, x1277),
-                ),
+            Self::mul_add(x145, x1261, Self::mul_add(-x147, x1259, x1309)),
         );
-        let x1285 = Self::mul_add(-0.7026, s_q1 * x1283, x1284);
-        let x1286 = Self::mul_add(-s_q3, x111, x157);
-        let x1287 = Self::mul_add(c_q3, x111, x161);
-        let x1288 = Self::mul_add(0.475, x1287, Self::mul_add(c_q3, x1248, x1261));
-        let x1289 = Self::mul_add(7.11, x1287, x1249);
-        let x1290 = Self::mul_add(0.475, x1286, Self::mul_add(-s_q3, x1248, x1260));
-        let x1291 = Self::mul_add(-s_q2, x1287, c_q2 * x1286);
-        let x1292 = Self::mul_add(
-            -s_q1,
-            x1289,
-            c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(c_q2, x1287, s_q2 * x1286),
-                    Self::mul_add(s_q2, x1290, c_q2 * x1288),
-                ),
+        let x1311 = Self::mul_add(
+            -x149,
+            x1176,
+            Self::mul_add(x151, x1174, Self::mul_add(x154, x1172, x156 * x1157)),
         );
-        let x1293 = Self::mul_add(-0.7026, s_q1 * x1291, x1292);
-        let x1294 = 47.471 * s_q4;
-        let x1295 = 47.471 * c_q4;
-        let x1296 = Self::mul_add(s_q3, x1295, c_q3 * x1294);
-        let x1297 = Self::mul_add(-c_q3, x1295, s_q3 * x1294);
-        let x1298 = c_q1 * Self::mul_add(-s_q2, x1297, c_q2 * x1296);
-        let x1299 = 9.336 * c_q5;
-        let x1300 = 9.336 * s_q5;
-        let x1301 = c_q4 * x1299;
-        let x1302 = s_q4 * x1299;
-        let x1303 = Self::mul_add(-s_q3, x1302, c_q3 * x1301);
-        let x1304 = Self::mul_add(c_q3, x1302, s_q3 * x1301);
-        let x1305 = Self::mul_add(
-            -s_q1,
-            x1300,
-            c_q1 * Self::mul_add(-s_q2, x1304, c_q2 * x1303),
+        let x1312 = Self::mul_add(
+            -x143,
+            x1183,
+            Self::mul_add(x145, x1181, Self::mul_add(-x147, x1179, x1311)),
         );
-        let x1306 = 1.0
-            / (66279.65991417361
-                - (x1280
-                    - (x1275
-                        - Self::mul_add(
-                            -(s_q1 * c_q1),
-                            x1278 + x1278,
-                            s_q1 * s_q1 * (x1275 - (-65693.9112265768 + x1269)),
-                        ) - x1280)));
-        let x1307 = x1281 * x1306;
-        let x1308 = x1282 * x1306;
-        let x1309 = x1285 * x1306;
-        let x1310 = x1293 * x1306;
-        let x1311 = x1298 * x1306;
-        let x1312 = x1305 * x1306;
-        let x1313 = 1.0
-            / Self::mul_add(-x1281, x1307, 65697.3302265768 - (x1266 - x1274));
-        let x1314 = Self::mul_add(-x1281, x1308, x1279);
-        let x1315 = x1313 * x1314;
+        let x1313 = Self::mul_add(
+            -x149,
+            x1087,
+            Self::mul_add(x151, x1084, Self::mul_add(x154, x1081, x156 * x1066)),
+        );
+        let x1314 = Self::mul_add(
+            x143,
+            x1095,
+            Self::mul_add(-x145, x1092, Self::mul_add(x147, x1089, x1313)),
+        );
+        let x1315 = -x1314;
         let x1316 = Self::mul_add(
-            -x1281,
-            x1309,
-            Self::mul_add(0.5692, x1283, Self::mul_add(-s_q2, x1262, x1276)),
+            -x149,
+            x1019,
+            Self::mul_add(x151, x1019, Self::mul_add(x154, x1017, x156 * x1011)),
         );
-        let x1317 = x1313 * x1316;
-        let x1318 = Self::mul_add(
-            x1281,
-            x1310,
-            Self::mul_add(-0.5692, x1291, Self::mul_add(-c_q2, x1290, s_q2 * x1288)),
+        let x1317 = Self::mul_add(
+            x143,
+            x1023,
+            Self::mul_add(-x145, x1021, Self::mul_add(x147, x1019, x1316)),
         );
-        let x1319 = x1313 * x1318;
+        let x1318 = -x1317;
+        let x1319 = Self::mul_add(
+            -x149,
+            x975,
+            Self::mul_add(x151, x975, Self::mul_add(x154, x973, x156 * x967)),
+        );
         let x1320 = Self::mul_add(
-            x1281,
-            x1311,
-            Self::mul_add(c_q2, x1297, s_q2 * x1296),
+            -x143,
+            x979,
+            Self::mul_add(-x145, x977, Self::mul_add(x147, x975, x1319)),
         );
-        let x1321 = x1313 * x1320;
+        let x1321 = Self::mul_add(
+            -x164,
+            x1299,
+            Self::mul_add(-x166, x1297, Self::mul_add(x168, x1292, x170 * x1289)),
+        );
         let x1322 = Self::mul_add(
-            x1281,
-            x1312,
-            Self::mul_add(c_q2, x1304, s_q2 * x1303),
+            x161,
+            x1305,
+            Self::mul_add(-x162, x1303, Self::mul_add(x163, x1301, x1321)),
         );
-        let x1323 = x1313 * x1322;
-        let x1324 = 1.0
-            / Self::mul_add(-x1314, x1315, Self::mul_add(-x1282, x1308, x1269));
-        let x1325 = Self::mul_add(x1314, x1317, Self::mul_add(x1282, x1309, x1263));
-        let x1326 = x1324 * x1325;
-        let x1327 = Self::mul_add(-x1314, x1319, Self::mul_add(x1282, x1310, x1289));
-        let x1328 = x1324 * x1327;
-        let x1329 = Self::mul_add(-x1314, x1321, x1282 * x1311);
-        let x1330 = x1324 * x1329;
-        let x1331 = Self::mul_add(-x1314, x1323, Self::mul_add(x1282, x1312, x1300));
-        let x1332 = x1324 * x1331;
+        let x1323 = Self::mul_add(
+            -x164,
+            x1257,
+            Self::mul_add(-x166, x1255, Self::mul_add(x168, x1251, x170 * x1244)),
+        );
+        let x1324 = Self::mul_add(
+            x161,
+            x1263,
+            Self::mul_add(-x162, x1261, Self::mul_add(x163, x1259, x1323)),
+        );
+        let x1325 = Self::mul_add(
+            -x164,
+            x1176,
+            Self::mul_add(-x166, x1174, Self::mul_add(x168, x1172, x170 * x1157)),
+        );
+        let x1326 = Self::mul_add(
+            x161,
+            x1183,
+            Self::mul_add(-x162, x1181, Self::mul_add(x163, x1179, x1325)),
+        );
+        let x1327 = Self::mul_add(
+            -x164,
+            x1087,
+            Self::mul_add(-x166, x1084, Self::mul_add(x168, x1081, x170 * x1066)),
+        );
+        let x1328 = Self::mul_add(
+            -x161,
+            x1095,
+            Self::mul_add(x162, x1092, Self::mul_add(-x163, x1089, x1327)),
+        );
+        let x1329 = -x1328;
+        let x1330 = Self::mul_add(
+            -x164,
+            x1019,
+            Self::mul_add(-x166, x1019, Self::mul_add(x168, x1017, x170 * x1011)),
+        );
+        let x1331 = Self::mul_add(
+            -x161,
+            x1023,
+            Self::mul_add(x162, x1021, Self::mul_add(-x163, x1019, x1330)),
+        );
+        let x1332 = -x1331;
         let x1333 = Self::mul_add(
-            -x1325,
-            x1326,
-            Self::mul_add(-x1316, x1317, Self::mul_add(-x1285, x1309, x1254)),
+            -x164,
+            x975,
+            Self::mul_add(-x166, x975, Self::mul_add(x168, x973, x170 * x967)),
         );
-        let x1334 = 1.0 / x1333;
+        let x1334 = Self::mul_add(
+            x161,
+            x979,
+            Self::mul_add(x162, x977, Self::mul_add(-x163, x975, x1333)),
+        );
         let x1335 = Self::mul_add(
-            x1325,
-            x1328,
-            Self::mul_add(-x1316, x1319, Self::mul_add(x1285, x1310, x1249)),
+            x179,
+            x1299,
+            Self::mul_add(-x182, x1297, Self::mul_add(x184, x1292, x186 * x1289)),
         );
-        let x1336 = x1334 * x1335;
+        let x1336 = Self::mul_add(
+            -x174,
+            x1305,
+            Self::mul_add(-x176, x1303, Self::mul_add(-x177, x1301, x1335)),
+        );
         let x1337 = Self::mul_add(
-            x1325,
-            x1330,
-            Self::mul_add(-x1316, x1321, x1285 * x1311),
+            x179,
+            x1257,
+            Self::mul_add(-x182, x1255, Self::mul_add(x184, x1251, x186 * x1244)),
         );
-        let x1338 = x1334 * x1337;
+        let x1338 = Self::mul_add(
+            -x174,
+            x1263,
+            Self::mul_add(-x176, x1261, Self::mul_add(-x177, x1259, x1337)),
+        );
         let x1339 = Self::mul_add(
-            x1325,
-            x1332,
-            Self::mul_add(-x1316, x1323, Self::mul_add(x1285, x1312, x1300)),
+            x179,
+            x1176,
+            Self::mul_add(-x182, x1174, Self::mul_add(x184, x1172, x186 * x1157)),
         );
-        let x1340 = x1334 * x1339;
+        let x1340 = Self::mul_add(
+            -x174,
+            x1183,
+            Self::mul_add(-x176, x1181, Self::mul_add(-x177, x1179, x1339)),
+        );
         let x1341 = Self::mul_add(
-            -x1327,
-            x1328,
-            Self::mul_add(-x1318, x1319, Self::mul_add(-x1293, x1310, x1244)),
+            x179,
+            x1087,
+            Self::mul_add(-x182, x1084, Self::mul_add(x184, x1081, x186 * x1066)),
         );
-        let x1342 = 1.0 / Self::mul_add(-x1335, x1336, x1341);
-        let x1343 = Self::mul_add(
-            x1335,
-            x1338,
-            Self::mul_add(x1327, x1330, Self::mul_add(x1318, x1321, x1293 * x1311)),
+        let x1342 = Self::mul_add(
+            x174,
+            x1095,
+            Self::mul_add(x176, x1092, Self::mul_add(x177, x1089, x1341)),
         );
-        let x1344 = x1342 * x1343;
+        let x1343 = -x1342;
+        let x1344 = Self::mul_add(
+            x179,
+            x1019,
+            Self::mul_add(-x182, x1019, Self::mul_add(x184, x1017, x186 * x1011)),
+        );
         let x1345 = Self::mul_add(
-            x1327,
-            x1332,
-            Self::mul_add(x1318, x1323, Self::mul_add(x1293, x1312, x1300)),
+            x174,
+            x1023,
+            Self::mul_add(x176, x1021, Self::mul_add(x177, x1019, x1344)),
         );
-        let x1346 = Self::mul_add(x1335, x1340, x1345);
-        let x1347 = x1342 * x1346;
+        let x1346 = -x1345;
+        let x1347 = Self::mul_add(
+            x179,
+            x975,
+            Self::mul_add(-x182, x975, Self::mul_add(x184, x973, x186 * x967)),
+        );
         let x1348 = Self::mul_add(
-            -x1329,
-            x1330,
-            Self::mul_add(-x1320, x1321, Self::mul_add(-x1298, x1311, 47.471)),
+            -x174,
+            x979,
+            Self::mul_add(x176, x977, Self::mul_add(x177, x975, x1347)),
         );
-        let x1349 = 1.0
-            / Self::mul_add(-x1343, x1344, Self::mul_add(-x1337, x1338, x1348));
+        let x1349 = Self::mul_add(
+            x194,
+            x1299,
+            Self::mul_add(-x195, x1297, Self::mul_add(x198, x1292, x201 * x1289)),
+        );
         let x1350 = Self::mul_add(
-            x1337,
-            x1340,
-            Self::mul_add(x1329, x1332, Self::mul_add(x1320, x1323, x1298 * x1312)),
+            x188,
+            x1305,
+            Self::mul_add(-x190, x1303, Self::mul_add(x192, x1301, x1349)),
         );
-        let x1351 = Self::mul_add(x1343, x1347, x1350);
-        let x1352 = x1349 * x1351;
+        let x1351 = -x1350;
+        let x1352 = Self::mul_add(
+            x194,
+            x1257,
+            Self::mul_add(-x195, x1255, Self::mul_add(x198, x1251, x201 * x1244)),
+        );
         let x1353 = Self::mul_add(
-            -x1331,
-            x1332,
-            Self::mul_add(-x1322, x1323, Self::mul_add(-x1305, x1312, 9.336)),
+            x188,
+            x1263,
+            Self::mul_add(-x190, x1261, Self::mul_add(x192, x1259, x1352)),
         );
-        let x1354 = Self::mul_add(
-            -x1351,
-            x1352,
-            Self::mul_add(-x1346, x1347, Self::mul_add(-x1339, x1340, x1353)),
+        let x1354 = -x1353;
+        let x1355 = Self::mul_add(
+            x194,
+            x1176,
+            Self::mul_add(-x195, x1174, Self::mul_add(x198, x1172, x201 * x1157)),
         );
-        let x1355 = 1.0 / x1354;
-        let x1356 = Self::mul_add(-x1307, x1315, x1308);
-        let x1357 = Self::mul_add(x1326, x1356, Self::mul_add(-x1307, x1317, x1309));
+        let x1356 = Self::mul_add(
+            x188,
+            x1183,
+            Self::mul_add(-x190, x1181, Self::mul_add(x192, x1179, x1355)),
+        );
+        let x1357 = -x1356;
         let x1358 = Self::mul_add(
-            x1336,
-            x1357,
-            Self::mul_add(x1328, x1356, Self::mul_add(x1307, x1319, x1310)),
+            x194,
+            x1087,
+            Self::mul_add(-x195, x1084, Self::mul_add(x198, x1081, x201 * x1066)),
         );
         let x1359 = Self::mul_add(
-            x1338,
-            x1357,
-            Self::mul_add(x1330, x1356, Self::mul_add(x1307, x1321, x1311)),
+            -x188,
+            x1095,
+            Self::mul_add(x190, x1092, Self::mul_add(-x192, x1089, x1358)),
         );
-        let x1360 = Self::mul_add(x1344, x1358, x1359);
+        let x1360 = Self::mul_add(
+            x194,
+            x1019,
+            Self::mul_add(-x195, x1019, Self::mul_add(x198, x1017, x201 * x1011)),
+        );
         let x1361 = Self::mul_add(
-            x1340,
-            x1357,
-            Self::mul_add(x1332, x1356, Self::mul_add(x1307, x1323, x1312)),
+            -x188,
+            x1023,
+            Self::mul_add(x190, x1021, Self::mul_add(-x192, x1019, x1360)),
         );
-        let x1362 = x1355
-            * Self::mul_add(x1352, x1360, Self::mul_add(x1347, x1358, x1361));
-        let x1363 = -x1362;
-        let x1364 = Self::mul_add(x1352, x1362, x1349 * x1360);
-        let x1365 = -x1364;
+        let x1362 = Self::mul_add(
+            x194,
+            x975,
+            Self::mul_add(-x195, x975, Self::mul_add(x198, x973, x201 * x967)),
+        );
+        let x1363 = Self::mul_add(
+            x188,
+            x979,
+            Self::mul_add(x190, x977, Self::mul_add(-x192, x975, x1362)),
+        );
+        let x1364 = -x1363;
+        let x1365 = Self::mul_add(
+            x207,
+            x1299,
+            Self::mul_add(-x209, x1297, Self::mul_add(x211, x1292, x213 * x1289)),
+        );
         let x1366 = Self::mul_add(
-            x1347,
-            x1362,
-            Self::mul_add(x1344, x1364, x1342 * x1358),
+            -x203,
+            x1305,
+            Self::mul_add(-x205, x1303, Self::mul_add(x206, x1301, x1365)),
         );
         let x1367 = Self::mul_add(
-            x1340,
-            x1362,
-            Self::mul_add(x1338, x1364, Self::mul_add(x1336, x1366, x1334 * x1357)),
+            x207,
+            x1257,
+            Self::mul_add(-x209, x1255, Self::mul_add(x211, x1251, x213 * x1244)),
         );
         let x1368 = Self::mul_add(
-            x1330,
-            x1364,
-            Self::mul_add(x1328, x1366, Self::mul_add(x1326, x1367, x1324 * x1356)),
+            -x203,
+            x1263,
+            Self::mul_add(-x205, x1261, Self::mul_add(x206, x1259, x1367)),
         );
-        let x1369 = Self::mul_add(x1332, x1362, x1368);
+        let x1369 = Self::mul_add(
+            x207,
+            x1176,
+            Self::mul_add(-x209, x1174, Self::mul_add(x211, x1172, x213 * x1157)),
+        );
         let x1370 = Self::mul_add(
-            x1319,
-            x1366,
-            Self::mul_add(-x1317, x1367, Self::mul_add(-x1315, x1369, x1307 * x1313)),
+            -x203,
+            x1183,
+            Self::mul_add(-x205, x1181, Self::mul_add(x206, x1179, x1369)),
         );
-        let x1371 = Self::mul_add(x1323, x1362, Self::mul_add(x1321, x1364, x1370));
-        let x1372 = -x1371;
-        let x1373 = Self::mul_add(
-            x1309,
-            x1367,
-            Self::mul_add(x1308, x1369, Self::mul_add(x1307, x1371, x1306)),
+        let x1371 = Self::mul_add(
+            x207,
+            x1087,
+            Self::mul_add(-x209, x1084, Self::mul_add(x211, x1081, x213 * x1066)),
         );
+        let x1372 = Self::mul_add(
+            x203,
+            x1095,
+            Self::mul_add(x205, x1092, Self::mul_add(-x206, x1089, x1371)),
+        );
+        let x1373 = -x1372;
         let x1374 = Self::mul_add(
-            x1312,
-            x1362,
-            Self::mul_add(x1311, x1364, Self::mul_add(x1310, x1366, x1373)),
+            x207,
+            x1019,
+            Self::mul_add(-x209, x1019, Self::mul_add(x211, x1017, x213 * x1011)),
         );
-        let x1375 = Self::mul_add(x1315, x1326, x1317);
-        let x1376 = Self::mul_add(-x1336, x1375, Self::mul_add(-x1315, x1328, x1319));
+        let x1375 = Self::mul_add(
+            x203,
+            x1023,
+            Self::mul_add(x205, x1021, Self::mul_add(-x206, x1019, x1374)),
+        );
+        let x1376 = -x1375;
         let x1377 = Self::mul_add(
-            x1344,
-            x1376,
-            Self::mul_add(-x1338, x1375, Self::mul_add(-x1315, x1330, x1321)),
+            x207,
+            x975,
+            Self::mul_add(-x209, x975, Self::mul_add(x211, x973, x213 * x967)),
         );
         let x1378 = Self::mul_add(
-            x1347,
-            x1376,
-            Self::mul_add(-x1340, x1375, Self::mul_add(-x1315, x1332, x1323)),
+            -x203,
+            x979,
+            Self::mul_add(x205, x977, Self::mul_add(-x206, x975, x1377)),
         );
-        let x1379 = x1355 * Self::mul_add(x1352, x1377, x1378);
-        let x1380 = Self::mul_add(x1352, x1379, x1349 * x1377);
+        let x1379 = Self::mul_add(
+            x217,
+            x1299,
+            Self::mul_add(-x219, x1297, Self::mul_add(x221, x1292, x223 * x1289)),
+        );
+        let x1380 = Self::mul_add(
+            x214,
+            x1305,
+            Self::mul_add(-x215, x1303, Self::mul_add(x216, x1301, x1379)),
+        );
         let x1381 = Self::mul_add(
-            x1347,
-            x1379,
-            Self::mul_add(x1344, x1380, x1342 * x1376),
+            x217,
+            x1257,
+            Self::mul_add(-x219, x1255, Self::mul_add(x221, x1251, x223 * x1244)),
         );
-        let x1382 = -x1381;
+        let x1382 = Self::mul_add(
+            x214,
+            x1263,
+            Self::mul_add(-x215, x1261, Self::mul_add(x216, x1259, x1381)),
+        );
         let x1383 = Self::mul_add(
-            -x1340,
-            x1379,
-            Self::mul_add(-x1338, x1380, Self::mul_add(-x1336, x1381, x1334 * x1375)),
+            x217,
+            x1176,
+            Self::mul_add(-x219, x1174, Self::mul_add(x221, x1172, x223 * x1157)),
         );
         let x1384 = Self::mul_add(
-            -x1330,
-            x1380,
-            Self::mul_add(-x1328, x1381, Self::mul_add(x1326, x1383, x1315 * x1324)),
+            x214,
+            x1183,
+            Self::mul_add(-x215, x1181, Self::mul_add(x216, x1179, x1383)),
         );
-        let x1385 = Self::mul_add(-x1332, x1379, x1384);
+        let x1385 = Self::mul_add(
+            x217,
+            x1087,
+            Self::mul_add(-x219, x1084, Self::mul_add(x221, x1081, x223 * x1066)),
+        );
         let x1386 = Self::mul_add(
-            x1319,
-            x1381,
-            Self::mul_add(x1317, x1383, Self::mul_add(x1315, x1385, x1313)),
+            -x214,
+            x1095,
+            Self::mul_add(x215, x1092, Self::mul_add(-x216, x1089, x1385)),
         );
-        let x1387 = Self::mul_add(x1323, x1379, Self::mul_add(x1321, x1380, x1386));
+        let x1387 = -x1386;
         let x1388 = Self::mul_add(
-            x1310,
-            x1381,
-            Self::mul_add(-x1309, x1383, Self::mul_add(-x1308, x1385, x1307 * x1387)),
+            x217,
+            x1019,
+            Self::mul_add(-x219, x1019, Self::mul_add(x221, x1017, x223 * x1011)),
         );
-        let x1389 = Self::mul_add(x1312, x1379, Self::mul_add(x1311, x1380, x1388));
+        let x1389 = Self::mul_add(
+            -x214,
+            x1023,
+            Self::mul_add(x215, x1021, Self::mul_add(-x216, x1019, x1388)),
+        );
         let x1390 = -x1389;
-        let x1391 = Self::mul_add(x1326, x1336, x1328);
-        let x1392 = Self::mul_add(x1344, x1391, Self::mul_add(x1326, x1338, x1330));
-        let x1393 = Self::mul_add(
-            x1352,
-            x1392,
-            Self::mul_add(x1347, x1391, Self::mul_add(x1326, x1340, x1332)),
+        let x1391 = Self::mul_add(
+            x217,
+            x975,
+            Self::mul_add(-x219, x975, Self::mul_add(x221, x973, x223 * x967)),
         );
-        let x1394 = x1355 * x1393;
-        let x1395 = -x1394;
-        let x1396 = Self::mul_add(x1352, x1394, x1349 * x1392);
-        let x1397 = -x1396;
+        let x1392 = Self::mul_add(
+            x214,
+            x979,
+            Self::mul_add(x215, x977, Self::mul_add(-x216, x975, x1391)),
+        );
+        let x1393 = Self::mul_add(
+            x225,
+            x1299,
+            Self::mul_add(-x227, x1297, Self::mul_add(x229, x1292, x231 * x1289)),
+        );
+        let x1394 = Self::mul_add(
+            x136,
+            x1305,
+            Self::mul_add(-x214, x1303, Self::mul_add(x224, x1301, x1393)),
+        );
+        let x1395 = Self::mul_add(
+            x225,
+            x1257,
+            Self::mul_add(-x227, x1255, Self::mul_add(x229, x1251, x231 * x1244)),
+        );
+        let x1396 = Self::mul_add(
+            x136,
+            x1263,
+            Self::mul_add(-x214, x1261, Self::mul_add(x224, x1259, x1395)),
+        );
+        let x1397 = Self::mul_add(
+            x225,
+            x1176,
+            Self::mul_add(-x227, x1174, Self::mul_add(x229, x1172, x231 * x1157)),
+        );
         let x1398 = Self::mul_add(
-            x1347,
-            x1394,
-            Self::mul_add(x1344, x1396, x1342 * x1391),
+            x136,
+            x1183,
+            Self::mul_add(-x214, x1181, Self::mul_add(x224, x1179, x1397)),
         );
         let x1399 = Self::mul_add(
-            x1340,
-            x1394,
-            Self::mul_add(x1338, x1396, Self::mul_add(x1336, x1398, x1326 * x1334)),
+            x225,
+            x1087,
+            Self::mul_add(-x227, x1084, Self::mul_add(x229, x1081, x231 * x1066)),
         );
         let x1400 = Self::mul_add(
-            x1330,
-            x1396,
-            Self::mul_add(x1328, x1398, Self::mul_add(x1326, x1399, x1324)),
+            -x136,
+            x1095,
+            Self::mul_add(x214, x1092, Self::mul_add(-x224, x1089, x1399)),
         );
-        let x1401 = Self::mul_add(x1332, x1394, x1400);
+        let x1401 = -x1400;
         let x1402 = Self::mul_add(
-            -x1321,
-            x1396,
-            Self::mul_add(-x1319, x1398, Self::mul_add(x1317, x1399, x1315 * x1401)),
+            x225,
+            x1019,
+            Self::mul_add(-x227, x1019, Self::mul_add(x229, x1017, x231 * x1011)),
         );
-        let x1403 = Self::mul_add(-x1323, x1394, x1402);
-        let x1404 = Self::mul_add(
-            -x1310,
-            x1398,
-            Self::mul_add(-x1309, x1399, Self::mul_add(-x1308, x1401, x1307 * x1403)),
+        let x1403 = Self::mul_add(
+            -x136,
+            x1023,
+            Self::mul_add(x214, x1021, Self::mul_add(-x224, x1019, x1402)),
         );
-        let x1405 = Self::mul_add(-x1312, x1394, Self::mul_add(-x1311, x1396, x1404));
-        let x1406 = -x1405;
-        let x1407 = Self::mul_add(x1336, x1344, x1338);
-        let x1408 = x1355
-            * Self::mul_add(x1352, x1407, Self::mul_add(x1336, x1347, x1340));
-        let x1409 = -x1408;
-        let x1410 = Self::mul_add(x1352, x1408, x1349 * x1407);
-        let x1411 = -x1410;
+        let x1404 = -x1403;
+        let x1405 = Self::mul_add(
+            x225,
+            x975,
+            Self::mul_add(-x227, x975, Self::mul_add(x229, x973, x231 * x967)),
+        );
+        let x1406 = Self::mul_add(
+            x136,
+            x979,
+            Self::mul_add(x214, x977, Self::mul_add(-x224, x975, x1405)),
+        );
+        let x1407 = Self::mul_add(
+            -x149,
+            x1145,
+            Self::mul_add(x151, x1232, Self::mul_add(x154, x1280, x156 * x1270)),
+        );
+        let x1408 = Self::mul_add(
+            -x143,
+            x962,
+            Self::mul_add(x145, x1006, Self::mul_add(-x147, x1054, x1407)),
+        );
+        let x1409 = Self::mul_add(
+            x149,
+            x1300,
+            Self::mul_add(-x151, x1298, Self::mul_add(x154, x1296, x156 * x1291)),
+        );
+        let x1410 = Self::mul_add(
+            x143,
+            x1306,
+            Self::mul_add(-x145, x1304, Self::mul_add(x147, x1302, x1409)),
+        );
+        let x1411 = Self::mul_add(
+            -x149,
+            x1258,
+            Self::mul_add(x151, x1256, Self::mul_add(-x154, x1254, x156 * x1248)),
+        );
         let x1412 = Self::mul_add(
-            x1347,
-            x1408,
-            Self::mul_add(x1344, x1410, x1336 * x1342),
+            x143,
+            x1264,
+            Self::mul_add(-x145, x1262, Self::mul_add(-x147, x1260, x1411)),
         );
         let x1413 = Self::mul_add(
-            x1340,
-            x1408,
-            Self::mul_add(x1338, x1410, Self::mul_add(x1336, x1412, x1334)),
+            -x149,
+            x1178,
+            Self::mul_add(x151, x1175, Self::mul_add(-x154, x1173, x156 * x1166)),
         );
         let x1414 = Self::mul_add(
-            x1332,
-            x1408,
-            Self::mul_add(x1330, x1410, Self::mul_add(x1328, x1412, x1326 * x1413)),
+            x143,
+            x1184,
+            Self::mul_add(-x145, x1182, Self::mul_add(-x147, x1180, x1413)),
         );
         let x1415 = Self::mul_add(
-            -x1321,
-            x1410,
-            Self::mul_add(-x1319, x1412, Self::mul_add(x1317, x1413, x1315 * x1414)),
+            -x149,
+            x1088,
+            Self::mul_add(x151, x1086, Self::mul_add(-x154, x1082, x156 * x1075)),
         );
-        let x1416 = Self::mul_add(-x1323, x1408, x1415);
-        let x1417 = Self::mul_add(
-            -x1310,
-            x1412,
-            Self::mul_add(-x1309, x1413, Self::mul_add(-x1308, x1414, x1307 * x1416)),
+        let x1416 = Self::mul_add(
+            x143,
+            x1097,
+            Self::mul_add(-x145, x1094, Self::mul_add(x147, x1091, x1415)),
         );
-        let x1418 = Self::mul_add(-x1312, x1408, Self::mul_add(-x1311, x1410, x1417));
-        let x1419 = -x1418;
-        let x1420 = x1355 * Self::mul_add(x1344, x1352, x1347);
-        let x1421 = -x1420;
-        let x1422 = Self::mul_add(x1352, x1420, x1344 * x1349);
-        let x1423 = -x1422;
-        let x1424 = Self::mul_add(x1347, x1420, Self::mul_add(x1344, x1422, x1342));
+        let x1417 = -x1416;
+        let x1418 = Self::mul_add(
+            -x149,
+            x1020,
+            Self::mul_add(x151, x1020, Self::mul_add(-x154, x1018, x156 * x1014)),
+        );
+        let x1419 = Self::mul_add(
+            x143,
+            x1024,
+            Self::mul_add(-x145, x1022, Self::mul_add(x147, x1020, x1418)),
+        );
+        let x1420 = -x1419;
+        let x1421 = Self::mul_add(
+            -x149,
+            x976,
+            Self::mul_add(x151, x976, Self::mul_add(-x154, x974, x156 * x970)),
+        );
+        let x1422 = Self::mul_add(
+            -x143,
+            x980,
+            Self::mul_add(-x145, x978, Self::mul_add(x147, x976, x1421)),
+        );
+        let x1423 = Self::mul_add(
+            -x164,
+            x1145,
+            Self::mul_add(-x166, x1232, Self::mul_add(x168, x1280, x170 * x1270)),
+        );
+        let x1424 = Self::mul_add(
+            x161,
+            x962,
+            Self::mul_add(-x162, x1006, Self::mul_add(x163, x1054, x1423)),
+        );
         let x1425 = Self::mul_add(
-            x1340,
-            x1420,
-            Self::mul_add(x1338, x1422, x1336 * x1424),
+            x164,
+            x1300,
+            Self::mul_add(x166, x1298, Self::mul_add(x168, x1296, x170 * x1291)),
         );
         let x1426 = Self::mul_add(
-            x1332,
-            x1420,
-            Self::mul_add(x1330, x1422, Self::mul_add(x1328, x1424, x1326 * x1425)),
+            -x161,
+            x1306,
+            Self::mul_add(x162, x1304, Self::mul_add(-x163, x1302, x1425)),
         );
         let x1427 = Self::mul_add(
-            -x1321,
-            x1422,
-            Self::mul_add(-x1319, x1424, Self::mul_add(x1317, x1425, x1315 * x1426)),
+            -x164,
+            x1258,
+            Self::mul_add(-x166, x1256, Self::mul_add(-x168, x1254, x170 * x1248)),
         );
-        let x1428 = Self::mul_add(-x1323, x1420, x1427);
+        let x1428 = Self::mul_add(
+            -x161,
+            x1264,
+            Self::mul_add(x162, x1262, Self::mul_add(x163, x1260, x1427)),
+        );
         let x1429 = Self::mul_add(
-            -x1310,
-            x1424,
-            Self::mul_add(-x1309, x1425, Self::mul_add(-x1308, x1426, x1307 * x1428)),
+            -x164,
+            x1178,
+            Self::mul_add(-x166, x1175, Self::mul_add(-x168, x1173, x170 * x1166)),
         );
-        let x1430 = Self::mul_add(-x1312, x1420, Self::mul_add(-x1311, x1422, x1429));
-        let x1431 = -x1430;
-        let x1432 = x1352 * x1355;
-        let x1433 = Self::mul_add(x1352, x1432, x1349);
-        let x1434 = Self::mul_add(x1347, x1432, x1344 * x1433);
-        let x1435 = -x1434;
-        let x1436 = Self::mul_add(
-            x1340,
-            x1432,
-            Self::mul_add(x1338, x1433, x1336 * x1434),
+        let x1430 = Self::mul_add(
+            -x161,
+            x1184,
+            Self::mul_add(x162, x1182, Self::mul_add(x163, x1180, x1429)),
         );
-        let x1437 = -x1436;
+        let x1431 = Self::mul_add(
+            -x164,
+            x1088,
+            Self::mul_add(-x166, x1086, Self::mul_add(-x168, x1082, x170 * x1075)),
+        );
+        let x1432 = Self::mul_add(
+            -x161,
+            x1097,
+            Self::mul_add(x162, x1094, Self::mul_add(-x163, x1091, x1431)),
+        );
+        let x1433 = -x1432;
+        let x1434 = Self::mul_add(
+            -x164,
+            x1020,
+            Self::mul_add(-x166, x1020, Self::mul_add(-x168, x1018, x170 * x1014)),
+        );
+        let x1435 = Self::mul_add(
+            -x161,
+            x1024,
+            Self::mul_add(x162, x1022, Self::mul_add(-x163, x1020, x1434)),
+        );
+        let x1436 = -x1435;
+        let x1437 = Self::mul_add(
+            -x164,
+            x976,
+            Self::mul_add(-x166, x976, Self::mul_add(-x168, x974, x170 * x970)),
+        );
         let x1438 = Self::mul_add(
-            x1332,
-            x1432,
-            Self::mul_add(x1330, x1433, Self::mul_add(x1328, x1434, x1326 * x1436)),
+            x161,
+            x980,
+            Self::mul_add(x162, x978, Self::mul_add(-x163, x976, x1437)),
         );
-        let x1439 = -x1438;
+        let x1439 = Self::mul_add(
+            x179,
+            x1145,
+            Self::mul_add(-x182, x1232, Self::mul_add(x184, x1280, x186 * x1270)),
+        );
         let x1440 = Self::mul_add(
-            -x1321,
-            x1433,
-            Self::mul_add(-x1319, x1434, Self::mul_add(x1317, x1436, x1315 * x1438)),
+            -x174,
+            x962,
+            Self::mul_add(-x176, x1006, Self::mul_add(-x177, x1054, x1439)),
         );
-        let x1441 = Self::mul_add(-x1323, x1432, x1440);
-        let x1442 = -x1441;
+        let x1441 = Self::mul_add(
+            -x179,
+            x1300,
+            Self::mul_add(x182, x1298, Self::mul_add(x184, x1296, x186 * x1291)),
+        );
+        let x1442 = Self::mul_add(
+            x174,
+            x1306,
+            Self::mul_add(x176, x1304, Self::mul_add(x177, x1302, x1441)),
+        );
         let x1443 = Self::mul_add(
-            -x1310,
-            x1434,
-            Self::mul_add(-x1309, x1436, Self::mul_add(-x1308, x1438, x1307 * x1441)),
+            x179,
+            x1258,
+            Self::mul_add(-x182, x1256, Self::mul_add(-x184, x1254, x186 * x1248)),
         );
-        let x1444 = Self::mul_add(-x1312, x1432, Self::mul_add(-x1311, x1433, x1443));
-        let x1445 = Self::mul_add(x1347, x1355, x1344 * x1432);
-        let x1446 = -x1445;
+        let x1444 = Self::mul_add(
+            x174,
+            x1264,
+            Self::mul_add(x176, x1262, Self::mul_add(-x177, x1260, x1443)),
+        );
+        let x1445 = Self::mul_add(
+            x179,
+            x1178,
+            Self::mul_add(-x182, x1175, Self::mul_add(-x184, x1173, x186 * x1166)),
+        );
+        let x1446 = Self::mul_add(
+            x174,
+            x1184,
+            Self::mul_add(x176, x1182, Self::mul_add(-x177, x1180, x1445)),
+        );
         let x1447 = Self::mul_add(
-            x1340,
-            x1355,
-            Self::mul_add(x1338, x1432, x1336 * x1445),
+            x179,
+            x1088,
+            Self::mul_add(-x182, x1086, Self::mul_add(-x184, x1082, x186 * x1075)),
         );
-        let x1448 = -x1447;
-        let x1449 = Self::mul_add(
-            x1332,
-            x1355,
-            Self::mul_add(x1330, x1432, Self::mul_add(x1328, x1445, x1326 * x1447)),
+        let x1448 = Self::mul_add(
+            x174,
+            x1097,
+            Self::mul_add(x176, x1094, Self::mul_add(x177, x1091, x1447)),
         );
-        let x1450 = -x1449;
+        let x1449 = -x1448;
+        let x1450 = Self::mul_add(
+            x179,
+            x1020,
+            Self::mul_add(-x182, x1020, Self::mul_add(-x184, x1018, x186 * x1014)),
+        );
         let x1451 = Self::mul_add(
-            -x1321,
-            x1432,
-            Self::mul_add(-x1319, x1445, Self::mul_add(x1317, x1447, x1315 * x1449)),
+            x174,
+            x1024,
+            Self::mul_add(x176, x1022, Self::mul_add(x177, x1020, x1450)),
         );
-        let x1452 = Self::mul_add(-x1323, x1355, x1451);
-        let x1453 = -x1452;
+        let x1452 = -x1451;
+        let x1453 = Self::mul_add(
+            x179,
+            x976,
+            Self::mul_add(-x182, x976, Self::mul_add(-x184, x974, x186 * x970)),
+        );
         let x1454 = Self::mul_add(
-            -x1310,
-            x1445,
-            Self::mul_add(-x1309, x1447, Self::mul_add(-x1308, x1449, x1307 * x1452)),
+            -x174,
+            x980,
+            Self::mul_add(x176, x978, Self::mul_add(x177, x976, x1453)),
         );
-        let x1455 = Self::mul_add(-x1312, x1355, Self::mul_add(-x1311, x1432, x1454));
+        let x1455 = Self::mul_add(
+            x194,
+            x1145,
+            Self::mul_add(-x195, x1232, Self::mul_add(x198, x1280, x201 * x1270)),
+        );
         let x1456 = Self::mul_add(
-            -x1233,
-            x1367,
-            Self::mul_add(-x1231, x1369, Self::mul_add(-x1226, x1371, x1223 * x1374)),
+            x188,
+            x962,
+            Self::mul_add(-x190, x1006, Self::mul_add(x192, x1054, x1455)),
         );
-        let x1457 = Self::mul_add(
-            -x1239,
-            x1362,
-            Self::mul_add(-x1237, x1364, Self::mul_add(x1235, x1366, x1456)),
-        );
+        let x1457 = -x1456;
         let x1458 = Self::mul_add(
-            -x1191,
-            x1367,
-            Self::mul_add(-x1189, x1369, Self::mul_add(-x1185, x1371, x1178 * x1374)),
+            -x194,
+            x1300,
+            Self::mul_add(x195, x1298, Self::mul_add(x198, x1296, x201 * x1291)),
         );
         let x1459 = Self::mul_add(
-            -x1197,
-            x1362,
-            Self::mul_add(-x1195, x1364, Self::mul_add(x1193, x1366, x1458)),
+            -x188,
+            x1306,
+            Self::mul_add(x190, x1304, Self::mul_add(-x192, x1302, x1458)),
         );
-        let x1460 = Self::mul_add(
-            -x1110,
-            x1367,
-            Self::mul_add(-x1108, x1369, Self::mul_add(-x1106, x1371, x1091 * x1374)),
-        );
+        let x1460 = -x1459;
         let x1461 = Self::mul_add(
-            -x1117,
-            x1362,
-            Self::mul_add(-x1115, x1364, Self::mul_add(x1113, x1366, x1460)),
+            x194,
+            x1258,
+            Self::mul_add(-x195, x1256, Self::mul_add(-x198, x1254, x201 * x1248)),
         );
         let x1462 = Self::mul_add(
-            -x1021,
-            x1367,
-            Self::mul_add(-x1018, x1369, Self::mul_add(-x1015, x1371, x1000 * x1374)),
+            -x188,
+            x1264,
+            Self::mul_add(x190, x1262, Self::mul_add(x192, x1260, x1461)),
         );
-        let x1463 = Self::mul_add(
-            x1029,
-            x1362,
-            Self::mul_add(x1026, x1364, Self::mul_add(-x1023, x1366, x1462)),
+        let x1463 = -x1462;
+        let x1464 = Self::mul_add(
+            x194,
+            x1178,
+            Self::mul_add(-x195, x1175, Self::mul_add(-x198, x1173, x201 * x1166)),
         );
-        let x1464 = -x1463;
         let x1465 = Self::mul_add(
-            -x953,
-            x1367,
-            Self::mul_add(-x953, x1369, Self::mul_add(-x951, x1371, x945 * x1374)),
+            -x188,
+            x1184,
+            Self::mul_add(x190, x1182, Self::mul_add(x192, x1180, x1464)),
         );
-        let x1466 = Self::mul_add(
-            -x957,
-            x1362,
-            Self::mul_add(-x955, x1364, Self::mul_add(-x953, x1366, x1465)),
-        );
+        let x1466 = -x1465;
         let x1467 = Self::mul_add(
-            -x909,
-            x1367,
-            Self::mul_add(-x909, x1369, Self::mul_add(-x907, x1371, x901 * x1374)),
+            x194,
+            x1088,
+            Self::mul_add(-x195, x1086, Self::mul_add(-x198, x1082, x201 * x1075)),
         );
         let x1468 = Self::mul_add(
-            -x913,
-            x1362,
-            Self::mul_add(-x911, x1364, Self::mul_add(-x909, x1366, x1467)),
+            -x188,
+            x1097,
+            Self::mul_add(x190, x1094, Self::mul_add(-x192, x1091, x1467)),
         );
         let x1469 = Self::mul_add(
-            x1233,
-            x1383,
-            Self::mul_add(x1231, x1385, Self::mul_add(-x1226, x1387, x1223 * x1389)),
+            x194,
+            x1020,
+            Self::mul_add(-x195, x1020, Self::mul_add(-x198, x1018, x201 * x1014)),
         );
         let x1470 = Self::mul_add(
-            -x1239,
-            x1379,
-            Self::mul_add(-x1237, x1380, Self::mul_add(x1235, x1381, x1469)),
+            -x188,
+            x1024,
+            Self::mul_add(x190, x1022, Self::mul_add(-x192, x1020, x1469)),
         );
-        let x1471 = -x1470;
+        let x1471 = Self::mul_add(
+            x194,
+            x976,
+            Self::mul_add(-x195, x976, Self::mul_add(-x198, x974, x201 * x970)),
+        );
         let x1472 = Self::mul_add(
-            x1191,
-            x1383,
-            Self::mul_add(x1189, x1385, Self::mul_add(-x1185, x1387, x1178 * x1389)),
+            x188,
+            x980,
+            Self::mul_add(x190, x978, Self::mul_add(-x192, x976, x1471)),
         );
-        let x1473 = Self::mul_add(
-            -x1197,
-            x1379,
-            Self::mul_add(-x1195, x1380, Self::mul_add(x1193, x1381, x1472)),
+        let x1473 = -x1472;
+        let x1474 = Self::mul_add(
+            x207,
+            x1145,
+            Self::mul_add(-x209, x1232, Self::mul_add(x211, x1280, x213 * x1270)),
         );
-        let x1474 = -x1473;
         let x1475 = Self::mul_add(
-            x1110,
-            x1383,
-            Self::mul_add(x1108, x1385, Self::mul_add(-x1106, x1387, x1091 * x1389)),
+            -x203,
+            x962,
+            Self::mul_add(-x205, x1006, Self::mul_add(x206, x1054, x1474)),
         );
         let x1476 = Self::mul_add(
-            -x1117,
-            x1379,
-            Self::mul_add(-x1115, x1380, Self::mul_add(x1113, x1381, x1475)),
+            -x207,
+            x1300,
+            Self::mul_add(x209, x1298, Self::mul_add(x211, x1296, x213 * x1291)),
         );
-        let x1477 = -x1476;
+        let x1477 = Self::mul_add(
+            x203,
+            x1306,
+            Self::mul_add(x205, x1304, Self::mul_add(-x206, x1302, x1476)),
+        );
         let x1478 = Self::mul_add(
-            x1021,
-            x1383,
-            Self::mul_add(x1018, x1385, Self::mul_add(-x1015, x1387, x1000 * x1389)),
+            x207,
+            x1258,
+            Self::mul_add(-x209, x1256, Self::mul_add(-x211, x1254, x213 * x1248)),
         );
         let x1479 = Self::mul_add(
-            x1029,
-            x1379,
-            Self::mul_add(x1026, x1380, Self::mul_add(-x1023, x1381, x1478)),
+            x203,
+            x1264,
+            Self::mul_add(x205, x1262, Self::mul_add(x206, x1260, x1478)),
         );
         let x1480 = Self::mul_add(
-            x953,
-            x1383,
-            Self::mul_add(x953, x1385, Self::mul_add(-x951, x1387, x945 * x1389)),
+            x207,
+            x1178,
+            Self::mul_add(-x209, x1175, Self::mul_add(-x211, x1173, x213 * x1166)),
         );
         let x1481 = Self::mul_add(
-            -x957,
-            x1379,
-            Self::mul_add(-x955, x1380, Self::mul_add(-x953, x1381, x1480)),
+            x203,
+            x1184,
+            Self::mul_add(x205, x1182, Self::mul_add(x206, x1180, x1480)),
         );
-        let x1482 = -x1481;
+        let x1482 = Self::mul_add(
+            x207,
+            x1088,
+            Self::mul_add(-x209, x1086, Self::mul_add(-x211, x1082, x213 * x1075)),
+        );
         let x1483 = Self::mul_add(
-            x909,
-            x1383,
-            Self::mul_add(x909, x1385, Self::mul_add(-x907, x1387, x901 * x1389)),
+            x203,
+            x1097,
+            Self::mul_add(x205, x1094, Self::mul_add(-x206, x1091, x1482)),
         );
-        let x1484 = Self::mul_add(
-            -x913,
-            x1379,
-            Self::mul_add(-x911, x1380, Self::mul_add(-x909, x1381, x1483)),
+        let x1484 = -x1483;
+        let x1485 = Self::mul_add(
+            x207,
+            x1020,
+            Self::mul_add(-x209, x1020, Self::mul_add(-x211, x1018, x213 * x1014)),
         );
-        let x1485 = -x1484;
         let x1486 = Self::mul_add(
-            x1233,
-            x1399,
-            Self::mul_add(x1231, x1401, Self::mul_add(-x1226, x1403, x1223 * x1405)),
+            x203,
+            x1024,
+            Self::mul_add(x205, x1022, Self::mul_add(-x206, x1020, x1485)),
         );
-        let x1487 = Self::mul_add(
-            x1239,
-            x1394,
-            Self::mul_add(x1237, x1396, Self::mul_add(-x1235, x1398, x1486)),
+        let x1487 = -x1486;
+        let x1488 = Self::mul_add(
+            x207,
+            x976,
+            Self::mul_add(-x209, x976, Self::mul_add(-x211, x974, x213 * x970)),
         );
-        let x1488 = -x1487;
         let x1489 = Self::mul_add(
-            x1191,
-            x1399,
-            Self::mul_add(x1189, x1401, Self::mul_add(-x1185, x1403, x1178 * x1405)),
+            -x203,
+            x980,
+            Self::mul_add(x205, x978, Self::mul_add(-x206, x976, x1488)),
         );
         let x1490 = Self::mul_add(
-            x1197,
-            x1394,
-            Self::mul_add(x1195, x1396, Self::mul_add(-x1193, x1398, x1489)),
+            x217,
+            x1145,
+            Self::mul_add(-x219, x1232, Self::mul_add(x221, x1280, x223 * x1270)),
         );
-        let x1491 = -x1490;
+        let x1491 = Self::mul_add(
+            x214,
+            x962,
+            Self::mul_add(-x215, x1006, Self::mul_add(x216, x1054, x1490)),
+        );
         let x1492 = Self::mul_add(
-            x1110,
-            x1399,
-            Self::mul_add(x1108, x1401, Self::mul_add(-x1106, x1403, x1091 * x1405)),
+            -x217,
+            x1300,
+            Self::mul_add(x219, x1298, Self::mul_add(x221, x1296, x223 * x1291)),
         );
         let x1493 = Self::mul_add(
-            x1117,
-            x1394,
-            Self::mul_add(x1115, x1396, Self::mul_add(-x1113, x1398, x1492)),
+            -x214,
+            x1306,
+            Self::mul_add(x215, x1304, Self::mul_add(-x216, x1302, x1492)),
         );
-        let x1494 = -x1493;
+        let x1494 = Self::mul_add(
+            x217,
+            x1258,
+            Self::mul_add(-x219, x1256, Self::mul_add(-x221, x1254, x223 * x1248)),
+        );
         let x1495 = Self::mul_add(
-            x1021,
-            x1399,
-            Self::mul_add(x1018, x1401, Self::mul_add(-x1015, x1403, x1000 * x1405)),
+            -x214,
+            x1264,
+            Self::mul_add(x215, x1262, Self::mul_add(x216, x1260, x1494)),
         );
         let x1496 = Self::mul_add(
-            -x1029,
-            x1394,
-            Self::mul_add(-x1026, x1396, Self::mul_add(x1023, x1398, x1495)),
+            x217,
+            x1178,
+            Self::mul_add(-x219, x1175, Self::mul_add(-x221, x1173, x223 * x1166)),
         );
         let x1497 = Self::mul_add(
-            x953,
-            x1399,
-            Self::mul_add(x953, x1401, Self::mul_add(-x951, x1403, x945 * x1405)),
+            -x214,
+            x1184,
+            Self::mul_add(x215, x1182, Self::mul_add(x216, x1180, x1496)),
         );
         let x1498 = Self::mul_add(
-            x957,
-            x1394,
-            Self::mul_add(x955, x1396, Self::mul_add(x953, x1398, x1497)),
+            x217,
+            x1088,
+            Self::mul_add(-x219, x1086, Self::mul_add(-x221, x1082, x223 * x1075)),
         );
-        let x1499 = -x1498;
-        let x1500 = Self::mul_add(
-            x909,
-            x1399,
-            Self::mul_add(x909, x1401, Self::mul_add(-x907, x1403, x901 * x1405)),
+        let x1499 = Self::mul_add(
+            -x214,
+            x1097,
+            Self::mul_add(x215, x1094, Self::mul_add(-x216, x1091, x1498)),
         );
+        let x1500 = -x1499;
         let x1501 = Self::mul_add(
-            x913,
-            x1394,
-            Self::mul_add(x911, x1396, Self::mul_add(x909, x1398, x1500)),
+            x217,
+            x1020,
+            Self::mul_add(-x219, x1020, Self::mul_add(-x221, x1018, x223 * x1014)),
         );
-        let x1502 = -x1501;
-        let x1503 = Self::mul_add(
-            x1233,
-            x1413,
-            Self::mul_add(x1231, x1414, Self::mul_add(-x1226, x1416, x1223 * x1418)),
+        let x1502 = Self::mul_add(
+            -x214,
+            x1024,
+            Self::mul_add(x215, x1022, Self::mul_add(-x216, x1020, x1501)),
         );
+        let x1503 = -x1502;
         let x1504 = Self::mul_add(
-            x1239,
-            x1408,
-            Self::mul_add(x1237, x1410, Self::mul_add(-x1235, x1412, x1503)),
+            x217,
+            x976,
+            Self::mul_add(-x219, x976, Self::mul_add(-x221, x974, x223 * x970)),
         );
-        let x1505 = -x1504;
+        let x1505 = Self::mul_add(
+            x214,
+            x980,
+            Self::mul_add(x215, x978, Self::mul_add(-x216, x976, x1504)),
+        );
         let x1506 = Self::mul_add(
-            x1191,
-            x1413,
-            Self::mul_add(x1189, x1414, Self::mul_add(-x1185, x1416, x1178 * x1418)),
+            x225,
+            x1145,
+            Self::mul_add(-x227, x1232, Self::mul_add(x229, x1280, x231 * x1270)),
         );
         let x1507 = Self::mul_add(
-            x1197,
-            x1408,
-            Self::mul_add(x1195, x1410, Self::mul_add(-x1193, x1412, x1506)),
+            x136,
+            x962,
+            Self::mul_add(-x214, x1006, Self::mul_add(x224, x1054, x1506)),
         );
-        let x1508 = -x1507;
+        let x1508 = Self::mul_add(
+            -x225,
+            x1300,
+            Self::mul_add(x227, x1298, Self::mul_add(x229, x1296, x231 * x1291)),
+        );
         let x1509 = Self::mul_add(
-            x1110,
-            x1413,
-            Self::mul_add(x1108, x1414, Self::mul_add(-x1106, x1416, x1091 * x1418)),
+            -x136,
+            x1306,
+            Self::mul_add(x214, x1304, Self::mul_add(-x224, x1302, x1508)),
         );
         let x1510 = Self::mul_add(
-            x1117,
-            x1408,
-            Self::mul_add(x1115, x1410, Self::mul_add(-x1113, x1412, x1509)),
+            x225,
+            x1258,
+            Self::mul_add(-x227, x1256, Self::mul_add(-x229, x1254, x231 * x1248)),
         );
-        let x1511 = -x1510;
+        let x1511 = Self::mul_add(
+            -x136,
+            x1264,
+            Self::mul_add(x214, x1262, Self::mul_add(x224, x1260, x1510)),
+        );
         let x1512 = Self::mul_add(
-            x1021,
-            x1413,
-            Self::mul_add(x1018, x1414, Self::mul_add(-x1015, x1416, x1000 * x1418)),
+            x225,
+            x1178,
+            Self::mul_add(-x227, x1175, Self::mul_add(-x229, x1173, x231 * x1166)),
         );
         let x1513 = Self::mul_add(
-            -x1029,
-            x1408,
-            Self::mul_add(-x1026, x1410, Self::mul_add(x1023, x1412, x1512)),
+            -x136,
+            x1184,
+            Self::mul_add(x214, x1182, Self::mul_add(x224, x1180, x1512)),
         );
         let x1514 = Self::mul_add(
-            x953,
-            x1413,
-            Self::mul_add(x953, x1414, Self::mul_add(-x951, x1416, x945 * x1418)),
+            x225,
+            x1088,
+            Self::mul_add(-x227, x1086, Self::mul_add(-x229, x1082, x231 * x1075)),
         );
         let x1515 = Self::mul_add(
-            x957,
-            x1408,
-            Self::mul_add(x955, x1410, Self::mul_add(x953, x1412, x1514)),
+            -x136,
+            x1097,
+            Self::mul_add(x214, x1094, Self::mul_add(-x224, x1091, x1514)),
         );
         let x1516 = -x1515;
         let x1517 = Self::mul_add(
-            x909,
-            x1413,
-            Self::mul_add(x909, x1414, Self::mul_add(-x907, x1416, x901 * x1418)),
+            x225,
+            x1020,
+            Self::mul_add(-x227, x1020, Self::mul_add(-x229, x1018, x231 * x1014)),
         );
         let x1518 = Self::mul_add(
-            x913,
-            x1408,
-            Self::mul_add(x911, x1410, Self::mul_add(x909, x1412, x1517)),
+            -x136,
+            x1024,
+            Self::mul_add(x214, x1022, Self::mul_add(-x224, x1020, x1517)),
         );
         let x1519 = -x1518;
         let x1520 = Self::mul_add(
-            x1233,
-            x1425,
-            Self::mul_add(x1231, x1426, Self::mul_add(-x1226, x1428, x1223 * x1430)),
+            x225,
+            x976,
+            Self::mul_add(-x227, x976, Self::mul_add(-x229, x974, x231 * x970)),
         );
         let x1521 = Self::mul_add(
-            x1239,
-            x1420,
-            Self::mul_add(x1237, x1422, Self::mul_add(-x1235, x1424, x1520)),
-        );
-        let x1522 = -x1521;
-        let x1523 = Self::mul_add(
-            x1191,
-            x1425,
-            Self::mul_add(x1189, x1426, Self::mul_add(-x1185, x1428, x1178 * x1430)),
-        );
-        let x1524 = Self::mul_add(
-            x1197,
-            x1420,
-            Self::mul_add(x1195, x1422, Self::mul_add(-x1193, x1424, x1523)),
-        );
-        let x1525 = -x1524;
-        let x1526 = Self::mul_add(
-            x1110,
-            x1425,
-            Self::mul_add(x1108, x1426, Self::mul_add(-x1106, x1428, x1091 * x1430)),
-        );
-        let x1527 = Self::mul_add(
-            x1117,
-            x1420,
-            Self::mul_add(x1115, x1422, Self::mul_add(-x1113, x1424, x1526)),
-        );
-        let x1528 = -x1527;
-        let x1529 = Self::mul_add(
-            x1021,
-            x1425,
-            Self::mul_add(x1018, x1426, Self::mul_add(-x1015, x1428, x1000 * x1430)),
-        );
-        let x1530 = Self::mul_add(
-            -x1029,
-            x1420,
-            Self::mul_add(-x1026, x1422, Self::mul_add(x1023, x1424, x1529)),
-        );
-        let x1531 = Self::mul_add(
-            x953,
-            x1425,
-            Self::mul_add(x953, x1426, Self::mul_add(-x951, x1428, x945 * x1430)),
-        );
-        let x1532 = Self::mul_add(
-            x957,
-            x1420,
-            Self::mul_add(x955, x1422, Self::mul_add(x953, x1424, x1531)),
-        );
-        let x1533 = -x1532;
-        let x1534 = Self::mul_add(
-            x909,
-            x1425,
-            Self::mul_add(x909, x1426, Self::mul_add(-x907, x1428, x901 * x1430)),
-        );
-        let x1535 = Self::mul_add(
-            x913,
-            x1420,
-            Self::mul_add(x911, x1422, Self::mul_add(x909, x1424, x1534)),
-        );
-        let x1536 = -x1535;
-        let x1537 = Self::mul_add(
-            x1233,
-            x1436,
-            Self::mul_add(x1231, x1438, Self::mul_add(-x1226, x1441, x1223 * x1444)),
-        );
-        let x1538 = Self::mul_add(
-            x1239,
-            x1432,
-            Self::mul_add(x1237, x1433, Self::mul_add(-x1235, x1434, x1537)),
-        );
-        let x1539 = Self::mul_add(
-            x1191,
-            x1436,
-            Self::mul_add(x1189, x1438, Self::mul_add(-x1185, x1441, x1178 * x1444)),
-        );
-        let x1540 = Self::mul_add(
-            x1197,
-            x1432,
-            Self::mul_add(x1195, x1433, Self::mul_add(-x1193, x1434, x1539)),
-        );
-        let x1541 = Self::mul_add(
-            x1110,
-            x1436,
-            Self::mul_add(x1108, x1438, Self::mul_add(-x1106, x1441, x1091 * x1444)),
-        );
-        let x1542 = Self::mul_add(
-            x1117,
-            x1432,
-            Self::mul_add(x1115, x1433, Self::mul_add(-x1113, x1434, x1541)),
-        );
-        let x1543 = Self::mul_add(
-            x1021,
-            x1436,
-            Self::mul_add(x1018, x1438, Self::mul_add(-x1015, x1441, x1000 * x1444)),
-        );
-        let x1544 = Self::mul_add(
-            -x1029,
-            x1432,
-            Self::mul_add(-x1026, x1433, Self::mul_add(x1023, x1434, x1543)),
-        );
-        let x1545 = -x1544;
-        let x1546 = Self::mul_add(
-            x953,
-            x1436,
-            Self::mul_add(x953, x1438, Self::mul_add(-x951, x1441, x945 * x1444)),
-        );
-        let x1547 = Self::mul_add(
-            x957,
-            x1432,
-            Self::mul_add(x955, x1433, Self::mul_add(x953, x1434, x1546)),
-        );
-        let x1548 = Self::mul_add(
-            x909,
-            x1436,
-            Self::mul_add(x909, x1438, Self::mul_add(-x907, x1441, x901 * x1444)),
-        );
-        let x1549 = Self::mul_add(
-            x913,
-            x1432,
-            Self::mul_add(x911, x1433, Self::mul_add(x909, x1434, x1548)),
-        );
-        let x1550 = Self::mul_add(
-            x1233,
-            x1447,
-            Self::mul_add(x1231, x1449, Self::mul_add(-x1226, x1452, x1223 * x1455)),
-        );
-        let x1551 = Self::mul_add(
-            x1239,
-            x1355,
-            Self::mul_add(x1237, x1432, Self::mul_add(-x1235, x1445, x1550)),
-        );
-        let x1552 = Self::mul_add(
-            x1191,
-            x1447,
-            Self::mul_add(x1189, x1449, Self::mul_add(-x1185, x1452, x1178 * x1455)),
-        );
-        let x1553 = Self::mul_add(
-            x1197,
-            x1355,
-            Self::mul_add(x1195, x1432, Self::mul_add(-x1193, x1445, x1552)),
-        );
-        let x1554 = Self::mul_add(
-            x1110,
-            x1447,
-            Self::mul_add(x1108, x1449, Self::mul_add(-x1106, x1452, x1091 * x1455)),
-        );
-        let x1555 = Self::mul_add(
-            x1117,
-            x1355,
-            Self::mul_add(x1115, x1432, Self::mul_add(-x1113, x1445, x1554)),
-        );
-        let x1556 = Self::mul_add(
-            x1021,
-            x1447,
-            Self::mul_add(x1018, x1449, Self::mul_add(-x1015, x1452, x1000 * x1455)),
-        );
-        let x1557 = Self::mul_add(
-            -x1029,
-            x1355,
-            Self::mul_add(-x1026, x1432, Self::mul_add(x1023, x1445, x1556)),
-        );
-        let x1558 = -x1557;
-        let x1559 = Self::mul_add(
-            x953,
-            x1447,
-            Self::mul_add(x953, x1449, Self::mul_add(-x951, x1452, x945 * x1455)),
-        );
-        let x1560 = Self::mul_add(
-            x957,
-            x1355,
-            Self::mul_add(x955, x1432, Self::mul_add(x953, x1445, x1559)),
-        );
-        let x1561 = Self::mul_add(
-            x909,
-            x1447,
-            Self::mul_add(x909, x1449, Self::mul_add(-x907, x1452, x901 * x1455)),
-        );
-        let x1562 = Self::mul_add(
-            x913,
-            x1355,
-            Self::mul_add(x911, x1432, Self::mul_add(x909, x1445, x1561)),
-        );
-        let x1563 = Self::mul_add(
-            -x1079,
-            x1367,
-            Self::mul_add(-x1166, x1369, Self::mul_add(-x1214, x1371, x1204 * x1374)),
-        );
-        let x1564 = Self::mul_add(
-            -x896,
-            x1362,
-            Self::mul_add(-x940, x1364, Self::mul_add(x988, x1366, x1563)),
-        );
-        let x1565 = Self::mul_add(
-            x1234,
-            x1367,
-            Self::mul_add(x1232, x1369, Self::mul_add(-x1230, x1371, x1225 * x1374)),
-        );
-        let x1566 = Self::mul_add(
-            x1240,
-            x1362,
-            Self::mul_add(x1238, x1364, Self::mul_add(-x1236, x1366, x1565)),
-        );
-        let x1567 = Self::mul_add(
-            -x1192,
-            x1367,
-            Self::mul_add(-x1190, x1369, Self::mul_add(x1188, x1371, x1182 * x1374)),
-        );
-        let x1568 = Self::mul_add(
-            x1198,
-            x1362,
-            Self::mul_add(x1196, x1364, Self::mul_add(x1194, x1366, x1567)),
-        );
-        let x1569 = Self::mul_add(
-            -x1112,
-            x1367,
-            Self::mul_add(-x1109, x1369, Self::mul_add(x1107, x1371, x1100 * x1374)),
-        );
-        let x1570 = Self::mul_add(
-            x1118,
-            x1362,
-            Self::mul_add(x1116, x1364, Self::mul_add(x1114, x1366, x1569)),
-        );
-        let x1571 = Self::mul_add(
-            -x1022,
-            x1367,
-            Self::mul_add(-x1020, x1369, Self::mul_add(x1016, x1371, x1009 * x1374)),
-        );
-        let x1572 = Self::mul_add(
-            x1031,
-            x1362,
-            Self::mul_add(x1028, x1364, Self::mul_add(-x1025, x1366, x1571)),
-        );
-        let x1573 = -x1572;
-        let x1574 = Self::mul_add(
-            -x954,
-            x1367,
-            Self::mul_add(-x954, x1369, Self::mul_add(x952, x1371, x948 * x1374)),
-        );
-        let x1575 = Self::mul_add(
-            -x958,
-            x1362,
-            Self::mul_add(-x956, x1364, Self::mul_add(-x954, x1366, x1574)),
-        );
-        let x1576 = Self::mul_add(
-            -x910,
-            x1367,
-            Self::mul_add(-x910, x1369, Self::mul_add(x908, x1371, x904 * x1374)),
-        );
-        let x1577 = Self::mul_add(
-            -x914,
-            x1362,
-            Self::mul_add(-x912, x1364, Self::mul_add(-x910, x1366, x1576)),
-        );
-        let x1578 = Self::mul_add(
-            x1079,
-            x1383,
-            Self::mul_add(x1166, x1385, Self::mul_add(-x1214, x1387, x1204 * x1389)),
-        );
-        let x1579 = Self::mul_add(
-            -x896,
-            x1379,
-            Self::mul_add(-x940, x1380, Self::mul_add(x988, x1381, x1578)),
-        );
-        let x1580 = -x1579;
-        let x1581 = Self::mul_add(
-            -x1234,
-            x1383,
-            Self::mul_add(-x1232, x1385, Self::mul_add(-x1230, x1387, x1225 * x1389)),
-        );
-        let x1582 = Self::mul_add(
-            x1240,
-            x1379,
-            Self::mul_add(x1238, x1380, Self::mul_add(-x1236, x1381, x1581)),
-        );
-        let x1583 = -x1582;
-        let x1584 = Self::mul_add(
-            x1192,
-            x1383,
-            Self::mul_add(x1190, x1385, Self::mul_add(x1188, x1387, x1182 * x1389)),
-        );
-        let x1585 = Self::mul_add(
-            x1198,
-            x1379,
-            Self::mul_add(x1196, x1380, Self::mul_add(x1194, x1381, x1584)),
-        );
-        let x1586 = -x1585;
-        let x1587 = Self::mul_add(
-            x1112,
-            x1383,
-            Self::mul_add(x1109, x1385, Self::mul_add(x1107, x1387, x1100 * x1389)),
-        );
-        let x1588 = Self::mul_add(
-            x1118,
-            x1379,
-            Self::mul_add(x1116, x1380, Self::mul_add(x1114, x1381, x1587)),
-        );
-        let x1589 = -x1588;
-        let x1590 = Self::mul_add(
-            x1022,
-            x1383,
-            Self::mul_add(x1020, x1385, Self::mul_add(x1016, x1387, x1009 * x1389)),
-        );
-        let x1591 = Self::mul_add(
-            x1031,
-            x1379,
-            Self::mul_add(x1028, x1380, Self::mul_add(-x1025, x1381, x1590)),
-        );
-        let x1592 = Self::mul_add(
-            x954,
-            x1383,
-            Self::mul_add(x954, x1385, Self::mul_add(x952, x1387, x948 * x1389)),
-        );
-        let x1593 = Self::mul_add(
-            -x958,
-            x1379,
-            Self::mul_add(-x956, x1380, Self::mul_add(-x954, x1381, x1592)),
-        );
-        let x1594 = -x1593;
-        let x1595 = Self::mul_add(
-            x910,
-            x1383,
-            Self::mul_add(x910, x1385, Self::mul_add(x908, x1387, x904 * x1389)),
-        );
-        let x1596 = Self::mul_add(
-            -x914,
-            x1379,
-            Self::mul_add(-x912, x1380, Self::mul_add(-x910, x1381, x1595)),
-        );
-        let x1597 = -x1596;
-        let x1598 = Self::mul_add(
-            x1079,
-            x1399,
-            Self::mul_add(x1166, x1401, Self::mul_add(-x1214, x1403, x1204 * x1405)),
-        );
-        let x1599 = Self::mul_add(
-            x896,
-            x1394,
-            Self::mul_add(x940, x1396, Self::mul_add(-x988, x1398, x1598)),
-        );
-        let x1600 = -x1599;
-        let x1601 = Self::mul_add(
-            -x1234,
-            x1399,
-            Self::mul_add(-x1232, x1401, Self::mul_add(-x1230, x1403, x1225 * x1405)),
-        );
-        let x1602 = Self::mul_add(
-            -x1240,
-            x1394,
-            Self::mul_add(-x1238, x1396, Self::mul_add(x1236, x1398, x1601)),
-        );
-        let x1603 = -x1602;
-        let x1604 = Self::mul_add(
-            x1192,
-            x1399,
-            Self::mul_add(x1190, x1401, Self::mul_add(x1188, x1403, x1182 * x1405)),
-        );
-        let x1605 = Self::mul_add(
-            -x1198,
-            x1394,
-            Self::mul_add(-x1196, x1396, Self::mul_add(-x1194, x1398, x1604)),
-        );
-        let x1606 = -x1605;
-        let x1607 = Self::mul_add(
-            x1112,
-            x1399,
-            Self::mul_add(x1109, x1401, Self::mul_add(x1107, x1403, x1100 * x1405)),
-        );
-        let x1608 = Self::mul_add(
-            -x1118,
-            x1394,
-            Self::mul_add(-x1116, x1396, Self::mul_add(-x1114, x1398, x1607)),
-        );
-        let x1609 = -x1608;
-        let x1610 = Self::mul_add(
-            x1022,
-            x1399,
-            Self::mul_add(x1020, x1401, Self::mul_add(x1016, x1403, x1009 * x1405)),
-        );
-        let x1611 = Self::mul_add(
-            -x1031,
-            x1394,
-            Self::mul_add(-x1028, x1396, Self::mul_add(x1025, x1398, x1610)),
-        );
-        let x1612 = Self::mul_add(
-            x954,
-            x1399,
-            Self::mul_add(x954, x1401, Self::mul_add(x952, x1403, x948 * x1405)),
-        );
-        let x1613 = Self::mul_add(
-            x958,
-            x1394,
-            Self::mul_add(x956, x1396, Self::mul_add(x954, x1398, x1612)),
-        );
-        let x1614 = -x1613;
-        let x1615 = Self::mul_add(
-            x910,
-            x1399,
-            Self::mul_add(x910, x1401, Self::mul_add(x908, x1403, x904 * x1405)),
-        );
-        let x1616 = Self::mul_add(
-            x914,
-            x1394,
-            Self::mul_add(x912, x1396, Self::mul_add(x910, x1398, x1615)),
-        );
-        let x1617 = -x1616;
-        let x1618 = Self::mul_add(
-            x1079,
-            x1413,
-            Self::mul_add(x1166, x1414, Self::mul_add(-x1214, x1416, x1204 * x1418)),
-        );
-        let x1619 = Self::mul_add(
-            x896,
-            x1408,
-            Self::mul_add(x940, x1410, Self::mul_add(-x988, x1412, x1618)),
-        );
-        let x1620 = -x1619;
-        let x1621 = Self::mul_add(
-            -x1234,
-            x1413,
-            Self::mul_add(-x1232, x1414, Self::mul_add(-x1230, x1416, x1225 * x1418)),
-        );
-        let x1622 = Self::mul_add(
-            -x1240,
-            x1408,
-            Self::mul_add(-x1238, x1410, Self::mul_add(x1236, x1412, x1621)),
-        );
-        let x1623 = -x1622;
-        let x1624 = Self::mul_add(
-            x1192,
-            x1413,
-            Self::mul_add(x1190, x1414, Self::mul_add(x1188, x1416, x1182 * x1418)),
-        );
-        let x1625 = Self::mul_add(
-            -x1198,
-            x1408,
-            Self::mul_add(-x1196, x1410, Self::mul_add(-x1194, x1412, x1624)),
-        );
-        let x1626 = -x1625;
-        let x1627 = Self::mul_add(
-            x1112,
-            x1413,
-            Self::mul_add(x1109, x1414, Self::mul_add(x1107, x1416, x1100 * x1418)),
-        );
-        let x1628 = Self::mul_add(
-            -x1118,
-            x1408,
-            Self::mul_add(-x1116, x1410, Self::mul_add(-x1114, x1412, x1627)),
-        );
-        let x1629 = -x1628;
-        let x1630 = Self::mul_add(
-            x1022,
-            x1413,
-            Self::mul_add(x1020, x1414, Self::mul_add(x1016, x1416, x1009 * x1418)),
-        );
-        let x1631 = Self::mul_add(
-            -x1031,
-            x1408,
-            Self::mul_add(-x1028, x1410, Self::mul_add(x1025, x1412, x1630)),
-        );
-        let x1632 = Self::mul_add(
-            x954,
-            x1413,
-            Self::mul_add(x954, x1414, Self::mul_add(x952, x1416, x948 * x1418)),
-        );
-        let x1633 = Self::mul_add(
-            x958,
-            x1408,
-            Self::mul_add(x956, x1410, Self::mul_add(x954, x1412, x1632)),
-        );
-        let x1634 = -x1633;
-        let x1635 = Self::mul_add(
-            x910,
-            x1413,
-            Self::mul_add(x910, x1414, Self::mul_add(x908, x1416, x904 * x1418)),
-        );
-        let x1636 = Self::mul_add(
-            x914,
-            x1408,
-            Self::mul_add(x912, x1410, Self::mul_add(x910, x1412, x1635)),
-        );
-        let x1637 = -x1636;
-        let x1638 = Self::mul_add(
-            x1079,
-            x1425,
-            Self::mul_add(x1166, x1426, Self::mul_add(-x1214, x1428, x1204 * x1430)),
-        );
-        let x1639 = Self::mul_add(
-            x896,
-            x1420,
-            Self::mul_add(x940, x1422, Self::mul_add(-x988, x1424, x1638)),
-        );
-        let x1640 = -x1639;
-        let x1641 = Self::mul_add(
-            -x1234,
-            x1425,
-            Self::mul_add(-x1232, x1426, Self::mul_add(-x1230, x1428, x1225 * x1430)),
-        );
-        let x1642 = Self::mul_add(
-            -x1240,
-            x1420,
-            Self::mul_add(-x1238, x1422, Self::mul_add(x1236, x1424, x1641)),
-        );
-        let x1643 = -x1642;
-        let x1644 = Self::mul_add(
-            x1192,
-            x1425,
-            Self::mul_add(x1190, x1426, Self::mul_add(x1188, x1428, x1182 * x1430)),
-        );
-        let x1645 = Self::mul_add(
-            -x1198,
-            x1420,
-            Self::mul_add(-x1196, x1422, Self::mul_add(-x1194, x1424, x1644)),
-        );
-        let x1646 = -x1645;
-        let x1647 = Self::mul_add(
-            x1112,
-            x1425,
-            Self::mul_add(x1109, x1426, Self::mul_add(x1107, x1428, x1100 * x1430)),
-        );
-        let x1648 = Self::mul_add(
-            -x1118,
-            x1420,
-            Self::mul_add(-x1116, x1422, Self::mul_add(-x1114, x1424, x1647)),
-        );
-        let x1649 = -x1648;
-        let x1650 = Self::mul_add(
-            x1022,
-            x1425,
-            Self::mul_add(x1020, x1426, Self::mul_add(x1016, x1428, x1009 * x1430)),
-        );
-        let x1651 = Self::mul_add(
-            -x1031,
-            x1420,
-            Self::mul_add(-x1028, x1422, Self::mul_add(x1025, x1424, x1650)),
-        );
-        let x1652 = Self::mul_add(
-            x954,
-            x1425,
-            Self::mul_add(x954, x1426, Self::mul_add(x952, x1428, x948 * x1430)),
-        );
-        let x1653 = Self::mul_add(
-            x958,
-            x1420,
-            Self::mul_add(x956, x1422, Self::mul_add(x954, x1424, x1652)),
-        );
-        let x1654 = -x1653;
-        let x1655 = Self::mul_add(
-            x910,
-            x1425,
-            Self::mul_add(x910, x1426, Self::mul_add(x908, x1428, x904 * x1430)),
-        );
-        let x1656 = Self::mul_add(
-            x914,
-            x1420,
-            Self::mul_add(x912, x1422, Self::mul_add(x910, x1424, x1655)),
-        );
-        let x1657 = -x1656;
-        let x1658 = Self::mul_add(
-            x1079,
-            x1436,
-            Self::mul_add(x1166, x1438, Self::mul_add(-x1214, x1441, x1204 * x1444)),
-        );
-        let x1659 = Self::mul_add(
-            x896,
-            x1432,
-            Self::mul_add(x940, x1433, Self::mul_add(-x988, x1434, x1658)),
-        );
-        let x1660 = Self::mul_add(
-            -x1234,
-            x1436,
-            Self::mul_add(-x1232, x1438, Self::mul_add(-x1230, x1441, x1225 * x1444)),
-        );
-        let x1661 = Self::mul_add(
-            -x1240,
-            x1432,
-            Self::mul_add(-x1238, x1433, Self::mul_add(x1236, x1434, x1660)),
-        );
-        let x1662 = Self::mul_add(
-            x1192,
-            x1436,
-            Self::mul_add(x1190, x1438, Self::mul_add(x1188, x1441, x1182 * x1444)),
-        );
-        let x1663 = Self::mul_add(
-            -x1198,
-            x1432,
-            Self::mul_add(-x1196, x1433, Self::mul_add(-x1194, x1434, x1662)),
-        );
-        let x1664 = Self::mul_add(
-            x1112,
-            x1436,
-            Self::mul_add(x1109, x1438, Self::mul_add(x1107, x1441, x1100 * x1444)),
-        );
-        let x1665 = Self::mul_add(
-            -x1118,
-            x1432,
-            Self::mul_add(-x1116, x1433, Self::mul_add(-x1114, x1434, x1664)),
-        );
-        let x1666 = Self::mul_add(
-            x1022,
-            x1436,
-            Self::mul_add(x1020, x1438, Self::mul_add(x1016, x1441, x1009 * x1444)),
-        );
-        let x1667 = Self::mul_add(
-            -x1031,
-            x1432,
-            Self::mul_add(-x1028, x1433, Self::mul_add(x1025, x1434, x1666)),
-        );
-        let x1668 = -x1667;
-        let x1669 = Self::mul_add(
-            x954,
-            x1436,
-            Self::mul_add(x954, x1438, Self::mul_add(x952, x1441, x948 * x1444)),
-        );
-        let x1670 = Self::mul_add(
-            x958,
-            x1432,
-            Self::mul_add(x956, x1433, Self::mul_add(x954, x1434, x1669)),
-        );
-        let x1671 = Self::mul_add(
-            x910,
-            x1436,
-            Self::mul_add(x910, x1438, Self::mul_add(x908, x1441, x904 * x1444)),
-        );
-        let x1672 = Self::mul_add(
-            x914,
-            x1432,
-            Self::mul_add(x912, x1433, Self::mul_add(x910, x1434, x1671)),
-        );
-        let x1673 = Self::mul_add(
-            x1079,
-            x1447,
-            Self::mul_add(x1166, x1449, Self::mul_add(-x1214, x1452, x1204 * x1455)),
-        );
-        let x1674 = Self::mul_add(
-            x896,
-            x1355,
-            Self::mul_add(x940, x1432, Self::mul_add(-x988, x1445, x1673)),
-        );
-        let x1675 = Self::mul_add(
-            -x1234,
-            x1447,
-            Self::mul_add(-x1232, x1449, Self::mul_add(-x1230, x1452, x1225 * x1455)),
-        );
-        let x1676 = Self::mul_add(
-            -x1240,
-            x1355,
-            Self::mul_add(-x1238, x1432, Self::mul_add(x1236, x1445, x1675)),
-        );
-        let x1677 = Self::mul_add(
-            x1192,
-            x1447,
-            Self::mul_add(x1190, x1449, Self::mul_add(x1188, x1452, x1182 * x1455)),
-        );
-        let x1678 = Self::mul_add(
-            -x1198,
-            x1355,
-            Self::mul_add(-x1196, x1432, Self::mul_add(-x1194, x1445, x1677)),
-        );
-        let x1679 = Self::mul_add(
-            x1112,
-            x1447,
-            Self::mul_add(x1109, x1449, Self::mul_add(x1107, x1452, x1100 * x1455)),
-        );
-        let x1680 = Self::mul_add(
-            -x1118,
-            x1355,
-            Self::mul_add(-x1116, x1432, Self::mul_add(-x1114, x1445, x1679)),
-        );
-        let x1681 = Self::mul_add(
-            x1022,
-            x1447,
-            Self::mul_add(x1020, x1449, Self::mul_add(x1016, x1452, x1009 * x1455)),
-        );
-        let x1682 = Self::mul_add(
-            -x1031,
-            x1355,
-            Self::mul_add(-x1028, x1432, Self::mul_add(x1025, x1445, x1681)),
-        );
-        let x1683 = -x1682;
-        let x1684 = Self::mul_add(
-            x954,
-            x1447,
-            Self::mul_add(x954, x1449, Self::mul_add(x952, x1452, x948 * x1455)),
-        );
-        let x1685 = Self::mul_add(
-            x958,
-            x1355,
-            Self::mul_add(x956, x1432, Self::mul_add(x954, x1445, x1684)),
-        );
-        let x1686 = Self::mul_add(
-            x910,
-            x1447,
-            Self::mul_add(x910, x1449, Self::mul_add(x908, x1452, x904 * x1455)),
-        );
-        let x1687 = Self::mul_add(
-            x914,
-            x1355,
-            Self::mul_add(x912, x1432, Self::mul_add(x910, x1445, x1686)),
+            x136,
+            x980,
+            Self::mul_add(x214, x978, Self::mul_add(-x224, x976, x1520)),
         );
         (
             [
-                [0.0, x1457, x1459, x1461, x1464, x1466, x1468],
-                [0.0, x1471, x1474, x1477, x1479, x1482, x1485],
-                [0.0, x1488, x1491, x1494, x1496, x1499, x1502],
-                [0.0, x1505, x1508, x1511, x1513, x1516, x1519],
-                [0.0, x1522, x1525, x1528, x1530, x1533, x1536],
-                [0.0, x1538, x1540, x1542, x1545, x1547, x1549],
-                [0.0, x1551, x1553, x1555, x1558, x1560, x1562],
+                [0.0, x1308, x1310, x1312, x1315, x1318, x1320],
+                [0.0, x1322, x1324, x1326, x1329, x1332, x1334],
+                [0.0, x1336, x1338, x1340, x1343, x1346, x1348],
+                [0.0, x1351, x1354, x1357, x1359, x1361, x1364],
+                [0.0, x1366, x1368, x1370, x1373, x1376, x1378],
+                [0.0, x1380, x1382, x1384, x1387, x1390, x1392],
+                [0.0, x1394, x1396, x1398, x1401, x1404, x1406],
             ],
             [
-                [x1564, x1566, x1568, x1570, x1573, x1575, x1577],
-                [x1580, x1583, x1586, x1589, x1591, x1594, x1597],
-                [x1600, x1603, x1606, x1609, x1611, x1614, x1617],
-                [x1620, x1623, x1626, x1629, x1631, x1634, x1637],
-                [x1640, x1643, x1646, x1649, x1651, x1654, x1657],
-                [x1659, x1661, x1663, x1665, x1668, x1670, x1672],
-                [x1674, x1676, x1678, x1680, x1683, x1685, x1687],
+                [x1408, x1410, x1412, x1414, x1417, x1420, x1422],
+                [x1424, x1426, x1428, x1430, x1433, x1436, x1438],
+                [x1440, x1442, x1444, x1446, x1449, x1452, x1454],
+                [x1457, x1460, x1463, x1466, x1468, x1470, x1473],
+                [x1475, x1477, x1479, x1481, x1484, x1487, x1489],
+                [x1491, x1493, x1495, x1497, x1500, x1503, x1505],
+                [x1507, x1509, x1511, x1513, x1516, x1519, x1521],
             ],
             [
-                [x1374, x1372, x1369, x1367, x1366, x1365, x1363],
-                [x1390, x1387, x1385, x1383, x1382, x1380, x1379],
-                [x1406, x1403, x1401, x1399, x1398, x1397, x1395],
-                [x1419, x1416, x1414, x1413, x1412, x1411, x1409],
-                [x1431, x1428, x1426, x1425, x1424, x1423, x1421],
-                [x1444, x1442, x1439, x1437, x1435, x1433, x1432],
-                [x1455, x1453, x1450, x1448, x1446, x1432, x1355],
+                [x156, x154, x152, x149, x148, x146, x144],
+                [x170, x168, x166, x164, x163, x162, x161],
+                [x186, x184, x182, x180, x178, x176, x175],
+                [x202, x199, x196, x194, x193, x191, x189],
+                [x213, x211, x209, x208, x206, x205, x204],
+                [x223, x221, x219, x218, x216, x215, x214],
+                [x231, x229, x227, x226, x224, x214, x136],
             ],
         )
     }
