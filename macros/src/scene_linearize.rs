@@ -6,7 +6,7 @@
 //! its input (`kanegen_runtime::scene::linearize`) — the code `kanegen simulate --linearize`
 //! runs over the run-time algorithms.
 
-use crate::scene_provider::Shape;
+use crate::scene_provider::{phase_match, Shape};
 use kanegen_runtime::scene::{linearizable, SceneEffects};
 use kanegen_scene::{Integrator, Scene};
 use proc_macro2::{Literal, TokenStream};
@@ -52,20 +52,15 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
         Literal::usize_unsuffixed(sh.nv),
     );
     let nan = quote!([[f64::NAN; #nvl]; #nvl]);
-    let arms = |call: &dyn Fn(&Ident) -> TokenStream, nan: &TokenStream| {
-        let arms = sh.phases.iter().enumerate().map(|(k, dy)| {
-            let (k, c) = (Literal::usize_unsuffixed(k), call(dy));
-            quote!(#k => #c,)
-        });
-        quote!(match self.0 { #(#arms)* _ => #nan })
-    };
-    let forward = arms(
-        &|dy| quote!(#dy::forward_dynamics_derivatives(q, v, tau)),
+    let forward = phase_match(
+        sh,
         &quote!((#nan, #nan, #nan)),
+        |dy| quote!(#dy::forward_dynamics_derivatives(q, v, tau)),
     );
-    let inverse = arms(
-        &|dy| quote!(#dy::inverse_dynamics_derivatives(q, v, qdd)),
+    let inverse = phase_match(
+        sh,
         &quote!((#nan, #nan)),
+        |dy| quote!(#dy::inverse_dynamics_derivatives(q, v, qdd)),
     );
     quote! {
         impl #rt::scene::SceneDerivatives for #ty {

@@ -189,7 +189,7 @@ pub fn provider(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
 }
 
 /// `match self.0 { k => <call on phase k's type>, … }`, `nan` for a phase out of range.
-fn phase_match(
+pub fn phase_match(
     sh: &Shape<'_>,
     nan: &TokenStream,
     call: impl Fn(&Ident) -> TokenStream,

@@ -117,9 +117,7 @@ impl SceneDynamics for RunTimeDynamics {
             }
             None => self.algorithm.mass_matrix.mass_matrix(&self.params, q),
         };
-        for (row, dst) in a.iter().zip(m.chunks_exact_mut(a.len())) {
-            dst.copy_from_slice(row);
-        }
+        copy_rows(&a, m);
     }
 
     fn inverse(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], w: &[f64], tau: &mut [f64]) {
