@@ -1,24 +1,18 @@
 //! Forward dynamics at run time, no compilation: the model read from its file, then either the
-//! articulated-body algorithm in a preallocated workspace ([`aba::forward_dynamics_in`]), the
-//! allocating [`aba::forward_dynamics`], the model's own trace of the articulated-body
-//! algorithm (regrouped parameters, constants folded, common subexpressions shared: the graph
-//! the code generator emits) evaluated as a flat tape of `f64` registers, or the compact form's
-//! articulated-body kernel (`kanegen_runtime::compact::aba`) on slices, its tables built at run
-//! time. ns per call (best of 7 rounds of 20000 calls), on SSRMS and the random chains of
-//! `benches/data`. Run: `cargo run --release --example runtime_fd`.
-//!
-//! Measured (wall clock on a loaded 2-core machine, so only the ratios mean much): workspace
-//! 2349, 2716, 5512, 11155, 21420 ns for SSRMS and N = 8, 16, 32, 64; the compact kernel 1273,
-//! 1355, 3092, 6050, 12388 ns (0.50–0.58 of the workspace's time); the tape 10794 to 482913 ns
-//! (959 to 51611 instructions), its per-instruction dispatch costing more than the arithmetic.
-//! The run-time path (`kanegen_sim`'s provider) is the workspace ABA, which also takes armature,
-//! base-frame wrenches and a free-floating base; the kernel has none of these. Its side-by-side
-//! numbers against Pinocchio are in `benches/peers` (`aba_runtime`).
+//! local-frame articulated-body algorithm of `kanegen-dynamics` in a preallocated workspace
+//! ([`aba::forward_dynamics_in`]), the allocating [`aba::forward_dynamics`], the model's own
+//! trace of the articulated-body algorithm (regrouped parameters, constants folded, common
+//! subexpressions shared: the graph the code generator emits) evaluated as a flat tape of `f64`
+//! registers, or the run-time path: the compact form's articulated-body kernel
+//! (`kanegen_runtime::compact::aba`) on tables built at run time
+//! (`kanegen_dynamics::kernels`). ns per call (best of 7 rounds of 20000 calls), on SSRMS and
+//! the random chains of `benches/data`. Run: `cargo run --release --example runtime_fd`; the
+//! measured table is in `docs/performance.md` ("The run-time path").
 
-use kanegen::codegen::compact::tables::{numbers, Numbers};
 use kanegen::dynamics::algorithms::aba;
+use kanegen::dynamics::kernels::{KernelData, KernelTables};
 use kanegen::dynamics::{Loads, Params};
-use kanegen::runtime::compact::{self as kernels, Articulated, Bodies, Rates, Tables, Transform};
+use kanegen::runtime::compact::{self as kernels, Rates};
 use kanegen::trace::{trace, Function, Node, Spec, Subject};
 use std::hint::black_box;
 use std::time::Instant;
@@ -135,82 +129,33 @@ impl Tape {
     }
 }
 
-/// The compact form's articulated-body kernel (`kanegen_runtime::compact::aba`) on slices: the
-/// model's tables built at run time (`kanegen_codegen`'s, unregrouped, no gravity), its scratch
-/// in `Vec`s allocated once.
+/// The compact form's articulated-body kernel (`kanegen_runtime::compact::aba`) on slices, as
+/// the run-time path calls it: the model's tables built at run time
+/// ([`KernelTables`], unregrouped, no gravity), its scratch ([`KernelData`]) allocated once.
 struct Kernel {
-    t: Numbers,
-    ancestor: Option<Vec<bool>>,
-    x: [Vec<Transform<f64>>; 2],
-    s0: Vec<[f64; 6]>,
-    i0: Vec<[f64; 10]>,
-    six: [Vec<[f64; 6]>; 5],
-    ia: Vec<[f64; 21]>,
-    du: [Vec<f64>; 2],
+    t: KernelTables,
+    data: KernelData,
 }
 
 impl Kernel {
     fn new(model: &kanegen::model::Model) -> Self {
-        let mut opts = kanegen::codegen::Options::new("R");
-        opts.regroup = false;
-        let t = numbers(model, &opts);
-        let n = t.parent.len();
-        let id = Transform {
-            e: [[0.0; 3]; 3],
-            r: [0.0; 3],
-        };
+        let t = KernelTables::new(&Params::<f64>::new(model), None);
         Kernel {
-            ancestor: t.ancestor.as_ref().map(|rows| rows.concat()),
+            data: KernelData::new(t.dof()),
             t,
-            x: [vec![id; n], vec![id; n]],
-            s0: vec![[0.0; 6]; n],
-            i0: vec![[0.0; 10]; n],
-            six: core::array::from_fn(|_| vec![[0.0; 6]; n]),
-            ia: vec![[0.0; 21]; n],
-            du: [vec![0.0; n], vec![0.0; n]],
         }
     }
 
     /// `q̈` into `qdd`: the joint transforms, then the articulated-body algorithm.
     fn forward_dynamics(&mut self, q: &[f64], qd: &[f64], tau: &[f64], qdd: &mut [f64]) {
-        let t = &self.t;
-        let tables = Tables {
-            parent: &t.parent,
-            revolute: &t.revolute,
-            a: &t.a,
-            b: &t.b,
-            c: &t.c,
-            l: &t.l,
-            slide: &t.slide,
-            s: &t.s,
-            inertia: &t.inertia,
-            ancestor: self.ancestor.as_deref(),
-            a0: t.a0,
-        };
-        let [x, x0] = &mut self.x;
-        let mut b = Bodies {
-            x,
-            x0,
-            s0: &mut self.s0,
-            i0: &mut self.i0,
-        };
-        let [v, c, pa, ui, a] = &mut self.six;
-        let [d, u] = &mut self.du;
-        let mut ab = Articulated {
-            v,
-            c,
-            ia: &mut self.ia,
-            pa,
-            ui,
-            d,
-            u,
-            a,
-        };
+        let tables = self.t.tables();
+        let (mut b, mut ab, _) = self.data.split();
         kernels::spatial::transforms(&tables, q, f64::sin_cos, b.x);
         let rates = Rates {
             qd,
             tau,
             f_ext: None,
+            armature: None,
         };
         kernels::aba::aba(&tables, tables.inertia, rates, &mut b, &mut ab, qdd);
     }

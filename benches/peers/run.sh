@@ -265,7 +265,7 @@ publish = false
 
 [dependencies]
 kanegen = { path = "$KANEGEN_DIR", default-features = false }
-# the run-time path (aba_runtime): the model read from its URDF, the workspace ABA
+# the run-time path (aba_runtime): the model read from its URDF, the kernel ABA
 kanegen-dynamics = { path = "$KANEGEN_DIR/dynamics" }
 kanegen-model = { path = "$KANEGEN_DIR/model" }
 

@@ -307,8 +307,8 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let inertia = t.inertia.iter().map(|v| vector(float, v));
     let revolute = &t.revolute;
     let ancestor = match &t.ancestor {
-        Some(rows) => {
-            let rows = rows.iter().map(|r| quote!(#(#r,)*));
+        Some(flat) => {
+            let rows = flat.chunks(t.dof().max(1)).map(|r| quote!(#(#r,)*));
             quote!(Some(&[#(#rows)*]))
         }
         None => quote!(None),

@@ -6,7 +6,7 @@
 //! counted independently of the tracer by a scalar that counts its own operations.
 
 use kanegen_codegen::compact::kernel_counts;
-use kanegen_codegen::compact::tables::{numbers, Numbers};
+use kanegen_codegen::compact::tables::{numbers, KernelTables};
 use kanegen_codegen::{generate_items, Form, Options};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::metrics::rel_err;
@@ -43,7 +43,7 @@ struct Owned<S> {
 }
 
 impl<S: Scalar + Copy> Owned<S> {
-    fn new(t: &Numbers, s: impl Fn(f64) -> S) -> Self {
+    fn new(t: &KernelTables, s: impl Fn(f64) -> S) -> Self {
         let m3 = |m: &[[f64; 3]; 3]| m.map(|r| r.map(&s));
         Owned {
             a: t.a.iter().map(m3).collect(),
@@ -53,12 +53,12 @@ impl<S: Scalar + Copy> Owned<S> {
             slide: t.slide.iter().map(|v| v.map(&s)).collect(),
             s: t.s.iter().map(|v| v.map(&s)).collect(),
             inertia: t.inertia.iter().map(|v| v.map(&s)).collect(),
-            ancestor: t.ancestor.as_ref().map(|rows| rows.concat()),
+            ancestor: t.ancestor.clone(),
             a0: t.a0.map(&s),
         }
     }
 
-    fn tables<'a>(&'a self, t: &'a Numbers) -> Tables<'a, S> {
+    fn tables<'a>(&'a self, t: &'a KernelTables) -> Tables<'a, S> {
         Tables {
             parent: &t.parent,
             revolute: &t.revolute,
@@ -276,7 +276,7 @@ impl Scalar for Counted {
 
 /// The operations each compact function's kernel executes, counted by running it on
 /// [`Counted`].
-fn counted<const N: usize>(t: &Numbers, f: Function, payload: bool) -> [u64; 4] {
+fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64; 4] {
     let owned = Owned::new(t, Counted);
     let t = owned.tables(t);
     let x = |k: usize| Counted(0.1 + 0.01 * k as f64);

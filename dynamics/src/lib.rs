@@ -13,6 +13,8 @@
 //!   nonlinear-effects method and the forward-dynamics method ([`ForwardMethod`]: LDLᵀ or the
 //!   articulated-body algorithm) separately.
 //! - [`ldlt`]: the branch-free LDLᵀ of forward dynamics; [`metrics`]: error measures.
+//! - [`kernels`]: a model's numbers and scratch for the runtime kernels (`kanegen_runtime::compact`),
+//!   which the run-time path and the compact form call.
 //! - `scalars` (feature `research`): research scalars (dual, compensated, double-double, exact
 //!   rationals), a leaf.
 //!
@@ -34,6 +36,7 @@
 pub mod algorithms;
 pub mod base;
 pub mod joint;
+pub mod kernels;
 pub mod ldlt;
 pub mod linalg;
 pub mod loads;

@@ -1,13 +1,14 @@
-//! The run-time dynamics under a scene's right-hand side ([`kanegen_runtime::scene`]): the
-//! algorithms of `kanegen-dynamics` over a model's numbers, on the run-time fast path (the
-//! articulated-body algorithm in a preallocated workspace, rotor inertia as its armature) or
-//! by `A` and `b` of the scene's algorithm then LDLᵀ.
+//! The run-time dynamics under a scene's right-hand side ([`kanegen_runtime::scene`]): on the
+//! run-time fast path, the articulated-body kernel of the compact form
+//! ([`kanegen_runtime::compact::aba`]) over the model's tables built at run time (rotor inertia
+//! as its armature, a free-floating base as its root); otherwise the algorithms of
+//! `kanegen-dynamics`: `M` and `τ − c` of the scene's algorithm, then LDLᵀ.
 
 use crate::scene::Scene;
-use kanegen_dynamics::algorithms::aba::{self, Workspace};
 use kanegen_dynamics::algorithms::derivatives;
 use kanegen_dynamics::algorithms::floating;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::{ForwardMethod, Loads, Methods, Params};
 use kanegen_runtime::scene::{forward_with_armature, SceneDerivatives, SceneDynamics};
@@ -32,8 +33,8 @@ pub struct RunTimeDynamics {
     pub base: Option<FloatingBase<f64>>,
     /// The algorithm of `A`, `b` and inverse dynamics.
     pub algorithm: Methods,
-    /// The workspace of the articulated-body algorithm on the fast path, `None` for LDLᵀ.
-    ws: Option<Workspace<f64>>,
+    /// The kernels' tables and scratch on the fast path, `None` for LDLᵀ.
+    fast: Option<(KernelTables, KernelData)>,
     /// Gravity, `τ` (preallocated) and the scene's wrenches (their values written per call).
     loads: Loads<f64>,
 }
@@ -49,8 +50,9 @@ impl RunTimeDynamics {
                 Some(FloatingBase::from_inertial(inertial))
             }
         };
+        let gravity = scene.gravity.filter(|_| base.is_none());
         RunTimeDynamics {
-            ws: (forward == ForwardMethod::Aba).then(|| Workspace::new(&params)),
+            fast: (forward == ForwardMethod::Aba).then(|| kernel_model(&params, gravity)),
             params,
             base,
             algorithm: scene.simulation.algorithm,
@@ -64,8 +66,10 @@ impl RunTimeDynamics {
 
     /// Replaces the model's numbers (a payload captured or released).
     pub fn set_params(&mut self, params: Params<f64>) {
-        if self.ws.is_some() {
-            self.ws = Some(Workspace::new(&params));
+        if let Some((t, _)) = &self.fast {
+            let g = t.a0;
+            let gravity = (g != [0.0; 6]).then_some([-g[3], -g[4], -g[5]]);
+            self.fast = Some(kernel_model(&params, gravity));
         }
         self.params = params;
     }
@@ -83,24 +87,50 @@ impl RunTimeDynamics {
 
     /// Forward dynamics by the fast path (with `armature`) or by the scene's algorithm.
     fn accelerations(&mut self, q: &[f64], v: &[f64], armature: Option<&[f64]>, acc: &mut [f64]) {
+        if self.fast.is_some() {
+            self.kernel_accelerations(q, v, armature, acc);
+            return;
+        }
         let (p, loads) = (&self.params, &self.loads);
-        match (&self.base, self.ws.as_mut()) {
-            (Some(b), Some(ws)) => {
-                let st = floating_state(q, v);
-                aba::floating_in(p, ws, b, &st, &q[7..], &v[6..], loads, armature, acc);
-            }
-            (Some(b), None) => {
+        match &self.base {
+            Some(b) => {
                 let st = floating_state(q, v);
                 let alg = self.algorithm;
                 let a = floating::forward_dynamics(alg, p, b, &st, &q[7..], &v[6..], loads);
                 acc.copy_from_slice(&a);
             }
-            (None, Some(ws)) => aba::forward_dynamics_in(p, ws, q, v, loads, armature, acc),
-            (None, None) => {
-                acc.copy_from_slice(&self.algorithm.forward_dynamics(p, q, v, loads));
-            }
+            None => acc.copy_from_slice(&self.algorithm.forward_dynamics(p, q, v, loads)),
         }
     }
+
+    /// The fast path: the run-time kernels ([`kernels::forward_dynamics`]).
+    fn kernel_accelerations(
+        &mut self,
+        q: &[f64],
+        v: &[f64],
+        armature: Option<&[f64]>,
+        acc: &mut [f64],
+    ) {
+        let Some((t, data)) = self.fast.as_mut() else {
+            return;
+        };
+        let loads = &self.loads;
+        match &self.base {
+            Some(b) => {
+                let st = floating_state(q, v);
+                let fb = Some((b, &st));
+                kernels::forward_dynamics(t, data, fb, &q[7..], &v[6..], loads, armature, acc);
+            }
+            None => kernels::forward_dynamics(t, data, None, q, v, loads, armature, acc),
+        }
+    }
+}
+
+/// The kernels' tables of `params` (gravity `g` as their `a₀`) and their scratch.
+fn kernel_model(params: &Params<f64>, gravity: Option<[f64; 3]>) -> (KernelTables, KernelData) {
+    let t = KernelTables::new(params, gravity);
+    let data = KernelData::new(t.dof());
+    (t, data)
 }
 
 impl SceneDynamics for RunTimeDynamics {
@@ -140,7 +170,7 @@ impl SceneDynamics for RunTimeDynamics {
         acc: &mut [f64],
         work: &mut [f64],
     ) {
-        if self.ws.is_some() {
+        if self.fast.is_some() {
             self.set_loads(Some(tau), w);
             self.accelerations(q, v, Some(armature), acc);
         } else {

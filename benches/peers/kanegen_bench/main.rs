@@ -25,11 +25,12 @@
 //!          with DERIVS=1; row i = output i, column j = input j, as Pinocchio)
 //!   sincos_n  N x libm::sincos (what the generated code calls), for scale
 //!   aba_runtime  forward dynamics on the run-time path, no compilation: the model read from
-//!          its URDF when the program starts, `aba::forward_dynamics_in` with a workspace
-//!          allocated once (what `kanegen simulate` evaluates per right-hand side); checked
+//!          its URDF when the program starts, `kernels::forward_dynamics` (the compact
+//!          form's articulated-body kernel on tables built then, scratch allocated once: what
+//!          `kanegen simulate` evaluates per right-hand side); checked
 //!          against the generated forward_dynamics at every state first (default and native
 //!          builds)
-use kanegen_dynamics::algorithms::aba;
+use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
 use kanegen_dynamics::{Loads, Params};
 use std::hint::black_box;
 use std::time::Instant;
@@ -293,15 +294,15 @@ macro_rules! bench_model {
         });
         #[cfg(feature = "derivs")]
         bench_derivatives!($ty, $name, s, sfx, ctx);
-        // the run-time path: the URDF read now, the workspace ABA (default and native builds)
+        // the run-time path: the URDF read now, the kernel ABA (default and native builds)
         if sfx.is_empty() && (ctx.label == "default" || ctx.label == "native") {
             let path = format!("{}/models/{}.urdf", env!("CARGO_MANIFEST_DIR"), $name);
             let model = kanegen_model::io::load_model(std::path::Path::new(&path))
                 .unwrap_or_else(|e| panic!("{path}: {e}"));
             let names: Vec<&str> = model.joints().iter().map(|j| j.name.as_str()).collect();
             assert_eq!(names, $ty::JOINTS, "{path}: joint order");
-            let p = Params::<f64>::new(&model);
-            let mut ws = aba::Workspace::new(&p);
+            let t = KernelTables::new(&Params::<f64>::new(&model), None);
+            let mut data = KernelData::new(t.dof());
             let mut loads: Vec<Loads<f64>> = s
                 .tau
                 .iter()
@@ -312,7 +313,9 @@ macro_rules! bench_model {
                 .collect();
             let mut qdd = [0.0f64; N];
             for k in 0..k_n {
-                aba::forward_dynamics_in(&p, &mut ws, &s.q[k], &s.v[k], &loads[k], None, &mut qdd);
+                kernels::forward_dynamics(
+                    &t, &mut data, None, &s.q[k], &s.v[k], &loads[k], None, &mut qdd,
+                );
                 let want = $ty::forward_dynamics(&s.q[k], &s.v[k], &s.tau[k]);
                 let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
                 for i in 0..N {
@@ -326,9 +329,10 @@ macro_rules! bench_model {
             }
             let loads = &mut loads;
             ctx.time($name, sfx, "aba_runtime", k_n, N, |k, e| {
-                aba::forward_dynamics_in(
-                    &p,
-                    &mut ws,
+                kernels::forward_dynamics(
+                    &t,
+                    &mut data,
+                    None,
                     black_box(&s.q[k]),
                     black_box(&s.v[k]),
                     black_box(&loads[k]),

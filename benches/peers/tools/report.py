@@ -230,7 +230,7 @@ R["runtime"] = []
 if any(ns("kanegen", "default", m, "aba_runtime") for m in models):
     L.append("## Run-time path (no compilation): forward dynamics vs numeric Pinocchio `aba`\n")
     L.append("kanegen run-time = `aba_runtime`: the model read from its URDF when the bench starts, "
-             "`kanegen_dynamics::algorithms::aba::forward_dynamics_in` with a workspace allocated once "
+             "`kanegen_dynamics::kernels::forward_dynamics` (the compact form's articulated-body kernel on tables built then, scratch allocated once) "
              "(what `kanegen simulate` evaluates per right-hand side; no code generated or compiled), checked "
              "against the generated `forward_dynamics` at every state before timing. Pinocchio: numeric "
              "`pinocchio::aba` (LOCAL and WORLD conventions). Generated: kanegen's `dynamics!` "

@@ -109,17 +109,18 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
             Box::new(move |q, qd| methods.forward_dynamics(p, q, qd, &Loads::default())[6]),
         ));
     }
-    // The run-time fast path of `kanegen simulate`: ABA in a workspace allocated once.
-    let mut ws = kanegen_dynamics::algorithms::aba::Workspace::new(&p);
+    // The run-time fast path of `kanegen simulate`: the articulated-body kernel on tables
+    // built at run time, scratch allocated once.
+    let tables = kanegen_dynamics::kernels::KernelTables::new(&p, None);
+    let mut data = kanegen_dynamics::kernels::KernelData::new(n);
     let mut qdd = vec![0.0; n];
-    let pr = &p;
     c.push((
-        "interpreted aba workspace".into(),
+        "interpreted run-time kernel".into(),
         "forward_dynamics".into(),
         Box::new(move |q, qd| {
             let l = Loads::default();
-            kanegen_dynamics::algorithms::aba::forward_dynamics_in(
-                pr, &mut ws, q, qd, &l, None, &mut qdd,
+            kanegen_dynamics::kernels::forward_dynamics(
+                &tables, &mut data, None, q, qd, &l, None, &mut qdd,
             );
             qdd[6]
         }),

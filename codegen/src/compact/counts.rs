@@ -11,7 +11,7 @@
 //! (`codegen/tests/compact_kernels.rs` counts the entry points themselves with a counting `f64`
 //! and compares).
 
-use crate::compact::tables::Numbers;
+use crate::compact::tables::KernelTables;
 use kanegen_runtime::compact::{self as k, Articulated, Bodies, Motions, Rates, Tables, Transform};
 use kanegen_runtime::Scalar;
 use kanegen_trace::sym::{Convention, Counts, Sym, Tracer};
@@ -21,7 +21,7 @@ use kanegen_trace::Function;
 /// `t` (`payload`: the last body's inertia built from a runtime payload per call), or `None`
 /// for a function without a compact body.
 #[must_use]
-pub fn counts(t: &Numbers, f: Function, payload: bool) -> Option<Counts> {
+pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     let tr = Tracer::new();
     let n = t.parent.len();
     let x = || tr.input("x");
@@ -37,7 +37,7 @@ pub fn counts(t: &Numbers, f: Function, payload: bool) -> Option<Counts> {
             *last = k::payload_inertia(x(), &v3(), &m3());
         }
     }
-    let ancestor: Option<Vec<bool>> = t.ancestor.as_ref().map(|rows| rows.concat());
+    let ancestor: Option<Vec<bool>> = t.ancestor.clone();
     let tables = Tables {
         parent: &t.parent,
         revolute: &t.revolute,
@@ -121,6 +121,7 @@ fn trace_kernel(
                 qd: &qd,
                 tau: &tau,
                 f_ext: f_ext.as_deref(),
+                armature: None,
             };
             let (mut v, mut c, mut pa, mut ui, mut a) = (
                 vec![[zero; 6]; n],

@@ -23,6 +23,7 @@ pub fn forward_dynamics<S: Scalar + Copy, const N: usize>(
             qd,
             tau,
             f_ext: None,
+            armature: None,
         },
         sincos,
     )
@@ -44,6 +45,7 @@ pub fn forward_dynamics_with_wrenches<S: Scalar + Copy, const N: usize>(
         qd,
         tau,
         f_ext: Some(f_ext),
+        armature: None,
     };
     articulated(t, inertia, q, rates, sincos)
 }
@@ -73,9 +75,10 @@ fn articulated<S: Scalar + Copy, const N: usize>(
     qdd
 }
 
-/// What the articulated-body algorithm runs at besides `q`: `q̇`, `τ`, and the external
-/// wrenches, `f_ext[i] = [force; moment]` in body `i`'s frame at its origin (`None`: no
-/// wrenches, nothing computed for them). One entry per joint.
+/// What the articulated-body algorithm runs at besides `q`: `q̇`, `τ`, the external wrenches,
+/// `f_ext[i] = [force; moment]` in body `i`'s frame at its origin, and the armature `a_i ≥ 0`
+/// (the reflected rotor inertia `I_m n²` of a geared motor, Pinocchio's `Model::armature`:
+/// `(M + diag(a)) q̈ = τ − c`). One entry per joint; `None`: absent, nothing computed for it.
 #[derive(Clone, Copy, Debug)]
 pub struct Rates<'a, S> {
     /// `q̇`.
@@ -84,6 +87,8 @@ pub struct Rates<'a, S> {
     pub tau: &'a [S],
     /// The external wrenches.
     pub f_ext: Option<&'a [[S; 6]]>,
+    /// The armature.
+    pub armature: Option<&'a [S]>,
 }
 
 /// The bodies' quantities in the articulated-body algorithm (RBDA Table 7.1), one entry per
@@ -211,10 +216,8 @@ fn sym_minus_outer<S: Scalar + Copy>(m: &[S; 21], w: &[S; 6], u: &[S; 6]) -> [S;
 
 /// The articulated-body algorithm (RBDA Table 7.1) in base coordinates (RBDA §7.3's "any
 /// coordinate system", as Pinocchio's), so that no transform is needed between bodies, on the
-/// joint transforms `b.x`, into `qdd`: the bodies carried to the base ([`world`]), velocities
-/// and bias terms outwards ([`outward`]), articulated inertias inwards ([`inward`]),
-/// accelerations outwards from `a₀` ([`Tables::a0`], [`accelerations`]). `ab`: scratch, one
-/// entry per joint.
+/// joint transforms `b.x`, into `qdd`: the bodies carried to the base ([`world`]), then
+/// [`aba_on_world`]. `ab`: scratch, one entry per joint.
 #[inline(always)]
 pub fn aba<S: Scalar + Copy>(
     t: &Tables<'_, S>,
@@ -225,24 +228,120 @@ pub fn aba<S: Scalar + Copy>(
     qdd: &mut [S],
 ) {
     world(t, inertia, b);
-    outward(t, b, rates, ab);
-    inward(t, b.s0, rates.tau, ab);
-    accelerations(t, b.s0, ab, qdd);
+    aba_on_world(t, rates, b, ab, qdd);
 }
 
-/// RBDA Table 7.1, third pass: `a' = a_λ + c_i`, `q̈_i = (u_i − U_iᵀ a') / D_i`,
+/// [`aba`] on bodies already carried to the base ([`world`]): velocities and bias terms
+/// outwards ([`outward`]), articulated inertias inwards ([`inward`]), accelerations outwards
+/// from `a₀` ([`Tables::a0`], [`accelerations`]).
+#[inline(always)]
+pub fn aba_on_world<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    rates: Rates<'_, S>,
+    b: &Bodies<'_, S>,
+    ab: &mut Articulated<'_, S>,
+    qdd: &mut [S],
+) {
+    outward(t, b, rates, &[S::zero(); 6], ab);
+    inward(t, b.s0, rates, ab, None);
+    accelerations(t, b.s0, ab, &t.a0, qdd);
+}
+
+/// The free-floating base of [`aba_floating_on_world`]: body 0, moved by a 6-dof joint, whose
+/// frame is the base coordinates of the kernels (the tables' placements are relative to it).
+#[derive(Clone, Copy, Debug)]
+pub struct FloatingRoot<S> {
+    /// Its spatial inertia about its origin, `[m, h (3), Ī upper triangle (6)]` as
+    /// [`Tables::inertia`].
+    pub inertia: [S; 10],
+    /// Its spatial velocity `v_0 = [ω_b; v_b]` in its own coordinates.
+    pub v: [S; 6],
+    /// The external wrench on it, `[force; moment]` in its frame at its origin.
+    pub f_ext: Option<[S; 6]>,
+    /// Gravity in its coordinates, `R₀ᵀ g`.
+    pub gravity: Option<[S; 3]>,
+}
+
+/// Forward dynamics on a free-floating base by the articulated-body algorithm (RBDA ch. 9,
+/// spatial_v2's `FDfb`) on bodies already carried to the base ([`world`]), into
+/// `nu_dot = [v̇_b (3); ω̇_b (3); q̈ (N)]`: the base's spatial acceleration in its own
+/// coordinates, then the joints'. The base is the root of the passes: `v_0` starts the outward
+/// pass, `I^A_0 = I_0`, `p^A_0 = v_0 ×* I_0 v_0 − f^x_0` gather the joints on it, and
+/// `a'_0 = −(I^A_0)⁻¹ p^A_0` (a 6×6 LDLᵀ) starts the accelerations. Gravity stays out of the
+/// passes (every `a'_i = a_i − a_g` obeys the same recursion; [`Tables::a0`] is not read) and is
+/// put back on the base: `a_0 = a'_0 + [0; R₀ᵀ g]`.
+#[inline(always)]
+pub fn aba_floating_on_world<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    rates: Rates<'_, S>,
+    root: &FloatingRoot<S>,
+    b: &Bodies<'_, S>,
+    ab: &mut Articulated<'_, S>,
+    nu_dot: &mut [S],
+) {
+    let k = &root.inertia;
+    outward(t, b, rates, &root.v, ab);
+    let mut ia0 = packed_inertia(k);
+    let p0 = crf(&root.v, &inertia_mul(k, &root.v));
+    let mut pa0 = match &root.f_ext {
+        Some(e) => sub(&p0, &[e[3], e[4], e[5], e[0], e[1], e[2]]),
+        None => p0,
+    };
+    inward(t, b.s0, rates, ab, Some((&mut ia0, &mut pa0)));
+    // I^A_0 a'_0 = −p^A_0.
+    let mut m6: [S; 36] = core::array::from_fn(|k| ia0[SYM[k / 6][k % 6]]);
+    let mut d_inv = [S::zero(); 6];
+    let mut a0: [S; 6] = core::array::from_fn(|r| -pa0[r]);
+    // 36 and 6 entries: the buffers are never short.
+    if crate::ldlt::factor_in_place(&mut m6, 6, &mut d_inv).is_ok() {
+        let _ = crate::ldlt::solve_in_place(&m6, 6, &d_inv, &mut a0);
+    }
+    let (head, qdd) = nu_dot.split_at_mut(6.min(nu_dot.len()));
+    accelerations(t, b.s0, ab, &a0, qdd);
+    // a_0 = a'_0 + [0; R₀ᵀ g], written [linear; angular].
+    let mut lin = [a0[3], a0[4], a0[5]];
+    if let Some(g) = &root.gravity {
+        lin = [lin[0] + g[0], lin[1] + g[1], lin[2] + g[2]];
+    }
+    for (o, v) in head
+        .iter_mut()
+        .zip(lin.into_iter().chain([a0[0], a0[1], a0[2]]))
+    {
+        *o = v;
+    }
+}
+
+/// `I = [Ī h̃; h̃ᵀ m1]` (RBDA eq. (2.63)) of a spatial inertia `[m, h, Ī]`, its upper triangle by
+/// rows ([`SYM`]).
+#[inline(always)]
+fn packed_inertia<S: Scalar + Copy>(k: &[S; 10]) -> [S; 21] {
+    let zero = S::zero();
+    #[rustfmt::skip]
+    let i = [
+        k[4], k[5], k[6], zero, -k[3], k[2],
+        k[7], k[8], k[3], zero, -k[1],
+        k[9], -k[2], k[1], zero,
+        k[0], zero, zero,
+        k[0], zero,
+        k[0],
+    ];
+    i
+}
+
+/// RBDA Table 7.1, third pass (`a_root`: the root's acceleration): `a' = a_λ + c_i`, `q̈_i = (u_i − U_iᵀ a') / D_i`,
 /// `a_i = a' + S_i q̈_i`.
 #[inline(always)]
 fn accelerations<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     s0: &[[S; 6]],
     ab: &mut Articulated<'_, S>,
+    a_root: &[S; 6],
     qdd: &mut [S],
 ) {
     for i in 0..ab.a.len() {
         let ap = match t.parent.get(i).copied().flatten().and_then(|l| ab.a.get(l)) {
             Some(p) => *p,
-            None => t.a0,
+            None => *a_root,
         };
         let (Some(s), Some(c), Some(ui), Some(&u), Some(&d), Some(qddi)) = (
             s0.get(i),
@@ -262,20 +361,20 @@ fn accelerations<S: Scalar + Copy>(
     }
 }
 
-/// RBDA Table 7.1, first pass (base coordinates): `v_i = v_λ + S_i q̇_i`,
+/// RBDA Table 7.1, first pass (base coordinates; `v_root`: the root's velocity): `v_i = v_λ + S_i q̇_i`,
 /// `c_i = v_i ×ₘ S_i q̇_i`, `I^A_i = I_i`, `p^A_i = v_i ×* I_i v_i − f^x_i`.
 #[inline(always)]
 fn outward<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     b: &Bodies<'_, S>,
     rates: Rates<'_, S>,
+    v_root: &[S; 6],
     ab: &mut Articulated<'_, S>,
 ) {
-    let zero = S::zero();
     for i in 0..ab.v.len() {
         let vp = match t.parent.get(i).copied().flatten().and_then(|l| ab.v.get(l)) {
             Some(p) => *p,
-            None => [zero; 6],
+            None => *v_root,
         };
         let (Some(s), Some(k), Some(x0), Some(&qd)) =
             (b.s0.get(i), b.i0.get(i), b.x0.get(i), rates.qd.get(i))
@@ -289,17 +388,7 @@ fn outward<S: Scalar + Copy>(
         let vj = scale(qd, s);
         let v = add(&vp, &vj);
         *c = crm(&v, &vj);
-        // I = [Ī h̃; h̃ᵀ m1] (RBDA eq. (2.63)), upper triangle by rows.
-        #[rustfmt::skip]
-        let i0 = [
-            k[4], k[5], k[6], zero, -k[3], k[2],
-            k[7], k[8], k[3], zero, -k[1],
-            k[9], -k[2], k[1], zero,
-            k[0], zero, zero,
-            k[0], zero,
-            k[0],
-        ];
-        *ia = i0;
+        *ia = packed_inertia(k);
         let iv = inertia_mul(k, &v);
         let p = crf(&v, &iv);
         *pa = match rates.f_ext.and_then(|f| f.get(i)) {
@@ -313,19 +402,22 @@ fn outward<S: Scalar + Copy>(
 }
 
 /// RBDA Table 7.1, second pass (base coordinates, leaves first): `U_i = I^A_i S_i`,
-/// `D_i = S_iᵀ U_i`, `u_i = τ_i − S_iᵀ p^A_i`, `I^A_λ += I^A_i − U_i U_iᵀ / D_i`,
-/// `p^A_λ += p^A_i + (I^A_i − U_i U_iᵀ / D_i) c_i + U_i u_i / D_i`.
+/// `D_i = S_iᵀ U_i + a_i` (armature `a_i`), `u_i = τ_i − S_iᵀ p^A_i`,
+/// `I^A_λ += I^A_i − U_i U_iᵀ / D_i`, `p^A_λ += p^A_i + (I^A_i − U_i U_iᵀ / D_i) c_i + U_i u_i / D_i`;
+/// a joint on the base gives to `root` when the base is floating (`None`: a fixed base, nothing
+/// given).
 #[inline(always)]
 fn inward<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     s0: &[[S; 6]],
-    tau: &[S],
+    rates: Rates<'_, S>,
     ab: &mut Articulated<'_, S>,
+    mut root: Option<(&mut [S; 21], &mut [S; 6])>,
 ) {
     for i in (0..ab.ia.len()).rev() {
         let (Some(s), Some(&taui), Some(&ia), Some(&pa), Some(&c)) = (
             s0.get(i),
-            tau.get(i),
+            rates.tau.get(i),
             ab.ia.get(i),
             ab.pa.get(i),
             ab.c.get(i),
@@ -333,24 +425,30 @@ fn inward<S: Scalar + Copy>(
             continue;
         };
         let ui = sym_times(&ia, s);
-        let d = dot(s, &ui);
+        let d = match rates.armature.and_then(|a| a.get(i)) {
+            Some(&a) => dot(s, &ui) + a,
+            None => dot(s, &ui),
+        };
         let u = taui - dot(s, &pa);
         if let (Some(di), Some(uu), Some(uv)) = (ab.d.get_mut(i), ab.u.get_mut(i), ab.ui.get_mut(i))
         {
             (*di, *uu, *uv) = (d, u, ui);
         }
-        if let Some(l) = t.parent.get(i).copied().flatten() {
+        let parent = t.parent.get(i).copied().flatten();
+        let target = match parent {
+            Some(l) => ab.ia.get_mut(l).zip(ab.pa.get_mut(l)),
+            None => root.as_mut().map(|(ia, pa)| (&mut **ia, &mut **pa)),
+        };
+        if let Some((ial, pal)) = target {
             let dinv = S::one() / d;
             let w = scale(dinv, &ui);
             let m = sym_minus_outer(&ia, &w, &ui);
             let p = axpy(&pa, u, &w);
             let p = add(&p, &sym_times(&m, &c));
-            if let (Some(ial), Some(pal)) = (ab.ia.get_mut(l), ab.pa.get_mut(l)) {
-                for (a, b) in ial.iter_mut().zip(m) {
-                    *a = *a + b;
-                }
-                *pal = add(pal, &p);
+            for (a, b) in ial.iter_mut().zip(m) {
+                *a = *a + b;
             }
+            *pal = add(pal, &p);
         }
     }
 }

@@ -11,7 +11,10 @@
 //! - [`mass_matrix_and_nonlinear_effects`]: both on one set of joint transforms;
 //! - [`forward_dynamics`], [`forward_dynamics_with_wrenches`]: the articulated-body algorithm
 //!   (RBDA Table 7.1), [`aba`];
-//! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`].
+//! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`];
+//! - [`aba::aba_floating_on_world`]: forward dynamics on a free-floating base ([`FloatingRoot`]);
+//!   the run-time path calls it and [`aba::aba_on_world`] on tables built at run time, with
+//!   the armature and wrenches of a scene.
 //!
 //! Every kernel is generic over the scalar (`S: Scalar + Copy`: `f64`, `f32`, and the tracer
 //! `Sym` of `kanegen-trace`, which runs them to count what a compact type executes) and written
@@ -42,7 +45,8 @@ pub mod spatial;
 pub mod tables;
 
 pub use aba::{
-    forward_dynamics, forward_dynamics_with_wrenches, Articulated, ArticulatedStore, Rates,
+    forward_dynamics, forward_dynamics_with_wrenches, Articulated, ArticulatedStore, FloatingRoot,
+    Rates,
 };
 pub use crba::{mass_matrix, mass_matrix_and_nonlinear_effects};
 pub use payload::{payload_inertia, with_payload};

@@ -1,0 +1,368 @@
+//! A model's numbers as the runtime kernels read them ([`kanegen_runtime::compact`]), built from
+//! its [`Params`], and the kernels' scratch in `Vec`s: the model and the data (Pinocchio's split)
+//! of the run-time path and of the compact form's tables, which `kanegen-codegen` writes out as
+//! `const`s from the same [`KernelTables`].
+
+use crate::base::{FloatingBase, FloatingState, BASE_BODY};
+use crate::linalg::Vec3;
+use crate::loads::{ExternalWrench, LoadFrame, Loads};
+use crate::params::{JointParams, Params};
+use kanegen_model::JointKind;
+use kanegen_runtime::compact::aba::{aba_floating_on_world, aba_on_world};
+use kanegen_runtime::compact::spatial::{rot, transforms, world};
+use kanegen_runtime::compact::{Articulated, Bodies, FloatingRoot, Rates, Tables, Transform};
+
+/// A 3×3 matrix, rows first.
+pub type M3 = [[f64; 3]; 3];
+
+fn transpose(m: &M3) -> M3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| m[j][i]))
+}
+
+fn mul(a: &M3, b: &M3) -> M3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+/// The numbers of [`Tables`] for a model, one entry per joint (its fields, in `Vec`s; the module
+/// docs of [`kanegen_runtime::compact`] derive `A`, `B`, `C`).
+#[derive(Clone, Debug)]
+pub struct KernelTables {
+    /// `λ(j)`.
+    pub parent: Vec<Option<usize>>,
+    /// Revolute (else prismatic).
+    pub revolute: Vec<bool>,
+    /// `A_j`.
+    pub a: Vec<M3>,
+    /// `B_j`.
+    pub b: Vec<M3>,
+    /// `C_j`.
+    pub c: Vec<M3>,
+    /// `l_j`.
+    pub l: Vec<[f64; 3]>,
+    /// `Υ_j u_j` of a prismatic joint.
+    pub slide: Vec<[f64; 3]>,
+    /// `S_j`.
+    pub s: Vec<[f64; 6]>,
+    /// The spatial inertias, `[m, h, Ī upper triangle]`.
+    pub inertia: Vec<[f64; 10]>,
+    /// On a tree, whether joint `j` is joint `i` or one of its ancestors, entry `i N + j` (rows
+    /// first); `None` on a chain.
+    pub ancestor: Option<Vec<bool>>,
+    /// `a₀ = [0; −g]`.
+    pub a0: [f64; 6],
+}
+
+/// `(A, B, C, slide, S)` of one joint (the module docs of [`kanegen_runtime::compact`]).
+fn joint_numbers(jp: &JointParams<f64>) -> (M3, M3, M3, [f64; 3], [f64; 6]) {
+    let u = jp.axis.0;
+    let ups = jp.upsilon.0;
+    let uu: M3 = core::array::from_fn(|i| core::array::from_fn(|j| u[i] * u[j]));
+    let one_minus: M3 =
+        core::array::from_fn(|i| core::array::from_fn(|j| f64::from(u8::from(i == j)) - uu[i][j]));
+    let skew: M3 = [[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]];
+    match jp.kind {
+        JointKind::Revolute => (
+            transpose(&mul(&ups, &uu)),
+            transpose(&mul(&ups, &one_minus)),
+            transpose(&mul(&ups, &skew)),
+            [0.0; 3],
+            [u[0], u[1], u[2], 0.0, 0.0, 0.0],
+        ),
+        JointKind::Prismatic => (
+            transpose(&ups),
+            [[0.0; 3]; 3],
+            [[0.0; 3]; 3],
+            core::array::from_fn(|i| (0..3).map(|k| ups[i][k] * u[k]).sum()),
+            [0.0, 0.0, 0.0, u[0], u[1], u[2]],
+        ),
+    }
+}
+
+/// A spatial inertia as the kernels hold it: `[m, h (3), Ī upper triangle (6)]`.
+#[must_use]
+pub fn inertia_row(i: &crate::spatial::RbInertia<f64>) -> [f64; 10] {
+    let ib = i.ibar.0;
+    [
+        i.m, i.h.0[0], i.h.0[1], i.h.0[2], ib[0][0], ib[0][1], ib[0][2], ib[1][1], ib[1][2],
+        ib[2][2],
+    ]
+}
+
+impl KernelTables {
+    /// The tables of `p` (its joints' placements, axes and inertias as they are), with gravity
+    /// `g` in the base frame as `a₀` (`None`: none).
+    #[must_use]
+    pub fn new(p: &Params<f64>, gravity: Option<[f64; 3]>) -> Self {
+        let n = p.joints.len();
+        let mut t = KernelTables {
+            parent: Vec::with_capacity(n),
+            revolute: Vec::with_capacity(n),
+            a: Vec::with_capacity(n),
+            b: Vec::with_capacity(n),
+            c: Vec::with_capacity(n),
+            l: Vec::with_capacity(n),
+            slide: Vec::with_capacity(n),
+            s: Vec::with_capacity(n),
+            inertia: Vec::with_capacity(n),
+            ancestor: None,
+            a0: [0.0; 6],
+        };
+        for jp in &p.joints {
+            let (a, b, c, slide, s) = joint_numbers(jp);
+            t.a.push(a);
+            t.b.push(b);
+            t.c.push(c);
+            t.slide.push(slide);
+            t.s.push(s);
+            t.l.push(jp.l.0);
+            t.inertia.push(inertia_row(&jp.inertia));
+            t.parent.push(jp.parent);
+            t.revolute.push(jp.kind == JointKind::Revolute);
+        }
+        let chain = (0..n).all(|j| t.parent[j] == j.checked_sub(1));
+        if !chain {
+            t.ancestor = Some(ancestors(&t.parent));
+        }
+        if let Some(g) = gravity {
+            t.a0 = [0.0, 0.0, 0.0, -g[0], -g[1], -g[2]];
+        }
+        t
+    }
+
+    /// The number of joints.
+    #[must_use]
+    pub fn dof(&self) -> usize {
+        self.parent.len()
+    }
+
+    /// The tables as the kernels take them.
+    #[must_use]
+    pub fn tables(&self) -> Tables<'_, f64> {
+        Tables {
+            parent: &self.parent,
+            revolute: &self.revolute,
+            a: &self.a,
+            b: &self.b,
+            c: &self.c,
+            l: &self.l,
+            slide: &self.slide,
+            s: &self.s,
+            inertia: &self.inertia,
+            ancestor: self.ancestor.as_deref(),
+            a0: self.a0,
+        }
+    }
+}
+
+/// On a tree, row `i` of `H` keeps the entries of `i`'s ancestors (RBDA §6.2: the others are
+/// zero): entry `i N + j` says whether `j` is `i` or an ancestor of it.
+fn ancestors(parent: &[Option<usize>]) -> Vec<bool> {
+    let n = parent.len();
+    let mut anc = vec![false; n * n];
+    for i in 0..n {
+        let mut j = Some(i);
+        while let Some(k) = j {
+            anc[i * n + k] = true;
+            j = parent[k];
+        }
+    }
+    anc
+}
+
+/// The kernels' per-body scratch for `N` joints in `Vec`s: [`Bodies`] and [`Articulated`], made
+/// once and overwritten by every call (the data of Pinocchio's model/data split).
+#[derive(Clone, Debug)]
+pub struct KernelData {
+    bodies: BodyVecs,
+    six: [Vec<[f64; 6]>; 5],
+    ia: Vec<[f64; 21]>,
+    du: [Vec<f64>; 2],
+    f_ext: Vec<[f64; 6]>,
+    zero_tau: Vec<f64>,
+}
+
+/// The storage of [`Bodies`].
+#[derive(Clone, Debug)]
+struct BodyVecs {
+    x: Vec<Transform<f64>>,
+    x0: Vec<Transform<f64>>,
+    s0: Vec<[f64; 6]>,
+    i0: Vec<[f64; 10]>,
+}
+
+impl KernelData {
+    /// Scratch for `n` joints.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        let id = Transform {
+            e: [[0.0; 3]; 3],
+            r: [0.0; 3],
+        };
+        KernelData {
+            bodies: BodyVecs {
+                x: vec![id; n],
+                x0: vec![id; n],
+                s0: vec![[0.0; 6]; n],
+                i0: vec![[0.0; 10]; n],
+            },
+            six: core::array::from_fn(|_| vec![[0.0; 6]; n]),
+            ia: vec![[0.0; 21]; n],
+            du: [vec![0.0; n], vec![0.0; n]],
+            f_ext: vec![[0.0; 6]; n],
+            zero_tau: vec![0.0; n],
+        }
+    }
+
+    /// The scratch as the kernels take it: the bodies, the articulated-body quantities, and a
+    /// per-body wrench buffer.
+    pub fn split(&mut self) -> (Bodies<'_, f64>, Articulated<'_, f64>, &mut [[f64; 6]]) {
+        split(
+            &mut self.bodies,
+            &mut self.six,
+            &mut self.ia,
+            &mut self.du,
+            &mut self.f_ext,
+        )
+    }
+}
+
+/// [`KernelData::split`] over its fields (so that a caller may still read the others).
+fn split<'a>(
+    bodies: &'a mut BodyVecs,
+    six: &'a mut [Vec<[f64; 6]>; 5],
+    ia: &'a mut [[f64; 21]],
+    du: &'a mut [Vec<f64>; 2],
+    f_ext: &'a mut [[f64; 6]],
+) -> (Bodies<'a, f64>, Articulated<'a, f64>, &'a mut [[f64; 6]]) {
+    let [v, c, pa, ui, a] = six;
+    let [d, u] = du;
+    let b = Bodies {
+        x: &mut bodies.x,
+        x0: &mut bodies.x0,
+        s0: &mut bodies.s0,
+        i0: &mut bodies.i0,
+    };
+    let articulated = Articulated {
+        v,
+        c,
+        ia,
+        pa,
+        ui,
+        d,
+        u,
+        a,
+    };
+    (b, articulated, f_ext)
+}
+
+/// Forward dynamics on the run-time path: the articulated-body kernel
+/// ([`kanegen_runtime::compact::aba`]) on the tables `t` with the scratch `data`, into `out`.
+/// On a fixed base (`floating = None`) `out = q̈`; on a free-floating one `out = ν̇ =
+/// [v̇_b; ω̇_b; q̈]` as [`crate::algorithms::aba::floating`] writes it, `q`, `qd` the joints'
+/// (the tables then hold no gravity: it comes from `loads`). Loads as the algorithms of this crate
+/// take them (drives, gravity, wrenches in a body's or the base's frame; `tau = None`: zero);
+/// `armature` as [`crate::algorithms::aba::forward_dynamics_in`]'s. Allocates nothing.
+#[allow(clippy::too_many_arguments)]
+pub fn forward_dynamics(
+    t: &KernelTables,
+    data: &mut KernelData,
+    floating: Option<(&FloatingBase<f64>, &FloatingState<f64>)>,
+    q: &[f64],
+    qd: &[f64],
+    loads: &Loads<f64>,
+    armature: Option<&[f64]>,
+    out: &mut [f64],
+) {
+    let tables = t.tables();
+    let zero_tau = &data.zero_tau;
+    let (mut b, mut ab, f_ext) = split(
+        &mut data.bodies,
+        &mut data.six,
+        &mut data.ia,
+        &mut data.du,
+        &mut data.f_ext,
+    );
+    transforms(&tables, q, f64::sin_cos, b.x);
+    world(&tables, tables.inertia, &mut b);
+    // R₀ᵀ of a free-floating base: inertial-frame vectors into base coordinates.
+    let r0t = floating.map(|(_, st)| st.rotation.transpose().0);
+    let external = &loads.external;
+    if !external.is_empty() {
+        body_wrenches(external, r0t.as_ref(), b.x0, f_ext);
+    }
+    let rates = Rates {
+        qd,
+        tau: loads.tau.as_deref().unwrap_or(zero_tau),
+        f_ext: (!external.is_empty()).then_some(&*f_ext),
+        armature,
+    };
+    match (floating, r0t) {
+        (Some((base, st)), Some(r0t)) => {
+            let (w, v) = (&st.omega_b.0, &st.v_b.0);
+            let root = FloatingRoot {
+                inertia: inertia_row(&base.inertia),
+                v: [w[0], w[1], w[2], v[0], v[1], v[2]],
+                f_ext: base_wrench(external, &r0t),
+                gravity: loads.gravity.as_ref().map(|g| rot(&r0t, &g.0)),
+            };
+            aba_floating_on_world(&tables, rates, &root, &b, &mut ab, out);
+        }
+        _ => aba_on_world(&tables, rates, &b, &mut ab, out),
+    }
+}
+
+/// A wrench `[force; moment]` in the frame whose rotation from the loads' frame is `e` (`None`:
+/// the loads are in that frame already).
+fn wrench_in(w: &ExternalWrench<f64>, e: Option<&[[f64; 3]; 3]>) -> [f64; 6] {
+    let turn = |v: &Vec3<f64>| match e {
+        Some(e) => rot(e, &v.0),
+        None => v.0,
+    };
+    let (f, m) = (turn(&w.force), turn(&w.moment));
+    [f[0], f[1], f[2], m[0], m[1], m[2]]
+}
+
+/// Each body's external wrenches summed in its own frame into `f_ext` (`[force; moment]` at its
+/// origin): body-frame wrenches as they are, base-frame (inertial-frame) ones rotated by `E_0j`
+/// (`E_0j R₀ᵀ` on a free-floating base, `r0t` = `R₀ᵀ`).
+fn body_wrenches(
+    external: &[ExternalWrench<f64>],
+    r0t: Option<&[[f64; 3]; 3]>,
+    x0: &[Transform<f64>],
+    f_ext: &mut [[f64; 6]],
+) {
+    f_ext.fill([0.0; 6]);
+    for w in external {
+        let (Some(f), Some(x)) = (f_ext.get_mut(w.body), x0.get(w.body)) else {
+            continue;
+        };
+        let local = match (w.frame, r0t) {
+            (LoadFrame::Body, _) => wrench_in(w, None),
+            (LoadFrame::Base, None) => wrench_in(w, Some(&x.e)),
+            (LoadFrame::Base, Some(r)) => {
+                let e = core::array::from_fn(|i| {
+                    core::array::from_fn(|j| (0..3).map(|k| x.e[i][k] * r[k][j]).sum())
+                });
+                wrench_in(w, Some(&e))
+            }
+        };
+        for (a, b) in f.iter_mut().zip(local) {
+            *a += b;
+        }
+    }
+}
+
+/// The external wrench on a free-floating base body, `[force; moment]` in its frame (`r0t` =
+/// `R₀ᵀ` takes inertial-frame ones there), `None` when none acts on it.
+fn base_wrench(external: &[ExternalWrench<f64>], r0t: &[[f64; 3]; 3]) -> Option<[f64; 6]> {
+    let mut on_base = external.iter().filter(|w| w.body == BASE_BODY).peekable();
+    on_base.peek()?;
+    let mut sum = [0.0; 6];
+    for w in on_base {
+        let e = (w.frame == LoadFrame::Base).then_some(r0t);
+        for (a, b) in sum.iter_mut().zip(wrench_in(w, e)) {
+            *a += b;
+        }
+    }
+    Some(sum)
+}
