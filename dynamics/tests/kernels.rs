@@ -5,89 +5,17 @@
 //! frame, and armature; and both against the same algorithm in double-double ([`Wide`]) on the
 //! two space arms, to say which rounds less.
 
+mod common;
+
+use common::{base_inertial, base_state, loads, models};
 use kanegen_dynamics::algorithms::aba::{self, Workspace};
-use kanegen_dynamics::base::{FloatingBase, FloatingState, BASE_BODY};
+use kanegen_dynamics::base::FloatingBase;
 use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
-use kanegen_dynamics::linalg::{axis_rotation, Vec3};
+use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::metrics::rel_err;
 use kanegen_dynamics::scalars::wide::Wide;
-use kanegen_dynamics::{ExternalWrench, LoadFrame, Loads, Params, Real, Scalar};
-use kanegen_model::random::{
-    random_chain, random_inertial, random_tree, random_vec, rng, ChainSpec,
-};
-use kanegen_model::Model;
-
-/// Random trees N = 1…10 and chains N = 2…12, a third of the joints prismatic.
-fn models() -> Vec<Model> {
-    let spec = |n| ChainSpec {
-        n,
-        prismatic_fraction: 0.35,
-        ..Default::default()
-    };
-    (1..=10)
-        .map(|n| random_tree(&spec(n), 40 + n as u64))
-        .chain((2..=12).map(|n| random_chain(&spec(n), 80 + n as u64)))
-        .collect()
-}
-
-fn wrench(body: usize, frame: LoadFrame, w: &[f64]) -> ExternalWrench<f64> {
-    ExternalWrench {
-        body,
-        frame,
-        force: Vec3::new(w[0], w[1], w[2]),
-        moment: Vec3::new(w[3], w[4], w[5]),
-    }
-}
-
-/// Drives, gravity and wrenches (two on a middle body, one per frame; on a floating base, one
-/// per frame); `variant` 1 has drives only, 2 no drives.
-fn loads(n: usize, seed: u64, floating: bool, variant: usize) -> Loads<f64> {
-    let mut r = rng(seed);
-    let w = random_vec(&mut r, 36, 5.0);
-    let mut external = vec![
-        wrench(n - 1, LoadFrame::Body, &w[0..6]),
-        wrench(0, LoadFrame::Base, &w[6..12]),
-        wrench(n / 2, LoadFrame::Body, &w[12..18]),
-        wrench(n / 2, LoadFrame::Base, &w[18..24]),
-    ];
-    if floating {
-        external.push(wrench(BASE_BODY, LoadFrame::Body, &w[24..30]));
-        external.push(wrench(BASE_BODY, LoadFrame::Base, &w[30..36]));
-    }
-    let tau = Some(random_vec(&mut r, n, 20.0));
-    match variant {
-        0 => Loads {
-            tau,
-            gravity: Some(Vec3::new(0.7, -1.3, -9.81)),
-            external,
-        },
-        1 => Loads {
-            tau,
-            ..Loads::default()
-        },
-        _ => Loads {
-            tau: None,
-            gravity: Some(Vec3::new(0.0, 0.0, -9.81)),
-            external: external.split_off(2),
-        },
-    }
-}
-
-fn base_state(seed: u64) -> FloatingState<f64> {
-    let mut r = rng(seed);
-    let w = random_vec(&mut r, 10, 1.0);
-    let n = (w[6] * w[6] + w[7] * w[7] + w[8] * w[8]).sqrt();
-    FloatingState {
-        position: Vec3::new(w[0], w[1], w[2]),
-        rotation: axis_rotation(
-            &Vec3::new(w[6] / n, w[7] / n, w[8] / n),
-            &(2.0 * w[9]).sin(),
-            &(2.0 * w[9]).cos(),
-        ),
-        v_b: Vec3::new(w[3], w[4], w[5]),
-        omega_b: Vec3::new(w[5], -w[3], w[4]),
-    }
-}
+use kanegen_dynamics::{Loads, Params, Real, Scalar};
+use kanegen_model::random::{random_vec, rng};
 
 /// The kernel against the local-frame ABA, fixed base: every load variant, with and without
 /// armature (which the kernel puts into `D_i` as the workspace ABA does).
@@ -128,7 +56,7 @@ fn floating_base_kernel_matches_the_local_frame_aba() {
     for (k, m) in models().iter().enumerate() {
         let p = Params::<f64>::new(m);
         let n = p.dof();
-        let base = FloatingBase::from_inertial(&random_inertial(&mut rng(k as u64), 80.0, 1.2));
+        let base = FloatingBase::from_inertial(&base_inertial(k as u64));
         for variant in 0..3 {
             let mut g = rng(900 + 10 * k as u64 + variant as u64);
             let (q, qd) = (random_vec(&mut g, n, 2.5), random_vec(&mut g, n, 1.5));
