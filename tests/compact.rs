@@ -321,3 +321,67 @@ fn compact_f32_is_close_to_f64() {
         1e-3,
     );
 }
+
+kanegen::dynamics!(
+    Ur5C,
+    "tests/data/erd/ur5_robot.urdf",
+    form = "compact",
+    gravity = [0.0, 0.0, -9.81]
+);
+kanegen::dynamics!(
+    Ur5U,
+    "tests/data/erd/ur5_robot.urdf",
+    form = "unrolled",
+    gravity = [0.0, 0.0, -9.81]
+);
+
+/// The compact frame functions (loops over the support path, `kanegen_runtime::compact::frames`)
+/// equal the unrolled ones on UR5's frames: two on the wrist, two on the base.
+#[test]
+fn compact_frames_equal_unrolled() {
+    let placement = |(x, r): ([f64; 3], [[f64; 3]; 3])| -> Vec<f64> {
+        x.into_iter().chain(r.into_iter().flatten()).collect()
+    };
+    let jac = |j: [[f64; 6]; 6]| -> Vec<f64> { j.into_iter().flatten().collect() };
+    let mut r = rng(17);
+    for _ in 0..20 {
+        let q: [f64; 6] = arr(random_vec(&mut r, 6, 3.0));
+        close(
+            "ee_link placement",
+            &placement(Ur5C::ee_link_placement(&q)),
+            &placement(Ur5U::ee_link_placement(&q)),
+            1e-14,
+        );
+        close(
+            "tool0 placement",
+            &placement(Ur5C::tool0_placement(&q)),
+            &placement(Ur5U::tool0_placement(&q)),
+            1e-14,
+        );
+        close(
+            "base_link placement",
+            &placement(Ur5C::base_link_placement(&q)),
+            &placement(Ur5U::base_link_placement(&q)),
+            1e-15,
+        );
+        close(
+            "ee_link jacobian",
+            &jac(Ur5C::ee_link_jacobian(&q)),
+            &jac(Ur5U::ee_link_jacobian(&q)),
+            1e-14,
+        );
+        close(
+            "tool0 jacobian",
+            &jac(Ur5C::tool0_jacobian(&q)),
+            &jac(Ur5U::tool0_jacobian(&q)),
+            1e-14,
+        );
+        assert_eq!(Ur5C::base_jacobian(&q), [[0.0; 6]; 6]);
+        close(
+            "M",
+            &flat(&Ur5C::mass_matrix(&q)),
+            &flat(&Ur5U::mass_matrix(&q)),
+            1e-13,
+        );
+    }
+}

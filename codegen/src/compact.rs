@@ -79,6 +79,7 @@ use self::tables::{numbers, M3};
 use crate::options::{Error, Float, Form, Options};
 use kanegen_dynamics::{ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::{BaseKind, Model};
+use kanegen_runtime::compact::Frame;
 use kanegen_trace::{Counts, Function};
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
@@ -245,12 +246,14 @@ pub fn methods(f: Function) -> Methods {
     }
 }
 
-/// Whether the compact form has its own body for `f` (the frame functions stay straight-line).
+/// Whether the compact form has its own body for `f`.
 #[must_use]
 pub fn has_body(f: Function) -> bool {
     matches!(
         f,
-        Function::MassMatrix
+        Function::FramePlacement(_)
+            | Function::FrameJacobian(_)
+            | Function::MassMatrix
             | Function::NonlinearEffects
             | Function::Gravity
             | Function::InverseDynamics
@@ -314,6 +317,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         None => quote!(None),
     };
     let a0 = vector(float, &t.a0);
+    let frames = frames(&rt, float, &t.frames);
     Ok(quote! {
         /// Compact form: the model's numbers as the runtime kernels read them
         /// (`kanegen_runtime::compact::Tables`: parents, joint kinds, the joint transforms'
@@ -331,7 +335,34 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
             ancestor: #ancestor,
             a0: #a0,
         };
+        #frames
     })
+}
+
+/// The frames' constants of the compact form (`CX_FRAMES`, none without frames): each frame's
+/// body, origin and orientation in the body frame, as the frame kernels read them.
+fn frames(rt: &TokenStream, float: Float, frames: &[Frame<f64>]) -> TokenStream {
+    if frames.is_empty() {
+        return TokenStream::new();
+    }
+    let fl = float.ty();
+    let k = Literal::usize_unsuffixed(frames.len());
+    let each = frames.iter().map(|f| {
+        let body = match f.body {
+            Some(b) => {
+                let b = Literal::usize_unsuffixed(b);
+                quote!(Some(#b))
+            }
+            None => quote!(None),
+        };
+        let (t, r) = (vector(float, &f.translation), mat(float, &f.rotation));
+        quote!(#rt::compact::Frame { body: #body, translation: #t, rotation: #r })
+    });
+    quote! {
+        /// Compact form: the named frames (body, origin and orientation in the body frame), in
+        /// the model's order, as the frame kernels read them.
+        const CX_FRAMES: [#rt::compact::Frame<#fl>; #k] = [#(#each),*];
+    }
 }
 
 /// The body of `f` in the compact form (a model of `n` joints): one call of its runtime kernel
@@ -374,6 +405,14 @@ pub fn body(f: Function, opts: &Options, n: usize) -> Result<Option<TokenStream>
         Function::ForwardDynamicsWithWrenches => quote! {
             #k::forward_dynamics_with_wrenches(&Self::CX, #i, q, qd, tau, f_ext, #sincos)
         },
+        Function::FramePlacement(f) => {
+            let f = Literal::usize_unsuffixed(f);
+            quote!(#k::frame_placement(&Self::CX, &Self::CX_FRAMES[#f], q, #sincos))
+        }
+        Function::FrameJacobian(f) => {
+            let f = Literal::usize_unsuffixed(f);
+            quote!(#k::frame_jacobian(&Self::CX, &Self::CX_FRAMES[#f], q, #sincos))
+        }
         _ => return Ok(None),
     }))
 }

@@ -277,6 +277,7 @@ impl Scalar for Counted {
 /// The operations each compact function's kernel executes, counted by running it on
 /// [`Counted`].
 fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64; 4] {
+    let t_frames = &t.frames;
     let owned = Owned::new(t, Counted);
     let t = owned.tables(t);
     let x = |k: usize| Counted(0.1 + 0.01 * k as f64);
@@ -301,6 +302,19 @@ fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64
             let f_ext = [[x(6); 6]; N];
             _ = k::forward_dynamics_with_wrenches(&t, &inertia, &v, &v, &v, &f_ext, sc);
         }
+        Function::FramePlacement(k) | Function::FrameJacobian(k) => {
+            let fr = &t_frames[k];
+            let frame = k::Frame {
+                body: fr.body,
+                translation: fr.translation.map(Counted),
+                rotation: fr.rotation.map(|r| r.map(Counted)),
+            };
+            if let Function::FramePlacement(_) = f {
+                _ = k::frame_placement(&t, &frame, &v, sc);
+            } else {
+                _ = k::frame_jacobian(&t, &frame, &v, sc);
+            }
+        }
         _ => unreachable!("{f:?} has no kernel"),
     }
     take()
@@ -322,7 +336,9 @@ const KERNELS: [Function; 7] = [
 fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
     let t = numbers(model, opts);
     let items = generate_items(model, opts).unwrap().items.to_string();
-    for f in KERNELS {
+    let frames =
+        (0..t.frames.len()).flat_map(|k| [Function::FramePlacement(k), Function::FrameJacobian(k)]);
+    for f in KERNELS.into_iter().chain(frames) {
         if f == Function::Gravity && opts.gravity.is_none() {
             continue; // no `gravity` function in space
         }
@@ -334,11 +350,21 @@ fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
             "{f:?} of {}",
             model.name()
         );
-        assert!(c.mul > 0 && c.add > 0);
+        // A frame on the base costs nothing; every other kernel computes.
+        let on_base = match f {
+            Function::FramePlacement(k) | Function::FrameJacobian(k) => t.frames[k].body.is_none(),
+            _ => false,
+        };
+        assert_eq!(c.mul > 0 && c.add > 0, !on_base, "{f:?}");
         // The generated type reports them.
+        let name = match f {
+            Function::FramePlacement(k) => format!("{}_placement", model.frames()[k].name),
+            Function::FrameJacobian(k) => format!("{}_jacobian", model.frames()[k].name),
+            _ => f.name().to_string(),
+        };
         let entry = format!(
             "function : \"{}\" , mass_matrix_method : {}",
-            f.name(),
+            name,
             if f.uses_mass_matrix() && !f.is_forward_dynamics() {
                 "Some (\"crba\")"
             } else {
@@ -370,6 +396,13 @@ fn op_counts_of_compact_types_are_what_the_kernels_execute() {
     o.runtime_payload = true;
     o.gravity = None;
     counts_follow::<7>(&random_tree(&spec(7), 43), &o);
+    // UR5's four frames (two on the base, two on the wrist) in the compact form.
+    let ur5 =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/erd/ur5_robot.urdf");
+    let ur5 = kanegen_model::io::load_model(&ur5).unwrap();
+    assert_eq!(ur5.frames().len(), 4);
+    o.runtime_payload = false;
+    counts_follow::<6>(&ur5, &o);
 }
 
 /// The counts follow the kernels above 64 joints too (the kernels are traced for any number of

@@ -10,7 +10,9 @@ use crate::params::{JointParams, Params};
 use kanegen_model::JointKind;
 use kanegen_runtime::compact::aba::{aba_floating_on_world, aba_on_world};
 use kanegen_runtime::compact::spatial::{rot, transforms, world};
-use kanegen_runtime::compact::{Articulated, Bodies, FloatingRoot, Rates, Tables, Transform};
+use kanegen_runtime::compact::{
+    Articulated, Bodies, FloatingRoot, Frame, Rates, Tables, Transform,
+};
 
 /// A 3×3 matrix, rows first.
 pub type M3 = [[f64; 3]; 3];
@@ -50,6 +52,8 @@ pub struct KernelTables {
     pub ancestor: Option<Vec<bool>>,
     /// `a₀ = [0; −g]`.
     pub a0: [f64; 6],
+    /// The model's named frames, in its order.
+    pub frames: Vec<Frame<f64>>,
 }
 
 /// `(A, B, C, slide, S)` of one joint (the module docs of [`kanegen_runtime::compact`]).
@@ -106,6 +110,15 @@ impl KernelTables {
             inertia: Vec::with_capacity(n),
             ancestor: None,
             a0: [0.0; 6],
+            frames: p
+                .frames
+                .iter()
+                .map(|f| Frame {
+                    body: f.parent,
+                    translation: f.translation.0,
+                    rotation: f.rotation.0,
+                })
+                .collect(),
         };
         for jp in &p.joints {
             let (a, b, c, slide, s) = joint_numbers(jp);

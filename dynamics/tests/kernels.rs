@@ -127,3 +127,73 @@ fn both_paths_against_double_double_on_the_space_arms() {
         );
     }
 }
+
+/// The frame kernels (`kanegen_runtime::compact::frames`, over the support path in base
+/// coordinates) against this crate's local-frame kinematics (`algorithms::frames`): placement and
+/// Jacobian of frames at random offsets and orientations on every body of random trees and
+/// chains, and on the base.
+#[test]
+fn frame_kernels_match_the_local_frame_kinematics() {
+    use kanegen_dynamics::algorithms::frames;
+    use kanegen_dynamics::linalg::{axis_rotation, Mat3};
+    use kanegen_dynamics::FrameParams;
+    use kanegen_runtime::compact::frames::{jacobian_columns, origin, pose, support_placements};
+    use kanegen_runtime::compact::spatial::transforms;
+    use kanegen_runtime::compact::{Frame, Transform};
+    let mut worst = 0.0_f64;
+    for (k, m) in models().iter().enumerate() {
+        let p = Params::<f64>::new(m);
+        let n = p.dof();
+        let t = KernelTables::new(&p, None);
+        let tables = t.tables();
+        let mut g = rng(1300 + k as u64);
+        let q = random_vec(&mut g, n, 2.5);
+        let id = Transform {
+            e: [[0.0; 3]; 3],
+            r: [0.0; 3],
+        };
+        let mut x = vec![id; n];
+        transforms(&tables, &q, f64::sin_cos, &mut x);
+        for body in std::iter::once(None).chain((0..n).map(Some)) {
+            let w = random_vec(&mut g, 7, 1.0);
+            let norm = (w[3] * w[3] + w[4] * w[4] + w[5] * w[5]).sqrt();
+            let axis = Vec3::new(w[3] / norm, w[4] / norm, w[5] / norm);
+            let rotation: Mat3<f64> = axis_rotation(&axis, &w[6].sin(), &w[6].cos());
+            let fp = FrameParams {
+                parent: body,
+                translation: Vec3::new(w[0], w[1], w[2]),
+                rotation: rotation.clone(),
+            };
+            let frame = Frame {
+                body,
+                translation: [w[0], w[1], w[2]],
+                rotation: rotation.0,
+            };
+            let mut x0 = vec![id; n];
+            if let Some(i) = body {
+                support_placements(&tables, i, &x, &mut x0);
+            }
+            let (xf, rf) = pose(&frame, &x0);
+            assert_eq!(xf, origin(&frame, &x0));
+            let mut cols = vec![[0.0; 6]; n];
+            jacobian_columns(&tables, &frame, &x0, &xf, &mut cols);
+            let (want_x, want_r) = frames::placement(&p, &q, &fp);
+            let want_j = frames::jacobian(&p, &q, &fp);
+            let got: Vec<f64> = xf
+                .into_iter()
+                .chain(rf.into_iter().flatten())
+                .chain((0..6).flat_map(|r| cols.iter().map(move |c| c[r])))
+                .collect();
+            let want: Vec<f64> = want_x
+                .0
+                .into_iter()
+                .chain(want_r.0.into_iter().flatten())
+                .chain(want_j.iter().flatten().copied())
+                .collect();
+            let e = rel_err(&got, &want);
+            assert!(e < 1e-13, "{} frame on {body:?}: {e:e}", m.name());
+            worst = worst.max(e);
+        }
+    }
+    eprintln!("worst frame kernel vs local-frame kinematics: {worst:e}");
+}

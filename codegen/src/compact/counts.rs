@@ -53,7 +53,18 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     };
     let joints = || -> Vec<Sym> { (0..n).map(|_| x()).collect() };
     let q = joints();
-    let out = trace_kernel(&tables, f, &q, &mut || joints(), &x)?;
+    let out = match f {
+        Function::FramePlacement(k) | Function::FrameJacobian(k) => {
+            let fr = t.frames.get(k)?;
+            let frame = k::Frame {
+                body: fr.body,
+                translation: v3(),
+                rotation: m3(),
+            };
+            trace_frame(&tables, f, &frame, &q)
+        }
+        _ => trace_kernel(&tables, f, &q, &mut || joints(), &x)?,
+    };
     Some(tr.finish(&out).counts(Convention::Paper))
 }
 
@@ -146,6 +157,39 @@ fn trace_kernel(
             qdd
         }
     })
+}
+
+/// The outputs of a frame function's kernel on `tables` at `q`, as its entry point computes them:
+/// the joint transforms and placements of the frame body's support path, then the placement
+/// `[x_f; R_f rows]` or the Jacobian's rows.
+fn trace_frame(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    frame: &k::Frame<Sym>,
+    q: &[Sym],
+) -> Vec<Sym> {
+    let zero = Sym::zero();
+    let id = Transform {
+        e: [[zero; 3]; 3],
+        r: [zero; 3],
+    };
+    let n = q.len();
+    let (mut x, mut x0) = (vec![id; n], vec![id; n]);
+    if let Some(i) = frame.body {
+        let upto = (i + 1).min(n);
+        k::spatial::transforms(tables, &q[..upto], |a: Sym| a.sin_cos(), &mut x[..upto]);
+        k::frames::support_placements(tables, i, &x, &mut x0);
+    }
+    if let Function::FramePlacement(_) = f {
+        let (p, r) = k::frames::pose(frame, &x0);
+        return p.into_iter().chain(r.into_iter().flatten()).collect();
+    }
+    let xf = k::frames::origin(frame, &x0);
+    let mut cols = vec![[zero; 6]; n];
+    k::frames::jacobian_columns(tables, frame, &x0, &xf, &mut cols);
+    (0..6)
+        .flat_map(|r| cols.iter().map(move |c| c[r]))
+        .collect()
 }
 
 /// The CRBA's `H` (rows first) on the joint transforms of `b`.

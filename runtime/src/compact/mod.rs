@@ -12,6 +12,8 @@
 //! - [`forward_dynamics`], [`forward_dynamics_with_wrenches`]: the articulated-body algorithm
 //!   (RBDA Table 7.1), [`aba`];
 //! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`];
+//! - [`frame_placement`], [`frame_jacobian`]: a named frame's placement and Jacobian over its
+//!   body's support path ([`Frame`]), [`frames`];
 //! - [`aba::aba_floating_on_world`]: forward dynamics on a free-floating base ([`FloatingRoot`]);
 //!   the run-time path calls it and [`aba::aba_on_world`] on tables built at run time, with
 //!   the armature and wrenches of a scene.
@@ -39,6 +41,7 @@
 
 pub mod aba;
 pub mod crba;
+pub mod frames;
 pub mod payload;
 pub mod rnea;
 pub mod spatial;
@@ -49,6 +52,7 @@ pub use aba::{
     Rates,
 };
 pub use crba::{mass_matrix, mass_matrix_and_nonlinear_effects};
+pub use frames::{frame_jacobian, frame_placement, Frame};
 pub use payload::{payload_inertia, with_payload};
 pub use rnea::{gravity, inverse_dynamics, nonlinear_effects, Motions};
 pub use spatial::Transform;

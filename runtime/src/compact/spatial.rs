@@ -263,7 +263,8 @@ pub fn world<S: Scalar + Copy>(t: &Tables<'_, S>, inertia: &[[S; 10]], w: &mut B
 /// `(E_0i, p_0i)` of a body from its joint transform `x` and its parent's `p`:
 /// `E_0i = E_i E_0λ`, `p_0i = p_0λ + E_0λᵀ r_i` (RBDA §2.8).
 #[inline(always)]
-fn compose<S: Scalar + Copy>(x: &Transform<S>, p: &Transform<S>) -> Transform<S> {
+#[must_use]
+pub fn compose<S: Scalar + Copy>(x: &Transform<S>, p: &Transform<S>) -> Transform<S> {
     let (e, r, el) = (&x.e, &x.r, &p.e);
     let row = |a: usize| {
         let e0 = |b: usize| e[a][0] * el[0][b] + e[a][1] * el[1][b] + e[a][2] * el[2][b];
