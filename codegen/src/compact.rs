@@ -99,8 +99,8 @@ pub const AUTO_LIMIT: u64 = 4_000;
 pub const LINEAR_AUTO_LIMIT: u64 = 4_000;
 
 /// Whether `f` may keep its unrolled body in a model that [`decide`] made compact: under
-/// [`Form::Auto`], an O(N) Newton–Euler function (then it does when its unrolled body has at
-/// most [`LINEAR_AUTO_LIMIT`] emitted operations, [`keeps_unrolled`]).
+/// [`Form::Auto`], an O(N) Newton–Euler function or a frame function (then it does when its
+/// unrolled body has at most [`LINEAR_AUTO_LIMIT`] emitted operations, [`keeps_unrolled`]).
 #[must_use]
 pub fn may_keep_unrolled(opts: &Options, f: Function) -> bool {
     opts.form == Form::Auto

@@ -9,7 +9,7 @@ use quote::{format_ident, quote};
 /// of `kanegen generate`, `allow_large = true` of `dynamics!`). Large models take the compact
 /// form, decided from a traced prefix ([`crate::plan`]), so generating is quick at that size;
 /// beyond it the generated code is what grows: its functions keep O(N) arrays on the caller's
-/// stack, and its frame functions stay straight-line (6·N Jacobian entries).
+/// stack (a frame Jacobian returns 6·N entries).
 pub const MAX_JOINTS: usize = 1000;
 
 /// Version of the generator, written into every generated header.

@@ -294,6 +294,14 @@ fn plan_body(
 ) -> Result<(Choice, Option<Traced>), Error> {
     let traced = if decision.form != Form::Compact || !compact::has_body(f) {
         Some(choose_in(model, subjects, f, mass, opts)?)
+    } else if compact::may_keep_unrolled(opts, f) && f.frame().is_some() {
+        // A frame function is O(depth) and the prefixes have no frames: traced whole.
+        let (choice, graph) = choose_in(model, subjects, f, mass, opts)?;
+        let size = compact::Size {
+            ops: choice.counts().total(),
+            joints: model.dof(),
+        };
+        compact::keeps_unrolled(opts, f, size).then_some((choice, graph))
     } else if compact::may_keep_unrolled(opts, f) {
         let limit = compact::LINEAR_AUTO_LIMIT;
         let (size, traced) = size_on_prefixes(model, subjects, opts, limit, &[f], mass)?;
