@@ -9,7 +9,7 @@ mod common;
 
 use common::{base_inertial, base_state, loads, models};
 use kanegen_dynamics::algorithms::aba::{self, Workspace};
-use kanegen_dynamics::base::FloatingBase;
+use kanegen_dynamics::base::{FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::metrics::rel_err;
@@ -196,4 +196,139 @@ fn frame_kernels_match_the_local_frame_kinematics() {
         }
     }
     eprintln!("worst frame kernel vs local-frame kinematics: {worst:e}");
+}
+
+/// The free-floating kernels (`kanegen_runtime::compact::floating`: `M`, `c`, inverse and
+/// forward dynamics with the base as the root, wrenches on the base and the bodies) against this
+/// crate's local-frame algorithms on random trees and chains with random base inertias, poses
+/// and twists, with gravity.
+#[test]
+fn floating_kernels_match_the_local_frame_algorithms() {
+    use kanegen_dynamics::algorithms::{floating, rnea};
+    use kanegen_dynamics::base::quat_to_matrix;
+    use kanegen_dynamics::kernels::inertia_row;
+    use kanegen_dynamics::{LoadFrame, MassMatrixMethod};
+    use kanegen_model::random::{random_chain, random_tree, ChainSpec};
+    use kanegen_runtime::compact::floating::{self as fk, Base};
+
+    fn check<const N: usize, const NV: usize>(m: &kanegen_model::Model, seed: u64) -> f64 {
+        let p = Params::<f64>::new(m);
+        let t = KernelTables::new(&p, None);
+        let tables = t.tables();
+        let fb = FloatingBase::from_inertial(&base_inertial(seed));
+        let g = [0.4, -0.7, -9.81];
+        let base = Base {
+            inertia: inertia_row(&fb.inertia),
+            gravity: Some(g),
+        };
+        let mut r = rng(seed);
+        let w = random_vec(&mut r, 4, 1.0);
+        let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let quat = [w[0] / norm, w[1] / norm, w[2] / norm, w[3] / norm];
+        let qj = random_vec(&mut r, N, 2.5);
+        let q: Vec<f64> = [0.3, -0.2, 1.1]
+            .into_iter()
+            .chain(quat)
+            .chain(qj.clone())
+            .collect();
+        let nu = random_vec(&mut r, NV, 1.0);
+        let nu_dot = random_vec(&mut r, NV, 1.0);
+        let tau: [f64; N] = core::array::from_fn(|i| 5.0 * (i as f64 + 1.0).sin());
+        let f_ext: Vec<[f64; 6]> = (0..=N)
+            .map(|k| core::array::from_fn(|i| ((k * 6 + i) as f64).cos()))
+            .collect();
+        let st = FloatingState {
+            position: Vec3::new(q[0], q[1], q[2]),
+            rotation: quat_to_matrix(&quat),
+            v_b: Vec3::new(nu[0], nu[1], nu[2]),
+            omega_b: Vec3::new(nu[3], nu[4], nu[5]),
+        };
+        let gravity = Some(Vec3::new(g[0], g[1], g[2]));
+        let loads = Loads {
+            tau: Some(tau.to_vec()),
+            gravity,
+            external: vec![],
+        };
+        let passive = Loads {
+            tau: None,
+            ..loads.clone()
+        };
+        let sc = f64::sin_cos;
+        let mut worst = 0.0_f64;
+        let mut agree = |what: &str, got: &[f64], want: &[f64]| {
+            let e = rel_err(got, want);
+            assert!(e < 1e-12, "{} {what}: {e:e}", m.name());
+            worst = worst.max(e);
+        };
+        let mm = fk::mass_matrix::<f64, N, NV>(&tables, &t.inertia, &base, &q, sc);
+        let want = floating::mass_matrix(MassMatrixMethod::Crba, &p, &fb, &st, &qj);
+        agree("M", mm.as_flattened(), &want.concat());
+        let c =
+            fk::inverse_dynamics::<f64, N, NV>(&tables, &t.inertia, &base, &q, Some(&nu), None, sc);
+        let minus_c = rnea::floating_tau_minus_c(&p, &fb, &st, &qj, &nu[6..], &passive);
+        agree("c", &c, &minus_c.iter().map(|x| -x).collect::<Vec<_>>());
+        let id = fk::inverse_dynamics::<f64, N, NV>(
+            &tables,
+            &t.inertia,
+            &base,
+            &q,
+            Some(&nu),
+            Some(&nu_dot),
+            sc,
+        );
+        let acc: [f64; 6] = core::array::from_fn(|i| nu_dot[i]);
+        let want = rnea::floating_inverse_dynamics(
+            &p,
+            &fb,
+            &st,
+            &qj,
+            &nu[6..],
+            &acc,
+            &nu_dot[6..],
+            &passive,
+        );
+        agree("inverse dynamics", &id, &want);
+        let fd =
+            fk::forward_dynamics::<f64, N, NV>(&tables, &t.inertia, &base, &q, &nu, &tau, None, sc);
+        let want = aba::floating(&p, &fb, &st, &qj, &nu[6..], &loads);
+        agree("forward dynamics", &fd, &want);
+        let fdw = fk::forward_dynamics::<f64, N, NV>(
+            &tables,
+            &t.inertia,
+            &base,
+            &q,
+            &nu,
+            &tau,
+            Some(&f_ext),
+            sc,
+        );
+        let mut with = loads.clone();
+        with.external = f_ext
+            .iter()
+            .enumerate()
+            .map(|(k, f)| kanegen_dynamics::ExternalWrench {
+                body: if k == 0 { BASE_BODY } else { k - 1 },
+                frame: LoadFrame::Body,
+                force: Vec3::new(f[0], f[1], f[2]),
+                moment: Vec3::new(f[3], f[4], f[5]),
+            })
+            .collect();
+        let want = aba::floating(&p, &fb, &st, &qj, &nu[6..], &with);
+        agree("forward dynamics with wrenches", &fdw, &want);
+        worst
+    }
+    let spec = |n| ChainSpec {
+        n,
+        prismatic_fraction: 0.3,
+        ..Default::default()
+    };
+    let worst = [
+        check::<1, 7>(&random_chain(&spec(1), 1), 11),
+        check::<5, 11>(&random_chain(&spec(5), 2), 12),
+        check::<7, 13>(&random_tree(&spec(7), 3), 13),
+        check::<12, 18>(&random_tree(&spec(12), 4), 14),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    eprintln!("worst floating kernel vs local-frame algorithms: {worst:e}");
 }

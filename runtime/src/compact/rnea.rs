@@ -103,12 +103,42 @@ pub fn rnea<S: Scalar + Copy>(
     m: &mut [[[S; 6]; 3]],
     tau: &mut [S],
 ) {
-    let zero = S::zero();
+    let root = Root {
+        v: [S::zero(); 6],
+        a: t.a0,
+    };
+    rnea_rooted(t, x, inertia, motions, &root, m, tau, None);
+}
+
+/// The motion of the body the joints without a parent hang on: the fixed base (`v = 0`,
+/// `a = a₀`) or a free-floating base.
+#[derive(Clone, Copy, Debug)]
+pub struct Root<S> {
+    /// Its spatial velocity in its own coordinates.
+    pub v: [S; 6],
+    /// Its spatial acceleration (gravity's fictitious one included, RBDA §5.3).
+    pub a: [S; 6],
+}
+
+/// [`rnea`] from the root's motion `root`, the forces the joints on it carry there summed into
+/// `root_force` (`None`: not wanted).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn rnea_rooted<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    x: &[Transform<S>],
+    inertia: &[[S; 10]],
+    motions: Motions<'_, S>,
+    root: &Root<S>,
+    m: &mut [[[S; 6]; 3]],
+    tau: &mut [S],
+    mut root_force: Option<&mut [S; 6]>,
+) {
     let n = x.len().min(m.len());
     for i in 0..n {
         let (vp, ap) = match t.parent.get(i).copied().flatten().and_then(|l| m.get(l)) {
             Some([vp, ap, _]) => (*vp, *ap),
-            None => ([zero; 6], t.a0),
+            None => (root.v, root.a),
         };
         let (Some(s), Some(ii)) = (t.s.get(i), inertia.get(i)) else {
             continue;
@@ -137,10 +167,18 @@ pub fn rnea<S: Scalar + Copy>(
         if let (Some(s), Some(taui)) = (t.s.get(i), tau.get_mut(i)) {
             *taui = dot(s, &fi);
         }
-        if let Some(l) = t.parent.get(i).copied().flatten() {
-            let carried = x[i].apply_tr(&fi);
-            if let Some([_, _, fl]) = m.get_mut(l) {
-                *fl = add(fl, &carried);
+        let carried = || x[i].apply_tr(&fi);
+        match t.parent.get(i).copied().flatten() {
+            Some(l) => {
+                let c = carried();
+                if let Some([_, _, fl]) = m.get_mut(l) {
+                    *fl = add(fl, &c);
+                }
+            }
+            None => {
+                if let Some(f0) = root_force.as_deref_mut() {
+                    *f0 = add(f0, &carried());
+                }
             }
         }
     }
