@@ -385,3 +385,112 @@ fn compact_frames_equal_unrolled() {
         );
     }
 }
+
+kanegen::dynamics!(
+    B1Z1C,
+    "tests/data/erd/b1-z1.urdf",
+    base = "free-floating",
+    form = "compact",
+    gravity = [0.0, 0.0, -9.81]
+);
+
+/// The compact form on a free-floating base (B1 + Z1, a 19-joint tree; the kernels of
+/// `kanegen_runtime::compact::floating`) against the interpreted local-frame algorithms: `M`,
+/// `c`, inverse dynamics, forward dynamics with and without wrenches, and `(M, c)`.
+#[test]
+fn compact_free_floating_equals_interpreted() {
+    use kanegen::dynamics::algorithms::{aba, floating, rnea};
+    use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
+    use kanegen::dynamics::{ExternalWrench, LoadFrame, MassMatrixMethod};
+    const N: usize = 19;
+    let mut model = kanegen::model::io::load_model(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/erd/b1-z1.urdf"
+    )))
+    .unwrap();
+    model = model
+        .with_base_kind(kanegen::model::BaseKind::FreeFloating)
+        .unwrap();
+    let p = Params::<f64>::new(&model);
+    let fb = FloatingBase::<f64>::from_inertial(model.base_inertial().unwrap());
+    let mut r = rng(23);
+    for _ in 0..5 {
+        let w = random_vec(&mut r, 4, 1.0);
+        let norm = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let quat = [w[0] / norm, w[1] / norm, w[2] / norm, w[3] / norm];
+        let qj = random_vec(&mut r, N, 1.5);
+        let q: [f64; N + 7] = arr([0.2, -0.1, 0.4]
+            .into_iter()
+            .chain(quat)
+            .chain(qj.iter().copied())
+            .collect());
+        let v: [f64; N + 6] = arr(random_vec(&mut r, N + 6, 1.0));
+        let a: [f64; N + 6] = arr(random_vec(&mut r, N + 6, 1.0));
+        let tau: [f64; N] = arr(random_vec(&mut r, N, 10.0));
+        let f_ext: [[f64; 6]; N + 1] =
+            core::array::from_fn(|k| core::array::from_fn(|i| ((6 * k + i) as f64).sin()));
+        let st = FloatingState {
+            position: Vec3::new(q[0], q[1], q[2]),
+            rotation: quat_to_matrix(&quat),
+            v_b: Vec3::new(v[0], v[1], v[2]),
+            omega_b: Vec3::new(v[3], v[4], v[5]),
+        };
+        let loads = Loads {
+            tau: Some(tau.to_vec()),
+            gravity: Some(Vec3::new(0.0, 0.0, -9.81)),
+            external: vec![],
+        };
+        let passive = Loads {
+            tau: None,
+            ..loads.clone()
+        };
+        let m = floating::mass_matrix(MassMatrixMethod::Crba, &p, &fb, &st, &qj);
+        close("M", &flat(&B1Z1C::mass_matrix(&q)), &m.concat(), 1e-12);
+        let c: Vec<f64> = rnea::floating_tau_minus_c(&p, &fb, &st, &qj, &v[6..], &passive)
+            .iter()
+            .map(|x| -x)
+            .collect();
+        close("c", &B1Z1C::nonlinear_effects(&q, &v), &c, 1e-12);
+        let (mm, cc) = B1Z1C::mass_matrix_and_nonlinear_effects(&q, &v);
+        close(
+            "(M, c)",
+            &[flat(&mm), cc.to_vec()].concat(),
+            &[m.concat(), c].concat(),
+            1e-12,
+        );
+        let acc: [f64; 6] = core::array::from_fn(|i| a[i]);
+        let id =
+            rnea::floating_inverse_dynamics(&p, &fb, &st, &qj, &v[6..], &acc, &a[6..], &passive);
+        close(
+            "inverse dynamics",
+            &B1Z1C::inverse_dynamics(&q, &v, &a),
+            &id,
+            1e-12,
+        );
+        let fd = aba::floating(&p, &fb, &st, &qj, &v[6..], &loads);
+        close(
+            "forward dynamics",
+            &B1Z1C::forward_dynamics(&q, &v, &tau),
+            &fd,
+            1e-11,
+        );
+        let mut with = loads.clone();
+        with.external = f_ext
+            .iter()
+            .enumerate()
+            .map(|(k, f)| ExternalWrench {
+                body: if k == 0 { BASE_BODY } else { k - 1 },
+                frame: LoadFrame::Body,
+                force: Vec3::new(f[0], f[1], f[2]),
+                moment: Vec3::new(f[3], f[4], f[5]),
+            })
+            .collect();
+        let fdw = aba::floating(&p, &fb, &st, &qj, &v[6..], &with);
+        close(
+            "forward dynamics with wrenches",
+            &B1Z1C::forward_dynamics_with_wrenches(&q, &v, &tau, &f_ext),
+            &fdw,
+            1e-11,
+        );
+    }
+}

@@ -78,7 +78,8 @@ pub mod tables;
 use self::tables::{numbers, M3};
 use crate::options::{Error, Float, Form, Options};
 use kanegen_dynamics::{ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod};
-use kanegen_model::{BaseKind, Model};
+use kanegen_model::Model;
+use kanegen_runtime::compact::floating::Base;
 use kanegen_runtime::compact::Frame;
 use kanegen_trace::{Counts, Function};
 use proc_macro2::{Literal, TokenStream};
@@ -125,7 +126,8 @@ pub fn unsupported(model: &Model, opts: &Options) -> Option<&'static str> {
         // The compact form has its own algorithms (CRBA, RNEA, ABA).
         return Some("a forced algorithm");
     }
-    (model.base_kind() == BaseKind::FreeFloating).then_some("a free-floating base")
+    let _ = model;
+    None
 }
 
 /// The traced counts of the runtime kernel that the compact body of `f` calls
@@ -246,9 +248,22 @@ pub fn methods(f: Function) -> Methods {
     }
 }
 
-/// Whether the compact form has its own body for `f`.
+/// Whether the compact form has its own body for `f` on a fixed base, or on a free-floating one
+/// (`floating`: the dynamics functions; the frames, momentum and base reaction stay
+/// straight-line there).
 #[must_use]
-pub fn has_body(f: Function) -> bool {
+pub fn has_body(f: Function, floating: bool) -> bool {
+    if floating {
+        return matches!(
+            f,
+            Function::MassMatrix
+                | Function::NonlinearEffects
+                | Function::InverseDynamics
+                | Function::MassMatrixAndNonlinearEffects
+                | Function::ForwardDynamics
+                | Function::ForwardDynamicsWithWrenches
+        );
+    }
     matches!(
         f,
         Function::FramePlacement(_)
@@ -317,7 +332,10 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         None => quote!(None),
     };
     let a0 = vector(float, &t.a0);
-    let frames = frames(&rt, float, &t.frames);
+    let frames = match &t.base {
+        None => frames(&rt, float, &t.frames),
+        Some(base) => floating_base(&rt, float, base),
+    };
     Ok(quote! {
         /// Compact form: the model's numbers as the runtime kernels read them
         /// (`kanegen_runtime::compact::Tables`: parents, joint kinds, the joint transforms'
@@ -337,6 +355,64 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         };
         #frames
     })
+}
+
+/// The body of `f` on a free-floating base of `n` joints: one call of a kernel of
+/// `kanegen_runtime::compact::floating` (`None`: `f` stays straight-line).
+fn floating_body(
+    f: Function,
+    k: &TokenStream,
+    i: &TokenStream,
+    sincos: &TokenStream,
+    n: usize,
+) -> Option<TokenStream> {
+    let (nl, nvl) = (
+        Literal::usize_unsuffixed(n),
+        Literal::usize_unsuffixed(n + 6),
+    );
+    let fk = quote!(#k::floating);
+    let args = quote!(&Self::CX, #i, &Self::CX_BASE, q);
+    Some(match f {
+        Function::MassMatrix => quote!(#fk::mass_matrix::<_, #nl, #nvl>(#args, #sincos)),
+        Function::NonlinearEffects => {
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), None, #sincos))
+        }
+        Function::InverseDynamics => {
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), Some(a), #sincos))
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            quote!(#fk::mass_matrix_and_nonlinear_effects::<_, #nl, #nvl>(#args, v, #sincos))
+        }
+        Function::ForwardDynamics => {
+            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, None, #sincos))
+        }
+        Function::ForwardDynamicsWithWrenches => {
+            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, Some(f_ext), #sincos))
+        }
+        _ => return None,
+    })
+}
+
+/// The free-floating base's constant of the compact form (`CX_BASE`): its spatial inertia about
+/// its origin and gravity in the inertial frame, as the floating kernels read them.
+fn floating_base(rt: &TokenStream, float: Float, base: &Base<f64>) -> TokenStream {
+    let fl = float.ty();
+    let inertia = vector(float, &base.inertia);
+    let gravity = match &base.gravity {
+        Some(g) => {
+            let g = vector(float, g);
+            quote!(Some(#g))
+        }
+        None => quote!(None),
+    };
+    quote! {
+        /// Compact form: the free-floating base's spatial inertia about its origin
+        /// (`[m, h, Ī]`) and gravity in the inertial frame, as the floating kernels read them.
+        const CX_BASE: #rt::compact::floating::Base<#fl> = #rt::compact::floating::Base {
+            inertia: #inertia,
+            gravity: #gravity,
+        };
+    }
 }
 
 /// The frames' constants of the compact form (`CX_FRAMES`, none without frames): each frame's
@@ -371,7 +447,12 @@ fn frames(rt: &TokenStream, float: Float, frames: &[Frame<f64>]) -> TokenStream 
 ///
 /// # Errors
 /// A runtime or libm path that is not a Rust path.
-pub fn body(f: Function, opts: &Options, n: usize) -> Result<Option<TokenStream>, Error> {
+pub fn body(
+    f: Function,
+    opts: &Options,
+    n: usize,
+    floating: bool,
+) -> Result<Option<TokenStream>, Error> {
     let rt = opts.runtime()?;
     let sincos = if opts.table_sincos() {
         quote!(Self::sincos)
@@ -387,6 +468,9 @@ pub fn body(f: Function, opts: &Options, n: usize) -> Result<Option<TokenStream>
         quote!(Self::CX.inertia)
     };
     let k = quote!(#rt::compact);
+    if floating {
+        return Ok(floating_body(f, &k, &i, &sincos, n));
+    }
     Ok(Some(match f {
         Function::MassMatrix => quote!(#k::mass_matrix(&Self::CX, #i, q, #sincos)),
         Function::NonlinearEffects => {

@@ -168,7 +168,7 @@ fn function_body(
     texts: Option<&mut Vec<String>>,
 ) -> Result<Body, Error> {
     let compact_tokens = match fp.kernel {
-        Kernel::Compact(_) => compact::body(fp.function, opts, plan.model.dof())?,
+        Kernel::Compact(_) => compact::body(fp.function, opts, plan.model.dof(), plan.floating())?,
         Kernel::Unrolled => None,
     };
     let body = match (texts, compact_tokens, graph) {

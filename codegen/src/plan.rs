@@ -193,7 +193,9 @@ impl Plan {
         }
         self.functions
             .iter()
-            .filter(|fp| fp.kernel == Kernel::Unrolled && compact::has_body(fp.function))
+            .filter(|fp| {
+                fp.kernel == Kernel::Unrolled && compact::has_body(fp.function, self.floating())
+            })
             .map(|fp| format!("`{}` ({})", fp.function.name(), fp.choice.counts().total()))
             .collect()
     }
@@ -292,7 +294,8 @@ fn plan_body(
     mass: MassMatrixMethod,
     opts: &Options,
 ) -> Result<(Choice, Option<Traced>), Error> {
-    let traced = if decision.form != Form::Compact || !compact::has_body(f) {
+    let floating = model.base_kind() == BaseKind::FreeFloating;
+    let traced = if decision.form != Form::Compact || !compact::has_body(f, floating) {
         Some(choose_in(model, subjects, f, mass, opts)?)
     } else if compact::may_keep_unrolled(opts, f) && f.frame().is_some() {
         // A frame function is O(depth) and the prefixes have no frames: traced whole.

@@ -9,6 +9,7 @@ use crate::loads::{ExternalWrench, LoadFrame, Loads};
 use crate::params::{JointParams, Params};
 use kanegen_model::JointKind;
 use kanegen_runtime::compact::aba::{aba_floating_on_world, aba_on_world};
+use kanegen_runtime::compact::floating::Base;
 use kanegen_runtime::compact::spatial::{rot, transforms, world};
 use kanegen_runtime::compact::{
     Articulated, Bodies, FloatingRoot, Frame, Rates, Tables, Transform,
@@ -54,6 +55,8 @@ pub struct KernelTables {
     pub a0: [f64; 6],
     /// The model's named frames, in its order.
     pub frames: Vec<Frame<f64>>,
+    /// A free-floating base's inertia and gravity (`None`: a fixed base, gravity in `a0`).
+    pub base: Option<Base<f64>>,
 }
 
 /// `(A, B, C, slide, S)` of one joint (the module docs of [`kanegen_runtime::compact`]).
@@ -119,6 +122,7 @@ impl KernelTables {
                     rotation: f.rotation.0,
                 })
                 .collect(),
+            base: None,
         };
         for jp in &p.joints {
             let (a, b, c, slide, s) = joint_numbers(jp);
@@ -139,6 +143,18 @@ impl KernelTables {
         if let Some(g) = gravity {
             t.a0 = [0.0, 0.0, 0.0, -g[0], -g[1], -g[2]];
         }
+        t
+    }
+
+    /// The tables of `p` on the free-floating base `base` under gravity `g` (inertial frame):
+    /// `a₀` zero, the base's inertia and gravity in [`KernelTables::base`].
+    #[must_use]
+    pub fn floating(p: &Params<f64>, base: &FloatingBase<f64>, gravity: Option<[f64; 3]>) -> Self {
+        let mut t = KernelTables::new(p, None);
+        t.base = Some(Base {
+            inertia: inertia_row(&base.inertia),
+            gravity,
+        });
         t
     }
 

@@ -55,6 +55,9 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     let q = joints();
     let out = match f {
         Function::FramePlacement(k) | Function::FrameJacobian(k) => {
+            if t.base.is_some() {
+                return None;
+            }
             let fr = t.frames.get(k)?;
             let frame = k::Frame {
                 body: fr.body,
@@ -63,7 +66,16 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
             };
             trace_frame(&tables, f, &frame, &q)
         }
-        _ => trace_kernel(&tables, f, &q, &mut || joints(), &x)?,
+        _ => match &t.base {
+            Some(base) => {
+                let base = k::floating::Base {
+                    inertia: core::array::from_fn(|_| x()),
+                    gravity: base.gravity.map(|_| v3()),
+                };
+                trace_floating(&tables, f, &base, n, &x)?
+            }
+            None => trace_kernel(&tables, f, &q, &mut || joints(), &x)?,
+        },
     };
     Some(tr.finish(&out).counts(Convention::Paper))
 }
@@ -99,7 +111,7 @@ fn trace_kernel(
         out.clone()
     };
     let sincos = |a: Sym| a.sin_cos();
-    if !crate::compact::has_body(f) {
+    if !crate::compact::has_body(f, false) {
         return None;
     }
     k::spatial::transforms(tables, q, sincos, b.x);
@@ -190,6 +202,92 @@ fn trace_frame(
     (0..6)
         .flat_map(|r| cols.iter().map(move |c| c[r]))
         .collect()
+}
+
+/// The outputs of a free-floating function's kernel (`kanegen_runtime::compact::floating`) on
+/// `tables` of `n` joints, as its entry point computes them, every argument a fresh input
+/// (`x`), the scratch in `Vec`s.
+fn trace_floating(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    base: &k::floating::Base<Sym>,
+    n: usize,
+    x: &dyn Fn() -> Sym,
+) -> Option<Vec<Sym>> {
+    use k::floating::{forward_dynamics_in, inverse_dynamics_in, mass_matrix_in};
+    if !crate::compact::has_body(f, true) {
+        return None;
+    }
+    let zero = Sym::zero();
+    let args = |len: usize| -> Vec<Sym> { (0..len).map(|_| x()).collect() };
+    let (q, v, a, tau) = (args(7 + n), args(6 + n), args(6 + n), args(n));
+    let id = Transform {
+        e: [[zero; 3]; 3],
+        r: [zero; 3],
+    };
+    let (mut xs, mut x0) = (vec![id; n], vec![id; n]);
+    let (mut s0, mut i0) = (vec![[zero; 6]; n], vec![[zero; 10]; n]);
+    let mut b = Bodies {
+        x: &mut xs,
+        x0: &mut x0,
+        s0: &mut s0,
+        i0: &mut i0,
+    };
+    k::spatial::transforms(tables, &q[7..], |s: Sym| s.sin_cos(), b.x);
+    let inertia = tables.inertia;
+    let nv = n + 6;
+    let mass = |b: &mut Bodies<'_, Sym>| {
+        let (mut st, mut h, mut out) = (vec![zero; 6 * n], vec![zero; n * n], vec![zero; nv * nv]);
+        mass_matrix_in(tables, inertia, base, b, &mut st, &mut h, &mut out);
+        out
+    };
+    let id_at = |b: &Bodies<'_, Sym>, acc: Option<&[Sym]>| {
+        let (mut m, mut out) = (vec![[[zero; 6]; 3]; n], vec![zero; nv]);
+        inverse_dynamics_in(
+            tables,
+            b.x,
+            inertia,
+            base,
+            &q,
+            Some(&v),
+            acc,
+            &mut m,
+            &mut out,
+        );
+        out
+    };
+    Some(match f {
+        Function::MassMatrix => mass(&mut b),
+        Function::NonlinearEffects => id_at(&b, None),
+        Function::InverseDynamics => id_at(&b, Some(&a)),
+        Function::MassMatrixAndNonlinearEffects => {
+            let c = id_at(&b, None);
+            [mass(&mut b), c].concat()
+        }
+        _ => {
+            let f_ext: Option<Vec<[Sym; 6]>> = (f == Function::ForwardDynamicsWithWrenches)
+                .then(|| (0..=n).map(|_| core::array::from_fn(|_| x())).collect());
+            let six = || vec![[zero; 6]; n];
+            let (mut vv, mut c, mut pa, mut ui, mut aa) = (six(), six(), six(), six(), six());
+            let (mut ia, mut d, mut u) = (vec![[zero; 21]; n], vec![zero; n], vec![zero; n]);
+            let mut ab = Articulated {
+                v: &mut vv,
+                c: &mut c,
+                ia: &mut ia,
+                pa: &mut pa,
+                ui: &mut ui,
+                d: &mut d,
+                u: &mut u,
+                a: &mut aa,
+            };
+            let mut out = vec![zero; nv];
+            let f_ext = f_ext.as_deref();
+            forward_dynamics_in(
+                tables, inertia, base, &q, &v, &tau, f_ext, &mut b, &mut ab, &mut out,
+            );
+            out
+        }
+    })
 }
 
 /// The CRBA's `H` (rows first) on the joint transforms of `b`.

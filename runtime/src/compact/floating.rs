@@ -13,8 +13,8 @@
 use super::aba::{aba_floating_on_world, Articulated, ArticulatedStore, FloatingRoot, Rates};
 use super::crba::crba;
 use super::rnea::{rnea_rooted, Motions, Root};
-use super::spatial::{add, crf, inertia_mul, transforms, world};
-use super::tables::{BodyStore, Tables};
+use super::spatial::{add, crf, inertia_mul, transforms, world, Transform};
+use super::tables::{Bodies, BodyStore, Tables};
 use crate::scalar::Scalar;
 
 /// The free-floating base of a compact model: its spatial inertia about its origin in its frame
@@ -55,12 +55,6 @@ fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
     core::array::from_fn(|i| r[0][i] * g[0] + r[1][i] * g[1] + r[2][i] * g[2])
 }
 
-/// The joints' entries of a free-floating vector (`skip` = 7 for positions, 6 for speeds).
-#[inline(always)]
-fn joints<S: Copy, const N: usize>(x: &[S], skip: usize, zero: S) -> [S; N] {
-    core::array::from_fn(|i| x.get(skip + i).copied().unwrap_or(zero))
-}
-
 /// `[ω_b; v_b]` of `ν = [v_b; ω_b; …]`.
 #[inline(always)]
 fn spatial<S: Copy>(nu: &[S], zero: S) -> [S; 6] {
@@ -68,10 +62,8 @@ fn spatial<S: Copy>(nu: &[S], zero: S) -> [S; 6] {
     [at(3), at(4), at(5), at(0), at(1), at(2)]
 }
 
-/// `M(q)`, `(6 + N) × (6 + N)` (`NV = 6 + N`): the joints' block by the composite-rigid-body
-/// algorithm ([`crba`]); the base's column of joint `j` is `F_j = I^c_j S_j` and the base's block
-/// the composite inertia of the whole system `I^c_0 = I_0 + Σ I^c_root` (RBDA §9.2), both
-/// written in the order `[v_b; ω_b]` (force rows first).
+/// `M(q)`, `(6 + N) × (6 + N)` (`NV = 6 + N`): [`mass_matrix_in`] on the joint transforms of `q`,
+/// on stack storage of `N` joints.
 #[inline]
 pub fn mass_matrix<S: Scalar + Copy, const N: usize, const NV: usize>(
     t: &Tables<'_, S>,
@@ -81,20 +73,48 @@ pub fn mass_matrix<S: Scalar + Copy, const N: usize, const NV: usize>(
     sincos: impl Fn(S) -> (S, S),
 ) -> [[S; NV]; NV] {
     let zero = S::zero();
-    let qj: [S; N] = joints(q, 7, zero);
     let mut store = BodyStore::<S, N>::new();
     let mut b = store.bodies();
     let mut st = [[zero; N]; 6];
     let mut h = [[zero; N]; N];
-    transforms(t, &qj, sincos, b.x);
-    crba(
+    let mut out = [[zero; NV]; NV];
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    mass_matrix_in(
         t,
         inertia,
+        base,
         &mut b,
         st.as_flattened_mut(),
         h.as_flattened_mut(),
+        out.as_flattened_mut(),
     );
-    let mut out = [[zero; NV]; NV];
+    out
+}
+
+/// `M` into `out` (`NV × NV`, rows first, `NV = 6 + N`) on the joint transforms `b.x`: the
+/// joints' block by the composite-rigid-body algorithm ([`crba`], into `h`, `N × N`; `st`:
+/// its scratch of `6 N`); the base's column of joint `j` is `F_j = I^c_j S_j` and the base's
+/// block the composite inertia of the whole system `I^c_0 = I_0 + Σ I^c_root` (RBDA §9.2), both
+/// written in the order `[v_b; ω_b]` (force rows first).
+#[inline(always)]
+pub fn mass_matrix_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    b: &mut Bodies<'_, S>,
+    st: &mut [S],
+    h: &mut [S],
+    out: &mut [S],
+) {
+    let zero = S::zero();
+    crba(t, inertia, b, st, h);
+    let n = b.s0.len();
+    let nv = n + 6;
+    let mut put = |r: usize, c: usize, x: S| {
+        if let Some(o) = out.get_mut(r * nv + c) {
+            *o = x;
+        }
+    };
     let mut ic0 = base.inertia;
     for (i, ici) in b.i0.iter().enumerate() {
         if t.parent.get(i).copied().flatten().is_none() {
@@ -102,47 +122,67 @@ pub fn mass_matrix<S: Scalar + Copy, const N: usize, const NV: usize>(
                 *a = *a + *c;
             }
         }
-        let (Some(s), Some(row)) = (b.s0.get(i), h.get(i)) else {
+        let Some(s) = b.s0.get(i) else {
             continue;
         };
         let f = inertia_mul(ici, s);
-        let col = [f[3], f[4], f[5], f[0], f[1], f[2]];
-        for (r, x) in col.into_iter().enumerate() {
-            out[r][6 + i] = x;
-            out[6 + i][r] = x;
+        for (r, x) in [f[3], f[4], f[5], f[0], f[1], f[2]].into_iter().enumerate() {
+            put(r, 6 + i, x);
+            put(6 + i, r, x);
         }
-        for (j, x) in row.iter().enumerate() {
-            out[6 + i][6 + j] = *x;
+        for j in 0..n {
+            put(6 + i, 6 + j, h.get(i * n + j).copied().unwrap_or(zero));
         }
     }
     // I^c_0 = [Ī h̃; h̃ᵀ m1] in [ω; v] order, written in [v; ω] order: [m1 h̃ᵀ; h̃ Ī].
-    let (m, h3) = (ic0[0], [ic0[1], ic0[2], ic0[3]]);
+    let h3 = [ic0[1], ic0[2], ic0[3]];
     let ib = [
         [ic0[4], ic0[5], ic0[6]],
         [ic0[5], ic0[7], ic0[8]],
         [ic0[6], ic0[8], ic0[9]],
     ];
-    // h̃ (rows of the ω block against v): h̃ v = h × v.
     let ht = [
         [zero, -h3[2], h3[1]],
         [h3[2], zero, -h3[0]],
         [-h3[1], h3[0], zero],
     ];
     for r in 0..3 {
-        out[r][r] = m;
         for c in 0..3 {
-            out[3 + r][3 + c] = ib[r][c];
-            out[3 + r][c] = ht[r][c];
-            out[c][3 + r] = ht[r][c];
+            put(r, c, if r == c { ic0[0] } else { zero });
+            put(3 + r, 3 + c, ib[r][c]);
+            put(3 + r, c, ht[r][c]);
+            put(c, 3 + r, ht[r][c]);
         }
     }
+}
+
+/// `(M(q), c(q, ν))` on one set of joint transforms: [`mass_matrix_in`] and
+/// [`inverse_dynamics_in`] at `ν̇ = 0`.
+#[inline]
+pub fn mass_matrix_and_nonlinear_effects<S: Scalar + Copy, const N: usize, const NV: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    sincos: impl Fn(S) -> (S, S),
+) -> ([[S; NV]; NV], [S; NV]) {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut st = [[zero; N]; 6];
+    let mut h = [[zero; N]; N];
+    let mut m = [[[zero; 6]; 3]; N];
+    let mut out = ([[zero; NV]; NV], [zero; NV]);
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    inverse_dynamics_in(t, b.x, inertia, base, q, Some(v), None, &mut m, &mut out.1);
+    let (st, h) = (st.as_flattened_mut(), h.as_flattened_mut());
+    mass_matrix_in(t, inertia, base, &mut b, st, h, out.0.as_flattened_mut());
     out
 }
 
-/// Inverse dynamics `[f_b; n_b; τ] = M ν̇ + c` (`NV = 6 + N` entries) by the recursive
-/// Newton–Euler algorithm from the base's motion (RBDA §9.5): `v_0 = [ω_b; v_b]`,
-/// `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]`, the joints as [`rnea_rooted`], then
-/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 + Σ_{λ(i) = base} Xup_iᵀ f_i`. `a = None`: `ν̇ = 0` (then the
+/// Inverse dynamics `[f_b; n_b; τ] = M ν̇ + c` (`NV = 6 + N` entries): [`inverse_dynamics_in`]
+/// on the joint transforms of `q`, on stack storage of `N` joints. `a = None`: `ν̇ = 0` (then the
 /// result is `c`); `v = None`: `ν = 0`.
 #[inline]
 pub fn inverse_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
@@ -155,10 +195,33 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
     sincos: impl Fn(S) -> (S, S),
 ) -> [S; NV] {
     let zero = S::zero();
-    let qj: [S; N] = joints(q, 7, zero);
     let mut store = BodyStore::<S, N>::new();
     let b = store.bodies();
-    transforms(t, &qj, sincos, b.x);
+    let mut m = [[[zero; 6]; 3]; N];
+    let mut out = [zero; NV];
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    inverse_dynamics_in(t, b.x, inertia, base, q, v, a, &mut m, &mut out);
+    out
+}
+
+/// Inverse dynamics into `out` (`6 + N`) by the recursive Newton–Euler algorithm from the
+/// base's motion (RBDA §9.5) on the joint transforms `x`: `v_0 = [ω_b; v_b]`,
+/// `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]`, the joints as [`rnea_rooted`] (`m`: its scratch), then
+/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 + Σ_{λ(i) = base} Xup_iᵀ f_i`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn inverse_dynamics_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    x: &[Transform<S>],
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: Option<&[S]>,
+    a: Option<&[S]>,
+    m: &mut [[[S; 6]; 3]],
+    out: &mut [S],
+) {
+    let zero = S::zero();
     let v0 = v.map_or([zero; 6], |v| spatial(v, zero));
     let mut a0 = a.map_or([zero; 6], |a| spatial(a, zero));
     if let Some(g) = &base.gravity {
@@ -172,44 +235,30 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
             a0[5] - gb[2],
         ];
     }
-    let (qd, qdd): ([S; N], [S; N]) = (
-        v.map_or([zero; N], |v| joints(v, 6, zero)),
-        a.map_or([zero; N], |a| joints(a, 6, zero)),
-    );
     let motions = Motions {
-        qd: v.map(|_| &qd[..]),
-        qdd: a.map(|_| &qdd[..]),
+        qd: v.map(|v| v.get(6..).unwrap_or(&[])),
+        qdd: a.map(|a| a.get(6..).unwrap_or(&[])),
     };
     let k = &base.inertia;
     let mut f0 = inertia_mul(k, &a0);
     if v.is_some() {
         f0 = add(&f0, &crf(&v0, &inertia_mul(k, &v0)));
     }
-    let mut m = [[[zero; 6]; 3]; N];
-    let mut tau = [zero; N];
     let root = Root { v: v0, a: a0 };
-    rnea_rooted(
-        t,
-        b.x,
-        inertia,
-        motions,
-        &root,
-        &mut m,
-        &mut tau,
-        Some(&mut f0),
-    );
-    let mut out = [zero; NV];
-    let head = [f0[3], f0[4], f0[5], f0[0], f0[1], f0[2]];
-    for (o, x) in out.iter_mut().zip(head.into_iter().chain(tau)) {
+    let (head, tau) = out.split_at_mut(6.min(out.len()));
+    rnea_rooted(t, x, inertia, motions, &root, m, tau, Some(&mut f0));
+    for (o, x) in head
+        .iter_mut()
+        .zip([f0[3], f0[4], f0[5], f0[0], f0[1], f0[2]])
+    {
         *o = x;
     }
-    out
 }
 
 /// Forward dynamics `ν̇` (`NV = 6 + N` entries) under the joint drives `tau` and, with `f_ext`,
 /// the wrenches `f_ext[0]` on the base and `f_ext[1 + i]` on body `i` (`[force; moment]` in the
-/// body's frame at its origin): the articulated-body algorithm with the base as its root
-/// ([`aba_floating_on_world`]).
+/// body's frame at its origin): [`forward_dynamics_in`] on the joint transforms of `q`, on stack
+/// storage of `N` joints.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn forward_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
@@ -222,15 +271,39 @@ pub fn forward_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
     f_ext: Option<&[[S; 6]]>,
     sincos: impl Fn(S) -> (S, S),
 ) -> [S; NV] {
-    let zero = S::zero();
-    let qj: [S; N] = joints(q, 7, zero);
-    let qd: [S; N] = joints(v, 6, zero);
     let mut store = BodyStore::<S, N>::new();
     let mut b = store.bodies();
-    transforms(t, &qj, sincos, b.x);
-    world(t, inertia, &mut b);
+    let mut scratch = ArticulatedStore::<S, N>::new();
+    let mut out = [S::zero(); NV];
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    let mut ab = scratch.articulated();
+    forward_dynamics_in(
+        t, inertia, base, q, v, tau, f_ext, &mut b, &mut ab, &mut out,
+    );
+    out
+}
+
+/// Forward dynamics into `out` (`6 + N`) on the joint transforms `b.x`: the bodies carried to
+/// the base ([`world`]), then the articulated-body algorithm with the base as its root
+/// ([`aba_floating_on_world`]; `ab`: its scratch).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn forward_dynamics_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    tau: &[S],
+    f_ext: Option<&[[S; 6]]>,
+    b: &mut Bodies<'_, S>,
+    ab: &mut Articulated<'_, S>,
+    out: &mut [S],
+) {
+    let zero = S::zero();
+    world(t, inertia, b);
     let rates = Rates {
-        qd: &qd,
+        qd: v.get(6..).unwrap_or(&[]),
         tau,
         f_ext: f_ext.map(|f| f.get(1..).unwrap_or(&[])),
         armature: None,
@@ -241,9 +314,5 @@ pub fn forward_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
         f_ext: f_ext.and_then(|f| f.first().copied()),
         gravity: base.gravity.map(|g| gravity_in_base(q, &g)),
     };
-    let mut scratch = ArticulatedStore::<S, N>::new();
-    let mut ab: Articulated<'_, S> = scratch.articulated();
-    let mut out = [zero; NV];
-    aba_floating_on_world(t, rates, &root, &b, &mut ab, &mut out);
-    out
+    aba_floating_on_world(t, rates, &root, b, ab, out);
 }
