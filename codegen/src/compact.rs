@@ -258,6 +258,7 @@ pub fn has_body(f: Function, floating: bool) -> bool {
             f,
             Function::MassMatrix
                 | Function::NonlinearEffects
+                | Function::Gravity
                 | Function::InverseDynamics
                 | Function::MassMatrixAndNonlinearEffects
                 | Function::ForwardDynamics
@@ -376,6 +377,9 @@ fn floating_body(
         Function::MassMatrix => quote!(#fk::mass_matrix::<_, #nl, #nvl>(#args, #sincos)),
         Function::NonlinearEffects => {
             quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), None, #sincos))
+        }
+        Function::Gravity => {
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, None, None, #sincos))
         }
         Function::InverseDynamics => {
             quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), Some(a), #sincos))

@@ -416,3 +416,86 @@ fn op_counts_of_large_compact_types_are_what_the_kernels_execute() {
     o.runtime_payload = true;
     counts_follow::<66>(&random_tree(&spec(66), 45), &o);
 }
+
+/// The operations a free-floating compact function's kernel executes
+/// (`kanegen_runtime::compact::floating`), counted by running it on [`Counted`].
+fn counted_floating<const N: usize, const NV: usize>(t: &KernelTables, f: Function) -> [u64; 4] {
+    use k::floating as fk;
+    let base = t.base.expect("a free-floating model");
+    let base = fk::Base {
+        inertia: base.inertia.map(Counted),
+        gravity: base.gravity.map(|g| g.map(Counted)),
+    };
+    let owned = Owned::new(t, Counted);
+    let t = owned.tables(t);
+    let x = |k: usize| Counted(0.1 + 0.01 * k as f64);
+    let q: [Counted; 64] = core::array::from_fn(x);
+    let (q, v) = (&q[..N + 7], &q[..NV]);
+    let tau: [Counted; N] = core::array::from_fn(x);
+    let f_ext = [[x(6); 6]; 64];
+    let sc = |a: Counted| a.sin_cos();
+    let inertia = t.inertia;
+    take();
+    match f {
+        Function::MassMatrix => _ = fk::mass_matrix::<_, N, NV>(&t, inertia, &base, q, sc),
+        Function::NonlinearEffects => {
+            _ = fk::inverse_dynamics::<_, N, NV>(&t, inertia, &base, q, Some(v), None, sc);
+        }
+        Function::Gravity => {
+            _ = fk::inverse_dynamics::<_, N, NV>(&t, inertia, &base, q, None, None, sc);
+        }
+        Function::InverseDynamics => {
+            _ = fk::inverse_dynamics::<_, N, NV>(&t, inertia, &base, q, Some(v), Some(v), sc);
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            _ = fk::mass_matrix_and_nonlinear_effects::<_, N, NV>(&t, inertia, &base, q, v, sc);
+        }
+        Function::ForwardDynamics => {
+            _ = fk::forward_dynamics::<_, N, NV>(&t, inertia, &base, q, v, &tau, None, sc);
+        }
+        Function::ForwardDynamicsWithWrenches => {
+            let w = Some(&f_ext[..=N]);
+            _ = fk::forward_dynamics::<_, N, NV>(&t, inertia, &base, q, v, &tau, w, sc);
+        }
+        _ => unreachable!("{f:?} has no floating kernel"),
+    }
+    take()
+}
+
+/// A free-floating compact type's `OP_COUNTS` of its kernel functions are what the floating
+/// kernels execute, on SSRMS (a chain) and a two-armed tree, with gravity (so `gravity` has a kernel too).
+#[test]
+fn op_counts_of_free_floating_compact_types_are_what_the_kernels_execute() {
+    fn check<const N: usize, const NV: usize>(model: &Model) {
+        let mut o = Options::new("Arm");
+        o.form = Form::Compact;
+        o.gravity = Some(G);
+        let model = &model
+            .clone()
+            .with_base_kind(kanegen_model::BaseKind::FreeFloating)
+            .unwrap();
+        let t = numbers(model, &o);
+        for f in KERNELS {
+            let c = kernel_counts(model, &o, f).expect("a kernel function");
+            let ran = counted_floating::<N, NV>(&t, f);
+            assert_eq!(
+                [c.mul, c.add, c.div, c.sincos],
+                ran,
+                "{f:?} of {}",
+                model.name()
+            );
+            assert!(c.mul > 0 && c.add > 0);
+        }
+    }
+    let ssrms = kanegen_model::io::load_model(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/ssrms.toml"),
+    )
+    .unwrap();
+    check::<7, 13>(&ssrms);
+    let dextre = kanegen_model::io::load_model(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/dextre_standin.toml"),
+    )
+    .unwrap();
+    assert!(!dextre.is_chain());
+    check::<14, 20>(&dextre);
+}

@@ -80,6 +80,39 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     Some(tr.finish(&out).counts(Convention::Paper))
 }
 
+/// The kernels' per-body scratch of `n` joints, in `Vec`s.
+struct BodyVecs {
+    x: Vec<Transform<Sym>>,
+    x0: Vec<Transform<Sym>>,
+    s0: Vec<[Sym; 6]>,
+    i0: Vec<[Sym; 10]>,
+}
+
+impl BodyVecs {
+    fn new(n: usize) -> Self {
+        let zero = Sym::zero();
+        let id = Transform {
+            e: [[zero; 3]; 3],
+            r: [zero; 3],
+        };
+        BodyVecs {
+            x: vec![id; n],
+            x0: vec![id; n],
+            s0: vec![[zero; 6]; n],
+            i0: vec![[zero; 10]; n],
+        }
+    }
+
+    fn bodies(&mut self) -> Bodies<'_, Sym> {
+        Bodies {
+            x: &mut self.x,
+            x0: &mut self.x0,
+            s0: &mut self.s0,
+            i0: &mut self.i0,
+        }
+    }
+}
+
 /// The outputs of `f`'s kernel on `tables` at `q`, as its entry point computes them
 /// (`arg`: a fresh vector of joint inputs, `x`: a fresh input), its scratch in `Vec`s.
 fn trace_kernel(
@@ -91,18 +124,8 @@ fn trace_kernel(
 ) -> Option<Vec<Sym>> {
     let n = q.len();
     let zero = Sym::zero();
-    let identity = Transform {
-        e: [[zero; 3]; 3],
-        r: [zero; 3],
-    };
-    let (mut xs, mut x0) = (vec![identity; n], vec![identity; n]);
-    let (mut s0, mut i0) = (vec![[zero; 6]; n], vec![[zero; 10]; n]);
-    let mut b = Bodies {
-        x: &mut xs,
-        x0: &mut x0,
-        s0: &mut s0,
-        i0: &mut i0,
-    };
+    let mut store = BodyVecs::new(n);
+    let mut b = store.bodies();
     let inertia = tables.inertia;
     let mut m = vec![[[zero; 6]; 3]; n];
     let mut out = vec![zero; n];
@@ -221,18 +244,8 @@ fn trace_floating(
     let zero = Sym::zero();
     let args = |len: usize| -> Vec<Sym> { (0..len).map(|_| x()).collect() };
     let (q, v, a, tau) = (args(7 + n), args(6 + n), args(6 + n), args(n));
-    let id = Transform {
-        e: [[zero; 3]; 3],
-        r: [zero; 3],
-    };
-    let (mut xs, mut x0) = (vec![id; n], vec![id; n]);
-    let (mut s0, mut i0) = (vec![[zero; 6]; n], vec![[zero; 10]; n]);
-    let mut b = Bodies {
-        x: &mut xs,
-        x0: &mut x0,
-        s0: &mut s0,
-        i0: &mut i0,
-    };
+    let mut store = BodyVecs::new(n);
+    let mut b = store.bodies();
     k::spatial::transforms(tables, &q[7..], |s: Sym| s.sin_cos(), b.x);
     let inertia = tables.inertia;
     let nv = n + 6;
@@ -241,27 +254,19 @@ fn trace_floating(
         mass_matrix_in(tables, inertia, base, b, &mut st, &mut h, &mut out);
         out
     };
-    let id_at = |b: &Bodies<'_, Sym>, acc: Option<&[Sym]>| {
+    let id_at = |b: &Bodies<'_, Sym>, vel: Option<&[Sym]>, acc: Option<&[Sym]>| {
         let (mut m, mut out) = (vec![[[zero; 6]; 3]; n], vec![zero; nv]);
-        inverse_dynamics_in(
-            tables,
-            b.x,
-            inertia,
-            base,
-            &q,
-            Some(&v),
-            acc,
-            &mut m,
-            &mut out,
-        );
+        let x = &*b.x;
+        inverse_dynamics_in(tables, x, inertia, base, &q, vel, acc, &mut m, &mut out);
         out
     };
     Some(match f {
         Function::MassMatrix => mass(&mut b),
-        Function::NonlinearEffects => id_at(&b, None),
-        Function::InverseDynamics => id_at(&b, Some(&a)),
+        Function::NonlinearEffects => id_at(&b, Some(&v), None),
+        Function::Gravity => id_at(&b, None, None),
+        Function::InverseDynamics => id_at(&b, Some(&v), Some(&a)),
         Function::MassMatrixAndNonlinearEffects => {
-            let c = id_at(&b, None);
+            let c = id_at(&b, Some(&v), None);
             [mass(&mut b), c].concat()
         }
         _ => {
