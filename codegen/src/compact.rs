@@ -14,19 +14,25 @@
 //!   (RBDA Table 5.1; gravity as the base's fictitious acceleration `a₀ = −a_g`, RBDA §5.3);
 //! - `forward_dynamics`, `forward_dynamics_with_wrenches`: the articulated-body algorithm
 //!   (RBDA Table 7.1), O(N) instead of the unrolled form's CRBA + RNEA + LDLᵀ;
-//! - `mass_matrix_and_nonlinear_effects`: CRBA and RNEA on one set of joint transforms.
+//! - `mass_matrix_and_nonlinear_effects`: CRBA and RNEA on one set of joint transforms;
+//! - `<frame>_placement`, `<frame>_jacobian` (fixed base): loops over the support path of the
+//!   frame's body (`kanegen_runtime::compact::frames`);
+//! - on a free-floating base, the dynamics functions above with the base as the root of the
+//!   passes (`kanegen_runtime::compact::floating`, `const CX_BASE`).
 //!
 //! The kernels take the type's sine–cosine (`Self::sincos`, or libm's per
 //! [`Options::libm_trig`] and for `f32`). Nothing allocates, no function panics, `f32` works as
 //! `f64`. A compact function's `OP_COUNTS` entry is the kernel traced on the tracer `Sym` with
 //! the tables as symbolic inputs ([`counts`]): every operation its loops execute, for any
 //! number of joints (the kernels' cores take slices, so one instance on `Sym` traces them all).
-//! The frame functions (`<frame>_placement`, `<frame>_jacobian`) stay straight-line code: their
-//! cost grows with one path of the tree, not with its size.
+//! Under [`Form::Auto`] the O(N) functions (Newton–Euler, frames) keep their straight-line body
+//! while it is small ([`LINEAR_AUTO_LIMIT`]).
 //!
-//! Supported: a fixed base, chains and trees, `f64` and `f32`, gravity, a runtime payload (the
-//! last body's inertia built from it at each call), with or without regrouping. Not supported (the generator keeps the unrolled form, and
-//! `form = "compact"` is an error): a free-floating base.
+//! Supported: a fixed or free-floating base, chains and trees, `f64` and `f32`, gravity, a
+//! runtime payload (the last body's inertia built from it at each call), with or without
+//! regrouping (none on a free-floating base). On a free-floating base the momentum, the base
+//! reaction and the frame functions stay straight-line. Not supported (`form = "compact"` is an
+//! error): a forced algorithm.
 //!
 //! # Measured: when compact code wins
 //!
@@ -200,10 +206,10 @@ pub fn decide(
     let compact = |why: String| Decision {
         form: Form::Compact,
         line: format!(
-            "Form: compact: loops over constant tables (CRBA, RNEA, ABA; frame functions \
-             straight-line) ({why}). `OP_COUNTS` of the functions in loops are the traced counts \
-             of the runtime kernels they call (every operation their loops execute); \
-             `CANDIDATES` and the table below hold the straight-line functions only."
+            "Form: compact: loops over constant tables (CRBA, RNEA, ABA; on a fixed base the \
+             frames along their support paths) ({why}). `OP_COUNTS` of the functions in loops \
+             are the traced counts of the runtime kernels they call (every operation their loops \
+             execute); `CANDIDATES` and the table below hold the straight-line functions only."
         ),
     };
     let unrolled = |why: String| Decision {
