@@ -202,7 +202,7 @@ fn ancestors(parent: &[Option<usize>]) -> Vec<bool> {
 /// once and overwritten by every call (the data of Pinocchio's model/data split).
 #[derive(Clone, Debug)]
 pub struct KernelData {
-    bodies: BodyVecs,
+    bodies: BodyVecs<f64>,
     six: [Vec<[f64; 6]>; 5],
     ia: Vec<[f64; 21]>,
     du: [Vec<f64>; 2],
@@ -210,30 +210,49 @@ pub struct KernelData {
     zero_tau: Vec<f64>,
 }
 
-/// The storage of [`Bodies`].
+/// The storage of [`Bodies`] for `n` joints in `Vec`s, on any scalar (the tracer's too).
 #[derive(Clone, Debug)]
-struct BodyVecs {
-    x: Vec<Transform<f64>>,
-    x0: Vec<Transform<f64>>,
-    s0: Vec<[f64; 6]>,
-    i0: Vec<[f64; 10]>,
+pub struct BodyVecs<S> {
+    x: Vec<Transform<S>>,
+    x0: Vec<Transform<S>>,
+    s0: Vec<[S; 6]>,
+    i0: Vec<[S; 10]>,
+}
+
+impl<S: kanegen_runtime::Scalar + Copy> BodyVecs<S> {
+    /// Zeroed storage for `n` joints.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        let zero = S::zero();
+        let id = Transform {
+            e: [[zero; 3]; 3],
+            r: [zero; 3],
+        };
+        BodyVecs {
+            x: vec![id; n],
+            x0: vec![id; n],
+            s0: vec![[zero; 6]; n],
+            i0: vec![[zero; 10]; n],
+        }
+    }
+
+    /// The storage as the kernels' scratch.
+    pub fn bodies(&mut self) -> Bodies<'_, S> {
+        Bodies {
+            x: &mut self.x,
+            x0: &mut self.x0,
+            s0: &mut self.s0,
+            i0: &mut self.i0,
+        }
+    }
 }
 
 impl KernelData {
     /// Scratch for `n` joints.
     #[must_use]
     pub fn new(n: usize) -> Self {
-        let id = Transform {
-            e: [[0.0; 3]; 3],
-            r: [0.0; 3],
-        };
         KernelData {
-            bodies: BodyVecs {
-                x: vec![id; n],
-                x0: vec![id; n],
-                s0: vec![[0.0; 6]; n],
-                i0: vec![[0.0; 10]; n],
-            },
+            bodies: BodyVecs::new(n),
             six: core::array::from_fn(|_| vec![[0.0; 6]; n]),
             ia: vec![[0.0; 21]; n],
             du: [vec![0.0; n], vec![0.0; n]],
@@ -257,7 +276,7 @@ impl KernelData {
 
 /// [`KernelData::split`] over its fields (so that a caller may still read the others).
 fn split<'a>(
-    bodies: &'a mut BodyVecs,
+    bodies: &'a mut BodyVecs<f64>,
     six: &'a mut [Vec<[f64; 6]>; 5],
     ia: &'a mut [[f64; 21]],
     du: &'a mut [Vec<f64>; 2],
@@ -265,12 +284,7 @@ fn split<'a>(
 ) -> (Bodies<'a, f64>, Articulated<'a, f64>, &'a mut [[f64; 6]]) {
     let [v, c, pa, ui, a] = six;
     let [d, u] = du;
-    let b = Bodies {
-        x: &mut bodies.x,
-        x0: &mut bodies.x0,
-        s0: &mut bodies.s0,
-        i0: &mut bodies.i0,
-    };
+    let b = bodies.bodies();
     let articulated = Articulated {
         v,
         c,

@@ -12,6 +12,7 @@
 //! and compares).
 
 use crate::compact::tables::KernelTables;
+use kanegen_dynamics::kernels::BodyVecs;
 use kanegen_runtime::compact::{self as k, Articulated, Bodies, Motions, Rates, Tables, Transform};
 use kanegen_runtime::Scalar;
 use kanegen_trace::sym::{Convention, Counts, Sym, Tracer};
@@ -80,39 +81,6 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     Some(tr.finish(&out).counts(Convention::Paper))
 }
 
-/// The kernels' per-body scratch of `n` joints, in `Vec`s.
-struct BodyVecs {
-    x: Vec<Transform<Sym>>,
-    x0: Vec<Transform<Sym>>,
-    s0: Vec<[Sym; 6]>,
-    i0: Vec<[Sym; 10]>,
-}
-
-impl BodyVecs {
-    fn new(n: usize) -> Self {
-        let zero = Sym::zero();
-        let id = Transform {
-            e: [[zero; 3]; 3],
-            r: [zero; 3],
-        };
-        BodyVecs {
-            x: vec![id; n],
-            x0: vec![id; n],
-            s0: vec![[zero; 6]; n],
-            i0: vec![[zero; 10]; n],
-        }
-    }
-
-    fn bodies(&mut self) -> Bodies<'_, Sym> {
-        Bodies {
-            x: &mut self.x,
-            x0: &mut self.x0,
-            s0: &mut self.s0,
-            i0: &mut self.i0,
-        }
-    }
-}
-
 /// The outputs of `f`'s kernel on `tables` at `q`, as its entry point computes them
 /// (`arg`: a fresh vector of joint inputs, `x`: a fresh input), its scratch in `Vec`s.
 fn trace_kernel(
@@ -124,7 +92,7 @@ fn trace_kernel(
 ) -> Option<Vec<Sym>> {
     let n = q.len();
     let zero = Sym::zero();
-    let mut store = BodyVecs::new(n);
+    let mut store = BodyVecs::<Sym>::new(n);
     let mut b = store.bodies();
     let inertia = tables.inertia;
     let mut m = vec![[[zero; 6]; 3]; n];
@@ -244,7 +212,7 @@ fn trace_floating(
     let zero = Sym::zero();
     let args = |len: usize| -> Vec<Sym> { (0..len).map(|_| x()).collect() };
     let (q, v, a, tau) = (args(7 + n), args(6 + n), args(6 + n), args(n));
-    let mut store = BodyVecs::new(n);
+    let mut store = BodyVecs::<Sym>::new(n);
     let mut b = store.bodies();
     k::spatial::transforms(tables, &q[7..], |s: Sym| s.sin_cos(), b.x);
     let inertia = tables.inertia;
