@@ -64,6 +64,7 @@ kanegen::scene!(Ur5TorqueInput, "scenes/ur5_torque_input.toml");
 kanegen::scene!(FreeFloating7, "scenes/free_floating_7dof.toml");
 kanegen::scene!(Dextre, "scenes/dextre_free_floating.toml");
 kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
+kanegen::scene!(FrameClash, "tests/data/scenes/frame_name_clash.toml");
 kanegen::scene!(FloatingWrenches, "tests/data/scenes/floating_wrenches.toml");
 kanegen::scene!(FloatingMidpoint, "tests/data/scenes/floating_midpoint.toml");
 kanegen::scene!(CtWrench, "tests/data/scenes/computed_torque_wrench.toml");
@@ -143,6 +144,11 @@ agree!(
     gravity_wrench_agrees,
     GravityWrench,
     "tests/data/scenes/gravity_wrench.toml"
+);
+agree!(
+    frame_name_clash_agrees,
+    FrameClash,
+    "tests/data/scenes/frame_name_clash.toml"
 );
 agree!(
     floating_wrenches_agrees,

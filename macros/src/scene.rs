@@ -74,7 +74,7 @@ fn scene_model(scene: &Scene, rel: &str) -> Result<(Model, Vec<Option<String>>),
     for (k, w) in scene.wrenches.iter().enumerate() {
         let needs = (w.frame == LoadFrame::Base || computed_torque) && w.body != BASE_BODY;
         wrench_frames.push(needs.then(|| {
-            let name = format!("scene_wrench_{k}");
+            let name = unused_name(&format!("scene_wrench_{k}"), &frames);
             frames.push(Frame {
                 name: name.clone(),
                 parent: Some(w.body),
@@ -86,7 +86,7 @@ fn scene_model(scene: &Scene, rel: &str) -> Result<(Model, Vec<Option<String>>),
     for (k, e) in scene.events.iter().enumerate() {
         if let EventKind::Capture { payload, .. } = &e.kind {
             frames.push(Frame {
-                name: format!("scene_capture_{k}"),
+                name: unused_name(&format!("scene_capture_{k}"), &frames),
                 parent: Some(e.body),
                 placement: Placement {
                     translation: payload.com,
@@ -99,6 +99,16 @@ fn scene_model(scene: &Scene, rel: &str) -> Result<(Model, Vec<Option<String>>),
         .with_frames(frames)
         .map_err(|e| format!("{rel}: model frames: {e}"))?;
     Ok((model, wrench_frames))
+}
+
+/// `stem`, or `stem` with underscores appended until no frame of `frames` has the name: the
+/// frames `scene!` adds never clash with the model's own.
+fn unused_name(stem: &str, frames: &[Frame]) -> String {
+    let mut name = stem.to_string();
+    while frames.iter().any(|f| f.name == name) {
+        name.push('_');
+    }
+    name
 }
 
 fn base_kind(scene: &Scene) -> BaseKind {
