@@ -125,15 +125,12 @@ pub fn keeps_unrolled(opts: &Options, f: Function, size: Size) -> bool {
     may_keep_unrolled(opts, f) && !size.above(LINEAR_AUTO_LIMIT)
 }
 
-/// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
+/// Why the compact form cannot be emitted under `opts` (any model, fixed or free-floating), or
+/// `None` when it can.
 #[must_use]
-pub fn unsupported(model: &Model, opts: &Options) -> Option<&'static str> {
-    if opts.algorithm.is_some() {
-        // The compact form has its own algorithms (CRBA, RNEA, ABA).
-        return Some("a forced algorithm");
-    }
-    let _ = model;
-    None
+pub fn unsupported(opts: &Options) -> Option<&'static str> {
+    // The compact form has its own algorithms (CRBA, RNEA, ABA).
+    opts.algorithm.is_some().then_some("a forced algorithm")
 }
 
 /// The traced counts of the runtime kernel that the compact body of `f` calls

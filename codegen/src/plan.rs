@@ -253,7 +253,7 @@ fn decide_form(
     subjects: &Subjects,
     opts: &Options,
 ) -> Result<(Decision, Vec<(Choice, Traced)>), Error> {
-    let why_not = compact::unsupported(model, opts);
+    let why_not = compact::unsupported(opts);
     let (size, traced) = match (opts.form, why_not) {
         (Form::Auto, None) => {
             let fs = [

@@ -203,9 +203,7 @@ fn ancestors(parent: &[Option<usize>]) -> Vec<bool> {
 #[derive(Clone, Debug)]
 pub struct KernelData {
     bodies: BodyVecs<f64>,
-    six: [Vec<[f64; 6]>; 5],
-    ia: Vec<[f64; 21]>,
-    du: [Vec<f64>; 2],
+    articulated: ArticulatedVecs<f64>,
     f_ext: Vec<[f64; 6]>,
     zero_tau: Vec<f64>,
 }
@@ -253,9 +251,7 @@ impl KernelData {
     pub fn new(n: usize) -> Self {
         KernelData {
             bodies: BodyVecs::new(n),
-            six: core::array::from_fn(|_| vec![[0.0; 6]; n]),
-            ia: vec![[0.0; 21]; n],
-            du: [vec![0.0; n], vec![0.0; n]],
+            articulated: ArticulatedVecs::new(n),
             f_ext: vec![[0.0; 6]; n],
             zero_tau: vec![0.0; n],
         }
@@ -264,38 +260,46 @@ impl KernelData {
     /// The scratch as the kernels take it: the bodies, the articulated-body quantities, and a
     /// per-body wrench buffer.
     pub fn split(&mut self) -> (Bodies<'_, f64>, Articulated<'_, f64>, &mut [[f64; 6]]) {
-        split(
-            &mut self.bodies,
-            &mut self.six,
-            &mut self.ia,
-            &mut self.du,
-            &mut self.f_ext,
-        )
+        let b = self.bodies.bodies();
+        (b, self.articulated.articulated(), &mut self.f_ext)
     }
 }
 
-/// [`KernelData::split`] over its fields (so that a caller may still read the others).
-fn split<'a>(
-    bodies: &'a mut BodyVecs<f64>,
-    six: &'a mut [Vec<[f64; 6]>; 5],
-    ia: &'a mut [[f64; 21]],
-    du: &'a mut [Vec<f64>; 2],
-    f_ext: &'a mut [[f64; 6]],
-) -> (Bodies<'a, f64>, Articulated<'a, f64>, &'a mut [[f64; 6]]) {
-    let [v, c, pa, ui, a] = six;
-    let [d, u] = du;
-    let b = bodies.bodies();
-    let articulated = Articulated {
-        v,
-        c,
-        ia,
-        pa,
-        ui,
-        d,
-        u,
-        a,
-    };
-    (b, articulated, f_ext)
+/// The storage of [`Articulated`] for `n` joints in `Vec`s, on any scalar (the tracer's too).
+#[derive(Clone, Debug)]
+pub struct ArticulatedVecs<S> {
+    six: [Vec<[S; 6]>; 5],
+    ia: Vec<[S; 21]>,
+    du: [Vec<S>; 2],
+}
+
+impl<S: kanegen_runtime::Scalar + Copy> ArticulatedVecs<S> {
+    /// Zeroed storage for `n` joints.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
+        let zero = S::zero();
+        ArticulatedVecs {
+            six: core::array::from_fn(|_| vec![[zero; 6]; n]),
+            ia: vec![[zero; 21]; n],
+            du: [vec![zero; n], vec![zero; n]],
+        }
+    }
+
+    /// The storage as the articulated-body kernel's scratch.
+    pub fn articulated(&mut self) -> Articulated<'_, S> {
+        let [v, c, pa, ui, a] = &mut self.six;
+        let [d, u] = &mut self.du;
+        Articulated {
+            v,
+            c,
+            ia: &mut self.ia,
+            pa,
+            ui,
+            d,
+            u,
+            a,
+        }
+    }
 }
 
 /// Forward dynamics on the run-time path: the articulated-body kernel
@@ -318,13 +322,9 @@ pub fn forward_dynamics(
 ) {
     let tables = t.tables();
     let zero_tau = &data.zero_tau;
-    let (mut b, mut ab, f_ext) = split(
-        &mut data.bodies,
-        &mut data.six,
-        &mut data.ia,
-        &mut data.du,
-        &mut data.f_ext,
-    );
+    let mut b = data.bodies.bodies();
+    let mut ab = data.articulated.articulated();
+    let f_ext = &mut data.f_ext;
     transforms(&tables, q, f64::sin_cos, b.x);
     world(&tables, tables.inertia, &mut b);
     // R₀ᵀ of a free-floating base: inertial-frame vectors into base coordinates.

@@ -66,10 +66,10 @@ impl RunTimeDynamics {
 
     /// Replaces the model's numbers (a payload captured or released).
     pub fn set_params(&mut self, params: Params<f64>) {
-        if let Some((t, _)) = &self.fast {
-            let g = t.a0;
-            let gravity = (g != [0.0; 6]).then_some([-g[3], -g[4], -g[5]]);
-            self.fast = Some(kernel_model(&params, gravity));
+        if self.fast.is_some() {
+            // The tables hold gravity on a fixed base only (a floating one takes it per call).
+            let g = self.loads.gravity.as_ref().filter(|_| self.base.is_none());
+            self.fast = Some(kernel_model(&params, g.map(|g| g.0)));
         }
         self.params = params;
     }

@@ -12,8 +12,8 @@
 //! and compares).
 
 use crate::compact::tables::KernelTables;
-use kanegen_dynamics::kernels::BodyVecs;
-use kanegen_runtime::compact::{self as k, Articulated, Bodies, Motions, Rates, Tables, Transform};
+use kanegen_dynamics::kernels::{ArticulatedVecs, BodyVecs};
+use kanegen_runtime::compact::{self as k, Bodies, Motions, Rates, Tables, Transform};
 use kanegen_runtime::Scalar;
 use kanegen_trace::sym::{Convention, Counts, Sym, Tracer};
 use kanegen_trace::Function;
@@ -137,24 +137,8 @@ fn trace_kernel(
                 f_ext: f_ext.as_deref(),
                 armature: None,
             };
-            let (mut v, mut c, mut pa, mut ui, mut a) = (
-                vec![[zero; 6]; n],
-                vec![[zero; 6]; n],
-                vec![[zero; 6]; n],
-                vec![[zero; 6]; n],
-                vec![[zero; 6]; n],
-            );
-            let (mut ia, mut d, mut u) = (vec![[zero; 21]; n], vec![zero; n], vec![zero; n]);
-            let mut ab = Articulated {
-                v: &mut v,
-                c: &mut c,
-                ia: &mut ia,
-                pa: &mut pa,
-                ui: &mut ui,
-                d: &mut d,
-                u: &mut u,
-                a: &mut a,
-            };
+            let mut store = ArticulatedVecs::<Sym>::new(n);
+            let mut ab = store.articulated();
             let mut qdd = vec![zero; n];
             k::aba::aba(tables, inertia, rates, &mut b, &mut ab, &mut qdd);
             qdd
@@ -240,19 +224,8 @@ fn trace_floating(
         _ => {
             let f_ext: Option<Vec<[Sym; 6]>> = (f == Function::ForwardDynamicsWithWrenches)
                 .then(|| (0..=n).map(|_| core::array::from_fn(|_| x())).collect());
-            let six = || vec![[zero; 6]; n];
-            let (mut vv, mut c, mut pa, mut ui, mut aa) = (six(), six(), six(), six(), six());
-            let (mut ia, mut d, mut u) = (vec![[zero; 21]; n], vec![zero; n], vec![zero; n]);
-            let mut ab = Articulated {
-                v: &mut vv,
-                c: &mut c,
-                ia: &mut ia,
-                pa: &mut pa,
-                ui: &mut ui,
-                d: &mut d,
-                u: &mut u,
-                a: &mut aa,
-            };
+            let mut store = ArticulatedVecs::<Sym>::new(n);
+            let mut ab = store.articulated();
             let mut out = vec![zero; nv];
             let f_ext = f_ext.as_deref();
             forward_dynamics_in(
