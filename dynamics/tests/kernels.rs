@@ -128,6 +128,32 @@ fn both_paths_against_double_double_on_the_space_arms() {
     }
 }
 
+/// A frame at a random offset and orientation on `body`, as this crate and the kernels hold it.
+fn random_frame(
+    g: &mut rand_chacha::ChaCha8Rng,
+    body: Option<usize>,
+) -> (
+    kanegen_dynamics::FrameParams<f64>,
+    kanegen_runtime::compact::Frame<f64>,
+) {
+    use kanegen_dynamics::linalg::{axis_rotation, Mat3};
+    let w = random_vec(g, 7, 1.0);
+    let norm = (w[3] * w[3] + w[4] * w[4] + w[5] * w[5]).sqrt();
+    let axis = Vec3::new(w[3] / norm, w[4] / norm, w[5] / norm);
+    let rotation: Mat3<f64> = axis_rotation(&axis, &w[6].sin(), &w[6].cos());
+    let fp = kanegen_dynamics::FrameParams {
+        parent: body,
+        translation: Vec3::new(w[0], w[1], w[2]),
+        rotation: rotation.clone(),
+    };
+    let frame = kanegen_runtime::compact::Frame {
+        body,
+        translation: [w[0], w[1], w[2]],
+        rotation: rotation.0,
+    };
+    (fp, frame)
+}
+
 /// The frame kernels (`kanegen_runtime::compact::frames`, over the support path in base
 /// coordinates) against this crate's local-frame kinematics (`algorithms::frames`): placement and
 /// Jacobian of frames at random offsets and orientations on every body of random trees and
@@ -135,11 +161,9 @@ fn both_paths_against_double_double_on_the_space_arms() {
 #[test]
 fn frame_kernels_match_the_local_frame_kinematics() {
     use kanegen_dynamics::algorithms::frames;
-    use kanegen_dynamics::linalg::{axis_rotation, Mat3};
-    use kanegen_dynamics::FrameParams;
     use kanegen_runtime::compact::frames::{jacobian_columns, origin, pose, support_placements};
     use kanegen_runtime::compact::spatial::transforms;
-    use kanegen_runtime::compact::{Frame, Transform};
+    use kanegen_runtime::compact::Transform;
     let mut worst = 0.0_f64;
     for (k, m) in models().iter().enumerate() {
         let p = Params::<f64>::new(m);
@@ -155,20 +179,7 @@ fn frame_kernels_match_the_local_frame_kinematics() {
         let mut x = vec![id; n];
         transforms(&tables, &q, f64::sin_cos, &mut x);
         for body in std::iter::once(None).chain((0..n).map(Some)) {
-            let w = random_vec(&mut g, 7, 1.0);
-            let norm = (w[3] * w[3] + w[4] * w[4] + w[5] * w[5]).sqrt();
-            let axis = Vec3::new(w[3] / norm, w[4] / norm, w[5] / norm);
-            let rotation: Mat3<f64> = axis_rotation(&axis, &w[6].sin(), &w[6].cos());
-            let fp = FrameParams {
-                parent: body,
-                translation: Vec3::new(w[0], w[1], w[2]),
-                rotation: rotation.clone(),
-            };
-            let frame = Frame {
-                body,
-                translation: [w[0], w[1], w[2]],
-                rotation: rotation.0,
-            };
+            let (fp, frame) = random_frame(&mut g, body);
             let mut x0 = vec![id; n];
             if let Some(i) = body {
                 support_placements(&tables, i, &x, &mut x0);
@@ -204,12 +215,13 @@ fn frame_kernels_match_the_local_frame_kinematics() {
 /// and twists, with gravity.
 #[test]
 fn floating_kernels_match_the_local_frame_algorithms() {
-    use kanegen_dynamics::algorithms::{floating, rnea};
+    use kanegen_dynamics::algorithms::{floating, frames, momentum, rnea};
     use kanegen_dynamics::base::quat_to_matrix;
     use kanegen_dynamics::kernels::inertia_row;
     use kanegen_dynamics::{LoadFrame, MassMatrixMethod};
     use kanegen_model::random::{random_chain, random_tree, ChainSpec};
     use kanegen_runtime::compact::floating::{self as fk, Base};
+    use kanegen_runtime::compact::floating_frames as ff;
 
     fn check<const N: usize, const NV: usize>(m: &kanegen_model::Model, seed: u64) -> f64 {
         let p = Params::<f64>::new(m);
@@ -315,6 +327,30 @@ fn floating_kernels_match_the_local_frame_algorithms() {
             .collect();
         let want = aba::floating(&p, &fb, &st, &qj, &nu[6..], &with);
         agree("forward dynamics with wrenches", &fdw, &want);
+        let h = fk::momentum::<f64, N>(&tables, &t.inertia, &base, &q, &nu, sc);
+        let (lin, ang) = momentum::momentum(&p, &fb, &st, &qj, &nu[6..]);
+        agree("momentum", &h, &[lin.0, ang.0].concat());
+        let reaction =
+            fk::base_reaction::<f64, N>(&tables, &t.inertia, &base, &q, &nu, &nu_dot, sc);
+        let want = rnea::base_reaction(&p, &st, &qj, &nu[6..], &acc, &nu_dot[6..], &passive);
+        agree("base reaction", &reaction, &want);
+        for body in std::iter::once(None).chain((0..N).map(Some)) {
+            let (fp, frame) = random_frame(&mut r, body);
+            let (x, rot) = ff::frame_placement::<f64, N>(&tables, &frame, &q, sc);
+            let (want_x, want_r) = frames::floating_placement(&p, &st, &qj, &fp);
+            let got = [x.as_slice(), rot.as_flattened()].concat();
+            agree(
+                "frame placement",
+                &got,
+                &[want_x.0.as_slice(), want_r.0.as_flattened()].concat(),
+            );
+            let j = ff::frame_jacobian::<f64, N, NV>(&tables, &frame, &q, sc);
+            let want = frames::floating_jacobian(&p, &st, &qj, &fp);
+            agree("frame Jacobian", j.as_flattened(), &want.concat());
+            let gj = ff::generalized_jacobian::<f64, N>(&tables, &t.inertia, &base, &frame, &q, sc);
+            let want = frames::generalized_jacobian(&p, &fb, &st, &qj, &fp);
+            agree("generalized Jacobian", gj.as_flattened(), &want.concat());
+        }
         worst
     }
     let spec = |n| ChainSpec {

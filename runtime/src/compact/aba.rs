@@ -289,13 +289,9 @@ pub fn aba_floating_on_world<S: Scalar + Copy>(
     };
     inward(t, b.s0, rates, ab, Some((&mut ia0, &mut pa0)));
     // I^A_0 a'_0 = −p^A_0.
-    let mut m6: [S; 36] = core::array::from_fn(|k| ia0[SYM[k / 6][k % 6]]);
-    let mut d_inv = [S::zero(); 6];
+    let factor = SpatialFactor::new(&ia0);
     let mut a0: [S; 6] = core::array::from_fn(|r| -pa0[r]);
-    // 36 and 6 entries: the buffers are never short.
-    if crate::ldlt::factor_in_place(&mut m6, 6, &mut d_inv).is_ok() {
-        let _ = crate::ldlt::solve_in_place(&m6, 6, &d_inv, &mut a0);
-    }
+    factor.solve(&mut a0);
     let (head, qdd) = nu_dot.split_at_mut(6.min(nu_dot.len()));
     accelerations(t, b.s0, ab, &a0, qdd);
     // a_0 = a'_0 + [0; R₀ᵀ g], written [linear; angular].
@@ -311,10 +307,37 @@ pub fn aba_floating_on_world<S: Scalar + Copy>(
     }
 }
 
+/// The LDLᵀ factors of a symmetric positive definite 6×6 matrix (a spatial inertia, articulated
+/// or composite), for solving `I a = f` with it ([`crate::ldlt`]).
+pub(crate) struct SpatialFactor<S> {
+    l: [S; 36],
+    d_inv: [S; 6],
+}
+
+impl<S: Scalar + Copy> SpatialFactor<S> {
+    /// The factors of the matrix kept as its 21 upper-triangle entries ([`SYM`]).
+    #[inline(always)]
+    pub(crate) fn new(packed: &[S; 21]) -> Self {
+        let mut f = SpatialFactor {
+            l: core::array::from_fn(|k| packed[SYM[k / 6][k % 6]]),
+            d_inv: [S::zero(); 6],
+        };
+        // 36 and 6 entries: the buffers are never short.
+        let _ = crate::ldlt::factor_in_place(&mut f.l, 6, &mut f.d_inv);
+        f
+    }
+
+    /// `x ← I⁻¹ x`.
+    #[inline(always)]
+    pub(crate) fn solve(&self, x: &mut [S; 6]) {
+        let _ = crate::ldlt::solve_in_place(&self.l, 6, &self.d_inv, x);
+    }
+}
+
 /// `I = [Ī h̃; h̃ᵀ m1]` (RBDA eq. (2.63)) of a spatial inertia `[m, h, Ī]`, its upper triangle by
 /// rows ([`SYM`]).
 #[inline(always)]
-fn packed_inertia<S: Scalar + Copy>(k: &[S; 10]) -> [S; 21] {
+pub(crate) fn packed_inertia<S: Scalar + Copy>(k: &[S; 10]) -> [S; 21] {
     let zero = S::zero();
     #[rustfmt::skip]
     let i = [

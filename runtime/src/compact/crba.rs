@@ -118,15 +118,33 @@ pub fn crba<S: Scalar + Copy>(
     }
 }
 
-/// The bodies carried to the base ([`world`]), then RBDA Table 6.2's composite inertias
-/// `I^c_λ(i) += I^c_i` leaves first (one frame, no transform) in `b.i0`, and the `S_j` side by
-/// side for [`row`]: `st[k N + j] = S_j[k]`.
+/// [`composite_inertias`], and the `S_j` side by side for [`row`]: `st[k N + j] = S_j[k]`.
 #[inline(always)]
 fn composite<S: Scalar + Copy>(
     t: &Tables<'_, S>,
     inertia: &[[S; 10]],
     b: &mut Bodies<'_, S>,
     st: &mut [S],
+) {
+    composite_inertias(t, inertia, b);
+    let n = b.s0.len();
+    if n == 0 {
+        return;
+    }
+    for (k, row) in st.chunks_exact_mut(n).enumerate() {
+        for (x, s) in row.iter_mut().zip(b.s0.iter()) {
+            *x = s.get(k).copied().unwrap_or_else(S::zero);
+        }
+    }
+}
+
+/// The bodies carried to the base ([`world`]), then RBDA Table 6.2's composite inertias
+/// `I^c_λ(i) += I^c_i` leaves first (one frame, no transform) in `b.i0`.
+#[inline(always)]
+pub fn composite_inertias<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    b: &mut Bodies<'_, S>,
 ) {
     world(t, inertia, b);
     let ic = &mut *b.i0;
@@ -139,15 +157,6 @@ fn composite<S: Scalar + Copy>(
                     *a = *a + b;
                 }
             }
-        }
-    }
-    let n = b.s0.len();
-    if n == 0 {
-        return;
-    }
-    for (k, row) in st.chunks_exact_mut(n).enumerate() {
-        for (x, s) in row.iter_mut().zip(b.s0.iter()) {
-            *x = s.get(k).copied().unwrap_or_else(S::zero);
         }
     }
 }

@@ -13,7 +13,7 @@
 use super::aba::{aba_floating_on_world, Articulated, ArticulatedStore, FloatingRoot, Rates};
 use super::crba::crba;
 use super::rnea::{rnea_rooted, Motions, Root};
-use super::spatial::{add, crf, inertia_mul, transforms, world, Transform};
+use super::spatial::{add, crf, cross, inertia_mul, rot, rot_tr, transforms, world, Transform};
 use super::tables::{Bodies, BodyStore, Tables};
 use crate::scalar::Scalar;
 
@@ -27,15 +27,16 @@ pub struct Base<S> {
     pub gravity: Option<[S; 3]>,
 }
 
-/// `R₀ᵀ g` for the quaternion `[x, y, z, w]` of `q[3..7]`: gravity in base coordinates.
+/// `R₀ = 1 + 2w ũ + 2 ũ ũ` of the quaternion `[x, y, z, w]` of `q[3..7]` (written out for a unit
+/// quaternion; not normalized): base to inertial coordinates.
 #[inline(always)]
-fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
+pub fn base_rotation<S: Scalar + Copy>(q: &[S]) -> [[S; 3]; 3] {
     let zero = S::zero();
     let at = |k: usize| q.get(k).copied().unwrap_or(zero);
     let (x, y, z, w) = (at(3), at(4), at(5), at(6));
     let two = S::constant(2.0);
     let one = S::one();
-    let r = [
+    [
         [
             one - two * (y * y + z * z),
             two * (x * y - w * z),
@@ -51,8 +52,20 @@ fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
             two * (y * z + w * x),
             one - two * (x * x + y * y),
         ],
-    ];
-    core::array::from_fn(|i| r[0][i] * g[0] + r[1][i] * g[1] + r[2][i] * g[2])
+    ]
+}
+
+/// `R₀ᵀ g` for the quaternion of `q[3..7]`: gravity in base coordinates.
+#[inline(always)]
+fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
+    rot_tr(&base_rotation(q), g)
+}
+
+/// The base's position `p₀ = q[0..3]` in the inertial frame.
+#[inline(always)]
+pub(crate) fn base_position<S: Scalar + Copy>(q: &[S]) -> [S; 3] {
+    let zero = S::zero();
+    core::array::from_fn(|k| q.get(k).copied().unwrap_or(zero))
 }
 
 /// `[ω_b; v_b]` of `ν = [v_b; ω_b; …]`.
@@ -221,30 +234,16 @@ pub fn inverse_dynamics_in<S: Scalar + Copy>(
     m: &mut [[[S; 6]; 3]],
     out: &mut [S],
 ) {
-    let zero = S::zero();
-    let v0 = v.map_or([zero; 6], |v| spatial(v, zero));
-    let mut a0 = a.map_or([zero; 6], |a| spatial(a, zero));
-    if let Some(g) = &base.gravity {
-        let gb = gravity_in_base(q, g);
-        a0 = [
-            a0[0],
-            a0[1],
-            a0[2],
-            a0[3] - gb[0],
-            a0[4] - gb[1],
-            a0[5] - gb[2],
-        ];
-    }
+    let root = root_motion(base, q, v, a);
     let motions = Motions {
         qd: v.map(|v| v.get(6..).unwrap_or(&[])),
         qdd: a.map(|a| a.get(6..).unwrap_or(&[])),
     };
     let k = &base.inertia;
-    let mut f0 = inertia_mul(k, &a0);
+    let mut f0 = inertia_mul(k, &root.a);
     if v.is_some() {
-        f0 = add(&f0, &crf(&v0, &inertia_mul(k, &v0)));
+        f0 = add(&f0, &crf(&root.v, &inertia_mul(k, &root.v)));
     }
-    let root = Root { v: v0, a: a0 };
     let (head, tau) = out.split_at_mut(6.min(out.len()));
     rnea_rooted(t, x, inertia, motions, &root, m, tau, Some(&mut f0));
     for (o, x) in head
@@ -253,6 +252,140 @@ pub fn inverse_dynamics_in<S: Scalar + Copy>(
     {
         *o = x;
     }
+}
+
+/// The base's motion as the root of the passes (RBDA §9.5): `v_0 = [ω_b; v_b]` of `ν` (zero
+/// without `v`), `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]` of `ν̇` (zero without `a`; gravity as the base's
+/// fictitious acceleration, RBDA §5.3).
+#[inline(always)]
+fn root_motion<S: Scalar + Copy>(
+    base: &Base<S>,
+    q: &[S],
+    v: Option<&[S]>,
+    a: Option<&[S]>,
+) -> Root<S> {
+    let zero = S::zero();
+    let mut a0 = a.map_or([zero; 6], |a| spatial(a, zero));
+    if let Some(g) = &base.gravity {
+        let gb = gravity_in_base(q, g);
+        for k in 0..3 {
+            a0[3 + k] = a0[3 + k] - gb[k];
+        }
+    }
+    Root {
+        v: v.map_or([zero; 6], |v| spatial(v, zero)),
+        a: a0,
+    }
+}
+
+/// The wrench the arm exerts on the base for the motion `(q, ν, ν̇)` under gravity, `[f; n]`
+/// (force, moment about the base origin, base coordinates): [`base_reaction_in`] on the joint
+/// transforms of `q`, on stack storage of `N` joints.
+#[inline]
+pub fn base_reaction<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; 6] {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let b = store.bodies();
+    let mut m = [[[zero; 6]; 3]; N];
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    base_reaction_in(t, b.x, inertia, base, q, v, a, &mut m)
+}
+
+/// The arm's reaction on its base on the joint transforms `x`: the recursive Newton–Euler
+/// passes from the base's motion ([`rnea_rooted`], `m`: its scratch) with the base's own
+/// inertia left out, `−Σ_{λ(i) = base} Xup_iᵀ f_i` (Newton's third law; the base's equation is
+/// `w_b + reaction = I_0 a_0 + v_0 ×* I_0 v_0`), written `[f; n]`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn base_reaction_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    x: &[Transform<S>],
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    m: &mut [[[S; 6]; 3]],
+) -> [S; 6] {
+    let root = root_motion(base, q, Some(v), Some(a));
+    let motions = Motions {
+        qd: Some(v.get(6..).unwrap_or(&[])),
+        qdd: Some(a.get(6..).unwrap_or(&[])),
+    };
+    let mut f0 = [S::zero(); 6];
+    rnea_rooted(t, x, inertia, motions, &root, m, &mut [], Some(&mut f0));
+    [-f0[3], -f0[4], -f0[5], -f0[0], -f0[1], -f0[2]]
+}
+
+/// The total momentum of base and arm `[P; L]` (inertial frame, `L` about the inertial
+/// origin): [`momentum_in`] on the joint transforms of `q`, on stack storage of `N` joints.
+#[inline]
+pub fn momentum<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    sincos: impl Fn(S) -> (S, S),
+) -> [S; 6] {
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut vw = [[S::zero(); 6]; N];
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    momentum_in(t, inertia, base, q, v, &mut b, &mut vw)
+}
+
+/// The momentum on the joint transforms `b.x`: the bodies carried to the base ([`world`]), their
+/// velocities in base coordinates `ᴼv_i = ᴼv_λ(i) + ᴼS_i q̇_i` from `ᴼv_0 = [ω_b; v_b]` (into
+/// `vw`), `h = I_0 v_0 + Σ ᴼI_i ᴼv_i` about the base origin (RBDA §2.13), then
+/// `P = R₀ h_f`, `L = R₀ h_n + p₀ × P`.
+#[inline(always)]
+pub fn momentum_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    b: &mut Bodies<'_, S>,
+    vw: &mut [[S; 6]],
+) -> [S; 6] {
+    let zero = S::zero();
+    world(t, inertia, b);
+    let v0 = spatial(v, zero);
+    let mut h = inertia_mul(&base.inertia, &v0);
+    let qd = v.get(6..).unwrap_or(&[]);
+    for i in 0..vw.len() {
+        let vp = match t.parent.get(i).copied().flatten().and_then(|l| vw.get(l)) {
+            Some(vp) => *vp,
+            None => v0,
+        };
+        let (Some(s0), Some(i0), Some(&qdi)) = (b.s0.get(i), b.i0.get(i), qd.get(i)) else {
+            continue;
+        };
+        let vi = add(&vp, &super::spatial::scale(qdi, s0));
+        h = add(&h, &inertia_mul(i0, &vi));
+        vw[i] = vi;
+    }
+    let r0 = base_rotation(q);
+    let lin = rot(&r0, &[h[3], h[4], h[5]]);
+    let ang = rot(&r0, &[h[0], h[1], h[2]]);
+    let pl = cross(&base_position(q), &lin);
+    [
+        lin[0],
+        lin[1],
+        lin[2],
+        ang[0] + pl[0],
+        ang[1] + pl[1],
+        ang[2] + pl[2],
+    ]
 }
 
 /// Forward dynamics `ν̇` (`NV = 6 + N` entries) under the joint drives `tau` and, with `f_ext`,

@@ -110,12 +110,13 @@ pub fn jacobian_columns<S: Scalar + Copy>(
     }
 }
 
-/// The joint transforms and placements of the support path of `frame`'s body, on the stack.
+/// The joint transforms and placements of the support path of `frame`'s body at the joint
+/// positions `q`, on the stack of `N` joints.
 #[inline(always)]
-fn placements<S: Scalar + Copy, const N: usize>(
+pub(crate) fn placements<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     frame: &Frame<S>,
-    q: &[S; N],
+    q: &[S],
     sincos: impl Fn(S) -> (S, S),
 ) -> [Transform<S>; N] {
     let zero = S::zero();
@@ -125,7 +126,7 @@ fn placements<S: Scalar + Copy, const N: usize>(
     };
     let (mut x, mut x0) = ([id; N], [id; N]);
     if let Some(i) = frame.body {
-        let upto = (i + 1).min(N);
+        let upto = (i + 1).min(N).min(q.len());
         transforms(t, &q[..upto], sincos, &mut x[..upto]);
         support_placements(t, i, &x, &mut x0);
     }
@@ -140,7 +141,7 @@ pub fn frame_placement<S: Scalar + Copy, const N: usize>(
     q: &[S; N],
     sincos: impl Fn(S) -> (S, S),
 ) -> ([S; 3], [[S; 3]; 3]) {
-    pose(frame, &placements(t, frame, q, sincos))
+    pose(frame, &placements::<S, N>(t, frame, q, sincos))
 }
 
 /// The frame's geometric Jacobian at `q`: rows `[v; ω]` of its origin in base axes, one column
@@ -152,7 +153,7 @@ pub fn frame_jacobian<S: Scalar + Copy, const N: usize>(
     q: &[S; N],
     sincos: impl Fn(S) -> (S, S),
 ) -> [[S; N]; 6] {
-    let x0 = placements(t, frame, q, sincos);
+    let x0 = placements::<S, N>(t, frame, q, sincos);
     let xf = origin(frame, &x0);
     let mut cols = [[S::zero(); 6]; N];
     jacobian_columns(t, frame, &x0, &xf, &mut cols);

@@ -14,7 +14,9 @@
 //! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`];
 //! - [`frame_placement`], [`frame_jacobian`]: a named frame's placement and Jacobian over its
 //!   body's support path ([`Frame`]), [`frames`];
-//! - [`floating`]: `M`, `c`, inverse and forward dynamics on a free-floating base;
+//! - [`floating`]: `M`, `c`, inverse and forward dynamics, the momentum and the arm's reaction
+//!   on its base on a free-floating base; [`floating_frames`]: its frames' placements,
+//!   Jacobians and generalized Jacobians;
 //! - [`aba::aba_floating_on_world`]: forward dynamics on a free-floating base ([`FloatingRoot`]);
 //!   the run-time path calls it and [`aba::aba_on_world`] on tables built at run time, with
 //!   the armature and wrenches of a scene.
@@ -43,6 +45,7 @@
 pub mod aba;
 pub mod crba;
 pub mod floating;
+pub mod floating_frames;
 pub mod frames;
 pub mod payload;
 pub mod rnea;
