@@ -395,11 +395,13 @@ kanegen::dynamics!(
 );
 
 /// The compact form on a free-floating base (B1 + Z1, a 19-joint tree; the kernels of
-/// `kanegen_runtime::compact::floating`) against the interpreted local-frame algorithms: `M`,
-/// `c`, inverse dynamics, forward dynamics with and without wrenches, and `(M, c)`.
+/// `kanegen_runtime::compact::floating` and `::floating_frames`) against the interpreted
+/// local-frame algorithms: `M`, `c`, inverse dynamics, forward dynamics with and without
+/// wrenches, `(M, c)`, the momentum, the base reaction, and the placement, Jacobian and
+/// generalized Jacobian of a foot, a frame on the base and the arm's gripper.
 #[test]
 fn compact_free_floating_equals_interpreted() {
-    use kanegen::dynamics::algorithms::{aba, floating, rnea};
+    use kanegen::dynamics::algorithms::{aba, floating, frames, momentum, rnea};
     use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
     use kanegen::dynamics::{ExternalWrench, LoadFrame, MassMatrixMethod};
     const N: usize = 19;
@@ -492,5 +494,58 @@ fn compact_free_floating_equals_interpreted() {
             &fdw,
             1e-11,
         );
+        let (lin, ang) = momentum::momentum(&p, &fb, &st, &qj, &v[6..]);
+        let h = [lin.0, ang.0].concat();
+        close("momentum", &B1Z1C::momentum(&q, &v), &h, 1e-12);
+        let reaction = rnea::base_reaction(&p, &st, &qj, &v[6..], &acc, &a[6..], &passive);
+        close(
+            "base reaction",
+            &B1Z1C::base_reaction(&q, &v, &a),
+            &reaction,
+            1e-12,
+        );
+        type Placement = ([f64; 3], [[f64; 3]; 3]);
+        type Frame = (
+            &'static str,
+            fn(&[f64; N + 7]) -> Placement,
+            fn(&[f64; N + 7]) -> [[f64; N + 6]; 6],
+            fn(&[f64; N + 7]) -> [[f64; N]; 6],
+        );
+        let frames: [Frame; 3] = [
+            (
+                "FR_foot",
+                B1Z1C::fr_foot_placement,
+                B1Z1C::fr_foot_jacobian,
+                B1Z1C::fr_foot_generalized_jacobian,
+            ),
+            (
+                "trunk",
+                B1Z1C::trunk_placement,
+                B1Z1C::trunk_jacobian,
+                B1Z1C::trunk_generalized_jacobian,
+            ),
+            (
+                "gripperStator",
+                B1Z1C::gripperstator_placement,
+                B1Z1C::gripperstator_jacobian,
+                B1Z1C::gripperstator_generalized_jacobian,
+            ),
+        ];
+        for (name, placement, jacobian, generalized) in frames {
+            let k = model.frames().iter().position(|f| f.name == name).unwrap();
+            let fp = &p.frames[k];
+            let (x, rot) = placement(&q);
+            let (want_x, want_r) = frames::floating_placement(&p, &st, &qj, fp);
+            close(
+                name,
+                &[x.as_slice(), rot.as_flattened()].concat(),
+                &[want_x.0.as_slice(), want_r.0.as_flattened()].concat(),
+                1e-13,
+            );
+            let want = frames::floating_jacobian(&p, &st, &qj, fp).concat();
+            close(name, jacobian(&q).as_flattened(), &want, 1e-13);
+            let want = frames::generalized_jacobian(&p, &fb, &st, &qj, fp).concat();
+            close(name, generalized(&q).as_flattened(), &want, 1e-12);
+        }
     }
 }

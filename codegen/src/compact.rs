@@ -15,10 +15,13 @@
 //! - `forward_dynamics`, `forward_dynamics_with_wrenches`: the articulated-body algorithm
 //!   (RBDA Table 7.1), O(N) instead of the unrolled form's CRBA + RNEA + LDLᵀ;
 //! - `mass_matrix_and_nonlinear_effects`: CRBA and RNEA on one set of joint transforms;
-//! - `<frame>_placement`, `<frame>_jacobian` (fixed base): loops over the support path of the
-//!   frame's body (`kanegen_runtime::compact::frames`);
+//! - `<frame>_placement`, `<frame>_jacobian`: loops over the support path of the frame's body
+//!   (`kanegen_runtime::compact::frames`, `const CX_FRAMES`);
 //! - on a free-floating base, the dynamics functions above with the base as the root of the
-//!   passes (`kanegen_runtime::compact::floating`, `const CX_BASE`).
+//!   passes (`kanegen_runtime::compact::floating`, `const CX_BASE`), `momentum` and
+//!   `base_reaction` (one pass each), and the frames in the inertial frame with their
+//!   `<frame>_generalized_jacobian` (`kanegen_runtime::compact::floating_frames`: the composite
+//!   inertias, one 6×6 LDLᵀ, one solve per joint).
 //!
 //! The kernels take the type's sine–cosine (`Self::sincos`, or libm's per
 //! [`Options::libm_trig`] and for `f32`). Nothing allocates, no function panics, `f32` works as
@@ -30,9 +33,10 @@
 //!
 //! Supported: a fixed or free-floating base, chains and trees, `f64` and `f32`, gravity, a
 //! runtime payload (the last body's inertia built from it at each call), with or without
-//! regrouping (none on a free-floating base). On a free-floating base the momentum, the base
-//! reaction and the frame functions stay straight-line. Not supported (`form = "compact"` is an
-//! error): a forced algorithm.
+//! regrouping (none on a free-floating base), with frames. Not supported (`form = "compact"` is
+//! an error): a forced algorithm. The frame functions' entry points are `#[inline]`, not
+//! `#[inline(always)]`: every frame of a model calls one instance, so a model with many frames
+//! (pr2: 51) compiles one copy of the loops, not one per function.
 //!
 //! # Measured: when compact code wins
 //!
@@ -203,8 +207,8 @@ pub fn decide(
     let compact = |why: String| Decision {
         form: Form::Compact,
         line: format!(
-            "Form: compact: loops over constant tables (CRBA, RNEA, ABA; on a fixed base the \
-             frames along their support paths) ({why}). `OP_COUNTS` of the functions in loops \
+            "Form: compact: loops over constant tables (CRBA, RNEA, ABA; the frames along their \
+             support paths) ({why}). `OP_COUNTS` of the functions in loops \
              are the traced counts of the runtime kernels they call (every operation their loops \
              execute); `CANDIDATES` and the table below hold the straight-line functions only."
         ),
@@ -252,23 +256,10 @@ pub fn methods(f: Function) -> Methods {
 }
 
 /// Whether the compact form has its own body for `f` on a fixed base, or on a free-floating one
-/// (`floating`: the dynamics functions; the frames, momentum and base reaction stay
-/// straight-line there).
+/// (`floating`: also the momentum, the base reaction and the generalized Jacobians).
 #[must_use]
 pub fn has_body(f: Function, floating: bool) -> bool {
-    if floating {
-        return matches!(
-            f,
-            Function::MassMatrix
-                | Function::NonlinearEffects
-                | Function::Gravity
-                | Function::InverseDynamics
-                | Function::MassMatrixAndNonlinearEffects
-                | Function::ForwardDynamics
-                | Function::ForwardDynamicsWithWrenches
-        );
-    }
-    matches!(
+    let both = matches!(
         f,
         Function::FramePlacement(_)
             | Function::FrameJacobian(_)
@@ -279,7 +270,12 @@ pub fn has_body(f: Function, floating: bool) -> bool {
             | Function::ForwardDynamics
             | Function::ForwardDynamicsWithWrenches
             | Function::MassMatrixAndNonlinearEffects
-    )
+    );
+    both || (floating
+        && matches!(
+            f,
+            Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_)
+        ))
 }
 
 fn mat(float: Float, m: &M3) -> TokenStream {
@@ -336,10 +332,8 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         None => quote!(None),
     };
     let a0 = vector(float, &t.a0);
-    let frames = match &t.base {
-        None => frames(&rt, float, &t.frames),
-        Some(base) => floating_base(&rt, float, base),
-    };
+    let base = t.base.as_ref().map(|base| floating_base(&rt, float, base));
+    let frames = frames(&rt, float, &t.frames);
     Ok(quote! {
         /// Compact form: the model's numbers as the runtime kernels read them
         /// (`kanegen_runtime::compact::Tables`: parents, joint kinds, the joint transforms'
@@ -357,6 +351,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
             ancestor: #ancestor,
             a0: #a0,
         };
+        #base
         #frames
     })
 }
@@ -375,8 +370,29 @@ fn floating_body(
         Literal::usize_unsuffixed(n + 6),
     );
     let fk = quote!(#k::floating);
+    let ff = quote!(#k::floating_frames);
     let args = quote!(&Self::CX, #i, &Self::CX_BASE, q);
+    let frame = |k: usize| {
+        let k = Literal::usize_unsuffixed(k);
+        quote!(&Self::CX_FRAMES[#k])
+    };
     Some(match f {
+        Function::Momentum => quote!(#fk::momentum::<_, #nl>(#args, v, #sincos)),
+        Function::BaseReaction => quote!(#fk::base_reaction::<_, #nl>(#args, v, a, #sincos)),
+        Function::FramePlacement(k) => {
+            let fr = frame(k);
+            quote!(#ff::frame_placement::<_, #nl>(&Self::CX, #fr, q, #sincos))
+        }
+        Function::FrameJacobian(k) => {
+            let fr = frame(k);
+            quote!(#ff::frame_jacobian::<_, #nl, #nvl>(&Self::CX, #fr, q, #sincos))
+        }
+        Function::GeneralizedJacobian(k) => {
+            let fr = frame(k);
+            quote! {
+                #ff::generalized_jacobian::<_, #nl>(&Self::CX, #i, &Self::CX_BASE, #fr, q, #sincos)
+            }
+        }
         Function::MassMatrix => quote!(#fk::mass_matrix::<_, #nl, #nvl>(#args, #sincos)),
         Function::NonlinearEffects => {
             quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), None, #sincos))

@@ -303,12 +303,7 @@ fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64
             _ = k::forward_dynamics_with_wrenches(&t, &inertia, &v, &v, &v, &f_ext, sc);
         }
         Function::FramePlacement(k) | Function::FrameJacobian(k) => {
-            let fr = &t_frames[k];
-            let frame = k::Frame {
-                body: fr.body,
-                translation: fr.translation.map(Counted),
-                rotation: fr.rotation.map(|r| r.map(Counted)),
-            };
+            let frame = counted_frame(&t_frames[k]);
             if let Function::FramePlacement(_) = f {
                 _ = k::frame_placement(&t, &frame, &v, sc);
             } else {
@@ -318,6 +313,15 @@ fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64
         _ => unreachable!("{f:?} has no kernel"),
     }
     take()
+}
+
+/// A frame of the tables on [`Counted`].
+fn counted_frame(fr: &k::Frame<f64>) -> k::Frame<Counted> {
+    k::Frame {
+        body: fr.body,
+        translation: fr.translation.map(Counted),
+        rotation: fr.rotation.map(|r| r.map(Counted)),
+    }
 }
 
 const KERNELS: [Function; 7] = [
@@ -421,6 +425,8 @@ fn op_counts_of_large_compact_types_are_what_the_kernels_execute() {
 /// (`kanegen_runtime::compact::floating`), counted by running it on [`Counted`].
 fn counted_floating<const N: usize, const NV: usize>(t: &KernelTables, f: Function) -> [u64; 4] {
     use k::floating as fk;
+    use k::floating_frames as ff;
+    let frames = &t.frames;
     let base = t.base.expect("a free-floating model");
     let base = fk::Base {
         inertia: base.inertia.map(Counted),
@@ -457,13 +463,29 @@ fn counted_floating<const N: usize, const NV: usize>(t: &KernelTables, f: Functi
             let w = Some(&f_ext[..=N]);
             _ = fk::forward_dynamics::<_, N, NV>(&t, inertia, &base, q, v, &tau, w, sc);
         }
+        Function::Momentum => _ = fk::momentum::<_, N>(&t, inertia, &base, q, v, sc),
+        Function::BaseReaction => {
+            _ = fk::base_reaction::<_, N>(&t, inertia, &base, q, v, v, sc);
+        }
+        Function::FramePlacement(k) => {
+            _ = ff::frame_placement::<_, N>(&t, &counted_frame(&frames[k]), q, sc);
+        }
+        Function::FrameJacobian(k) => {
+            _ = ff::frame_jacobian::<_, N, NV>(&t, &counted_frame(&frames[k]), q, sc);
+        }
+        Function::GeneralizedJacobian(k) => {
+            let frame = counted_frame(&frames[k]);
+            _ = ff::generalized_jacobian::<_, N>(&t, inertia, &base, &frame, q, sc);
+        }
         _ => unreachable!("{f:?} has no floating kernel"),
     }
     take()
 }
 
 /// A free-floating compact type's `OP_COUNTS` of its kernel functions are what the floating
-/// kernels execute, on SSRMS (a chain) and a two-armed tree, with gravity (so `gravity` has a kernel too).
+/// kernels execute, on SSRMS (a chain) and a two-armed tree with three frames, with gravity (so
+/// `gravity` has a kernel too): the dynamics, the momentum, the base reaction and each frame's
+/// placement, Jacobian and generalized Jacobian.
 #[test]
 fn op_counts_of_free_floating_compact_types_are_what_the_kernels_execute() {
     fn check<const N: usize, const NV: usize>(model: &Model) {
@@ -475,7 +497,15 @@ fn op_counts_of_free_floating_compact_types_are_what_the_kernels_execute() {
             .with_base_kind(kanegen_model::BaseKind::FreeFloating)
             .unwrap();
         let t = numbers(model, &o);
-        for f in KERNELS {
+        let frames = (0..t.frames.len()).flat_map(|k| {
+            [
+                Function::FramePlacement(k),
+                Function::FrameJacobian(k),
+                Function::GeneralizedJacobian(k),
+            ]
+        });
+        let floating_only = [Function::Momentum, Function::BaseReaction];
+        for f in KERNELS.into_iter().chain(floating_only).chain(frames) {
             let c = kernel_counts(model, &o, f).expect("a kernel function");
             let ran = counted_floating::<N, NV>(&t, f);
             assert_eq!(

@@ -55,10 +55,7 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
     let joints = || -> Vec<Sym> { (0..n).map(|_| x()).collect() };
     let q = joints();
     let out = match f {
-        Function::FramePlacement(k) | Function::FrameJacobian(k) => {
-            if t.base.is_some() {
-                return None;
-            }
+        Function::FramePlacement(k) | Function::FrameJacobian(k) if t.base.is_none() => {
             let fr = t.frames.get(k)?;
             let frame = k::Frame {
                 body: fr.body,
@@ -73,7 +70,12 @@ pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
                     inertia: core::array::from_fn(|_| x()),
                     gravity: base.gravity.map(|_| v3()),
                 };
-                trace_floating(&tables, f, &base, n, &x)?
+                let frame = f.frame().and_then(|k| t.frames.get(k)).map(|fr| k::Frame {
+                    body: fr.body,
+                    translation: v3(),
+                    rotation: m3(),
+                });
+                trace_floating(&tables, f, &base, frame.as_ref(), n, &x)?
             }
             None => trace_kernel(&tables, f, &q, &mut || joints(), &x)?,
         },
@@ -156,17 +158,8 @@ fn trace_frame(
     q: &[Sym],
 ) -> Vec<Sym> {
     let zero = Sym::zero();
-    let id = Transform {
-        e: [[zero; 3]; 3],
-        r: [zero; 3],
-    };
     let n = q.len();
-    let (mut x, mut x0) = (vec![id; n], vec![id; n]);
-    if let Some(i) = frame.body {
-        let upto = (i + 1).min(n);
-        k::spatial::transforms(tables, &q[..upto], |a: Sym| a.sin_cos(), &mut x[..upto]);
-        k::frames::support_placements(tables, i, &x, &mut x0);
-    }
+    let x0 = support_path(tables, frame, q);
     if let Function::FramePlacement(_) = f {
         let (p, r) = k::frames::pose(frame, &x0);
         return p.into_iter().chain(r.into_iter().flatten()).collect();
@@ -179,13 +172,14 @@ fn trace_frame(
         .collect()
 }
 
-/// The outputs of a free-floating function's kernel (`kanegen_runtime::compact::floating`) on
-/// `tables` of `n` joints, as its entry point computes them, every argument a fresh input
-/// (`x`), the scratch in `Vec`s.
+/// The outputs of a free-floating function's kernel (`kanegen_runtime::compact::floating` and
+/// `::floating_frames`) on `tables` of `n` joints, as its entry point computes them, every
+/// argument a fresh input (`x`), the scratch in `Vec`s; `frame`: a frame function's frame.
 fn trace_floating(
     tables: &Tables<'_, Sym>,
     f: Function,
     base: &k::floating::Base<Sym>,
+    frame: Option<&k::Frame<Sym>>,
     n: usize,
     x: &dyn Fn() -> Sym,
 ) -> Option<Vec<Sym>> {
@@ -195,6 +189,9 @@ fn trace_floating(
     }
     let zero = Sym::zero();
     let args = |len: usize| -> Vec<Sym> { (0..len).map(|_| x()).collect() };
+    if let Some(frame) = frame {
+        return Some(trace_floating_frame(tables, f, base, frame, &args(7 + n)));
+    }
     let (q, v, a, tau) = (args(7 + n), args(6 + n), args(6 + n), args(n));
     let mut store = BodyVecs::<Sym>::new(n);
     let mut b = store.bodies();
@@ -214,6 +211,14 @@ fn trace_floating(
     };
     Some(match f {
         Function::MassMatrix => mass(&mut b),
+        Function::Momentum => {
+            let mut vw = vec![[zero; 6]; n];
+            k::floating::momentum_in(tables, inertia, base, &q, &v, &mut b, &mut vw).to_vec()
+        }
+        Function::BaseReaction => {
+            let mut m = vec![[[zero; 6]; 3]; n];
+            k::floating::base_reaction_in(tables, b.x, inertia, base, &q, &v, &a, &mut m).to_vec()
+        }
         Function::NonlinearEffects => id_at(&b, Some(&v), None),
         Function::Gravity => id_at(&b, None, None),
         Function::InverseDynamics => id_at(&b, Some(&v), Some(&a)),
@@ -234,6 +239,58 @@ fn trace_floating(
             out
         }
     })
+}
+
+/// The placements of the support path of `frame`'s body at the joint positions `q`, as the
+/// frame kernels' entry points compute them (the joint transforms up to the body first).
+fn support_path(tables: &Tables<'_, Sym>, frame: &k::Frame<Sym>, q: &[Sym]) -> Vec<Transform<Sym>> {
+    let zero = Sym::zero();
+    let id = Transform {
+        e: [[zero; 3]; 3],
+        r: [zero; 3],
+    };
+    let n = q.len();
+    let (mut x, mut x0) = (vec![id; n], vec![id; n]);
+    if let Some(i) = frame.body {
+        let upto = (i + 1).min(n);
+        k::spatial::transforms(tables, &q[..upto], |a: Sym| a.sin_cos(), &mut x[..upto]);
+        k::frames::support_placements(tables, i, &x, &mut x0);
+    }
+    x0
+}
+
+/// The outputs of a frame function's kernel on a free-floating base (`q`: the `7 + N`
+/// positions), as its entry point computes them: the placement `[x; R rows]`, the Jacobian's
+/// rows, or the generalized Jacobian's rows.
+fn trace_floating_frame(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    base: &k::floating::Base<Sym>,
+    frame: &k::Frame<Sym>,
+    q: &[Sym],
+) -> Vec<Sym> {
+    use k::floating_frames as ff;
+    let zero = Sym::zero();
+    let n = q.len() - 7;
+    let sincos = |a: Sym| a.sin_cos();
+    let mut cols = vec![[zero; 6]; n];
+    if let Function::GeneralizedJacobian(_) = f {
+        let mut store = BodyVecs::<Sym>::new(n);
+        let mut b = store.bodies();
+        k::spatial::transforms(tables, &q[7..], sincos, b.x);
+        let mut out = vec![zero; 6 * n];
+        let i = tables.inertia;
+        ff::generalized_jacobian_in(tables, i, base, frame, q, &mut b, &mut cols, &mut out);
+        return out;
+    }
+    let x0 = support_path(tables, frame, &q[7..]);
+    if let Function::FramePlacement(_) = f {
+        let (p, r) = ff::placement_in(frame, q, &x0);
+        return p.into_iter().chain(r.into_iter().flatten()).collect();
+    }
+    let mut out = vec![zero; 6 * (6 + n)];
+    ff::jacobian_in(tables, frame, q, &x0, &mut cols, &mut out);
+    out
 }
 
 /// The CRBA's `H` (rows first) on the joint transforms of `b`.

@@ -22,7 +22,7 @@ use super::tables::{Bodies, BodyStore, Tables};
 use crate::scalar::Scalar;
 
 /// The frame's placement `(x, R)` in the inertial frame at `q = [p₀; quat; q_joints]`.
-#[inline(always)]
+#[inline]
 pub fn frame_placement<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     frame: &Frame<S>,
@@ -51,7 +51,7 @@ pub fn placement_in<S: Scalar + Copy>(
 }
 
 /// The frame's geometric Jacobian at `q`: rows `[v; ω]` in inertial axes, `NV = 6 + N` columns.
-#[inline(always)]
+#[inline]
 pub fn frame_jacobian<S: Scalar + Copy, const N: usize, const NV: usize>(
     t: &Tables<'_, S>,
     frame: &Frame<S>,

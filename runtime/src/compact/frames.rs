@@ -134,7 +134,7 @@ pub(crate) fn placements<S: Scalar + Copy, const N: usize>(
 }
 
 /// The frame's placement `(x_f, R_f)` in the base frame at `q`.
-#[inline(always)]
+#[inline]
 pub fn frame_placement<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     frame: &Frame<S>,
@@ -146,7 +146,7 @@ pub fn frame_placement<S: Scalar + Copy, const N: usize>(
 
 /// The frame's geometric Jacobian at `q`: rows `[v; ω]` of its origin in base axes, one column
 /// per joint.
-#[inline(always)]
+#[inline]
 pub fn frame_jacobian<S: Scalar + Copy, const N: usize>(
     t: &Tables<'_, S>,
     frame: &Frame<S>,
