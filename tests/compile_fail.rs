@@ -1,5 +1,5 @@
 //! `dynamics!` rejects bad models at compile time with the reader's message at the path literal
-//! (also a model with joints that move no mass, and one with mimic joints, naming the joints),
+//! (also a model with joints that move no mass, naming the joints, and the compact form asked for a model with mimic joints),
 //! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
 //! `algorithm = "fastest"`, `form = "rolled"`, gravity beyond its bound, an unknown key, a
 //! key given twice) at the option; `scene!` rejects a

@@ -13,6 +13,9 @@
 //! refuses the file), fixed base with gravity and free-floating, to 1e-9 relative; the files
 //! not copied are listed with the reason.
 
+mod common;
+
+use common::nums;
 use kanegen::dynamics::metrics::rel_err;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -20,14 +23,6 @@ use std::process::Command;
 
 fn dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/erd")
-}
-
-fn nums(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Array(xs) => xs.iter().flat_map(nums).collect(),
-        Value::Number(n) => vec![n.as_f64().unwrap()],
-        other => panic!("not a number: {other}"),
-    }
 }
 
 fn models() -> Vec<String> {

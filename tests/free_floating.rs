@@ -7,6 +7,9 @@
 //! stand-in base inertial). Joint order: Pinocchio's (`"joints"`), permuted by name to the
 //! order of `JOINTS`.
 
+mod common;
+
+use common::nums;
 use kanegen::dynamics::metrics::rel_err;
 use serde_json::Value;
 use std::path::Path;
@@ -28,14 +31,6 @@ fn reference(name: &str) -> Value {
     let p =
         Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/data/erd/{name}.reference.json"));
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
-fn nums(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Array(xs) => xs.iter().flat_map(nums).collect(),
-        Value::Number(n) => vec![n.as_f64().unwrap()],
-        other => panic!("not a number: {other}"),
-    }
 }
 
 /// `perm[k]`: the index in Pinocchio's order of our joint `k`.

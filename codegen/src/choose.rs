@@ -315,6 +315,13 @@ pub fn choose_in(
         Some(m) if f.uses_mass_matrix() || f.uses_nonlinear_effects() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
+    // Mimic joints: forward dynamics solves the reduced `M` (no articulated-body pass).
+    let all: Vec<Methods> = all
+        .into_iter()
+        .filter(|m| {
+            !(model.has_mimics() && f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)
+        })
+        .collect();
     let n = model.dof();
     let kept: Vec<Methods> = all.iter().copied().filter(|m| can_win(f, *m, n)).collect();
     for m in if kept.is_empty() { all } else { kept } {

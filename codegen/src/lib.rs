@@ -121,19 +121,9 @@ fn generate_items_with(
     })
 }
 
-/// What the generated type cannot be made for: mimic joints (not supported yet), and joints that
-/// move no mass (its forward dynamics would divide by a singular `M`).
+/// What the generated type cannot be made for: joints that move no mass (its forward dynamics
+/// would divide by a singular `M`).
 fn check_generable(model: &Model) -> Result<(), Error> {
-    if let Some(j) = model.mimics().iter().position(Option::is_some) {
-        return Err(Error(format!(
-            "model `{}`: mimic joints are not supported by code generation yet (joint `{}` \
-             mimics another); `kanegen eval` computes M and c of the independent coordinates, \
-             and `ignore_mimic = true` (dynamics!) or `--ignore-mimic` (kanegen generate) \
-             generates every mimic joint as an independent joint (Pinocchio's mimic=False)",
-            model.name(),
-            model.joints()[j].name
-        )));
-    }
     model
         .check_forward_dynamics()
         .map_err(|e| Error(e.to_string()))
@@ -425,7 +415,7 @@ fn type_items(
     fmas: &[u64],
 ) -> Result<TokenStream, Error> {
     let model = &plan.model;
-    let n = model.dof();
+    let n = model.coordinate_count();
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())
@@ -514,9 +504,10 @@ fn type_items(
 /// `NQ` and `NV`, `OP_COUNTS` and `CANDIDATES`.
 fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> TokenStream {
     let model = &plan.model;
-    let n = model.dof();
+    let coordinates = model.coordinates();
+    let n = coordinates.len();
     let nl = Literal::usize_unsuffixed(n);
-    let joint_names = model.joints().iter().map(|j| j.name.as_str());
+    let joint_names = coordinates.iter().map(|&j| model.joints()[j].name.as_str());
     let frame_names = model.frames().iter().map(|f| f.name.as_str());
     let n_frames = Literal::usize_unsuffixed(model.frames().len());
     let floating_consts = if plan.floating() {
@@ -533,13 +524,16 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
     } else {
         quote!()
     };
-    let limits = limit_consts(model.limits(), float);
+    let limits: Vec<kanegen_model::Limits> =
+        coordinates.iter().map(|&j| model.limits()[j]).collect();
+    let limits = limit_consts(&limits, float);
     let n_fns = Literal::usize_unsuffixed(plan.functions.len());
     let (emitted, all) = op_count_entries(plan, fmas, op_ty);
     quote! {
         /// Degrees of freedom.
         pub const N: usize = #nl;
-        /// Joint names, in the order of the joint entries of `q`.
+        /// Joint names, in the order of the joint entries of `q` (a mimic joint follows its
+        /// primary and has no entry).
         pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
         /// Named frames, in the model's order (one `<frame>_…` function family each).
         pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];

@@ -85,9 +85,12 @@ pub struct Plan {
 pub const DERIVATIVES_MAX_NV: usize = 24;
 
 /// Whether the derivative functions can be generated for `model` in the form `decision`: in
-/// the unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds.
+/// the unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds, without mimic joints.
 #[must_use]
 pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
+    if model.has_mimics() {
+        return false;
+    }
     let nv = model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {
             6
@@ -253,7 +256,8 @@ fn decide_form(
     subjects: &Subjects,
     opts: &Options,
 ) -> Result<(Decision, Vec<(Choice, Traced)>), Error> {
-    let why_not = compact::unsupported(opts);
+    // The compact kernels run on the full joint list, with no coupling of mimic joints.
+    let why_not = compact::unsupported(opts).or(model.has_mimics().then_some("mimic joints"));
     let (size, traced) = match (opts.form, why_not) {
         (Form::Auto, None) => {
             let fs = [
@@ -417,7 +421,8 @@ fn prefix(model: &Model, joints: usize) -> Option<Model> {
 /// The plan of `f`: its name, arguments and shape, with its choice and kernel.
 fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> FunctionPlan {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    let n = model.dof();
+    // The arguments are the independent coordinates (mimic joints follow theirs).
+    let n = model.coordinate_count();
     FunctionPlan {
         function: f,
         name: api::fn_name(f, model),

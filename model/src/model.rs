@@ -468,6 +468,13 @@ impl Model {
             .collect()
     }
 
+    /// The number of independent coordinates (the joints that mimic none): the length of `q`'s
+    /// joint part.
+    #[must_use]
+    pub fn coordinate_count(&self) -> usize {
+        self.mimics.iter().filter(|m| m.is_none()).count()
+    }
+
     /// The model with these mimic couplings (one per joint), already resolved to primaries.
     ///
     /// # Errors

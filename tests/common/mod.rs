@@ -1,5 +1,6 @@
-//! Helpers shared by the scene tests (`mod common;`): the project root, scene files and texts,
-//! the binary, and the comparison of a compiled run (`kanegen::scene!`) with an interpreted one.
+//! Helpers shared by the tests (`mod common;`): the project root, scene files and texts, the
+//! binary, the comparison of a compiled run (`kanegen::scene!`) with an interpreted one, and the
+//! numbers of a reference file.
 // Each test crate uses some of them.
 #![allow(dead_code)]
 
@@ -70,4 +71,13 @@ pub fn worst<const D: usize>(name: &str, c: &[(f64, [f64; D])], i: &Run) -> f64 
         }
     }
     w
+}
+
+/// Every number of a JSON value, nested arrays flattened in order.
+pub fn nums(v: &serde_json::Value) -> Vec<f64> {
+    match v {
+        serde_json::Value::Array(xs) => xs.iter().flat_map(nums).collect(),
+        serde_json::Value::Number(n) => vec![n.as_f64().unwrap()],
+        other => panic!("not a number: {other}"),
+    }
 }

@@ -1,3 +1,3 @@
-kanegen::dynamics!(Hand, "bad/mimic.urdf");
+kanegen::dynamics!(Hand, "bad/mimic.urdf", form = "compact");
 
 fn main() {}

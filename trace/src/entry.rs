@@ -21,6 +21,7 @@
 //! assert!(x.iter().zip(&y).all(|(a, b)| (a - b).abs() < 1e-12));
 //! ```
 
+use crate::coupled;
 use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
@@ -29,13 +30,16 @@ use kanegen_dynamics::algorithms::derivatives::{
 };
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
-use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
+use kanegen_dynamics::base::{
+    quat_to_matrix, FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF,
+};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::params::{axis_turn, is_near_signed_permutation};
 use kanegen_dynamics::regroup::regrouped;
 use kanegen_dynamics::spatial::RbInertia;
 use kanegen_dynamics::{
-    ExternalWrench, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods,
+    ExternalWrench, ForwardMethod, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods,
     NonlinearEffectsMethod, Params, Scalar,
 };
 use kanegen_model::JointKind;
@@ -104,8 +108,13 @@ pub fn trace(
         });
     };
     let floating = matches!(spec.base, Base::FreeFloating(_));
-    let args = Arguments::new(function, n, floating, &mut input);
+    let coupling = match subject {
+        Subject::Model(m) if m.has_mimics() => Some(Coupling::new(m.mimics())),
+        _ => None,
+    };
+    let args = Arguments::new(function, n, floating, coupling.as_ref(), &mut input);
     let effects = Effects::new(spec, &args, floating, &mut input);
+    let offset = if floating { FLOATING_BASE_DOF } else { 0 };
     let out = match (&spec.base, &args.state) {
         (Base::FreeFloating(inertial), Some(state)) => {
             let base =
@@ -115,9 +124,39 @@ pub fn trace(
                 base: &base,
                 state,
             };
-            floating_outputs(function, methods, &system, &args, &effects)
+            match &coupling {
+                Some(c) if function.is_forward_dynamics() => {
+                    let m = floating::mass_matrix(methods.mass_matrix, &p, &base, state, &args.q);
+                    let l = effects.loads(args.arg(Arg::Tau));
+                    let b = floating::tau_minus_c(
+                        methods.nonlinear_effects,
+                        &p,
+                        &base,
+                        state,
+                        &args.q,
+                        &args.qd,
+                        &l,
+                    );
+                    coupled::forward_dynamics(c, offset, &m, &b)
+                }
+                _ => floating_outputs(function, methods, &system, &args, &effects),
+            }
         }
-        _ => fixed_outputs(function, methods, &p, &args, &effects),
+        _ => match &coupling {
+            Some(c) if function.is_forward_dynamics() => {
+                let m = methods.mass_matrix.mass_matrix(&p, &args.q);
+                let l = effects.loads(args.arg(Arg::Tau));
+                let b = methods
+                    .nonlinear_effects
+                    .tau_minus_c(&p, &args.q, &args.qd, &l);
+                coupled::forward_dynamics(c, offset, &m, &b)
+            }
+            _ => fixed_outputs(function, methods, &p, &args, &effects),
+        },
+    };
+    let out = match &coupling {
+        Some(c) if !function.is_forward_dynamics() => coupled::reduce(function, c, offset, out),
+        _ => out,
     };
     Ok(Traced {
         trace: t.finish(&out),
@@ -206,26 +245,33 @@ struct Arguments {
 }
 
 impl Arguments {
-    /// Creates the inputs of `function`'s arguments ([`Function::args`]), in order.
+    /// Creates the inputs of `function`'s arguments ([`Function::args`]), in order, for `n`
+    /// joints (one `f_ext` row per body); with mimic joints (`coupling`) the joint arguments
+    /// are the independent coordinates, expanded to the `n` joints ([`crate::coupled`]).
     fn new(
         function: Function,
         n: usize,
         floating: bool,
+        coupling: Option<&Coupling>,
         input: &mut impl FnMut(Input) -> Sym,
     ) -> Self {
         let mut args: HashMap<Arg, Vec<Sym>> = HashMap::new();
         let mut rows: Vec<[Sym; 6]> = Vec::new();
+        let coords = coupling.map_or(n, Coupling::reduced);
         for &a in function.args(floating) {
             if a == Arg::FExt {
                 rows = (0..a.len(n, floating))
                     .map(|r| core::array::from_fn(|c| input(Input::Row(a, r, c))))
                     .collect();
             } else {
-                let v = (0..a.len(n, floating))
+                let v = (0..a.len(coords, floating))
                     .map(|i| input(Input::Joint(a, i)))
                     .collect();
                 args.insert(a, v);
             }
+        }
+        if let Some(c) = coupling {
+            expand(&mut args, c, floating);
         }
         let arg = |a: Arg| args.get(&a).cloned();
         let zeros = vec![Sym::zero(); n];
@@ -269,6 +315,27 @@ impl Arguments {
     /// Argument `a`, whole (`None` when the function does not take it).
     fn arg(&self, a: Arg) -> Option<Vec<Sym>> {
         self.args.get(&a).cloned()
+    }
+}
+
+/// The arguments in the independent coordinates of `c` expanded to the full joint list: the
+/// joint parts of `q` (`G q + o`), of the rates and accelerations (`G x`), and the drives (the
+/// independent joints', zero on mimic joints); a free-floating base's parts kept.
+fn expand(args: &mut HashMap<Arg, Vec<Sym>>, c: &Coupling, floating: bool) {
+    for (a, v) in args.iter_mut() {
+        let head = match (a, floating) {
+            (Arg::Q, true) => 7,
+            (Arg::V | Arg::A, true) => FLOATING_BASE_DOF,
+            _ => 0,
+        };
+        let (base, joints) = v.split_at(head.min(v.len()));
+        let joints = match a {
+            Arg::Q => c.full_positions(joints),
+            Arg::Tau => c.full_drives(joints),
+            Arg::Qd | Arg::Qdd | Arg::V | Arg::A => c.full_rates(joints),
+            Arg::FExt => continue,
+        };
+        *v = [base, &joints].concat();
     }
 }
 
@@ -636,6 +703,9 @@ fn check(
         }
     }
     if let Subject::Model(m) = subject {
+        if m.has_mimics() {
+            check_mimic(function, methods, spec)?;
+        }
         // The paper's inertial-frame algorithms handle serial chains only.
         let p = Params::<f64>::new(m);
         let uses = |b: bool| b || floating;
@@ -651,6 +721,24 @@ fn check(
     }
     let _ = NonlinearEffectsMethod::ALL; // every nonlinear-effects method traces every remaining combination
     Ok(())
+}
+
+/// What a model with mimic joints is not traced with ([`crate::coupled`]): derivatives and
+/// `M⁻¹` (not reduced after the fact), forward dynamics by the articulated-body algorithm (it runs
+/// on the full tree; the coupled forward dynamics solve the reduced `M` by LDLᵀ), and damping
+/// (one entry per joint, not per coordinate).
+fn check_mimic(function: Function, methods: Methods, spec: &Spec) -> Result<(), String> {
+    let why = if function.is_derivative() {
+        "the derivatives and M⁻¹ are not traced in the independent coordinates of mimic joints yet"
+    } else if function.is_forward_dynamics() && methods.forward == ForwardMethod::Aba {
+        "the articulated-body algorithm does not run in the independent coordinates of mimic \
+         joints (forward dynamics solves the reduced M by LDLᵀ)"
+    } else if spec.damping.is_some() {
+        "damping is one entry per joint, not per independent coordinate of mimic joints"
+    } else {
+        return Ok(());
+    };
+    Err(why.into())
 }
 
 /// The upper triangle of a symmetric matrix, row-major.

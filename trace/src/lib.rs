@@ -19,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod count;
+mod coupled;
 mod entry;
 mod function;
 #[cfg(feature = "table1")]
