@@ -30,7 +30,13 @@
 //! use kanegen_model::random::{random_chain, ChainSpec};
 //! let model = random_chain(&ChainSpec { n: 2, ..Default::default() }, 1);
 //! let src = generate_file(&model, &Options::new("Arm")).unwrap();
-//! assert!(src.contains("pub fn nonlinear_effects(q: &[f64; 2], qd: &[f64; 2]) -> [f64; 2]"));
+//! // Primitive types by their full paths: the including module may call something `f64`.
+//! assert!(src.contains(
+//!     "pub fn nonlinear_effects(
+//!         q: &[::core::primitive::f64; 2],
+//!         qd: &[::core::primitive::f64; 2],
+//!     ) -> [::core::primitive::f64; 2] {"
+//! ));
 //! ```
 #![warn(missing_docs)]
 
@@ -40,6 +46,7 @@ pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
+pub mod paths;
 pub mod plan;
 pub mod sincos;
 
@@ -363,14 +370,10 @@ fn op_count_entries(
         let ch = &fp.choice;
         let (m, c, frames) = (cand.methods, cand.counts, cand.frames.name());
         let function = &fp.name;
-        let opt = |x: Option<&str>| match x {
-            Some(s) => quote!(Some(#s)),
-            None => quote!(None),
-        };
         let (mm, bm, fm) = (
-            opt(ch.mass_matrix_method(m)),
-            opt(ch.nonlinear_effects_method(m)),
-            opt(ch.forward_method(m)),
+            paths::option(ch.mass_matrix_method(m)),
+            paths::option(ch.nonlinear_effects_method(m)),
+            paths::option(ch.forward_method(m)),
         );
         let (mul, add, div, sqrt, sincos) = (c.mul, c.add, c.div, c.sqrt, c.sincos);
         quote!(#op_ty {
@@ -452,6 +455,8 @@ fn type_items(
     );
     let consts = type_consts(plan, opts.float, fmas, op_ty);
     let helpers = helper_items(plan, opts, fmas)?;
+    let (name, u64) = (paths::static_str(), paths::primitive("u64"));
+    let method = paths::option_type(&name);
     Ok(quote! {
         #(#struct_docs)*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -463,29 +468,29 @@ fn type_items(
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
         pub struct #op_ty {
             /// The generated function.
-            pub function: &'static str,
+            pub function: #name,
             /// Its mass-matrix method.
-            pub mass_matrix_method: Option<&'static str>,
+            pub mass_matrix_method: #method,
             /// Its nonlinear-effects method.
-            pub nonlinear_effects_method: Option<&'static str>,
+            pub nonlinear_effects_method: #method,
             /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
             /// the articulated-body algorithm, which uses neither), for forward dynamics.
-            pub forward_method: Option<&'static str>,
+            pub forward_method: #method,
             /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
             /// joint axis z, modified-DH x; the same joint-space results).
-            pub frames: &'static str,
+            pub frames: #name,
             /// Multiplications.
-            pub mul: u64,
+            pub mul: #u64,
             /// Additions and subtractions.
-            pub add: u64,
+            pub add: #u64,
             /// Divisions.
-            pub div: u64,
+            pub div: #u64,
             /// Square roots.
-            pub sqrt: u64,
+            pub sqrt: #u64,
             /// Angles whose sine and cosine are taken.
-            pub sincos: u64,
+            pub sincos: #u64,
             /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-            pub fma: u64,
+            pub fma: #u64,
         }
 
         #[allow(
@@ -519,6 +524,7 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
     let joint_names = model.joints().iter().map(|j| j.name.as_str());
     let frame_names = model.frames().iter().map(|f| f.name.as_str());
     let n_frames = Literal::usize_unsuffixed(model.frames().len());
+    let (usize, name) = (paths::primitive("usize"), paths::static_str());
     let floating_consts = if plan.floating() {
         let (nq, nv) = (
             Literal::usize_unsuffixed(n + 7),
@@ -526,9 +532,9 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
         );
         quote! {
             /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
-            pub const NQ: usize = #nq;
+            pub const NQ: #usize = #nq;
             /// Length of `v`: base linear and angular velocity (base frame), joint rates.
-            pub const NV: usize = #nv;
+            pub const NV: #usize = #nv;
         }
     } else {
         quote!()
@@ -538,11 +544,11 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
     let (emitted, all) = op_count_entries(plan, fmas, op_ty);
     quote! {
         /// Degrees of freedom.
-        pub const N: usize = #nl;
+        pub const N: #usize = #nl;
         /// Joint names, in the order of the joint entries of `q`.
-        pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
+        pub const JOINTS: [#name; #nl] = [#(#joint_names),*];
         /// Named frames, in the model's order (one `<frame>_…` function family each).
-        pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
+        pub const FRAMES: [#name; #n_frames] = [#(#frame_names),*];
         #limits
         #floating_consts
         /// Emitted operation counts of each generated function, in emission order.
@@ -737,9 +743,10 @@ pub use kanegen_model;
 /// (`kanegen_runtime::fma`): one fused instruction where the build targets it, `a·b + c` (two
 /// roundings, bit-identical to unfused code) elsewhere.
 fn mul_add_fn(float: Float, runtime: &TokenStream) -> TokenStream {
-    let (ty, f) = match float {
-        Float::F64 => (quote!(f64), quote!(mul_add)),
-        Float::F32 => (quote!(f32), quote!(mul_add_f32)),
+    let ty = float.ty();
+    let f = match float {
+        Float::F64 => quote!(mul_add),
+        Float::F32 => quote!(mul_add_f32),
     };
     quote! {
         /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64

@@ -319,8 +319,9 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| e.to_string())?;
     let items = g.items;
     let abs_lit = LitStr::new(&abs, Span::call_site());
+    let u8 = kanegen_codegen::paths::primitive("u8");
     Ok(quote! {
-        const _: &[u8] = include_bytes!(#abs_lit);
+        const _: &[#u8] = ::core::include_bytes!(#abs_lit);
         #items
     })
 }
