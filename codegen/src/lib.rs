@@ -155,11 +155,69 @@ struct Names {
 
 impl Names {
     fn new(opts: &Options) -> Result<Self, Error> {
-        Ok(Names {
+        let names = Names {
             ty: ident("type name", &opts.type_name)?,
             payload: ident("payload name", &opts.payload_name)?,
             op_count: ident("op-count name", &opts.op_count_name)?,
-        })
+        };
+        check_names(opts)?;
+        Ok(names)
+    }
+}
+
+/// Checks that the items the generated code declares in the including module, the type
+/// ([`Options::type_name`]), its op-count struct ([`Options::op_count_name`]) and, with
+/// [`Options::runtime_payload`], its payload struct ([`Options::payload_name`]), have names of
+/// their own, and that none of them shadows a crate or module the emitted code calls into (the
+/// first segment of the libm, runtime and fma paths): one clear error instead of the compiler's
+/// cascade over the generated code.
+///
+/// # Errors
+/// Naming the clash and what to rename.
+pub fn check_names(opts: &Options) -> Result<(), Error> {
+    let mut declared = vec![
+        ("the generated type", &opts.type_name),
+        ("its op-count struct", &opts.op_count_name),
+    ];
+    if opts.runtime_payload {
+        declared.push(("its payload struct", &opts.payload_name));
+    }
+    for (k, (what, name)) in declared.iter().enumerate() {
+        if let Some((first, _)) = declared[..k].iter().find(|(_, n)| n == name) {
+            return Err(Error(format!(
+                "{first} and {what} are both called `{name}`: {}",
+                rename(first)
+            )));
+        }
+    }
+    let mut called = vec![("libm", opts.libm()?), ("runtime", opts.runtime()?)];
+    if let (true, Some(p)) = (opts.fma, &opts.fma_path) {
+        let p: syn::Path = syn::parse_str(p).map_err(|e| Error(format!("fma path `{p}`: {e}")))?;
+        called.push(("fma", quote!(#p)));
+    }
+    for (path_name, path) in &called {
+        // A path from the crate root (`::libm`) or `$crate` cannot be shadowed.
+        let Some(proc_macro2::TokenTree::Ident(head)) = path.clone().into_iter().next() else {
+            continue;
+        };
+        if let Some((what, name)) = declared.iter().find(|(_, n)| head == n) {
+            return Err(Error(format!(
+                "{what} is called `{name}`, which would shadow the first segment of the {path_name} \
+                 path `{}` the generated code calls: {}",
+                path.to_string().replace(' ', ""),
+                rename(what)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// What to rename in a name clash of [`check_names`] involving `what`.
+fn rename(what: &str) -> &'static str {
+    if what == "the generated type" {
+        "give the type another name"
+    } else {
+        "rename one of them"
     }
 }
 
@@ -916,6 +974,59 @@ mod tests {
         // Not used without fma.
         o.fma = false;
         assert!(generate_items(&chain, &o).is_ok());
+    }
+
+    /// Two declared items of one name, or a declared name that would shadow a path the code
+    /// calls, is one error naming the clash; the payload's name is free without a payload struct,
+    /// and a path from the crate root cannot be shadowed.
+    #[test]
+    fn clashing_names_are_one_error() {
+        let chain = random_chain(&ChainSpec::default(), 1);
+        let err = |o: &Options| check_names(o).err().map(|e| e.0);
+        let mut o = Options::new("OpCount");
+        let clash = "the generated type and its op-count struct are both called `OpCount`: give \
+                     the type another name";
+        assert_eq!(err(&o).as_deref(), Some(clash));
+        assert_eq!(
+            generate_items(&chain, &o).err().map(|e| e.0).as_deref(),
+            Some(clash)
+        );
+        o.type_name = "Payload".into();
+        assert_eq!(err(&o), None);
+        o.runtime_payload = true;
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "the generated type and its payload struct are both called `Payload`: give the \
+                 type another name"
+            )
+        );
+        o.type_name = "Arm".into();
+        o.op_count_name = "Payload".into();
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "its op-count struct and its payload struct are both called `Payload`: rename \
+                 one of them"
+            )
+        );
+        let mut o = Options::new("libm");
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "the generated type is called `libm`, which would shadow the first segment of \
+                 the libm path `libm` the generated code calls: give the type another name"
+            )
+        );
+        o.libm_path = "::libm".into();
+        assert_eq!(err(&o), None);
+        o.type_name = "kanegen_runtime".into();
+        assert!(err(&o).is_some_and(|e| e.contains("the runtime path `kanegen_runtime`")));
+        let mut o = Options::new("f64");
+        o.fma_path = Some("f64::mul_add".into());
+        assert_eq!(err(&o), None, "the fma path is not called without fma");
+        o.fma = true;
+        assert!(err(&o).is_some_and(|e| e.contains("the fma path `f64::mul_add`")));
     }
 
     /// The f32 code names no f64 anywhere; the fma code calls the fma path and says how many it
