@@ -473,7 +473,11 @@ fn f32_source_is_f32_throughout() {
     let src = kanegen::codegen::generate_file(&chain, &o).unwrap();
     assert!(!src.contains("f64"));
     assert!(src.contains("//! Precision: `f32`"));
-    assert!(src.contains("pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7]"));
+    assert!(src.contains(
+        "pub fn mass_matrix(
+        q: &[::core::primitive::f32; 7],
+    ) -> [[::core::primitive::f32; 7]; 7] {"
+    ));
     assert!(src.contains("libm::sincosf("));
     assert!(!src.contains("libm::sincos("));
 }

@@ -2,7 +2,8 @@
 //! (also a model with joints that move no mass, naming the joints, and the compact form asked for a model with mimic joints),
 //! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
 //! `algorithm = "fastest"`, `form = "rolled"`, gravity beyond its bound, an unknown key, a
-//! key given twice) at the option; `scene!` rejects a
+//! key given twice) at the option, and a type name that would shadow a path the generated code
+//! calls (`f64` with `fma_path = f64::mul_add`) at the name; `scene!` rejects a
 //! bad scene key (the scene reader's message) and a feature it does not generate (a tabulated
 //! wrench with a computed-torque drive), naming the key and the scene file, at the path literal.
 //!

@@ -1,7 +1,8 @@
 //! `kanegen::dynamics!` on random-geometry models (prismatic joints, gravity, a runtime payload):
 //! the emitted functions equal the interpreted f64 algorithms. The precision variants of the
 //! SSRMS code (`scalar = f32`, `fma = true`) agree with the checked-in f64 code to their
-//! precision.
+//! precision. Types named `f64`, `Option`, `Some`, … (and a module that defines every such
+//! name) compile and compute what a plainly named type of the same options does.
 
 use kanegen::dynamics::metrics::rel_err;
 use kanegen::dynamics::Params;
@@ -642,4 +643,112 @@ fn limits_are_the_urdf_limit_attributes() {
         .iter()
         .all(|x| *x == f64::NEG_INFINITY));
     assert!(Random5::EFFORT_LIMIT.iter().all(|x| *x == f64::INFINITY));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Types named like primitive types and prelude items: the expansion names those by full paths.
+
+/// Declares, in module `$module`, `dynamics!` of a small spacecraft arm named `$name` in a module
+/// of its own (`shadowed`, where the type shadows the primitive type or prelude item of that
+/// name, and the items after `;` give more names a meaning of their own) and named `Plain`,
+/// both with the options `$key = $value`: the same code, so the same results, bit for bit.
+macro_rules! twins {
+    ($module:ident, $name:ident $(, $key:ident = $value:tt)* $(; $($item:item)*)?) => {
+        #[allow(non_camel_case_types, dead_code)]
+        mod $module {
+            pub mod shadowed {
+                $($($item)*)?
+                kanegen::dynamics!(
+                    $name,
+                    "tests/data/reference/spart_sc_3dof.urdf",
+                    derivatives = false
+                    $(, $key = $value)*
+                );
+            }
+            kanegen::dynamics!(
+                Plain,
+                "tests/data/reference/spart_sc_3dof.urdf",
+                derivatives = false
+                $(, $key = $value)*
+            );
+        }
+    };
+}
+
+twins!(
+    named_f64,
+    f64,
+    runtime_payload = true,
+    gravity = [0.0, 0.0, -9.81]
+);
+twins!(named_f32, f32, scalar = f32);
+twins!(named_option, Option, form = "compact");
+twins!(named_some, Some, base = "free-floating");
+twins!(named_none, None, base = "free-floating", form = "compact");
+twins!(named_usize, usize);
+twins!(named_str, str);
+// Every primitive type and prelude item the expansion could name, and `core`, defined next to
+// a type with a runtime payload.
+twins!(
+    crowded,
+    Arm,
+    runtime_payload = true;
+    pub struct f64;
+    pub struct f32;
+    pub struct usize;
+    pub struct u64;
+    pub struct u8;
+    pub struct bool;
+    pub struct str;
+    pub struct Option;
+    pub struct Some;
+    pub struct None;
+    pub mod core {}
+);
+
+/// Joint angles of any length and precision (the same for both twins).
+fn angles<T: From<f32>, const K: usize>() -> [T; K] {
+    core::array::from_fn(|k| T::from((0.4 + 0.9 * k as f32).sin()))
+}
+
+/// Asserts that each `module::Name`'s mass matrix is its `Plain` twin's.
+macro_rules! same_mass_matrix {
+    ($($module:ident :: $name:ident),*) => {$(
+        assert_eq!(
+            $module::shadowed::$name::mass_matrix(&angles()),
+            $module::Plain::mass_matrix(&angles()),
+            stringify!($name)
+        );
+    )*};
+}
+
+#[test]
+fn types_named_like_primitives_and_prelude_items_compute_what_plain_ones_do() {
+    same_mass_matrix!(
+        named_f32::f32,
+        named_option::Option,
+        named_some::Some,
+        named_none::None,
+        named_usize::usize,
+        named_str::str
+    );
+    let m =
+        named_f64::shadowed::f64::mass_matrix(&angles(), &named_f64::shadowed::f64Payload::NOMINAL);
+    assert!(m[0][0] > 0.0);
+    assert_eq!(
+        m,
+        named_f64::Plain::mass_matrix(&angles(), &named_f64::PlainPayload::NOMINAL)
+    );
+    assert_eq!(
+        crowded::shadowed::Arm::mass_matrix(&angles(), &crowded::shadowed::ArmPayload::NOMINAL),
+        crowded::Plain::mass_matrix(&angles(), &crowded::PlainPayload::NOMINAL)
+    );
+    // The constants and op counts come through too.
+    assert_eq!(named_usize::shadowed::usize::N, named_usize::Plain::N);
+    assert_eq!(named_some::shadowed::Some::NQ, named_some::Plain::NQ);
+    assert_eq!(named_str::shadowed::str::JOINTS, named_str::Plain::JOINTS);
+    let crowded_ops =
+        crowded::shadowed::Arm::OP_COUNTS.map(|c| (c.function, c.mass_matrix_method, c.mul));
+    let plain_ops = crowded::Plain::OP_COUNTS.map(|c| (c.function, c.mass_matrix_method, c.mul));
+    assert_eq!(crowded_ops, plain_ops);
 }

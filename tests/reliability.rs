@@ -408,7 +408,9 @@ fn generate_at_n_200_stays_under_1_gb() {
     println!("generate N = 200: {mb:.0} MB peak, {secs:.1} s");
     assert!(mb < 1024.0, "{mb:.0} MB");
     let code = std::fs::read_to_string(&out).unwrap();
-    assert!(code.contains("pub fn forward_dynamics(") && code.contains("[f64; 200]"));
+    assert!(
+        code.contains("pub fn forward_dynamics(") && code.contains("[::core::primitive::f64; 200]")
+    );
     std::fs::remove_dir_all(&d).ok();
 }
 

@@ -87,6 +87,7 @@ pub mod tables;
 
 use self::tables::{numbers, M3};
 use crate::options::{Error, Float, Form, Options};
+use crate::paths;
 use kanegen_dynamics::{ForwardMethod, MassMatrixMethod, Methods, NonlinearEffectsMethod};
 use kanegen_model::Model;
 use kanegen_runtime::compact::floating::Base;
@@ -307,13 +308,10 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         let v = v.iter().map(|v| vector(float, v));
         quote!(&[#(#v),*])
     };
-    let parent = t.parent.iter().map(|p| match p {
-        Some(l) => {
-            let l = Literal::usize_unsuffixed(*l);
-            quote!(Some(#l))
-        }
-        None => quote!(None),
-    });
+    let parent = t
+        .parent
+        .iter()
+        .map(|p| paths::option(p.map(Literal::usize_unsuffixed)));
     let (a, b, c, l, slide) = (
         mats(&t.a),
         mats(&t.b),
@@ -324,13 +322,10 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let s = t.s.iter().map(|v| vector(float, v));
     let inertia = t.inertia.iter().map(|v| vector(float, v));
     let revolute = &t.revolute;
-    let ancestor = match &t.ancestor {
-        Some(flat) => {
-            let rows = flat.chunks(t.dof().max(1)).map(|r| quote!(#(#r,)*));
-            quote!(Some(&[#(#rows)*]))
-        }
-        None => quote!(None),
-    };
+    let ancestor = paths::option(t.ancestor.as_ref().map(|flat| {
+        let rows = flat.chunks(t.dof().max(1)).map(|r| quote!(#(#r,)*));
+        quote!(&[#(#rows)*])
+    }));
     let a0 = vector(float, &t.a0);
     let base = t.base.as_ref().map(|base| floating_base(&rt, float, base));
     let frames = frames(&rt, float, &t.frames);
@@ -376,6 +371,10 @@ fn floating_body(
         let k = Literal::usize_unsuffixed(k);
         quote!(&Self::CX_FRAMES[#k])
     };
+    let none = paths::option(None::<TokenStream>);
+    let [some_v, some_a, some_f_ext] = [quote!(v), quote!(a), quote!(f_ext)]
+        .map(Some)
+        .map(paths::option);
     Some(match f {
         Function::Momentum => quote!(#fk::momentum::<_, #nl>(#args, v, #sincos)),
         Function::BaseReaction => quote!(#fk::base_reaction::<_, #nl>(#args, v, a, #sincos)),
@@ -395,22 +394,22 @@ fn floating_body(
         }
         Function::MassMatrix => quote!(#fk::mass_matrix::<_, #nl, #nvl>(#args, #sincos)),
         Function::NonlinearEffects => {
-            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), None, #sincos))
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, #some_v, #none, #sincos))
         }
         Function::Gravity => {
-            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, None, None, #sincos))
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, #none, #none, #sincos))
         }
         Function::InverseDynamics => {
-            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, Some(v), Some(a), #sincos))
+            quote!(#fk::inverse_dynamics::<_, #nl, #nvl>(#args, #some_v, #some_a, #sincos))
         }
         Function::MassMatrixAndNonlinearEffects => {
             quote!(#fk::mass_matrix_and_nonlinear_effects::<_, #nl, #nvl>(#args, v, #sincos))
         }
         Function::ForwardDynamics => {
-            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, None, #sincos))
+            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, #none, #sincos))
         }
         Function::ForwardDynamicsWithWrenches => {
-            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, Some(f_ext), #sincos))
+            quote!(#fk::forward_dynamics::<_, #nl, #nvl>(#args, v, tau, #some_f_ext, #sincos))
         }
         _ => return None,
     })
@@ -421,13 +420,7 @@ fn floating_body(
 fn floating_base(rt: &TokenStream, float: Float, base: &Base<f64>) -> TokenStream {
     let fl = float.ty();
     let inertia = vector(float, &base.inertia);
-    let gravity = match &base.gravity {
-        Some(g) => {
-            let g = vector(float, g);
-            quote!(Some(#g))
-        }
-        None => quote!(None),
-    };
+    let gravity = paths::option(base.gravity.as_ref().map(|g| vector(float, g)));
     quote! {
         /// Compact form: the free-floating base's spatial inertia about its origin
         /// (`[m, h, Ī]`) and gravity in the inertial frame, as the floating kernels read them.
@@ -447,13 +440,7 @@ fn frames(rt: &TokenStream, float: Float, frames: &[Frame<f64>]) -> TokenStream 
     let fl = float.ty();
     let k = Literal::usize_unsuffixed(frames.len());
     let each = frames.iter().map(|f| {
-        let body = match f.body {
-            Some(b) => {
-                let b = Literal::usize_unsuffixed(b);
-                quote!(Some(#b))
-            }
-            None => quote!(None),
-        };
+        let body = paths::option(f.body.map(Literal::usize_unsuffixed));
         let (t, r) = (vector(float, &f.translation), mat(float, &f.rotation));
         quote!(#rt::compact::Frame { body: #body, translation: #t, rotation: #r })
     });

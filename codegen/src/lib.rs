@@ -30,7 +30,13 @@
 //! use kanegen_model::random::{random_chain, ChainSpec};
 //! let model = random_chain(&ChainSpec { n: 2, ..Default::default() }, 1);
 //! let src = generate_file(&model, &Options::new("Arm")).unwrap();
-//! assert!(src.contains("pub fn nonlinear_effects(q: &[f64; 2], qd: &[f64; 2]) -> [f64; 2]"));
+//! // Primitive types by their full paths: the including module may call something `f64`.
+//! assert!(src.contains(
+//!     "pub fn nonlinear_effects(
+//!         q: &[::core::primitive::f64; 2],
+//!         qd: &[::core::primitive::f64; 2],
+//!     ) -> [::core::primitive::f64; 2] {"
+//! ));
 //! ```
 #![warn(missing_docs)]
 
@@ -40,6 +46,7 @@ pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
+pub mod paths;
 pub mod plan;
 pub mod sincos;
 
@@ -138,11 +145,69 @@ struct Names {
 
 impl Names {
     fn new(opts: &Options) -> Result<Self, Error> {
-        Ok(Names {
+        let names = Names {
             ty: ident("type name", &opts.type_name)?,
             payload: ident("payload name", &opts.payload_name)?,
             op_count: ident("op-count name", &opts.op_count_name)?,
-        })
+        };
+        check_names(opts)?;
+        Ok(names)
+    }
+}
+
+/// Checks that the items the generated code declares in the including module, the type
+/// ([`Options::type_name`]), its op-count struct ([`Options::op_count_name`]) and, with
+/// [`Options::runtime_payload`], its payload struct ([`Options::payload_name`]), have names of
+/// their own, and that none of them shadows a crate or module the emitted code calls into (the
+/// first segment of the libm, runtime and fma paths): one clear error instead of the compiler's
+/// cascade over the generated code.
+///
+/// # Errors
+/// Naming the clash and what to rename.
+pub fn check_names(opts: &Options) -> Result<(), Error> {
+    let mut declared = vec![
+        ("the generated type", &opts.type_name),
+        ("its op-count struct", &opts.op_count_name),
+    ];
+    if opts.runtime_payload {
+        declared.push(("its payload struct", &opts.payload_name));
+    }
+    for (k, (what, name)) in declared.iter().enumerate() {
+        if let Some((first, _)) = declared[..k].iter().find(|(_, n)| n == name) {
+            return Err(Error(format!(
+                "{first} and {what} are both called `{name}`: {}",
+                rename(first)
+            )));
+        }
+    }
+    let mut called = vec![("libm", opts.libm()?), ("runtime", opts.runtime()?)];
+    if let (true, Some(p)) = (opts.fma, &opts.fma_path) {
+        let p: syn::Path = syn::parse_str(p).map_err(|e| Error(format!("fma path `{p}`: {e}")))?;
+        called.push(("fma", quote!(#p)));
+    }
+    for (path_name, path) in &called {
+        // A path from the crate root (`::libm`) or `$crate` cannot be shadowed.
+        let Some(proc_macro2::TokenTree::Ident(head)) = path.clone().into_iter().next() else {
+            continue;
+        };
+        if let Some((what, name)) = declared.iter().find(|(_, n)| head == n) {
+            return Err(Error(format!(
+                "{what} is called `{name}`, which would shadow the first segment of the {path_name} \
+                 path `{}` the generated code calls: {}",
+                path.to_string().replace(' ', ""),
+                rename(what)
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// What to rename in a name clash of [`check_names`] involving `what`.
+fn rename(what: &str) -> &'static str {
+    if what == "the generated type" {
+        "give the type another name"
+    } else {
+        "rename one of them"
     }
 }
 
@@ -353,14 +418,10 @@ fn op_count_entries(
         let ch = &fp.choice;
         let (m, c, frames) = (cand.methods, cand.counts, cand.frames.name());
         let function = &fp.name;
-        let opt = |x: Option<&str>| match x {
-            Some(s) => quote!(Some(#s)),
-            None => quote!(None),
-        };
         let (mm, bm, fm) = (
-            opt(ch.mass_matrix_method(m)),
-            opt(ch.nonlinear_effects_method(m)),
-            opt(ch.forward_method(m)),
+            paths::option(ch.mass_matrix_method(m)),
+            paths::option(ch.nonlinear_effects_method(m)),
+            paths::option(ch.forward_method(m)),
         );
         let (mul, add, div, sqrt, sincos) = (c.mul, c.add, c.div, c.sqrt, c.sincos);
         quote!(#op_ty {
@@ -442,6 +503,8 @@ fn type_items(
     );
     let consts = type_consts(plan, opts.float, fmas, op_ty);
     let helpers = helper_items(plan, opts, fmas)?;
+    let (name, u64) = (paths::static_str(), paths::primitive("u64"));
+    let method = paths::option_type(&name);
     Ok(quote! {
         #(#struct_docs)*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -453,29 +516,29 @@ fn type_items(
         #[derive(Clone, Copy, Debug, PartialEq, Eq)]
         pub struct #op_ty {
             /// The generated function.
-            pub function: &'static str,
+            pub function: #name,
             /// Its mass-matrix method.
-            pub mass_matrix_method: Option<&'static str>,
+            pub mass_matrix_method: #method,
             /// Its nonlinear-effects method.
-            pub nonlinear_effects_method: Option<&'static str>,
+            pub nonlinear_effects_method: #method,
             /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
             /// the articulated-body algorithm, which uses neither), for forward dynamics.
-            pub forward_method: Option<&'static str>,
+            pub forward_method: #method,
             /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
             /// joint axis z, modified-DH x; the same joint-space results).
-            pub frames: &'static str,
+            pub frames: #name,
             /// Multiplications.
-            pub mul: u64,
+            pub mul: #u64,
             /// Additions and subtractions.
-            pub add: u64,
+            pub add: #u64,
             /// Divisions.
-            pub div: u64,
+            pub div: #u64,
             /// Square roots.
-            pub sqrt: u64,
+            pub sqrt: #u64,
             /// Angles whose sine and cosine are taken.
-            pub sincos: u64,
+            pub sincos: #u64,
             /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-            pub fma: u64,
+            pub fma: #u64,
         }
 
         #[allow(
@@ -510,6 +573,7 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
     let joint_names = coordinates.iter().map(|&j| model.joints()[j].name.as_str());
     let frame_names = model.frames().iter().map(|f| f.name.as_str());
     let n_frames = Literal::usize_unsuffixed(model.frames().len());
+    let (usize, name) = (paths::primitive("usize"), paths::static_str());
     let floating_consts = if plan.floating() {
         let (nq, nv) = (
             Literal::usize_unsuffixed(n + 7),
@@ -517,9 +581,9 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
         );
         quote! {
             /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
-            pub const NQ: usize = #nq;
+            pub const NQ: #usize = #nq;
             /// Length of `v`: base linear and angular velocity (base frame), joint rates.
-            pub const NV: usize = #nv;
+            pub const NV: #usize = #nv;
         }
     } else {
         quote!()
@@ -531,12 +595,12 @@ fn type_consts(plan: &Plan, float: Float, fmas: &[u64], op_ty: &syn::Ident) -> T
     let (emitted, all) = op_count_entries(plan, fmas, op_ty);
     quote! {
         /// Degrees of freedom.
-        pub const N: usize = #nl;
+        pub const N: #usize = #nl;
         /// Joint names, in the order of the joint entries of `q` (a mimic joint follows its
         /// primary and has no entry).
-        pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
+        pub const JOINTS: [#name; #nl] = [#(#joint_names),*];
         /// Named frames, in the model's order (one `<frame>_…` function family each).
-        pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
+        pub const FRAMES: [#name; #n_frames] = [#(#frame_names),*];
         #limits
         #floating_consts
         /// Emitted operation counts of each generated function, in emission order.
@@ -731,9 +795,10 @@ pub use kanegen_model;
 /// (`kanegen_runtime::fma`): one fused instruction where the build targets it, `a·b + c` (two
 /// roundings, bit-identical to unfused code) elsewhere.
 fn mul_add_fn(float: Float, runtime: &TokenStream) -> TokenStream {
-    let (ty, f) = match float {
-        Float::F64 => (quote!(f64), quote!(mul_add)),
-        Float::F32 => (quote!(f32), quote!(mul_add_f32)),
+    let ty = float.ty();
+    let f = match float {
+        Float::F64 => quote!(mul_add),
+        Float::F32 => quote!(mul_add_f32),
     };
     quote! {
         /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
@@ -903,6 +968,59 @@ mod tests {
         // Not used without fma.
         o.fma = false;
         assert!(generate_items(&chain, &o).is_ok());
+    }
+
+    /// Two declared items of one name, or a declared name that would shadow a path the code
+    /// calls, is one error naming the clash; the payload's name is free without a payload struct,
+    /// and a path from the crate root cannot be shadowed.
+    #[test]
+    fn clashing_names_are_one_error() {
+        let chain = random_chain(&ChainSpec::default(), 1);
+        let err = |o: &Options| check_names(o).err().map(|e| e.0);
+        let mut o = Options::new("OpCount");
+        let clash = "the generated type and its op-count struct are both called `OpCount`: give \
+                     the type another name";
+        assert_eq!(err(&o).as_deref(), Some(clash));
+        assert_eq!(
+            generate_items(&chain, &o).err().map(|e| e.0).as_deref(),
+            Some(clash)
+        );
+        o.type_name = "Payload".into();
+        assert_eq!(err(&o), None);
+        o.runtime_payload = true;
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "the generated type and its payload struct are both called `Payload`: give the \
+                 type another name"
+            )
+        );
+        o.type_name = "Arm".into();
+        o.op_count_name = "Payload".into();
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "its op-count struct and its payload struct are both called `Payload`: rename \
+                 one of them"
+            )
+        );
+        let mut o = Options::new("libm");
+        assert_eq!(
+            err(&o).as_deref(),
+            Some(
+                "the generated type is called `libm`, which would shadow the first segment of \
+                 the libm path `libm` the generated code calls: give the type another name"
+            )
+        );
+        o.libm_path = "::libm".into();
+        assert_eq!(err(&o), None);
+        o.type_name = "kanegen_runtime".into();
+        assert!(err(&o).is_some_and(|e| e.contains("the runtime path `kanegen_runtime`")));
+        let mut o = Options::new("f64");
+        o.fma_path = Some("f64::mul_add".into());
+        assert_eq!(err(&o), None, "the fma path is not called without fma");
+        o.fma = true;
+        assert!(err(&o).is_some_and(|e| e.contains("the fma path `f64::mul_add`")));
     }
 
     /// The f32 code names no f64 anywhere; the fma code calls the fma path and says how many it

@@ -180,9 +180,9 @@ impl Float {
         }
     }
 
+    /// The type in emitted code, by its full path ([`crate::paths::primitive`]).
     pub(crate) fn ty(self) -> TokenStream {
-        let t = format_ident!("{}", self.name());
-        quote!(#t)
+        crate::paths::primitive(self.name())
     }
 
     /// The libm function `base` for this type: `sin` or `sinf`.

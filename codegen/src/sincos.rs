@@ -26,11 +26,15 @@ pub fn item(runtime: &TokenStream, mul_add: bool) -> TokenStream {
     } else {
         quote!(#runtime::sincos::sincos_n_unfused)
     };
+    let (f64, usize) = (
+        crate::paths::primitive("f64"),
+        crate::paths::primitive("usize"),
+    );
     quote! {
         /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
         #[inline(always)]
         #[must_use]
-        pub fn sincos(x: f64) -> (f64, f64) {
+        pub fn sincos(x: #f64) -> (#f64, #f64) {
             let [sc] = Self::sincos_n([x]);
             sc
         }
@@ -40,7 +44,7 @@ pub fn item(runtime: &TokenStream, mul_add: bool) -> TokenStream {
         /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
         #[inline(always)]
         #[must_use]
-        pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+        pub fn sincos_n<const N: #usize>(x: [#f64; N]) -> [(#f64, #f64); N] {
             #batched(x)
         }
     }

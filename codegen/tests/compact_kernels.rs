@@ -339,7 +339,11 @@ const KERNELS: [Function; 7] = [
 /// changed without the counts following fails here.
 fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
     let t = numbers(model, opts);
-    let items = generate_items(model, opts).unwrap().items.to_string();
+    let items = generate_items(model, opts)
+        .unwrap()
+        .items
+        .to_string()
+        .replace(' ', "");
     let frames =
         (0..t.frames.len()).flat_map(|k| [Function::FramePlacement(k), Function::FrameJacobian(k)]);
     for f in KERNELS.into_iter().chain(frames) {
@@ -367,10 +371,10 @@ fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
             _ => f.name().to_string(),
         };
         let entry = format!(
-            "function : \"{}\" , mass_matrix_method : {}",
+            "function:\"{}\",mass_matrix_method:::core::option::Option::{}",
             name,
             if f.uses_mass_matrix() && !f.is_forward_dynamics() {
-                "Some (\"crba\")"
+                "Some(\"crba\")"
             } else {
                 "None"
             }
@@ -379,7 +383,7 @@ fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
             .find(&entry)
             .unwrap_or_else(|| panic!("no `{entry}` in OP_COUNTS"));
         let end = at + items[at..].find('}').unwrap();
-        let reported = items[at..end].replace(' ', "");
+        let reported = &items[at..end];
         assert!(
             reported.contains(&format!(
                 "mul:{}u64,add:{}u64,div:{}u64",

@@ -98,29 +98,31 @@ pub struct FreeFloating7;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCount {
     /// The generated function.
-    pub function: &'static str,
+    pub function: &'static ::core::primitive::str,
     /// Its mass-matrix method.
-    pub mass_matrix_method: Option<&'static str>,
+    pub mass_matrix_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// Its nonlinear-effects method.
-    pub nonlinear_effects_method: Option<&'static str>,
+    pub nonlinear_effects_method: ::core::option::Option<
+        &'static ::core::primitive::str,
+    >,
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
-    pub forward_method: Option<&'static str>,
+    pub forward_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
     /// joint axis z, modified-DH x; the same joint-space results).
-    pub frames: &'static str,
+    pub frames: &'static ::core::primitive::str,
     /// Multiplications.
-    pub mul: u64,
+    pub mul: ::core::primitive::u64,
     /// Additions and subtractions.
-    pub add: u64,
+    pub add: ::core::primitive::u64,
     /// Divisions.
-    pub div: u64,
+    pub div: ::core::primitive::u64,
     /// Square roots.
-    pub sqrt: u64,
+    pub sqrt: ::core::primitive::u64,
     /// Angles whose sine and cosine are taken.
-    pub sincos: u64,
+    pub sincos: ::core::primitive::u64,
     /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-    pub fma: u64,
+    pub fma: ::core::primitive::u64,
 }
 #[allow(
     clippy::approx_constant,
@@ -136,9 +138,9 @@ pub struct OpCount {
 )]
 impl FreeFloating7 {
     /// Degrees of freedom.
-    pub const N: usize = 7;
+    pub const N: ::core::primitive::usize = 7;
     /// Joint names, in the order of the joint entries of `q`.
-    pub const JOINTS: [&'static str; 7] = [
+    pub const JOINTS: [&'static ::core::primitive::str; 7] = [
         "joint_1",
         "joint_2",
         "joint_3",
@@ -148,9 +150,9 @@ impl FreeFloating7 {
         "joint_7",
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
-    pub const FRAMES: [&'static str; 0] = [];
+    pub const FRAMES: [&'static ::core::primitive::str; 0] = [];
     /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
-    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+    pub const LOWER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         -3.141592653589793f64,
         -3.141592653589793f64,
         -3.141592653589793f64,
@@ -160,7 +162,7 @@ impl FreeFloating7 {
         -3.141592653589793f64,
     ];
     /// Highest joint positions (rad or m; `+∞` where the model gives none).
-    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+    pub const UPPER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         3.141592653589793f64,
         3.141592653589793f64,
         3.141592653589793f64,
@@ -170,22 +172,24 @@ impl FreeFloating7 {
         3.141592653589793f64,
     ];
     /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
-    pub const VELOCITY_LIMIT: [f64; 7] = [1f64, 1f64, 1f64, 1f64, 1f64, 1f64, 1f64];
+    pub const VELOCITY_LIMIT: [::core::primitive::f64; 7] = [
+        1f64, 1f64, 1f64, 1f64, 1f64, 1f64, 1f64,
+    ];
     /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
-    pub const EFFORT_LIMIT: [f64; 7] = [
+    pub const EFFORT_LIMIT: [::core::primitive::f64; 7] = [
         10000f64, 10000f64, 10000f64, 10000f64, 10000f64, 10000f64, 10000f64,
     ];
     /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
-    pub const NQ: usize = 14;
+    pub const NQ: ::core::primitive::usize = 14;
     /// Length of `v`: base linear and angular velocity (base frame), joint rates.
-    pub const NV: usize = 13;
+    pub const NV: ::core::primitive::usize = 13;
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 8] = [
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 445u64,
             add: 439u64,
@@ -196,9 +200,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 504u64,
             add: 412u64,
@@ -209,9 +213,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 518u64,
             add: 441u64,
@@ -222,9 +226,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1449u64,
             add: 1286u64,
@@ -235,9 +239,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 949u64,
             add: 847u64,
@@ -248,9 +252,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1463u64,
             add: 1350u64,
@@ -261,9 +265,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "momentum",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 350u64,
             add: 283u64,
@@ -274,9 +278,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "base_reaction",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 688u64,
             add: 566u64,
@@ -290,9 +294,9 @@ impl FreeFloating7 {
     pub const CANDIDATES: &'static [OpCount] = &[
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1825u64,
             add: 2486u64,
@@ -303,9 +307,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1840u64,
             add: 2501u64,
@@ -316,9 +320,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 2104u64,
             add: 2555u64,
@@ -329,9 +333,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 2119u64,
             add: 2570u64,
@@ -342,9 +346,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 3454u64,
             add: 2893u64,
@@ -355,9 +359,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 3469u64,
             add: 2908u64,
@@ -368,9 +372,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1303u64,
             add: 1037u64,
@@ -381,9 +385,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1318u64,
             add: 1052u64,
@@ -394,9 +398,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 456u64,
             add: 450u64,
@@ -407,9 +411,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 445u64,
             add: 439u64,
@@ -420,9 +424,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1147u64,
             add: 881u64,
@@ -433,9 +437,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1162u64,
             add: 896u64,
@@ -446,9 +450,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1564u64,
             add: 1276u64,
@@ -459,9 +463,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1579u64,
             add: 1291u64,
@@ -472,9 +476,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 631u64,
             add: 502u64,
@@ -485,9 +489,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 633u64,
             add: 502u64,
@@ -498,9 +502,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 509u64,
             add: 415u64,
@@ -511,9 +515,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 504u64,
             add: 412u64,
@@ -524,9 +528,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 670u64,
             add: 548u64,
@@ -537,9 +541,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 672u64,
             add: 548u64,
@@ -550,9 +554,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 670u64,
             add: 548u64,
@@ -563,9 +567,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 672u64,
             add: 548u64,
@@ -576,9 +580,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 670u64,
             add: 548u64,
@@ -589,9 +593,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 672u64,
             add: 548u64,
@@ -602,9 +606,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 523u64,
             add: 444u64,
@@ -615,9 +619,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 518u64,
             add: 441u64,
@@ -628,9 +632,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2103u64,
             add: 1770u64,
@@ -641,9 +645,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2104u64,
             add: 1768u64,
@@ -654,9 +658,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2520u64,
             add: 2165u64,
@@ -667,9 +671,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2521u64,
             add: 2163u64,
@@ -680,9 +684,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1585u64,
             add: 1389u64,
@@ -693,9 +697,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1578u64,
             add: 1378u64,
@@ -706,9 +710,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1463u64,
             add: 1302u64,
@@ -719,9 +723,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1449u64,
             add: 1286u64,
@@ -732,9 +736,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2505u64,
             add: 2118u64,
@@ -745,9 +749,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2520u64,
             add: 2133u64,
@@ -758,9 +762,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2922u64,
             add: 2513u64,
@@ -771,9 +775,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2937u64,
             add: 2528u64,
@@ -784,9 +788,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2545u64,
             add: 2066u64,
@@ -797,9 +801,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2562u64,
             add: 2081u64,
@@ -810,9 +814,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2423u64,
             add: 1979u64,
@@ -823,9 +827,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 2430u64,
             add: 1985u64,
@@ -836,9 +840,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 1592u64,
             add: 1277u64,
@@ -849,9 +853,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "canonical",
             mul: 1601u64,
             add: 1280u64,
@@ -862,9 +866,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1603u64,
             add: 1331u64,
@@ -875,9 +879,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1604u64,
             add: 1329u64,
@@ -888,9 +892,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 2020u64,
             add: 1726u64,
@@ -901,9 +905,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 2021u64,
             add: 1724u64,
@@ -914,9 +918,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1085u64,
             add: 950u64,
@@ -927,9 +931,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1078u64,
             add: 939u64,
@@ -940,9 +944,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 963u64,
             add: 863u64,
@@ -953,9 +957,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 949u64,
             add: 847u64,
@@ -966,9 +970,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1894u64,
             add: 1591u64,
@@ -979,9 +983,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1909u64,
             add: 1606u64,
@@ -992,9 +996,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 2311u64,
             add: 1986u64,
@@ -1005,9 +1009,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 2326u64,
             add: 2001u64,
@@ -1018,9 +1022,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1934u64,
             add: 1539u64,
@@ -1031,9 +1035,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1951u64,
             add: 1554u64,
@@ -1044,9 +1048,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1812u64,
             add: 1452u64,
@@ -1057,9 +1061,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 1819u64,
             add: 1458u64,
@@ -1070,9 +1074,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2247u64,
             add: 1914u64,
@@ -1083,9 +1087,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2664u64,
             add: 2309u64,
@@ -1096,9 +1100,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1585u64,
             add: 1437u64,
@@ -1109,9 +1113,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1463u64,
             add: 1350u64,
@@ -1122,9 +1126,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2649u64,
             add: 2262u64,
@@ -1135,9 +1139,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 3066u64,
             add: 2657u64,
@@ -1148,9 +1152,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2545u64,
             add: 2114u64,
@@ -1161,9 +1165,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 2423u64,
             add: 2027u64,
@@ -1174,9 +1178,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 1592u64,
             add: 1325u64,
@@ -1187,9 +1191,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "momentum",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 350u64,
             add: 283u64,
@@ -1200,9 +1204,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "base_reaction",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 688u64,
             add: 566u64,
@@ -1213,9 +1217,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "base_reaction",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 688u64,
             add: 566u64,
@@ -1226,9 +1230,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "base_reaction",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 688u64,
             add: 566u64,
@@ -1239,9 +1243,9 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "base_reaction",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 688u64,
             add: 566u64,
@@ -1255,7 +1259,9 @@ impl FreeFloating7 {
     ///
     /// Methods: mass matrix `crba`: 445 mul, 439 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 268 fused where the target has FMA.
     #[must_use]
-    pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
+    pub fn mass_matrix(
+        q: &[::core::primitive::f64; 14],
+    ) -> [[::core::primitive::f64; 13]; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -1885,7 +1891,10 @@ impl FreeFloating7 {
     ///
     /// Methods: nonlinear effects `newton-euler`: 504 mul, 412 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 308 fused where the target has FMA.
     #[must_use]
-    pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
+    pub fn nonlinear_effects(
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+    ) -> [::core::primitive::f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -2410,7 +2419,11 @@ impl FreeFloating7 {
     ///
     /// Methods: nonlinear effects `newton-euler`: 518 mul, 441 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
     #[must_use]
-    pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
+    pub fn inverse_dynamics(
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+        a: &[::core::primitive::f64; 13],
+    ) -> [::core::primitive::f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -2956,7 +2969,11 @@ impl FreeFloating7 {
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 1449 mul, 1286 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
     #[must_use]
-    pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
+    pub fn forward_dynamics(
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+        tau: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -4713,9 +4730,9 @@ impl FreeFloating7 {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 949 mul, 847 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 576 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 14],
-        v: &[f64; 13],
-    ) -> ([[f64; 13]; 13], [f64; 13]) {
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+    ) -> ([[::core::primitive::f64; 13]; 13], [::core::primitive::f64; 13]) {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -5929,11 +5946,11 @@ impl FreeFloating7 {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 1463 mul, 1350 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 14],
-        v: &[f64; 13],
-        tau: &[f64; 7],
-        f_ext: &[[f64; 6]; 8],
-    ) -> [f64; 13] {
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+        tau: &[::core::primitive::f64; 7],
+        f_ext: &[[::core::primitive::f64; 6]; 8],
+    ) -> [::core::primitive::f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -7733,7 +7750,10 @@ impl FreeFloating7 {
     ///
     /// : 350 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 215 fused where the target has FMA.
     #[must_use]
-    pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
+    pub fn momentum(
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -8090,7 +8110,11 @@ impl FreeFloating7 {
     ///
     /// Methods: nonlinear effects `recurrent`: 688 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 426 fused where the target has FMA.
     #[must_use]
-    pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
+    pub fn base_reaction(
+        q: &[::core::primitive::f64; 14],
+        v: &[::core::primitive::f64; 13],
+        a: &[::core::primitive::f64; 13],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
         (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
             q[7],
@@ -8701,13 +8725,19 @@ impl FreeFloating7 {
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
     /// elsewhere.
     #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
+    fn mul_add(
+        a: ::core::primitive::f64,
+        b: ::core::primitive::f64,
+        c: ::core::primitive::f64,
+    ) -> ::core::primitive::f64 {
         kanegen_runtime::fma::mul_add(a, b, c)
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
-    pub fn sincos(x: f64) -> (f64, f64) {
+    pub fn sincos(
+        x: ::core::primitive::f64,
+    ) -> (::core::primitive::f64, ::core::primitive::f64) {
         let [sc] = Self::sincos_n([x]);
         sc
     }
@@ -8716,7 +8746,9 @@ impl FreeFloating7 {
     /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
-    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+    pub fn sincos_n<const N: ::core::primitive::usize>(
+        x: [::core::primitive::f64; N],
+    ) -> [(::core::primitive::f64, ::core::primitive::f64); N] {
         kanegen_runtime::sincos::sincos_n(x)
     }
 }

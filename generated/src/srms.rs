@@ -93,29 +93,31 @@ pub struct Srms;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCount {
     /// The generated function.
-    pub function: &'static str,
+    pub function: &'static ::core::primitive::str,
     /// Its mass-matrix method.
-    pub mass_matrix_method: Option<&'static str>,
+    pub mass_matrix_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// Its nonlinear-effects method.
-    pub nonlinear_effects_method: Option<&'static str>,
+    pub nonlinear_effects_method: ::core::option::Option<
+        &'static ::core::primitive::str,
+    >,
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
-    pub forward_method: Option<&'static str>,
+    pub forward_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
     /// joint axis z, modified-DH x; the same joint-space results).
-    pub frames: &'static str,
+    pub frames: &'static ::core::primitive::str,
     /// Multiplications.
-    pub mul: u64,
+    pub mul: ::core::primitive::u64,
     /// Additions and subtractions.
-    pub add: u64,
+    pub add: ::core::primitive::u64,
     /// Divisions.
-    pub div: u64,
+    pub div: ::core::primitive::u64,
     /// Square roots.
-    pub sqrt: u64,
+    pub sqrt: ::core::primitive::u64,
     /// Angles whose sine and cosine are taken.
-    pub sincos: u64,
+    pub sincos: ::core::primitive::u64,
     /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-    pub fma: u64,
+    pub fma: ::core::primitive::u64,
 }
 #[allow(
     clippy::approx_constant,
@@ -131,9 +133,9 @@ pub struct OpCount {
 )]
 impl Srms {
     /// Degrees of freedom.
-    pub const N: usize = 6;
+    pub const N: ::core::primitive::usize = 6;
     /// Joint names, in the order of the joint entries of `q`.
-    pub const JOINTS: [&'static str; 6] = [
+    pub const JOINTS: [&'static ::core::primitive::str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",
         "elbow_pitch",
@@ -142,9 +144,9 @@ impl Srms {
         "wrist_roll",
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
-    pub const FRAMES: [&'static str; 0] = [];
+    pub const FRAMES: [&'static ::core::primitive::str; 0] = [];
     /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
-    pub const LOWER_POSITION_LIMIT: [f64; 6] = [
+    pub const LOWER_POSITION_LIMIT: [::core::primitive::f64; 6] = [
         -3.0962f64,
         0f64,
         -2.75064f64,
@@ -153,7 +155,7 @@ impl Srms {
         -7.714f64,
     ];
     /// Highest joint positions (rad or m; `+∞` where the model gives none).
-    pub const UPPER_POSITION_LIMIT: [f64; 6] = [
+    pub const UPPER_POSITION_LIMIT: [::core::primitive::f64; 6] = [
         3.0962f64,
         2.485f64,
         0f64,
@@ -162,7 +164,7 @@ impl Srms {
         7.714f64,
     ];
     /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
-    pub const VELOCITY_LIMIT: [f64; 6] = [
+    pub const VELOCITY_LIMIT: [::core::primitive::f64; 6] = [
         0.03997f64,
         0.03997f64,
         0.056f64,
@@ -171,16 +173,16 @@ impl Srms {
         0.0831f64,
     ];
     /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
-    pub const EFFORT_LIMIT: [f64; 6] = [
+    pub const EFFORT_LIMIT: [::core::primitive::f64; 6] = [
         1570f64, 1570f64, 1074f64, 470f64, 470f64, 470f64,
     ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 118u64,
             add: 114u64,
@@ -191,9 +193,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 220u64,
             add: 157u64,
@@ -204,9 +206,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 232u64,
             add: 178u64,
@@ -217,9 +219,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
             add: 342u64,
@@ -230,9 +232,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 338u64,
             add: 271u64,
@@ -243,9 +245,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 430u64,
             add: 375u64,
@@ -259,9 +261,9 @@ impl Srms {
     pub const CANDIDATES: &'static [OpCount] = &[
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 468u64,
             add: 392u64,
@@ -272,9 +274,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 468u64,
             add: 392u64,
@@ -285,9 +287,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 519u64,
             add: 422u64,
@@ -298,9 +300,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 519u64,
             add: 422u64,
@@ -311,9 +313,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 505u64,
             add: 352u64,
@@ -324,9 +326,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 505u64,
             add: 352u64,
@@ -337,9 +339,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 450u64,
             add: 339u64,
@@ -350,9 +352,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 450u64,
             add: 339u64,
@@ -363,9 +365,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 118u64,
             add: 115u64,
@@ -376,9 +378,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 118u64,
             add: 114u64,
@@ -389,9 +391,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 537u64,
             add: 386u64,
@@ -402,9 +404,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 537u64,
             add: 386u64,
@@ -415,9 +417,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 580u64,
             add: 428u64,
@@ -428,9 +430,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 580u64,
             add: 428u64,
@@ -441,9 +443,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 254u64,
             add: 181u64,
@@ -454,9 +456,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 254u64,
             add: 181u64,
@@ -467,9 +469,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 220u64,
             add: 157u64,
@@ -480,9 +482,9 @@ impl Srms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 220u64,
             add: 157u64,
@@ -493,9 +495,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 689u64,
             add: 537u64,
@@ -506,9 +508,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 689u64,
             add: 536u64,
@@ -519,9 +521,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 732u64,
             add: 579u64,
@@ -532,9 +534,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 732u64,
             add: 578u64,
@@ -545,9 +547,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 278u64,
             add: 207u64,
@@ -558,9 +560,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 278u64,
             add: 207u64,
@@ -571,9 +573,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 232u64,
             add: 178u64,
@@ -584,9 +586,9 @@ impl Srms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 232u64,
             add: 178u64,
@@ -597,9 +599,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 741u64,
             add: 572u64,
@@ -610,9 +612,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 741u64,
             add: 571u64,
@@ -623,9 +625,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 784u64,
             add: 614u64,
@@ -636,9 +638,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 784u64,
             add: 613u64,
@@ -649,9 +651,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 458u64,
             add: 367u64,
@@ -662,9 +664,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 458u64,
             add: 366u64,
@@ -675,9 +677,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 424u64,
             add: 343u64,
@@ -688,9 +690,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
             add: 342u64,
@@ -701,9 +703,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 801u64,
             add: 647u64,
@@ -714,9 +716,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 801u64,
             add: 647u64,
@@ -727,9 +729,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 844u64,
             add: 689u64,
@@ -740,9 +742,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 844u64,
             add: 689u64,
@@ -753,9 +755,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 790u64,
             add: 591u64,
@@ -766,9 +768,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 790u64,
             add: 591u64,
@@ -779,9 +781,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 756u64,
             add: 567u64,
@@ -792,9 +794,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 756u64,
             add: 567u64,
@@ -805,9 +807,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 567u64,
             add: 411u64,
@@ -818,9 +820,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "canonical",
             mul: 574u64,
             add: 414u64,
@@ -831,9 +833,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 655u64,
             add: 501u64,
@@ -844,9 +846,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 655u64,
             add: 500u64,
@@ -857,9 +859,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 698u64,
             add: 543u64,
@@ -870,9 +872,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 698u64,
             add: 542u64,
@@ -883,9 +885,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 372u64,
             add: 296u64,
@@ -896,9 +898,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 372u64,
             add: 295u64,
@@ -909,9 +911,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 338u64,
             add: 272u64,
@@ -922,9 +924,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 338u64,
             add: 271u64,
@@ -935,9 +937,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 715u64,
             add: 576u64,
@@ -948,9 +950,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 715u64,
             add: 576u64,
@@ -961,9 +963,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 758u64,
             add: 618u64,
@@ -974,9 +976,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 758u64,
             add: 618u64,
@@ -987,9 +989,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 704u64,
             add: 520u64,
@@ -1000,9 +1002,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 704u64,
             add: 520u64,
@@ -1013,9 +1015,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 670u64,
             add: 496u64,
@@ -1026,9 +1028,9 @@ impl Srms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 670u64,
             add: 496u64,
@@ -1039,9 +1041,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 817u64,
             add: 649u64,
@@ -1052,9 +1054,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 860u64,
             add: 691u64,
@@ -1065,9 +1067,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 464u64,
             add: 399u64,
@@ -1078,9 +1080,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 430u64,
             add: 375u64,
@@ -1091,9 +1093,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 877u64,
             add: 724u64,
@@ -1104,9 +1106,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 920u64,
             add: 766u64,
@@ -1117,9 +1119,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 796u64,
             add: 623u64,
@@ -1130,9 +1132,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 762u64,
             add: 599u64,
@@ -1143,9 +1145,9 @@ impl Srms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 573u64,
             add: 443u64,
@@ -1159,7 +1161,9 @@ impl Srms {
     ///
     /// Methods: mass matrix `crba`: 118 mul, 114 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 52 fused where the target has FMA.
     #[must_use]
-    pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
+    pub fn mass_matrix(
+        q: &[::core::primitive::f64; 6],
+    ) -> [[::core::primitive::f64; 6]; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -1302,7 +1306,10 @@ impl Srms {
     ///
     /// Methods: nonlinear effects `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
     #[must_use]
-    pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
+    pub fn nonlinear_effects(
+        q: &[::core::primitive::f64; 6],
+        qd: &[::core::primitive::f64; 6],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -1474,7 +1481,11 @@ impl Srms {
     ///
     /// Methods: nonlinear effects `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 134 fused where the target has FMA.
     #[must_use]
-    pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
+    pub fn inverse_dynamics(
+        q: &[::core::primitive::f64; 6],
+        qd: &[::core::primitive::f64; 6],
+        qdd: &[::core::primitive::f64; 6],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -1677,7 +1688,11 @@ impl Srms {
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 424 mul, 342 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
     #[must_use]
-    pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
+    pub fn forward_dynamics(
+        q: &[::core::primitive::f64; 6],
+        qd: &[::core::primitive::f64; 6],
+        tau: &[::core::primitive::f64; 6],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -2088,9 +2103,9 @@ impl Srms {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 338 mul, 271 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 6],
-        qd: &[f64; 6],
-    ) -> ([[f64; 6]; 6], [f64; 6]) {
+        q: &[::core::primitive::f64; 6],
+        qd: &[::core::primitive::f64; 6],
+    ) -> ([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6]) {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -2411,11 +2426,11 @@ impl Srms {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 430 mul, 375 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 6],
-        qd: &[f64; 6],
-        tau: &[f64; 6],
-        f_ext: &[[f64; 6]; 6],
-    ) -> [f64; 6] {
+        q: &[::core::primitive::f64; 6],
+        qd: &[::core::primitive::f64; 6],
+        tau: &[::core::primitive::f64; 6],
+        f_ext: &[[::core::primitive::f64; 6]; 6],
+    ) -> [::core::primitive::f64; 6] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -2848,13 +2863,19 @@ impl Srms {
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
     /// elsewhere.
     #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
+    fn mul_add(
+        a: ::core::primitive::f64,
+        b: ::core::primitive::f64,
+        c: ::core::primitive::f64,
+    ) -> ::core::primitive::f64 {
         kanegen_runtime::fma::mul_add(a, b, c)
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
-    pub fn sincos(x: f64) -> (f64, f64) {
+    pub fn sincos(
+        x: ::core::primitive::f64,
+    ) -> (::core::primitive::f64, ::core::primitive::f64) {
         let [sc] = Self::sincos_n([x]);
         sc
     }
@@ -2863,7 +2884,9 @@ impl Srms {
     /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
-    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+    pub fn sincos_n<const N: ::core::primitive::usize>(
+        x: [::core::primitive::f64; N],
+    ) -> [(::core::primitive::f64, ::core::primitive::f64); N] {
         kanegen_runtime::sincos::sincos_n(x)
     }
 }

@@ -99,29 +99,31 @@ pub struct Ssrms;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCount {
     /// The generated function.
-    pub function: &'static str,
+    pub function: &'static ::core::primitive::str,
     /// Its mass-matrix method.
-    pub mass_matrix_method: Option<&'static str>,
+    pub mass_matrix_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// Its nonlinear-effects method.
-    pub nonlinear_effects_method: Option<&'static str>,
+    pub nonlinear_effects_method: ::core::option::Option<
+        &'static ::core::primitive::str,
+    >,
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
-    pub forward_method: Option<&'static str>,
+    pub forward_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
     /// joint axis z, modified-DH x; the same joint-space results).
-    pub frames: &'static str,
+    pub frames: &'static ::core::primitive::str,
     /// Multiplications.
-    pub mul: u64,
+    pub mul: ::core::primitive::u64,
     /// Additions and subtractions.
-    pub add: u64,
+    pub add: ::core::primitive::u64,
     /// Divisions.
-    pub div: u64,
+    pub div: ::core::primitive::u64,
     /// Square roots.
-    pub sqrt: u64,
+    pub sqrt: ::core::primitive::u64,
     /// Angles whose sine and cosine are taken.
-    pub sincos: u64,
+    pub sincos: ::core::primitive::u64,
     /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-    pub fma: u64,
+    pub fma: ::core::primitive::u64,
 }
 #[allow(
     clippy::approx_constant,
@@ -137,9 +139,9 @@ pub struct OpCount {
 )]
 impl Ssrms {
     /// Degrees of freedom.
-    pub const N: usize = 7;
+    pub const N: ::core::primitive::usize = 7;
     /// Joint names, in the order of the joint entries of `q`.
-    pub const JOINTS: [&'static str; 7] = [
+    pub const JOINTS: [&'static ::core::primitive::str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
         "shoulder_pitch",
@@ -149,9 +151,9 @@ impl Ssrms {
         "wrist_roll",
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
-    pub const FRAMES: [&'static str; 0] = [];
+    pub const FRAMES: [&'static ::core::primitive::str; 0] = [];
     /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
-    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+    pub const LOWER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         -4.71239f64,
         -4.71239f64,
         -4.71239f64,
@@ -161,7 +163,7 @@ impl Ssrms {
         -4.71239f64,
     ];
     /// Highest joint positions (rad or m; `+∞` where the model gives none).
-    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+    pub const UPPER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         4.71239f64,
         4.71239f64,
         4.71239f64,
@@ -171,7 +173,7 @@ impl Ssrms {
         4.71239f64,
     ];
     /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
-    pub const VELOCITY_LIMIT: [f64; 7] = [
+    pub const VELOCITY_LIMIT: [::core::primitive::f64; 7] = [
         0.0698132f64,
         0.0698132f64,
         0.0698132f64,
@@ -181,16 +183,16 @@ impl Ssrms {
         0.0698132f64,
     ];
     /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
-    pub const EFFORT_LIMIT: [f64; 7] = [
+    pub const EFFORT_LIMIT: [::core::primitive::f64; 7] = [
         2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64,
     ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 9] = [
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 120u64,
             add: 97u64,
@@ -201,9 +203,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 206u64,
             add: 141u64,
@@ -214,9 +216,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 216u64,
             add: 156u64,
@@ -227,9 +229,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
             add: 339u64,
@@ -240,9 +242,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 326u64,
             add: 238u64,
@@ -253,9 +255,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 465u64,
             add: 386u64,
@@ -266,9 +268,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 2033u64,
             add: 2091u64,
@@ -279,9 +281,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 3373u64,
             add: 3173u64,
@@ -292,9 +294,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_inverse",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 309u64,
             add: 240u64,
@@ -308,9 +310,9 @@ impl Ssrms {
     pub const CANDIDATES: &'static [OpCount] = &[
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 681u64,
             add: 661u64,
@@ -321,9 +323,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 681u64,
             add: 661u64,
@@ -334,9 +336,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 778u64,
             add: 703u64,
@@ -347,9 +349,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 778u64,
             add: 703u64,
@@ -360,9 +362,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 709u64,
             add: 510u64,
@@ -373,9 +375,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 709u64,
             add: 510u64,
@@ -386,9 +388,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 577u64,
             add: 454u64,
@@ -399,9 +401,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 577u64,
             add: 454u64,
@@ -412,9 +414,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 120u64,
             add: 99u64,
@@ -425,9 +427,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 120u64,
             add: 97u64,
@@ -438,9 +440,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 618u64,
             add: 450u64,
@@ -451,9 +453,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 618u64,
             add: 450u64,
@@ -464,9 +466,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 708u64,
             add: 536u64,
@@ -477,9 +479,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 708u64,
             add: 536u64,
@@ -490,9 +492,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 256u64,
             add: 176u64,
@@ -503,9 +505,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 253u64,
             add: 174u64,
@@ -516,9 +518,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 207u64,
             add: 142u64,
@@ -529,9 +531,9 @@ impl Ssrms {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 206u64,
             add: 141u64,
@@ -542,9 +544,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 777u64,
             add: 590u64,
@@ -555,9 +557,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 777u64,
             add: 588u64,
@@ -568,9 +570,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 867u64,
             add: 676u64,
@@ -581,9 +583,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 867u64,
             add: 674u64,
@@ -594,9 +596,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 268u64,
             add: 191u64,
@@ -607,9 +609,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 265u64,
             add: 189u64,
@@ -620,9 +622,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 217u64,
             add: 157u64,
@@ -633,9 +635,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 216u64,
             add: 156u64,
@@ -646,9 +648,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 864u64,
             add: 650u64,
@@ -659,9 +661,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 864u64,
             add: 648u64,
@@ -672,9 +674,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 954u64,
             add: 736u64,
@@ -685,9 +687,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 954u64,
             add: 734u64,
@@ -698,9 +700,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 502u64,
             add: 376u64,
@@ -711,9 +713,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 499u64,
             add: 372u64,
@@ -724,9 +726,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 453u64,
             add: 342u64,
@@ -737,9 +739,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
             add: 339u64,
@@ -750,9 +752,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1034u64,
             add: 865u64,
@@ -763,9 +765,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1034u64,
             add: 865u64,
@@ -776,9 +778,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1124u64,
             add: 951u64,
@@ -789,9 +791,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1124u64,
             add: 951u64,
@@ -802,9 +804,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 959u64,
             add: 735u64,
@@ -815,9 +817,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 956u64,
             add: 733u64,
@@ -828,9 +830,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 910u64,
             add: 701u64,
@@ -841,9 +843,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 909u64,
             add: 700u64,
@@ -854,9 +856,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 554u64,
             add: 388u64,
@@ -867,9 +869,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "canonical",
             mul: 554u64,
             add: 389u64,
@@ -880,9 +882,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 738u64,
             add: 549u64,
@@ -893,9 +895,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 738u64,
             add: 547u64,
@@ -906,9 +908,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 828u64,
             add: 635u64,
@@ -919,9 +921,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 828u64,
             add: 633u64,
@@ -932,9 +934,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 376u64,
             add: 275u64,
@@ -945,9 +947,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 373u64,
             add: 271u64,
@@ -958,9 +960,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 327u64,
             add: 241u64,
@@ -971,9 +973,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 326u64,
             add: 238u64,
@@ -984,9 +986,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 908u64,
             add: 760u64,
@@ -997,9 +999,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 908u64,
             add: 760u64,
@@ -1010,9 +1012,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 998u64,
             add: 846u64,
@@ -1023,9 +1025,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 998u64,
             add: 846u64,
@@ -1036,9 +1038,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 833u64,
             add: 630u64,
@@ -1049,9 +1051,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 830u64,
             add: 628u64,
@@ -1062,9 +1064,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 784u64,
             add: 596u64,
@@ -1075,9 +1077,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 783u64,
             add: 595u64,
@@ -1088,9 +1090,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 968u64,
             add: 755u64,
@@ -1101,9 +1103,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1058u64,
             add: 841u64,
@@ -1114,9 +1116,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 514u64,
             add: 420u64,
@@ -1127,9 +1129,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 465u64,
             add: 386u64,
@@ -1140,9 +1142,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1138u64,
             add: 970u64,
@@ -1153,9 +1155,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1228u64,
             add: 1056u64,
@@ -1166,9 +1168,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 971u64,
             add: 779u64,
@@ -1179,9 +1181,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 922u64,
             add: 745u64,
@@ -1192,9 +1194,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 566u64,
             add: 433u64,
@@ -1205,9 +1207,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 2033u64,
             add: 2091u64,
@@ -1218,9 +1220,9 @@ impl Ssrms {
         },
         OpCount {
             function: "inverse_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 2036u64,
             add: 2094u64,
@@ -1231,9 +1233,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 3373u64,
             add: 3174u64,
@@ -1244,9 +1246,9 @@ impl Ssrms {
         },
         OpCount {
             function: "forward_dynamics_derivatives",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 3373u64,
             add: 3173u64,
@@ -1257,9 +1259,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_inverse",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 309u64,
             add: 242u64,
@@ -1270,9 +1272,9 @@ impl Ssrms {
         },
         OpCount {
             function: "mass_matrix_inverse",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 309u64,
             add: 240u64,
@@ -1286,7 +1288,9 @@ impl Ssrms {
     ///
     /// Methods: mass matrix `crba`: 120 mul, 97 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 58 fused where the target has FMA.
     #[must_use]
-    pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
+    pub fn mass_matrix(
+        q: &[::core::primitive::f64; 7],
+    ) -> [[::core::primitive::f64; 7]; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -1432,7 +1436,10 @@ impl Ssrms {
     ///
     /// Methods: nonlinear effects `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
     #[must_use]
-    pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
+    pub fn nonlinear_effects(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
@@ -1605,7 +1612,11 @@ impl Ssrms {
     ///
     /// Methods: nonlinear effects `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
     #[must_use]
-    pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
+    pub fn inverse_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        qdd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
@@ -1785,7 +1796,11 @@ impl Ssrms {
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
     #[must_use]
-    pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
+    pub fn forward_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -2243,9 +2258,9 @@ impl Ssrms {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-    ) -> ([[f64; 7]; 7], [f64; 7]) {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> ([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7]) {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -2568,11 +2583,11 @@ impl Ssrms {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-        tau: &[f64; 7],
-        f_ext: &[[f64; 6]; 7],
-    ) -> [f64; 7] {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+        f_ext: &[[::core::primitive::f64; 6]; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -3073,10 +3088,10 @@ impl Ssrms {
     /// : 2033 mul, 2091 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 1098 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics_derivatives(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-        qdd: &[f64; 7],
-    ) -> ([[f64; 7]; 7], [[f64; 7]; 7]) {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        qdd: &[::core::primitive::f64; 7],
+    ) -> ([[::core::primitive::f64; 7]; 7], [[::core::primitive::f64; 7]; 7]) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5)] = Self::sincos_n([q[0], q[1], q[2], q[3], q[4], q[5]]);
         let x6 = c_q0 * s_q1;
@@ -4607,10 +4622,14 @@ impl Ssrms {
     /// : 3373 mul, 3173 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 2094 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_derivatives(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-        tau: &[f64; 7],
-    ) -> ([[f64; 7]; 7], [[f64; 7]; 7], [[f64; 7]; 7]) {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+    ) -> (
+        [[::core::primitive::f64; 7]; 7],
+        [[::core::primitive::f64; 7]; 7],
+        [[::core::primitive::f64; 7]; 7],
+    ) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -7914,7 +7933,9 @@ impl Ssrms {
     ///
     /// : 309 mul, 240 add, 7 div, 0 sqrt, 5 sincos (emitted), of which 201 fused where the target has FMA.
     #[must_use]
-    pub fn mass_matrix_inverse(q: &[f64; 7]) -> [[f64; 7]; 7] {
+    pub fn mass_matrix_inverse(
+        q: &[::core::primitive::f64; 7],
+    ) -> [[::core::primitive::f64; 7]; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -8277,13 +8298,19 @@ impl Ssrms {
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
     /// elsewhere.
     #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
+    fn mul_add(
+        a: ::core::primitive::f64,
+        b: ::core::primitive::f64,
+        c: ::core::primitive::f64,
+    ) -> ::core::primitive::f64 {
         kanegen_runtime::fma::mul_add(a, b, c)
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
-    pub fn sincos(x: f64) -> (f64, f64) {
+    pub fn sincos(
+        x: ::core::primitive::f64,
+    ) -> (::core::primitive::f64, ::core::primitive::f64) {
         let [sc] = Self::sincos_n([x]);
         sc
     }
@@ -8292,7 +8319,9 @@ impl Ssrms {
     /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
-    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+    pub fn sincos_n<const N: ::core::primitive::usize>(
+        x: [::core::primitive::f64; N],
+    ) -> [(::core::primitive::f64, ::core::primitive::f64); N] {
         kanegen_runtime::sincos::sincos_n(x)
     }
 }

@@ -94,29 +94,31 @@ pub struct SsrmsFma;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCount {
     /// The generated function.
-    pub function: &'static str,
+    pub function: &'static ::core::primitive::str,
     /// Its mass-matrix method.
-    pub mass_matrix_method: Option<&'static str>,
+    pub mass_matrix_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// Its nonlinear-effects method.
-    pub nonlinear_effects_method: Option<&'static str>,
+    pub nonlinear_effects_method: ::core::option::Option<
+        &'static ::core::primitive::str,
+    >,
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
-    pub forward_method: Option<&'static str>,
+    pub forward_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
     /// joint axis z, modified-DH x; the same joint-space results).
-    pub frames: &'static str,
+    pub frames: &'static ::core::primitive::str,
     /// Multiplications.
-    pub mul: u64,
+    pub mul: ::core::primitive::u64,
     /// Additions and subtractions.
-    pub add: u64,
+    pub add: ::core::primitive::u64,
     /// Divisions.
-    pub div: u64,
+    pub div: ::core::primitive::u64,
     /// Square roots.
-    pub sqrt: u64,
+    pub sqrt: ::core::primitive::u64,
     /// Angles whose sine and cosine are taken.
-    pub sincos: u64,
+    pub sincos: ::core::primitive::u64,
     /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-    pub fma: u64,
+    pub fma: ::core::primitive::u64,
 }
 #[allow(
     clippy::approx_constant,
@@ -132,9 +134,9 @@ pub struct OpCount {
 )]
 impl SsrmsFma {
     /// Degrees of freedom.
-    pub const N: usize = 7;
+    pub const N: ::core::primitive::usize = 7;
     /// Joint names, in the order of the joint entries of `q`.
-    pub const JOINTS: [&'static str; 7] = [
+    pub const JOINTS: [&'static ::core::primitive::str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
         "shoulder_pitch",
@@ -144,9 +146,9 @@ impl SsrmsFma {
         "wrist_roll",
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
-    pub const FRAMES: [&'static str; 0] = [];
+    pub const FRAMES: [&'static ::core::primitive::str; 0] = [];
     /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
-    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+    pub const LOWER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         -4.71239f64,
         -4.71239f64,
         -4.71239f64,
@@ -156,7 +158,7 @@ impl SsrmsFma {
         -4.71239f64,
     ];
     /// Highest joint positions (rad or m; `+∞` where the model gives none).
-    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+    pub const UPPER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         4.71239f64,
         4.71239f64,
         4.71239f64,
@@ -166,7 +168,7 @@ impl SsrmsFma {
         4.71239f64,
     ];
     /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
-    pub const VELOCITY_LIMIT: [f64; 7] = [
+    pub const VELOCITY_LIMIT: [::core::primitive::f64; 7] = [
         0.0698132f64,
         0.0698132f64,
         0.0698132f64,
@@ -176,16 +178,16 @@ impl SsrmsFma {
         0.0698132f64,
     ];
     /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
-    pub const EFFORT_LIMIT: [f64; 7] = [
+    pub const EFFORT_LIMIT: [::core::primitive::f64; 7] = [
         2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64,
     ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 120u64,
             add: 97u64,
@@ -196,9 +198,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 206u64,
             add: 141u64,
@@ -209,9 +211,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 216u64,
             add: 156u64,
@@ -222,9 +224,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
             add: 339u64,
@@ -235,9 +237,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 326u64,
             add: 238u64,
@@ -248,9 +250,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 465u64,
             add: 386u64,
@@ -264,9 +266,9 @@ impl SsrmsFma {
     pub const CANDIDATES: &'static [OpCount] = &[
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 681u64,
             add: 661u64,
@@ -277,9 +279,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 681u64,
             add: 661u64,
@@ -290,9 +292,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 778u64,
             add: 703u64,
@@ -303,9 +305,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent-r1"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent-r1"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 778u64,
             add: 703u64,
@@ -316,9 +318,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 709u64,
             add: 510u64,
@@ -329,9 +331,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("kane-direct"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("kane-direct"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 709u64,
             add: 510u64,
@@ -342,9 +344,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 577u64,
             add: 454u64,
@@ -355,9 +357,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 577u64,
             add: 454u64,
@@ -368,9 +370,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 120u64,
             add: 99u64,
@@ -381,9 +383,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 120u64,
             add: 97u64,
@@ -394,9 +396,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 618u64,
             add: 450u64,
@@ -407,9 +409,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 618u64,
             add: 450u64,
@@ -420,9 +422,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 708u64,
             add: 536u64,
@@ -433,9 +435,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 708u64,
             add: 536u64,
@@ -446,9 +448,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 256u64,
             add: 176u64,
@@ -459,9 +461,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 253u64,
             add: 174u64,
@@ -472,9 +474,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 207u64,
             add: 142u64,
@@ -485,9 +487,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 206u64,
             add: 141u64,
@@ -498,9 +500,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 777u64,
             add: 590u64,
@@ -511,9 +513,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 777u64,
             add: 588u64,
@@ -524,9 +526,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 867u64,
             add: 676u64,
@@ -537,9 +539,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 867u64,
             add: 674u64,
@@ -550,9 +552,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 268u64,
             add: 191u64,
@@ -563,9 +565,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 265u64,
             add: 189u64,
@@ -576,9 +578,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 217u64,
             add: 157u64,
@@ -589,9 +591,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 216u64,
             add: 156u64,
@@ -602,9 +604,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 864u64,
             add: 650u64,
@@ -615,9 +617,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 864u64,
             add: 648u64,
@@ -628,9 +630,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 954u64,
             add: 736u64,
@@ -641,9 +643,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 954u64,
             add: 734u64,
@@ -654,9 +656,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 502u64,
             add: 376u64,
@@ -667,9 +669,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 499u64,
             add: 372u64,
@@ -680,9 +682,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 453u64,
             add: 342u64,
@@ -693,9 +695,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 452u64,
             add: 339u64,
@@ -706,9 +708,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1034u64,
             add: 865u64,
@@ -719,9 +721,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1034u64,
             add: 865u64,
@@ -732,9 +734,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1124u64,
             add: 951u64,
@@ -745,9 +747,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 1124u64,
             add: 951u64,
@@ -758,9 +760,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 959u64,
             add: 735u64,
@@ -771,9 +773,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 956u64,
             add: 733u64,
@@ -784,9 +786,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 910u64,
             add: 701u64,
@@ -797,9 +799,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "canonical",
             mul: 909u64,
             add: 700u64,
@@ -810,9 +812,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 554u64,
             add: 388u64,
@@ -823,9 +825,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "canonical",
             mul: 554u64,
             add: 389u64,
@@ -836,9 +838,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 738u64,
             add: 549u64,
@@ -849,9 +851,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 738u64,
             add: 547u64,
@@ -862,9 +864,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 828u64,
             add: 635u64,
@@ -875,9 +877,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 828u64,
             add: 633u64,
@@ -888,9 +890,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 376u64,
             add: 275u64,
@@ -901,9 +903,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 373u64,
             add: 271u64,
@@ -914,9 +916,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 327u64,
             add: 241u64,
@@ -927,9 +929,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 326u64,
             add: 238u64,
@@ -940,9 +942,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 908u64,
             add: 760u64,
@@ -953,9 +955,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 908u64,
             add: 760u64,
@@ -966,9 +968,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 998u64,
             add: 846u64,
@@ -979,9 +981,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 998u64,
             add: 846u64,
@@ -992,9 +994,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 833u64,
             add: 630u64,
@@ -1005,9 +1007,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 830u64,
             add: 628u64,
@@ -1018,9 +1020,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 784u64,
             add: 596u64,
@@ -1031,9 +1033,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::None,
             frames: "canonical",
             mul: 783u64,
             add: 595u64,
@@ -1044,9 +1046,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 968u64,
             add: 755u64,
@@ -1057,9 +1059,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1058u64,
             add: 841u64,
@@ -1070,9 +1072,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 514u64,
             add: 420u64,
@@ -1083,9 +1085,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 465u64,
             add: 386u64,
@@ -1096,9 +1098,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1138u64,
             add: 970u64,
@@ -1109,9 +1111,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("kane-direct"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("kane-direct"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1228u64,
             add: 1056u64,
@@ -1122,9 +1124,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("rnea"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("rnea"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 971u64,
             add: 779u64,
@@ -1135,9 +1137,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba-inertial"),
-            nonlinear_effects_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("crba-inertial"),
+            nonlinear_effects_method: ::core::option::Option::Some("newton-euler"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 922u64,
             add: 745u64,
@@ -1148,9 +1150,9 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: None,
-            nonlinear_effects_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::Some("aba"),
             frames: "model",
             mul: 566u64,
             add: 433u64,
@@ -1164,7 +1166,9 @@ impl SsrmsFma {
     ///
     /// Methods: mass matrix `crba`: 120 mul, 97 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 58 fused multiply-adds.
     #[must_use]
-    pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
+    pub fn mass_matrix(
+        q: &[::core::primitive::f64; 7],
+    ) -> [[::core::primitive::f64; 7]; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
             q[1],
             q[2],
@@ -1302,7 +1306,10 @@ impl SsrmsFma {
     ///
     /// Methods: nonlinear effects `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused multiply-adds.
     #[must_use]
-    pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
+    pub fn nonlinear_effects(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
@@ -1461,7 +1468,11 @@ impl SsrmsFma {
     ///
     /// Methods: nonlinear effects `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused multiply-adds.
     #[must_use]
-    pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
+    pub fn inverse_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        qdd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
@@ -1628,7 +1639,11 @@ impl SsrmsFma {
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused multiply-adds.
     #[must_use]
-    pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
+    pub fn forward_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -2060,9 +2075,9 @@ impl SsrmsFma {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-    ) -> ([[f64; 7]; 7], [f64; 7]) {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> ([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7]) {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -2363,11 +2378,11 @@ impl SsrmsFma {
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-        tau: &[f64; 7],
-        f_ext: &[[f64; 6]; 7],
-    ) -> [f64; 7] {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+        f_ext: &[[::core::primitive::f64; 6]; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
         (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
@@ -2823,7 +2838,9 @@ impl SsrmsFma {
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
-    pub fn sincos(x: f64) -> (f64, f64) {
+    pub fn sincos(
+        x: ::core::primitive::f64,
+    ) -> (::core::primitive::f64, ::core::primitive::f64) {
         let [sc] = Self::sincos_n([x]);
         sc
     }
@@ -2832,7 +2849,9 @@ impl SsrmsFma {
     /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
-    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+    pub fn sincos_n<const N: ::core::primitive::usize>(
+        x: [::core::primitive::f64; N],
+    ) -> [(::core::primitive::f64, ::core::primitive::f64); N] {
         kanegen_runtime::sincos::sincos_n_unfused(x)
     }
 }

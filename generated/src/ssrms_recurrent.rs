@@ -30,29 +30,31 @@ pub struct SsrmsRecurrent;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct OpCount {
     /// The generated function.
-    pub function: &'static str,
+    pub function: &'static ::core::primitive::str,
     /// Its mass-matrix method.
-    pub mass_matrix_method: Option<&'static str>,
+    pub mass_matrix_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// Its nonlinear-effects method.
-    pub nonlinear_effects_method: Option<&'static str>,
+    pub nonlinear_effects_method: ::core::option::Option<
+        &'static ::core::primitive::str,
+    >,
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and `τ − c`; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
-    pub forward_method: Option<&'static str>,
+    pub forward_method: ::core::option::Option<&'static ::core::primitive::str>,
     /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
     /// joint axis z, modified-DH x; the same joint-space results).
-    pub frames: &'static str,
+    pub frames: &'static ::core::primitive::str,
     /// Multiplications.
-    pub mul: u64,
+    pub mul: ::core::primitive::u64,
     /// Additions and subtractions.
-    pub add: u64,
+    pub add: ::core::primitive::u64,
     /// Divisions.
-    pub div: u64,
+    pub div: ::core::primitive::u64,
     /// Square roots.
-    pub sqrt: u64,
+    pub sqrt: ::core::primitive::u64,
     /// Angles whose sine and cosine are taken.
-    pub sincos: u64,
+    pub sincos: ::core::primitive::u64,
     /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
-    pub fma: u64,
+    pub fma: ::core::primitive::u64,
 }
 #[allow(
     clippy::approx_constant,
@@ -68,9 +70,9 @@ pub struct OpCount {
 )]
 impl SsrmsRecurrent {
     /// Degrees of freedom.
-    pub const N: usize = 7;
+    pub const N: ::core::primitive::usize = 7;
     /// Joint names, in the order of the joint entries of `q`.
-    pub const JOINTS: [&'static str; 7] = [
+    pub const JOINTS: [&'static ::core::primitive::str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
         "shoulder_pitch",
@@ -80,9 +82,9 @@ impl SsrmsRecurrent {
         "wrist_roll",
     ];
     /// Named frames, in the model's order (one `<frame>_…` function family each).
-    pub const FRAMES: [&'static str; 0] = [];
+    pub const FRAMES: [&'static ::core::primitive::str; 0] = [];
     /// Lowest joint positions (rad or m; `-∞` where the model gives none), in the order of `JOINTS`.
-    pub const LOWER_POSITION_LIMIT: [f64; 7] = [
+    pub const LOWER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         -4.71239f64,
         -4.71239f64,
         -4.71239f64,
@@ -92,7 +94,7 @@ impl SsrmsRecurrent {
         -4.71239f64,
     ];
     /// Highest joint positions (rad or m; `+∞` where the model gives none).
-    pub const UPPER_POSITION_LIMIT: [f64; 7] = [
+    pub const UPPER_POSITION_LIMIT: [::core::primitive::f64; 7] = [
         4.71239f64,
         4.71239f64,
         4.71239f64,
@@ -102,7 +104,7 @@ impl SsrmsRecurrent {
         4.71239f64,
     ];
     /// Largest joint speeds (rad/s or m/s; `+∞` where the model gives none).
-    pub const VELOCITY_LIMIT: [f64; 7] = [
+    pub const VELOCITY_LIMIT: [::core::primitive::f64; 7] = [
         0.0698132f64,
         0.0698132f64,
         0.0698132f64,
@@ -112,16 +114,16 @@ impl SsrmsRecurrent {
         0.0698132f64,
     ];
     /// Largest drive torques or forces (N·m or N; `+∞` where the model gives none).
-    pub const EFFORT_LIMIT: [f64; 7] = [
+    pub const EFFORT_LIMIT: [::core::primitive::f64; 7] = [
         2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64, 2332f64,
     ];
     /// Emitted operation counts of each generated function, in emission order.
     pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 681u64,
             add: 661u64,
@@ -132,9 +134,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 618u64,
             add: 450u64,
@@ -145,9 +147,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1059u64,
             add: 1016u64,
@@ -158,9 +160,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1138u64,
             add: 1072u64,
@@ -171,9 +173,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1012u64,
             add: 967u64,
@@ -184,9 +186,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1242u64,
             add: 1177u64,
@@ -200,9 +202,9 @@ impl SsrmsRecurrent {
     pub const CANDIDATES: &'static [OpCount] = &[
         OpCount {
             function: "mass_matrix",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: None,
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::None,
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 681u64,
             add: 661u64,
@@ -213,9 +215,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "nonlinear_effects",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 618u64,
             add: 450u64,
@@ -226,9 +228,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "inverse_dynamics",
-            mass_matrix_method: None,
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::None,
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1059u64,
             add: 1016u64,
@@ -239,9 +241,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1138u64,
             add: 1072u64,
@@ -252,9 +254,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: None,
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::None,
             frames: "model",
             mul: 1012u64,
             add: 967u64,
@@ -265,9 +267,9 @@ impl SsrmsRecurrent {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("recurrent"),
-            nonlinear_effects_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
+            mass_matrix_method: ::core::option::Option::Some("recurrent"),
+            nonlinear_effects_method: ::core::option::Option::Some("recurrent"),
+            forward_method: ::core::option::Option::Some("ldlt"),
             frames: "model",
             mul: 1242u64,
             add: 1177u64,
@@ -281,7 +283,9 @@ impl SsrmsRecurrent {
     ///
     /// Methods: mass matrix `recurrent`: 681 mul, 661 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 389 fused where the target has FMA.
     #[must_use]
-    pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
+    pub fn mass_matrix(
+        q: &[::core::primitive::f64; 7],
+    ) -> [[::core::primitive::f64; 7]; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -1032,7 +1036,10 @@ impl SsrmsRecurrent {
     ///
     /// Methods: nonlinear effects `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
-    pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
+    pub fn nonlinear_effects(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -1481,7 +1488,11 @@ impl SsrmsRecurrent {
     ///
     /// Methods: nonlinear effects `recurrent`: 1059 mul, 1016 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 601 fused where the target has FMA.
     #[must_use]
-    pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
+    pub fn inverse_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        qdd: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -2596,7 +2607,11 @@ impl SsrmsRecurrent {
     ///
     /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`, forward `ldlt`: 1138 mul, 1072 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 660 fused where the target has FMA.
     #[must_use]
-    pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
+    pub fn forward_dynamics(
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -3827,9 +3842,9 @@ impl SsrmsRecurrent {
     /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`: 1012 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 562 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-    ) -> ([[f64; 7]; 7], [f64; 7]) {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+    ) -> ([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7]) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -4895,11 +4910,11 @@ impl SsrmsRecurrent {
     /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`, forward `ldlt`: 1242 mul, 1177 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 732 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 7],
-        qd: &[f64; 7],
-        tau: &[f64; 7],
-        f_ext: &[[f64; 6]; 7],
-    ) -> [f64; 7] {
+        q: &[::core::primitive::f64; 7],
+        qd: &[::core::primitive::f64; 7],
+        tau: &[::core::primitive::f64; 7],
+        f_ext: &[[::core::primitive::f64; 6]; 7],
+    ) -> [::core::primitive::f64; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
         (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
             q[0],
@@ -6341,13 +6356,19 @@ impl SsrmsRecurrent {
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
     /// elsewhere.
     #[inline(always)]
-    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
+    fn mul_add(
+        a: ::core::primitive::f64,
+        b: ::core::primitive::f64,
+        c: ::core::primitive::f64,
+    ) -> ::core::primitive::f64 {
         kanegen_runtime::fma::mul_add(a, b, c)
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
-    pub fn sincos(x: f64) -> (f64, f64) {
+    pub fn sincos(
+        x: ::core::primitive::f64,
+    ) -> (::core::primitive::f64, ::core::primitive::f64) {
         let [sc] = Self::sincos_n([x]);
         sc
     }
@@ -6356,7 +6377,9 @@ impl SsrmsRecurrent {
     /// `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
-    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
+    pub fn sincos_n<const N: ::core::primitive::usize>(
+        x: [::core::primitive::f64; N],
+    ) -> [(::core::primitive::f64, ::core::primitive::f64); N] {
         kanegen_runtime::sincos::sincos_n(x)
     }
 }

@@ -259,35 +259,20 @@ pub fn dynamics(input: TokenStream) -> TokenStream {
     let input = syn::parse_macro_input!(input as Input);
     match expand(&input) {
         Ok(ts) => ts.into(),
-        Err(msg) => syn::Error::new(input.path.span(), msg)
-            .to_compile_error()
-            .into(),
+        Err(e) => e.to_compile_error().into(),
     }
 }
 
-fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
-    let rel = input.path.value();
-    let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
-    let path = std::path::Path::new(&dir).join(&rel);
-    let abs = path.display().to_string();
-    let v = kanegen_codegen::kanegen_model::Validation {
-        allow_nonphysical_inertia: input.allow_nonphysical,
-    };
-    // Messages name the path as written, not the machine's absolute path.
-    let mut model = kanegen_codegen::kanegen_model::io::load_model_with(&path, v)
-        .map_err(|e| e.to_string().replace(&abs, &rel))?;
-    if input.ignore_mimic {
-        model = model.without_mimics();
-    }
-    let n = model.dof();
-    if n > kanegen_codegen::MAX_JOINTS && !input.allow_large {
-        return Err(format!(
-            "`{rel}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
-             on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
-             `allow_large = true` generates it anyway",
-            kanegen_codegen::MAX_JOINTS
-        ));
-    }
+/// The expansion; an error at the type name for a name clash ([`kanegen_codegen::check_names`]),
+/// else at the model's path.
+fn expand(input: &Input) -> syn::Result<proc_macro2::TokenStream> {
+    let opts = options(input);
+    kanegen_codegen::check_names(&opts).map_err(|e| syn::Error::new(input.name.span(), e.0))?;
+    generate(input, &opts).map_err(|msg| syn::Error::new(input.path.span(), msg))
+}
+
+/// The generator options of `input`.
+fn options(input: &Input) -> kanegen_codegen::Options {
     let name = input.name.to_string();
     let mut opts = kanegen_codegen::Options::new(name.clone());
     opts.gravity = input.gravity;
@@ -316,11 +301,43 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         .fma_path
         .as_ref()
         .map(|p| quote!(#p).to_string().replace(' ', ""));
-    let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| e.to_string())?;
+    opts
+}
+
+/// The items for `input`'s model under `opts` (the model read, checked for size, then
+/// generated), after a constant that includes the model file so that a change to it rebuilds.
+fn generate(
+    input: &Input,
+    opts: &kanegen_codegen::Options,
+) -> Result<proc_macro2::TokenStream, String> {
+    let rel = input.path.value();
+    let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
+    let path = std::path::Path::new(&dir).join(&rel);
+    let abs = path.display().to_string();
+    let v = kanegen_codegen::kanegen_model::Validation {
+        allow_nonphysical_inertia: input.allow_nonphysical,
+    };
+    // Messages name the path as written, not the machine's absolute path.
+    let mut model = kanegen_codegen::kanegen_model::io::load_model_with(&path, v)
+        .map_err(|e| e.to_string().replace(&abs, &rel))?;
+    if input.ignore_mimic {
+        model = model.without_mimics();
+    }
+    let n = model.dof();
+    if n > kanegen_codegen::MAX_JOINTS && !input.allow_large {
+        return Err(format!(
+            "`{rel}` has {n} joints, more than {}: the generated functions would keep O(N) arrays \
+             on the caller's stack and straight-line frame functions of 6·N Jacobian entries; \
+             `allow_large = true` generates it anyway",
+            kanegen_codegen::MAX_JOINTS
+        ));
+    }
+    let g = kanegen_codegen::generate_items(&model, opts).map_err(|e| e.to_string())?;
     let items = g.items;
     let abs_lit = LitStr::new(&abs, Span::call_site());
+    let u8 = kanegen_codegen::paths::primitive("u8");
     Ok(quote! {
-        const _: &[u8] = include_bytes!(#abs_lit);
+        const _: &[#u8] = ::core::include_bytes!(#abs_lit);
         #items
     })
 }

@@ -45,24 +45,35 @@ pub fn generate(model: &Model, opts: &Options) -> Result<String, kanegen_codegen
 /// As [`generate`], or a non-finite constant.
 pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String> {
     let code = generate(model, opts)?;
-    let checked = checked_lines(&code);
+    if let Some((line, token)) = non_finite_constant(&code) {
+        anyhow::bail!(
+            "the generated code holds the non-finite constant `{token}` (line {}): a model \
+             quantity folded into the code overflowed",
+            line + 1
+        );
+    }
+    Ok(code)
+}
+
+/// The first non-finite constant of `code` outside comments and the joint-limit tables: its
+/// line (0-based) and its name (`f64::INFINITY`; the code names it by its full path,
+/// `::core::primitive::f64::INFINITY`).
+fn non_finite_constant(code: &str) -> Option<(usize, String)> {
+    let checked = checked_lines(code);
     for ty in ["f64", "f32"] {
         for c in ["NAN", "INFINITY", "NEG_INFINITY"] {
             let token = format!("{ty}::{c}");
+            let path = format!("::{token}");
             if let Some(&(line, _)) = checked.iter().find(|(_, l)| {
                 !l.trim_start().starts_with("//")
                     && l.split(|ch: char| !(ch.is_alphanumeric() || ch == '_' || ch == ':'))
-                        .any(|w| w == token)
+                        .any(|w| w == token || w.ends_with(&path))
             }) {
-                anyhow::bail!(
-                    "the generated code holds the non-finite constant `{token}` (line {}): a \
-                     model quantity folded into the code overflowed",
-                    line + 1
-                );
+                return Some((line, token));
             }
         }
     }
-    Ok(code)
+    None
 }
 
 /// The lines of `code` (0-based number, text) outside the joint-limit tables
@@ -264,5 +275,34 @@ impl GeneratedFile {
     pub fn render(&self, root: &std::path::Path) -> Result<String, String> {
         let model = self.model(root).map_err(|e| e.to_string())?;
         generate(&model, &self.options()).map_err(|e| e.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::non_finite_constant;
+
+    /// A non-finite constant is found by its full path or its short one, outside comments and
+    /// the joint-limit tables (where `±∞` marks an absent limit).
+    #[test]
+    fn non_finite_constants_are_found_outside_the_limit_tables() {
+        let limits = "    pub const EFFORT_LIMIT: [::core::primitive::f64; 2] = [\n        \
+                      ::core::primitive::f64::INFINITY,\n        1f64,\n    ];\n";
+        let comment = "    // f64::NAN\n";
+        assert_eq!(non_finite_constant(&format!("{limits}{comment}")), None);
+        for (code, token) in [
+            (
+                "let x = ::core::primitive::f64::NEG_INFINITY;",
+                "f64::NEG_INFINITY",
+            ),
+            ("let x = f32::NAN * q[0];", "f32::NAN"),
+        ] {
+            let text = format!("{limits}{comment}{code}\n");
+            assert_eq!(
+                non_finite_constant(&text),
+                Some((5, token.to_string())),
+                "{code}"
+            );
+        }
     }
 }
