@@ -134,7 +134,8 @@ pub struct OpCount {
 impl Ssrms6 {
     /// Degrees of freedom.
     pub const N: ::core::primitive::usize = 6;
-    /// Joint names, in the order of the joint entries of `q`.
+    /// Joint names, in the order of the joint entries of `q` (a mimic joint follows its
+    /// primary and has no entry).
     pub const JOINTS: [&'static ::core::primitive::str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",

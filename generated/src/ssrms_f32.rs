@@ -135,7 +135,8 @@ pub struct OpCount {
 impl SsrmsF32 {
     /// Degrees of freedom.
     pub const N: ::core::primitive::usize = 7;
-    /// Joint names, in the order of the joint entries of `q`.
+    /// Joint names, in the order of the joint entries of `q` (a mimic joint follows its
+    /// primary and has no entry).
     pub const JOINTS: [&'static ::core::primitive::str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
