@@ -368,3 +368,69 @@ fn floating_kernels_match_the_local_frame_algorithms() {
     .fold(0.0, f64::max);
     eprintln!("worst floating kernel vs local-frame algorithms: {worst:e}");
 }
+
+/// The compact derivative kernels (`kanegen_runtime::compact::derivatives`: Carpentier–Mansard
+/// over the tables, `M⁻¹` by LDLᵀ) against this crate's local-parameter derivatives
+/// (`algorithms::derivatives`, themselves checked against dual numbers and Pinocchio), on random
+/// chains and trees with prismatic joints, under gravity.
+#[test]
+fn derivative_kernels_match_the_local_frame_derivatives() {
+    use kanegen_dynamics::algorithms::derivatives::{aba as fd, minverse, rnea as id};
+    use kanegen_model::random::{random_chain, random_tree, ChainSpec};
+    use kanegen_runtime::compact::derivatives as dk;
+
+    fn check<const N: usize>(m: &kanegen_model::Model, seed: u64) -> f64 {
+        let p = Params::<f64>::new(m);
+        let g = [0.4, -0.7, -9.81];
+        let t = KernelTables::new(&p, Some(g));
+        let tables = t.tables();
+        let gravity = Vec3::new(g[0], g[1], g[2]);
+        let mut r = rng(seed);
+        let v = |r: &mut _, s| -> [f64; N] { random_vec(r, N, s).try_into().unwrap() };
+        let (q, qd, qdd, tau) = (
+            v(&mut r, 2.5),
+            v(&mut r, 1.0),
+            v(&mut r, 1.0),
+            v(&mut r, 5.0),
+        );
+        let sc = f64::sin_cos;
+        let mut worst = 0.0_f64;
+        // The matrices of one function against their common scale (∂τ/∂q̇ of one joint is
+        // zero up to rounding).
+        let mut agree = |what: &str, got: &[&[[f64; N]; N]], want: &[&[Vec<f64>]]| {
+            let got: Vec<f64> = got.iter().flat_map(|m| m.as_flattened().to_vec()).collect();
+            let want: Vec<f64> = want.iter().flat_map(|m| m.concat()).collect();
+            let e = rel_err(&got, &want);
+            assert!(e < 1e-12, "{} {what}: {e:e}", m.name());
+            worst = worst.max(e);
+        };
+        let (dq, dv) = dk::inverse_dynamics_derivatives(&tables, &t.inertia, &q, &qd, &qdd, sc);
+        let (wq, wv) = id::derivatives(&p, &q, &qd, &qdd, Some(&gravity));
+        agree("(∂τ/∂q, ∂τ/∂q̇)", &[&dq, &dv], &[&wq, &wv]);
+        let minv = dk::mass_matrix_inverse(&tables, &t.inertia, &q, sc);
+        agree("M⁻¹", &[&minv], &[&minverse::mass_matrix_inverse(&p, &q)]);
+        let (aq, av, ainv) =
+            dk::forward_dynamics_derivatives(&tables, &t.inertia, &q, &qd, &tau, sc);
+        let (wq, wv, winv) = fd::derivatives(&p, &q, &qd, &tau, Some(&gravity));
+        agree(
+            "(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)",
+            &[&aq, &av, &ainv],
+            &[&wq, &wv, &winv],
+        );
+        worst
+    }
+    let spec = |n| ChainSpec {
+        n,
+        prismatic_fraction: 0.3,
+        ..Default::default()
+    };
+    let worst = [
+        check::<1>(&random_chain(&spec(1), 21), 31),
+        check::<6>(&random_chain(&spec(6), 22), 32),
+        check::<7>(&random_tree(&spec(7), 23), 33),
+        check::<12>(&random_tree(&spec(12), 24), 34),
+    ]
+    .into_iter()
+    .fold(0.0, f64::max);
+    eprintln!("worst derivative kernel vs local-frame derivatives: {worst:e}");
+}

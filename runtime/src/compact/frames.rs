@@ -28,7 +28,7 @@ pub struct Frame<S> {
 
 /// Whether joint `j` is on the support path of body `i` (`j ≤ i` on a chain).
 #[inline(always)]
-fn supports<S>(t: &Tables<'_, S>, i: usize, j: usize) -> bool {
+pub(crate) fn supports<S>(t: &Tables<'_, S>, i: usize, j: usize) -> bool {
     match t.ancestor {
         Some(anc) => anc.get(i * t.parent.len() + j).copied().unwrap_or(false),
         None => j <= i,

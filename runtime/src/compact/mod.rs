@@ -14,6 +14,7 @@
 //! - [`with_payload`]: the inertia table with a runtime payload as the last body's, [`payload`];
 //! - [`frame_placement`], [`frame_jacobian`]: a named frame's placement and Jacobian over its
 //!   body's support path ([`Frame`]), [`frames`];
+//! - [`derivatives`]: `∂τ/∂q`, `∂τ/∂q̇` (Carpentier–Mansard), `∂q̈/∂q`, `∂q̈/∂q̇` and `M⁻¹`;
 //! - [`floating`]: `M`, `c`, inverse and forward dynamics, the momentum and the arm's reaction
 //!   on its base on a free-floating base; [`floating_frames`]: its frames' placements,
 //!   Jacobians and generalized Jacobians;
@@ -44,6 +45,7 @@
 
 pub mod aba;
 pub mod crba;
+pub mod derivatives;
 pub mod floating;
 pub mod floating_frames;
 pub mod frames;

@@ -1,0 +1,312 @@
+//! Analytical derivatives of the dynamics as loops over the tables (fixed base): `∂τ/∂q`,
+//! `∂τ/∂q̇` of inverse dynamics by J. Carpentier and N. Mansard, "Analytical Derivatives of
+//! Rigid Body Dynamics Algorithms", *Robotics: Science and Systems* (RSS) 2018, Algorithm 1
+//! (Pinocchio's `computeRNEADerivatives`), and from them those of forward dynamics,
+//! `∂q̈/∂x = −M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)` (eq. (3); Pinocchio's `computeABADerivatives`),
+//! with `M⁻¹` by LDLᵀ ([`crate::ldlt`]) of the CRBA's `M`.
+//!
+//! Every spatial quantity is in base coordinates, where the compact kernels already carry the
+//! bodies ([`world`]): moving joint `j` turns its whole subtree about `S_j`, so a body's
+//! quantity in that subtree varies as `S_j ×` it (eq. (7)) plus what the subtree's velocity and
+//! acceleration gain beyond the turn (eqs. (9)–(12)):
+//!
+//! - forward, joint `j` on parent `λ` (RBDA Table 5.1, `a_0 = −a_grav` = [`Tables::a0`]):
+//!   `v_j = v_λ + S_j q̇_j`, `a_j = a_λ + S_j q̈_j + (v_j ×ₘ S_j) q̇_j`, `h_j = I_j v_j`,
+//!   `f_j = I_j a_j + v_j ×* h_j`; `∂v/∂q_j = v_λ ×ₘ S_j`,
+//!   `∂a/∂q_j = a_λ ×ₘ S_j + v_λ ×ₘ ∂v/∂q_j`, `∂a/∂q̇_j = v_j ×ₘ S_j + ∂v/∂q_j`, and the bias
+//!   force's variation with the velocity `B_j δ = δ ×* h_j + v_j ×* I_j δ − I_j (v_j ×ₘ δ)`;
+//! - backward, subtree composites `Y_j = Σ I_k`, `B^C_j = Σ B_k`, `F_j = Σ f_k`, and
+//!   `∂F_j/∂q_j = S_j ×* F_j + Y_j ∂a/∂q_j + B^C_j ∂v/∂q_j`,
+//!   `∂F_j/∂q̇_j = Y_j ∂a/∂q̇_j + B^C_j S_j`;
+//! - entries (eq. (13)): for `i` in the subtree of `j`,
+//!   `∂τ_i/∂q_j = (Y_i S_i)ᵀ ∂a/∂q_j + (B^C_iᵀ S_i)ᵀ ∂v/∂q_j`,
+//!   `∂τ_i/∂q̇_j = (Y_i S_i)ᵀ ∂a/∂q̇_j + (B^C_iᵀ S_i)ᵀ S_j`; for `i` a strict ancestor of `j`,
+//!   `∂τ_i/∂q_j = S_iᵀ ∂F_j/∂q_j`, `∂τ_i/∂q̇_j = S_iᵀ ∂F_j/∂q̇_j`; zero otherwise.
+//!
+//! The same equations as `kanegen_dynamics::algorithms::derivatives::rnea` (which the unrolled
+//! form traces on the model's local parameters), here over [`Tables`] and slices.
+
+use super::crba::crba;
+use super::frames::supports;
+use super::rnea::{rnea, Motions};
+use super::spatial::{add, crf, crm, dot, inertia_mul, scale, sub, transforms, world};
+use super::tables::{Bodies, BodyStore, Tables};
+use crate::scalar::Scalar;
+
+/// One joint's quantities of the passes ([module docs](self)), in base coordinates.
+#[derive(Clone, Copy, Debug)]
+pub struct Joint<S> {
+    v: [S; 6],
+    a: [S; 6],
+    dvdq: [S; 6],
+    dadq: [S; 6],
+    dadv: [S; 6],
+    /// `Y`: the subtree's composite inertia (the body's own after the forward pass).
+    y: [S; 10],
+    /// `B^C`, columns first: `bc[k]` is `B^C e_k`.
+    bc: [[S; 6]; 6],
+    /// `F`: the subtree's force.
+    f: [S; 6],
+    /// `Y_i S_i`.
+    ys: [S; 6],
+    /// `B^Cᵀ_i S_i`.
+    bs: [S; 6],
+}
+
+impl<S: Scalar + Copy> Joint<S> {
+    /// Zeroed.
+    #[inline(always)]
+    #[must_use]
+    pub fn zero() -> Self {
+        let z = [S::zero(); 6];
+        Joint {
+            v: z,
+            a: z,
+            dvdq: z,
+            dadq: z,
+            dadv: z,
+            y: [S::zero(); 10],
+            bc: [z; 6],
+            f: z,
+            ys: z,
+            bs: z,
+        }
+    }
+}
+
+/// `B^C δ` of `B^C` kept by columns.
+#[inline(always)]
+fn bc_mul<S: Scalar + Copy>(bc: &[[S; 6]; 6], d: &[S; 6]) -> [S; 6] {
+    let mut out = scale(d[0], &bc[0]);
+    for k in 1..6 {
+        out = add(&out, &scale(d[k], &bc[k]));
+    }
+    out
+}
+
+/// `(∂τ/∂q, ∂τ/∂q̇)` of `τ = M(q) q̈ + c(q, q̇)` (gravity as [`Tables::a0`]), `N × N` each, row
+/// `i` = `τ_i`, column `j` = `∂/∂q_j`: [`rnea_derivatives_in`] on the bodies of `q`, on stack
+/// storage of `N` joints.
+#[inline]
+pub fn inverse_dynamics_derivatives<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    qdd: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> ([[S; N]; N], [[S; N]; N]) {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut js = [Joint::zero(); N];
+    let mut out = ([[zero; N]; N], [[zero; N]; N]);
+    transforms(t, q, sincos, b.x);
+    world(t, inertia, &mut b);
+    let (dq, dv) = (out.0.as_flattened_mut(), out.1.as_flattened_mut());
+    rnea_derivatives_in(t, &b, qd, qdd, &mut js, dq, dv);
+    out
+}
+
+/// The derivatives into `dq` and `dv` (`N × N`, rows first, zero on entry: only the entries
+/// of joints on one path are written) on bodies carried to the base ([`world`]); `js`: scratch
+/// of `N` joints ([module docs](self)).
+#[inline(always)]
+pub fn rnea_derivatives_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    b: &Bodies<'_, S>,
+    qd: &[S],
+    qdd: &[S],
+    js: &mut [Joint<S>],
+    dq: &mut [S],
+    dv: &mut [S],
+) {
+    let n = js.len();
+    // Forward: motions, columns, each body's I, B, f.
+    for j in 0..n {
+        let (vp, ap) = match t.parent.get(j).copied().flatten().and_then(|l| js.get(l)) {
+            Some(p) => (p.v, p.a),
+            None => ([S::zero(); 6], t.a0),
+        };
+        let (Some(s), Some(i), Some(&qdj), Some(&qddj)) =
+            (b.s0.get(j), b.i0.get(j), qd.get(j), qdd.get(j))
+        else {
+            continue;
+        };
+        let v = add(&vp, &scale(qdj, s));
+        let vs = crm(&v, s);
+        let a = add(&add(&ap, &scale(qddj, s)), &scale(qdj, &vs));
+        let dvdq = crm(&vp, s);
+        let h = inertia_mul(i, &v);
+        let jt = &mut js[j];
+        jt.dadq = add(&crm(&ap, s), &crm(&vp, &dvdq));
+        jt.dadv = add(&vs, &dvdq);
+        jt.dvdq = dvdq;
+        jt.f = add(&inertia_mul(i, &a), &crf(&v, &h));
+        jt.bc = core::array::from_fn(|k| {
+            let d: [S; 6] = core::array::from_fn(|r| if r == k { S::one() } else { S::zero() });
+            let id = inertia_mul(i, &d);
+            sub(
+                &add(&crf(&d, &h), &crf(&v, &id)),
+                &inertia_mul(i, &crm(&v, &d)),
+            )
+        });
+        jt.y = *i;
+        jt.v = v;
+        jt.a = a;
+    }
+    // Backward: composites, then column j's entries (eq. (13)).
+    for j in (0..n).rev() {
+        let Some(&s) = b.s0.get(j) else {
+            continue;
+        };
+        let jt = js[j];
+        let ys = inertia_mul(&jt.y, &s);
+        let bs: [S; 6] = core::array::from_fn(|k| dot(&jt.bc[k], &s));
+        js[j].ys = ys;
+        js[j].bs = bs;
+        let dfdq = add(
+            &add(&crf(&s, &jt.f), &inertia_mul(&jt.y, &jt.dadq)),
+            &bc_mul(&jt.bc, &jt.dvdq),
+        );
+        let dfdv = add(&inertia_mul(&jt.y, &jt.dadv), &bc_mul(&jt.bc, &s));
+        for (r, jr) in js.iter().enumerate() {
+            let (eq, ev) = if supports(t, r, j) {
+                // r in the subtree of j (its Y S, B^Cᵀ S are final: r ≥ j).
+                (
+                    dot(&jr.ys, &jt.dadq) + dot(&jr.bs, &jt.dvdq),
+                    dot(&jr.ys, &jt.dadv) + dot(&jr.bs, &s),
+                )
+            } else if supports(t, j, r) {
+                let sr = b.s0.get(r).copied().unwrap_or([S::zero(); 6]);
+                (dot(&dfdq, &sr), dot(&dfdv, &sr))
+            } else {
+                continue;
+            };
+            if let (Some(x), Some(y)) = (dq.get_mut(r * n + j), dv.get_mut(r * n + j)) {
+                *x = eq;
+                *y = ev;
+            }
+        }
+        // Y_λ += Y_j, B^C_λ += B^C_j, F_λ += F_j.
+        if let Some(p) = t
+            .parent
+            .get(j)
+            .copied()
+            .flatten()
+            .and_then(|l| js.get_mut(l))
+        {
+            for (a, x) in p.y.iter_mut().zip(jt.y) {
+                *a = *a + x;
+            }
+            for (col, x) in p.bc.iter_mut().zip(jt.bc) {
+                *col = add(col, &x);
+            }
+            p.f = add(&p.f, &jt.f);
+        }
+    }
+}
+
+/// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)`, `N × N` each, rows first.
+pub type ForwardDerivatives<S, const N: usize> = ([[S; N]; N], [[S; N]; N], [[S; N]; N]);
+
+/// `M⁻¹` into `out` (`n × n`, rows first) from `M` in `m` (overwritten by its LDLᵀ factors,
+/// [`crate::ldlt`]; `d_inv`: scratch of `n`): row `c` of the symmetric inverse is `M⁻¹ e_c`.
+#[inline(always)]
+pub fn inverse_in<S: Scalar + Copy>(m: &mut [S], n: usize, d_inv: &mut [S], out: &mut [S]) {
+    if crate::ldlt::factor_in_place(m, n, d_inv).is_err() {
+        return;
+    }
+    for (c, row) in out.chunks_exact_mut(n.max(1)).take(n).enumerate() {
+        for (k, x) in row.iter_mut().enumerate() {
+            *x = if k == c { S::one() } else { S::zero() };
+        }
+        let _ = crate::ldlt::solve_in_place(m, n, d_inv, row);
+    }
+}
+
+/// `out = −A B` of `n × n` matrices (rows first).
+#[inline(always)]
+pub fn neg_product<S: Scalar + Copy>(a: &[S], b: &[S], n: usize, out: &mut [S]) {
+    for (r, orow) in out.chunks_exact_mut(n.max(1)).take(n).enumerate() {
+        for (c, o) in orow.iter_mut().enumerate() {
+            let mut acc = S::zero();
+            for k in 0..n {
+                if let (Some(&x), Some(&y)) = (a.get(r * n + k), b.get(k * n + c)) {
+                    acc = acc + x * y;
+                }
+            }
+            *o = -acc;
+        }
+    }
+}
+
+/// `M(q)⁻¹`, `N × N`: the CRBA's `M` ([`crba`]) inverted by LDLᵀ ([`inverse_in`]).
+#[inline]
+pub fn mass_matrix_inverse<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> [[S; N]; N] {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let (mut st, mut h, mut d_inv) = ([[zero; N]; 6], [[zero; N]; N], [zero; N]);
+    let mut out = [[zero; N]; N];
+    transforms(t, q, sincos, b.x);
+    let h = h.as_flattened_mut();
+    crba(t, inertia, &mut b, st.as_flattened_mut(), h);
+    inverse_in(h, N, &mut d_inv, out.as_flattened_mut());
+    out
+}
+
+/// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of `q̈ = M⁻¹ (τ − c)` (gravity as [`Tables::a0`]), `N × N` each: `M⁻¹`
+/// ([`mass_matrix_inverse`]'s steps), `c` by the RNEA ([`rnea`]), `q̈`, then
+/// `∂q̈/∂x = −M⁻¹ ∂τ/∂x` with `∂τ/∂x` of [`rnea_derivatives_in`] at `q̈` (eq. (3)).
+#[inline]
+pub fn forward_dynamics_derivatives<S: Scalar + Copy, const N: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    q: &[S; N],
+    qd: &[S; N],
+    tau: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> ForwardDerivatives<S, N> {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut js = [Joint::zero(); N];
+    let (mut st, mut h, mut d_inv) = ([[zero; N]; 6], [[zero; N]; N], [zero; N]);
+    let (mut m, mut c, mut qdd) = ([[[zero; 6]; 3]; N], [zero; N], [zero; N]);
+    let (mut dtq, mut dtv) = ([[zero; N]; N], [[zero; N]; N]);
+    let mut out = ([[zero; N]; N], [[zero; N]; N], [[zero; N]; N]);
+    transforms(t, q, sincos, b.x);
+    rnea(t, b.x, inertia, Motions::velocity(qd), &mut m, &mut c);
+    let h = h.as_flattened_mut();
+    crba(t, inertia, &mut b, st.as_flattened_mut(), h);
+    let minv = out.2.as_flattened_mut();
+    inverse_in(h, N, &mut d_inv, minv);
+    accelerations(minv, tau, &c, &mut qdd);
+    world(t, inertia, &mut b);
+    let (dtq, dtv) = (dtq.as_flattened_mut(), dtv.as_flattened_mut());
+    rnea_derivatives_in(t, &b, qd, &qdd, &mut js, dtq, dtv);
+    neg_product(minv, dtq, N, out.0.as_flattened_mut());
+    neg_product(minv, dtv, N, out.1.as_flattened_mut());
+    out
+}
+
+/// `q̈ = M⁻¹ (τ − c)` into `qdd`.
+#[inline(always)]
+pub fn accelerations<S: Scalar + Copy>(minv: &[S], tau: &[S], c: &[S], qdd: &mut [S]) {
+    let n = qdd.len();
+    for (r, x) in qdd.iter_mut().enumerate() {
+        let mut acc = S::zero();
+        for (k, (t, c)) in tau.iter().zip(c).enumerate() {
+            if let Some(&m) = minv.get(r * n + k) {
+                acc = acc + m * (*t - *c);
+            }
+        }
+        *x = acc;
+    }
+}
