@@ -110,9 +110,8 @@ kanegen::dynamics!(
     gravity = [0.3, -1.2, -9.81]
 );
 
-/// A runtime payload other than the nominal one: the compact form reads it like the unrolled.
-#[test]
-fn compact_runtime_payload_equals_unrolled() {
+/// A payload other than the nominal one, for the compact and the unrolled type.
+fn payloads() -> (Tree7PCPayload, Tree7PUPayload) {
     let pc = Tree7PCPayload {
         mass: 7.5,
         com: [0.1, -0.2, 0.3],
@@ -123,6 +122,13 @@ fn compact_runtime_payload_equals_unrolled() {
         com: pc.com,
         inertia: pc.inertia,
     };
+    (pc, pu)
+}
+
+/// A runtime payload other than the nominal one: the compact form reads it like the unrolled.
+#[test]
+fn compact_runtime_payload_equals_unrolled() {
+    let (pc, pu) = payloads();
     let mut r = rng(9);
     let q: [f64; 7] = arr(random_vec(&mut r, 7, 2.0));
     let qd: [f64; 7] = arr(random_vec(&mut r, 7, 1.0));
@@ -158,6 +164,53 @@ fn compact_runtime_payload_equals_unrolled() {
             &Tree7PC::nonlinear_effects(&q, &qd, &nominal),
             &Tree7PC::nonlinear_effects(&q, &qd, &pc)
         ) > 1e-3
+    );
+}
+
+/// The compact form's derivatives (`kanegen_runtime::compact::derivatives`, loops over the
+/// tables) against the unrolled form's (Carpentier–Mansard traced on the model's local
+/// parameters, checked against dual numbers and Pinocchio in `tests/derivatives.rs`): a tree
+/// under gravity, the same tree with a runtime payload other than the nominal one, and a chain.
+#[test]
+fn compact_derivatives_equal_unrolled() {
+    let mut r = rng(19);
+    type Three = ([[f64; 7]; 7], [[f64; 7]; 7], [[f64; 7]; 7]);
+    let flat3 = |m: &Three| [flat(&m.0), flat(&m.1), flat(&m.2)].concat();
+    let q: [f64; 7] = arr(random_vec(&mut r, 7, 2.0));
+    let qd: [f64; 7] = arr(random_vec(&mut r, 7, 1.0));
+    let x: [f64; 7] = arr(random_vec(&mut r, 7, 5.0));
+    let (cq, cv) = Tree7C::inverse_dynamics_derivatives(&q, &qd, &x);
+    let (uq, uv) = Tree7U::inverse_dynamics_derivatives(&q, &qd, &x);
+    let both = |a: &[[f64; 7]; 7], b: &[[f64; 7]; 7]| [flat(a), flat(b)].concat();
+    close("ID derivatives", &both(&cq, &cv), &both(&uq, &uv), 1e-12);
+    let c = Tree7C::forward_dynamics_derivatives(&q, &qd, &x);
+    let u = Tree7U::forward_dynamics_derivatives(&q, &qd, &x);
+    close("FD derivatives", &flat3(&c), &flat3(&u), 1e-11);
+    close(
+        "M⁻¹",
+        &flat(&Tree7C::mass_matrix_inverse(&q)),
+        &flat(&Tree7U::mass_matrix_inverse(&q)),
+        1e-12,
+    );
+    let (pc, pu) = payloads();
+    let c = Tree7PC::forward_dynamics_derivatives(&q, &qd, &x, &pc);
+    let u = Tree7PU::forward_dynamics_derivatives(&q, &qd, &x, &pu);
+    close(
+        "FD derivatives with a payload",
+        &flat3(&c),
+        &flat3(&u),
+        1e-11,
+    );
+    let q: [f64; 3] = arr(random_vec(&mut r, 3, 2.0));
+    let qd: [f64; 3] = arr(random_vec(&mut r, 3, 1.0));
+    let x: [f64; 3] = arr(random_vec(&mut r, 3, 5.0));
+    let (cq, cv, _) = Chain3C::forward_dynamics_derivatives(&q, &qd, &x);
+    let (uq, uv, _) = Chain3U::forward_dynamics_derivatives(&q, &qd, &x);
+    close(
+        "FD derivatives of a chain",
+        &[flat(&cq), flat(&cv)].concat(),
+        &[flat(&uq), flat(&uv)].concat(),
+        1e-11,
     );
 }
 

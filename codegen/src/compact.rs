@@ -17,6 +17,9 @@
 //! - `mass_matrix_and_nonlinear_effects`: CRBA and RNEA on one set of joint transforms;
 //! - `<frame>_placement`, `<frame>_jacobian`: loops over the support path of the frame's body
 //!   (`kanegen_runtime::compact::frames`, `const CX_FRAMES`);
+//! - `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse`
+//!   (fixed base): Carpentier–Mansard's derivatives over the tables, `M⁻¹` by LDLᵀ
+//!   (`kanegen_runtime::compact::derivatives`);
 //! - on a free-floating base, the dynamics functions above with the base as the root of the
 //!   passes (`kanegen_runtime::compact::floating`, `const CX_BASE`), `momentum` and
 //!   `base_reaction` (one pass each), and the frames in the inertial frame with their
@@ -256,8 +259,9 @@ pub fn methods(f: Function) -> Methods {
     }
 }
 
-/// Whether the compact form has its own body for `f` on a fixed base, or on a free-floating one
-/// (`floating`: also the momentum, the base reaction and the generalized Jacobians).
+/// Whether the compact form has its own body for `f` on a fixed base (also the derivatives), or
+/// on a free-floating one (`floating`: also the momentum, the base reaction and the generalized
+/// Jacobians; no derivatives).
 #[must_use]
 pub fn has_body(f: Function, floating: bool) -> bool {
     let both = matches!(
@@ -272,11 +276,17 @@ pub fn has_body(f: Function, floating: bool) -> bool {
             | Function::ForwardDynamicsWithWrenches
             | Function::MassMatrixAndNonlinearEffects
     );
-    both || (floating
-        && matches!(
-            f,
-            Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_)
-        ))
+    let fixed_only = matches!(
+        f,
+        Function::InverseDynamicsDerivatives
+            | Function::ForwardDynamicsDerivatives
+            | Function::MassMatrixInverse
+    );
+    let floating_only = matches!(
+        f,
+        Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_)
+    );
+    both || if floating { floating_only } else { fixed_only }
 }
 
 fn mat(float: Float, m: &M3) -> TokenStream {
@@ -506,6 +516,15 @@ pub fn body(
         Function::FrameJacobian(f) => {
             let f = Literal::usize_unsuffixed(f);
             quote!(#k::frame_jacobian(&Self::CX, &Self::CX_FRAMES[#f], q, #sincos))
+        }
+        Function::InverseDynamicsDerivatives => quote! {
+            #k::derivatives::inverse_dynamics_derivatives(&Self::CX, #i, q, qd, qdd, #sincos)
+        },
+        Function::ForwardDynamicsDerivatives => quote! {
+            #k::derivatives::forward_dynamics_derivatives(&Self::CX, #i, q, qd, tau, #sincos)
+        },
+        Function::MassMatrixInverse => {
+            quote!(#k::derivatives::mass_matrix_inverse(&Self::CX, #i, q, #sincos))
         }
         _ => return Ok(None),
     }))

@@ -85,11 +85,15 @@ pub struct Plan {
 pub const DERIVATIVES_MAX_NV: usize = 24;
 
 /// Whether the derivative functions can be generated for `model` in the form `decision`: in
-/// the unrolled form, up to [`DERIVATIVES_MAX_NV`] speeds, without mimic joints.
+/// the unrolled form up to [`DERIVATIVES_MAX_NV`] speeds, in the compact form on a fixed base
+/// (`kanegen_runtime::compact::derivatives`), without mimic joints.
 #[must_use]
 pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
     if model.has_mimics() {
         return false;
+    }
+    if decision.form == Form::Compact {
+        return model.base_kind() == BaseKind::Fixed;
     }
     let nv = model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {
@@ -97,7 +101,7 @@ pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
         } else {
             0
         };
-    decision.form != Form::Compact && nv <= DERIVATIVES_MAX_NV
+    nv <= DERIVATIVES_MAX_NV
 }
 
 /// The traced graph of each function of a [`Plan`] with an unrolled body (`None` for a compact

@@ -302,6 +302,15 @@ fn counted<const N: usize>(t: &KernelTables, f: Function, payload: bool) -> [u64
             let f_ext = [[x(6); 6]; N];
             _ = k::forward_dynamics_with_wrenches(&t, &inertia, &v, &v, &v, &f_ext, sc);
         }
+        Function::InverseDynamicsDerivatives => {
+            _ = k::derivatives::inverse_dynamics_derivatives(&t, &inertia, &v, &v, &v, sc);
+        }
+        Function::ForwardDynamicsDerivatives => {
+            _ = k::derivatives::forward_dynamics_derivatives(&t, &inertia, &v, &v, &v, sc);
+        }
+        Function::MassMatrixInverse => {
+            _ = k::derivatives::mass_matrix_inverse(&t, &inertia, &v, sc);
+        }
         Function::FramePlacement(k) | Function::FrameJacobian(k) => {
             let frame = counted_frame(&t_frames[k]);
             if let Function::FramePlacement(_) = f {
@@ -323,6 +332,13 @@ fn counted_frame(fr: &k::Frame<f64>) -> k::Frame<Counted> {
         rotation: fr.rotation.map(|r| r.map(Counted)),
     }
 }
+
+/// The derivative kernels (fixed base).
+const DERIVATIVES: [Function; 3] = [
+    Function::InverseDynamicsDerivatives,
+    Function::ForwardDynamicsDerivatives,
+    Function::MassMatrixInverse,
+];
 
 const KERNELS: [Function; 7] = [
     Function::MassMatrix,
@@ -346,7 +362,7 @@ fn counts_follow<const N: usize>(model: &Model, opts: &Options) {
         .replace(' ', "");
     let frames =
         (0..t.frames.len()).flat_map(|k| [Function::FramePlacement(k), Function::FrameJacobian(k)]);
-    for f in KERNELS.into_iter().chain(frames) {
+    for f in KERNELS.into_iter().chain(DERIVATIVES).chain(frames) {
         if f == Function::Gravity && opts.gravity.is_none() {
             continue; // no `gravity` function in space
         }

@@ -121,6 +121,12 @@ fn trace_kernel(
         qdd: None,
     };
     Some(match f {
+        Function::InverseDynamicsDerivatives
+        | Function::ForwardDynamicsDerivatives
+        | Function::MassMatrixInverse => {
+            let tau = arg();
+            trace_derivatives(tables, f, &mut b, &qd, &qdd, &tau)
+        }
         Function::MassMatrix => crba(tables, &mut b),
         Function::NonlinearEffects => rnea(&b, velocity),
         Function::Gravity => rnea(&b, rest),
@@ -291,6 +297,53 @@ fn trace_floating_frame(
     let mut out = vec![zero; 6 * (6 + n)];
     ff::jacobian_in(tables, frame, q, &x0, &mut cols, &mut out);
     out
+}
+
+/// The outputs of a derivative kernel (`kanegen_runtime::compact::derivatives`) on the joint
+/// transforms of `b`, as its entry point composes it: `(∂τ/∂q, ∂τ/∂q̇)` at `(q̇, q̈)`; `M⁻¹`; or
+/// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` under the drives `tau`.
+fn trace_derivatives(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    b: &mut Bodies<'_, Sym>,
+    qd: &[Sym],
+    qdd: &[Sym],
+    tau: &[Sym],
+) -> Vec<Sym> {
+    use k::derivatives as dk;
+    let n = qd.len();
+    let zero = Sym::zero();
+    let mut js = vec![dk::Joint::zero(); n];
+    let (mut dtq, mut dtv) = (vec![zero; n * n], vec![zero; n * n]);
+    if f == Function::InverseDynamicsDerivatives {
+        k::spatial::world(tables, tables.inertia, b);
+        dk::rnea_derivatives_in(tables, b, qd, qdd, &mut js, &mut dtq, &mut dtv);
+        return [dtq, dtv].concat();
+    }
+    let (mut m, mut c, mut a) = (vec![[[zero; 6]; 3]; n], vec![zero; n], vec![zero; n]);
+    if f == Function::ForwardDynamicsDerivatives {
+        k::rnea::rnea(
+            tables,
+            b.x,
+            tables.inertia,
+            Motions::velocity(qd),
+            &mut m,
+            &mut c,
+        );
+    }
+    let mut h = crba(tables, b);
+    let (mut d_inv, mut minv) = (vec![zero; n], vec![zero; n * n]);
+    dk::inverse_in(&mut h, n, &mut d_inv, &mut minv);
+    if f == Function::MassMatrixInverse {
+        return minv;
+    }
+    dk::accelerations(&minv, tau, &c, &mut a);
+    k::spatial::world(tables, tables.inertia, b);
+    dk::rnea_derivatives_in(tables, b, qd, &a, &mut js, &mut dtq, &mut dtv);
+    let (mut aq, mut av) = (vec![zero; n * n], vec![zero; n * n]);
+    dk::neg_product(&minv, &dtq, n, &mut aq);
+    dk::neg_product(&minv, &dtv, n, &mut av);
+    [aq, av, minv].concat()
 }
 
 /// The CRBA's `H` (rows first) on the joint transforms of `b`.
