@@ -450,11 +450,12 @@ kanegen::dynamics!(
 /// The compact form on a free-floating base (B1 + Z1, a 19-joint tree; the kernels of
 /// `kanegen_runtime::compact::floating` and `::floating_frames`) against the interpreted
 /// local-frame algorithms: `M`, `c`, inverse dynamics, forward dynamics with and without
-/// wrenches, `(M, c)`, the momentum, the base reaction, and the placement, Jacobian and
-/// generalized Jacobian of a foot, a frame on the base and the arm's gripper.
+/// wrenches, `(M, c)`, the momentum, the base reaction, the derivatives and `M⁻¹`, and the
+/// placement, Jacobian and generalized Jacobian of a foot, a frame on the base and the arm's
+/// gripper.
 #[test]
 fn compact_free_floating_equals_interpreted() {
-    use kanegen::dynamics::algorithms::{aba, floating, frames, momentum, rnea};
+    use kanegen::dynamics::algorithms::{aba, derivatives, floating, frames, momentum, rnea};
     use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
     use kanegen::dynamics::{ExternalWrench, LoadFrame, MassMatrixMethod};
     const N: usize = 19;
@@ -584,6 +585,39 @@ fn compact_free_floating_equals_interpreted() {
                 B1Z1C::gripperstator_generalized_jacobian,
             ),
         ];
+        let g = Vec3::new(0.0, 0.0, -9.81);
+        let (dq, dv) = B1Z1C::inverse_dynamics_derivatives(&q, &v, &a);
+        let (wq, wv) = derivatives::rnea::floating_derivatives(
+            &p,
+            &fb,
+            &st,
+            &qj,
+            &v[6..],
+            &acc,
+            &a[6..],
+            Some(&g),
+        );
+        close(
+            "(∂τ/∂q, ∂τ/∂v)",
+            &[dq.as_flattened(), dv.as_flattened()].concat(),
+            &[wq.concat(), wv.concat()].concat(),
+            1e-12,
+        );
+        let (aq, av, minv) = B1Z1C::forward_dynamics_derivatives(&q, &v, &tau);
+        let (wq, wv, winv) =
+            derivatives::aba::floating_derivatives(&p, &fb, &st, &qj, &v[6..], &tau, Some(&g));
+        close(
+            "(∂v̇/∂q, ∂v̇/∂v, M⁻¹)",
+            &[aq.as_flattened(), av.as_flattened(), minv.as_flattened()].concat(),
+            &[wq.concat(), wv.concat(), winv.concat()].concat(),
+            1e-10,
+        );
+        close(
+            "M⁻¹",
+            B1Z1C::mass_matrix_inverse(&q).as_flattened(),
+            &winv.concat(),
+            1e-10,
+        );
         for (name, placement, jacobian, generalized) in frames {
             let k = model.frames().iter().position(|f| f.name == name).unwrap();
             let fp = &p.frames[k];

@@ -17,8 +17,9 @@
 //! - `mass_matrix_and_nonlinear_effects`: CRBA and RNEA on one set of joint transforms;
 //! - `<frame>_placement`, `<frame>_jacobian`: loops over the support path of the frame's body
 //!   (`kanegen_runtime::compact::frames`, `const CX_FRAMES`);
-//! - `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse`
-//!   (fixed base): Carpentier–Mansard's derivatives over the tables, `M⁻¹` by LDLᵀ
+//! - `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse`:
+//!   Carpentier–Mansard's derivatives over the tables (on a free-floating base, the base as body
+//!   0 with six columns, its `∂/∂q` in the tangent space), `M⁻¹` by LDLᵀ
 //!   (`kanegen_runtime::compact::derivatives`);
 //! - on a free-floating base, the dynamics functions above with the base as the root of the
 //!   passes (`kanegen_runtime::compact::floating`, `const CX_BASE`), `momentum` and
@@ -259,9 +260,8 @@ pub fn methods(f: Function) -> Methods {
     }
 }
 
-/// Whether the compact form has its own body for `f` on a fixed base (also the derivatives), or
-/// on a free-floating one (`floating`: also the momentum, the base reaction and the generalized
-/// Jacobians; no derivatives).
+/// Whether the compact form has its own body for `f` on a fixed base, or on a free-floating one
+/// (`floating`: also the momentum, the base reaction and the generalized Jacobians).
 #[must_use]
 pub fn has_body(f: Function, floating: bool) -> bool {
     let both = matches!(
@@ -276,7 +276,7 @@ pub fn has_body(f: Function, floating: bool) -> bool {
             | Function::ForwardDynamicsWithWrenches
             | Function::MassMatrixAndNonlinearEffects
     );
-    let fixed_only = matches!(
+    let derivatives = matches!(
         f,
         Function::InverseDynamicsDerivatives
             | Function::ForwardDynamicsDerivatives
@@ -286,7 +286,7 @@ pub fn has_body(f: Function, floating: bool) -> bool {
         f,
         Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_)
     );
-    both || if floating { floating_only } else { fixed_only }
+    both || derivatives || (floating && floating_only)
 }
 
 fn mat(float: Float, m: &M3) -> TokenStream {
@@ -385,7 +385,17 @@ fn floating_body(
     let [some_v, some_a, some_f_ext] = [quote!(v), quote!(a), quote!(f_ext)]
         .map(Some)
         .map(paths::option);
+    let dk = quote!(#k::derivatives);
     Some(match f {
+        Function::InverseDynamicsDerivatives => quote! {
+            #dk::floating_inverse_dynamics_derivatives::<_, #nl, #nvl>(#args, v, a, #sincos)
+        },
+        Function::ForwardDynamicsDerivatives => quote! {
+            #dk::floating_forward_dynamics_derivatives::<_, #nl, #nvl>(#args, v, tau, #sincos)
+        },
+        Function::MassMatrixInverse => {
+            quote!(#dk::floating_mass_matrix_inverse::<_, #nl, #nvl>(#args, #sincos))
+        }
         Function::Momentum => quote!(#fk::momentum::<_, #nl>(#args, v, #sincos)),
         Function::BaseReaction => quote!(#fk::base_reaction::<_, #nl>(#args, v, a, #sincos)),
         Function::FramePlacement(k) => {

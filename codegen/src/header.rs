@@ -74,8 +74,8 @@ fn form_line(plan: &Plan) -> String {
                 .to_string()
         } else if plan.derivatives_asked {
             format!(
-                "generated in the unrolled form up to {} speeds and in the compact form on a \
-                 fixed base; docs/limits.md",
+                "generated in the unrolled form up to {} speeds, and in the compact form; \
+                 docs/limits.md",
                 crate::plan::DERIVATIVES_MAX_NV
             )
         } else {

@@ -85,7 +85,7 @@ pub struct Plan {
 pub const DERIVATIVES_MAX_NV: usize = 24;
 
 /// Whether the derivative functions can be generated for `model` in the form `decision`: in
-/// the unrolled form up to [`DERIVATIVES_MAX_NV`] speeds, in the compact form on a fixed base
+/// the unrolled form up to [`DERIVATIVES_MAX_NV`] speeds, in the compact form at any size
 /// (`kanegen_runtime::compact::derivatives`), without mimic joints.
 #[must_use]
 pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
@@ -93,7 +93,7 @@ pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
         return false;
     }
     if decision.form == Form::Compact {
-        return model.base_kind() == BaseKind::Fixed;
+        return true;
     }
     let nv = model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {

@@ -444,6 +444,7 @@ fn op_counts_of_large_compact_types_are_what_the_kernels_execute() {
 /// The operations a free-floating compact function's kernel executes
 /// (`kanegen_runtime::compact::floating`), counted by running it on [`Counted`].
 fn counted_floating<const N: usize, const NV: usize>(t: &KernelTables, f: Function) -> [u64; 4] {
+    use k::derivatives as dk;
     use k::floating as fk;
     use k::floating_frames as ff;
     let frames = &t.frames;
@@ -484,6 +485,19 @@ fn counted_floating<const N: usize, const NV: usize>(t: &KernelTables, f: Functi
             _ = fk::forward_dynamics::<_, N, NV>(&t, inertia, &base, q, v, &tau, w, sc);
         }
         Function::Momentum => _ = fk::momentum::<_, N>(&t, inertia, &base, q, v, sc),
+        Function::InverseDynamicsDerivatives => {
+            _ = dk::floating_inverse_dynamics_derivatives::<_, N, NV>(
+                &t, inertia, &base, q, v, v, sc,
+            );
+        }
+        Function::ForwardDynamicsDerivatives => {
+            _ = dk::floating_forward_dynamics_derivatives::<_, N, NV>(
+                &t, inertia, &base, q, v, &tau, sc,
+            );
+        }
+        Function::MassMatrixInverse => {
+            _ = dk::floating_mass_matrix_inverse::<_, N, NV>(&t, inertia, &base, q, sc);
+        }
         Function::BaseReaction => {
             _ = fk::base_reaction::<_, N>(&t, inertia, &base, q, v, v, sc);
         }
@@ -525,7 +539,8 @@ fn op_counts_of_free_floating_compact_types_are_what_the_kernels_execute() {
             ]
         });
         let floating_only = [Function::Momentum, Function::BaseReaction];
-        for f in KERNELS.into_iter().chain(floating_only).chain(frames) {
+        let all = KERNELS.into_iter().chain(DERIVATIVES).chain(floating_only);
+        for f in all.chain(frames) {
             let c = kernel_counts(model, &o, f).expect("a kernel function");
             let ran = counted_floating::<N, NV>(&t, f);
             assert_eq!(

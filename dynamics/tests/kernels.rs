@@ -210,16 +210,18 @@ fn frame_kernels_match_the_local_frame_kinematics() {
 }
 
 /// The free-floating kernels (`kanegen_runtime::compact::floating`: `M`, `c`, inverse and
-/// forward dynamics with the base as the root, wrenches on the base and the bodies) against this
-/// crate's local-frame algorithms on random trees and chains with random base inertias, poses
+/// forward dynamics with the base as the root, wrenches on the base and the bodies, the
+/// momentum, the base reaction, the frames; `::derivatives`: the derivatives and `M⁻¹`) against
+/// this crate's local-frame algorithms on random trees and chains with random base inertias, poses
 /// and twists, with gravity.
 #[test]
 fn floating_kernels_match_the_local_frame_algorithms() {
-    use kanegen_dynamics::algorithms::{floating, frames, momentum, rnea};
+    use kanegen_dynamics::algorithms::{derivatives, floating, frames, momentum, rnea};
     use kanegen_dynamics::base::quat_to_matrix;
     use kanegen_dynamics::kernels::inertia_row;
     use kanegen_dynamics::{LoadFrame, MassMatrixMethod};
     use kanegen_model::random::{random_chain, random_tree, ChainSpec};
+    use kanegen_runtime::compact::derivatives as dk;
     use kanegen_runtime::compact::floating::{self as fk, Base};
     use kanegen_runtime::compact::floating_frames as ff;
 
@@ -351,6 +353,34 @@ fn floating_kernels_match_the_local_frame_algorithms() {
             let want = frames::generalized_jacobian(&p, &fb, &st, &qj, &fp);
             agree("generalized Jacobian", gj.as_flattened(), &want.concat());
         }
+        let (dq, dv) = dk::floating_inverse_dynamics_derivatives::<f64, N, NV>(
+            &tables, &t.inertia, &base, &q, &nu, &nu_dot, sc,
+        );
+        let gv = Vec3::new(g[0], g[1], g[2]);
+        let (wq, wv) = derivatives::rnea::floating_derivatives(
+            &p,
+            &fb,
+            &st,
+            &qj,
+            &nu[6..],
+            &acc,
+            &nu_dot[6..],
+            Some(&gv),
+        );
+        let got = [dq.as_flattened(), dv.as_flattened()].concat();
+        agree("(∂τ/∂q, ∂τ/∂ν)", &got, &[wq.concat(), wv.concat()].concat());
+        let minv =
+            dk::floating_mass_matrix_inverse::<f64, N, NV>(&tables, &t.inertia, &base, &q, sc);
+        let want = derivatives::minverse::floating_mass_matrix_inverse(&p, &fb, &qj);
+        agree("M⁻¹", minv.as_flattened(), &want.concat());
+        let (aq, av, ainv) = dk::floating_forward_dynamics_derivatives::<f64, N, NV>(
+            &tables, &t.inertia, &base, &q, &nu, &tau, sc,
+        );
+        let (wq, wv, winv) =
+            derivatives::aba::floating_derivatives(&p, &fb, &st, &qj, &nu[6..], &tau, Some(&gv));
+        let got = [aq.as_flattened(), av.as_flattened(), ainv.as_flattened()].concat();
+        let want = [wq.concat(), wv.concat(), winv.concat()].concat();
+        agree("(∂ν̇/∂q, ∂ν̇/∂ν, M⁻¹)", &got, &want);
         worst
     }
     let spec = |n| ChainSpec {

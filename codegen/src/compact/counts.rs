@@ -216,6 +216,11 @@ fn trace_floating(
         out
     };
     Some(match f {
+        Function::InverseDynamicsDerivatives
+        | Function::ForwardDynamicsDerivatives
+        | Function::MassMatrixInverse => {
+            trace_floating_derivatives(tables, f, base, &mut b, &q, &v, &a, &tau)
+        }
         Function::MassMatrix => mass(&mut b),
         Function::Momentum => {
             let mut vw = vec![[zero; 6]; n];
@@ -343,6 +348,80 @@ fn trace_derivatives(
     let (mut aq, mut av) = (vec![zero; n * n], vec![zero; n * n]);
     dk::neg_product(&minv, &dtq, n, &mut aq);
     dk::neg_product(&minv, &dtv, n, &mut av);
+    [aq, av, minv].concat()
+}
+
+/// The outputs of a free-floating derivative kernel (`kanegen_runtime::compact::derivatives`) on
+/// the joint transforms of `b`, as its entry point composes it: `(∂τ/∂q, ∂τ/∂ν)` at `(ν, ν̇)`;
+/// `M⁻¹`; or `(∂ν̇/∂q, ∂ν̇/∂ν, M⁻¹)` under the joint drives `tau`.
+#[allow(clippy::too_many_arguments)]
+fn trace_floating_derivatives(
+    tables: &Tables<'_, Sym>,
+    f: Function,
+    base: &k::floating::Base<Sym>,
+    b: &mut Bodies<'_, Sym>,
+    q: &[Sym],
+    v: &[Sym],
+    a: &[Sym],
+    tau: &[Sym],
+) -> Vec<Sym> {
+    use k::derivatives as dk;
+    let n = tau.len();
+    let nv = n + 6;
+    let zero = Sym::zero();
+    let inertia = tables.inertia;
+    let mut js = vec![dk::Joint::zero(); n];
+    let (mut dtq, mut dtv) = (vec![zero; nv * nv], vec![zero; nv * nv]);
+    if f == Function::InverseDynamicsDerivatives {
+        k::spatial::world(tables, inertia, b);
+        let mut root = dk::floating_root(base, q, v, a);
+        let (qd, qdd) = (&v[6..], &a[6..]);
+        dk::floating_rnea_derivatives_in(
+            tables, b, &mut root, qd, qdd, &mut js, &mut dtq, &mut dtv,
+        );
+        return [dtq, dtv].concat();
+    }
+    let (mut mm, mut c) = (vec![[[zero; 6]; 3]; n], vec![zero; nv]);
+    if f == Function::ForwardDynamicsDerivatives {
+        let x = &*b.x;
+        k::floating::inverse_dynamics_in(
+            tables,
+            x,
+            inertia,
+            base,
+            q,
+            Some(v),
+            None,
+            &mut mm,
+            &mut c,
+        );
+    }
+    let (mut st, mut h, mut m) = (vec![zero; 6 * n], vec![zero; n * n], vec![zero; nv * nv]);
+    k::floating::mass_matrix_in(tables, inertia, base, b, &mut st, &mut h, &mut m);
+    let (mut d_inv, mut minv) = (vec![zero; nv], vec![zero; nv * nv]);
+    dk::inverse_in(&mut m, nv, &mut d_inv, &mut minv);
+    if f == Function::MassMatrixInverse {
+        return minv;
+    }
+    let drives: Vec<Sym> = [vec![zero; 6], tau.to_vec()].concat();
+    let mut nu_dot = vec![zero; nv];
+    dk::accelerations(&minv, &drives, &c, &mut nu_dot);
+    k::spatial::world(tables, inertia, b);
+    let mut root = dk::floating_root(base, q, v, &nu_dot);
+    let qdd = &nu_dot[6..];
+    dk::floating_rnea_derivatives_in(
+        tables,
+        b,
+        &mut root,
+        &v[6..],
+        qdd,
+        &mut js,
+        &mut dtq,
+        &mut dtv,
+    );
+    let (mut aq, mut av) = (vec![zero; nv * nv], vec![zero; nv * nv]);
+    dk::neg_product(&minv, &dtq, nv, &mut aq);
+    dk::neg_product(&minv, &dtv, nv, &mut av);
     [aq, av, minv].concat()
 }
 

@@ -27,6 +27,7 @@
 //! form traces on the model's local parameters), here over [`Tables`] and slices.
 
 use super::crba::crba;
+use super::floating::{gravity_in_base, inverse_dynamics_in, mass_matrix_in, root_motion, Base};
 use super::frames::supports;
 use super::rnea::{rnea, Motions};
 use super::spatial::{add, crf, crm, dot, inertia_mul, scale, sub, transforms, world};
@@ -121,12 +122,93 @@ pub fn rnea_derivatives_in<S: Scalar + Copy>(
     dq: &mut [S],
     dv: &mut [S],
 ) {
-    let n = js.len();
-    // Forward: motions, columns, each body's I, B, f.
-    for j in 0..n {
+    forward(t, b, qd, qdd, ([S::zero(); 6], t.a0), js);
+    backward(t, b, js, None, dq, dv);
+}
+
+/// A free-floating base as the root of the passes (Carpentier–Mansard on a free-flyer, as
+/// Pinocchio): body 0 with six columns, the unit motions of `ν_b = [v_b; ω_b]` (linear first) in
+/// base coordinates, on the inertial frame (`v_λ = 0`, `a_λ = −a_grav`).
+#[derive(Clone, Copy, Debug)]
+pub struct FloatingRoot<S> {
+    /// The base body: its motion `v_0 = [ω_b; v_b]`, `a_0 = [ω̇_b; v̇_b] − a_grav`, then its
+    /// composites (its own inertia, bias variation and force first).
+    pub body: Joint<S>,
+    /// `−a_grav = [0; −R₀ᵀ g]`.
+    pub a_grav: [S; 6],
+}
+
+impl<S: Scalar + Copy> FloatingRoot<S> {
+    /// The base of spatial inertia `i` (`[m, h, Ī]`) in motion `(v, a)` (`a` with gravity's
+    /// fictitious acceleration `a_grav` in it).
+    #[inline(always)]
+    #[must_use]
+    pub fn new(i: &[S; 10], v: [S; 6], a: [S; 6], a_grav: [S; 6]) -> Self {
+        let mut body = Joint::zero();
+        (body.f, body.bc) = body_terms(i, &v, &a);
+        body.y = *i;
+        body.v = v;
+        body.a = a;
+        FloatingRoot { body, a_grav }
+    }
+}
+
+/// `(∂τ/∂q, ∂τ/∂ν)` of free-floating inverse dynamics into `dq`, `dv` (`(6 + N) × (6 + N)`,
+/// rows first, zero on entry; the base's rows and columns first, its `∂/∂q` columns in the
+/// tangent space), on bodies carried to the base ([`world`]); `qd`, `qdd`: the joints' rates.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn floating_rnea_derivatives_in<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    b: &Bodies<'_, S>,
+    root: &mut FloatingRoot<S>,
+    qd: &[S],
+    qdd: &[S],
+    js: &mut [Joint<S>],
+    dq: &mut [S],
+    dv: &mut [S],
+) {
+    forward(t, b, qd, qdd, (root.body.v, root.body.a), js);
+    backward(t, b, js, Some(root), dq, dv);
+}
+
+/// `f = I a + v ×* (I v)` and the bias force's variation with the velocity, by columns:
+/// `B e_k = e_k ×* h + v ×* I e_k − I (v ×ₘ e_k)` with `h = I v`.
+#[inline(always)]
+fn body_terms<S: Scalar + Copy>(i: &[S; 10], v: &[S; 6], a: &[S; 6]) -> ([S; 6], [[S; 6]; 6]) {
+    let h = inertia_mul(i, v);
+    let f = add(&inertia_mul(i, a), &crf(v, &h));
+    let bc = core::array::from_fn(|k| {
+        let d = unit(k);
+        let id = inertia_mul(i, &d);
+        sub(
+            &add(&crf(&d, &h), &crf(v, &id)),
+            &inertia_mul(i, &crm(v, &d)),
+        )
+    });
+    (f, bc)
+}
+
+/// The unit motion of entry `k` of `[ω; v]`.
+#[inline(always)]
+fn unit<S: Scalar + Copy>(k: usize) -> [S; 6] {
+    core::array::from_fn(|r| if r == k { S::one() } else { S::zero() })
+}
+
+/// The forward pass over the joints from the root's motion `(v, a)` ([module docs](self)).
+#[inline(always)]
+fn forward<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    b: &Bodies<'_, S>,
+    qd: &[S],
+    qdd: &[S],
+    root: ([S; 6], [S; 6]),
+    js: &mut [Joint<S>],
+) {
+    for j in 0..js.len() {
         let (vp, ap) = match t.parent.get(j).copied().flatten().and_then(|l| js.get(l)) {
             Some(p) => (p.v, p.a),
-            None => ([S::zero(); 6], t.a0),
+            None => root,
         };
         let (Some(s), Some(i), Some(&qdj), Some(&qddj)) =
             (b.s0.get(j), b.i0.get(j), qd.get(j), qdd.get(j))
@@ -137,65 +219,80 @@ pub fn rnea_derivatives_in<S: Scalar + Copy>(
         let vs = crm(&v, s);
         let a = add(&add(&ap, &scale(qddj, s)), &scale(qdj, &vs));
         let dvdq = crm(&vp, s);
-        let h = inertia_mul(i, &v);
         let jt = &mut js[j];
         jt.dadq = add(&crm(&ap, s), &crm(&vp, &dvdq));
         jt.dadv = add(&vs, &dvdq);
         jt.dvdq = dvdq;
-        jt.f = add(&inertia_mul(i, &a), &crf(&v, &h));
-        jt.bc = core::array::from_fn(|k| {
-            let d: [S; 6] = core::array::from_fn(|r| if r == k { S::one() } else { S::zero() });
-            let id = inertia_mul(i, &d);
-            sub(
-                &add(&crf(&d, &h), &crf(&v, &id)),
-                &inertia_mul(i, &crm(&v, &d)),
-            )
-        });
+        (jt.f, jt.bc) = body_terms(i, &v, &a);
         jt.y = *i;
         jt.v = v;
         jt.a = a;
     }
-    // Backward: composites, then column j's entries (eq. (13)).
+}
+
+/// The backward pass: composites, then each column's entries (eq. (13)); with a floating
+/// `root`, its six rows and columns first.
+#[inline(always)]
+fn backward<S: Scalar + Copy>(
+    t: &Tables<'_, S>,
+    b: &Bodies<'_, S>,
+    js: &mut [Joint<S>],
+    mut root: Option<&mut FloatingRoot<S>>,
+    dq: &mut [S],
+    dv: &mut [S],
+) {
+    let n = js.len();
+    let off = if root.is_some() { 6 } else { 0 };
+    let nv = n + off;
+    let mut put = |r: usize, c: usize, (x, y): (S, S)| {
+        if let (Some(a), Some(b)) = (dq.get_mut(r * nv + c), dv.get_mut(r * nv + c)) {
+            *a = x;
+            *b = y;
+        }
+    };
+    // The base's column `c` is entry `(c + 3) % 6` of `[ω; v]` (ν_b lists v_b first).
+    let base_s = |c: usize| unit::<S>((c + 3) % 6);
     for j in (0..n).rev() {
         let Some(&s) = b.s0.get(j) else {
             continue;
         };
         let jt = js[j];
-        let ys = inertia_mul(&jt.y, &s);
-        let bs: [S; 6] = core::array::from_fn(|k| dot(&jt.bc[k], &s));
-        js[j].ys = ys;
-        js[j].bs = bs;
+        js[j].ys = inertia_mul(&jt.y, &s);
+        js[j].bs = core::array::from_fn(|k| dot(&jt.bc[k], &s));
         let dfdq = add(
             &add(&crf(&s, &jt.f), &inertia_mul(&jt.y, &jt.dadq)),
             &bc_mul(&jt.bc, &jt.dvdq),
         );
         let dfdv = add(&inertia_mul(&jt.y, &jt.dadv), &bc_mul(&jt.bc, &s));
         for (r, jr) in js.iter().enumerate() {
-            let (eq, ev) = if supports(t, r, j) {
+            if supports(t, r, j) {
                 // r in the subtree of j (its Y S, B^Cᵀ S are final: r ≥ j).
-                (
-                    dot(&jr.ys, &jt.dadq) + dot(&jr.bs, &jt.dvdq),
-                    dot(&jr.ys, &jt.dadv) + dot(&jr.bs, &s),
-                )
+                put(
+                    off + r,
+                    off + j,
+                    (
+                        dot(&jr.ys, &jt.dadq) + dot(&jr.bs, &jt.dvdq),
+                        dot(&jr.ys, &jt.dadv) + dot(&jr.bs, &s),
+                    ),
+                );
             } else if supports(t, j, r) {
                 let sr = b.s0.get(r).copied().unwrap_or([S::zero(); 6]);
-                (dot(&dfdq, &sr), dot(&dfdv, &sr))
-            } else {
-                continue;
-            };
-            if let (Some(x), Some(y)) = (dq.get_mut(r * n + j), dv.get_mut(r * n + j)) {
-                *x = eq;
-                *y = ev;
+                put(off + r, off + j, (dot(&dfdq, &sr), dot(&dfdv, &sr)));
             }
         }
-        // Y_λ += Y_j, B^C_λ += B^C_j, F_λ += F_j.
-        if let Some(p) = t
-            .parent
-            .get(j)
-            .copied()
-            .flatten()
-            .and_then(|l| js.get_mut(l))
-        {
+        if root.is_some() {
+            // The base is an ancestor of every joint.
+            for r in 0..6 {
+                let sr = base_s(r);
+                put(r, off + j, (dot(&dfdq, &sr), dot(&dfdv, &sr)));
+            }
+        }
+        // Y_λ += Y_j, B^C_λ += B^C_j, F_λ += F_j (the base's on a free-floating root).
+        let parent = match t.parent.get(j).copied().flatten() {
+            Some(l) => js.get_mut(l),
+            None => root.as_deref_mut().map(|r| &mut r.body),
+        };
+        if let Some(p) = parent {
             for (a, x) in p.y.iter_mut().zip(jt.y) {
                 *a = *a + x;
             }
@@ -203,6 +300,33 @@ pub fn rnea_derivatives_in<S: Scalar + Copy>(
                 *col = add(col, &x);
             }
             p.f = add(&p.f, &jt.f);
+        }
+    }
+    let Some(root) = root else {
+        return;
+    };
+    // The base's columns: every body is in its subtree (∂v/∂q = 0 for them).
+    let base = &root.body;
+    let us: [([S; 6], [S; 6]); 6] = core::array::from_fn(|r| {
+        let sr = base_s(r);
+        (
+            inertia_mul(&base.y, &sr),
+            core::array::from_fn(|k| dot(&base.bc[k], &sr)),
+        )
+    });
+    for c in 0..6 {
+        let sc = base_s(c);
+        let dadq = crm(&root.a_grav, &sc);
+        let dadv = crm(&base.v, &sc);
+        for (r, (ys, bs)) in us.iter().enumerate() {
+            put(r, c, (dot(ys, &dadq), dot(ys, &dadv) + dot(bs, &sc)));
+        }
+        for (r, jr) in js.iter().enumerate() {
+            put(
+                off + r,
+                c,
+                (dot(&jr.ys, &dadq), dot(&jr.ys, &dadv) + dot(&jr.bs, &sc)),
+            );
         }
     }
 }
@@ -309,4 +433,116 @@ pub fn accelerations<S: Scalar + Copy>(minv: &[S], tau: &[S], c: &[S], qdd: &mut
         }
         *x = acc;
     }
+}
+
+/// `(∂τ/∂q, ∂τ/∂ν)` of free-floating inverse dynamics `[f_b; n_b; τ] = M ν̇ + c`
+/// ([`super::floating::inverse_dynamics`]'s layouts), `NV × NV` each (`NV = 6 + N`), the base's
+/// `∂/∂q` columns in the tangent space (`q` moved by Pinocchio's `integrate(q, δν)`):
+/// [`floating_rnea_derivatives_in`] on the bodies of `q`, on stack storage of `N` joints.
+#[inline]
+pub fn floating_inverse_dynamics_derivatives<S: Scalar + Copy, const N: usize, const NV: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    sincos: impl Fn(S) -> (S, S),
+) -> ([[S; NV]; NV], [[S; NV]; NV]) {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut js = [Joint::zero(); N];
+    let mut out = ([[zero; NV]; NV], [[zero; NV]; NV]);
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    world(t, inertia, &mut b);
+    let mut root = floating_root(base, q, v, a);
+    let (dq, dv) = (out.0.as_flattened_mut(), out.1.as_flattened_mut());
+    let (qd, qdd) = (v.get(6..).unwrap_or(&[]), a.get(6..).unwrap_or(&[]));
+    floating_rnea_derivatives_in(t, &b, &mut root, qd, qdd, &mut js, dq, dv);
+    out
+}
+
+/// The base as the root of the derivatives' passes at `(q, ν, ν̇)`, gravity from `base`.
+#[inline(always)]
+pub fn floating_root<S: Scalar + Copy>(
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+) -> FloatingRoot<S> {
+    let root = root_motion(base, q, Some(v), Some(a));
+    let mut a_grav = [S::zero(); 6];
+    if let Some(g) = &base.gravity {
+        let gb = gravity_in_base(q, g);
+        a_grav = [S::zero(), S::zero(), S::zero(), -gb[0], -gb[1], -gb[2]];
+    }
+    FloatingRoot::new(&base.inertia, root.v, root.a, a_grav)
+}
+
+/// `M(q)⁻¹` on a free-floating base, `NV × NV`: [`super::floating::mass_matrix_in`] inverted by
+/// LDLᵀ ([`inverse_in`]).
+#[inline]
+pub fn floating_mass_matrix_inverse<S: Scalar + Copy, const N: usize, const NV: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    sincos: impl Fn(S) -> (S, S),
+) -> [[S; NV]; NV] {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let (mut st, mut h, mut m) = ([[zero; N]; 6], [[zero; N]; N], [[zero; NV]; NV]);
+    let (mut d_inv, mut out) = ([zero; NV], [[zero; NV]; NV]);
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    let m = m.as_flattened_mut();
+    let (st, h) = (st.as_flattened_mut(), h.as_flattened_mut());
+    mass_matrix_in(t, inertia, base, &mut b, st, h, m);
+    inverse_in(m, NV, &mut d_inv, out.as_flattened_mut());
+    out
+}
+
+/// `(∂ν̇/∂q, ∂ν̇/∂ν, M⁻¹)` of free-floating forward dynamics `ν̇ = M⁻¹ ([0; τ] − c)` (the base
+/// not actuated; [`super::floating::forward_dynamics`]'s layouts), `NV × NV` each: `c` by
+/// [`inverse_dynamics_in`], `M⁻¹` as [`floating_mass_matrix_inverse`], `ν̇`, then
+/// `∂ν̇/∂x = −M⁻¹ ∂τ/∂x` with `∂τ/∂x` of [`floating_rnea_derivatives_in`] at `ν̇`.
+#[inline]
+pub fn floating_forward_dynamics_derivatives<S: Scalar + Copy, const N: usize, const NV: usize>(
+    t: &Tables<'_, S>,
+    inertia: &[[S; 10]],
+    base: &Base<S>,
+    q: &[S],
+    v: &[S],
+    tau: &[S; N],
+    sincos: impl Fn(S) -> (S, S),
+) -> ForwardDerivatives<S, NV> {
+    let zero = S::zero();
+    let mut store = BodyStore::<S, N>::new();
+    let mut b = store.bodies();
+    let mut js = [Joint::zero(); N];
+    let (mut st, mut h, mut m) = ([[zero; N]; 6], [[zero; N]; N], [[zero; NV]; NV]);
+    let (mut d_inv, mut mm, mut c) = ([zero; NV], [[[zero; 6]; 3]; N], [zero; NV]);
+    let (mut drives, mut nu_dot) = ([zero; NV], [zero; NV]);
+    let (mut dtq, mut dtv) = ([[zero; NV]; NV], [[zero; NV]; NV]);
+    let mut out = ([[zero; NV]; NV], [[zero; NV]; NV], [[zero; NV]; NV]);
+    transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
+    inverse_dynamics_in(t, b.x, inertia, base, q, Some(v), None, &mut mm, &mut c);
+    let m = m.as_flattened_mut();
+    let (st, h) = (st.as_flattened_mut(), h.as_flattened_mut());
+    mass_matrix_in(t, inertia, base, &mut b, st, h, m);
+    let minv = out.2.as_flattened_mut();
+    inverse_in(m, NV, &mut d_inv, minv);
+    for (d, x) in drives.iter_mut().skip(6).zip(tau) {
+        *d = *x;
+    }
+    accelerations(minv, &drives, &c, &mut nu_dot);
+    world(t, inertia, &mut b);
+    let mut root = floating_root(base, q, v, &nu_dot);
+    let (dtq, dtv) = (dtq.as_flattened_mut(), dtv.as_flattened_mut());
+    let qd = v.get(6..).unwrap_or(&[]);
+    floating_rnea_derivatives_in(t, &b, &mut root, qd, &nu_dot[6..], &mut js, dtq, dtv);
+    neg_product(minv, dtq, NV, out.0.as_flattened_mut());
+    neg_product(minv, dtv, NV, out.1.as_flattened_mut());
+    out
 }

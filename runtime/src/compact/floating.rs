@@ -57,7 +57,7 @@ pub fn base_rotation<S: Scalar + Copy>(q: &[S]) -> [[S; 3]; 3] {
 
 /// `R₀ᵀ g` for the quaternion of `q[3..7]`: gravity in base coordinates.
 #[inline(always)]
-fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
+pub(crate) fn gravity_in_base<S: Scalar + Copy>(q: &[S], g: &[S; 3]) -> [S; 3] {
     rot_tr(&base_rotation(q), g)
 }
 
@@ -258,7 +258,7 @@ pub fn inverse_dynamics_in<S: Scalar + Copy>(
 /// without `v`), `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]` of `ν̇` (zero without `a`; gravity as the base's
 /// fictitious acceleration, RBDA §5.3).
 #[inline(always)]
-fn root_motion<S: Scalar + Copy>(
+pub(crate) fn root_motion<S: Scalar + Copy>(
     base: &Base<S>,
     q: &[S],
     v: Option<&[S]>,
