@@ -11,6 +11,8 @@ use kanegen::model::random::{random_vec, rng};
 use kanegen::model::{Inertial, Model};
 use std::path::Path;
 
+mod common;
+
 kanegen::dynamics!(Random3, "tests/data/codegen/random3_prismatic.toml");
 kanegen::dynamics!(Random5, "tests/data/codegen/random5.toml");
 kanegen::dynamics!(
@@ -687,23 +689,13 @@ twins!(named_some, Some, base = "free-floating");
 twins!(named_none, None, base = "free-floating", form = "compact");
 twins!(named_usize, usize);
 twins!(named_str, str);
-// Every primitive type and prelude item the expansion could name, and `core`, defined next to
-// a type with a runtime payload.
+// Every primitive type, prelude item and built-in macro the expansion could name, and `core`,
+// defined next to a type with a runtime payload.
 twins!(
     crowded,
     Arm,
     runtime_payload = true;
-    pub struct f64;
-    pub struct f32;
-    pub struct usize;
-    pub struct u64;
-    pub struct u8;
-    pub struct bool;
-    pub struct str;
-    pub struct Option;
-    pub struct Some;
-    pub struct None;
-    pub mod core {}
+    crate::common::shadowing_items!();
 );
 
 /// Joint angles of any length and precision (the same for both twins).

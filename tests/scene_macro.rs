@@ -40,7 +40,10 @@
 //!   bound 1e-12);
 //! - the compiled right-hand side and one RK4 step ([`SsrmsEffects::step`]) off the equilibrium
 //!   are the interpreted ones; ten midpoint steps ([`FloatingMidpoint::step`]) are the run's
-//!   state at its first output sample.
+//!   state at its first output sample;
+//! - scene types named `f64` and `Option`, and scenes in a module that names structs like every
+//!   primitive type and prelude item (`common::shadowing_items!`), compile and simulate what
+//!   their plainly named twins do, bit for bit.
 //!
 //! The checks see a wrong provider: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves
 //! the SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
@@ -343,4 +346,84 @@ fn midpoint_steps_are_the_run() {
     assert_eq!(first.unwrap(), st);
     let norm: f64 = st.q[3..7].iter().map(|x| x * x).sum();
     assert!((norm - 1.0).abs() < 1e-14, "|quat|² − 1 = {}", norm - 1.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Scene types named like primitive types and prelude items: the expansion names those by full
+// paths, so each simulates what its normally named twin above does.
+
+// The flexible-joint scene (Rosenbrock) beside its twin `crowded::shadowed::Flexible`.
+kanegen::scene!(Flexible, "tests/data/scenes/flex_k1e3.toml");
+
+/// A scene type called `f64` (dopri5, step Jacobians): inside `impl f64` every `f64` of the
+/// expansion would be the scene type if it were not named by its full path.
+#[allow(non_camel_case_types, dead_code)]
+mod named_f64 {
+    kanegen::scene!(f64, "scenes/srms.toml");
+}
+
+/// A scene type called `Option` (events: a capture and a release, free-floating, dopri5).
+#[allow(dead_code)]
+mod named_option {
+    kanegen::scene!(Option, "scenes/capture_free_floating.toml");
+}
+
+/// Scenes in a module that gives every primitive type, prelude item and built-in macro the
+/// expansion could name, and `core`, a meaning of its own: computed torque with its inverse
+/// dynamics and step Jacobians, wrenches compensated through the generated frames, capture
+/// with rotor inertia (RK4), flexible joints.
+#[allow(non_camel_case_types, dead_code, clippy::upper_case_acronyms)]
+mod crowded {
+    pub mod shadowed {
+        crate::common::shadowing_items!();
+
+        kanegen::scene!(SsrmsPayload, "scenes/ssrms_payload_fixed.toml");
+        kanegen::scene!(CtWrench, "tests/data/scenes/computed_torque_wrench.toml");
+        kanegen::scene!(CaptureRotor, "tests/data/scenes/capture_rotor_rk4.toml");
+        kanegen::scene!(Flexible, "tests/data/scenes/flex_k1e3.toml");
+    }
+}
+
+/// Asserts that the scene type `shadowed` simulates what `plain` does, bit for bit: the samples
+/// and counts of `run`, `rhs` and one `step` off the initial state, and the step Jacobians when
+/// the scene has them (`jacobians` after `;`).
+macro_rules! same_trajectory {
+    ($shadowed:path, $plain:ident $(; $jacobians:ident)?) => {{
+        type Shadowed = $shadowed;
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let stats_a = Shadowed::run(|t, s| a.push((t, s.to_array()))).unwrap();
+        let stats_b = $plain::run(|t, s| b.push((t, s.to_array()))).unwrap();
+        assert!(b.len() > 1, "{}", $plain::SCENE);
+        assert_eq!((stats_a, a), (stats_b, b), "{}", $plain::SCENE);
+        let (mut sa, mut sb) = (Shadowed::initial_state(), $plain::initial_state());
+        assert_eq!(sa.to_array(), sb.to_array());
+        // Off the initial state, so that every effect matters.
+        for (i, (qa, qb)) in sa.q.iter_mut().zip(&mut sb.q).enumerate() {
+            *qa += 1e-3 * (i as f64).sin();
+            *qb += 1e-3 * (i as f64).sin();
+        }
+        assert_eq!(
+            Shadowed::rhs(0.1, &sa).to_array(),
+            $plain::rhs(0.1, &sb).to_array()
+        );
+        Shadowed::step(0.1, &mut sa, $plain::STEP).unwrap();
+        $plain::step(0.1, &mut sb, $plain::STEP).unwrap();
+        assert_eq!(sa.to_array(), sb.to_array());
+        $(
+            let $jacobians = [0.1; $plain::N];
+            let (s1, a1, b1) = Shadowed::step_jacobians(0.1, &sa, &$jacobians, $plain::STEP).unwrap();
+            let (s2, a2, b2) = $plain::step_jacobians(0.1, &sb, &$jacobians, $plain::STEP).unwrap();
+            assert_eq!((s1.to_array(), a1, b1), (s2.to_array(), a2, b2));
+        )?
+    }};
+}
+
+#[test]
+fn scene_types_named_like_primitives_and_prelude_items_simulate_what_plain_ones_do() {
+    same_trajectory!(named_f64::f64, Srms; u);
+    same_trajectory!(named_option::Option, Capture);
+    same_trajectory!(crowded::shadowed::SsrmsPayload, SsrmsPayload; u);
+    same_trajectory!(crowded::shadowed::CtWrench, CtWrench);
+    same_trajectory!(crowded::shadowed::CaptureRotor, CaptureRotor);
+    same_trajectory!(crowded::shadowed::Flexible, Flexible);
 }

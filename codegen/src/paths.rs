@@ -1,7 +1,7 @@
-//! The primitive types and prelude items the emitted code names, each by its full path
-//! (`::core::primitive::f64`, `::core::option::Option::Some`): the generated items land in the
-//! caller's module, where a generated type, or anything else, may be called `f64`, `usize`,
-//! `str`, `Option`, `Some` or `None` and would otherwise change what the code means.
+//! The primitive types and prelude items the emitted code (and `scene!`'s) names, each by its
+//! full path (`::core::primitive::f64`, `::core::option::Option::Some`): the generated items
+//! land in the caller's module, where a generated type, or anything else, may be called `f64`,
+//! `usize`, `str`, `Option`, `Some` or `None` and would otherwise change what the code means.
 
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote, ToTokens};
@@ -35,37 +35,105 @@ pub fn option<T: ToTokens>(x: Option<T>) -> TokenStream {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use crate::{generate_items, Float, Form, Options};
-    use kanegen_model::random::{random_chain, ChainSpec};
-    use kanegen_model::BaseKind;
+/// `Result<T, E>`, by its full path.
+#[must_use]
+pub fn result_type(t: &TokenStream, e: &TokenStream) -> TokenStream {
+    quote!(::core::result::Result<#t, #e>)
+}
+
+/// `Ok(x)`, by its full path (an expression or a pattern).
+#[must_use]
+pub fn ok<T: ToTokens>(x: T) -> TokenStream {
+    quote!(::core::result::Result::Ok(#x))
+}
+
+/// `Err(x)`, by its full path (an expression or a pattern).
+#[must_use]
+pub fn err<T: ToTokens>(x: T) -> TokenStream {
+    quote!(::core::result::Result::Err(#x))
+}
+
+/// Names the including module may give another meaning: the primitive types, the prelude's
+/// items (the traits among them name a bound such as `impl FnMut(…)`; a method call finds a
+/// prelude trait whatever the module calls its name), the built-in macros the emitted code
+/// calls and the standard crates.
+pub const SHADOWABLE: &[&str] = &[
+    "bool",
+    "char",
+    "str",
+    "f32",
+    "f64",
+    "i8",
+    "i16",
+    "i32",
+    "i64",
+    "i128",
+    "isize",
+    "u8",
+    "u16",
+    "u32",
+    "u64",
+    "u128",
+    "usize",
+    "Option",
+    "Some",
+    "None",
+    "Result",
+    "Ok",
+    "Err",
+    "Box",
+    "String",
+    "Vec",
+    "Default",
+    "Clone",
+    "Copy",
+    "Iterator",
+    "IntoIterator",
+    "Into",
+    "From",
+    "TryFrom",
+    "TryInto",
+    "Fn",
+    "FnMut",
+    "FnOnce",
+    "include_bytes",
+    "core",
+    "std",
+    "alloc",
+];
+
+/// The paths of `items` (every path: types, expressions, patterns, bounds, macro calls) that
+/// start with a [`SHADOWABLE`] name and no leading `::`, as text: none, when the code means the
+/// same in any module.
+///
+/// # Errors
+/// The parse error when `items` are not Rust items.
+pub fn unqualified(items: TokenStream) -> syn::Result<Vec<String>> {
     use syn::visit::Visit;
-
-    /// Names the caller's module may give another meaning: the primitive types, the prelude's
-    /// items and the standard crates.
-    const SHADOWABLE: &[&str] = &[
-        "bool", "char", "str", "f32", "f64", "i8", "i16", "i32", "i64", "i128", "isize", "u8",
-        "u16", "u32", "u64", "u128", "usize", "Option", "Some", "None", "Result", "Ok", "Err",
-        "Box", "String", "Vec", "Default", "Clone", "Copy", "Iterator", "Into", "From", "core",
-        "std", "alloc",
-    ];
-
-    /// The paths of the emitted code that start with a shadowable name (no leading `::`).
     #[derive(Default)]
     struct Unqualified(Vec<String>);
-
     impl<'a> Visit<'a> for Unqualified {
         fn visit_path(&mut self, p: &'a syn::Path) {
             let first = p.segments.first().map(|s| s.ident.to_string());
             if let (None, Some(first)) = (&p.leading_colon, first) {
                 if SHADOWABLE.contains(&first.as_str()) {
-                    self.0.push(quote::quote!(#p).to_string());
+                    self.0.push(quote!(#p).to_string());
                 }
             }
             syn::visit::visit_path(self, p);
         }
     }
+    let file: syn::File = syn::parse2(items)?;
+    let mut v = Unqualified::default();
+    v.visit_file(&file);
+    Ok(v.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{generate_items, Float, Form, Options};
+    use kanegen_model::random::{random_chain, ChainSpec};
+    use kanegen_model::BaseKind;
 
     /// Every variant of the emitted code (straight-line and compact, fixed and free-floating,
     /// `f64` and `f32`, a runtime payload, gravity, the fused and the table helpers) names every
@@ -113,10 +181,11 @@ mod tests {
             o.fma = fma;
             o.derivatives = false;
             let items = generate_items(model, &o).unwrap().items;
-            let file: syn::File = syn::parse2(items).unwrap();
-            let mut v = Unqualified::default();
-            v.visit_file(&file);
-            assert!(v.0.is_empty(), "{form:?} {float:?} {base:?}: {:?}", v.0);
+            let unqualified = super::unqualified(items).unwrap();
+            assert!(
+                unqualified.is_empty(),
+                "{form:?} {float:?} {base:?}: {unqualified:?}"
+            );
         }
     }
 }

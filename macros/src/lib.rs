@@ -333,13 +333,19 @@ fn generate(
         ));
     }
     let g = kanegen_codegen::generate_items(&model, opts).map_err(|e| e.to_string())?;
-    let items = g.items;
-    let abs_lit = LitStr::new(&abs, Span::call_site());
-    let u8 = kanegen_codegen::paths::primitive("u8");
+    let (include, items) = (include_file(&abs), g.items);
     Ok(quote! {
-        const _: &[#u8] = ::core::include_bytes!(#abs_lit);
+        #include
         #items
     })
+}
+
+/// `const _: &[u8] = include_bytes!("abs");`, by full paths: the file at `abs` becomes an input
+/// of the build, so that a change to it expands the macro again.
+fn include_file(abs: &str) -> proc_macro2::TokenStream {
+    let abs = LitStr::new(abs, Span::call_site());
+    let u8 = kanegen_codegen::paths::primitive("u8");
+    quote!(const _: &[#u8] = ::core::include_bytes!(#abs);)
 }
 
 struct SceneInput {

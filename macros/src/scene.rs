@@ -10,13 +10,16 @@
 //! `kanegen-runtime` (`kanegen::ode`) on the stack, the code `kanegen_sim::integrate` runs.
 //! Payload captures and releases (`[[events]]`) are in [`crate::scene_events`]: one dynamics
 //! type per model phase, a run segment by segment, and the capture impulse. A scene error is a
-//! compile error naming the key and the scene file.
+//! compile error naming the key and the scene file. The emitted code names every primitive type
+//! and prelude item by its full path ([`kanegen_codegen::paths`]), as the generated dynamics do:
+//! the including module may call something `f64`, `Option`, `Ok` or `core`.
 
 use crate::scene_linearize;
 use crate::scene_provider::{self, arr, lit, Shape};
 use kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
 use kanegen_codegen::kanegen_dynamics::LoadFrame;
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Model, Placement};
+use kanegen_codegen::paths;
 use kanegen_scene::{BaseSpec, Drives, EventKind, Integrator, Scene};
 use proc_macro2::{Literal, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -217,22 +220,23 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let docs = Docs::of(scene, &model, &layout, name, rel);
     let (struct_doc, integrator_doc) = (docs.scene, docs.integrator);
     let linearize_doc = scene_linearize::doc(name, &linearize);
-    let scene_lit = LitStr::new(&src.abs, Span::call_site());
-    let model_lit = LitStr::new(&src.model_path.display().to_string(), Span::call_site());
+    let include_scene = crate::include_file(&src.abs);
+    let include_model = crate::include_file(&src.model_path.display().to_string());
+    let usize = paths::primitive("usize");
     let model_doc = format!(
         " The generated dynamics of [`{name}`] as the provider of its right-hand side, in the \
          model phase `.0` (0 before the first event, `k` after event `k − 1`)."
     );
     Ok(quote! {
-        const _: &[u8] = include_bytes!(#scene_lit);
-        const _: &[u8] = include_bytes!(#model_lit);
+        #include_scene
+        #include_model
 
         #dyn_items
         #state
 
         #[doc = #model_doc]
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-        pub struct #model_ty(pub usize);
+        pub struct #model_ty(pub #usize);
 
         #[allow(clippy::unreadable_literal, clippy::excessive_precision)]
         #provider
@@ -349,6 +353,7 @@ fn state_items(scene: &Scene, l: &Layout, name: &Ident, dyn_name: &str) -> Token
     );
     let dim = Literal::usize_unsuffixed(l.dim);
     let (state_ty, vname) = (&l.state_ty, &l.vname);
+    let f64 = paths::primitive("f64");
     let state_doc = if l.flexible {
         format!(
             " The state of [`{name}`]: link positions `q` and rates `qd`, motor positions \
@@ -375,9 +380,9 @@ fn state_items(scene: &Scene, l: &Layout, name: &Ident, dyn_name: &str) -> Token
     let motor_fields = if l.flexible {
         quote! {
             /// Motor positions (link side, `θ`).
-            pub theta: [f64; #nl],
+            pub theta: [#f64; #nl],
             /// Motor rates.
-            pub thetad: [f64; #nl],
+            pub thetad: [#f64; #nl],
         }
     } else {
         quote!()
@@ -387,7 +392,7 @@ fn state_items(scene: &Scene, l: &Layout, name: &Ident, dyn_name: &str) -> Token
         let three = Literal::usize_unsuffixed(3 * n);
         (
             quote! {
-                core::array::from_fn(|i| match i / #nl {
+                ::core::array::from_fn(|i| match i / #nl {
                     0 => self.q[i],
                     1 => self.qd[i - #nl],
                     2 => self.theta[i - #two],
@@ -396,20 +401,20 @@ fn state_items(scene: &Scene, l: &Layout, name: &Ident, dyn_name: &str) -> Token
             },
             quote! {
                 #state_ty {
-                    q: core::array::from_fn(|i| x[i]),
-                    qd: core::array::from_fn(|i| x[#nl + i]),
-                    theta: core::array::from_fn(|i| x[#two + i]),
-                    thetad: core::array::from_fn(|i| x[#three + i]),
+                    q: ::core::array::from_fn(|i| x[i]),
+                    qd: ::core::array::from_fn(|i| x[#nl + i]),
+                    theta: ::core::array::from_fn(|i| x[#two + i]),
+                    thetad: ::core::array::from_fn(|i| x[#three + i]),
                 }
             },
         )
     } else {
         (
-            quote!(core::array::from_fn(|i| if i < #nql { self.q[i] } else { self.#vname[i - #nql] })),
+            quote!(::core::array::from_fn(|i| if i < #nql { self.q[i] } else { self.#vname[i - #nql] })),
             quote! {
                 #state_ty {
-                    q: core::array::from_fn(|i| x[i]),
-                    #vname: core::array::from_fn(|i| x[#nql + i]),
+                    q: ::core::array::from_fn(|i| x[i]),
+                    #vname: ::core::array::from_fn(|i| x[#nql + i]),
                 }
             },
         )
@@ -420,27 +425,27 @@ fn state_items(scene: &Scene, l: &Layout, name: &Ident, dyn_name: &str) -> Token
         #[derive(Clone, Copy, Debug, PartialEq)]
         pub struct #state_ty {
             /// Positions.
-            pub q: [f64; #nql],
+            pub q: [#f64; #nql],
             #[doc = #vdoc]
-            pub #vname: [f64; #nvl],
+            pub #vname: [#f64; #nvl],
             #motor_fields
         }
 
         impl #state_ty {
             /// The state as one vector `[q, v]` (the interpreted simulator's layout).
             #[must_use]
-            pub fn to_array(&self) -> [f64; #dim] {
+            pub fn to_array(&self) -> [#f64; #dim] {
                 #to_array
             }
 
             /// The state of a vector `[q, v]`.
             #[must_use]
-            pub fn from_array(x: &[f64; #dim]) -> Self {
+            pub fn from_array(x: &[#f64; #dim]) -> Self {
                 #from_array
             }
 
             /// The scene's initial state.
-            const INITIAL: [f64; #dim] = #x0;
+            const INITIAL: [#f64; #dim] = #x0;
         }
     }
 }
@@ -473,7 +478,7 @@ impl Methods {
             };
             quote!(#ode::ArrayScratch::<{ #ode::#module::scratch_len(#dim) }, #pivots>::new())
         };
-        let max_step = lit(sim.max_step);
+        let (max_step, f64) = (lit(sim.max_step), paths::primitive("f64"));
         let options = if matches!(sim.integrator, Integrator::Rk4 | Integrator::Midpoint) {
             quote! {
                 #ode::Rk4Options {
@@ -487,7 +492,7 @@ impl Methods {
                     tolerance: Self::TOLERANCE,
                     max_step: #max_step,
                     initial_step: Self::STEP,
-                    output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
+                    output_interval: Self::STEP * Self::OUTPUT_EVERY as #f64,
                 }
             }
         };
@@ -542,11 +547,12 @@ fn run_body(
 /// The signature of `rhs` (`rhs_in` with the model phase as its first argument when the scene
 /// has events) and the phase it runs in.
 fn rhs_signature(scene: &Scene, state_ty: &Ident) -> (TokenStream, TokenStream) {
+    let (f64, usize) = (paths::primitive("f64"), paths::primitive("usize"));
     if scene.events.is_empty() {
         let sig = quote! {
             /// The right-hand side `ẋ = f(t, x)` with the scene's effects only.
             #[must_use]
-            pub fn rhs(t: f64, s: &#state_ty) -> #state_ty
+            pub fn rhs(t: #f64, s: &#state_ty) -> #state_ty
         };
         (sig, quote!(0))
     } else {
@@ -554,7 +560,7 @@ fn rhs_signature(scene: &Scene, state_ty: &Ident) -> (TokenStream, TokenStream) 
             /// The right-hand side `ẋ = f(t, x)` with the scene's effects only, with the model
             /// of `phase` (0 before the first event, `k` after event `k − 1`).
             #[must_use]
-            pub fn rhs_in(phase: usize, t: f64, s: &#state_ty) -> #state_ty
+            pub fn rhs_in(phase: #usize, t: #f64, s: &#state_ty) -> #state_ty
         };
         (sig, quote!(phase))
     }
@@ -599,6 +605,10 @@ fn simulator_items(
     let step_doc = step_doc(scene.simulation.integrator);
     let constants = constants(&rt, scene, l, rel);
     let (step_fn, run_scratch, step_scratch) = (&m.step_fn, &m.run_scratch, &m.step_scratch);
+    let f64 = paths::primitive("f64");
+    let step_result = paths::result_type(&quote!(()), &quote!(#ode::Stop));
+    let run_result = paths::result_type(&quote!(#ode::Stats), &quote!(#ode::Stop));
+    let (done, sample) = (paths::ok(quote!(())), paths::ok(quote!(x)));
     quote! {
         #[allow(clippy::too_many_lines, clippy::unreadable_literal, clippy::excessive_precision)]
         impl #name {
@@ -623,15 +633,15 @@ fn simulator_items(
             /// A `kanegen::ode::Stop` when the new state is not finite (or the midpoint
             /// iterations do not converge); `state` is then unchanged.
             pub fn step(
-                t: f64,
+                t: #f64,
                 state: &mut #state_ty,
-                h: f64,
-            ) -> Result<(), #ode::Stop> {
+                h: #f64,
+            ) -> #step_result {
                 let mut x = state.to_array();
                 let mut work = [0.0f64; Self::WORK];
                 #ode::#step_fn(&mut #step_system, t, h, &mut x, &mut #step_scratch)?;
                 *state = #state_ty::from_array(&x);
-                Ok(())
+                #done
             }
 
             /// Integrates the scene from its initial state over its duration with its
@@ -643,14 +653,14 @@ fn simulator_items(
             /// size underflows or its error estimate overflows); the observer has seen every
             /// sample up to there.
             pub fn run(
-                mut observe: impl FnMut(f64, &#state_ty),
-            ) -> Result<#ode::Stats, #ode::Stop> {
+                mut observe: impl ::core::ops::FnMut(#f64, &#state_ty),
+            ) -> #run_result {
                 let mut x = Self::initial_state().to_array();
                 let mut scratch = #run_scratch;
                 let mut work = [0.0f64; Self::WORK];
                 #[allow(unused_mut)]
-                let mut obs = |t: f64, x: &[f64]| {
-                    if let Ok(x) = <&[f64; #dim]>::try_from(x) {
+                let mut obs = |t: #f64, x: &[#f64]| {
+                    if let #sample = <&[#f64; #dim]>::try_from(x) {
                         observe(t, &#state_ty::from_array(x));
                     }
                 };
@@ -675,6 +685,11 @@ fn constants(rt: &TokenStream, scene: &Scene, l: &Layout, rel: &str) -> TokenStr
         Literal::usize_unsuffixed(l.dim),
     );
     let rel_lit = LitStr::new(rel, Span::call_site());
+    let (f64, usize, str) = (
+        paths::primitive("f64"),
+        paths::primitive("usize"),
+        paths::static_str(),
+    );
     let dim_doc = if l.flexible {
         format!(
             " Length of the flat state vector ({} + {} + {} + {}).",
@@ -685,24 +700,49 @@ fn constants(rt: &TokenStream, scene: &Scene, l: &Layout, rel: &str) -> TokenStr
     };
     quote! {
             /// Joint degrees of freedom.
-            pub const N: usize = #nl;
+            pub const N: #usize = #nl;
             #[doc = #dim_doc]
-            pub const DIM: usize = #dim;
+            pub const DIM: #usize = #dim;
             /// The scene file (relative to the crate).
-            pub const SCENE: &'static str = #rel_lit;
+            pub const SCENE: #str = #rel_lit;
             /// Simulated duration, s.
-            pub const DURATION: f64 = #duration;
+            pub const DURATION: #f64 = #duration;
             /// Step (RK4), or first step tried (dopri5), s.
-            pub const STEP: f64 = #step;
+            pub const STEP: #f64 = #step;
             /// dopri5 tolerance (`rtol = atol`; unused by RK4 scenes).
-            pub const TOLERANCE: f64 = #tolerance;
+            pub const TOLERANCE: #f64 = #tolerance;
             /// An output sample every this many steps (RK4), or every `OUTPUT_EVERY · STEP`
             /// seconds (dopri5).
-            pub const OUTPUT_EVERY: usize = #every;
+            pub const OUTPUT_EVERY: #usize = #every;
             /// The scene's effects: the data of its right-hand side
             /// (`kanegen::runtime::scene::deriv`).
             pub const EFFECTS: #rt::scene::SceneEffects<'static> = #effects;
             /// Length of the work memory of the right-hand side.
-            pub const WORK: usize = Self::EFFECTS.work_len();
+            pub const WORK: #usize = Self::EFFECTS.work_len();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every scene of `scenes/` and `tests/data/scenes/` (every integrator, drive and effect,
+    /// events, wrenches, flexible joints, step Jacobians) expands to code that names every
+    /// primitive type and prelude item by its full path (`kanegen_codegen::paths`).
+    #[test]
+    fn expansion_names_primitives_and_prelude_items_by_full_paths() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let runtime: syn::Path = syn::parse_quote!(::kanegen);
+        let name = quote::format_ident!("Scene");
+        let mut scenes = 0;
+        for dir in ["scenes", "tests/data/scenes"] {
+            for entry in std::fs::read_dir(root.join(dir)).unwrap() {
+                let file = entry.unwrap().file_name().into_string().unwrap();
+                let rel = format!("../{dir}/{file}");
+                let items = super::expand(&runtime, &name, &rel).unwrap();
+                let unqualified = kanegen_codegen::paths::unqualified(items).unwrap();
+                assert!(unqualified.is_empty(), "{rel}: {unqualified:?}");
+                scenes += 1;
+            }
+        }
+        assert!(scenes > 20, "{scenes} scenes");
     }
 }

@@ -7,6 +7,7 @@
 
 use crate::scene_provider::{arr, lit};
 use kanegen_codegen::kanegen_model::{BaseKind, Model};
+use kanegen_codegen::paths;
 use kanegen_scene::{BaseSpec, EventKind, Scene};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -65,6 +66,7 @@ pub fn run_segments(
     sys: &TokenStream,
     call: &TokenStream,
 ) -> TokenStream {
+    let done = paths::ok(quote!(stats));
     quote! {
         let mut stats = #runtime::__private::runtime::ode::Stats::default();
         let mut t0 = 0.0;
@@ -83,7 +85,7 @@ pub fn run_segments(
             stats.accumulate(#call?);
             t0 = t1;
         }
-        Ok(stats)
+        #done
     }
 }
 
@@ -103,6 +105,7 @@ pub fn event_items(
     let count = Literal::usize_unsuffixed(times.len());
     let times = arr(&times);
     let rt = quote!(#runtime::__private::runtime);
+    let (f64, usize) = (paths::primitive("f64"), paths::primitive("usize"));
     let arms = scene.events.iter().enumerate().map(|(k, e)| {
         let kl = Literal::usize_unsuffixed(k);
         match &e.kind {
@@ -138,19 +141,19 @@ pub fn event_items(
     });
     quote! {
         /// The event times (`[[events]]`), s.
-        pub const EVENT_TIMES: [f64; #count] = #times;
+        pub const EVENT_TIMES: [#f64; #count] = #times;
 
         /// The model phase at `t`: the number of events at or before `t` (at an event time, the
         /// model after it).
         #[must_use]
-        pub fn phase_at(t: f64) -> usize {
+        pub fn phase_at(t: #f64) -> #usize {
             Self::EVENT_TIMES.iter().filter(|te| **te <= t).count()
         }
 
         /// The right-hand side `ẋ = f(t, x)` with the scene's effects only, with the model of
         /// [`Self::phase_at`]`(t)`.
         #[must_use]
-        pub fn rhs(t: f64, s: &#state_ty) -> #state_ty {
+        pub fn rhs(t: #f64, s: &#state_ty) -> #state_ty {
             Self::rhs_in(Self::phase_at(t), t, s)
         }
 
@@ -158,7 +161,7 @@ pub fn event_items(
         /// of the plastic-impact equation `H' v⁺ = H v⁻ + J_pᵀ h_p` (total linear and angular
         /// momentum conserved); a release keeps the state (the model of the next phase lets
         /// go of the payload).
-        pub fn apply_event(k: usize, s: &mut #state_ty) {
+        pub fn apply_event(k: #usize, s: &mut #state_ty) {
             match k {
                 #(#arms)*
                 _ => {}

@@ -6,7 +6,8 @@
 //! its input (`kanegen_runtime::scene::linearize`) — the code `kanegen simulate --linearize`
 //! runs over the run-time algorithms.
 
-use crate::scene_provider::{phase_match, Shape};
+use crate::scene_provider::{as_arrays, phase_match, Shape};
+use kanegen_codegen::paths;
 use kanegen_runtime::scene::{linearizable, SceneEffects};
 use kanegen_scene::{Integrator, Scene};
 use proc_macro2::{Literal, TokenStream};
@@ -47,11 +48,9 @@ pub fn doc(name: &Ident, available: &Result<(), String>) -> String {
 /// the provider's phase.
 pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
     let Shape { rt, ty, .. } = sh;
-    let (nl, nvl) = (
-        Literal::usize_unsuffixed(sh.n),
-        Literal::usize_unsuffixed(sh.nv),
-    );
-    let nan = quote!([[f64::NAN; #nvl]; #nvl]);
+    let nvl = Literal::usize_unsuffixed(sh.nv);
+    let f64 = paths::primitive("f64");
+    let nan = quote!([[#f64::NAN; #nvl]; #nvl]);
     let forward = phase_match(
         sh,
         &quote!((#nan, #nan, #nan)),
@@ -62,26 +61,33 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
         &quote!((#nan, #nan)),
         |dy| quote!(#dy::inverse_dynamics_derivatives(q, v, qdd)),
     );
+    let forward_args = as_arrays(
+        &[("q", sh.n), ("v", sh.n), ("tau", sh.n)],
+        &quote! {
+            dq.fill(#f64::NAN);
+            dv.fill(#f64::NAN);
+            return minv.fill(#f64::NAN);
+        },
+    );
+    let inverse_args = as_arrays(
+        &[("q", sh.n), ("v", sh.n), ("qdd", sh.n)],
+        &quote! {
+            dq.fill(#f64::NAN);
+            return dv.fill(#f64::NAN);
+        },
+    );
     quote! {
         impl #rt::scene::SceneDerivatives for #ty {
             fn forward_derivatives(
                 &mut self,
-                q: &[f64],
-                v: &[f64],
-                tau: &[f64],
-                dq: &mut [f64],
-                dv: &mut [f64],
-                minv: &mut [f64],
+                q: &[#f64],
+                v: &[#f64],
+                tau: &[#f64],
+                dq: &mut [#f64],
+                dv: &mut [#f64],
+                minv: &mut [#f64],
             ) {
-                let (Ok(q), Ok(v), Ok(tau)) = (
-                    <&[f64; #nl]>::try_from(q),
-                    <&[f64; #nl]>::try_from(v),
-                    <&[f64; #nl]>::try_from(tau),
-                ) else {
-                    dq.fill(f64::NAN);
-                    dv.fill(f64::NAN);
-                    return minv.fill(f64::NAN);
-                };
+                #forward_args
                 let (a, b, c) = #forward;
                 for (m, dst) in [(a, dq), (b, dv), (c, minv)] {
                     for (row, d) in m.iter().zip(dst.chunks_exact_mut(#nvl)) {
@@ -92,20 +98,13 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
 
             fn inverse_derivatives(
                 &mut self,
-                q: &[f64],
-                v: &[f64],
-                qdd: &[f64],
-                dq: &mut [f64],
-                dv: &mut [f64],
+                q: &[#f64],
+                v: &[#f64],
+                qdd: &[#f64],
+                dq: &mut [#f64],
+                dv: &mut [#f64],
             ) {
-                let (Ok(q), Ok(v), Ok(qdd)) = (
-                    <&[f64; #nl]>::try_from(q),
-                    <&[f64; #nl]>::try_from(v),
-                    <&[f64; #nl]>::try_from(qdd),
-                ) else {
-                    dq.fill(f64::NAN);
-                    return dv.fill(f64::NAN);
-                };
+                #inverse_args
                 let (a, b) = #inverse;
                 for (m, dst) in [(a, dq), (b, dv)] {
                     for (row, d) in m.iter().zip(dst.chunks_exact_mut(#nvl)) {
@@ -128,6 +127,16 @@ pub fn step_jacobians(
 ) -> TokenStream {
     let ode = quote!(#rt::ode);
     let (nl, dl) = (Literal::usize_unsuffixed(n), Literal::usize_unsuffixed(dim));
+    let f64 = paths::primitive("f64");
+    let result = paths::result_type(
+        &quote!((#state_ty, [[#f64; #dl]; #dl], [[#f64; #nl]; #dl])),
+        &quote!(#ode::Stop),
+    );
+    let done = paths::ok(quote! {(
+        #state_ty::from_array(&x),
+        ::core::array::from_fn(|i| ::core::array::from_fn(|j| a[i * #dl + j])),
+        ::core::array::from_fn(|i| ::core::array::from_fn(|j| b[i * #nl + j])),
+    )});
     let (call, scratch, scheme) = if scene.simulation.integrator == Integrator::Midpoint {
         (
             quote!(#ode::midpoint_step_jacobians),
@@ -157,11 +166,11 @@ pub fn step_jacobians(
         /// do not converge).
         #[allow(clippy::type_complexity)]
         pub fn step_jacobians(
-            t: f64,
+            t: #f64,
             state: &#state_ty,
-            u: &[f64; #nl],
-            h: f64,
-        ) -> Result<(#state_ty, [[f64; #dl]; #dl], [[f64; #nl]; #dl]), #ode::Stop> {
+            u: &[#f64; #nl],
+            h: #f64,
+        ) -> #result {
             let mut x = state.to_array();
             let mut work = [0.0f64; #rt::scene::linearize::jacobian_work_len(&Self::EFFECTS)];
             let mut model = #model_ty(0);
@@ -172,11 +181,7 @@ pub fn step_jacobians(
             };
             let (mut a, mut b) = ([0.0f64; #dl * #dl], [0.0f64; #dl * #nl]);
             #call(&mut sys, t, h, &mut x, u, &mut a, &mut b, &mut #scratch)?;
-            Ok((
-                #state_ty::from_array(&x),
-                core::array::from_fn(|i| core::array::from_fn(|j| a[i * #dl + j])),
-                core::array::from_fn(|i| core::array::from_fn(|j| b[i * #nl + j])),
-            ))
+            #done
         }
     }
 }

@@ -6,6 +6,7 @@
 
 use kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
 use kanegen_codegen::kanegen_dynamics::LoadFrame;
+use kanegen_codegen::paths;
 use kanegen_runtime::scene::{Drive, Profile, SceneEffects};
 use kanegen_scene::Scene;
 use proc_macro2::{Literal, TokenStream};
@@ -28,8 +29,24 @@ fn rows(v: &[[f64; 3]]) -> TokenStream {
     quote!([#(#v),*])
 }
 
-fn opt(v: Option<TokenStream>) -> TokenStream {
-    v.map_or(quote!(None), |v| quote!(Some(#v)))
+/// `let (Ok(q), Ok(v), …) = (<&[f64; NQ]>::try_from(q), …) else { otherwise };`: the slice
+/// arguments `args` (name, length) as arrays of their lengths, `otherwise` when one is not.
+pub fn as_arrays(args: &[(&str, usize)], otherwise: &TokenStream) -> TokenStream {
+    let f64 = paths::primitive("f64");
+    let names: Vec<Ident> = args
+        .iter()
+        .map(|(name, _)| format_ident!("{name}"))
+        .collect();
+    let arrays = names.iter().zip(args).map(|(name, (_, len))| {
+        let len = Literal::usize_unsuffixed(*len);
+        quote!(<&[#f64; #len]>::try_from(#name))
+    });
+    let oks = names.iter().map(paths::ok);
+    if args.len() == 1 {
+        quote!(let #(#oks)* = #(#arrays)* else { #otherwise };)
+    } else {
+        quote!(let (#(#oks),*) = (#(#arrays),*) else { #otherwise };)
+    }
 }
 
 /// The `SceneEffects` literal of `fx` (`rt` the runtime's path).
@@ -82,13 +99,13 @@ pub fn effects(rt: &TokenStream, fx: &SceneEffects<'_>) -> TokenStream {
             quote!(#s::Profile::Table { time: &#t, force: &#f, moment: &#m })
         }
     });
-    let damping = opt(fx.damping.map(slice));
-    let coulomb = opt(fx.coulomb.map(|c| {
+    let damping = paths::option(fx.damping.map(slice));
+    let coulomb = paths::option(fx.coulomb.map(|c| {
         let (tc, vs) = (slice(c.tau_c), lit(c.v_s));
         quote!(#s::Coulomb { tau_c: #tc, v_s: #vs })
     }));
-    let armature = opt(fx.armature.map(slice));
-    let flexible = opt(fx.flexible.map(|f| {
+    let armature = paths::option(fx.armature.map(slice));
+    let flexible = paths::option(fx.flexible.map(|f| {
         let (k, d, b) = (slice(f.stiffness), slice(f.damping), slice(f.reflected));
         quote!(#s::Flexible { stiffness: #k, damping: #d, reflected: #b })
     }));
@@ -130,14 +147,21 @@ pub struct Shape<'a> {
 /// function of the provider's phase; `Err` names a wrench without the frame it needs.
 pub fn provider(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
     let Shape { rt, ty, .. } = sh;
-    let (nl, nql, nvl) = (
-        Literal::usize_unsuffixed(sh.n),
-        Literal::usize_unsuffixed(sh.nq),
-        Literal::usize_unsuffixed(sh.nv),
+    let nvl = Literal::usize_unsuffixed(sh.nv);
+    let f64 = paths::primitive("f64");
+    let forward_args = as_arrays(
+        &[
+            ("q", sh.nq),
+            ("v", sh.nv),
+            ("tau", sh.n),
+            ("w", 6 * scene.wrenches.len()),
+        ],
+        &quote!(return acc.fill(#f64::NAN);),
     );
-    let wl = Literal::usize_unsuffixed(6 * scene.wrenches.len());
+    let mass_args = as_arrays(&[("q", sh.nq)], &quote!(return m.fill(#f64::NAN);));
+    let (acc_ok, acc_err) = (paths::ok(quote!(acc)), paths::err(quote!(_)));
     let f_ext = f_ext(scene, sh)?;
-    let forward = phase_match(sh, &quote!([f64::NAN; #nvl]), |dy| {
+    let forward = phase_match(sh, &quote!([#f64::NAN; #nvl]), |dy| {
         if scene.wrenches.is_empty() {
             quote!(#dy::forward_dynamics(q, v, tau))
         } else {
@@ -146,42 +170,33 @@ pub fn provider(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
     });
     let mass = phase_match(
         sh,
-        &quote!([[f64::NAN; #nvl]; #nvl]),
+        &quote!([[#f64::NAN; #nvl]; #nvl]),
         |dy| quote!(#dy::mass_matrix(q)),
     );
     let inverse = inverse(scene, sh)?;
     Ok(quote! {
         impl #rt::scene::SceneDynamics for #ty {
             #[inline(always)]
-            fn forward(&mut self, q: &[f64], v: &[f64], tau: &[f64], w: &[f64], acc: &mut [f64]) {
-                let (Ok(q), Ok(v), Ok(tau), Ok(w)) = (
-                    <&[f64; #nql]>::try_from(q),
-                    <&[f64; #nvl]>::try_from(v),
-                    <&[f64; #nl]>::try_from(tau),
-                    <&[f64; #wl]>::try_from(w),
-                ) else {
-                    return acc.fill(f64::NAN);
-                };
+            fn forward(&mut self, q: &[#f64], v: &[#f64], tau: &[#f64], w: &[#f64], acc: &mut [#f64]) {
+                #forward_args
                 let _ = w;
                 #f_ext
-                let a: [f64; #nvl] = #forward;
-                match <&mut [f64; #nvl]>::try_from(&mut *acc) {
-                    Ok(acc) => *acc = a,
-                    Err(_) => acc.fill(f64::NAN),
+                let a: [#f64; #nvl] = #forward;
+                match <&mut [#f64; #nvl]>::try_from(&mut *acc) {
+                    #acc_ok => *acc = a,
+                    #acc_err => acc.fill(#f64::NAN),
                 }
             }
 
-            fn mass_matrix(&mut self, q: &[f64], m: &mut [f64]) {
-                let Ok(q) = <&[f64; #nql]>::try_from(q) else {
-                    return m.fill(f64::NAN);
-                };
-                let mm: [[f64; #nvl]; #nvl] = #mass;
+            fn mass_matrix(&mut self, q: &[#f64], m: &mut [#f64]) {
+                #mass_args
+                let mm: [[#f64; #nvl]; #nvl] = #mass;
                 for (row, dst) in mm.iter().zip(m.chunks_exact_mut(#nvl)) {
                     #rt::scene::copy_into(dst, row);
                 }
             }
 
-            fn inverse(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], w: &[f64], tau: &mut [f64]) {
+            fn inverse(&mut self, q: &[#f64], qd: &[#f64], qdd: &[#f64], w: &[#f64], tau: &mut [#f64]) {
                 #inverse
             }
         }
@@ -211,6 +226,7 @@ fn f_ext(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
     let (rt, dyn_ty) = (&sh.rt, &sh.phases[0]);
     let floating = scene.is_floating();
     let rows_n = Literal::usize_unsuffixed(sh.n + usize::from(floating));
+    let f64 = paths::primitive("f64");
     let mut code = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
         let is_base = w.body == BASE_BODY;
@@ -237,7 +253,7 @@ fn f_ext(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
                 }
             },
             Some(r) => quote! {
-                let r: [[f64; 3]; 3] = #r;
+                let r: [[#f64; 3]; 3] = #r;
                 for i in 0..3 {
                     f_ext[#row][i] += r[0][i] * #f[0] + r[1][i] * #f[1] + r[2][i] * #f[2];
                     f_ext[#row][3 + i] += r[0][i] * #m[0] + r[1][i] * #m[1] + r[2][i] * #m[2];
@@ -267,16 +283,25 @@ fn wrench_value(k: usize) -> (TokenStream, TokenStream) {
 /// base only, as the scene allows computed torque only there); NaN without a computed-torque
 /// drive (never called).
 fn inverse(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
+    let f64 = paths::primitive("f64");
     if !matches!(scene.drives, kanegen_scene::Drives::ComputedTorque { .. }) || scene.is_floating()
     {
         return Ok(quote! {
             let _ = (q, qd, qdd, w);
-            tau.fill(f64::NAN);
+            tau.fill(#f64::NAN);
         });
     }
     let (rt, dyn_ty) = (&sh.rt, &sh.phases[0]);
     let nl = Literal::usize_unsuffixed(sh.n);
-    let wl = Literal::usize_unsuffixed(6 * scene.wrenches.len());
+    let args = as_arrays(
+        &[
+            ("q", sh.n),
+            ("qd", sh.n),
+            ("qdd", sh.n),
+            ("w", 6 * scene.wrenches.len()),
+        ],
+        &quote!(return tau.fill(#f64::NAN);),
+    );
     let mut compensate = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
         let Some(fname) = &sh.wrench_frames[k] else {
@@ -290,16 +315,16 @@ fn inverse(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
         let to_base = if w.frame == LoadFrame::Body {
             quote! {
                 let r = #dyn_ty::#pl(q).1;
-                let (f, m): ([f64; 3], [f64; 3]) = (
-                    core::array::from_fn(|i| r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2]),
-                    core::array::from_fn(|i| r[i][0] * m[0] + r[i][1] * m[1] + r[i][2] * m[2]),
+                let (f, m): ([#f64; 3], [#f64; 3]) = (
+                    ::core::array::from_fn(|i| r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2]),
+                    ::core::array::from_fn(|i| r[i][0] * m[0] + r[i][1] * m[1] + r[i][2] * m[2]),
                 );
             }
         } else {
             quote!()
         };
         compensate.push(quote! {{
-            let (f, m): ([f64; 3], [f64; 3]) = (#f, #m);
+            let (f, m): ([#f64; 3], [#f64; 3]) = (#f, #m);
             #to_base
             let jac = #dyn_ty::#jac(q);
             for j in 0..#nl {
@@ -309,17 +334,10 @@ fn inverse(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
         }});
     }
     Ok(quote! {
-        let (Ok(q), Ok(qd), Ok(qdd), Ok(w)) = (
-            <&[f64; #nl]>::try_from(q),
-            <&[f64; #nl]>::try_from(qd),
-            <&[f64; #nl]>::try_from(qdd),
-            <&[f64; #wl]>::try_from(w),
-        ) else {
-            return tau.fill(f64::NAN);
-        };
+        #args
         let _ = w;
         #[allow(unused_mut)]
-        let mut t: [f64; #nl] = #dyn_ty::inverse_dynamics(q, qd, qdd);
+        let mut t: [#f64; #nl] = #dyn_ty::inverse_dynamics(q, qd, qdd);
         #(#compensate)*
         #rt::scene::copy_into(tau, &t);
     })

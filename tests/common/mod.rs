@@ -81,3 +81,38 @@ pub fn nums(v: &serde_json::Value) -> Vec<f64> {
         other => panic!("not a number: {other}"),
     }
 }
+
+/// Items named like every primitive type, prelude item and built-in macro that the expansion of
+/// `dynamics!` or `scene!` could name, and `core`, for the module the macro is called in: an
+/// expansion that names one of those without its full path means something else there and does
+/// not compile (`tests/macro.rs`, `tests/scene_macro.rs`).
+#[allow(unused_macros)]
+macro_rules! shadowing_items {
+    () => {
+        pub struct f64;
+        pub struct f32;
+        pub struct usize;
+        pub struct u64;
+        pub struct u8;
+        pub struct bool;
+        pub struct str;
+        pub struct Option;
+        pub struct Some;
+        pub struct None;
+        pub struct Result;
+        pub struct Ok;
+        pub struct Err;
+        pub struct Default;
+        pub struct TryFrom;
+        pub struct Iterator;
+        pub struct FnMut;
+        pub mod core {}
+        // Takes no file: an unqualified `include_bytes!("…")` does not compile.
+        #[allow(unused_macros)]
+        macro_rules! include_bytes {
+            () => {};
+        }
+    };
+}
+#[allow(unused_imports)]
+pub(crate) use shadowing_items;
