@@ -88,6 +88,7 @@
 
 pub mod counts;
 pub mod tables;
+pub mod tally;
 
 use self::tables::{numbers, M3};
 use crate::options::{Error, Float, Form, Options};

@@ -326,7 +326,8 @@ fn unsupported_models_stay_unrolled() {
         form_line(&g.header),
         "Form: unrolled straight-line code (asked for). Not generated: \
          `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` \
-         (generated in the unrolled form up to 24 speeds; docs/limits.md)."
+         (generated in the unrolled form up to 24 speeds, and in the compact form; \
+         docs/limits.md)."
     );
 }
 

@@ -27,7 +27,10 @@ pub fn availability(
         return Err("its step is a Rodas4 step".into());
     }
     if !has_derivatives {
-        return Err("the generated dynamics carry no derivatives (more than 24 speeds)".into());
+        return Err(
+            "the generated dynamics carry no derivatives (unrolled with more than 24 speeds)"
+                .into(),
+        );
     }
     Ok(())
 }

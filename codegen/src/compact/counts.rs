@@ -2,7 +2,8 @@
 //! (`kanegen_runtime::compact`) run on the tracer [`Sym`], with every number of the tables, the
 //! payload and the arguments a symbolic *input* (so no constant folding hides a multiplication
 //! that the loops really do), counted under [`Convention::Paper`]: every operation the kernel
-//! executes, which is what the compiled loops execute (their tables are read from memory).
+//! executes, which is what the compiled loops execute (their tables are read from memory). The
+//! derivative kernels, O(N³), run on the counting scalar [`Tally`] instead (no graph).
 //!
 //! The kernels' cores take slices of any length with caller-provided scratch, so one instance on
 //! `Sym` traces a model of any number of joints, its storage in `Vec`s. Each function is traced
@@ -12,6 +13,7 @@
 //! and compares).
 
 use crate::compact::tables::KernelTables;
+use crate::compact::tally::{self, Tally};
 use kanegen_dynamics::kernels::{ArticulatedVecs, BodyVecs};
 use kanegen_runtime::compact::{self as k, Bodies, Motions, Rates, Tables, Transform};
 use kanegen_runtime::Scalar;
@@ -23,6 +25,9 @@ use kanegen_trace::Function;
 /// for a function without a compact body.
 #[must_use]
 pub fn counts(t: &KernelTables, f: Function, payload: bool) -> Option<Counts> {
+    if f.is_derivative() {
+        return Some(derivative_counts(t, f, payload));
+    }
     let tr = Tracer::new();
     let n = t.parent.len();
     let x = || tr.input("x");
@@ -121,12 +126,6 @@ fn trace_kernel(
         qdd: None,
     };
     Some(match f {
-        Function::InverseDynamicsDerivatives
-        | Function::ForwardDynamicsDerivatives
-        | Function::MassMatrixInverse => {
-            let tau = arg();
-            trace_derivatives(tables, f, &mut b, &qd, &qdd, &tau)
-        }
         Function::MassMatrix => crba(tables, &mut b),
         Function::NonlinearEffects => rnea(&b, velocity),
         Function::Gravity => rnea(&b, rest),
@@ -216,11 +215,6 @@ fn trace_floating(
         out
     };
     Some(match f {
-        Function::InverseDynamicsDerivatives
-        | Function::ForwardDynamicsDerivatives
-        | Function::MassMatrixInverse => {
-            trace_floating_derivatives(tables, f, base, &mut b, &q, &v, &a, &tau)
-        }
         Function::MassMatrix => mass(&mut b),
         Function::Momentum => {
             let mut vw = vec![[zero; 6]; n];
@@ -304,20 +298,71 @@ fn trace_floating_frame(
     out
 }
 
+/// The counts of a derivative kernel (`kanegen_runtime::compact::derivatives`): run on
+/// [`Tally`], from the payload's inertia and the joint transforms on, as its entry point
+/// composes it. Its O(N³) operations (`M⁻¹`, two `N × N` products) are counted without a graph.
+fn derivative_counts(t: &KernelTables, f: Function, payload: bool) -> Counts {
+    let n = t.parent.len();
+    let z = Tally;
+    let _ = tally::take();
+    let m3 = vec![[[z; 3]; 3]; n];
+    let v3 = vec![[z; 3]; n];
+    let s = vec![[z; 6]; n];
+    let mut inertia = vec![[z; 10]; n];
+    if payload {
+        if let Some(last) = inertia.last_mut() {
+            *last = k::payload_inertia(z, &[z; 3], &[[z; 3]; 3]);
+        }
+    }
+    let tables = Tables {
+        parent: &t.parent,
+        revolute: &t.revolute,
+        a: &m3,
+        b: &m3,
+        c: &m3,
+        l: &v3,
+        slide: &v3,
+        s: &s,
+        inertia: &inertia,
+        ancestor: t.ancestor.as_deref(),
+        a0: [z; 6],
+    };
+    let joints = vec![z; n];
+    let mut store = BodyVecs::<Tally>::new(n);
+    let mut b = store.bodies();
+    let sincos = |a: Tally| a.sin_cos();
+    match &t.base {
+        None => {
+            k::spatial::transforms(&tables, &joints, sincos, b.x);
+            trace_derivatives(&tables, f, &mut b, &joints, &joints, &joints);
+        }
+        Some(base) => {
+            let base = k::floating::Base {
+                inertia: [z; 10],
+                gravity: base.gravity.map(|_| [z; 3]),
+            };
+            let (q, v) = (vec![z; 7 + n], vec![z; 6 + n]);
+            k::spatial::transforms(&tables, &joints, sincos, b.x);
+            trace_floating_derivatives(&tables, f, &base, &mut b, &q, &v, &v, &joints);
+        }
+    }
+    tally::take()
+}
+
 /// The outputs of a derivative kernel (`kanegen_runtime::compact::derivatives`) on the joint
 /// transforms of `b`, as its entry point composes it: `(∂τ/∂q, ∂τ/∂q̇)` at `(q̇, q̈)`; `M⁻¹`; or
 /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` under the drives `tau`.
-fn trace_derivatives(
-    tables: &Tables<'_, Sym>,
+fn trace_derivatives<S: Scalar + Copy>(
+    tables: &Tables<'_, S>,
     f: Function,
-    b: &mut Bodies<'_, Sym>,
-    qd: &[Sym],
-    qdd: &[Sym],
-    tau: &[Sym],
-) -> Vec<Sym> {
+    b: &mut Bodies<'_, S>,
+    qd: &[S],
+    qdd: &[S],
+    tau: &[S],
+) -> Vec<S> {
     use k::derivatives as dk;
     let n = qd.len();
-    let zero = Sym::zero();
+    let zero = S::zero();
     let mut js = vec![dk::Joint::zero(); n];
     let (mut dtq, mut dtv) = (vec![zero; n * n], vec![zero; n * n]);
     if f == Function::InverseDynamicsDerivatives {
@@ -355,20 +400,20 @@ fn trace_derivatives(
 /// the joint transforms of `b`, as its entry point composes it: `(∂τ/∂q, ∂τ/∂ν)` at `(ν, ν̇)`;
 /// `M⁻¹`; or `(∂ν̇/∂q, ∂ν̇/∂ν, M⁻¹)` under the joint drives `tau`.
 #[allow(clippy::too_many_arguments)]
-fn trace_floating_derivatives(
-    tables: &Tables<'_, Sym>,
+fn trace_floating_derivatives<S: Scalar + Copy>(
+    tables: &Tables<'_, S>,
     f: Function,
-    base: &k::floating::Base<Sym>,
-    b: &mut Bodies<'_, Sym>,
-    q: &[Sym],
-    v: &[Sym],
-    a: &[Sym],
-    tau: &[Sym],
-) -> Vec<Sym> {
+    base: &k::floating::Base<S>,
+    b: &mut Bodies<'_, S>,
+    q: &[S],
+    v: &[S],
+    a: &[S],
+    tau: &[S],
+) -> Vec<S> {
     use k::derivatives as dk;
     let n = tau.len();
     let nv = n + 6;
-    let zero = Sym::zero();
+    let zero = S::zero();
     let inertia = tables.inertia;
     let mut js = vec![dk::Joint::zero(); n];
     let (mut dtq, mut dtv) = (vec![zero; nv * nv], vec![zero; nv * nv]);
@@ -403,7 +448,7 @@ fn trace_floating_derivatives(
     if f == Function::MassMatrixInverse {
         return minv;
     }
-    let drives: Vec<Sym> = [vec![zero; 6], tau.to_vec()].concat();
+    let drives: Vec<S> = [vec![zero; 6], tau.to_vec()].concat();
     let mut nu_dot = vec![zero; nv];
     dk::accelerations(&minv, &drives, &c, &mut nu_dot);
     k::spatial::world(tables, inertia, b);
@@ -426,9 +471,9 @@ fn trace_floating_derivatives(
 }
 
 /// The CRBA's `H` (rows first) on the joint transforms of `b`.
-fn crba(tables: &Tables<'_, Sym>, b: &mut Bodies<'_, Sym>) -> Vec<Sym> {
+fn crba<S: Scalar + Copy>(tables: &Tables<'_, S>, b: &mut Bodies<'_, S>) -> Vec<S> {
     let n = b.x.len();
-    let zero = Sym::zero();
+    let zero = S::zero();
     let (mut st, mut h) = (vec![zero; 6 * n], vec![zero; n * n]);
     k::crba::crba(tables, tables.inertia, b, &mut st, &mut h);
     h
