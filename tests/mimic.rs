@@ -138,3 +138,14 @@ fn functions_in_the_coordinates_equal_the_full_model_reduced() {
     }
     eprintln!("worst coordinates vs full model reduced: {worst:e}");
 }
+
+/// `kanegen count` counts in the coordinates (`n` = 8) and lists no derivatives for a model with
+/// mimic joints (they are not traced in its coordinates), where it used to stop at them.
+#[test]
+fn count_takes_the_independent_coordinates() {
+    let out = common::kanegen(&["count", "tests/data/erd_all/panda.urdf", "--json"]);
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["n"], 8);
+    assert!(v.get("derivatives").is_none());
+    assert!(!v["counts"].as_array().unwrap().is_empty());
+}

@@ -29,7 +29,8 @@ pub struct CountReport {
     pub omitted: Vec<String>,
     /// The derivative functions (`inverse_dynamics_derivatives`, `forward_dynamics_derivatives`,
     /// `mass_matrix_inverse`), their one analytical candidate per convention; absent above
-    /// `kanegen_codegen::plan::DERIVATIVES_MAX_NV` speeds, where they are not generated.
+    /// `kanegen_codegen::plan::DERIVATIVES_MAX_NV` speeds (their unrolled candidate is not
+    /// traced there) and for a model with mimic joints (not traced in its coordinates).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub derivatives: Vec<CountLine>,
 }
@@ -127,14 +128,15 @@ pub fn count_with_progress(
         } else {
             0
         };
-    let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV {
+    // The derivatives are not traced in the independent coordinates of mimic joints.
+    let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV && !model.has_mimics() {
         derivative_lines(model, &spec)?
     } else {
         Vec::new()
     };
     Ok(CountReport {
         model: model.name().into(),
-        n: model.dof(),
+        n: model.coordinate_count(),
         base: model.base_kind().name().into(),
         gravity: gravity.is_some(),
         counts,
