@@ -4,7 +4,8 @@
 # For each model, a scratch crate under target/compact-measure/ is built once (dependencies),
 # then its own source touched and rebuilt with `cargo build --release`: the wall and user CPU
 # seconds of that rebuild (the proc-macro run, type checking and LLVM) are printed, then the
-# binary's ns per call of M+c and forward dynamics (median of 5 rounds).
+# binary's ns per call of M+c and forward dynamics (median of 5 rounds); with DERIVS=1 also of
+# inverse_dynamics_derivatives, forward_dynamics_derivatives and mass_matrix_inverse.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 form="$1"; shift
@@ -28,6 +29,38 @@ debug = false
 TOML
   key=""
   if [ "$form" != default ]; then key=", form = \"$form\""; fi
+  derivs=""
+  if [ "${DERIVS:-0}" = 1 ]; then
+    derivs='
+    let mut acc = 0.0f64;
+    let calls = (calls / N).max(50);
+    let mut t3 = Vec::new();
+    for _ in 0..5 {
+        let t = std::time::Instant::now();
+        for k in 0..calls {
+            q[k % N] += 1e-9;
+            let (a, b) = R::inverse_dynamics_derivatives(std::hint::black_box(&q), std::hint::black_box(&qd), std::hint::black_box(&qd));
+            acc += a[N - 1][0] + b[0][0];
+        }
+        let id = t.elapsed().as_nanos() as f64 / calls as f64;
+        let t = std::time::Instant::now();
+        for k in 0..calls {
+            q[k % N] += 1e-9;
+            let (a, b, c) = R::forward_dynamics_derivatives(std::hint::black_box(&q), std::hint::black_box(&qd), std::hint::black_box(&qd));
+            acc += a[N - 1][0] + b[0][0] + c[0][0];
+        }
+        let fdd = t.elapsed().as_nanos() as f64 / calls as f64;
+        let t = std::time::Instant::now();
+        for k in 0..calls {
+            q[k % N] += 1e-9;
+            acc += R::mass_matrix_inverse(std::hint::black_box(&q))[N - 1][0];
+        }
+        t3.push((id, fdd, t.elapsed().as_nanos() as f64 / calls as f64));
+    }
+    std::hint::black_box(acc);
+    let med = |k: usize| { let mut v: Vec<f64> = t3.iter().map(|t| [t.0, t.1, t.2][k]).collect(); v.sort_by(f64::total_cmp); v[2] };
+    print!(" ID-derivs {:.0} FD-derivs {:.0} Minv {:.0}", med(0), med(1), med(2));'
+  fi
   cat > "$crate/src/main.rs" <<RS
 kanegen::dynamics!(R, "$(realpath "$model")"$key);
 fn main() {
@@ -65,7 +98,9 @@ fn main() {
     let mc = rounds[2].0;
     rounds.sort_by(|a, b| a.1.total_cmp(&b.1));
     let fd = rounds[2].1;
-    println!("ns/call M+c {mc:.0} FD {fd:.0}");
+    print!("ns/call M+c {mc:.0} FD {fd:.0}");
+    $derivs
+    println!();
 }
 RS
   export CARGO_TARGET_DIR="$dir/target"
