@@ -334,33 +334,55 @@ fn backward<S: Scalar + Copy>(
 /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)`, `N × N` each, rows first.
 pub type ForwardDerivatives<S, const N: usize> = ([[S; N]; N], [[S; N]; N], [[S; N]; N]);
 
-/// `M⁻¹` into `out` (`n × n`, rows first) from `M` in `m` (overwritten by its LDLᵀ factors,
-/// [`crate::ldlt`]; `d_inv`: scratch of `n`): row `c` of the symmetric inverse is `M⁻¹ e_c`.
+/// `M⁻¹` into `out` (`n × n`, rows first) from `M` in `m` (overwritten; `d_inv`: scratch of
+/// `n`): `M = L D Lᵀ` ([`crate::ldlt`]), `W = L⁻¹` in place of `L` (unit lower triangular, row by
+/// row: `W_ij = −(L_ij + Σ_{j<k<i} L_ik W_kj)`), then `M⁻¹ = Wᵀ D⁻¹ W`, whose entry `(i, j)`,
+/// `i ≤ j`, is `Σ_{k ≥ j} W_ki W_kj / D_k` (`W_kk = 1`), mirrored. About `2N³/3` multiplications
+/// against `7N³/6` for one solve per unit column.
 #[inline(always)]
 pub fn inverse_in<S: Scalar + Copy>(m: &mut [S], n: usize, d_inv: &mut [S], out: &mut [S]) {
-    if crate::ldlt::factor_in_place(m, n, d_inv).is_err() {
+    if crate::ldlt::factor_in_place(m, n, d_inv).is_err() || out.len() < n * n {
         return;
     }
-    for (c, row) in out.chunks_exact_mut(n.max(1)).take(n).enumerate() {
-        for (k, x) in row.iter_mut().enumerate() {
-            *x = if k == c { S::one() } else { S::zero() };
+    for i in 1..n {
+        for j in 0..i {
+            let mut acc = m[i * n + j];
+            for k in j + 1..i {
+                acc = acc + m[i * n + k] * m[k * n + j];
+            }
+            m[i * n + j] = -acc;
         }
-        let _ = crate::ldlt::solve_in_place(m, n, d_inv, row);
+    }
+    for i in 0..n {
+        for j in i..n {
+            // k = j: W_jj = 1.
+            let mut acc = if i == j {
+                d_inv[j]
+            } else {
+                m[j * n + i] * d_inv[j]
+            };
+            for k in j + 1..n {
+                acc = acc + m[k * n + i] * m[k * n + j] * d_inv[k];
+            }
+            out[i * n + j] = acc;
+            out[j * n + i] = acc;
+        }
     }
 }
 
-/// `out = −A B` of `n × n` matrices (rows first).
+/// `out = −A B` of `n × n` matrices (rows first), row by row as `−Σ_k A_rk B_k·` so that the
+/// inner loop runs along rows of `B` and `out` (contiguous: the compiler vectorizes it).
 #[inline(always)]
 pub fn neg_product<S: Scalar + Copy>(a: &[S], b: &[S], n: usize, out: &mut [S]) {
     for (r, orow) in out.chunks_exact_mut(n.max(1)).take(n).enumerate() {
-        for (c, o) in orow.iter_mut().enumerate() {
-            let mut acc = S::zero();
-            for k in 0..n {
-                if let (Some(&x), Some(&y)) = (a.get(r * n + k), b.get(k * n + c)) {
-                    acc = acc + x * y;
-                }
+        orow.fill(S::zero());
+        for k in 0..n {
+            let (Some(&x), Some(brow)) = (a.get(r * n + k), b.get(k * n..k * n + n)) else {
+                continue;
+            };
+            for (o, &y) in orow.iter_mut().zip(brow) {
+                *o = *o - x * y;
             }
-            *o = -acc;
         }
     }
 }
