@@ -742,7 +742,7 @@ fn check_mimic(function: Function, methods: Methods, spec: &Spec) -> Result<(), 
 }
 
 /// The upper triangle of a symmetric matrix, row-major.
-fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
+pub(crate) fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
     a.iter()
         .enumerate()
         .flat_map(|(i, row)| row[i..].to_vec())
