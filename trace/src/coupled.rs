@@ -6,7 +6,6 @@
 //! articulated-body algorithm runs on the full tree); it solves `M q̈ = Gᵀ (τ_full − c_full)` by
 //! LDLᵀ. `G` is constant, so the trace folds it into the emitted code.
 
-use crate::entry::upper;
 use crate::function::Function;
 use crate::sym::Sym;
 use kanegen_dynamics::ldlt::{ldlt, solve};
@@ -24,6 +23,14 @@ fn from_upper(upper: &[Sym], n: usize) -> Vec<Vec<Sym>> {
             .unwrap_or_else(Sym::zero)
     };
     (0..n).map(|i| (0..n).map(|j| at(i, j)).collect()).collect()
+}
+
+/// The upper triangle of a symmetric matrix, row-major.
+pub(crate) fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
+    a.iter()
+        .enumerate()
+        .flat_map(|(i, row)| row[i..].to_vec())
+        .collect()
 }
 
 /// The outputs `out` of `function` traced on the full joint list, in the independent

@@ -21,7 +21,7 @@
 //! assert!(x.iter().zip(&y).all(|(a, b)| (a - b).abs() < 1e-12));
 //! ```
 
-use crate::coupled;
+use crate::coupled::{self, upper};
 use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
@@ -739,14 +739,6 @@ fn check_mimic(function: Function, methods: Methods, spec: &Spec) -> Result<(), 
         return Ok(());
     };
     Err(why.into())
-}
-
-/// The upper triangle of a symmetric matrix, row-major.
-pub(crate) fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
-    a.iter()
-        .enumerate()
-        .flat_map(|(i, row)| row[i..].to_vec())
-        .collect()
 }
 
 /// A placement as outputs: the origin, then the rotation row by row.
