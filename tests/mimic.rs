@@ -20,7 +20,8 @@ kanegen::dynamics!(
 kanegen::dynamics!(
     PandaFree,
     "tests/data/erd_all/panda.urdf",
-    base = "free-floating"
+    base = "free-floating",
+    derivatives = false
 );
 kanegen::dynamics!(
     PandaFull,
@@ -139,13 +140,254 @@ fn functions_in_the_coordinates_equal_the_full_model_reduced() {
     eprintln!("worst coordinates vs full model reduced: {worst:e}");
 }
 
-/// `kanegen count` counts in the coordinates (`n` = 8) and lists no derivatives for a model with
-/// mimic joints (they are not traced in its coordinates), where it used to stop at them.
+/// `kanegen count` counts in the coordinates (`n` = 8), derivatives included.
 #[test]
 fn count_takes_the_independent_coordinates() {
     let out = common::kanegen(&["count", "tests/data/erd_all/panda.urdf", "--json"]);
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["n"], 8);
-    assert!(v.get("derivatives").is_none());
+    let mut functions: Vec<&str> = v["derivatives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["function"].as_str().unwrap())
+        .collect();
+    functions.dedup();
+    assert_eq!(
+        functions,
+        [
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives",
+            "mass_matrix_inverse"
+        ]
+    );
     assert!(!v["counts"].as_array().unwrap().is_empty());
+}
+
+/// `Gᵀ D G` of a full `(offset + 9)²` matrix (row-major) of Panda: the second finger's row and
+/// column added to the first's.
+fn reduce_matrix(d: &[f64], offset: usize) -> Vec<Vec<f64>> {
+    let (nf, n) = (offset + 9, offset + 8);
+    let mut r = vec![vec![0.0; n]; n];
+    for (i, row) in d.chunks(nf).enumerate() {
+        for (j, x) in row.iter().enumerate() {
+            r[i.min(n - 1)][j.min(n - 1)] += x;
+        }
+    }
+    r
+}
+
+/// `A B` of square matrices.
+fn product(a: &[Vec<f64>], b: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    a.iter()
+        .map(|row| {
+            (0..b[0].len())
+                .map(|j| row.iter().zip(b).map(|(x, br)| x * br[j]).sum())
+                .collect()
+        })
+        .collect()
+}
+
+fn rows<const K: usize>(m: &[[f64; K]]) -> Vec<Vec<f64>> {
+    m.iter().map(|r| r.to_vec()).collect()
+}
+
+fn flat(m: &[Vec<f64>]) -> Vec<f64> {
+    m.concat()
+}
+
+/// The generated derivatives in the coordinates, fixed base with gravity: `∂τ/∂x = Gᵀ D_full G`
+/// against the full model's (checked against Pinocchio and dual numbers in
+/// `tests/derivatives.rs`) reduced by hand; `M⁻¹ M = I`; `∂q̈/∂x = −M⁻¹ ∂τ/∂x` at
+/// `q̈ = FD(q, q̇, τ)`; and `∂q̈/∂q`, `∂q̈/∂q̇` against central differences of
+/// `forward_dynamics` (step 1e-5: truncation about 1e-10 of the entries, rounding about 1e-11).
+#[test]
+fn derivatives_in_the_coordinates_equal_the_full_model_reduced() {
+    let mut worst = [0.0_f64; 4];
+    for k in 0..4 {
+        let t = f64::from(k);
+        let q: [f64; 8] = core::array::from_fn(|i| (0.3 * t + 1.1 * i as f64).sin());
+        let qd: [f64; 8] = core::array::from_fn(|i| (0.6 * t - 0.7 * i as f64).cos());
+        let qdd: [f64; 8] = core::array::from_fn(|i| (0.9 * t + 0.4 * i as f64).sin());
+        let (dq, dv) = Panda::inverse_dynamics_derivatives(&q, &qd, &qdd);
+        let (dqf, dvf) =
+            PandaFull::inverse_dynamics_derivatives(&full(&q), &full(&qd), &full(&qdd));
+        let e = rel_err(
+            dq.as_flattened(),
+            &flat(&reduce_matrix(dqf.as_flattened(), 0)),
+        )
+        .max(rel_err(
+            dv.as_flattened(),
+            &flat(&reduce_matrix(dvf.as_flattened(), 0)),
+        ));
+        assert!(e < 1e-12, "∂τ against the full model reduced: {e:e}");
+        worst[0] = worst[0].max(e);
+
+        let tau = Panda::inverse_dynamics(&q, &qd, &qdd);
+        let (aq, av, minv) = Panda::forward_dynamics_derivatives(&q, &qd, &tau);
+        let identity: Vec<Vec<f64>> = (0..8)
+            .map(|i| (0..8).map(|j| f64::from(u8::from(i == j))).collect())
+            .collect();
+        let e = rel_err(
+            &flat(&product(&rows(&minv), &rows(&Panda::mass_matrix(&q)))),
+            &flat(&identity),
+        );
+        assert!(e < 1e-11, "M⁻¹ M = I: {e:e}");
+        worst[1] = worst[1].max(e);
+        let neg = |m: Vec<Vec<f64>>| -> Vec<f64> { m.concat().iter().map(|x| -x).collect() };
+        let e = rel_err(aq.as_flattened(), &neg(product(&rows(&minv), &rows(&dq)))).max(rel_err(
+            av.as_flattened(),
+            &neg(product(&rows(&minv), &rows(&dv))),
+        ));
+        assert!(e < 1e-11, "∂q̈/∂x = −M⁻¹ ∂τ/∂x: {e:e}");
+        worst[2] = worst[2].max(e);
+
+        let h = 1e-5;
+        let column = |x: &[f64; 8], j: usize, at: &dyn Fn(&[f64; 8]) -> [f64; 8]| -> Vec<f64> {
+            let (mut up, mut down) = (*x, *x);
+            up[j] += h;
+            down[j] -= h;
+            let (u, d) = (at(&up), at(&down));
+            u.iter().zip(&d).map(|(u, d)| (u - d) / (2.0 * h)).collect()
+        };
+        for j in 0..8 {
+            let by_q = column(&q, j, &|q| Panda::forward_dynamics(q, &qd, &tau));
+            let by_v = column(&qd, j, &|qd| Panda::forward_dynamics(&q, qd, &tau));
+            let col = |m: &[[f64; 8]; 8]| -> Vec<f64> { m.iter().map(|r| r[j]).collect() };
+            let scale = aq
+                .as_flattened()
+                .iter()
+                .chain(av.as_flattened())
+                .fold(0.0_f64, |m, x| m.max(x.abs()));
+            let e = by_q
+                .iter()
+                .zip(col(&aq))
+                .chain(by_v.iter().zip(col(&av)))
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()))
+                / scale;
+            assert!(e < 1e-7, "central differences, column {j}: {e:e}");
+            worst[3] = worst[3].max(e);
+        }
+    }
+    eprintln!(
+        "worst: ∂τ vs full reduced {:e}, M⁻¹ M − I {:e}, ∂q̈ vs −M⁻¹ ∂τ {:e}, vs central differences {:e}",
+        worst[0], worst[1], worst[2], worst[3]
+    );
+}
+
+/// The traced derivatives on a free-floating base (tangent space, base speeds first and kept):
+/// `∂τ/∂x` against the full model's traced derivatives reduced by hand, and the forward-dynamics
+/// derivatives and `M⁻¹` against `−M⁻¹ ∂τ/∂x` and `M⁻¹ M = I` with the traced reduced `M`.
+#[test]
+fn free_floating_derivatives_in_the_coordinates() {
+    use kanegen::dynamics::Methods;
+    use kanegen::model::BaseKind;
+    use kanegen::trace::{trace, Base, Function, Spec, Subject};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/erd_all/panda.urdf");
+    let model = kanegen::model::io::load_model(&path)
+        .unwrap()
+        .with_base_kind(BaseKind::FreeFloating)
+        .unwrap();
+    let full_model = model.clone().without_mimics();
+    let spec = Spec {
+        base: Base::FreeFloating(model.base_inertial().unwrap().clone()),
+        ..Spec::default()
+    };
+    let eval = |m: &kanegen::model::Model, f: Function, inputs: &[f64]| -> Vec<f64> {
+        trace(Subject::Model(m), f, Methods::SPATIAL, &spec)
+            .unwrap()
+            .trace
+            .eval(inputs)
+    };
+    let base_q = [0.1, -0.2, 0.3, 0.2, -0.1, 0.3, (1.0_f64 - 0.14).sqrt()];
+    let q: Vec<f64> = (0..8).map(|i| (1.1 * f64::from(i)).sin()).collect();
+    let v: Vec<f64> = (0..14).map(|i| (0.7 * f64::from(i)).cos()).collect();
+    let a: Vec<f64> = (0..14).map(|i| (0.4 * f64::from(i)).sin()).collect();
+    // G x: the second finger (last) follows the first (the last coordinate).
+    let expand = |x: &[f64]| -> Vec<f64> { [x, &x[x.len() - 1..]].concat() };
+    let (qf, vf, af) = ([&base_q[..], &expand(&q)].concat(), expand(&v), expand(&a));
+    let id = eval(
+        &model,
+        Function::InverseDynamicsDerivatives,
+        &[&base_q[..], &q, &v, &a].concat(),
+    );
+    let idf = eval(
+        &full_model,
+        Function::InverseDynamicsDerivatives,
+        &[&qf[..], &vf, &af].concat(),
+    );
+    let (dq, dv) = id.split_at(14 * 14);
+    let (dqf, dvf) = idf.split_at(15 * 15);
+    let e =
+        rel_err(dq, &flat(&reduce_matrix(dqf, 6))).max(rel_err(dv, &flat(&reduce_matrix(dvf, 6))));
+    assert!(
+        e < 1e-12,
+        "free-floating ∂τ against the full model reduced: {e:e}"
+    );
+
+    // τ = ID(q, v, a) has the base's wrench first; forward dynamics takes the joints' drives with
+    // an unactuated base, so drive it at the accelerations FD returns at these drives.
+    let tau = &eval(
+        &model,
+        Function::InverseDynamics,
+        &[&base_q[..], &q, &v, &a].concat(),
+    )[6..];
+    let fd = eval(
+        &model,
+        Function::ForwardDynamicsDerivatives,
+        &[&base_q[..], &q, &v, tau].concat(),
+    );
+    let square = |x: &[f64]| -> Vec<Vec<f64>> { x.chunks(14).map(<[f64]>::to_vec).collect() };
+    let (aq, rest) = fd.split_at(14 * 14);
+    let (av, minv) = rest.split_at(14 * 14);
+    let nu_dot = eval(
+        &model,
+        Function::ForwardDynamics,
+        &[&base_q[..], &q, &v, tau].concat(),
+    );
+    let at = eval(
+        &model,
+        Function::InverseDynamicsDerivatives,
+        &[&base_q[..], &q, &v, &nu_dot].concat(),
+    );
+    let (dq, dv) = at.split_at(14 * 14);
+    let neg = |m: Vec<Vec<f64>>| -> Vec<f64> { m.concat().iter().map(|x| -x).collect() };
+    let e = rel_err(aq, &neg(product(&square(minv), &square(dq))))
+        .max(rel_err(av, &neg(product(&square(minv), &square(dv)))));
+    assert!(e < 1e-11, "free-floating ∂ν̇/∂x = −M⁻¹ ∂τ/∂x: {e:e}");
+    let upper = eval(
+        &model,
+        Function::MassMatrix,
+        &base_q.iter().chain(&q).copied().collect::<Vec<_>>(),
+    );
+    let mut m = vec![vec![0.0; 14]; 14];
+    let mut k = 0;
+    for i in 0..14 {
+        for j in i..14 {
+            (m[i][j], m[j][i]) = (upper[k], upper[k]);
+            k += 1;
+        }
+    }
+    let identity: Vec<Vec<f64>> = (0..14)
+        .map(|i| (0..14).map(|j| f64::from(u8::from(i == j))).collect())
+        .collect();
+    let e = rel_err(&flat(&product(&square(minv), &m)), &flat(&identity));
+    assert!(e < 1e-11, "free-floating M⁻¹ M = I: {e:e}");
+    let upper_inv = eval(
+        &model,
+        Function::MassMatrixInverse,
+        &base_q.iter().chain(&q).copied().collect::<Vec<_>>(),
+    );
+    let mut k = 0;
+    let mut e = 0.0_f64;
+    for i in 0..14 {
+        for j in i..14 {
+            e = e.max((upper_inv[k] - minv[i * 14 + j]).abs());
+            k += 1;
+        }
+    }
+    assert!(
+        e < 1e-12,
+        "mass_matrix_inverse against forward_dynamics_derivatives' M⁻¹: {e:e}"
+    );
 }

@@ -69,10 +69,7 @@ fn form_line(plan: &Plan) -> String {
     }
     let missing = plan.not_generated();
     if !missing.is_empty() {
-        let why = if plan.derivatives_asked && plan.model.has_mimics() {
-            "not traced in the independent coordinates of mimic joints yet; docs/limits.md"
-                .to_string()
-        } else if plan.derivatives_asked {
+        let why = if plan.derivatives_asked {
             format!(
                 "generated in the unrolled form up to {} speeds, and in the compact form; \
                  docs/limits.md",

@@ -86,12 +86,9 @@ pub const DERIVATIVES_MAX_NV: usize = 24;
 
 /// Whether the derivative functions can be generated for `model` in the form `decision`: in
 /// the unrolled form up to [`DERIVATIVES_MAX_NV`] speeds, in the compact form at any size
-/// (`kanegen_runtime::compact::derivatives`), without mimic joints.
+/// (`kanegen_runtime::compact::derivatives`).
 #[must_use]
 pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
-    if model.has_mimics() {
-        return false;
-    }
     if decision.form == Form::Compact {
         return true;
     }

@@ -4,10 +4,12 @@
 //! independent joints), and the results are reduced after: `M = Gᵀ M_full G`,
 //! `c = Gᵀ c_full`, a Jacobian `J G`. Forward dynamics cannot be reduced after the fact (the
 //! articulated-body algorithm runs on the full tree); it solves `M q̈ = Gᵀ (τ_full − c_full)` by
-//! LDLᵀ. `G` is constant, so the trace folds it into the emitted code.
+//! LDLᵀ, and so do its derivatives and `M⁻¹` (`kanegen_dynamics::algorithms::derivatives::coupled`);
+//! the inverse-dynamics derivatives are `Gᵀ D G`. `G` is constant, so the trace folds it into the emitted code.
 
 use crate::function::Function;
 use crate::sym::Sym;
+use kanegen_dynamics::algorithms::derivatives::coupled as derivatives;
 use kanegen_dynamics::ldlt::{ldlt, solve};
 use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::Scalar;
@@ -35,7 +37,9 @@ pub(crate) fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
 
 /// The outputs `out` of `function` traced on the full joint list, in the independent
 /// coordinates of `c` (`offset`: the base's six speeds of a free-floating model, kept).
-/// `function` is not forward dynamics ([`forward_dynamics`]) nor a derivative (refused before).
+/// Forward dynamics ([`forward_dynamics`]), its derivatives and `M⁻¹`
+/// ([`kanegen_dynamics::algorithms::derivatives::coupled`]) are not reduced after the fact: they
+/// come back unchanged.
 #[must_use]
 pub fn reduce(function: Function, c: &Coupling, offset: usize, out: Vec<Sym>) -> Vec<Sym> {
     let nv = offset + c.full();
@@ -57,6 +61,13 @@ pub fn reduce(function: Function, c: &Coupling, offset: usize, out: Vec<Sym>) ->
         | Function::Gravity
         | Function::InverseDynamics => c.reduce_vector(&out, offset),
         Function::FrameJacobian(_) => rows(&out, offset),
+        // Gᵀ (∂τ_full/∂x_full) G for x = q, q̇.
+        Function::InverseDynamicsDerivatives => {
+            let square = |m: &[Sym]| m.chunks(nv).map(<[Sym]>::to_vec).collect::<Vec<_>>();
+            let (dq, dv) = out.split_at(nv * nv);
+            let (dq, dv) = derivatives::reduce_pair(c, offset, (square(dq), square(dv)));
+            [dq, dv].concat().concat()
+        }
         // J* G: the reduced system's coupling columns are A_bm G.
         Function::GeneralizedJacobian(_) => rows(&out, 0),
         Function::Momentum
@@ -64,7 +75,6 @@ pub fn reduce(function: Function, c: &Coupling, offset: usize, out: Vec<Sym>) ->
         | Function::FramePlacement(_)
         | Function::ForwardDynamics
         | Function::ForwardDynamicsWithWrenches
-        | Function::InverseDynamicsDerivatives
         | Function::ForwardDynamicsDerivatives
         | Function::MassMatrixInverse => out,
     }

@@ -26,7 +26,7 @@ use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
 use kanegen_dynamics::algorithms::derivatives::{
-    aba as fd_derivatives, minverse, rnea as id_derivatives,
+    aba as fd_derivatives, coupled as coupled_derivatives, minverse, rnea as id_derivatives,
 };
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
@@ -114,49 +114,20 @@ pub fn trace(
     };
     let args = Arguments::new(function, n, floating, coupling.as_ref(), &mut input);
     let effects = Effects::new(spec, &args, floating, &mut input);
-    let offset = if floating { FLOATING_BASE_DOF } else { 0 };
-    let out = match (&spec.base, &args.state) {
-        (Base::FreeFloating(inertial), Some(state)) => {
-            let base =
-                regrouped_base.unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial));
-            let system = FloatingSystem {
-                p: &p,
-                base: &base,
-                state,
-            };
-            match &coupling {
-                Some(c) if function.is_forward_dynamics() => {
-                    let m = floating::mass_matrix(methods.mass_matrix, &p, &base, state, &args.q);
-                    let l = effects.loads(args.arg(Arg::Tau));
-                    let b = floating::tau_minus_c(
-                        methods.nonlinear_effects,
-                        &p,
-                        &base,
-                        state,
-                        &args.q,
-                        &args.qd,
-                        &l,
-                    );
-                    coupled::forward_dynamics(c, offset, &m, &b)
-                }
-                _ => floating_outputs(function, methods, &system, &args, &effects),
-            }
-        }
-        _ => match &coupling {
-            Some(c) if function.is_forward_dynamics() => {
-                let m = methods.mass_matrix.mass_matrix(&p, &args.q);
-                let l = effects.loads(args.arg(Arg::Tau));
-                let b = methods
-                    .nonlinear_effects
-                    .tau_minus_c(&p, &args.q, &args.qd, &l);
-                coupled::forward_dynamics(c, offset, &m, &b)
-            }
-            _ => fixed_outputs(function, methods, &p, &args, &effects),
-        },
+    let base = match (&spec.base, &args.state) {
+        (Base::FreeFloating(inertial), Some(state)) => Some((
+            regrouped_base.unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial)),
+            state,
+        )),
+        _ => None,
+    };
+    let system = match &base {
+        Some((base, state)) => System::Floating(FloatingSystem { p: &p, base, state }),
+        None => System::Fixed(&p),
     };
     let out = match &coupling {
-        Some(c) if !function.is_forward_dynamics() => coupled::reduce(function, c, offset, out),
-        _ => out,
+        Some(c) => coupled_outputs(function, methods, c, &system, &args, &effects),
+        None => system.outputs(function, methods, &args, &effects),
     };
     Ok(Traced {
         trace: t.finish(&out),
@@ -442,6 +413,130 @@ struct FloatingSystem<'a> {
     state: &'a FloatingState<Sym>,
 }
 
+/// The traced system: an arm on a fixed base, or on its free-floating base.
+enum System<'a> {
+    Fixed(&'a Params<Sym>),
+    Floating(FloatingSystem<'a>),
+}
+
+impl System<'_> {
+    /// The speeds of the base (6 free-floating, 0 fixed).
+    fn base_speeds(&self) -> usize {
+        match self {
+            System::Fixed(_) => 0,
+            System::Floating(_) => FLOATING_BASE_DOF,
+        }
+    }
+
+    /// The outputs of `function` (on the full joint list).
+    fn outputs(
+        &self,
+        function: Function,
+        methods: Methods,
+        args: &Arguments,
+        effects: &Effects,
+    ) -> Vec<Sym> {
+        match self {
+            System::Fixed(p) => fixed_outputs(function, methods, p, args, effects),
+            System::Floating(s) => floating_outputs(function, methods, s, args, effects),
+        }
+    }
+
+    /// The full mass matrix by `method`.
+    fn mass_matrix(&self, method: MassMatrixMethod, q: &[Sym]) -> Vec<Vec<Sym>> {
+        match self {
+            System::Fixed(p) => method.mass_matrix(p, q),
+            System::Floating(s) => floating::mass_matrix(method, s.p, s.base, s.state, q),
+        }
+    }
+
+    /// `τ − c` under `loads` by `method`.
+    fn tau_minus_c(
+        &self,
+        method: NonlinearEffectsMethod,
+        args: &Arguments,
+        loads: &Loads<Sym>,
+    ) -> Vec<Sym> {
+        let (q, qd) = (&args.q, &args.qd);
+        match self {
+            System::Fixed(p) => method.tau_minus_c(p, q, qd, loads),
+            System::Floating(s) => {
+                floating::tau_minus_c(method, s.p, s.base, s.state, q, qd, loads)
+            }
+        }
+    }
+
+    /// `(∂τ/∂q, ∂τ/∂q̇)` at the accelerations `acc` (`[a_b; q̈]` on a free-floating base).
+    fn id_derivatives(
+        &self,
+        args: &Arguments,
+        acc: &[Sym],
+        gravity: Option<&Vec3<Sym>>,
+    ) -> (Vec<Vec<Sym>>, Vec<Vec<Sym>>) {
+        let (q, qd) = (&args.q, &args.qd);
+        match self {
+            System::Fixed(p) => id_derivatives::derivatives(p, q, qd, acc, gravity),
+            System::Floating(s) => {
+                let base_acc: [Sym; 6] = core::array::from_fn(|k| acc[k]);
+                id_derivatives::floating_derivatives(
+                    s.p,
+                    s.base,
+                    s.state,
+                    q,
+                    qd,
+                    &base_acc,
+                    &acc[6..],
+                    gravity,
+                )
+            }
+        }
+    }
+}
+
+/// The outputs of `function` in the independent coordinates of mimic joints `c`
+/// ([`crate::coupled`]): forward dynamics, its derivatives and `M⁻¹` from the reduced `M`; every
+/// other function traced on the full joint list and reduced after.
+fn coupled_outputs(
+    function: Function,
+    methods: Methods,
+    c: &Coupling,
+    system: &System,
+    args: &Arguments,
+    effects: &Effects,
+) -> Vec<Sym> {
+    let offset = system.base_speeds();
+    let m_full = || system.mass_matrix(methods.mass_matrix, &args.q);
+    let b_full = || {
+        let loads = effects.loads(args.arg(Arg::Tau));
+        system.tau_minus_c(methods.nonlinear_effects, args, &loads)
+    };
+    match function {
+        f if f.is_forward_dynamics() => coupled::forward_dynamics(c, offset, &m_full(), &b_full()),
+        Function::MassMatrixInverse => upper(&coupled_derivatives::mass_matrix_inverse(
+            c,
+            offset,
+            &m_full(),
+        )),
+        Function::ForwardDynamicsDerivatives => {
+            let g = effects.gravity.as_ref();
+            let (dq, dv, minv) = coupled_derivatives::forward_dynamics_derivatives(
+                c,
+                offset,
+                &m_full(),
+                &b_full(),
+                |acc| system.id_derivatives(args, acc, g),
+            );
+            [dq, dv, minv].concat().concat()
+        }
+        _ => coupled::reduce(
+            function,
+            c,
+            offset,
+            system.outputs(function, methods, args, effects),
+        ),
+    }
+}
+
 /// The outputs of `function` on a free-floating base.
 fn floating_outputs(
     function: Function,
@@ -723,14 +818,11 @@ fn check(
     Ok(())
 }
 
-/// What a model with mimic joints is not traced with ([`crate::coupled`]): derivatives and
-/// `M⁻¹` (not reduced after the fact), forward dynamics by the articulated-body algorithm (it runs
-/// on the full tree; the coupled forward dynamics solve the reduced `M` by LDLᵀ), and damping
-/// (one entry per joint, not per coordinate).
+/// What a model with mimic joints is not traced with ([`crate::coupled`]): forward dynamics by
+/// the articulated-body algorithm (it runs on the full tree; the coupled forward dynamics solve
+/// the reduced `M` by LDLᵀ), and damping (one entry per joint, not per coordinate).
 fn check_mimic(function: Function, methods: Methods, spec: &Spec) -> Result<(), String> {
-    let why = if function.is_derivative() {
-        "the derivatives and M⁻¹ are not traced in the independent coordinates of mimic joints yet"
-    } else if function.is_forward_dynamics() && methods.forward == ForwardMethod::Aba {
+    let why = if function.is_forward_dynamics() && methods.forward == ForwardMethod::Aba {
         "the articulated-body algorithm does not run in the independent coordinates of mimic \
          joints (forward dynamics solves the reduced M by LDLᵀ)"
     } else if spec.damping.is_some() {

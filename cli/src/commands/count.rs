@@ -128,8 +128,7 @@ pub fn count_with_progress(
         } else {
             0
         };
-    // The derivatives are not traced in the independent coordinates of mimic joints.
-    let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV && !model.has_mimics() {
+    let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV {
         derivative_lines(model, &spec)?
     } else {
         Vec::new()

@@ -86,7 +86,7 @@ pub fn floating_derivatives<S: Scalar>(
 }
 
 /// `M⁻¹ b`.
-fn product<S: Scalar>(minv: &[Vec<S>], b: &[S]) -> Vec<S> {
+pub(crate) fn product<S: Scalar>(minv: &[Vec<S>], b: &[S]) -> Vec<S> {
     minv.iter()
         .map(|row| {
             row.iter()

@@ -13,7 +13,7 @@ use crate::scalar::Scalar;
 
 /// `M⁻¹` of a symmetric positive definite `M`: `L D Lᵀ x = e_k` for every `k` (column `k` of
 /// `M⁻¹`, stored as its row `k` by symmetry).
-fn inverse<S: Scalar>(m: &[Vec<S>]) -> Matrix<S> {
+pub(crate) fn inverse<S: Scalar>(m: &[Vec<S>]) -> Matrix<S> {
     let n = m.len();
     let f = ldlt(m);
     (0..n)

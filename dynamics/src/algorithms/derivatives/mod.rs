@@ -6,6 +6,7 @@
 //! | [`rnea`] | `∂τ/∂q`, `∂τ/∂q̇` of inverse dynamics: J. Carpentier and N. Mansard, "Analytical Derivatives of Rigid Body Dynamics Algorithms", RSS 2018, Algorithm 1 (Pinocchio's `computeRNEADerivatives`) |
 //! | [`minverse`] | `M(q)⁻¹` from the LDLᵀ factors of the CRBA mass matrix |
 //! | [`aba`] | `∂q̈/∂q`, `∂q̈/∂q̇` of forward dynamics: `−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)` (Carpentier & Mansard 2018, eq. (3)) |
+//! | [`coupled`] | the three above in the independent coordinates of mimic joints (`Gᵀ D G`, the reduced `M⁻¹`) |
 //!
 //! **Layout** (Pinocchio's): row `i` = output `i`, column `j` = `∂/∂` input `j`; `NV` speeds
 //! (`N` on a fixed base, `6 + N` on a free-floating one, base first in `ν = [v_b; ω_b; q̇]`).
@@ -18,6 +19,7 @@
 //! a free-floating one), no external wrenches; `τ` the joint drives.
 
 pub mod aba;
+pub mod coupled;
 pub mod minverse;
 pub mod rnea;
 
