@@ -10,7 +10,7 @@
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4403 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1098, `forward_dynamics_derivatives` 2094, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4313 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1053, `forward_dynamics_derivatives` 2049, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -86,10 +86,10 @@
 //! | `forward_dynamics_with_wrenches` | `crba-inertial` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
 //! | `forward_dynamics_with_wrenches` | `crba-inertial` | `newton-euler` | `ldlt` | model | 922 | 745 | 7 | 0 | 7 | 1667 |
 //! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 566 | 433 | 5 | 0 | 6 | 999 |
-//! | `inverse_dynamics_derivatives` * | — | — | — | model | 2033 | 2091 | 0 | 0 | 6 | 4124 |
-//! | `inverse_dynamics_derivatives` | — | — | — | canonical | 2036 | 2094 | 0 | 0 | 6 | 4130 |
-//! | `forward_dynamics_derivatives` | — | — | — | model | 3373 | 3174 | 7 | 0 | 7 | 6547 |
-//! | `forward_dynamics_derivatives` * | — | — | — | canonical | 3373 | 3173 | 7 | 0 | 7 | 6546 |
+//! | `inverse_dynamics_derivatives` * | — | — | — | model | 1933 | 1853 | 0 | 0 | 6 | 3786 |
+//! | `inverse_dynamics_derivatives` | — | — | — | canonical | 1936 | 1856 | 0 | 0 | 6 | 3792 |
+//! | `forward_dynamics_derivatives` | — | — | — | model | 3273 | 2936 | 7 | 0 | 7 | 6209 |
+//! | `forward_dynamics_derivatives` * | — | — | — | canonical | 3273 | 2935 | 7 | 0 | 7 | 6208 |
 //! | `mass_matrix_inverse` | — | — | — | model | 309 | 242 | 7 | 0 | 5 | 551 |
 //! | `mass_matrix_inverse` * | — | — | — | canonical | 309 | 240 | 7 | 0 | 5 | 549 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
@@ -273,12 +273,12 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "model",
-            mul: 2033u64,
-            add: 2091u64,
+            mul: 1933u64,
+            add: 1853u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 1098u64,
+            fma: 1053u64,
         },
         OpCount {
             function: "forward_dynamics_derivatives",
@@ -286,12 +286,12 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "canonical",
-            mul: 3373u64,
-            add: 3173u64,
+            mul: 3273u64,
+            add: 2935u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 2094u64,
+            fma: 2049u64,
         },
         OpCount {
             function: "mass_matrix_inverse",
@@ -1212,8 +1212,8 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "model",
-            mul: 2033u64,
-            add: 2091u64,
+            mul: 1933u64,
+            add: 1853u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1225,8 +1225,8 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "canonical",
-            mul: 2036u64,
-            add: 2094u64,
+            mul: 1936u64,
+            add: 1856u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1238,8 +1238,8 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "model",
-            mul: 3373u64,
-            add: 3174u64,
+            mul: 3273u64,
+            add: 2936u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1251,8 +1251,8 @@ impl Ssrms {
             nonlinear_effects_method: ::core::option::Option::None,
             forward_method: ::core::option::Option::None,
             frames: "canonical",
-            mul: 3373u64,
-            add: 3173u64,
+            mul: 3273u64,
+            add: 2935u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -3086,7 +3086,7 @@ impl Ssrms {
     }
     /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`.
     ///
-    /// : 2033 mul, 2091 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 1098 fused where the target has FMA.
+    /// : 1933 mul, 1853 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 1053 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics_derivatives(
         q: &[::core::primitive::f64; 7],
@@ -3176,1451 +3176,1256 @@ impl Ssrms {
         let x83 = Self::mul_add(qd[0], x35, x71) - x72 + (x77 - x78);
         let x84 = Self::mul_add(x39, x44, x73) - x74 - (x79 - x80);
         let x85 = Self::mul_add(-x43, x45, x75 + x76) - (x81 - x82);
-        let x86 = x17 * x44;
-        let x87 = x16 * x45;
-        let x88 = x86 + x87;
-        let x89 = qd[0] * x17;
-        let x90 = x15 * x45;
-        let x91 = x89 + x90;
-        let x92 = qd[0] * x16;
-        let x93 = x15 * x44;
-        let x94 = x92 - x93;
-        let x95 = x38 * x45;
-        let x96 = x41 * x44;
-        let x97 = x35 * x45;
-        let x98 = x35 * x44;
-        let x99 = x17 * x48;
-        let x100 = x16 * x47;
-        let x101 = x99 + x100;
-        let x102 = x36 * x45;
-        let x103 = x37 * x44;
-        let x104 = x39 * x45;
-        let x105 = x43 * x44;
-        let x106 = qd[0] * x42;
-        let x107 = qd[0] * x39;
-        let x108 = x15 * x46;
-        let x109 = x99 + x108;
-        let x110 = qd[0] * x40;
-        let x111 = qd[0] * x43;
-        let x112 = x100 + x108;
-        let x113 = c_q1 * c_q2;
-        let x114 = Self::mul_add(s_q0, s_q2, x6 * c_q2);
-        let x115 = Self::mul_add(-c_q0, s_q2, x7 * c_q2);
-        let x116 = c_q1 * s_q2;
-        let x117 = Self::mul_add(-s_q0, c_q2, x6 * s_q2);
-        let x118 = Self::mul_add(c_q0, c_q2, x7 * s_q2);
-        let x119 = Self::mul_add(s_q1, 0.5692, 1.3589);
-        let x120 = Self::mul_add(x8, 0.5692, x10);
-        let x121 = Self::mul_add(x9, -0.5692, x11);
-        let x122 = Self::mul_add(x9, x120, x8 * x121);
-        let x123 = Self::mul_add(x9, x119, s_q1 * x121);
-        let x124 = Self::mul_add(-x8, x119, s_q1 * x120);
-        let x125 = 5224.5702 * x113;
-        let x126 = 5224.5702 * x114;
-        let x127 = 5224.5702 * x115;
-        let x128 = Self::mul_add(3946.1881206800003, s_q1, x113 * 39234.47412200001);
-        let x129 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x113);
-        let x130 = Self::mul_add(-3946.1881206800003, x8, x114 * 39234.47412200001);
-        let x131 = Self::mul_add(39241.404122, x8, 3946.18812068 * x114);
-        let x132 = Self::mul_add(-3946.1881206800003, x9, x115 * 39234.47412200001);
-        let x133 = Self::mul_add(39241.404122, x9, 3946.18812068 * x115);
-        let x134 = x121 * x127;
-        let x135 = x120 * x126;
-        let x136 = x134 - x135;
-        let x137 = x120 * x125;
-        let x138 = x121 * x125;
-        let x139 = x119 * x126;
-        let x140 = x119 * x125;
-        let x141 = x134 + x140;
-        let x142 = x121 * x126;
-        let x143 = x119 * x127;
-        let x144 = x120 * x127;
-        let x145 = x135 - x140;
-        let x146 = x136 - (Self::mul_add(s_q1, x129, x113 * x128) - x136);
-        let x147 = x139 + (Self::mul_add(-x8, x129, x114 * x128) - x137);
-        let x148 = x143 + (Self::mul_add(-x9, x129, x115 * x128) + x138);
-        let x149 = x137 - (Self::mul_add(s_q1, x131, x113 * x130) + x139);
-        let x150 = x141 - (Self::mul_add(-x8, x131, x114 * x130) - x141);
-        let x151 = x144 - (Self::mul_add(-x9, x131, x115 * x130) + x142);
-        let x152 = x138 + (Self::mul_add(s_q1, x133, x113 * x132) + x143);
-        let x153 = x142 + (Self::mul_add(-x8, x133, x114 * x132) - x144);
-        let x154 = x145 + (Self::mul_add(-x9, x133, x115 * x132) + x145);
-        let x155 = Self::mul_add(-qd[2], s_q1, qd[0]);
-        let x156 = Self::mul_add(-qd[2], x8, x44);
-        let x157 = Self::mul_add(qd[2], x9, x45);
-        let x158 = Self::mul_add(-qd[2], x122, x46);
-        let x159 = Self::mul_add(qd[2], x123, x47);
-        let x160 = Self::mul_add(qd[2], x124, x48);
-        let x161 = Self::mul_add(x9, x156, x8 * x157);
-        let x162 = Self::mul_add(x9, x155, s_q1 * x157);
-        let x163 = Self::mul_add(-x8, x155, s_q1 * x156);
-        let x164 = Self::mul_add(-x9, x159, x8 * x160);
-        let x165 = Self::mul_add(-x9, x158, s_q1 * x160);
-        let x166 = Self::mul_add(-x8, x158, s_q1 * x159);
-        let x167 = Self::mul_add(x124, x156, x123 * x157) + x164;
-        let x168 = Self::mul_add(-x124, x155, x122 * x157) - x165;
-        let x169 = Self::mul_add(x123, x155, x122 * x156) + x166;
-        let x170 = Self::mul_add(-qd[2], x161, Self::mul_add(-qdd[2], s_q1, x57));
-        let x171 = Self::mul_add(qd[2], x162, Self::mul_add(-qdd[2], x8, x58));
-        let x172 = Self::mul_add(-qd[2], x163, Self::mul_add(qdd[2], x9, x59));
-        let x173 = Self::mul_add(qd[2], x167, Self::mul_add(-qdd[2], x122, x60));
-        let x174 = Self::mul_add(qd[2], x168, Self::mul_add(qdd[2], x123, x61));
-        let x175 = Self::mul_add(qd[2], x169, Self::mul_add(qdd[2], x124, x62));
-        let x176 = Self::mul_add(x9, x44, x8 * x45);
-        let x177 = Self::mul_add(qd[0], x9, s_q1 * x45);
-        let x178 = Self::mul_add(-qd[0], x8, s_q1 * x44);
-        let x179 = Self::mul_add(x44, x124, x45 * x123)
+        let x86 = Self::mul_add(x16, x45, x17 * x44);
+        let x87 = Self::mul_add(x15, x45, qd[0] * x17);
+        let x88 = Self::mul_add(-x15, x44, qd[0] * x16);
+        let x89 = Self::mul_add(-x41, x44, x38 * x45);
+        let x90 = Self::mul_add(-qd[0], x42, x36 * x45);
+        let x91 = Self::mul_add(-qd[0], x40, x37 * x44);
+        let x92 = x15 * x46;
+        let x93 = x16 * x47;
+        let x94 = x17 * x48;
+        let x95 = x92 + x93 + x94;
+        let x96 = x95 + x95;
+        let x97 = c_q1 * c_q2;
+        let x98 = Self::mul_add(s_q0, s_q2, x6 * c_q2);
+        let x99 = Self::mul_add(-c_q0, s_q2, x7 * c_q2);
+        let x100 = c_q1 * s_q2;
+        let x101 = Self::mul_add(-s_q0, c_q2, x6 * s_q2);
+        let x102 = Self::mul_add(c_q0, c_q2, x7 * s_q2);
+        let x103 = Self::mul_add(s_q1, 0.5692, 1.3589);
+        let x104 = Self::mul_add(x8, 0.5692, x10);
+        let x105 = Self::mul_add(x9, -0.5692, x11);
+        let x106 = Self::mul_add(x9, x104, x8 * x105);
+        let x107 = Self::mul_add(x9, x103, s_q1 * x105);
+        let x108 = Self::mul_add(-x8, x103, s_q1 * x104);
+        let x109 = 5224.5702 * x97;
+        let x110 = 5224.5702 * x98;
+        let x111 = 5224.5702 * x99;
+        let x112 = Self::mul_add(3946.1881206800003, s_q1, x97 * 39234.47412200001);
+        let x113 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x97);
+        let x114 = Self::mul_add(-3946.1881206800003, x8, x98 * 39234.47412200001);
+        let x115 = Self::mul_add(39241.404122, x8, 3946.18812068 * x98);
+        let x116 = Self::mul_add(-3946.1881206800003, x9, x99 * 39234.47412200001);
+        let x117 = Self::mul_add(39241.404122, x9, 3946.18812068 * x99);
+        let x118 = x105 * x111;
+        let x119 = x104 * x110;
+        let x120 = x118 - x119;
+        let x121 = x104 * x109;
+        let x122 = x105 * x109;
+        let x123 = x103 * x110;
+        let x124 = x103 * x109;
+        let x125 = x118 + x124;
+        let x126 = x105 * x110;
+        let x127 = x103 * x111;
+        let x128 = x104 * x111;
+        let x129 = x119 - x124;
+        let x130 = x120 - (Self::mul_add(s_q1, x113, x97 * x112) - x120);
+        let x131 = x123 + (Self::mul_add(-x8, x113, x98 * x112) - x121);
+        let x132 = x127 + (Self::mul_add(-x9, x113, x99 * x112) + x122);
+        let x133 = x121 - (Self::mul_add(s_q1, x115, x97 * x114) + x123);
+        let x134 = x125 - (Self::mul_add(-x8, x115, x98 * x114) - x125);
+        let x135 = x128 - (Self::mul_add(-x9, x115, x99 * x114) + x126);
+        let x136 = x122 + (Self::mul_add(s_q1, x117, x97 * x116) + x127);
+        let x137 = x126 + (Self::mul_add(-x8, x117, x98 * x116) - x128);
+        let x138 = x129 + (Self::mul_add(-x9, x117, x99 * x116) + x129);
+        let x139 = Self::mul_add(-qd[2], s_q1, qd[0]);
+        let x140 = Self::mul_add(-qd[2], x8, x44);
+        let x141 = Self::mul_add(qd[2], x9, x45);
+        let x142 = Self::mul_add(-qd[2], x106, x46);
+        let x143 = Self::mul_add(qd[2], x107, x47);
+        let x144 = Self::mul_add(qd[2], x108, x48);
+        let x145 = Self::mul_add(x9, x140, x8 * x141);
+        let x146 = Self::mul_add(x9, x139, s_q1 * x141);
+        let x147 = Self::mul_add(-x8, x139, s_q1 * x140);
+        let x148 = Self::mul_add(-x9, x143, x8 * x144);
+        let x149 = Self::mul_add(-x9, x142, s_q1 * x144);
+        let x150 = Self::mul_add(-x8, x142, s_q1 * x143);
+        let x151 = Self::mul_add(x108, x140, x107 * x141) + x148;
+        let x152 = Self::mul_add(-x108, x139, x106 * x141) - x149;
+        let x153 = Self::mul_add(x107, x139, x106 * x140) + x150;
+        let x154 = Self::mul_add(-qd[2], x145, Self::mul_add(-qdd[2], s_q1, x57));
+        let x155 = Self::mul_add(qd[2], x146, Self::mul_add(-qdd[2], x8, x58));
+        let x156 = Self::mul_add(-qd[2], x147, Self::mul_add(qdd[2], x9, x59));
+        let x157 = Self::mul_add(qd[2], x151, Self::mul_add(-qdd[2], x106, x60));
+        let x158 = Self::mul_add(qd[2], x152, Self::mul_add(qdd[2], x107, x61));
+        let x159 = Self::mul_add(qd[2], x153, Self::mul_add(qdd[2], x108, x62));
+        let x160 = Self::mul_add(x9, x44, x8 * x45);
+        let x161 = Self::mul_add(qd[0], x9, s_q1 * x45);
+        let x162 = Self::mul_add(-qd[0], x8, s_q1 * x44);
+        let x163 = Self::mul_add(x44, x108, x45 * x107)
             + Self::mul_add(-x9, x47, x8 * x48);
-        let x180 = Self::mul_add(-qd[0], x124, x45 * x122)
+        let x164 = Self::mul_add(-qd[0], x108, x45 * x106)
             - Self::mul_add(-x9, x46, s_q1 * x48);
-        let x181 = Self::mul_add(qd[0], x123, x44 * x122)
+        let x165 = Self::mul_add(qd[0], x107, x44 * x106)
             + Self::mul_add(-x8, x46, s_q1 * x47);
-        let x182 = Self::mul_add(x9, x58, x8 * x59)
-            - Self::mul_add(x44, x178, x45 * x177);
-        let x183 = Self::mul_add(x9, x57, s_q1 * x59)
-            + Self::mul_add(-qd[0], x178, x45 * x176);
-        let x184 = Self::mul_add(-x8, x57, s_q1 * x58)
-            + Self::mul_add(qd[0], x177, x44 * x176);
-        let x185 = Self::mul_add(x58, x124, x59 * x123)
+        let x166 = Self::mul_add(x9, x58, x8 * x59)
+            - Self::mul_add(x44, x162, x45 * x161);
+        let x167 = Self::mul_add(x9, x57, s_q1 * x59)
+            + Self::mul_add(-qd[0], x162, x45 * x160);
+        let x168 = Self::mul_add(-x8, x57, s_q1 * x58)
+            + Self::mul_add(qd[0], x161, x44 * x160);
+        let x169 = Self::mul_add(x58, x108, x59 * x107)
             + Self::mul_add(-x9, x61, x8 * x62)
-            + (Self::mul_add(x44, x181, x45 * x180)
-                - Self::mul_add(-x47, x178, x48 * x177));
-        let x186 = Self::mul_add(-x57, x124, x59 * x122)
+            + (Self::mul_add(x44, x165, x45 * x164)
+                - Self::mul_add(-x47, x162, x48 * x161));
+        let x170 = Self::mul_add(-x57, x108, x59 * x106)
             - Self::mul_add(-x9, x60, s_q1 * x62)
-            - (Self::mul_add(qd[0], x181, x45 * x179)
-                + Self::mul_add(x46, x178, x48 * x176));
-        let x187 = Self::mul_add(x57, x123, x58 * x122)
+            - (Self::mul_add(qd[0], x165, x45 * x163)
+                + Self::mul_add(x46, x162, x48 * x160));
+        let x171 = Self::mul_add(x57, x107, x58 * x106)
             + Self::mul_add(-x8, x60, s_q1 * x61)
-            - (Self::mul_add(-qd[0], x180, x44 * x179)
-                - Self::mul_add(x46, x177, x47 * x176));
-        let x188 = x161 + x176;
-        let x189 = x162 + x177;
-        let x190 = x163 + x178;
-        let x191 = x167 + x179;
-        let x192 = x168 + x180;
-        let x193 = x169 + x181;
-        let x194 = x147 * x156;
-        let x195 = x148 * x157;
-        let x196 = x149 * x155;
-        let x197 = x151 * x157;
-        let x198 = x152 * x155;
-        let x199 = x153 * x156;
-        let x200 = x127 * x159;
-        let x201 = x126 * x160;
-        let x202 = x127 * x158;
-        let x203 = x125 * x160;
-        let x204 = x126 * x158;
-        let x205 = x125 * x159;
-        let x206 = Self::mul_add(x146, x155, x194) - x195 + (x200 - x201);
-        let x207 = Self::mul_add(-x150, x156, x196) + x197 + (x202 + x203);
-        let x208 = Self::mul_add(x154, x157, x198 - x199) + (x204 + x205);
-        let x209 = x127 * x156;
-        let x210 = x126 * x157;
-        let x211 = x209 + x210;
-        let x212 = x127 * x155;
-        let x213 = x125 * x157;
-        let x214 = x212 - x213;
-        let x215 = x126 * x155;
-        let x216 = x125 * x156;
-        let x217 = x215 + x216;
-        let x218 = x149 * x157;
-        let x219 = x152 * x156;
-        let x220 = x146 * x157;
-        let x221 = x146 * x156;
-        let x222 = x127 * x160;
-        let x223 = x126 * x159;
-        let x224 = x222 + x223;
-        let x225 = x147 * x157;
-        let x226 = x148 * x156;
-        let x227 = x150 * x157;
-        let x228 = x154 * x156;
-        let x229 = x153 * x155;
-        let x230 = x150 * x155;
-        let x231 = x125 * x158;
-        let x232 = x222 - x231;
-        let x233 = x151 * x155;
-        let x234 = x154 * x155;
-        let x235 = x223 - x231;
-        let x236 = Self::mul_add(-x116, s_q3, x113 * c_q3);
-        let x237 = Self::mul_add(-x117, s_q3, x114 * c_q3);
-        let x238 = Self::mul_add(-x118, s_q3, x115 * c_q3);
-        let x239 = Self::mul_add(x116, c_q3, x113 * s_q3);
-        let x240 = Self::mul_add(x117, c_q3, x114 * s_q3);
-        let x241 = Self::mul_add(x118, c_q3, x115 * s_q3);
-        let x242 = x119 + Self::mul_add(s_q1, 0.475, 7.11 * x113);
-        let x243 = x120 - Self::mul_add(x8, -0.475, 7.11 * x114);
-        let x244 = x121 + Self::mul_add(x9, -0.475, 7.11 * x115);
-        let x245 = Self::mul_add(x9, x243, x8 * x244);
-        let x246 = Self::mul_add(x9, x242, s_q1 * x244);
-        let x247 = Self::mul_add(-x8, x242, s_q1 * x243);
-        let x248 = 3239.4582 * x236;
-        let x249 = 3239.4582 * x237;
-        let x250 = 3239.4582 * x238;
-        let x251 = Self::mul_add(1375.0472756800002, s_q1, x236 * 24989.305802);
-        let x252 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x236);
-        let x253 = Self::mul_add(-1375.0472756800002, x8, x237 * 24989.305802);
-        let x254 = Self::mul_add(24998.827802, x8, 1375.0472756800002 * x237);
-        let x255 = Self::mul_add(-1375.0472756800002, x9, x238 * 24989.305802);
-        let x256 = Self::mul_add(24998.827802, x9, 1375.0472756800002 * x238);
-        let x257 = x244 * x250;
-        let x258 = x243 * x249;
-        let x259 = x257 - x258;
-        let x260 = x243 * x248;
-        let x261 = x244 * x248;
-        let x262 = x242 * x249;
-        let x263 = x242 * x248;
-        let x264 = x257 + x263;
-        let x265 = x244 * x249;
-        let x266 = x242 * x250;
-        let x267 = x243 * x250;
-        let x268 = x258 - x263;
-        let x269 = x259 - (Self::mul_add(s_q1, x252, x236 * x251) - x259);
-        let x270 = x262 + (Self::mul_add(-x8, x252, x237 * x251) - x260);
-        let x271 = x266 + (Self::mul_add(-x9, x252, x238 * x251) + x261);
-        let x272 = x260 - (Self::mul_add(s_q1, x254, x236 * x253) + x262);
-        let x273 = x264 - (Self::mul_add(-x8, x254, x237 * x253) - x264);
-        let x274 = x267 - (Self::mul_add(-x9, x254, x238 * x253) + x265);
-        let x275 = x261 + (Self::mul_add(s_q1, x256, x236 * x255) + x266);
-        let x276 = x265 + (Self::mul_add(-x8, x256, x237 * x255) - x267);
-        let x277 = x268 + (Self::mul_add(-x9, x256, x238 * x255) + x268);
-        let x278 = Self::mul_add(-qd[3], s_q1, x155);
-        let x279 = Self::mul_add(-qd[3], x8, x156);
-        let x280 = Self::mul_add(qd[3], x9, x157);
-        let x281 = Self::mul_add(-qd[3], x245, x158);
-        let x282 = Self::mul_add(qd[3], x246, x159);
-        let x283 = Self::mul_add(qd[3], x247, x160);
-        let x284 = Self::mul_add(x9, x279, x8 * x280);
-        let x285 = Self::mul_add(x9, x278, s_q1 * x280);
-        let x286 = Self::mul_add(-x8, x278, s_q1 * x279);
-        let x287 = Self::mul_add(-x9, x282, x8 * x283);
-        let x288 = Self::mul_add(-x9, x281, s_q1 * x283);
-        let x289 = Self::mul_add(-x8, x281, s_q1 * x282);
-        let x290 = Self::mul_add(x247, x279, x246 * x280) + x287;
-        let x291 = Self::mul_add(-x247, x278, x245 * x280) - x288;
-        let x292 = Self::mul_add(x246, x278, x245 * x279) + x289;
-        let x293 = Self::mul_add(-qd[3], x284, Self::mul_add(-qdd[3], s_q1, x170));
-        let x294 = Self::mul_add(qd[3], x285, Self::mul_add(-qdd[3], x8, x171));
-        let x295 = Self::mul_add(-qd[3], x286, Self::mul_add(qdd[3], x9, x172));
-        let x296 = Self::mul_add(qd[3], x290, Self::mul_add(-qdd[3], x245, x173));
-        let x297 = Self::mul_add(qd[3], x291, Self::mul_add(qdd[3], x246, x174));
-        let x298 = Self::mul_add(qd[3], x292, Self::mul_add(qdd[3], x247, x175));
-        let x299 = x164 + Self::mul_add(x156, x247, x157 * x246);
-        let x300 = x165 - Self::mul_add(-x155, x247, x157 * x245);
-        let x301 = x166 + Self::mul_add(x155, x246, x156 * x245);
-        let x302 = Self::mul_add(x9, x171, x8 * x172)
-            - Self::mul_add(x156, x163, x157 * x162);
-        let x303 = Self::mul_add(x9, x170, s_q1 * x172)
-            + Self::mul_add(-x155, x163, x157 * x161);
-        let x304 = Self::mul_add(-x8, x170, s_q1 * x171)
-            + Self::mul_add(x155, x162, x156 * x161);
-        let x305 = Self::mul_add(x171, x247, x172 * x246)
-            + Self::mul_add(-x9, x174, x8 * x175)
-            - (Self::mul_add(-x156, x301, x157 * x300)
-                + Self::mul_add(-x159, x163, x160 * x162));
-        let x306 = Self::mul_add(-x170, x247, x172 * x245)
-            - Self::mul_add(-x9, x173, s_q1 * x175)
-            - (Self::mul_add(x155, x301, x157 * x299)
-                + Self::mul_add(x158, x163, x160 * x161));
-        let x307 = Self::mul_add(x170, x246, x171 * x245)
-            + Self::mul_add(-x8, x173, s_q1 * x174)
-            - (Self::mul_add(x155, x300, x156 * x299)
-                - Self::mul_add(x158, x162, x159 * x161));
-        let x308 = x161 + x284;
-        let x309 = x162 + x285;
-        let x310 = x163 + x286;
-        let x311 = x290 + x299;
-        let x312 = x291 - x300;
-        let x313 = x292 + x301;
-        let x314 = x270 * x279;
-        let x315 = x271 * x280;
-        let x316 = x272 * x278;
-        let x317 = x274 * x280;
-        let x318 = x275 * x278;
-        let x319 = x276 * x279;
-        let x320 = x250 * x282;
-        let x321 = x249 * x283;
-        let x322 = x250 * x281;
-        let x323 = x248 * x283;
-        let x324 = x249 * x281;
-        let x325 = x248 * x282;
-        let x326 = Self::mul_add(x269, x278, x314) - x315 + (x320 - x321);
-        let x327 = Self::mul_add(-x273, x279, x316) + x317 + (x322 + x323);
-        let x328 = Self::mul_add(x277, x280, x318 - x319) + (x324 + x325);
-        let x329 = x250 * x279;
-        let x330 = x249 * x280;
-        let x331 = x329 + x330;
-        let x332 = x250 * x278;
-        let x333 = x248 * x280;
+            - (Self::mul_add(-qd[0], x164, x44 * x163)
+                - Self::mul_add(x46, x161, x47 * x160));
+        let x172 = x145 + x160;
+        let x173 = x146 + x161;
+        let x174 = x147 + x162;
+        let x175 = x151 + x163;
+        let x176 = x152 + x164;
+        let x177 = x153 + x165;
+        let x178 = x131 * x140;
+        let x179 = x132 * x141;
+        let x180 = x133 * x139;
+        let x181 = x135 * x141;
+        let x182 = x136 * x139;
+        let x183 = x137 * x140;
+        let x184 = x111 * x143;
+        let x185 = x110 * x144;
+        let x186 = x111 * x142;
+        let x187 = x109 * x144;
+        let x188 = x110 * x142;
+        let x189 = x109 * x143;
+        let x190 = Self::mul_add(x130, x139, x178) - x179 + (x184 - x185);
+        let x191 = Self::mul_add(-x134, x140, x180) + x181 + (x186 + x187);
+        let x192 = Self::mul_add(x138, x141, x182 - x183) + (x188 + x189);
+        let x193 = Self::mul_add(x110, x141, x111 * x140);
+        let x194 = Self::mul_add(-x109, x141, x111 * x139);
+        let x195 = Self::mul_add(x109, x140, x110 * x139);
+        let x196 = Self::mul_add(-x136, x140, x133 * x141);
+        let x197 = Self::mul_add(-x137, x139, x131 * x141);
+        let x198 = Self::mul_add(-x135, x139, x132 * x140);
+        let x199 = x109 * x142;
+        let x200 = x110 * x143;
+        let x201 = x111 * x144;
+        let x202 = x199 - x200 - x201;
+        let x203 = x202 + x202;
+        let x204 = Self::mul_add(-x100, s_q3, x97 * c_q3);
+        let x205 = Self::mul_add(-x101, s_q3, x98 * c_q3);
+        let x206 = Self::mul_add(-x102, s_q3, x99 * c_q3);
+        let x207 = Self::mul_add(x100, c_q3, x97 * s_q3);
+        let x208 = Self::mul_add(x101, c_q3, x98 * s_q3);
+        let x209 = Self::mul_add(x102, c_q3, x99 * s_q3);
+        let x210 = x103 + Self::mul_add(s_q1, 0.475, 7.11 * x97);
+        let x211 = x104 - Self::mul_add(x8, -0.475, 7.11 * x98);
+        let x212 = x105 + Self::mul_add(x9, -0.475, 7.11 * x99);
+        let x213 = Self::mul_add(x9, x211, x8 * x212);
+        let x214 = Self::mul_add(x9, x210, s_q1 * x212);
+        let x215 = Self::mul_add(-x8, x210, s_q1 * x211);
+        let x216 = 3239.4582 * x204;
+        let x217 = 3239.4582 * x205;
+        let x218 = 3239.4582 * x206;
+        let x219 = Self::mul_add(1375.0472756800002, s_q1, x204 * 24989.305802);
+        let x220 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x204);
+        let x221 = Self::mul_add(-1375.0472756800002, x8, x205 * 24989.305802);
+        let x222 = Self::mul_add(24998.827802, x8, 1375.0472756800002 * x205);
+        let x223 = Self::mul_add(-1375.0472756800002, x9, x206 * 24989.305802);
+        let x224 = Self::mul_add(24998.827802, x9, 1375.0472756800002 * x206);
+        let x225 = x212 * x218;
+        let x226 = x211 * x217;
+        let x227 = x225 - x226;
+        let x228 = x211 * x216;
+        let x229 = x212 * x216;
+        let x230 = x210 * x217;
+        let x231 = x210 * x216;
+        let x232 = x225 + x231;
+        let x233 = x212 * x217;
+        let x234 = x210 * x218;
+        let x235 = x211 * x218;
+        let x236 = x226 - x231;
+        let x237 = x227 - (Self::mul_add(s_q1, x220, x204 * x219) - x227);
+        let x238 = x230 + (Self::mul_add(-x8, x220, x205 * x219) - x228);
+        let x239 = x234 + (Self::mul_add(-x9, x220, x206 * x219) + x229);
+        let x240 = x228 - (Self::mul_add(s_q1, x222, x204 * x221) + x230);
+        let x241 = x232 - (Self::mul_add(-x8, x222, x205 * x221) - x232);
+        let x242 = x235 - (Self::mul_add(-x9, x222, x206 * x221) + x233);
+        let x243 = x229 + (Self::mul_add(s_q1, x224, x204 * x223) + x234);
+        let x244 = x233 + (Self::mul_add(-x8, x224, x205 * x223) - x235);
+        let x245 = x236 + (Self::mul_add(-x9, x224, x206 * x223) + x236);
+        let x246 = Self::mul_add(-qd[3], s_q1, x139);
+        let x247 = Self::mul_add(-qd[3], x8, x140);
+        let x248 = Self::mul_add(qd[3], x9, x141);
+        let x249 = Self::mul_add(-qd[3], x213, x142);
+        let x250 = Self::mul_add(qd[3], x214, x143);
+        let x251 = Self::mul_add(qd[3], x215, x144);
+        let x252 = Self::mul_add(x9, x247, x8 * x248);
+        let x253 = Self::mul_add(x9, x246, s_q1 * x248);
+        let x254 = Self::mul_add(-x8, x246, s_q1 * x247);
+        let x255 = Self::mul_add(-x9, x250, x8 * x251);
+        let x256 = Self::mul_add(-x9, x249, s_q1 * x251);
+        let x257 = Self::mul_add(-x8, x249, s_q1 * x250);
+        let x258 = Self::mul_add(x215, x247, x214 * x248) + x255;
+        let x259 = Self::mul_add(-x215, x246, x213 * x248) - x256;
+        let x260 = Self::mul_add(x214, x246, x213 * x247) + x257;
+        let x261 = Self::mul_add(-qd[3], x252, Self::mul_add(-qdd[3], s_q1, x154));
+        let x262 = Self::mul_add(qd[3], x253, Self::mul_add(-qdd[3], x8, x155));
+        let x263 = Self::mul_add(-qd[3], x254, Self::mul_add(qdd[3], x9, x156));
+        let x264 = Self::mul_add(qd[3], x258, Self::mul_add(-qdd[3], x213, x157));
+        let x265 = Self::mul_add(qd[3], x259, Self::mul_add(qdd[3], x214, x158));
+        let x266 = Self::mul_add(qd[3], x260, Self::mul_add(qdd[3], x215, x159));
+        let x267 = x148 + Self::mul_add(x140, x215, x141 * x214);
+        let x268 = x149 - Self::mul_add(-x139, x215, x141 * x213);
+        let x269 = x150 + Self::mul_add(x139, x214, x140 * x213);
+        let x270 = Self::mul_add(x9, x155, x8 * x156)
+            - Self::mul_add(x140, x147, x141 * x146);
+        let x271 = Self::mul_add(x9, x154, s_q1 * x156)
+            + Self::mul_add(-x139, x147, x141 * x145);
+        let x272 = Self::mul_add(-x8, x154, s_q1 * x155)
+            + Self::mul_add(x139, x146, x140 * x145);
+        let x273 = Self::mul_add(x155, x215, x156 * x214)
+            + Self::mul_add(-x9, x158, x8 * x159)
+            - (Self::mul_add(-x140, x269, x141 * x268)
+                + Self::mul_add(-x143, x147, x144 * x146));
+        let x274 = Self::mul_add(-x154, x215, x156 * x213)
+            - Self::mul_add(-x9, x157, s_q1 * x159)
+            - (Self::mul_add(x139, x269, x141 * x267)
+                + Self::mul_add(x142, x147, x144 * x145));
+        let x275 = Self::mul_add(x154, x214, x155 * x213)
+            + Self::mul_add(-x8, x157, s_q1 * x158)
+            - (Self::mul_add(x139, x268, x140 * x267)
+                - Self::mul_add(x142, x146, x143 * x145));
+        let x276 = x145 + x252;
+        let x277 = x146 + x253;
+        let x278 = x147 + x254;
+        let x279 = x258 + x267;
+        let x280 = x259 - x268;
+        let x281 = x260 + x269;
+        let x282 = x238 * x247;
+        let x283 = x239 * x248;
+        let x284 = x240 * x246;
+        let x285 = x242 * x248;
+        let x286 = x243 * x246;
+        let x287 = x244 * x247;
+        let x288 = x218 * x250;
+        let x289 = x217 * x251;
+        let x290 = x218 * x249;
+        let x291 = x216 * x251;
+        let x292 = x217 * x249;
+        let x293 = x216 * x250;
+        let x294 = Self::mul_add(x237, x246, x282) - x283 + (x288 - x289);
+        let x295 = Self::mul_add(-x241, x247, x284) + x285 + (x290 + x291);
+        let x296 = Self::mul_add(x245, x248, x286 - x287) + (x292 + x293);
+        let x297 = Self::mul_add(x217, x248, x218 * x247);
+        let x298 = Self::mul_add(-x216, x248, x218 * x246);
+        let x299 = Self::mul_add(x216, x247, x217 * x246);
+        let x300 = Self::mul_add(-x243, x247, x240 * x248);
+        let x301 = Self::mul_add(-x244, x246, x238 * x248);
+        let x302 = Self::mul_add(-x242, x246, x239 * x247);
+        let x303 = x216 * x249;
+        let x304 = x217 * x250;
+        let x305 = x218 * x251;
+        let x306 = x303 - x304 - x305;
+        let x307 = x306 + x306;
+        let x308 = Self::mul_add(-x207, s_q4, x204 * c_q4);
+        let x309 = Self::mul_add(-x208, s_q4, x205 * c_q4);
+        let x310 = Self::mul_add(-x209, s_q4, x206 * c_q4);
+        let x311 = Self::mul_add(x207, c_q4, x204 * s_q4);
+        let x312 = Self::mul_add(x208, c_q4, x205 * s_q4);
+        let x313 = Self::mul_add(x209, c_q4, x206 * s_q4);
+        let x314 = Self::mul_add(7.11, x204, x210);
+        let x315 = Self::mul_add(-7.11, x205, x211);
+        let x316 = Self::mul_add(7.11, x206, x212);
+        let x317 = Self::mul_add(x9, x315, x8 * x316);
+        let x318 = Self::mul_add(x9, x314, s_q1 * x316);
+        let x319 = Self::mul_add(-x8, x314, s_q1 * x315);
+        let x320 = x311 * 171.195516;
+        let x321 = x312 * 171.195516;
+        let x322 = x313 * 171.195516;
+        let x323 = 132.6783695416 * x308;
+        let x324 = Self::mul_add(x311, 97.44448770720001, 135.4729695416 * s_q1);
+        let x325 = s_q1 * 97.44448770720001;
+        let x326 = 132.6783695416 * x309;
+        let x327 = Self::mul_add(x312, -97.44448770720001, 135.4729695416 * x8);
+        let x328 = x8 * 97.44448770720001;
+        let x329 = 132.6783695416 * x310;
+        let x330 = Self::mul_add(x313, -97.44448770720001, 135.4729695416 * x9);
+        let x331 = x9 * 97.44448770720001;
+        let x332 = x316 * x322;
+        let x333 = x315 * x321;
         let x334 = x332 - x333;
-        let x335 = x249 * x278;
-        let x336 = x248 * x279;
-        let x337 = x335 + x336;
-        let x338 = x272 * x280;
-        let x339 = x275 * x279;
-        let x340 = x269 * x280;
-        let x341 = x269 * x279;
-        let x342 = x250 * x283;
-        let x343 = x249 * x282;
-        let x344 = x342 + x343;
-        let x345 = x270 * x280;
-        let x346 = x271 * x279;
-        let x347 = x273 * x280;
-        let x348 = x277 * x279;
-        let x349 = x276 * x278;
-        let x350 = x273 * x278;
-        let x351 = x248 * x281;
-        let x352 = x342 - x351;
-        let x353 = x274 * x278;
-        let x354 = x277 * x278;
-        let x355 = x343 - x351;
-        let x356 = Self::mul_add(-x239, s_q4, x236 * c_q4);
-        let x357 = Self::mul_add(-x240, s_q4, x237 * c_q4);
-        let x358 = Self::mul_add(-x241, s_q4, x238 * c_q4);
-        let x359 = Self::mul_add(x239, c_q4, x236 * s_q4);
-        let x360 = Self::mul_add(x240, c_q4, x237 * s_q4);
-        let x361 = Self::mul_add(x241, c_q4, x238 * s_q4);
-        let x362 = Self::mul_add(7.11, x236, x242);
-        let x363 = Self::mul_add(-7.11, x237, x243);
-        let x364 = Self::mul_add(7.11, x238, x244);
-        let x365 = Self::mul_add(x9, x363, x8 * x364);
-        let x366 = Self::mul_add(x9, x362, s_q1 * x364);
-        let x367 = Self::mul_add(-x8, x362, s_q1 * x363);
-        let x368 = x359 * 171.195516;
-        let x369 = x360 * 171.195516;
-        let x370 = x361 * 171.195516;
-        let x371 = 132.6783695416 * x356;
-        let x372 = Self::mul_add(x359, 97.44448770720001, 135.4729695416 * s_q1);
-        let x373 = s_q1 * 97.44448770720001;
-        let x374 = 132.6783695416 * x357;
-        let x375 = Self::mul_add(x360, -97.44448770720001, 135.4729695416 * x8);
-        let x376 = x8 * 97.44448770720001;
-        let x377 = 132.6783695416 * x358;
-        let x378 = Self::mul_add(x361, -97.44448770720001, 135.4729695416 * x9);
-        let x379 = x9 * 97.44448770720001;
-        let x380 = x364 * x370;
-        let x381 = x363 * x369;
-        let x382 = x380 - x381;
-        let x383 = x363 * x368;
-        let x384 = x364 * x368;
-        let x385 = x362 * x369;
-        let x386 = x362 * x368;
-        let x387 = x380 + x386;
-        let x388 = x364 * x369;
-        let x389 = x362 * x370;
-        let x390 = x363 * x370;
-        let x391 = x381 - x386;
-        let x392 = x382
-            - (Self::mul_add(x359, x373, Self::mul_add(s_q1, x372, x356 * x371)) - x382);
-        let x393 = x385
-            + (Self::mul_add(x360, x373, Self::mul_add(-x8, x372, x357 * x371)) - x383);
-        let x394 = x389
-            + (Self::mul_add(x361, x373, Self::mul_add(-x9, x372, x358 * x371)) + x384);
-        let x395 = x383
-            - (Self::mul_add(-x359, x376, Self::mul_add(-s_q1, x375, x356 * x374))
-                + x385);
-        let x396 = x387
-            - (Self::mul_add(-x360, x376, Self::mul_add(x8, x375, x357 * x374)) - x387);
-        let x397 = x390
-            - (Self::mul_add(-x361, x376, Self::mul_add(x9, x375, x358 * x374)) + x388);
-        let x398 = x384
-            + (Self::mul_add(-x359, x379, Self::mul_add(-s_q1, x378, x356 * x377))
-                + x389);
-        let x399 = x388
-            + (Self::mul_add(-x360, x379, Self::mul_add(x8, x378, x357 * x377)) - x390);
-        let x400 = x391
-            + (Self::mul_add(-x361, x379, Self::mul_add(x9, x378, x358 * x377)) + x391);
-        let x401 = Self::mul_add(-qd[4], s_q1, x278);
-        let x402 = Self::mul_add(-qd[4], x8, x279);
-        let x403 = Self::mul_add(qd[4], x9, x280);
-        let x404 = Self::mul_add(-qd[4], x365, x281);
-        let x405 = Self::mul_add(qd[4], x366, x282);
-        let x406 = Self::mul_add(qd[4], x367, x283);
-        let x407 = Self::mul_add(x9, x402, x8 * x403);
-        let x408 = Self::mul_add(x9, x401, s_q1 * x403);
-        let x409 = Self::mul_add(-x8, x401, s_q1 * x402);
-        let x410 = Self::mul_add(x367, x402, x366 * x403)
-            + Self::mul_add(-x9, x405, x8 * x406);
-        let x411 = Self::mul_add(-x367, x401, x365 * x403)
-            - Self::mul_add(-x9, x404, s_q1 * x406);
-        let x412 = Self::mul_add(x366, x401, x365 * x402)
-            + Self::mul_add(-x8, x404, s_q1 * x405);
-        let x413 = Self::mul_add(-qd[4], x407, Self::mul_add(-qdd[4], s_q1, x293));
-        let x414 = Self::mul_add(qd[4], x408, Self::mul_add(-qdd[4], x8, x294));
-        let x415 = Self::mul_add(-qd[4], x409, Self::mul_add(qdd[4], x9, x295));
-        let x416 = Self::mul_add(qd[4], x410, Self::mul_add(-qdd[4], x365, x296));
-        let x417 = Self::mul_add(qd[4], x411, Self::mul_add(qdd[4], x366, x297));
-        let x418 = Self::mul_add(qd[4], x412, Self::mul_add(qdd[4], x367, x298));
-        let x419 = x287 + Self::mul_add(x279, x367, x280 * x366);
-        let x420 = x288 - Self::mul_add(-x278, x367, x280 * x365);
-        let x421 = x289 + Self::mul_add(x278, x366, x279 * x365);
-        let x422 = Self::mul_add(x9, x294, x8 * x295)
-            - Self::mul_add(x279, x286, x280 * x285);
-        let x423 = Self::mul_add(x9, x293, s_q1 * x295)
-            + Self::mul_add(-x278, x286, x280 * x284);
-        let x424 = Self::mul_add(-x8, x293, s_q1 * x294)
-            + Self::mul_add(x278, x285, x279 * x284);
-        let x425 = Self::mul_add(x294, x367, x295 * x366)
-            + Self::mul_add(-x9, x297, x8 * x298)
-            - (Self::mul_add(-x279, x421, x280 * x420)
-                + Self::mul_add(-x282, x286, x283 * x285));
-        let x426 = Self::mul_add(-x293, x367, x295 * x365)
-            - Self::mul_add(-x9, x296, s_q1 * x298)
-            - (Self::mul_add(x278, x421, x280 * x419)
-                + Self::mul_add(x281, x286, x283 * x284));
-        let x427 = Self::mul_add(x293, x366, x294 * x365)
-            + Self::mul_add(-x8, x296, s_q1 * x297)
-            - (Self::mul_add(x278, x420, x279 * x419)
-                - Self::mul_add(x281, x285, x282 * x284));
-        let x428 = x284 + x407;
-        let x429 = x285 + x408;
-        let x430 = x286 + x409;
-        let x431 = x410 + x419;
-        let x432 = x411 - x420;
-        let x433 = x412 + x421;
-        let x434 = x393 * x402;
-        let x435 = x394 * x403;
-        let x436 = x395 * x401;
-        let x437 = x397 * x403;
-        let x438 = x398 * x401;
-        let x439 = x399 * x402;
-        let x440 = x370 * x405;
-        let x441 = x369 * x406;
-        let x442 = x370 * x404;
-        let x443 = x368 * x406;
-        let x444 = x369 * x404;
-        let x445 = x368 * x405;
-        let x446 = Self::mul_add(x392, x401, x434) - x435 + (x440 - x441);
-        let x447 = Self::mul_add(-x396, x402, x436) + x437 + (x442 + x443);
-        let x448 = Self::mul_add(x400, x403, x438 - x439) + (x444 + x445);
-        let x449 = x370 * x402;
-        let x450 = x369 * x403;
-        let x451 = x449 + x450;
-        let x452 = x370 * x401;
-        let x453 = x368 * x403;
-        let x454 = x452 - x453;
-        let x455 = x369 * x401;
-        let x456 = x368 * x402;
-        let x457 = x455 + x456;
-        let x458 = Self::mul_add(x369, x415, x370 * x414)
-            - Self::mul_add(-x402, x457, x403 * x454);
-        let x459 = Self::mul_add(-x368, x415, x370 * x413)
-            + Self::mul_add(x401, x457, x403 * x451);
-        let x460 = Self::mul_add(x368, x414, x369 * x413)
-            - Self::mul_add(x401, x454, x402 * x451);
-        let x461 = x395 * x403;
-        let x462 = x398 * x402;
-        let x463 = x392 * x403;
-        let x464 = x392 * x402;
-        let x465 = x370 * x406;
-        let x466 = x369 * x405;
-        let x467 = x465 + x466;
-        let x468 = x393 * x403;
-        let x469 = x394 * x402;
-        let x470 = x396 * x403;
-        let x471 = x400 * x402;
-        let x472 = x456 + (x455 + x457);
-        let x473 = x453 - (x452 + x454);
-        let x474 = x399 * x401;
-        let x475 = x396 * x401;
-        let x476 = x368 * x404;
-        let x477 = x465 - x476;
-        let x478 = x397 * x401;
-        let x479 = x400 * x401;
-        let x480 = x455 + (x456 + x457);
-        let x481 = x450 + (x449 + x451);
-        let x482 = x466 - x476;
-        let x483 = x452 - (x453 - x454);
-        let x484 = x449 + (x450 + x451);
-        let x485 = x456 + (x455 - x457);
-        let x486 = x453 - (x452 - x454);
-        let x487 = x455 + (x456 - x457);
-        let x488 = x450 + (x449 - x451);
-        let x489 = x452 - (x453 + x454);
-        let x490 = x449 + (x450 - x451);
-        let x491 = Self::mul_add(-s_q1, s_q5, x356 * c_q5);
-        let x492 = Self::mul_add(x8, s_q5, x357 * c_q5);
-        let x493 = Self::mul_add(x9, s_q5, x358 * c_q5);
-        let x494 = Self::mul_add(s_q1, c_q5, x356 * s_q5);
-        let x495 = Self::mul_add(-x8, c_q5, x357 * s_q5);
-        let x496 = Self::mul_add(-x9, c_q5, x358 * s_q5);
-        let x497 = 44.41 * x494;
-        let x498 = 47.471 * x359;
-        let x499 = 44.41 * x495;
-        let x500 = 47.471 * x360;
-        let x501 = 44.41 * x496;
-        let x502 = 47.471 * x361;
-        let x503 = Self::mul_add(x359, x498, x494 * x497);
-        let x504 = Self::mul_add(x360, x498, x495 * x497);
-        let x505 = Self::mul_add(x361, x498, x496 * x497);
-        let x506 = Self::mul_add(x359, x500, x494 * x499);
-        let x507 = Self::mul_add(x360, x500, x495 * x499);
-        let x508 = Self::mul_add(x361, x500, x496 * x499);
-        let x509 = Self::mul_add(x359, x502, x494 * x501);
-        let x510 = Self::mul_add(x360, x502, x495 * x501);
-        let x511 = Self::mul_add(x361, x502, x496 * x501);
-        let x512 = Self::mul_add(qd[5], x359, x401);
-        let x513 = Self::mul_add(-qd[5], x360, x402);
-        let x514 = Self::mul_add(qd[5], x361, x403);
-        let x515 = Self::mul_add(x361, x513, x360 * x514);
-        let x516 = Self::mul_add(-x361, x512, x359 * x514);
-        let x517 = Self::mul_add(x360, x512, x359 * x513);
-        let x518 = Self::mul_add(-qd[5], x515, Self::mul_add(qdd[5], x359, x413));
-        let x519 = Self::mul_add(-qd[5], x516, Self::mul_add(-qdd[5], x360, x414));
-        let x520 = Self::mul_add(qd[5], x517, Self::mul_add(qdd[5], x361, x415));
-        let x521 = Self::mul_add(x361, x402, x360 * x403);
-        let x522 = Self::mul_add(-x361, x401, x359 * x403);
-        let x523 = Self::mul_add(x360, x401, x359 * x402);
-        let x524 = Self::mul_add(x361, x414, x360 * x415)
-            + Self::mul_add(x402, x523, x403 * x522);
-        let x525 = Self::mul_add(-x361, x413, x359 * x415)
-            - Self::mul_add(x401, x523, x403 * x521);
-        let x526 = Self::mul_add(x360, x413, x359 * x414)
-            - Self::mul_add(-x401, x522, x402 * x521);
-        let x527 = x515 + x521;
-        let x528 = x516 + x522;
-        let x529 = x517 + x523;
-        let x530 = x504 * x513;
-        let x531 = x505 * x514;
-        let x532 = Self::mul_add(x503, x512, -x530) + x531;
-        let x533 = x506 * x512;
-        let x534 = x508 * x514;
-        let x535 = Self::mul_add(-x507, x513, x533) + x534;
-        let x536 = x509 * x512;
-        let x537 = x510 * x513;
-        let x538 = Self::mul_add(x511, x514, x536 - x537);
-        let x539 = x506 * x514;
-        let x540 = x509 * x513;
-        let x541 = x503 * x514;
-        let x542 = x503 * x513;
-        let x543 = x504 * x514;
-        let x544 = x505 * x513;
-        let x545 = x507 * x514;
-        let x546 = x511 * x513;
-        let x547 = x510 * x512;
-        let x548 = x507 * x512;
-        let x549 = x508 * x512;
-        let x550 = x511 * x512;
-        let x551 = 9.336 * x491;
-        let x552 = 9.336 * x492;
-        let x553 = 9.336 * x493;
-        let x554 = x491 * x551;
-        let x555 = x492 * x551;
-        let x556 = x493 * x551;
-        let x557 = x491 * x552;
-        let x558 = x492 * x552;
-        let x559 = x493 * x552;
-        let x560 = x491 * x553;
-        let x561 = x492 * x553;
-        let x562 = x493 * x553;
-        let x563 = Self::mul_add(qd[6], x491, x512);
-        let x564 = Self::mul_add(-qd[6], x492, x513);
-        let x565 = Self::mul_add(qd[6], x493, x514);
-        let x566 = Self::mul_add(x493, x564, x492 * x565);
-        let x567 = Self::mul_add(-x493, x563, x491 * x565);
-        let x568 = Self::mul_add(x492, x563, x491 * x564);
-        let x569 = Self::mul_add(-qd[6], x566, Self::mul_add(qdd[6], x491, x518));
-        let x570 = Self::mul_add(-qd[6], x567, Self::mul_add(-qdd[6], x492, x519));
-        let x571 = Self::mul_add(qd[6], x568, Self::mul_add(qdd[6], x493, x520));
-        let x572 = Self::mul_add(x493, x513, x492 * x514);
-        let x573 = Self::mul_add(-x493, x512, x491 * x514);
-        let x574 = Self::mul_add(x492, x512, x491 * x513);
-        let x575 = Self::mul_add(x493, x519, x492 * x520)
-            + Self::mul_add(x513, x574, x514 * x573);
-        let x576 = Self::mul_add(-x493, x518, x491 * x520)
-            - Self::mul_add(x512, x574, x514 * x572);
-        let x577 = Self::mul_add(x492, x518, x491 * x519)
-            - Self::mul_add(-x512, x573, x513 * x572);
-        let x578 = x566 + x572;
-        let x579 = x567 + x573;
-        let x580 = x568 + x574;
-        let x581 = x555 * x564;
-        let x582 = x556 * x565;
-        let x583 = Self::mul_add(x554, x563, -x581) + x582;
-        let x584 = x557 * x563;
-        let x585 = x559 * x565;
-        let x586 = Self::mul_add(-x558, x564, x584) + x585;
-        let x587 = x560 * x563;
-        let x588 = x561 * x564;
-        let x589 = Self::mul_add(x562, x565, x587 - x588);
-        let x590 = Self::mul_add(x556, x571, Self::mul_add(-x555, x570, x554 * x569))
-            - Self::mul_add(x564, x589, x565 * x586);
-        let x591 = Self::mul_add(x559, x571, Self::mul_add(-x558, x570, x557 * x569))
-            + Self::mul_add(-x563, x589, x565 * x583);
-        let x592 = Self::mul_add(x562, x571, Self::mul_add(-x561, x570, x560 * x569))
-            + Self::mul_add(x563, x586, x564 * x583);
-        let x593 = x557 * x565;
-        let x594 = x560 * x564;
-        let x595 = x554 * x565;
-        let x596 = x554 * x564;
-        let x597 = x555 * x565;
-        let x598 = x556 * x564;
-        let x599 = x558 * x565;
-        let x600 = x562 * x564;
-        let x601 = x593 + x594 + (x597 + x598);
-        let x602 = x589 + (x587 - x595) + Self::mul_add(x559, x564, x599);
-        let x603 = x586 + (x584 + x596) - Self::mul_add(x561, x565, x600);
-        let x604 = x561 * x563;
-        let x605 = x558 * x563;
-        let x606 = x559 * x563;
-        let x607 = x562 * x563;
-        let x608 = x589 - (x588 + x599) + Self::mul_add(-x556, x563, x595);
-        let x609 = x597 - x604 + (x593 - x606);
-        let x610 = x583 - (x581 + x605) - Self::mul_add(x560, x565, -x607);
-        let x611 = x586 + (x585 + x600) - Self::mul_add(x555, x563, x596);
-        let x612 = x583 + (x582 - x607) + Self::mul_add(x557, x564, x605);
-        let x613 = x598 + x606 + (x594 + x604);
-        let x614 = Self::mul_add(x493, x556, Self::mul_add(x492, x555, x491 * x554));
-        let x615 = Self::mul_add(x493, x559, Self::mul_add(x492, x558, x491 * x557));
-        let x616 = Self::mul_add(x493, x562, Self::mul_add(x492, x561, x491 * x560));
-        let x617 = x491 * x601;
-        let x618 = Self::mul_add(-x493, x603, Self::mul_add(x492, x602, x617));
-        let x619 = -x618;
-        let x620 = x492 * x609;
-        let x621 = Self::mul_add(-x493, x610, Self::mul_add(x491, x608, x620));
-        let x622 = x493 * x613;
-        let x623 = Self::mul_add(-x492, x612, x491 * x611) - x622;
-        let x624 = Self::mul_add(-x492, x592, x493 * x591)
-            + Self::mul_add(-x556, x577, Self::mul_add(-x555, x576, x554 * x575))
-            - Self::mul_add(-x574, x611, Self::mul_add(x573, x608, x572 * x601));
-        let x625 = -x624;
-        let x626 = Self::mul_add(-x491, x592, x493 * x590)
-            - Self::mul_add(-x559, x577, Self::mul_add(-x558, x576, x557 * x575))
-            + Self::mul_add(x574, x612, Self::mul_add(x573, x609, x572 * x602));
-        let x627 = Self::mul_add(-x491, x591, x492 * x590)
-            + Self::mul_add(-x562, x577, Self::mul_add(-x561, x576, x560 * x575))
-            + Self::mul_add(-x574, x613, Self::mul_add(x573, x610, x572 * x603));
-        let x628 = Self::mul_add(-x556, x580, Self::mul_add(-x555, x579, x554 * x578))
-            + Self::mul_add(x493, x611, Self::mul_add(-x492, x608, x617));
-        let x629 = -x628;
-        let x630 = Self::mul_add(-x559, x580, Self::mul_add(-x558, x579, x557 * x578))
-            - Self::mul_add(x493, x612, Self::mul_add(-x491, x602, x620));
-        let x631 = Self::mul_add(-x562, x580, Self::mul_add(-x561, x579, x560 * x578))
-            - (x622 + Self::mul_add(-x492, x610, x491 * x603));
-        let x632 = -Self::mul_add(c_q0, x627, s_q0 * x626);
-        let x633 = Self::mul_add(-c_q0, x631, s_q0 * x630);
-        let x634 = Self::mul_add(-x9, x627, Self::mul_add(x8, x626, s_q1 * x624));
-        let x635 = Self::mul_add(-x9, x631, Self::mul_add(-x8, x630, s_q1 * x628));
-        let x636 = -Self::mul_add(x361, x627, Self::mul_add(-x360, x626, x359 * x624));
-        let x637 = -Self::mul_add(x361, x631, Self::mul_add(x360, x630, x359 * x628));
-        let x638 = -(Self::mul_add(-x577, x616, Self::mul_add(-x576, x615, x575 * x614))
-            - Self::mul_add(-x574, x623, Self::mul_add(x573, x621, x572 * x618)));
-        let x639 = -(Self::mul_add(-x580, x616, Self::mul_add(-x579, x615, x578 * x614))
-            + Self::mul_add(x493, x623, Self::mul_add(-x492, x621, x491 * x618)));
-        let x640 = x503 + x554;
-        let x641 = x504 + x555;
-        let x642 = x505 + x556;
-        let x643 = x506 + x557;
-        let x644 = x507 + x558;
-        let x645 = x508 + x559;
-        let x646 = x509 + x560;
-        let x647 = x510 + x561;
-        let x648 = x511 + x562;
-        let x649 = x539 + x540 + (x543 + x544) + x601;
-        let x650 = x538 - (x537 + x545) + Self::mul_add(-x505, x512, x541) + x608;
-        let x651 = x535 + (x534 + x546) - Self::mul_add(x504, x512, x542) + x611;
-        let x652 = x538 + (x536 - x541) + Self::mul_add(x508, x513, x545) + x602;
-        let x653 = x543 - x547 + (x539 - x549) + x609;
-        let x654 = x532 + (x531 - x550) + Self::mul_add(x506, x513, x548) + x612;
-        let x655 = x535 + (x533 + x542) - Self::mul_add(x510, x514, x546) + x603;
-        let x656 = x532 - (x530 + x548) - Self::mul_add(x509, x514, -x550) + x610;
-        let x657 = x544 + x549 + (x540 + x547) + x613;
-        let x658 = Self::mul_add(x505, x520, Self::mul_add(-x504, x519, x503 * x518))
-            - Self::mul_add(x513, x538, x514 * x535) + x590;
-        let x659 = Self::mul_add(x508, x520, Self::mul_add(-x507, x519, x506 * x518))
-            + Self::mul_add(-x512, x538, x514 * x532) + x591;
-        let x660 = Self::mul_add(x511, x520, Self::mul_add(-x510, x519, x509 * x518))
-            + Self::mul_add(x512, x535, x513 * x532) + x592;
-        let x661 = Self::mul_add(x361, x642, Self::mul_add(x360, x641, x359 * x640));
-        let x662 = Self::mul_add(x361, x645, Self::mul_add(x360, x644, x359 * x643));
-        let x663 = Self::mul_add(x361, x648, Self::mul_add(x360, x647, x359 * x646));
-        let x664 = x359 * x649;
-        let x665 = Self::mul_add(-x361, x655, Self::mul_add(x360, x652, x664));
-        let x666 = -x665;
-        let x667 = x360 * x653;
-        let x668 = Self::mul_add(-x361, x656, Self::mul_add(x359, x650, x667));
-        let x669 = x361 * x657;
-        let x670 = Self::mul_add(-x360, x654, x359 * x651) - x669;
-        let x671 = Self::mul_add(-x360, x660, x361 * x659)
-            + Self::mul_add(-x526, x642, Self::mul_add(-x525, x641, x524 * x640))
-            - Self::mul_add(-x523, x651, Self::mul_add(x522, x650, x521 * x649));
-        let x672 = -x671;
-        let x673 = Self::mul_add(-x359, x660, x361 * x658)
-            - Self::mul_add(-x526, x645, Self::mul_add(-x525, x644, x524 * x643))
-            + Self::mul_add(x523, x654, Self::mul_add(x522, x653, x521 * x652));
-        let x674 = Self::mul_add(-x359, x659, x360 * x658)
-            + Self::mul_add(-x526, x648, Self::mul_add(-x525, x647, x524 * x646))
-            + Self::mul_add(-x523, x657, Self::mul_add(x522, x656, x521 * x655));
-        let x675 = Self::mul_add(-x529, x642, Self::mul_add(-x528, x641, x527 * x640))
-            + Self::mul_add(x361, x651, Self::mul_add(-x360, x650, x664));
-        let x676 = -x675;
-        let x677 = Self::mul_add(-x529, x645, Self::mul_add(-x528, x644, x527 * x643))
-            - Self::mul_add(x361, x654, Self::mul_add(-x359, x652, x667));
-        let x678 = Self::mul_add(-x529, x648, Self::mul_add(-x528, x647, x527 * x646))
-            - (x669 + Self::mul_add(-x360, x656, x359 * x655));
-        let x679 = -Self::mul_add(c_q0, x674, s_q0 * x673);
-        let x680 = Self::mul_add(-c_q0, x678, s_q0 * x677);
-        let x681 = Self::mul_add(-x9, x674, Self::mul_add(x8, x673, s_q1 * x671));
-        let x682 = Self::mul_add(-x9, x678, Self::mul_add(-x8, x677, s_q1 * x675));
-        let x683 = -(Self::mul_add(-x526, x663, Self::mul_add(-x525, x662, x524 * x661))
-            - Self::mul_add(-x523, x670, Self::mul_add(x522, x668, x521 * x665)));
-        let x684 = -(Self::mul_add(-x529, x663, Self::mul_add(-x528, x662, x527 * x661))
-            + Self::mul_add(x361, x670, Self::mul_add(-x360, x668, x359 * x665)));
-        let x685 = -(Self::mul_add(-x526, x616, Self::mul_add(-x525, x615, x524 * x614))
-            - Self::mul_add(-x523, x623, Self::mul_add(x522, x621, x521 * x618)));
-        let x686 = -(Self::mul_add(-x529, x616, Self::mul_add(-x528, x615, x527 * x614))
-            + Self::mul_add(x361, x623, Self::mul_add(-x360, x621, x359 * x618)));
-        let x687 = x392 - x640;
-        let x688 = x393 + x641;
-        let x689 = x394 + x642;
-        let x690 = x395 - x643;
-        let x691 = x396 - x644;
-        let x692 = x397 - x645;
-        let x693 = x398 + x646;
-        let x694 = x399 + x647;
-        let x695 = x400 + x648;
-        let x696 = x461 - x462 + x467 + (x467 - (x468 + x469)) - x649;
-        let x697 = x448 - (x445 + (x439 - x470))
-            + (x444 - Self::mul_add(x394, x401, x463)) + x650;
-        let x698 = x447 - (x443 - (x437 - x471))
-            + (x442 - Self::mul_add(-x393, x401, x464)) - x651;
-        let x699 = x448 - (x444 - (x438 + x463))
-            + (x445 - Self::mul_add(x397, x402, x470)) + x652;
-        let x700 = x468 - x474 + x477 + (x477 - (x461 - x478)) + x653;
-        let x701 = x446 + (x441 - (x435 - x479))
-            + (x440 + Self::mul_add(x395, x402, x475)) - x654;
-        let x702 = x447 - (x442 - (x436 + x464))
-            + (x443 + Self::mul_add(x399, x403, x471)) - x655;
-        let x703 = x446 - (x440 - (x434 - x475))
-            - (x441 - Self::mul_add(x398, x403, -x479)) - x656;
-        let x704 = x469 - x478 + x482 + (x482 + (x462 + x474)) + x657;
-        let x705 = Self::mul_add(-x394, x415, Self::mul_add(x393, x414, x392 * x413))
-            + Self::mul_add(-x369, x418, x370 * x417)
-            - (Self::mul_add(-x402, x448, x403 * x447)
-                + Self::mul_add(x405, x457, x406 * x454)) - x658;
-        let x706 = Self::mul_add(x397, x415, Self::mul_add(-x396, x414, x395 * x413))
-            + Self::mul_add(x368, x418, x370 * x416)
-            + (Self::mul_add(x401, x448, x403 * x446)
-                + Self::mul_add(-x404, x457, x406 * x451)) - x659;
-        let x707 = Self::mul_add(x400, x415, Self::mul_add(-x399, x414, x398 * x413))
-            + Self::mul_add(x368, x417, x369 * x416)
-            - (Self::mul_add(x401, x447, x402 * x446)
-                - Self::mul_add(x404, x454, x405 * x451)) + x660;
-        let x708 = Self::mul_add(x9, x689, Self::mul_add(x8, x688, s_q1 * x687))
-            - Self::mul_add(-x367, x369, x366 * x370);
-        let x709 = Self::mul_add(-x9, x692, Self::mul_add(-x8, x691, s_q1 * x690))
-            + Self::mul_add(-x367, x368, x365 * x370);
-        let x710 = Self::mul_add(-x9, x695, Self::mul_add(-x8, x694, s_q1 * x693))
-            + Self::mul_add(-x366, x368, x365 * x369);
-        let x711 = Self::mul_add(-x9, x369, x8 * x370);
-        let x712 = Self::mul_add(x9, x368, s_q1 * x370);
-        let x713 = Self::mul_add(x8, x368, s_q1 * x369);
-        let x714 = s_q1 * x696;
-        let x715 = Self::mul_add(
-            x366,
-            x472,
-            Self::mul_add(x9, x702, Self::mul_add(x8, x699, x714)),
-        );
-        let x716 = Self::mul_add(-x367, x473, x715);
-        let x717 = -x716;
-        let x718 = x8 * x700;
-        let x719 = Self::mul_add(
-            -x365,
-            x480,
-            Self::mul_add(-x9, x703, Self::mul_add(s_q1, x697, -x718)),
-        );
-        let x720 = Self::mul_add(-x367, x481, x719);
-        let x721 = x9 * x704;
-        let x722 = Self::mul_add(
-            x366,
-            x484,
-            Self::mul_add(-x365, x483, Self::mul_add(x8, x701, s_q1 * x698) - x721),
-        );
-        let x723 = Self::mul_add(-x9, x486, x8 * x485);
-        let x724 = Self::mul_add(-x9, x488, s_q1 * x487);
-        let x725 = Self::mul_add(x8, x490, s_q1 * x489);
-        let x726 = Self::mul_add(
-            -x420,
-            x487,
-            Self::mul_add(x286, x698, Self::mul_add(x285, x697, x284 * x696)),
-        );
-        let x727 = Self::mul_add(
-            -x419,
-            x485,
-            Self::mul_add(x286, x701, Self::mul_add(-x285, x700, x284 * x699)),
-        );
-        let x728 = Self::mul_add(
-            x419,
-            x486,
-            Self::mul_add(-x286, x704, Self::mul_add(-x285, x703, x284 * x702)),
-        );
-        let x729 = Self::mul_add(x8, x707, x9 * x706)
-            + Self::mul_add(x366, x460, x367 * x459)
-            + (Self::mul_add(-x424, x689, Self::mul_add(-x423, x688, x422 * x687))
-                - Self::mul_add(-x369, x427, x370 * x426))
-            - Self::mul_add(x421, x489, x726);
-        let x730 = Self::mul_add(-s_q1, x707, x9 * x705)
-            + Self::mul_add(x365, x460, x367 * x458)
-            - (Self::mul_add(x424, x692, Self::mul_add(x423, x691, x422 * x690))
-                - Self::mul_add(x368, x427, x370 * x425))
-            - Self::mul_add(x421, x490, x727);
-        let x731 = Self::mul_add(s_q1, x706, x8 * x705)
-            + Self::mul_add(-x365, x459, x366 * x458)
-            - (Self::mul_add(x424, x695, Self::mul_add(x423, x694, x422 * x693))
-                - Self::mul_add(x368, x426, x369 * x425))
-            + Self::mul_add(x420, x488, x728);
-        let x732 = Self::mul_add(x8, x460, x9 * x459)
-            - Self::mul_add(-x369, x424, x370 * x423)
-            - Self::mul_add(x286, x483, x285 * x480);
-        let x733 = Self::mul_add(-s_q1, x460, x9 * x458)
-            - Self::mul_add(-x368, x424, x370 * x422)
-            - Self::mul_add(x286, x484, x284 * x472);
-        let x734 = Self::mul_add(s_q1, x459, x8 * x458)
-            - Self::mul_add(-x368, x423, x369 * x422)
-            - Self::mul_add(x285, x481, x284 * x473);
-        let x735 = Self::mul_add(
-            x366,
-            x487,
-            Self::mul_add(-x9, x698, Self::mul_add(-x8, x697, x714)),
-        );
-        let x736 = Self::mul_add(
-            x365,
-            x485,
-            Self::mul_add(-x9, x701, Self::mul_add(s_q1, x699, x718)),
-        );
-        let x737 = Self::mul_add(
-            -x366,
-            x488,
-            Self::mul_add(-x365, x486, x721 + Self::mul_add(x8, x703, s_q1 * x702)),
-        );
-        let x738 = Self::mul_add(-x430, x689, Self::mul_add(-x429, x688, x428 * x687))
-            - Self::mul_add(-x369, x433, x370 * x432) - Self::mul_add(x367, x489, x735);
-        let x739 = Self::mul_add(x430, x692, Self::mul_add(x429, x691, x428 * x690))
-            - Self::mul_add(x368, x433, x370 * x431) + Self::mul_add(x367, x490, x736);
-        let x740 = Self::mul_add(x430, x695, Self::mul_add(x429, x694, x428 * x693))
-            - Self::mul_add(x368, x432, x369 * x431) - x737;
-        let x741 = Self::mul_add(-x369, x430, x370 * x429)
-            - Self::mul_add(x9, x483, x8 * x480);
-        let x742 = Self::mul_add(-x368, x430, x370 * x428)
-            + Self::mul_add(-x9, x484, s_q1 * x472);
-        let x743 = Self::mul_add(-x368, x429, x369 * x428)
-            + Self::mul_add(-x8, x481, s_q1 * x473);
-        let x744 = Self::mul_add(c_q0, x731, s_q0 * x730)
-            - Self::mul_add(-x14, x734, Self::mul_add(x13, x733, x12 * x732));
-        let x745 = -(Self::mul_add(c_q0, x740, s_q0 * x739)
-            - Self::mul_add(-x14, x743, Self::mul_add(x13, x742, x12 * x741)));
-        let x746 = Self::mul_add(-x9, x731, Self::mul_add(x8, x730, s_q1 * x729));
-        let x747 = -(x746
-            - Self::mul_add(x124, x734, Self::mul_add(-x123, x733, x122 * x732)));
-        let x748 = Self::mul_add(x9, x740, Self::mul_add(-x8, x739, s_q1 * x738));
-        let x749 = -(x748
-            + Self::mul_add(x124, x743, Self::mul_add(-x123, x742, x122 * x741)));
-        let x750 = -(x746
-            - Self::mul_add(x247, x734, Self::mul_add(-x246, x733, x245 * x732)));
-        let x751 = -(x748
-            + Self::mul_add(x247, x743, Self::mul_add(-x246, x742, x245 * x741)));
-        let x752 = -(Self::mul_add(-x424, x710, Self::mul_add(x423, x709, x422 * x708))
-            + Self::mul_add(x427, x713, Self::mul_add(-x426, x712, x425 * x711))
-            - (Self::mul_add(x286, x722, Self::mul_add(x285, x720, x284 * x716))
-                - Self::mul_add(-x421, x725, Self::mul_add(x420, x724, x419 * x723))));
-        let x753 = Self::mul_add(-x9, x722, Self::mul_add(-x8, x720, s_q1 * x716));
-        let x754 = -(Self::mul_add(-x430, x710, Self::mul_add(x429, x709, x428 * x708))
-            + Self::mul_add(x433, x713, Self::mul_add(-x432, x712, x431 * x711))
-            - (x753
-                + Self::mul_add(x367, x725, Self::mul_add(x366, x724, x365 * x723))));
-        let x755 = -(Self::mul_add(x424, x663, Self::mul_add(x423, x662, x422 * x661))
-            - Self::mul_add(x286, x670, Self::mul_add(-x285, x668, x284 * x665)));
-        let x756 = Self::mul_add(-x9, x670, Self::mul_add(x8, x668, s_q1 * x665));
-        let x757 = -(Self::mul_add(x430, x663, Self::mul_add(x429, x662, x428 * x661))
-            - x756);
-        let x758 = -(Self::mul_add(x424, x616, Self::mul_add(x423, x615, x422 * x614))
-            - Self::mul_add(x286, x623, Self::mul_add(-x285, x621, x284 * x618)));
-        let x759 = Self::mul_add(-x9, x623, Self::mul_add(x8, x621, s_q1 * x618));
-        let x760 = -(Self::mul_add(x430, x616, Self::mul_add(x429, x615, x428 * x614))
-            - x759);
-        let x761 = x248 - x368;
-        let x762 = x249 - x369;
-        let x763 = x250 - x370;
-        let x764 = x269 - x687;
-        let x765 = x270 - x688;
-        let x766 = x271 - x689;
-        let x767 = x272 - x690;
-        let x768 = x273 - x691;
-        let x769 = x274 - x692;
-        let x770 = x275 - x693;
-        let x771 = x276 - x694;
-        let x772 = x277 - x695;
-        let x773 = x338 - x339 + x344 + (x344 - (x345 + x346)) - x696;
-        let x774 = x328 - (x325 + (x319 - x347))
-            + (x324 - Self::mul_add(x271, x278, x340)) - x697;
-        let x775 = x327 - (x323 - (x317 - x348))
-            + (x322 - Self::mul_add(-x270, x278, x341)) - x698;
-        let x776 = x335 + (x336 - x337) - x487;
-        let x777 = x332 - (x333 + x334) - x489;
-        let x778 = x328 - (x324 - (x318 + x340))
-            + (x325 - Self::mul_add(x274, x279, x347)) - x699;
-        let x779 = x345 - x349 + x352 + (x352 - (x338 - x353)) - x700;
-        let x780 = x326 + (x321 - (x315 - x354))
-            + (x320 + Self::mul_add(x272, x279, x350)) - x701;
-        let x781 = x336 + (x335 - x337) - x485;
-        let x782 = x329 + (x330 - x331) - x490;
-        let x783 = x327 - (x322 - (x316 + x341))
-            + (x323 + Self::mul_add(x276, x280, x348)) - x702;
-        let x784 = x326 - (x320 - (x314 - x350))
-            - (x321 - Self::mul_add(x275, x280, -x354)) - x703;
-        let x785 = x346 - x353 + x355 + (x355 + (x339 + x349)) - x704;
-        let x786 = x333 - (x332 - x334) - x486;
-        let x787 = x330 + (x329 - x331) - x488;
-        let x788 = x335 + (x336 + x337) - x480;
-        let x789 = x332 - (x333 - x334) - x483;
-        let x790 = x336 + (x335 + x337) - x472;
-        let x791 = x329 + (x330 + x331) - x484;
-        let x792 = x333 - (x332 + x334) - x473;
-        let x793 = x330 + (x329 + x331) - x481;
-        let x794 = Self::mul_add(-x271, x295, Self::mul_add(x270, x294, x269 * x293))
-            + Self::mul_add(-x249, x298, x250 * x297)
-            - (Self::mul_add(-x279, x328, x280 * x327)
-                + Self::mul_add(x282, x337, x283 * x334)) - x705;
-        let x795 = Self::mul_add(x274, x295, Self::mul_add(-x273, x294, x272 * x293))
-            + Self::mul_add(x248, x298, x250 * x296)
-            + (Self::mul_add(x278, x328, x280 * x326)
-                + Self::mul_add(-x281, x337, x283 * x331)) - x706;
-        let x796 = Self::mul_add(x277, x295, Self::mul_add(-x276, x294, x275 * x293))
-            + Self::mul_add(x248, x297, x249 * x296)
-            - (Self::mul_add(x278, x327, x279 * x326)
-                - Self::mul_add(x281, x334, x282 * x331)) - x707;
-        let x797 = Self::mul_add(x249, x295, x250 * x294)
-            - Self::mul_add(-x279, x337, x280 * x334) - x458;
-        let x798 = Self::mul_add(-x248, x295, x250 * x293)
-            + Self::mul_add(x278, x337, x280 * x331) - x459;
-        let x799 = Self::mul_add(x248, x294, x249 * x293)
-            - Self::mul_add(x278, x334, x279 * x331) - x460;
-        let x800 = Self::mul_add(x9, x766, Self::mul_add(x8, x765, s_q1 * x764))
-            - Self::mul_add(-x247, x762, x246 * x763);
-        let x801 = Self::mul_add(-x9, x769, Self::mul_add(-x8, x768, s_q1 * x767))
-            + Self::mul_add(-x247, x761, x245 * x763);
-        let x802 = Self::mul_add(-x9, x772, Self::mul_add(-x8, x771, s_q1 * x770))
-            + Self::mul_add(-x246, x761, x245 * x762);
-        let x803 = Self::mul_add(-x9, x762, x8 * x763);
-        let x804 = Self::mul_add(x9, x761, s_q1 * x763);
-        let x805 = Self::mul_add(x8, x761, s_q1 * x762);
-        let x806 = s_q1 * x773;
-        let x807 = Self::mul_add(
-            x246,
-            x790,
-            Self::mul_add(x9, x783, Self::mul_add(x8, x778, x806)),
-        );
-        let x808 = Self::mul_add(-x247, x792, x807);
-        let x809 = x8 * x779;
-        let x810 = Self::mul_add(
-            -x245,
-            x788,
-            Self::mul_add(-x9, x784, Self::mul_add(s_q1, x774, -x809)),
-        );
-        let x811 = Self::mul_add(-x247, x793, x810);
-        let x812 = x9 * x785;
-        let x813 = Self::mul_add(
-            x246,
-            x791,
-            Self::mul_add(-x245, x789, Self::mul_add(x8, x780, s_q1 * x775) - x812),
-        );
-        let x814 = Self::mul_add(-x9, x786, x8 * x781);
-        let x815 = Self::mul_add(-x9, x787, s_q1 * x776);
-        let x816 = Self::mul_add(x8, x782, s_q1 * x777);
-        let x817 = Self::mul_add(
-            -x300,
-            x776,
-            Self::mul_add(x163, x775, Self::mul_add(x162, x774, x161 * x773)),
-        );
+        let x335 = x315 * x320;
+        let x336 = x316 * x320;
+        let x337 = x314 * x321;
+        let x338 = x314 * x320;
+        let x339 = x332 + x338;
+        let x340 = x316 * x321;
+        let x341 = x314 * x322;
+        let x342 = x315 * x322;
+        let x343 = x333 - x338;
+        let x344 = x334
+            - (Self::mul_add(x311, x325, Self::mul_add(s_q1, x324, x308 * x323)) - x334);
+        let x345 = x337
+            + (Self::mul_add(x312, x325, Self::mul_add(-x8, x324, x309 * x323)) - x335);
+        let x346 = x341
+            + (Self::mul_add(x313, x325, Self::mul_add(-x9, x324, x310 * x323)) + x336);
+        let x347 = x335
+            - (Self::mul_add(-x311, x328, Self::mul_add(-s_q1, x327, x308 * x326))
+                + x337);
+        let x348 = x339
+            - (Self::mul_add(-x312, x328, Self::mul_add(x8, x327, x309 * x326)) - x339);
+        let x349 = x342
+            - (Self::mul_add(-x313, x328, Self::mul_add(x9, x327, x310 * x326)) + x340);
+        let x350 = x336
+            + (Self::mul_add(-x311, x331, Self::mul_add(-s_q1, x330, x308 * x329))
+                + x341);
+        let x351 = x340
+            + (Self::mul_add(-x312, x331, Self::mul_add(x8, x330, x309 * x329)) - x342);
+        let x352 = x343
+            + (Self::mul_add(-x313, x331, Self::mul_add(x9, x330, x310 * x329)) + x343);
+        let x353 = Self::mul_add(-qd[4], s_q1, x246);
+        let x354 = Self::mul_add(-qd[4], x8, x247);
+        let x355 = Self::mul_add(qd[4], x9, x248);
+        let x356 = Self::mul_add(-qd[4], x317, x249);
+        let x357 = Self::mul_add(qd[4], x318, x250);
+        let x358 = Self::mul_add(qd[4], x319, x251);
+        let x359 = Self::mul_add(x9, x354, x8 * x355);
+        let x360 = Self::mul_add(x9, x353, s_q1 * x355);
+        let x361 = Self::mul_add(-x8, x353, s_q1 * x354);
+        let x362 = Self::mul_add(x319, x354, x318 * x355)
+            + Self::mul_add(-x9, x357, x8 * x358);
+        let x363 = Self::mul_add(-x319, x353, x317 * x355)
+            - Self::mul_add(-x9, x356, s_q1 * x358);
+        let x364 = Self::mul_add(x318, x353, x317 * x354)
+            + Self::mul_add(-x8, x356, s_q1 * x357);
+        let x365 = Self::mul_add(-qd[4], x359, Self::mul_add(-qdd[4], s_q1, x261));
+        let x366 = Self::mul_add(qd[4], x360, Self::mul_add(-qdd[4], x8, x262));
+        let x367 = Self::mul_add(-qd[4], x361, Self::mul_add(qdd[4], x9, x263));
+        let x368 = Self::mul_add(qd[4], x362, Self::mul_add(-qdd[4], x317, x264));
+        let x369 = Self::mul_add(qd[4], x363, Self::mul_add(qdd[4], x318, x265));
+        let x370 = Self::mul_add(qd[4], x364, Self::mul_add(qdd[4], x319, x266));
+        let x371 = x255 + Self::mul_add(x247, x319, x248 * x318);
+        let x372 = x256 - Self::mul_add(-x246, x319, x248 * x317);
+        let x373 = x257 + Self::mul_add(x246, x318, x247 * x317);
+        let x374 = Self::mul_add(x9, x262, x8 * x263)
+            - Self::mul_add(x247, x254, x248 * x253);
+        let x375 = Self::mul_add(x9, x261, s_q1 * x263)
+            + Self::mul_add(-x246, x254, x248 * x252);
+        let x376 = Self::mul_add(-x8, x261, s_q1 * x262)
+            + Self::mul_add(x246, x253, x247 * x252);
+        let x377 = Self::mul_add(x262, x319, x263 * x318)
+            + Self::mul_add(-x9, x265, x8 * x266)
+            - (Self::mul_add(-x247, x373, x248 * x372)
+                + Self::mul_add(-x250, x254, x251 * x253));
+        let x378 = Self::mul_add(-x261, x319, x263 * x317)
+            - Self::mul_add(-x9, x264, s_q1 * x266)
+            - (Self::mul_add(x246, x373, x248 * x371)
+                + Self::mul_add(x249, x254, x251 * x252));
+        let x379 = Self::mul_add(x261, x318, x262 * x317)
+            + Self::mul_add(-x8, x264, s_q1 * x265)
+            - (Self::mul_add(x246, x372, x247 * x371)
+                - Self::mul_add(x249, x253, x250 * x252));
+        let x380 = x252 + x359;
+        let x381 = x253 + x360;
+        let x382 = x254 + x361;
+        let x383 = x362 + x371;
+        let x384 = x363 - x372;
+        let x385 = x364 + x373;
+        let x386 = x345 * x354;
+        let x387 = x346 * x355;
+        let x388 = x347 * x353;
+        let x389 = x349 * x355;
+        let x390 = x350 * x353;
+        let x391 = x351 * x354;
+        let x392 = x322 * x357;
+        let x393 = x321 * x358;
+        let x394 = x322 * x356;
+        let x395 = x320 * x358;
+        let x396 = x321 * x356;
+        let x397 = x320 * x357;
+        let x398 = Self::mul_add(x344, x353, x386) - x387 + (x392 - x393);
+        let x399 = Self::mul_add(-x348, x354, x388) + x389 + (x394 + x395);
+        let x400 = Self::mul_add(x352, x355, x390 - x391) + (x396 + x397);
+        let x401 = Self::mul_add(x321, x355, x322 * x354);
+        let x402 = Self::mul_add(-x320, x355, x322 * x353);
+        let x403 = Self::mul_add(x320, x354, x321 * x353);
+        let x404 = Self::mul_add(x321, x367, x322 * x366)
+            - Self::mul_add(-x354, x403, x355 * x402);
+        let x405 = Self::mul_add(-x320, x367, x322 * x365)
+            + Self::mul_add(x353, x403, x355 * x401);
+        let x406 = Self::mul_add(x320, x366, x321 * x365)
+            - Self::mul_add(x353, x402, x354 * x401);
+        let x407 = Self::mul_add(-x350, x354, x347 * x355);
+        let x408 = Self::mul_add(-x351, x353, x345 * x355);
+        let x409 = Self::mul_add(-x349, x353, x346 * x354);
+        let x410 = x320 * x356;
+        let x411 = x321 * x357;
+        let x412 = x322 * x358;
+        let x413 = x410 - x411 - x412;
+        let x414 = x413 + x413;
+        let x415 = Self::mul_add(-s_q1, s_q5, x308 * c_q5);
+        let x416 = Self::mul_add(x8, s_q5, x309 * c_q5);
+        let x417 = Self::mul_add(x9, s_q5, x310 * c_q5);
+        let x418 = Self::mul_add(s_q1, c_q5, x308 * s_q5);
+        let x419 = Self::mul_add(-x8, c_q5, x309 * s_q5);
+        let x420 = Self::mul_add(-x9, c_q5, x310 * s_q5);
+        let x421 = 44.41 * x418;
+        let x422 = 47.471 * x311;
+        let x423 = 44.41 * x419;
+        let x424 = 47.471 * x312;
+        let x425 = 44.41 * x420;
+        let x426 = 47.471 * x313;
+        let x427 = Self::mul_add(x311, x422, x418 * x421);
+        let x428 = Self::mul_add(x312, x422, x419 * x421);
+        let x429 = Self::mul_add(x313, x422, x420 * x421);
+        let x430 = Self::mul_add(x311, x424, x418 * x423);
+        let x431 = Self::mul_add(x312, x424, x419 * x423);
+        let x432 = Self::mul_add(x313, x424, x420 * x423);
+        let x433 = Self::mul_add(x311, x426, x418 * x425);
+        let x434 = Self::mul_add(x312, x426, x419 * x425);
+        let x435 = Self::mul_add(x313, x426, x420 * x425);
+        let x436 = Self::mul_add(qd[5], x311, x353);
+        let x437 = Self::mul_add(-qd[5], x312, x354);
+        let x438 = Self::mul_add(qd[5], x313, x355);
+        let x439 = Self::mul_add(x313, x437, x312 * x438);
+        let x440 = Self::mul_add(-x313, x436, x311 * x438);
+        let x441 = Self::mul_add(x312, x436, x311 * x437);
+        let x442 = Self::mul_add(-qd[5], x439, Self::mul_add(qdd[5], x311, x365));
+        let x443 = Self::mul_add(-qd[5], x440, Self::mul_add(-qdd[5], x312, x366));
+        let x444 = Self::mul_add(qd[5], x441, Self::mul_add(qdd[5], x313, x367));
+        let x445 = Self::mul_add(x313, x354, x312 * x355);
+        let x446 = Self::mul_add(-x313, x353, x311 * x355);
+        let x447 = Self::mul_add(x312, x353, x311 * x354);
+        let x448 = Self::mul_add(x313, x366, x312 * x367)
+            + Self::mul_add(x354, x447, x355 * x446);
+        let x449 = Self::mul_add(-x313, x365, x311 * x367)
+            - Self::mul_add(x353, x447, x355 * x445);
+        let x450 = Self::mul_add(x312, x365, x311 * x366)
+            - Self::mul_add(-x353, x446, x354 * x445);
+        let x451 = x439 + x445;
+        let x452 = x440 + x446;
+        let x453 = x441 + x447;
+        let x454 = x428 * x437;
+        let x455 = x429 * x438;
+        let x456 = Self::mul_add(x427, x436, -x454) + x455;
+        let x457 = x430 * x436;
+        let x458 = x432 * x438;
+        let x459 = Self::mul_add(-x431, x437, x457) + x458;
+        let x460 = x433 * x436;
+        let x461 = x434 * x437;
+        let x462 = Self::mul_add(x435, x438, x460 - x461);
+        let x463 = Self::mul_add(x433, x437, x430 * x438);
+        let x464 = Self::mul_add(-x434, x436, x428 * x438);
+        let x465 = Self::mul_add(x432, x436, x429 * x437);
+        let x466 = 9.336 * x415;
+        let x467 = 9.336 * x416;
+        let x468 = 9.336 * x417;
+        let x469 = x415 * x466;
+        let x470 = x416 * x466;
+        let x471 = x417 * x466;
+        let x472 = x415 * x467;
+        let x473 = x416 * x467;
+        let x474 = x417 * x467;
+        let x475 = x415 * x468;
+        let x476 = x416 * x468;
+        let x477 = x417 * x468;
+        let x478 = Self::mul_add(qd[6], x415, x436);
+        let x479 = Self::mul_add(-qd[6], x416, x437);
+        let x480 = Self::mul_add(qd[6], x417, x438);
+        let x481 = Self::mul_add(x417, x479, x416 * x480);
+        let x482 = Self::mul_add(-x417, x478, x415 * x480);
+        let x483 = Self::mul_add(x416, x478, x415 * x479);
+        let x484 = Self::mul_add(-qd[6], x481, Self::mul_add(qdd[6], x415, x442));
+        let x485 = Self::mul_add(-qd[6], x482, Self::mul_add(-qdd[6], x416, x443));
+        let x486 = Self::mul_add(qd[6], x483, Self::mul_add(qdd[6], x417, x444));
+        let x487 = Self::mul_add(x417, x437, x416 * x438);
+        let x488 = Self::mul_add(-x417, x436, x415 * x438);
+        let x489 = Self::mul_add(x416, x436, x415 * x437);
+        let x490 = Self::mul_add(x417, x443, x416 * x444)
+            + Self::mul_add(x437, x489, x438 * x488);
+        let x491 = Self::mul_add(-x417, x442, x415 * x444)
+            - Self::mul_add(x436, x489, x438 * x487);
+        let x492 = Self::mul_add(x416, x442, x415 * x443)
+            - Self::mul_add(-x436, x488, x437 * x487);
+        let x493 = x481 + x487;
+        let x494 = x482 + x488;
+        let x495 = x483 + x489;
+        let x496 = x470 * x479;
+        let x497 = x471 * x480;
+        let x498 = Self::mul_add(x469, x478, -x496) + x497;
+        let x499 = x472 * x478;
+        let x500 = x474 * x480;
+        let x501 = Self::mul_add(-x473, x479, x499) + x500;
+        let x502 = x475 * x478;
+        let x503 = x476 * x479;
+        let x504 = Self::mul_add(x477, x480, x502 - x503);
+        let x505 = Self::mul_add(x471, x486, Self::mul_add(-x470, x485, x469 * x484))
+            - Self::mul_add(x479, x504, x480 * x501);
+        let x506 = Self::mul_add(x474, x486, Self::mul_add(-x473, x485, x472 * x484))
+            + Self::mul_add(-x478, x504, x480 * x498);
+        let x507 = Self::mul_add(x477, x486, Self::mul_add(-x476, x485, x475 * x484))
+            + Self::mul_add(x478, x501, x479 * x498);
+        let x508 = Self::mul_add(x475, x479, x472 * x480);
+        let x509 = Self::mul_add(-x476, x478, x470 * x480);
+        let x510 = Self::mul_add(x474, x478, x471 * x479);
+        let x511 = x508 + x508;
+        let x512 = Self::mul_add(-x469, x480, x502) + Self::mul_add(x473, x480, x503);
+        let x513 = Self::mul_add(x469, x479, x499) - Self::mul_add(x477, x479, x500);
+        let x514 = x509 + x509;
+        let x515 = Self::mul_add(x473, x478, x496) + Self::mul_add(-x477, x478, x497);
+        let x516 = x510 + x510;
+        let x517 = Self::mul_add(x417, x471, Self::mul_add(x416, x470, x415 * x469));
+        let x518 = Self::mul_add(x417, x474, Self::mul_add(x416, x473, x415 * x472));
+        let x519 = Self::mul_add(x417, x477, Self::mul_add(x416, x476, x415 * x475));
+        let x520 = Self::mul_add(-x417, x513, Self::mul_add(x416, x512, x415 * x511));
+        let x521 = Self::mul_add(-x417, x515, Self::mul_add(-x416, x514, x415 * x512));
+        let x522 = Self::mul_add(x417, x516, Self::mul_add(x416, x515, x415 * x513));
+        let x523 = Self::mul_add(-x416, x504, x417 * x501);
+        let x524 = Self::mul_add(-x415, x504, x417 * x498);
+        let x525 = Self::mul_add(-x415, x501, x416 * x498);
+        let x526 = x520 - x523;
+        let x527 = -x526;
+        let x528 = x521 + x524;
+        let x529 = x522 + x525;
+        let x530 = Self::mul_add(-x416, x507, x417 * x506)
+            + Self::mul_add(-x471, x492, Self::mul_add(-x470, x491, x469 * x490))
+            + (Self::mul_add(-x488, x504, x489 * x501)
+                - Self::mul_add(x489, x513, Self::mul_add(-x488, x512, x487 * x511)));
+        let x531 = -x530;
+        let x532 = Self::mul_add(-x415, x507, x417 * x505)
+            - Self::mul_add(-x474, x492, Self::mul_add(-x473, x491, x472 * x490))
+            + (Self::mul_add(x487, x504, x489 * x498)
+                + Self::mul_add(x489, x515, Self::mul_add(x488, x514, x487 * x512)));
+        let x533 = Self::mul_add(-x415, x506, x416 * x505)
+            + Self::mul_add(-x477, x492, Self::mul_add(-x476, x491, x475 * x490))
+            + (Self::mul_add(x487, x501, x488 * x498)
+                + Self::mul_add(-x489, x516, Self::mul_add(-x488, x515, x487 * x513)));
+        let x534 = Self::mul_add(-x471, x495, Self::mul_add(-x470, x494, x469 * x493))
+            + (x520 + x523);
+        let x535 = -x534;
+        let x536 = Self::mul_add(-x474, x495, Self::mul_add(-x473, x494, x472 * x493))
+            + (x521 - x524);
+        let x537 = Self::mul_add(-x477, x495, Self::mul_add(-x476, x494, x475 * x493))
+            - (x522 - x525);
+        let x538 = -Self::mul_add(c_q0, x533, s_q0 * x532);
+        let x539 = Self::mul_add(-c_q0, x537, s_q0 * x536);
+        let x540 = Self::mul_add(-x9, x533, Self::mul_add(x8, x532, s_q1 * x530));
+        let x541 = Self::mul_add(-x9, x537, Self::mul_add(-x8, x536, s_q1 * x534));
+        let x542 = -Self::mul_add(x313, x533, Self::mul_add(-x312, x532, x311 * x530));
+        let x543 = -Self::mul_add(x313, x537, Self::mul_add(x312, x536, x311 * x534));
+        let x544 = -(Self::mul_add(-x492, x519, Self::mul_add(-x491, x518, x490 * x517))
+            - Self::mul_add(x489, x529, Self::mul_add(-x488, x528, x487 * x526)));
+        let x545 = -(Self::mul_add(-x495, x519, Self::mul_add(-x494, x518, x493 * x517))
+            + Self::mul_add(-x417, x529, Self::mul_add(x416, x528, x415 * x526)));
+        let x546 = x427 + x469;
+        let x547 = x428 + x470;
+        let x548 = x429 + x471;
+        let x549 = x430 + x472;
+        let x550 = x431 + x473;
+        let x551 = x432 + x474;
+        let x552 = x433 + x475;
+        let x553 = x434 + x476;
+        let x554 = x435 + x477;
+        let x555 = x456 + x498;
+        let x556 = x459 + x501;
+        let x557 = x462 + x504;
+        let x558 = x463 + x463 + x511;
+        let x559 = Self::mul_add(-x427, x438, x460) + Self::mul_add(x431, x438, x461)
+            + x512;
+        let x560 = Self::mul_add(x427, x437, x457) - Self::mul_add(x435, x437, x458)
+            + x513;
+        let x561 = x464 + x464 + x514;
+        let x562 = Self::mul_add(x431, x436, x454) + Self::mul_add(-x435, x436, x455)
+            + x515;
+        let x563 = x465 + x465 + x516;
+        let x564 = Self::mul_add(x429, x444, Self::mul_add(-x428, x443, x427 * x442))
+            - Self::mul_add(x437, x462, x438 * x459) + x505;
+        let x565 = Self::mul_add(x432, x444, Self::mul_add(-x431, x443, x430 * x442))
+            + Self::mul_add(-x436, x462, x438 * x456) + x506;
+        let x566 = Self::mul_add(x435, x444, Self::mul_add(-x434, x443, x433 * x442))
+            + Self::mul_add(x436, x459, x437 * x456) + x507;
+        let x567 = Self::mul_add(x313, x548, Self::mul_add(x312, x547, x311 * x546));
+        let x568 = Self::mul_add(x313, x551, Self::mul_add(x312, x550, x311 * x549));
+        let x569 = Self::mul_add(x313, x554, Self::mul_add(x312, x553, x311 * x552));
+        let x570 = Self::mul_add(-x313, x560, Self::mul_add(x312, x559, x311 * x558));
+        let x571 = Self::mul_add(-x313, x562, Self::mul_add(-x312, x561, x311 * x559));
+        let x572 = Self::mul_add(x313, x563, Self::mul_add(x312, x562, x311 * x560));
+        let x573 = Self::mul_add(-x312, x557, x313 * x556);
+        let x574 = Self::mul_add(-x311, x557, x313 * x555);
+        let x575 = Self::mul_add(-x311, x556, x312 * x555);
+        let x576 = x570 - x573;
+        let x577 = -x576;
+        let x578 = x571 + x574;
+        let x579 = x572 + x575;
+        let x580 = Self::mul_add(-x312, x566, x313 * x565)
+            + Self::mul_add(-x450, x548, Self::mul_add(-x449, x547, x448 * x546))
+            + (Self::mul_add(-x446, x557, x447 * x556)
+                - Self::mul_add(x447, x560, Self::mul_add(-x446, x559, x445 * x558)));
+        let x581 = -x580;
+        let x582 = Self::mul_add(-x311, x566, x313 * x564)
+            - Self::mul_add(-x450, x551, Self::mul_add(-x449, x550, x448 * x549))
+            + (Self::mul_add(x445, x557, x447 * x555)
+                + Self::mul_add(x447, x562, Self::mul_add(x446, x561, x445 * x559)));
+        let x583 = Self::mul_add(-x311, x565, x312 * x564)
+            + Self::mul_add(-x450, x554, Self::mul_add(-x449, x553, x448 * x552))
+            + (Self::mul_add(x445, x556, x446 * x555)
+                + Self::mul_add(-x447, x563, Self::mul_add(-x446, x562, x445 * x560)));
+        let x584 = Self::mul_add(-x453, x548, Self::mul_add(-x452, x547, x451 * x546))
+            + (x570 + x573);
+        let x585 = -x584;
+        let x586 = Self::mul_add(-x453, x551, Self::mul_add(-x452, x550, x451 * x549))
+            + (x571 - x574);
+        let x587 = Self::mul_add(-x453, x554, Self::mul_add(-x452, x553, x451 * x552))
+            - (x572 - x575);
+        let x588 = -Self::mul_add(c_q0, x583, s_q0 * x582);
+        let x589 = Self::mul_add(-c_q0, x587, s_q0 * x586);
+        let x590 = Self::mul_add(-x9, x583, Self::mul_add(x8, x582, s_q1 * x580));
+        let x591 = Self::mul_add(-x9, x587, Self::mul_add(-x8, x586, s_q1 * x584));
+        let x592 = -(Self::mul_add(-x450, x569, Self::mul_add(-x449, x568, x448 * x567))
+            - Self::mul_add(x447, x579, Self::mul_add(-x446, x578, x445 * x576)));
+        let x593 = -(Self::mul_add(-x453, x569, Self::mul_add(-x452, x568, x451 * x567))
+            + Self::mul_add(-x313, x579, Self::mul_add(x312, x578, x311 * x576)));
+        let x594 = -(Self::mul_add(-x450, x519, Self::mul_add(-x449, x518, x448 * x517))
+            - Self::mul_add(x447, x529, Self::mul_add(-x446, x528, x445 * x526)));
+        let x595 = -(Self::mul_add(-x453, x519, Self::mul_add(-x452, x518, x451 * x517))
+            + Self::mul_add(-x313, x529, Self::mul_add(x312, x528, x311 * x526)));
+        let x596 = x344 - x546;
+        let x597 = x345 + x547;
+        let x598 = x346 + x548;
+        let x599 = x347 - x549;
+        let x600 = x348 - x550;
+        let x601 = x349 - x551;
+        let x602 = x350 + x552;
+        let x603 = x351 + x553;
+        let x604 = x352 + x554;
+        let x605 = x398 - x555;
+        let x606 = x399 - x556;
+        let x607 = x400 + x557;
+        let x608 = x414 - (x410 + (x410 + (x407 + x407))) + x558;
+        let x609 = x397
+            - (x396
+                - (Self::mul_add(x344, x355, x390) + Self::mul_add(-x348, x355, x391)))
+            + x559;
+        let x610 = x395
+            - (x394
+                - (Self::mul_add(x344, x354, x388) - Self::mul_add(-x352, x354, x389)))
+            - x560;
+        let x611 = x414 + (x411 + (x411 - (x408 + x408))) - x561;
+        let x612 = x393
+            + (x392
+                - (Self::mul_add(-x348, x353, x386) + Self::mul_add(-x352, x353, x387)))
+            - x562;
+        let x613 = x414 + (x412 + (x412 - (x409 + x409))) - x563;
+        let x614 = Self::mul_add(-x346, x367, Self::mul_add(x345, x366, x344 * x365))
+            + Self::mul_add(-x321, x370, x322 * x369)
+            - (Self::mul_add(-x354, x400, x355 * x399)
+                + Self::mul_add(x357, x403, x358 * x402)) - x564;
+        let x615 = Self::mul_add(x349, x367, Self::mul_add(-x348, x366, x347 * x365))
+            + Self::mul_add(x320, x370, x322 * x368)
+            + (Self::mul_add(x353, x400, x355 * x398)
+                + Self::mul_add(-x356, x403, x358 * x401)) - x565;
+        let x616 = Self::mul_add(x352, x367, Self::mul_add(-x351, x366, x350 * x365))
+            + Self::mul_add(x320, x369, x321 * x368)
+            - (Self::mul_add(x353, x399, x354 * x398)
+                - Self::mul_add(x356, x402, x357 * x401)) + x566;
+        let x617 = Self::mul_add(x9, x598, Self::mul_add(x8, x597, s_q1 * x596))
+            - Self::mul_add(-x319, x321, x318 * x322);
+        let x618 = Self::mul_add(-x9, x601, Self::mul_add(-x8, x600, s_q1 * x599))
+            + Self::mul_add(-x319, x320, x317 * x322);
+        let x619 = Self::mul_add(-x9, x604, Self::mul_add(-x8, x603, s_q1 * x602))
+            + Self::mul_add(-x318, x320, x317 * x321);
+        let x620 = Self::mul_add(-x9, x321, x8 * x322);
+        let x621 = Self::mul_add(x9, x320, s_q1 * x322);
+        let x622 = Self::mul_add(x8, x320, s_q1 * x321);
+        let x623 = Self::mul_add(x319, x402, x318 * x403);
+        let x624 = Self::mul_add(x319, x401, x317 * x403);
+        let x625 = Self::mul_add(-x318, x401, x317 * x402);
+        let x626 = Self::mul_add(-x9, x610, Self::mul_add(-x8, x609, s_q1 * x608))
+            - x623;
+        let x627 = Self::mul_add(-x9, x612, Self::mul_add(-x8, x611, s_q1 * x609))
+            + x624;
+        let x628 = Self::mul_add(-x9, x613, Self::mul_add(-x8, x612, s_q1 * x610))
+            + x625;
+        let x629 = Self::mul_add(x9, x402, x8 * x403);
+        let x630 = Self::mul_add(-x9, x401, s_q1 * x403);
+        let x631 = Self::mul_add(x8, x401, s_q1 * x402);
+        let x632 = x623 + Self::mul_add(x8, x607, x9 * x606);
+        let x633 = x624 + Self::mul_add(-s_q1, x607, x9 * x605);
+        let x634 = x625 - Self::mul_add(s_q1, x606, x8 * x605);
+        let x635 = x626 - x632;
+        let x636 = x627 + x633;
+        let x637 = x628 + x634;
+        let x638 = Self::mul_add(-x372, x403, x373 * x402);
+        let x639 = Self::mul_add(-x371, x403, x373 * x401);
+        let x640 = Self::mul_add(-x371, x402, x372 * x401);
+        let x641 = Self::mul_add(x253, x403, x254 * x402);
+        let x642 = Self::mul_add(x252, x403, x254 * x401);
+        let x643 = Self::mul_add(-x252, x402, x253 * x401);
+        let x644 = Self::mul_add(x8, x616, x9 * x615)
+            + Self::mul_add(x318, x406, x319 * x405)
+            + (Self::mul_add(-x376, x598, Self::mul_add(-x375, x597, x374 * x596))
+                - Self::mul_add(-x321, x379, x322 * x378))
+            - (Self::mul_add(x253, x607, x254 * x606) - x638
+                + (x638
+                    - Self::mul_add(
+                        x254,
+                        x610,
+                        Self::mul_add(x253, x609, x252 * x608),
+                    )));
+        let x645 = Self::mul_add(-s_q1, x616, x9 * x614)
+            + Self::mul_add(x317, x406, x319 * x404)
+            - (Self::mul_add(x376, x601, Self::mul_add(x375, x600, x374 * x599))
+                - Self::mul_add(x320, x379, x322 * x377))
+            - (Self::mul_add(x252, x607, x254 * x605) - x639
+                + (x639
+                    + Self::mul_add(
+                        x254,
+                        x612,
+                        Self::mul_add(x253, x611, x252 * x609),
+                    )));
+        let x646 = Self::mul_add(s_q1, x615, x8 * x614)
+            + Self::mul_add(-x317, x405, x318 * x404)
+            - (Self::mul_add(x376, x604, Self::mul_add(x375, x603, x374 * x602))
+                - Self::mul_add(x320, x378, x321 * x377))
+            - (Self::mul_add(-x252, x606, x253 * x605) + x640
+                - (x640
+                    + Self::mul_add(
+                        x254,
+                        x613,
+                        Self::mul_add(x253, x612, x252 * x610),
+                    )));
+        let x647 = Self::mul_add(x8, x406, x9 * x405)
+            - Self::mul_add(-x321, x376, x322 * x375) - (x641 + x641);
+        let x648 = Self::mul_add(-s_q1, x406, x9 * x404)
+            - Self::mul_add(-x320, x376, x322 * x374) - (x642 + x642);
+        let x649 = Self::mul_add(s_q1, x405, x8 * x404)
+            - Self::mul_add(-x320, x375, x321 * x374) - (x643 + x643);
+        let x650 = Self::mul_add(-x382, x598, Self::mul_add(-x381, x597, x380 * x596))
+            - Self::mul_add(-x321, x385, x322 * x384) + (x626 + x632);
+        let x651 = Self::mul_add(x382, x601, Self::mul_add(x381, x600, x380 * x599))
+            - Self::mul_add(x320, x385, x322 * x383) + (x627 - x633);
+        let x652 = Self::mul_add(x382, x604, Self::mul_add(x381, x603, x380 * x602))
+            - Self::mul_add(x320, x384, x321 * x383) - (x628 - x634);
+        let x653 = Self::mul_add(-x321, x382, x322 * x381) - (x629 + x629);
+        let x654 = Self::mul_add(-x320, x382, x322 * x380) + (x630 + x630);
+        let x655 = Self::mul_add(-x320, x381, x321 * x380) - (x631 + x631);
+        let x656 = Self::mul_add(c_q0, x646, s_q0 * x645)
+            - Self::mul_add(-x14, x649, Self::mul_add(x13, x648, x12 * x647));
+        let x657 = -(Self::mul_add(c_q0, x652, s_q0 * x651)
+            - Self::mul_add(-x14, x655, Self::mul_add(x13, x654, x12 * x653)));
+        let x658 = Self::mul_add(-x9, x646, Self::mul_add(x8, x645, s_q1 * x644));
+        let x659 = -(x658
+            - Self::mul_add(x108, x649, Self::mul_add(-x107, x648, x106 * x647)));
+        let x660 = Self::mul_add(x9, x652, Self::mul_add(-x8, x651, s_q1 * x650));
+        let x661 = -(x660
+            + Self::mul_add(x108, x655, Self::mul_add(-x107, x654, x106 * x653)));
+        let x662 = -(x658
+            - Self::mul_add(x215, x649, Self::mul_add(-x214, x648, x213 * x647)));
+        let x663 = -(x660
+            + Self::mul_add(x215, x655, Self::mul_add(-x214, x654, x213 * x653)));
+        let x664 = -(Self::mul_add(-x376, x619, Self::mul_add(x375, x618, x374 * x617))
+            + Self::mul_add(x379, x622, Self::mul_add(-x378, x621, x377 * x620))
+            + Self::mul_add(x254, x637, Self::mul_add(x253, x636, x252 * x635)));
+        let x665 = Self::mul_add(-x9, x637, Self::mul_add(-x8, x636, s_q1 * x635));
+        let x666 = -(Self::mul_add(-x382, x619, Self::mul_add(x381, x618, x380 * x617))
+            + Self::mul_add(x385, x622, Self::mul_add(-x384, x621, x383 * x620)) + x665);
+        let x667 = -(Self::mul_add(x376, x569, Self::mul_add(x375, x568, x374 * x567))
+            - Self::mul_add(-x254, x579, Self::mul_add(x253, x578, x252 * x576)));
+        let x668 = Self::mul_add(x9, x579, Self::mul_add(-x8, x578, s_q1 * x576));
+        let x669 = -(Self::mul_add(x382, x569, Self::mul_add(x381, x568, x380 * x567))
+            - x668);
+        let x670 = -(Self::mul_add(x376, x519, Self::mul_add(x375, x518, x374 * x517))
+            - Self::mul_add(-x254, x529, Self::mul_add(x253, x528, x252 * x526)));
+        let x671 = Self::mul_add(x9, x529, Self::mul_add(-x8, x528, s_q1 * x526));
+        let x672 = -(Self::mul_add(x382, x519, Self::mul_add(x381, x518, x380 * x517))
+            - x671);
+        let x673 = x216 - x320;
+        let x674 = x217 - x321;
+        let x675 = x218 - x322;
+        let x676 = x237 - x596;
+        let x677 = x238 - x597;
+        let x678 = x239 - x598;
+        let x679 = x240 - x599;
+        let x680 = x241 - x600;
+        let x681 = x242 - x601;
+        let x682 = x243 - x602;
+        let x683 = x244 - x603;
+        let x684 = x245 - x604;
+        let x685 = x294 - x605;
+        let x686 = x295 - x606;
+        let x687 = x296 - x607;
+        let x688 = x297 - x401;
+        let x689 = x298 - x402;
+        let x690 = x299 - x403;
+        let x691 = x307 - (x303 + (x303 + (x300 + x300))) - x608;
+        let x692 = x293
+            - (x292
+                - (Self::mul_add(x237, x248, x286) + Self::mul_add(-x241, x248, x287)))
+            - x609;
+        let x693 = x291
+            - (x290
+                - (Self::mul_add(x237, x247, x284) - Self::mul_add(-x245, x247, x285)))
+            - x610;
+        let x694 = x307 + (x304 + (x304 - (x301 + x301))) - x611;
+        let x695 = x289
+            + (x288
+                - (Self::mul_add(-x241, x246, x282) + Self::mul_add(-x245, x246, x283)))
+            - x612;
+        let x696 = x307 + (x305 + (x305 - (x302 + x302))) - x613;
+        let x697 = Self::mul_add(-x239, x263, Self::mul_add(x238, x262, x237 * x261))
+            + Self::mul_add(-x217, x266, x218 * x265)
+            - (Self::mul_add(-x247, x296, x248 * x295)
+                + Self::mul_add(x250, x299, x251 * x298)) - x614;
+        let x698 = Self::mul_add(x242, x263, Self::mul_add(-x241, x262, x240 * x261))
+            + Self::mul_add(x216, x266, x218 * x264)
+            + (Self::mul_add(x246, x296, x248 * x294)
+                + Self::mul_add(-x249, x299, x251 * x297)) - x615;
+        let x699 = Self::mul_add(x245, x263, Self::mul_add(-x244, x262, x243 * x261))
+            + Self::mul_add(x216, x265, x217 * x264)
+            - (Self::mul_add(x246, x295, x247 * x294)
+                - Self::mul_add(x249, x298, x250 * x297)) - x616;
+        let x700 = Self::mul_add(x217, x263, x218 * x262)
+            - Self::mul_add(-x247, x299, x248 * x298) - x404;
+        let x701 = Self::mul_add(-x216, x263, x218 * x261)
+            + Self::mul_add(x246, x299, x248 * x297) - x405;
+        let x702 = Self::mul_add(x216, x262, x217 * x261)
+            - Self::mul_add(x246, x298, x247 * x297) - x406;
+        let x703 = Self::mul_add(x9, x678, Self::mul_add(x8, x677, s_q1 * x676))
+            - Self::mul_add(-x215, x674, x214 * x675);
+        let x704 = Self::mul_add(-x9, x681, Self::mul_add(-x8, x680, s_q1 * x679))
+            + Self::mul_add(-x215, x673, x213 * x675);
+        let x705 = Self::mul_add(-x9, x684, Self::mul_add(-x8, x683, s_q1 * x682))
+            + Self::mul_add(-x214, x673, x213 * x674);
+        let x706 = Self::mul_add(-x9, x674, x8 * x675);
+        let x707 = Self::mul_add(x9, x673, s_q1 * x675);
+        let x708 = Self::mul_add(x8, x673, s_q1 * x674);
+        let x709 = Self::mul_add(x215, x689, x214 * x690);
+        let x710 = Self::mul_add(x215, x688, x213 * x690);
+        let x711 = Self::mul_add(-x214, x688, x213 * x689);
+        let x712 = Self::mul_add(-x9, x693, Self::mul_add(-x8, x692, s_q1 * x691))
+            - x709;
+        let x713 = Self::mul_add(-x9, x695, Self::mul_add(-x8, x694, s_q1 * x692))
+            + x710;
+        let x714 = Self::mul_add(-x9, x696, Self::mul_add(-x8, x695, s_q1 * x693))
+            + x711;
+        let x715 = Self::mul_add(x9, x689, x8 * x690);
+        let x716 = Self::mul_add(-x9, x688, s_q1 * x690);
+        let x717 = Self::mul_add(x8, x688, s_q1 * x689);
+        let x718 = x709 + Self::mul_add(x8, x687, x9 * x686);
+        let x719 = x710 + Self::mul_add(-s_q1, x687, x9 * x685);
+        let x720 = x711 - Self::mul_add(s_q1, x686, x8 * x685);
+        let x721 = x712 - x718;
+        let x722 = -x721;
+        let x723 = x713 + x719;
+        let x724 = x714 + x720;
+        let x725 = Self::mul_add(-x268, x690, x269 * x689);
+        let x726 = Self::mul_add(-x267, x690, x269 * x688);
+        let x727 = Self::mul_add(-x267, x689, x268 * x688);
+        let x728 = Self::mul_add(x146, x690, x147 * x689);
+        let x729 = Self::mul_add(x145, x690, x147 * x688);
+        let x730 = Self::mul_add(-x145, x689, x146 * x688);
+        let x731 = Self::mul_add(x8, x699, x9 * x698)
+            + Self::mul_add(x214, x702, x215 * x701)
+            + (Self::mul_add(-x272, x678, Self::mul_add(-x271, x677, x270 * x676))
+                - Self::mul_add(-x275, x674, x274 * x675))
+            - (Self::mul_add(x146, x687, x147 * x686) - x725
+                + (x725
+                    - Self::mul_add(
+                        x147,
+                        x693,
+                        Self::mul_add(x146, x692, x145 * x691),
+                    )));
+        let x732 = -x731;
+        let x733 = Self::mul_add(-s_q1, x699, x9 * x697)
+            + Self::mul_add(x213, x702, x215 * x700)
+            - (Self::mul_add(x272, x681, Self::mul_add(x271, x680, x270 * x679))
+                - Self::mul_add(x275, x673, x273 * x675))
+            - (Self::mul_add(x145, x687, x147 * x685) - x726
+                + (x726
+                    + Self::mul_add(
+                        x147,
+                        x695,
+                        Self::mul_add(x146, x694, x145 * x692),
+                    )));
+        let x734 = Self::mul_add(s_q1, x698, x8 * x697)
+            + Self::mul_add(-x213, x701, x214 * x700)
+            - (Self::mul_add(x272, x684, Self::mul_add(x271, x683, x270 * x682))
+                - Self::mul_add(x274, x673, x273 * x674))
+            - (Self::mul_add(-x145, x686, x146 * x685) + x727
+                - (x727
+                    + Self::mul_add(
+                        x147,
+                        x696,
+                        Self::mul_add(x146, x695, x145 * x693),
+                    )));
+        let x735 = Self::mul_add(x8, x702, x9 * x701)
+            - Self::mul_add(-x272, x674, x271 * x675) - (x728 + x728);
+        let x736 = Self::mul_add(-s_q1, x702, x9 * x700)
+            - Self::mul_add(-x272, x673, x270 * x675) - (x729 + x729);
+        let x737 = Self::mul_add(s_q1, x701, x8 * x700)
+            - Self::mul_add(-x271, x673, x270 * x674) - (x730 + x730);
+        let x738 = Self::mul_add(-x278, x678, Self::mul_add(-x277, x677, x276 * x676))
+            - Self::mul_add(-x281, x674, x280 * x675) + (x712 + x718);
+        let x739 = -x738;
+        let x740 = Self::mul_add(x278, x681, Self::mul_add(x277, x680, x276 * x679))
+            - Self::mul_add(x281, x673, x279 * x675) + (x713 - x719);
+        let x741 = Self::mul_add(x278, x684, Self::mul_add(x277, x683, x276 * x682))
+            - Self::mul_add(x280, x673, x279 * x674) - (x714 - x720);
+        let x742 = Self::mul_add(-x278, x674, x277 * x675) - (x715 + x715);
+        let x743 = Self::mul_add(-x278, x673, x276 * x675) + (x716 + x716);
+        let x744 = Self::mul_add(-x277, x673, x276 * x674) - (x717 + x717);
+        let x745 = -(Self::mul_add(c_q0, x734, s_q0 * x733)
+            - Self::mul_add(-x14, x737, Self::mul_add(x13, x736, x12 * x735)));
+        let x746 = Self::mul_add(c_q0, x741, s_q0 * x740)
+            - Self::mul_add(-x14, x744, Self::mul_add(x13, x743, x12 * x742));
+        let x747 = Self::mul_add(-x9, x734, Self::mul_add(x8, x733, s_q1 * x731))
+            - Self::mul_add(x108, x737, Self::mul_add(-x107, x736, x106 * x735));
+        let x748 = Self::mul_add(x9, x741, Self::mul_add(-x8, x740, s_q1 * x738))
+            + Self::mul_add(x108, x744, Self::mul_add(-x107, x743, x106 * x742));
+        let x749 = Self::mul_add(-x272, x705, Self::mul_add(x271, x704, x270 * x703))
+            + Self::mul_add(x275, x708, Self::mul_add(-x274, x707, x273 * x706))
+            + Self::mul_add(x147, x724, Self::mul_add(x146, x723, x145 * x721));
+        let x750 = Self::mul_add(-x9, x724, Self::mul_add(-x8, x723, s_q1 * x721));
+        let x751 = Self::mul_add(-x278, x705, Self::mul_add(x277, x704, x276 * x703))
+            + Self::mul_add(x281, x708, Self::mul_add(-x280, x707, x279 * x706)) + x750;
+        let x752 = -(Self::mul_add(-x272, x619, Self::mul_add(x271, x618, x270 * x617))
+            + Self::mul_add(x275, x622, Self::mul_add(-x274, x621, x273 * x620))
+            + Self::mul_add(x147, x637, Self::mul_add(x146, x636, x145 * x635)));
+        let x753 = -(x665
+            + (Self::mul_add(-x278, x619, Self::mul_add(x277, x618, x276 * x617))
+                + Self::mul_add(x281, x622, Self::mul_add(-x280, x621, x279 * x620))));
+        let x754 = -(Self::mul_add(x272, x569, Self::mul_add(x271, x568, x270 * x567))
+            - Self::mul_add(-x147, x579, Self::mul_add(x146, x578, x145 * x576)));
+        let x755 = x668
+            - Self::mul_add(x278, x569, Self::mul_add(x277, x568, x276 * x567));
+        let x756 = -(Self::mul_add(x272, x519, Self::mul_add(x271, x518, x270 * x517))
+            - Self::mul_add(-x147, x529, Self::mul_add(x146, x528, x145 * x526)));
+        let x757 = x671
+            - Self::mul_add(x278, x519, Self::mul_add(x277, x518, x276 * x517));
+        let x758 = x109 + x673;
+        let x759 = x110 + x674;
+        let x760 = x111 + x675;
+        let x761 = x130 + x676;
+        let x762 = x131 + x677;
+        let x763 = x132 + x678;
+        let x764 = x133 + x679;
+        let x765 = x134 + x680;
+        let x766 = x135 + x681;
+        let x767 = x136 + x682;
+        let x768 = x137 + x683;
+        let x769 = x138 + x684;
+        let x770 = x190 + x685;
+        let x771 = x191 + x686;
+        let x772 = x192 + x687;
+        let x773 = x193 + x688;
+        let x774 = x194 + x689;
+        let x775 = x195 + x690;
+        let x776 = x203 - (x199 + (x199 + (x196 + x196))) + x691;
+        let x777 = x189
+            - (x188
+                - (Self::mul_add(x130, x141, x182) + Self::mul_add(-x134, x141, x183)))
+            + x692;
+        let x778 = x187
+            - (x186
+                - (Self::mul_add(x130, x140, x180) - Self::mul_add(-x138, x140, x181)))
+            + x693;
+        let x779 = x203 + (x200 + (x200 - (x197 + x197))) + x694;
+        let x780 = x185
+            + (x184
+                - (Self::mul_add(-x134, x139, x178) + Self::mul_add(-x138, x139, x179)))
+            + x695;
+        let x781 = x203 + (x201 + (x201 - (x198 + x198))) + x696;
+        let x782 = Self::mul_add(-x132, x156, Self::mul_add(x131, x155, x130 * x154))
+            + Self::mul_add(-x110, x159, x111 * x158)
+            - (Self::mul_add(-x140, x192, x141 * x191)
+                + Self::mul_add(x143, x195, x144 * x194)) + x697;
+        let x783 = Self::mul_add(x135, x156, Self::mul_add(-x134, x155, x133 * x154))
+            + Self::mul_add(x109, x159, x111 * x157)
+            + (Self::mul_add(x139, x192, x141 * x190)
+                + Self::mul_add(-x142, x195, x144 * x193)) + x698;
+        let x784 = Self::mul_add(x138, x156, Self::mul_add(-x137, x155, x136 * x154))
+            + Self::mul_add(x109, x158, x110 * x157)
+            - (Self::mul_add(x139, x191, x140 * x190)
+                - Self::mul_add(x142, x194, x143 * x193)) + x699;
+        let x785 = Self::mul_add(x110, x156, x111 * x155)
+            - Self::mul_add(-x140, x195, x141 * x194) + x700;
+        let x786 = Self::mul_add(-x109, x156, x111 * x154)
+            + Self::mul_add(x139, x195, x141 * x193) + x701;
+        let x787 = Self::mul_add(x109, x155, x110 * x154)
+            - Self::mul_add(x139, x194, x140 * x193) + x702;
+        let x788 = Self::mul_add(x9, x763, Self::mul_add(x8, x762, s_q1 * x761))
+            - Self::mul_add(-x108, x759, x107 * x760);
+        let x789 = Self::mul_add(-x9, x766, Self::mul_add(-x8, x765, s_q1 * x764))
+            + Self::mul_add(-x108, x758, x106 * x760);
+        let x790 = Self::mul_add(-x9, x769, Self::mul_add(-x8, x768, s_q1 * x767))
+            + Self::mul_add(-x107, x758, x106 * x759);
+        let x791 = Self::mul_add(-x9, x759, x8 * x760);
+        let x792 = Self::mul_add(x9, x758, s_q1 * x760);
+        let x793 = Self::mul_add(x8, x758, s_q1 * x759);
+        let x794 = Self::mul_add(x108, x774, x107 * x775);
+        let x795 = Self::mul_add(x108, x773, x106 * x775);
+        let x796 = Self::mul_add(-x107, x773, x106 * x774);
+        let x797 = Self::mul_add(-x9, x778, Self::mul_add(-x8, x777, s_q1 * x776))
+            - x794;
+        let x798 = Self::mul_add(-x9, x780, Self::mul_add(-x8, x779, s_q1 * x777))
+            + x795;
+        let x799 = Self::mul_add(-x9, x781, Self::mul_add(-x8, x780, s_q1 * x778))
+            + x796;
+        let x800 = Self::mul_add(x9, x774, x8 * x775);
+        let x801 = Self::mul_add(-x9, x773, s_q1 * x775);
+        let x802 = Self::mul_add(x8, x773, s_q1 * x774);
+        let x803 = x794 + Self::mul_add(x8, x772, x9 * x771);
+        let x804 = x795 + Self::mul_add(-s_q1, x772, x9 * x770);
+        let x805 = x796 - Self::mul_add(s_q1, x771, x8 * x770);
+        let x806 = x797 - x803;
+        let x807 = -x806;
+        let x808 = x798 + x804;
+        let x809 = x799 + x805;
+        let x810 = Self::mul_add(x164, x775, x165 * x774);
+        let x811 = Self::mul_add(-x163, x775, x165 * x773);
+        let x812 = Self::mul_add(x163, x774, x164 * x773);
+        let x813 = Self::mul_add(x161, x775, x162 * x774);
+        let x814 = Self::mul_add(x160, x775, x162 * x773);
+        let x815 = Self::mul_add(-x160, x774, x161 * x773);
+        let x816 = -(Self::mul_add(x8, x784, x9 * x783)
+            + Self::mul_add(x107, x787, x108 * x786)
+            + (Self::mul_add(-x168, x763, Self::mul_add(-x167, x762, x166 * x761))
+                - Self::mul_add(-x171, x759, x170 * x760))
+            - (Self::mul_add(x161, x772, x162 * x771) - x810
+                + (x810
+                    - Self::mul_add(
+                        x162,
+                        x778,
+                        Self::mul_add(x161, x777, x160 * x776),
+                    ))));
+        let x817 = -(Self::mul_add(-x174, x763, Self::mul_add(-x173, x762, x172 * x761))
+            - Self::mul_add(-x177, x759, x176 * x760) + (x797 + x803));
         let x818 = Self::mul_add(
-            -x299,
-            x781,
-            Self::mul_add(x163, x780, Self::mul_add(-x162, x779, x161 * x778)),
+            c_q0,
+            Self::mul_add(s_q1, x783, x8 * x782)
+                + Self::mul_add(-x106, x786, x107 * x785)
+                - (Self::mul_add(x168, x769, Self::mul_add(x167, x768, x166 * x767))
+                    - Self::mul_add(x170, x758, x169 * x759))
+                - (Self::mul_add(-x160, x771, x161 * x770) - x812
+                    + (x812
+                        - Self::mul_add(
+                            x162,
+                            x781,
+                            Self::mul_add(x161, x780, x160 * x778),
+                        ))),
+            s_q0
+                * (Self::mul_add(-s_q1, x784, x9 * x782)
+                    + Self::mul_add(x106, x787, x108 * x785)
+                    - (Self::mul_add(x168, x766, Self::mul_add(x167, x765, x166 * x764))
+                        - Self::mul_add(x171, x758, x169 * x760))
+                    - (Self::mul_add(x160, x772, x162 * x770) - x811
+                        + (x811
+                            + Self::mul_add(
+                                x162,
+                                x780,
+                                Self::mul_add(x161, x779, x160 * x777),
+                            )))),
         );
         let x819 = Self::mul_add(
-            x299,
-            x786,
-            Self::mul_add(-x163, x785, Self::mul_add(-x162, x784, x161 * x783)),
-        );
-        let x820 = Self::mul_add(x8, x796, x9 * x795)
-            + Self::mul_add(x246, x799, x247 * x798)
-            + (Self::mul_add(-x304, x766, Self::mul_add(-x303, x765, x302 * x764))
-                - Self::mul_add(-x307, x762, x306 * x763))
-            - Self::mul_add(x301, x777, x817);
-        let x821 = -x820;
-        let x822 = Self::mul_add(-s_q1, x796, x9 * x794)
-            + Self::mul_add(x245, x799, x247 * x797)
-            - (Self::mul_add(x304, x769, Self::mul_add(x303, x768, x302 * x767))
-                - Self::mul_add(x307, x761, x305 * x763))
-            - Self::mul_add(x301, x782, x818);
-        let x823 = Self::mul_add(s_q1, x795, x8 * x794)
-            + Self::mul_add(-x245, x798, x246 * x797)
-            - (Self::mul_add(x304, x772, Self::mul_add(x303, x771, x302 * x770))
-                - Self::mul_add(x306, x761, x305 * x762))
-            + Self::mul_add(x300, x787, x819);
-        let x824 = Self::mul_add(x8, x799, x9 * x798)
-            - Self::mul_add(-x304, x762, x303 * x763)
-            - Self::mul_add(x163, x789, x162 * x788);
-        let x825 = Self::mul_add(-s_q1, x799, x9 * x797)
-            - Self::mul_add(-x304, x761, x302 * x763)
-            - Self::mul_add(x163, x791, x161 * x790);
-        let x826 = Self::mul_add(s_q1, x798, x8 * x797)
-            - Self::mul_add(-x303, x761, x302 * x762)
-            - Self::mul_add(x162, x793, x161 * x792);
-        let x827 = Self::mul_add(
-            x246,
-            x776,
-            Self::mul_add(-x9, x775, Self::mul_add(-x8, x774, x806)),
-        );
-        let x828 = Self::mul_add(
-            x245,
-            x781,
-            Self::mul_add(-x9, x780, Self::mul_add(s_q1, x778, x809)),
-        );
-        let x829 = Self::mul_add(
-            -x246,
-            x787,
-            Self::mul_add(-x245, x786, x812 + Self::mul_add(x8, x784, s_q1 * x783)),
-        );
-        let x830 = Self::mul_add(-x310, x766, Self::mul_add(-x309, x765, x308 * x764))
-            - Self::mul_add(-x313, x762, x312 * x763) - Self::mul_add(x247, x777, x827);
-        let x831 = -x830;
-        let x832 = Self::mul_add(x310, x769, Self::mul_add(x309, x768, x308 * x767))
-            - Self::mul_add(x313, x761, x311 * x763) + Self::mul_add(x247, x782, x828);
-        let x833 = Self::mul_add(x310, x772, Self::mul_add(x309, x771, x308 * x770))
-            - Self::mul_add(x312, x761, x311 * x762) - x829;
-        let x834 = Self::mul_add(-x310, x762, x309 * x763)
-            - Self::mul_add(x9, x789, x8 * x788);
-        let x835 = Self::mul_add(-x310, x761, x308 * x763)
-            + Self::mul_add(-x9, x791, s_q1 * x790);
-        let x836 = Self::mul_add(-x309, x761, x308 * x762)
-            + Self::mul_add(-x8, x793, s_q1 * x792);
-        let x837 = -(Self::mul_add(c_q0, x823, s_q0 * x822)
-            - Self::mul_add(-x14, x826, Self::mul_add(x13, x825, x12 * x824)));
-        let x838 = Self::mul_add(c_q0, x833, s_q0 * x832)
-            - Self::mul_add(-x14, x836, Self::mul_add(x13, x835, x12 * x834));
-        let x839 = Self::mul_add(-x9, x823, Self::mul_add(x8, x822, s_q1 * x820))
-            - Self::mul_add(x124, x826, Self::mul_add(-x123, x825, x122 * x824));
-        let x840 = Self::mul_add(x9, x833, Self::mul_add(-x8, x832, s_q1 * x830))
-            + Self::mul_add(x124, x836, Self::mul_add(-x123, x835, x122 * x834));
-        let x841 = Self::mul_add(-x304, x802, Self::mul_add(x303, x801, x302 * x800))
-            + Self::mul_add(x307, x805, Self::mul_add(-x306, x804, x305 * x803))
-            - (Self::mul_add(x163, x813, Self::mul_add(x162, x811, x161 * x808))
-                - Self::mul_add(-x301, x816, Self::mul_add(x300, x815, x299 * x814)));
-        let x842 = Self::mul_add(-x9, x813, Self::mul_add(-x8, x811, s_q1 * x808));
-        let x843 = Self::mul_add(-x310, x802, Self::mul_add(x309, x801, x308 * x800))
-            + Self::mul_add(x313, x805, Self::mul_add(-x312, x804, x311 * x803))
-            - (x842 + Self::mul_add(x247, x816, Self::mul_add(x246, x815, x245 * x814)));
-        let x844 = -(Self::mul_add(-x304, x710, Self::mul_add(x303, x709, x302 * x708))
-            + Self::mul_add(x307, x713, Self::mul_add(-x306, x712, x305 * x711))
-            - (Self::mul_add(x163, x722, Self::mul_add(x162, x720, x161 * x716))
-                - Self::mul_add(-x301, x725, Self::mul_add(x300, x724, x299 * x723))));
-        let x845 = -(Self::mul_add(-x310, x710, Self::mul_add(x309, x709, x308 * x708))
-            + Self::mul_add(x313, x713, Self::mul_add(-x312, x712, x311 * x711))
-            - (x753
-                + Self::mul_add(x247, x725, Self::mul_add(x246, x724, x245 * x723))));
-        let x846 = -(Self::mul_add(x304, x663, Self::mul_add(x303, x662, x302 * x661))
-            - Self::mul_add(x163, x670, Self::mul_add(-x162, x668, x161 * x665)));
-        let x847 = x756
-            - Self::mul_add(x310, x663, Self::mul_add(x309, x662, x308 * x661));
-        let x848 = -(Self::mul_add(x304, x616, Self::mul_add(x303, x615, x302 * x614))
-            - Self::mul_add(x163, x623, Self::mul_add(-x162, x621, x161 * x618)));
-        let x849 = x759
-            - Self::mul_add(x310, x616, Self::mul_add(x309, x615, x308 * x614));
-        let x850 = x125 + x761;
-        let x851 = x126 + x762;
-        let x852 = x127 + x763;
-        let x853 = x146 + x764;
-        let x854 = x147 + x765;
-        let x855 = x148 + x766;
-        let x856 = x149 + x767;
-        let x857 = x150 + x768;
-        let x858 = x151 + x769;
-        let x859 = x152 + x770;
-        let x860 = x153 + x771;
-        let x861 = x154 + x772;
-        let x862 = x218 - x219 + x224 + (x224 - (x225 + x226)) + x773;
-        let x863 = x208 - (x205 + (x199 - x227))
-            + (x204 - Self::mul_add(x148, x155, x220)) + x774;
-        let x864 = x207 - (x203 - (x197 - x228))
-            + (x202 - Self::mul_add(-x147, x155, x221)) + x775;
-        let x865 = x215 + (x216 - x217) + x776;
-        let x866 = x212 - (x213 + x214) + x777;
-        let x867 = x208 - (x204 - (x198 + x220))
-            + (x205 - Self::mul_add(x151, x156, x227)) + x778;
-        let x868 = x225 - x229 + x232 + (x232 - (x218 - x233)) + x779;
-        let x869 = x206 + (x201 - (x195 - x234))
-            + (x200 + Self::mul_add(x149, x156, x230)) + x780;
-        let x870 = x216 + (x215 - x217) + x781;
-        let x871 = x209 + (x210 - x211) + x782;
-        let x872 = x207 - (x202 - (x196 + x221))
-            + (x203 + Self::mul_add(x153, x157, x228)) + x783;
-        let x873 = x206 - (x200 - (x194 - x230))
-            - (x201 - Self::mul_add(x152, x157, -x234)) + x784;
-        let x874 = x226 - x233 + x235 + (x235 + (x219 + x229)) + x785;
-        let x875 = x213 - (x212 - x214) + x786;
-        let x876 = x210 + (x209 - x211) + x787;
-        let x877 = x215 + (x216 + x217) + x788;
-        let x878 = x212 - (x213 - x214) + x789;
-        let x879 = x216 + (x215 + x217) + x790;
-        let x880 = x209 + (x210 + x211) + x791;
-        let x881 = x213 - (x212 + x214) + x792;
-        let x882 = x210 + (x209 + x211) + x793;
-        let x883 = Self::mul_add(-x148, x172, Self::mul_add(x147, x171, x146 * x170))
-            + Self::mul_add(-x126, x175, x127 * x174)
-            - (Self::mul_add(-x156, x208, x157 * x207)
-                + Self::mul_add(x159, x217, x160 * x214)) + x794;
-        let x884 = Self::mul_add(x151, x172, Self::mul_add(-x150, x171, x149 * x170))
-            + Self::mul_add(x125, x175, x127 * x173)
-            + (Self::mul_add(x155, x208, x157 * x206)
-                + Self::mul_add(-x158, x217, x160 * x211)) + x795;
-        let x885 = Self::mul_add(x154, x172, Self::mul_add(-x153, x171, x152 * x170))
-            + Self::mul_add(x125, x174, x126 * x173)
-            - (Self::mul_add(x155, x207, x156 * x206)
-                - Self::mul_add(x158, x214, x159 * x211)) + x796;
-        let x886 = Self::mul_add(x126, x172, x127 * x171)
-            - Self::mul_add(-x156, x217, x157 * x214) + x797;
-        let x887 = Self::mul_add(-x125, x172, x127 * x170)
-            + Self::mul_add(x155, x217, x157 * x211) + x798;
-        let x888 = Self::mul_add(x125, x171, x126 * x170)
-            - Self::mul_add(x155, x214, x156 * x211) + x799;
-        let x889 = Self::mul_add(x9, x855, Self::mul_add(x8, x854, s_q1 * x853))
-            - Self::mul_add(-x124, x851, x123 * x852);
-        let x890 = Self::mul_add(-x9, x858, Self::mul_add(-x8, x857, s_q1 * x856))
-            + Self::mul_add(-x124, x850, x122 * x852);
-        let x891 = Self::mul_add(-x9, x861, Self::mul_add(-x8, x860, s_q1 * x859))
-            + Self::mul_add(-x123, x850, x122 * x851);
-        let x892 = Self::mul_add(-x9, x851, x8 * x852);
-        let x893 = Self::mul_add(x9, x850, s_q1 * x852);
-        let x894 = Self::mul_add(x8, x850, s_q1 * x851);
-        let x895 = s_q1 * x862;
-        let x896 = Self::mul_add(
-            x123,
-            x879,
-            Self::mul_add(x9, x872, Self::mul_add(x8, x867, x895)),
-        );
-        let x897 = Self::mul_add(-x124, x881, x896);
-        let x898 = x8 * x868;
-        let x899 = Self::mul_add(
-            -x122,
-            x877,
-            Self::mul_add(-x9, x873, Self::mul_add(s_q1, x863, -x898)),
-        );
-        let x900 = Self::mul_add(-x124, x882, x899);
-        let x901 = x9 * x874;
-        let x902 = Self::mul_add(
-            x123,
-            x880,
-            Self::mul_add(-x122, x878, Self::mul_add(x8, x869, s_q1 * x864) - x901),
-        );
-        let x903 = Self::mul_add(-x9, x875, x8 * x870);
-        let x904 = Self::mul_add(-x9, x876, s_q1 * x865);
-        let x905 = Self::mul_add(x8, x871, s_q1 * x866);
-        let x906 = Self::mul_add(
-            x180,
-            x865,
-            Self::mul_add(x178, x864, Self::mul_add(x177, x863, x176 * x862)),
-        );
-        let x907 = Self::mul_add(
-            -x179,
-            x870,
-            Self::mul_add(x178, x869, Self::mul_add(-x177, x868, x176 * x867)),
-        );
-        let x908 = Self::mul_add(
-            x179,
-            x875,
-            Self::mul_add(-x178, x874, Self::mul_add(-x177, x873, x176 * x872)),
-        );
-        let x909 = -(Self::mul_add(x8, x885, x9 * x884)
-            + Self::mul_add(x123, x888, x124 * x887)
-            + (Self::mul_add(-x184, x855, Self::mul_add(-x183, x854, x182 * x853))
-                - Self::mul_add(-x187, x851, x186 * x852))
-            - Self::mul_add(x181, x866, x906));
-        let x910 = Self::mul_add(
-            x123,
-            x865,
-            Self::mul_add(-x9, x864, Self::mul_add(-x8, x863, x895)),
-        );
-        let x911 = Self::mul_add(
-            x122,
-            x870,
-            Self::mul_add(-x9, x869, Self::mul_add(s_q1, x867, x898)),
-        );
-        let x912 = Self::mul_add(
-            -x123,
-            x876,
-            Self::mul_add(-x122, x875, x901 + Self::mul_add(x8, x873, s_q1 * x872)),
-        );
-        let x913 = -(Self::mul_add(-x190, x855, Self::mul_add(-x189, x854, x188 * x853))
-            - Self::mul_add(-x193, x851, x192 * x852) - Self::mul_add(x124, x866, x910));
-        let x914 = Self::mul_add(
-            c_q0,
-            Self::mul_add(s_q1, x884, x8 * x883)
-                + Self::mul_add(-x122, x887, x123 * x886)
-                - (Self::mul_add(x184, x861, Self::mul_add(x183, x860, x182 * x859))
-                    - Self::mul_add(x186, x850, x185 * x851))
-                + Self::mul_add(-x180, x876, x908),
-            s_q0
-                * (Self::mul_add(-s_q1, x885, x9 * x883)
-                    + Self::mul_add(x122, x888, x124 * x886)
-                    - (Self::mul_add(x184, x858, Self::mul_add(x183, x857, x182 * x856))
-                        - Self::mul_add(x187, x850, x185 * x852))
-                    - Self::mul_add(x181, x871, x907)),
-        );
-        let x915 = Self::mul_add(
             -x14,
-            Self::mul_add(s_q1, x887, x8 * x886)
-                - Self::mul_add(-x183, x850, x182 * x851)
-                - Self::mul_add(x177, x882, x176 * x881),
+            Self::mul_add(s_q1, x786, x8 * x785)
+                - Self::mul_add(-x167, x758, x166 * x759) - (x815 + x815),
             Self::mul_add(
                 x13,
-                Self::mul_add(-s_q1, x888, x9 * x886)
-                    - Self::mul_add(-x184, x850, x182 * x852)
-                    - Self::mul_add(x178, x880, x176 * x879),
+                Self::mul_add(-s_q1, x787, x9 * x785)
+                    - Self::mul_add(-x168, x758, x166 * x760) - (x814 + x814),
                 x12
-                    * (Self::mul_add(x8, x888, x9 * x887)
-                        - Self::mul_add(-x184, x851, x183 * x852)
-                        - Self::mul_add(x178, x878, x177 * x877)),
+                    * (Self::mul_add(x8, x787, x9 * x786)
+                        - Self::mul_add(-x168, x759, x167 * x760) - (x813 + x813)),
             ),
         );
-        let x916 = -(x914 - x915);
-        let x917 = Self::mul_add(
+        let x820 = -(x818 - x819);
+        let x821 = Self::mul_add(
             c_q0,
-            Self::mul_add(x190, x861, Self::mul_add(x189, x860, x188 * x859))
-                - Self::mul_add(x192, x850, x191 * x851) - x912,
+            Self::mul_add(x174, x769, Self::mul_add(x173, x768, x172 * x767))
+                - Self::mul_add(x176, x758, x175 * x759) - (x799 - x805),
             s_q0
-                * (Self::mul_add(x190, x858, Self::mul_add(x189, x857, x188 * x856))
-                    - Self::mul_add(x193, x850, x191 * x852)
-                    + Self::mul_add(x124, x871, x911)),
+                * (Self::mul_add(x174, x766, Self::mul_add(x173, x765, x172 * x764))
+                    - Self::mul_add(x177, x758, x175 * x760) + (x798 - x804)),
         );
-        let x918 = Self::mul_add(
+        let x822 = Self::mul_add(
             -x14,
-            Self::mul_add(-x189, x850, x188 * x851)
-                + Self::mul_add(-x8, x882, s_q1 * x881),
+            Self::mul_add(-x173, x758, x172 * x759) - (x802 + x802),
             Self::mul_add(
                 x13,
-                Self::mul_add(-x190, x850, x188 * x852)
-                    + Self::mul_add(-x9, x880, s_q1 * x879),
-                x12
-                    * (Self::mul_add(-x190, x851, x189 * x852)
-                        - Self::mul_add(x9, x878, x8 * x877)),
+                Self::mul_add(-x174, x758, x172 * x760) + (x801 + x801),
+                x12 * (Self::mul_add(-x174, x759, x173 * x760) - (x800 + x800)),
             ),
         );
-        let x919 = x917 - x918;
-        let x920 = Self::mul_add(-x184, x891, Self::mul_add(x183, x890, x182 * x889))
-            + Self::mul_add(x187, x894, Self::mul_add(-x186, x893, x185 * x892))
-            - (Self::mul_add(x178, x902, Self::mul_add(x177, x900, x176 * x897))
-                - Self::mul_add(-x181, x905, Self::mul_add(-x180, x904, x179 * x903)));
-        let x921 = Self::mul_add(-x190, x891, Self::mul_add(x189, x890, x188 * x889))
-            + Self::mul_add(x193, x894, Self::mul_add(-x192, x893, x191 * x892))
-            - (Self::mul_add(-x9, x902, Self::mul_add(-x8, x900, s_q1 * x897))
-                + Self::mul_add(x124, x905, Self::mul_add(x123, x904, x122 * x903)));
-        let x922 = Self::mul_add(-x184, x802, Self::mul_add(x183, x801, x182 * x800))
-            + Self::mul_add(x187, x805, Self::mul_add(-x186, x804, x185 * x803))
-            - (Self::mul_add(x178, x813, Self::mul_add(x177, x811, x176 * x808))
-                - Self::mul_add(-x181, x816, Self::mul_add(-x180, x815, x179 * x814)));
-        let x923 = Self::mul_add(-x190, x802, Self::mul_add(x189, x801, x188 * x800))
-            + Self::mul_add(x193, x805, Self::mul_add(-x192, x804, x191 * x803))
-            - (x842 + Self::mul_add(x124, x816, Self::mul_add(x123, x815, x122 * x814)));
-        let x924 = -(Self::mul_add(-x184, x710, Self::mul_add(x183, x709, x182 * x708))
-            + Self::mul_add(x187, x713, Self::mul_add(-x186, x712, x185 * x711))
-            - (Self::mul_add(x178, x722, Self::mul_add(x177, x720, x176 * x716))
-                - Self::mul_add(-x181, x725, Self::mul_add(-x180, x724, x179 * x723))));
-        let x925 = -(Self::mul_add(-x190, x710, Self::mul_add(x189, x709, x188 * x708))
-            + Self::mul_add(x193, x713, Self::mul_add(-x192, x712, x191 * x711))
-            - (x753
-                + Self::mul_add(x124, x725, Self::mul_add(x123, x724, x122 * x723))));
-        let x926 = -(Self::mul_add(x184, x663, Self::mul_add(x183, x662, x182 * x661))
-            - Self::mul_add(x178, x670, Self::mul_add(-x177, x668, x176 * x665)));
-        let x927 = x756
-            - Self::mul_add(x190, x663, Self::mul_add(x189, x662, x188 * x661));
-        let x928 = -(Self::mul_add(x184, x616, Self::mul_add(x183, x615, x182 * x614))
-            - Self::mul_add(x178, x623, Self::mul_add(-x177, x621, x176 * x618)));
-        let x929 = x759
-            - Self::mul_add(x190, x616, Self::mul_add(x189, x615, x188 * x614));
-        let x930 = x15 + x850;
-        let x931 = x16 - x851;
-        let x932 = x17 - x852;
-        let x933 = x36 - x854;
-        let x934 = x37 - x855;
-        let x935 = -(x95 - x96 - x101 - (x101 - (x102 + x103)) + x862);
-        let x936 = x85 - (x82 - (x76 - x104)) - (x81 - Self::mul_add(qd[0], x37, x97))
-            + x863;
-        let x937 = x84 - (x80 + (x74 - x105)) - (x79 - Self::mul_add(-qd[0], x36, x98))
-            + x864;
-        let x938 = x92 - (x93 + x94) - x865;
-        let x939 = x89 + (x90 - x91) - x866;
-        let x940 = Self::mul_add(-c_q0, x40 - x858, s_q0 * (x39 - x857))
-            - Self::mul_add(-x14, x930, x12 * x932);
-        let x941 = Self::mul_add(-c_q0, x43 - x861, s_q0 * (x42 - x860))
-            - Self::mul_add(-x13, x930, x12 * x931);
-        let x942 = c_q0 * x930;
-        let x943 = s_q0 * x930;
-        let x944 = Self::mul_add(
-            -x13,
-            x93 - (x92 + x94) + x879,
-            Self::mul_add(
-                -c_q0,
-                x84 + (x79 + (x73 - x98)) + (x80 - Self::mul_add(x42, x45, x105)) + x872,
-                s_q0
-                    * (x85 + (x81 + (x75 - x97)) + (x82 + Self::mul_add(x40, x44, x104))
-                        + x867),
-            ),
-        );
-        let x945 = -Self::mul_add(x14, x90 + (x89 + x91) + x881, x944);
-        let x946 = Self::mul_add(
-            x12,
-            x92 - (x93 - x94) - x877,
-            Self::mul_add(
-                -c_q0,
-                x83 - (x77 - (x71 - x107)) - (x78 + Self::mul_add(x41, x45, x111))
-                    - x873,
-                s_q0 * (x102 - x106 + x109 + (x109 + (x95 + x110)) - x868),
-            ),
-        );
-        let x947 = Self::mul_add(-x14, x87 + (x86 + x88) - x882, x946);
-        let x948 = Self::mul_add(
-            -x12,
-            x89 + (x90 + x91) - x878,
-            Self::mul_add(
-                c_q0,
-                x103 - x110 + x112 + (x112 - (x96 - x106)) - x874,
-                s_q0
-                    * (x83 + (x78 - (x72 - x111))
-                        + (x77 + Self::mul_add(-x38, x44, x107)) - x869),
-            ),
-        );
-        let x949 = Self::mul_add(-x13, x86 + (x87 + x88) - x880, x948);
-        let x950 = c_q0 * (x87 + (x86 - x88) - x876);
-        let x951 = s_q0 * (x86 + (x87 - x88) - x871);
-        let x952 = Self::mul_add(
+        let x823 = x821 - x822;
+        let x824 = Self::mul_add(-x168, x790, Self::mul_add(x167, x789, x166 * x788))
+            + Self::mul_add(x171, x793, Self::mul_add(-x170, x792, x169 * x791))
+            + Self::mul_add(x162, x809, Self::mul_add(x161, x808, x160 * x806));
+        let x825 = Self::mul_add(-x174, x790, Self::mul_add(x173, x789, x172 * x788))
+            + Self::mul_add(x177, x793, Self::mul_add(-x176, x792, x175 * x791))
+            + Self::mul_add(-x9, x809, Self::mul_add(-x8, x808, s_q1 * x806));
+        let x826 = Self::mul_add(-x168, x705, Self::mul_add(x167, x704, x166 * x703))
+            + Self::mul_add(x171, x708, Self::mul_add(-x170, x707, x169 * x706))
+            + Self::mul_add(x162, x724, Self::mul_add(x161, x723, x160 * x721));
+        let x827 = x750
+            + (Self::mul_add(-x174, x705, Self::mul_add(x173, x704, x172 * x703))
+                + Self::mul_add(x177, x708, Self::mul_add(-x176, x707, x175 * x706)));
+        let x828 = -(Self::mul_add(-x168, x619, Self::mul_add(x167, x618, x166 * x617))
+            + Self::mul_add(x171, x622, Self::mul_add(-x170, x621, x169 * x620))
+            + Self::mul_add(x162, x637, Self::mul_add(x161, x636, x160 * x635)));
+        let x829 = -(x665
+            + (Self::mul_add(-x174, x619, Self::mul_add(x173, x618, x172 * x617))
+                + Self::mul_add(x177, x622, Self::mul_add(-x176, x621, x175 * x620))));
+        let x830 = -(Self::mul_add(x168, x569, Self::mul_add(x167, x568, x166 * x567))
+            - Self::mul_add(-x162, x579, Self::mul_add(x161, x578, x160 * x576)));
+        let x831 = x668
+            - Self::mul_add(x174, x569, Self::mul_add(x173, x568, x172 * x567));
+        let x832 = -(Self::mul_add(x168, x519, Self::mul_add(x167, x518, x166 * x517))
+            - Self::mul_add(-x162, x529, Self::mul_add(x161, x528, x160 * x526)));
+        let x833 = x671
+            - Self::mul_add(x174, x519, Self::mul_add(x173, x518, x172 * x517));
+        let x834 = x15 + x758;
+        let x835 = x16 - x759;
+        let x836 = x17 - x760;
+        let x837 = x36 - x762;
+        let x838 = x37 - x763;
+        let x839 = x83 - x770;
+        let x840 = x84 + x771;
+        let x841 = x85 + x772;
+        let x842 = x86 - x773;
+        let x843 = x87 - x774;
+        let x844 = x88 - x775;
+        let x845 = x96 - (x92 + (x92 + (x89 + x89))) + x776;
+        let x846 = x82
+            + (x81 + (Self::mul_add(-x35, x45, x75) - Self::mul_add(-x39, x45, x76)))
+            + x777;
+        let x847 = x80
+            + (x79 + (Self::mul_add(-x35, x44, x73) + Self::mul_add(-x43, x44, x74)))
+            + x778;
+        let x848 = x78
+            + (x77 - (Self::mul_add(-qd[0], x39, x71) + Self::mul_add(-qd[0], x43, x72)))
+            - x780;
+        let x849 = Self::mul_add(-c_q0, x40 - x766, s_q0 * (x39 - x765))
+            - Self::mul_add(-x14, x834, x12 * x836);
+        let x850 = Self::mul_add(-c_q0, x43 - x769, s_q0 * (x42 - x768))
+            - Self::mul_add(-x13, x834, x12 * x835);
+        let x851 = c_q0 * x834;
+        let x852 = s_q0 * x834;
+        let x853 = Self::mul_add(x14, x843, x13 * x844);
+        let x854 = Self::mul_add(-x14, x842, x12 * x844);
+        let x855 = Self::mul_add(x13, x842, x12 * x843);
+        let x856 = Self::mul_add(-c_q0, x847, s_q0 * x846) + x853;
+        let x857 = x853 - Self::mul_add(-s_q0, x841, c_q0 * x840);
+        let x858 = -(x856 + x857);
+        let x859 = Self::mul_add(
+            c_q0,
+            x848,
+            s_q0 * (x96 - (x93 + (x93 - (x90 + x90))) + x779),
+        ) + x854 + Self::mul_add(-c_q0, x839, x854);
+        let x860 = Self::mul_add(
+            c_q0,
+            x96 - (x94 + (x94 - (x91 + x91))) + x781,
+            s_q0 * x848,
+        ) - x855 - Self::mul_add(-s_q0, x839, x855);
+        let x861 = Self::mul_add(
             -s_q0,
             Self::mul_add(-x43, x59, Self::mul_add(x42, x58, x41 * x57))
                 - Self::mul_add(-x15, x61, x16 * x60)
                 + (Self::mul_add(-qd[0], x84, x44 * x83)
-                    - Self::mul_add(x46, x91, x47 * x88)) + x885,
+                    - Self::mul_add(x46, x87, x47 * x86)) + x784,
             c_q0
                 * (Self::mul_add(-x40, x59, Self::mul_add(x39, x58, x38 * x57))
                     - Self::mul_add(-x15, x62, x17 * x60)
                     - (Self::mul_add(-qd[0], x85, x45 * x83)
-                        + Self::mul_add(-x46, x94, x48 * x88)) + x884),
+                        + Self::mul_add(-x46, x88, x48 * x86)) + x783),
         );
-        let x953 = Self::mul_add(
-            -x53,
-            x939,
-            Self::mul_add(x52, x938, Self::mul_add(x51, x937, x50 * x936)),
-        );
-        let x954 = -(x952
+        let x862 = Self::mul_add(-x52, x844, x53 * x843);
+        let x863 = -(x861
             - Self::mul_add(
                 x13,
                 Self::mul_add(-x15, x58, x16 * x57)
-                    - Self::mul_add(qd[0], x91, x44 * x88) - x888,
+                    - Self::mul_add(qd[0], x87, x44 * x86) - x787,
                 x14
                     * (Self::mul_add(x15, x59, x17 * x57)
-                        + Self::mul_add(qd[0], x94, x45 * x88) - x887),
+                        + Self::mul_add(qd[0], x88, x45 * x86) - x786),
             )
-            + (Self::mul_add(x64, x934, x63 * x933)
-                - Self::mul_add(x66, x931, x65 * x932)) - x953);
-        let x955 = Self::mul_add(
-            -x14,
-            x939,
-            Self::mul_add(-x13, x938, Self::mul_add(-c_q0, x937, s_q0 * x936)),
-        );
-        let x956 = -(Self::mul_add(
+            + (Self::mul_add(x64, x838, x63 * x837)
+                - Self::mul_add(x66, x835, x65 * x836))
+            - (Self::mul_add(x50, x841, x51 * x840) + x862
+                - (x862 + Self::mul_add(x51, x847, x50 * x846))));
+        let x864 = -(Self::mul_add(
             x68,
-            x934,
-            Self::mul_add(x67, x933, x49 * (x35 - x853)),
-        ) - Self::mul_add(x70, x931, x69 * x932) - x955);
-        let x957 = -(Self::mul_add(-x64, x941, x63 * x940)
-            - Self::mul_add(-x66, x943, x65 * x942)
-            - (Self::mul_add(-x51, x949, x50 * x947)
-                + Self::mul_add(-x53, x951, x52 * x950)));
-        let x958 = Self::mul_add(
+            x838,
+            Self::mul_add(x67, x837, x49 * (x35 - x761)),
+        ) - Self::mul_add(x70, x835, x69 * x836) + (x856 - x857));
+        let x865 = -(Self::mul_add(-x64, x850, x63 * x849)
+            - Self::mul_add(-x66, x852, x65 * x851)
+            - Self::mul_add(-x51, x860, x50 * x859));
+        let x866 = Self::mul_add(
             -x68,
-            x941,
+            x850,
             Self::mul_add(
                 x67,
-                x940,
+                x849,
                 x49
-                    * (Self::mul_add(-c_q0, x934, s_q0 * x933)
-                        + Self::mul_add(-x14, x931, x13 * x932)),
+                    * (Self::mul_add(-c_q0, x838, s_q0 * x837)
+                        + Self::mul_add(-x14, x835, x13 * x836)),
             ),
         );
-        let x959 = Self::mul_add(
+        let x867 = Self::mul_add(
             -x70,
-            x943,
-            Self::mul_add(x69, x942, x54 * Self::mul_add(c_q0, x931, s_q0 * x932)),
+            x852,
+            Self::mul_add(x69, x851, x54 * Self::mul_add(c_q0, x835, s_q0 * x836)),
         );
-        let x960 = Self::mul_add(
-            x14,
-            x951,
-            Self::mul_add(
-                x13,
-                x950,
-                x12
-                    * Self::mul_add(
-                        c_q0,
-                        x90 + (x89 - x91) + x875,
-                        s_q0 * (x93 - (x92 - x94) + x870),
-                    ),
-            ),
-        );
-        let x961 = -(x958 - x959 - (Self::mul_add(c_q0, x949, s_q0 * x947) - x960));
-        let x962 = Self::mul_add(-x64, x891, x63 * x890)
-            + Self::mul_add(x66, x894, x65 * x893)
-            - (Self::mul_add(x51, x902, x50 * x900)
-                - Self::mul_add(-x53, x905, x52 * x904));
-        let x963 = -(Self::mul_add(x68, x891, Self::mul_add(-x67, x890, x49 * x889))
-            - Self::mul_add(x70, x894, Self::mul_add(x69, x893, x54 * x892))
-            + (Self::mul_add(-c_q0, x902, s_q0 * x900)
-                - Self::mul_add(-x14, x905, Self::mul_add(-x13, x904, x12 * x903))));
-        let x964 = Self::mul_add(-x64, x802, x63 * x801)
-            + Self::mul_add(x66, x805, x65 * x804)
-            - (Self::mul_add(x51, x813, x50 * x811)
-                - Self::mul_add(-x53, x816, x52 * x815));
-        let x965 = -(Self::mul_add(x68, x802, Self::mul_add(-x67, x801, x49 * x800))
-            - Self::mul_add(x70, x805, Self::mul_add(x69, x804, x54 * x803))
-            + (Self::mul_add(-c_q0, x813, s_q0 * x811)
-                - Self::mul_add(-x14, x816, Self::mul_add(-x13, x815, x12 * x814))));
-        let x966 = -(Self::mul_add(-x64, x710, x63 * x709)
-            + Self::mul_add(x66, x713, x65 * x712)
-            - (Self::mul_add(x51, x722, x50 * x720)
-                - Self::mul_add(-x53, x725, x52 * x724)));
-        let x967 = Self::mul_add(x68, x710, Self::mul_add(-x67, x709, x49 * x708))
-            - Self::mul_add(x70, x713, Self::mul_add(x69, x712, x54 * x711))
-            + (Self::mul_add(-c_q0, x722, s_q0 * x720)
-                - Self::mul_add(-x14, x725, Self::mul_add(-x13, x724, x12 * x723)));
-        let x968 = -(Self::mul_add(x64, x663, x63 * x662)
-            + Self::mul_add(-x51, x670, x50 * x668));
-        let x969 = Self::mul_add(-x68, x663, Self::mul_add(-x67, x662, x49 * x661))
-            - Self::mul_add(c_q0, x670, s_q0 * x668);
-        let x970 = -(Self::mul_add(x64, x616, x63 * x615)
-            + Self::mul_add(-x51, x623, x50 * x621));
-        let x971 = Self::mul_add(-x68, x616, Self::mul_add(-x67, x615, x49 * x614))
-            - Self::mul_add(c_q0, x623, s_q0 * x621);
+        let x868 = -(x866 - x867 - Self::mul_add(c_q0, x860, s_q0 * x859));
+        let x869 = Self::mul_add(-x64, x790, x63 * x789)
+            + Self::mul_add(x66, x793, x65 * x792)
+            + Self::mul_add(x51, x809, x50 * x808);
+        let x870 = -(Self::mul_add(x68, x790, Self::mul_add(-x67, x789, x49 * x788))
+            - Self::mul_add(x70, x793, Self::mul_add(x69, x792, x54 * x791))
+            - Self::mul_add(-c_q0, x809, s_q0 * x808));
+        let x871 = Self::mul_add(-x64, x705, x63 * x704)
+            + Self::mul_add(x66, x708, x65 * x707)
+            + Self::mul_add(x51, x724, x50 * x723);
+        let x872 = -(Self::mul_add(x68, x705, Self::mul_add(-x67, x704, x49 * x703))
+            - Self::mul_add(x70, x708, Self::mul_add(x69, x707, x54 * x706))
+            - Self::mul_add(-c_q0, x724, s_q0 * x723));
+        let x873 = -(Self::mul_add(-x64, x619, x63 * x618)
+            + Self::mul_add(x66, x622, x65 * x621)
+            + Self::mul_add(x51, x637, x50 * x636));
+        let x874 = Self::mul_add(x68, x619, Self::mul_add(-x67, x618, x49 * x617))
+            - Self::mul_add(x70, x622, Self::mul_add(x69, x621, x54 * x620))
+            - Self::mul_add(-c_q0, x637, s_q0 * x636);
+        let x875 = -(Self::mul_add(x64, x569, x63 * x568)
+            - Self::mul_add(-x51, x579, x50 * x578));
+        let x876 = Self::mul_add(-x68, x569, Self::mul_add(-x67, x568, x49 * x567))
+            + Self::mul_add(c_q0, x579, s_q0 * x578);
+        let x877 = -(Self::mul_add(x64, x519, x63 * x518)
+            - Self::mul_add(-x51, x529, x50 * x528));
+        let x878 = Self::mul_add(-x68, x519, Self::mul_add(-x67, x518, x49 * x517))
+            + Self::mul_add(c_q0, x529, s_q0 * x528);
         (
             [
-                [0.0, x954, x909, x821, x729, x672, x625],
-                [0.0, x957, x916, x837, x744, x679, x632],
-                [0.0, x962, x920, x839, x747, x681, x634],
-                [0.0, x964, x922, x841, x750, x681, x634],
-                [0.0, x966, x924, x844, x752, x681, x634],
-                [0.0, x968, x926, x846, x755, x683, x636],
-                [0.0, x970, x928, x848, x758, x685, x638],
+                [0.0, x863, x816, x732, x644, x581, x531],
+                [0.0, x865, x820, x745, x656, x588, x538],
+                [0.0, x869, x824, x747, x659, x590, x540],
+                [0.0, x871, x826, x749, x662, x590, x540],
+                [0.0, x873, x828, x752, x664, x590, x540],
+                [0.0, x875, x830, x754, x667, x592, x542],
+                [0.0, x877, x832, x756, x670, x594, x544],
             ],
             [
-                [x935, x956, x913, x831, x738, x676, x629],
-                [x945, x961, x919, x838, x745, x680, x633],
-                [x897, x963, x921, x840, x749, x682, x635],
-                [x808, x965, x923, x843, x751, x682, x635],
-                [x717, x967, x925, x845, x754, x682, x635],
-                [x666, x969, x927, x847, x757, x684, x637],
-                [x619, x971, x929, x849, x760, x686, x639],
+                [x845, x864, x817, x739, x650, x585, x535],
+                [x858, x868, x823, x746, x657, x589, x539],
+                [x807, x870, x825, x748, x661, x591, x541],
+                [x722, x872, x827, x751, x663, x591, x541],
+                [x635, x874, x829, x753, x666, x591, x541],
+                [x577, x876, x831, x755, x669, x593, x543],
+                [x527, x878, x833, x757, x672, x595, x545],
             ],
         )
     }
     /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`.
     ///
-    /// : 3373 mul, 3173 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 2094 fused where the target has FMA.
+    /// : 3273 mul, 2935 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 2049 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_derivatives(
         q: &[::core::primitive::f64; 7],
@@ -5422,2502 +5227,2261 @@ impl Ssrms {
         let x430 = Self::mul_add(qd[0], x382, x418) - x419 + (x424 - x425);
         let x431 = Self::mul_add(x386, x391, x420) - x421 - (x426 - x427);
         let x432 = Self::mul_add(-x390, x392, x422 + x423) - (x428 - x429);
-        let x433 = x364 * x391;
-        let x434 = x363 * x392;
-        let x435 = x433 + x434;
-        let x436 = qd[0] * x364;
-        let x437 = x60 * x392;
-        let x438 = x436 + x437;
-        let x439 = qd[0] * x363;
-        let x440 = x60 * x391;
-        let x441 = x439 - x440;
-        let x442 = x385 * x392;
-        let x443 = x388 * x391;
-        let x444 = x382 * x392;
-        let x445 = x382 * x391;
-        let x446 = x364 * x395;
-        let x447 = x363 * x394;
-        let x448 = x446 + x447;
-        let x449 = x383 * x392;
-        let x450 = x384 * x391;
-        let x451 = x386 * x392;
-        let x452 = x390 * x391;
-        let x453 = qd[0] * x389;
-        let x454 = qd[0] * x386;
-        let x455 = x60 * x393;
-        let x456 = x446 + x455;
-        let x457 = qd[0] * x387;
-        let x458 = qd[0] * x390;
-        let x459 = x447 + x455;
-        let x460 = c_q1 * c_q2;
-        let x461 = Self::mul_add(s_q0, s_q2, c_q2 * x354);
-        let x462 = Self::mul_add(-c_q0, s_q2, c_q2 * x355);
-        let x463 = c_q1 * s_q2;
-        let x464 = Self::mul_add(-s_q0, c_q2, s_q2 * x354);
-        let x465 = Self::mul_add(c_q0, c_q2, s_q2 * x355);
-        let x466 = Self::mul_add(0.5692, s_q1, 1.3589);
-        let x467 = Self::mul_add(0.5692, x356, x358);
-        let x468 = Self::mul_add(-0.5692, x357, x359);
-        let x469 = Self::mul_add(x357, x467, x356 * x468);
-        let x470 = Self::mul_add(x357, x466, s_q1 * x468);
-        let x471 = Self::mul_add(-x356, x466, s_q1 * x467);
-        let x472 = 5224.5702 * x460;
-        let x473 = 5224.5702 * x461;
-        let x474 = 5224.5702 * x462;
-        let x475 = 3946.1881206800003 * s_q1;
-        let x476 = 39234.474122 * x463;
-        let x477 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x460);
-        let x478 = 3946.1881206800003 * x356;
-        let x479 = 39234.474122 * x464;
-        let x480 = Self::mul_add(39241.404122, x356, 3946.18812068 * x461);
-        let x481 = 3946.1881206800003 * x357;
-        let x482 = 39234.474122 * x465;
-        let x483 = Self::mul_add(39241.404122, x357, 3946.18812068 * x462);
-        let x484 = x468 * x474;
-        let x485 = x467 * x473;
-        let x486 = x484 - x485;
-        let x487 = x467 * x472;
-        let x488 = x468 * x472;
-        let x489 = x466 * x473;
-        let x490 = x466 * x472;
-        let x491 = x484 + x490;
-        let x492 = x468 * x473;
-        let x493 = x466 * x474;
-        let x494 = x467 * x474;
-        let x495 = x485 - x490;
-        let x496 = x486
-            - (Self::mul_add(s_q1, x477, Self::mul_add(-x463, x476, x460 * x475))
-                - x486);
-        let x497 = x489
-            + (Self::mul_add(-x356, x477, Self::mul_add(-x464, x476, x461 * x475))
-                - x487);
-        let x498 = x493
-            + (Self::mul_add(-x357, x477, Self::mul_add(-x465, x476, x462 * x475))
-                + x488);
-        let x499 = x487
-            + (Self::mul_add(-s_q1, x480, Self::mul_add(x463, x479, x460 * x478))
-                - x489);
-        let x500 = x491
-            + (Self::mul_add(x356, x480, Self::mul_add(x464, x479, x461 * x478)) + x491);
-        let x501 = x494
-            + (Self::mul_add(x357, x480, Self::mul_add(x465, x479, x462 * x478)) - x492);
-        let x502 = x488
-            - (Self::mul_add(-s_q1, x483, Self::mul_add(x463, x482, x460 * x481))
-                - x493);
-        let x503 = x492
-            - (Self::mul_add(x356, x483, Self::mul_add(x464, x482, x461 * x481)) + x494);
-        let x504 = x495
-            - (Self::mul_add(x357, x483, Self::mul_add(x465, x482, x462 * x481)) - x495);
-        let x505 = Self::mul_add(-qd[2], s_q1, qd[0]);
-        let x506 = Self::mul_add(-qd[2], x356, x391);
-        let x507 = Self::mul_add(qd[2], x357, x392);
-        let x508 = Self::mul_add(-qd[2], x469, x393);
-        let x509 = Self::mul_add(qd[2], x470, x394);
-        let x510 = Self::mul_add(qd[2], x471, x395);
-        let x511 = Self::mul_add(x357, x506, x356 * x507);
-        let x512 = Self::mul_add(x357, x505, s_q1 * x507);
-        let x513 = Self::mul_add(-x356, x505, s_q1 * x506);
-        let x514 = Self::mul_add(-x357, x509, x356 * x510);
-        let x515 = Self::mul_add(-x357, x508, s_q1 * x510);
-        let x516 = Self::mul_add(-x356, x508, s_q1 * x509);
-        let x517 = Self::mul_add(x471, x506, x470 * x507) + x514;
-        let x518 = Self::mul_add(-x471, x505, x469 * x507) - x515;
-        let x519 = Self::mul_add(x470, x505, x469 * x506) + x516;
-        let x520 = Self::mul_add(-qd[2], x511, Self::mul_add(-s_q1, x345, x404));
-        let x521 = Self::mul_add(qd[2], x512, Self::mul_add(-x345, x356, x405));
-        let x522 = Self::mul_add(-qd[2], x513, Self::mul_add(x345, x357, x406));
-        let x523 = Self::mul_add(qd[2], x517, Self::mul_add(-x345, x469, x407));
-        let x524 = Self::mul_add(qd[2], x518, Self::mul_add(x345, x470, x408));
-        let x525 = Self::mul_add(qd[2], x519, Self::mul_add(x345, x471, x409));
-        let x526 = Self::mul_add(x357, x391, x356 * x392);
-        let x527 = Self::mul_add(qd[0], x357, s_q1 * x392);
-        let x528 = Self::mul_add(-qd[0], x356, s_q1 * x391);
-        let x529 = Self::mul_add(x391, x471, x392 * x470)
+        let x433 = Self::mul_add(x363, x392, x364 * x391);
+        let x434 = Self::mul_add(x60, x392, qd[0] * x364);
+        let x435 = Self::mul_add(-x60, x391, qd[0] * x363);
+        let x436 = Self::mul_add(-x388, x391, x385 * x392);
+        let x437 = Self::mul_add(-qd[0], x389, x383 * x392);
+        let x438 = Self::mul_add(-qd[0], x387, x384 * x391);
+        let x439 = x60 * x393;
+        let x440 = x363 * x394;
+        let x441 = x364 * x395;
+        let x442 = x439 + x440 + x441;
+        let x443 = x442 + x442;
+        let x444 = c_q1 * c_q2;
+        let x445 = Self::mul_add(s_q0, s_q2, c_q2 * x354);
+        let x446 = Self::mul_add(-c_q0, s_q2, c_q2 * x355);
+        let x447 = c_q1 * s_q2;
+        let x448 = Self::mul_add(-s_q0, c_q2, s_q2 * x354);
+        let x449 = Self::mul_add(c_q0, c_q2, s_q2 * x355);
+        let x450 = Self::mul_add(0.5692, s_q1, 1.3589);
+        let x451 = Self::mul_add(0.5692, x356, x358);
+        let x452 = Self::mul_add(-0.5692, x357, x359);
+        let x453 = Self::mul_add(x357, x451, x356 * x452);
+        let x454 = Self::mul_add(x357, x450, s_q1 * x452);
+        let x455 = Self::mul_add(-x356, x450, s_q1 * x451);
+        let x456 = 5224.5702 * x444;
+        let x457 = 5224.5702 * x445;
+        let x458 = 5224.5702 * x446;
+        let x459 = 3946.1881206800003 * s_q1;
+        let x460 = 39234.474122 * x447;
+        let x461 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x444);
+        let x462 = 3946.1881206800003 * x356;
+        let x463 = 39234.474122 * x448;
+        let x464 = Self::mul_add(39241.404122, x356, 3946.18812068 * x445);
+        let x465 = 3946.1881206800003 * x357;
+        let x466 = 39234.474122 * x449;
+        let x467 = Self::mul_add(39241.404122, x357, 3946.18812068 * x446);
+        let x468 = x452 * x458;
+        let x469 = x451 * x457;
+        let x470 = x468 - x469;
+        let x471 = x451 * x456;
+        let x472 = x452 * x456;
+        let x473 = x450 * x457;
+        let x474 = x450 * x456;
+        let x475 = x468 + x474;
+        let x476 = x452 * x457;
+        let x477 = x450 * x458;
+        let x478 = x451 * x458;
+        let x479 = x469 - x474;
+        let x480 = x470
+            - (Self::mul_add(s_q1, x461, Self::mul_add(-x447, x460, x444 * x459))
+                - x470);
+        let x481 = x473
+            + (Self::mul_add(-x356, x461, Self::mul_add(-x448, x460, x445 * x459))
+                - x471);
+        let x482 = x477
+            + (Self::mul_add(-x357, x461, Self::mul_add(-x449, x460, x446 * x459))
+                + x472);
+        let x483 = x471
+            + (Self::mul_add(-s_q1, x464, Self::mul_add(x447, x463, x444 * x462))
+                - x473);
+        let x484 = x475
+            + (Self::mul_add(x356, x464, Self::mul_add(x448, x463, x445 * x462)) + x475);
+        let x485 = x478
+            + (Self::mul_add(x357, x464, Self::mul_add(x449, x463, x446 * x462)) - x476);
+        let x486 = x472
+            - (Self::mul_add(-s_q1, x467, Self::mul_add(x447, x466, x444 * x465))
+                - x477);
+        let x487 = x476
+            - (Self::mul_add(x356, x467, Self::mul_add(x448, x466, x445 * x465)) + x478);
+        let x488 = x479
+            - (Self::mul_add(x357, x467, Self::mul_add(x449, x466, x446 * x465)) - x479);
+        let x489 = Self::mul_add(-qd[2], s_q1, qd[0]);
+        let x490 = Self::mul_add(-qd[2], x356, x391);
+        let x491 = Self::mul_add(qd[2], x357, x392);
+        let x492 = Self::mul_add(-qd[2], x453, x393);
+        let x493 = Self::mul_add(qd[2], x454, x394);
+        let x494 = Self::mul_add(qd[2], x455, x395);
+        let x495 = Self::mul_add(x357, x490, x356 * x491);
+        let x496 = Self::mul_add(x357, x489, s_q1 * x491);
+        let x497 = Self::mul_add(-x356, x489, s_q1 * x490);
+        let x498 = Self::mul_add(-x357, x493, x356 * x494);
+        let x499 = Self::mul_add(-x357, x492, s_q1 * x494);
+        let x500 = Self::mul_add(-x356, x492, s_q1 * x493);
+        let x501 = Self::mul_add(x455, x490, x454 * x491) + x498;
+        let x502 = Self::mul_add(-x455, x489, x453 * x491) - x499;
+        let x503 = Self::mul_add(x454, x489, x453 * x490) + x500;
+        let x504 = Self::mul_add(-qd[2], x495, Self::mul_add(-s_q1, x345, x404));
+        let x505 = Self::mul_add(qd[2], x496, Self::mul_add(-x345, x356, x405));
+        let x506 = Self::mul_add(-qd[2], x497, Self::mul_add(x345, x357, x406));
+        let x507 = Self::mul_add(qd[2], x501, Self::mul_add(-x345, x453, x407));
+        let x508 = Self::mul_add(qd[2], x502, Self::mul_add(x345, x454, x408));
+        let x509 = Self::mul_add(qd[2], x503, Self::mul_add(x345, x455, x409));
+        let x510 = Self::mul_add(x357, x391, x356 * x392);
+        let x511 = Self::mul_add(qd[0], x357, s_q1 * x392);
+        let x512 = Self::mul_add(-qd[0], x356, s_q1 * x391);
+        let x513 = Self::mul_add(x391, x455, x392 * x454)
             + Self::mul_add(-x357, x394, x356 * x395);
-        let x530 = Self::mul_add(-qd[0], x471, x392 * x469)
+        let x514 = Self::mul_add(-qd[0], x455, x392 * x453)
             - Self::mul_add(-x357, x393, s_q1 * x395);
-        let x531 = Self::mul_add(qd[0], x470, x391 * x469)
+        let x515 = Self::mul_add(qd[0], x454, x391 * x453)
             + Self::mul_add(-x356, x393, s_q1 * x394);
-        let x532 = Self::mul_add(x357, x405, x356 * x406)
-            - Self::mul_add(x391, x528, x392 * x527);
-        let x533 = Self::mul_add(x357, x404, s_q1 * x406)
-            + Self::mul_add(-qd[0], x528, x392 * x526);
-        let x534 = Self::mul_add(-x356, x404, s_q1 * x405)
-            + Self::mul_add(qd[0], x527, x391 * x526);
-        let x535 = Self::mul_add(x405, x471, x406 * x470)
+        let x516 = Self::mul_add(x357, x405, x356 * x406)
+            - Self::mul_add(x391, x512, x392 * x511);
+        let x517 = Self::mul_add(x357, x404, s_q1 * x406)
+            + Self::mul_add(-qd[0], x512, x392 * x510);
+        let x518 = Self::mul_add(-x356, x404, s_q1 * x405)
+            + Self::mul_add(qd[0], x511, x391 * x510);
+        let x519 = Self::mul_add(x405, x455, x406 * x454)
             + Self::mul_add(-x357, x408, x356 * x409)
-            + (Self::mul_add(x391, x531, x392 * x530)
-                - Self::mul_add(-x394, x528, x395 * x527));
-        let x536 = Self::mul_add(-x404, x471, x406 * x469)
+            + (Self::mul_add(x391, x515, x392 * x514)
+                - Self::mul_add(-x394, x512, x395 * x511));
+        let x520 = Self::mul_add(-x404, x455, x406 * x453)
             - Self::mul_add(-x357, x407, s_q1 * x409)
-            - (Self::mul_add(qd[0], x531, x392 * x529)
-                + Self::mul_add(x393, x528, x395 * x526));
-        let x537 = Self::mul_add(x404, x470, x405 * x469)
+            - (Self::mul_add(qd[0], x515, x392 * x513)
+                + Self::mul_add(x393, x512, x395 * x510));
+        let x521 = Self::mul_add(x404, x454, x405 * x453)
             + Self::mul_add(-x356, x407, s_q1 * x408)
-            - (Self::mul_add(-qd[0], x530, x391 * x529)
-                - Self::mul_add(x393, x527, x394 * x526));
-        let x538 = x511 + x526;
-        let x539 = x512 + x527;
-        let x540 = x513 + x528;
-        let x541 = x517 + x529;
-        let x542 = x518 + x530;
-        let x543 = x519 + x531;
-        let x544 = x497 * x506;
-        let x545 = x498 * x507;
-        let x546 = x499 * x505;
-        let x547 = x501 * x507;
-        let x548 = x502 * x505;
-        let x549 = x503 * x506;
-        let x550 = x474 * x509;
-        let x551 = x473 * x510;
-        let x552 = x474 * x508;
-        let x553 = x472 * x510;
-        let x554 = x473 * x508;
-        let x555 = x472 * x509;
-        let x556 = Self::mul_add(x496, x505, x544) - x545 + (x550 - x551);
-        let x557 = Self::mul_add(-x500, x506, x546) + x547 + (x552 + x553);
-        let x558 = Self::mul_add(x504, x507, x548 - x549) + (x554 + x555);
-        let x559 = x474 * x506;
-        let x560 = x473 * x507;
-        let x561 = x559 + x560;
-        let x562 = x474 * x505;
-        let x563 = x472 * x507;
-        let x564 = x562 - x563;
-        let x565 = x473 * x505;
-        let x566 = x472 * x506;
-        let x567 = x565 + x566;
-        let x568 = x499 * x507;
-        let x569 = x502 * x506;
-        let x570 = x496 * x507;
-        let x571 = x496 * x506;
-        let x572 = x474 * x510;
-        let x573 = x473 * x509;
-        let x574 = x572 + x573;
-        let x575 = x497 * x507;
-        let x576 = x498 * x506;
-        let x577 = x500 * x507;
-        let x578 = x504 * x506;
-        let x579 = x503 * x505;
-        let x580 = x500 * x505;
-        let x581 = x472 * x508;
-        let x582 = x572 - x581;
-        let x583 = x501 * x505;
-        let x584 = x504 * x505;
-        let x585 = x573 - x581;
-        let x586 = Self::mul_add(-s_q3, x463, c_q3 * x460);
-        let x587 = Self::mul_add(-s_q3, x464, c_q3 * x461);
-        let x588 = Self::mul_add(-s_q3, x465, c_q3 * x462);
-        let x589 = Self::mul_add(c_q3, x463, s_q3 * x460);
-        let x590 = Self::mul_add(c_q3, x464, s_q3 * x461);
-        let x591 = Self::mul_add(c_q3, x465, s_q3 * x462);
-        let x592 = x466 + Self::mul_add(s_q1, 0.475, 7.11 * x460);
-        let x593 = x467 - Self::mul_add(-0.475, x356, 7.11 * x461);
-        let x594 = x468 + Self::mul_add(-0.475, x357, 7.11 * x462);
-        let x595 = Self::mul_add(x357, x593, x356 * x594);
-        let x596 = Self::mul_add(x357, x592, s_q1 * x594);
-        let x597 = Self::mul_add(-x356, x592, s_q1 * x593);
-        let x598 = 3239.4582 * x586;
-        let x599 = 3239.4582 * x587;
-        let x600 = 3239.4582 * x588;
-        let x601 = 1375.0472756800002 * s_q1;
-        let x602 = 24989.305802 * x589;
-        let x603 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x586);
-        let x604 = 1375.0472756800002 * x356;
-        let x605 = 24989.305802 * x590;
-        let x606 = Self::mul_add(24998.827802, x356, 1375.0472756800002 * x587);
-        let x607 = 1375.0472756800002 * x357;
-        let x608 = 24989.305802 * x591;
-        let x609 = Self::mul_add(24998.827802, x357, 1375.0472756800002 * x588);
-        let x610 = x594 * x600;
-        let x611 = x593 * x599;
-        let x612 = x610 - x611;
-        let x613 = x593 * x598;
-        let x614 = x594 * x598;
-        let x615 = x592 * x599;
-        let x616 = x592 * x598;
-        let x617 = x610 + x616;
-        let x618 = x594 * x599;
-        let x619 = x592 * x600;
-        let x620 = x593 * x600;
-        let x621 = x611 - x616;
-        let x622 = x612
-            - (Self::mul_add(s_q1, x603, Self::mul_add(-x589, x602, x586 * x601))
-                - x612);
-        let x623 = x615
-            + (Self::mul_add(-x356, x603, Self::mul_add(-x590, x602, x587 * x601))
-                - x613);
-        let x624 = x619
-            + (Self::mul_add(-x357, x603, Self::mul_add(-x591, x602, x588 * x601))
-                + x614);
-        let x625 = x613
-            + (Self::mul_add(-s_q1, x606, Self::mul_add(x589, x605, x586 * x604))
-                - x615);
-        let x626 = x617
-            + (Self::mul_add(x356, x606, Self::mul_add(x590, x605, x587 * x604)) + x617);
-        let x627 = x620
-            + (Self::mul_add(x357, x606, Self::mul_add(x591, x605, x588 * x604)) - x618);
-        let x628 = x614
-            - (Self::mul_add(-s_q1, x609, Self::mul_add(x589, x608, x586 * x607))
-                - x619);
-        let x629 = x618
-            - (Self::mul_add(x356, x609, Self::mul_add(x590, x608, x587 * x607)) + x620);
-        let x630 = x621
-            - (Self::mul_add(x357, x609, Self::mul_add(x591, x608, x588 * x607)) - x621);
-        let x631 = Self::mul_add(-qd[3], s_q1, x505);
-        let x632 = Self::mul_add(-qd[3], x356, x506);
-        let x633 = Self::mul_add(qd[3], x357, x507);
-        let x634 = Self::mul_add(-qd[3], x595, x508);
-        let x635 = Self::mul_add(qd[3], x596, x509);
-        let x636 = Self::mul_add(qd[3], x597, x510);
-        let x637 = Self::mul_add(x357, x632, x356 * x633);
-        let x638 = Self::mul_add(x357, x631, s_q1 * x633);
-        let x639 = Self::mul_add(-x356, x631, s_q1 * x632);
-        let x640 = Self::mul_add(-x357, x635, x356 * x636);
-        let x641 = Self::mul_add(-x357, x634, s_q1 * x636);
-        let x642 = Self::mul_add(-x356, x634, s_q1 * x635);
-        let x643 = Self::mul_add(x597, x632, x596 * x633) + x640;
-        let x644 = Self::mul_add(-x597, x631, x595 * x633) - x641;
-        let x645 = Self::mul_add(x596, x631, x595 * x632) + x642;
-        let x646 = Self::mul_add(-qd[3], x637, Self::mul_add(s_q1, x347, x520));
-        let x647 = Self::mul_add(qd[3], x638, Self::mul_add(x347, x356, x521));
-        let x648 = Self::mul_add(-qd[3], x639, Self::mul_add(-x347, x357, x522));
-        let x649 = Self::mul_add(qd[3], x643, Self::mul_add(x347, x595, x523));
-        let x650 = Self::mul_add(qd[3], x644, Self::mul_add(-x347, x596, x524));
-        let x651 = Self::mul_add(qd[3], x645, Self::mul_add(-x347, x597, x525));
-        let x652 = x514 + Self::mul_add(x506, x597, x507 * x596);
-        let x653 = x515 - Self::mul_add(-x505, x597, x507 * x595);
-        let x654 = x516 + Self::mul_add(x505, x596, x506 * x595);
-        let x655 = Self::mul_add(x357, x521, x356 * x522)
-            - Self::mul_add(x506, x513, x507 * x512);
-        let x656 = Self::mul_add(x357, x520, s_q1 * x522)
-            + Self::mul_add(-x505, x513, x507 * x511);
-        let x657 = Self::mul_add(-x356, x520, s_q1 * x521)
-            + Self::mul_add(x505, x512, x506 * x511);
-        let x658 = Self::mul_add(x521, x597, x522 * x596)
-            + Self::mul_add(-x357, x524, x356 * x525)
-            - (Self::mul_add(-x506, x654, x507 * x653)
-                + Self::mul_add(-x509, x513, x510 * x512));
-        let x659 = Self::mul_add(-x520, x597, x522 * x595)
-            - Self::mul_add(-x357, x523, s_q1 * x525)
-            - (Self::mul_add(x505, x654, x507 * x652)
-                + Self::mul_add(x508, x513, x510 * x511));
-        let x660 = Self::mul_add(x520, x596, x521 * x595)
-            + Self::mul_add(-x356, x523, s_q1 * x524)
-            - (Self::mul_add(x505, x653, x506 * x652)
-                - Self::mul_add(x508, x512, x509 * x511));
-        let x661 = x511 + x637;
-        let x662 = x512 + x638;
-        let x663 = x513 + x639;
-        let x664 = x643 + x652;
-        let x665 = x644 - x653;
-        let x666 = x645 + x654;
-        let x667 = x623 * x632;
-        let x668 = x624 * x633;
-        let x669 = x625 * x631;
-        let x670 = x627 * x633;
-        let x671 = x628 * x631;
-        let x672 = x629 * x632;
-        let x673 = x600 * x635;
-        let x674 = x599 * x636;
-        let x675 = x600 * x634;
-        let x676 = x598 * x636;
-        let x677 = x599 * x634;
-        let x678 = x598 * x635;
-        let x679 = Self::mul_add(x622, x631, x667) - x668 + (x673 - x674);
-        let x680 = Self::mul_add(-x626, x632, x669) + x670 + (x675 + x676);
-        let x681 = Self::mul_add(x630, x633, x671 - x672) + (x677 + x678);
-        let x682 = x600 * x632;
-        let x683 = x599 * x633;
-        let x684 = x682 + x683;
-        let x685 = x600 * x631;
-        let x686 = x598 * x633;
-        let x687 = x685 - x686;
-        let x688 = x599 * x631;
-        let x689 = x598 * x632;
-        let x690 = x688 + x689;
-        let x691 = x625 * x633;
-        let x692 = x628 * x632;
-        let x693 = x622 * x633;
-        let x694 = x622 * x632;
-        let x695 = x600 * x636;
-        let x696 = x599 * x635;
-        let x697 = x695 + x696;
-        let x698 = x623 * x633;
-        let x699 = x624 * x632;
-        let x700 = x626 * x633;
-        let x701 = x630 * x632;
-        let x702 = x629 * x631;
-        let x703 = x626 * x631;
-        let x704 = x598 * x634;
-        let x705 = x695 - x704;
-        let x706 = x627 * x631;
-        let x707 = x630 * x631;
-        let x708 = x696 - x704;
-        let x709 = Self::mul_add(c_q4, x589, s_q4 * x586);
-        let x710 = Self::mul_add(c_q4, x590, s_q4 * x587);
-        let x711 = Self::mul_add(c_q4, x591, s_q4 * x588);
-        let x712 = Self::mul_add(7.11, x586, x592);
-        let x713 = Self::mul_add(-7.11, x587, x593);
-        let x714 = Self::mul_add(7.11, x588, x594);
-        let x715 = Self::mul_add(x357, x713, x356 * x714);
-        let x716 = Self::mul_add(x357, x712, s_q1 * x714);
-        let x717 = Self::mul_add(-x356, x712, s_q1 * x713);
-        let x718 = 171.195516 * x709;
-        let x719 = 171.195516 * x710;
-        let x720 = 171.195516 * x711;
-        let x721 = Self::mul_add(-97.44448770720001, s_q1, 177.0883695416 * x709);
-        let x722 = Self::mul_add(179.8829695416, s_q1, 97.44448770720001 * x709);
-        let x723 = Self::mul_add(97.44448770720001, x356, 177.0883695416 * x710);
-        let x724 = Self::mul_add(-179.8829695416, x356, 97.44448770720001 * x710);
-        let x725 = Self::mul_add(97.44448770720001, x357, 177.0883695416 * x711);
-        let x726 = Self::mul_add(-179.8829695416, x357, 97.44448770720001 * x711);
-        let x727 = x714 * x720;
-        let x728 = x713 * x719;
-        let x729 = x727 - x728;
-        let x730 = x713 * x718;
-        let x731 = x714 * x718;
-        let x732 = x712 * x719;
-        let x733 = x712 * x718;
-        let x734 = x727 + x733;
-        let x735 = x714 * x719;
-        let x736 = x712 * x720;
-        let x737 = x713 * x720;
-        let x738 = x728 - x733;
-        let x739 = x729 + (Self::mul_add(-s_q1, x722, x709 * x721) + x729);
-        let x740 = x732 - (Self::mul_add(x356, x722, x710 * x721) + x730);
-        let x741 = x736 - (Self::mul_add(x357, x722, x711 * x721) - x731);
-        let x742 = x730 + (Self::mul_add(-s_q1, x724, x709 * x723) - x732);
-        let x743 = x734 + (Self::mul_add(x356, x724, x710 * x723) + x734);
-        let x744 = x737 + (Self::mul_add(x357, x724, x711 * x723) - x735);
-        let x745 = x731 - (Self::mul_add(-s_q1, x726, x709 * x725) - x736);
-        let x746 = x735 - (Self::mul_add(x356, x726, x710 * x725) + x737);
-        let x747 = x738 - (Self::mul_add(x357, x726, x711 * x725) - x738);
-        let x748 = Self::mul_add(-qd[4], s_q1, x631);
-        let x749 = Self::mul_add(-qd[4], x356, x632);
-        let x750 = Self::mul_add(qd[4], x357, x633);
-        let x751 = Self::mul_add(-qd[4], x715, x634);
-        let x752 = Self::mul_add(qd[4], x716, x635);
-        let x753 = Self::mul_add(qd[4], x717, x636);
-        let x754 = Self::mul_add(x357, x749, x356 * x750);
-        let x755 = Self::mul_add(x357, x748, s_q1 * x750);
-        let x756 = Self::mul_add(-x356, x748, s_q1 * x749);
-        let x757 = Self::mul_add(x717, x749, x716 * x750)
-            + Self::mul_add(-x357, x752, x356 * x753);
-        let x758 = Self::mul_add(-x717, x748, x715 * x750)
-            - Self::mul_add(-x357, x751, s_q1 * x753);
-        let x759 = Self::mul_add(x716, x748, x715 * x749)
-            + Self::mul_add(-x356, x751, s_q1 * x752);
-        let x760 = Self::mul_add(-qd[4], x754, Self::mul_add(-s_q1, x349, x646));
-        let x761 = Self::mul_add(qd[4], x755, Self::mul_add(-x349, x356, x647));
-        let x762 = Self::mul_add(-qd[4], x756, Self::mul_add(x349, x357, x648));
-        let x763 = Self::mul_add(qd[4], x757, Self::mul_add(-x349, x715, x649));
-        let x764 = Self::mul_add(qd[4], x758, Self::mul_add(x349, x716, x650));
-        let x765 = Self::mul_add(qd[4], x759, Self::mul_add(x349, x717, x651));
-        let x766 = x640 + Self::mul_add(x632, x717, x633 * x716);
-        let x767 = x641 - Self::mul_add(-x631, x717, x633 * x715);
-        let x768 = x642 + Self::mul_add(x631, x716, x632 * x715);
-        let x769 = Self::mul_add(x357, x647, x356 * x648)
-            - Self::mul_add(x632, x639, x633 * x638);
-        let x770 = Self::mul_add(x357, x646, s_q1 * x648)
-            + Self::mul_add(-x631, x639, x633 * x637);
-        let x771 = Self::mul_add(-x356, x646, s_q1 * x647)
-            + Self::mul_add(x631, x638, x632 * x637);
-        let x772 = Self::mul_add(x647, x717, x648 * x716)
-            + Self::mul_add(-x357, x650, x356 * x651)
-            - (Self::mul_add(-x632, x768, x633 * x767)
-                + Self::mul_add(-x635, x639, x636 * x638));
-        let x773 = Self::mul_add(-x646, x717, x648 * x715)
-            - Self::mul_add(-x357, x649, s_q1 * x651)
-            - (Self::mul_add(x631, x768, x633 * x766)
-                + Self::mul_add(x634, x639, x636 * x637));
-        let x774 = Self::mul_add(x646, x716, x647 * x715)
-            + Self::mul_add(-x356, x649, s_q1 * x650)
-            - (Self::mul_add(x631, x767, x632 * x766)
-                - Self::mul_add(x634, x638, x635 * x637));
-        let x775 = x637 + x754;
-        let x776 = x638 + x755;
-        let x777 = x639 + x756;
-        let x778 = x757 + x766;
-        let x779 = x758 - x767;
-        let x780 = x759 + x768;
-        let x781 = x740 * x749;
-        let x782 = x741 * x750;
-        let x783 = x742 * x748;
-        let x784 = x744 * x750;
-        let x785 = x745 * x748;
-        let x786 = x746 * x749;
-        let x787 = x720 * x752;
-        let x788 = x719 * x753;
-        let x789 = x720 * x751;
-        let x790 = x718 * x753;
-        let x791 = x719 * x751;
-        let x792 = x718 * x752;
-        let x793 = Self::mul_add(x739, x748, x781) - x782 + (x787 - x788);
-        let x794 = Self::mul_add(-x743, x749, x783) + x784 + (x789 + x790);
-        let x795 = Self::mul_add(x747, x750, x785 - x786) + (x791 + x792);
-        let x796 = x720 * x749;
-        let x797 = x719 * x750;
-        let x798 = x796 + x797;
-        let x799 = x720 * x748;
-        let x800 = x718 * x750;
-        let x801 = x799 - x800;
-        let x802 = x719 * x748;
-        let x803 = x718 * x749;
-        let x804 = x802 + x803;
-        let x805 = Self::mul_add(x719, x762, x720 * x761)
-            - Self::mul_add(-x749, x804, x750 * x801);
-        let x806 = Self::mul_add(-x718, x762, x720 * x760)
-            + Self::mul_add(x748, x804, x750 * x798);
-        let x807 = Self::mul_add(x718, x761, x719 * x760)
-            - Self::mul_add(x748, x801, x749 * x798);
-        let x808 = x742 * x750;
-        let x809 = x745 * x749;
-        let x810 = x739 * x750;
-        let x811 = x739 * x749;
-        let x812 = x720 * x753;
-        let x813 = x719 * x752;
-        let x814 = x812 + x813;
-        let x815 = x740 * x750;
-        let x816 = x741 * x749;
-        let x817 = x743 * x750;
-        let x818 = x747 * x749;
-        let x819 = x803 + (x802 + x804);
-        let x820 = x800 - (x799 + x801);
-        let x821 = x746 * x748;
-        let x822 = x743 * x748;
-        let x823 = x718 * x751;
-        let x824 = x812 - x823;
-        let x825 = x744 * x748;
-        let x826 = x747 * x748;
-        let x827 = x802 + (x803 + x804);
-        let x828 = x797 + (x796 + x798);
-        let x829 = x813 - x823;
-        let x830 = x799 - (x800 - x801);
-        let x831 = x796 + (x797 + x798);
-        let x832 = x803 + (x802 - x804);
-        let x833 = x800 - (x799 - x801);
-        let x834 = x802 + (x803 - x804);
-        let x835 = x797 + (x796 - x798);
-        let x836 = x799 - (x800 + x801);
-        let x837 = x796 + (x797 - x798);
-        let x838 = Self::mul_add(
+            - (Self::mul_add(-qd[0], x514, x391 * x513)
+                - Self::mul_add(x393, x511, x394 * x510));
+        let x522 = x495 + x510;
+        let x523 = x496 + x511;
+        let x524 = x497 + x512;
+        let x525 = x501 + x513;
+        let x526 = x502 + x514;
+        let x527 = x503 + x515;
+        let x528 = x481 * x490;
+        let x529 = x482 * x491;
+        let x530 = x483 * x489;
+        let x531 = x485 * x491;
+        let x532 = x486 * x489;
+        let x533 = x487 * x490;
+        let x534 = x458 * x493;
+        let x535 = x457 * x494;
+        let x536 = x458 * x492;
+        let x537 = x456 * x494;
+        let x538 = x457 * x492;
+        let x539 = x456 * x493;
+        let x540 = Self::mul_add(x480, x489, x528) - x529 + (x534 - x535);
+        let x541 = Self::mul_add(-x484, x490, x530) + x531 + (x536 + x537);
+        let x542 = Self::mul_add(x488, x491, x532 - x533) + (x538 + x539);
+        let x543 = Self::mul_add(x457, x491, x458 * x490);
+        let x544 = Self::mul_add(-x456, x491, x458 * x489);
+        let x545 = Self::mul_add(x456, x490, x457 * x489);
+        let x546 = Self::mul_add(-x486, x490, x483 * x491);
+        let x547 = Self::mul_add(-x487, x489, x481 * x491);
+        let x548 = Self::mul_add(-x485, x489, x482 * x490);
+        let x549 = x456 * x492;
+        let x550 = x457 * x493;
+        let x551 = x458 * x494;
+        let x552 = x549 - x550 - x551;
+        let x553 = x552 + x552;
+        let x554 = Self::mul_add(-s_q3, x447, c_q3 * x444);
+        let x555 = Self::mul_add(-s_q3, x448, c_q3 * x445);
+        let x556 = Self::mul_add(-s_q3, x449, c_q3 * x446);
+        let x557 = Self::mul_add(c_q3, x447, s_q3 * x444);
+        let x558 = Self::mul_add(c_q3, x448, s_q3 * x445);
+        let x559 = Self::mul_add(c_q3, x449, s_q3 * x446);
+        let x560 = x450 + Self::mul_add(s_q1, 0.475, 7.11 * x444);
+        let x561 = x451 - Self::mul_add(-0.475, x356, 7.11 * x445);
+        let x562 = x452 + Self::mul_add(-0.475, x357, 7.11 * x446);
+        let x563 = Self::mul_add(x357, x561, x356 * x562);
+        let x564 = Self::mul_add(x357, x560, s_q1 * x562);
+        let x565 = Self::mul_add(-x356, x560, s_q1 * x561);
+        let x566 = 3239.4582 * x554;
+        let x567 = 3239.4582 * x555;
+        let x568 = 3239.4582 * x556;
+        let x569 = 1375.0472756800002 * s_q1;
+        let x570 = 24989.305802 * x557;
+        let x571 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x554);
+        let x572 = 1375.0472756800002 * x356;
+        let x573 = 24989.305802 * x558;
+        let x574 = Self::mul_add(24998.827802, x356, 1375.0472756800002 * x555);
+        let x575 = 1375.0472756800002 * x357;
+        let x576 = 24989.305802 * x559;
+        let x577 = Self::mul_add(24998.827802, x357, 1375.0472756800002 * x556);
+        let x578 = x562 * x568;
+        let x579 = x561 * x567;
+        let x580 = x578 - x579;
+        let x581 = x561 * x566;
+        let x582 = x562 * x566;
+        let x583 = x560 * x567;
+        let x584 = x560 * x566;
+        let x585 = x578 + x584;
+        let x586 = x562 * x567;
+        let x587 = x560 * x568;
+        let x588 = x561 * x568;
+        let x589 = x579 - x584;
+        let x590 = x580
+            - (Self::mul_add(s_q1, x571, Self::mul_add(-x557, x570, x554 * x569))
+                - x580);
+        let x591 = x583
+            + (Self::mul_add(-x356, x571, Self::mul_add(-x558, x570, x555 * x569))
+                - x581);
+        let x592 = x587
+            + (Self::mul_add(-x357, x571, Self::mul_add(-x559, x570, x556 * x569))
+                + x582);
+        let x593 = x581
+            + (Self::mul_add(-s_q1, x574, Self::mul_add(x557, x573, x554 * x572))
+                - x583);
+        let x594 = x585
+            + (Self::mul_add(x356, x574, Self::mul_add(x558, x573, x555 * x572)) + x585);
+        let x595 = x588
+            + (Self::mul_add(x357, x574, Self::mul_add(x559, x573, x556 * x572)) - x586);
+        let x596 = x582
+            - (Self::mul_add(-s_q1, x577, Self::mul_add(x557, x576, x554 * x575))
+                - x587);
+        let x597 = x586
+            - (Self::mul_add(x356, x577, Self::mul_add(x558, x576, x555 * x575)) + x588);
+        let x598 = x589
+            - (Self::mul_add(x357, x577, Self::mul_add(x559, x576, x556 * x575)) - x589);
+        let x599 = Self::mul_add(-qd[3], s_q1, x489);
+        let x600 = Self::mul_add(-qd[3], x356, x490);
+        let x601 = Self::mul_add(qd[3], x357, x491);
+        let x602 = Self::mul_add(-qd[3], x563, x492);
+        let x603 = Self::mul_add(qd[3], x564, x493);
+        let x604 = Self::mul_add(qd[3], x565, x494);
+        let x605 = Self::mul_add(x357, x600, x356 * x601);
+        let x606 = Self::mul_add(x357, x599, s_q1 * x601);
+        let x607 = Self::mul_add(-x356, x599, s_q1 * x600);
+        let x608 = Self::mul_add(-x357, x603, x356 * x604);
+        let x609 = Self::mul_add(-x357, x602, s_q1 * x604);
+        let x610 = Self::mul_add(-x356, x602, s_q1 * x603);
+        let x611 = Self::mul_add(x565, x600, x564 * x601) + x608;
+        let x612 = Self::mul_add(-x565, x599, x563 * x601) - x609;
+        let x613 = Self::mul_add(x564, x599, x563 * x600) + x610;
+        let x614 = Self::mul_add(-qd[3], x605, Self::mul_add(s_q1, x347, x504));
+        let x615 = Self::mul_add(qd[3], x606, Self::mul_add(x347, x356, x505));
+        let x616 = Self::mul_add(-qd[3], x607, Self::mul_add(-x347, x357, x506));
+        let x617 = Self::mul_add(qd[3], x611, Self::mul_add(x347, x563, x507));
+        let x618 = Self::mul_add(qd[3], x612, Self::mul_add(-x347, x564, x508));
+        let x619 = Self::mul_add(qd[3], x613, Self::mul_add(-x347, x565, x509));
+        let x620 = x498 + Self::mul_add(x490, x565, x491 * x564);
+        let x621 = x499 - Self::mul_add(-x489, x565, x491 * x563);
+        let x622 = x500 + Self::mul_add(x489, x564, x490 * x563);
+        let x623 = Self::mul_add(x357, x505, x356 * x506)
+            - Self::mul_add(x490, x497, x491 * x496);
+        let x624 = Self::mul_add(x357, x504, s_q1 * x506)
+            + Self::mul_add(-x489, x497, x491 * x495);
+        let x625 = Self::mul_add(-x356, x504, s_q1 * x505)
+            + Self::mul_add(x489, x496, x490 * x495);
+        let x626 = Self::mul_add(x505, x565, x506 * x564)
+            + Self::mul_add(-x357, x508, x356 * x509)
+            - (Self::mul_add(-x490, x622, x491 * x621)
+                + Self::mul_add(-x493, x497, x494 * x496));
+        let x627 = Self::mul_add(-x504, x565, x506 * x563)
+            - Self::mul_add(-x357, x507, s_q1 * x509)
+            - (Self::mul_add(x489, x622, x491 * x620)
+                + Self::mul_add(x492, x497, x494 * x495));
+        let x628 = Self::mul_add(x504, x564, x505 * x563)
+            + Self::mul_add(-x356, x507, s_q1 * x508)
+            - (Self::mul_add(x489, x621, x490 * x620)
+                - Self::mul_add(x492, x496, x493 * x495));
+        let x629 = x495 + x605;
+        let x630 = x496 + x606;
+        let x631 = x497 + x607;
+        let x632 = x611 + x620;
+        let x633 = x612 - x621;
+        let x634 = x613 + x622;
+        let x635 = x591 * x600;
+        let x636 = x592 * x601;
+        let x637 = x593 * x599;
+        let x638 = x595 * x601;
+        let x639 = x596 * x599;
+        let x640 = x597 * x600;
+        let x641 = x568 * x603;
+        let x642 = x567 * x604;
+        let x643 = x568 * x602;
+        let x644 = x566 * x604;
+        let x645 = x567 * x602;
+        let x646 = x566 * x603;
+        let x647 = Self::mul_add(x590, x599, x635) - x636 + (x641 - x642);
+        let x648 = Self::mul_add(-x594, x600, x637) + x638 + (x643 + x644);
+        let x649 = Self::mul_add(x598, x601, x639 - x640) + (x645 + x646);
+        let x650 = Self::mul_add(x567, x601, x568 * x600);
+        let x651 = Self::mul_add(-x566, x601, x568 * x599);
+        let x652 = Self::mul_add(x566, x600, x567 * x599);
+        let x653 = Self::mul_add(-x596, x600, x593 * x601);
+        let x654 = Self::mul_add(-x597, x599, x591 * x601);
+        let x655 = Self::mul_add(-x595, x599, x592 * x600);
+        let x656 = x566 * x602;
+        let x657 = x567 * x603;
+        let x658 = x568 * x604;
+        let x659 = x656 - x657 - x658;
+        let x660 = x659 + x659;
+        let x661 = Self::mul_add(c_q4, x557, s_q4 * x554);
+        let x662 = Self::mul_add(c_q4, x558, s_q4 * x555);
+        let x663 = Self::mul_add(c_q4, x559, s_q4 * x556);
+        let x664 = Self::mul_add(7.11, x554, x560);
+        let x665 = Self::mul_add(-7.11, x555, x561);
+        let x666 = Self::mul_add(7.11, x556, x562);
+        let x667 = Self::mul_add(x357, x665, x356 * x666);
+        let x668 = Self::mul_add(x357, x664, s_q1 * x666);
+        let x669 = Self::mul_add(-x356, x664, s_q1 * x665);
+        let x670 = 171.195516 * x661;
+        let x671 = 171.195516 * x662;
+        let x672 = 171.195516 * x663;
+        let x673 = Self::mul_add(-97.44448770720001, s_q1, 177.0883695416 * x661);
+        let x674 = Self::mul_add(179.8829695416, s_q1, 97.44448770720001 * x661);
+        let x675 = Self::mul_add(97.44448770720001, x356, 177.0883695416 * x662);
+        let x676 = Self::mul_add(-179.8829695416, x356, 97.44448770720001 * x662);
+        let x677 = Self::mul_add(97.44448770720001, x357, 177.0883695416 * x663);
+        let x678 = Self::mul_add(-179.8829695416, x357, 97.44448770720001 * x663);
+        let x679 = x666 * x672;
+        let x680 = x665 * x671;
+        let x681 = x679 - x680;
+        let x682 = x665 * x670;
+        let x683 = x666 * x670;
+        let x684 = x664 * x671;
+        let x685 = x664 * x670;
+        let x686 = x679 + x685;
+        let x687 = x666 * x671;
+        let x688 = x664 * x672;
+        let x689 = x665 * x672;
+        let x690 = x680 - x685;
+        let x691 = x681 + (Self::mul_add(-s_q1, x674, x661 * x673) + x681);
+        let x692 = x684 - (Self::mul_add(x356, x674, x662 * x673) + x682);
+        let x693 = x688 - (Self::mul_add(x357, x674, x663 * x673) - x683);
+        let x694 = x682 + (Self::mul_add(-s_q1, x676, x661 * x675) - x684);
+        let x695 = x686 + (Self::mul_add(x356, x676, x662 * x675) + x686);
+        let x696 = x689 + (Self::mul_add(x357, x676, x663 * x675) - x687);
+        let x697 = x683 - (Self::mul_add(-s_q1, x678, x661 * x677) - x688);
+        let x698 = x687 - (Self::mul_add(x356, x678, x662 * x677) + x689);
+        let x699 = x690 - (Self::mul_add(x357, x678, x663 * x677) - x690);
+        let x700 = Self::mul_add(-qd[4], s_q1, x599);
+        let x701 = Self::mul_add(-qd[4], x356, x600);
+        let x702 = Self::mul_add(qd[4], x357, x601);
+        let x703 = Self::mul_add(-qd[4], x667, x602);
+        let x704 = Self::mul_add(qd[4], x668, x603);
+        let x705 = Self::mul_add(qd[4], x669, x604);
+        let x706 = Self::mul_add(x357, x701, x356 * x702);
+        let x707 = Self::mul_add(x357, x700, s_q1 * x702);
+        let x708 = Self::mul_add(-x356, x700, s_q1 * x701);
+        let x709 = Self::mul_add(x669, x701, x668 * x702)
+            + Self::mul_add(-x357, x704, x356 * x705);
+        let x710 = Self::mul_add(-x669, x700, x667 * x702)
+            - Self::mul_add(-x357, x703, s_q1 * x705);
+        let x711 = Self::mul_add(x668, x700, x667 * x701)
+            + Self::mul_add(-x356, x703, s_q1 * x704);
+        let x712 = Self::mul_add(-qd[4], x706, Self::mul_add(-s_q1, x349, x614));
+        let x713 = Self::mul_add(qd[4], x707, Self::mul_add(-x349, x356, x615));
+        let x714 = Self::mul_add(-qd[4], x708, Self::mul_add(x349, x357, x616));
+        let x715 = Self::mul_add(qd[4], x709, Self::mul_add(-x349, x667, x617));
+        let x716 = Self::mul_add(qd[4], x710, Self::mul_add(x349, x668, x618));
+        let x717 = Self::mul_add(qd[4], x711, Self::mul_add(x349, x669, x619));
+        let x718 = x608 + Self::mul_add(x600, x669, x601 * x668);
+        let x719 = x609 - Self::mul_add(-x599, x669, x601 * x667);
+        let x720 = x610 + Self::mul_add(x599, x668, x600 * x667);
+        let x721 = Self::mul_add(x357, x615, x356 * x616)
+            - Self::mul_add(x600, x607, x601 * x606);
+        let x722 = Self::mul_add(x357, x614, s_q1 * x616)
+            + Self::mul_add(-x599, x607, x601 * x605);
+        let x723 = Self::mul_add(-x356, x614, s_q1 * x615)
+            + Self::mul_add(x599, x606, x600 * x605);
+        let x724 = Self::mul_add(x615, x669, x616 * x668)
+            + Self::mul_add(-x357, x618, x356 * x619)
+            - (Self::mul_add(-x600, x720, x601 * x719)
+                + Self::mul_add(-x603, x607, x604 * x606));
+        let x725 = Self::mul_add(-x614, x669, x616 * x667)
+            - Self::mul_add(-x357, x617, s_q1 * x619)
+            - (Self::mul_add(x599, x720, x601 * x718)
+                + Self::mul_add(x602, x607, x604 * x605));
+        let x726 = Self::mul_add(x614, x668, x615 * x667)
+            + Self::mul_add(-x356, x617, s_q1 * x618)
+            - (Self::mul_add(x599, x719, x600 * x718)
+                - Self::mul_add(x602, x606, x603 * x605));
+        let x727 = x605 + x706;
+        let x728 = x606 + x707;
+        let x729 = x607 + x708;
+        let x730 = x709 + x718;
+        let x731 = x710 - x719;
+        let x732 = x711 + x720;
+        let x733 = x692 * x701;
+        let x734 = x693 * x702;
+        let x735 = x694 * x700;
+        let x736 = x696 * x702;
+        let x737 = x697 * x700;
+        let x738 = x698 * x701;
+        let x739 = x672 * x704;
+        let x740 = x671 * x705;
+        let x741 = x672 * x703;
+        let x742 = x670 * x705;
+        let x743 = x671 * x703;
+        let x744 = x670 * x704;
+        let x745 = Self::mul_add(x691, x700, x733) - x734 + (x739 - x740);
+        let x746 = Self::mul_add(-x695, x701, x735) + x736 + (x741 + x742);
+        let x747 = Self::mul_add(x699, x702, x737 - x738) + (x743 + x744);
+        let x748 = Self::mul_add(x671, x702, x672 * x701);
+        let x749 = Self::mul_add(-x670, x702, x672 * x700);
+        let x750 = Self::mul_add(x670, x701, x671 * x700);
+        let x751 = Self::mul_add(x671, x714, x672 * x713)
+            - Self::mul_add(-x701, x750, x702 * x749);
+        let x752 = Self::mul_add(-x670, x714, x672 * x712)
+            + Self::mul_add(x700, x750, x702 * x748);
+        let x753 = Self::mul_add(x670, x713, x671 * x712)
+            - Self::mul_add(x700, x749, x701 * x748);
+        let x754 = Self::mul_add(-x697, x701, x694 * x702);
+        let x755 = Self::mul_add(-x698, x700, x692 * x702);
+        let x756 = Self::mul_add(-x696, x700, x693 * x701);
+        let x757 = x670 * x703;
+        let x758 = x671 * x704;
+        let x759 = x672 * x705;
+        let x760 = x757 - x758 - x759;
+        let x761 = x760 + x760;
+        let x762 = Self::mul_add(
             -s_q1,
             s_q5,
-            c_q5 * Self::mul_add(-s_q4, x589, c_q4 * x586),
+            c_q5 * Self::mul_add(-s_q4, x557, c_q4 * x554),
         );
-        let x839 = Self::mul_add(
+        let x763 = Self::mul_add(
             s_q5,
             x356,
-            c_q5 * Self::mul_add(-s_q4, x590, c_q4 * x587),
+            c_q5 * Self::mul_add(-s_q4, x558, c_q4 * x555),
         );
-        let x840 = Self::mul_add(
+        let x764 = Self::mul_add(
             s_q5,
             x357,
-            c_q5 * Self::mul_add(-s_q4, x591, c_q4 * x588),
+            c_q5 * Self::mul_add(-s_q4, x559, c_q4 * x556),
         );
-        let x841 = 44.41 * x838;
-        let x842 = 47.471 * x709;
-        let x843 = 44.41 * x839;
-        let x844 = 47.471 * x710;
-        let x845 = 44.41 * x840;
-        let x846 = 47.471 * x711;
-        let x847 = Self::mul_add(-x709, x842, x838 * x841);
-        let x848 = Self::mul_add(-x710, x842, x839 * x841);
-        let x849 = Self::mul_add(-x711, x842, x840 * x841);
-        let x850 = Self::mul_add(-x709, x844, x838 * x843);
-        let x851 = Self::mul_add(-x710, x844, x839 * x843);
-        let x852 = Self::mul_add(-x711, x844, x840 * x843);
-        let x853 = Self::mul_add(-x709, x846, x838 * x845);
-        let x854 = Self::mul_add(-x710, x846, x839 * x845);
-        let x855 = Self::mul_add(-x711, x846, x840 * x845);
-        let x856 = Self::mul_add(qd[5], x709, x748);
-        let x857 = Self::mul_add(-qd[5], x710, x749);
-        let x858 = Self::mul_add(qd[5], x711, x750);
-        let x859 = Self::mul_add(x711, x857, x710 * x858);
-        let x860 = Self::mul_add(-x711, x856, x709 * x858);
-        let x861 = Self::mul_add(x710, x856, x709 * x857);
-        let x862 = Self::mul_add(-qd[5], x859, Self::mul_add(x351, x709, x760));
-        let x863 = Self::mul_add(-qd[5], x860, Self::mul_add(-x351, x710, x761));
-        let x864 = Self::mul_add(qd[5], x861, Self::mul_add(x351, x711, x762));
-        let x865 = Self::mul_add(x711, x749, x710 * x750);
-        let x866 = Self::mul_add(-x711, x748, x709 * x750);
-        let x867 = Self::mul_add(x710, x748, x709 * x749);
-        let x868 = Self::mul_add(x711, x761, x710 * x762)
-            + Self::mul_add(x749, x867, x750 * x866);
-        let x869 = Self::mul_add(-x711, x760, x709 * x762)
-            - Self::mul_add(x748, x867, x750 * x865);
-        let x870 = Self::mul_add(x710, x760, x709 * x761)
-            - Self::mul_add(-x748, x866, x749 * x865);
-        let x871 = x859 + x865;
-        let x872 = x860 + x866;
-        let x873 = x861 + x867;
-        let x874 = x848 * x857;
-        let x875 = x849 * x858;
-        let x876 = Self::mul_add(x847, x856, -x874) + x875;
-        let x877 = x850 * x856;
-        let x878 = x852 * x858;
-        let x879 = Self::mul_add(-x851, x857, x877) + x878;
-        let x880 = x853 * x856;
-        let x881 = x854 * x857;
-        let x882 = Self::mul_add(x855, x858, x880 - x881);
-        let x883 = x850 * x858;
-        let x884 = x853 * x857;
-        let x885 = x847 * x858;
-        let x886 = x847 * x857;
-        let x887 = x848 * x858;
-        let x888 = x849 * x857;
-        let x889 = x851 * x858;
-        let x890 = x855 * x857;
-        let x891 = x854 * x856;
-        let x892 = x851 * x856;
-        let x893 = x852 * x856;
-        let x894 = x855 * x856;
-        let x895 = 9.336 * x838;
-        let x896 = 9.336 * x839;
-        let x897 = 9.336 * x840;
-        let x898 = x838 * x895;
-        let x899 = x839 * x895;
-        let x900 = x840 * x895;
-        let x901 = x838 * x896;
-        let x902 = x839 * x896;
-        let x903 = x840 * x896;
-        let x904 = x838 * x897;
-        let x905 = x839 * x897;
-        let x906 = x840 * x897;
-        let x907 = Self::mul_add(qd[6], x838, x856);
-        let x908 = Self::mul_add(-qd[6], x839, x857);
-        let x909 = Self::mul_add(qd[6], x840, x858);
-        let x910 = Self::mul_add(x840, x908, x839 * x909);
-        let x911 = Self::mul_add(-x840, x907, x838 * x909);
-        let x912 = Self::mul_add(x839, x907, x838 * x908);
-        let x913 = Self::mul_add(-qd[6], x910, Self::mul_add(x353, x838, x862));
-        let x914 = Self::mul_add(-qd[6], x911, Self::mul_add(-x353, x839, x863));
-        let x915 = Self::mul_add(qd[6], x912, Self::mul_add(x353, x840, x864));
-        let x916 = Self::mul_add(x840, x857, x839 * x858);
-        let x917 = Self::mul_add(-x840, x856, x838 * x858);
-        let x918 = Self::mul_add(x839, x856, x838 * x857);
-        let x919 = Self::mul_add(x840, x863, x839 * x864)
-            + Self::mul_add(x857, x918, x858 * x917);
-        let x920 = Self::mul_add(-x840, x862, x838 * x864)
-            - Self::mul_add(x856, x918, x858 * x916);
-        let x921 = Self::mul_add(x839, x862, x838 * x863)
-            - Self::mul_add(-x856, x917, x857 * x916);
-        let x922 = x910 + x916;
-        let x923 = x911 + x917;
-        let x924 = x912 + x918;
-        let x925 = x899 * x908;
-        let x926 = x900 * x909;
-        let x927 = Self::mul_add(x898, x907, -x925) + x926;
-        let x928 = x901 * x907;
-        let x929 = x903 * x909;
-        let x930 = Self::mul_add(-x902, x908, x928) + x929;
-        let x931 = x904 * x907;
-        let x932 = x905 * x908;
-        let x933 = Self::mul_add(x906, x909, x931 - x932);
-        let x934 = Self::mul_add(x900, x915, Self::mul_add(-x899, x914, x898 * x913))
-            - Self::mul_add(x908, x933, x909 * x930);
-        let x935 = Self::mul_add(x903, x915, Self::mul_add(-x902, x914, x901 * x913))
-            + Self::mul_add(-x907, x933, x909 * x927);
-        let x936 = Self::mul_add(x906, x915, Self::mul_add(-x905, x914, x904 * x913))
-            + Self::mul_add(x907, x930, x908 * x927);
-        let x937 = x901 * x909;
-        let x938 = x904 * x908;
-        let x939 = x898 * x909;
-        let x940 = x898 * x908;
-        let x941 = x899 * x909;
-        let x942 = x900 * x908;
-        let x943 = x902 * x909;
-        let x944 = x906 * x908;
-        let x945 = x937 + x938 + (x941 + x942);
-        let x946 = x933 + (x931 - x939) + Self::mul_add(x903, x908, x943);
-        let x947 = x930 + (x928 + x940) - Self::mul_add(x905, x909, x944);
-        let x948 = x905 * x907;
-        let x949 = x902 * x907;
-        let x950 = x903 * x907;
-        let x951 = x906 * x907;
-        let x952 = x933 - (x932 + x943) + Self::mul_add(-x900, x907, x939);
-        let x953 = x941 - x948 + (x937 - x950);
-        let x954 = x927 - (x925 + x949) - Self::mul_add(x904, x909, -x951);
-        let x955 = x930 + (x929 + x944) - Self::mul_add(x899, x907, x940);
-        let x956 = x927 + (x926 - x951) + Self::mul_add(x901, x908, x949);
-        let x957 = x942 + x950 + (x938 + x948);
-        let x958 = Self::mul_add(x840, x900, Self::mul_add(x839, x899, x838 * x898));
-        let x959 = Self::mul_add(x840, x903, Self::mul_add(x839, x902, x838 * x901));
-        let x960 = Self::mul_add(x840, x906, Self::mul_add(x839, x905, x838 * x904));
-        let x961 = x838 * x945;
-        let x962 = Self::mul_add(-x840, x947, Self::mul_add(x839, x946, x961));
-        let x963 = x839 * x953;
-        let x964 = Self::mul_add(-x840, x954, Self::mul_add(x838, x952, x963));
-        let x965 = x840 * x957;
-        let x966 = Self::mul_add(-x839, x956, x838 * x955) - x965;
-        let x967 = Self::mul_add(-x839, x936, x840 * x935)
-            + Self::mul_add(-x900, x921, Self::mul_add(-x899, x920, x898 * x919))
-            - Self::mul_add(-x918, x955, Self::mul_add(x917, x952, x916 * x945));
-        let x968 = Self::mul_add(-x838, x936, x840 * x934)
-            - Self::mul_add(-x903, x921, Self::mul_add(-x902, x920, x901 * x919))
-            + Self::mul_add(x918, x956, Self::mul_add(x917, x953, x916 * x946));
-        let x969 = Self::mul_add(-x838, x935, x839 * x934)
-            + Self::mul_add(-x906, x921, Self::mul_add(-x905, x920, x904 * x919))
-            + Self::mul_add(-x918, x957, Self::mul_add(x917, x954, x916 * x947));
-        let x970 = Self::mul_add(-x900, x924, Self::mul_add(-x899, x923, x898 * x922))
-            + Self::mul_add(x840, x955, Self::mul_add(-x839, x952, x961));
-        let x971 = Self::mul_add(-x903, x924, Self::mul_add(-x902, x923, x901 * x922))
-            - Self::mul_add(x840, x956, Self::mul_add(-x838, x946, x963));
-        let x972 = Self::mul_add(-x906, x924, Self::mul_add(-x905, x923, x904 * x922))
-            - (x965 + Self::mul_add(-x839, x954, x838 * x947));
-        let x973 = Self::mul_add(c_q0, x969, s_q0 * x968);
-        let x974 = Self::mul_add(-c_q0, x972, s_q0 * x971);
-        let x975 = Self::mul_add(-x357, x969, Self::mul_add(x356, x968, s_q1 * x967));
-        let x976 = Self::mul_add(-x357, x972, Self::mul_add(-x356, x971, s_q1 * x970));
-        let x977 = Self::mul_add(x711, x969, Self::mul_add(-x710, x968, x709 * x967));
-        let x978 = Self::mul_add(x711, x972, Self::mul_add(x710, x971, x709 * x970));
-        let x979 = Self::mul_add(-x921, x960, Self::mul_add(-x920, x959, x919 * x958))
-            - Self::mul_add(-x918, x966, Self::mul_add(x917, x964, x916 * x962));
-        let x980 = Self::mul_add(-x924, x960, Self::mul_add(-x923, x959, x922 * x958))
-            + Self::mul_add(x840, x966, Self::mul_add(-x839, x964, x838 * x962));
-        let x981 = x847 - x898;
-        let x982 = x848 - x899;
-        let x983 = x849 - x900;
-        let x984 = x850 - x901;
-        let x985 = x851 - x902;
-        let x986 = x852 - x903;
-        let x987 = x853 - x904;
-        let x988 = x854 - x905;
-        let x989 = x855 - x906;
-        let x990 = x883 + x884 + (x887 + x888) - x945;
-        let x991 = x882 - (x881 + x889) + Self::mul_add(-x849, x856, x885) - x952;
-        let x992 = x879 + (x878 + x890) - Self::mul_add(x848, x856, x886) - x955;
-        let x993 = x882 + (x880 - x885) + Self::mul_add(x852, x857, x889) - x946;
-        let x994 = x887 - x891 + (x883 - x893) - x953;
-        let x995 = x876 + (x875 - x894) + Self::mul_add(x850, x857, x892) - x956;
-        let x996 = x879 + (x877 + x886) - Self::mul_add(x854, x858, x890) - x947;
-        let x997 = x876 - (x874 + x892) - Self::mul_add(x853, x858, -x894) - x954;
-        let x998 = x888 + x893 + (x884 + x891) - x957;
-        let x999 = Self::mul_add(x849, x864, Self::mul_add(-x848, x863, x847 * x862))
-            - Self::mul_add(x857, x882, x858 * x879) - x934;
-        let x1000 = Self::mul_add(x852, x864, Self::mul_add(-x851, x863, x850 * x862))
-            + Self::mul_add(-x856, x882, x858 * x876) - x935;
-        let x1001 = Self::mul_add(x855, x864, Self::mul_add(-x854, x863, x853 * x862))
-            + Self::mul_add(x856, x879, x857 * x876) - x936;
-        let x1002 = Self::mul_add(x711, x983, Self::mul_add(x710, x982, x709 * x981));
-        let x1003 = Self::mul_add(x711, x986, Self::mul_add(x710, x985, x709 * x984));
-        let x1004 = Self::mul_add(x711, x989, Self::mul_add(x710, x988, x709 * x987));
-        let x1005 = x709 * x990;
-        let x1006 = Self::mul_add(-x711, x996, Self::mul_add(x710, x993, x1005));
-        let x1007 = x710 * x994;
-        let x1008 = Self::mul_add(-x711, x997, Self::mul_add(x709, x991, x1007));
-        let x1009 = x711 * x998;
-        let x1010 = Self::mul_add(-x710, x995, x709 * x992) - x1009;
-        let x1011 = Self::mul_add(-x710, x1001, x711 * x1000)
-            + Self::mul_add(-x870, x983, Self::mul_add(-x869, x982, x868 * x981))
-            - Self::mul_add(-x867, x992, Self::mul_add(x866, x991, x865 * x990));
-        let x1012 = Self::mul_add(-x709, x1001, x711 * x999)
-            - Self::mul_add(-x870, x986, Self::mul_add(-x869, x985, x868 * x984))
-            + Self::mul_add(x867, x995, Self::mul_add(x866, x994, x865 * x993));
-        let x1013 = Self::mul_add(-x709, x1000, x710 * x999)
-            + Self::mul_add(-x870, x989, Self::mul_add(-x869, x988, x868 * x987))
-            + Self::mul_add(-x867, x998, Self::mul_add(x866, x997, x865 * x996));
-        let x1014 = Self::mul_add(-x873, x983, Self::mul_add(-x872, x982, x871 * x981))
-            + Self::mul_add(x711, x992, Self::mul_add(-x710, x991, x1005));
-        let x1015 = Self::mul_add(-x873, x986, Self::mul_add(-x872, x985, x871 * x984))
-            - Self::mul_add(x711, x995, Self::mul_add(-x709, x993, x1007));
-        let x1016 = Self::mul_add(-x873, x989, Self::mul_add(-x872, x988, x871 * x987))
-            - (x1009 + Self::mul_add(-x710, x997, x709 * x996));
-        let x1017 = Self::mul_add(c_q0, x1013, s_q0 * x1012);
-        let x1018 = Self::mul_add(-c_q0, x1016, s_q0 * x1015);
-        let x1019 = Self::mul_add(
+        let x765 = 44.41 * x762;
+        let x766 = 47.471 * x661;
+        let x767 = 44.41 * x763;
+        let x768 = 47.471 * x662;
+        let x769 = 44.41 * x764;
+        let x770 = 47.471 * x663;
+        let x771 = Self::mul_add(-x661, x766, x762 * x765);
+        let x772 = Self::mul_add(-x662, x766, x763 * x765);
+        let x773 = Self::mul_add(-x663, x766, x764 * x765);
+        let x774 = Self::mul_add(-x661, x768, x762 * x767);
+        let x775 = Self::mul_add(-x662, x768, x763 * x767);
+        let x776 = Self::mul_add(-x663, x768, x764 * x767);
+        let x777 = Self::mul_add(-x661, x770, x762 * x769);
+        let x778 = Self::mul_add(-x662, x770, x763 * x769);
+        let x779 = Self::mul_add(-x663, x770, x764 * x769);
+        let x780 = Self::mul_add(qd[5], x661, x700);
+        let x781 = Self::mul_add(-qd[5], x662, x701);
+        let x782 = Self::mul_add(qd[5], x663, x702);
+        let x783 = Self::mul_add(x663, x781, x662 * x782);
+        let x784 = Self::mul_add(-x663, x780, x661 * x782);
+        let x785 = Self::mul_add(x662, x780, x661 * x781);
+        let x786 = Self::mul_add(-qd[5], x783, Self::mul_add(x351, x661, x712));
+        let x787 = Self::mul_add(-qd[5], x784, Self::mul_add(-x351, x662, x713));
+        let x788 = Self::mul_add(qd[5], x785, Self::mul_add(x351, x663, x714));
+        let x789 = Self::mul_add(x663, x701, x662 * x702);
+        let x790 = Self::mul_add(-x663, x700, x661 * x702);
+        let x791 = Self::mul_add(x662, x700, x661 * x701);
+        let x792 = Self::mul_add(x663, x713, x662 * x714)
+            + Self::mul_add(x701, x791, x702 * x790);
+        let x793 = Self::mul_add(-x663, x712, x661 * x714)
+            - Self::mul_add(x700, x791, x702 * x789);
+        let x794 = Self::mul_add(x662, x712, x661 * x713)
+            - Self::mul_add(-x700, x790, x701 * x789);
+        let x795 = x783 + x789;
+        let x796 = x784 + x790;
+        let x797 = x785 + x791;
+        let x798 = x772 * x781;
+        let x799 = x773 * x782;
+        let x800 = Self::mul_add(x771, x780, -x798) + x799;
+        let x801 = x774 * x780;
+        let x802 = x776 * x782;
+        let x803 = Self::mul_add(-x775, x781, x801) + x802;
+        let x804 = x777 * x780;
+        let x805 = x778 * x781;
+        let x806 = Self::mul_add(x779, x782, x804 - x805);
+        let x807 = Self::mul_add(x777, x781, x774 * x782);
+        let x808 = Self::mul_add(-x778, x780, x772 * x782);
+        let x809 = Self::mul_add(x776, x780, x773 * x781);
+        let x810 = 9.336 * x762;
+        let x811 = 9.336 * x763;
+        let x812 = 9.336 * x764;
+        let x813 = x762 * x810;
+        let x814 = x763 * x810;
+        let x815 = x764 * x810;
+        let x816 = x762 * x811;
+        let x817 = x763 * x811;
+        let x818 = x764 * x811;
+        let x819 = x762 * x812;
+        let x820 = x763 * x812;
+        let x821 = x764 * x812;
+        let x822 = Self::mul_add(qd[6], x762, x780);
+        let x823 = Self::mul_add(-qd[6], x763, x781);
+        let x824 = Self::mul_add(qd[6], x764, x782);
+        let x825 = Self::mul_add(x764, x823, x763 * x824);
+        let x826 = Self::mul_add(-x764, x822, x762 * x824);
+        let x827 = Self::mul_add(x763, x822, x762 * x823);
+        let x828 = Self::mul_add(-qd[6], x825, Self::mul_add(x353, x762, x786));
+        let x829 = Self::mul_add(-qd[6], x826, Self::mul_add(-x353, x763, x787));
+        let x830 = Self::mul_add(qd[6], x827, Self::mul_add(x353, x764, x788));
+        let x831 = Self::mul_add(x764, x781, x763 * x782);
+        let x832 = Self::mul_add(-x764, x780, x762 * x782);
+        let x833 = Self::mul_add(x763, x780, x762 * x781);
+        let x834 = Self::mul_add(x764, x787, x763 * x788)
+            + Self::mul_add(x781, x833, x782 * x832);
+        let x835 = Self::mul_add(-x764, x786, x762 * x788)
+            - Self::mul_add(x780, x833, x782 * x831);
+        let x836 = Self::mul_add(x763, x786, x762 * x787)
+            - Self::mul_add(-x780, x832, x781 * x831);
+        let x837 = x825 + x831;
+        let x838 = x826 + x832;
+        let x839 = x827 + x833;
+        let x840 = x814 * x823;
+        let x841 = x815 * x824;
+        let x842 = Self::mul_add(x813, x822, -x840) + x841;
+        let x843 = x816 * x822;
+        let x844 = x818 * x824;
+        let x845 = Self::mul_add(-x817, x823, x843) + x844;
+        let x846 = x819 * x822;
+        let x847 = x820 * x823;
+        let x848 = Self::mul_add(x821, x824, x846 - x847);
+        let x849 = Self::mul_add(x815, x830, Self::mul_add(-x814, x829, x813 * x828))
+            - Self::mul_add(x823, x848, x824 * x845);
+        let x850 = Self::mul_add(x818, x830, Self::mul_add(-x817, x829, x816 * x828))
+            + Self::mul_add(-x822, x848, x824 * x842);
+        let x851 = Self::mul_add(x821, x830, Self::mul_add(-x820, x829, x819 * x828))
+            + Self::mul_add(x822, x845, x823 * x842);
+        let x852 = Self::mul_add(x819, x823, x816 * x824);
+        let x853 = Self::mul_add(-x820, x822, x814 * x824);
+        let x854 = Self::mul_add(x818, x822, x815 * x823);
+        let x855 = x852 + x852;
+        let x856 = Self::mul_add(-x813, x824, x846) + Self::mul_add(x817, x824, x847);
+        let x857 = Self::mul_add(x813, x823, x843) - Self::mul_add(x821, x823, x844);
+        let x858 = x853 + x853;
+        let x859 = Self::mul_add(x817, x822, x840) + Self::mul_add(-x821, x822, x841);
+        let x860 = x854 + x854;
+        let x861 = Self::mul_add(x764, x815, Self::mul_add(x763, x814, x762 * x813));
+        let x862 = Self::mul_add(x764, x818, Self::mul_add(x763, x817, x762 * x816));
+        let x863 = Self::mul_add(x764, x821, Self::mul_add(x763, x820, x762 * x819));
+        let x864 = Self::mul_add(-x764, x857, Self::mul_add(x763, x856, x762 * x855));
+        let x865 = Self::mul_add(-x764, x859, Self::mul_add(-x763, x858, x762 * x856));
+        let x866 = Self::mul_add(x764, x860, Self::mul_add(x763, x859, x762 * x857));
+        let x867 = Self::mul_add(-x763, x848, x764 * x845);
+        let x868 = Self::mul_add(-x762, x848, x764 * x842);
+        let x869 = Self::mul_add(-x762, x845, x763 * x842);
+        let x870 = x864 - x867;
+        let x871 = x865 + x868;
+        let x872 = x866 + x869;
+        let x873 = Self::mul_add(-x763, x851, x764 * x850)
+            + Self::mul_add(-x815, x836, Self::mul_add(-x814, x835, x813 * x834))
+            + (Self::mul_add(-x832, x848, x833 * x845)
+                - Self::mul_add(x833, x857, Self::mul_add(-x832, x856, x831 * x855)));
+        let x874 = Self::mul_add(-x762, x851, x764 * x849)
+            - Self::mul_add(-x818, x836, Self::mul_add(-x817, x835, x816 * x834))
+            + (Self::mul_add(x831, x848, x833 * x842)
+                + Self::mul_add(x833, x859, Self::mul_add(x832, x858, x831 * x856)));
+        let x875 = Self::mul_add(-x762, x850, x763 * x849)
+            + Self::mul_add(-x821, x836, Self::mul_add(-x820, x835, x819 * x834))
+            + (Self::mul_add(x831, x845, x832 * x842)
+                + Self::mul_add(-x833, x860, Self::mul_add(-x832, x859, x831 * x857)));
+        let x876 = Self::mul_add(-x815, x839, Self::mul_add(-x814, x838, x813 * x837))
+            + (x864 + x867);
+        let x877 = Self::mul_add(-x818, x839, Self::mul_add(-x817, x838, x816 * x837))
+            + (x865 - x868);
+        let x878 = Self::mul_add(-x821, x839, Self::mul_add(-x820, x838, x819 * x837))
+            - (x866 - x869);
+        let x879 = Self::mul_add(c_q0, x875, s_q0 * x874);
+        let x880 = Self::mul_add(-c_q0, x878, s_q0 * x877);
+        let x881 = Self::mul_add(-x357, x875, Self::mul_add(x356, x874, s_q1 * x873));
+        let x882 = Self::mul_add(-x357, x878, Self::mul_add(-x356, x877, s_q1 * x876));
+        let x883 = Self::mul_add(x663, x875, Self::mul_add(-x662, x874, x661 * x873));
+        let x884 = Self::mul_add(x663, x878, Self::mul_add(x662, x877, x661 * x876));
+        let x885 = Self::mul_add(-x836, x863, Self::mul_add(-x835, x862, x834 * x861))
+            - Self::mul_add(x833, x872, Self::mul_add(-x832, x871, x831 * x870));
+        let x886 = Self::mul_add(-x839, x863, Self::mul_add(-x838, x862, x837 * x861))
+            + Self::mul_add(-x764, x872, Self::mul_add(x763, x871, x762 * x870));
+        let x887 = x771 - x813;
+        let x888 = x772 - x814;
+        let x889 = x773 - x815;
+        let x890 = x774 - x816;
+        let x891 = x775 - x817;
+        let x892 = x776 - x818;
+        let x893 = x777 - x819;
+        let x894 = x778 - x820;
+        let x895 = x779 - x821;
+        let x896 = x800 - x842;
+        let x897 = x803 - x845;
+        let x898 = x806 - x848;
+        let x899 = x807 + x807 - x855;
+        let x900 = Self::mul_add(-x771, x782, x804) + Self::mul_add(x775, x782, x805)
+            - x856;
+        let x901 = Self::mul_add(x771, x781, x801) - Self::mul_add(x779, x781, x802)
+            - x857;
+        let x902 = x808 + x808 - x858;
+        let x903 = Self::mul_add(x775, x780, x798) + Self::mul_add(-x779, x780, x799)
+            - x859;
+        let x904 = x809 + x809 - x860;
+        let x905 = Self::mul_add(x773, x788, Self::mul_add(-x772, x787, x771 * x786))
+            - Self::mul_add(x781, x806, x782 * x803) - x849;
+        let x906 = Self::mul_add(x776, x788, Self::mul_add(-x775, x787, x774 * x786))
+            + Self::mul_add(-x780, x806, x782 * x800) - x850;
+        let x907 = Self::mul_add(x779, x788, Self::mul_add(-x778, x787, x777 * x786))
+            + Self::mul_add(x780, x803, x781 * x800) - x851;
+        let x908 = Self::mul_add(x663, x889, Self::mul_add(x662, x888, x661 * x887));
+        let x909 = Self::mul_add(x663, x892, Self::mul_add(x662, x891, x661 * x890));
+        let x910 = Self::mul_add(x663, x895, Self::mul_add(x662, x894, x661 * x893));
+        let x911 = Self::mul_add(-x663, x901, Self::mul_add(x662, x900, x661 * x899));
+        let x912 = Self::mul_add(-x663, x903, Self::mul_add(-x662, x902, x661 * x900));
+        let x913 = Self::mul_add(x663, x904, Self::mul_add(x662, x903, x661 * x901));
+        let x914 = Self::mul_add(-x662, x898, x663 * x897);
+        let x915 = Self::mul_add(-x661, x898, x663 * x896);
+        let x916 = Self::mul_add(-x661, x897, x662 * x896);
+        let x917 = x911 - x914;
+        let x918 = x912 + x915;
+        let x919 = x913 + x916;
+        let x920 = Self::mul_add(-x662, x907, x663 * x906)
+            + Self::mul_add(-x794, x889, Self::mul_add(-x793, x888, x792 * x887))
+            + (Self::mul_add(-x790, x898, x791 * x897)
+                - Self::mul_add(x791, x901, Self::mul_add(-x790, x900, x789 * x899)));
+        let x921 = Self::mul_add(-x661, x907, x663 * x905)
+            - Self::mul_add(-x794, x892, Self::mul_add(-x793, x891, x792 * x890))
+            + (Self::mul_add(x789, x898, x791 * x896)
+                + Self::mul_add(x791, x903, Self::mul_add(x790, x902, x789 * x900)));
+        let x922 = Self::mul_add(-x661, x906, x662 * x905)
+            + Self::mul_add(-x794, x895, Self::mul_add(-x793, x894, x792 * x893))
+            + (Self::mul_add(x789, x897, x790 * x896)
+                + Self::mul_add(-x791, x904, Self::mul_add(-x790, x903, x789 * x901)));
+        let x923 = Self::mul_add(-x797, x889, Self::mul_add(-x796, x888, x795 * x887))
+            + (x911 + x914);
+        let x924 = Self::mul_add(-x797, x892, Self::mul_add(-x796, x891, x795 * x890))
+            + (x912 - x915);
+        let x925 = Self::mul_add(-x797, x895, Self::mul_add(-x796, x894, x795 * x893))
+            - (x913 - x916);
+        let x926 = Self::mul_add(c_q0, x922, s_q0 * x921);
+        let x927 = Self::mul_add(-c_q0, x925, s_q0 * x924);
+        let x928 = Self::mul_add(-x357, x922, Self::mul_add(x356, x921, s_q1 * x920));
+        let x929 = Self::mul_add(-x357, x925, Self::mul_add(-x356, x924, s_q1 * x923));
+        let x930 = Self::mul_add(-x794, x910, Self::mul_add(-x793, x909, x792 * x908))
+            - Self::mul_add(x791, x919, Self::mul_add(-x790, x918, x789 * x917));
+        let x931 = Self::mul_add(-x797, x910, Self::mul_add(-x796, x909, x795 * x908))
+            + Self::mul_add(-x663, x919, Self::mul_add(x662, x918, x661 * x917));
+        let x932 = Self::mul_add(-x794, x863, Self::mul_add(-x793, x862, x792 * x861))
+            - Self::mul_add(x791, x872, Self::mul_add(-x790, x871, x789 * x870));
+        let x933 = Self::mul_add(-x797, x863, Self::mul_add(-x796, x862, x795 * x861))
+            + Self::mul_add(-x663, x872, Self::mul_add(x662, x871, x661 * x870));
+        let x934 = x691 + x887;
+        let x935 = x692 - x888;
+        let x936 = x693 - x889;
+        let x937 = x694 + x890;
+        let x938 = x695 + x891;
+        let x939 = x696 + x892;
+        let x940 = x697 - x893;
+        let x941 = x698 - x894;
+        let x942 = x699 - x895;
+        let x943 = x745 + x896;
+        let x944 = x746 + x897;
+        let x945 = x747 - x898;
+        let x946 = x761 - (x757 + (x757 + (x754 + x754))) - x899;
+        let x947 = x744
+            - (x743
+                - (Self::mul_add(x691, x702, x737) + Self::mul_add(-x695, x702, x738)))
+            - x900;
+        let x948 = x742
+            - (x741
+                - (Self::mul_add(x691, x701, x735) - Self::mul_add(-x699, x701, x736)))
+            + x901;
+        let x949 = x761 + (x758 + (x758 - (x755 + x755))) + x902;
+        let x950 = x740
+            + (x739
+                - (Self::mul_add(-x695, x700, x733) + Self::mul_add(-x699, x700, x734)))
+            + x903;
+        let x951 = x761 + (x759 + (x759 - (x756 + x756))) + x904;
+        let x952 = Self::mul_add(-x693, x714, Self::mul_add(x692, x713, x691 * x712))
+            + Self::mul_add(-x671, x717, x672 * x716)
+            - (Self::mul_add(-x701, x747, x702 * x746)
+                + Self::mul_add(x704, x750, x705 * x749)) + x905;
+        let x953 = Self::mul_add(x696, x714, Self::mul_add(-x695, x713, x694 * x712))
+            + Self::mul_add(x670, x717, x672 * x715)
+            + (Self::mul_add(x700, x747, x702 * x745)
+                + Self::mul_add(-x703, x750, x705 * x748)) + x906;
+        let x954 = Self::mul_add(x699, x714, Self::mul_add(-x698, x713, x697 * x712))
+            + Self::mul_add(x670, x716, x671 * x715)
+            - (Self::mul_add(x700, x746, x701 * x745)
+                - Self::mul_add(x703, x749, x704 * x748)) - x907;
+        let x955 = Self::mul_add(x357, x936, Self::mul_add(x356, x935, s_q1 * x934))
+            - Self::mul_add(-x669, x671, x668 * x672);
+        let x956 = Self::mul_add(-x357, x939, Self::mul_add(-x356, x938, s_q1 * x937))
+            + Self::mul_add(-x669, x670, x667 * x672);
+        let x957 = Self::mul_add(-x357, x942, Self::mul_add(-x356, x941, s_q1 * x940))
+            + Self::mul_add(-x668, x670, x667 * x671);
+        let x958 = Self::mul_add(-x357, x671, x356 * x672);
+        let x959 = Self::mul_add(x357, x670, s_q1 * x672);
+        let x960 = Self::mul_add(x356, x670, s_q1 * x671);
+        let x961 = Self::mul_add(x669, x749, x668 * x750);
+        let x962 = Self::mul_add(x669, x748, x667 * x750);
+        let x963 = Self::mul_add(-x668, x748, x667 * x749);
+        let x964 = Self::mul_add(-x357, x948, Self::mul_add(-x356, x947, s_q1 * x946))
+            - x961;
+        let x965 = Self::mul_add(-x357, x950, Self::mul_add(-x356, x949, s_q1 * x947))
+            + x962;
+        let x966 = Self::mul_add(-x357, x951, Self::mul_add(-x356, x950, s_q1 * x948))
+            + x963;
+        let x967 = Self::mul_add(x357, x749, x356 * x750);
+        let x968 = Self::mul_add(-x357, x748, s_q1 * x750);
+        let x969 = Self::mul_add(x356, x748, s_q1 * x749);
+        let x970 = x961 + Self::mul_add(x356, x945, x357 * x944);
+        let x971 = x962 + Self::mul_add(-s_q1, x945, x357 * x943);
+        let x972 = x963 - Self::mul_add(s_q1, x944, x356 * x943);
+        let x973 = x964 - x970;
+        let x974 = x965 + x971;
+        let x975 = x966 + x972;
+        let x976 = Self::mul_add(-x719, x750, x720 * x749);
+        let x977 = Self::mul_add(-x718, x750, x720 * x748);
+        let x978 = Self::mul_add(-x718, x749, x719 * x748);
+        let x979 = Self::mul_add(x606, x750, x607 * x749);
+        let x980 = Self::mul_add(x605, x750, x607 * x748);
+        let x981 = Self::mul_add(-x605, x749, x606 * x748);
+        let x982 = Self::mul_add(x356, x954, x357 * x953)
+            + Self::mul_add(x668, x753, x669 * x752)
+            + (Self::mul_add(-x723, x936, Self::mul_add(-x722, x935, x721 * x934))
+                - Self::mul_add(-x671, x726, x672 * x725))
+            - (Self::mul_add(x606, x945, x607 * x944) - x976
+                + (x976
+                    - Self::mul_add(
+                        x607,
+                        x948,
+                        Self::mul_add(x606, x947, x605 * x946),
+                    )));
+        let x983 = Self::mul_add(-s_q1, x954, x357 * x952)
+            + Self::mul_add(x667, x753, x669 * x751)
+            - (Self::mul_add(x723, x939, Self::mul_add(x722, x938, x721 * x937))
+                - Self::mul_add(x670, x726, x672 * x724))
+            - (Self::mul_add(x605, x945, x607 * x943) - x977
+                + (x977
+                    + Self::mul_add(
+                        x607,
+                        x950,
+                        Self::mul_add(x606, x949, x605 * x947),
+                    )));
+        let x984 = Self::mul_add(s_q1, x953, x356 * x952)
+            + Self::mul_add(-x667, x752, x668 * x751)
+            - (Self::mul_add(x723, x942, Self::mul_add(x722, x941, x721 * x940))
+                - Self::mul_add(x670, x725, x671 * x724))
+            - (Self::mul_add(-x605, x944, x606 * x943) + x978
+                - (x978
+                    + Self::mul_add(
+                        x607,
+                        x951,
+                        Self::mul_add(x606, x950, x605 * x948),
+                    )));
+        let x985 = Self::mul_add(x356, x753, x357 * x752)
+            - Self::mul_add(-x671, x723, x672 * x722) - (x979 + x979);
+        let x986 = Self::mul_add(-s_q1, x753, x357 * x751)
+            - Self::mul_add(-x670, x723, x672 * x721) - (x980 + x980);
+        let x987 = Self::mul_add(s_q1, x752, x356 * x751)
+            - Self::mul_add(-x670, x722, x671 * x721) - (x981 + x981);
+        let x988 = Self::mul_add(-x729, x936, Self::mul_add(-x728, x935, x727 * x934))
+            - Self::mul_add(-x671, x732, x672 * x731) + (x964 + x970);
+        let x989 = Self::mul_add(x729, x939, Self::mul_add(x728, x938, x727 * x937))
+            - Self::mul_add(x670, x732, x672 * x730) + (x965 - x971);
+        let x990 = Self::mul_add(x729, x942, Self::mul_add(x728, x941, x727 * x940))
+            - Self::mul_add(x670, x731, x671 * x730) - (x966 - x972);
+        let x991 = Self::mul_add(-x671, x729, x672 * x728) - (x967 + x967);
+        let x992 = Self::mul_add(-x670, x729, x672 * x727) + (x968 + x968);
+        let x993 = Self::mul_add(-x670, x728, x671 * x727) - (x969 + x969);
+        let x994 = Self::mul_add(c_q0, x984, s_q0 * x983)
+            - Self::mul_add(-x362, x987, Self::mul_add(x361, x986, x360 * x985));
+        let x995 = Self::mul_add(c_q0, x990, s_q0 * x989)
+            - Self::mul_add(-x362, x993, Self::mul_add(x361, x992, x360 * x991));
+        let x996 = Self::mul_add(-x357, x984, Self::mul_add(x356, x983, s_q1 * x982));
+        let x997 = x996
+            - Self::mul_add(x455, x987, Self::mul_add(-x454, x986, x453 * x985));
+        let x998 = Self::mul_add(x357, x990, Self::mul_add(-x356, x989, s_q1 * x988));
+        let x999 = x998
+            + Self::mul_add(x455, x993, Self::mul_add(-x454, x992, x453 * x991));
+        let x1000 = x996
+            - Self::mul_add(x565, x987, Self::mul_add(-x564, x986, x563 * x985));
+        let x1001 = x998
+            + Self::mul_add(x565, x993, Self::mul_add(-x564, x992, x563 * x991));
+        let x1002 = Self::mul_add(-x723, x957, Self::mul_add(x722, x956, x721 * x955))
+            + Self::mul_add(x726, x960, Self::mul_add(-x725, x959, x724 * x958))
+            + Self::mul_add(x607, x975, Self::mul_add(x606, x974, x605 * x973));
+        let x1003 = Self::mul_add(-x357, x975, Self::mul_add(-x356, x974, s_q1 * x973));
+        let x1004 = Self::mul_add(-x729, x957, Self::mul_add(x728, x956, x727 * x955))
+            + Self::mul_add(x732, x960, Self::mul_add(-x731, x959, x730 * x958)) + x1003;
+        let x1005 = Self::mul_add(x723, x910, Self::mul_add(x722, x909, x721 * x908))
+            - Self::mul_add(-x607, x919, Self::mul_add(x606, x918, x605 * x917));
+        let x1006 = Self::mul_add(x357, x919, Self::mul_add(-x356, x918, s_q1 * x917));
+        let x1007 = Self::mul_add(x729, x910, Self::mul_add(x728, x909, x727 * x908))
+            - x1006;
+        let x1008 = Self::mul_add(x723, x863, Self::mul_add(x722, x862, x721 * x861))
+            - Self::mul_add(-x607, x872, Self::mul_add(x606, x871, x605 * x870));
+        let x1009 = Self::mul_add(x357, x872, Self::mul_add(-x356, x871, s_q1 * x870));
+        let x1010 = Self::mul_add(x729, x863, Self::mul_add(x728, x862, x727 * x861))
+            - x1009;
+        let x1011 = x566 - x670;
+        let x1012 = x567 - x671;
+        let x1013 = x568 - x672;
+        let x1014 = x590 - x934;
+        let x1015 = x591 - x935;
+        let x1016 = x592 - x936;
+        let x1017 = x593 - x937;
+        let x1018 = x594 - x938;
+        let x1019 = x595 - x939;
+        let x1020 = x596 - x940;
+        let x1021 = x597 - x941;
+        let x1022 = x598 - x942;
+        let x1023 = x647 - x943;
+        let x1024 = x648 - x944;
+        let x1025 = x649 - x945;
+        let x1026 = x650 - x748;
+        let x1027 = x651 - x749;
+        let x1028 = x652 - x750;
+        let x1029 = x660 - (x656 + (x656 + (x653 + x653))) - x946;
+        let x1030 = x646
+            - (x645
+                - (Self::mul_add(x590, x601, x639) + Self::mul_add(-x594, x601, x640)))
+            - x947;
+        let x1031 = x644
+            - (x643
+                - (Self::mul_add(x590, x600, x637) - Self::mul_add(-x598, x600, x638)))
+            - x948;
+        let x1032 = x660 + (x657 + (x657 - (x654 + x654))) - x949;
+        let x1033 = x642
+            + (x641
+                - (Self::mul_add(-x594, x599, x635) + Self::mul_add(-x598, x599, x636)))
+            - x950;
+        let x1034 = x660 + (x658 + (x658 - (x655 + x655))) - x951;
+        let x1035 = Self::mul_add(-x592, x616, Self::mul_add(x591, x615, x590 * x614))
+            + Self::mul_add(-x567, x619, x568 * x618)
+            - (Self::mul_add(-x600, x649, x601 * x648)
+                + Self::mul_add(x603, x652, x604 * x651)) - x952;
+        let x1036 = Self::mul_add(x595, x616, Self::mul_add(-x594, x615, x593 * x614))
+            + Self::mul_add(x566, x619, x568 * x617)
+            + (Self::mul_add(x599, x649, x601 * x647)
+                + Self::mul_add(-x602, x652, x604 * x650)) - x953;
+        let x1037 = Self::mul_add(x598, x616, Self::mul_add(-x597, x615, x596 * x614))
+            + Self::mul_add(x566, x618, x567 * x617)
+            - (Self::mul_add(x599, x648, x600 * x647)
+                - Self::mul_add(x602, x651, x603 * x650)) - x954;
+        let x1038 = Self::mul_add(x567, x616, x568 * x615)
+            - Self::mul_add(-x600, x652, x601 * x651) - x751;
+        let x1039 = Self::mul_add(-x566, x616, x568 * x614)
+            + Self::mul_add(x599, x652, x601 * x650) - x752;
+        let x1040 = Self::mul_add(x566, x615, x567 * x614)
+            - Self::mul_add(x599, x651, x600 * x650) - x753;
+        let x1041 = Self::mul_add(x357, x1016, Self::mul_add(x356, x1015, s_q1 * x1014))
+            - Self::mul_add(-x565, x1012, x564 * x1013);
+        let x1042 = Self::mul_add(
             -x357,
-            x1013,
-            Self::mul_add(x356, x1012, s_q1 * x1011),
-        );
-        let x1020 = Self::mul_add(
+            x1019,
+            Self::mul_add(-x356, x1018, s_q1 * x1017),
+        ) + Self::mul_add(-x565, x1011, x563 * x1013);
+        let x1043 = Self::mul_add(
             -x357,
-            x1016,
-            Self::mul_add(-x356, x1015, s_q1 * x1014),
-        );
-        let x1021 = Self::mul_add(
-            -x870,
-            x1004,
-            Self::mul_add(-x869, x1003, x868 * x1002),
-        ) - Self::mul_add(-x867, x1010, Self::mul_add(x866, x1008, x865 * x1006));
-        let x1022 = Self::mul_add(
-            -x873,
-            x1004,
-            Self::mul_add(-x872, x1003, x871 * x1002),
-        ) + Self::mul_add(x711, x1010, Self::mul_add(-x710, x1008, x709 * x1006));
-        let x1023 = Self::mul_add(-x870, x960, Self::mul_add(-x869, x959, x868 * x958))
-            - Self::mul_add(-x867, x966, Self::mul_add(x866, x964, x865 * x962));
-        let x1024 = Self::mul_add(-x873, x960, Self::mul_add(-x872, x959, x871 * x958))
-            + Self::mul_add(x711, x966, Self::mul_add(-x710, x964, x709 * x962));
-        let x1025 = x739 + x981;
-        let x1026 = x740 - x982;
-        let x1027 = x741 - x983;
-        let x1028 = x742 + x984;
-        let x1029 = x743 + x985;
-        let x1030 = x744 + x986;
-        let x1031 = x745 - x987;
-        let x1032 = x746 - x988;
-        let x1033 = x747 - x989;
-        let x1034 = x808 - x809 + x814 + (x814 - (x815 + x816)) + x990;
-        let x1035 = x795 - (x792 + (x786 - x817))
-            + (x791 - Self::mul_add(x741, x748, x810)) - x991;
-        let x1036 = x794 - (x790 - (x784 - x818))
-            + (x789 - Self::mul_add(-x740, x748, x811)) + x992;
-        let x1037 = x795 - (x791 - (x785 + x810))
-            + (x792 - Self::mul_add(x744, x749, x817)) - x993;
-        let x1038 = x815 - x821 + x824 + (x824 - (x808 - x825)) - x994;
-        let x1039 = x793 + (x788 - (x782 - x826))
-            + (x787 + Self::mul_add(x742, x749, x822)) + x995;
-        let x1040 = x794 - (x789 - (x783 + x811))
-            + (x790 + Self::mul_add(x746, x750, x818)) + x996;
-        let x1041 = x793 - (x787 - (x781 - x822))
-            - (x788 - Self::mul_add(x745, x750, -x826)) + x997;
-        let x1042 = x816 - x825 + x829 + (x829 + (x809 + x821)) - x998;
-        let x1043 = Self::mul_add(-x741, x762, Self::mul_add(x740, x761, x739 * x760))
-            + Self::mul_add(-x719, x765, x720 * x764)
-            - (Self::mul_add(-x749, x795, x750 * x794)
-                + Self::mul_add(x752, x804, x753 * x801)) + x999;
-        let x1044 = Self::mul_add(x744, x762, Self::mul_add(-x743, x761, x742 * x760))
-            + Self::mul_add(x718, x765, x720 * x763)
-            + (Self::mul_add(x748, x795, x750 * x793)
-                + Self::mul_add(-x751, x804, x753 * x798)) + x1000;
-        let x1045 = Self::mul_add(x747, x762, Self::mul_add(-x746, x761, x745 * x760))
-            + Self::mul_add(x718, x764, x719 * x763)
-            - (Self::mul_add(x748, x794, x749 * x793)
-                - Self::mul_add(x751, x801, x752 * x798)) - x1001;
-        let x1046 = Self::mul_add(x357, x1027, Self::mul_add(x356, x1026, s_q1 * x1025))
-            - Self::mul_add(-x717, x719, x716 * x720);
-        let x1047 = Self::mul_add(
+            x1022,
+            Self::mul_add(-x356, x1021, s_q1 * x1020),
+        ) + Self::mul_add(-x564, x1011, x563 * x1012);
+        let x1044 = Self::mul_add(-x357, x1012, x356 * x1013);
+        let x1045 = Self::mul_add(x357, x1011, s_q1 * x1013);
+        let x1046 = Self::mul_add(x356, x1011, s_q1 * x1012);
+        let x1047 = Self::mul_add(x565, x1027, x564 * x1028);
+        let x1048 = Self::mul_add(x565, x1026, x563 * x1028);
+        let x1049 = Self::mul_add(-x564, x1026, x563 * x1027);
+        let x1050 = Self::mul_add(
             -x357,
-            x1030,
-            Self::mul_add(-x356, x1029, s_q1 * x1028),
-        ) + Self::mul_add(-x717, x718, x715 * x720);
-        let x1048 = Self::mul_add(
+            x1031,
+            Self::mul_add(-x356, x1030, s_q1 * x1029),
+        ) - x1047;
+        let x1051 = Self::mul_add(
             -x357,
             x1033,
-            Self::mul_add(-x356, x1032, s_q1 * x1031),
-        ) + Self::mul_add(-x716, x718, x715 * x719);
-        let x1049 = Self::mul_add(-x357, x719, x356 * x720);
-        let x1050 = Self::mul_add(x357, x718, s_q1 * x720);
-        let x1051 = Self::mul_add(x356, x718, s_q1 * x719);
-        let x1052 = s_q1 * x1034;
-        let x1053 = Self::mul_add(
-            x716,
-            x819,
-            Self::mul_add(x357, x1040, Self::mul_add(x356, x1037, x1052)),
-        );
-        let x1054 = Self::mul_add(-x717, x820, x1053);
-        let x1055 = x356 * x1038;
-        let x1056 = Self::mul_add(
-            -x715,
-            x827,
-            Self::mul_add(-x357, x1041, Self::mul_add(s_q1, x1035, -x1055)),
-        );
-        let x1057 = Self::mul_add(-x717, x828, x1056);
-        let x1058 = x357 * x1042;
-        let x1059 = Self::mul_add(
-            x716,
-            x831,
-            Self::mul_add(-x715, x830, Self::mul_add(x356, x1039, s_q1 * x1036) - x1058),
-        );
-        let x1060 = Self::mul_add(-x357, x833, x356 * x832);
-        let x1061 = Self::mul_add(-x357, x835, s_q1 * x834);
-        let x1062 = Self::mul_add(x356, x837, s_q1 * x836);
-        let x1063 = Self::mul_add(
-            -x767,
-            x834,
-            Self::mul_add(x639, x1036, Self::mul_add(x638, x1035, x637 * x1034)),
-        );
-        let x1064 = Self::mul_add(
-            -x766,
-            x832,
-            Self::mul_add(x639, x1039, Self::mul_add(-x638, x1038, x637 * x1037)),
-        );
-        let x1065 = Self::mul_add(
-            x766,
-            x833,
-            Self::mul_add(-x639, x1042, Self::mul_add(-x638, x1041, x637 * x1040)),
-        );
-        let x1066 = Self::mul_add(x356, x1045, x357 * x1044)
-            + Self::mul_add(x716, x807, x717 * x806)
-            + (Self::mul_add(-x771, x1027, Self::mul_add(-x770, x1026, x769 * x1025))
-                - Self::mul_add(-x719, x774, x720 * x773))
-            - Self::mul_add(x768, x836, x1063);
-        let x1067 = Self::mul_add(-s_q1, x1045, x357 * x1043)
-            + Self::mul_add(x715, x807, x717 * x805)
-            - (Self::mul_add(x771, x1030, Self::mul_add(x770, x1029, x769 * x1028))
-                - Self::mul_add(x718, x774, x720 * x772))
-            - Self::mul_add(x768, x837, x1064);
-        let x1068 = Self::mul_add(s_q1, x1044, x356 * x1043)
-            + Self::mul_add(-x715, x806, x716 * x805)
-            - (Self::mul_add(x771, x1033, Self::mul_add(x770, x1032, x769 * x1031))
-                - Self::mul_add(x718, x773, x719 * x772))
-            + Self::mul_add(x767, x835, x1065);
-        let x1069 = Self::mul_add(x356, x807, x357 * x806)
-            - Self::mul_add(-x719, x771, x720 * x770)
-            - Self::mul_add(x639, x830, x638 * x827);
-        let x1070 = Self::mul_add(-s_q1, x807, x357 * x805)
-            - Self::mul_add(-x718, x771, x720 * x769)
-            - Self::mul_add(x639, x831, x637 * x819);
-        let x1071 = Self::mul_add(s_q1, x806, x356 * x805)
-            - Self::mul_add(-x718, x770, x719 * x769)
-            - Self::mul_add(x638, x828, x637 * x820);
-        let x1072 = Self::mul_add(
-            x716,
-            x834,
-            Self::mul_add(-x357, x1036, Self::mul_add(-x356, x1035, x1052)),
-        );
-        let x1073 = Self::mul_add(
-            x715,
-            x832,
-            Self::mul_add(-x357, x1039, Self::mul_add(s_q1, x1037, x1055)),
-        );
+            Self::mul_add(-x356, x1032, s_q1 * x1030),
+        ) + x1048;
+        let x1052 = Self::mul_add(
+            -x357,
+            x1034,
+            Self::mul_add(-x356, x1033, s_q1 * x1031),
+        ) + x1049;
+        let x1053 = Self::mul_add(x357, x1027, x356 * x1028);
+        let x1054 = Self::mul_add(-x357, x1026, s_q1 * x1028);
+        let x1055 = Self::mul_add(x356, x1026, s_q1 * x1027);
+        let x1056 = x1047 + Self::mul_add(x356, x1025, x357 * x1024);
+        let x1057 = x1048 + Self::mul_add(-s_q1, x1025, x357 * x1023);
+        let x1058 = x1049 - Self::mul_add(s_q1, x1024, x356 * x1023);
+        let x1059 = x1050 - x1056;
+        let x1060 = x1051 + x1057;
+        let x1061 = x1052 + x1058;
+        let x1062 = Self::mul_add(-x621, x1028, x622 * x1027);
+        let x1063 = Self::mul_add(-x620, x1028, x622 * x1026);
+        let x1064 = Self::mul_add(-x620, x1027, x621 * x1026);
+        let x1065 = Self::mul_add(x496, x1028, x497 * x1027);
+        let x1066 = Self::mul_add(x495, x1028, x497 * x1026);
+        let x1067 = Self::mul_add(-x495, x1027, x496 * x1026);
+        let x1068 = Self::mul_add(x356, x1037, x357 * x1036)
+            + Self::mul_add(x564, x1040, x565 * x1039)
+            + (Self::mul_add(-x625, x1016, Self::mul_add(-x624, x1015, x623 * x1014))
+                - Self::mul_add(-x628, x1012, x627 * x1013))
+            - (Self::mul_add(x496, x1025, x497 * x1024) - x1062
+                + (x1062
+                    - Self::mul_add(
+                        x497,
+                        x1031,
+                        Self::mul_add(x496, x1030, x495 * x1029),
+                    )));
+        let x1069 = Self::mul_add(-s_q1, x1037, x357 * x1035)
+            + Self::mul_add(x563, x1040, x565 * x1038)
+            - (Self::mul_add(x625, x1019, Self::mul_add(x624, x1018, x623 * x1017))
+                - Self::mul_add(x628, x1011, x626 * x1013))
+            - (Self::mul_add(x495, x1025, x497 * x1023) - x1063
+                + (x1063
+                    + Self::mul_add(
+                        x497,
+                        x1033,
+                        Self::mul_add(x496, x1032, x495 * x1030),
+                    )));
+        let x1070 = Self::mul_add(s_q1, x1036, x356 * x1035)
+            + Self::mul_add(-x563, x1039, x564 * x1038)
+            - (Self::mul_add(x625, x1022, Self::mul_add(x624, x1021, x623 * x1020))
+                - Self::mul_add(x627, x1011, x626 * x1012))
+            - (Self::mul_add(-x495, x1024, x496 * x1023) + x1064
+                - (x1064
+                    + Self::mul_add(
+                        x497,
+                        x1034,
+                        Self::mul_add(x496, x1033, x495 * x1031),
+                    )));
+        let x1071 = Self::mul_add(x356, x1040, x357 * x1039)
+            - Self::mul_add(-x625, x1012, x624 * x1013) - (x1065 + x1065);
+        let x1072 = Self::mul_add(-s_q1, x1040, x357 * x1038)
+            - Self::mul_add(-x625, x1011, x623 * x1013) - (x1066 + x1066);
+        let x1073 = Self::mul_add(s_q1, x1039, x356 * x1038)
+            - Self::mul_add(-x624, x1011, x623 * x1012) - (x1067 + x1067);
         let x1074 = Self::mul_add(
-            -x716,
-            x835,
-            Self::mul_add(-x715, x833, x1058 + Self::mul_add(x356, x1041, s_q1 * x1040)),
-        );
-        let x1075 = Self::mul_add(
-            -x777,
-            x1027,
-            Self::mul_add(-x776, x1026, x775 * x1025),
-        ) - Self::mul_add(-x719, x780, x720 * x779) - Self::mul_add(x717, x836, x1072);
-        let x1076 = Self::mul_add(x777, x1030, Self::mul_add(x776, x1029, x775 * x1028))
-            - Self::mul_add(x718, x780, x720 * x778) + Self::mul_add(x717, x837, x1073);
-        let x1077 = Self::mul_add(x777, x1033, Self::mul_add(x776, x1032, x775 * x1031))
-            - Self::mul_add(x718, x779, x719 * x778) - x1074;
-        let x1078 = Self::mul_add(-x719, x777, x720 * x776)
-            - Self::mul_add(x357, x830, x356 * x827);
-        let x1079 = Self::mul_add(-x718, x777, x720 * x775)
-            + Self::mul_add(-x357, x831, s_q1 * x819);
-        let x1080 = Self::mul_add(-x718, x776, x719 * x775)
-            + Self::mul_add(-x356, x828, s_q1 * x820);
-        let x1081 = Self::mul_add(c_q0, x1068, s_q0 * x1067)
-            - Self::mul_add(-x362, x1071, Self::mul_add(x361, x1070, x360 * x1069));
-        let x1082 = Self::mul_add(c_q0, x1077, s_q0 * x1076)
-            - Self::mul_add(-x362, x1080, Self::mul_add(x361, x1079, x360 * x1078));
-        let x1083 = Self::mul_add(
-            -x357,
-            x1068,
-            Self::mul_add(x356, x1067, s_q1 * x1066),
-        );
-        let x1084 = x1083
-            - Self::mul_add(x471, x1071, Self::mul_add(-x470, x1070, x469 * x1069));
+            -x631,
+            x1016,
+            Self::mul_add(-x630, x1015, x629 * x1014),
+        ) - Self::mul_add(-x634, x1012, x633 * x1013) + (x1050 + x1056);
+        let x1075 = Self::mul_add(x631, x1019, Self::mul_add(x630, x1018, x629 * x1017))
+            - Self::mul_add(x634, x1011, x632 * x1013) + (x1051 - x1057);
+        let x1076 = Self::mul_add(x631, x1022, Self::mul_add(x630, x1021, x629 * x1020))
+            - Self::mul_add(x633, x1011, x632 * x1012) - (x1052 - x1058);
+        let x1077 = Self::mul_add(-x631, x1012, x630 * x1013) - (x1053 + x1053);
+        let x1078 = Self::mul_add(-x631, x1011, x629 * x1013) + (x1054 + x1054);
+        let x1079 = Self::mul_add(-x630, x1011, x629 * x1012) - (x1055 + x1055);
+        let x1080 = Self::mul_add(c_q0, x1070, s_q0 * x1069)
+            - Self::mul_add(-x362, x1073, Self::mul_add(x361, x1072, x360 * x1071));
+        let x1081 = Self::mul_add(c_q0, x1076, s_q0 * x1075)
+            - Self::mul_add(-x362, x1079, Self::mul_add(x361, x1078, x360 * x1077));
+        let x1082 = Self::mul_add(-x357, x1070, Self::mul_add(x356, x1069, s_q1 * x1068))
+            - Self::mul_add(x455, x1073, Self::mul_add(-x454, x1072, x453 * x1071));
+        let x1083 = Self::mul_add(x357, x1076, Self::mul_add(-x356, x1075, s_q1 * x1074))
+            + Self::mul_add(x455, x1079, Self::mul_add(-x454, x1078, x453 * x1077));
+        let x1084 = Self::mul_add(-x625, x1043, Self::mul_add(x624, x1042, x623 * x1041))
+            + Self::mul_add(x628, x1046, Self::mul_add(-x627, x1045, x626 * x1044))
+            + Self::mul_add(x497, x1061, Self::mul_add(x496, x1060, x495 * x1059));
         let x1085 = Self::mul_add(
-            x357,
-            x1077,
-            Self::mul_add(-x356, x1076, s_q1 * x1075),
-        );
-        let x1086 = x1085
-            + Self::mul_add(x471, x1080, Self::mul_add(-x470, x1079, x469 * x1078));
-        let x1087 = x1083
-            - Self::mul_add(x597, x1071, Self::mul_add(-x596, x1070, x595 * x1069));
-        let x1088 = x1085
-            + Self::mul_add(x597, x1080, Self::mul_add(-x596, x1079, x595 * x1078));
-        let x1089 = Self::mul_add(-x771, x1048, Self::mul_add(x770, x1047, x769 * x1046))
-            + Self::mul_add(x774, x1051, Self::mul_add(-x773, x1050, x772 * x1049))
-            - (Self::mul_add(x639, x1059, Self::mul_add(x638, x1057, x637 * x1054))
-                - Self::mul_add(-x768, x1062, Self::mul_add(x767, x1061, x766 * x1060)));
-        let x1090 = Self::mul_add(
             -x357,
-            x1059,
-            Self::mul_add(-x356, x1057, s_q1 * x1054),
+            x1061,
+            Self::mul_add(-x356, x1060, s_q1 * x1059),
         );
-        let x1091 = Self::mul_add(-x777, x1048, Self::mul_add(x776, x1047, x775 * x1046))
-            + Self::mul_add(x780, x1051, Self::mul_add(-x779, x1050, x778 * x1049))
-            - (x1090
-                + Self::mul_add(x717, x1062, Self::mul_add(x716, x1061, x715 * x1060)));
-        let x1092 = Self::mul_add(x771, x1004, Self::mul_add(x770, x1003, x769 * x1002))
-            - Self::mul_add(x639, x1010, Self::mul_add(-x638, x1008, x637 * x1006));
-        let x1093 = Self::mul_add(
+        let x1086 = Self::mul_add(-x631, x1043, Self::mul_add(x630, x1042, x629 * x1041))
+            + Self::mul_add(x634, x1046, Self::mul_add(-x633, x1045, x632 * x1044))
+            + x1085;
+        let x1087 = Self::mul_add(-x625, x957, Self::mul_add(x624, x956, x623 * x955))
+            + Self::mul_add(x628, x960, Self::mul_add(-x627, x959, x626 * x958))
+            + Self::mul_add(x497, x975, Self::mul_add(x496, x974, x495 * x973));
+        let x1088 = x1003
+            + (Self::mul_add(-x631, x957, Self::mul_add(x630, x956, x629 * x955))
+                + Self::mul_add(x634, x960, Self::mul_add(-x633, x959, x632 * x958)));
+        let x1089 = Self::mul_add(x625, x910, Self::mul_add(x624, x909, x623 * x908))
+            - Self::mul_add(-x497, x919, Self::mul_add(x496, x918, x495 * x917));
+        let x1090 = x1006
+            - Self::mul_add(x631, x910, Self::mul_add(x630, x909, x629 * x908));
+        let x1091 = Self::mul_add(x625, x863, Self::mul_add(x624, x862, x623 * x861))
+            - Self::mul_add(-x497, x872, Self::mul_add(x496, x871, x495 * x870));
+        let x1092 = x1009
+            - Self::mul_add(x631, x863, Self::mul_add(x630, x862, x629 * x861));
+        let x1093 = x456 + x1011;
+        let x1094 = x457 + x1012;
+        let x1095 = x458 + x1013;
+        let x1096 = x480 + x1014;
+        let x1097 = x481 + x1015;
+        let x1098 = x482 + x1016;
+        let x1099 = x483 + x1017;
+        let x1100 = x484 + x1018;
+        let x1101 = x485 + x1019;
+        let x1102 = x486 + x1020;
+        let x1103 = x487 + x1021;
+        let x1104 = x488 + x1022;
+        let x1105 = x540 + x1023;
+        let x1106 = x541 + x1024;
+        let x1107 = x542 + x1025;
+        let x1108 = x543 + x1026;
+        let x1109 = x544 + x1027;
+        let x1110 = x545 + x1028;
+        let x1111 = x553 - (x549 + (x549 + (x546 + x546))) + x1029;
+        let x1112 = x539
+            - (x538
+                - (Self::mul_add(x480, x491, x532) + Self::mul_add(-x484, x491, x533)))
+            + x1030;
+        let x1113 = x537
+            - (x536
+                - (Self::mul_add(x480, x490, x530) - Self::mul_add(-x488, x490, x531)))
+            + x1031;
+        let x1114 = x553 + (x550 + (x550 - (x547 + x547))) + x1032;
+        let x1115 = x535
+            + (x534
+                - (Self::mul_add(-x484, x489, x528) + Self::mul_add(-x488, x489, x529)))
+            + x1033;
+        let x1116 = x553 + (x551 + (x551 - (x548 + x548))) + x1034;
+        let x1117 = Self::mul_add(-x482, x506, Self::mul_add(x481, x505, x480 * x504))
+            + Self::mul_add(-x457, x509, x458 * x508)
+            - (Self::mul_add(-x490, x542, x491 * x541)
+                + Self::mul_add(x493, x545, x494 * x544)) + x1035;
+        let x1118 = Self::mul_add(x485, x506, Self::mul_add(-x484, x505, x483 * x504))
+            + Self::mul_add(x456, x509, x458 * x507)
+            + (Self::mul_add(x489, x542, x491 * x540)
+                + Self::mul_add(-x492, x545, x494 * x543)) + x1036;
+        let x1119 = Self::mul_add(x488, x506, Self::mul_add(-x487, x505, x486 * x504))
+            + Self::mul_add(x456, x508, x457 * x507)
+            - (Self::mul_add(x489, x541, x490 * x540)
+                - Self::mul_add(x492, x544, x493 * x543)) + x1037;
+        let x1120 = Self::mul_add(x457, x506, x458 * x505)
+            - Self::mul_add(-x490, x545, x491 * x544) + x1038;
+        let x1121 = Self::mul_add(-x456, x506, x458 * x504)
+            + Self::mul_add(x489, x545, x491 * x543) + x1039;
+        let x1122 = Self::mul_add(x456, x505, x457 * x504)
+            - Self::mul_add(x489, x544, x490 * x543) + x1040;
+        let x1123 = Self::mul_add(x357, x1098, Self::mul_add(x356, x1097, s_q1 * x1096))
+            - Self::mul_add(-x455, x1094, x454 * x1095);
+        let x1124 = Self::mul_add(
             -x357,
-            x1010,
-            Self::mul_add(x356, x1008, s_q1 * x1006),
-        );
-        let x1094 = Self::mul_add(x777, x1004, Self::mul_add(x776, x1003, x775 * x1002))
-            - x1093;
-        let x1095 = Self::mul_add(x771, x960, Self::mul_add(x770, x959, x769 * x958))
-            - Self::mul_add(x639, x966, Self::mul_add(-x638, x964, x637 * x962));
-        let x1096 = Self::mul_add(-x357, x966, Self::mul_add(x356, x964, s_q1 * x962));
-        let x1097 = Self::mul_add(x777, x960, Self::mul_add(x776, x959, x775 * x958))
-            - x1096;
-        let x1098 = x598 - x718;
-        let x1099 = x599 - x719;
-        let x1100 = x600 - x720;
-        let x1101 = x622 - x1025;
-        let x1102 = x623 - x1026;
-        let x1103 = x624 - x1027;
-        let x1104 = x625 - x1028;
-        let x1105 = x626 - x1029;
-        let x1106 = x627 - x1030;
-        let x1107 = x628 - x1031;
-        let x1108 = x629 - x1032;
-        let x1109 = x630 - x1033;
-        let x1110 = x691 - x692 + x697 + (x697 - (x698 + x699)) - x1034;
-        let x1111 = x681 - (x678 + (x672 - x700))
-            + (x677 - Self::mul_add(x624, x631, x693)) - x1035;
-        let x1112 = x680 - (x676 - (x670 - x701))
-            + (x675 - Self::mul_add(-x623, x631, x694)) - x1036;
-        let x1113 = x688 + (x689 - x690) - x834;
-        let x1114 = x685 - (x686 + x687) - x836;
-        let x1115 = x681 - (x677 - (x671 + x693))
-            + (x678 - Self::mul_add(x627, x632, x700)) - x1037;
-        let x1116 = x698 - x702 + x705 + (x705 - (x691 - x706)) - x1038;
-        let x1117 = x679 + (x674 - (x668 - x707))
-            + (x673 + Self::mul_add(x625, x632, x703)) - x1039;
-        let x1118 = x689 + (x688 - x690) - x832;
-        let x1119 = x682 + (x683 - x684) - x837;
-        let x1120 = x680 - (x675 - (x669 + x694))
-            + (x676 + Self::mul_add(x629, x633, x701)) - x1040;
-        let x1121 = x679 - (x673 - (x667 - x703))
-            - (x674 - Self::mul_add(x628, x633, -x707)) - x1041;
-        let x1122 = x699 - x706 + x708 + (x708 + (x692 + x702)) - x1042;
-        let x1123 = x686 - (x685 - x687) - x833;
-        let x1124 = x683 + (x682 - x684) - x835;
-        let x1125 = x688 + (x689 + x690) - x827;
-        let x1126 = x685 - (x686 - x687) - x830;
-        let x1127 = x689 + (x688 + x690) - x819;
-        let x1128 = x682 + (x683 + x684) - x831;
-        let x1129 = x686 - (x685 + x687) - x820;
-        let x1130 = x683 + (x682 + x684) - x828;
-        let x1131 = Self::mul_add(-x624, x648, Self::mul_add(x623, x647, x622 * x646))
-            + Self::mul_add(-x599, x651, x600 * x650)
-            - (Self::mul_add(-x632, x681, x633 * x680)
-                + Self::mul_add(x635, x690, x636 * x687)) - x1043;
-        let x1132 = Self::mul_add(x627, x648, Self::mul_add(-x626, x647, x625 * x646))
-            + Self::mul_add(x598, x651, x600 * x649)
-            + (Self::mul_add(x631, x681, x633 * x679)
-                + Self::mul_add(-x634, x690, x636 * x684)) - x1044;
-        let x1133 = Self::mul_add(x630, x648, Self::mul_add(-x629, x647, x628 * x646))
-            + Self::mul_add(x598, x650, x599 * x649)
-            - (Self::mul_add(x631, x680, x632 * x679)
-                - Self::mul_add(x634, x687, x635 * x684)) - x1045;
-        let x1134 = Self::mul_add(x599, x648, x600 * x647)
-            - Self::mul_add(-x632, x690, x633 * x687) - x805;
-        let x1135 = Self::mul_add(-x598, x648, x600 * x646)
-            + Self::mul_add(x631, x690, x633 * x684) - x806;
-        let x1136 = Self::mul_add(x598, x647, x599 * x646)
-            - Self::mul_add(x631, x687, x632 * x684) - x807;
-        let x1137 = Self::mul_add(x357, x1103, Self::mul_add(x356, x1102, s_q1 * x1101))
-            - Self::mul_add(-x597, x1099, x596 * x1100);
-        let x1138 = Self::mul_add(
+            x1101,
+            Self::mul_add(-x356, x1100, s_q1 * x1099),
+        ) + Self::mul_add(-x455, x1093, x453 * x1095);
+        let x1125 = Self::mul_add(
             -x357,
-            x1106,
-            Self::mul_add(-x356, x1105, s_q1 * x1104),
-        ) + Self::mul_add(-x597, x1098, x595 * x1100);
-        let x1139 = Self::mul_add(
+            x1104,
+            Self::mul_add(-x356, x1103, s_q1 * x1102),
+        ) + Self::mul_add(-x454, x1093, x453 * x1094);
+        let x1126 = Self::mul_add(-x357, x1094, x356 * x1095);
+        let x1127 = Self::mul_add(x357, x1093, s_q1 * x1095);
+        let x1128 = Self::mul_add(x356, x1093, s_q1 * x1094);
+        let x1129 = Self::mul_add(x455, x1109, x454 * x1110);
+        let x1130 = Self::mul_add(x455, x1108, x453 * x1110);
+        let x1131 = Self::mul_add(-x454, x1108, x453 * x1109);
+        let x1132 = Self::mul_add(
             -x357,
-            x1109,
-            Self::mul_add(-x356, x1108, s_q1 * x1107),
-        ) + Self::mul_add(-x596, x1098, x595 * x1099);
-        let x1140 = Self::mul_add(-x357, x1099, x356 * x1100);
-        let x1141 = Self::mul_add(x357, x1098, s_q1 * x1100);
-        let x1142 = Self::mul_add(x356, x1098, s_q1 * x1099);
-        let x1143 = s_q1 * x1110;
-        let x1144 = Self::mul_add(
-            x596,
-            x1127,
-            Self::mul_add(x357, x1120, Self::mul_add(x356, x1115, x1143)),
-        );
-        let x1145 = Self::mul_add(-x597, x1129, x1144);
-        let x1146 = x356 * x1116;
-        let x1147 = Self::mul_add(
-            -x595,
-            x1125,
-            Self::mul_add(-x357, x1121, Self::mul_add(s_q1, x1111, -x1146)),
-        );
-        let x1148 = Self::mul_add(-x597, x1130, x1147);
-        let x1149 = x357 * x1122;
-        let x1150 = Self::mul_add(
-            x596,
-            x1128,
-            Self::mul_add(-x595, x1126, Self::mul_add(x356, x1117, s_q1 * x1112) - x1149),
-        );
-        let x1151 = Self::mul_add(-x357, x1123, x356 * x1118);
-        let x1152 = Self::mul_add(-x357, x1124, s_q1 * x1113);
-        let x1153 = Self::mul_add(x356, x1119, s_q1 * x1114);
-        let x1154 = Self::mul_add(
-            -x653,
             x1113,
-            Self::mul_add(x513, x1112, Self::mul_add(x512, x1111, x511 * x1110)),
+            Self::mul_add(-x356, x1112, s_q1 * x1111),
+        ) - x1129;
+        let x1133 = Self::mul_add(
+            -x357,
+            x1115,
+            Self::mul_add(-x356, x1114, s_q1 * x1112),
+        ) + x1130;
+        let x1134 = Self::mul_add(
+            -x357,
+            x1116,
+            Self::mul_add(-x356, x1115, s_q1 * x1113),
+        ) + x1131;
+        let x1135 = Self::mul_add(x357, x1109, x356 * x1110);
+        let x1136 = Self::mul_add(-x357, x1108, s_q1 * x1110);
+        let x1137 = Self::mul_add(x356, x1108, s_q1 * x1109);
+        let x1138 = x1129 + Self::mul_add(x356, x1107, x357 * x1106);
+        let x1139 = x1130 + Self::mul_add(-s_q1, x1107, x357 * x1105);
+        let x1140 = x1131 - Self::mul_add(s_q1, x1106, x356 * x1105);
+        let x1141 = x1132 - x1138;
+        let x1142 = x1133 + x1139;
+        let x1143 = x1134 + x1140;
+        let x1144 = Self::mul_add(x514, x1110, x515 * x1109);
+        let x1145 = Self::mul_add(-x513, x1110, x515 * x1108);
+        let x1146 = Self::mul_add(x513, x1109, x514 * x1108);
+        let x1147 = Self::mul_add(x511, x1110, x512 * x1109);
+        let x1148 = Self::mul_add(x510, x1110, x512 * x1108);
+        let x1149 = Self::mul_add(-x510, x1109, x511 * x1108);
+        let x1150 = Self::mul_add(x356, x1119, x357 * x1118)
+            + Self::mul_add(x454, x1122, x455 * x1121)
+            + (Self::mul_add(-x518, x1098, Self::mul_add(-x517, x1097, x516 * x1096))
+                - Self::mul_add(-x521, x1094, x520 * x1095))
+            - (Self::mul_add(x511, x1107, x512 * x1106) - x1144
+                + (x1144
+                    - Self::mul_add(
+                        x512,
+                        x1113,
+                        Self::mul_add(x511, x1112, x510 * x1111),
+                    )));
+        let x1151 = Self::mul_add(
+            -x524,
+            x1098,
+            Self::mul_add(-x523, x1097, x522 * x1096),
+        ) - Self::mul_add(-x527, x1094, x526 * x1095) + (x1132 + x1138);
+        let x1152 = Self::mul_add(
+            c_q0,
+            Self::mul_add(s_q1, x1118, x356 * x1117)
+                + Self::mul_add(-x453, x1121, x454 * x1120)
+                - (Self::mul_add(x518, x1104, Self::mul_add(x517, x1103, x516 * x1102))
+                    - Self::mul_add(x520, x1093, x519 * x1094))
+                - (Self::mul_add(-x510, x1106, x511 * x1105) - x1146
+                    + (x1146
+                        - Self::mul_add(
+                            x512,
+                            x1116,
+                            Self::mul_add(x511, x1115, x510 * x1113),
+                        ))),
+            s_q0
+                * (Self::mul_add(-s_q1, x1119, x357 * x1117)
+                    + Self::mul_add(x453, x1122, x455 * x1120)
+                    - (Self::mul_add(
+                        x518,
+                        x1101,
+                        Self::mul_add(x517, x1100, x516 * x1099),
+                    ) - Self::mul_add(x521, x1093, x519 * x1095))
+                    - (Self::mul_add(x510, x1107, x512 * x1105) - x1145
+                        + (x1145
+                            + Self::mul_add(
+                                x512,
+                                x1115,
+                                Self::mul_add(x511, x1114, x510 * x1112),
+                            )))),
         );
+        let x1153 = Self::mul_add(
+            -x362,
+            Self::mul_add(s_q1, x1121, x356 * x1120)
+                - Self::mul_add(-x517, x1093, x516 * x1094) - (x1149 + x1149),
+            Self::mul_add(
+                x361,
+                Self::mul_add(-s_q1, x1122, x357 * x1120)
+                    - Self::mul_add(-x518, x1093, x516 * x1095) - (x1148 + x1148),
+                x360
+                    * (Self::mul_add(x356, x1122, x357 * x1121)
+                        - Self::mul_add(-x518, x1094, x517 * x1095) - (x1147 + x1147)),
+            ),
+        );
+        let x1154 = x1152 - x1153;
         let x1155 = Self::mul_add(
-            -x652,
-            x1118,
-            Self::mul_add(x513, x1117, Self::mul_add(-x512, x1116, x511 * x1115)),
+            c_q0,
+            Self::mul_add(x524, x1104, Self::mul_add(x523, x1103, x522 * x1102))
+                - Self::mul_add(x526, x1093, x525 * x1094) - (x1134 - x1140),
+            s_q0
+                * (Self::mul_add(x524, x1101, Self::mul_add(x523, x1100, x522 * x1099))
+                    - Self::mul_add(x527, x1093, x525 * x1095) + (x1133 - x1139)),
         );
         let x1156 = Self::mul_add(
-            x652,
-            x1123,
-            Self::mul_add(-x513, x1122, Self::mul_add(-x512, x1121, x511 * x1120)),
-        );
-        let x1157 = Self::mul_add(x356, x1133, x357 * x1132)
-            + Self::mul_add(x596, x1136, x597 * x1135)
-            + (Self::mul_add(-x657, x1103, Self::mul_add(-x656, x1102, x655 * x1101))
-                - Self::mul_add(-x660, x1099, x659 * x1100))
-            - Self::mul_add(x654, x1114, x1154);
-        let x1158 = Self::mul_add(-s_q1, x1133, x357 * x1131)
-            + Self::mul_add(x595, x1136, x597 * x1134)
-            - (Self::mul_add(x657, x1106, Self::mul_add(x656, x1105, x655 * x1104))
-                - Self::mul_add(x660, x1098, x658 * x1100))
-            - Self::mul_add(x654, x1119, x1155);
-        let x1159 = Self::mul_add(s_q1, x1132, x356 * x1131)
-            + Self::mul_add(-x595, x1135, x596 * x1134)
-            - (Self::mul_add(x657, x1109, Self::mul_add(x656, x1108, x655 * x1107))
-                - Self::mul_add(x659, x1098, x658 * x1099))
-            + Self::mul_add(x653, x1124, x1156);
-        let x1160 = Self::mul_add(x356, x1136, x357 * x1135)
-            - Self::mul_add(-x657, x1099, x656 * x1100)
-            - Self::mul_add(x513, x1126, x512 * x1125);
-        let x1161 = Self::mul_add(-s_q1, x1136, x357 * x1134)
-            - Self::mul_add(-x657, x1098, x655 * x1100)
-            - Self::mul_add(x513, x1128, x511 * x1127);
-        let x1162 = Self::mul_add(s_q1, x1135, x356 * x1134)
-            - Self::mul_add(-x656, x1098, x655 * x1099)
-            - Self::mul_add(x512, x1130, x511 * x1129);
-        let x1163 = Self::mul_add(
-            x596,
-            x1113,
-            Self::mul_add(-x357, x1112, Self::mul_add(-x356, x1111, x1143)),
-        );
-        let x1164 = Self::mul_add(
-            x595,
-            x1118,
-            Self::mul_add(-x357, x1117, Self::mul_add(s_q1, x1115, x1146)),
-        );
-        let x1165 = Self::mul_add(
-            -x596,
-            x1124,
-            Self::mul_add(-x595, x1123, x1149 + Self::mul_add(x356, x1121, s_q1 * x1120)),
-        );
-        let x1166 = Self::mul_add(
-            -x663,
-            x1103,
-            Self::mul_add(-x662, x1102, x661 * x1101),
-        ) - Self::mul_add(-x666, x1099, x665 * x1100)
-            - Self::mul_add(x597, x1114, x1163);
-        let x1167 = Self::mul_add(x663, x1106, Self::mul_add(x662, x1105, x661 * x1104))
-            - Self::mul_add(x666, x1098, x664 * x1100)
-            + Self::mul_add(x597, x1119, x1164);
-        let x1168 = Self::mul_add(x663, x1109, Self::mul_add(x662, x1108, x661 * x1107))
-            - Self::mul_add(x665, x1098, x664 * x1099) - x1165;
-        let x1169 = Self::mul_add(-x663, x1099, x662 * x1100)
-            - Self::mul_add(x357, x1126, x356 * x1125);
-        let x1170 = Self::mul_add(-x663, x1098, x661 * x1100)
-            + Self::mul_add(-x357, x1128, s_q1 * x1127);
-        let x1171 = Self::mul_add(-x662, x1098, x661 * x1099)
-            + Self::mul_add(-x356, x1130, s_q1 * x1129);
-        let x1172 = Self::mul_add(c_q0, x1159, s_q0 * x1158)
-            - Self::mul_add(-x362, x1162, Self::mul_add(x361, x1161, x360 * x1160));
-        let x1173 = Self::mul_add(c_q0, x1168, s_q0 * x1167)
-            - Self::mul_add(-x362, x1171, Self::mul_add(x361, x1170, x360 * x1169));
-        let x1174 = Self::mul_add(-x357, x1159, Self::mul_add(x356, x1158, s_q1 * x1157))
-            - Self::mul_add(x471, x1162, Self::mul_add(-x470, x1161, x469 * x1160));
-        let x1175 = Self::mul_add(x357, x1168, Self::mul_add(-x356, x1167, s_q1 * x1166))
-            + Self::mul_add(x471, x1171, Self::mul_add(-x470, x1170, x469 * x1169));
-        let x1176 = Self::mul_add(-x657, x1139, Self::mul_add(x656, x1138, x655 * x1137))
-            + Self::mul_add(x660, x1142, Self::mul_add(-x659, x1141, x658 * x1140))
-            - (Self::mul_add(x513, x1150, Self::mul_add(x512, x1148, x511 * x1145))
-                - Self::mul_add(-x654, x1153, Self::mul_add(x653, x1152, x652 * x1151)));
-        let x1177 = Self::mul_add(
-            -x357,
-            x1150,
-            Self::mul_add(-x356, x1148, s_q1 * x1145),
-        );
-        let x1178 = Self::mul_add(-x663, x1139, Self::mul_add(x662, x1138, x661 * x1137))
-            + Self::mul_add(x666, x1142, Self::mul_add(-x665, x1141, x664 * x1140))
-            - (x1177
-                + Self::mul_add(x597, x1153, Self::mul_add(x596, x1152, x595 * x1151)));
-        let x1179 = Self::mul_add(-x657, x1048, Self::mul_add(x656, x1047, x655 * x1046))
-            + Self::mul_add(x660, x1051, Self::mul_add(-x659, x1050, x658 * x1049))
-            - (Self::mul_add(x513, x1059, Self::mul_add(x512, x1057, x511 * x1054))
-                - Self::mul_add(-x654, x1062, Self::mul_add(x653, x1061, x652 * x1060)));
-        let x1180 = Self::mul_add(-x663, x1048, Self::mul_add(x662, x1047, x661 * x1046))
-            + Self::mul_add(x666, x1051, Self::mul_add(-x665, x1050, x664 * x1049))
-            - (x1090
-                + Self::mul_add(x597, x1062, Self::mul_add(x596, x1061, x595 * x1060)));
-        let x1181 = Self::mul_add(x657, x1004, Self::mul_add(x656, x1003, x655 * x1002))
-            - Self::mul_add(x513, x1010, Self::mul_add(-x512, x1008, x511 * x1006));
-        let x1182 = x1093
-            - Self::mul_add(x663, x1004, Self::mul_add(x662, x1003, x661 * x1002));
-        let x1183 = Self::mul_add(x657, x960, Self::mul_add(x656, x959, x655 * x958))
-            - Self::mul_add(x513, x966, Self::mul_add(-x512, x964, x511 * x962));
-        let x1184 = x1096
-            - Self::mul_add(x663, x960, Self::mul_add(x662, x959, x661 * x958));
-        let x1185 = x472 + x1098;
-        let x1186 = x473 + x1099;
-        let x1187 = x474 + x1100;
-        let x1188 = x496 + x1101;
-        let x1189 = x497 + x1102;
-        let x1190 = x498 + x1103;
-        let x1191 = x499 + x1104;
-        let x1192 = x500 + x1105;
-        let x1193 = x501 + x1106;
-        let x1194 = x502 + x1107;
-        let x1195 = x503 + x1108;
-        let x1196 = x504 + x1109;
-        let x1197 = x568 - x569 + x574 + (x574 - (x575 + x576)) + x1110;
-        let x1198 = x558 - (x555 + (x549 - x577))
-            + (x554 - Self::mul_add(x498, x505, x570)) + x1111;
-        let x1199 = x557 - (x553 - (x547 - x578))
-            + (x552 - Self::mul_add(-x497, x505, x571)) + x1112;
-        let x1200 = x565 + (x566 - x567) + x1113;
-        let x1201 = x562 - (x563 + x564) + x1114;
-        let x1202 = x558 - (x554 - (x548 + x570))
-            + (x555 - Self::mul_add(x501, x506, x577)) + x1115;
-        let x1203 = x575 - x579 + x582 + (x582 - (x568 - x583)) + x1116;
-        let x1204 = x556 + (x551 - (x545 - x584))
-            + (x550 + Self::mul_add(x499, x506, x580)) + x1117;
-        let x1205 = x566 + (x565 - x567) + x1118;
-        let x1206 = x559 + (x560 - x561) + x1119;
-        let x1207 = x557 - (x552 - (x546 + x571))
-            + (x553 + Self::mul_add(x503, x507, x578)) + x1120;
-        let x1208 = x556 - (x550 - (x544 - x580))
-            - (x551 - Self::mul_add(x502, x507, -x584)) + x1121;
-        let x1209 = x576 - x583 + x585 + (x585 + (x569 + x579)) + x1122;
-        let x1210 = x563 - (x562 - x564) + x1123;
-        let x1211 = x560 + (x559 - x561) + x1124;
-        let x1212 = x565 + (x566 + x567) + x1125;
-        let x1213 = x562 - (x563 - x564) + x1126;
-        let x1214 = x566 + (x565 + x567) + x1127;
-        let x1215 = x559 + (x560 + x561) + x1128;
-        let x1216 = x563 - (x562 + x564) + x1129;
-        let x1217 = x560 + (x559 + x561) + x1130;
-        let x1218 = Self::mul_add(-x498, x522, Self::mul_add(x497, x521, x496 * x520))
-            + Self::mul_add(-x473, x525, x474 * x524)
-            - (Self::mul_add(-x506, x558, x507 * x557)
-                + Self::mul_add(x509, x567, x510 * x564)) + x1131;
-        let x1219 = Self::mul_add(x501, x522, Self::mul_add(-x500, x521, x499 * x520))
-            + Self::mul_add(x472, x525, x474 * x523)
-            + (Self::mul_add(x505, x558, x507 * x556)
-                + Self::mul_add(-x508, x567, x510 * x561)) + x1132;
-        let x1220 = Self::mul_add(x504, x522, Self::mul_add(-x503, x521, x502 * x520))
-            + Self::mul_add(x472, x524, x473 * x523)
-            - (Self::mul_add(x505, x557, x506 * x556)
-                - Self::mul_add(x508, x564, x509 * x561)) + x1133;
-        let x1221 = Self::mul_add(x473, x522, x474 * x521)
-            - Self::mul_add(-x506, x567, x507 * x564) + x1134;
-        let x1222 = Self::mul_add(-x472, x522, x474 * x520)
-            + Self::mul_add(x505, x567, x507 * x561) + x1135;
-        let x1223 = Self::mul_add(x472, x521, x473 * x520)
-            - Self::mul_add(x505, x564, x506 * x561) + x1136;
-        let x1224 = Self::mul_add(x357, x1190, Self::mul_add(x356, x1189, s_q1 * x1188))
-            - Self::mul_add(-x471, x1186, x470 * x1187);
-        let x1225 = Self::mul_add(
-            -x357,
-            x1193,
-            Self::mul_add(-x356, x1192, s_q1 * x1191),
-        ) + Self::mul_add(-x471, x1185, x469 * x1187);
-        let x1226 = Self::mul_add(
-            -x357,
-            x1196,
-            Self::mul_add(-x356, x1195, s_q1 * x1194),
-        ) + Self::mul_add(-x470, x1185, x469 * x1186);
-        let x1227 = Self::mul_add(-x357, x1186, x356 * x1187);
-        let x1228 = Self::mul_add(x357, x1185, s_q1 * x1187);
-        let x1229 = Self::mul_add(x356, x1185, s_q1 * x1186);
-        let x1230 = s_q1 * x1197;
-        let x1231 = Self::mul_add(
-            x470,
-            x1214,
-            Self::mul_add(x357, x1207, Self::mul_add(x356, x1202, x1230)),
-        );
-        let x1232 = Self::mul_add(-x471, x1216, x1231);
-        let x1233 = x356 * x1203;
-        let x1234 = Self::mul_add(
-            -x469,
-            x1212,
-            Self::mul_add(-x357, x1208, Self::mul_add(s_q1, x1198, -x1233)),
-        );
-        let x1235 = Self::mul_add(-x471, x1217, x1234);
-        let x1236 = x357 * x1209;
-        let x1237 = Self::mul_add(
-            x470,
-            x1215,
-            Self::mul_add(-x469, x1213, Self::mul_add(x356, x1204, s_q1 * x1199) - x1236),
-        );
-        let x1238 = Self::mul_add(-x357, x1210, x356 * x1205);
-        let x1239 = Self::mul_add(-x357, x1211, s_q1 * x1200);
-        let x1240 = Self::mul_add(x356, x1206, s_q1 * x1201);
-        let x1241 = Self::mul_add(
-            x530,
-            x1200,
-            Self::mul_add(x528, x1199, Self::mul_add(x527, x1198, x526 * x1197)),
-        );
-        let x1242 = Self::mul_add(
-            -x529,
-            x1205,
-            Self::mul_add(x528, x1204, Self::mul_add(-x527, x1203, x526 * x1202)),
-        );
-        let x1243 = Self::mul_add(
-            x529,
-            x1210,
-            Self::mul_add(-x528, x1209, Self::mul_add(-x527, x1208, x526 * x1207)),
-        );
-        let x1244 = Self::mul_add(x356, x1220, x357 * x1219)
-            + Self::mul_add(x470, x1223, x471 * x1222)
-            + (Self::mul_add(-x534, x1190, Self::mul_add(-x533, x1189, x532 * x1188))
-                - Self::mul_add(-x537, x1186, x536 * x1187))
-            - Self::mul_add(x531, x1201, x1241);
-        let x1245 = Self::mul_add(
-            x470,
-            x1200,
-            Self::mul_add(-x357, x1199, Self::mul_add(-x356, x1198, x1230)),
-        );
-        let x1246 = Self::mul_add(
-            x469,
-            x1205,
-            Self::mul_add(-x357, x1204, Self::mul_add(s_q1, x1202, x1233)),
-        );
-        let x1247 = Self::mul_add(
-            -x470,
-            x1211,
-            Self::mul_add(-x469, x1210, x1236 + Self::mul_add(x356, x1208, s_q1 * x1207)),
-        );
-        let x1248 = Self::mul_add(
-            -x540,
-            x1190,
-            Self::mul_add(-x539, x1189, x538 * x1188),
-        ) - Self::mul_add(-x543, x1186, x542 * x1187)
-            - Self::mul_add(x471, x1201, x1245);
-        let x1249 = Self::mul_add(
-            c_q0,
-            Self::mul_add(s_q1, x1219, x356 * x1218)
-                + Self::mul_add(-x469, x1222, x470 * x1221)
-                - (Self::mul_add(x534, x1196, Self::mul_add(x533, x1195, x532 * x1194))
-                    - Self::mul_add(x536, x1185, x535 * x1186))
-                + Self::mul_add(-x530, x1211, x1243),
-            s_q0
-                * (Self::mul_add(-s_q1, x1220, x357 * x1218)
-                    + Self::mul_add(x469, x1223, x471 * x1221)
-                    - (Self::mul_add(
-                        x534,
-                        x1193,
-                        Self::mul_add(x533, x1192, x532 * x1191),
-                    ) - Self::mul_add(x537, x1185, x535 * x1187))
-                    - Self::mul_add(x531, x1206, x1242)),
-        );
-        let x1250 = Self::mul_add(
             -x362,
-            Self::mul_add(s_q1, x1222, x356 * x1221)
-                - Self::mul_add(-x533, x1185, x532 * x1186)
-                - Self::mul_add(x527, x1217, x526 * x1216),
+            Self::mul_add(-x523, x1093, x522 * x1094) - (x1137 + x1137),
             Self::mul_add(
                 x361,
-                Self::mul_add(-s_q1, x1223, x357 * x1221)
-                    - Self::mul_add(-x534, x1185, x532 * x1187)
-                    - Self::mul_add(x528, x1215, x526 * x1214),
-                x360
-                    * (Self::mul_add(x356, x1223, x357 * x1222)
-                        - Self::mul_add(-x534, x1186, x533 * x1187)
-                        - Self::mul_add(x528, x1213, x527 * x1212)),
+                Self::mul_add(-x524, x1093, x522 * x1095) + (x1136 + x1136),
+                x360 * (Self::mul_add(-x524, x1094, x523 * x1095) - (x1135 + x1135)),
             ),
         );
-        let x1251 = x1249 - x1250;
-        let x1252 = Self::mul_add(
+        let x1157 = x1155 - x1156;
+        let x1158 = Self::mul_add(-x518, x1125, Self::mul_add(x517, x1124, x516 * x1123))
+            + Self::mul_add(x521, x1128, Self::mul_add(-x520, x1127, x519 * x1126))
+            + Self::mul_add(x512, x1143, Self::mul_add(x511, x1142, x510 * x1141));
+        let x1159 = Self::mul_add(-x524, x1125, Self::mul_add(x523, x1124, x522 * x1123))
+            + Self::mul_add(x527, x1128, Self::mul_add(-x526, x1127, x525 * x1126))
+            + Self::mul_add(-x357, x1143, Self::mul_add(-x356, x1142, s_q1 * x1141));
+        let x1160 = Self::mul_add(-x518, x1043, Self::mul_add(x517, x1042, x516 * x1041))
+            + Self::mul_add(x521, x1046, Self::mul_add(-x520, x1045, x519 * x1044))
+            + Self::mul_add(x512, x1061, Self::mul_add(x511, x1060, x510 * x1059));
+        let x1161 = x1085
+            + (Self::mul_add(-x524, x1043, Self::mul_add(x523, x1042, x522 * x1041))
+                + Self::mul_add(x527, x1046, Self::mul_add(-x526, x1045, x525 * x1044)));
+        let x1162 = Self::mul_add(-x518, x957, Self::mul_add(x517, x956, x516 * x955))
+            + Self::mul_add(x521, x960, Self::mul_add(-x520, x959, x519 * x958))
+            + Self::mul_add(x512, x975, Self::mul_add(x511, x974, x510 * x973));
+        let x1163 = x1003
+            + (Self::mul_add(-x524, x957, Self::mul_add(x523, x956, x522 * x955))
+                + Self::mul_add(x527, x960, Self::mul_add(-x526, x959, x525 * x958)));
+        let x1164 = Self::mul_add(x518, x910, Self::mul_add(x517, x909, x516 * x908))
+            - Self::mul_add(-x512, x919, Self::mul_add(x511, x918, x510 * x917));
+        let x1165 = x1006
+            - Self::mul_add(x524, x910, Self::mul_add(x523, x909, x522 * x908));
+        let x1166 = Self::mul_add(x518, x863, Self::mul_add(x517, x862, x516 * x861))
+            - Self::mul_add(-x512, x872, Self::mul_add(x511, x871, x510 * x870));
+        let x1167 = x1009
+            - Self::mul_add(x524, x863, Self::mul_add(x523, x862, x522 * x861));
+        let x1168 = x60 + x1093;
+        let x1169 = x363 - x1094;
+        let x1170 = x364 - x1095;
+        let x1171 = x383 - x1097;
+        let x1172 = x384 - x1098;
+        let x1173 = x430 - x1105;
+        let x1174 = x431 + x1106;
+        let x1175 = x432 + x1107;
+        let x1176 = x433 - x1108;
+        let x1177 = x434 - x1109;
+        let x1178 = x435 - x1110;
+        let x1179 = x443 - (x439 + (x439 + (x436 + x436))) + x1111;
+        let x1180 = x429
+            + (x428
+                + (Self::mul_add(-x382, x392, x422) - Self::mul_add(-x386, x392, x423)))
+            + x1112;
+        let x1181 = x427
+            + (x426
+                + (Self::mul_add(-x382, x391, x420) + Self::mul_add(-x390, x391, x421)))
+            + x1113;
+        let x1182 = x425
+            + (x424
+                - (Self::mul_add(-qd[0], x386, x418)
+                    + Self::mul_add(-qd[0], x390, x419))) - x1115;
+        let x1183 = Self::mul_add(-c_q0, x387 - x1101, s_q0 * (x386 - x1100))
+            - Self::mul_add(-x362, x1168, x360 * x1170);
+        let x1184 = Self::mul_add(-c_q0, x390 - x1104, s_q0 * (x389 - x1103))
+            - Self::mul_add(-x361, x1168, x360 * x1169);
+        let x1185 = c_q0 * x1168;
+        let x1186 = s_q0 * x1168;
+        let x1187 = Self::mul_add(x362, x1177, x361 * x1178);
+        let x1188 = Self::mul_add(-x362, x1176, x360 * x1178);
+        let x1189 = Self::mul_add(x361, x1176, x360 * x1177);
+        let x1190 = Self::mul_add(-c_q0, x1181, s_q0 * x1180) + x1187;
+        let x1191 = x1187 - Self::mul_add(-s_q0, x1175, c_q0 * x1174);
+        let x1192 = x1190 + x1191;
+        let x1193 = Self::mul_add(
             c_q0,
-            Self::mul_add(x540, x1196, Self::mul_add(x539, x1195, x538 * x1194))
-                - Self::mul_add(x542, x1185, x541 * x1186) - x1247,
-            s_q0
-                * (Self::mul_add(x540, x1193, Self::mul_add(x539, x1192, x538 * x1191))
-                    - Self::mul_add(x543, x1185, x541 * x1187)
-                    + Self::mul_add(x471, x1206, x1246)),
-        );
-        let x1253 = Self::mul_add(
-            -x362,
-            Self::mul_add(-x539, x1185, x538 * x1186)
-                + Self::mul_add(-x356, x1217, s_q1 * x1216),
-            Self::mul_add(
-                x361,
-                Self::mul_add(-x540, x1185, x538 * x1187)
-                    + Self::mul_add(-x357, x1215, s_q1 * x1214),
-                x360
-                    * (Self::mul_add(-x540, x1186, x539 * x1187)
-                        - Self::mul_add(x357, x1213, x356 * x1212)),
-            ),
-        );
-        let x1254 = x1252 - x1253;
-        let x1255 = Self::mul_add(-x534, x1226, Self::mul_add(x533, x1225, x532 * x1224))
-            + Self::mul_add(x537, x1229, Self::mul_add(-x536, x1228, x535 * x1227))
-            - (Self::mul_add(x528, x1237, Self::mul_add(x527, x1235, x526 * x1232))
-                - Self::mul_add(
-                    -x531,
-                    x1240,
-                    Self::mul_add(-x530, x1239, x529 * x1238),
-                ));
-        let x1256 = Self::mul_add(-x540, x1226, Self::mul_add(x539, x1225, x538 * x1224))
-            + Self::mul_add(x543, x1229, Self::mul_add(-x542, x1228, x541 * x1227))
-            - (Self::mul_add(-x357, x1237, Self::mul_add(-x356, x1235, s_q1 * x1232))
-                + Self::mul_add(x471, x1240, Self::mul_add(x470, x1239, x469 * x1238)));
-        let x1257 = Self::mul_add(-x534, x1139, Self::mul_add(x533, x1138, x532 * x1137))
-            + Self::mul_add(x537, x1142, Self::mul_add(-x536, x1141, x535 * x1140))
-            - (Self::mul_add(x528, x1150, Self::mul_add(x527, x1148, x526 * x1145))
-                - Self::mul_add(
-                    -x531,
-                    x1153,
-                    Self::mul_add(-x530, x1152, x529 * x1151),
-                ));
-        let x1258 = Self::mul_add(-x540, x1139, Self::mul_add(x539, x1138, x538 * x1137))
-            + Self::mul_add(x543, x1142, Self::mul_add(-x542, x1141, x541 * x1140))
-            - (x1177
-                + Self::mul_add(x471, x1153, Self::mul_add(x470, x1152, x469 * x1151)));
-        let x1259 = Self::mul_add(-x534, x1048, Self::mul_add(x533, x1047, x532 * x1046))
-            + Self::mul_add(x537, x1051, Self::mul_add(-x536, x1050, x535 * x1049))
-            - (Self::mul_add(x528, x1059, Self::mul_add(x527, x1057, x526 * x1054))
-                - Self::mul_add(
-                    -x531,
-                    x1062,
-                    Self::mul_add(-x530, x1061, x529 * x1060),
-                ));
-        let x1260 = Self::mul_add(-x540, x1048, Self::mul_add(x539, x1047, x538 * x1046))
-            + Self::mul_add(x543, x1051, Self::mul_add(-x542, x1050, x541 * x1049))
-            - (x1090
-                + Self::mul_add(x471, x1062, Self::mul_add(x470, x1061, x469 * x1060)));
-        let x1261 = Self::mul_add(x534, x1004, Self::mul_add(x533, x1003, x532 * x1002))
-            - Self::mul_add(x528, x1010, Self::mul_add(-x527, x1008, x526 * x1006));
-        let x1262 = x1093
-            - Self::mul_add(x540, x1004, Self::mul_add(x539, x1003, x538 * x1002));
-        let x1263 = Self::mul_add(x534, x960, Self::mul_add(x533, x959, x532 * x958))
-            - Self::mul_add(x528, x966, Self::mul_add(-x527, x964, x526 * x962));
-        let x1264 = x1096
-            - Self::mul_add(x540, x960, Self::mul_add(x539, x959, x538 * x958));
-        let x1265 = x60 + x1185;
-        let x1266 = x363 - x1186;
-        let x1267 = x364 - x1187;
-        let x1268 = x383 - x1189;
-        let x1269 = x384 - x1190;
-        let x1270 = x442 - x443 - x448 - (x448 - (x449 + x450)) + x1197;
-        let x1271 = x432 - (x429 - (x423 - x451))
-            - (x428 - Self::mul_add(qd[0], x384, x444)) + x1198;
-        let x1272 = x431 - (x427 + (x421 - x452))
-            - (x426 - Self::mul_add(-qd[0], x383, x445)) + x1199;
-        let x1273 = x439 - (x440 + x441) - x1200;
-        let x1274 = x436 + (x437 - x438) - x1201;
-        let x1275 = Self::mul_add(-c_q0, x387 - x1193, s_q0 * (x386 - x1192))
-            - Self::mul_add(-x362, x1265, x360 * x1267);
-        let x1276 = Self::mul_add(-c_q0, x390 - x1196, s_q0 * (x389 - x1195))
-            - Self::mul_add(-x361, x1265, x360 * x1266);
-        let x1277 = c_q0 * x1265;
-        let x1278 = s_q0 * x1265;
-        let x1279 = Self::mul_add(
-            -x361,
-            x440 - (x439 + x441) + x1214,
-            Self::mul_add(
-                -c_q0,
-                x431 + (x426 + (x420 - x445)) + (x427 - Self::mul_add(x389, x392, x452))
-                    + x1207,
-                s_q0
-                    * (x432 + (x428 + (x422 - x444))
-                        + (x429 + Self::mul_add(x387, x391, x451)) + x1202),
-            ),
-        );
-        let x1280 = Self::mul_add(x362, x437 + (x436 + x438) + x1216, x1279);
-        let x1281 = Self::mul_add(
-            x360,
-            x439 - (x440 - x441) - x1212,
-            Self::mul_add(
-                -c_q0,
-                x430 - (x424 - (x418 - x454)) - (x425 + Self::mul_add(x388, x392, x458))
-                    - x1208,
-                s_q0 * (x449 - x453 + x456 + (x456 + (x442 + x457)) - x1203),
-            ),
-        );
-        let x1282 = Self::mul_add(-x362, x434 + (x433 + x435) - x1217, x1281);
-        let x1283 = Self::mul_add(
-            -x360,
-            x436 + (x437 + x438) - x1213,
-            Self::mul_add(
-                c_q0,
-                x450 - x457 + x459 + (x459 - (x443 - x453)) - x1209,
-                s_q0
-                    * (x430 + (x425 - (x419 - x458))
-                        + (x424 + Self::mul_add(-x385, x391, x454)) - x1204),
-            ),
-        );
-        let x1284 = Self::mul_add(-x361, x433 + (x434 + x435) - x1215, x1283);
-        let x1285 = c_q0 * (x434 + (x433 - x435) - x1211);
-        let x1286 = s_q0 * (x433 + (x434 - x435) - x1206);
-        let x1287 = Self::mul_add(
+            x1182,
+            s_q0 * (x443 - (x440 + (x440 - (x437 + x437))) + x1114),
+        ) + x1188 + Self::mul_add(-c_q0, x1173, x1188);
+        let x1194 = Self::mul_add(
+            c_q0,
+            x443 - (x441 + (x441 - (x438 + x438))) + x1116,
+            s_q0 * x1182,
+        ) - x1189 - Self::mul_add(-s_q0, x1173, x1189);
+        let x1195 = Self::mul_add(
             -s_q0,
             Self::mul_add(-x390, x406, Self::mul_add(x389, x405, x388 * x404))
                 - Self::mul_add(-x60, x408, x363 * x407)
                 + (Self::mul_add(-qd[0], x431, x391 * x430)
-                    - Self::mul_add(x393, x438, x394 * x435)) + x1220,
+                    - Self::mul_add(x393, x434, x394 * x433)) + x1119,
             c_q0
                 * (Self::mul_add(-x387, x406, Self::mul_add(x386, x405, x385 * x404))
                     - Self::mul_add(-x60, x409, x364 * x407)
                     - (Self::mul_add(-qd[0], x432, x392 * x430)
-                        + Self::mul_add(-x393, x441, x395 * x435)) + x1219),
+                        + Self::mul_add(-x393, x435, x395 * x433)) + x1118),
         );
-        let x1288 = Self::mul_add(
-            -x400,
-            x1274,
-            Self::mul_add(x399, x1273, Self::mul_add(x398, x1272, x397 * x1271)),
-        );
-        let x1289 = x1287
+        let x1196 = Self::mul_add(-x399, x1178, x400 * x1177);
+        let x1197 = x1195
             - Self::mul_add(
                 x361,
                 Self::mul_add(-x60, x405, x363 * x404)
-                    - Self::mul_add(qd[0], x438, x391 * x435) - x1223,
+                    - Self::mul_add(qd[0], x434, x391 * x433) - x1122,
                 x362
                     * (Self::mul_add(x60, x406, x364 * x404)
-                        + Self::mul_add(qd[0], x441, x392 * x435) - x1222),
+                        + Self::mul_add(qd[0], x435, x392 * x433) - x1121),
             )
-            + (Self::mul_add(x411, x1269, x410 * x1268)
-                - Self::mul_add(x413, x1266, x412 * x1267)) - x1288;
-        let x1290 = Self::mul_add(
-            -x362,
-            x1274,
-            Self::mul_add(-x361, x1273, Self::mul_add(-c_q0, x1272, s_q0 * x1271)),
-        );
-        let x1291 = Self::mul_add(
+            + (Self::mul_add(x411, x1172, x410 * x1171)
+                - Self::mul_add(x413, x1169, x412 * x1170))
+            - (Self::mul_add(x397, x1175, x398 * x1174) + x1196
+                - (x1196 + Self::mul_add(x398, x1181, x397 * x1180)));
+        let x1198 = Self::mul_add(
             x415,
-            x1269,
-            Self::mul_add(x414, x1268, x396 * (x382 - x1188)),
-        ) - Self::mul_add(x417, x1266, x416 * x1267) - x1290;
-        let x1292 = Self::mul_add(-x411, x1276, x410 * x1275)
-            - Self::mul_add(-x413, x1278, x412 * x1277)
-            - (Self::mul_add(-x398, x1284, x397 * x1282)
-                + Self::mul_add(-x400, x1286, x399 * x1285));
-        let x1293 = Self::mul_add(
+            x1172,
+            Self::mul_add(x414, x1171, x396 * (x382 - x1096)),
+        ) - Self::mul_add(x417, x1169, x416 * x1170) + (x1190 - x1191);
+        let x1199 = Self::mul_add(-x411, x1184, x410 * x1183)
+            - Self::mul_add(-x413, x1186, x412 * x1185)
+            - Self::mul_add(-x398, x1194, x397 * x1193);
+        let x1200 = Self::mul_add(
             -x415,
-            x1276,
+            x1184,
             Self::mul_add(
                 x414,
-                x1275,
+                x1183,
                 x396
-                    * (Self::mul_add(-c_q0, x1269, s_q0 * x1268)
-                        + Self::mul_add(-x362, x1266, x361 * x1267)),
+                    * (Self::mul_add(-c_q0, x1172, s_q0 * x1171)
+                        + Self::mul_add(-x362, x1169, x361 * x1170)),
             ),
         );
-        let x1294 = Self::mul_add(
+        let x1201 = Self::mul_add(
             -x417,
-            x1278,
-            Self::mul_add(x416, x1277, x401 * Self::mul_add(c_q0, x1266, s_q0 * x1267)),
+            x1186,
+            Self::mul_add(x416, x1185, x401 * Self::mul_add(c_q0, x1169, s_q0 * x1170)),
+        );
+        let x1202 = x1200 - x1201 - Self::mul_add(c_q0, x1194, s_q0 * x1193);
+        let x1203 = Self::mul_add(-x411, x1125, x410 * x1124)
+            + Self::mul_add(x413, x1128, x412 * x1127)
+            + Self::mul_add(x398, x1143, x397 * x1142);
+        let x1204 = Self::mul_add(x415, x1125, Self::mul_add(-x414, x1124, x396 * x1123))
+            - Self::mul_add(x417, x1128, Self::mul_add(x416, x1127, x401 * x1126))
+            - Self::mul_add(-c_q0, x1143, s_q0 * x1142);
+        let x1205 = Self::mul_add(-x411, x1043, x410 * x1042)
+            + Self::mul_add(x413, x1046, x412 * x1045)
+            + Self::mul_add(x398, x1061, x397 * x1060);
+        let x1206 = Self::mul_add(x415, x1043, Self::mul_add(-x414, x1042, x396 * x1041))
+            - Self::mul_add(x417, x1046, Self::mul_add(x416, x1045, x401 * x1044))
+            - Self::mul_add(-c_q0, x1061, s_q0 * x1060);
+        let x1207 = Self::mul_add(-x411, x957, x410 * x956)
+            + Self::mul_add(x413, x960, x412 * x959)
+            + Self::mul_add(x398, x975, x397 * x974);
+        let x1208 = Self::mul_add(x415, x957, Self::mul_add(-x414, x956, x396 * x955))
+            - Self::mul_add(x417, x960, Self::mul_add(x416, x959, x401 * x958))
+            - Self::mul_add(-c_q0, x975, s_q0 * x974);
+        let x1209 = Self::mul_add(x411, x910, x410 * x909)
+            - Self::mul_add(-x398, x919, x397 * x918);
+        let x1210 = Self::mul_add(-x415, x910, Self::mul_add(-x414, x909, x396 * x908))
+            + Self::mul_add(c_q0, x919, s_q0 * x918);
+        let x1211 = Self::mul_add(x411, x863, x410 * x862)
+            - Self::mul_add(-x398, x872, x397 * x871);
+        let x1212 = Self::mul_add(-x415, x863, Self::mul_add(-x414, x862, x396 * x861))
+            + Self::mul_add(c_q0, x872, s_q0 * x871);
+        let x1213 = Self::mul_add(
+            -x149,
+            x1205,
+            Self::mul_add(x151, x1203, Self::mul_add(x154, x1199, x156 * x1197)),
+        );
+        let x1214 = Self::mul_add(
+            -x143,
+            x1211,
+            Self::mul_add(x145, x1209, Self::mul_add(-x147, x1207, x1213)),
+        );
+        let x1215 = Self::mul_add(
+            -x149,
+            x1160,
+            Self::mul_add(x151, x1158, Self::mul_add(x154, x1154, x156 * x1150)),
+        );
+        let x1216 = Self::mul_add(
+            -x143,
+            x1166,
+            Self::mul_add(x145, x1164, Self::mul_add(-x147, x1162, x1215)),
+        );
+        let x1217 = Self::mul_add(
+            -x149,
+            x1084,
+            Self::mul_add(x151, x1082, Self::mul_add(x154, x1080, x156 * x1068)),
+        );
+        let x1218 = Self::mul_add(
+            -x143,
+            x1091,
+            Self::mul_add(x145, x1089, Self::mul_add(-x147, x1087, x1217)),
+        );
+        let x1219 = Self::mul_add(
+            -x149,
+            x1000,
+            Self::mul_add(x151, x997, Self::mul_add(x154, x994, x156 * x982)),
+        );
+        let x1220 = Self::mul_add(
+            x143,
+            x1008,
+            Self::mul_add(-x145, x1005, Self::mul_add(x147, x1002, x1219)),
+        );
+        let x1221 = -x1220;
+        let x1222 = Self::mul_add(
+            -x149,
+            x928,
+            Self::mul_add(x151, x928, Self::mul_add(x154, x926, x156 * x920)),
+        );
+        let x1223 = Self::mul_add(
+            x143,
+            x932,
+            Self::mul_add(-x145, x930, Self::mul_add(x147, x928, x1222)),
+        );
+        let x1224 = -x1223;
+        let x1225 = Self::mul_add(
+            -x149,
+            x881,
+            Self::mul_add(x151, x881, Self::mul_add(x154, x879, x156 * x873)),
+        );
+        let x1226 = Self::mul_add(
+            -x143,
+            x885,
+            Self::mul_add(-x145, x883, Self::mul_add(x147, x881, x1225)),
+        );
+        let x1227 = Self::mul_add(
+            -x164,
+            x1205,
+            Self::mul_add(-x166, x1203, Self::mul_add(x168, x1199, x170 * x1197)),
+        );
+        let x1228 = Self::mul_add(
+            x161,
+            x1211,
+            Self::mul_add(-x162, x1209, Self::mul_add(x163, x1207, x1227)),
+        );
+        let x1229 = Self::mul_add(
+            -x164,
+            x1160,
+            Self::mul_add(-x166, x1158, Self::mul_add(x168, x1154, x170 * x1150)),
+        );
+        let x1230 = Self::mul_add(
+            x161,
+            x1166,
+            Self::mul_add(-x162, x1164, Self::mul_add(x163, x1162, x1229)),
+        );
+        let x1231 = Self::mul_add(
+            -x164,
+            x1084,
+            Self::mul_add(-x166, x1082, Self::mul_add(x168, x1080, x170 * x1068)),
+        );
+        let x1232 = Self::mul_add(
+            x161,
+            x1091,
+            Self::mul_add(-x162, x1089, Self::mul_add(x163, x1087, x1231)),
+        );
+        let x1233 = Self::mul_add(
+            -x164,
+            x1000,
+            Self::mul_add(-x166, x997, Self::mul_add(x168, x994, x170 * x982)),
+        );
+        let x1234 = Self::mul_add(
+            -x161,
+            x1008,
+            Self::mul_add(x162, x1005, Self::mul_add(-x163, x1002, x1233)),
+        );
+        let x1235 = -x1234;
+        let x1236 = Self::mul_add(
+            -x164,
+            x928,
+            Self::mul_add(-x166, x928, Self::mul_add(x168, x926, x170 * x920)),
+        );
+        let x1237 = Self::mul_add(
+            -x161,
+            x932,
+            Self::mul_add(x162, x930, Self::mul_add(-x163, x928, x1236)),
+        );
+        let x1238 = -x1237;
+        let x1239 = Self::mul_add(
+            -x164,
+            x881,
+            Self::mul_add(-x166, x881, Self::mul_add(x168, x879, x170 * x873)),
+        );
+        let x1240 = Self::mul_add(
+            x161,
+            x885,
+            Self::mul_add(x162, x883, Self::mul_add(-x163, x881, x1239)),
+        );
+        let x1241 = Self::mul_add(
+            x179,
+            x1205,
+            Self::mul_add(-x182, x1203, Self::mul_add(x184, x1199, x186 * x1197)),
+        );
+        let x1242 = Self::mul_add(
+            -x174,
+            x1211,
+            Self::mul_add(-x176, x1209, Self::mul_add(-x177, x1207, x1241)),
+        );
+        let x1243 = Self::mul_add(
+            x179,
+            x1160,
+            Self::mul_add(-x182, x1158, Self::mul_add(x184, x1154, x186 * x1150)),
+        );
+        let x1244 = Self::mul_add(
+            -x174,
+            x1166,
+            Self::mul_add(-x176, x1164, Self::mul_add(-x177, x1162, x1243)),
+        );
+        let x1245 = Self::mul_add(
+            x179,
+            x1084,
+            Self::mul_add(-x182, x1082, Self::mul_add(x184, x1080, x186 * x1068)),
+        );
+        let x1246 = Self::mul_add(
+            -x174,
+            x1091,
+            Self::mul_add(-x176, x1089, Self::mul_add(-x177, x1087, x1245)),
+        );
+        let x1247 = Self::mul_add(
+            x179,
+            x1000,
+            Self::mul_add(-x182, x997, Self::mul_add(x184, x994, x186 * x982)),
+        );
+        let x1248 = Self::mul_add(
+            x174,
+            x1008,
+            Self::mul_add(x176, x1005, Self::mul_add(x177, x1002, x1247)),
+        );
+        let x1249 = -x1248;
+        let x1250 = Self::mul_add(
+            x179,
+            x928,
+            Self::mul_add(-x182, x928, Self::mul_add(x184, x926, x186 * x920)),
+        );
+        let x1251 = Self::mul_add(
+            x174,
+            x932,
+            Self::mul_add(x176, x930, Self::mul_add(x177, x928, x1250)),
+        );
+        let x1252 = -x1251;
+        let x1253 = Self::mul_add(
+            x179,
+            x881,
+            Self::mul_add(-x182, x881, Self::mul_add(x184, x879, x186 * x873)),
+        );
+        let x1254 = Self::mul_add(
+            -x174,
+            x885,
+            Self::mul_add(x176, x883, Self::mul_add(x177, x881, x1253)),
+        );
+        let x1255 = Self::mul_add(
+            x194,
+            x1205,
+            Self::mul_add(-x195, x1203, Self::mul_add(x198, x1199, x201 * x1197)),
+        );
+        let x1256 = Self::mul_add(
+            x188,
+            x1211,
+            Self::mul_add(-x190, x1209, Self::mul_add(x192, x1207, x1255)),
+        );
+        let x1257 = -x1256;
+        let x1258 = Self::mul_add(
+            x194,
+            x1160,
+            Self::mul_add(-x195, x1158, Self::mul_add(x198, x1154, x201 * x1150)),
+        );
+        let x1259 = Self::mul_add(
+            x188,
+            x1166,
+            Self::mul_add(-x190, x1164, Self::mul_add(x192, x1162, x1258)),
+        );
+        let x1260 = -x1259;
+        let x1261 = Self::mul_add(
+            x194,
+            x1084,
+            Self::mul_add(-x195, x1082, Self::mul_add(x198, x1080, x201 * x1068)),
+        );
+        let x1262 = Self::mul_add(
+            x188,
+            x1091,
+            Self::mul_add(-x190, x1089, Self::mul_add(x192, x1087, x1261)),
+        );
+        let x1263 = -x1262;
+        let x1264 = Self::mul_add(
+            x194,
+            x1000,
+            Self::mul_add(-x195, x997, Self::mul_add(x198, x994, x201 * x982)),
+        );
+        let x1265 = Self::mul_add(
+            -x188,
+            x1008,
+            Self::mul_add(x190, x1005, Self::mul_add(-x192, x1002, x1264)),
+        );
+        let x1266 = Self::mul_add(
+            x194,
+            x928,
+            Self::mul_add(-x195, x928, Self::mul_add(x198, x926, x201 * x920)),
+        );
+        let x1267 = Self::mul_add(
+            -x188,
+            x932,
+            Self::mul_add(x190, x930, Self::mul_add(-x192, x928, x1266)),
+        );
+        let x1268 = Self::mul_add(
+            x194,
+            x881,
+            Self::mul_add(-x195, x881, Self::mul_add(x198, x879, x201 * x873)),
+        );
+        let x1269 = Self::mul_add(
+            x188,
+            x885,
+            Self::mul_add(x190, x883, Self::mul_add(-x192, x881, x1268)),
+        );
+        let x1270 = -x1269;
+        let x1271 = Self::mul_add(
+            x207,
+            x1205,
+            Self::mul_add(-x209, x1203, Self::mul_add(x211, x1199, x213 * x1197)),
+        );
+        let x1272 = Self::mul_add(
+            -x203,
+            x1211,
+            Self::mul_add(-x205, x1209, Self::mul_add(x206, x1207, x1271)),
+        );
+        let x1273 = Self::mul_add(
+            x207,
+            x1160,
+            Self::mul_add(-x209, x1158, Self::mul_add(x211, x1154, x213 * x1150)),
+        );
+        let x1274 = Self::mul_add(
+            -x203,
+            x1166,
+            Self::mul_add(-x205, x1164, Self::mul_add(x206, x1162, x1273)),
+        );
+        let x1275 = Self::mul_add(
+            x207,
+            x1084,
+            Self::mul_add(-x209, x1082, Self::mul_add(x211, x1080, x213 * x1068)),
+        );
+        let x1276 = Self::mul_add(
+            -x203,
+            x1091,
+            Self::mul_add(-x205, x1089, Self::mul_add(x206, x1087, x1275)),
+        );
+        let x1277 = Self::mul_add(
+            x207,
+            x1000,
+            Self::mul_add(-x209, x997, Self::mul_add(x211, x994, x213 * x982)),
+        );
+        let x1278 = Self::mul_add(
+            x203,
+            x1008,
+            Self::mul_add(x205, x1005, Self::mul_add(-x206, x1002, x1277)),
+        );
+        let x1279 = -x1278;
+        let x1280 = Self::mul_add(
+            x207,
+            x928,
+            Self::mul_add(-x209, x928, Self::mul_add(x211, x926, x213 * x920)),
+        );
+        let x1281 = Self::mul_add(
+            x203,
+            x932,
+            Self::mul_add(x205, x930, Self::mul_add(-x206, x928, x1280)),
+        );
+        let x1282 = -x1281;
+        let x1283 = Self::mul_add(
+            x207,
+            x881,
+            Self::mul_add(-x209, x881, Self::mul_add(x211, x879, x213 * x873)),
+        );
+        let x1284 = Self::mul_add(
+            -x203,
+            x885,
+            Self::mul_add(x205, x883, Self::mul_add(-x206, x881, x1283)),
+        );
+        let x1285 = Self::mul_add(
+            x217,
+            x1205,
+            Self::mul_add(-x219, x1203, Self::mul_add(x221, x1199, x223 * x1197)),
+        );
+        let x1286 = Self::mul_add(
+            x214,
+            x1211,
+            Self::mul_add(-x215, x1209, Self::mul_add(x216, x1207, x1285)),
+        );
+        let x1287 = Self::mul_add(
+            x217,
+            x1160,
+            Self::mul_add(-x219, x1158, Self::mul_add(x221, x1154, x223 * x1150)),
+        );
+        let x1288 = Self::mul_add(
+            x214,
+            x1166,
+            Self::mul_add(-x215, x1164, Self::mul_add(x216, x1162, x1287)),
+        );
+        let x1289 = Self::mul_add(
+            x217,
+            x1084,
+            Self::mul_add(-x219, x1082, Self::mul_add(x221, x1080, x223 * x1068)),
+        );
+        let x1290 = Self::mul_add(
+            x214,
+            x1091,
+            Self::mul_add(-x215, x1089, Self::mul_add(x216, x1087, x1289)),
+        );
+        let x1291 = Self::mul_add(
+            x217,
+            x1000,
+            Self::mul_add(-x219, x997, Self::mul_add(x221, x994, x223 * x982)),
+        );
+        let x1292 = Self::mul_add(
+            -x214,
+            x1008,
+            Self::mul_add(x215, x1005, Self::mul_add(-x216, x1002, x1291)),
+        );
+        let x1293 = -x1292;
+        let x1294 = Self::mul_add(
+            x217,
+            x928,
+            Self::mul_add(-x219, x928, Self::mul_add(x221, x926, x223 * x920)),
         );
         let x1295 = Self::mul_add(
-            x362,
-            x1286,
-            Self::mul_add(
-                x361,
-                x1285,
-                x360
-                    * Self::mul_add(
-                        c_q0,
-                        x437 + (x436 - x438) + x1210,
-                        s_q0 * (x440 - (x439 - x441) + x1205),
-                    ),
-            ),
+            -x214,
+            x932,
+            Self::mul_add(x215, x930, Self::mul_add(-x216, x928, x1294)),
         );
-        let x1296 = x1293 - x1294 - (Self::mul_add(c_q0, x1284, s_q0 * x1282) - x1295);
-        let x1297 = Self::mul_add(-x411, x1226, x410 * x1225)
-            + Self::mul_add(x413, x1229, x412 * x1228)
-            - (Self::mul_add(x398, x1237, x397 * x1235)
-                - Self::mul_add(-x400, x1240, x399 * x1239));
-        let x1298 = Self::mul_add(x415, x1226, Self::mul_add(-x414, x1225, x396 * x1224))
-            - Self::mul_add(x417, x1229, Self::mul_add(x416, x1228, x401 * x1227))
-            + (Self::mul_add(-c_q0, x1237, s_q0 * x1235)
-                - Self::mul_add(
-                    -x362,
-                    x1240,
-                    Self::mul_add(-x361, x1239, x360 * x1238),
-                ));
-        let x1299 = Self::mul_add(-x411, x1139, x410 * x1138)
-            + Self::mul_add(x413, x1142, x412 * x1141)
-            - (Self::mul_add(x398, x1150, x397 * x1148)
-                - Self::mul_add(-x400, x1153, x399 * x1152));
-        let x1300 = Self::mul_add(x415, x1139, Self::mul_add(-x414, x1138, x396 * x1137))
-            - Self::mul_add(x417, x1142, Self::mul_add(x416, x1141, x401 * x1140))
-            + (Self::mul_add(-c_q0, x1150, s_q0 * x1148)
-                - Self::mul_add(
-                    -x362,
-                    x1153,
-                    Self::mul_add(-x361, x1152, x360 * x1151),
-                ));
-        let x1301 = Self::mul_add(-x411, x1048, x410 * x1047)
-            + Self::mul_add(x413, x1051, x412 * x1050)
-            - (Self::mul_add(x398, x1059, x397 * x1057)
-                - Self::mul_add(-x400, x1062, x399 * x1061));
-        let x1302 = Self::mul_add(x415, x1048, Self::mul_add(-x414, x1047, x396 * x1046))
-            - Self::mul_add(x417, x1051, Self::mul_add(x416, x1050, x401 * x1049))
-            + (Self::mul_add(-c_q0, x1059, s_q0 * x1057)
-                - Self::mul_add(
-                    -x362,
-                    x1062,
-                    Self::mul_add(-x361, x1061, x360 * x1060),
-                ));
-        let x1303 = Self::mul_add(x411, x1004, x410 * x1003)
-            + Self::mul_add(-x398, x1010, x397 * x1008);
+        let x1296 = -x1295;
+        let x1297 = Self::mul_add(
+            x217,
+            x881,
+            Self::mul_add(-x219, x881, Self::mul_add(x221, x879, x223 * x873)),
+        );
+        let x1298 = Self::mul_add(
+            x214,
+            x885,
+            Self::mul_add(x215, x883, Self::mul_add(-x216, x881, x1297)),
+        );
+        let x1299 = Self::mul_add(
+            x225,
+            x1205,
+            Self::mul_add(-x227, x1203, Self::mul_add(x229, x1199, x231 * x1197)),
+        );
+        let x1300 = Self::mul_add(
+            x136,
+            x1211,
+            Self::mul_add(-x214, x1209, Self::mul_add(x224, x1207, x1299)),
+        );
+        let x1301 = Self::mul_add(
+            x225,
+            x1160,
+            Self::mul_add(-x227, x1158, Self::mul_add(x229, x1154, x231 * x1150)),
+        );
+        let x1302 = Self::mul_add(
+            x136,
+            x1166,
+            Self::mul_add(-x214, x1164, Self::mul_add(x224, x1162, x1301)),
+        );
+        let x1303 = Self::mul_add(
+            x225,
+            x1084,
+            Self::mul_add(-x227, x1082, Self::mul_add(x229, x1080, x231 * x1068)),
+        );
         let x1304 = Self::mul_add(
-            -x415,
-            x1004,
-            Self::mul_add(-x414, x1003, x396 * x1002),
-        ) - Self::mul_add(c_q0, x1010, s_q0 * x1008);
-        let x1305 = Self::mul_add(x411, x960, x410 * x959)
-            + Self::mul_add(-x398, x966, x397 * x964);
-        let x1306 = Self::mul_add(-x415, x960, Self::mul_add(-x414, x959, x396 * x958))
-            - Self::mul_add(c_q0, x966, s_q0 * x964);
-        let x1307 = Self::mul_add(
-            -x149,
-            x1299,
-            Self::mul_add(x151, x1297, Self::mul_add(x154, x1292, x156 * x1289)),
+            x136,
+            x1091,
+            Self::mul_add(-x214, x1089, Self::mul_add(x224, x1087, x1303)),
         );
+        let x1305 = Self::mul_add(
+            x225,
+            x1000,
+            Self::mul_add(-x227, x997, Self::mul_add(x229, x994, x231 * x982)),
+        );
+        let x1306 = Self::mul_add(
+            -x136,
+            x1008,
+            Self::mul_add(x214, x1005, Self::mul_add(-x224, x1002, x1305)),
+        );
+        let x1307 = -x1306;
         let x1308 = Self::mul_add(
-            -x143,
-            x1305,
-            Self::mul_add(x145, x1303, Self::mul_add(-x147, x1301, x1307)),
+            x225,
+            x928,
+            Self::mul_add(-x227, x928, Self::mul_add(x229, x926, x231 * x920)),
         );
         let x1309 = Self::mul_add(
-            -x149,
-            x1257,
-            Self::mul_add(x151, x1255, Self::mul_add(x154, x1251, x156 * x1244)),
+            -x136,
+            x932,
+            Self::mul_add(x214, x930, Self::mul_add(-x224, x928, x1308)),
         );
-        let x1310 = Self::mul_add(
-            -x143,
-            x1263,
-            Self::mul_add(x145, x1261, Self::mul_add(-x147, x1259, x1309)),
-        );
+        let x1310 = -x1309;
         let x1311 = Self::mul_add(
-            -x149,
-            x1176,
-            Self::mul_add(x151, x1174, Self::mul_add(x154, x1172, x156 * x1157)),
+            x225,
+            x881,
+            Self::mul_add(-x227, x881, Self::mul_add(x229, x879, x231 * x873)),
         );
         let x1312 = Self::mul_add(
-            -x143,
-            x1183,
-            Self::mul_add(x145, x1181, Self::mul_add(-x147, x1179, x1311)),
+            x136,
+            x885,
+            Self::mul_add(x214, x883, Self::mul_add(-x224, x881, x1311)),
         );
         let x1313 = Self::mul_add(
             -x149,
-            x1087,
-            Self::mul_add(x151, x1084, Self::mul_add(x154, x1081, x156 * x1066)),
+            x1059,
+            Self::mul_add(x151, x1141, Self::mul_add(-x154, x1192, x156 * x1179)),
         );
         let x1314 = Self::mul_add(
             x143,
-            x1095,
-            Self::mul_add(-x145, x1092, Self::mul_add(x147, x1089, x1313)),
+            x870,
+            Self::mul_add(-x145, x917, Self::mul_add(-x147, x973, x1313)),
         );
         let x1315 = -x1314;
         let x1316 = Self::mul_add(
-            -x149,
-            x1019,
-            Self::mul_add(x151, x1019, Self::mul_add(x154, x1017, x156 * x1011)),
+            x149,
+            x1206,
+            Self::mul_add(-x151, x1204, Self::mul_add(x154, x1202, x156 * x1198)),
         );
         let x1317 = Self::mul_add(
             x143,
-            x1023,
-            Self::mul_add(-x145, x1021, Self::mul_add(x147, x1019, x1316)),
+            x1212,
+            Self::mul_add(-x145, x1210, Self::mul_add(x147, x1208, x1316)),
         );
-        let x1318 = -x1317;
-        let x1319 = Self::mul_add(
+        let x1318 = Self::mul_add(
             -x149,
-            x975,
-            Self::mul_add(x151, x975, Self::mul_add(x154, x973, x156 * x967)),
+            x1161,
+            Self::mul_add(x151, x1159, Self::mul_add(-x154, x1157, x156 * x1151)),
+        );
+        let x1319 = Self::mul_add(
+            x143,
+            x1167,
+            Self::mul_add(-x145, x1165, Self::mul_add(-x147, x1163, x1318)),
         );
         let x1320 = Self::mul_add(
-            -x143,
-            x979,
-            Self::mul_add(-x145, x977, Self::mul_add(x147, x975, x1319)),
+            -x149,
+            x1086,
+            Self::mul_add(x151, x1083, Self::mul_add(-x154, x1081, x156 * x1074)),
         );
         let x1321 = Self::mul_add(
-            -x164,
-            x1299,
-            Self::mul_add(-x166, x1297, Self::mul_add(x168, x1292, x170 * x1289)),
+            x143,
+            x1092,
+            Self::mul_add(-x145, x1090, Self::mul_add(-x147, x1088, x1320)),
         );
         let x1322 = Self::mul_add(
-            x161,
-            x1305,
-            Self::mul_add(-x162, x1303, Self::mul_add(x163, x1301, x1321)),
+            -x149,
+            x1001,
+            Self::mul_add(x151, x999, Self::mul_add(-x154, x995, x156 * x988)),
         );
         let x1323 = Self::mul_add(
-            -x164,
-            x1257,
-            Self::mul_add(-x166, x1255, Self::mul_add(x168, x1251, x170 * x1244)),
+            x143,
+            x1010,
+            Self::mul_add(-x145, x1007, Self::mul_add(x147, x1004, x1322)),
         );
-        let x1324 = Self::mul_add(
-            x161,
-            x1263,
-            Self::mul_add(-x162, x1261, Self::mul_add(x163, x1259, x1323)),
-        );
+        let x1324 = -x1323;
         let x1325 = Self::mul_add(
-            -x164,
-            x1176,
-            Self::mul_add(-x166, x1174, Self::mul_add(x168, x1172, x170 * x1157)),
+            -x149,
+            x929,
+            Self::mul_add(x151, x929, Self::mul_add(-x154, x927, x156 * x923)),
         );
         let x1326 = Self::mul_add(
-            x161,
-            x1183,
-            Self::mul_add(-x162, x1181, Self::mul_add(x163, x1179, x1325)),
+            x143,
+            x933,
+            Self::mul_add(-x145, x931, Self::mul_add(x147, x929, x1325)),
         );
-        let x1327 = Self::mul_add(
-            -x164,
-            x1087,
-            Self::mul_add(-x166, x1084, Self::mul_add(x168, x1081, x170 * x1066)),
-        );
+        let x1327 = -x1326;
         let x1328 = Self::mul_add(
-            -x161,
-            x1095,
-            Self::mul_add(x162, x1092, Self::mul_add(-x163, x1089, x1327)),
+            -x149,
+            x882,
+            Self::mul_add(x151, x882, Self::mul_add(-x154, x880, x156 * x876)),
         );
-        let x1329 = -x1328;
+        let x1329 = Self::mul_add(
+            -x143,
+            x886,
+            Self::mul_add(-x145, x884, Self::mul_add(x147, x882, x1328)),
+        );
         let x1330 = Self::mul_add(
             -x164,
-            x1019,
-            Self::mul_add(-x166, x1019, Self::mul_add(x168, x1017, x170 * x1011)),
+            x1059,
+            Self::mul_add(-x166, x1141, Self::mul_add(-x168, x1192, x170 * x1179)),
         );
         let x1331 = Self::mul_add(
             -x161,
-            x1023,
-            Self::mul_add(x162, x1021, Self::mul_add(-x163, x1019, x1330)),
+            x870,
+            Self::mul_add(x162, x917, Self::mul_add(x163, x973, x1330)),
         );
         let x1332 = -x1331;
         let x1333 = Self::mul_add(
-            -x164,
-            x975,
-            Self::mul_add(-x166, x975, Self::mul_add(x168, x973, x170 * x967)),
+            x164,
+            x1206,
+            Self::mul_add(x166, x1204, Self::mul_add(x168, x1202, x170 * x1198)),
         );
         let x1334 = Self::mul_add(
-            x161,
-            x979,
-            Self::mul_add(x162, x977, Self::mul_add(-x163, x975, x1333)),
+            -x161,
+            x1212,
+            Self::mul_add(x162, x1210, Self::mul_add(-x163, x1208, x1333)),
         );
         let x1335 = Self::mul_add(
-            x179,
-            x1299,
-            Self::mul_add(-x182, x1297, Self::mul_add(x184, x1292, x186 * x1289)),
+            -x164,
+            x1161,
+            Self::mul_add(-x166, x1159, Self::mul_add(-x168, x1157, x170 * x1151)),
         );
         let x1336 = Self::mul_add(
-            -x174,
-            x1305,
-            Self::mul_add(-x176, x1303, Self::mul_add(-x177, x1301, x1335)),
+            -x161,
+            x1167,
+            Self::mul_add(x162, x1165, Self::mul_add(x163, x1163, x1335)),
         );
         let x1337 = Self::mul_add(
-            x179,
-            x1257,
-            Self::mul_add(-x182, x1255, Self::mul_add(x184, x1251, x186 * x1244)),
+            -x164,
+            x1086,
+            Self::mul_add(-x166, x1083, Self::mul_add(-x168, x1081, x170 * x1074)),
         );
         let x1338 = Self::mul_add(
-            -x174,
-            x1263,
-            Self::mul_add(-x176, x1261, Self::mul_add(-x177, x1259, x1337)),
+            -x161,
+            x1092,
+            Self::mul_add(x162, x1090, Self::mul_add(x163, x1088, x1337)),
         );
         let x1339 = Self::mul_add(
-            x179,
-            x1176,
-            Self::mul_add(-x182, x1174, Self::mul_add(x184, x1172, x186 * x1157)),
+            -x164,
+            x1001,
+            Self::mul_add(-x166, x999, Self::mul_add(-x168, x995, x170 * x988)),
         );
         let x1340 = Self::mul_add(
-            -x174,
-            x1183,
-            Self::mul_add(-x176, x1181, Self::mul_add(-x177, x1179, x1339)),
+            -x161,
+            x1010,
+            Self::mul_add(x162, x1007, Self::mul_add(-x163, x1004, x1339)),
         );
-        let x1341 = Self::mul_add(
-            x179,
-            x1087,
-            Self::mul_add(-x182, x1084, Self::mul_add(x184, x1081, x186 * x1066)),
-        );
+        let x1341 = -x1340;
         let x1342 = Self::mul_add(
-            x174,
-            x1095,
-            Self::mul_add(x176, x1092, Self::mul_add(x177, x1089, x1341)),
+            -x164,
+            x929,
+            Self::mul_add(-x166, x929, Self::mul_add(-x168, x927, x170 * x923)),
         );
-        let x1343 = -x1342;
-        let x1344 = Self::mul_add(
-            x179,
-            x1019,
-            Self::mul_add(-x182, x1019, Self::mul_add(x184, x1017, x186 * x1011)),
+        let x1343 = Self::mul_add(
+            -x161,
+            x933,
+            Self::mul_add(x162, x931, Self::mul_add(-x163, x929, x1342)),
         );
+        let x1344 = -x1343;
         let x1345 = Self::mul_add(
-            x174,
-            x1023,
-            Self::mul_add(x176, x1021, Self::mul_add(x177, x1019, x1344)),
+            -x164,
+            x882,
+            Self::mul_add(-x166, x882, Self::mul_add(-x168, x880, x170 * x876)),
         );
-        let x1346 = -x1345;
+        let x1346 = Self::mul_add(
+            x161,
+            x886,
+            Self::mul_add(x162, x884, Self::mul_add(-x163, x882, x1345)),
+        );
         let x1347 = Self::mul_add(
             x179,
-            x975,
-            Self::mul_add(-x182, x975, Self::mul_add(x184, x973, x186 * x967)),
+            x1059,
+            Self::mul_add(-x182, x1141, Self::mul_add(-x184, x1192, x186 * x1179)),
         );
         let x1348 = Self::mul_add(
-            -x174,
-            x979,
-            Self::mul_add(x176, x977, Self::mul_add(x177, x975, x1347)),
+            x174,
+            x870,
+            Self::mul_add(x176, x917, Self::mul_add(-x177, x973, x1347)),
         );
-        let x1349 = Self::mul_add(
-            x194,
-            x1299,
-            Self::mul_add(-x195, x1297, Self::mul_add(x198, x1292, x201 * x1289)),
-        );
+        let x1349 = -x1348;
         let x1350 = Self::mul_add(
-            x188,
-            x1305,
-            Self::mul_add(-x190, x1303, Self::mul_add(x192, x1301, x1349)),
+            -x179,
+            x1206,
+            Self::mul_add(x182, x1204, Self::mul_add(x184, x1202, x186 * x1198)),
         );
-        let x1351 = -x1350;
+        let x1351 = Self::mul_add(
+            x174,
+            x1212,
+            Self::mul_add(x176, x1210, Self::mul_add(x177, x1208, x1350)),
+        );
         let x1352 = Self::mul_add(
-            x194,
-            x1257,
-            Self::mul_add(-x195, x1255, Self::mul_add(x198, x1251, x201 * x1244)),
+            x179,
+            x1161,
+            Self::mul_add(-x182, x1159, Self::mul_add(-x184, x1157, x186 * x1151)),
         );
         let x1353 = Self::mul_add(
-            x188,
-            x1263,
-            Self::mul_add(-x190, x1261, Self::mul_add(x192, x1259, x1352)),
+            x174,
+            x1167,
+            Self::mul_add(x176, x1165, Self::mul_add(-x177, x1163, x1352)),
         );
-        let x1354 = -x1353;
+        let x1354 = Self::mul_add(
+            x179,
+            x1086,
+            Self::mul_add(-x182, x1083, Self::mul_add(-x184, x1081, x186 * x1074)),
+        );
         let x1355 = Self::mul_add(
-            x194,
-            x1176,
-            Self::mul_add(-x195, x1174, Self::mul_add(x198, x1172, x201 * x1157)),
+            x174,
+            x1092,
+            Self::mul_add(x176, x1090, Self::mul_add(-x177, x1088, x1354)),
         );
         let x1356 = Self::mul_add(
-            x188,
-            x1183,
-            Self::mul_add(-x190, x1181, Self::mul_add(x192, x1179, x1355)),
+            x179,
+            x1001,
+            Self::mul_add(-x182, x999, Self::mul_add(-x184, x995, x186 * x988)),
         );
-        let x1357 = -x1356;
-        let x1358 = Self::mul_add(
-            x194,
-            x1087,
-            Self::mul_add(-x195, x1084, Self::mul_add(x198, x1081, x201 * x1066)),
+        let x1357 = Self::mul_add(
+            x174,
+            x1010,
+            Self::mul_add(x176, x1007, Self::mul_add(x177, x1004, x1356)),
         );
+        let x1358 = -x1357;
         let x1359 = Self::mul_add(
-            -x188,
-            x1095,
-            Self::mul_add(x190, x1092, Self::mul_add(-x192, x1089, x1358)),
+            x179,
+            x929,
+            Self::mul_add(-x182, x929, Self::mul_add(-x184, x927, x186 * x923)),
         );
         let x1360 = Self::mul_add(
-            x194,
-            x1019,
-            Self::mul_add(-x195, x1019, Self::mul_add(x198, x1017, x201 * x1011)),
+            x174,
+            x933,
+            Self::mul_add(x176, x931, Self::mul_add(x177, x929, x1359)),
         );
-        let x1361 = Self::mul_add(
-            -x188,
-            x1023,
-            Self::mul_add(x190, x1021, Self::mul_add(-x192, x1019, x1360)),
-        );
+        let x1361 = -x1360;
         let x1362 = Self::mul_add(
-            x194,
-            x975,
-            Self::mul_add(-x195, x975, Self::mul_add(x198, x973, x201 * x967)),
+            x179,
+            x882,
+            Self::mul_add(-x182, x882, Self::mul_add(-x184, x880, x186 * x876)),
         );
         let x1363 = Self::mul_add(
-            x188,
-            x979,
-            Self::mul_add(x190, x977, Self::mul_add(-x192, x975, x1362)),
+            -x174,
+            x886,
+            Self::mul_add(x176, x884, Self::mul_add(x177, x882, x1362)),
         );
-        let x1364 = -x1363;
+        let x1364 = Self::mul_add(
+            x194,
+            x1059,
+            Self::mul_add(-x195, x1141, Self::mul_add(-x198, x1192, x201 * x1179)),
+        );
         let x1365 = Self::mul_add(
-            x207,
-            x1299,
-            Self::mul_add(-x209, x1297, Self::mul_add(x211, x1292, x213 * x1289)),
+            -x188,
+            x870,
+            Self::mul_add(x190, x917, Self::mul_add(x192, x973, x1364)),
         );
         let x1366 = Self::mul_add(
-            -x203,
-            x1305,
-            Self::mul_add(-x205, x1303, Self::mul_add(x206, x1301, x1365)),
+            -x194,
+            x1206,
+            Self::mul_add(x195, x1204, Self::mul_add(x198, x1202, x201 * x1198)),
         );
         let x1367 = Self::mul_add(
-            x207,
-            x1257,
-            Self::mul_add(-x209, x1255, Self::mul_add(x211, x1251, x213 * x1244)),
+            -x188,
+            x1212,
+            Self::mul_add(x190, x1210, Self::mul_add(-x192, x1208, x1366)),
         );
-        let x1368 = Self::mul_add(
-            -x203,
-            x1263,
-            Self::mul_add(-x205, x1261, Self::mul_add(x206, x1259, x1367)),
-        );
+        let x1368 = -x1367;
         let x1369 = Self::mul_add(
-            x207,
-            x1176,
-            Self::mul_add(-x209, x1174, Self::mul_add(x211, x1172, x213 * x1157)),
+            x194,
+            x1161,
+            Self::mul_add(-x195, x1159, Self::mul_add(-x198, x1157, x201 * x1151)),
         );
         let x1370 = Self::mul_add(
-            -x203,
-            x1183,
-            Self::mul_add(-x205, x1181, Self::mul_add(x206, x1179, x1369)),
+            -x188,
+            x1167,
+            Self::mul_add(x190, x1165, Self::mul_add(x192, x1163, x1369)),
         );
-        let x1371 = Self::mul_add(
-            x207,
-            x1087,
-            Self::mul_add(-x209, x1084, Self::mul_add(x211, x1081, x213 * x1066)),
-        );
+        let x1371 = -x1370;
         let x1372 = Self::mul_add(
-            x203,
-            x1095,
-            Self::mul_add(x205, x1092, Self::mul_add(-x206, x1089, x1371)),
+            x194,
+            x1086,
+            Self::mul_add(-x195, x1083, Self::mul_add(-x198, x1081, x201 * x1074)),
         );
-        let x1373 = -x1372;
-        let x1374 = Self::mul_add(
-            x207,
-            x1019,
-            Self::mul_add(-x209, x1019, Self::mul_add(x211, x1017, x213 * x1011)),
+        let x1373 = Self::mul_add(
+            -x188,
+            x1092,
+            Self::mul_add(x190, x1090, Self::mul_add(x192, x1088, x1372)),
         );
+        let x1374 = -x1373;
         let x1375 = Self::mul_add(
-            x203,
-            x1023,
-            Self::mul_add(x205, x1021, Self::mul_add(-x206, x1019, x1374)),
+            x194,
+            x1001,
+            Self::mul_add(-x195, x999, Self::mul_add(-x198, x995, x201 * x988)),
         );
-        let x1376 = -x1375;
+        let x1376 = Self::mul_add(
+            -x188,
+            x1010,
+            Self::mul_add(x190, x1007, Self::mul_add(-x192, x1004, x1375)),
+        );
         let x1377 = Self::mul_add(
-            x207,
-            x975,
-            Self::mul_add(-x209, x975, Self::mul_add(x211, x973, x213 * x967)),
+            x194,
+            x929,
+            Self::mul_add(-x195, x929, Self::mul_add(-x198, x927, x201 * x923)),
         );
         let x1378 = Self::mul_add(
-            -x203,
-            x979,
-            Self::mul_add(x205, x977, Self::mul_add(-x206, x975, x1377)),
+            -x188,
+            x933,
+            Self::mul_add(x190, x931, Self::mul_add(-x192, x929, x1377)),
         );
         let x1379 = Self::mul_add(
-            x217,
-            x1299,
-            Self::mul_add(-x219, x1297, Self::mul_add(x221, x1292, x223 * x1289)),
+            x194,
+            x882,
+            Self::mul_add(-x195, x882, Self::mul_add(-x198, x880, x201 * x876)),
         );
         let x1380 = Self::mul_add(
-            x214,
-            x1305,
-            Self::mul_add(-x215, x1303, Self::mul_add(x216, x1301, x1379)),
+            x188,
+            x886,
+            Self::mul_add(x190, x884, Self::mul_add(-x192, x882, x1379)),
         );
-        let x1381 = Self::mul_add(
-            x217,
-            x1257,
-            Self::mul_add(-x219, x1255, Self::mul_add(x221, x1251, x223 * x1244)),
-        );
+        let x1381 = -x1380;
         let x1382 = Self::mul_add(
-            x214,
-            x1263,
-            Self::mul_add(-x215, x1261, Self::mul_add(x216, x1259, x1381)),
+            x207,
+            x1059,
+            Self::mul_add(-x209, x1141, Self::mul_add(-x211, x1192, x213 * x1179)),
         );
         let x1383 = Self::mul_add(
-            x217,
-            x1176,
-            Self::mul_add(-x219, x1174, Self::mul_add(x221, x1172, x223 * x1157)),
+            x203,
+            x870,
+            Self::mul_add(x205, x917, Self::mul_add(x206, x973, x1382)),
         );
-        let x1384 = Self::mul_add(
-            x214,
-            x1183,
-            Self::mul_add(-x215, x1181, Self::mul_add(x216, x1179, x1383)),
-        );
+        let x1384 = -x1383;
         let x1385 = Self::mul_add(
-            x217,
-            x1087,
-            Self::mul_add(-x219, x1084, Self::mul_add(x221, x1081, x223 * x1066)),
+            -x207,
+            x1206,
+            Self::mul_add(x209, x1204, Self::mul_add(x211, x1202, x213 * x1198)),
         );
         let x1386 = Self::mul_add(
-            -x214,
-            x1095,
-            Self::mul_add(x215, x1092, Self::mul_add(-x216, x1089, x1385)),
+            x203,
+            x1212,
+            Self::mul_add(x205, x1210, Self::mul_add(-x206, x1208, x1385)),
         );
-        let x1387 = -x1386;
+        let x1387 = Self::mul_add(
+            x207,
+            x1161,
+            Self::mul_add(-x209, x1159, Self::mul_add(-x211, x1157, x213 * x1151)),
+        );
         let x1388 = Self::mul_add(
-            x217,
-            x1019,
-            Self::mul_add(-x219, x1019, Self::mul_add(x221, x1017, x223 * x1011)),
+            x203,
+            x1167,
+            Self::mul_add(x205, x1165, Self::mul_add(x206, x1163, x1387)),
         );
         let x1389 = Self::mul_add(
-            -x214,
-            x1023,
-            Self::mul_add(x215, x1021, Self::mul_add(-x216, x1019, x1388)),
+            x207,
+            x1086,
+            Self::mul_add(-x209, x1083, Self::mul_add(-x211, x1081, x213 * x1074)),
         );
-        let x1390 = -x1389;
+        let x1390 = Self::mul_add(
+            x203,
+            x1092,
+            Self::mul_add(x205, x1090, Self::mul_add(x206, x1088, x1389)),
+        );
         let x1391 = Self::mul_add(
-            x217,
-            x975,
-            Self::mul_add(-x219, x975, Self::mul_add(x221, x973, x223 * x967)),
+            x207,
+            x1001,
+            Self::mul_add(-x209, x999, Self::mul_add(-x211, x995, x213 * x988)),
         );
         let x1392 = Self::mul_add(
-            x214,
-            x979,
-            Self::mul_add(x215, x977, Self::mul_add(-x216, x975, x1391)),
+            x203,
+            x1010,
+            Self::mul_add(x205, x1007, Self::mul_add(-x206, x1004, x1391)),
         );
-        let x1393 = Self::mul_add(
-            x225,
-            x1299,
-            Self::mul_add(-x227, x1297, Self::mul_add(x229, x1292, x231 * x1289)),
-        );
+        let x1393 = -x1392;
         let x1394 = Self::mul_add(
-            x136,
-            x1305,
-            Self::mul_add(-x214, x1303, Self::mul_add(x224, x1301, x1393)),
+            x207,
+            x929,
+            Self::mul_add(-x209, x929, Self::mul_add(-x211, x927, x213 * x923)),
         );
         let x1395 = Self::mul_add(
-            x225,
-            x1257,
-            Self::mul_add(-x227, x1255, Self::mul_add(x229, x1251, x231 * x1244)),
+            x203,
+            x933,
+            Self::mul_add(x205, x931, Self::mul_add(-x206, x929, x1394)),
         );
-        let x1396 = Self::mul_add(
-            x136,
-            x1263,
-            Self::mul_add(-x214, x1261, Self::mul_add(x224, x1259, x1395)),
-        );
+        let x1396 = -x1395;
         let x1397 = Self::mul_add(
-            x225,
-            x1176,
-            Self::mul_add(-x227, x1174, Self::mul_add(x229, x1172, x231 * x1157)),
+            x207,
+            x882,
+            Self::mul_add(-x209, x882, Self::mul_add(-x211, x880, x213 * x876)),
         );
         let x1398 = Self::mul_add(
-            x136,
-            x1183,
-            Self::mul_add(-x214, x1181, Self::mul_add(x224, x1179, x1397)),
+            -x203,
+            x886,
+            Self::mul_add(x205, x884, Self::mul_add(-x206, x882, x1397)),
         );
         let x1399 = Self::mul_add(
-            x225,
-            x1087,
-            Self::mul_add(-x227, x1084, Self::mul_add(x229, x1081, x231 * x1066)),
+            x217,
+            x1059,
+            Self::mul_add(-x219, x1141, Self::mul_add(-x221, x1192, x223 * x1179)),
         );
         let x1400 = Self::mul_add(
-            -x136,
-            x1095,
-            Self::mul_add(x214, x1092, Self::mul_add(-x224, x1089, x1399)),
+            -x214,
+            x870,
+            Self::mul_add(x215, x917, Self::mul_add(x216, x973, x1399)),
         );
         let x1401 = -x1400;
         let x1402 = Self::mul_add(
-            x225,
-            x1019,
-            Self::mul_add(-x227, x1019, Self::mul_add(x229, x1017, x231 * x1011)),
+            -x217,
+            x1206,
+            Self::mul_add(x219, x1204, Self::mul_add(x221, x1202, x223 * x1198)),
         );
         let x1403 = Self::mul_add(
-            -x136,
-            x1023,
-            Self::mul_add(x214, x1021, Self::mul_add(-x224, x1019, x1402)),
+            -x214,
+            x1212,
+            Self::mul_add(x215, x1210, Self::mul_add(-x216, x1208, x1402)),
         );
-        let x1404 = -x1403;
+        let x1404 = Self::mul_add(
+            x217,
+            x1161,
+            Self::mul_add(-x219, x1159, Self::mul_add(-x221, x1157, x223 * x1151)),
+        );
         let x1405 = Self::mul_add(
-            x225,
-            x975,
-            Self::mul_add(-x227, x975, Self::mul_add(x229, x973, x231 * x967)),
+            -x214,
+            x1167,
+            Self::mul_add(x215, x1165, Self::mul_add(x216, x1163, x1404)),
         );
         let x1406 = Self::mul_add(
-            x136,
-            x979,
-            Self::mul_add(x214, x977, Self::mul_add(-x224, x975, x1405)),
+            x217,
+            x1086,
+            Self::mul_add(-x219, x1083, Self::mul_add(-x221, x1081, x223 * x1074)),
         );
         let x1407 = Self::mul_add(
-            -x149,
-            x1145,
-            Self::mul_add(x151, x1232, Self::mul_add(x154, x1280, x156 * x1270)),
+            -x214,
+            x1092,
+            Self::mul_add(x215, x1090, Self::mul_add(x216, x1088, x1406)),
         );
         let x1408 = Self::mul_add(
-            -x143,
-            x962,
-            Self::mul_add(x145, x1006, Self::mul_add(-x147, x1054, x1407)),
+            x217,
+            x1001,
+            Self::mul_add(-x219, x999, Self::mul_add(-x221, x995, x223 * x988)),
         );
         let x1409 = Self::mul_add(
-            x149,
-            x1300,
-            Self::mul_add(-x151, x1298, Self::mul_add(x154, x1296, x156 * x1291)),
+            -x214,
+            x1010,
+            Self::mul_add(x215, x1007, Self::mul_add(-x216, x1004, x1408)),
         );
-        let x1410 = Self::mul_add(
-            x143,
-            x1306,
-            Self::mul_add(-x145, x1304, Self::mul_add(x147, x1302, x1409)),
-        );
+        let x1410 = -x1409;
         let x1411 = Self::mul_add(
-            -x149,
-            x1258,
-            Self::mul_add(x151, x1256, Self::mul_add(-x154, x1254, x156 * x1248)),
+            x217,
+            x929,
+            Self::mul_add(-x219, x929, Self::mul_add(-x221, x927, x223 * x923)),
         );
         let x1412 = Self::mul_add(
-            x143,
-            x1264,
-            Self::mul_add(-x145, x1262, Self::mul_add(-x147, x1260, x1411)),
+            -x214,
+            x933,
+            Self::mul_add(x215, x931, Self::mul_add(-x216, x929, x1411)),
         );
-        let x1413 = Self::mul_add(
-            -x149,
-            x1178,
-            Self::mul_add(x151, x1175, Self::mul_add(-x154, x1173, x156 * x1166)),
-        );
+        let x1413 = -x1412;
         let x1414 = Self::mul_add(
-            x143,
-            x1184,
-            Self::mul_add(-x145, x1182, Self::mul_add(-x147, x1180, x1413)),
+            x217,
+            x882,
+            Self::mul_add(-x219, x882, Self::mul_add(-x221, x880, x223 * x876)),
         );
         let x1415 = Self::mul_add(
-            -x149,
-            x1088,
-            Self::mul_add(x151, x1086, Self::mul_add(-x154, x1082, x156 * x1075)),
+            x214,
+            x886,
+            Self::mul_add(x215, x884, Self::mul_add(-x216, x882, x1414)),
         );
         let x1416 = Self::mul_add(
-            x143,
-            x1097,
-            Self::mul_add(-x145, x1094, Self::mul_add(x147, x1091, x1415)),
+            x225,
+            x1059,
+            Self::mul_add(-x227, x1141, Self::mul_add(-x229, x1192, x231 * x1179)),
         );
-        let x1417 = -x1416;
-        let x1418 = Self::mul_add(
-            -x149,
-            x1020,
-            Self::mul_add(x151, x1020, Self::mul_add(-x154, x1018, x156 * x1014)),
+        let x1417 = Self::mul_add(
+            -x136,
+            x870,
+            Self::mul_add(x214, x917, Self::mul_add(x224, x973, x1416)),
         );
+        let x1418 = -x1417;
         let x1419 = Self::mul_add(
-            x143,
-            x1024,
-            Self::mul_add(-x145, x1022, Self::mul_add(x147, x1020, x1418)),
+            -x225,
+            x1206,
+            Self::mul_add(x227, x1204, Self::mul_add(x229, x1202, x231 * x1198)),
         );
-        let x1420 = -x1419;
+        let x1420 = Self::mul_add(
+            -x136,
+            x1212,
+            Self::mul_add(x214, x1210, Self::mul_add(-x224, x1208, x1419)),
+        );
         let x1421 = Self::mul_add(
-            -x149,
-            x976,
-            Self::mul_add(x151, x976, Self::mul_add(-x154, x974, x156 * x970)),
+            x225,
+            x1161,
+            Self::mul_add(-x227, x1159, Self::mul_add(-x229, x1157, x231 * x1151)),
         );
         let x1422 = Self::mul_add(
-            -x143,
-            x980,
-            Self::mul_add(-x145, x978, Self::mul_add(x147, x976, x1421)),
+            -x136,
+            x1167,
+            Self::mul_add(x214, x1165, Self::mul_add(x224, x1163, x1421)),
         );
         let x1423 = Self::mul_add(
-            -x164,
-            x1145,
-            Self::mul_add(-x166, x1232, Self::mul_add(x168, x1280, x170 * x1270)),
+            x225,
+            x1086,
+            Self::mul_add(-x227, x1083, Self::mul_add(-x229, x1081, x231 * x1074)),
         );
         let x1424 = Self::mul_add(
-            x161,
-            x962,
-            Self::mul_add(-x162, x1006, Self::mul_add(x163, x1054, x1423)),
+            -x136,
+            x1092,
+            Self::mul_add(x214, x1090, Self::mul_add(x224, x1088, x1423)),
         );
         let x1425 = Self::mul_add(
-            x164,
-            x1300,
-            Self::mul_add(x166, x1298, Self::mul_add(x168, x1296, x170 * x1291)),
+            x225,
+            x1001,
+            Self::mul_add(-x227, x999, Self::mul_add(-x229, x995, x231 * x988)),
         );
         let x1426 = Self::mul_add(
-            -x161,
-            x1306,
-            Self::mul_add(x162, x1304, Self::mul_add(-x163, x1302, x1425)),
+            -x136,
+            x1010,
+            Self::mul_add(x214, x1007, Self::mul_add(-x224, x1004, x1425)),
         );
-        let x1427 = Self::mul_add(
-            -x164,
-            x1258,
-            Self::mul_add(-x166, x1256, Self::mul_add(-x168, x1254, x170 * x1248)),
-        );
+        let x1427 = -x1426;
         let x1428 = Self::mul_add(
-            -x161,
-            x1264,
-            Self::mul_add(x162, x1262, Self::mul_add(x163, x1260, x1427)),
+            x225,
+            x929,
+            Self::mul_add(-x227, x929, Self::mul_add(-x229, x927, x231 * x923)),
         );
         let x1429 = Self::mul_add(
-            -x164,
-            x1178,
-            Self::mul_add(-x166, x1175, Self::mul_add(-x168, x1173, x170 * x1166)),
+            -x136,
+            x933,
+            Self::mul_add(x214, x931, Self::mul_add(-x224, x929, x1428)),
         );
-        let x1430 = Self::mul_add(
-            -x161,
-            x1184,
-            Self::mul_add(x162, x1182, Self::mul_add(x163, x1180, x1429)),
-        );
+        let x1430 = -x1429;
         let x1431 = Self::mul_add(
-            -x164,
-            x1088,
-            Self::mul_add(-x166, x1086, Self::mul_add(-x168, x1082, x170 * x1075)),
+            x225,
+            x882,
+            Self::mul_add(-x227, x882, Self::mul_add(-x229, x880, x231 * x876)),
         );
         let x1432 = Self::mul_add(
-            -x161,
-            x1097,
-            Self::mul_add(x162, x1094, Self::mul_add(-x163, x1091, x1431)),
-        );
-        let x1433 = -x1432;
-        let x1434 = Self::mul_add(
-            -x164,
-            x1020,
-            Self::mul_add(-x166, x1020, Self::mul_add(-x168, x1018, x170 * x1014)),
-        );
-        let x1435 = Self::mul_add(
-            -x161,
-            x1024,
-            Self::mul_add(x162, x1022, Self::mul_add(-x163, x1020, x1434)),
-        );
-        let x1436 = -x1435;
-        let x1437 = Self::mul_add(
-            -x164,
-            x976,
-            Self::mul_add(-x166, x976, Self::mul_add(-x168, x974, x170 * x970)),
-        );
-        let x1438 = Self::mul_add(
-            x161,
-            x980,
-            Self::mul_add(x162, x978, Self::mul_add(-x163, x976, x1437)),
-        );
-        let x1439 = Self::mul_add(
-            x179,
-            x1145,
-            Self::mul_add(-x182, x1232, Self::mul_add(x184, x1280, x186 * x1270)),
-        );
-        let x1440 = Self::mul_add(
-            -x174,
-            x962,
-            Self::mul_add(-x176, x1006, Self::mul_add(-x177, x1054, x1439)),
-        );
-        let x1441 = Self::mul_add(
-            -x179,
-            x1300,
-            Self::mul_add(x182, x1298, Self::mul_add(x184, x1296, x186 * x1291)),
-        );
-        let x1442 = Self::mul_add(
-            x174,
-            x1306,
-            Self::mul_add(x176, x1304, Self::mul_add(x177, x1302, x1441)),
-        );
-        let x1443 = Self::mul_add(
-            x179,
-            x1258,
-            Self::mul_add(-x182, x1256, Self::mul_add(-x184, x1254, x186 * x1248)),
-        );
-        let x1444 = Self::mul_add(
-            x174,
-            x1264,
-            Self::mul_add(x176, x1262, Self::mul_add(-x177, x1260, x1443)),
-        );
-        let x1445 = Self::mul_add(
-            x179,
-            x1178,
-            Self::mul_add(-x182, x1175, Self::mul_add(-x184, x1173, x186 * x1166)),
-        );
-        let x1446 = Self::mul_add(
-            x174,
-            x1184,
-            Self::mul_add(x176, x1182, Self::mul_add(-x177, x1180, x1445)),
-        );
-        let x1447 = Self::mul_add(
-            x179,
-            x1088,
-            Self::mul_add(-x182, x1086, Self::mul_add(-x184, x1082, x186 * x1075)),
-        );
-        let x1448 = Self::mul_add(
-            x174,
-            x1097,
-            Self::mul_add(x176, x1094, Self::mul_add(x177, x1091, x1447)),
-        );
-        let x1449 = -x1448;
-        let x1450 = Self::mul_add(
-            x179,
-            x1020,
-            Self::mul_add(-x182, x1020, Self::mul_add(-x184, x1018, x186 * x1014)),
-        );
-        let x1451 = Self::mul_add(
-            x174,
-            x1024,
-            Self::mul_add(x176, x1022, Self::mul_add(x177, x1020, x1450)),
-        );
-        let x1452 = -x1451;
-        let x1453 = Self::mul_add(
-            x179,
-            x976,
-            Self::mul_add(-x182, x976, Self::mul_add(-x184, x974, x186 * x970)),
-        );
-        let x1454 = Self::mul_add(
-            -x174,
-            x980,
-            Self::mul_add(x176, x978, Self::mul_add(x177, x976, x1453)),
-        );
-        let x1455 = Self::mul_add(
-            x194,
-            x1145,
-            Self::mul_add(-x195, x1232, Self::mul_add(x198, x1280, x201 * x1270)),
-        );
-        let x1456 = Self::mul_add(
-            x188,
-            x962,
-            Self::mul_add(-x190, x1006, Self::mul_add(x192, x1054, x1455)),
-        );
-        let x1457 = -x1456;
-        let x1458 = Self::mul_add(
-            -x194,
-            x1300,
-            Self::mul_add(x195, x1298, Self::mul_add(x198, x1296, x201 * x1291)),
-        );
-        let x1459 = Self::mul_add(
-            -x188,
-            x1306,
-            Self::mul_add(x190, x1304, Self::mul_add(-x192, x1302, x1458)),
-        );
-        let x1460 = -x1459;
-        let x1461 = Self::mul_add(
-            x194,
-            x1258,
-            Self::mul_add(-x195, x1256, Self::mul_add(-x198, x1254, x201 * x1248)),
-        );
-        let x1462 = Self::mul_add(
-            -x188,
-            x1264,
-            Self::mul_add(x190, x1262, Self::mul_add(x192, x1260, x1461)),
-        );
-        let x1463 = -x1462;
-        let x1464 = Self::mul_add(
-            x194,
-            x1178,
-            Self::mul_add(-x195, x1175, Self::mul_add(-x198, x1173, x201 * x1166)),
-        );
-        let x1465 = Self::mul_add(
-            -x188,
-            x1184,
-            Self::mul_add(x190, x1182, Self::mul_add(x192, x1180, x1464)),
-        );
-        let x1466 = -x1465;
-        let x1467 = Self::mul_add(
-            x194,
-            x1088,
-            Self::mul_add(-x195, x1086, Self::mul_add(-x198, x1082, x201 * x1075)),
-        );
-        let x1468 = Self::mul_add(
-            -x188,
-            x1097,
-            Self::mul_add(x190, x1094, Self::mul_add(-x192, x1091, x1467)),
-        );
-        let x1469 = Self::mul_add(
-            x194,
-            x1020,
-            Self::mul_add(-x195, x1020, Self::mul_add(-x198, x1018, x201 * x1014)),
-        );
-        let x1470 = Self::mul_add(
-            -x188,
-            x1024,
-            Self::mul_add(x190, x1022, Self::mul_add(-x192, x1020, x1469)),
-        );
-        let x1471 = Self::mul_add(
-            x194,
-            x976,
-            Self::mul_add(-x195, x976, Self::mul_add(-x198, x974, x201 * x970)),
-        );
-        let x1472 = Self::mul_add(
-            x188,
-            x980,
-            Self::mul_add(x190, x978, Self::mul_add(-x192, x976, x1471)),
-        );
-        let x1473 = -x1472;
-        let x1474 = Self::mul_add(
-            x207,
-            x1145,
-            Self::mul_add(-x209, x1232, Self::mul_add(x211, x1280, x213 * x1270)),
-        );
-        let x1475 = Self::mul_add(
-            -x203,
-            x962,
-            Self::mul_add(-x205, x1006, Self::mul_add(x206, x1054, x1474)),
-        );
-        let x1476 = Self::mul_add(
-            -x207,
-            x1300,
-            Self::mul_add(x209, x1298, Self::mul_add(x211, x1296, x213 * x1291)),
-        );
-        let x1477 = Self::mul_add(
-            x203,
-            x1306,
-            Self::mul_add(x205, x1304, Self::mul_add(-x206, x1302, x1476)),
-        );
-        let x1478 = Self::mul_add(
-            x207,
-            x1258,
-            Self::mul_add(-x209, x1256, Self::mul_add(-x211, x1254, x213 * x1248)),
-        );
-        let x1479 = Self::mul_add(
-            x203,
-            x1264,
-            Self::mul_add(x205, x1262, Self::mul_add(x206, x1260, x1478)),
-        );
-        let x1480 = Self::mul_add(
-            x207,
-            x1178,
-            Self::mul_add(-x209, x1175, Self::mul_add(-x211, x1173, x213 * x1166)),
-        );
-        let x1481 = Self::mul_add(
-            x203,
-            x1184,
-            Self::mul_add(x205, x1182, Self::mul_add(x206, x1180, x1480)),
-        );
-        let x1482 = Self::mul_add(
-            x207,
-            x1088,
-            Self::mul_add(-x209, x1086, Self::mul_add(-x211, x1082, x213 * x1075)),
-        );
-        let x1483 = Self::mul_add(
-            x203,
-            x1097,
-            Self::mul_add(x205, x1094, Self::mul_add(-x206, x1091, x1482)),
-        );
-        let x1484 = -x1483;
-        let x1485 = Self::mul_add(
-            x207,
-            x1020,
-            Self::mul_add(-x209, x1020, Self::mul_add(-x211, x1018, x213 * x1014)),
-        );
-        let x1486 = Self::mul_add(
-            x203,
-            x1024,
-            Self::mul_add(x205, x1022, Self::mul_add(-x206, x1020, x1485)),
-        );
-        let x1487 = -x1486;
-        let x1488 = Self::mul_add(
-            x207,
-            x976,
-            Self::mul_add(-x209, x976, Self::mul_add(-x211, x974, x213 * x970)),
-        );
-        let x1489 = Self::mul_add(
-            -x203,
-            x980,
-            Self::mul_add(x205, x978, Self::mul_add(-x206, x976, x1488)),
-        );
-        let x1490 = Self::mul_add(
-            x217,
-            x1145,
-            Self::mul_add(-x219, x1232, Self::mul_add(x221, x1280, x223 * x1270)),
-        );
-        let x1491 = Self::mul_add(
-            x214,
-            x962,
-            Self::mul_add(-x215, x1006, Self::mul_add(x216, x1054, x1490)),
-        );
-        let x1492 = Self::mul_add(
-            -x217,
-            x1300,
-            Self::mul_add(x219, x1298, Self::mul_add(x221, x1296, x223 * x1291)),
-        );
-        let x1493 = Self::mul_add(
-            -x214,
-            x1306,
-            Self::mul_add(x215, x1304, Self::mul_add(-x216, x1302, x1492)),
-        );
-        let x1494 = Self::mul_add(
-            x217,
-            x1258,
-            Self::mul_add(-x219, x1256, Self::mul_add(-x221, x1254, x223 * x1248)),
-        );
-        let x1495 = Self::mul_add(
-            -x214,
-            x1264,
-            Self::mul_add(x215, x1262, Self::mul_add(x216, x1260, x1494)),
-        );
-        let x1496 = Self::mul_add(
-            x217,
-            x1178,
-            Self::mul_add(-x219, x1175, Self::mul_add(-x221, x1173, x223 * x1166)),
-        );
-        let x1497 = Self::mul_add(
-            -x214,
-            x1184,
-            Self::mul_add(x215, x1182, Self::mul_add(x216, x1180, x1496)),
-        );
-        let x1498 = Self::mul_add(
-            x217,
-            x1088,
-            Self::mul_add(-x219, x1086, Self::mul_add(-x221, x1082, x223 * x1075)),
-        );
-        let x1499 = Self::mul_add(
-            -x214,
-            x1097,
-            Self::mul_add(x215, x1094, Self::mul_add(-x216, x1091, x1498)),
-        );
-        let x1500 = -x1499;
-        let x1501 = Self::mul_add(
-            x217,
-            x1020,
-            Self::mul_add(-x219, x1020, Self::mul_add(-x221, x1018, x223 * x1014)),
-        );
-        let x1502 = Self::mul_add(
-            -x214,
-            x1024,
-            Self::mul_add(x215, x1022, Self::mul_add(-x216, x1020, x1501)),
-        );
-        let x1503 = -x1502;
-        let x1504 = Self::mul_add(
-            x217,
-            x976,
-            Self::mul_add(-x219, x976, Self::mul_add(-x221, x974, x223 * x970)),
-        );
-        let x1505 = Self::mul_add(
-            x214,
-            x980,
-            Self::mul_add(x215, x978, Self::mul_add(-x216, x976, x1504)),
-        );
-        let x1506 = Self::mul_add(
-            x225,
-            x1145,
-            Self::mul_add(-x227, x1232, Self::mul_add(x229, x1280, x231 * x1270)),
-        );
-        let x1507 = Self::mul_add(
             x136,
-            x962,
-            Self::mul_add(-x214, x1006, Self::mul_add(x224, x1054, x1506)),
-        );
-        let x1508 = Self::mul_add(
-            -x225,
-            x1300,
-            Self::mul_add(x227, x1298, Self::mul_add(x229, x1296, x231 * x1291)),
-        );
-        let x1509 = Self::mul_add(
-            -x136,
-            x1306,
-            Self::mul_add(x214, x1304, Self::mul_add(-x224, x1302, x1508)),
-        );
-        let x1510 = Self::mul_add(
-            x225,
-            x1258,
-            Self::mul_add(-x227, x1256, Self::mul_add(-x229, x1254, x231 * x1248)),
-        );
-        let x1511 = Self::mul_add(
-            -x136,
-            x1264,
-            Self::mul_add(x214, x1262, Self::mul_add(x224, x1260, x1510)),
-        );
-        let x1512 = Self::mul_add(
-            x225,
-            x1178,
-            Self::mul_add(-x227, x1175, Self::mul_add(-x229, x1173, x231 * x1166)),
-        );
-        let x1513 = Self::mul_add(
-            -x136,
-            x1184,
-            Self::mul_add(x214, x1182, Self::mul_add(x224, x1180, x1512)),
-        );
-        let x1514 = Self::mul_add(
-            x225,
-            x1088,
-            Self::mul_add(-x227, x1086, Self::mul_add(-x229, x1082, x231 * x1075)),
-        );
-        let x1515 = Self::mul_add(
-            -x136,
-            x1097,
-            Self::mul_add(x214, x1094, Self::mul_add(-x224, x1091, x1514)),
-        );
-        let x1516 = -x1515;
-        let x1517 = Self::mul_add(
-            x225,
-            x1020,
-            Self::mul_add(-x227, x1020, Self::mul_add(-x229, x1018, x231 * x1014)),
-        );
-        let x1518 = Self::mul_add(
-            -x136,
-            x1024,
-            Self::mul_add(x214, x1022, Self::mul_add(-x224, x1020, x1517)),
-        );
-        let x1519 = -x1518;
-        let x1520 = Self::mul_add(
-            x225,
-            x976,
-            Self::mul_add(-x227, x976, Self::mul_add(-x229, x974, x231 * x970)),
-        );
-        let x1521 = Self::mul_add(
-            x136,
-            x980,
-            Self::mul_add(x214, x978, Self::mul_add(-x224, x976, x1520)),
+            x886,
+            Self::mul_add(x214, x884, Self::mul_add(-x224, x882, x1431)),
         );
         (
             [
-                [0.0, x1308, x1310, x1312, x1315, x1318, x1320],
-                [0.0, x1322, x1324, x1326, x1329, x1332, x1334],
-                [0.0, x1336, x1338, x1340, x1343, x1346, x1348],
-                [0.0, x1351, x1354, x1357, x1359, x1361, x1364],
-                [0.0, x1366, x1368, x1370, x1373, x1376, x1378],
-                [0.0, x1380, x1382, x1384, x1387, x1390, x1392],
-                [0.0, x1394, x1396, x1398, x1401, x1404, x1406],
+                [0.0, x1214, x1216, x1218, x1221, x1224, x1226],
+                [0.0, x1228, x1230, x1232, x1235, x1238, x1240],
+                [0.0, x1242, x1244, x1246, x1249, x1252, x1254],
+                [0.0, x1257, x1260, x1263, x1265, x1267, x1270],
+                [0.0, x1272, x1274, x1276, x1279, x1282, x1284],
+                [0.0, x1286, x1288, x1290, x1293, x1296, x1298],
+                [0.0, x1300, x1302, x1304, x1307, x1310, x1312],
             ],
             [
-                [x1408, x1410, x1412, x1414, x1417, x1420, x1422],
-                [x1424, x1426, x1428, x1430, x1433, x1436, x1438],
-                [x1440, x1442, x1444, x1446, x1449, x1452, x1454],
-                [x1457, x1460, x1463, x1466, x1468, x1470, x1473],
-                [x1475, x1477, x1479, x1481, x1484, x1487, x1489],
-                [x1491, x1493, x1495, x1497, x1500, x1503, x1505],
-                [x1507, x1509, x1511, x1513, x1516, x1519, x1521],
+                [x1315, x1317, x1319, x1321, x1324, x1327, x1329],
+                [x1332, x1334, x1336, x1338, x1341, x1344, x1346],
+                [x1349, x1351, x1353, x1355, x1358, x1361, x1363],
+                [x1365, x1368, x1371, x1374, x1376, x1378, x1381],
+                [x1384, x1386, x1388, x1390, x1393, x1396, x1398],
+                [x1401, x1403, x1405, x1407, x1410, x1413, x1415],
+                [x1418, x1420, x1422, x1424, x1427, x1430, x1432],
             ],
             [
                 [x156, x154, x152, x149, x148, x146, x144],

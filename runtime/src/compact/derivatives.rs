@@ -14,8 +14,12 @@
 //!   `v_j = v_λ + S_j q̇_j`, `a_j = a_λ + S_j q̈_j + (v_j ×ₘ S_j) q̇_j`, `h_j = I_j v_j`,
 //!   `f_j = I_j a_j + v_j ×* h_j`; `∂v/∂q_j = v_λ ×ₘ S_j`,
 //!   `∂a/∂q_j = a_λ ×ₘ S_j + v_λ ×ₘ ∂v/∂q_j`, `∂a/∂q̇_j = v_j ×ₘ S_j + ∂v/∂q_j`, and the bias
-//!   force's variation with the velocity `B_j δ = δ ×* h_j + v_j ×* I_j δ − I_j (v_j ×ₘ δ)`;
-//! - backward, subtree composites `Y_j = Σ I_k`, `B^C_j = Σ B_k`, `F_j = Σ f_k`, and
+//!   force's variation with the velocity `B_j δ = δ ×* h_j + v_j ×* I_j δ − I_j (v_j ×ₘ δ)
+//!   = δ ×* h_j + İ_j δ`, with the rate `İ_j = v_j ×* I_j − I_j v_j ×ₘ` of the body's inertia
+//!   (RBDA eq. (2.73)), of the rigid-body form without mass ([`inertia_rate`]), so `B` is never a
+//!   6×6 matrix: `B^C_j δ = δ ×* H_j + İ^C_j δ` and `B^Cᵀ_j S = İ^C_j S − S ×* H_j` with the
+//!   composite momentum `H_j = Σ h_k` and `İ^C_j = Σ İ_k` (9 numbers);
+//! - backward, subtree composites `Y_j = Σ I_k`, `H_j`, `İ^C_j`, `F_j = Σ f_k`, and
 //!   `∂F_j/∂q_j = S_j ×* F_j + Y_j ∂a/∂q_j + B^C_j ∂v/∂q_j`,
 //!   `∂F_j/∂q̇_j = Y_j ∂a/∂q̇_j + B^C_j S_j`;
 //! - entries (eq. (13)): for `i` in the subtree of `j`,
@@ -30,7 +34,7 @@ use super::crba::crba;
 use super::floating::{gravity_in_base, inverse_dynamics_in, mass_matrix_in, root_motion, Base};
 use super::frames::supports;
 use super::rnea::{rnea, Motions};
-use super::spatial::{add, crf, crm, dot, inertia_mul, scale, sub, transforms, world};
+use super::spatial::{add, crf, crm, cross, dot, inertia_mul, scale, sub, transforms, world};
 use super::tables::{Bodies, BodyStore, Tables};
 use crate::scalar::Scalar;
 
@@ -44,8 +48,10 @@ pub struct Joint<S> {
     dadv: [S; 6],
     /// `Y`: the subtree's composite inertia (the body's own after the forward pass).
     y: [S; 10],
-    /// `B^C`, columns first: `bc[k]` is `B^C e_k`.
-    bc: [[S; 6]; 6],
+    /// `H`: the subtree's momentum (the body's own `h = I v` after the forward pass).
+    hc: [S; 6],
+    /// `İ^C`: the subtree's inertia rate, `[ḣ; Ī̇]` ([`inertia_rate`]).
+    ic: [S; 9],
     /// `F`: the subtree's force.
     f: [S; 6],
     /// `Y_i S_i`.
@@ -67,7 +73,8 @@ impl<S: Scalar + Copy> Joint<S> {
             dadq: z,
             dadv: z,
             y: [S::zero(); 10],
-            bc: [z; 6],
+            hc: z,
+            ic: [S::zero(); 9],
             f: z,
             ys: z,
             bs: z,
@@ -75,14 +82,63 @@ impl<S: Scalar + Copy> Joint<S> {
     }
 }
 
-/// `B^C δ` of `B^C` kept by columns.
-#[inline(always)]
-fn bc_mul<S: Scalar + Copy>(bc: &[[S; 6]; 6], d: &[S; 6]) -> [S; 6] {
-    let mut out = scale(d[0], &bc[0]);
-    for k in 1..6 {
-        out = add(&out, &scale(d[k], &bc[k]));
+impl<S: Scalar + Copy> Joint<S> {
+    /// `B^C δ = δ ×* H + İ^C δ`.
+    #[inline(always)]
+    fn bias_variation(&self, d: &[S; 6]) -> [S; 6] {
+        add(&crf(d, &self.hc), &rate_mul(&self.ic, d))
     }
-    out
+
+    /// `B^Cᵀ s = İ^C s − s ×* H` (`δ ↦ δ ×* H` is skew-symmetric, `İ^C` symmetric).
+    #[inline(always)]
+    fn bias_variation_transposed(&self, s: &[S; 6]) -> [S; 6] {
+        sub(&rate_mul(&self.ic, s), &crf(s, &self.hc))
+    }
+}
+
+/// The rate `İ = v ×* I − I v ×ₘ` of inertia `i` (`[m, h, Ī]`, [`inertia_mul`]'s layout) moving
+/// with `v = [ω; v_O]`: `[ḣ; Ī̇]` with `ḣ = m v_O + ω × h` and the symmetric
+/// `Ī̇ = A + Aᵀ + 2 (h·v_O) 1 − v_O hᵀ − h v_Oᵀ`, `A = ω̃ Ī`, stored `xx, xy, xz, yy, yz, zz`.
+#[inline(always)]
+fn inertia_rate<S: Scalar + Copy>(i: &[S; 10], v: &[S; 6]) -> [S; 9] {
+    let (w, vo, h) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]], [i[1], i[2], i[3]]);
+    // a[c] = A e_c = ω × (Ī e_c)
+    let a = [
+        cross(&w, &[i[4], i[5], i[6]]),
+        cross(&w, &[i[5], i[7], i[8]]),
+        cross(&w, &[i[6], i[8], i[9]]),
+    ];
+    let hv = h[0] * vo[0] + h[1] * vo[1] + h[2] * vo[2];
+    let two_hv = hv + hv;
+    let e = |r: usize, c: usize| a[c][r] + a[r][c] - vo[r] * h[c] - h[r] * vo[c];
+    let wh = cross(&w, &h);
+    [
+        i[0] * vo[0] + wh[0],
+        i[0] * vo[1] + wh[1],
+        i[0] * vo[2] + wh[2],
+        e(0, 0) + two_hv,
+        e(0, 1),
+        e(0, 2),
+        e(1, 1) + two_hv,
+        e(1, 2),
+        e(2, 2) + two_hv,
+    ]
+}
+
+/// `İ δ = [Ī̇ ω + ḣ × v; −ḣ × ω]` of an [`inertia_rate`].
+#[inline(always)]
+fn rate_mul<S: Scalar + Copy>(r: &[S; 9], d: &[S; 6]) -> [S; 6] {
+    let (w, v, h) = ([d[0], d[1], d[2]], [d[3], d[4], d[5]], [r[0], r[1], r[2]]);
+    let hv = cross(&h, &v);
+    let hw = cross(&h, &w);
+    [
+        r[3] * w[0] + r[4] * w[1] + r[5] * w[2] + hv[0],
+        r[4] * w[0] + r[6] * w[1] + r[7] * w[2] + hv[1],
+        r[5] * w[0] + r[7] * w[1] + r[8] * w[2] + hv[2],
+        -hw[0],
+        -hw[1],
+        -hw[2],
+    ]
 }
 
 /// `(∂τ/∂q, ∂τ/∂q̇)` of `τ = M(q) q̈ + c(q, q̇)` (gravity as [`Tables::a0`]), `N × N` each, row
@@ -145,7 +201,7 @@ impl<S: Scalar + Copy> FloatingRoot<S> {
     #[must_use]
     pub fn new(i: &[S; 10], v: [S; 6], a: [S; 6], a_grav: [S; 6]) -> Self {
         let mut body = Joint::zero();
-        (body.f, body.bc) = body_terms(i, &v, &a);
+        (body.f, body.hc, body.ic) = body_terms(i, &v, &a);
         body.y = *i;
         body.v = v;
         body.a = a;
@@ -172,21 +228,13 @@ pub fn floating_rnea_derivatives_in<S: Scalar + Copy>(
     backward(t, b, js, Some(root), dq, dv);
 }
 
-/// `f = I a + v ×* (I v)` and the bias force's variation with the velocity, by columns:
-/// `B e_k = e_k ×* h + v ×* I e_k − I (v ×ₘ e_k)` with `h = I v`.
+/// `f = I a + v ×* h`, the momentum `h = I v` and the inertia rate `İ` ([`inertia_rate`]): what
+/// the bias force's variation with the velocity is made of.
 #[inline(always)]
-fn body_terms<S: Scalar + Copy>(i: &[S; 10], v: &[S; 6], a: &[S; 6]) -> ([S; 6], [[S; 6]; 6]) {
+fn body_terms<S: Scalar + Copy>(i: &[S; 10], v: &[S; 6], a: &[S; 6]) -> ([S; 6], [S; 6], [S; 9]) {
     let h = inertia_mul(i, v);
     let f = add(&inertia_mul(i, a), &crf(v, &h));
-    let bc = core::array::from_fn(|k| {
-        let d = unit(k);
-        let id = inertia_mul(i, &d);
-        sub(
-            &add(&crf(&d, &h), &crf(v, &id)),
-            &inertia_mul(i, &crm(v, &d)),
-        )
-    });
-    (f, bc)
+    (f, h, inertia_rate(i, v))
 }
 
 /// The unit motion of entry `k` of `[ω; v]`.
@@ -223,7 +271,7 @@ fn forward<S: Scalar + Copy>(
         jt.dadq = add(&crm(&ap, s), &crm(&vp, &dvdq));
         jt.dadv = add(&vs, &dvdq);
         jt.dvdq = dvdq;
-        (jt.f, jt.bc) = body_terms(i, &v, &a);
+        (jt.f, jt.hc, jt.ic) = body_terms(i, &v, &a);
         jt.y = *i;
         jt.v = v;
         jt.a = a;
@@ -258,12 +306,12 @@ fn backward<S: Scalar + Copy>(
         };
         let jt = js[j];
         js[j].ys = inertia_mul(&jt.y, &s);
-        js[j].bs = core::array::from_fn(|k| dot(&jt.bc[k], &s));
+        js[j].bs = jt.bias_variation_transposed(&s);
         let dfdq = add(
             &add(&crf(&s, &jt.f), &inertia_mul(&jt.y, &jt.dadq)),
-            &bc_mul(&jt.bc, &jt.dvdq),
+            &jt.bias_variation(&jt.dvdq),
         );
-        let dfdv = add(&inertia_mul(&jt.y, &jt.dadv), &bc_mul(&jt.bc, &s));
+        let dfdv = add(&inertia_mul(&jt.y, &jt.dadv), &jt.bias_variation(&s));
         for (r, jr) in js.iter().enumerate() {
             if supports(t, r, j) {
                 // r in the subtree of j (its Y S, B^Cᵀ S are final: r ≥ j).
@@ -287,7 +335,7 @@ fn backward<S: Scalar + Copy>(
                 put(r, off + j, (dot(&dfdq, &sr), dot(&dfdv, &sr)));
             }
         }
-        // Y_λ += Y_j, B^C_λ += B^C_j, F_λ += F_j (the base's on a free-floating root).
+        // Y_λ += Y_j, H_λ += H_j, İ^C_λ += İ^C_j, F_λ += F_j (the base's on a free-floating root).
         let parent = match t.parent.get(j).copied().flatten() {
             Some(l) => js.get_mut(l),
             None => root.as_deref_mut().map(|r| &mut r.body),
@@ -296,8 +344,9 @@ fn backward<S: Scalar + Copy>(
             for (a, x) in p.y.iter_mut().zip(jt.y) {
                 *a = *a + x;
             }
-            for (col, x) in p.bc.iter_mut().zip(jt.bc) {
-                *col = add(col, &x);
+            p.hc = add(&p.hc, &jt.hc);
+            for (a, x) in p.ic.iter_mut().zip(jt.ic) {
+                *a = *a + x;
             }
             p.f = add(&p.f, &jt.f);
         }
@@ -311,7 +360,7 @@ fn backward<S: Scalar + Copy>(
         let sr = base_s(r);
         (
             inertia_mul(&base.y, &sr),
-            core::array::from_fn(|k| dot(&base.bc[k], &sr)),
+            base.bias_variation_transposed(&sr),
         )
     });
     for c in 0..6 {

@@ -15,8 +15,15 @@
 //! - per column (eqs. (9)–(12)): `∂v/∂q_i = v_λ ×ₘ S_i`, `∂a/∂q_i = a_λ ×ₘ S_i + v_λ ×ₘ ∂v/∂q_i`,
 //!   `∂a/∂q̇_i = v_i ×ₘ S_i + ∂v/∂q_i`;
 //! - per body, the variation of the bias force with the velocity (the paper's `B_i`, Pinocchio's
-//!   `doYcrb`): `B_i δ = δ ×* h_i + v_i ×* I_i δ − I_i (v_i ×ₘ δ)`;
-//! - backward, composites over the subtree: `Y_i = Σ I_k`, `B^C_i = Σ B_k`, `F_i = Σ f_k`,
+//!   `doYcrb`): `B_i δ = δ ×* h_i + v_i ×* I_i δ − I_i (v_i ×ₘ δ) = δ ×* h_i + İ_i δ`, where
+//!   `İ_i = v_i ×* I_i − I_i v_i ×ₘ` is the rate of the body's inertia in the fixed frame
+//!   (RBDA eq. (2.73)). It is itself of the rigid-body form, with no mass: first moment
+//!   `ḣ = m v_O + ω × h` and rotational part `Ī̇ = ω̃ Ī − Ī ω̃ + 2 (h·v_O) 1 − v_O hᵀ − h v_Oᵀ`
+//!   (symmetric) for `v_i = [ω; v_O]` ([`InertiaRate`]). So `B` is never formed as a 6×6
+//!   matrix, as Pinocchio forms it: its composite is `B^C_i δ = δ ×* H_i + İ^C_i δ` with the
+//!   composite momentum `H_i = Σ h_k` and `İ^C_i = Σ İ_k` (9 numbers), and
+//!   `B^Cᵀ_i S = İ^C_i S − S ×* H_i` (`δ ↦ δ ×* h` is skew-symmetric, `İ` symmetric);
+//! - backward, composites over the subtree: `Y_i = Σ I_k`, `H_i`, `İ^C_i`, `F_i = Σ f_k`,
 //!   `τ_i = S_iᵀ F_i`, and
 //!   `∂F_j/∂q_j = S_j ×* F_j + Y_j ∂a/∂q_j + B^C_j ∂v/∂q_j`,
 //!   `∂F_j/∂q̇_j = Y_j ∂a/∂q̇_j + B^C_j S_j`;
@@ -33,89 +40,79 @@
 use super::{base_unit, compose, motion_back, motion_scale, power, Matrix};
 use crate::base::{FloatingBase, FloatingState, FLOATING_BASE_DOF};
 use crate::joint::{s_times, xup};
-use crate::linalg::Vec3;
+use crate::linalg::{Mat3, Vec3};
 use crate::params::Params;
 use crate::scalar::Scalar;
 use crate::spatial::{Force, Motion, RbInertia, Xform};
 
-/// A 6×6 matrix from motions `[ω; v]` to forces `[n; f]` (rows and columns in those orders).
-type Mat6<S> = [[S; 6]; 6];
-
-/// The entries `[ω; v]` of a motion.
-fn motion_entries<S: Scalar>(m: &Motion<S>) -> [S; 6] {
-    let (a, l) = (&m.ang.0, &m.lin.0);
-    [
-        a[0].clone(),
-        a[1].clone(),
-        a[2].clone(),
-        l[0].clone(),
-        l[1].clone(),
-        l[2].clone(),
-    ]
+/// The rate `İ = v ×* I − I v ×ₘ` of a rigid body's inertia `I` moving with `v` in a fixed
+/// frame: of the rigid-body form with no mass (module docs), symmetric as a 6×6 matrix.
+#[derive(Clone, Debug)]
+struct InertiaRate<S> {
+    /// `ḣ = m v_O + ω × h`.
+    h: Vec3<S>,
+    /// `Ī̇ = ω̃ Ī − Ī ω̃ + 2 (h·v_O) 1 − v_O hᵀ − h v_Oᵀ` (symmetric).
+    ibar: Mat3<S>,
 }
 
-/// The force `[n; f]` of six entries.
-fn force_of<S: Scalar>(x: [S; 6]) -> Force<S> {
-    let [a, b, c, d, e, f] = x;
-    Force {
-        ang: Vec3::new(a, b, c),
-        lin: Vec3::new(d, e, f),
+impl<S: Scalar> InertiaRate<S> {
+    /// `İ` of inertia `i` moving with `v = [ω; v_O]`.
+    fn new(i: &RbInertia<S>, v: &Motion<S>) -> Self {
+        let (w, vo) = (&v.ang, &v.lin);
+        // A = ω̃ Ī column by column; ω̃ Ī − Ī ω̃ = A + Aᵀ.
+        let a: [Vec3<S>; 3] = core::array::from_fn(|c| w.cross(&i.ibar.col(c)));
+        let hv = i.h.dot(vo);
+        let two_hv = hv.clone() + hv;
+        let entry = |r: usize, c: usize| {
+            let x = a[c].at(r) + a[r].at(c) - vo.at(r) * i.h.at(c) - i.h.at(r) * vo.at(c);
+            if r == c {
+                x + two_hv.clone()
+            } else {
+                x
+            }
+        };
+        InertiaRate {
+            h: vo.scale(&i.m) + w.cross(&i.h),
+            ibar: symmetric(entry),
+        }
+    }
+
+    /// `İ δ = [Ī̇ ω + ḣ × v; −ḣ × ω]`.
+    fn mul(&self, d: &Motion<S>) -> Force<S> {
+        Force {
+            ang: self.ibar.mul_vec(&d.ang) + self.h.cross(&d.lin),
+            lin: -self.h.cross(&d.ang),
+        }
+    }
+
+    /// `İ_a + İ_b`.
+    fn add(&self, o: &Self) -> Self {
+        InertiaRate {
+            h: self.h.clone() + o.h.clone(),
+            ibar: symmetric(|r, c| self.ibar.at(r, c) + o.ibar.at(r, c)),
+        }
     }
 }
 
-/// `B m`.
-fn mat6_mul<S: Scalar>(b: &Mat6<S>, m: &Motion<S>) -> Force<S> {
-    let x = motion_entries(m);
-    force_of(core::array::from_fn(|r| {
-        (1..6).fold(b[r][0].clone() * x[0].clone(), |s, k| {
-            s + b[r][k].clone() * x[k].clone()
-        })
+/// The symmetric 3×3 matrix of upper-triangle entries `entry(r, c ≥ r)` (six evaluations).
+fn symmetric<S: Scalar>(entry: impl Fn(usize, usize) -> S) -> Mat3<S> {
+    let upper: [[Option<S>; 3]; 3] =
+        core::array::from_fn(|r| core::array::from_fn(|c| (c >= r).then(|| entry(r, c))));
+    Mat3(core::array::from_fn(|r| {
+        core::array::from_fn(|c| upper[r.min(c)][r.max(c)].clone().expect("upper triangle"))
     }))
-}
-
-/// `Bᵀ m`, as a force (paired with motions by [`power`]).
-fn mat6_tr_mul<S: Scalar>(b: &Mat6<S>, m: &Motion<S>) -> Force<S> {
-    let x = motion_entries(m);
-    force_of(core::array::from_fn(|c| {
-        (1..6).fold(b[0][c].clone() * x[0].clone(), |s, k| {
-            s + b[k][c].clone() * x[k].clone()
-        })
-    }))
-}
-
-/// `A + B`.
-fn mat6_add<S: Scalar>(a: &Mat6<S>, b: &Mat6<S>) -> Mat6<S> {
-    core::array::from_fn(|r| core::array::from_fn(|c| a[r][c].clone() + b[r][c].clone()))
-}
-
-/// The unit motion of entry `k` of `[ω; v]`.
-fn unit_motion<S: Scalar>(k: usize) -> Motion<S> {
-    // base_unit counts linear first.
-    base_unit((k + 3) % 6)
-}
-
-/// `B δ = δ ×* h + v ×* I δ − I (v ×ₘ δ)`, column by column (the paper's `B_i`, eq. (12)).
-fn bias_variation<S: Scalar>(i: &RbInertia<S>, v: &Motion<S>, h: &Force<S>) -> Mat6<S> {
-    let cols: [[S; 6]; 6] = core::array::from_fn(|k| {
-        let d = unit_motion::<S>(k);
-        let col = d.crf(h) + v.crf(&i.mul(&d)) - i.mul(&v.crm(&d));
-        let Force { ang, lin } = col;
-        let [a, b, c] = ang.0;
-        let [x, y, z] = lin.0;
-        [a, b, c, x, y, z]
-    });
-    core::array::from_fn(|r| core::array::from_fn(|c| cols[c][r].clone()))
 }
 
 /// A body of the passes, in base coordinates: its parent body, its inertia, velocity and
-/// acceleration (`a_0 = −a_grav` included), and the subtree composites `Y`, `B^C`, `F`
-/// (initialized with the body's own `I`, `B`, `f`, completed by the backward pass).
+/// acceleration (`a_0 = −a_grav` included), and the subtree composites `Y`, `H`, `İ^C`, `F`
+/// (initialized with the body's own `I`, `h`, `İ`, `f`, completed by the backward pass).
 struct Body<S> {
     parent: Option<usize>,
     v: Motion<S>,
     a: Motion<S>,
     yc: RbInertia<S>,
-    bc: Mat6<S>,
+    hc: Force<S>,
+    idc: InertiaRate<S>,
     fc: Force<S>,
 }
 
@@ -137,19 +134,30 @@ struct Root<'a, S> {
 
 impl<S: Scalar> Body<S> {
     /// A body of inertia `i` (base coordinates) in motion `(v, a)`: `h = I v`,
-    /// `f = I a + v ×* h`, `B` of [`bias_variation`].
+    /// `f = I a + v ×* h`, `İ` ([`InertiaRate`]).
     fn new(parent: Option<usize>, i: RbInertia<S>, v: Motion<S>, a: Motion<S>) -> Self {
         let h = i.mul(&v);
         let f = i.mul(&a) + v.crf(&h);
-        let bc = bias_variation(&i, &v, &h);
+        let idc = InertiaRate::new(&i, &v);
         Body {
             parent,
             v,
             a,
             yc: i,
-            bc,
+            hc: h,
+            idc,
             fc: f,
         }
+    }
+
+    /// `B^C δ = δ ×* H + İ^C δ`.
+    fn bias_variation(&self, d: &Motion<S>) -> Force<S> {
+        d.crf(&self.hc) + self.idc.mul(d)
+    }
+
+    /// `B^Cᵀ s = İ^C s − s ×* H`, as a force (paired with motions by [`power`]).
+    fn bias_variation_transposed(&self, s: &Motion<S>) -> Force<S> {
+        self.idc.mul(s) - s.crf(&self.hc)
     }
 }
 
@@ -254,13 +262,17 @@ fn backward<S: Scalar>(mut bodies: Vec<Body<S>>, cols: &[Column<S>]) -> (Matrix<
         let own: Vec<usize> = (0..nv).filter(|&c| cols[c].body == b).collect();
         let body = &bodies[b];
         for &c in &own {
-            u[c] = (body.yc.mul(&cols[c].s), mat6_tr_mul(&body.bc, &cols[c].s));
+            u[c] = (
+                body.yc.mul(&cols[c].s),
+                body.bias_variation_transposed(&cols[c].s),
+            );
         }
         for &c in &own {
             let col = &cols[c];
             // ∂F/∂q = S ×* F + Y ∂a/∂q + B^C ∂v/∂q; ∂F/∂q̇ = Y ∂a/∂q̇ + B^C S
-            let dfdq = col.s.crf(&body.fc) + body.yc.mul(&col.dadq) + mat6_mul(&body.bc, &col.dvdq);
-            let dfdv = body.yc.mul(&col.dadv) + mat6_mul(&body.bc, &col.s);
+            let dfdq =
+                col.s.crf(&body.fc) + body.yc.mul(&col.dadq) + body.bias_variation(&col.dvdq);
+            let dfdv = body.yc.mul(&col.dadv) + body.bias_variation(&col.s);
             for r in 0..nv {
                 let br = cols[r].body;
                 if is_ancestor_or_self(&bodies, b, br) {
@@ -273,16 +285,18 @@ fn backward<S: Scalar>(mut bodies: Vec<Body<S>>, cols: &[Column<S>]) -> (Matrix<
                 }
             }
         }
-        // Y_λ += Y_i, B^C_λ += B^C_i, F_λ += F_i
+        // Y_λ += Y_i, H_λ += H_i, İ^C_λ += İ^C_i, F_λ += F_i
         if let Some(l) = bodies[b].parent {
-            let (yc, bc, fc) = (
+            let (yc, hc, idc, fc) = (
                 bodies[b].yc.clone(),
-                bodies[b].bc.clone(),
+                bodies[b].hc.clone(),
+                bodies[b].idc.clone(),
                 bodies[b].fc.clone(),
             );
             let parent = &mut bodies[l];
             parent.yc = parent.yc.clone() + yc;
-            parent.bc = mat6_add(&parent.bc, &bc);
+            parent.hc = parent.hc.clone() + hc;
+            parent.idc = parent.idc.add(&idc);
             parent.fc = parent.fc.clone() + fc;
         }
     }
