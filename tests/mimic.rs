@@ -361,12 +361,9 @@ fn free_floating_derivatives_in_the_coordinates() {
         &base_q.iter().chain(&q).copied().collect::<Vec<_>>(),
     );
     let mut m = vec![vec![0.0; 14]; 14];
-    let mut k = 0;
-    for i in 0..14 {
-        for j in i..14 {
-            (m[i][j], m[j][i]) = (upper[k], upper[k]);
-            k += 1;
-        }
+    let upper_pairs = (0..14).flat_map(|i| (i..14).map(move |j| (i, j)));
+    for ((i, j), &value) in upper_pairs.zip(&upper) {
+        (m[i][j], m[j][i]) = (value, value);
     }
     let identity: Vec<Vec<f64>> = (0..14)
         .map(|i| (0..14).map(|j| f64::from(u8::from(i == j))).collect())
