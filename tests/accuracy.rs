@@ -82,6 +82,14 @@ fn same_run(subject: &str, a: &IntegrationRow, b: &IntegrationRow) {
     );
 }
 
+/// Committed and fresh errors of one row agree: round-off errors may move a little with the
+/// machine's libm; a factor 2 is a change.
+fn same_errors(label: &str, committed: [f64; 3], fresh: [f64; 3]) {
+    for (x, y) in committed.into_iter().zip(fresh) {
+        assert!(close(x, y, 2.0), "{label}: {x:e} vs {y:e}; {STALE}");
+    }
+}
+
 #[test]
 fn docs_accuracy_json_is_fresh() {
     let (old, new) = (committed(), fresh());
@@ -102,20 +110,22 @@ fn docs_accuracy_json_is_fresh() {
         );
         assert_eq!(o.evaluation.len(), n.evaluation.len(), "{stale}");
         for (a, b) in o.evaluation.iter().zip(&n.evaluation) {
-            // Round-off errors may move a little with the machine's libm; a factor 2 is a change.
-            for (x, y) in [
-                (a.rel_err_a, b.rel_err_a),
-                (a.rel_err_b, b.rel_err_b),
-                (a.rel_err_qdd, b.rel_err_qdd),
-            ] {
-                assert!(
-                    close(x, y, 2.0),
-                    "{} {} {}: {x:e} vs {y:e}; {stale}",
-                    o.subject,
-                    a.precision,
-                    a.path
-                );
-            }
+            let label = format!("{} {} {}", o.subject, a.precision, a.path);
+            same_errors(
+                &label,
+                [a.rel_err_a, a.rel_err_b, a.rel_err_qdd],
+                [b.rel_err_a, b.rel_err_b, b.rel_err_qdd],
+            );
+        }
+        assert_eq!(o.derivatives.len(), n.derivatives.len(), "{stale}");
+        for (a, b) in o.derivatives.iter().zip(&n.derivatives) {
+            assert_eq!((&a.precision, &a.path), (&b.precision, &b.path), "{stale}");
+            let label = format!("{} derivatives {} {}", o.subject, a.precision, a.path);
+            same_errors(
+                &label,
+                [a.rel_err_dtau, a.rel_err_dqdd, a.rel_err_minv],
+                [b.rel_err_dtau, b.rel_err_dqdd, b.rel_err_minv],
+            );
         }
         assert_eq!(o.integration.len(), n.integration.len(), "{stale}");
         for (a, b) in o.integration.iter().zip(&n.integration) {
@@ -204,6 +214,7 @@ fn the_rows_say_what_they_should() {
         ) {
             assert!(g32.rel_err_qdd > 1e6 * g64.rel_err_qdd, "{}", r.subject);
         }
+        derivative_rows_say_what_they_should(&r);
         // Fixed-step integrators: halving the step divides the error by about 2^p while above
         // the reference's floor (RK4 p = 4, midpoint p = 2); checked on the two finest steps.
         // With Coulomb friction the steps of the ladder are not yet in the asymptotic range
@@ -347,4 +358,53 @@ fn fixed_step_orders_on_a_fresh_run_against_a_measured_reference() {
             );
         }
     }
+}
+
+/// The derivative rows of a model: interpreted and generated `f64` within a few hundred ulps
+/// of the double-double reference for `∂τ/∂x` and `M⁻¹` (products and sums of the state's
+/// sines, no cancellation beyond `M`'s conditioning: measured ≤ 7e-16 on SSRMS), `∂q̈/∂x =
+/// −M⁻¹ ∂τ/∂x` within `10·cond(A)·ε` like `q̈`; `f32` at least four digits worse; double-double
+/// within 1e-28 of exact rationals. The generated rows are those of the checked-in SSRMS
+/// variants, all generated with derivatives.
+fn derivative_rows_say_what_they_should(r: &AccuracyReport) {
+    if r.kind != "model" {
+        assert!(r.derivatives.is_empty(), "{}", r.subject);
+        return;
+    }
+    let row = |p: &str, path: &str| {
+        r.derivatives
+            .iter()
+            .find(|e| e.precision == p && e.path == path)
+            .unwrap_or_else(|| panic!("{}: no {p} {path} derivative row", r.subject))
+    };
+    let wide = row("wide", "interpreted");
+    assert!(
+        wide.rel_err_dtau < 1e-28 && wide.rel_err_dqdd < 1e-26 && wide.rel_err_minv < 1e-28,
+        "{}: {wide:?}",
+        r.subject
+    );
+    for path in ["interpreted", "generated"] {
+        let (f32r, f64r) = (row("f32", path), row("f64", path));
+        assert!(
+            f64r.rel_err_dtau < 1e-14 && f64r.rel_err_minv < 1e-14,
+            "{} {path}: {f64r:?}",
+            r.subject
+        );
+        assert!(
+            f64r.rel_err_dqdd < 10.0 * r.cond_a * f64::EPSILON,
+            "{} {path}: {f64r:?}",
+            r.subject
+        );
+        assert!(
+            f32r.rel_err_dtau > 1e4 * f64r.rel_err_dtau,
+            "{} {path}: {f32r:?}",
+            r.subject
+        );
+    }
+    let fma = row("f64-fma", "generated");
+    assert!(
+        fma.rel_err_dtau < 1e-14 && fma.rel_err_minv < 1e-14,
+        "{}: {fma:?}",
+        r.subject
+    );
 }

@@ -188,6 +188,15 @@ pub fn render_markdown(reports: &[AccuracyReport], timing: bool) -> Result<Strin
                         "ns": time(format!("{:.0}", e.ns)), "sentence": if timing { s.clone() } else { "—".into() }})
                 })
                 .collect();
+            let derivatives: Vec<serde_json::Value> = r
+                .derivatives
+                .iter()
+                .map(|d| {
+                    serde_json::json!({"precision": d.precision, "path": d.path,
+                        "dtau": sci(d.rel_err_dtau), "dqdd": sci(d.rel_err_dqdd),
+                        "minv": sci(d.rel_err_minv), "ns": time(format!("{:.0}", d.ns))})
+                })
+                .collect();
             let integration: Vec<serde_json::Value> = r
                 .integration
                 .iter()
@@ -218,7 +227,7 @@ pub fn render_markdown(reports: &[AccuracyReport], timing: bool) -> Result<Strin
             serde_json::json!({"subject": r.subject, "kind": r.kind, "base": r.base, "n": r.n,
                 "algorithm": r.algorithm, "cond_a": format!("{:.3e}", r.cond_a),
                 "reference_check": r.reference_check,
-                "evaluation": evaluation, "integration": integration, "effects": effects,
+                "evaluation": evaluation, "derivatives": derivatives, "integration": integration, "effects": effects,
                 "friction": friction, "friction_tolerance": sci(crate::reports::accuracy::friction::TOLERANCE),
                 "duration": r.duration, "reference_error": r.integration_reference_error.map_or("—".into(), sci),
                 "figure": figure_name(r, Cost::Wall), "figure_evals": figure_name(r, Cost::Evals)})

@@ -170,7 +170,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
-        derivatives: false,
+        derivatives: true,
     },
     GeneratedFile {
         file: "generated/src/ssrms_fma.rs",
@@ -182,7 +182,7 @@ pub const GENERATED: [GeneratedFile; 7] = [
         base: None,
         allow_nonphysical: false,
         algorithm: None,
-        derivatives: false,
+        derivatives: true,
     },
     GeneratedFile {
         file: "generated/src/free_floating_7dof.rs",

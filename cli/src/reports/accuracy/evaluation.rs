@@ -313,6 +313,9 @@ pub fn cond(a: &[Vec<f64>]) -> f64 {
 /// A function of the state `(q, q̇, τ)` giving an `N`-vector.
 pub type StateFn = fn(&[f64], &[f64], &[f64]) -> Vec<f64>;
 
+/// A function of `(q, q̇, x)` giving `K` matrices (row = output, column = input).
+pub type MatricesFn<const K: usize> = fn(&[f64], &[f64], &[f64]) -> [Vec<Vec<f64>>; K];
+
 /// Generated code of a model in one precision (`f64`, `f32`, `f64-fma`), on `f64` slices
 /// (an `f32` variant rounds its inputs and widens its outputs).
 #[derive(Clone, Copy, Debug)]
@@ -325,6 +328,10 @@ pub struct GeneratedFns {
     pub tau_minus_c: StateFn,
     /// `q̈ = M⁻¹ (τ − c)` (the generated unrolled LDLᵀ).
     pub forward_dynamics: StateFn,
+    /// `(∂τ/∂q, ∂τ/∂q̇)` at `(q, q̇, q̈)`, if the variant was generated with derivatives.
+    pub inverse_dynamics_derivatives: Option<MatricesFn<2>>,
+    /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` at `(q, q̇, τ)`, if the variant was generated with derivatives.
+    pub forward_dynamics_derivatives: Option<MatricesFn<3>>,
 }
 
 impl GeneratedFns {

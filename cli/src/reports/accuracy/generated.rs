@@ -1,5 +1,5 @@
 //! The generated-code rows of `kanegen accuracy`: the SSRMS functions emitted by kanegen in each
-//! precision, wrapped as [`GeneratedFns`] on `f64` slices.
+//! precision, wrapped as [`GeneratedFns`] on `f64` slices, derivatives included.
 //!
 //! All three are checked-in files of `kanegen-generated` (`ssrms`, `ssrms_f32`, `ssrms_fma`),
 //! generated from the same model file (`tests/data/reference/ssrms_nguyen_hughes_1994.urdf`), so
@@ -26,10 +26,7 @@ macro_rules! generated_fns {
             core::array::from_fn(|i| x[i] as $t)
         }
         fn mass_matrix(q: &[f64]) -> Vec<Vec<f64>> {
-            <$ty>::mass_matrix(&arr(q))
-                .iter()
-                .map(|r| r.iter().map(|&x| f64::from(x)).collect())
-                .collect()
+            widen(&<$ty>::mass_matrix(&arr(q)))
         }
         fn tau_minus_c(q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
             let c = <$ty>::nonlinear_effects(&arr(q), &arr(qd));
@@ -41,11 +38,26 @@ macro_rules! generated_fns {
                 .map(f64::from)
                 .to_vec()
         }
+        fn widen(m: &[[$t; N]; N]) -> Vec<Vec<f64>> {
+            m.iter()
+                .map(|r| r.iter().map(|&x| f64::from(x)).collect())
+                .collect()
+        }
+        fn inverse_dynamics_derivatives(q: &[f64], qd: &[f64], qdd: &[f64]) -> [Vec<Vec<f64>>; 2] {
+            let (dq, dv) = <$ty>::inverse_dynamics_derivatives(&arr(q), &arr(qd), &arr(qdd));
+            [widen(&dq), widen(&dv)]
+        }
+        fn forward_dynamics_derivatives(q: &[f64], qd: &[f64], tau: &[f64]) -> [Vec<Vec<f64>>; 3] {
+            let (dq, dv, minv) = <$ty>::forward_dynamics_derivatives(&arr(q), &arr(qd), &arr(tau));
+            [widen(&dq), widen(&dv), widen(&minv)]
+        }
         GeneratedFns {
             precision: $precision,
             mass_matrix,
             tau_minus_c,
             forward_dynamics,
+            inverse_dynamics_derivatives: Some(inverse_dynamics_derivatives),
+            forward_dynamics_derivatives: Some(forward_dynamics_derivatives),
         }
     }};
 }

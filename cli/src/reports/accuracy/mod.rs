@@ -1,6 +1,7 @@
 //! `kanegen accuracy`: what accuracy costs in time.
 //!
-//! For a model or a scene, three tables (four for a scene with Coulomb friction): **evaluation** (`A`, `b`, `q̈` in `f32`, `f64`, fused
+//! For a model or a scene, three tables (a fourth, **derivatives**, for a model: `∂τ/∂x`,
+//! `∂q̈/∂x` and `M⁻¹` per precision, [`derivatives`]) (four for a scene with Coulomb friction): **evaluation** (`A`, `b`, `q̈` in `f32`, `f64`, fused
 //! multiply-add and double-double, generated and interpreted: error against the wide reference
 //! and ns per call), **integration** (every integrator over a ladder of steps or tolerances:
 //! final-state error against a tight reference and wall time, the work–precision diagram), and
@@ -8,6 +9,7 @@
 //! moves without it), and **friction** (the regularization speed of Coulomb friction: error
 //! against a finer one and steps, [`friction`]). Each row carries a sentence on what its next digit costs.
 
+pub mod derivatives;
 pub mod effects;
 pub mod evaluation;
 pub mod friction;
@@ -15,6 +17,7 @@ pub mod generated;
 pub mod integration;
 
 use anyhow::Result;
+use derivatives::{derivative_rows, DerivativeRow};
 use effects::{effects_report, EffectRow};
 use evaluation::{evaluation_report, random_states, EvalRow, GeneratedFns, Subject};
 use friction::{friction_report, friction_sentences, FrictionRow};
@@ -38,6 +41,9 @@ pub struct AccuracyReport {
     pub cond_a: f64,
     /// Evaluation rows.
     pub evaluation: Vec<EvalRow>,
+    /// Derivative rows (models only: `∂τ/∂x`, `∂q̈/∂x`, `M⁻¹`, [`derivatives`]).
+    #[serde(default)]
+    pub derivatives: Vec<DerivativeRow>,
     /// Integration rows (scenes only).
     pub integration: Vec<IntegrationRow>,
     /// Simulated time of the integration rows, s.
@@ -198,6 +204,7 @@ pub fn model_report(
         algorithm: alg.name(),
         cond_a: ev.cond_a,
         evaluation: ev.rows,
+        derivatives: derivative_rows(chain, generated, &states, opts.timing),
         integration: Vec::new(),
         duration: None,
         integration_reference_error: None,
@@ -278,6 +285,7 @@ pub fn scene_report(
         algorithm: alg.name(),
         cond_a: ev.cond_a,
         evaluation: ev.rows,
+        derivatives: Vec::new(),
         integration: integ.rows,
         duration: Some(integ.duration),
         integration_reference_error: Some(integ.reference_error),
