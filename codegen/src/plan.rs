@@ -257,8 +257,7 @@ fn decide_form(
     subjects: &Subjects,
     opts: &Options,
 ) -> Result<(Decision, Vec<(Choice, Traced)>), Error> {
-    // The compact kernels run on the full joint list, with no coupling of mimic joints.
-    let why_not = compact::unsupported(opts).or(model.has_mimics().then_some("mimic joints"));
+    let why_not = compact::unsupported(opts);
     let (size, traced) = match (opts.form, why_not) {
         (Form::Auto, None) => {
             let fs = [
