@@ -421,7 +421,8 @@ fn prefix(model: &Model, joints: usize) -> Option<Model> {
 /// The plan of `f`: its name, arguments and shape, with its choice and kernel.
 fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> FunctionPlan {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    // The arguments are the independent coordinates (mimic joints follow theirs).
+    // The arguments are the independent coordinates (mimic joints follow theirs); the external
+    // wrenches one row per body of the full tree.
     let n = model.coordinate_count();
     FunctionPlan {
         function: f,
@@ -429,7 +430,10 @@ fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> 
         args: f
             .args(floating)
             .iter()
-            .map(|a| (*a, a.len(n, floating)))
+            .map(|a| match a {
+                Arg::FExt => (*a, a.len(model.dof(), floating)),
+                _ => (*a, a.len(n, floating)),
+            })
             .collect(),
         shape: api::shape(f, n, floating),
         choice,
