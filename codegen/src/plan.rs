@@ -276,7 +276,15 @@ fn decide_form(
         }
         _ => (None, Vec::new()),
     };
-    let decision = compact::decide(opts, model.dof(), why_not, size)?;
+    let mut decision = compact::decide(opts, model.dof(), why_not, size)?;
+    if decision.form == Form::Compact && model.has_mimics() {
+        decision.line.push_str(
+            " Mimic joints: the loops run on the full joint list (`CX_COUPLING`: the state \
+             expanded, `q_full = G q + o`, `q̇_full = G q̇`), the results reduced (`M = Gᵀ M_full \
+             G`, `c = Gᵀ c_full`, `J G`, `Gᵀ ∂τ G`); forward dynamics, its derivatives and `M⁻¹` \
+             solve the reduced `M` by LDLᵀ; `f_ext` has one row per body of the full tree.",
+        );
+    }
     // Compact: the whole model's unrolled `M` and `(M, c)` are not emitted.
     let traced = if decision.form == Form::Compact {
         Vec::new()
