@@ -1,5 +1,5 @@
 //! `dynamics!` rejects bad models at compile time with the reader's message at the path literal
-//! (also a model with joints that move no mass, naming the joints, and the compact form asked for a model with mimic joints),
+//! (also a model with joints that move no mass, naming the joints),
 //! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
 //! `algorithm = "fastest"`, `form = "rolled"`, gravity beyond its bound, an unknown key, a
 //! key given twice) at the option, and a type name that would shadow a path the generated code

@@ -144,13 +144,21 @@ pub fn unsupported(opts: &Options) -> Option<&'static str> {
 }
 
 /// The traced counts of the runtime kernel that the compact body of `f` calls
-/// ([`counts::counts`]): every operation its loops execute.
+/// ([`counts::counts`]; with mimic joints, [`counts::coupled_counts`]): every operation its
+/// loops execute.
 ///
 /// # Errors
 /// `f` has no compact body ([`has_body`]).
 pub fn kernel_counts(model: &Model, opts: &Options, f: Function) -> Result<Counts, Error> {
-    counts::counts(&numbers(model, opts), f, opts.runtime_payload)
-        .ok_or_else(|| Error(format!("`{}` has no compact body", f.name())))
+    let t = numbers(model, opts);
+    let full = |g: Function| counts::counts(&t, g, opts.runtime_payload);
+    let counts = if model.has_mimics() {
+        let c = kanegen_dynamics::mimic::Coupling::new(model.mimics());
+        counts::coupled_counts(&c.table(), f, t.base.is_some(), full)
+    } else {
+        full(f)
+    };
+    counts.ok_or_else(|| Error(format!("`{}` has no compact body", f.name())))
 }
 
 /// The form emitted and why, as the header says it.
@@ -340,6 +348,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let a0 = vector(float, &t.a0);
     let base = t.base.as_ref().map(|base| floating_base(&rt, float, base));
     let frames = frames(&rt, float, &t.frames);
+    let coupling = model.has_mimics().then(|| coupling(&rt, model));
     Ok(quote! {
         /// Compact form: the model's numbers as the runtime kernels read them
         /// (`kanegen_runtime::compact::Tables`: parents, joint kinds, the joint transforms'
@@ -359,6 +368,164 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         };
         #base
         #frames
+        #coupling
+    })
+}
+
+/// The mimic joints' constant of the compact form (`CX_COUPLING`): for each joint of the full
+/// list, the coordinate it follows, its multiplier and offset, whether it is independent and
+/// whether it is the first joint of its coordinate (`kanegen_runtime::coupling`).
+fn coupling(rt: &TokenStream, model: &Model) -> TokenStream {
+    let c = kanegen_dynamics::mimic::Coupling::new(model.mimics());
+    let reduced = Literal::usize_unsuffixed(c.reduced());
+    let joints = c.joints().iter().map(|f| {
+        let coordinate = Literal::usize_unsuffixed(f.coordinate);
+        let (k, o) = (
+            Literal::f64_suffixed(f.multiplier),
+            Literal::f64_suffixed(f.offset),
+        );
+        let (independent, first) = (f.independent, f.first);
+        quote! {
+            #rt::coupling::Follower {
+                coordinate: #coordinate,
+                multiplier: #k,
+                offset: #o,
+                independent: #independent,
+                first: #first,
+            }
+        }
+    });
+    quote! {
+        /// Compact form: the mimic joints' coupling of the full joint list (the tables' rows)
+        /// to the independent coordinates (the arguments): `q_j = k_j q_c(j) + o_j`.
+        const CX_COUPLING: #rt::coupling::Coupling<'static> = #rt::coupling::Coupling {
+            joints: &[#(#joints),*],
+            reduced: #reduced,
+        };
+    }
+}
+
+/// The body of `f` on a model with mimic joints (`n` joints in the tables, `r` coordinates):
+/// one call of a kernel of `kanegen_runtime::compact::coupled` (`None`: `f` stays
+/// straight-line).
+fn coupled_body(
+    f: Function,
+    k: &TokenStream,
+    i: &TokenStream,
+    sincos: &TokenStream,
+    (n, r): (usize, usize),
+    floating: bool,
+) -> Option<TokenStream> {
+    let [nl, rl, nvl, rvl, nql] = [n, r, n + 6, r + 6, n + 7].map(Literal::usize_unsuffixed);
+    let cx = quote!(&Self::CX, &Self::CX_COUPLING);
+    let frame = |k: usize| {
+        let k = Literal::usize_unsuffixed(k);
+        quote!(&Self::CX_FRAMES[#k])
+    };
+    let none = paths::option(None::<TokenStream>);
+    let [some_v, some_a, some_f_ext] = [quote!(v), quote!(a), quote!(f_ext)]
+        .map(Some)
+        .map(paths::option);
+    if floating {
+        let fk = quote!(#k::coupled::floating);
+        let args = quote!(#cx, #i, &Self::CX_BASE, q);
+        let sizes = quote!(_, #nl, #nvl, #nql, #rvl);
+        return Some(match f {
+            Function::MassMatrix => quote!(#fk::mass_matrix::<#sizes>(#args, #sincos)),
+            Function::NonlinearEffects => {
+                quote!(#fk::inverse_dynamics::<#sizes>(#args, #some_v, #none, #sincos))
+            }
+            Function::Gravity => {
+                quote!(#fk::inverse_dynamics::<#sizes>(#args, #none, #none, #sincos))
+            }
+            Function::InverseDynamics => {
+                quote!(#fk::inverse_dynamics::<#sizes>(#args, #some_v, #some_a, #sincos))
+            }
+            Function::MassMatrixAndNonlinearEffects => {
+                quote!(#fk::mass_matrix_and_nonlinear_effects::<#sizes>(#args, v, #sincos))
+            }
+            Function::ForwardDynamics => quote! {
+                #fk::forward_dynamics::<_, #nl, #nvl, #nql, #rl, #rvl>(#args, v, tau, #none, #sincos)
+            },
+            Function::ForwardDynamicsWithWrenches => quote! {
+                #fk::forward_dynamics::<_, #nl, #nvl, #nql, #rl, #rvl>(
+                    #args, v, tau, #some_f_ext, #sincos
+                )
+            },
+            Function::Momentum => {
+                quote!(#fk::momentum::<_, #nl, #nvl, #nql>(#args, v, #sincos))
+            }
+            Function::BaseReaction => {
+                quote!(#fk::base_reaction::<_, #nl, #nvl, #nql>(#args, v, a, #sincos))
+            }
+            Function::FramePlacement(k) => {
+                let fr = frame(k);
+                quote!(#fk::frame_placement::<_, #nl, #nql>(#cx, #fr, q, #sincos))
+            }
+            Function::FrameJacobian(k) => {
+                let fr = frame(k);
+                quote!(#fk::frame_jacobian::<_, #nl, #nvl, #nql, #rvl>(#cx, #fr, q, #sincos))
+            }
+            Function::GeneralizedJacobian(k) => {
+                let fr = frame(k);
+                quote! {
+                    #fk::generalized_jacobian::<_, #nl, #nql, #rl>(
+                        #cx, #i, &Self::CX_BASE, #fr, q, #sincos
+                    )
+                }
+            }
+            Function::InverseDynamicsDerivatives => quote! {
+                #fk::inverse_dynamics_derivatives::<#sizes>(#args, v, a, #sincos)
+            },
+            Function::ForwardDynamicsDerivatives => quote! {
+                #fk::forward_dynamics_derivatives::<_, #nl, #nvl, #nql, #rl, #rvl>(
+                    #args, v, tau, #sincos
+                )
+            },
+            Function::MassMatrixInverse => {
+                quote!(#fk::mass_matrix_inverse::<#sizes>(#args, #sincos))
+            }
+            _ => return None,
+        });
+    }
+    let ck = quote!(#k::coupled);
+    let sizes = quote!(_, #nl, #rl);
+    Some(match f {
+        Function::MassMatrix => quote!(#ck::mass_matrix::<#sizes>(#cx, #i, q, #sincos)),
+        Function::NonlinearEffects => {
+            quote!(#ck::nonlinear_effects::<#sizes>(#cx, #i, q, qd, #sincos))
+        }
+        Function::Gravity => quote!(#ck::gravity::<#sizes>(#cx, #i, q, #sincos)),
+        Function::InverseDynamics => {
+            quote!(#ck::inverse_dynamics::<#sizes>(#cx, #i, q, qd, qdd, #sincos))
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            quote!(#ck::mass_matrix_and_nonlinear_effects::<#sizes>(#cx, #i, q, qd, #sincos))
+        }
+        Function::ForwardDynamics => {
+            quote!(#ck::forward_dynamics::<#sizes>(#cx, #i, q, qd, tau, #sincos))
+        }
+        Function::ForwardDynamicsWithWrenches => quote! {
+            #ck::forward_dynamics_with_wrenches::<#sizes>(#cx, #i, q, qd, tau, f_ext, #sincos)
+        },
+        Function::FramePlacement(k) => {
+            let fr = frame(k);
+            quote!(#ck::frame_placement::<#sizes>(#cx, #fr, q, #sincos))
+        }
+        Function::FrameJacobian(k) => {
+            let fr = frame(k);
+            quote!(#ck::frame_jacobian::<#sizes>(#cx, #fr, q, #sincos))
+        }
+        Function::InverseDynamicsDerivatives => quote! {
+            #ck::inverse_dynamics_derivatives::<#sizes>(#cx, #i, q, qd, qdd, #sincos)
+        },
+        Function::ForwardDynamicsDerivatives => quote! {
+            #ck::forward_dynamics_derivatives::<#sizes>(#cx, #i, q, qd, tau, #sincos)
+        },
+        Function::MassMatrixInverse => {
+            quote!(#ck::mass_matrix_inverse::<#sizes>(#cx, #i, q, #sincos))
+        }
+        _ => return None,
     })
 }
 
@@ -472,18 +639,19 @@ fn frames(rt: &TokenStream, float: Float, frames: &[Frame<f64>]) -> TokenStream 
     }
 }
 
-/// The body of `f` in the compact form (a model of `n` joints): one call of its runtime kernel
-/// (`kanegen_runtime::compact`) on the type's tables (`None`: `f` stays straight-line,
-/// [`has_body`]).
+/// The body of `f` in the compact form of `model`: one call of its runtime kernel
+/// (`kanegen_runtime::compact`, `kanegen_runtime::compact::coupled` with mimic joints) on the
+/// type's tables (`None`: `f` stays straight-line, [`has_body`]).
 ///
 /// # Errors
 /// A runtime or libm path that is not a Rust path.
 pub fn body(
     f: Function,
     opts: &Options,
-    n: usize,
+    model: &Model,
     floating: bool,
 ) -> Result<Option<TokenStream>, Error> {
+    let n = model.dof();
     let rt = opts.runtime()?;
     let sincos = if opts.table_sincos() {
         quote!(Self::sincos)
@@ -499,6 +667,10 @@ pub fn body(
         quote!(Self::CX.inertia)
     };
     let k = quote!(#rt::compact);
+    if model.has_mimics() {
+        let sizes = (n, model.coordinate_count());
+        return Ok(coupled_body(f, &k, &i, &sincos, sizes, floating));
+    }
     if floating {
         return Ok(floating_body(f, &k, &i, &sincos, n));
     }

@@ -223,7 +223,7 @@ fn function_body(
     texts: Option<&mut Vec<String>>,
 ) -> Result<Body, Error> {
     let compact_tokens = match fp.kernel {
-        Kernel::Compact(_) => compact::body(fp.function, opts, plan.model.dof(), plan.floating())?,
+        Kernel::Compact(_) => compact::body(fp.function, opts, &plan.model, plan.floating())?,
         Kernel::Unrolled => None,
     };
     let body = match (texts, compact_tokens, graph) {

@@ -257,8 +257,7 @@ fn decide_form(
     subjects: &Subjects,
     opts: &Options,
 ) -> Result<(Decision, Vec<(Choice, Traced)>), Error> {
-    // The compact kernels run on the full joint list, with no coupling of mimic joints.
-    let why_not = compact::unsupported(opts).or(model.has_mimics().then_some("mimic joints"));
+    let why_not = compact::unsupported(opts);
     let (size, traced) = match (opts.form, why_not) {
         (Form::Auto, None) => {
             let fs = [
@@ -277,7 +276,15 @@ fn decide_form(
         }
         _ => (None, Vec::new()),
     };
-    let decision = compact::decide(opts, model.dof(), why_not, size)?;
+    let mut decision = compact::decide(opts, model.dof(), why_not, size)?;
+    if decision.form == Form::Compact && model.has_mimics() {
+        decision.line.push_str(
+            " Mimic joints: the loops run on the full joint list (`CX_COUPLING`: the state \
+             expanded, `q_full = G q + o`, `q̇_full = G q̇`), the results reduced (`M = Gᵀ M_full \
+             G`, `c = Gᵀ c_full`, `J G`, `Gᵀ ∂τ G`); forward dynamics, its derivatives and `M⁻¹` \
+             solve the reduced `M` by LDLᵀ; `f_ext` has one row per body of the full tree.",
+        );
+    }
     // Compact: the whole model's unrolled `M` and `(M, c)` are not emitted.
     let traced = if decision.form == Form::Compact {
         Vec::new()
@@ -422,7 +429,8 @@ fn prefix(model: &Model, joints: usize) -> Option<Model> {
 /// The plan of `f`: its name, arguments and shape, with its choice and kernel.
 fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> FunctionPlan {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    // The arguments are the independent coordinates (mimic joints follow theirs).
+    // The arguments are the independent coordinates (mimic joints follow theirs); the external
+    // wrenches one row per body of the full tree.
     let n = model.coordinate_count();
     FunctionPlan {
         function: f,
@@ -430,7 +438,10 @@ fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> 
         args: f
             .args(floating)
             .iter()
-            .map(|a| (*a, a.len(n, floating)))
+            .map(|a| match a {
+                Arg::FExt => (*a, a.len(model.dof(), floating)),
+                _ => (*a, a.len(n, floating)),
+            })
             .collect(),
         shape: api::shape(f, n, floating),
         choice,

@@ -14,7 +14,9 @@
 //!
 //! Every algorithm keeps computing the full model; [`Coupling`] expands the state before and
 //! reduces `M` and the right-hand side after, generic over the scalar (so a trace records it too).
-//! A free-floating base's six leading speeds map to themselves (`offset = 6`).
+//! A free-floating base's six leading speeds map to themselves (`offset = 6`). The arithmetic is
+//! `kanegen_runtime::coupling`'s (the compact kernels run the same); this type owns its table
+//! and wraps it in `Vec`s.
 //!
 //! ```
 //! use kanegen_dynamics::mimic::Coupling;
@@ -30,18 +32,13 @@
 
 use crate::scalar::Scalar;
 use kanegen_model::Mimic;
+use kanegen_runtime::coupling::{self, Follower};
 
 /// The constant coupling of the full joint list to the independent coordinates.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Coupling {
-    /// For each joint of the full list, the reduced coordinate it moves with.
-    coordinate: Vec<usize>,
-    /// `k_j` (1 on independent joints).
-    multiplier: Vec<f64>,
-    /// `o_j` (0 on independent joints).
-    offset: Vec<f64>,
-    /// Whether each joint is independent (mimics none).
-    independent: Vec<bool>,
+    /// One entry per joint of the full list.
+    joints: Vec<Follower>,
     /// The number of independent coordinates.
     reduced: usize,
 }
@@ -59,21 +56,38 @@ impl Coupling {
                 reduced += 1;
             }
         }
-        let coordinate = mimics
+        let mut seen = vec![false; reduced];
+        let joints = mimics
             .iter()
             .enumerate()
-            .map(|(j, m)| m.map_or(index[j], |m| index[m.primary]))
+            .map(|(j, m)| {
+                let coordinate = m.map_or(index[j], |m| index[m.primary]);
+                let first = !std::mem::replace(&mut seen[coordinate], true);
+                Follower {
+                    coordinate,
+                    multiplier: m.map_or(1.0, |m| m.multiplier),
+                    offset: m.map_or(0.0, |m| m.offset),
+                    independent: m.is_none(),
+                    first,
+                }
+            })
             .collect();
-        Coupling {
-            coordinate,
-            multiplier: mimics
-                .iter()
-                .map(|m| m.map_or(1.0, |m| m.multiplier))
-                .collect(),
-            offset: mimics.iter().map(|m| m.map_or(0.0, |m| m.offset)).collect(),
-            independent: mimics.iter().map(Option::is_none).collect(),
-            reduced,
+        Coupling { joints, reduced }
+    }
+
+    /// The table as the runtime reads it (what a compact generated type holds as a constant).
+    #[must_use]
+    pub fn table(&self) -> coupling::Coupling<'_> {
+        coupling::Coupling {
+            joints: &self.joints,
+            reduced: self.reduced,
         }
+    }
+
+    /// The joints of the full list, in order.
+    #[must_use]
+    pub fn joints(&self) -> &[Follower] {
+        &self.joints
     }
 
     /// Number of independent coordinates.
@@ -85,88 +99,50 @@ impl Coupling {
     /// Number of joints of the full list.
     #[must_use]
     pub fn full(&self) -> usize {
-        self.coordinate.len()
-    }
-
-    /// `k_j x` (no operation when `k_j = 1`: model structure, not data).
-    fn scaled<S: Scalar>(&self, j: usize, x: S) -> S {
-        if self.multiplier[j] == 1.0 {
-            x
-        } else {
-            S::constant(self.multiplier[j]) * x
-        }
+        self.joints.len()
     }
 
     /// `q_full = G q + o`.
     #[must_use]
     pub fn full_positions<S: Scalar>(&self, q: &[S]) -> Vec<S> {
-        (0..self.full())
-            .map(|j| {
-                let x = self.scaled(j, q[self.coordinate[j]].clone());
-                if self.offset[j] == 0.0 {
-                    x
-                } else {
-                    x + S::constant(self.offset[j])
-                }
-            })
-            .collect()
+        let mut out = vec![S::zero(); self.full()];
+        self.table().expand_positions(q, &mut out);
+        out
     }
 
     /// `q̇_full = G q̇` (also `q̈_full = G q̈`).
     #[must_use]
     pub fn full_rates<S: Scalar>(&self, qd: &[S]) -> Vec<S> {
-        (0..self.full())
-            .map(|j| self.scaled(j, qd[self.coordinate[j]].clone()))
-            .collect()
+        let mut out = vec![S::zero(); self.full()];
+        self.table().expand_rates(qd, &mut out);
+        out
     }
 
     /// `τ_full`: the drives of the independent joints, zero on mimic joints (they are driven
     /// through the coupling).
     #[must_use]
     pub fn full_drives<S: Scalar>(&self, tau: &[S]) -> Vec<S> {
-        (0..self.full())
-            .map(|j| match self.independent[j] {
-                true => tau[self.coordinate[j]].clone(),
-                false => S::zero(),
-            })
-            .collect()
+        let mut out = vec![S::zero(); self.full()];
+        self.table().expand_drives(tau, &mut out);
+        out
     }
 
     /// `Gᵀ v` for a full vector whose first `offset` entries are the base's own (kept).
     #[must_use]
     pub fn reduce_vector<S: Scalar>(&self, v: &[S], offset: usize) -> Vec<S> {
-        let mut out: Vec<Option<S>> = vec![None; offset + self.reduced];
-        for (k, x) in v.iter().take(offset).enumerate() {
-            out[k] = Some(x.clone());
-        }
-        for j in 0..self.full() {
-            let r = offset + self.coordinate[j];
-            let x = self.scaled(j, v[offset + j].clone());
-            out[r] = Some(match out[r].take() {
-                None => x,
-                Some(acc) => acc + x,
-            });
-        }
-        out.into_iter().map(|x| x.unwrap_or_else(S::zero)).collect()
+        let mut out = vec![S::zero(); offset + self.reduced];
+        self.table().reduce_vector(v, offset, &mut out);
+        out
     }
 
     /// `Gᵀ M G` for a full square matrix whose first `offset` rows and columns are the base's.
     #[must_use]
     pub fn reduce_matrix<S: Scalar>(&self, m: &[Vec<S>], offset: usize) -> Vec<Vec<S>> {
-        // Columns first (M G), then rows (Gᵀ (M G)), each by `reduce_vector`.
-        let mg: Vec<Vec<S>> = m
-            .iter()
-            .map(|row| self.reduce_vector(row, offset))
-            .collect();
         let n = offset + self.reduced;
-        let columns: Vec<Vec<S>> = (0..n)
-            .map(|c| {
-                let col: Vec<S> = mg.iter().map(|row| row[c].clone()).collect();
-                self.reduce_vector(&col, offset)
-            })
-            .collect();
-        (0..n)
-            .map(|r| (0..n).map(|c| columns[c][r].clone()).collect())
-            .collect()
+        let mut scratch = vec![S::zero(); m.len() * n];
+        let mut out = vec![S::zero(); n * n];
+        self.table()
+            .reduce_matrix(&m.concat(), offset, &mut scratch, &mut out);
+        out.chunks(n.max(1)).map(<[S]>::to_vec).collect()
     }
 }

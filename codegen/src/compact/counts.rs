@@ -119,11 +119,13 @@ fn trace_kernel(
         Motions {
             qd: Some(&qd),
             qdd: Some(&qdd),
+            f_ext: None,
         },
     );
     let rest = Motions {
         qd: None,
         qdd: None,
+        f_ext: None,
     };
     Some(match f {
         Function::MassMatrix => crba(tables, &mut b),
@@ -211,7 +213,9 @@ fn trace_floating(
     let id_at = |b: &Bodies<'_, Sym>, vel: Option<&[Sym]>, acc: Option<&[Sym]>| {
         let (mut m, mut out) = (vec![[[zero; 6]; 3]; n], vec![zero; nv]);
         let x = &*b.x;
-        inverse_dynamics_in(tables, x, inertia, base, &q, vel, acc, &mut m, &mut out);
+        inverse_dynamics_in(
+            tables, x, inertia, base, &q, vel, acc, None, &mut m, &mut out,
+        );
         out
     };
     Some(match f {
@@ -437,6 +441,7 @@ fn trace_floating_derivatives<S: Scalar + Copy>(
             q,
             Some(v),
             None,
+            None,
             &mut mm,
             &mut c,
         );
@@ -477,4 +482,147 @@ fn crba<S: Scalar + Copy>(tables: &Tables<'_, S>, b: &mut Bodies<'_, S>) -> Vec<
     let (mut st, mut h) = (vec![zero; 6 * n], vec![zero; n * n]);
     k::crba::crba(tables, tables.inertia, b, &mut st, &mut h);
     h
+}
+
+/// The counts of the compact body of `f` on a model with mimic joints
+/// (`kanegen_runtime::compact::coupled`): the full-tree kernels it calls (`full`: the counts
+/// of a function's kernel on the full tables, [`counts`]), plus its own steps run on [`Tally`]:
+/// the state expanded by the coupling `c`, the results reduced, and for forward dynamics, its
+/// derivatives and `M⁻¹` the right-hand side, the LDLᵀ solve or inverse of the reduced `M`
+/// and the products with it. `floating`: on a free-floating base. `None`: no compact body.
+pub fn coupled_counts(
+    c: &kanegen_runtime::coupling::Coupling<'_>,
+    f: Function,
+    floating: bool,
+    full: impl Fn(Function) -> Option<Counts>,
+) -> Option<Counts> {
+    let z = Tally;
+    let (n, r) = (c.full(), c.reduced);
+    let o = if floating { 6 } else { 0 };
+    let (nf, rf) = (n + o, r + o);
+    let _ = tally::take();
+    let mut full_vec = vec![z; nf];
+    let mut red_vec = vec![z; rf];
+    let expand_q = |out: &mut Vec<Tally>| c.expand_positions(&vec![z; r], &mut out[..n]);
+    let expand_rates = |out: &mut Vec<Tally>| c.expand_rates(&vec![z; r], &mut out[..n]);
+    let reduce_matrix = || {
+        let (m, mut scratch, mut out) = (vec![z; nf * nf], vec![z; nf * rf], vec![z; rf * rf]);
+        c.reduce_matrix(&m, o, &mut scratch, &mut out);
+    };
+    let mut reduce_vector = || c.reduce_vector(&vec![z; nf], o, &mut red_vec);
+    // The right-hand side `τ_full − c_full` of forward dynamics, reduced with `M`.
+    let rhs = |full_vec: &mut Vec<Tally>| {
+        c.expand_drives(&vec![z; r], &mut full_vec[..n]);
+        for x in full_vec.iter_mut() {
+            *x = *x - z;
+        }
+    };
+    let kernels: &[Function] = match f {
+        Function::MassMatrix | Function::MassMatrixInverse => {
+            expand_q(&mut full_vec);
+            reduce_matrix();
+            if f == Function::MassMatrixInverse {
+                let (mut m, mut d_inv, mut out) = (vec![z; rf * rf], vec![z; rf], vec![z; rf * rf]);
+                k::derivatives::inverse_in(&mut m, rf, &mut d_inv, &mut out);
+            }
+            &[Function::MassMatrix]
+        }
+        Function::NonlinearEffects | Function::Gravity | Function::InverseDynamics => {
+            expand_q(&mut full_vec);
+            let rates = match f {
+                Function::NonlinearEffects => 1,
+                Function::Gravity => 0,
+                _ => 2,
+            };
+            for _ in 0..rates {
+                expand_rates(&mut full_vec);
+            }
+            reduce_vector();
+            &[f]
+        }
+        Function::MassMatrixAndNonlinearEffects => {
+            expand_q(&mut full_vec);
+            expand_rates(&mut full_vec);
+            reduce_matrix();
+            reduce_vector();
+            &[f]
+        }
+        Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
+            expand_q(&mut full_vec);
+            expand_rates(&mut full_vec);
+            rhs(&mut full_vec);
+            if f == Function::ForwardDynamicsWithWrenches {
+                // One wrench subtracted per body (and the base).
+                let mut fe = vec![[z; 6]; n + usize::from(floating)];
+                for w in &mut fe {
+                    *w = core::array::from_fn(|k| w[k] - z);
+                }
+            }
+            reduce_matrix();
+            reduce_vector();
+            let (mut m, mut d_inv, mut x) = (vec![z; rf * rf], vec![z; rf], vec![z; rf]);
+            if kanegen_runtime::ldlt::factor_in_place(&mut m, rf, &mut d_inv).is_ok() {
+                let _ = kanegen_runtime::ldlt::solve_in_place(&m, rf, &d_inv, &mut x);
+            }
+            &[Function::MassMatrixAndNonlinearEffects]
+        }
+        Function::FramePlacement(_)
+        | Function::Momentum
+        | Function::BaseReaction
+        | Function::FrameJacobian(_)
+        | Function::GeneralizedJacobian(_) => {
+            expand_q(&mut full_vec);
+            let rates = match f {
+                Function::Momentum => 1,
+                Function::BaseReaction => 2,
+                _ => 0,
+            };
+            for _ in 0..rates {
+                expand_rates(&mut full_vec);
+            }
+            let offset = match f {
+                Function::FrameJacobian(_) => Some(o),
+                Function::GeneralizedJacobian(_) => Some(0),
+                _ => None,
+            };
+            if let Some(offset) = offset {
+                let (m, mut out) = (vec![z; 6 * (offset + n)], vec![z; 6 * (offset + r)]);
+                c.reduce_rows(&m, offset, &mut out);
+            }
+            &[f]
+        }
+        Function::InverseDynamicsDerivatives => {
+            expand_q(&mut full_vec);
+            expand_rates(&mut full_vec);
+            expand_rates(&mut full_vec);
+            reduce_matrix();
+            reduce_matrix();
+            &[f]
+        }
+        Function::ForwardDynamicsDerivatives => {
+            expand_q(&mut full_vec);
+            expand_rates(&mut full_vec);
+            rhs(&mut full_vec);
+            reduce_matrix();
+            reduce_vector();
+            let (mut m, mut d_inv, mut minv) = (vec![z; rf * rf], vec![z; rf], vec![z; rf * rf]);
+            k::derivatives::inverse_in(&mut m, rf, &mut d_inv, &mut minv);
+            let mut qdd = vec![z; rf];
+            k::coupled::product(&minv, &vec![z; rf], &mut qdd);
+            expand_rates(&mut full_vec);
+            reduce_matrix();
+            reduce_matrix();
+            let (d, mut out) = (vec![z; rf * rf], vec![z; rf * rf]);
+            k::derivatives::neg_product(&minv, &d, rf, &mut out);
+            k::derivatives::neg_product(&minv, &d, rf, &mut out);
+            &[
+                Function::MassMatrixAndNonlinearEffects,
+                Function::InverseDynamicsDerivatives,
+            ]
+        }
+        _ => return None,
+    };
+    // The own steps' tally first: a derivative kernel's counts reset it.
+    let own = tally::take();
+    kernels.iter().try_fold(own, |acc, &g| Some(acc + full(g)?))
 }

@@ -598,7 +598,18 @@ pub fn floating_forward_dynamics_derivatives<S: Scalar + Copy, const N: usize, c
     let (mut dtq, mut dtv) = ([[zero; NV]; NV], [[zero; NV]; NV]);
     let mut out = ([[zero; NV]; NV], [[zero; NV]; NV], [[zero; NV]; NV]);
     transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
-    inverse_dynamics_in(t, b.x, inertia, base, q, Some(v), None, &mut mm, &mut c);
+    inverse_dynamics_in(
+        t,
+        b.x,
+        inertia,
+        base,
+        q,
+        Some(v),
+        None,
+        None,
+        &mut mm,
+        &mut c,
+    );
     let m = m.as_flattened_mut();
     let (st, h) = (st.as_flattened_mut(), h.as_flattened_mut());
     mass_matrix_in(t, inertia, base, &mut b, st, h, m);

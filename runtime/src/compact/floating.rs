@@ -13,7 +13,9 @@
 use super::aba::{aba_floating_on_world, Articulated, ArticulatedStore, FloatingRoot, Rates};
 use super::crba::crba;
 use super::rnea::{rnea_rooted, Motions, Root};
-use super::spatial::{add, crf, cross, inertia_mul, rot, rot_tr, transforms, world, Transform};
+use super::spatial::{
+    add, crf, cross, inertia_mul, rot, rot_tr, sub, transforms, world, Transform,
+};
 use super::tables::{Bodies, BodyStore, Tables};
 use crate::scalar::Scalar;
 
@@ -188,7 +190,18 @@ pub fn mass_matrix_and_nonlinear_effects<S: Scalar + Copy, const N: usize, const
     let mut m = [[[zero; 6]; 3]; N];
     let mut out = ([[zero; NV]; NV], [zero; NV]);
     transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
-    inverse_dynamics_in(t, b.x, inertia, base, q, Some(v), None, &mut m, &mut out.1);
+    inverse_dynamics_in(
+        t,
+        b.x,
+        inertia,
+        base,
+        q,
+        Some(v),
+        None,
+        None,
+        &mut m,
+        &mut out.1,
+    );
     let (st, h) = (st.as_flattened_mut(), h.as_flattened_mut());
     mass_matrix_in(t, inertia, base, &mut b, st, h, out.0.as_flattened_mut());
     out
@@ -213,14 +226,16 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize, const NV: usize>(
     let mut m = [[[zero; 6]; 3]; N];
     let mut out = [zero; NV];
     transforms(t, q.get(7..).unwrap_or(&[]), sincos, b.x);
-    inverse_dynamics_in(t, b.x, inertia, base, q, v, a, &mut m, &mut out);
+    inverse_dynamics_in(t, b.x, inertia, base, q, v, a, None, &mut m, &mut out);
     out
 }
 
 /// Inverse dynamics into `out` (`6 + N`) by the recursive Newton–Euler algorithm from the
 /// base's motion (RBDA §9.5) on the joint transforms `x`: `v_0 = [ω_b; v_b]`,
 /// `a_0 = [ω̇_b; v̇_b − R₀ᵀ g]`, the joints as [`rnea_rooted`] (`m`: its scratch), then
-/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 + Σ_{λ(i) = base} Xup_iᵀ f_i`.
+/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 + Σ_{λ(i) = base} Xup_iᵀ f_i`. With `f_ext` (`[force;
+/// moment]` in each body's frame at its origin: `f_ext[0]` on the base, `f_ext[1 + i]` on body
+/// `i`), each body's wrench is subtracted from its force: the result is `M ν̇ + c − Jᵀ f_ext`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn inverse_dynamics_in<S: Scalar + Copy>(
@@ -231,6 +246,7 @@ pub fn inverse_dynamics_in<S: Scalar + Copy>(
     q: &[S],
     v: Option<&[S]>,
     a: Option<&[S]>,
+    f_ext: Option<&[[S; 6]]>,
     m: &mut [[[S; 6]; 3]],
     out: &mut [S],
 ) {
@@ -238,11 +254,15 @@ pub fn inverse_dynamics_in<S: Scalar + Copy>(
     let motions = Motions {
         qd: v.map(|v| v.get(6..).unwrap_or(&[])),
         qdd: a.map(|a| a.get(6..).unwrap_or(&[])),
+        f_ext: f_ext.map(|f| f.get(1..).unwrap_or(&[])),
     };
     let k = &base.inertia;
     let mut f0 = inertia_mul(k, &root.a);
     if v.is_some() {
         f0 = add(&f0, &crf(&root.v, &inertia_mul(k, &root.v)));
+    }
+    if let Some(e) = f_ext.and_then(<[_]>::first) {
+        f0 = sub(&f0, &[e[3], e[4], e[5], e[0], e[1], e[2]]);
     }
     let (head, tau) = out.split_at_mut(6.min(out.len()));
     rnea_rooted(t, x, inertia, motions, &root, m, tau, Some(&mut f0));
@@ -319,6 +339,7 @@ pub fn base_reaction_in<S: Scalar + Copy>(
     let motions = Motions {
         qd: Some(v.get(6..).unwrap_or(&[])),
         qdd: Some(a.get(6..).unwrap_or(&[])),
+        f_ext: None,
     };
     let mut f0 = [S::zero(); 6];
     rnea_rooted(t, x, inertia, motions, &root, m, &mut [], Some(&mut f0));

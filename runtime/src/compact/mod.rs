@@ -18,6 +18,9 @@
 //! - [`floating`]: `M`, `c`, inverse and forward dynamics, the momentum and the arm's reaction
 //!   on its base on a free-floating base; [`floating_frames`]: its frames' placements,
 //!   Jacobians and generalized Jacobians;
+//! - [`coupled`]: all of the above for a model with mimic joints, in its independent
+//!   coordinates (the state expanded to the full joint list, the results reduced, forward
+//!   dynamics solved with the reduced `M`; [`crate::coupling`]);
 //! - [`aba::aba_floating_on_world`]: forward dynamics on a free-floating base ([`FloatingRoot`]);
 //!   the run-time path calls it and [`aba::aba_on_world`] on tables built at run time, with
 //!   the armature and wrenches of a scene.
@@ -44,6 +47,7 @@
 //! table serves both kinds without a branch on the kind in the transforms.
 
 pub mod aba;
+pub mod coupled;
 pub mod crba;
 pub mod derivatives;
 pub mod floating;

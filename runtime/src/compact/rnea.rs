@@ -1,7 +1,7 @@
 //! Inverse dynamics, nonlinear effects and gravity by the recursive Newton–Euler algorithm
 //! (RBDA Table 5.1).
 
-use super::spatial::{add, axpy, crf, crm, dot, inertia_mul, scale, transforms, Transform};
+use super::spatial::{add, axpy, crf, crm, dot, inertia_mul, scale, sub, transforms, Transform};
 use super::tables::{BodyStore, Tables};
 use crate::scalar::Scalar;
 
@@ -13,6 +13,9 @@ pub struct Motions<'a, S> {
     pub qd: Option<&'a [S]>,
     /// `q̈`.
     pub qdd: Option<&'a [S]>,
+    /// External wrenches, `f_ext[i] = [force; moment]` on body `i` in its frame at its origin
+    /// (`None`: none): the RNEA gives `M q̈ + c − Jᵀ f_ext`.
+    pub f_ext: Option<&'a [[S; 6]]>,
 }
 
 impl<'a, S> Motions<'a, S> {
@@ -23,6 +26,7 @@ impl<'a, S> Motions<'a, S> {
         Motions {
             qd: Some(qd),
             qdd: None,
+            f_ext: None,
         }
     }
 }
@@ -69,6 +73,7 @@ pub fn gravity<S: Scalar + Copy, const N: usize>(
     let motions = Motions {
         qd: None,
         qdd: None,
+        f_ext: None,
     };
     newton_euler(t, inertia, q, motions, sincos)
 }
@@ -86,6 +91,7 @@ pub fn inverse_dynamics<S: Scalar + Copy, const N: usize>(
     let motions = Motions {
         qd: Some(qd),
         qdd: Some(qdd),
+        f_ext: None,
     };
     newton_euler(t, inertia, q, motions, sincos)
 }
@@ -160,6 +166,9 @@ pub fn rnea_rooted<S: Scalar + Copy>(
         if motions.qd.is_some() {
             let iv = inertia_mul(ii, v);
             *f = add(f, &crf(v, &iv));
+        }
+        if let Some(e) = motions.f_ext.and_then(|f| f.get(i)) {
+            *f = sub(f, &[e[3], e[4], e[5], e[0], e[1], e[2]]);
         }
     }
     for i in (0..n).rev() {

@@ -1,3 +1,0 @@
-kanegen::dynamics!(Hand, "bad/mimic.urdf", form = "compact");
-
-fn main() {}
