@@ -169,4 +169,19 @@ impl Coupling {
             .map(|r| (0..n).map(|c| columns[c][r].clone()).collect())
             .collect()
     }
+
+    /// Forward dynamics in the independent coordinates: `M q̈ = b` with `M = Gᵀ M_full G` and
+    /// `b = Gᵀ (τ_full − c_full)` (the full matrix and right-hand side, `offset` base speeds
+    /// first), by LDLᵀ ([`crate::ldlt`]).
+    #[must_use]
+    pub fn forward_dynamics<S: Scalar>(
+        &self,
+        offset: usize,
+        m_full: &[Vec<S>],
+        b_full: &[S],
+    ) -> Vec<S> {
+        let m = self.reduce_matrix(m_full, offset);
+        let b = self.reduce_vector(b_full, offset);
+        crate::ldlt::solve(&crate::ldlt::ldlt(&m), &b)
+    }
 }
