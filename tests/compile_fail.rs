@@ -4,7 +4,8 @@
 //! `algorithm = "fastest"`, `form = "rolled"`, gravity beyond its bound, an unknown key, a
 //! key given twice) at the option, and a type name that would shadow a path the generated code
 //! calls (`f64` with `fma_path = f64::mul_add`) at the name; `scene!` rejects a
-//! bad scene key (the scene reader's message) and a feature it does not generate (a tabulated
+//! bad scene key (the scene reader's message), a value for a mimic joint (naming the joint it
+//! follows) and a feature it does not generate (a tabulated
 //! wrench with a computed-torque drive), naming the key and the scene file, at the path literal.
 //!
 //! trybuild compiles each case in its own project, `<target>/tests/trybuild/kanegen`, whose

@@ -429,20 +429,17 @@ fn prefix(model: &Model, joints: usize) -> Option<Model> {
 /// The plan of `f`: its name, arguments and shape, with its choice and kernel.
 fn function_plan(model: &Model, f: Function, choice: Choice, kernel: Kernel) -> FunctionPlan {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    // The arguments are the independent coordinates (mimic joints follow theirs); the external
-    // wrenches one row per body of the full tree.
+    // The arguments are the independent coordinates (mimic joints follow theirs); `f_ext` has
+    // a row per body, mimic joints' bodies included (the trace reads one per joint).
     let n = model.coordinate_count();
+    let len = |a: Arg| match a {
+        Arg::FExt => a.len(model.dof(), floating),
+        _ => a.len(n, floating),
+    };
     FunctionPlan {
         function: f,
         name: api::fn_name(f, model),
-        args: f
-            .args(floating)
-            .iter()
-            .map(|a| match a {
-                Arg::FExt => (*a, a.len(model.dof(), floating)),
-                _ => (*a, a.len(n, floating)),
-            })
-            .collect(),
+        args: f.args(floating).iter().map(|a| (*a, len(*a))).collect(),
         shape: api::shape(f, n, floating),
         choice,
         kernel,

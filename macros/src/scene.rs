@@ -162,7 +162,7 @@ struct Layout {
 
 impl Layout {
     fn of(scene: &Scene, name: &Ident) -> Layout {
-        let n = scene.model.dof();
+        let n = scene.dof();
         let floating = scene.is_floating();
         let flexible = scene.flexible.is_some();
         let (nq, nv) = if floating { (n + 7, n + 6) } else { (n, n) };
@@ -193,6 +193,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         ty: &model_ty,
         phases: &phase_tys,
         n: layout.n,
+        bodies: scene.model.dof(),
         nq: layout.nq,
         nv: layout.nv,
         wrench_frames: &wrench_frames,

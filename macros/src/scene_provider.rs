@@ -134,6 +134,9 @@ pub struct Shape<'a> {
     pub phases: &'a [Ident],
     /// Joints, positions, speeds.
     pub n: usize,
+    /// Bodies (joints of the full list: with mimic joints more than `n`), the rows of `f_ext`
+    /// after the base's.
+    pub bodies: usize,
     /// Positions.
     pub nq: usize,
     /// Speeds.
@@ -225,7 +228,7 @@ fn f_ext(scene: &Scene, sh: &Shape<'_>) -> Result<TokenStream, String> {
     }
     let (rt, dyn_ty) = (&sh.rt, &sh.phases[0]);
     let floating = scene.is_floating();
-    let rows_n = Literal::usize_unsuffixed(sh.n + usize::from(floating));
+    let rows_n = Literal::usize_unsuffixed(sh.bodies + usize::from(floating));
     let f64 = paths::primitive("f64");
     let mut code = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {

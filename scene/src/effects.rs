@@ -69,7 +69,7 @@ impl Scene {
     #[must_use]
     pub fn effects<'a>(&'a self, wrenches: &'a [Profile<'a>]) -> SceneEffects<'a> {
         SceneEffects {
-            dof: self.model.dof(),
+            dof: self.dof(),
             floating: self.is_floating(),
             drive: self.drive(),
             damping: self.damping.as_deref(),

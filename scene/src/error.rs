@@ -99,3 +99,57 @@ mod tests {
         );
     }
 }
+
+/// The joint coordinates of a scene's model: what its per-joint lists (`initial.q`,
+/// `drives.kp`, `effects.damping`, …) hold one value for. With mimic joints they are the
+/// independent joints only (a mimic joint moves with the joint it follows and has no value of
+/// its own).
+#[derive(Clone, Copy)]
+pub(crate) struct Coordinates<'a>(pub &'a kanegen_model::Model);
+
+impl Coordinates<'_> {
+    /// How many values a per-joint list holds.
+    pub(crate) fn len(self) -> usize {
+        self.0.coordinate_count()
+    }
+
+    /// The error of a per-joint list `key` of `got` values: the expected count and, with mimic
+    /// joints, the coordinates by name and each mimic joint with the joint it follows.
+    pub(crate) fn wrong_count(self, key: &str, got: usize) -> SceneError {
+        let (model, n) = (self.0, self.len());
+        if !model.has_mimics() {
+            return SceneError::invalid(format!(
+                "{key}: expected {n} values (the model's degrees of freedom), got {got}"
+            ));
+        }
+        let joints = model.joints();
+        let names: Vec<&str> = model
+            .coordinates()
+            .into_iter()
+            .map(|j| joints[j].name.as_str())
+            .collect();
+        let mimics: Vec<String> = model
+            .mimics()
+            .iter()
+            .enumerate()
+            .filter_map(|(j, m)| {
+                m.map(|m| {
+                    format!(
+                        "`{}` follows `{}` (q = {} · q_{} + {})",
+                        joints[j].name,
+                        joints[m.primary].name,
+                        m.multiplier,
+                        joints[m.primary].name,
+                        m.offset
+                    )
+                })
+            })
+            .collect();
+        SceneError::invalid(format!(
+            "{key}: expected {n} values, one per coordinate of the model ({}), got {got}; a \
+             mimic joint has no value of its own: {}",
+            names.join(", "),
+            mimics.join(", ")
+        ))
+    }
+}

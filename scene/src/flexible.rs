@@ -25,6 +25,7 @@
 //! `motor_inertia` `I_m` (kg·m², `> 0`), `gear_ratio` `n` (`!= 0`, default 1). Fixed base only;
 //! not with `[effects] rotor` (the motor inertia is given here).
 
+use crate::error::Coordinates;
 use crate::Result;
 use kanegen_model::bounds::GAIN;
 use serde::Deserialize;
@@ -61,43 +62,45 @@ pub struct Flexible {
     pub reflected: Vec<f64>,
 }
 
-/// `n` values, finite and within [`GAIN`] (the messages of the parser's `check_len`, which this
-/// module does not call: the parser calls this module).
-fn checked(key: &str, v: Vec<f64>, n: usize) -> Result<Vec<f64>> {
-    if v.len() != n {
-        bail!(
-            "{key}: expected {n} values (the model's degrees of freedom), got {}",
-            v.len()
-        );
+/// One value per coordinate `n`, finite and within [`GAIN`] (the messages of the parser's
+/// `check_len`, which this module does not call: the parser calls this module).
+fn checked(key: &str, v: Vec<f64>, n: Coordinates<'_>) -> Result<Vec<f64>> {
+    if v.len() != n.len() {
+        return Err(n.wrong_count(key, v.len()));
     }
     GAIN.check(&v).map_err(|e| invalid!("{key}: {e}"))?;
     Ok(v)
 }
 
-fn values(key: &str, g: RawValues, n: usize) -> Result<Vec<f64>> {
+fn values(key: &str, g: RawValues, n: Coordinates<'_>) -> Result<Vec<f64>> {
     let v = match g {
-        RawValues::Scalar(x) => vec![x; n],
+        RawValues::Scalar(x) => vec![x; n.len()],
         RawValues::Vector(v) => v,
     };
     checked(key, v, n)
 }
 
 impl Flexible {
-    /// Validates the raw table of a scene with `n` joints (`line`: where the table starts).
-    pub(crate) fn from_raw(r: RawFlexible, n: usize, line: usize) -> Result<Flexible> {
+    /// Validates the raw table of a scene with the joint coordinates `coordinates` (`line`:
+    /// where the table starts).
+    pub(crate) fn from_raw(
+        r: RawFlexible,
+        coordinates: Coordinates<'_>,
+        line: usize,
+    ) -> Result<Flexible> {
         let key = |k: &str| format!("effects.flexible.{k} (line {line})");
-        let stiffness = values(&key("stiffness"), r.stiffness, n)?;
+        let stiffness = values(&key("stiffness"), r.stiffness, coordinates)?;
         if stiffness.iter().any(|k| *k <= 0.0) {
             bail!("{}: must be > 0 (N·m/rad)", key("stiffness"));
         }
         let damping = match r.damping {
-            None => vec![0.0; n],
-            Some(d) => values(&key("damping"), d, n)?,
+            None => vec![0.0; coordinates.len()],
+            Some(d) => values(&key("damping"), d, coordinates)?,
         };
         if damping.iter().any(|d| *d < 0.0) {
             bail!("{}: must be >= 0 (N·m·s/rad)", key("damping"));
         }
-        let motor_inertia = values(&key("motor_inertia"), r.motor_inertia, n)?;
+        let motor_inertia = values(&key("motor_inertia"), r.motor_inertia, coordinates)?;
         if motor_inertia.iter().any(|i| *i <= 0.0) {
             bail!(
                 "{}: must be > 0 (kg·m²; the motor equation divides by it)",
@@ -105,8 +108,8 @@ impl Flexible {
             );
         }
         let gear_ratio = match r.gear_ratio {
-            None => vec![1.0; n],
-            Some(g) => values(&key("gear_ratio"), g, n)?,
+            None => vec![1.0; coordinates.len()],
+            Some(g) => values(&key("gear_ratio"), g, coordinates)?,
         };
         if gear_ratio.contains(&0.0) {
             bail!("{}: must be non-zero", key("gear_ratio"));
@@ -116,7 +119,7 @@ impl Flexible {
             .zip(&gear_ratio)
             .map(|(i, g)| i * g * g)
             .collect();
-        let reflected = checked(&key("motor_inertia"), reflected, n)?;
+        let reflected = checked(&key("motor_inertia"), reflected, coordinates)?;
         Ok(Flexible {
             stiffness,
             damping,

@@ -46,6 +46,8 @@ pub mod flexible;
 
 pub use error::SceneError;
 
+use error::Coordinates;
+
 use kanegen_dynamics::base::BASE_BODY;
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::{ExternalWrench, ForwardMethod, LoadFrame, Methods};
@@ -570,12 +572,10 @@ pub struct Scene {
     pub events: Vec<Event>,
 }
 
-fn check_len(key: &str, v: &[f64], n: usize, b: Bound) -> Result<()> {
-    if v.len() != n {
-        bail!(
-            "{key}: expected {n} values (the model's degrees of freedom), got {}",
-            v.len()
-        );
+/// One value per coordinate of the model (`n`), within the bound `b`.
+fn check_len(key: &str, v: &[f64], n: Coordinates<'_>, b: Bound) -> Result<()> {
+    if v.len() != n.len() {
+        return Err(n.wrong_count(key, v.len()));
     }
     check_bound(key, v, b)
 }
@@ -592,9 +592,9 @@ fn check_bound(key: &str, v: &[f64], b: Bound) -> Result<()> {
     b.check(v).map_err(|e| invalid!("{key}: {e}"))
 }
 
-fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
+fn gain(key: &str, g: Option<RawGain>, n: Coordinates<'_>) -> Result<Vec<f64>> {
     let v = match g.ok_or_else(|| invalid!("{key}: required by this drive type"))? {
-        RawGain::Scalar(x) => vec![x; n],
+        RawGain::Scalar(x) => vec![x; n.len()],
         RawGain::Vector(v) => {
             check_len(key, &v, n, GAIN)?;
             v
@@ -638,6 +638,7 @@ fn with_payloads(
         joints,
         validation,
     )
+    .and_then(|m| m.with_mimics(chain.mimics().to_vec()))
     .map_err(|e| invalid!("{e}"))
 }
 
@@ -661,6 +662,12 @@ fn parse_events(
             bail!(
                 "events[{k}] (line {line}): payload capture and release need a free-floating \
                  base (base.type = \"free-floating\"), where the impulse conserves momentum"
+            );
+        }
+        if chain0.has_mimics() {
+            bail!(
+                "events[{k}] (line {line}): payload capture and release are not supported on \
+                 a model with mimic joints"
             );
         }
         if !(e.time.is_finite() && e.time > 0.0 && e.time < duration) {
@@ -758,17 +765,12 @@ fn parse_events(
     Ok(events)
 }
 
-/// The scene's model at `model_path`: loaded, without mimic joints, its forward dynamics
-/// defined (errors name the model file).
+/// The scene's model at `model_path`: loaded, its forward dynamics defined (errors name the
+/// model file). With mimic joints the scene runs in the model's coordinates, the joints that
+/// follow none ([`Model::coordinates`]).
 fn load_chain(model_path: &Path, validation: Validation) -> Result<Model> {
     let chain = kanegen_model::io::load_model_with(model_path, validation)
         .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
-    if chain.has_mimics() {
-        bail!(
-            "model: `{}`: mimic joints are not supported by the simulator yet",
-            model_path.display()
-        );
-    }
     chain
         .check_forward_dynamics()
         .map_err(|e| invalid!("model: `{}`: {e}", model_path.display()))?;
@@ -918,7 +920,7 @@ fn parse_wrenches(raw: Vec<RawWrench>, chain: &Model, floating: bool) -> Result<
 fn parse_rotor(
     raw: Option<toml::Spanned<RawRotor>>,
     text: &str,
-    n: usize,
+    n: Coordinates<'_>,
 ) -> Result<Option<Rotor>> {
     let Some(r) = raw else {
         return Ok(None);
@@ -953,7 +955,7 @@ fn parse_rotor(
 fn parse_friction(
     raw: Option<toml::Spanned<RawFriction>>,
     text: &str,
-    n: usize,
+    n: Coordinates<'_>,
     damping: &mut Option<Vec<f64>>,
 ) -> Result<Option<Coulomb>> {
     let Some(f) = raw else {
@@ -999,7 +1001,7 @@ fn parse_friction(
 fn parse_flexible(
     raw: Option<toml::Spanned<flexible::RawFlexible>>,
     text: &str,
-    n: usize,
+    n: Coordinates<'_>,
     floating: bool,
     rotor: bool,
 ) -> Result<Option<flexible::Flexible>> {
@@ -1024,7 +1026,7 @@ fn parse_flexible(
 }
 
 /// `[drives]`: the keys its type uses (and no other), validated.
-fn parse_drives(raw: Option<RawDrives>, n: usize, floating: bool) -> Result<Drives> {
+fn parse_drives(raw: Option<RawDrives>, n: Coordinates<'_>, floating: bool) -> Result<Drives> {
     let Some(d) = raw else {
         return Ok(Drives::None);
     };
@@ -1274,7 +1276,7 @@ impl Scene {
             allow_nonphysical_inertia: raw.allow_nonphysical,
         };
         let chain0 = load_chain(&dir.join(&raw.model), validation)?;
-        let n = chain0.dof();
+        let n = Coordinates(&chain0);
         let attached: Vec<(usize, Inertial)> = parse_payload(raw.payload, &chain0, validation)?
             .into_iter()
             .collect();
@@ -1297,9 +1299,9 @@ impl Scene {
         let rotor = parse_rotor(e.rotor, text, n)?;
         let coulomb = parse_friction(e.friction, text, n, &mut damping)?;
         let flexible = parse_flexible(e.flexible, text, n, floating, rotor.is_some())?;
-        let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
+        let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n.len()]);
         check_len("initial.q", &q0, n, POSITION)?;
-        let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
+        let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n.len()]);
         check_len("initial.qd", &qd0, n, RATE)?;
         let drives = parse_drives(raw.drives, n, floating)?;
         let simulation = parse_simulation(raw.simulation, &chain, options)?;
@@ -1327,6 +1329,24 @@ impl Scene {
             qd0,
             simulation,
         })
+    }
+
+    /// The joint degrees of freedom of the state: the model's coordinates, its joints without
+    /// the mimic joints (a mimic joint moves with the joint it follows).
+    #[must_use]
+    pub fn dof(&self) -> usize {
+        self.model.coordinate_count()
+    }
+
+    /// The names of the joints of the state, in its order ([`Scene::dof`] of them).
+    #[must_use]
+    pub fn coordinate_names(&self) -> Vec<&str> {
+        let joints = self.model.joints();
+        let coordinates = self.model.coordinates();
+        coordinates
+            .into_iter()
+            .map(|j| joints[j].name.as_str())
+            .collect()
     }
 
     /// Whether the base is free-floating.

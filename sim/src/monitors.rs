@@ -20,6 +20,7 @@ impl SceneSystem<'_> {
             return self.scene.gravity.is_none().then_some(t);
         }
         let q = &x[..self.n];
+        let q_full = self.dynamics.full_positions(q);
         // The motors' kinetic and the springs' potential energy.
         let t = match &self.scene.flexible {
             Some(f) => {
@@ -44,7 +45,7 @@ impl SceneSystem<'_> {
                             translation: jp.com.clone(),
                             rotation: Mat3::identity(),
                         };
-                        let (x, _) = frames::placement(&self.dynamics.params, q, &com);
+                        let (x, _) = frames::placement(&self.dynamics.params, &q_full, &com);
                         -jp.mass * g.dot(&x)
                     })
                     .sum()
@@ -59,15 +60,21 @@ impl SceneSystem<'_> {
         let (q, qd, st) = self.split(x);
         match (&self.dynamics.base, st) {
             (Some(b), Some(st)) => {
-                kinetic_energy(&self.dynamics.params, b, &st, q, qd) + self.rotor_energy(qd)
+                let (q, qd_full) = (
+                    self.dynamics.full_positions(q),
+                    self.dynamics.full_rates(qd),
+                );
+                kinetic_energy(&self.dynamics.params, b, &st, &q, &qd_full) + self.rotor_energy(qd)
             }
             _ => {
-                let a = self
-                    .scene
-                    .simulation
-                    .algorithm
-                    .mass_matrix
-                    .mass_matrix(&self.dynamics.params, q);
+                // ½ q̇ᵀ M q̇ with the mass matrix of the coordinates (reduced by mimic joints).
+                let algorithm = self.scene.simulation.algorithm.mass_matrix;
+                let a =
+                    algorithm.mass_matrix(&self.dynamics.params, &self.dynamics.full_positions(q));
+                let a = match &self.dynamics.coupling {
+                    Some(c) => c.reduce_matrix(&a, 0),
+                    None => a,
+                };
                 0.5 * (0..self.n)
                     .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
                     .sum::<f64>()
@@ -93,7 +100,11 @@ impl SceneSystem<'_> {
     pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let (q, qd, st) = self.split(x);
         let (b, st) = (self.dynamics.base.as_ref()?, st?);
-        let (l, a) = momentum(&self.dynamics.params, b, &st, q, qd);
+        let (q, qd) = (
+            self.dynamics.full_positions(q),
+            self.dynamics.full_rates(qd),
+        );
+        let (l, a) = momentum(&self.dynamics.params, b, &st, &q, &qd);
         Some((l.into_array(), a.into_array()))
     }
 }

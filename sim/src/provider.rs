@@ -2,7 +2,11 @@
 //! run-time fast path, the articulated-body kernel of the compact form
 //! ([`kanegen_runtime::compact::aba`]) over the model's tables built at run time (rotor inertia
 //! as its armature, a free-floating base as its root); otherwise the algorithms of
-//! `kanegen-dynamics`: `M` and `τ − c` of the scene's algorithm, then LDLᵀ.
+//! `kanegen-dynamics`: `M` and `τ − c` of the scene's algorithm, then LDLᵀ. A model with mimic
+//! joints runs in its coordinates ([`kanegen_dynamics::mimic`]): the state is expanded to the
+//! full joint list, the algorithms run on the full tree (drives on the independent joints,
+//! wrenches on their bodies), and `M`, `τ − c`, inverse dynamics and the derivatives are reduced
+//! by the coupling `G` (`Gᵀ M_full G`, `Gᵀ (τ_full − c_full)`), then LDLᵀ.
 
 use crate::scene::Scene;
 use kanegen_dynamics::algorithms::derivatives;
@@ -10,7 +14,8 @@ use kanegen_dynamics::algorithms::floating;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
 use kanegen_dynamics::linalg::Vec3;
-use kanegen_dynamics::{ForwardMethod, Loads, Methods, Params};
+use kanegen_dynamics::mimic::Coupling;
+use kanegen_dynamics::{Dynamics, ForwardMethod, Loads, Methods, Params};
 use kanegen_runtime::scene::{forward_with_armature, SceneDerivatives, SceneDynamics};
 
 /// The state of a free-floating base from the provider's positions `q = [p₀, quat, …]` and
@@ -35,6 +40,8 @@ pub struct RunTimeDynamics {
     pub algorithm: Methods,
     /// The kernels' tables and scratch on the fast path, `None` for LDLᵀ.
     fast: Option<(KernelTables, KernelData)>,
+    /// The coupling of a model with mimic joints to its coordinates, `None` without.
+    pub coupling: Option<Coupling>,
     /// Gravity, `τ` (preallocated) and the scene's wrenches (their values written per call).
     loads: Loads<f64>,
 }
@@ -51,13 +58,21 @@ impl RunTimeDynamics {
             }
         };
         let gravity = scene.gravity.filter(|_| base.is_none());
+        let coupling = scene
+            .model
+            .has_mimics()
+            .then(|| Coupling::new(scene.model.mimics()));
+        // The articulated-body kernels run on the full tree: mimic joints take LDLᵀ of the
+        // reduced `M`.
+        let aba = forward == ForwardMethod::Aba && coupling.is_none();
         RunTimeDynamics {
-            fast: (forward == ForwardMethod::Aba).then(|| kernel_model(&params, gravity)),
+            fast: aba.then(|| kernel_model(&params, gravity)),
+            coupling,
             params,
             base,
             algorithm: scene.simulation.algorithm,
             loads: Loads {
-                tau: Some(vec![0.0; scene.model.dof()]),
+                tau: Some(vec![0.0; scene.dof()]),
                 gravity: scene.gravity.map(Vec3::from_f64),
                 external: scene.wrenches.iter().map(|w| w.at(0.0)).collect(),
             },
@@ -91,6 +106,14 @@ impl RunTimeDynamics {
             self.kernel_accelerations(q, v, armature, acc);
             return;
         }
+        if let Some(c) = &self.coupling {
+            let Dynamics {
+                mass_matrix,
+                tau_minus_c,
+            } = self.full_dynamics(q, v);
+            acc.copy_from_slice(&c.forward_dynamics(self.offset(), &mass_matrix, &tau_minus_c));
+            return;
+        }
         let (p, loads) = (&self.params, &self.loads);
         match &self.base {
             Some(b) => {
@@ -100,6 +123,63 @@ impl RunTimeDynamics {
                 acc.copy_from_slice(&a);
             }
             None => acc.copy_from_slice(&self.algorithm.forward_dynamics(p, q, v, loads)),
+        }
+    }
+
+    /// The speeds of the base that precede the joints' (6 free-floating, 0 fixed).
+    fn offset(&self) -> usize {
+        if self.base.is_some() {
+            6
+        } else {
+            0
+        }
+    }
+
+    /// The joint positions of the full joint list at the provider's joint positions `q` (without
+    /// the base's): `G q + o` with mimic joints, else `q`.
+    #[must_use]
+    pub fn full_positions(&self, q: &[f64]) -> Vec<f64> {
+        self.coupling
+            .as_ref()
+            .map_or_else(|| q.to_vec(), |c| c.full_positions(q))
+    }
+
+    /// The joint rates (or accelerations) of the full joint list: `G q̇` with mimic joints, else
+    /// `q̇`.
+    #[must_use]
+    pub fn full_rates(&self, qd: &[f64]) -> Vec<f64> {
+        self.coupling
+            .as_ref()
+            .map_or_else(|| qd.to_vec(), |c| c.full_rates(qd))
+    }
+
+    /// The joint positions and rates of the full joint list ([`Self::full_positions`],
+    /// [`Self::full_rates`]).
+    fn full_joints(&self, q: &[f64], qd: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        (self.full_positions(q), self.full_rates(qd))
+    }
+
+    /// `M_full` and `τ_full − c_full` of the full joint list at the provider's `q`, `v` (drives
+    /// on the independent joints: the loads' `τ` is expanded), base first when free-floating.
+    fn full_dynamics(&self, q: &[f64], v: &[f64]) -> Dynamics<f64> {
+        let c = self.coupling.as_ref();
+        let tau = self.loads.tau.as_deref();
+        let loads = Loads {
+            tau: tau.map(|t| c.map_or_else(|| t.to_vec(), |c| c.full_drives(t))),
+            gravity: self.loads.gravity.clone(),
+            external: self.loads.external.clone(),
+        };
+        let alg = self.algorithm;
+        match &self.base {
+            Some(b) => {
+                let st = floating_state(q, v);
+                let (qf, vf) = self.full_joints(&q[7..], &v[6..]);
+                floating::dynamics(alg, &self.params, b, &st, &qf, &vf, &loads)
+            }
+            None => {
+                let (qf, vf) = self.full_joints(q, v);
+                alg.dynamics(&self.params, &qf, &vf, &loads)
+            }
         }
     }
 
@@ -143,19 +223,31 @@ impl SceneDynamics for RunTimeDynamics {
         let a = match &self.base {
             Some(b) => {
                 let st = floating_state(q, &[0.0; 6]);
-                floating::mass_matrix(self.algorithm.mass_matrix, &self.params, b, &st, &q[7..])
+                let qf = self.full_positions(&q[7..]);
+                floating::mass_matrix(self.algorithm.mass_matrix, &self.params, b, &st, &qf)
             }
-            None => self.algorithm.mass_matrix.mass_matrix(&self.params, q),
+            None => {
+                let qf = self.full_positions(q);
+                self.algorithm.mass_matrix.mass_matrix(&self.params, &qf)
+            }
         };
-        copy_rows(&a, m);
+        match &self.coupling {
+            Some(c) => copy_rows(&c.reduce_matrix(&a, self.offset()), m),
+            None => copy_rows(&a, m),
+        }
     }
 
     fn inverse(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], w: &[f64], tau: &mut [f64]) {
         self.set_loads(None, w);
+        let (qf, qdf) = self.full_joints(q, qd);
+        let qddf = self.full_rates(qdd);
         let id = self
             .algorithm
-            .inverse_dynamics(&self.params, q, qd, qdd, &self.loads);
-        tau.copy_from_slice(&id);
+            .inverse_dynamics(&self.params, &qf, &qdf, &qddf, &self.loads);
+        match &self.coupling {
+            Some(c) => tau.copy_from_slice(&c.reduce_vector(&id, 0)),
+            None => tau.copy_from_slice(&id),
+        }
     }
 
     /// The fast path takes the armature into the articulated-body algorithm (Pinocchio's
@@ -198,8 +290,24 @@ impl SceneDerivatives for RunTimeDynamics {
         dv: &mut [f64],
         minv: &mut [f64],
     ) {
+        if self.coupling.is_some() {
+            self.set_loads(Some(tau), &[]);
+        }
         let g = self.loads.gravity.as_ref();
-        let (a, b, m) = derivatives::aba::derivatives(&self.params, q, v, tau, g);
+        let (a, b, m) = match &self.coupling {
+            Some(c) => {
+                let (qf, vf) = self.full_joints(q, v);
+                let d = self.full_dynamics(q, v);
+                derivatives::coupled::forward_dynamics_derivatives(
+                    c,
+                    0,
+                    &d.mass_matrix,
+                    &d.tau_minus_c,
+                    |qdd| derivatives::rnea::derivatives(&self.params, &qf, &vf, qdd, g),
+                )
+            }
+            None => derivatives::aba::derivatives(&self.params, q, v, tau, g),
+        };
         copy_rows(&a, dq);
         copy_rows(&b, dv);
         copy_rows(&m, minv);
@@ -214,7 +322,13 @@ impl SceneDerivatives for RunTimeDynamics {
         dv: &mut [f64],
     ) {
         let g = self.loads.gravity.as_ref();
-        let (a, b) = derivatives::rnea::derivatives(&self.params, q, v, qdd, g);
+        let (qf, vf) = self.full_joints(q, v);
+        let qddf = self.full_rates(qdd);
+        let full = derivatives::rnea::derivatives(&self.params, &qf, &vf, &qddf, g);
+        let (a, b) = match &self.coupling {
+            Some(c) => derivatives::coupled::reduce_pair(c, 0, full),
+            None => full,
+        };
         copy_rows(&a, dq);
         copy_rows(&b, dv);
     }

@@ -15,24 +15,30 @@
 
 use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::{FloatingBase, FloatingState};
+use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::{FrameParams, Params};
 
-/// `σ_min(J*)` of `frame` at joint positions `q` and base state `state` (nalgebra's SVD of the
-/// 6 × N `J*`, Golub–Kahan: no squaring, so `σ_min` is resolved to about `ε σ_max`); `None` with
-/// fewer than 6 joints, where `J*` has a null row space by construction.
+/// `σ_min(J*)` of `frame` at the positions `q` of the full joint list and base state `state`
+/// (nalgebra's SVD of the 6 × N `J*`, Golub–Kahan: no squaring, so `σ_min` is resolved to about
+/// `ε σ_max`); with mimic joints (`coupling`) of `J* G`, the 6 × N Jacobian of the coordinates;
+/// `None` with fewer than 6 coordinates, where `J*` has a null row space by construction.
 #[must_use]
 pub fn sigma_min(
     params: &Params<f64>,
     base: &FloatingBase<f64>,
     state: &FloatingState<f64>,
-    q: &[f64],
+    (q, coupling): (&[f64], Option<&Coupling>),
     frame: &FrameParams<f64>,
 ) -> Option<f64> {
-    if q.len() < 6 {
+    let n = coupling.map_or(q.len(), Coupling::reduced);
+    if n < 6 {
         return None;
     }
-    let j = frames::generalized_jacobian(params, base, state, q, frame);
-    let m = nalgebra::DMatrix::from_fn(6, q.len(), |r, c| j[r][c]);
+    let mut j = frames::generalized_jacobian(params, base, state, q, frame);
+    if let Some(c) = coupling {
+        j = j.iter().map(|row| c.reduce_vector(row, 0)).collect();
+    }
+    let m = nalgebra::DMatrix::from_fn(6, n, |r, c| j[r][c]);
     Some(
         m.singular_values()
             .iter()

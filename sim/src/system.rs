@@ -65,7 +65,7 @@ impl<'a> SceneSystem<'a> {
             dynamics: RunTimeDynamics::new(scene, scene.simulation.forward),
             profiles,
             work,
-            n: scene.model.dof(),
+            n: scene.model.coordinate_count(),
             stop: None,
         }
     }
@@ -94,7 +94,8 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn component_name(&self, i: usize) -> String {
         let n = self.n;
-        let joint = |k: usize| self.scene.model.joints()[k].name.clone();
+        let coordinates = self.scene.model.coordinates();
+        let joint = |k: usize| self.scene.model.joints()[coordinates[k]].name.clone();
         let xyz = ["x", "y", "z"];
         if self.dynamics.base.is_none() {
             return match i / n {
@@ -137,7 +138,8 @@ impl<'a> SceneSystem<'a> {
         self.scene
     }
 
-    /// Joint degrees of freedom `N`.
+    /// Joint degrees of freedom `N`: the model's coordinates (its joints without the mimic
+    /// joints).
     #[must_use]
     pub fn n(&self) -> usize {
         self.n
@@ -170,7 +172,10 @@ impl<'a> SceneSystem<'a> {
             &self.dynamics.params,
             self.dynamics.base.as_ref()?,
             &st?,
-            q,
+            (
+                &self.dynamics.full_positions(q),
+                self.dynamics.coupling.as_ref(),
+            ),
             frame,
         )
     }
@@ -178,7 +183,7 @@ impl<'a> SceneSystem<'a> {
     /// The origin frame of the last body (the frame whose `σ_min(J*)` the summary reports).
     pub(crate) fn last_body_frame(&self) -> FrameParams<f64> {
         FrameParams {
-            parent: Some(self.n - 1),
+            parent: Some(self.scene.model.dof() - 1),
             translation: Vec3::zero(),
             rotation: Mat3::identity(),
         }

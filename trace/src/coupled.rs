@@ -10,7 +10,6 @@
 use crate::function::Function;
 use crate::sym::Sym;
 use kanegen_dynamics::algorithms::derivatives::coupled as derivatives;
-use kanegen_dynamics::ldlt::{ldlt, solve};
 use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::Scalar;
 
@@ -80,9 +79,8 @@ pub fn reduce(function: Function, c: &Coupling, offset: usize, out: Vec<Sym>) ->
     }
 }
 
-/// Forward dynamics in the independent coordinates: `M q̈ = b` with `M = Gᵀ M_full G` and
-/// `b = Gᵀ (τ_full − c_full)` (the full matrix and right-hand side, `offset` base speeds first),
-/// by LDLᵀ.
+/// Forward dynamics in the independent coordinates ([`Coupling::forward_dynamics`]: the reduced
+/// `M q̈ = Gᵀ (τ_full − c_full)` by LDLᵀ), the full matrix and right-hand side traced.
 #[must_use]
 pub fn forward_dynamics(
     c: &Coupling,
@@ -90,7 +88,5 @@ pub fn forward_dynamics(
     m_full: &[Vec<Sym>],
     b_full: &[Sym],
 ) -> Vec<Sym> {
-    let m = c.reduce_matrix(m_full, offset);
-    let b = c.reduce_vector(b_full, offset);
-    solve(&ldlt(&m), &b)
+    c.forward_dynamics(offset, m_full, b_full)
 }

@@ -31,7 +31,7 @@ pub fn to_json(
         "t": 0.0,
         "h": scene.simulation.step,
         "state": names,
-        "inputs": scene.model.joints().iter().map(|jt| jt.name.clone()).collect::<Vec<_>>(),
+        "inputs": scene.coordinate_names(),
         "x": x,
         "x_next": j.state,
         "A": j.a,
@@ -55,12 +55,7 @@ pub fn render_text(
             })
             .collect()
     };
-    let inputs: Vec<&str> = scene
-        .model
-        .joints()
-        .iter()
-        .map(|jt| jt.name.as_str())
-        .collect();
+    let inputs = scene.coordinate_names();
     format!(
         "x⁺ = Φ(x, u): one {} step of {} s from the initial state at t = 0, u = 0 (u: joint \
          torques added to the drive: {}); exact for the scheme\nA = ∂x⁺/∂x ({d} × {d}; columns in \

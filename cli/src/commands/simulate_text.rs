@@ -59,16 +59,12 @@ pub fn events_text(s: &Summary) -> String {
         .collect()
 }
 
-/// The CSV header of a scene's trajectory: `t`, `q_<joint>`…, `qd_<joint>`…, and for a
+/// The CSV header of a scene's trajectory: `t`, `q_<joint>`…, `qd_<joint>`… (the model's
+/// coordinates: mimic joints have no column), and for a
 /// free-floating base `p0_x…`, `quat_x, quat_y, quat_z, quat_w`, `v_b_x…`, `omega_b_x…`.
 #[must_use]
 pub fn csv_header(scene: &Scene) -> Vec<String> {
-    let names: Vec<&str> = scene
-        .model
-        .joints()
-        .iter()
-        .map(|j| j.name.as_str())
-        .collect();
+    let names = scene.coordinate_names();
     let mut h = vec!["t".to_string()];
     h.extend(names.iter().map(|n| format!("q_{n}")));
     h.extend(names.iter().map(|n| format!("qd_{n}")));
@@ -93,7 +89,7 @@ pub fn csv_header(scene: &Scene) -> Vec<String> {
 /// round-trip `{:e}` form.
 #[must_use]
 pub fn csv_row(scene: &Scene, s: &Sample) -> String {
-    let n = scene.model.dof();
+    let n = scene.dof();
     let x = &s.x;
     let mut row: Vec<f64> = vec![s.t];
     if scene.is_floating() {

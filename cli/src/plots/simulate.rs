@@ -71,10 +71,12 @@ pub fn line_chart(title: &str, y_desc: &str, series: &[Series]) -> Result<String
 /// model's first named frame, or the origin of the last body when it names none.
 #[must_use]
 pub fn end_effector_series(scene: &Scene, run: &Run) -> Vec<Series> {
-    let n = scene.model.dof();
+    let n = scene.dof();
     let params = Params::<f64>::new(&scene.model);
+    // The joints' positions from the coordinates (mimic joints follow theirs).
+    let coupling = kanegen_dynamics::mimic::Coupling::new(scene.model.mimics());
     let target = params.frames.first().cloned().unwrap_or(FrameParams {
-        parent: Some(n - 1),
+        parent: Some(scene.model.dof() - 1),
         translation: Vec3::zero(),
         rotation: Mat3::identity(),
     });
@@ -89,7 +91,7 @@ pub fn end_effector_series(scene: &Scene, run: &Run) -> Vec<Series> {
         } else {
             &x[..n]
         };
-        let (o, _) = frames::placement(&params, q, &target);
+        let (o, _) = frames::placement(&params, &coupling.full_positions(q), &target);
         let p = if scene.is_floating() {
             let quat: [f64; 4] = x[3..7].try_into().expect("4 entries");
             &quat_to_matrix(&quat).mul_vec(&o) + &Vec3::new(x[0], x[1], x[2])
@@ -135,17 +137,14 @@ pub fn base_attitude_series(run: &Run) -> Vec<Series> {
 /// scene monitors any conserved quantity, `drift.svg` (relative energy and momentum drift):
 /// `(file name, SVG)`.
 pub fn render_plots(scene: &Scene, run: &Run) -> Result<Vec<(&'static str, String)>> {
-    let n = scene.model.dof();
     let off = if scene.is_floating() { 7 } else { 0 };
     let joints: Vec<Series> = scene
-        .model
-        .joints()
-        .iter()
+        .coordinate_names()
+        .into_iter()
         .enumerate()
-        .take(n)
         .map(|(i, j)| {
             (
-                j.name.clone(),
+                j.to_string(),
                 run.samples.iter().map(|s| (s.t, s.x[off + i])).collect(),
             )
         })

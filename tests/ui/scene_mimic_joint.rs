@@ -1,0 +1,3 @@
+kanegen::scene!(Hand, "bad/scene_mimic_joint.toml");
+
+fn main() {}
