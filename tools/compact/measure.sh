@@ -40,20 +40,20 @@ TOML
         for k in 0..calls {
             q[k % N] += 1e-9;
             let (a, b) = R::inverse_dynamics_derivatives(std::hint::black_box(&q), std::hint::black_box(&qd), std::hint::black_box(&qd));
-            acc += a[N - 1][0] + b[0][0];
+            acc += a.iter().chain(&b).flatten().sum::<f64>();
         }
         let id = t.elapsed().as_nanos() as f64 / calls as f64;
         let t = std::time::Instant::now();
         for k in 0..calls {
             q[k % N] += 1e-9;
             let (a, b, c) = R::forward_dynamics_derivatives(std::hint::black_box(&q), std::hint::black_box(&qd), std::hint::black_box(&qd));
-            acc += a[N - 1][0] + b[0][0] + c[0][0];
+            acc += a.iter().chain(&b).chain(&c).flatten().sum::<f64>();
         }
         let fdd = t.elapsed().as_nanos() as f64 / calls as f64;
         let t = std::time::Instant::now();
         for k in 0..calls {
             q[k % N] += 1e-9;
-            acc += R::mass_matrix_inverse(std::hint::black_box(&q))[N - 1][0];
+            acc += R::mass_matrix_inverse(std::hint::black_box(&q)).iter().flatten().sum::<f64>();
         }
         t3.push((id, fdd, t.elapsed().as_nanos() as f64 / calls as f64));
     }
@@ -80,14 +80,14 @@ fn main() {
         for k in 0..calls {
             q[k % N] += 1e-9;
             let (m, c) = R::mass_matrix_and_nonlinear_effects(std::hint::black_box(&q), std::hint::black_box(&qd));
-            acc += m[N - 1][0] + c[0];
+            acc += m.iter().flatten().sum::<f64>() + c.iter().sum::<f64>();
         }
         let mc = t.elapsed().as_nanos() as f64 / calls as f64;
         let t = std::time::Instant::now();
         for k in 0..calls {
             q[k % N] += 1e-9;
             let a = R::forward_dynamics(std::hint::black_box(&q), std::hint::black_box(&qd), std::hint::black_box(&qd));
-            acc += a[0];
+            acc += a.iter().sum::<f64>();
         }
         let fd = t.elapsed().as_nanos() as f64 / calls as f64;
         std::hint::black_box(acc);
