@@ -53,30 +53,34 @@ fn drives<S: Scalar + Copy, const N: usize>(c: &Coupling<'_>, tau: &[S]) -> [S; 
     out
 }
 
+/// `[x[..head]; expand(x[head..])]`: a free-floating base's entries (`head` of them) kept, the
+/// joints' expanded to the full tree (`K` entries in all).
+#[inline(always)]
+fn with_base<S: Scalar + Copy, const K: usize>(
+    x: &[S],
+    head: usize,
+    expand: impl FnOnce(&[S], &mut [S]),
+) -> [S; K] {
+    let mut out = [S::zero(); K];
+    for (o, v) in out.iter_mut().zip(x.iter().take(head)) {
+        *o = *v;
+    }
+    if let (Some(joints), Some(rest)) = (x.get(head..), out.get_mut(head..)) {
+        expand(joints, rest);
+    }
+    out
+}
+
 /// A free-floating base's full positions `[p₀; quat; q_full]` (`NQ = N + 7`) of `[p₀; quat; q]`.
 #[inline(always)]
 fn floating_positions<S: Scalar + Copy, const NQ: usize>(c: &Coupling<'_>, q: &[S]) -> [S; NQ] {
-    let mut out = [S::zero(); NQ];
-    for (o, x) in out.iter_mut().zip(q.iter().take(7)) {
-        *o = *x;
-    }
-    if let (Some(joints), Some(out)) = (q.get(7..), out.get_mut(7..)) {
-        c.expand_positions(joints, out);
-    }
-    out
+    with_base(q, 7, |joints, out| c.expand_positions(joints, out))
 }
 
 /// A free-floating base's full speeds or accelerations `[base (6); G x]` (`NV`).
 #[inline(always)]
 fn floating_rates<S: Scalar + Copy, const NV: usize>(c: &Coupling<'_>, v: &[S]) -> [S; NV] {
-    let mut out = [S::zero(); NV];
-    for (o, x) in out.iter_mut().zip(v.iter().take(6)) {
-        *o = *x;
-    }
-    if let (Some(joints), Some(out)) = (v.get(6..), out.get_mut(6..)) {
-        c.expand_rates(joints, out);
-    }
-    out
+    with_base(v, 6, |joints, out| c.expand_rates(joints, out))
 }
 
 /// `Gᵀ v` (`offset` base entries kept) of a full vector.
