@@ -14,7 +14,8 @@
 //! Scenes: `scenes/srms.toml` (dopri5, so its step is RK4; PD drives and damping, fixed base),
 //! `tests/data/scenes/linearize_ct_midpoint.toml` (UR5 under gravity, a computed-torque drive
 //! along a quintic, viscous and Coulomb friction, implicit midpoint) and
-//! `scenes/ur5_torque_input.toml` (UR5 under gravity, damping, no drive, RK4).
+//! `scenes/ur5_torque_input.toml` (UR5 under gravity, damping, no drive, RK4) and
+//! `scenes/ssrms_drives.toml` (rotor inertia, stiff PD, viscous and Coulomb friction, RK4).
 
 use kanegen::sim::linearize::{scheme, step_jacobians};
 use kanegen::sim::scene::Scene;
@@ -24,6 +25,7 @@ use std::path::Path;
 kanegen::scene!(Srms, "scenes/srms.toml");
 kanegen::scene!(CtMidpoint, "tests/data/scenes/linearize_ct_midpoint.toml");
 kanegen::scene!(FreeUr5, "scenes/ur5_torque_input.toml");
+kanegen::scene!(SsrmsDrives, "scenes/ssrms_drives.toml");
 
 /// One step with its Jacobians at `(x, u)`: the new state, `A` (`D × D`) and `B` (`D × N`).
 type Jac<const D: usize, const N: usize> = ([f64; D], [[f64; D]; D], [[f64; N]; D]);
@@ -201,13 +203,21 @@ scene_tests!(
     2.0
 );
 
+scene_tests!(
+    rotor_inertia,
+    SsrmsDrives,
+    SsrmsDrivesState,
+    "scenes/ssrms_drives.toml",
+    0.0,
+    50.0
+);
+
 /// What the step Jacobians do not cover is refused, named.
 #[test]
 fn uncovered_scenes_are_refused_by_name() {
     for (file, words) in [
         ("scenes/free_floating_7dof.toml", "free-floating base"),
         ("scenes/ssrms_effects.toml", "external wrenches"),
-        ("scenes/ssrms_drives.toml", "rotor inertia"),
         ("scenes/ssrms_flexible.toml", "flexible joints"),
     ] {
         let scene = interpreted(file);

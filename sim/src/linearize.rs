@@ -34,7 +34,7 @@ pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let scene = sys.scene();
     let profiles = scene.wrench_profiles();
     if let Err(what) = linearizable(&scene.effects(&profiles)) {
-        bail!("step Jacobians cover fixed-base scenes without external wrenches, rotor inertia or flexible joints; this scene has {what}");
+        bail!("step Jacobians cover fixed-base scenes without external wrenches or flexible joints; this scene has {what}");
     }
     match scene.simulation.integrator {
         Integrator::Rk4 | Integrator::Dopri5 => Ok("rk4"),

@@ -11,17 +11,18 @@
 //! ```
 //!
 //! with `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the applied torques (Carpentier &
-//! Mansard, RSS 2018, eq. (3)) and the drive's `∂τ`: `−diag(k_p)`, `−diag(k_d)` for PD;
+//! Mansard, RSS 2018, eq. (3); with rotor inertia, of `M + diag(armature)`, from the
+//! inverse-dynamics derivatives and LDLᵀ solves) and the drive's `∂τ`: `−diag(k_p)`, `−diag(k_d)` for PD;
 //! `∂ID/∂q − M diag(k_p)`, `∂ID/∂q̇ − M diag(k_d)` for computed torque; `−diag(b)` of joint
 //! damping and `−diag(τ_c / v_s · sech²(q̇ / v_s))` of Coulomb friction on `∂τ/∂q̇`.
 //!
-//! Covered ([`linearizable`]): a fixed base without external wrenches, rotor inertia or
-//! flexible joints.
+//! Covered ([`linearizable`]): a fixed base without external wrenches or flexible joints.
 
 // Index loops over matrix entries.
 #![allow(clippy::needless_range_loop)]
 
 use super::{deriv_input, drive_torques, Drive, SceneDynamics, SceneEffects};
+use crate::ldlt::{factor_in_place, solve_in_place};
 use crate::ode::ControlledSystem;
 
 /// The derivatives of a provider's dynamics (no external wrench), row-major `N × N` each.
@@ -57,8 +58,6 @@ pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
         Err("a free-floating base (its quaternion has no additive step Jacobian here)")
     } else if !fx.wrenches.is_empty() {
         Err("external wrenches")
-    } else if fx.armature.is_some() {
-        Err("rotor inertia (armature)")
     } else if fx.flexible.is_some() {
         Err("flexible joints")
     } else {
@@ -104,13 +103,22 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     deriv_input(dynamics, fx, t, x, u, dx, rhs_work);
     let (q, qd) = x.split_at(n);
     let [tq, tv, dq, dv, minv, mm] = matrices(work, n);
-    let (tau, cmd) = (&mut rhs_work[..n], &mut mm[..n]);
-    drive_torques(dynamics, fx, t, q, qd, &[], tau, cmd);
+    let (tau, rest) = rhs_work.split_at_mut(n);
+    drive_torques(dynamics, fx, t, q, qd, &[], tau, &mut mm[..n]);
     for (ti, ui) in tau.iter_mut().zip(u) {
         *ti += ui;
     }
     drive_jacobians(dynamics, fx, t, q, qd, tq, tv, mm);
-    dynamics.forward_derivatives(q, qd, tau, dq, dv, minv);
+    match fx.armature {
+        None => dynamics.forward_derivatives(q, qd, tau, dq, dv, minv),
+        Some(a) => {
+            // The scene's own work holds `nv² + 2 nv` more with an armature ([`work_len`]).
+            let (d_inv, col) = rest[..2 * n].split_at_mut(n);
+            let qdd = &dx[n..];
+            let f = [&mut *dq, &mut *dv, &mut *minv];
+            armature_derivatives(dynamics, q, qd, qdd, a, f, &mut mm[..n * n], d_inv, col);
+        }
+    }
     // F: the kinematic rows [0 I], then ∂q̈ + M⁻¹ ∂τ; G: [0; M⁻¹].
     fxm.fill(0.0);
     fum.fill(0.0);
@@ -125,6 +133,57 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
             fxm[(n + i) * d + j] = sq;
             fxm[(n + i) * d + n + j] = sv;
             fum[(n + i) * n + j] = minv[i * n + j];
+        }
+    }
+}
+
+/// `(∂q̈/∂q, ∂q̈/∂q̇, (M + A)⁻¹)` into `f` with the armature `A = diag(a)` on the joint diagonal
+/// (RBDA Sec. 9.1): `(M + A) q̈ = τ − c` differentiated at fixed `τ` is
+/// `(M + A) ∂q̈ = −∂ID/∂x` with `ID(q, q̇, q̈) = M q̈ + c` (no armature) at the scene's `q̈`
+/// (Carpentier & Mansard, RSS 2018, eq. (3), with `M + A` for `M`): the provider's
+/// inverse-dynamics derivatives, then LDLᵀ solves ([`crate::ldlt`]) of `M + A` column by column.
+/// `m` (`N²`), `d_inv` and `col` (`N` each) are work memory; a pivot that is not positive gives
+/// NaN.
+#[allow(clippy::too_many_arguments)]
+fn armature_derivatives<D: SceneDerivatives + ?Sized>(
+    dynamics: &mut D,
+    q: &[f64],
+    qd: &[f64],
+    qdd: &[f64],
+    a: &[f64],
+    f: [&mut [f64]; 3],
+    m: &mut [f64],
+    d_inv: &mut [f64],
+    col: &mut [f64],
+) {
+    let n = q.len();
+    let [dq, dv, minv] = f;
+    dynamics.inverse_derivatives(q, qd, qdd, dq, dv);
+    dynamics.mass_matrix(q, m);
+    for (i, ai) in a.iter().enumerate() {
+        m[i * n + i] += ai;
+    }
+    if factor_in_place(m, n, d_inv).is_err() || !d_inv.iter().all(|d| *d > 0.0 && d.is_finite()) {
+        for x in [dq, dv, minv] {
+            x.fill(f64::NAN);
+        }
+        return;
+    }
+    // Column j of each result: `(M + A)⁻¹` times column j of `−∂ID/∂q`, `−∂ID/∂q̇`, `I`.
+    for (x, sign) in [(dq, -1.0), (dv, -1.0), (minv, 0.0)] {
+        for j in 0..n {
+            for i in 0..n {
+                col[i] = if sign == 0.0 {
+                    f64::from(u8::from(i == j))
+                } else {
+                    sign * x[i * n + j]
+                };
+            }
+            // Lengths hold: `m` is `N²`, `d_inv` and `col` `N`.
+            let _ = solve_in_place(m, n, d_inv, col);
+            for i in 0..n {
+                x[i * n + j] = col[i];
+            }
         }
     }
 }
