@@ -4,7 +4,8 @@
 //! against dual numbers in `dynamics/tests/derivatives.rs`) at random states: a chain with
 //! prismatic joints, gravity and a runtime payload; a tree; a free-floating arm with gravity
 //! (its base pose from the quaternion of `q`); `f32` with fused multiply-adds to `f32`
-//! precision. A compact model has none of them (`docs/limits.md`).
+//! precision; a random 8-joint chain whose `M + c` is straight-line and whose larger derivatives
+//! call the compact kernels (the size rule of `kanegen_codegen::compact`).
 //!
 //! Then the algorithms against Pinocchio 4.1's `computeRNEADerivatives`,
 //! `computeABADerivatives` and `computeMinverse` on example-robot-data URDFs
@@ -30,6 +31,12 @@ kanegen::dynamics!(
     runtime_payload = true,
 );
 kanegen::dynamics!(Tree7, "tests/data/compact/tree7.toml", form = "unrolled");
+// Unrolled `M + c`, its larger derivatives in loops (the compact kernels, by the size rule).
+kanegen::dynamics!(
+    Chain8,
+    "benches/data/random_n8.toml",
+    gravity = [0.3, -1.2, -9.81],
+);
 kanegen::dynamics!(
     FreeFloating7,
     "tests/data/reference/bmsd_7dof_free_floating.urdf",
@@ -133,6 +140,9 @@ fn generated_fixed_base_derivatives_equal_the_algorithms() {
     );
     println!("tree7: {e:.1e}");
     assert!(e < 1e-11, "tree7: {e:e}");
+    let e = check_fixed!(Chain8, 8, load("benches/data/random_n8.toml"), Some(G),);
+    println!("random_n8 (derivatives in loops), gravity: {e:.1e}");
+    assert!(e < 1e-11, "random_n8: {e:e}");
 }
 
 #[test]

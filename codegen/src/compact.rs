@@ -135,6 +135,42 @@ pub fn keeps_unrolled(opts: &Options, f: Function, size: Size) -> bool {
     may_keep_unrolled(opts, f) && !size.above(LINEAR_AUTO_LIMIT)
 }
 
+/// Under [`Form::Auto`], an unrolled model keeps a derivative function (`∂τ`, `∂q̈` with
+/// `M⁻¹`, `M⁻¹`) straight-line while its cheapest unrolled body has at most this many emitted
+/// operations, or at most [`DERIVATIVES_UNROLLED_SHARE`] percent of its compact kernel's traced
+/// operations; above both it is emitted in loops, the compact form's kernel
+/// ([`derivative_keeps_unrolled`]).
+///
+/// Measured side by side (`DERIVS=1 tools/compact/measure.sh unrolled|compact`, `-C
+/// target-cpu=native`, ns per call, median of 5 rounds; docs/performance.md): straight-line
+/// derivatives run at 0.08–0.10 ns per emitted operation up to 6,957 operations (Panda's `∂τ`),
+/// then at 0.17–0.21 past a cliff at 8,849 (a random 8-joint chain's `∂τ`: 1,838 ns unrolled
+/// against 1,216 compact) as the body outgrows the instruction cache; the compact kernels run
+/// at 0.12–0.16 ns per traced operation. Past the cliff, the straight-line body wins while it has
+/// fewer than about 0.72× the kernel's operations (Panda's forward-dynamics derivatives: 12,100
+/// against 21,280, 2,117 ns against 3,296; a random 6-joint chain's: 10,340 against 12,531,
+/// 1,761 ns against 1,631).
+pub const DERIVATIVES_AUTO_LIMIT: u64 = 7_000;
+
+/// See [`DERIVATIVES_AUTO_LIMIT`]: the share (percent) of the compact kernel's traced operations
+/// below which a straight-line derivative body is kept past the limit.
+pub const DERIVATIVES_UNROLLED_SHARE: u64 = 72;
+
+/// Whether an unrolled model may emit its derivative functions in loops: under [`Form::Auto`],
+/// when the compact form supports the options ([`unsupported`]).
+#[must_use]
+pub fn loops_derivatives(opts: &Options) -> bool {
+    opts.form == Form::Auto && unsupported(opts).is_none()
+}
+
+/// Whether a derivative function of an unrolled model keeps its straight-line body of `ops`
+/// emitted operations against a compact kernel of `kernel_ops` traced operations
+/// ([`DERIVATIVES_AUTO_LIMIT`]).
+#[must_use]
+pub fn derivative_keeps_unrolled(ops: u64, kernel_ops: u64) -> bool {
+    ops <= DERIVATIVES_AUTO_LIMIT || ops * 100 <= kernel_ops * DERIVATIVES_UNROLLED_SHARE
+}
+
 /// Why the compact form cannot be emitted under `opts` (any model, fixed or free-floating), or
 /// `None` when it can.
 #[must_use]

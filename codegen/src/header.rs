@@ -67,12 +67,25 @@ fn form_line(plan: &Plan) -> String {
             compact::LINEAR_AUTO_LIMIT
         ));
     }
+    let looped = plan.looped_derivatives();
+    if !looped.is_empty() {
+        line.push_str(&format!(
+            " In loops all the same: {} (the compact form's derivative kernels, \
+             `kanegen_runtime::compact::derivatives`, on the model's constant tables: a \
+             straight-line body above {} emitted operations and {} % of the kernel's, or above \
+             {} speeds, measured slower).",
+            looped.join(", "),
+            compact::DERIVATIVES_AUTO_LIMIT,
+            compact::DERIVATIVES_UNROLLED_SHARE,
+            crate::plan::DERIVATIVES_MAX_NV
+        ));
+    }
     let missing = plan.not_generated();
     if !missing.is_empty() {
         let why = if plan.derivatives_asked {
             format!(
-                "generated in the unrolled form up to {} speeds, and in the compact form; \
-                 docs/limits.md",
+                "generated straight-line up to {} speeds and in loops at any size, but \
+                 `form = \"unrolled\"` or a forced algorithm has no loops; docs/limits.md",
                 crate::plan::DERIVATIVES_MAX_NV
             )
         } else {

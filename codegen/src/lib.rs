@@ -646,7 +646,7 @@ fn limit_consts(limits: &[kanegen_model::Limits], float: Float) -> TokenStream {
 /// target, the type's own sine–cosine where a function takes one, and the compact form's
 /// tables and loops.
 fn helper_items(plan: &Plan, opts: &Options, fmas: &[u64]) -> Result<TokenStream, Error> {
-    let compact = plan.compact();
+    let compact = plan.has_loops();
     let compact_items = if compact {
         compact::items(&plan.model, opts)?
     } else {

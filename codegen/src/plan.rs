@@ -77,6 +77,8 @@ pub struct Plan {
     pub functions: Vec<FunctionPlan>,
     /// Whether the derivative functions were asked for ([`Options::derivatives`]).
     pub derivatives_asked: bool,
+    /// Whether they are generated: asked for and [`derivatives_fit`].
+    pub derivatives_generated: bool,
 }
 
 /// The most speeds (`N`, or `6 + N` free-floating) the derivative functions are generated for:
@@ -84,21 +86,25 @@ pub struct Plan {
 /// matrices), some 10⁵ operations at 32 speeds, which is what the compact form exists to avoid.
 pub const DERIVATIVES_MAX_NV: usize = 24;
 
-/// Whether the derivative functions can be generated for `model` in the form `decision`: in
-/// the unrolled form up to [`DERIVATIVES_MAX_NV`] speeds, in the compact form at any size
-/// (`kanegen_runtime::compact::derivatives`).
+/// Whether the derivative functions can be generated for `model` in the form `decision` under
+/// `opts`: in the compact form at any size (`kanegen_runtime::compact::derivatives`); in the
+/// unrolled form straight-line up to [`DERIVATIVES_MAX_NV`] speeds, and above it in loops when
+/// [`compact::loops_derivatives`] allows (under [`Form::Auto`]).
 #[must_use]
-pub fn derivatives_fit(model: &Model, decision: &Decision) -> bool {
-    if decision.form == Form::Compact {
-        return true;
-    }
-    let nv = model.dof()
+pub fn derivatives_fit(model: &Model, decision: &Decision, opts: &Options) -> bool {
+    decision.form == Form::Compact
+        || speeds(model) <= DERIVATIVES_MAX_NV
+        || compact::loops_derivatives(opts)
+}
+
+/// The speeds of `model`: `N`, or `6 + N` on a free-floating base.
+fn speeds(model: &Model) -> usize {
+    model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {
             6
         } else {
             0
-        };
-    nv <= DERIVATIVES_MAX_NV
+        }
 }
 
 /// The traced graph of each function of a [`Plan`] with an unrolled body (`None` for a compact
@@ -122,8 +128,9 @@ impl Plan {
         let mut functions = Vec::new();
         let mut graphs = Vec::new();
         let mut mass = MassMatrixMethod::Crba;
+        let derivatives = opts.derivatives && derivatives_fit(&model, &decision, opts);
         for f in api::functions(&model, opts) {
-            if f.is_derivative() && !(opts.derivatives && derivatives_fit(&model, &decision)) {
+            if f.is_derivative() && !derivatives {
                 continue; // `Plan::not_generated` names them
             }
             let (choice, graph) = match decided.iter().position(|(c, _)| c.function == f) {
@@ -146,6 +153,7 @@ impl Plan {
         check_names(&functions)?;
         let plan = Plan {
             derivatives_asked: opts.derivatives,
+            derivatives_generated: derivatives,
             model,
             snap,
             subjects,
@@ -157,11 +165,11 @@ impl Plan {
     }
 
     /// The functions not generated, as the header names them (`` `name` ``): the derivatives
-    /// when not asked for, in the compact form, which has no kernel for them, and above
-    /// [`DERIVATIVES_MAX_NV`] speeds (see [`derivatives_fit`]). Empty when they are generated.
+    /// when not asked for, or when they do not fit (above [`DERIVATIVES_MAX_NV`] speeds
+    /// unrolled without loops, [`derivatives_fit`]). Empty when they are generated.
     #[must_use]
     pub fn not_generated(&self) -> Vec<String> {
-        if self.derivatives_asked && derivatives_fit(&self.model, &self.decision) {
+        if self.derivatives_generated {
             return Vec::new();
         }
         Function::ALL
@@ -181,6 +189,29 @@ impl Plan {
     #[must_use]
     pub fn compact(&self) -> bool {
         self.decision.form == Form::Compact
+    }
+
+    /// Whether some function has a body in loops ([`Kernel::Compact`]): in the compact form,
+    /// or the derivatives of an unrolled model ([`compact::loops_derivatives`]).
+    #[must_use]
+    pub fn has_loops(&self) -> bool {
+        self.functions
+            .iter()
+            .any(|fp| matches!(fp.kernel, Kernel::Compact(_)))
+    }
+
+    /// The derivative functions of an unrolled model emitted in loops, as the header names them:
+    /// `` `name` ``.
+    #[must_use]
+    pub fn looped_derivatives(&self) -> Vec<String> {
+        if self.compact() {
+            return Vec::new();
+        }
+        self.functions
+            .iter()
+            .filter(|fp| matches!(fp.kernel, Kernel::Compact(_)))
+            .map(|fp| format!("`{}`", fp.function.name()))
+            .collect()
     }
 
     /// The choices, in emission order.
@@ -307,7 +338,9 @@ fn plan_body(
     opts: &Options,
 ) -> Result<(Choice, Option<Traced>), Error> {
     let floating = model.base_kind() == BaseKind::FreeFloating;
-    let traced = if decision.form != Form::Compact || !compact::has_body(f, floating) {
+    let traced = if decision.form != Form::Compact && f.is_derivative() {
+        unrolled_derivative(model, subjects, f, mass, opts)?
+    } else if decision.form != Form::Compact || !compact::has_body(f, floating) {
         Some(choose_in(model, subjects, f, mass, opts)?)
     } else if compact::may_keep_unrolled(opts, f) && f.frame().is_some() {
         // A frame function is O(depth) and the prefixes have no frames: traced whole.
@@ -331,6 +364,29 @@ fn plan_body(
         Some((choice, graph)) => (choice, Some(graph)),
         None => (compact_choice(f), None),
     })
+}
+
+/// The choice and graph of the derivative function `f` of an unrolled model, `None` when it
+/// is emitted in loops: above [`DERIVATIVES_MAX_NV`] speeds (not traced), or when its cheapest
+/// unrolled body is larger than [`compact::derivative_keeps_unrolled`] allows against the
+/// compact kernel's traced operations.
+fn unrolled_derivative(
+    model: &Model,
+    subjects: &Subjects,
+    f: Function,
+    mass: MassMatrixMethod,
+    opts: &Options,
+) -> Result<Option<(Choice, Traced)>, Error> {
+    if !compact::loops_derivatives(opts) {
+        return choose_in(model, subjects, f, mass, opts).map(Some);
+    }
+    if speeds(model) > DERIVATIVES_MAX_NV {
+        return Ok(None);
+    }
+    let (choice, graph) = choose_in(model, subjects, f, mass, opts)?;
+    let ops = choice.counts().total();
+    let kernel_ops = compact::kernel_counts(model, opts, f)?.total();
+    Ok(compact::derivative_keeps_unrolled(ops, kernel_ops).then_some((choice, graph)))
 }
 
 /// The choice of a compact body: the methods of its loops, no candidate traced.

@@ -326,8 +326,8 @@ fn unsupported_models_stay_unrolled() {
         form_line(&g.header),
         "Form: unrolled straight-line code (asked for). Not generated: \
          `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` \
-         (generated in the unrolled form up to 24 speeds, and in the compact form; \
-         docs/limits.md)."
+         (generated straight-line up to 24 speeds and in loops at any size, but \
+         `form = \"unrolled\"` or a forced algorithm has no loops; docs/limits.md)."
     );
 }
 
@@ -380,4 +380,42 @@ fn a_500_joint_chain_generates_compact_in_seconds() {
         assert!(untraced(&g, f), "{f}");
     }
     assert!(s < 60.0, "{s} s");
+}
+
+/// Under `Auto`, an unrolled model keeps its derivative functions straight-line while they are
+/// small, and calls the compact derivative kernels for those past the size rule
+/// (`compact::derivative_keeps_unrolled`); the form line names them; `Unrolled` keeps them all
+/// straight-line.
+#[test]
+fn large_derivatives_of_an_unrolled_model_run_in_loops() {
+    let kernel = |f: &str| format!("kanegen_runtime::compact::derivatives::{f}(&Self::CX");
+    let names = [
+        "inverse_dynamics_derivatives",
+        "forward_dynamics_derivatives",
+        "mass_matrix_inverse",
+    ];
+    let o = Options::new("Arm");
+    let small = generate_file(&chain_default(3), &o)
+        .unwrap()
+        .replace([' ', '\n'], "");
+    assert!(names.iter().all(|f| !small.contains(&kernel(f))));
+    let model = chain_default(8);
+    let g = generate_items(&model, &o).unwrap();
+    let line = form_line(&g.header);
+    assert!(
+        line.starts_with("Form: unrolled straight-line code (auto: "),
+        "{line}"
+    );
+    assert!(line.contains(" In loops all the same: `"), "{line}");
+    let src = generate_file(&model, &o).unwrap().replace([' ', '\n'], "");
+    let looped: Vec<_> = names.iter().filter(|f| src.contains(&kernel(f))).collect();
+    assert!(!looped.is_empty(), "{line}");
+    for f in &looped {
+        assert!(line.contains(&format!("`{f}`")), "{f}: {line}");
+    }
+    assert!(src.contains("constCX:kanegen_runtime::compact::Tables"));
+    let mut o = o;
+    o.form = Form::Unrolled;
+    let src = generate_file(&model, &o).unwrap().replace([' ', '\n'], "");
+    assert!(names.iter().all(|f| !src.contains(&kernel(f))));
 }
