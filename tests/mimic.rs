@@ -388,3 +388,54 @@ fn free_floating_derivatives_in_the_coordinates() {
         "mass_matrix_inverse against forward_dynamics_derivatives' M⁻¹: {e:e}"
     );
 }
+
+/// Damping per independent coordinate, traced in the coordinates: `c` with damping `d` is `c`
+/// without it plus `d ∘ q̇` (the coordinate of the coupled fingers included), and `kanegen count`
+/// counts a mimic scene with damping.
+#[test]
+fn damping_in_the_coordinates_is_traced() {
+    use kanegen::trace::{trace, Function, Spec, Subject};
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/erd_all/panda.urdf");
+    let model = kanegen::model::io::load_model(&path).unwrap();
+    let d: Vec<f64> = (0..8).map(|k| 0.1 + 0.3 * k as f64).collect();
+    let c_of = |damping: Option<Vec<f64>>| {
+        let spec = Spec {
+            gravity: Some([0.0, 0.0, -9.81]),
+            damping,
+            ..Spec::default()
+        };
+        let f = Function::NonlinearEffects;
+        let methods = kanegen::dynamics::Methods::SPATIAL;
+        trace(Subject::Model(&model), f, methods, &spec).unwrap()
+    };
+    let (plain, damped) = (c_of(None), c_of(Some(d.clone())));
+    let x: Vec<f64> = (0..16).map(|i| 0.3 * (i as f64 * 0.7).sin()).collect();
+    let (c0, c1) = (plain.trace.eval(&x), damped.trace.eval(&x));
+    let worst = (0..8).fold(0.0_f64, |m, k| {
+        m.max((c1[k] - c0[k] - d[k] * x[8 + k]).abs())
+    });
+    assert!(worst < 1e-12, "{worst:e}");
+    let short = Spec {
+        damping: Some(vec![0.5; 9]),
+        ..Spec::default()
+    };
+    let spatial = kanegen::dynamics::Methods::SPATIAL;
+    let err = trace(
+        Subject::Model(&model),
+        Function::NonlinearEffects,
+        spatial,
+        &short,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("damping has 9 entries for 8 coordinates"),
+        "{err}"
+    );
+    let out = common::kanegen(&["count", "tests/data/scenes/panda_mimic_pd.toml"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

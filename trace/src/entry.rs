@@ -113,7 +113,12 @@ pub fn trace(
         _ => None,
     };
     let args = Arguments::new(function, n, floating, coupling.as_ref(), &mut input);
-    let effects = Effects::new(spec, &args, floating, &mut input);
+    // Damping per independent coordinate acts at its joint of the full tree (none on mimic joints).
+    let damping = spec.damping.as_ref().map(|d| match &coupling {
+        Some(c) => c.full_drives(d),
+        None => d.clone(),
+    });
+    let effects = Effects::new(spec, damping.as_deref(), &args, floating, &mut input);
     let base = match (&spec.base, &args.state) {
         (Base::FreeFloating(inertial), Some(state)) => Some((
             regrouped_base.unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial)),
@@ -319,9 +324,11 @@ struct Effects {
 }
 
 impl Effects {
-    /// Creates the runtime wrenches' inputs (after the arguments').
+    /// Creates the runtime wrenches' inputs (after the arguments'); `damping` per joint of the
+    /// traced tree.
     fn new(
         spec: &Spec,
+        damping: Option<&[f64]>,
         args: &Arguments,
         floating: bool,
         input: &mut impl FnMut(Input) -> Sym,
@@ -364,7 +371,7 @@ impl Effects {
             moment: Vec3([w[3], w[4], w[5]]),
         }));
         let gravity = spec.gravity.map(Vec3::from_f64);
-        let damping: Option<Vec<Sym>> = spec.damping.as_ref().map(|d| {
+        let damping: Option<Vec<Sym>> = damping.map(|d| {
             d.iter()
                 .zip(&args.qd)
                 .map(|(di, qdi)| Sym::constant(*di) * *qdi)
@@ -773,8 +780,16 @@ fn check(
         }
     }
     if let Some(d) = &spec.damping {
-        if d.len() != n {
-            return Err(format!("damping has {} entries for N = {n}", d.len()));
+        // One entry per independent coordinate (the joints, or fewer with mimic joints).
+        let coordinates = match subject {
+            Subject::Model(m) => m.coordinate_count(),
+            _ => n,
+        };
+        if d.len() != coordinates {
+            return Err(format!(
+                "damping has {} entries for {coordinates} coordinates",
+                d.len()
+            ));
         }
     }
     let floating = matches!(spec.base, Base::FreeFloating(_));
@@ -799,7 +814,7 @@ fn check(
     }
     if let Subject::Model(m) = subject {
         if m.has_mimics() {
-            check_mimic(function, methods, spec)?;
+            check_mimic(function, methods)?;
         }
         // The paper's inertial-frame algorithms handle serial chains only.
         let p = Params::<f64>::new(m);
@@ -820,17 +835,16 @@ fn check(
 
 /// What a model with mimic joints is not traced with ([`crate::coupled`]): forward dynamics by
 /// the articulated-body algorithm (it runs on the full tree; the coupled forward dynamics solve
-/// the reduced `M` by LDLᵀ), and damping (one entry per joint, not per coordinate).
-fn check_mimic(function: Function, methods: Methods, spec: &Spec) -> Result<(), String> {
-    let why = if function.is_forward_dynamics() && methods.forward == ForwardMethod::Aba {
-        "the articulated-body algorithm does not run in the independent coordinates of mimic \
-         joints (forward dynamics solves the reduced M by LDLᵀ)"
-    } else if spec.damping.is_some() {
-        "damping is one entry per joint, not per independent coordinate of mimic joints"
-    } else {
-        return Ok(());
-    };
-    Err(why.into())
+/// the reduced `M` by LDLᵀ).
+fn check_mimic(function: Function, methods: Methods) -> Result<(), String> {
+    if function.is_forward_dynamics() && methods.forward == ForwardMethod::Aba {
+        return Err(
+            "the articulated-body algorithm does not run in the independent coordinates of mimic \
+             joints (forward dynamics solves the reduced M by LDLᵀ)"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// A placement as outputs: the origin, then the rotation row by row.

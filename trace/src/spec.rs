@@ -82,7 +82,8 @@ pub struct Spec {
     pub gravity: Option<[f64; 3]>,
     /// External wrenches.
     pub wrenches: Vec<Wrench>,
-    /// Joint viscous damping `τ_d = −d q̇`, coefficients per joint.
+    /// Joint viscous damping `τ_d = −d q̇`, coefficients per independent coordinate (per joint;
+    /// with mimic joints, per coordinate, acting at its joint of the full tree).
     pub damping: Option<Vec<f64>>,
     /// The last body's mass properties are runtime inputs ([`crate::PayloadField`]).
     pub runtime_payload: bool,
