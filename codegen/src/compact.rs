@@ -156,6 +156,21 @@ pub const DERIVATIVES_AUTO_LIMIT: u64 = 7_000;
 /// below which a straight-line derivative body is kept past the limit.
 pub const DERIVATIVES_UNROLLED_SHARE: u64 = 72;
 
+/// The counts of `kanegen_runtime::composed`'s loops for `nv` speeds, run on the counting
+/// scalar: `q̈ = M⁻¹ (τ − c)` and the two products `−M⁻¹ ∂τ/∂x`.
+#[must_use]
+pub fn composed_counts(nv: usize) -> Counts {
+    use kanegen_runtime::compact::derivatives::{accelerations, neg_product};
+    let z = tally::Tally;
+    let _ = tally::take();
+    let (m, mut out) = (vec![z; nv * nv], vec![z; nv * nv]);
+    let (full, c, mut qdd) = (vec![z; nv], vec![z; nv], vec![z; nv]);
+    accelerations(&m, &full, &c, &mut qdd);
+    neg_product(&m, &m, nv, &mut out);
+    neg_product(&m, &m, nv, &mut out);
+    tally::take()
+}
+
 /// Whether an unrolled model may emit its derivative functions in loops: under [`Form::Auto`],
 /// when the compact form supports the options ([`unsupported`]).
 #[must_use]
@@ -163,12 +178,17 @@ pub fn loops_derivatives(opts: &Options) -> bool {
     opts.form == Form::Auto && unsupported(opts).is_none()
 }
 
-/// Whether a derivative function of an unrolled model keeps its straight-line body of `ops`
-/// emitted operations against a compact kernel of `kernel_ops` traced operations
-/// ([`DERIVATIVES_AUTO_LIMIT`]).
+/// Whether the derivative function `f` of an unrolled model keeps its straight-line body of
+/// `ops` emitted operations against a compact kernel of `kernel_ops` traced operations
+/// ([`DERIVATIVES_AUTO_LIMIT`]). `forward_dynamics_derivatives` past the limit is composed
+/// from the type's other functions instead (`kanegen_runtime::composed`), which costs about
+/// what they cost and is never slower than the kernel (which recomputes them): the share does
+/// not apply to it.
 #[must_use]
-pub fn derivative_keeps_unrolled(ops: u64, kernel_ops: u64) -> bool {
-    ops <= DERIVATIVES_AUTO_LIMIT || ops * 100 <= kernel_ops * DERIVATIVES_UNROLLED_SHARE
+pub fn derivative_keeps_unrolled(f: Function, ops: u64, kernel_ops: u64) -> bool {
+    ops <= DERIVATIVES_AUTO_LIMIT
+        || (f != Function::ForwardDynamicsDerivatives
+            && ops * 100 <= kernel_ops * DERIVATIVES_UNROLLED_SHARE)
 }
 
 /// Why the compact form cannot be emitted under `opts` (any model, fixed or free-floating), or

@@ -80,6 +80,15 @@ fn form_line(plan: &Plan) -> String {
             crate::plan::DERIVATIVES_MAX_NV
         ));
     }
+    let composed = plan.composed();
+    if !composed.is_empty() {
+        line.push_str(&format!(
+            " Composed: {} (`q̈ = M⁻¹ (τ − c)` from `mass_matrix_inverse` and \
+             `nonlinear_effects`, then `−M⁻¹ ∂τ/∂x` from `inverse_dynamics_derivatives`, \
+             `kanegen_runtime::composed`: its straight-line body is past the size rule).",
+            composed.join(", ")
+        ));
+    }
     let missing = plan.not_generated();
     if !missing.is_empty() {
         let why = if plan.derivatives_asked {

@@ -56,7 +56,7 @@ pub use options::{forced_algorithm, Error, Float, Form, Options, MAX_JOINTS, VER
 pub use plan::Plan;
 
 use kanegen_model::Model;
-use kanegen_trace::{Arg, Counts};
+use kanegen_trace::{Arg, Counts, Function};
 use plan::{FunctionPlan, Kernel};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -224,6 +224,7 @@ fn function_body(
 ) -> Result<Body, Error> {
     let compact_tokens = match fp.kernel {
         Kernel::Compact(_) => compact::body(fp.function, opts, &plan.model, plan.floating())?,
+        Kernel::Composed(_) => Some(composed_body(plan, fp, opts)?),
         Kernel::Unrolled => None,
     };
     let body = match (texts, compact_tokens, graph) {
@@ -266,6 +267,30 @@ fn function_body(
         }
     };
     Ok(body)
+}
+
+/// The body of a composed function ([`Kernel::Composed`]): `M⁻¹` and `c` from the type's own
+/// functions, `q̈ = M⁻¹ (τ − c)`, then `−M⁻¹ ∂τ/∂x` from its inverse-dynamics derivatives
+/// (`kanegen_runtime::composed`).
+fn composed_body(plan: &Plan, fp: &FunctionPlan, opts: &Options) -> Result<TokenStream, Error> {
+    let rt = opts.runtime()?;
+    let name = |f: Function| -> Result<syn::Ident, Error> {
+        let fp = (plan.functions.iter().find(|g| g.function == f))
+            .ok_or_else(|| Error(format!("`{}` composes `{}`", fp.name, f.name())))?;
+        Ok(format_ident!("{}", fp.name))
+    };
+    let (minv, c, id) = (
+        name(Function::MassMatrixInverse)?,
+        name(Function::NonlinearEffects)?,
+        name(Function::InverseDynamicsDerivatives)?,
+    );
+    let [q, qd, tau] = [0, 1, 2].map(|k| format_ident!("{}", fp.args[k].0.name()));
+    let p = opts.runtime_payload.then(|| quote!(, payload));
+    Ok(quote! {
+        let minv = Self::#minv(#q #p);
+        let qdd = #rt::composed::accelerations(&minv, #tau, &Self::#c(#q, #qd #p));
+        #rt::composed::forward_dynamics_derivatives(minv, Self::#id(#q, #qd, &qdd #p))
+    })
 }
 
 /// The placeholder of the `k`-th formatted body ([`generate_file`]).
@@ -377,6 +402,16 @@ fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (Str
     .flatten()
     .collect::<Vec<_>>()
     .join(", ");
+    if let Kernel::Composed(c) = fp.kernel {
+        let doc2 = format!(
+            " Composed (Carpentier & Mansard 2018, eq. (3); `kanegen_runtime::composed`): \
+             `q̈ = M⁻¹ (τ − c)` from `mass_matrix_inverse` and `nonlinear_effects`, then \
+             `∂q̈/∂x = −M⁻¹ ∂τ/∂x` from `inverse_dynamics_derivatives` at that `q̈`: {} mul, \
+             {} add, {} div, {} sqrt, {} sincos (the three functions' and the two loops').",
+            c.mul, c.add, c.div, c.sqrt, c.sincos
+        );
+        return (doc1, doc2);
+    }
     if let Kernel::Compact(c) = fp.kernel {
         let doc2 = format!(
             " Compact form: loops over the model's constant tables (RBDA), {methods}, the \
@@ -449,7 +484,9 @@ fn op_count_entries(
                 counts,
             };
             match (fp.kernel, fp.choice.candidate()) {
-                (Kernel::Compact(counts), _) => entry(fp, &kernel(counts), 0),
+                (Kernel::Compact(counts) | Kernel::Composed(counts), _) => {
+                    entry(fp, &kernel(counts), 0)
+                }
                 (Kernel::Unrolled, Some(chosen)) => entry(fp, chosen, *k),
                 (Kernel::Unrolled, None) => entry(fp, &kernel(Counts::default()), *k),
             }

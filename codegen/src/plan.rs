@@ -39,6 +39,11 @@ pub enum Kernel {
     /// The compact form's loops ([`compact::body`]): a kernel of `kanegen_runtime::compact`,
     /// with its traced counts ([`compact::counts`]).
     Compact(Counts),
+    /// `forward_dynamics_derivatives` of an unrolled model past the size rule, composed from
+    /// the type's own `mass_matrix_inverse`, `nonlinear_effects` and
+    /// `inverse_dynamics_derivatives` (`kanegen_runtime::composed`): their counts and the
+    /// composition's.
+    Composed(Counts),
 }
 
 /// One generated function.
@@ -79,6 +84,25 @@ pub struct Plan {
     pub derivatives_asked: bool,
     /// Whether they are generated: asked for and [`derivatives_fit`].
     pub derivatives_generated: bool,
+}
+
+impl FunctionPlan {
+    /// Its operation counts: the chosen candidate's emitted counts, or its kernel's.
+    #[must_use]
+    pub fn counts(&self) -> Counts {
+        match self.kernel {
+            Kernel::Unrolled => self.choice.counts(),
+            Kernel::Compact(c) | Kernel::Composed(c) => c,
+        }
+    }
+
+    /// The side of its square matrices (the speeds) for [`Shape::Matrices`], else 0.
+    fn speeds(&self) -> usize {
+        match self.shape {
+            Shape::Matrices(_, nv) => nv,
+            _ => 0,
+        }
+    }
 }
 
 /// The most speeds (`N`, or `6 + N` free-floating) the derivative functions are generated for:
@@ -145,11 +169,13 @@ impl Plan {
             }
             let kernel = match &graph {
                 Some(_) => Kernel::Unrolled,
+                None if composes(&decision, f) => Kernel::Composed(Counts::default()),
                 None => Kernel::Compact(compact::kernel_counts(&model, opts, f)?),
             };
             functions.push(function_plan(&model, f, choice, kernel));
             graphs.push(graph);
         }
+        composed_counts(&mut functions);
         check_names(&functions)?;
         let plan = Plan {
             derivatives_asked: opts.derivatives,
@@ -201,7 +227,7 @@ impl Plan {
     }
 
     /// The derivative functions of an unrolled model emitted in loops, as the header names them:
-    /// `` `name` ``.
+    /// `` `name` `` (a composed one is not: [`Plan::composed`]).
     #[must_use]
     pub fn looped_derivatives(&self) -> Vec<String> {
         if self.compact() {
@@ -211,6 +237,16 @@ impl Plan {
             .iter()
             .filter(|fp| matches!(fp.kernel, Kernel::Compact(_)))
             .map(|fp| format!("`{}`", fp.function.name()))
+            .collect()
+    }
+
+    /// The composed functions ([`Kernel::Composed`]), as the header names them: `` `name` ``.
+    #[must_use]
+    pub fn composed(&self) -> Vec<String> {
+        self.functions
+            .iter()
+            .filter(|fp| matches!(fp.kernel, Kernel::Composed(_)))
+            .map(|fp| format!("`{}`", fp.name))
             .collect()
     }
 
@@ -386,7 +422,39 @@ fn unrolled_derivative(
     let (choice, graph) = choose_in(model, subjects, f, mass, opts)?;
     let ops = choice.counts().total();
     let kernel_ops = compact::kernel_counts(model, opts, f)?.total();
-    Ok(compact::derivative_keeps_unrolled(ops, kernel_ops).then_some((choice, graph)))
+    Ok(compact::derivative_keeps_unrolled(f, ops, kernel_ops).then_some((choice, graph)))
+}
+
+/// Whether `f` without a straight-line body is composed ([`Kernel::Composed`]): the
+/// forward-dynamics derivatives of an unrolled model.
+fn composes(decision: &Decision, f: Function) -> bool {
+    decision.form != Form::Compact && f == Function::ForwardDynamicsDerivatives
+}
+
+/// The counts of a composed function: those of the three functions it calls and of
+/// `kanegen_runtime::composed`'s loops ([`compact::composed_counts`]).
+fn composed_counts(functions: &mut [FunctionPlan]) {
+    let counts_of = |fs: &[FunctionPlan], f: Function| {
+        fs.iter()
+            .find(|fp| fp.function == f)
+            .map_or_else(Counts::default, FunctionPlan::counts)
+    };
+    let parts = [
+        Function::MassMatrixInverse,
+        Function::NonlinearEffects,
+        Function::InverseDynamicsDerivatives,
+    ];
+    for k in 0..functions.len() {
+        if let Kernel::Composed(_) = functions[k].kernel {
+            let nv = functions[k].speeds();
+            let own = compact::composed_counts(nv);
+            let total = parts
+                .iter()
+                .map(|&f| counts_of(functions, f))
+                .fold(own, |a, b| a + b);
+            functions[k].kernel = Kernel::Composed(total);
+        }
+    }
 }
 
 /// The choice of a compact body: the methods of its loops, no candidate traced.

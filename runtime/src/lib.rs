@@ -8,6 +8,7 @@
 //! - [`scalar`]: the [`Scalar`](scalar::Scalar) trait every algorithm is generic over (`f64`,
 //!   `f32`, research scalars, and the tracer `Sym`, which counts what a kernel does).
 //! - [`compact`]: the compact form's kernels (CRBA, RNEA, ABA as loops over a model's tables).
+//! - [`composed`]: forward-dynamics derivatives composed from a generated type's own functions.
 //! - [`coupling`]: mimic joints' constant coupling of the full joint list to the independent
 //!   coordinates (expanding the state, reducing `M`, vectors and derivatives).
 //! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
@@ -25,6 +26,7 @@
 extern crate std;
 
 pub mod compact;
+pub mod composed;
 pub mod coupling;
 pub mod fma;
 pub mod inertia;

@@ -1,0 +1,71 @@
+//! Forward-dynamics derivatives composed from a generated type's own functions (Carpentier &
+//! Mansard, RSS 2018, eq. (3)): `q̈ = M⁻¹ (τ − c)`, then `∂q̈/∂x = −M⁻¹ ∂τ/∂x` for
+//! `x = q, q̇`, with `∂τ/∂x` the inverse-dynamics derivatives at that `q̈`. A straight-line
+//! `forward_dynamics_derivatives` grows past the instruction cache from about eight joints
+//! (`kanegen_codegen::compact::DERIVATIVES_AUTO_LIMIT`); composed, it calls the type's
+//! `mass_matrix_inverse`, `nonlinear_effects` and `inverse_dynamics_derivatives` (each emitted
+//! in its own best form) and adds the two loops here. On a free-floating base the matrices are
+//! `NV × NV` (`NV = 6 + N`) in Pinocchio's tangent space and the drives act on the last `N`
+//! speeds; with mimic joints everything is in the independent coordinates.
+
+use crate::compact::derivatives::accelerations as solve;
+use crate::Scalar;
+
+/// `q̈ = M⁻¹ (τ_full − c)`, `τ_full = [0 (NV − N); τ]` (no drive on a free-floating base's own
+/// six speeds).
+#[inline]
+#[must_use]
+pub fn accelerations<S: Scalar + Copy, const N: usize, const NV: usize>(
+    minv: &[[S; NV]; NV],
+    tau: &[S; N],
+    c: &[S; NV],
+) -> [S; NV] {
+    let mut full = [S::zero(); NV];
+    for (f, t) in full[NV.saturating_sub(N)..].iter_mut().zip(tau) {
+        *f = *t;
+    }
+    let mut qdd = [S::zero(); NV];
+    solve(minv.as_flattened(), &full, c, &mut qdd);
+    qdd
+}
+
+/// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` from `M⁻¹` and the inverse-dynamics derivatives `(∂τ/∂q, ∂τ/∂q̇)`
+/// at the forward dynamics' `q̈` ([`accelerations`]): `∂q̈/∂x = −M⁻¹ ∂τ/∂x`.
+#[inline]
+#[must_use]
+#[allow(clippy::type_complexity)] // Pinocchio's three matrices, as the generated functions return them
+pub fn forward_dynamics_derivatives<S: Scalar + Copy, const NV: usize>(
+    minv: [[S; NV]; NV],
+    (dtq, dtv): ([[S; NV]; NV], [[S; NV]; NV]),
+) -> ([[S; NV]; NV], [[S; NV]; NV], [[S; NV]; NV]) {
+    let (mut dq, mut dv) = ([[S::zero(); NV]; NV], [[S::zero(); NV]; NV]);
+    // Row r of −M⁻¹ D: Σ_k −(M⁻¹)_rk D_k, each row of D a fixed-length loop (vectorized).
+    for (r, row) in minv.iter().enumerate() {
+        for (k, &x) in row.iter().enumerate() {
+            for j in 0..NV {
+                dq[r][j] = dq[r][j] - x * dtq[k][j];
+                dv[r][j] = dv[r][j] - x * dtv[k][j];
+            }
+        }
+    }
+    (dq, dv, minv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On a 2 × 2 example worked by hand: `q̈ = M⁻¹ (τ − c)` with the free-floating offset,
+    /// and `−M⁻¹ D`.
+    #[test]
+    fn composes_by_hand() {
+        let minv = [[2.0, 1.0], [1.0, 3.0]];
+        assert_eq!(accelerations(&minv, &[5.0, 7.0], &[1.0, 2.0]), [13.0, 19.0]);
+        assert_eq!(accelerations(&minv, &[7.0], &[1.0, 2.0]), [3.0, 14.0]);
+        let d = [[1.0, 0.0], [0.0, 2.0]];
+        let (dq, dv, m) = forward_dynamics_derivatives(minv, (d, [[0.0; 2]; 2]));
+        assert_eq!(dq, [[-2.0, -2.0], [-1.0, -6.0]]);
+        assert_eq!(dv, [[0.0; 2]; 2]);
+        assert_eq!(m, minv);
+    }
+}
