@@ -47,6 +47,13 @@ pub trait Lanes<F: Copy>:
     /// `a·b + c` with one rounding always (libm's `fma`).
     #[must_use]
     fn fma(self, b: Self, c: Self) -> Self;
+    /// `a·b + c` by the scalar function `f` on each lane (a fused multiply-add of the caller's
+    /// choice, e.g. `f64::mul_add`).
+    #[must_use]
+    #[inline(always)]
+    fn fma_with(self, b: Self, c: Self, f: impl Fn(F, F, F) -> F) -> Self {
+        Self::from_fn(|i| f(self.lane(i), b.lane(i), c.lane(i)))
+    }
     /// Square root, correctly rounded (libm's `sqrt`).
     #[must_use]
     fn sqrt(self) -> Self;
@@ -433,6 +440,8 @@ mod tests {
                     assert!($same(s(Lanes::neg(a)), Lanes::neg(x)));
                     assert!($same(s(Lanes::mul_add(a, b, c)), Lanes::mul_add(x, y, z)));
                     assert!($same(s(Lanes::fma(a, b, c)), Lanes::fma(x, y, z)));
+                    let f = |x: $t, y: $t, z: $t| x * y - z;
+                    assert!($same(s(Lanes::fma_with(a, b, c, f)), f(x, y, z)));
                     assert!($same(s(Lanes::sqrt(a)), Lanes::sqrt(x)));
                     assert!($same(s(Lanes::sin(a)), Lanes::sin(x)));
                     assert!($same(s(Lanes::cos(a)), Lanes::cos(x)));
