@@ -227,16 +227,22 @@ macro_rules! wide_lanes {
             }
             #[inline(always)]
             fn sincos(self) -> (Self, Self) {
-                let [(s, c)] = per_lane([self], |[x]: [$t; 1]| [<$t as Lanes<$t>>::sincos(x)]);
-                (s, c)
+                let r = self.to_array().map(<$t as Lanes<$t>>::sincos);
+                ($v::new(r.map(|r| r.0)), $v::new(r.map(|r| r.1)))
             }
             #[inline(always)]
             fn sincos_n<const K: usize>(x: [Self; K]) -> [(Self, Self); K] {
-                per_lane(x, <$t as Lanes<$t>>::sincos_n)
+                let r: [[($t, $t); K]; $l] = core::array::from_fn(|i| {
+                    <$t as Lanes<$t>>::sincos_n(x.map(|v| v.as_array_ref()[i]))
+                });
+                transpose(&r)
             }
             #[inline(always)]
             fn sincos_n_unfused<const K: usize>(x: [Self; K]) -> [(Self, Self); K] {
-                per_lane(x, <$t as Lanes<$t>>::sincos_n_unfused)
+                let r: [[($t, $t); K]; $l] = core::array::from_fn(|i| {
+                    <$t as Lanes<$t>>::sincos_n_unfused(x.map(|v| v.as_array_ref()[i]))
+                });
+                transpose(&r)
             }
         }
     };
@@ -256,21 +262,12 @@ trait Map<F: Copy>: Lanes<F> {
 
 impl<F: Copy, S: Lanes<F>> Map<F> for S {}
 
-/// A sine–cosine of `K` scalar angles applied to each lane's `K` angles.
+/// Each lane's `K` sine–cosine pairs (`r[lane][k]`) as `K` pairs of vectors.
 #[inline(always)]
-fn per_lane<F: Copy, S: Lanes<F>, const K: usize>(
-    x: [S; K],
-    f: impl Fn([F; K]) -> [(F, F); K],
+fn transpose<F: Copy, S: Lanes<F>, const K: usize, const L: usize>(
+    r: &[[(F, F); K]; L],
 ) -> [(S, S); K] {
-    let (mut s, mut c) = (x, x);
-    for i in 0..S::LANES {
-        let r = f(x.map(|v| v.lane(i)));
-        for k in 0..K {
-            s[k] = s[k].replace(i, r[k].0);
-            c[k] = c[k].replace(i, r[k].1);
-        }
-    }
-    core::array::from_fn(|k| (s[k], c[k]))
+    core::array::from_fn(|k| (S::from_fn(|i| r[i][k].0), S::from_fn(|i| r[i][k].1)))
 }
 
 /// Setting one lane.
