@@ -397,6 +397,7 @@ fn calls_per_function(src: &str, call: &str) -> Vec<(String, u64)> {
         if let Some(rest) = code.strip_prefix("pub fn ") {
             let name = rest.split(['(', '<']).next().unwrap();
             let name = name.strip_suffix("_lanes").unwrap_or(name);
+            let name = name.strip_suffix("_batch").unwrap_or(name);
             if out.last().is_none_or(|(f, _)| f != name) {
                 out.push((name.to_string(), 0));
             }

@@ -305,3 +305,52 @@ fn a_wrong_lane_is_caught() {
     scalar[2] = Ssrms::mass_matrix(&q[1]);
     same::<f64, f64x4, _>(&lanes, &scalar, "mass_matrix");
 }
+
+/// `NAME_batch` over slices equals the scalar calls state by state, bit for bit, for batch
+/// lengths around the lane count (a padded last chunk, an empty batch), with a payload and
+/// on `f32`; `out` past the shortest slice is left as it was.
+#[test]
+fn batches_are_the_scalar_calls() {
+    let mut rng = Rng(18);
+    for n in [0, 1, 3, 4, 5, 8, 11] {
+        let q: Vec<[f64; 7]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let qd: Vec<[f64; 7]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let tau: Vec<[f64; 7]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let mut out = vec![[f64::NAN; 7]; n + 2];
+        Ssrms::forward_dynamics_batch::<f64x4>(&q, &qd, &tau, &mut out);
+        for k in 0..n {
+            let want = Ssrms::forward_dynamics(&q[k], &qd[k], &tau[k]);
+            assert_eq!(
+                format!("{:?}", out[k]),
+                format!("{want:?}"),
+                "n = {n}, k = {k}"
+            );
+        }
+        assert!(out[n..].iter().flatten().all(|x| x.is_nan()), "n = {n}");
+        let mut mc = vec![([[0.0; 7]; 7], [0.0; 7]); n];
+        Ssrms::mass_matrix_and_nonlinear_effects_batch::<f64x2>(&q, &qd, &mut mc);
+        for k in 0..n {
+            let want = Ssrms::mass_matrix_and_nonlinear_effects(&q[k], &qd[k]);
+            assert_eq!(
+                format!("{:?}", mc[k]),
+                format!("{want:?}"),
+                "n = {n}, k = {k}"
+            );
+        }
+    }
+    let p = Random5F32PayloadPayload::NOMINAL;
+    let q: Vec<[f32; 5]> = (0..13).map(|_| Random::random(&mut rng)).collect();
+    let mut out = vec![[0.0_f32; 5]; 13];
+    Random5F32Payload::gravity_batch::<f32x8>(&q, &p, &mut out);
+    for k in 0..13 {
+        let want = Random5F32Payload::gravity(&q[k], &p);
+        assert_eq!(format!("{:?}", out[k]), format!("{want:?}"), "k = {k}");
+    }
+    // A compact function's batch: its `_lanes` calls the scalar function lane by lane.
+    let q: Vec<[f64; 6]> = (0..6).map(|_| Random::random(&mut rng)).collect();
+    let mut out = vec![[[0.0; 6]; 6]; 6];
+    Ur5Compact::mass_matrix_batch::<f64x4>(&q, &mut out);
+    for k in 0..6 {
+        assert_eq!(out[k], Ur5Compact::mass_matrix(&q[k]));
+    }
+}

@@ -63,7 +63,8 @@ fn lanes_line(plan: &Plan, opts: &Options) -> String {
         "Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<{f}>>` form \
          (`kanegen_runtime::lanes`) taking and returning `S` in place of `{f}`: `S::LANES` \
          states per call, one per lane of a SIMD vector (`wide`'s `{}`), each lane's results \
-         bit for bit those of `NAME` for that lane's state.",
+         bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices \
+         of states, `S::LANES` at a time.",
         match opts.float {
             Float::F64 => "f64x2`, `f64x4",
             Float::F32 => "f32x4`, `f32x8",

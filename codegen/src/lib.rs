@@ -337,6 +337,28 @@ fn function_item(
     let (ret, lanes_ret) = (return_type(fp.shape, &fl), return_type(fp.shape, &s));
     let (doc1, doc2) = function_docs(plan, fp, body.fmas, opts);
     let bound = quote!(S: #rt::lanes::Lanes<#fl>);
+    let batch_name = format_ident!("{}_batch", fp.name);
+    let batch_args: Vec<TokenStream> = fp
+        .args
+        .iter()
+        .map(|(a, len)| {
+            let len = Literal::usize_unsuffixed(*len);
+            let name = format_ident!("{}", a.name());
+            if *a == Arg::FExt {
+                quote!(#name: &[[[#fl; 6]; #len]])
+            } else {
+                quote!(#name: &[[#fl; #len]])
+            }
+        })
+        .collect();
+    let payload_arg_batch = opts.runtime_payload.then(|| quote!(payload: &#payload_ty,));
+    let batch_doc = format!(
+        " [`Self::{name}`] of every state of the slices, `S::LANES` states per call of \
+         [`Self::{lanes_name}`]: `out[k]` is `{name}` of the `k`-th entries, for `k` below the \
+         shortest slice's length (`out` included; entries of `out` past it are left as they \
+         are); a last chunk of fewer states is padded with the last state, whose extra results \
+         are discarded."
+    );
     let body = body.tokens;
     let (scalar_body, lanes_body, lanes_doc) = if matches!(fp.kernel, Kernel::Compact(_)) {
         let lane_of = arg_names
@@ -388,6 +410,14 @@ fn function_item(
         #[must_use]
         pub fn #lanes_name<#bound>(#(#lane_args),* #payload_arg) -> #lanes_ret {
             #lanes_body
+        }
+
+        #[doc = #batch_doc]
+        pub fn #batch_name<#bound>(#(#batch_args,)* #payload_arg_batch out: &mut [#ret]) {
+            let n = out.len() #(.min(#arg_names.len()))*;
+            #rt::lanes::batch::<#fl, S, _>(out, n, |start| {
+                Self::#lanes_name::<S>(#(&#rt::lanes::gather::<#fl, S, _>(#arg_names, start, n)),* #payload_pass)
+            });
         }
     })
 }
@@ -939,7 +969,7 @@ mod tests {
     }
 
     /// How a variant fuses products: not at all, through libm's `fma`, or through the
-    /// target-feature `Self::mul_add`.
+    /// target-feature `S::mul_add`.
     #[derive(Clone, Copy, PartialEq, Eq)]
     enum Fuse {
         None,

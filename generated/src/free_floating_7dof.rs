@@ -12,7 +12,7 @@
 //! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 4091 (`mass_matrix` 268, `nonlinear_effects` 308, `inverse_dynamics` 323, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 1796 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
-//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state. `NAME` is its `NAME_lanes` at `S = f64` (one body).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -2033,6 +2033,32 @@ impl FreeFloating7 {
             ],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        out: &mut [[[::core::primitive::f64; 13]; 13]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `newton-euler`: 504 mul, 412 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 308 fused where the target has FMA.
@@ -2750,6 +2776,40 @@ impl FreeFloating7 {
                 ),
         );
         [x232, x233, x234, x235, x236, x237, x226, x215, x203, x196, x188, x177, x165]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
@@ -3509,6 +3569,46 @@ impl FreeFloating7 {
                 ),
         );
         [x238, x239, x240, x241, x242, x243, x232, x221, x209, x202, x194, x183, x171]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        a: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(a.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(a, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -5594,6 +5694,46 @@ impl FreeFloating7 {
         let x790 = S::neg(x789);
         [x790, x786, x783, x780, x777, x773, x769, x767, x765, x763, x762, x761, x760]
     }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 949 mul, 847 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 576 fused where the target has FMA.
@@ -7144,6 +7284,40 @@ impl FreeFloating7 {
                 x502,
             ],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [([[::core::primitive::f64; 13]; 13], [::core::primitive::f64; 13])],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
@@ -9274,6 +9448,52 @@ impl FreeFloating7 {
         );
         [x792, x789, x786, x783, x780, x777, x773, x771, x769, x767, x766, x765, x764]
     }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 8]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
+    }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
     /// : 350 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 215 fused where the target has FMA.
@@ -9765,6 +9985,38 @@ impl FreeFloating7 {
                 + S::mul_add(S::neg(q[0]), x156, q[1] * x155),
         );
         [x155, x156, x158, x159, x160, x161]
+    }
+    /// [`Self::momentum`] of every state of the slices, `S::LANES` states per call of [`Self::momentum_lanes`]: `out[k]` is `momentum` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn momentum_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::momentum_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
@@ -10591,6 +10843,44 @@ impl FreeFloating7 {
         );
         let x243 = S::neg(x237);
         [x238, x239, x240, x241, x242, x243]
+    }
+    /// [`Self::base_reaction`] of every state of the slices, `S::LANES` states per call of [`Self::base_reaction_lanes`]: `out[k]` is `base_reaction` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn base_reaction_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        a: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(a.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::base_reaction_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(a, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

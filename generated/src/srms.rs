@@ -12,7 +12,7 @@
 //! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 609 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
-//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state. `NAME` is its `NAME_lanes` at `S = f64` (one body).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1332,6 +1332,32 @@ impl Srms {
             [x86, x83, x83, x83, x10, S::splat(1.903)],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 6]],
+        out: &mut [[[::core::primitive::f64; 6]; 6]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
@@ -1588,6 +1614,40 @@ impl Srms {
         );
         let x94 = S::neg(x93);
         [x94, x92, x90, x81, x74, x68]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1846,6 +1906,46 @@ impl Srms {
         );
         let x98 = S::mul_add(S::splat(14222.257549666001), qdd[0], S::neg(x97));
         [x98, x96, x94, x85, x79, x74]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        qdd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -2374,6 +2474,46 @@ impl Srms {
         let x215 = S::mul_add(S::neg(x172), x208, S::mul_add(x171, x209, x214));
         [x215, x213, x211, x210, x209, x208]
     }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 338 mul, 271 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
@@ -2800,6 +2940,40 @@ impl Srms {
             ],
             [x173, x172, x171, x162, x155, x151],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -3355,6 +3529,52 @@ impl Srms {
         );
         let x218 = S::mul_add(x175, x211, S::mul_add(x174, x212, x217));
         [x218, x216, x214, x213, x212, x211]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        f_ext: &[[[::core::primitive::f64; 6]; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -12,7 +12,7 @@
 //! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 4313 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1053, `forward_dynamics_derivatives` 2049, `mass_matrix_inverse` 201), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
-//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state. `NAME` is its `NAME_lanes` at `S = f64` (one body).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1460,6 +1460,32 @@ impl Ssrms {
             [x91, x90, x85, x85, x85, S::splat(0.0), S::splat(9.336)],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 7]],
+        out: &mut [[[::core::primitive::f64; 7]; 7]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
@@ -1697,6 +1723,40 @@ impl Ssrms {
         );
         let x99 = S::neg(S::mul_add(S::splat(0.7026), x97, x98));
         [x99, x96, x94, x86, x78, x75, x68]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1955,6 +2015,46 @@ impl Ssrms {
             S::neg(S::mul_add(S::splat(0.7026), x100, x101)),
         );
         [x102, x99, x97, x90, x83, x79, x73]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -2489,6 +2589,46 @@ impl Ssrms {
         );
         [x243, x241, x239, x237, x236, x235, x234]
     }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
@@ -2884,6 +3024,40 @@ impl Ssrms {
             ],
             [x186, x183, x181, x173, x165, x162, x155],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -3489,6 +3663,52 @@ impl Ssrms {
             S::mul_add(S::neg(x183), x238, S::mul_add(x182, x239, x245)),
         );
         [x246, x244, x242, x240, x239, x238, x237]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`.
     ///
@@ -5049,6 +5269,46 @@ impl Ssrms {
                 [x527, x878, x833, x757, x672, x595, x545],
             ],
         )
+    }
+    /// [`Self::inverse_dynamics_derivatives`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_derivatives_lanes`]: `out[k]` is `inverse_dynamics_derivatives` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_derivatives_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [[::core::primitive::f64; 7]; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_derivatives_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`.
     ///
@@ -8420,6 +8680,50 @@ impl Ssrms {
             ],
         )
     }
+    /// [`Self::forward_dynamics_derivatives`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_derivatives_lanes`]: `out[k]` is `forward_dynamics_derivatives` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_derivatives_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [(
+            [[::core::primitive::f64; 7]; 7],
+            [[::core::primitive::f64; 7]; 7],
+            [[::core::primitive::f64; 7]; 7],
+        )],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_derivatives_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// The inverse of the joint-space inertia matrix, `M(q)⁻¹` (symmetric, both triangles written), from the LDLᵀ factors of `M`.
     ///
     /// : 309 mul, 240 add, 7 div, 0 sqrt, 5 sincos (emitted), of which 201 fused where the target has FMA.
@@ -8807,6 +9111,31 @@ impl Ssrms {
             [x143, x159, x171, x182, x188, x191, x190],
             [x141, x158, x170, x180, x187, x190, x133],
         ]
+    }
+    /// [`Self::mass_matrix_inverse`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_inverse_lanes`]: `out[k]` is `mass_matrix_inverse` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_inverse_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[[::core::primitive::f64; 7]], out: &mut [[[::core::primitive::f64; 7]; 7]]) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_inverse_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -12,7 +12,7 @@
 //! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 691 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 190), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 395 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
-//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state. `NAME` is its `NAME_lanes` at `S = f64` (one body).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1286,6 +1286,32 @@ impl Ssrms6 {
             [x56, x53, x53, x53, S::splat(0.0), S::splat(9.336)],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 6]],
+        out: &mut [[[::core::primitive::f64; 6]; 6]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `newton-euler`: 155 mul, 99 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 80 fused where the target has FMA.
@@ -1484,6 +1510,40 @@ impl Ssrms6 {
         );
         let x72 = S::neg(x71);
         [x72, x69, x65, x58, x56, x49]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1716,6 +1776,46 @@ impl Ssrms6 {
         );
         let x79 = S::mul_add(S::splat(1650.6386721183999), qdd[0], S::neg(x78));
         [x79, x76, x73, x66, x63, x57]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        qdd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -2117,6 +2217,46 @@ impl Ssrms6 {
         let x169 = S::mul_add(x127, x162, S::mul_add(x126, x163, x168));
         [x169, x167, x165, x164, x163, x162]
     }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`: 231 mul, 164 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 115 fused where the target has FMA.
@@ -2430,6 +2570,40 @@ impl Ssrms6 {
             ],
             [x128, x125, x122, x115, x112, x105],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -2858,6 +3032,52 @@ impl Ssrms6 {
         );
         let x171 = S::mul_add(x129, x164, S::mul_add(x128, x165, x170));
         [x171, x169, x167, x166, x165, x164]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        f_ext: &[[[::core::primitive::f64; 6]; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -12,7 +12,7 @@
 //! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
-//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state. `NAME` is its `NAME_lanes` at `S = f64` (one body).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1065,6 +1065,32 @@ impl SsrmsRecurrent {
             [x366, x380, x392, x392, x392, x413, x414],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 7]],
+        out: &mut [[[::core::primitive::f64; 7]; 7]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
@@ -1536,6 +1562,40 @@ impl SsrmsRecurrent {
         let x309 = S::neg(S::mul_add(x98, x294, S::mul_add(x96, x293, x94 * x292)));
         let x310 = S::neg(S::mul_add(x118, x279, S::mul_add(x116, x278, x114 * x277)));
         [x308, x304, x305, x306, x307, x309, x310]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -2696,6 +2756,46 @@ impl SsrmsRecurrent {
             S::mul_add(x119, x561, S::mul_add(x117, x560, x115 * x559)) - x605,
         );
         [x588, x591, x595, x597, x600, x603, x606]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -3966,6 +4066,46 @@ impl SsrmsRecurrent {
         );
         [x660, x658, x656, x654, x653, x652, x651]
     }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`: 1012 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 562 fused where the target has FMA.
@@ -5071,6 +5211,40 @@ impl SsrmsRecurrent {
             ],
             [x601, x597, x598, x599, x600, x602, x603],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -6555,6 +6729,52 @@ impl SsrmsRecurrent {
             S::mul_add(S::neg(x604), x667, S::mul_add(x603, x668, x674)),
         );
         [x675, x673, x671, x669, x668, x667, x666]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

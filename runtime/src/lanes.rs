@@ -383,6 +383,40 @@ pub fn lanewise<F: Copy, S: Lanes<F>, R: LaneValue<F, S>>(
     out
 }
 
+/// Lanes `start..start + S::LANES` of the first `n` states as one argument over `S`, states past
+/// `n` replaced by state `n − 1` (the padding of a batch's last chunk). `start < n ≤
+/// states.len()`.
+#[inline(always)]
+pub fn gather<F: Copy, S: Lanes<F>, T: LaneValue<F, S>>(
+    states: &[T],
+    start: usize,
+    n: usize,
+) -> T::Lanes {
+    let last = n - 1;
+    let mut out = states[start.min(last)].splat();
+    for l in 1..S::LANES {
+        states[(start + l).min(last)].set_lane(&mut out, l);
+    }
+    out
+}
+
+/// `out[k]` for the first `n` states (`n ≤ out.len()`), `S::LANES` at a time: `f(start)` gives
+/// the results of states `start..start + S::LANES` as one value over `S` (the last chunk padded,
+/// its padding lanes discarded).
+#[inline(always)]
+pub fn batch<F: Copy, S: Lanes<F>, R: LaneValue<F, S>>(
+    out: &mut [R],
+    n: usize,
+    mut f: impl FnMut(usize) -> R::Lanes,
+) {
+    for (c, chunk) in out[..n].chunks_mut(S::LANES).enumerate() {
+        let r = f(c * S::LANES);
+        for (l, o) in chunk.iter_mut().enumerate() {
+            *o = R::lane(&r, l);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
