@@ -151,7 +151,8 @@ pub mod __private {
 }
 
 /// The `no_std` runtime that generated code, the simulator and the run-time path share
-/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine, LDLᵀ and the parallel-axis shift.
+/// (`kanegen-runtime`): the scalar trait, integrators, sine–cosine, LDLᵀ, the parallel-axis shift,
+/// and the lane types of the generated `NAME_lanes` functions (`runtime::lanes`).
 pub use kanegen_runtime as runtime;
 
 #[cfg(feature = "std")]

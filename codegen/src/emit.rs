@@ -2,6 +2,11 @@
 //! subexpression and per output, single-use nodes inlined with the parentheses that keep the
 //! graph's evaluation order (so the code performs exactly the emitted operation count), one
 //! `sincos` per angle, optional fused multiply-adds.
+//!
+//! The code is generic over the lane type `S: kanegen_runtime::lanes::Lanes<F>` (`F` the
+//! emitted float type): constants are `S::splat(…)`, negation `S::neg`, and every call (fused
+//! multiply-add, square root, sine and cosine) a method of `S`, so one body serves the scalar
+//! function (`S = F`) and its `_lanes` form on SIMD vectors.
 
 use crate::options::{Error, Float, Options};
 use kanegen_trace::{Input, Node, PayloadField, Sym, Traced};
@@ -39,21 +44,21 @@ impl Expr {
     }
 }
 
-/// A constant of type `float`: the f64 value, rounded for `f32`.
-fn constant(x: f64, float: Float) -> Expr {
+/// The literal of a constant of type `float`: the f64 value, rounded for `f32`.
+fn literal(x: f64, float: Float) -> TokenStream {
     let ty = float.ty();
     let x = match float {
         Float::F64 => x,
         Float::F32 => f64::from(x as f32),
     };
     if x.is_nan() {
-        return Expr::atom(quote!(#ty::NAN));
+        return quote!(#ty::NAN);
     }
     if x.is_infinite() {
         return if x > 0.0 {
-            Expr::atom(quote!(#ty::INFINITY))
+            quote!(#ty::INFINITY)
         } else {
-            Expr::atom(quote!(#ty::NEG_INFINITY))
+            quote!(#ty::NEG_INFINITY)
         };
     }
     let lit = match float {
@@ -61,24 +66,42 @@ fn constant(x: f64, float: Float) -> Expr {
         Float::F32 => Literal::f32_unsuffixed((x as f32).abs()),
     };
     if x.is_sign_negative() && x != 0.0 {
-        Expr {
-            tokens: quote!(-#lit),
-            prec: P_NEG,
-        }
+        quote!(-#lit)
     } else {
-        Expr::atom(quote!(#lit))
+        quote!(#lit)
     }
 }
 
-/// How one graph is emitted: the libm path, the floating-point type and the fused multiply-add
-/// function (none: no fusion). Built from [`Options`] by [`Emitter::new`].
+/// A constant of type `float` in every lane: `S::splat(literal)`.
+fn constant(x: f64, float: Float) -> Expr {
+    let lit = literal(x, float);
+    Expr::atom(quote!(S::splat(#lit)))
+}
+
+/// How products are fused.
+#[derive(Clone, Debug)]
+enum Fuse {
+    /// `S::mul_add`: fused where the build targets FMA ([`Options::target_fma`]).
+    Target,
+    /// `S::fma`: libm's `fma`, always fused ([`Options::fma`]).
+    Libm,
+    /// `S::fma_with(a, b, c, path)`: [`Options::fma_path`] on each lane.
+    Path(TokenStream),
+}
+
+/// How one graph is emitted: the floating-point type, the fused multiply-add (none: no fusion)
+/// and the sine–cosine. Built from [`Options`] by [`Emitter::new`].
 #[derive(Clone, Debug)]
 pub struct Emitter {
-    libm: TokenStream,
     float: Float,
-    fma: Option<TokenStream>,
-    /// Sines and cosines by the type's `Self::sincos` ([`Options::table_sincos`]), not libm.
+    fma: Option<Fuse>,
+    /// Sines and cosines by the table sine–cosine `S::sincos_n` ([`Options::table_sincos`]),
+    /// not libm.
     table_sincos: bool,
+    /// The table sine–cosine's products fused where the build targets FMA (with
+    /// [`Options::target_fma`] and without [`Options::fma`]): `S::sincos_n`, else
+    /// `S::sincos_n_unfused`.
+    sincos_fused: bool,
 }
 
 impl Emitter {
@@ -87,29 +110,26 @@ impl Emitter {
     /// # Errors
     /// If [`Options::libm_path`] or [`Options::fma_path`] is not a Rust path.
     pub fn new(opts: &Options) -> Result<Self, Error> {
-        let libm = opts.libm()?;
+        opts.libm()?;
         let fma = if opts.fma {
             Some(match &opts.fma_path {
                 Some(p) => {
                     let path: syn::Path =
                         syn::parse_str(p).map_err(|e| Error(format!("fma path `{p}`: {e}")))?;
-                    quote!(#path)
+                    Fuse::Path(quote!(#path))
                 }
-                None => {
-                    let f = opts.float.libm_fn("fma");
-                    quote!(#libm::#f)
-                }
+                None => Fuse::Libm,
             })
         } else if opts.target_fma {
-            Some(quote!(Self::mul_add))
+            Some(Fuse::Target)
         } else {
             None
         };
         Ok(Emitter {
-            libm,
             float: opts.float,
             fma,
             table_sincos: opts.table_sincos(),
+            sincos_fused: !opts.fma && opts.target_fma,
         })
     }
 }
@@ -142,7 +162,8 @@ pub enum Shape {
     Placement,
 }
 
-/// The Rust expression that reads a trace input.
+/// The Rust expression that reads a trace input: an argument's entry (of type `S`), or a
+/// payload field (of type `F`, the same for every lane) splat over the lanes.
 #[must_use]
 pub fn input_tokens(input: &Input) -> TokenStream {
     let lit = Literal::usize_unsuffixed;
@@ -157,14 +178,14 @@ pub fn input_tokens(input: &Input) -> TokenStream {
             let (r, c) = (lit(*r), lit(*c));
             quote!(#a[#r][#c])
         }
-        Input::Payload(PayloadField::Mass) => quote!(payload.mass),
+        Input::Payload(PayloadField::Mass) => quote!(S::splat(payload.mass)),
         Input::Payload(PayloadField::Com(k)) => {
             let k = lit(*k);
-            quote!(payload.com[#k])
+            quote!(S::splat(payload.com[#k]))
         }
         Input::Payload(PayloadField::Inertia(r, c)) => {
             let (r, c) = (lit(*r), lit(*c));
-            quote!(payload.inertia[#r][#c])
+            quote!(S::splat(payload.inertia[#r][#c]))
         }
         other => {
             let name = format_ident!("{}", other.to_string().replace(['[', ']', '.'], "_"));
@@ -347,9 +368,9 @@ impl<'a> GraphEmitter<'a> {
         }
     }
 
-    /// With the type's own `sincos`: the sines and cosines of the inputs (joint angles), or of
+    /// With the table sine–cosine: the sines and cosines of the inputs (joint angles), or of
     /// an input plus a constant (a joint's angle offset, `JointParams::angle_offset`) used by
-    /// them alone, in one `Self::sincos_n` at the top, so their polynomials run side by side in
+    /// them alone, in one `S::sincos_n` at the top, so their polynomials run side by side in
     /// vector registers. The sums are written into the call and not bound apart (`hoisted`).
     fn hoist_sincos(&mut self, stmt: &mut dyn FnMut(TokenStream)) {
         let mut args: Vec<(u32, u32, Option<f64>)> = self
@@ -399,7 +420,17 @@ impl<'a> GraphEmitter<'a> {
                 }
             });
         }
-        stmt(quote!(let [#(#pats),*] = Self::sincos_n([#(#xs),*]);));
+        let f = self.sincos_n();
+        stmt(quote!(let [#(#pats),*] = #f([#(#xs),*]);));
+    }
+
+    /// The table sine–cosine of `K` angles: `S::sincos_n`, or `S::sincos_n_unfused`.
+    fn sincos_n(&self) -> TokenStream {
+        if self.emitter.sincos_fused {
+            quote!(S::sincos_n)
+        } else {
+            quote!(S::sincos_n_unfused)
+        }
     }
 
     /// Emits node `id`: records its expression, or binds it to a name by a `let`.
@@ -462,8 +493,8 @@ impl<'a> GraphEmitter<'a> {
             .unwrap_or(0)
     }
 
-    /// The sine and/or cosine of `a`, bound by one call when both are used: the type's own
-    /// `sincos` (a table and short polynomials) takes both at the price of one; libm has `sin`
+    /// The sine and/or cosine of `a`, bound by one call when both are used: the table
+    /// sine–cosine (a table and short polynomials) takes both at the price of one; libm has `sin`
     /// and `cos` apart.
     fn emit_trig(&mut self, id: u32, a: Sym, stmt: &mut dyn FnMut(TokenStream)) {
         if self.exprs.contains_key(&id) {
@@ -472,23 +503,18 @@ impl<'a> GraphEmitter<'a> {
         let arg = self.take(a, false).tokens;
         let base = self.trig_base(a.id());
         self.counter += 1;
-        let (libm, float) = (&self.emitter.libm, self.emitter.float);
         let (sin_call, cos_call, sincos_call) = if self.emitter.table_sincos {
+            let f = self.sincos_n();
             (
-                quote!(Self::sincos(#arg).0),
-                quote!(Self::sincos(#arg).1),
-                quote!(Self::sincos(#arg)),
+                quote!(#f([#arg])[0].0),
+                quote!(#f([#arg])[0].1),
+                quote!(#f([#arg])[0]),
             )
         } else {
-            let (s, c, sc) = (
-                float.libm_fn("sin"),
-                float.libm_fn("cos"),
-                float.libm_fn("sincos"),
-            );
             (
-                quote!(#libm::#s(#arg)),
-                quote!(#libm::#c(#arg)),
-                quote!(#libm::#sc(#arg)),
+                quote!(S::sin(#arg)),
+                quote!(S::cos(#arg)),
+                quote!(S::sincos(#arg)),
             )
         };
         match self.trig[&a.id()] {
@@ -533,8 +559,8 @@ impl<'a> GraphEmitter<'a> {
                 self.take(z, see_through).tokens
             }
             _ => {
-                let e = self.take(s, see_through).at(P_NEG);
-                quote!(-#e)
+                let e = self.take(s, see_through).tokens;
+                quote!(S::neg(#e))
             }
         }
     }
@@ -548,12 +574,16 @@ impl<'a> GraphEmitter<'a> {
     /// `fma(a, b, c)`, one more fused multiply-add.
     fn call(&mut self, a: TokenStream, b: TokenStream, c: TokenStream) -> Expr {
         self.fmas += 1;
-        let f = self
+        match self
             .emitter
             .fma
             .as_ref()
-            .expect("products fuse only with an fma function");
-        Expr::atom(quote!(#f(#a, #b, #c)))
+            .expect("products fuse only with an fma function")
+        {
+            Fuse::Target => Expr::atom(quote!(S::mul_add(#a, #b, #c))),
+            Fuse::Libm => Expr::atom(quote!(S::fma(#a, #b, #c))),
+            Fuse::Path(path) => Expr::atom(quote!(S::fma_with(#a, #b, #c, #path))),
+        }
     }
 
     /// The expression of an arithmetic node, with products fused into their users.
@@ -613,16 +643,12 @@ impl<'a> GraphEmitter<'a> {
             Node::Mul(a, b) => self.binary(a, b, st, "*"),
             Node::Div(a, b) => self.binary(a, b, st, "/"),
             Node::Neg(a) => {
-                let a = self.take(a, st).at(P_NEG);
-                Expr {
-                    tokens: quote!(-#a),
-                    prec: P_NEG,
-                }
+                let a = self.take(a, st).tokens;
+                Expr::atom(quote!(S::neg(#a)))
             }
             Node::Sqrt(a) => {
                 let a = self.take(a, st).tokens;
-                let (libm, f) = (&self.emitter.libm, self.emitter.float.libm_fn("sqrt"));
-                Expr::atom(quote!(#libm::#f(#a)))
+                Expr::atom(quote!(S::sqrt(#a)))
             }
             Node::Const(_) | Node::Input(_) | Node::Sin(_) | Node::Cos(_) => {
                 unreachable!("emitted by emit_node")

@@ -50,8 +50,40 @@ fn joint_list(model: &Model) -> String {
 pub fn lines(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
     let mut h = description(plan, opts, fmas);
     h.push(form_line(plan));
+    h.push(lanes_line(plan, opts));
     h.extend(count_table(plan));
     h
+}
+
+/// The lanes line: every function `NAME` has a `NAME_lanes` form over
+/// `kanegen_runtime::lanes::Lanes<F>`, several states per call on SIMD vectors.
+fn lanes_line(plan: &Plan, opts: &Options) -> String {
+    let f = opts.float.name();
+    let mut line = format!(
+        "Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<{f}>>` form \
+         (`kanegen_runtime::lanes`) taking and returning `S` in place of `{f}`: `S::LANES` \
+         states per call, one per lane of a SIMD vector (`wide`'s `{}`), each lane's results \
+         bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices \
+         of states, `S::LANES` at a time.",
+        match opts.float {
+            Float::F64 => "f64x2`, `f64x4",
+            Float::F32 => "f32x4`, `f32x8",
+        }
+    );
+    if plan
+        .functions
+        .iter()
+        .any(|fp| matches!(fp.kernel, crate::plan::Kernel::Compact(_)))
+    {
+        line.push_str(" A straight-line `NAME` is its `NAME_lanes` at `S = ");
+        line.push_str(f);
+        line.push_str("` (one body); a function in loops evaluates `NAME` lane by lane.");
+    } else {
+        line.push_str(" `NAME` is its `NAME_lanes` at `S = ");
+        line.push_str(f);
+        line.push_str("` (one body).");
+    }
+    line
 }
 
 /// The form line ([`crate::compact::decide`]), naming the functions a compact model keeps
@@ -185,8 +217,8 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
     ];
     if opts.table_sincos() && crate::choose::takes_trig(plan.choices()) {
         h.push(
-            "Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each \
-             function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a \
+            "Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table \
+             sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a \
              table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
              `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it)."
                 .into(),
@@ -210,13 +242,13 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
                 .into(),
         });
         h.push(if opts.fma {
-            let path = opts
-                .fma_path
-                .clone()
-                .unwrap_or_else(|| format!("{}::{}", opts.libm_path, opts.float.libm_fn("fma")));
+            let call = match &opts.fma_path {
+                Some(path) => format!("`S::fma_with(a, b, c, {path})`, `{path}` on each lane"),
+                None => format!("`S::fma(a, b, c)`, libm's `{}`", opts.float.libm_fn("fma")),
+            };
             format!(
-                "Fused multiply-adds: {total} ({per}), each `{path}(a, b, c)` = a·b + c rounded \
-                 once; the counts below count each as 1 mul + 1 add."
+                "Fused multiply-adds: {total} ({per}), each {call}: a·b + c rounded once; the \
+                 counts below count each as 1 mul + 1 add."
             )
         } else {
             "Fused multiply-adds: none.".into()
@@ -225,7 +257,7 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
     if !opts.fma && opts.target_fma && total > 0 {
         h.push(format!(
             "Fused multiply-adds where the target has them: {total} ({per}), each \
-             `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA \
+             `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA \
              (x86-64 with `target_feature = \"fma\"`, e.g. `-C target-cpu=native`; AArch64), \
              and `a·b + c` otherwise, where the code is bit-identical to unfused code. The \
              counts below count each as 1 mul + 1 add."

@@ -116,7 +116,7 @@ fn generate_items_with(
     for (fp, graph) in plan.functions.iter().zip(graphs) {
         let body = function_body(&plan, fp, graph, opts, &emitter, bodies.as_deref_mut())?;
         fmas.push(body.fmas);
-        fns.push(function_item(&plan, fp, body, opts, &names));
+        fns.push(function_item(&plan, fp, body, opts, &names)?);
     }
     let header = header::lines(&plan, opts, &fmas);
     let items = type_items(&plan, opts, &names, &header, header_on_struct, &fns, &fmas)?;
@@ -172,6 +172,12 @@ pub fn check_names(opts: &Options) -> Result<(), Error> {
     if opts.runtime_payload {
         declared.push(("its payload struct", &opts.payload_name));
     }
+    if opts.runtime_payload && opts.payload_name == LANE_TYPE {
+        return Err(Error(format!(
+            "the payload struct is called `{LANE_TYPE}`, the lane type parameter of the \
+             `_lanes` functions: rename it"
+        )));
+    }
     for (k, (what, name)) in declared.iter().enumerate() {
         if let Some((first, _)) = declared[..k].iter().find(|(_, n)| n == name) {
             return Err(Error(format!(
@@ -190,6 +196,13 @@ pub fn check_names(opts: &Options) -> Result<(), Error> {
         let Some(proc_macro2::TokenTree::Ident(head)) = path.clone().into_iter().next() else {
             continue;
         };
+        if head == LANE_TYPE {
+            return Err(Error(format!(
+                "the {path_name} path `{}` starts with `{LANE_TYPE}`, the lane type parameter of \
+                 the `_lanes` functions: give the path from the crate root (`::…`)",
+                path.to_string().replace(' ', "")
+            )));
+        }
         if let Some((what, name)) = declared.iter().find(|(_, n)| head == n) {
             return Err(Error(format!(
                 "{what} is called `{name}`, which would shadow the first segment of the {path_name} \
@@ -201,6 +214,10 @@ pub fn check_names(opts: &Options) -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// The lane type parameter of the `_lanes` functions (`S: Lanes<F>`), which a payload struct or
+/// a called path must not be named.
+const LANE_TYPE: &str = "S";
 
 /// What to rename in a name clash of [`check_names`] involving `what`.
 fn rename(what: &str) -> &'static str {
@@ -299,42 +316,135 @@ fn placeholder(k: usize) -> TokenStream {
     quote!(#name())
 }
 
-/// One generated function: its documentation (what it computes, by which methods, at what
-/// emitted cost), signature and body.
+/// One generated function and its `_lanes` form: the documentation (what it computes, by which
+/// methods, at what emitted cost), signatures and bodies.
+///
+/// Straight-line code is emitted once, as the body of `NAME_lanes<S: Lanes<F>>` (generic over
+/// the lane type, [`emit`]), and `NAME` is its instantiation at `S = F`. A compact body is the
+/// body of `NAME`, and `NAME_lanes` evaluates `NAME` lane by lane.
 fn function_item(
     plan: &Plan,
     fp: &FunctionPlan,
     body: Body,
     opts: &Options,
     names: &Names,
-) -> TokenStream {
+) -> Result<TokenStream, Error> {
     let fl = opts.float.ty();
+    let rt = opts.runtime()?;
+    let s = quote!(S);
     let name = format_ident!("{}", fp.name);
-    let args = fp.args.iter().map(|(a, len)| {
-        let len = Literal::usize_unsuffixed(*len);
-        let name = format_ident!("{}", a.name());
-        if *a == Arg::FExt {
-            quote!(#name: &[[#fl; 6]; #len])
-        } else {
-            quote!(#name: &[#fl; #len])
-        }
-    });
+    let lanes_name = format_ident!("{}_lanes", fp.name);
+    let args = |ty: &TokenStream| -> Vec<TokenStream> {
+        fp.args
+            .iter()
+            .map(|(a, len)| {
+                let len = Literal::usize_unsuffixed(*len);
+                let name = format_ident!("{}", a.name());
+                if *a == Arg::FExt {
+                    quote!(#name: &[[#ty; 6]; #len])
+                } else {
+                    quote!(#name: &[#ty; #len])
+                }
+            })
+            .collect()
+    };
+    let arg_names: Vec<syn::Ident> = fp
+        .args
+        .iter()
+        .map(|(a, _)| format_ident!("{}", a.name()))
+        .collect();
+    let (scalar_args, lane_args) = (args(&fl), args(&s));
     let payload_ty = &names.payload;
     let payload_arg = opts
         .runtime_payload
         .then(|| quote!(, payload: &#payload_ty));
-    let ret = return_type(fp.shape, &fl);
+    let payload_pass = opts.runtime_payload.then(|| quote!(, payload));
+    let (ret, lanes_ret) = (return_type(fp.shape, &fl), return_type(fp.shape, &s));
     let (doc1, doc2) = function_docs(plan, fp, body.fmas, opts);
+    let bound = quote!(S: #rt::lanes::Lanes<#fl>);
+    let batch_name = format_ident!("{}_batch", fp.name);
+    let batch_args: Vec<TokenStream> = fp
+        .args
+        .iter()
+        .map(|(a, len)| {
+            let len = Literal::usize_unsuffixed(*len);
+            let name = format_ident!("{}", a.name());
+            if *a == Arg::FExt {
+                quote!(#name: &[[[#fl; 6]; #len]])
+            } else {
+                quote!(#name: &[[#fl; #len]])
+            }
+        })
+        .collect();
+    let payload_arg_batch = opts.runtime_payload.then(|| quote!(payload: &#payload_ty,));
+    let batch_doc = format!(
+        " [`Self::{name}`] of every state of the slices, `S::LANES` states per call of \
+         [`Self::{lanes_name}`]: `out[k]` is `{name}` of the `k`-th entries, for `k` below the \
+         shortest slice's length (`out` included; entries of `out` past it are left as they \
+         are); a last chunk of fewer states is padded with the last state, whose extra results \
+         are discarded."
+    );
     let body = body.tokens;
-    quote! {
+    let (scalar_body, lanes_body, lanes_doc) = if matches!(fp.kernel, Kernel::Compact(_)) {
+        let lane_of = arg_names
+            .iter()
+            .map(|a| quote!(&#rt::lanes::lane::<#fl, S, _>(#a, i)));
+        (
+            body,
+            quote! {
+                #rt::lanes::lanewise::<#fl, S, _>(|i| Self::#name(#(#lane_of),* #payload_pass))
+            },
+            format!(
+                " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`{}` \
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): the \
+                 compact form evaluates the scalar function lane by lane.",
+                opts.float.name(),
+                match opts.float {
+                    Float::F64 => "f64x4",
+                    Float::F32 => "f32x8",
+                }
+            ),
+        )
+    } else {
+        (
+            quote!(Self::#lanes_name::<#fl>(#(#arg_names),* #payload_pass)),
+            body,
+            format!(
+                " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`{}` \
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): the same \
+                 straight-line code, each lane's results bit for bit the scalar function's for \
+                 that lane's state.",
+                opts.float.name(),
+                match opts.float {
+                    Float::F64 => "f64x4",
+                    Float::F32 => "f32x8",
+                }
+            ),
+        )
+    };
+    Ok(quote! {
         #[doc = #doc1]
         #[doc = ""]
         #[doc = #doc2]
         #[must_use]
-        pub fn #name(#(#args),* #payload_arg) -> #ret {
-            #body
+        pub fn #name(#(#scalar_args),* #payload_arg) -> #ret {
+            #scalar_body
         }
-    }
+
+        #[doc = #lanes_doc]
+        #[must_use]
+        pub fn #lanes_name<#bound>(#(#lane_args),* #payload_arg) -> #lanes_ret {
+            #lanes_body
+        }
+
+        #[doc = #batch_doc]
+        pub fn #batch_name<#bound>(#(#batch_args,)* #payload_arg_batch out: &mut [#ret]) {
+            let n = out.len() #(.min(#arg_names.len()))*;
+            #rt::lanes::batch::<#fl, S, _>(out, n, |start| {
+                Self::#lanes_name::<S>(#(&#rt::lanes::gather::<#fl, S, _>(#arg_names, start, n)),* #payload_pass)
+            });
+        }
+    })
 }
 
 /// The Rust type of a function's results.
@@ -539,7 +649,7 @@ fn type_items(
         opts.type_name
     );
     let consts = type_consts(plan, opts.float, fmas, op_ty);
-    let helpers = helper_items(plan, opts, fmas)?;
+    let helpers = helper_items(plan, opts)?;
     let (name, u64) = (paths::static_str(), paths::primitive("u64"));
     let method = paths::option_type(&name);
     Ok(quote! {
@@ -679,33 +789,25 @@ fn limit_consts(limits: &[kanegen_model::Limits], float: Float) -> TokenStream {
     }
 }
 
-/// The private helpers after the functions: `Self::mul_add` where a product is fused for the
-/// target, the type's own sine–cosine where a function takes one, and the compact form's
-/// tables and loops.
-fn helper_items(plan: &Plan, opts: &Options, fmas: &[u64]) -> Result<TokenStream, Error> {
+/// The helpers after the functions: the type's own sine–cosine where a function takes one, and
+/// the compact form's tables and loops.
+fn helper_items(plan: &Plan, opts: &Options) -> Result<TokenStream, Error> {
     let compact = plan.has_loops();
     let compact_items = if compact {
         compact::items(&plan.model, opts)?
     } else {
         quote!()
     };
-    // The type's own sine–cosine, where a function takes one (its products fused through
-    // `Self::mul_add` like the functions').
+    // The type's own sine–cosine, where a function takes one (its products fused where the
+    // functions' are).
     let sincos_item = opts.table_sincos() && (compact || choose::takes_trig(plan.choices()));
     let target_mul_add = !opts.fma && opts.target_fma;
-    let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
-        mul_add_fn(opts.float, &opts.runtime()?)
-    } else {
-        quote!()
-    };
     let sincos_item = if sincos_item {
         sincos::item(&opts.runtime()?, target_mul_add)
     } else {
         quote!()
     };
     Ok(quote! {
-        #mul_add_item
-
         #sincos_item
 
         #compact_items
@@ -828,26 +930,6 @@ pub use kanegen_dynamics;
 /// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
 
-/// The private `mul_add` of [`Options::target_fma`], forwarding to the runtime's
-/// (`kanegen_runtime::fma`): one fused instruction where the build targets it, `a·b + c` (two
-/// roundings, bit-identical to unfused code) elsewhere.
-fn mul_add_fn(float: Float, runtime: &TokenStream) -> TokenStream {
-    let ty = float.ty();
-    let f = match float {
-        Float::F64 => quote!(mul_add),
-        Float::F32 => quote!(mul_add_f32),
-    };
-    quote! {
-        /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-        /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-        /// elsewhere.
-        #[inline(always)]
-        fn mul_add(a: #ty, b: #ty, c: #ty) -> #ty {
-            #runtime::fma::#f(a, b, c)
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -885,12 +967,12 @@ mod tests {
                 Some("sqrt" | "sqrtf") => self.sqrt += 1,
                 Some("sincos" | "sincosf" | "sin" | "sinf" | "cos" | "cosf") => self.sincos += 1,
                 // One angle per element of its array.
-                Some("sincos_n") => {
+                Some("sincos_n" | "sincos_n_unfused") => {
                     if let Some(syn::Expr::Array(a)) = e.args.first() {
                         self.sincos += a.elems.len() as u64;
                     }
                 }
-                Some("fma" | "fmaf" | "mul_add") => {
+                Some("fma" | "fmaf" | "mul_add" | "fma_with") => {
                     self.fma += 1;
                     self.mul += 1;
                     self.add += 1;
@@ -924,7 +1006,7 @@ mod tests {
     }
 
     /// How a variant fuses products: not at all, through libm's `fma`, or through the
-    /// target-feature `Self::mul_add`.
+    /// target-feature `S::mul_add`.
     #[derive(Clone, Copy, PartialEq, Eq)]
     enum Fuse {
         None,
@@ -962,10 +1044,22 @@ mod tests {
             opts.target_fma = fuse == Fuse::Target;
             opts.form = Form::Unrolled;
             let g = generate_items(&chain, &opts).unwrap();
-            let mut fns = count_ops(g.items);
-            // The helpers `Self::mul_add`, `Self::sincos` and `Self::sincos_n` are not
-            // generated functions.
-            fns.retain(|name, _| name != "mul_add" && !name.starts_with("sincos"));
+            let all = count_ops(g.items);
+            // Each function is its `_lanes` body at `S = F`: a call, no operation of its own.
+            let mut fns = HashMap::new();
+            for (name, c) in all {
+                if let Some(f) = name.strip_suffix("_lanes") {
+                    fns.insert(f.to_string(), c);
+                } else if !name.starts_with("sincos") {
+                    // The helpers `Self::sincos` and `Self::sincos_n` are not generated
+                    // functions.
+                    assert_eq!(
+                        (c.mul, c.add, c.div, c.sqrt, c.sincos, c.fma),
+                        (0, 0, 0, 0, 0, 0),
+                        "{name}"
+                    );
+                }
+            }
             assert_eq!(
                 fns.len(),
                 10,
@@ -1082,7 +1176,9 @@ mod tests {
         let f32_src = generate_file(&chain, &o).unwrap();
         assert!(!f32_src.contains("f64"), "{f32_src}");
         assert!(f32_src.contains("Precision: `f32`"));
-        assert!(f32_src.contains("libm::sincosf("));
+        assert!(
+            f32_src.contains("S::sincos(") && f32_src.contains("Lanes<::core::primitive::f32>")
+        );
         assert!(f32_src.contains("Fused multiply-adds: none."));
 
         o.float = Float::F64;
@@ -1093,7 +1189,7 @@ mod tests {
         let calls = fma_src
             .lines()
             .filter(|l| !l.trim_start().starts_with("//"))
-            .map(|l| l.matches("f64::mul_add(").count() as u64)
+            .map(|l| l.matches("f64::mul_add").count() as u64)
             .sum::<u64>();
         let total: u64 = count_ops(g.items.clone()).values().map(|c| c.fma).sum();
         assert!(calls > 0);

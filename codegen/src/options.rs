@@ -56,8 +56,8 @@ pub struct Options {
     /// (default): `fma` (f64) or `fmaf` (f32) of [`Options::libm_path`]. `f64::mul_add` /
     /// `f32::mul_add` (UFCS of the std method; not `no_std`) work as well.
     pub fma_path: Option<String>,
-    /// Without [`Options::fma`]: fuse the same products through a private `Self::mul_add(a, b,
-    /// c)` that is one fused instruction where the build targets it (`x86_64` with
+    /// Without [`Options::fma`]: fuse the same products through `S::mul_add(a, b, c)` of the
+    /// lane type (`kanegen_runtime::lanes::Lanes`), one fused instruction where the build targets it (`x86_64` with
     /// `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64) and `a·b + c` otherwise,
     /// where the code is then bit-identical to unfused code. Default `true`.
     pub target_fma: bool,

@@ -4,8 +4,9 @@
 //! of 128 sines and short polynomials, branch-free and inlined for `|x| < 32768` rad,
 //! `libm::sincos` beyond), which holds the table and the algorithm.
 //!
-//! The functions take all joint angles' in one `Self::sincos_n([q[0], …])` at the top, whose
-//! steps the compiler vectorizes. The error against `libm::sincos` is measured by `kanegen
+//! The functions take all joint angles' in one `S::sincos_n([q[0], …])` at the top (the same
+//! runtime routine on each lane of the lane type `S`, `kanegen_runtime::lanes`), whose steps the
+//! compiler vectorizes. The error against `libm::sincos` is measured by `kanegen
 //! accuracy` (`docs/accuracy.md`) and bounded by `tests/sincos.rs`: 1 ulp of 1 at most, and 2 ulp
 //! of the value wherever it is at least 1/16.
 //!
@@ -17,7 +18,7 @@ use quote::quote;
 /// The emitted `pub fn sincos(x: f64) -> (f64, f64)` and `pub fn sincos_n<const N: usize>(x:
 /// [f64; N]) -> [(f64, f64); N]` of a generated type: `runtime` is the path of the
 /// `kanegen-runtime` crate; with `mul_add`, the products are fused where the build targets FMA
-/// (`sincos::sincos_n`, like the functions' `Self::mul_add`), else never
+/// (`sincos::sincos_n`, like the functions' `S::mul_add`), else never
 /// (`sincos::sincos_n_unfused`).
 #[must_use]
 pub fn item(runtime: &TokenStream, mul_add: bool) -> TokenStream {

@@ -9,9 +9,10 @@
 //! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
-//! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4091 (`mass_matrix` 268, `nonlinear_effects` 308, `inverse_dynamics` 323, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
+//! Fused multiply-adds where the target has them: 4091 (`mass_matrix` 268, `nonlinear_effects` 308, `inverse_dynamics` 323, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 576, `forward_dynamics_with_wrenches` 989, `momentum` 215, `base_reaction` 426), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 1796 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1263,481 +1264,625 @@ impl FreeFloating7 {
     pub fn mass_matrix(
         q: &[::core::primitive::f64; 14],
     ) -> [[::core::primitive::f64; 13]; 13] {
+        Self::mass_matrix_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 14],
+    ) -> [[S; 13]; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
-            q[8] + 1.5707963265897933,
-            q[9] + 1.5707963267948966,
+            q[8] + S::splat(1.5707963265897933),
+            q[9] + S::splat(1.5707963267948966),
             q[10],
             q[11],
-            q[12] - 1.5707963267948966,
-            q[13] - 1.5707963267948966,
+            q[12] - S::splat(1.5707963267948966),
+            q[13] - S::splat(1.5707963267948966),
         ]);
         let x7 = s_q13 * s_q13;
         let x8 = s_q13 * c_q13;
-        let x9 = Self::mul_add(x8, 0.001562, x7 * 1.2025609200000003);
-        let x10 = -1.2025609200000003 + x9;
-        let x11 = 0.000781 + Self::mul_add(x7, -0.001562, x8 * 1.2025609200000003);
-        let x12 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x13 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x14 = 4.806620000000001 * s_q13;
-        let x15 = 4.806620000000001 * c_q13;
-        let x16 = 1.4135609200000003 - x10;
+        let x9 = S::mul_add(x8, S::splat(0.001562), x7 * S::splat(1.2025609200000003));
+        let x10 = S::splat(-1.2025609200000003) + x9;
+        let x11 = S::splat(0.000781)
+            + S::mul_add(x7, S::splat(-0.001562), x8 * S::splat(1.2025609200000003));
+        let x12 = S::mul_add(
+            s_q13,
+            S::splat(-0.9614610000000001),
+            c_q13 * S::splat(0.0145),
+        );
+        let x13 = S::mul_add(
+            c_q13,
+            S::splat(0.9614610000000001),
+            s_q13 * S::splat(0.0145),
+        );
+        let x14 = S::splat(4.806620000000001) * s_q13;
+        let x15 = S::splat(4.806620000000001) * c_q13;
+        let x16 = S::splat(1.4135609200000003) - x10;
         let x17 = x13 + x13;
-        let x18 = Self::mul_add(-0.00000000020510342851533115, x17, x16);
-        let x19 = 0.00000000020510342851533115 * x15;
-        let x20 = 0.16 * x15;
-        let x21 = 0.55 * x14;
+        let x18 = S::mul_add(S::splat(-0.00000000020510342851533115), x17, x16);
+        let x19 = S::splat(0.00000000020510342851533115) * x15;
+        let x20 = S::splat(0.16) * x15;
+        let x21 = S::splat(0.55) * x14;
         let x22 = x20 - x21;
         let x23 = x20 - (x9 - x20);
-        let x24 = Self::mul_add(
-            0.55,
+        let x24 = S::mul_add(
+            S::splat(0.55),
             x15,
-            -Self::mul_add(
-                0.16,
-                x14,
-                Self::mul_add(0.00000000020510342851533115, x12, x11),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.16),
+                    x14,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x12, x11),
+                ),
             ),
         );
-        let x25 = 17.135250000000003 - x14;
-        let x26 = -3.6140000000000003 - x19;
-        let x27 = 1.9877000000000002
-            + Self::mul_add(
-                0.55,
+        let x25 = S::splat(17.135250000000003) - x14;
+        let x26 = S::splat(-3.6140000000000003) - x19;
+        let x27 = S::splat(1.9877000000000002)
+            + S::mul_add(
+                S::splat(0.55),
                 x19,
-                Self::mul_add(-0.00000000020510342851533115, x11, x12),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x11, x12),
             );
-        let x28 = -2.741639999592316 - x24;
-        let x29 = 5.252920330000002 + (x22 + (x10 + x18 + x22));
-        let x30 = 0.809539999555672
-            - Self::mul_add(
-                -0.16,
+        let x28 = S::splat(-2.741639999592316) - x24;
+        let x29 = S::splat(5.252920330000002) + (x22 + (x10 + x18 + x22));
+        let x30 = S::splat(0.809539999555672)
+            - S::mul_add(
+                S::splat(-0.16),
                 x19,
-                x13 - Self::mul_add(0.00000000020510342851533115, x16, x17),
+                x13 - S::mul_add(S::splat(0.00000000020510342851533115), x16, x17),
             );
-        let x31 = 9.740442170000001 - (x21 - (1.4135609200000003 - x18 - x21));
+        let x31 = S::splat(9.740442170000001)
+            - (x21 - (S::splat(1.4135609200000003) - x18 - x21));
         let x32 = s_q12 * s_q12;
         let x33 = s_q12 * c_q12;
         let x34 = x23 - x29;
         let x35 = x27 + x27;
-        let x36 = Self::mul_add(x33, x35, x32 * x34);
+        let x36 = S::mul_add(x33, x35, x32 * x34);
         let x37 = x29 + x36;
-        let x38 = x27 + Self::mul_add(-x32, x35, x33 * x34);
-        let x39 = Self::mul_add(-s_q12, x30, c_q12 * x28);
-        let x40 = Self::mul_add(c_q12, x30, s_q12 * x28);
-        let x41 = Self::mul_add(-s_q12, x26, c_q12 * x25);
-        let x42 = Self::mul_add(c_q12, x26, s_q12 * x25);
+        let x38 = x27 + S::mul_add(S::neg(x32), x35, x33 * x34);
+        let x39 = S::mul_add(S::neg(s_q12), x30, c_q12 * x28);
+        let x40 = S::mul_add(c_q12, x30, s_q12 * x28);
+        let x41 = S::mul_add(S::neg(s_q12), x26, c_q12 * x25);
+        let x42 = S::mul_add(c_q12, x26, s_q12 * x25);
         let x43 = x31 - x37;
         let x44 = x40 + x40;
-        let x45 = Self::mul_add(0.00000000020510342851533115, x44, x43);
-        let x46 = Self::mul_add(0.00000000020510342851533115, x38, x39);
-        let x47 = Self::mul_add(0.00000000020510342851533115, x42, x15);
+        let x45 = S::mul_add(S::splat(0.00000000020510342851533115), x44, x43);
+        let x46 = S::mul_add(S::splat(0.00000000020510342851533115), x38, x39);
+        let x47 = S::mul_add(S::splat(0.00000000020510342851533115), x42, x15);
         let x48 = x19 - x42;
-        let x49 = x48 * 0.36;
+        let x49 = x48 * S::splat(0.36);
         let x50 = x49 + (x23 - x36 + x49);
-        let x51 = -7.078399999258757 - x47;
-        let x52 = -0.01675
-            + Self::mul_add(
+        let x51 = S::splat(-7.078399999258757) - x47;
+        let x52 = S::splat(-0.01675)
+            + S::mul_add(
                 x41,
-                0.36,
-                Self::mul_add(-0.00000000020510342851533115, x39, x38),
+                S::splat(0.36),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x39, x38),
             );
-        let x53 = -3.8891049197628025 + (x49 + (x37 + x45 + x49));
-        let x54 = -2.5482240005325645
-            + Self::mul_add(
+        let x53 = S::splat(-3.8891049197628025) + (x49 + (x37 + x45 + x49));
+        let x54 = S::splat(-2.5482240005325645)
+            + S::mul_add(
                 x47,
-                -0.36,
-                x40 - Self::mul_add(-0.00000000020510342851533115, x43, x44),
+                S::splat(-0.36),
+                x40 - S::mul_add(S::splat(-0.00000000020510342851533115), x43, x44),
             );
-        let x55 = 3.970314919762802 + (x31 - x45);
+        let x55 = S::splat(3.970314919762802) + (x31 - x45);
         let x56 = s_q11 * s_q11;
         let x57 = s_q11 * c_q11;
         let x58 = x50 - x53;
         let x59 = x46 + x46;
-        let x60 = Self::mul_add(-x57, x59, x56 * x58);
-        let x61 = Self::mul_add(-s_q11, x51, c_q11 * x41);
-        let x62 = Self::mul_add(c_q11, x51, s_q11 * x41);
-        let x63 = 0.275 * x48;
-        let x64 = x62 * 0.63;
+        let x60 = S::mul_add(S::neg(x57), x59, x56 * x58);
+        let x61 = S::mul_add(S::neg(s_q11), x51, c_q11 * x41);
+        let x62 = S::mul_add(c_q11, x51, s_q11 * x41);
+        let x63 = S::splat(0.275) * x48;
+        let x64 = x62 * S::splat(0.63);
         let x65 = x63 + x64;
-        let x66 = Self::mul_add(x61, 0.63, x46 - Self::mul_add(x56, x59, x57 * x58));
-        let x67 = Self::mul_add(0.275, x61, Self::mul_add(-s_q11, x54, c_q11 * x52));
-        let x68 = Self::mul_add(0.275, x62, Self::mul_add(c_q11, x54, s_q11 * x52));
+        let x66 = S::mul_add(x61, S::splat(0.63), x46 - S::mul_add(x56, x59, x57 * x58));
+        let x67 = S::mul_add(
+            S::splat(0.275),
+            x61,
+            S::mul_add(S::neg(s_q11), x54, c_q11 * x52),
+        );
+        let x68 = S::mul_add(S::splat(0.275), x62, S::mul_add(c_q11, x54, s_q11 * x52));
         let x69 = x55 + x64;
         let x70 = x65 + (x50 - x60 + x65);
-        let x71 = -45.1584 - x62;
-        let x72 = -0.6328 - x67;
-        let x73 = -24.4950615 + (x63 + (x53 + x60 + x63));
-        let x74 = -24.35164200091464 - Self::mul_add(x48, 0.63, x68);
-        let x75 = 28.2393615 + (x64 + x69);
+        let x71 = S::splat(-45.1584) - x62;
+        let x72 = S::splat(-0.6328) - x67;
+        let x73 = S::splat(-24.4950615) + (x63 + (x53 + x60 + x63));
+        let x74 = S::splat(-24.35164200091464) - S::mul_add(x48, S::splat(0.63), x68);
+        let x75 = S::splat(28.2393615) + (x64 + x69);
         let x76 = s_q10 * s_q10;
         let x77 = s_q10 * c_q10;
         let x78 = x70 - x73;
         let x79 = x66 + x66;
-        let x80 = Self::mul_add(-x77, x79, x76 * x78);
-        let x81 = Self::mul_add(-s_q10, x74, c_q10 * x72);
-        let x82 = Self::mul_add(c_q10, x74, s_q10 * x72);
+        let x80 = S::mul_add(S::neg(x77), x79, x76 * x78);
+        let x81 = S::mul_add(S::neg(s_q10), x74, c_q10 * x72);
+        let x82 = S::mul_add(c_q10, x74, s_q10 * x72);
         let x83 = c_q10 * x61;
-        let x84 = Self::mul_add(s_q10, x71, x83);
+        let x84 = S::mul_add(s_q10, x71, x83);
         let x85 = s_q10 * x61;
-        let x86 = Self::mul_add(-c_q10, x71, x85);
-        let x87 = x86 * 0.87;
-        let x88 = Self::mul_add(x84, 0.87, x66 - Self::mul_add(x76, x79, x77 * x78));
+        let x86 = S::mul_add(S::neg(c_q10), x71, x85);
+        let x87 = x86 * S::splat(0.87);
+        let x88 = S::mul_add(x84, S::splat(0.87), x66 - S::mul_add(x76, x79, x77 * x78));
         let x89 = x75 + x87;
         let x90 = x87 + (x70 - x80 + x87);
-        let x91 = -81.53205 - x86;
-        let x92 = -0.00214 + x81;
-        let x93 = -63.36336825 + (x73 + x80);
-        let x94 = -36.18604050126307 + Self::mul_add(x48, -0.87, x82);
-        let x95 = 69.99836825 + (x87 + x89);
+        let x91 = S::splat(-81.53205) - x86;
+        let x92 = S::splat(-0.00214) + x81;
+        let x93 = S::splat(-63.36336825) + (x73 + x80);
+        let x94 = S::splat(-36.18604050126307) + S::mul_add(x48, S::splat(-0.87), x82);
+        let x95 = S::splat(69.99836825) + (x87 + x89);
         let x96 = s_q9 * s_q9;
         let x97 = s_q9 * c_q9;
         let x98 = x90 - x93;
         let x99 = x88 + x88;
-        let x100 = Self::mul_add(-x97, x99, x96 * x98);
+        let x100 = S::mul_add(S::neg(x97), x99, x96 * x98);
         let x101 = x93 + x100;
-        let x102 = x88 - Self::mul_add(x96, x99, x97 * x98);
-        let x103 = Self::mul_add(-s_q9, x94, c_q9 * x92);
-        let x104 = Self::mul_add(c_q9, x94, s_q9 * x92);
+        let x102 = x88 - S::mul_add(x96, x99, x97 * x98);
+        let x103 = S::mul_add(S::neg(s_q9), x94, c_q9 * x92);
+        let x104 = S::mul_add(c_q9, x94, s_q9 * x92);
         let x105 = c_q9 * x84;
-        let x106 = Self::mul_add(s_q9, x91, x105);
+        let x106 = S::mul_add(s_q9, x91, x105);
         let x107 = s_q9 * x84;
-        let x108 = Self::mul_add(-c_q9, x91, x107);
+        let x108 = S::mul_add(S::neg(c_q9), x91, x107);
         let x109 = x95 - x101;
         let x110 = x104 + x104;
-        let x111 = Self::mul_add(0.00000000020510342851533115, x110, x109);
-        let x112 = Self::mul_add(0.00000000020510342851533115, x108, x48);
-        let x113 = Self::mul_add(-0.00000000020510342851533115, x48, x108);
-        let x114 = 0.4 * x113;
-        let x115 = 0.275 * x112;
+        let x111 = S::mul_add(S::splat(0.00000000020510342851533115), x110, x109);
+        let x112 = S::mul_add(S::splat(0.00000000020510342851533115), x108, x48);
+        let x113 = S::mul_add(S::splat(-0.00000000020510342851533115), x48, x108);
+        let x114 = S::splat(0.4) * x113;
+        let x115 = S::splat(0.275) * x112;
         let x116 = x114 + x115;
-        let x117 = 0.275 * x106;
-        let x118 = 0.00000000005640344284171607 * x106;
+        let x117 = S::splat(0.275) * x106;
+        let x118 = S::splat(0.00000000005640344284171607) * x106;
         let x119 = x114 + x118;
         let x120 = x115 + x118;
         let x121 = x116 - (x90 - x100 - x116);
-        let x122 = Self::mul_add(
-            0.00000000005640344284171607,
+        let x122 = S::mul_add(
+            S::splat(0.00000000005640344284171607),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x106,
-                Self::mul_add(0.00000000020510342851533115, x103, x102),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x106,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x103, x102),
+                ),
             ),
         );
-        let x123 = Self::mul_add(
-            0.275,
+        let x123 = S::mul_add(
+            S::splat(0.275),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x112,
-                x104 - Self::mul_add(-0.00000000020510342851533115, x109, x110),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x112,
+                    x104
+                        - S::mul_add(S::splat(-0.00000000020510342851533115), x109, x110),
+                ),
             ),
         );
-        let x124 = 0.0000000059257457049506905 - x106;
-        let x125 = 12.701650001451807 + x112;
-        let x126 = -0.0000000005683321144643007
-            - Self::mul_add(
-                0.00000000005640344284171607,
+        let x124 = S::splat(0.0000000059257457049506905) - x106;
+        let x125 = S::splat(12.701650001451807) + x112;
+        let x126 = S::splat(-0.0000000005683321144643007)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
                 x112,
-                Self::mul_add(-0.00000000020510342851533115, x102, x103) + x117,
+                S::mul_add(S::splat(-0.00000000020510342851533115), x102, x103) + x117,
             );
-        let x127 = 0.0021399976297017177 + x122;
-        let x128 = -106.50196992080811 - (x119 - (x101 + x111 - x119));
-        let x129 = -5.080660022992534 - x123;
-        let x130 = 108.1389699208081 - (x120 - (x95 - x111 - x120));
+        let x127 = S::splat(0.0021399976297017177) + x122;
+        let x128 = S::splat(-106.50196992080811) - (x119 - (x101 + x111 - x119));
+        let x129 = S::splat(-5.080660022992534) - x123;
+        let x130 = S::splat(108.1389699208081) - (x120 - (x95 - x111 - x120));
         let x131 = s_q8 * s_q8;
         let x132 = s_q8 * c_q8;
         let x133 = x121 + x128;
         let x134 = x126 + x126;
-        let x135 = Self::mul_add(-x132, x134, x131 * x133);
+        let x135 = S::mul_add(S::neg(x132), x134, x131 * x133);
         let x136 = x128 - x135;
-        let x137 = x126 - Self::mul_add(x131, x134, x132 * x133);
-        let x138 = Self::mul_add(-s_q8, x129, c_q8 * x127);
-        let x139 = Self::mul_add(c_q8, x129, s_q8 * x127);
-        let x140 = Self::mul_add(-s_q8, x125, c_q8 * x124);
-        let x141 = Self::mul_add(c_q8, x125, s_q8 * x124);
+        let x137 = x126 - S::mul_add(x131, x134, x132 * x133);
+        let x138 = S::mul_add(S::neg(s_q8), x129, c_q8 * x127);
+        let x139 = S::mul_add(c_q8, x129, s_q8 * x127);
+        let x140 = S::mul_add(S::neg(s_q8), x125, c_q8 * x124);
+        let x141 = S::mul_add(c_q8, x125, s_q8 * x124);
         let x142 = x130 - x136;
         let x143 = x139 + x139;
-        let x144 = Self::mul_add(0.00000000020510342851533115, x143, x142);
-        let x145 = Self::mul_add(-0.00000000020510342851533115, x141, x113);
-        let x146 = Self::mul_add(0.00000000020510342851533115, x113, x141);
-        let x147 = 0.35 * x146;
+        let x144 = S::mul_add(S::splat(0.00000000020510342851533115), x143, x142);
+        let x145 = S::mul_add(S::splat(-0.00000000020510342851533115), x141, x113);
+        let x146 = S::mul_add(S::splat(0.00000000020510342851533115), x113, x141);
+        let x147 = S::splat(0.35) * x146;
         let x148 = x147 - (x121 - x135 - x147);
-        let x149 = -48.0240000085309 + x145;
-        let x150 = 0.07309 - Self::mul_add(0.00000000020510342851533115, x137, x138);
-        let x151 = 0.1132
-            + Self::mul_add(
-                -0.35,
+        let x149 = S::splat(-48.0240000085309) + x145;
+        let x150 = S::splat(0.07309)
+            - S::mul_add(S::splat(0.00000000020510342851533115), x137, x138);
+        let x151 = S::splat(0.1132)
+            + S::mul_add(
+                S::splat(-0.35),
                 x140,
-                Self::mul_add(-0.00000000020510342851533115, x138, x137),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x138, x137),
             );
-        let x152 = -125.18476992763283 + (x147 + (x136 + x144 + x147));
-        let x153 = 16.807689977165428
-            + Self::mul_add(
-                -0.35,
+        let x152 = S::splat(-125.18476992763283) + (x147 + (x136 + x144 + x147));
+        let x153 = S::splat(16.807689977165428)
+            + S::mul_add(
+                S::splat(-0.35),
                 x145,
-                x139 - Self::mul_add(-0.00000000020510342851533115, x142, x143),
+                x139 - S::mul_add(S::splat(-0.00000000020510342851533115), x142, x143),
             );
-        let x154 = 127.22056992763282 + (x130 - x144);
+        let x154 = S::splat(127.22056992763282) + (x130 - x144);
         let x155 = s_q7 * s_q7;
         let x156 = s_q7 * c_q7;
         let x157 = x148 - x152;
         let x158 = x150 + x150;
-        let x159 = Self::mul_add(x156, x158, x155 * x157);
-        let x160 = Self::mul_add(-s_q7, x149, c_q7 * x140);
-        let x161 = Self::mul_add(c_q7, x149, s_q7 * x140);
-        let x162 = -x161;
-        let x163 = -x160;
-        let x164 = 0.75 * x146;
-        let x165 = 0.65 * x161;
+        let x159 = S::mul_add(x156, x158, x155 * x157);
+        let x160 = S::mul_add(S::neg(s_q7), x149, c_q7 * x140);
+        let x161 = S::mul_add(c_q7, x149, s_q7 * x140);
+        let x162 = S::neg(x161);
+        let x163 = S::neg(x160);
+        let x164 = S::splat(0.75) * x146;
+        let x165 = S::splat(0.65) * x161;
         let x166 = x164 - x165;
-        let x167 = Self::mul_add(-0.75, x161, Self::mul_add(c_q7, x153, s_q7 * x151));
-        let x168 = -x167;
-        let x169 = -Self::mul_add(
-            0.65,
+        let x167 = S::mul_add(
+            S::splat(-0.75),
+            x161,
+            S::mul_add(c_q7, x153, s_q7 * x151),
+        );
+        let x168 = S::neg(x167);
+        let x169 = S::neg(
+            S::mul_add(
+                S::splat(0.65),
+                x160,
+                x150 + S::mul_add(S::neg(x155), x158, x156 * x157),
+            ),
+        );
+        let x170 = S::mul_add(
+            S::splat(-0.75),
             x160,
-            x150 + Self::mul_add(-x155, x158, x156 * x157),
+            S::mul_add(S::neg(s_q7), x153, c_q7 * x151),
         );
-        let x170 = Self::mul_add(-0.75, x160, Self::mul_add(-s_q7, x153, c_q7 * x151));
         let x171 = x154 - x165;
-        let x172 = 110.5455 - x161;
-        let x173 = 180.9502499901501 + x146;
-        let x174 = 1519.7808011559632 + (x164 + (x152 + x159 + x164));
-        let x175 = -117.61766249359756 - Self::mul_add(0.65, x146, x167);
-        let x176 = 1591.635376155963 + (x166 + (x148 - x159 + x166));
-        let x177 = 1271.854575 - (x165 - x171);
-        let x178 = -x173;
-        let x179 = -x172;
-        let x180 = 0.00000000020510342851533115 * x140;
-        let x181 = Self::mul_add(-0.00000000020510342851533115, x130, x139);
-        let x182 = Self::mul_add(0.35, x180, x138);
-        let x183 = Self::mul_add(
-            0.35,
+        let x172 = S::splat(110.5455) - x161;
+        let x173 = S::splat(180.9502499901501) + x146;
+        let x174 = S::splat(1519.7808011559632) + (x164 + (x152 + x159 + x164));
+        let x175 = S::splat(-117.61766249359756)
+            - S::mul_add(S::splat(0.65), x146, x167);
+        let x176 = S::splat(1591.635376155963) + (x166 + (x148 - x159 + x166));
+        let x177 = S::splat(1271.854575) - (x165 - x171);
+        let x178 = S::neg(x173);
+        let x179 = S::neg(x172);
+        let x180 = S::splat(0.00000000020510342851533115) * x140;
+        let x181 = S::mul_add(S::splat(-0.00000000020510342851533115), x130, x139);
+        let x182 = S::mul_add(S::splat(0.35), x180, x138);
+        let x183 = S::mul_add(
+            S::splat(0.35),
             x141,
-            Self::mul_add(0.00000000020510342851533115, x139, x130),
+            S::mul_add(S::splat(0.00000000020510342851533115), x139, x130),
         );
-        let x184 = Self::mul_add(c_q7, x180, s_q7 * x141);
-        let x185 = Self::mul_add(-s_q7, x180, c_q7 * x141);
-        let x186 = -x185;
-        let x187 = -Self::mul_add(-0.75, x185, Self::mul_add(-c_q7, x183, s_q7 * x182));
-        let x188 = Self::mul_add(s_q7, x183, c_q7 * x182)
-            + Self::mul_add(-0.65, x140, 0.75 * x184);
-        let x189 = Self::mul_add(-0.65, x185, x181);
-        let x190 = 0.00000000020510342851533115 * x106;
-        let x191 = x103 + Self::mul_add(-0.4, x190, x117);
-        let x192 = Self::mul_add(0.00000000020510342851533115, x104, x95)
-            - Self::mul_add(0.4, x108, x118);
-        let x193 = Self::mul_add(-0.00000000020510342851533115, x95, x104)
-            + Self::mul_add(0.00000000005640344284171607, x190, 0.275 * x108);
-        let x194 = Self::mul_add(-s_q8, x190, c_q8 * x108);
-        let x195 = Self::mul_add(c_q8, x190, s_q8 * x108);
-        let x196 = Self::mul_add(-0.00000000020510342851533115, x195, x106);
+        let x184 = S::mul_add(c_q7, x180, s_q7 * x141);
+        let x185 = S::mul_add(S::neg(s_q7), x180, c_q7 * x141);
+        let x186 = S::neg(x185);
+        let x187 = S::neg(
+            S::mul_add(
+                S::splat(-0.75),
+                x185,
+                S::mul_add(S::neg(c_q7), x183, s_q7 * x182),
+            ),
+        );
+        let x188 = S::mul_add(s_q7, x183, c_q7 * x182)
+            + S::mul_add(S::splat(-0.65), x140, S::splat(0.75) * x184);
+        let x189 = S::mul_add(S::splat(-0.65), x185, x181);
+        let x190 = S::splat(0.00000000020510342851533115) * x106;
+        let x191 = x103 + S::mul_add(S::splat(-0.4), x190, x117);
+        let x192 = S::mul_add(S::splat(0.00000000020510342851533115), x104, x95)
+            - S::mul_add(S::splat(0.4), x108, x118);
+        let x193 = S::mul_add(S::splat(-0.00000000020510342851533115), x95, x104)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x190,
+                S::splat(0.275) * x108,
+            );
+        let x194 = S::mul_add(S::neg(s_q8), x190, c_q8 * x108);
+        let x195 = S::mul_add(c_q8, x190, s_q8 * x108);
+        let x196 = S::mul_add(S::splat(-0.00000000020510342851533115), x195, x106);
         let x197 = x190 + x195;
-        let x198 = Self::mul_add(-c_q8, x192, s_q8 * x191);
-        let x199 = Self::mul_add(-0.00000000020510342851533115, x193, x198);
-        let x200 = Self::mul_add(-0.35, x196, Self::mul_add(s_q8, x192, c_q8 * x191));
-        let x201 = Self::mul_add(
-            -0.35,
+        let x198 = S::mul_add(S::neg(c_q8), x192, s_q8 * x191);
+        let x199 = S::mul_add(S::splat(-0.00000000020510342851533115), x193, x198);
+        let x200 = S::mul_add(
+            S::splat(-0.35),
+            x196,
+            S::mul_add(s_q8, x192, c_q8 * x191),
+        );
+        let x201 = S::mul_add(
+            S::splat(-0.35),
             x194,
-            Self::mul_add(0.00000000020510342851533115, x198, x193),
+            S::mul_add(S::splat(0.00000000020510342851533115), x198, x193),
         );
-        let x202 = Self::mul_add(c_q7, x196, s_q7 * x194);
-        let x203 = -x202;
-        let x204 = Self::mul_add(-s_q7, x196, c_q7 * x194);
-        let x205 = -Self::mul_add(0.75, x204, Self::mul_add(-c_q7, x201, s_q7 * x200));
-        let x206 = Self::mul_add(s_q7, x201, c_q7 * x200)
-            - Self::mul_add(0.65, x197, 0.75 * x202);
-        let x207 = Self::mul_add(0.65, x204, x199);
-        let x208 = Self::mul_add(c_q9, x86, x107);
-        let x209 = Self::mul_add(-s_q9, x86, x105);
-        let x210 = 0.00000000020510342851533115 * x209;
-        let x211 = Self::mul_add(c_q9, x82, s_q9 * x81);
-        let x212 = Self::mul_add(-s_q9, x82, c_q9 * x81)
-            - Self::mul_add(-0.275, x209, 0.4 * x210);
-        let x213 = Self::mul_add(0.00000000020510342851533115, x211, x89)
-            - Self::mul_add(0.00000000005640344284171607, x209, 0.4 * x208);
-        let x214 = Self::mul_add(-0.00000000020510342851533115, x89, x211)
-            + Self::mul_add(0.00000000005640344284171607, x210, 0.275 * x208);
-        let x215 = Self::mul_add(-s_q8, x210, c_q8 * x208);
-        let x216 = Self::mul_add(c_q8, x210, s_q8 * x208);
-        let x217 = Self::mul_add(-0.00000000020510342851533115, x216, x209);
+        let x202 = S::mul_add(c_q7, x196, s_q7 * x194);
+        let x203 = S::neg(x202);
+        let x204 = S::mul_add(S::neg(s_q7), x196, c_q7 * x194);
+        let x205 = S::neg(
+            S::mul_add(S::splat(0.75), x204, S::mul_add(S::neg(c_q7), x201, s_q7 * x200)),
+        );
+        let x206 = S::mul_add(s_q7, x201, c_q7 * x200)
+            - S::mul_add(S::splat(0.65), x197, S::splat(0.75) * x202);
+        let x207 = S::mul_add(S::splat(0.65), x204, x199);
+        let x208 = S::mul_add(c_q9, x86, x107);
+        let x209 = S::mul_add(S::neg(s_q9), x86, x105);
+        let x210 = S::splat(0.00000000020510342851533115) * x209;
+        let x211 = S::mul_add(c_q9, x82, s_q9 * x81);
+        let x212 = S::mul_add(S::neg(s_q9), x82, c_q9 * x81)
+            - S::mul_add(S::splat(-0.275), x209, S::splat(0.4) * x210);
+        let x213 = S::mul_add(S::splat(0.00000000020510342851533115), x211, x89)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x209,
+                S::splat(0.4) * x208,
+            );
+        let x214 = S::mul_add(S::splat(-0.00000000020510342851533115), x89, x211)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x210,
+                S::splat(0.275) * x208,
+            );
+        let x215 = S::mul_add(S::neg(s_q8), x210, c_q8 * x208);
+        let x216 = S::mul_add(c_q8, x210, s_q8 * x208);
+        let x217 = S::mul_add(S::splat(-0.00000000020510342851533115), x216, x209);
         let x218 = x210 + x216;
-        let x219 = Self::mul_add(-c_q8, x213, s_q8 * x212);
-        let x220 = Self::mul_add(-0.00000000020510342851533115, x214, x219);
-        let x221 = Self::mul_add(-0.35, x217, Self::mul_add(s_q8, x213, c_q8 * x212));
-        let x222 = Self::mul_add(
-            -0.35,
+        let x219 = S::mul_add(S::neg(c_q8), x213, s_q8 * x212);
+        let x220 = S::mul_add(S::splat(-0.00000000020510342851533115), x214, x219);
+        let x221 = S::mul_add(
+            S::splat(-0.35),
+            x217,
+            S::mul_add(s_q8, x213, c_q8 * x212),
+        );
+        let x222 = S::mul_add(
+            S::splat(-0.35),
             x215,
-            Self::mul_add(0.00000000020510342851533115, x219, x214),
+            S::mul_add(S::splat(0.00000000020510342851533115), x219, x214),
         );
-        let x223 = Self::mul_add(c_q7, x217, s_q7 * x215);
-        let x224 = -x223;
-        let x225 = Self::mul_add(-s_q7, x217, c_q7 * x215);
-        let x226 = -Self::mul_add(0.75, x225, Self::mul_add(-c_q7, x222, s_q7 * x221));
-        let x227 = Self::mul_add(s_q7, x222, c_q7 * x221)
-            - Self::mul_add(0.65, x218, 0.75 * x223);
-        let x228 = Self::mul_add(0.65, x225, x220);
-        let x229 = Self::mul_add(c_q10, x62, x85);
-        let x230 = Self::mul_add(-s_q10, x62, x83);
-        let x231 = Self::mul_add(-s_q10, x68, c_q10 * x67);
-        let x232 = Self::mul_add(c_q10, x68, s_q10 * x67);
-        let x233 = Self::mul_add(0.87, x229, x69);
-        let x234 = Self::mul_add(s_q9, x230, c_q9 * x229);
-        let x235 = Self::mul_add(-c_q9, x230, s_q9 * x229);
-        let x236 = 0.00000000020510342851533115 * x235;
-        let x237 = Self::mul_add(c_q9, x232, s_q9 * x231);
-        let x238 = Self::mul_add(-s_q9, x232, c_q9 * x231)
-            - Self::mul_add(-0.275, x235, 0.4 * x236);
-        let x239 = Self::mul_add(-0.00000000020510342851533115, x237, x233)
-            - Self::mul_add(-0.00000000005640344284171607, x235, 0.4 * x234);
-        let x240 = Self::mul_add(0.00000000020510342851533115, x233, x237)
-            - Self::mul_add(-0.00000000005640344284171607, x236, 0.275 * x234);
-        let x241 = -x240;
-        let x242 = Self::mul_add(s_q8, x236, c_q8 * x234);
-        let x243 = Self::mul_add(-c_q8, x236, s_q8 * x234);
-        let x244 = Self::mul_add(0.00000000020510342851533115, x243, x235);
+        let x223 = S::mul_add(c_q7, x217, s_q7 * x215);
+        let x224 = S::neg(x223);
+        let x225 = S::mul_add(S::neg(s_q7), x217, c_q7 * x215);
+        let x226 = S::neg(
+            S::mul_add(S::splat(0.75), x225, S::mul_add(S::neg(c_q7), x222, s_q7 * x221)),
+        );
+        let x227 = S::mul_add(s_q7, x222, c_q7 * x221)
+            - S::mul_add(S::splat(0.65), x218, S::splat(0.75) * x223);
+        let x228 = S::mul_add(S::splat(0.65), x225, x220);
+        let x229 = S::mul_add(c_q10, x62, x85);
+        let x230 = S::mul_add(S::neg(s_q10), x62, x83);
+        let x231 = S::mul_add(S::neg(s_q10), x68, c_q10 * x67);
+        let x232 = S::mul_add(c_q10, x68, s_q10 * x67);
+        let x233 = S::mul_add(S::splat(0.87), x229, x69);
+        let x234 = S::mul_add(s_q9, x230, c_q9 * x229);
+        let x235 = S::mul_add(S::neg(c_q9), x230, s_q9 * x229);
+        let x236 = S::splat(0.00000000020510342851533115) * x235;
+        let x237 = S::mul_add(c_q9, x232, s_q9 * x231);
+        let x238 = S::mul_add(S::neg(s_q9), x232, c_q9 * x231)
+            - S::mul_add(S::splat(-0.275), x235, S::splat(0.4) * x236);
+        let x239 = S::mul_add(S::splat(-0.00000000020510342851533115), x237, x233)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x235,
+                S::splat(0.4) * x234,
+            );
+        let x240 = S::mul_add(S::splat(0.00000000020510342851533115), x233, x237)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x236,
+                S::splat(0.275) * x234,
+            );
+        let x241 = S::neg(x240);
+        let x242 = S::mul_add(s_q8, x236, c_q8 * x234);
+        let x243 = S::mul_add(S::neg(c_q8), x236, s_q8 * x234);
+        let x244 = S::mul_add(S::splat(0.00000000020510342851533115), x243, x235);
         let x245 = x236 - x243;
-        let x246 = -x245;
-        let x247 = Self::mul_add(c_q8, x239, s_q8 * x238);
-        let x248 = Self::mul_add(-0.00000000020510342851533115, x240, x247);
-        let x249 = -x248;
-        let x250 = Self::mul_add(-0.35, x244, Self::mul_add(-s_q8, x239, c_q8 * x238));
-        let x251 = Self::mul_add(
-            0.35,
+        let x246 = S::neg(x245);
+        let x247 = S::mul_add(c_q8, x239, s_q8 * x238);
+        let x248 = S::mul_add(S::splat(-0.00000000020510342851533115), x240, x247);
+        let x249 = S::neg(x248);
+        let x250 = S::mul_add(
+            S::splat(-0.35),
+            x244,
+            S::mul_add(S::neg(s_q8), x239, c_q8 * x238),
+        );
+        let x251 = S::mul_add(
+            S::splat(0.35),
             x242,
-            Self::mul_add(0.00000000020510342851533115, x247, x240),
+            S::mul_add(S::splat(0.00000000020510342851533115), x247, x240),
         );
-        let x252 = Self::mul_add(-c_q7, x244, s_q7 * x242);
-        let x253 = -x252;
-        let x254 = Self::mul_add(s_q7, x244, c_q7 * x242);
-        let x255 = Self::mul_add(-0.75, x254, Self::mul_add(-c_q7, x251, s_q7 * x250));
-        let x256 = -(Self::mul_add(s_q7, x251, c_q7 * x250)
-            + Self::mul_add(-0.65, x245, 0.75 * x252));
-        let x257 = -Self::mul_add(-0.65, x254, x248);
-        let x258 = 0.00000000020510342851533115 * x41;
-        let x259 = Self::mul_add(-0.00000000020510342851533115, x31, x40);
-        let x260 = Self::mul_add(-0.36, x258, x39);
-        let x261 = Self::mul_add(
+        let x252 = S::mul_add(S::neg(c_q7), x244, s_q7 * x242);
+        let x253 = S::neg(x252);
+        let x254 = S::mul_add(s_q7, x244, c_q7 * x242);
+        let x255 = S::mul_add(
+            S::splat(-0.75),
+            x254,
+            S::mul_add(S::neg(c_q7), x251, s_q7 * x250),
+        );
+        let x256 = S::neg(
+            S::mul_add(s_q7, x251, c_q7 * x250)
+                + S::mul_add(S::splat(-0.65), x245, S::splat(0.75) * x252),
+        );
+        let x257 = S::neg(S::mul_add(S::splat(-0.65), x254, x248));
+        let x258 = S::splat(0.00000000020510342851533115) * x41;
+        let x259 = S::mul_add(S::splat(-0.00000000020510342851533115), x31, x40);
+        let x260 = S::mul_add(S::splat(-0.36), x258, x39);
+        let x261 = S::mul_add(
             x42,
-            -0.36,
-            Self::mul_add(0.00000000020510342851533115, x40, x31),
+            S::splat(-0.36),
+            S::mul_add(S::splat(0.00000000020510342851533115), x40, x31),
         );
-        let x262 = Self::mul_add(-s_q11, x258, c_q11 * x42);
-        let x263 = Self::mul_add(c_q11, x258, s_q11 * x42);
-        let x264 = Self::mul_add(s_q11, x261, c_q11 * x260)
-            - Self::mul_add(x41, -0.63, 0.275 * x263);
-        let x265 = Self::mul_add(0.275, x262, Self::mul_add(-c_q11, x261, s_q11 * x260));
-        let x266 = Self::mul_add(0.63, x262, x259);
-        let x267 = Self::mul_add(-s_q10, x263, c_q10 * x262);
-        let x268 = Self::mul_add(c_q10, x263, s_q10 * x262);
-        let x269 = Self::mul_add(c_q10, x265, s_q10 * x264);
-        let x270 = Self::mul_add(x41, 0.87, Self::mul_add(-s_q10, x265, c_q10 * x264));
-        let x271 = Self::mul_add(0.87, x267, x266);
-        let x272 = Self::mul_add(-s_q9, x268, c_q9 * x267);
-        let x273 = Self::mul_add(c_q9, x268, s_q9 * x267);
-        let x274 = Self::mul_add(0.00000000020510342851533115, x273, x41);
+        let x262 = S::mul_add(S::neg(s_q11), x258, c_q11 * x42);
+        let x263 = S::mul_add(c_q11, x258, s_q11 * x42);
+        let x264 = S::mul_add(s_q11, x261, c_q11 * x260)
+            - S::mul_add(x41, S::splat(-0.63), S::splat(0.275) * x263);
+        let x265 = S::mul_add(
+            S::splat(0.275),
+            x262,
+            S::mul_add(S::neg(c_q11), x261, s_q11 * x260),
+        );
+        let x266 = S::mul_add(S::splat(0.63), x262, x259);
+        let x267 = S::mul_add(S::neg(s_q10), x263, c_q10 * x262);
+        let x268 = S::mul_add(c_q10, x263, s_q10 * x262);
+        let x269 = S::mul_add(c_q10, x265, s_q10 * x264);
+        let x270 = S::mul_add(
+            x41,
+            S::splat(0.87),
+            S::mul_add(S::neg(s_q10), x265, c_q10 * x264),
+        );
+        let x271 = S::mul_add(S::splat(0.87), x267, x266);
+        let x272 = S::mul_add(S::neg(s_q9), x268, c_q9 * x267);
+        let x273 = S::mul_add(c_q9, x268, s_q9 * x267);
+        let x274 = S::mul_add(S::splat(0.00000000020510342851533115), x273, x41);
         let x275 = x258 - x273;
-        let x276 = Self::mul_add(c_q9, x269, s_q9 * x270);
-        let x277 = Self::mul_add(-s_q9, x269, c_q9 * x270)
-            - Self::mul_add(0.275, x275, 0.4 * x274);
-        let x278 = Self::mul_add(-0.00000000020510342851533115, x276, x271)
-            - Self::mul_add(0.00000000005640344284171607, x275, 0.4 * x272);
-        let x279 = Self::mul_add(0.00000000020510342851533115, x271, x276)
-            - Self::mul_add(-0.00000000005640344284171607, x274, 0.275 * x272);
-        let x280 = -x279;
-        let x281 = Self::mul_add(s_q8, x274, c_q8 * x272);
-        let x282 = Self::mul_add(-c_q8, x274, s_q8 * x272);
-        let x283 = Self::mul_add(-0.00000000020510342851533115, x282, x275);
-        let x284 = Self::mul_add(0.00000000020510342851533115, x275, x282);
-        let x285 = Self::mul_add(c_q8, x278, s_q8 * x277);
-        let x286 = Self::mul_add(-0.00000000020510342851533115, x279, x285);
-        let x287 = -x286;
-        let x288 = Self::mul_add(0.35, x283, Self::mul_add(-s_q8, x278, c_q8 * x277));
-        let x289 = Self::mul_add(
-            0.35,
+        let x276 = S::mul_add(c_q9, x269, s_q9 * x270);
+        let x277 = S::mul_add(S::neg(s_q9), x269, c_q9 * x270)
+            - S::mul_add(S::splat(0.275), x275, S::splat(0.4) * x274);
+        let x278 = S::mul_add(S::splat(-0.00000000020510342851533115), x276, x271)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x275,
+                S::splat(0.4) * x272,
+            );
+        let x279 = S::mul_add(S::splat(0.00000000020510342851533115), x271, x276)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x274,
+                S::splat(0.275) * x272,
+            );
+        let x280 = S::neg(x279);
+        let x281 = S::mul_add(s_q8, x274, c_q8 * x272);
+        let x282 = S::mul_add(S::neg(c_q8), x274, s_q8 * x272);
+        let x283 = S::mul_add(S::splat(-0.00000000020510342851533115), x282, x275);
+        let x284 = S::mul_add(S::splat(0.00000000020510342851533115), x275, x282);
+        let x285 = S::mul_add(c_q8, x278, s_q8 * x277);
+        let x286 = S::mul_add(S::splat(-0.00000000020510342851533115), x279, x285);
+        let x287 = S::neg(x286);
+        let x288 = S::mul_add(
+            S::splat(0.35),
+            x283,
+            S::mul_add(S::neg(s_q8), x278, c_q8 * x277),
+        );
+        let x289 = S::mul_add(
+            S::splat(0.35),
             x281,
-            Self::mul_add(0.00000000020510342851533115, x285, x279),
+            S::mul_add(S::splat(0.00000000020510342851533115), x285, x279),
         );
-        let x290 = Self::mul_add(c_q7, x283, s_q7 * x281);
-        let x291 = -x290;
-        let x292 = Self::mul_add(-s_q7, x283, c_q7 * x281);
-        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-c_q7, x289, s_q7 * x288));
-        let x294 = -(Self::mul_add(s_q7, x289, c_q7 * x288)
-            + Self::mul_add(0.65, x284, 0.75 * x290));
-        let x295 = -Self::mul_add(-0.65, x292, x286);
-        let x296 = 0.00000000020510342851533115 * x14;
-        let x297 = Self::mul_add(0.16, x296, x12);
+        let x290 = S::mul_add(c_q7, x283, s_q7 * x281);
+        let x291 = S::neg(x290);
+        let x292 = S::mul_add(S::neg(s_q7), x283, c_q7 * x281);
+        let x293 = S::mul_add(
+            S::splat(-0.75),
+            x292,
+            S::mul_add(S::neg(c_q7), x289, s_q7 * x288),
+        );
+        let x294 = S::neg(
+            S::mul_add(s_q7, x289, c_q7 * x288)
+                + S::mul_add(S::splat(0.65), x284, S::splat(0.75) * x290),
+        );
+        let x295 = S::neg(S::mul_add(S::splat(-0.65), x292, x286));
+        let x296 = S::splat(0.00000000020510342851533115) * x14;
+        let x297 = S::mul_add(S::splat(0.16), x296, x12);
         let x298 = x22
-            + Self::mul_add(-0.00000000020510342851533115, x13, 1.4135609200000003);
-        let x299 = Self::mul_add(-0.55, x296, x13 - -0.0000000002899261911072858);
-        let x300 = -x299;
-        let x301 = Self::mul_add(s_q12, x296, c_q12 * x15);
-        let x302 = Self::mul_add(-c_q12, x296, s_q12 * x15);
-        let x303 = Self::mul_add(0.00000000020510342851533115, x302, x14);
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x13,
+                S::splat(1.4135609200000003),
+            );
+        let x299 = S::mul_add(
+            S::splat(-0.55),
+            x296,
+            x13 - S::splat(-0.0000000002899261911072858),
+        );
+        let x300 = S::neg(x299);
+        let x301 = S::mul_add(s_q12, x296, c_q12 * x15);
+        let x302 = S::mul_add(S::neg(c_q12), x296, s_q12 * x15);
+        let x303 = S::mul_add(S::splat(0.00000000020510342851533115), x302, x14);
         let x304 = x296 - x302;
-        let x305 = Self::mul_add(c_q12, x298, s_q12 * x297);
-        let x306 = Self::mul_add(-0.00000000020510342851533115, x299, x305);
-        let x307 = -x306;
-        let x308 = Self::mul_add(-0.36, x303, Self::mul_add(-s_q12, x298, c_q12 * x297));
-        let x309 = Self::mul_add(
-            0.36,
+        let x305 = S::mul_add(c_q12, x298, s_q12 * x297);
+        let x306 = S::mul_add(S::splat(-0.00000000020510342851533115), x299, x305);
+        let x307 = S::neg(x306);
+        let x308 = S::mul_add(
+            S::splat(-0.36),
+            x303,
+            S::mul_add(S::neg(s_q12), x298, c_q12 * x297),
+        );
+        let x309 = S::mul_add(
+            S::splat(0.36),
             x301,
-            Self::mul_add(0.00000000020510342851533115, x305, x299),
+            S::mul_add(S::splat(0.00000000020510342851533115), x305, x299),
         );
-        let x310 = Self::mul_add(s_q11, x303, c_q11 * x301);
-        let x311 = Self::mul_add(-c_q11, x303, s_q11 * x301);
-        let x312 = Self::mul_add(s_q11, x309, c_q11 * x308)
-            + Self::mul_add(-0.63, x304, 0.275 * x311);
-        let x313 = Self::mul_add(
-            -0.275,
+        let x310 = S::mul_add(s_q11, x303, c_q11 * x301);
+        let x311 = S::mul_add(S::neg(c_q11), x303, s_q11 * x301);
+        let x312 = S::mul_add(s_q11, x309, c_q11 * x308)
+            + S::mul_add(S::splat(-0.63), x304, S::splat(0.275) * x311);
+        let x313 = S::mul_add(
+            S::splat(-0.275),
             x310,
-            Self::mul_add(-c_q11, x309, s_q11 * x308),
+            S::mul_add(S::neg(c_q11), x309, s_q11 * x308),
         );
-        let x314 = Self::mul_add(-0.63, x310, x306);
-        let x315 = -x314;
-        let x316 = Self::mul_add(-s_q10, x311, c_q10 * x310);
-        let x317 = Self::mul_add(c_q10, x311, s_q10 * x310);
-        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
-        let x319 = Self::mul_add(-0.87, x304, Self::mul_add(-s_q10, x313, c_q10 * x312));
-        let x320 = Self::mul_add(-0.87, x316, x314);
-        let x321 = -x320;
-        let x322 = Self::mul_add(-s_q9, x317, c_q9 * x316);
-        let x323 = Self::mul_add(c_q9, x317, s_q9 * x316);
-        let x324 = Self::mul_add(0.00000000020510342851533115, x323, x304);
-        let x325 = Self::mul_add(-0.00000000020510342851533115, x304, x323);
-        let x326 = Self::mul_add(c_q9, x318, s_q9 * x319);
-        let x327 = Self::mul_add(-s_q9, x318, c_q9 * x319)
-            + Self::mul_add(-0.275, x325, 0.4 * x324);
-        let x328 = Self::mul_add(-0.00000000020510342851533115, x326, x320)
-            + Self::mul_add(-0.00000000005640344284171607, x325, 0.4 * x322);
-        let x329 = Self::mul_add(0.00000000020510342851533115, x320, x326)
-            + Self::mul_add(-0.00000000005640344284171607, x324, 0.275 * x322);
-        let x330 = Self::mul_add(s_q8, x324, c_q8 * x322);
-        let x331 = Self::mul_add(-c_q8, x324, s_q8 * x322);
-        let x332 = Self::mul_add(0.00000000020510342851533115, x331, x325);
-        let x333 = Self::mul_add(-0.00000000020510342851533115, x325, x331);
-        let x334 = Self::mul_add(c_q8, x328, s_q8 * x327);
-        let x335 = Self::mul_add(-0.00000000020510342851533115, x329, x334);
-        let x336 = Self::mul_add(0.35, x332, Self::mul_add(-s_q8, x328, c_q8 * x327));
-        let x337 = Self::mul_add(
-            -0.35,
+        let x314 = S::mul_add(S::splat(-0.63), x310, x306);
+        let x315 = S::neg(x314);
+        let x316 = S::mul_add(S::neg(s_q10), x311, c_q10 * x310);
+        let x317 = S::mul_add(c_q10, x311, s_q10 * x310);
+        let x318 = S::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = S::mul_add(
+            S::splat(-0.87),
+            x304,
+            S::mul_add(S::neg(s_q10), x313, c_q10 * x312),
+        );
+        let x320 = S::mul_add(S::splat(-0.87), x316, x314);
+        let x321 = S::neg(x320);
+        let x322 = S::mul_add(S::neg(s_q9), x317, c_q9 * x316);
+        let x323 = S::mul_add(c_q9, x317, s_q9 * x316);
+        let x324 = S::mul_add(S::splat(0.00000000020510342851533115), x323, x304);
+        let x325 = S::mul_add(S::splat(-0.00000000020510342851533115), x304, x323);
+        let x326 = S::mul_add(c_q9, x318, s_q9 * x319);
+        let x327 = S::mul_add(S::neg(s_q9), x318, c_q9 * x319)
+            + S::mul_add(S::splat(-0.275), x325, S::splat(0.4) * x324);
+        let x328 = S::mul_add(S::splat(-0.00000000020510342851533115), x326, x320)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x325,
+                S::splat(0.4) * x322,
+            );
+        let x329 = S::mul_add(S::splat(0.00000000020510342851533115), x320, x326)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x324,
+                S::splat(0.275) * x322,
+            );
+        let x330 = S::mul_add(s_q8, x324, c_q8 * x322);
+        let x331 = S::mul_add(S::neg(c_q8), x324, s_q8 * x322);
+        let x332 = S::mul_add(S::splat(0.00000000020510342851533115), x331, x325);
+        let x333 = S::mul_add(S::splat(-0.00000000020510342851533115), x325, x331);
+        let x334 = S::mul_add(c_q8, x328, s_q8 * x327);
+        let x335 = S::mul_add(S::splat(-0.00000000020510342851533115), x329, x334);
+        let x336 = S::mul_add(
+            S::splat(0.35),
+            x332,
+            S::mul_add(S::neg(s_q8), x328, c_q8 * x327),
+        );
+        let x337 = S::mul_add(
+            S::splat(-0.35),
             x330,
-            Self::mul_add(0.00000000020510342851533115, x334, x329),
+            S::mul_add(S::splat(0.00000000020510342851533115), x334, x329),
         );
-        let x338 = Self::mul_add(-c_q7, x332, s_q7 * x330);
-        let x339 = -x338;
-        let x340 = Self::mul_add(s_q7, x332, c_q7 * x330);
-        let x341 = -Self::mul_add(0.75, x340, Self::mul_add(-c_q7, x337, s_q7 * x336));
-        let x342 = Self::mul_add(s_q7, x337, c_q7 * x336)
-            - Self::mul_add(0.65, x333, 0.75 * x338);
-        let x343 = Self::mul_add(0.65, x340, x335);
+        let x338 = S::mul_add(S::neg(c_q7), x332, s_q7 * x330);
+        let x339 = S::neg(x338);
+        let x340 = S::mul_add(s_q7, x332, c_q7 * x330);
+        let x341 = S::neg(
+            S::mul_add(S::splat(0.75), x340, S::mul_add(S::neg(c_q7), x337, s_q7 * x336)),
+        );
+        let x342 = S::mul_add(s_q7, x337, c_q7 * x336)
+            - S::mul_add(S::splat(0.65), x333, S::splat(0.75) * x338);
+        let x343 = S::mul_add(S::splat(0.65), x340, x335);
         [
             [
-                1170.07,
-                0.0,
-                0.0,
-                0.0,
+                S::splat(1170.07),
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(0.0),
                 x173,
                 x163,
                 x163,
@@ -1749,11 +1894,11 @@ impl FreeFloating7 {
                 x339,
             ],
             [
-                0.0,
-                1170.07,
-                0.0,
+                S::splat(0.0),
+                S::splat(1170.07),
+                S::splat(0.0),
                 x178,
-                0.0,
+                S::splat(0.0),
                 x172,
                 x162,
                 x186,
@@ -1764,13 +1909,13 @@ impl FreeFloating7 {
                 x340,
             ],
             [
-                0.0,
-                0.0,
-                1170.07,
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(1170.07),
                 x160,
                 x179,
-                0.0,
-                0.0,
+                S::splat(0.0),
+                S::splat(0.0),
                 x140,
                 x197,
                 x218,
@@ -1779,7 +1924,7 @@ impl FreeFloating7 {
                 x333,
             ],
             [
-                0.0,
+                S::splat(0.0),
                 x178,
                 x160,
                 x174,
@@ -1795,7 +1940,7 @@ impl FreeFloating7 {
             ],
             [
                 x173,
-                0.0,
+                S::splat(0.0),
                 x179,
                 x169,
                 x176,
@@ -1811,7 +1956,7 @@ impl FreeFloating7 {
             [
                 x163,
                 x172,
-                0.0,
+                S::splat(0.0),
                 x175,
                 x170,
                 x177,
@@ -1826,7 +1971,7 @@ impl FreeFloating7 {
             [
                 x163,
                 x162,
-                0.0,
+                S::splat(0.0),
                 x168,
                 x170,
                 x171,
@@ -1884,9 +2029,35 @@ impl FreeFloating7 {
                 x315,
                 x307,
                 x300,
-                1.4135609200000003,
+                S::splat(1.4135609200000003),
             ],
         ]
+    }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        out: &mut [[[::core::primitive::f64; 13]; 13]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
@@ -1896,66 +2067,77 @@ impl FreeFloating7 {
         q: &[::core::primitive::f64; 14],
         v: &[::core::primitive::f64; 13],
     ) -> [::core::primitive::f64; 13] {
+        Self::nonlinear_effects_lanes::<::core::primitive::f64>(q, v)
+    }
+    /// [`Self::nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 14], v: &[S; 13]) -> [S; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
-            q[8] + 1.5707963265897933,
-            q[9] + 1.5707963267948966,
+            q[8] + S::splat(1.5707963265897933),
+            q[9] + S::splat(1.5707963267948966),
             q[10],
             q[11],
-            q[12] - 1.5707963267948966,
-            q[13] - 1.5707963267948966,
+            q[12] - S::splat(1.5707963267948966),
+            q[13] - S::splat(1.5707963267948966),
         ]);
-        let x7 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x8 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x9 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x10 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x11 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x7 = S::mul_add(S::neg(v[2]), v[4], v[1] * v[5]);
+        let x8 = S::mul_add(S::neg(v[2]), v[3], v[0] * v[5]);
+        let x9 = S::mul_add(S::neg(v[1]), v[3], v[0] * v[4]);
+        let x10 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x11 = S::mul_add(v[4], s_q7, v[3] * c_q7);
         let x12 = v[4] * v[4];
-        let x13 = Self::mul_add(v[5], v[5], x12);
+        let x13 = S::mul_add(v[5], v[5], x12);
         let x14 = v[3] * v[4];
         let x15 = v[3] * v[5];
         let x16 = v[4] * v[5];
-        let x17 = Self::mul_add(v[3], v[3], x12);
-        let x18 = x7 + Self::mul_add(-0.75, x15, 0.65 * x13);
-        let x19 = x8 + Self::mul_add(0.75, x16, 0.65 * x14);
-        let x20 = x9 - Self::mul_add(-0.75, x17, 0.65 * x15);
-        let x21 = Self::mul_add(c_q7, x19, s_q7 * x18);
+        let x17 = S::mul_add(v[3], v[3], x12);
+        let x18 = x7 + S::mul_add(S::splat(-0.75), x15, S::splat(0.65) * x13);
+        let x19 = x8 + S::mul_add(S::splat(0.75), x16, S::splat(0.65) * x14);
+        let x20 = x9 - S::mul_add(S::splat(-0.75), x17, S::splat(0.65) * x15);
+        let x21 = S::mul_add(c_q7, x19, s_q7 * x18);
         let x22 = v[6] * x11;
         let x23 = v[6] * x10;
         let x24 = v[5] + v[6];
         let x25 = x10 * x10;
         let x26 = x11 * x24;
-        let x27 = Self::mul_add(-0.1132, x24, 0.07309 * x11);
-        let x28 = Self::mul_add(
-            -16.807689977165428,
+        let x27 = S::mul_add(S::splat(-0.1132), x24, S::splat(0.07309) * x11);
+        let x28 = S::mul_add(
+            S::splat(-16.807689977165428),
             x24,
-            Self::mul_add(x11, -125.18476992763283, 0.07309 * x10),
+            S::mul_add(x11, S::splat(-125.18476992763283), S::splat(0.07309) * x10),
         );
-        let x29 = Self::mul_add(
-            -127.22056992763282,
+        let x29 = S::mul_add(
+            S::splat(-127.22056992763282),
             x24,
-            Self::mul_add(16.807689977165428, x11, 0.1132 * x10),
+            S::mul_add(S::splat(16.807689977165428), x11, S::splat(0.1132) * x10),
         );
-        let x30 = Self::mul_add(
+        let x30 = S::mul_add(
             x20,
-            48.0240000085309,
-            Self::mul_add(0.07309, x23, Self::mul_add(x11, x29, x24 * x28)),
+            S::splat(48.0240000085309),
+            S::mul_add(S::splat(0.07309), x23, S::mul_add(x11, x29, x24 * x28)),
         );
-        let x31 = Self::mul_add(0.00000000020510342851533115, x11, x24);
-        let x32 = Self::mul_add(-s_q8, x31, x10 * c_q8);
-        let x33 = Self::mul_add(c_q8, x31, x10 * s_q8);
-        let x34 = Self::mul_add(0.35, Self::mul_add(-x10, x24, x23), x21);
-        let x35 = Self::mul_add(0.35, x22 - x26, Self::mul_add(-s_q7, x19, c_q7 * x18));
-        let x36 = Self::mul_add(0.35, Self::mul_add(x11, x11, x25), x20);
-        let x37 = Self::mul_add(0.00000000020510342851533115, x35, x36);
-        let x38 = Self::mul_add(-0.00000000020510342851533115, x36, x35);
-        let x39 = Self::mul_add(-s_q8, x37, c_q8 * x34);
-        let x40 = Self::mul_add(c_q8, x37, s_q8 * x34);
-        let x41 = 0.00000000020510342851533115 * x23;
-        let x42 = Self::mul_add(-v[7], x33, Self::mul_add(s_q8, x41, x22 * c_q8));
-        let x43 = Self::mul_add(v[7], x32, Self::mul_add(-c_q8, x41, x22 * s_q8));
-        let x44 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x11);
+        let x31 = S::mul_add(S::splat(0.00000000020510342851533115), x11, x24);
+        let x32 = S::mul_add(S::neg(s_q8), x31, x10 * c_q8);
+        let x33 = S::mul_add(c_q8, x31, x10 * s_q8);
+        let x34 = S::mul_add(S::splat(0.35), S::mul_add(S::neg(x10), x24, x23), x21);
+        let x35 = S::mul_add(
+            S::splat(0.35),
+            x22 - x26,
+            S::mul_add(S::neg(s_q7), x19, c_q7 * x18),
+        );
+        let x36 = S::mul_add(S::splat(0.35), S::mul_add(x11, x11, x25), x20);
+        let x37 = S::mul_add(S::splat(0.00000000020510342851533115), x35, x36);
+        let x38 = S::mul_add(S::splat(-0.00000000020510342851533115), x36, x35);
+        let x39 = S::mul_add(S::neg(s_q8), x37, c_q8 * x34);
+        let x40 = S::mul_add(c_q8, x37, s_q8 * x34);
+        let x41 = S::splat(0.00000000020510342851533115) * x23;
+        let x42 = S::mul_add(S::neg(v[7]), x33, S::mul_add(s_q8, x41, x22 * c_q8));
+        let x43 = S::mul_add(v[7], x32, S::mul_add(S::neg(c_q8), x41, x22 * s_q8));
+        let x44 = v[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x24, x11);
         let x45 = x33 * x33;
         let x46 = x44 * x44;
         let x47 = x45 + x46;
@@ -1968,175 +2150,241 @@ impl FreeFloating7 {
         let x54 = x33 * x44;
         let x55 = x43 + x50;
         let x56 = x42 - x54;
-        let x57 = Self::mul_add(
-            -0.0021399976297017177,
+        let x57 = S::mul_add(
+            S::splat(-0.0021399976297017177),
             x44,
-            x33 * 0.0000000005683321144643007,
+            x33 * S::splat(0.0000000005683321144643007),
         );
-        let x58 = Self::mul_add(
+        let x58 = S::mul_add(
             x44,
-            -5.080660022992534,
-            Self::mul_add(x33, -106.50196992080811, x32 * 0.0000000005683321144643007),
+            S::splat(-5.080660022992534),
+            S::mul_add(
+                x33,
+                S::splat(-106.50196992080811),
+                x32 * S::splat(0.0000000005683321144643007),
+            ),
         );
-        let x59 = Self::mul_add(
-            -108.1389699208081,
+        let x59 = S::mul_add(
+            S::splat(-108.1389699208081),
             x44,
-            Self::mul_add(x33, 5.080660022992536, 0.0021399976297017177 * x32),
+            S::mul_add(
+                x33,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x32,
+            ),
         );
-        let x60 = Self::mul_add(
-            0.0000000059257457049506905,
+        let x60 = S::mul_add(
+            S::splat(0.0000000059257457049506905),
             x38,
-            Self::mul_add(
+            S::mul_add(
                 x23,
-                5.080660022992534,
-                Self::mul_add(
+                S::splat(5.080660022992534),
+                S::mul_add(
                     x43,
-                    -106.50196992080811,
-                    x42 * 0.0000000005683321144643007,
+                    S::splat(-106.50196992080811),
+                    x42 * S::splat(0.0000000005683321144643007),
                 ),
-            ) - Self::mul_add(x32, x59, x44 * x57),
+            ) - S::mul_add(x32, x59, x44 * x57),
         );
-        let x61 = Self::mul_add(-0.00000000020510342851533115, x33, x44);
-        let x62 = Self::mul_add(-s_q9, x61, x32 * c_q9);
-        let x63 = Self::mul_add(c_q9, x61, x32 * s_q9);
+        let x61 = S::mul_add(S::splat(-0.00000000020510342851533115), x33, x44);
+        let x62 = S::mul_add(S::neg(s_q9), x61, x32 * c_q9);
+        let x63 = S::mul_add(c_q9, x61, x32 * s_q9);
         let x64 = x39
-            - Self::mul_add(
-                -0.4,
+            - S::mul_add(
+                S::splat(-0.4),
                 x43 - x50,
-                Self::mul_add(0.275, x49, 0.00000000005640344284171607 * x47),
+                S::mul_add(
+                    S::splat(0.275),
+                    x49,
+                    S::splat(0.00000000005640344284171607) * x47,
+                ),
             );
         let x65 = x40
-            + Self::mul_add(
-                -0.4,
+            + S::mul_add(
+                S::splat(-0.4),
                 x42 + x54,
-                Self::mul_add(-0.275, x53, 0.00000000005640344284171607 * x51),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x53,
+                    S::splat(0.00000000005640344284171607) * x51,
+                ),
             );
         let x66 = x38
-            + Self::mul_add(
-                0.4,
+            + S::mul_add(
+                S::splat(0.4),
                 x45 + x52,
-                Self::mul_add(-0.275, x56, 0.00000000005640344284171607 * x55),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x56,
+                    S::splat(0.00000000005640344284171607) * x55,
+                ),
             );
-        let x67 = Self::mul_add(-0.00000000020510342851533115, x65, x66);
-        let x68 = Self::mul_add(0.00000000020510342851533115, x66, x65);
-        let x69 = Self::mul_add(-s_q9, x67, c_q9 * x64);
-        let x70 = Self::mul_add(0.00000000020510342851533115, x43, x23);
+        let x67 = S::mul_add(S::splat(-0.00000000020510342851533115), x65, x66);
+        let x68 = S::mul_add(S::splat(0.00000000020510342851533115), x66, x65);
+        let x69 = S::mul_add(S::neg(s_q9), x67, c_q9 * x64);
+        let x70 = S::mul_add(S::splat(0.00000000020510342851533115), x43, x23);
         let x71 = x41 - x43;
-        let x72 = Self::mul_add(-v[8], x63, Self::mul_add(s_q9, x70, x42 * c_q9));
-        let x73 = Self::mul_add(v[8], x62, Self::mul_add(-c_q9, x70, x42 * s_q9));
-        let x74 = v[8] - Self::mul_add(0.00000000020510342851533115, x44, x33);
-        let x75 = Self::mul_add(x62, x63, x71);
-        let x76 = Self::mul_add(x62, x62, x74 * x74);
-        let x77 = Self::mul_add(-x63, x74, x72);
-        let x78 = 0.00214 * x74;
-        let x79 = Self::mul_add(x74, 36.18604050126307, x63 * 63.36336825);
-        let x80 = Self::mul_add(
-            69.99836825,
+        let x72 = S::mul_add(S::neg(v[8]), x63, S::mul_add(s_q9, x70, x42 * c_q9));
+        let x73 = S::mul_add(v[8], x62, S::mul_add(S::neg(c_q9), x70, x42 * s_q9));
+        let x74 = v[8] - S::mul_add(S::splat(0.00000000020510342851533115), x44, x33);
+        let x75 = S::mul_add(x62, x63, x71);
+        let x76 = S::mul_add(x62, x62, x74 * x74);
+        let x77 = S::mul_add(S::neg(x63), x74, x72);
+        let x78 = S::splat(0.00214) * x74;
+        let x79 = S::mul_add(
             x74,
-            Self::mul_add(x63, -36.18604050126307, 0.00214 * x62),
+            S::splat(36.18604050126307),
+            x63 * S::splat(63.36336825),
         );
-        let x81 = Self::mul_add(
+        let x80 = S::mul_add(
+            S::splat(69.99836825),
+            x74,
+            S::mul_add(x63, S::splat(-36.18604050126307), S::splat(0.00214) * x62),
+        );
+        let x81 = S::mul_add(
             x68,
-            81.53205,
-            Self::mul_add(0.00214, x71, -Self::mul_add(x63, x80, x74 * x79)),
+            S::splat(81.53205),
+            S::mul_add(S::splat(0.00214), x71, S::neg(S::mul_add(x63, x80, x74 * x79))),
         );
-        let x82 = Self::mul_add(
+        let x82 = S::mul_add(
             x69,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
+            S::splat(81.53205),
+            S::mul_add(
+                S::splat(69.99836825),
                 x71,
-                Self::mul_add(x73, -36.18604050126307, 0.00214 * x72),
-            ) + Self::mul_add(x62, x79, x63 * x78),
+                S::mul_add(x73, S::splat(-36.18604050126307), S::splat(0.00214) * x72),
+            ) + S::mul_add(x62, x79, x63 * x78),
         );
-        let x83 = Self::mul_add(-x63, s_q10, x62 * c_q10);
-        let x84 = Self::mul_add(x63, c_q10, x62 * s_q10);
-        let x85 = Self::mul_add(x75, 0.87, x69);
-        let x86 = Self::mul_add(x76, -0.87, Self::mul_add(c_q9, x67, s_q9 * x64));
-        let x87 = Self::mul_add(x77, 0.87, x68);
-        let x88 = Self::mul_add(-s_q10, x86, c_q10 * x85);
-        let x89 = Self::mul_add(-v[9], x84, Self::mul_add(-x73, s_q10, x72 * c_q10));
-        let x90 = Self::mul_add(v[9], x83, Self::mul_add(x73, c_q10, x72 * s_q10));
+        let x83 = S::mul_add(S::neg(x63), s_q10, x62 * c_q10);
+        let x84 = S::mul_add(x63, c_q10, x62 * s_q10);
+        let x85 = S::mul_add(x75, S::splat(0.87), x69);
+        let x86 = S::mul_add(x76, S::splat(-0.87), S::mul_add(c_q9, x67, s_q9 * x64));
+        let x87 = S::mul_add(x77, S::splat(0.87), x68);
+        let x88 = S::mul_add(S::neg(s_q10), x86, c_q10 * x85);
+        let x89 = S::mul_add(
+            S::neg(v[9]),
+            x84,
+            S::mul_add(S::neg(x73), s_q10, x72 * c_q10),
+        );
+        let x90 = S::mul_add(v[9], x83, S::mul_add(x73, c_q10, x72 * s_q10));
         let x91 = v[9] + x74;
-        let x92 = Self::mul_add(x83, x84, x71);
+        let x92 = S::mul_add(x83, x84, x71);
         let x93 = x83 * x83;
-        let x94 = Self::mul_add(x91, x91, x93);
+        let x94 = S::mul_add(x91, x91, x93);
         let x95 = x84 * x91;
         let x96 = x89 - x95;
-        let x97 = x91 * 0.6328;
-        let x98 = Self::mul_add(x91, 24.35164200091464, x84 * 24.4950615);
-        let x99 = Self::mul_add(
-            28.2393615,
+        let x97 = x91 * S::splat(0.6328);
+        let x98 = S::mul_add(
             x91,
-            Self::mul_add(x84, -24.351642000914637, x83 * 0.6328),
+            S::splat(24.35164200091464),
+            x84 * S::splat(24.4950615),
         );
-        let x100 = Self::mul_add(
+        let x99 = S::mul_add(
+            S::splat(28.2393615),
+            x91,
+            S::mul_add(x84, S::splat(-24.351642000914637), x83 * S::splat(0.6328)),
+        );
+        let x100 = S::mul_add(
             x87,
-            45.1584,
-            Self::mul_add(x71, 0.6328, -Self::mul_add(x84, x99, x91 * x98)),
+            S::splat(45.1584),
+            S::mul_add(x71, S::splat(0.6328), S::neg(S::mul_add(x84, x99, x91 * x98))),
         );
-        let x101 = Self::mul_add(
+        let x101 = S::mul_add(
             x88,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
+            S::splat(45.1584),
+            S::mul_add(
+                S::splat(28.2393615),
                 x71,
-                Self::mul_add(x90, -24.351642000914637, x89 * 0.6328),
-            ) + Self::mul_add(x83, x98, x84 * x97),
+                S::mul_add(x90, S::splat(-24.351642000914637), x89 * S::splat(0.6328)),
+            ) + S::mul_add(x83, x98, x84 * x97),
         );
-        let x102 = Self::mul_add(-x84, s_q11, x83 * c_q11);
-        let x103 = Self::mul_add(x84, c_q11, x83 * s_q11);
+        let x102 = S::mul_add(S::neg(x84), s_q11, x83 * c_q11);
+        let x103 = S::mul_add(x84, c_q11, x83 * s_q11);
         let x104 = x88
-            + Self::mul_add(-0.275, Self::mul_add(-x83, x91, x90), x92 * 0.63);
-        let x105 = Self::mul_add(c_q10, x86, s_q10 * x85)
-            - Self::mul_add(-0.275, x89 + x95, x94 * 0.63);
-        let x106 = x87 + Self::mul_add(0.275, Self::mul_add(x84, x84, x93), x96 * 0.63);
-        let x107 = Self::mul_add(-s_q11, x105, c_q11 * x104);
-        let x108 = Self::mul_add(-v[10], x103, Self::mul_add(-x90, s_q11, x89 * c_q11));
-        let x109 = Self::mul_add(v[10], x102, Self::mul_add(x90, c_q11, x89 * s_q11));
+            + S::mul_add(
+                S::splat(-0.275),
+                S::mul_add(S::neg(x83), x91, x90),
+                x92 * S::splat(0.63),
+            );
+        let x105 = S::mul_add(c_q10, x86, s_q10 * x85)
+            - S::mul_add(S::splat(-0.275), x89 + x95, x94 * S::splat(0.63));
+        let x106 = x87
+            + S::mul_add(
+                S::splat(0.275),
+                S::mul_add(x84, x84, x93),
+                x96 * S::splat(0.63),
+            );
+        let x107 = S::mul_add(S::neg(s_q11), x105, c_q11 * x104);
+        let x108 = S::mul_add(
+            S::neg(v[10]),
+            x103,
+            S::mul_add(S::neg(x90), s_q11, x89 * c_q11),
+        );
+        let x109 = S::mul_add(v[10], x102, S::mul_add(x90, c_q11, x89 * s_q11));
         let x110 = v[10] + x91;
         let x111 = x102 * x102;
         let x112 = x103 * x110;
-        let x113 = x110 * 0.01675;
-        let x114 = Self::mul_add(x110, -2.5482240005325645, x103 * 3.8891049197628025);
-        let x115 = Self::mul_add(
-            -3.970314919762802,
+        let x113 = x110 * S::splat(0.01675);
+        let x114 = S::mul_add(
             x110,
-            Self::mul_add(x103, -2.5482240005325645, x102 * 0.01675),
+            S::splat(-2.5482240005325645),
+            x103 * S::splat(3.8891049197628025),
         );
-        let x116 = Self::mul_add(
+        let x115 = S::mul_add(
+            S::splat(-3.970314919762802),
+            x110,
+            S::mul_add(x103, S::splat(-2.5482240005325645), x102 * S::splat(0.01675)),
+        );
+        let x116 = S::mul_add(
             x106,
-            7.078399999258757,
-            Self::mul_add(x71, 0.01675, Self::mul_add(-x103, x115, x110 * x114)),
-        );
-        let x117 = Self::mul_add(
-            x107,
-            7.078399999258757,
-            Self::mul_add(
-                -3.970314919762802,
+            S::splat(7.078399999258757),
+            S::mul_add(
                 x71,
-                Self::mul_add(x109, -2.5482240005325645, x108 * 0.01675),
-            ) + Self::mul_add(-x102, x114, x103 * x113),
+                S::splat(0.01675),
+                S::mul_add(S::neg(x103), x115, x110 * x114),
+            ),
         );
-        let x118 = Self::mul_add(0.00000000020510342851533115, x103, x110);
-        let x119 = Self::mul_add(s_q12, x118, x102 * c_q12);
-        let x120 = Self::mul_add(-c_q12, x118, x102 * s_q12);
-        let x121 = Self::mul_add(Self::mul_add(-x102, x110, x109), -0.36, x107);
-        let x122 = Self::mul_add(
+        let x117 = S::mul_add(
+            x107,
+            S::splat(7.078399999258757),
+            S::mul_add(
+                S::splat(-3.970314919762802),
+                x71,
+                S::mul_add(x109, S::splat(-2.5482240005325645), x108 * S::splat(0.01675)),
+            ) + S::mul_add(S::neg(x102), x114, x103 * x113),
+        );
+        let x118 = S::mul_add(S::splat(0.00000000020510342851533115), x103, x110);
+        let x119 = S::mul_add(s_q12, x118, x102 * c_q12);
+        let x120 = S::mul_add(S::neg(c_q12), x118, x102 * s_q12);
+        let x121 = S::mul_add(
+            S::mul_add(S::neg(x102), x110, x109),
+            S::splat(-0.36),
+            x107,
+        );
+        let x122 = S::mul_add(
             x108 + x112,
-            0.36,
-            Self::mul_add(c_q11, x105, s_q11 * x104),
+            S::splat(0.36),
+            S::mul_add(c_q11, x105, s_q11 * x104),
         );
-        let x123 = Self::mul_add(Self::mul_add(x103, x103, x111), 0.36, x106);
-        let x124 = Self::mul_add(-0.00000000020510342851533115, x122, x123);
-        let x125 = Self::mul_add(0.00000000020510342851533115, x123, x122);
-        let x126 = Self::mul_add(-s_q12, x124, c_q12 * x121);
-        let x127 = Self::mul_add(c_q12, x124, s_q12 * x121);
-        let x128 = Self::mul_add(0.00000000020510342851533115, x109, x71);
-        let x129 = Self::mul_add(-0.00000000020510342851533115, x71, x109);
-        let x130 = Self::mul_add(-v[11], x120, Self::mul_add(s_q12, x128, x108 * c_q12));
-        let x131 = Self::mul_add(v[11], x119, Self::mul_add(-c_q12, x128, x108 * s_q12));
-        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x110, x103);
+        let x123 = S::mul_add(S::mul_add(x103, x103, x111), S::splat(0.36), x106);
+        let x124 = S::mul_add(S::splat(-0.00000000020510342851533115), x122, x123);
+        let x125 = S::mul_add(S::splat(0.00000000020510342851533115), x123, x122);
+        let x126 = S::mul_add(S::neg(s_q12), x124, c_q12 * x121);
+        let x127 = S::mul_add(c_q12, x124, s_q12 * x121);
+        let x128 = S::mul_add(S::splat(0.00000000020510342851533115), x109, x71);
+        let x129 = S::mul_add(S::splat(-0.00000000020510342851533115), x71, x109);
+        let x130 = S::mul_add(
+            S::neg(v[11]),
+            x120,
+            S::mul_add(s_q12, x128, x108 * c_q12),
+        );
+        let x131 = S::mul_add(
+            v[11],
+            x119,
+            S::mul_add(S::neg(c_q12), x128, x108 * s_q12),
+        );
+        let x132 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x110, x103);
         let x133 = x120 * x120;
         let x134 = x132 * x132;
         let x135 = x133 + x134;
@@ -2146,275 +2394,422 @@ impl FreeFloating7 {
         let x139 = x119 * x119;
         let x140 = x120 * x132;
         let x141 = x131 + x137;
-        let x142 = Self::mul_add(x132, 2.741639999592316, 1.9877000000000002 * x120);
-        let x143 = Self::mul_add(
-            0.809539999555672,
+        let x142 = S::mul_add(
             x132,
-            Self::mul_add(-5.252920330000002, x120, 1.9877000000000002 * x119),
+            S::splat(2.741639999592316),
+            S::splat(1.9877000000000002) * x120,
         );
-        let x144 = Self::mul_add(
-            -9.740442170000001,
+        let x143 = S::mul_add(
+            S::splat(0.809539999555672),
             x132,
-            Self::mul_add(0.809539999555672, x120, x119 * 2.7416399995923166),
-        );
-        let x145 = Self::mul_add(
-            17.135250000000003,
-            x125,
-            Self::mul_add(
-                0.809539999555672,
-                x129,
-                Self::mul_add(-5.252920330000002, x131, 1.9877000000000002 * x130),
-            ) - Self::mul_add(-x119, x144, x132 * x142),
-        );
-        let x146 = Self::mul_add(0.00000000020510342851533115, x120, x132);
-        let x147 = Self::mul_add(s_q13, x146, x119 * c_q13);
-        let x148 = Self::mul_add(-c_q13, x146, x119 * s_q13);
-        let x149 = x127 + Self::mul_add(-0.16, x130 + x140, 0.55 * x138);
-        let x150 = x125 - Self::mul_add(-0.16, x133 + x139, 0.55 * x141);
-        let x151 = Self::mul_add(0.00000000020510342851533115, x131, x129);
-        let x152 = Self::mul_add(-0.00000000020510342851533115, x129, x131);
-        let x153 = Self::mul_add(-v[12], x148, Self::mul_add(s_q13, x151, x130 * c_q13));
-        let x154 = Self::mul_add(v[12], x147, Self::mul_add(-c_q13, x151, x130 * s_q13));
-        let x155 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x120);
-        let x156 = 4.806620000000001 * Self::mul_add(x147, x148, x152);
-        let x157 = 4.806620000000001 * Self::mul_add(x147, x147, x155 * x155);
-        let x158 = 4.806620000000001 * Self::mul_add(-x148, x155, x153);
-        let x159 = Self::mul_add(x155, 0.0145, 0.000781 * x148);
-        let x160 = Self::mul_add(
-            x155,
-            -0.9614610000000001,
-            Self::mul_add(x148, 1.2025609200000003, 0.000781 * x147),
-        );
-        let x161 = Self::mul_add(
-            -1.4135609200000003,
-            x155,
-            Self::mul_add(x148, -0.9614610000000001, x147 * 0.0145),
-        );
-        let x162 = Self::mul_add(
-            x152,
-            -0.9614610000000001,
-            Self::mul_add(x154, 1.2025609200000003, 0.000781 * x153),
-        ) - Self::mul_add(-x147, x161, x155 * x159);
-        let x163 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x150, x149),
-            Self::mul_add(x152, 0.0145, 0.000781 * x154)
-                + Self::mul_add(-x148, x161, x155 * x160),
-        );
-        let x164 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(0.00000000020510342851533115, x149, x150),
-                c_q13 * (x126 + Self::mul_add(0.16, x131 - x137, 0.55 * x135)),
+            S::mul_add(
+                S::splat(-5.252920330000002),
+                x120,
+                S::splat(1.9877000000000002) * x119,
             ),
-            Self::mul_add(
-                -1.4135609200000003,
-                x152,
-                Self::mul_add(x154, -0.9614610000000001, x153 * 0.0145),
-            ) + Self::mul_add(-x147, x160, x148 * x159),
         );
-        let x165 = -x164;
-        let x166 = Self::mul_add(-s_q13, x157, c_q13 * x156);
-        let x167 = Self::mul_add(c_q13, x157, s_q13 * x156);
-        let x168 = Self::mul_add(-0.00000000020510342851533115, x167, x158);
-        let x169 = Self::mul_add(0.00000000020510342851533115, x158, x167);
-        let x170 = Self::mul_add(-c_q13, x162, s_q13 * x163);
-        let x171 = Self::mul_add(
-            -3.6140000000000003,
-            x129 + x136,
-            17.135250000000003 * x135,
-        ) + x166;
-        let x172 = Self::mul_add(
-            3.6140000000000003,
-            x134 + x139,
-            17.135250000000003 * x138,
-        ) - x168;
-        let x173 = Self::mul_add(
-            -3.6140000000000003,
-            x130 - x140,
-            17.135250000000003 * x141,
-        ) - x169;
-        let x174 = Self::mul_add(
-            -3.6140000000000003,
+        let x144 = S::mul_add(
+            S::splat(-9.740442170000001),
+            x132,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x120,
+                x119 * S::splat(2.7416399995923166),
+            ),
+        );
+        let x145 = S::mul_add(
+            S::splat(17.135250000000003),
             x125,
-            Self::mul_add(x129, 2.741639999592316, 1.9877000000000002 * x131)
-                + Self::mul_add(-x120, x144, x132 * x143),
-        ) + Self::mul_add(-0.16, x168, Self::mul_add(s_q13, x162, c_q13 * x163));
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x129,
+                S::mul_add(
+                    S::splat(-5.252920330000002),
+                    x131,
+                    S::splat(1.9877000000000002) * x130,
+                ),
+            ) - S::mul_add(S::neg(x119), x144, x132 * x142),
+        );
+        let x146 = S::mul_add(S::splat(0.00000000020510342851533115), x120, x132);
+        let x147 = S::mul_add(s_q13, x146, x119 * c_q13);
+        let x148 = S::mul_add(S::neg(c_q13), x146, x119 * s_q13);
+        let x149 = x127
+            + S::mul_add(S::splat(-0.16), x130 + x140, S::splat(0.55) * x138);
+        let x150 = x125
+            - S::mul_add(S::splat(-0.16), x133 + x139, S::splat(0.55) * x141);
+        let x151 = S::mul_add(S::splat(0.00000000020510342851533115), x131, x129);
+        let x152 = S::mul_add(S::splat(-0.00000000020510342851533115), x129, x131);
+        let x153 = S::mul_add(
+            S::neg(v[12]),
+            x148,
+            S::mul_add(s_q13, x151, x130 * c_q13),
+        );
+        let x154 = S::mul_add(
+            v[12],
+            x147,
+            S::mul_add(S::neg(c_q13), x151, x130 * s_q13),
+        );
+        let x155 = v[12]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x132, x120);
+        let x156 = S::splat(4.806620000000001) * S::mul_add(x147, x148, x152);
+        let x157 = S::splat(4.806620000000001) * S::mul_add(x147, x147, x155 * x155);
+        let x158 = S::splat(4.806620000000001) * S::mul_add(S::neg(x148), x155, x153);
+        let x159 = S::mul_add(x155, S::splat(0.0145), S::splat(0.000781) * x148);
+        let x160 = S::mul_add(
+            x155,
+            S::splat(-0.9614610000000001),
+            S::mul_add(x148, S::splat(1.2025609200000003), S::splat(0.000781) * x147),
+        );
+        let x161 = S::mul_add(
+            S::splat(-1.4135609200000003),
+            x155,
+            S::mul_add(x148, S::splat(-0.9614610000000001), x147 * S::splat(0.0145)),
+        );
+        let x162 = S::mul_add(
+            x152,
+            S::splat(-0.9614610000000001),
+            S::mul_add(x154, S::splat(1.2025609200000003), S::splat(0.000781) * x153),
+        ) - S::mul_add(S::neg(x147), x161, x155 * x159);
+        let x163 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x150, x149),
+            S::mul_add(x152, S::splat(0.0145), S::splat(0.000781) * x154)
+                + S::mul_add(S::neg(x148), x161, x155 * x160),
+        );
+        let x164 = S::mul_add(
+            S::splat(-4.806620000000001),
+            S::mul_add(
+                s_q13,
+                S::mul_add(S::splat(0.00000000020510342851533115), x149, x150),
+                c_q13
+                    * (x126
+                        + S::mul_add(S::splat(0.16), x131 - x137, S::splat(0.55) * x135)),
+            ),
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x152,
+                S::mul_add(x154, S::splat(-0.9614610000000001), x153 * S::splat(0.0145)),
+            ) + S::mul_add(S::neg(x147), x160, x148 * x159),
+        );
+        let x165 = S::neg(x164);
+        let x166 = S::mul_add(S::neg(s_q13), x157, c_q13 * x156);
+        let x167 = S::mul_add(c_q13, x157, s_q13 * x156);
+        let x168 = S::mul_add(S::splat(-0.00000000020510342851533115), x167, x158);
+        let x169 = S::mul_add(S::splat(0.00000000020510342851533115), x158, x167);
+        let x170 = S::mul_add(S::neg(c_q13), x162, s_q13 * x163);
+        let x171 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x129 + x136,
+            S::splat(17.135250000000003) * x135,
+        ) + x166;
+        let x172 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x134 + x139,
+            S::splat(17.135250000000003) * x138,
+        ) - x168;
+        let x173 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x130 - x140,
+            S::splat(17.135250000000003) * x141,
+        ) - x169;
+        let x174 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x125,
+            S::mul_add(
+                x129,
+                S::splat(2.741639999592316),
+                S::splat(1.9877000000000002) * x131,
+            ) + S::mul_add(S::neg(x120), x144, x132 * x143),
+        ) + S::mul_add(S::splat(-0.16), x168, S::mul_add(s_q13, x162, c_q13 * x163));
         let x175 = x145
-            + (Self::mul_add(0.00000000020510342851533115, x170, x164)
-                - Self::mul_add(-0.55, x169, 0.16 * x166));
-        let x176 = Self::mul_add(
-            -9.740442170000001,
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x170, x164)
+                - S::mul_add(S::splat(-0.55), x169, S::splat(0.16) * x166));
+        let x176 = S::mul_add(
+            S::splat(-9.740442170000001),
             x129,
-            Self::mul_add(0.809539999555672, x131, x130 * 2.7416399995923166),
-        ) + Self::mul_add(-x119, x143, x120 * x142)
-            + Self::mul_add(-17.135250000000003, x127, 3.6140000000000003 * x126)
-            + Self::mul_add(
-                0.55,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x131,
+                x130 * S::splat(2.7416399995923166),
+            ),
+        ) + S::mul_add(S::neg(x119), x143, x120 * x142)
+            + S::mul_add(
+                S::splat(-17.135250000000003),
+                x127,
+                S::splat(3.6140000000000003) * x126,
+            )
+            + S::mul_add(
+                S::splat(0.55),
                 x168,
-                Self::mul_add(-0.00000000020510342851533115, x164, x170),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x164, x170),
             );
-        let x177 = -x176;
-        let x178 = Self::mul_add(s_q12, x172, c_q12 * x171);
-        let x179 = Self::mul_add(-c_q12, x172, s_q12 * x171);
-        let x180 = Self::mul_add(-0.00000000020510342851533115, x179, x173);
-        let x181 = Self::mul_add(-c_q12, x175, s_q12 * x174);
-        let x182 = Self::mul_add(
-            Self::mul_add(x102, x103, x71),
-            7.078399999258757,
-            -x178,
+        let x177 = S::neg(x176);
+        let x178 = S::mul_add(s_q12, x172, c_q12 * x171);
+        let x179 = S::mul_add(S::neg(c_q12), x172, s_q12 * x171);
+        let x180 = S::mul_add(S::splat(-0.00000000020510342851533115), x179, x173);
+        let x181 = S::mul_add(S::neg(c_q12), x175, s_q12 * x174);
+        let x182 = S::mul_add(
+            S::mul_add(x102, x103, x71),
+            S::splat(7.078399999258757),
+            S::neg(x178),
         );
-        let x183 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x110, x110, x111),
-            -x180,
+        let x183 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x110, x110, x111),
+            S::neg(x180),
         );
-        let x184 = Self::mul_add(
-            7.078399999258757,
+        let x184 = S::mul_add(
+            S::splat(7.078399999258757),
             x108 - x112,
-            Self::mul_add(0.00000000020510342851533115, x173, x179),
+            S::mul_add(S::splat(0.00000000020510342851533115), x173, x179),
         );
         let x185 = x116
-            + Self::mul_add(0.36, x180, Self::mul_add(s_q12, x175, c_q12 * x174));
-        let x186 = Self::mul_add(x71, -2.5482240005325645, x109 * 3.8891049197628025)
-            - Self::mul_add(-x102, x115, x110 * x113)
-            + Self::mul_add(
-                0.36,
+            + S::mul_add(S::splat(0.36), x180, S::mul_add(s_q12, x175, c_q12 * x174));
+        let x186 = S::mul_add(
+            x71,
+            S::splat(-2.5482240005325645),
+            x109 * S::splat(3.8891049197628025),
+        ) - S::mul_add(S::neg(x102), x115, x110 * x113)
+            + S::mul_add(
+                S::splat(0.36),
                 x178,
-                Self::mul_add(0.00000000020510342851533115, x181, x176),
+                S::mul_add(S::splat(0.00000000020510342851533115), x181, x176),
             );
-        let x187 = x117 + Self::mul_add(-0.00000000020510342851533115, x176, x181);
-        let x188 = -x187;
-        let x189 = Self::mul_add(-s_q11, x183, c_q11 * x182);
-        let x190 = Self::mul_add(c_q11, x183, s_q11 * x182);
-        let x191 = Self::mul_add(x92, 45.1584, -x189);
-        let x192 = Self::mul_add(45.1584, x94, -x190);
-        let x193 = Self::mul_add(45.1584, x96, -x184);
+        let x187 = x117
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x176, x181);
+        let x188 = S::neg(x187);
+        let x189 = S::mul_add(S::neg(s_q11), x183, c_q11 * x182);
+        let x190 = S::mul_add(c_q11, x183, s_q11 * x182);
+        let x191 = S::mul_add(x92, S::splat(45.1584), S::neg(x189));
+        let x192 = S::mul_add(S::splat(45.1584), x94, S::neg(x190));
+        let x193 = S::mul_add(S::splat(45.1584), x96, S::neg(x184));
         let x194 = x100
-            - (Self::mul_add(s_q11, x186, c_q11 * x185)
-                - Self::mul_add(-0.63, x184, 0.275 * x190));
-        let x195 = Self::mul_add(x71, 24.35164200091464, x90 * 24.4950615)
-            + Self::mul_add(-x83, x99, x91 * x97)
-            - Self::mul_add(0.275, x189, Self::mul_add(-c_q11, x186, s_q11 * x185));
-        let x196 = x101 - Self::mul_add(0.63, x189, x187);
-        let x197 = Self::mul_add(-s_q10, x192, c_q10 * x191);
-        let x198 = Self::mul_add(x75, 81.53205, x197);
-        let x199 = Self::mul_add(
-            81.53205,
+            - (S::mul_add(s_q11, x186, c_q11 * x185)
+                - S::mul_add(S::splat(-0.63), x184, S::splat(0.275) * x190));
+        let x195 = S::mul_add(
+            x71,
+            S::splat(24.35164200091464),
+            x90 * S::splat(24.4950615),
+        ) + S::mul_add(S::neg(x83), x99, x91 * x97)
+            - S::mul_add(
+                S::splat(0.275),
+                x189,
+                S::mul_add(S::neg(c_q11), x186, s_q11 * x185),
+            );
+        let x196 = x101 - S::mul_add(S::splat(0.63), x189, x187);
+        let x197 = S::mul_add(S::neg(s_q10), x192, c_q10 * x191);
+        let x198 = S::mul_add(x75, S::splat(81.53205), x197);
+        let x199 = S::mul_add(
+            S::splat(81.53205),
             x76,
-            Self::mul_add(c_q10, x192, s_q10 * x191),
+            S::mul_add(c_q10, x192, s_q10 * x191),
         );
-        let x200 = Self::mul_add(81.53205, x77, x193);
+        let x200 = S::mul_add(S::splat(81.53205), x77, x193);
         let x201 = x81
-            + Self::mul_add(0.87, x193, Self::mul_add(-s_q10, x195, c_q10 * x194));
-        let x202 = Self::mul_add(x71, 36.18604050126307, x73 * 63.36336825)
-            + Self::mul_add(-x62, x80, x74 * x78)
-            + Self::mul_add(c_q10, x195, s_q10 * x194);
-        let x203 = x82 + Self::mul_add(0.87, x197, x196);
-        let x204 = Self::mul_add(-s_q9, x199, c_q9 * x198);
-        let x205 = Self::mul_add(c_q9, x199, s_q9 * x198);
-        let x206 = Self::mul_add(0.00000000020510342851533115, x205, x200);
-        let x207 = Self::mul_add(-0.00000000020510342851533115, x200, x205);
-        let x208 = Self::mul_add(c_q9, x202, s_q9 * x201);
-        let x209 = Self::mul_add(
-            -12.701650001451807,
+            + S::mul_add(
+                S::splat(0.87),
+                x193,
+                S::mul_add(S::neg(s_q10), x195, c_q10 * x194),
+            );
+        let x202 = S::mul_add(
+            x71,
+            S::splat(36.18604050126307),
+            x73 * S::splat(63.36336825),
+        ) + S::mul_add(S::neg(x62), x80, x74 * x78)
+            + S::mul_add(c_q10, x195, s_q10 * x194);
+        let x203 = x82 + S::mul_add(S::splat(0.87), x197, x196);
+        let x204 = S::mul_add(S::neg(s_q9), x199, c_q9 * x198);
+        let x205 = S::mul_add(c_q9, x199, s_q9 * x198);
+        let x206 = S::mul_add(S::splat(0.00000000020510342851533115), x205, x200);
+        let x207 = S::mul_add(S::splat(-0.00000000020510342851533115), x200, x205);
+        let x208 = S::mul_add(c_q9, x202, s_q9 * x201);
+        let x209 = S::mul_add(
+            S::splat(-12.701650001451807),
             x49,
-            0.0000000059257457049506905 * x47,
+            S::splat(0.0000000059257457049506905) * x47,
         ) - x204;
-        let x210 = Self::mul_add(
-            12.701650001451807,
+        let x210 = S::mul_add(
+            S::splat(12.701650001451807),
             x53,
-            0.0000000059257457049506905 * x51,
+            S::splat(0.0000000059257457049506905) * x51,
         ) + x206;
-        let x211 = Self::mul_add(
-            12.701650001451807,
+        let x211 = S::mul_add(
+            S::splat(12.701650001451807),
             x56,
-            0.0000000059257457049506905 * x55,
+            S::splat(0.0000000059257457049506905) * x55,
         ) - x207;
-        let x212 = Self::mul_add(
-            12.701650001451807,
+        let x212 = S::mul_add(
+            S::splat(12.701650001451807),
             x38,
-            Self::mul_add(0.0021399976297017177, x23, x43 * 0.0000000005683321144643007)
-                + Self::mul_add(x33, x59, x44 * x58),
+            S::mul_add(
+                S::splat(0.0021399976297017177),
+                x23,
+                x43 * S::splat(0.0000000005683321144643007),
+            ) + S::mul_add(x33, x59, x44 * x58),
         )
-            + (Self::mul_add(-s_q9, x202, c_q9 * x201)
-                - Self::mul_add(-0.275, x207, 0.4 * x206));
+            + (S::mul_add(S::neg(s_q9), x202, c_q9 * x201)
+                - S::mul_add(S::splat(-0.275), x207, S::splat(0.4) * x206));
         let x213 = x60
-            - (Self::mul_add(-0.00000000020510342851533115, x208, x203)
-                - Self::mul_add(-0.00000000005640344284171607, x207, 0.4 * x204));
-        let x214 = Self::mul_add(
-            108.1389699208081,
+            - (S::mul_add(S::splat(-0.00000000020510342851533115), x208, x203)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x207,
+                    S::splat(0.4) * x204,
+                ));
+        let x214 = S::mul_add(
+            S::splat(108.1389699208081),
             x23,
-            Self::mul_add(x43, 5.080660022992536, 0.0021399976297017177 * x42),
-        ) - Self::mul_add(-x32, x58, x33 * x57)
-            + Self::mul_add(0.0000000059257457049506905, x40, 12.701650001451807 * x39)
-            + (Self::mul_add(0.00000000020510342851533115, x203, x208)
-                - Self::mul_add(-0.00000000005640344284171607, x206, 0.275 * x204));
-        let x215 = -x214;
-        let x216 = Self::mul_add(-s_q8, x210, c_q8 * x209);
-        let x217 = Self::mul_add(c_q8, x210, s_q8 * x209);
-        let x218 = Self::mul_add(0.00000000020510342851533115, x217, x211);
-        let x219 = Self::mul_add(-c_q8, x213, s_q8 * x212);
-        let x220 = Self::mul_add(x10 * x11, 48.0240000085309, x216);
-        let x221 = Self::mul_add(48.0240000085309, Self::mul_add(x24, x24, x25), x218);
-        let x222 = Self::mul_add(
-            48.0240000085309,
+            S::mul_add(
+                x43,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x42,
+            ),
+        ) - S::mul_add(S::neg(x32), x58, x33 * x57)
+            + S::mul_add(
+                S::splat(0.0000000059257457049506905),
+                x40,
+                S::splat(12.701650001451807) * x39,
+            )
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x203, x208)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x206,
+                    S::splat(0.275) * x204,
+                ));
+        let x215 = S::neg(x214);
+        let x216 = S::mul_add(S::neg(s_q8), x210, c_q8 * x209);
+        let x217 = S::mul_add(c_q8, x210, s_q8 * x209);
+        let x218 = S::mul_add(S::splat(0.00000000020510342851533115), x217, x211);
+        let x219 = S::mul_add(S::neg(c_q8), x213, s_q8 * x212);
+        let x220 = S::mul_add(x10 * x11, S::splat(48.0240000085309), x216);
+        let x221 = S::mul_add(
+            S::splat(48.0240000085309),
+            S::mul_add(x24, x24, x25),
+            x218,
+        );
+        let x222 = S::mul_add(
+            S::splat(48.0240000085309),
             x22 + x26,
-            -Self::mul_add(-0.00000000020510342851533115, x211, x217),
+            S::neg(S::mul_add(S::splat(-0.00000000020510342851533115), x211, x217)),
         );
         let x223 = x30
-            - Self::mul_add(0.35, x218, Self::mul_add(s_q8, x213, c_q8 * x212));
-        let x224 = Self::mul_add(x23, 125.18476992763283, 0.07309 * x22)
-            + Self::mul_add(x10, x29, x24 * x27)
-            - Self::mul_add(
-                -0.35,
+            - S::mul_add(S::splat(0.35), x218, S::mul_add(s_q8, x213, c_q8 * x212));
+        let x224 = S::mul_add(x23, S::splat(125.18476992763283), S::splat(0.07309) * x22)
+            + S::mul_add(x10, x29, x24 * x27)
+            - S::mul_add(
+                S::splat(-0.35),
                 x216,
-                Self::mul_add(0.00000000020510342851533115, x219, x214),
+                S::mul_add(S::splat(0.00000000020510342851533115), x219, x214),
             );
-        let x225 = Self::mul_add(
+        let x225 = S::mul_add(
             x21,
-            -48.0240000085309,
-            Self::mul_add(-16.807689977165428, x23, 0.1132 * x22)
-                + Self::mul_add(-x10, x28, x11 * x27),
-        ) + Self::mul_add(-0.00000000020510342851533115, x214, x219);
-        let x226 = -x225;
-        let x227 = Self::mul_add(-c_q7, x221, s_q7 * x220);
-        let x228 = Self::mul_add(s_q7, x221, c_q7 * x220);
-        let x229 = Self::mul_add(v[5], -117.61766249359756, 1519.7808011559632 * v[3]);
-        let x230 = 1591.635376155963 * v[4];
-        let x231 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+            S::splat(-48.0240000085309),
+            S::mul_add(S::splat(-16.807689977165428), x23, S::splat(0.1132) * x22)
+                + S::mul_add(S::neg(x10), x28, x11 * x27),
+        ) + S::mul_add(S::splat(-0.00000000020510342851533115), x214, x219);
+        let x226 = S::neg(x225);
+        let x227 = S::mul_add(S::neg(c_q7), x221, s_q7 * x220);
+        let x228 = S::mul_add(s_q7, x221, c_q7 * x220);
+        let x229 = S::mul_add(
+            v[5],
+            S::splat(-117.61766249359756),
+            S::splat(1519.7808011559632) * v[3],
+        );
+        let x230 = S::splat(1591.635376155963) * v[4];
+        let x231 = S::mul_add(
+            S::splat(-1271.854575),
+            v[5],
+            v[3] * S::splat(117.61766249359758),
+        );
         let x232 = x227
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x7,
-                Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
+                S::mul_add(S::splat(-180.9502499901501), x15, S::splat(110.5455) * x13),
             );
-        let x233 = -(x228
-            - Self::mul_add(
-                1170.07,
-                x8,
-                Self::mul_add(180.9502499901501, x16, 110.5455 * x14),
-            ));
+        let x233 = S::neg(
+            x228
+                - S::mul_add(
+                    S::splat(1170.07),
+                    x8,
+                    S::mul_add(
+                        S::splat(180.9502499901501),
+                        x16,
+                        S::splat(110.5455) * x14,
+                    ),
+                ),
+        );
         let x234 = x222
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x9,
-                -Self::mul_add(-180.9502499901501, x17, 110.5455 * x15),
+                S::neg(
+                    S::mul_add(
+                        S::splat(-180.9502499901501),
+                        x17,
+                        S::splat(110.5455) * x15,
+                    ),
+                ),
             );
-        let x235 = -(Self::mul_add(-0.75, x228, Self::mul_add(-c_q7, x224, s_q7 * x223))
-            + Self::mul_add(
-                180.9502499901501,
-                x8,
-                Self::mul_add(v[4], x231, v[5] * x230),
-            ));
-        let x236 = Self::mul_add(s_q7, x224, c_q7 * x223)
-            + Self::mul_add(-0.65, x222, 0.75 * x227)
-            + (Self::mul_add(v[3], x231, v[5] * x229)
-                - Self::mul_add(-110.5455, x9, 180.9502499901501 * x7));
-        let x237 = -(Self::mul_add(0.65, x228, x225)
-            + Self::mul_add(-110.5455, x8, Self::mul_add(-v[3], x230, v[4] * x229)));
+        let x235 = S::neg(
+            S::mul_add(
+                S::splat(-0.75),
+                x228,
+                S::mul_add(S::neg(c_q7), x224, s_q7 * x223),
+            )
+                + S::mul_add(
+                    S::splat(180.9502499901501),
+                    x8,
+                    S::mul_add(v[4], x231, v[5] * x230),
+                ),
+        );
+        let x236 = S::mul_add(s_q7, x224, c_q7 * x223)
+            + S::mul_add(S::splat(-0.65), x222, S::splat(0.75) * x227)
+            + (S::mul_add(v[3], x231, v[5] * x229)
+                - S::mul_add(S::splat(-110.5455), x9, S::splat(180.9502499901501) * x7));
+        let x237 = S::neg(
+            S::mul_add(S::splat(0.65), x228, x225)
+                + S::mul_add(
+                    S::splat(-110.5455),
+                    x8,
+                    S::mul_add(S::neg(v[3]), x230, v[4] * x229),
+                ),
+        );
         [x232, x233, x234, x235, x236, x237, x226, x215, x203, x196, x188, x177, x165]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
@@ -2425,74 +2820,89 @@ impl FreeFloating7 {
         v: &[::core::primitive::f64; 13],
         a: &[::core::primitive::f64; 13],
     ) -> [::core::primitive::f64; 13] {
+        Self::inverse_dynamics_lanes::<::core::primitive::f64>(q, v, a)
+    }
+    /// [`Self::inverse_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 14], v: &[S; 13], a: &[S; 13]) -> [S; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
-            q[8] + 1.5707963265897933,
-            q[9] + 1.5707963267948966,
+            q[8] + S::splat(1.5707963265897933),
+            q[9] + S::splat(1.5707963267948966),
             q[10],
             q[11],
-            q[12] - 1.5707963267948966,
-            q[13] - 1.5707963267948966,
+            q[12] - S::splat(1.5707963267948966),
+            q[13] - S::splat(1.5707963267948966),
         ]);
-        let x7 = a[0] - Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x8 = a[1] + Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x9 = a[2] - Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x10 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x11 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x7 = a[0] - S::mul_add(S::neg(v[2]), v[4], v[1] * v[5]);
+        let x8 = a[1] + S::mul_add(S::neg(v[2]), v[3], v[0] * v[5]);
+        let x9 = a[2] - S::mul_add(S::neg(v[1]), v[3], v[0] * v[4]);
+        let x10 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x11 = S::mul_add(v[4], s_q7, v[3] * c_q7);
         let x12 = v[4] * v[4];
-        let x13 = Self::mul_add(v[5], v[5], x12);
+        let x13 = S::mul_add(v[5], v[5], x12);
         let x14 = v[3] * v[5];
         let x15 = a[4] + x14;
-        let x16 = Self::mul_add(v[3], v[4], a[5]);
-        let x17 = Self::mul_add(-v[4], v[5], a[3]);
+        let x16 = S::mul_add(v[3], v[4], a[5]);
+        let x17 = S::mul_add(S::neg(v[4]), v[5], a[3]);
         let x18 = a[4] - x14;
-        let x19 = Self::mul_add(v[3], v[3], x12);
-        let x20 = x7 - Self::mul_add(-0.75, x15, 0.65 * x13);
-        let x21 = x8 + Self::mul_add(-0.75, x17, 0.65 * x16);
-        let x22 = x9 - Self::mul_add(0.75, x19, 0.65 * x18);
-        let x23 = Self::mul_add(-c_q7, x21, s_q7 * x20);
-        let x24 = Self::mul_add(v[6], x11, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
-        let x25 = Self::mul_add(-v[6], x10, Self::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x19 = S::mul_add(v[3], v[3], x12);
+        let x20 = x7 - S::mul_add(S::splat(-0.75), x15, S::splat(0.65) * x13);
+        let x21 = x8 + S::mul_add(S::splat(-0.75), x17, S::splat(0.65) * x16);
+        let x22 = x9 - S::mul_add(S::splat(0.75), x19, S::splat(0.65) * x18);
+        let x23 = S::mul_add(S::neg(c_q7), x21, s_q7 * x20);
+        let x24 = S::mul_add(v[6], x11, S::mul_add(S::neg(a[4]), c_q7, a[3] * s_q7));
+        let x25 = S::mul_add(S::neg(v[6]), x10, S::mul_add(a[4], s_q7, a[3] * c_q7));
         let x26 = a[5] + a[6];
         let x27 = v[5] + v[6];
         let x28 = x10 * x10;
         let x29 = x11 * x27;
-        let x30 = Self::mul_add(-0.1132, x27, 0.07309 * x11);
-        let x31 = Self::mul_add(
-            -16.807689977165428,
+        let x30 = S::mul_add(S::splat(-0.1132), x27, S::splat(0.07309) * x11);
+        let x31 = S::mul_add(
+            S::splat(-16.807689977165428),
             x27,
-            Self::mul_add(x11, -125.18476992763283, 0.07309 * x10),
+            S::mul_add(x11, S::splat(-125.18476992763283), S::splat(0.07309) * x10),
         );
-        let x32 = Self::mul_add(
-            -127.22056992763282,
+        let x32 = S::mul_add(
+            S::splat(-127.22056992763282),
             x27,
-            Self::mul_add(16.807689977165428, x11, 0.1132 * x10),
+            S::mul_add(S::splat(16.807689977165428), x11, S::splat(0.1132) * x10),
         );
-        let x33 = Self::mul_add(
+        let x33 = S::mul_add(
             x23,
-            48.0240000085309,
-            Self::mul_add(
-                -127.22056992763282,
+            S::splat(48.0240000085309),
+            S::mul_add(
+                S::splat(-127.22056992763282),
                 x26,
-                Self::mul_add(16.807689977165428, x25, 0.1132 * x24),
-            ) + Self::mul_add(-x10, x31, x11 * x30),
+                S::mul_add(S::splat(16.807689977165428), x25, S::splat(0.1132) * x24),
+            ) + S::mul_add(S::neg(x10), x31, x11 * x30),
         );
-        let x34 = Self::mul_add(0.00000000020510342851533115, x11, x27);
-        let x35 = Self::mul_add(-s_q8, x34, x10 * c_q8);
-        let x36 = Self::mul_add(c_q8, x34, x10 * s_q8);
-        let x37 = Self::mul_add(0.35, Self::mul_add(x10, x27, x25), x23);
-        let x38 = Self::mul_add(-0.35, x24 - x29, Self::mul_add(s_q7, x21, c_q7 * x20));
-        let x39 = Self::mul_add(-0.35, Self::mul_add(x11, x11, x28), x22);
-        let x40 = Self::mul_add(0.00000000020510342851533115, x38, x39);
-        let x41 = Self::mul_add(-0.00000000020510342851533115, x39, x38);
-        let x42 = Self::mul_add(-s_q8, x40, c_q8 * x37);
-        let x43 = Self::mul_add(c_q8, x40, s_q8 * x37);
-        let x44 = Self::mul_add(0.00000000020510342851533115, x25, x26);
-        let x45 = Self::mul_add(-v[7], x36, Self::mul_add(-s_q8, x44, x24 * c_q8));
-        let x46 = Self::mul_add(v[7], x35, Self::mul_add(c_q8, x44, x24 * s_q8));
-        let x47 = a[7] + Self::mul_add(-0.00000000020510342851533115, x26, x25);
-        let x48 = v[7] + Self::mul_add(-0.00000000020510342851533115, x27, x11);
+        let x34 = S::mul_add(S::splat(0.00000000020510342851533115), x11, x27);
+        let x35 = S::mul_add(S::neg(s_q8), x34, x10 * c_q8);
+        let x36 = S::mul_add(c_q8, x34, x10 * s_q8);
+        let x37 = S::mul_add(S::splat(0.35), S::mul_add(x10, x27, x25), x23);
+        let x38 = S::mul_add(
+            S::splat(-0.35),
+            x24 - x29,
+            S::mul_add(s_q7, x21, c_q7 * x20),
+        );
+        let x39 = S::mul_add(S::splat(-0.35), S::mul_add(x11, x11, x28), x22);
+        let x40 = S::mul_add(S::splat(0.00000000020510342851533115), x38, x39);
+        let x41 = S::mul_add(S::splat(-0.00000000020510342851533115), x39, x38);
+        let x42 = S::mul_add(S::neg(s_q8), x40, c_q8 * x37);
+        let x43 = S::mul_add(c_q8, x40, s_q8 * x37);
+        let x44 = S::mul_add(S::splat(0.00000000020510342851533115), x25, x26);
+        let x45 = S::mul_add(
+            S::neg(v[7]),
+            x36,
+            S::mul_add(S::neg(s_q8), x44, x24 * c_q8),
+        );
+        let x46 = S::mul_add(v[7], x35, S::mul_add(c_q8, x44, x24 * s_q8));
+        let x47 = a[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x26, x25);
+        let x48 = v[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x27, x11);
         let x49 = x36 * x36;
         let x50 = x48 * x48;
         let x51 = x49 + x50;
@@ -2505,177 +2915,248 @@ impl FreeFloating7 {
         let x58 = x36 * x48;
         let x59 = x46 + x54;
         let x60 = x45 - x58;
-        let x61 = Self::mul_add(
-            -0.0021399976297017177,
+        let x61 = S::mul_add(
+            S::splat(-0.0021399976297017177),
             x48,
-            x36 * 0.0000000005683321144643007,
+            x36 * S::splat(0.0000000005683321144643007),
         );
-        let x62 = Self::mul_add(
+        let x62 = S::mul_add(
             x48,
-            -5.080660022992534,
-            Self::mul_add(x36, -106.50196992080811, x35 * 0.0000000005683321144643007),
+            S::splat(-5.080660022992534),
+            S::mul_add(
+                x36,
+                S::splat(-106.50196992080811),
+                x35 * S::splat(0.0000000005683321144643007),
+            ),
         );
-        let x63 = Self::mul_add(
-            -108.1389699208081,
+        let x63 = S::mul_add(
+            S::splat(-108.1389699208081),
             x48,
-            Self::mul_add(x36, 5.080660022992536, 0.0021399976297017177 * x35),
+            S::mul_add(
+                x36,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x35,
+            ),
         );
-        let x64 = Self::mul_add(
-            -0.0000000059257457049506905,
+        let x64 = S::mul_add(
+            S::splat(-0.0000000059257457049506905),
             x41,
-            Self::mul_add(
+            S::mul_add(
                 x47,
-                -5.080660022992534,
-                Self::mul_add(
+                S::splat(-5.080660022992534),
+                S::mul_add(
                     x46,
-                    -106.50196992080811,
-                    x45 * 0.0000000005683321144643007,
+                    S::splat(-106.50196992080811),
+                    x45 * S::splat(0.0000000005683321144643007),
                 ),
-            ) - Self::mul_add(x35, x63, x48 * x61),
+            ) - S::mul_add(x35, x63, x48 * x61),
         );
-        let x65 = Self::mul_add(-0.00000000020510342851533115, x36, x48);
-        let x66 = Self::mul_add(-s_q9, x65, x35 * c_q9);
-        let x67 = Self::mul_add(c_q9, x65, x35 * s_q9);
+        let x65 = S::mul_add(S::splat(-0.00000000020510342851533115), x36, x48);
+        let x66 = S::mul_add(S::neg(s_q9), x65, x35 * c_q9);
+        let x67 = S::mul_add(c_q9, x65, x35 * s_q9);
         let x68 = x42
-            + Self::mul_add(
-                -0.4,
+            + S::mul_add(
+                S::splat(-0.4),
                 x46 - x54,
-                Self::mul_add(-0.275, x53, 0.00000000005640344284171607 * x51),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x53,
+                    S::splat(0.00000000005640344284171607) * x51,
+                ),
             );
         let x69 = x43
-            + Self::mul_add(
-                0.4,
+            + S::mul_add(
+                S::splat(0.4),
                 x45 + x58,
-                Self::mul_add(0.275, x57, 0.00000000005640344284171607 * x55),
+                S::mul_add(
+                    S::splat(0.275),
+                    x57,
+                    S::splat(0.00000000005640344284171607) * x55,
+                ),
             );
         let x70 = x41
-            - Self::mul_add(
-                0.4,
+            - S::mul_add(
+                S::splat(0.4),
                 x49 + x56,
-                Self::mul_add(-0.275, x60, 0.00000000005640344284171607 * x59),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x60,
+                    S::splat(0.00000000005640344284171607) * x59,
+                ),
             );
-        let x71 = Self::mul_add(-0.00000000020510342851533115, x69, x70);
-        let x72 = Self::mul_add(0.00000000020510342851533115, x70, x69);
-        let x73 = Self::mul_add(-s_q9, x71, c_q9 * x68);
-        let x74 = Self::mul_add(-0.00000000020510342851533115, x46, x47);
-        let x75 = Self::mul_add(-v[8], x67, Self::mul_add(-s_q9, x74, x45 * c_q9));
-        let x76 = Self::mul_add(v[8], x66, Self::mul_add(c_q9, x74, x45 * s_q9));
-        let x77 = a[8] - Self::mul_add(0.00000000020510342851533115, x47, x46);
-        let x78 = v[8] - Self::mul_add(0.00000000020510342851533115, x48, x36);
-        let x79 = Self::mul_add(x66, x67, x77);
-        let x80 = Self::mul_add(x66, x66, x78 * x78);
-        let x81 = Self::mul_add(-x67, x78, x75);
-        let x82 = 0.00214 * x78;
-        let x83 = Self::mul_add(x78, 36.18604050126307, x67 * 63.36336825);
-        let x84 = Self::mul_add(
-            69.99836825,
+        let x71 = S::mul_add(S::splat(-0.00000000020510342851533115), x69, x70);
+        let x72 = S::mul_add(S::splat(0.00000000020510342851533115), x70, x69);
+        let x73 = S::mul_add(S::neg(s_q9), x71, c_q9 * x68);
+        let x74 = S::mul_add(S::splat(-0.00000000020510342851533115), x46, x47);
+        let x75 = S::mul_add(
+            S::neg(v[8]),
+            x67,
+            S::mul_add(S::neg(s_q9), x74, x45 * c_q9),
+        );
+        let x76 = S::mul_add(v[8], x66, S::mul_add(c_q9, x74, x45 * s_q9));
+        let x77 = a[8] - S::mul_add(S::splat(0.00000000020510342851533115), x47, x46);
+        let x78 = v[8] - S::mul_add(S::splat(0.00000000020510342851533115), x48, x36);
+        let x79 = S::mul_add(x66, x67, x77);
+        let x80 = S::mul_add(x66, x66, x78 * x78);
+        let x81 = S::mul_add(S::neg(x67), x78, x75);
+        let x82 = S::splat(0.00214) * x78;
+        let x83 = S::mul_add(
             x78,
-            Self::mul_add(x67, -36.18604050126307, 0.00214 * x66),
+            S::splat(36.18604050126307),
+            x67 * S::splat(63.36336825),
         );
-        let x85 = Self::mul_add(
+        let x84 = S::mul_add(
+            S::splat(69.99836825),
+            x78,
+            S::mul_add(x67, S::splat(-36.18604050126307), S::splat(0.00214) * x66),
+        );
+        let x85 = S::mul_add(
             x72,
-            -81.53205,
-            Self::mul_add(0.00214, x77, -Self::mul_add(x67, x84, x78 * x83)),
+            S::splat(-81.53205),
+            S::mul_add(S::splat(0.00214), x77, S::neg(S::mul_add(x67, x84, x78 * x83))),
         );
-        let x86 = Self::mul_add(
+        let x86 = S::mul_add(
             x73,
-            -81.53205,
-            Self::mul_add(
-                69.99836825,
+            S::splat(-81.53205),
+            S::mul_add(
+                S::splat(69.99836825),
                 x77,
-                Self::mul_add(x76, -36.18604050126307, 0.00214 * x75),
-            ) + Self::mul_add(x66, x83, x67 * x82),
+                S::mul_add(x76, S::splat(-36.18604050126307), S::splat(0.00214) * x75),
+            ) + S::mul_add(x66, x83, x67 * x82),
         );
-        let x87 = Self::mul_add(-x67, s_q10, x66 * c_q10);
-        let x88 = Self::mul_add(x67, c_q10, x66 * s_q10);
-        let x89 = Self::mul_add(x79, -0.87, x73);
-        let x90 = Self::mul_add(x80, 0.87, Self::mul_add(c_q9, x71, s_q9 * x68));
-        let x91 = Self::mul_add(x81, -0.87, x72);
-        let x92 = Self::mul_add(-s_q10, x90, c_q10 * x89);
-        let x93 = Self::mul_add(-v[9], x88, Self::mul_add(-x76, s_q10, x75 * c_q10));
-        let x94 = Self::mul_add(v[9], x87, Self::mul_add(x76, c_q10, x75 * s_q10));
+        let x87 = S::mul_add(S::neg(x67), s_q10, x66 * c_q10);
+        let x88 = S::mul_add(x67, c_q10, x66 * s_q10);
+        let x89 = S::mul_add(x79, S::splat(-0.87), x73);
+        let x90 = S::mul_add(x80, S::splat(0.87), S::mul_add(c_q9, x71, s_q9 * x68));
+        let x91 = S::mul_add(x81, S::splat(-0.87), x72);
+        let x92 = S::mul_add(S::neg(s_q10), x90, c_q10 * x89);
+        let x93 = S::mul_add(
+            S::neg(v[9]),
+            x88,
+            S::mul_add(S::neg(x76), s_q10, x75 * c_q10),
+        );
+        let x94 = S::mul_add(v[9], x87, S::mul_add(x76, c_q10, x75 * s_q10));
         let x95 = a[9] + x77;
         let x96 = v[9] + x78;
-        let x97 = Self::mul_add(x87, x88, x95);
+        let x97 = S::mul_add(x87, x88, x95);
         let x98 = x87 * x87;
-        let x99 = Self::mul_add(x96, x96, x98);
+        let x99 = S::mul_add(x96, x96, x98);
         let x100 = x88 * x96;
         let x101 = x93 - x100;
-        let x102 = x96 * 0.6328;
-        let x103 = Self::mul_add(x96, 24.35164200091464, x88 * 24.4950615);
-        let x104 = Self::mul_add(
-            28.2393615,
+        let x102 = x96 * S::splat(0.6328);
+        let x103 = S::mul_add(
             x96,
-            Self::mul_add(x88, -24.351642000914637, x87 * 0.6328),
+            S::splat(24.35164200091464),
+            x88 * S::splat(24.4950615),
         );
-        let x105 = Self::mul_add(
+        let x104 = S::mul_add(
+            S::splat(28.2393615),
+            x96,
+            S::mul_add(x88, S::splat(-24.351642000914637), x87 * S::splat(0.6328)),
+        );
+        let x105 = S::mul_add(
             x91,
-            -45.1584,
-            Self::mul_add(x95, 0.6328, -Self::mul_add(x88, x104, x96 * x103)),
+            S::splat(-45.1584),
+            S::mul_add(x95, S::splat(0.6328), S::neg(S::mul_add(x88, x104, x96 * x103))),
         );
-        let x106 = Self::mul_add(
+        let x106 = S::mul_add(
             x92,
-            -45.1584,
-            Self::mul_add(
-                28.2393615,
+            S::splat(-45.1584),
+            S::mul_add(
+                S::splat(28.2393615),
                 x95,
-                Self::mul_add(x94, -24.351642000914637, x93 * 0.6328),
-            ) + Self::mul_add(x87, x103, x88 * x102),
+                S::mul_add(x94, S::splat(-24.351642000914637), x93 * S::splat(0.6328)),
+            ) + S::mul_add(x87, x103, x88 * x102),
         );
-        let x107 = Self::mul_add(-x88, s_q11, x87 * c_q11);
-        let x108 = Self::mul_add(x88, c_q11, x87 * s_q11);
+        let x107 = S::mul_add(S::neg(x88), s_q11, x87 * c_q11);
+        let x108 = S::mul_add(x88, c_q11, x87 * s_q11);
         let x109 = x92
-            - Self::mul_add(-0.275, Self::mul_add(-x87, x96, x94), x97 * 0.63);
-        let x110 = Self::mul_add(c_q10, x90, s_q10 * x89)
-            + Self::mul_add(-0.275, x93 + x100, x99 * 0.63);
-        let x111 = x91 - Self::mul_add(0.275, Self::mul_add(x88, x88, x98), x101 * 0.63);
-        let x112 = Self::mul_add(-s_q11, x110, c_q11 * x109);
-        let x113 = Self::mul_add(-v[10], x108, Self::mul_add(-x94, s_q11, x93 * c_q11));
-        let x114 = Self::mul_add(v[10], x107, Self::mul_add(x94, c_q11, x93 * s_q11));
+            - S::mul_add(
+                S::splat(-0.275),
+                S::mul_add(S::neg(x87), x96, x94),
+                x97 * S::splat(0.63),
+            );
+        let x110 = S::mul_add(c_q10, x90, s_q10 * x89)
+            + S::mul_add(S::splat(-0.275), x93 + x100, x99 * S::splat(0.63));
+        let x111 = x91
+            - S::mul_add(
+                S::splat(0.275),
+                S::mul_add(x88, x88, x98),
+                x101 * S::splat(0.63),
+            );
+        let x112 = S::mul_add(S::neg(s_q11), x110, c_q11 * x109);
+        let x113 = S::mul_add(
+            S::neg(v[10]),
+            x108,
+            S::mul_add(S::neg(x94), s_q11, x93 * c_q11),
+        );
+        let x114 = S::mul_add(v[10], x107, S::mul_add(x94, c_q11, x93 * s_q11));
         let x115 = a[10] + x95;
         let x116 = v[10] + x96;
         let x117 = x107 * x107;
         let x118 = x108 * x116;
-        let x119 = x116 * 0.01675;
-        let x120 = Self::mul_add(x116, -2.5482240005325645, x108 * 3.8891049197628025);
-        let x121 = Self::mul_add(
-            -3.970314919762802,
+        let x119 = x116 * S::splat(0.01675);
+        let x120 = S::mul_add(
             x116,
-            Self::mul_add(x108, -2.5482240005325645, x107 * 0.01675),
+            S::splat(-2.5482240005325645),
+            x108 * S::splat(3.8891049197628025),
         );
-        let x122 = Self::mul_add(
+        let x121 = S::mul_add(
+            S::splat(-3.970314919762802),
+            x116,
+            S::mul_add(x108, S::splat(-2.5482240005325645), x107 * S::splat(0.01675)),
+        );
+        let x122 = S::mul_add(
             x111,
-            -7.078399999258757,
-            Self::mul_add(x115, 0.01675, Self::mul_add(-x108, x121, x116 * x120)),
-        );
-        let x123 = Self::mul_add(
-            x112,
-            -7.078399999258757,
-            Self::mul_add(
-                -3.970314919762802,
+            S::splat(-7.078399999258757),
+            S::mul_add(
                 x115,
-                Self::mul_add(x114, -2.5482240005325645, x113 * 0.01675),
-            ) + Self::mul_add(-x107, x120, x108 * x119),
+                S::splat(0.01675),
+                S::mul_add(S::neg(x108), x121, x116 * x120),
+            ),
         );
-        let x124 = Self::mul_add(0.00000000020510342851533115, x108, x116);
-        let x125 = Self::mul_add(s_q12, x124, x107 * c_q12);
-        let x126 = Self::mul_add(-c_q12, x124, x107 * s_q12);
-        let x127 = Self::mul_add(Self::mul_add(-x107, x116, x114), 0.36, x112);
-        let x128 = Self::mul_add(
+        let x123 = S::mul_add(
+            x112,
+            S::splat(-7.078399999258757),
+            S::mul_add(
+                S::splat(-3.970314919762802),
+                x115,
+                S::mul_add(x114, S::splat(-2.5482240005325645), x113 * S::splat(0.01675)),
+            ) + S::mul_add(S::neg(x107), x120, x108 * x119),
+        );
+        let x124 = S::mul_add(S::splat(0.00000000020510342851533115), x108, x116);
+        let x125 = S::mul_add(s_q12, x124, x107 * c_q12);
+        let x126 = S::mul_add(S::neg(c_q12), x124, x107 * s_q12);
+        let x127 = S::mul_add(
+            S::mul_add(S::neg(x107), x116, x114),
+            S::splat(0.36),
+            x112,
+        );
+        let x128 = S::mul_add(
             x113 + x118,
-            -0.36,
-            Self::mul_add(c_q11, x110, s_q11 * x109),
+            S::splat(-0.36),
+            S::mul_add(c_q11, x110, s_q11 * x109),
         );
-        let x129 = Self::mul_add(Self::mul_add(x108, x108, x117), -0.36, x111);
-        let x130 = Self::mul_add(-0.00000000020510342851533115, x128, x129);
-        let x131 = Self::mul_add(0.00000000020510342851533115, x129, x128);
-        let x132 = Self::mul_add(-s_q12, x130, c_q12 * x127);
-        let x133 = Self::mul_add(c_q12, x130, s_q12 * x127);
-        let x134 = Self::mul_add(0.00000000020510342851533115, x114, x115);
-        let x135 = Self::mul_add(-v[11], x126, Self::mul_add(s_q12, x134, x113 * c_q12));
-        let x136 = Self::mul_add(v[11], x125, Self::mul_add(-c_q12, x134, x113 * s_q12));
-        let x137 = a[11] + Self::mul_add(-0.00000000020510342851533115, x115, x114);
-        let x138 = v[11] + Self::mul_add(-0.00000000020510342851533115, x116, x108);
+        let x129 = S::mul_add(S::mul_add(x108, x108, x117), S::splat(-0.36), x111);
+        let x130 = S::mul_add(S::splat(-0.00000000020510342851533115), x128, x129);
+        let x131 = S::mul_add(S::splat(0.00000000020510342851533115), x129, x128);
+        let x132 = S::mul_add(S::neg(s_q12), x130, c_q12 * x127);
+        let x133 = S::mul_add(c_q12, x130, s_q12 * x127);
+        let x134 = S::mul_add(S::splat(0.00000000020510342851533115), x114, x115);
+        let x135 = S::mul_add(
+            S::neg(v[11]),
+            x126,
+            S::mul_add(s_q12, x134, x113 * c_q12),
+        );
+        let x136 = S::mul_add(
+            v[11],
+            x125,
+            S::mul_add(S::neg(c_q12), x134, x113 * s_q12),
+        );
+        let x137 = a[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x115, x114);
+        let x138 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x116, x108);
         let x139 = x126 * x126;
         let x140 = x138 * x138;
         let x141 = x139 + x140;
@@ -2685,286 +3166,449 @@ impl FreeFloating7 {
         let x145 = x125 * x125;
         let x146 = x126 * x138;
         let x147 = x136 + x143;
-        let x148 = Self::mul_add(x138, 2.741639999592316, 1.9877000000000002 * x126);
-        let x149 = Self::mul_add(
-            0.809539999555672,
+        let x148 = S::mul_add(
             x138,
-            Self::mul_add(-5.252920330000002, x126, 1.9877000000000002 * x125),
+            S::splat(2.741639999592316),
+            S::splat(1.9877000000000002) * x126,
         );
-        let x150 = Self::mul_add(
-            -9.740442170000001,
+        let x149 = S::mul_add(
+            S::splat(0.809539999555672),
             x138,
-            Self::mul_add(0.809539999555672, x126, x125 * 2.7416399995923166),
-        );
-        let x151 = Self::mul_add(
-            -17.135250000000003,
-            x131,
-            Self::mul_add(
-                0.809539999555672,
-                x137,
-                Self::mul_add(-5.252920330000002, x136, 1.9877000000000002 * x135),
-            ) - Self::mul_add(-x125, x150, x138 * x148),
-        );
-        let x152 = Self::mul_add(0.00000000020510342851533115, x126, x138);
-        let x153 = Self::mul_add(s_q13, x152, x125 * c_q13);
-        let x154 = Self::mul_add(-c_q13, x152, x125 * s_q13);
-        let x155 = x133 - Self::mul_add(-0.16, x135 + x146, 0.55 * x144);
-        let x156 = x131 + Self::mul_add(-0.16, x139 + x145, 0.55 * x147);
-        let x157 = Self::mul_add(0.00000000020510342851533115, x136, x137);
-        let x158 = Self::mul_add(-v[12], x154, Self::mul_add(s_q13, x157, x135 * c_q13));
-        let x159 = Self::mul_add(v[12], x153, Self::mul_add(-c_q13, x157, x135 * s_q13));
-        let x160 = a[12] + Self::mul_add(-0.00000000020510342851533115, x137, x136);
-        let x161 = v[12] + Self::mul_add(-0.00000000020510342851533115, x138, x126);
-        let x162 = 4.806620000000001 * Self::mul_add(x153, x154, x160);
-        let x163 = 4.806620000000001 * Self::mul_add(x153, x153, x161 * x161);
-        let x164 = 4.806620000000001 * Self::mul_add(-x154, x161, x158);
-        let x165 = Self::mul_add(x161, 0.0145, 0.000781 * x154);
-        let x166 = Self::mul_add(
-            x161,
-            -0.9614610000000001,
-            Self::mul_add(x154, 1.2025609200000003, 0.000781 * x153),
-        );
-        let x167 = Self::mul_add(
-            -1.4135609200000003,
-            x161,
-            Self::mul_add(x154, -0.9614610000000001, x153 * 0.0145),
-        );
-        let x168 = Self::mul_add(
-            x160,
-            -0.9614610000000001,
-            Self::mul_add(x159, 1.2025609200000003, 0.000781 * x158),
-        ) - Self::mul_add(-x153, x167, x161 * x165);
-        let x169 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x156, x155),
-            Self::mul_add(x160, 0.0145, 0.000781 * x159)
-                + Self::mul_add(-x154, x167, x161 * x166),
-        );
-        let x170 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(0.00000000020510342851533115, x155, x156),
-                c_q13 * (x132 - Self::mul_add(0.16, x136 - x143, 0.55 * x141)),
+            S::mul_add(
+                S::splat(-5.252920330000002),
+                x126,
+                S::splat(1.9877000000000002) * x125,
             ),
-            Self::mul_add(
-                -1.4135609200000003,
-                x160,
-                Self::mul_add(x159, -0.9614610000000001, x158 * 0.0145),
-            ) + Self::mul_add(-x153, x166, x154 * x165),
         );
-        let x171 = -x170;
-        let x172 = Self::mul_add(-s_q13, x163, c_q13 * x162);
-        let x173 = Self::mul_add(c_q13, x163, s_q13 * x162);
-        let x174 = Self::mul_add(-0.00000000020510342851533115, x173, x164);
-        let x175 = Self::mul_add(0.00000000020510342851533115, x164, x173);
-        let x176 = Self::mul_add(-c_q13, x168, s_q13 * x169);
-        let x177 = Self::mul_add(
-            -3.6140000000000003,
-            x137 + x142,
-            17.135250000000003 * x141,
-        ) + x172;
-        let x178 = Self::mul_add(
-            3.6140000000000003,
-            x140 + x145,
-            17.135250000000003 * x144,
-        ) - x174;
-        let x179 = Self::mul_add(
-            -3.6140000000000003,
-            x135 - x146,
-            17.135250000000003 * x147,
-        ) - x175;
-        let x180 = Self::mul_add(
-            3.6140000000000003,
+        let x150 = S::mul_add(
+            S::splat(-9.740442170000001),
+            x138,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x126,
+                x125 * S::splat(2.7416399995923166),
+            ),
+        );
+        let x151 = S::mul_add(
+            S::splat(-17.135250000000003),
             x131,
-            Self::mul_add(x137, 2.741639999592316, 1.9877000000000002 * x136)
-                + Self::mul_add(-x126, x150, x138 * x149),
-        ) + Self::mul_add(-0.16, x174, Self::mul_add(s_q13, x168, c_q13 * x169));
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x137,
+                S::mul_add(
+                    S::splat(-5.252920330000002),
+                    x136,
+                    S::splat(1.9877000000000002) * x135,
+                ),
+            ) - S::mul_add(S::neg(x125), x150, x138 * x148),
+        );
+        let x152 = S::mul_add(S::splat(0.00000000020510342851533115), x126, x138);
+        let x153 = S::mul_add(s_q13, x152, x125 * c_q13);
+        let x154 = S::mul_add(S::neg(c_q13), x152, x125 * s_q13);
+        let x155 = x133
+            - S::mul_add(S::splat(-0.16), x135 + x146, S::splat(0.55) * x144);
+        let x156 = x131
+            + S::mul_add(S::splat(-0.16), x139 + x145, S::splat(0.55) * x147);
+        let x157 = S::mul_add(S::splat(0.00000000020510342851533115), x136, x137);
+        let x158 = S::mul_add(
+            S::neg(v[12]),
+            x154,
+            S::mul_add(s_q13, x157, x135 * c_q13),
+        );
+        let x159 = S::mul_add(
+            v[12],
+            x153,
+            S::mul_add(S::neg(c_q13), x157, x135 * s_q13),
+        );
+        let x160 = a[12]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x137, x136);
+        let x161 = v[12]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x138, x126);
+        let x162 = S::splat(4.806620000000001) * S::mul_add(x153, x154, x160);
+        let x163 = S::splat(4.806620000000001) * S::mul_add(x153, x153, x161 * x161);
+        let x164 = S::splat(4.806620000000001) * S::mul_add(S::neg(x154), x161, x158);
+        let x165 = S::mul_add(x161, S::splat(0.0145), S::splat(0.000781) * x154);
+        let x166 = S::mul_add(
+            x161,
+            S::splat(-0.9614610000000001),
+            S::mul_add(x154, S::splat(1.2025609200000003), S::splat(0.000781) * x153),
+        );
+        let x167 = S::mul_add(
+            S::splat(-1.4135609200000003),
+            x161,
+            S::mul_add(x154, S::splat(-0.9614610000000001), x153 * S::splat(0.0145)),
+        );
+        let x168 = S::mul_add(
+            x160,
+            S::splat(-0.9614610000000001),
+            S::mul_add(x159, S::splat(1.2025609200000003), S::splat(0.000781) * x158),
+        ) - S::mul_add(S::neg(x153), x167, x161 * x165);
+        let x169 = S::mul_add(
+            S::splat(-4.806620000000001),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x156, x155),
+            S::mul_add(x160, S::splat(0.0145), S::splat(0.000781) * x159)
+                + S::mul_add(S::neg(x154), x167, x161 * x166),
+        );
+        let x170 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(
+                s_q13,
+                S::mul_add(S::splat(0.00000000020510342851533115), x155, x156),
+                c_q13
+                    * (x132
+                        - S::mul_add(S::splat(0.16), x136 - x143, S::splat(0.55) * x141)),
+            ),
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x160,
+                S::mul_add(x159, S::splat(-0.9614610000000001), x158 * S::splat(0.0145)),
+            ) + S::mul_add(S::neg(x153), x166, x154 * x165),
+        );
+        let x171 = S::neg(x170);
+        let x172 = S::mul_add(S::neg(s_q13), x163, c_q13 * x162);
+        let x173 = S::mul_add(c_q13, x163, s_q13 * x162);
+        let x174 = S::mul_add(S::splat(-0.00000000020510342851533115), x173, x164);
+        let x175 = S::mul_add(S::splat(0.00000000020510342851533115), x164, x173);
+        let x176 = S::mul_add(S::neg(c_q13), x168, s_q13 * x169);
+        let x177 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x137 + x142,
+            S::splat(17.135250000000003) * x141,
+        ) + x172;
+        let x178 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x140 + x145,
+            S::splat(17.135250000000003) * x144,
+        ) - x174;
+        let x179 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x135 - x146,
+            S::splat(17.135250000000003) * x147,
+        ) - x175;
+        let x180 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x131,
+            S::mul_add(
+                x137,
+                S::splat(2.741639999592316),
+                S::splat(1.9877000000000002) * x136,
+            ) + S::mul_add(S::neg(x126), x150, x138 * x149),
+        ) + S::mul_add(S::splat(-0.16), x174, S::mul_add(s_q13, x168, c_q13 * x169));
         let x181 = x151
-            + (Self::mul_add(0.00000000020510342851533115, x176, x170)
-                - Self::mul_add(-0.55, x175, 0.16 * x172));
-        let x182 = Self::mul_add(
-            -9.740442170000001,
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x176, x170)
+                - S::mul_add(S::splat(-0.55), x175, S::splat(0.16) * x172));
+        let x182 = S::mul_add(
+            S::splat(-9.740442170000001),
             x137,
-            Self::mul_add(0.809539999555672, x136, x135 * 2.7416399995923166),
-        ) + Self::mul_add(-x125, x149, x126 * x148)
-            - Self::mul_add(-17.135250000000003, x133, 3.6140000000000003 * x132)
-            + Self::mul_add(
-                0.55,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x136,
+                x135 * S::splat(2.7416399995923166),
+            ),
+        ) + S::mul_add(S::neg(x125), x149, x126 * x148)
+            - S::mul_add(
+                S::splat(-17.135250000000003),
+                x133,
+                S::splat(3.6140000000000003) * x132,
+            )
+            + S::mul_add(
+                S::splat(0.55),
                 x174,
-                Self::mul_add(-0.00000000020510342851533115, x170, x176),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x170, x176),
             );
-        let x183 = -x182;
-        let x184 = Self::mul_add(s_q12, x178, c_q12 * x177);
-        let x185 = Self::mul_add(-c_q12, x178, s_q12 * x177);
-        let x186 = Self::mul_add(-0.00000000020510342851533115, x185, x179);
-        let x187 = Self::mul_add(-c_q12, x181, s_q12 * x180);
-        let x188 = Self::mul_add(
-            Self::mul_add(x107, x108, x115),
-            7.078399999258757,
-            -x184,
+        let x183 = S::neg(x182);
+        let x184 = S::mul_add(s_q12, x178, c_q12 * x177);
+        let x185 = S::mul_add(S::neg(c_q12), x178, s_q12 * x177);
+        let x186 = S::mul_add(S::splat(-0.00000000020510342851533115), x185, x179);
+        let x187 = S::mul_add(S::neg(c_q12), x181, s_q12 * x180);
+        let x188 = S::mul_add(
+            S::mul_add(x107, x108, x115),
+            S::splat(7.078399999258757),
+            S::neg(x184),
         );
-        let x189 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x116, x116, x117),
-            -x186,
+        let x189 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x116, x116, x117),
+            S::neg(x186),
         );
-        let x190 = Self::mul_add(
-            7.078399999258757,
+        let x190 = S::mul_add(
+            S::splat(7.078399999258757),
             x113 - x118,
-            Self::mul_add(0.00000000020510342851533115, x179, x185),
+            S::mul_add(S::splat(0.00000000020510342851533115), x179, x185),
         );
         let x191 = x122
-            + Self::mul_add(0.36, x186, Self::mul_add(s_q12, x181, c_q12 * x180));
-        let x192 = Self::mul_add(x115, -2.5482240005325645, x114 * 3.8891049197628025)
-            - Self::mul_add(-x107, x121, x116 * x119)
-            + Self::mul_add(
-                0.36,
+            + S::mul_add(S::splat(0.36), x186, S::mul_add(s_q12, x181, c_q12 * x180));
+        let x192 = S::mul_add(
+            x115,
+            S::splat(-2.5482240005325645),
+            x114 * S::splat(3.8891049197628025),
+        ) - S::mul_add(S::neg(x107), x121, x116 * x119)
+            + S::mul_add(
+                S::splat(0.36),
                 x184,
-                Self::mul_add(0.00000000020510342851533115, x187, x182),
+                S::mul_add(S::splat(0.00000000020510342851533115), x187, x182),
             );
-        let x193 = x123 + Self::mul_add(-0.00000000020510342851533115, x182, x187);
-        let x194 = -x193;
-        let x195 = Self::mul_add(-s_q11, x189, c_q11 * x188);
-        let x196 = Self::mul_add(c_q11, x189, s_q11 * x188);
-        let x197 = Self::mul_add(x97, 45.1584, -x195);
-        let x198 = Self::mul_add(45.1584, x99, -x196);
-        let x199 = Self::mul_add(45.1584, x101, -x190);
+        let x193 = x123
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x182, x187);
+        let x194 = S::neg(x193);
+        let x195 = S::mul_add(S::neg(s_q11), x189, c_q11 * x188);
+        let x196 = S::mul_add(c_q11, x189, s_q11 * x188);
+        let x197 = S::mul_add(x97, S::splat(45.1584), S::neg(x195));
+        let x198 = S::mul_add(S::splat(45.1584), x99, S::neg(x196));
+        let x199 = S::mul_add(S::splat(45.1584), x101, S::neg(x190));
         let x200 = x105
-            - (Self::mul_add(s_q11, x192, c_q11 * x191)
-                - Self::mul_add(-0.63, x190, 0.275 * x196));
-        let x201 = Self::mul_add(x95, 24.35164200091464, x94 * 24.4950615)
-            + Self::mul_add(-x87, x104, x96 * x102)
-            - Self::mul_add(0.275, x195, Self::mul_add(-c_q11, x192, s_q11 * x191));
-        let x202 = x106 - Self::mul_add(0.63, x195, x193);
-        let x203 = Self::mul_add(-s_q10, x198, c_q10 * x197);
-        let x204 = Self::mul_add(x79, 81.53205, x203);
-        let x205 = Self::mul_add(
-            81.53205,
-            x80,
-            Self::mul_add(c_q10, x198, s_q10 * x197),
-        );
-        let x206 = Self::mul_add(81.53205, x81, x199);
-        let x207 = x85
-            + Self::mul_add(0.87, x199, Self::mul_add(-s_q10, x201, c_q10 * x200));
-        let x208 = Self::mul_add(x77, 36.18604050126307, x76 * 63.36336825)
-            + Self::mul_add(-x66, x84, x78 * x82)
-            + Self::mul_add(c_q10, x201, s_q10 * x200);
-        let x209 = x86 + Self::mul_add(0.87, x203, x202);
-        let x210 = Self::mul_add(-s_q9, x205, c_q9 * x204);
-        let x211 = Self::mul_add(c_q9, x205, s_q9 * x204);
-        let x212 = Self::mul_add(0.00000000020510342851533115, x211, x206);
-        let x213 = Self::mul_add(-0.00000000020510342851533115, x206, x211);
-        let x214 = Self::mul_add(c_q9, x208, s_q9 * x207);
-        let x215 = Self::mul_add(
-            12.701650001451807,
-            x53,
-            0.0000000059257457049506905 * x51,
-        ) - x210;
-        let x216 = Self::mul_add(
-            -12.701650001451807,
-            x57,
-            0.0000000059257457049506905 * x55,
-        ) - x212;
-        let x217 = Self::mul_add(
-            12.701650001451807,
-            x60,
-            0.0000000059257457049506905 * x59,
-        ) - x213;
-        let x218 = Self::mul_add(
-            -12.701650001451807,
-            x41,
-            Self::mul_add(-0.0021399976297017177, x47, x46 * 0.0000000005683321144643007)
-                + Self::mul_add(x36, x63, x48 * x62),
-        )
-            + (Self::mul_add(-s_q9, x208, c_q9 * x207)
-                - Self::mul_add(-0.275, x213, 0.4 * x212));
-        let x219 = x64
-            - (Self::mul_add(-0.00000000020510342851533115, x214, x209)
-                - Self::mul_add(-0.00000000005640344284171607, x213, 0.4 * x210));
-        let x220 = Self::mul_add(
-            -108.1389699208081,
-            x47,
-            Self::mul_add(x46, 5.080660022992536, 0.0021399976297017177 * x45),
-        ) - Self::mul_add(-x35, x62, x36 * x61)
-            - Self::mul_add(0.0000000059257457049506905, x43, 12.701650001451807 * x42)
-            + (Self::mul_add(0.00000000020510342851533115, x209, x214)
-                - Self::mul_add(-0.00000000005640344284171607, x212, 0.275 * x210));
-        let x221 = -x220;
-        let x222 = Self::mul_add(s_q8, x216, c_q8 * x215);
-        let x223 = Self::mul_add(-c_q8, x216, s_q8 * x215);
-        let x224 = Self::mul_add(0.00000000020510342851533115, x223, x217);
-        let x225 = Self::mul_add(-c_q8, x219, s_q8 * x218);
-        let x226 = Self::mul_add(Self::mul_add(-x10, x11, x26), 48.0240000085309, -x222);
-        let x227 = Self::mul_add(48.0240000085309, Self::mul_add(x27, x27, x28), x224);
-        let x228 = Self::mul_add(
-            48.0240000085309,
-            x24 + x29,
-            -Self::mul_add(-0.00000000020510342851533115, x217, x223),
-        );
-        let x229 = Self::mul_add(
-            x22,
-            48.0240000085309,
-            Self::mul_add(-0.1132, x26, 0.07309 * x25)
-                - Self::mul_add(x11, x32, x27 * x31),
-        ) + Self::mul_add(0.35, x224, Self::mul_add(s_q8, x219, c_q8 * x218));
-        let x230 = Self::mul_add(
-            -16.807689977165428,
-            x26,
-            Self::mul_add(x25, -125.18476992763283, 0.07309 * x24),
-        ) + Self::mul_add(x10, x32, x27 * x30)
-            - Self::mul_add(
-                -0.35,
-                x222,
-                Self::mul_add(0.00000000020510342851533115, x225, x220),
+            - (S::mul_add(s_q11, x192, c_q11 * x191)
+                - S::mul_add(S::splat(-0.63), x190, S::splat(0.275) * x196));
+        let x201 = S::mul_add(
+            x95,
+            S::splat(24.35164200091464),
+            x94 * S::splat(24.4950615),
+        ) + S::mul_add(S::neg(x87), x104, x96 * x102)
+            - S::mul_add(
+                S::splat(0.275),
+                x195,
+                S::mul_add(S::neg(c_q11), x192, s_q11 * x191),
             );
-        let x231 = x33 + Self::mul_add(-0.00000000020510342851533115, x220, x225);
-        let x232 = -x231;
-        let x233 = Self::mul_add(c_q7, x227, s_q7 * x226);
-        let x234 = Self::mul_add(-s_q7, x227, c_q7 * x226);
-        let x235 = Self::mul_add(v[5], -117.61766249359756, 1519.7808011559632 * v[3]);
-        let x236 = 1591.635376155963 * v[4];
-        let x237 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x238 = -(x233
-            - Self::mul_add(
-                1170.07,
-                x7,
-                -Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
-            ));
+        let x202 = x106 - S::mul_add(S::splat(0.63), x195, x193);
+        let x203 = S::mul_add(S::neg(s_q10), x198, c_q10 * x197);
+        let x204 = S::mul_add(x79, S::splat(81.53205), x203);
+        let x205 = S::mul_add(
+            S::splat(81.53205),
+            x80,
+            S::mul_add(c_q10, x198, s_q10 * x197),
+        );
+        let x206 = S::mul_add(S::splat(81.53205), x81, x199);
+        let x207 = x85
+            + S::mul_add(
+                S::splat(0.87),
+                x199,
+                S::mul_add(S::neg(s_q10), x201, c_q10 * x200),
+            );
+        let x208 = S::mul_add(
+            x77,
+            S::splat(36.18604050126307),
+            x76 * S::splat(63.36336825),
+        ) + S::mul_add(S::neg(x66), x84, x78 * x82)
+            + S::mul_add(c_q10, x201, s_q10 * x200);
+        let x209 = x86 + S::mul_add(S::splat(0.87), x203, x202);
+        let x210 = S::mul_add(S::neg(s_q9), x205, c_q9 * x204);
+        let x211 = S::mul_add(c_q9, x205, s_q9 * x204);
+        let x212 = S::mul_add(S::splat(0.00000000020510342851533115), x211, x206);
+        let x213 = S::mul_add(S::splat(-0.00000000020510342851533115), x206, x211);
+        let x214 = S::mul_add(c_q9, x208, s_q9 * x207);
+        let x215 = S::mul_add(
+            S::splat(12.701650001451807),
+            x53,
+            S::splat(0.0000000059257457049506905) * x51,
+        ) - x210;
+        let x216 = S::mul_add(
+            S::splat(-12.701650001451807),
+            x57,
+            S::splat(0.0000000059257457049506905) * x55,
+        ) - x212;
+        let x217 = S::mul_add(
+            S::splat(12.701650001451807),
+            x60,
+            S::splat(0.0000000059257457049506905) * x59,
+        ) - x213;
+        let x218 = S::mul_add(
+            S::splat(-12.701650001451807),
+            x41,
+            S::mul_add(
+                S::splat(-0.0021399976297017177),
+                x47,
+                x46 * S::splat(0.0000000005683321144643007),
+            ) + S::mul_add(x36, x63, x48 * x62),
+        )
+            + (S::mul_add(S::neg(s_q9), x208, c_q9 * x207)
+                - S::mul_add(S::splat(-0.275), x213, S::splat(0.4) * x212));
+        let x219 = x64
+            - (S::mul_add(S::splat(-0.00000000020510342851533115), x214, x209)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x213,
+                    S::splat(0.4) * x210,
+                ));
+        let x220 = S::mul_add(
+            S::splat(-108.1389699208081),
+            x47,
+            S::mul_add(
+                x46,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x45,
+            ),
+        ) - S::mul_add(S::neg(x35), x62, x36 * x61)
+            - S::mul_add(
+                S::splat(0.0000000059257457049506905),
+                x43,
+                S::splat(12.701650001451807) * x42,
+            )
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x209, x214)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x212,
+                    S::splat(0.275) * x210,
+                ));
+        let x221 = S::neg(x220);
+        let x222 = S::mul_add(s_q8, x216, c_q8 * x215);
+        let x223 = S::mul_add(S::neg(c_q8), x216, s_q8 * x215);
+        let x224 = S::mul_add(S::splat(0.00000000020510342851533115), x223, x217);
+        let x225 = S::mul_add(S::neg(c_q8), x219, s_q8 * x218);
+        let x226 = S::mul_add(
+            S::mul_add(S::neg(x10), x11, x26),
+            S::splat(48.0240000085309),
+            S::neg(x222),
+        );
+        let x227 = S::mul_add(
+            S::splat(48.0240000085309),
+            S::mul_add(x27, x27, x28),
+            x224,
+        );
+        let x228 = S::mul_add(
+            S::splat(48.0240000085309),
+            x24 + x29,
+            S::neg(S::mul_add(S::splat(-0.00000000020510342851533115), x217, x223)),
+        );
+        let x229 = S::mul_add(
+            x22,
+            S::splat(48.0240000085309),
+            S::mul_add(S::splat(-0.1132), x26, S::splat(0.07309) * x25)
+                - S::mul_add(x11, x32, x27 * x31),
+        ) + S::mul_add(S::splat(0.35), x224, S::mul_add(s_q8, x219, c_q8 * x218));
+        let x230 = S::mul_add(
+            S::splat(-16.807689977165428),
+            x26,
+            S::mul_add(x25, S::splat(-125.18476992763283), S::splat(0.07309) * x24),
+        ) + S::mul_add(x10, x32, x27 * x30)
+            - S::mul_add(
+                S::splat(-0.35),
+                x222,
+                S::mul_add(S::splat(0.00000000020510342851533115), x225, x220),
+            );
+        let x231 = x33 + S::mul_add(S::splat(-0.00000000020510342851533115), x220, x225);
+        let x232 = S::neg(x231);
+        let x233 = S::mul_add(c_q7, x227, s_q7 * x226);
+        let x234 = S::mul_add(S::neg(s_q7), x227, c_q7 * x226);
+        let x235 = S::mul_add(
+            v[5],
+            S::splat(-117.61766249359756),
+            S::splat(1519.7808011559632) * v[3],
+        );
+        let x236 = S::splat(1591.635376155963) * v[4];
+        let x237 = S::mul_add(
+            S::splat(-1271.854575),
+            v[5],
+            v[3] * S::splat(117.61766249359758),
+        );
+        let x238 = S::neg(
+            x233
+                - S::mul_add(
+                    S::splat(1170.07),
+                    x7,
+                    S::neg(
+                        S::mul_add(
+                            S::splat(-180.9502499901501),
+                            x15,
+                            S::splat(110.5455) * x13,
+                        ),
+                    ),
+                ),
+        );
         let x239 = x234
-            + Self::mul_add(
-                1170.07,
+            + S::mul_add(
+                S::splat(1170.07),
                 x8,
-                Self::mul_add(-180.9502499901501, x17, 110.5455 * x16),
+                S::mul_add(S::splat(-180.9502499901501), x17, S::splat(110.5455) * x16),
             );
         let x240 = x228
-            + Self::mul_add(
-                1170.07,
+            + S::mul_add(
+                S::splat(1170.07),
                 x9,
-                -Self::mul_add(180.9502499901501, x19, 110.5455 * x18),
+                S::neg(
+                    S::mul_add(
+                        S::splat(180.9502499901501),
+                        x19,
+                        S::splat(110.5455) * x18,
+                    ),
+                ),
             );
-        let x241 = Self::mul_add(-0.75, x234, Self::mul_add(c_q7, x230, s_q7 * x229))
-            + Self::mul_add(
-                -180.9502499901501,
+        let x241 = S::mul_add(S::splat(-0.75), x234, S::mul_add(c_q7, x230, s_q7 * x229))
+            + S::mul_add(
+                S::splat(-180.9502499901501),
                 x8,
-                Self::mul_add(a[5], -117.61766249359756, 1519.7808011559632 * a[3])
-                    - Self::mul_add(v[4], x237, v[5] * x236),
+                S::mul_add(
+                    a[5],
+                    S::splat(-117.61766249359756),
+                    S::splat(1519.7808011559632) * a[3],
+                ) - S::mul_add(v[4], x237, v[5] * x236),
             );
-        let x242 = -(Self::mul_add(-s_q7, x230, c_q7 * x229)
-            + Self::mul_add(0.65, x228, 0.75 * x233)
-            - (Self::mul_add(
-                1591.635376155963,
-                a[4],
-                Self::mul_add(v[3], x237, v[5] * x235),
-            ) + Self::mul_add(-110.5455, x9, 180.9502499901501 * x7)));
-        let x243 = -(Self::mul_add(-0.65, x234, x231)
-            + Self::mul_add(
-                -110.5455,
-                x8,
-                Self::mul_add(-1271.854575, a[5], a[3] * 117.61766249359758)
-                    + Self::mul_add(-v[3], x236, v[4] * x235),
-            ));
+        let x242 = S::neg(
+            S::mul_add(S::neg(s_q7), x230, c_q7 * x229)
+                + S::mul_add(S::splat(0.65), x228, S::splat(0.75) * x233)
+                - (S::mul_add(
+                    S::splat(1591.635376155963),
+                    a[4],
+                    S::mul_add(v[3], x237, v[5] * x235),
+                )
+                    + S::mul_add(
+                        S::splat(-110.5455),
+                        x9,
+                        S::splat(180.9502499901501) * x7,
+                    )),
+        );
+        let x243 = S::neg(
+            S::mul_add(S::splat(-0.65), x234, x231)
+                + S::mul_add(
+                    S::splat(-110.5455),
+                    x8,
+                    S::mul_add(
+                        S::splat(-1271.854575),
+                        a[5],
+                        a[3] * S::splat(117.61766249359758),
+                    ) + S::mul_add(S::neg(v[3]), x236, v[4] * x235),
+                ),
+        );
         [x238, x239, x240, x241, x242, x243, x232, x221, x209, x202, x194, x183, x171]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        a: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(a.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(a, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -2975,475 +3619,593 @@ impl FreeFloating7 {
         v: &[::core::primitive::f64; 13],
         tau: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 13] {
+        Self::forward_dynamics_lanes::<::core::primitive::f64>(q, v, tau)
+    }
+    /// [`Self::forward_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 14], v: &[S; 13], tau: &[S; 7]) -> [S; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
-            q[8] + 1.5707963265897933,
-            q[9] + 1.5707963267948966,
+            q[8] + S::splat(1.5707963265897933),
+            q[9] + S::splat(1.5707963267948966),
             q[10],
             q[11],
-            q[12] - 1.5707963267948966,
-            q[13] - 1.5707963267948966,
+            q[12] - S::splat(1.5707963267948966),
+            q[13] - S::splat(1.5707963267948966),
         ]);
         let x7 = s_q13 * s_q13;
         let x8 = s_q13 * c_q13;
-        let x9 = Self::mul_add(x8, 0.001562, x7 * 1.2025609200000003);
-        let x10 = -1.2025609200000003 + x9;
-        let x11 = 0.000781 + Self::mul_add(x7, -0.001562, x8 * 1.2025609200000003);
-        let x12 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x13 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x14 = 4.806620000000001 * s_q13;
-        let x15 = 4.806620000000001 * c_q13;
-        let x16 = 1.4135609200000003 - x10;
+        let x9 = S::mul_add(x8, S::splat(0.001562), x7 * S::splat(1.2025609200000003));
+        let x10 = S::splat(-1.2025609200000003) + x9;
+        let x11 = S::splat(0.000781)
+            + S::mul_add(x7, S::splat(-0.001562), x8 * S::splat(1.2025609200000003));
+        let x12 = S::mul_add(
+            s_q13,
+            S::splat(-0.9614610000000001),
+            c_q13 * S::splat(0.0145),
+        );
+        let x13 = S::mul_add(
+            c_q13,
+            S::splat(0.9614610000000001),
+            s_q13 * S::splat(0.0145),
+        );
+        let x14 = S::splat(4.806620000000001) * s_q13;
+        let x15 = S::splat(4.806620000000001) * c_q13;
+        let x16 = S::splat(1.4135609200000003) - x10;
         let x17 = x13 + x13;
-        let x18 = Self::mul_add(-0.00000000020510342851533115, x17, x16);
-        let x19 = 0.00000000020510342851533115 * x15;
-        let x20 = 0.16 * x15;
-        let x21 = 0.55 * x14;
+        let x18 = S::mul_add(S::splat(-0.00000000020510342851533115), x17, x16);
+        let x19 = S::splat(0.00000000020510342851533115) * x15;
+        let x20 = S::splat(0.16) * x15;
+        let x21 = S::splat(0.55) * x14;
         let x22 = x20 - x21;
         let x23 = x20 - (x9 - x20);
-        let x24 = Self::mul_add(
-            0.55,
+        let x24 = S::mul_add(
+            S::splat(0.55),
             x15,
-            -Self::mul_add(
-                0.16,
-                x14,
-                Self::mul_add(0.00000000020510342851533115, x12, x11),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.16),
+                    x14,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x12, x11),
+                ),
             ),
         );
-        let x25 = 17.135250000000003 - x14;
-        let x26 = -3.6140000000000003 - x19;
-        let x27 = 1.9877000000000002
-            + Self::mul_add(
-                0.55,
+        let x25 = S::splat(17.135250000000003) - x14;
+        let x26 = S::splat(-3.6140000000000003) - x19;
+        let x27 = S::splat(1.9877000000000002)
+            + S::mul_add(
+                S::splat(0.55),
                 x19,
-                Self::mul_add(-0.00000000020510342851533115, x11, x12),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x11, x12),
             );
-        let x28 = -2.741639999592316 - x24;
-        let x29 = 5.252920330000002 + (x22 + (x10 + x18 + x22));
-        let x30 = 0.809539999555672
-            - Self::mul_add(
-                -0.16,
+        let x28 = S::splat(-2.741639999592316) - x24;
+        let x29 = S::splat(5.252920330000002) + (x22 + (x10 + x18 + x22));
+        let x30 = S::splat(0.809539999555672)
+            - S::mul_add(
+                S::splat(-0.16),
                 x19,
-                x13 - Self::mul_add(0.00000000020510342851533115, x16, x17),
+                x13 - S::mul_add(S::splat(0.00000000020510342851533115), x16, x17),
             );
-        let x31 = 9.740442170000001 - (x21 - (1.4135609200000003 - x18 - x21));
+        let x31 = S::splat(9.740442170000001)
+            - (x21 - (S::splat(1.4135609200000003) - x18 - x21));
         let x32 = s_q12 * s_q12;
         let x33 = s_q12 * c_q12;
         let x34 = x23 - x29;
         let x35 = x27 + x27;
-        let x36 = Self::mul_add(x33, x35, x32 * x34);
+        let x36 = S::mul_add(x33, x35, x32 * x34);
         let x37 = x29 + x36;
-        let x38 = x27 + Self::mul_add(-x32, x35, x33 * x34);
-        let x39 = Self::mul_add(-s_q12, x30, c_q12 * x28);
-        let x40 = Self::mul_add(c_q12, x30, s_q12 * x28);
-        let x41 = Self::mul_add(-s_q12, x26, c_q12 * x25);
-        let x42 = Self::mul_add(c_q12, x26, s_q12 * x25);
+        let x38 = x27 + S::mul_add(S::neg(x32), x35, x33 * x34);
+        let x39 = S::mul_add(S::neg(s_q12), x30, c_q12 * x28);
+        let x40 = S::mul_add(c_q12, x30, s_q12 * x28);
+        let x41 = S::mul_add(S::neg(s_q12), x26, c_q12 * x25);
+        let x42 = S::mul_add(c_q12, x26, s_q12 * x25);
         let x43 = x31 - x37;
         let x44 = x40 + x40;
-        let x45 = Self::mul_add(0.00000000020510342851533115, x44, x43);
-        let x46 = Self::mul_add(0.00000000020510342851533115, x38, x39);
-        let x47 = Self::mul_add(0.00000000020510342851533115, x42, x15);
+        let x45 = S::mul_add(S::splat(0.00000000020510342851533115), x44, x43);
+        let x46 = S::mul_add(S::splat(0.00000000020510342851533115), x38, x39);
+        let x47 = S::mul_add(S::splat(0.00000000020510342851533115), x42, x15);
         let x48 = x19 - x42;
-        let x49 = x48 * 0.36;
+        let x49 = x48 * S::splat(0.36);
         let x50 = x49 + (x23 - x36 + x49);
-        let x51 = -7.078399999258757 - x47;
-        let x52 = -0.01675
-            + Self::mul_add(
+        let x51 = S::splat(-7.078399999258757) - x47;
+        let x52 = S::splat(-0.01675)
+            + S::mul_add(
                 x41,
-                0.36,
-                Self::mul_add(-0.00000000020510342851533115, x39, x38),
+                S::splat(0.36),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x39, x38),
             );
-        let x53 = -3.8891049197628025 + (x49 + (x37 + x45 + x49));
-        let x54 = -2.5482240005325645
-            + Self::mul_add(
+        let x53 = S::splat(-3.8891049197628025) + (x49 + (x37 + x45 + x49));
+        let x54 = S::splat(-2.5482240005325645)
+            + S::mul_add(
                 x47,
-                -0.36,
-                x40 - Self::mul_add(-0.00000000020510342851533115, x43, x44),
+                S::splat(-0.36),
+                x40 - S::mul_add(S::splat(-0.00000000020510342851533115), x43, x44),
             );
-        let x55 = 3.970314919762802 + (x31 - x45);
+        let x55 = S::splat(3.970314919762802) + (x31 - x45);
         let x56 = s_q11 * s_q11;
         let x57 = s_q11 * c_q11;
         let x58 = x50 - x53;
         let x59 = x46 + x46;
-        let x60 = Self::mul_add(-x57, x59, x56 * x58);
-        let x61 = Self::mul_add(-s_q11, x51, c_q11 * x41);
-        let x62 = Self::mul_add(c_q11, x51, s_q11 * x41);
-        let x63 = 0.275 * x48;
-        let x64 = x62 * 0.63;
+        let x60 = S::mul_add(S::neg(x57), x59, x56 * x58);
+        let x61 = S::mul_add(S::neg(s_q11), x51, c_q11 * x41);
+        let x62 = S::mul_add(c_q11, x51, s_q11 * x41);
+        let x63 = S::splat(0.275) * x48;
+        let x64 = x62 * S::splat(0.63);
         let x65 = x63 + x64;
-        let x66 = Self::mul_add(x61, 0.63, x46 - Self::mul_add(x56, x59, x57 * x58));
-        let x67 = Self::mul_add(0.275, x61, Self::mul_add(-s_q11, x54, c_q11 * x52));
-        let x68 = Self::mul_add(0.275, x62, Self::mul_add(c_q11, x54, s_q11 * x52));
+        let x66 = S::mul_add(x61, S::splat(0.63), x46 - S::mul_add(x56, x59, x57 * x58));
+        let x67 = S::mul_add(
+            S::splat(0.275),
+            x61,
+            S::mul_add(S::neg(s_q11), x54, c_q11 * x52),
+        );
+        let x68 = S::mul_add(S::splat(0.275), x62, S::mul_add(c_q11, x54, s_q11 * x52));
         let x69 = x55 + x64;
         let x70 = x65 + (x50 - x60 + x65);
-        let x71 = -45.1584 - x62;
-        let x72 = -0.6328 - x67;
-        let x73 = -24.4950615 + (x63 + (x53 + x60 + x63));
-        let x74 = -24.35164200091464 - Self::mul_add(x48, 0.63, x68);
-        let x75 = 28.2393615 + (x64 + x69);
+        let x71 = S::splat(-45.1584) - x62;
+        let x72 = S::splat(-0.6328) - x67;
+        let x73 = S::splat(-24.4950615) + (x63 + (x53 + x60 + x63));
+        let x74 = S::splat(-24.35164200091464) - S::mul_add(x48, S::splat(0.63), x68);
+        let x75 = S::splat(28.2393615) + (x64 + x69);
         let x76 = s_q10 * s_q10;
         let x77 = s_q10 * c_q10;
         let x78 = x70 - x73;
         let x79 = x66 + x66;
-        let x80 = Self::mul_add(-x77, x79, x76 * x78);
-        let x81 = Self::mul_add(-s_q10, x74, c_q10 * x72);
-        let x82 = Self::mul_add(c_q10, x74, s_q10 * x72);
+        let x80 = S::mul_add(S::neg(x77), x79, x76 * x78);
+        let x81 = S::mul_add(S::neg(s_q10), x74, c_q10 * x72);
+        let x82 = S::mul_add(c_q10, x74, s_q10 * x72);
         let x83 = c_q10 * x61;
-        let x84 = Self::mul_add(s_q10, x71, x83);
+        let x84 = S::mul_add(s_q10, x71, x83);
         let x85 = s_q10 * x61;
-        let x86 = Self::mul_add(-c_q10, x71, x85);
-        let x87 = x86 * 0.87;
-        let x88 = Self::mul_add(x84, 0.87, x66 - Self::mul_add(x76, x79, x77 * x78));
+        let x86 = S::mul_add(S::neg(c_q10), x71, x85);
+        let x87 = x86 * S::splat(0.87);
+        let x88 = S::mul_add(x84, S::splat(0.87), x66 - S::mul_add(x76, x79, x77 * x78));
         let x89 = x75 + x87;
         let x90 = x87 + (x70 - x80 + x87);
-        let x91 = -81.53205 - x86;
-        let x92 = -0.00214 + x81;
-        let x93 = -63.36336825 + (x73 + x80);
-        let x94 = -36.18604050126307 + Self::mul_add(x48, -0.87, x82);
-        let x95 = 69.99836825 + (x87 + x89);
+        let x91 = S::splat(-81.53205) - x86;
+        let x92 = S::splat(-0.00214) + x81;
+        let x93 = S::splat(-63.36336825) + (x73 + x80);
+        let x94 = S::splat(-36.18604050126307) + S::mul_add(x48, S::splat(-0.87), x82);
+        let x95 = S::splat(69.99836825) + (x87 + x89);
         let x96 = s_q9 * s_q9;
         let x97 = s_q9 * c_q9;
         let x98 = x90 - x93;
         let x99 = x88 + x88;
-        let x100 = Self::mul_add(-x97, x99, x96 * x98);
+        let x100 = S::mul_add(S::neg(x97), x99, x96 * x98);
         let x101 = x93 + x100;
-        let x102 = x88 - Self::mul_add(x96, x99, x97 * x98);
-        let x103 = Self::mul_add(-s_q9, x94, c_q9 * x92);
-        let x104 = Self::mul_add(c_q9, x94, s_q9 * x92);
+        let x102 = x88 - S::mul_add(x96, x99, x97 * x98);
+        let x103 = S::mul_add(S::neg(s_q9), x94, c_q9 * x92);
+        let x104 = S::mul_add(c_q9, x94, s_q9 * x92);
         let x105 = c_q9 * x84;
-        let x106 = Self::mul_add(s_q9, x91, x105);
+        let x106 = S::mul_add(s_q9, x91, x105);
         let x107 = s_q9 * x84;
-        let x108 = Self::mul_add(-c_q9, x91, x107);
+        let x108 = S::mul_add(S::neg(c_q9), x91, x107);
         let x109 = x95 - x101;
         let x110 = x104 + x104;
-        let x111 = Self::mul_add(0.00000000020510342851533115, x110, x109);
-        let x112 = Self::mul_add(0.00000000020510342851533115, x108, x48);
-        let x113 = Self::mul_add(-0.00000000020510342851533115, x48, x108);
-        let x114 = 0.4 * x113;
-        let x115 = 0.275 * x112;
+        let x111 = S::mul_add(S::splat(0.00000000020510342851533115), x110, x109);
+        let x112 = S::mul_add(S::splat(0.00000000020510342851533115), x108, x48);
+        let x113 = S::mul_add(S::splat(-0.00000000020510342851533115), x48, x108);
+        let x114 = S::splat(0.4) * x113;
+        let x115 = S::splat(0.275) * x112;
         let x116 = x114 + x115;
-        let x117 = 0.275 * x106;
-        let x118 = 0.00000000005640344284171607 * x106;
+        let x117 = S::splat(0.275) * x106;
+        let x118 = S::splat(0.00000000005640344284171607) * x106;
         let x119 = x114 + x118;
         let x120 = x115 + x118;
         let x121 = x116 - (x90 - x100 - x116);
-        let x122 = Self::mul_add(
-            0.00000000005640344284171607,
+        let x122 = S::mul_add(
+            S::splat(0.00000000005640344284171607),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x106,
-                Self::mul_add(0.00000000020510342851533115, x103, x102),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x106,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x103, x102),
+                ),
             ),
         );
-        let x123 = Self::mul_add(
-            0.275,
+        let x123 = S::mul_add(
+            S::splat(0.275),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x112,
-                x104 - Self::mul_add(-0.00000000020510342851533115, x109, x110),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x112,
+                    x104
+                        - S::mul_add(S::splat(-0.00000000020510342851533115), x109, x110),
+                ),
             ),
         );
-        let x124 = 0.0000000059257457049506905 - x106;
-        let x125 = 12.701650001451807 + x112;
-        let x126 = -0.0000000005683321144643007
-            - Self::mul_add(
-                0.00000000005640344284171607,
+        let x124 = S::splat(0.0000000059257457049506905) - x106;
+        let x125 = S::splat(12.701650001451807) + x112;
+        let x126 = S::splat(-0.0000000005683321144643007)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
                 x112,
-                Self::mul_add(-0.00000000020510342851533115, x102, x103) + x117,
+                S::mul_add(S::splat(-0.00000000020510342851533115), x102, x103) + x117,
             );
-        let x127 = 0.0021399976297017177 + x122;
-        let x128 = -106.50196992080811 - (x119 - (x101 + x111 - x119));
-        let x129 = -5.080660022992534 - x123;
-        let x130 = 108.1389699208081 - (x120 - (x95 - x111 - x120));
+        let x127 = S::splat(0.0021399976297017177) + x122;
+        let x128 = S::splat(-106.50196992080811) - (x119 - (x101 + x111 - x119));
+        let x129 = S::splat(-5.080660022992534) - x123;
+        let x130 = S::splat(108.1389699208081) - (x120 - (x95 - x111 - x120));
         let x131 = s_q8 * s_q8;
         let x132 = s_q8 * c_q8;
         let x133 = x121 + x128;
         let x134 = x126 + x126;
-        let x135 = Self::mul_add(-x132, x134, x131 * x133);
+        let x135 = S::mul_add(S::neg(x132), x134, x131 * x133);
         let x136 = x128 - x135;
-        let x137 = x126 - Self::mul_add(x131, x134, x132 * x133);
-        let x138 = Self::mul_add(-s_q8, x129, c_q8 * x127);
-        let x139 = Self::mul_add(c_q8, x129, s_q8 * x127);
-        let x140 = Self::mul_add(-s_q8, x125, c_q8 * x124);
-        let x141 = Self::mul_add(c_q8, x125, s_q8 * x124);
+        let x137 = x126 - S::mul_add(x131, x134, x132 * x133);
+        let x138 = S::mul_add(S::neg(s_q8), x129, c_q8 * x127);
+        let x139 = S::mul_add(c_q8, x129, s_q8 * x127);
+        let x140 = S::mul_add(S::neg(s_q8), x125, c_q8 * x124);
+        let x141 = S::mul_add(c_q8, x125, s_q8 * x124);
         let x142 = x130 - x136;
         let x143 = x139 + x139;
-        let x144 = Self::mul_add(0.00000000020510342851533115, x143, x142);
-        let x145 = Self::mul_add(-0.00000000020510342851533115, x141, x113);
-        let x146 = Self::mul_add(0.00000000020510342851533115, x113, x141);
-        let x147 = 0.35 * x146;
+        let x144 = S::mul_add(S::splat(0.00000000020510342851533115), x143, x142);
+        let x145 = S::mul_add(S::splat(-0.00000000020510342851533115), x141, x113);
+        let x146 = S::mul_add(S::splat(0.00000000020510342851533115), x113, x141);
+        let x147 = S::splat(0.35) * x146;
         let x148 = x147 - (x121 - x135 - x147);
-        let x149 = -48.0240000085309 + x145;
-        let x150 = 0.07309 - Self::mul_add(0.00000000020510342851533115, x137, x138);
-        let x151 = 0.1132
-            + Self::mul_add(
-                -0.35,
+        let x149 = S::splat(-48.0240000085309) + x145;
+        let x150 = S::splat(0.07309)
+            - S::mul_add(S::splat(0.00000000020510342851533115), x137, x138);
+        let x151 = S::splat(0.1132)
+            + S::mul_add(
+                S::splat(-0.35),
                 x140,
-                Self::mul_add(-0.00000000020510342851533115, x138, x137),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x138, x137),
             );
-        let x152 = -125.18476992763283 + (x147 + (x136 + x144 + x147));
-        let x153 = 16.807689977165428
-            + Self::mul_add(
-                -0.35,
+        let x152 = S::splat(-125.18476992763283) + (x147 + (x136 + x144 + x147));
+        let x153 = S::splat(16.807689977165428)
+            + S::mul_add(
+                S::splat(-0.35),
                 x145,
-                x139 - Self::mul_add(-0.00000000020510342851533115, x142, x143),
+                x139 - S::mul_add(S::splat(-0.00000000020510342851533115), x142, x143),
             );
-        let x154 = 127.22056992763282 + (x130 - x144);
+        let x154 = S::splat(127.22056992763282) + (x130 - x144);
         let x155 = s_q7 * s_q7;
         let x156 = s_q7 * c_q7;
         let x157 = x148 - x152;
         let x158 = x150 + x150;
-        let x159 = Self::mul_add(x156, x158, x155 * x157);
-        let x160 = Self::mul_add(-s_q7, x149, c_q7 * x140);
-        let x161 = Self::mul_add(c_q7, x149, s_q7 * x140);
-        let x162 = 0.75 * x146;
-        let x163 = 0.65 * x161;
+        let x159 = S::mul_add(x156, x158, x155 * x157);
+        let x160 = S::mul_add(S::neg(s_q7), x149, c_q7 * x140);
+        let x161 = S::mul_add(c_q7, x149, s_q7 * x140);
+        let x162 = S::splat(0.75) * x146;
+        let x163 = S::splat(0.65) * x161;
         let x164 = x162 - x163;
-        let x165 = Self::mul_add(-0.75, x161, Self::mul_add(c_q7, x153, s_q7 * x151));
+        let x165 = S::mul_add(
+            S::splat(-0.75),
+            x161,
+            S::mul_add(c_q7, x153, s_q7 * x151),
+        );
         let x166 = x154 - x163;
-        let x167 = 110.5455 - x161;
-        let x168 = 180.9502499901501 + x146;
-        let x169 = 0.00000000020510342851533115 * x140;
-        let x170 = Self::mul_add(-0.00000000020510342851533115, x130, x139);
-        let x171 = Self::mul_add(0.35, x169, x138);
-        let x172 = Self::mul_add(
-            0.35,
+        let x167 = S::splat(110.5455) - x161;
+        let x168 = S::splat(180.9502499901501) + x146;
+        let x169 = S::splat(0.00000000020510342851533115) * x140;
+        let x170 = S::mul_add(S::splat(-0.00000000020510342851533115), x130, x139);
+        let x171 = S::mul_add(S::splat(0.35), x169, x138);
+        let x172 = S::mul_add(
+            S::splat(0.35),
             x141,
-            Self::mul_add(0.00000000020510342851533115, x139, x130),
+            S::mul_add(S::splat(0.00000000020510342851533115), x139, x130),
         );
-        let x173 = Self::mul_add(c_q7, x169, s_q7 * x141);
-        let x174 = Self::mul_add(-s_q7, x169, c_q7 * x141);
-        let x175 = 0.00000000020510342851533115 * x106;
-        let x176 = x103 + Self::mul_add(-0.4, x175, x117);
-        let x177 = Self::mul_add(0.00000000020510342851533115, x104, x95)
-            - Self::mul_add(0.4, x108, x118);
-        let x178 = Self::mul_add(-0.00000000020510342851533115, x95, x104)
-            + Self::mul_add(0.00000000005640344284171607, x175, 0.275 * x108);
-        let x179 = Self::mul_add(-s_q8, x175, c_q8 * x108);
-        let x180 = Self::mul_add(c_q8, x175, s_q8 * x108);
-        let x181 = Self::mul_add(-0.00000000020510342851533115, x180, x106);
+        let x173 = S::mul_add(c_q7, x169, s_q7 * x141);
+        let x174 = S::mul_add(S::neg(s_q7), x169, c_q7 * x141);
+        let x175 = S::splat(0.00000000020510342851533115) * x106;
+        let x176 = x103 + S::mul_add(S::splat(-0.4), x175, x117);
+        let x177 = S::mul_add(S::splat(0.00000000020510342851533115), x104, x95)
+            - S::mul_add(S::splat(0.4), x108, x118);
+        let x178 = S::mul_add(S::splat(-0.00000000020510342851533115), x95, x104)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x175,
+                S::splat(0.275) * x108,
+            );
+        let x179 = S::mul_add(S::neg(s_q8), x175, c_q8 * x108);
+        let x180 = S::mul_add(c_q8, x175, s_q8 * x108);
+        let x181 = S::mul_add(S::splat(-0.00000000020510342851533115), x180, x106);
         let x182 = x175 + x180;
-        let x183 = Self::mul_add(-c_q8, x177, s_q8 * x176);
-        let x184 = Self::mul_add(-0.00000000020510342851533115, x178, x183);
-        let x185 = Self::mul_add(-0.35, x181, Self::mul_add(s_q8, x177, c_q8 * x176));
-        let x186 = Self::mul_add(
-            -0.35,
+        let x183 = S::mul_add(S::neg(c_q8), x177, s_q8 * x176);
+        let x184 = S::mul_add(S::splat(-0.00000000020510342851533115), x178, x183);
+        let x185 = S::mul_add(
+            S::splat(-0.35),
+            x181,
+            S::mul_add(s_q8, x177, c_q8 * x176),
+        );
+        let x186 = S::mul_add(
+            S::splat(-0.35),
             x179,
-            Self::mul_add(0.00000000020510342851533115, x183, x178),
+            S::mul_add(S::splat(0.00000000020510342851533115), x183, x178),
         );
-        let x187 = Self::mul_add(c_q7, x181, s_q7 * x179);
-        let x188 = Self::mul_add(-s_q7, x181, c_q7 * x179);
-        let x189 = Self::mul_add(c_q9, x86, x107);
-        let x190 = Self::mul_add(-s_q9, x86, x105);
-        let x191 = 0.00000000020510342851533115 * x190;
-        let x192 = Self::mul_add(c_q9, x82, s_q9 * x81);
-        let x193 = Self::mul_add(-s_q9, x82, c_q9 * x81)
-            - Self::mul_add(-0.275, x190, 0.4 * x191);
-        let x194 = Self::mul_add(0.00000000020510342851533115, x192, x89)
-            - Self::mul_add(0.00000000005640344284171607, x190, 0.4 * x189);
-        let x195 = Self::mul_add(-0.00000000020510342851533115, x89, x192)
-            + Self::mul_add(0.00000000005640344284171607, x191, 0.275 * x189);
-        let x196 = Self::mul_add(-s_q8, x191, c_q8 * x189);
-        let x197 = Self::mul_add(c_q8, x191, s_q8 * x189);
-        let x198 = Self::mul_add(-0.00000000020510342851533115, x197, x190);
+        let x187 = S::mul_add(c_q7, x181, s_q7 * x179);
+        let x188 = S::mul_add(S::neg(s_q7), x181, c_q7 * x179);
+        let x189 = S::mul_add(c_q9, x86, x107);
+        let x190 = S::mul_add(S::neg(s_q9), x86, x105);
+        let x191 = S::splat(0.00000000020510342851533115) * x190;
+        let x192 = S::mul_add(c_q9, x82, s_q9 * x81);
+        let x193 = S::mul_add(S::neg(s_q9), x82, c_q9 * x81)
+            - S::mul_add(S::splat(-0.275), x190, S::splat(0.4) * x191);
+        let x194 = S::mul_add(S::splat(0.00000000020510342851533115), x192, x89)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x190,
+                S::splat(0.4) * x189,
+            );
+        let x195 = S::mul_add(S::splat(-0.00000000020510342851533115), x89, x192)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x191,
+                S::splat(0.275) * x189,
+            );
+        let x196 = S::mul_add(S::neg(s_q8), x191, c_q8 * x189);
+        let x197 = S::mul_add(c_q8, x191, s_q8 * x189);
+        let x198 = S::mul_add(S::splat(-0.00000000020510342851533115), x197, x190);
         let x199 = x191 + x197;
-        let x200 = Self::mul_add(-c_q8, x194, s_q8 * x193);
-        let x201 = Self::mul_add(-0.00000000020510342851533115, x195, x200);
-        let x202 = Self::mul_add(-0.35, x198, Self::mul_add(s_q8, x194, c_q8 * x193));
-        let x203 = Self::mul_add(
-            -0.35,
+        let x200 = S::mul_add(S::neg(c_q8), x194, s_q8 * x193);
+        let x201 = S::mul_add(S::splat(-0.00000000020510342851533115), x195, x200);
+        let x202 = S::mul_add(
+            S::splat(-0.35),
+            x198,
+            S::mul_add(s_q8, x194, c_q8 * x193),
+        );
+        let x203 = S::mul_add(
+            S::splat(-0.35),
             x196,
-            Self::mul_add(0.00000000020510342851533115, x200, x195),
+            S::mul_add(S::splat(0.00000000020510342851533115), x200, x195),
         );
-        let x204 = Self::mul_add(c_q7, x198, s_q7 * x196);
-        let x205 = Self::mul_add(-s_q7, x198, c_q7 * x196);
-        let x206 = Self::mul_add(c_q10, x62, x85);
-        let x207 = Self::mul_add(-s_q10, x62, x83);
-        let x208 = Self::mul_add(-s_q10, x68, c_q10 * x67);
-        let x209 = Self::mul_add(c_q10, x68, s_q10 * x67);
-        let x210 = Self::mul_add(0.87, x206, x69);
-        let x211 = Self::mul_add(s_q9, x207, c_q9 * x206);
-        let x212 = Self::mul_add(-c_q9, x207, s_q9 * x206);
-        let x213 = 0.00000000020510342851533115 * x212;
-        let x214 = Self::mul_add(c_q9, x209, s_q9 * x208);
-        let x215 = Self::mul_add(-s_q9, x209, c_q9 * x208)
-            - Self::mul_add(-0.275, x212, 0.4 * x213);
-        let x216 = Self::mul_add(-0.00000000020510342851533115, x214, x210)
-            - Self::mul_add(-0.00000000005640344284171607, x212, 0.4 * x211);
-        let x217 = Self::mul_add(0.00000000020510342851533115, x210, x214)
-            - Self::mul_add(-0.00000000005640344284171607, x213, 0.275 * x211);
-        let x218 = Self::mul_add(s_q8, x213, c_q8 * x211);
-        let x219 = Self::mul_add(-c_q8, x213, s_q8 * x211);
-        let x220 = Self::mul_add(0.00000000020510342851533115, x219, x212);
+        let x204 = S::mul_add(c_q7, x198, s_q7 * x196);
+        let x205 = S::mul_add(S::neg(s_q7), x198, c_q7 * x196);
+        let x206 = S::mul_add(c_q10, x62, x85);
+        let x207 = S::mul_add(S::neg(s_q10), x62, x83);
+        let x208 = S::mul_add(S::neg(s_q10), x68, c_q10 * x67);
+        let x209 = S::mul_add(c_q10, x68, s_q10 * x67);
+        let x210 = S::mul_add(S::splat(0.87), x206, x69);
+        let x211 = S::mul_add(s_q9, x207, c_q9 * x206);
+        let x212 = S::mul_add(S::neg(c_q9), x207, s_q9 * x206);
+        let x213 = S::splat(0.00000000020510342851533115) * x212;
+        let x214 = S::mul_add(c_q9, x209, s_q9 * x208);
+        let x215 = S::mul_add(S::neg(s_q9), x209, c_q9 * x208)
+            - S::mul_add(S::splat(-0.275), x212, S::splat(0.4) * x213);
+        let x216 = S::mul_add(S::splat(-0.00000000020510342851533115), x214, x210)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x212,
+                S::splat(0.4) * x211,
+            );
+        let x217 = S::mul_add(S::splat(0.00000000020510342851533115), x210, x214)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x213,
+                S::splat(0.275) * x211,
+            );
+        let x218 = S::mul_add(s_q8, x213, c_q8 * x211);
+        let x219 = S::mul_add(S::neg(c_q8), x213, s_q8 * x211);
+        let x220 = S::mul_add(S::splat(0.00000000020510342851533115), x219, x212);
         let x221 = x213 - x219;
-        let x222 = Self::mul_add(c_q8, x216, s_q8 * x215);
-        let x223 = Self::mul_add(-0.00000000020510342851533115, x217, x222);
-        let x224 = Self::mul_add(-0.35, x220, Self::mul_add(-s_q8, x216, c_q8 * x215));
-        let x225 = Self::mul_add(
-            0.35,
+        let x222 = S::mul_add(c_q8, x216, s_q8 * x215);
+        let x223 = S::mul_add(S::splat(-0.00000000020510342851533115), x217, x222);
+        let x224 = S::mul_add(
+            S::splat(-0.35),
+            x220,
+            S::mul_add(S::neg(s_q8), x216, c_q8 * x215),
+        );
+        let x225 = S::mul_add(
+            S::splat(0.35),
             x218,
-            Self::mul_add(0.00000000020510342851533115, x222, x217),
+            S::mul_add(S::splat(0.00000000020510342851533115), x222, x217),
         );
-        let x226 = Self::mul_add(-c_q7, x220, s_q7 * x218);
-        let x227 = Self::mul_add(s_q7, x220, c_q7 * x218);
-        let x228 = 0.00000000020510342851533115 * x41;
-        let x229 = Self::mul_add(-0.00000000020510342851533115, x31, x40);
-        let x230 = Self::mul_add(-0.36, x228, x39);
-        let x231 = Self::mul_add(
+        let x226 = S::mul_add(S::neg(c_q7), x220, s_q7 * x218);
+        let x227 = S::mul_add(s_q7, x220, c_q7 * x218);
+        let x228 = S::splat(0.00000000020510342851533115) * x41;
+        let x229 = S::mul_add(S::splat(-0.00000000020510342851533115), x31, x40);
+        let x230 = S::mul_add(S::splat(-0.36), x228, x39);
+        let x231 = S::mul_add(
             x42,
-            -0.36,
-            Self::mul_add(0.00000000020510342851533115, x40, x31),
+            S::splat(-0.36),
+            S::mul_add(S::splat(0.00000000020510342851533115), x40, x31),
         );
-        let x232 = Self::mul_add(-s_q11, x228, c_q11 * x42);
-        let x233 = Self::mul_add(c_q11, x228, s_q11 * x42);
-        let x234 = Self::mul_add(s_q11, x231, c_q11 * x230)
-            - Self::mul_add(x41, -0.63, 0.275 * x233);
-        let x235 = Self::mul_add(0.275, x232, Self::mul_add(-c_q11, x231, s_q11 * x230));
-        let x236 = Self::mul_add(0.63, x232, x229);
-        let x237 = Self::mul_add(-s_q10, x233, c_q10 * x232);
-        let x238 = Self::mul_add(c_q10, x233, s_q10 * x232);
-        let x239 = Self::mul_add(c_q10, x235, s_q10 * x234);
-        let x240 = Self::mul_add(x41, 0.87, Self::mul_add(-s_q10, x235, c_q10 * x234));
-        let x241 = Self::mul_add(0.87, x237, x236);
-        let x242 = Self::mul_add(-s_q9, x238, c_q9 * x237);
-        let x243 = Self::mul_add(c_q9, x238, s_q9 * x237);
-        let x244 = Self::mul_add(0.00000000020510342851533115, x243, x41);
+        let x232 = S::mul_add(S::neg(s_q11), x228, c_q11 * x42);
+        let x233 = S::mul_add(c_q11, x228, s_q11 * x42);
+        let x234 = S::mul_add(s_q11, x231, c_q11 * x230)
+            - S::mul_add(x41, S::splat(-0.63), S::splat(0.275) * x233);
+        let x235 = S::mul_add(
+            S::splat(0.275),
+            x232,
+            S::mul_add(S::neg(c_q11), x231, s_q11 * x230),
+        );
+        let x236 = S::mul_add(S::splat(0.63), x232, x229);
+        let x237 = S::mul_add(S::neg(s_q10), x233, c_q10 * x232);
+        let x238 = S::mul_add(c_q10, x233, s_q10 * x232);
+        let x239 = S::mul_add(c_q10, x235, s_q10 * x234);
+        let x240 = S::mul_add(
+            x41,
+            S::splat(0.87),
+            S::mul_add(S::neg(s_q10), x235, c_q10 * x234),
+        );
+        let x241 = S::mul_add(S::splat(0.87), x237, x236);
+        let x242 = S::mul_add(S::neg(s_q9), x238, c_q9 * x237);
+        let x243 = S::mul_add(c_q9, x238, s_q9 * x237);
+        let x244 = S::mul_add(S::splat(0.00000000020510342851533115), x243, x41);
         let x245 = x228 - x243;
-        let x246 = Self::mul_add(c_q9, x239, s_q9 * x240);
-        let x247 = Self::mul_add(-s_q9, x239, c_q9 * x240)
-            - Self::mul_add(0.275, x245, 0.4 * x244);
-        let x248 = Self::mul_add(-0.00000000020510342851533115, x246, x241)
-            - Self::mul_add(0.00000000005640344284171607, x245, 0.4 * x242);
-        let x249 = Self::mul_add(0.00000000020510342851533115, x241, x246)
-            - Self::mul_add(-0.00000000005640344284171607, x244, 0.275 * x242);
-        let x250 = Self::mul_add(s_q8, x244, c_q8 * x242);
-        let x251 = Self::mul_add(-c_q8, x244, s_q8 * x242);
-        let x252 = Self::mul_add(-0.00000000020510342851533115, x251, x245);
-        let x253 = Self::mul_add(0.00000000020510342851533115, x245, x251);
-        let x254 = Self::mul_add(c_q8, x248, s_q8 * x247);
-        let x255 = Self::mul_add(-0.00000000020510342851533115, x249, x254);
-        let x256 = Self::mul_add(0.35, x252, Self::mul_add(-s_q8, x248, c_q8 * x247));
-        let x257 = Self::mul_add(
-            0.35,
+        let x246 = S::mul_add(c_q9, x239, s_q9 * x240);
+        let x247 = S::mul_add(S::neg(s_q9), x239, c_q9 * x240)
+            - S::mul_add(S::splat(0.275), x245, S::splat(0.4) * x244);
+        let x248 = S::mul_add(S::splat(-0.00000000020510342851533115), x246, x241)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x245,
+                S::splat(0.4) * x242,
+            );
+        let x249 = S::mul_add(S::splat(0.00000000020510342851533115), x241, x246)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x244,
+                S::splat(0.275) * x242,
+            );
+        let x250 = S::mul_add(s_q8, x244, c_q8 * x242);
+        let x251 = S::mul_add(S::neg(c_q8), x244, s_q8 * x242);
+        let x252 = S::mul_add(S::splat(-0.00000000020510342851533115), x251, x245);
+        let x253 = S::mul_add(S::splat(0.00000000020510342851533115), x245, x251);
+        let x254 = S::mul_add(c_q8, x248, s_q8 * x247);
+        let x255 = S::mul_add(S::splat(-0.00000000020510342851533115), x249, x254);
+        let x256 = S::mul_add(
+            S::splat(0.35),
+            x252,
+            S::mul_add(S::neg(s_q8), x248, c_q8 * x247),
+        );
+        let x257 = S::mul_add(
+            S::splat(0.35),
             x250,
-            Self::mul_add(0.00000000020510342851533115, x254, x249),
+            S::mul_add(S::splat(0.00000000020510342851533115), x254, x249),
         );
-        let x258 = Self::mul_add(c_q7, x252, s_q7 * x250);
-        let x259 = Self::mul_add(-s_q7, x252, c_q7 * x250);
-        let x260 = 0.00000000020510342851533115 * x14;
-        let x261 = Self::mul_add(0.16, x260, x12);
+        let x258 = S::mul_add(c_q7, x252, s_q7 * x250);
+        let x259 = S::mul_add(S::neg(s_q7), x252, c_q7 * x250);
+        let x260 = S::splat(0.00000000020510342851533115) * x14;
+        let x261 = S::mul_add(S::splat(0.16), x260, x12);
         let x262 = x22
-            + Self::mul_add(-0.00000000020510342851533115, x13, 1.4135609200000003);
-        let x263 = Self::mul_add(-0.55, x260, x13 - -0.0000000002899261911072858);
-        let x264 = Self::mul_add(s_q12, x260, c_q12 * x15);
-        let x265 = Self::mul_add(-c_q12, x260, s_q12 * x15);
-        let x266 = Self::mul_add(0.00000000020510342851533115, x265, x14);
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x13,
+                S::splat(1.4135609200000003),
+            );
+        let x263 = S::mul_add(
+            S::splat(-0.55),
+            x260,
+            x13 - S::splat(-0.0000000002899261911072858),
+        );
+        let x264 = S::mul_add(s_q12, x260, c_q12 * x15);
+        let x265 = S::mul_add(S::neg(c_q12), x260, s_q12 * x15);
+        let x266 = S::mul_add(S::splat(0.00000000020510342851533115), x265, x14);
         let x267 = x260 - x265;
-        let x268 = Self::mul_add(c_q12, x262, s_q12 * x261);
-        let x269 = Self::mul_add(-0.00000000020510342851533115, x263, x268);
-        let x270 = Self::mul_add(-0.36, x266, Self::mul_add(-s_q12, x262, c_q12 * x261));
-        let x271 = Self::mul_add(
-            0.36,
+        let x268 = S::mul_add(c_q12, x262, s_q12 * x261);
+        let x269 = S::mul_add(S::splat(-0.00000000020510342851533115), x263, x268);
+        let x270 = S::mul_add(
+            S::splat(-0.36),
+            x266,
+            S::mul_add(S::neg(s_q12), x262, c_q12 * x261),
+        );
+        let x271 = S::mul_add(
+            S::splat(0.36),
             x264,
-            Self::mul_add(0.00000000020510342851533115, x268, x263),
+            S::mul_add(S::splat(0.00000000020510342851533115), x268, x263),
         );
-        let x272 = Self::mul_add(s_q11, x266, c_q11 * x264);
-        let x273 = Self::mul_add(-c_q11, x266, s_q11 * x264);
-        let x274 = Self::mul_add(s_q11, x271, c_q11 * x270)
-            + Self::mul_add(-0.63, x267, 0.275 * x273);
-        let x275 = Self::mul_add(
-            -0.275,
+        let x272 = S::mul_add(s_q11, x266, c_q11 * x264);
+        let x273 = S::mul_add(S::neg(c_q11), x266, s_q11 * x264);
+        let x274 = S::mul_add(s_q11, x271, c_q11 * x270)
+            + S::mul_add(S::splat(-0.63), x267, S::splat(0.275) * x273);
+        let x275 = S::mul_add(
+            S::splat(-0.275),
             x272,
-            Self::mul_add(-c_q11, x271, s_q11 * x270),
+            S::mul_add(S::neg(c_q11), x271, s_q11 * x270),
         );
-        let x276 = Self::mul_add(-0.63, x272, x269);
-        let x277 = Self::mul_add(-s_q10, x273, c_q10 * x272);
-        let x278 = Self::mul_add(c_q10, x273, s_q10 * x272);
-        let x279 = Self::mul_add(c_q10, x275, s_q10 * x274);
-        let x280 = Self::mul_add(-0.87, x267, Self::mul_add(-s_q10, x275, c_q10 * x274));
-        let x281 = Self::mul_add(-0.87, x277, x276);
-        let x282 = Self::mul_add(-s_q9, x278, c_q9 * x277);
-        let x283 = Self::mul_add(c_q9, x278, s_q9 * x277);
-        let x284 = Self::mul_add(0.00000000020510342851533115, x283, x267);
-        let x285 = Self::mul_add(-0.00000000020510342851533115, x267, x283);
-        let x286 = Self::mul_add(c_q9, x279, s_q9 * x280);
-        let x287 = Self::mul_add(-s_q9, x279, c_q9 * x280)
-            + Self::mul_add(-0.275, x285, 0.4 * x284);
-        let x288 = Self::mul_add(-0.00000000020510342851533115, x286, x281)
-            + Self::mul_add(-0.00000000005640344284171607, x285, 0.4 * x282);
-        let x289 = Self::mul_add(0.00000000020510342851533115, x281, x286)
-            + Self::mul_add(-0.00000000005640344284171607, x284, 0.275 * x282);
-        let x290 = Self::mul_add(s_q8, x284, c_q8 * x282);
-        let x291 = Self::mul_add(-c_q8, x284, s_q8 * x282);
-        let x292 = Self::mul_add(0.00000000020510342851533115, x291, x285);
-        let x293 = Self::mul_add(-0.00000000020510342851533115, x285, x291);
-        let x294 = Self::mul_add(c_q8, x288, s_q8 * x287);
-        let x295 = Self::mul_add(-0.00000000020510342851533115, x289, x294);
-        let x296 = Self::mul_add(0.35, x292, Self::mul_add(-s_q8, x288, c_q8 * x287));
-        let x297 = Self::mul_add(
-            -0.35,
+        let x276 = S::mul_add(S::splat(-0.63), x272, x269);
+        let x277 = S::mul_add(S::neg(s_q10), x273, c_q10 * x272);
+        let x278 = S::mul_add(c_q10, x273, s_q10 * x272);
+        let x279 = S::mul_add(c_q10, x275, s_q10 * x274);
+        let x280 = S::mul_add(
+            S::splat(-0.87),
+            x267,
+            S::mul_add(S::neg(s_q10), x275, c_q10 * x274),
+        );
+        let x281 = S::mul_add(S::splat(-0.87), x277, x276);
+        let x282 = S::mul_add(S::neg(s_q9), x278, c_q9 * x277);
+        let x283 = S::mul_add(c_q9, x278, s_q9 * x277);
+        let x284 = S::mul_add(S::splat(0.00000000020510342851533115), x283, x267);
+        let x285 = S::mul_add(S::splat(-0.00000000020510342851533115), x267, x283);
+        let x286 = S::mul_add(c_q9, x279, s_q9 * x280);
+        let x287 = S::mul_add(S::neg(s_q9), x279, c_q9 * x280)
+            + S::mul_add(S::splat(-0.275), x285, S::splat(0.4) * x284);
+        let x288 = S::mul_add(S::splat(-0.00000000020510342851533115), x286, x281)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x285,
+                S::splat(0.4) * x282,
+            );
+        let x289 = S::mul_add(S::splat(0.00000000020510342851533115), x281, x286)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x284,
+                S::splat(0.275) * x282,
+            );
+        let x290 = S::mul_add(s_q8, x284, c_q8 * x282);
+        let x291 = S::mul_add(S::neg(c_q8), x284, s_q8 * x282);
+        let x292 = S::mul_add(S::splat(0.00000000020510342851533115), x291, x285);
+        let x293 = S::mul_add(S::splat(-0.00000000020510342851533115), x285, x291);
+        let x294 = S::mul_add(c_q8, x288, s_q8 * x287);
+        let x295 = S::mul_add(S::splat(-0.00000000020510342851533115), x289, x294);
+        let x296 = S::mul_add(
+            S::splat(0.35),
+            x292,
+            S::mul_add(S::neg(s_q8), x288, c_q8 * x287),
+        );
+        let x297 = S::mul_add(
+            S::splat(-0.35),
             x290,
-            Self::mul_add(0.00000000020510342851533115, x294, x289),
+            S::mul_add(S::splat(0.00000000020510342851533115), x294, x289),
         );
-        let x298 = Self::mul_add(-c_q7, x292, s_q7 * x290);
-        let x299 = Self::mul_add(s_q7, x292, c_q7 * x290);
-        let x300 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x301 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x302 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x303 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x304 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x298 = S::mul_add(S::neg(c_q7), x292, s_q7 * x290);
+        let x299 = S::mul_add(s_q7, x292, c_q7 * x290);
+        let x300 = S::mul_add(S::neg(v[2]), v[4], v[1] * v[5]);
+        let x301 = S::mul_add(S::neg(v[2]), v[3], v[0] * v[5]);
+        let x302 = S::mul_add(S::neg(v[1]), v[3], v[0] * v[4]);
+        let x303 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x304 = S::mul_add(v[4], s_q7, v[3] * c_q7);
         let x305 = v[4] * v[4];
-        let x306 = Self::mul_add(v[5], v[5], x305);
+        let x306 = S::mul_add(v[5], v[5], x305);
         let x307 = v[3] * v[4];
         let x308 = v[3] * v[5];
         let x309 = v[4] * v[5];
-        let x310 = Self::mul_add(v[3], v[3], x305);
-        let x311 = x300 + Self::mul_add(-0.75, x308, 0.65 * x306);
-        let x312 = x301 + Self::mul_add(0.75, x309, 0.65 * x307);
-        let x313 = x302 - Self::mul_add(-0.75, x310, 0.65 * x308);
-        let x314 = Self::mul_add(c_q7, x312, s_q7 * x311);
+        let x310 = S::mul_add(v[3], v[3], x305);
+        let x311 = x300 + S::mul_add(S::splat(-0.75), x308, S::splat(0.65) * x306);
+        let x312 = x301 + S::mul_add(S::splat(0.75), x309, S::splat(0.65) * x307);
+        let x313 = x302 - S::mul_add(S::splat(-0.75), x310, S::splat(0.65) * x308);
+        let x314 = S::mul_add(c_q7, x312, s_q7 * x311);
         let x315 = v[6] * x304;
         let x316 = v[6] * x303;
         let x317 = v[5] + v[6];
         let x318 = x303 * x303;
         let x319 = x304 * x317;
-        let x320 = Self::mul_add(-0.1132, x317, 0.07309 * x304);
-        let x321 = Self::mul_add(
-            -16.807689977165428,
+        let x320 = S::mul_add(S::splat(-0.1132), x317, S::splat(0.07309) * x304);
+        let x321 = S::mul_add(
+            S::splat(-16.807689977165428),
             x317,
-            Self::mul_add(x304, -125.18476992763283, 0.07309 * x303),
+            S::mul_add(x304, S::splat(-125.18476992763283), S::splat(0.07309) * x303),
         );
-        let x322 = Self::mul_add(
-            -127.22056992763282,
+        let x322 = S::mul_add(
+            S::splat(-127.22056992763282),
             x317,
-            Self::mul_add(16.807689977165428, x304, 0.1132 * x303),
+            S::mul_add(S::splat(16.807689977165428), x304, S::splat(0.1132) * x303),
         );
-        let x323 = Self::mul_add(
+        let x323 = S::mul_add(
             x313,
-            48.0240000085309,
-            Self::mul_add(0.07309, x316, Self::mul_add(x304, x322, x317 * x321)),
+            S::splat(48.0240000085309),
+            S::mul_add(S::splat(0.07309), x316, S::mul_add(x304, x322, x317 * x321)),
         );
-        let x324 = Self::mul_add(0.00000000020510342851533115, x304, x317);
-        let x325 = Self::mul_add(-s_q8, x324, c_q8 * x303);
-        let x326 = Self::mul_add(c_q8, x324, s_q8 * x303);
-        let x327 = Self::mul_add(0.35, Self::mul_add(-x303, x317, x316), x314);
-        let x328 = Self::mul_add(
-            0.35,
+        let x324 = S::mul_add(S::splat(0.00000000020510342851533115), x304, x317);
+        let x325 = S::mul_add(S::neg(s_q8), x324, c_q8 * x303);
+        let x326 = S::mul_add(c_q8, x324, s_q8 * x303);
+        let x327 = S::mul_add(
+            S::splat(0.35),
+            S::mul_add(S::neg(x303), x317, x316),
+            x314,
+        );
+        let x328 = S::mul_add(
+            S::splat(0.35),
             x315 - x319,
-            Self::mul_add(-s_q7, x312, c_q7 * x311),
+            S::mul_add(S::neg(s_q7), x312, c_q7 * x311),
         );
-        let x329 = Self::mul_add(0.35, Self::mul_add(x304, x304, x318), x313);
-        let x330 = Self::mul_add(0.00000000020510342851533115, x328, x329);
-        let x331 = Self::mul_add(-0.00000000020510342851533115, x329, x328);
-        let x332 = Self::mul_add(-s_q8, x330, c_q8 * x327);
-        let x333 = Self::mul_add(c_q8, x330, s_q8 * x327);
-        let x334 = 0.00000000020510342851533115 * x316;
-        let x335 = Self::mul_add(-v[7], x326, Self::mul_add(s_q8, x334, c_q8 * x315));
-        let x336 = Self::mul_add(v[7], x325, Self::mul_add(-c_q8, x334, s_q8 * x315));
-        let x337 = v[7] + Self::mul_add(-0.00000000020510342851533115, x317, x304);
+        let x329 = S::mul_add(S::splat(0.35), S::mul_add(x304, x304, x318), x313);
+        let x330 = S::mul_add(S::splat(0.00000000020510342851533115), x328, x329);
+        let x331 = S::mul_add(S::splat(-0.00000000020510342851533115), x329, x328);
+        let x332 = S::mul_add(S::neg(s_q8), x330, c_q8 * x327);
+        let x333 = S::mul_add(c_q8, x330, s_q8 * x327);
+        let x334 = S::splat(0.00000000020510342851533115) * x316;
+        let x335 = S::mul_add(S::neg(v[7]), x326, S::mul_add(s_q8, x334, c_q8 * x315));
+        let x336 = S::mul_add(v[7], x325, S::mul_add(S::neg(c_q8), x334, s_q8 * x315));
+        let x337 = v[7]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x317, x304);
         let x338 = x326 * x326;
         let x339 = x337 * x337;
         let x340 = x338 + x339;
@@ -3456,180 +4218,253 @@ impl FreeFloating7 {
         let x347 = x326 * x337;
         let x348 = x336 + x343;
         let x349 = x335 - x347;
-        let x350 = Self::mul_add(
-            -0.0021399976297017177,
+        let x350 = S::mul_add(
+            S::splat(-0.0021399976297017177),
             x337,
-            x326 * 0.0000000005683321144643007,
+            x326 * S::splat(0.0000000005683321144643007),
         );
-        let x351 = Self::mul_add(
+        let x351 = S::mul_add(
             x337,
-            -5.080660022992534,
-            Self::mul_add(x326, -106.50196992080811, x325 * 0.0000000005683321144643007),
+            S::splat(-5.080660022992534),
+            S::mul_add(
+                x326,
+                S::splat(-106.50196992080811),
+                x325 * S::splat(0.0000000005683321144643007),
+            ),
         );
-        let x352 = Self::mul_add(
-            -108.1389699208081,
+        let x352 = S::mul_add(
+            S::splat(-108.1389699208081),
             x337,
-            Self::mul_add(x326, 5.080660022992536, 0.0021399976297017177 * x325),
+            S::mul_add(
+                x326,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x325,
+            ),
         );
-        let x353 = Self::mul_add(
-            0.0000000059257457049506905,
+        let x353 = S::mul_add(
+            S::splat(0.0000000059257457049506905),
             x331,
-            Self::mul_add(
+            S::mul_add(
                 x316,
-                5.080660022992534,
-                Self::mul_add(
+                S::splat(5.080660022992534),
+                S::mul_add(
                     x336,
-                    -106.50196992080811,
-                    x335 * 0.0000000005683321144643007,
+                    S::splat(-106.50196992080811),
+                    x335 * S::splat(0.0000000005683321144643007),
                 ),
-            ) - Self::mul_add(x325, x352, x337 * x350),
+            ) - S::mul_add(x325, x352, x337 * x350),
         );
-        let x354 = Self::mul_add(-0.00000000020510342851533115, x326, x337);
-        let x355 = Self::mul_add(-s_q9, x354, c_q9 * x325);
-        let x356 = Self::mul_add(c_q9, x354, s_q9 * x325);
+        let x354 = S::mul_add(S::splat(-0.00000000020510342851533115), x326, x337);
+        let x355 = S::mul_add(S::neg(s_q9), x354, c_q9 * x325);
+        let x356 = S::mul_add(c_q9, x354, s_q9 * x325);
         let x357 = x332
-            - Self::mul_add(
-                -0.4,
+            - S::mul_add(
+                S::splat(-0.4),
                 x336 - x343,
-                Self::mul_add(0.275, x342, 0.00000000005640344284171607 * x340),
+                S::mul_add(
+                    S::splat(0.275),
+                    x342,
+                    S::splat(0.00000000005640344284171607) * x340,
+                ),
             );
         let x358 = x333
-            + Self::mul_add(
-                -0.4,
+            + S::mul_add(
+                S::splat(-0.4),
                 x335 + x347,
-                Self::mul_add(-0.275, x346, 0.00000000005640344284171607 * x344),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x346,
+                    S::splat(0.00000000005640344284171607) * x344,
+                ),
             );
         let x359 = x331
-            + Self::mul_add(
-                0.4,
+            + S::mul_add(
+                S::splat(0.4),
                 x338 + x345,
-                Self::mul_add(-0.275, x349, 0.00000000005640344284171607 * x348),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x349,
+                    S::splat(0.00000000005640344284171607) * x348,
+                ),
             );
-        let x360 = Self::mul_add(-0.00000000020510342851533115, x358, x359);
-        let x361 = Self::mul_add(0.00000000020510342851533115, x359, x358);
-        let x362 = Self::mul_add(-s_q9, x360, c_q9 * x357);
-        let x363 = Self::mul_add(0.00000000020510342851533115, x336, x316);
+        let x360 = S::mul_add(S::splat(-0.00000000020510342851533115), x358, x359);
+        let x361 = S::mul_add(S::splat(0.00000000020510342851533115), x359, x358);
+        let x362 = S::mul_add(S::neg(s_q9), x360, c_q9 * x357);
+        let x363 = S::mul_add(S::splat(0.00000000020510342851533115), x336, x316);
         let x364 = x334 - x336;
-        let x365 = Self::mul_add(-v[8], x356, Self::mul_add(s_q9, x363, c_q9 * x335));
-        let x366 = Self::mul_add(v[8], x355, Self::mul_add(-c_q9, x363, s_q9 * x335));
-        let x367 = v[8] - Self::mul_add(0.00000000020510342851533115, x337, x326);
-        let x368 = Self::mul_add(x355, x356, x364);
-        let x369 = Self::mul_add(x355, x355, x367 * x367);
-        let x370 = Self::mul_add(-x356, x367, x365);
-        let x371 = 0.00214 * x367;
-        let x372 = Self::mul_add(x367, 36.18604050126307, x356 * 63.36336825);
-        let x373 = Self::mul_add(
-            69.99836825,
+        let x365 = S::mul_add(S::neg(v[8]), x356, S::mul_add(s_q9, x363, c_q9 * x335));
+        let x366 = S::mul_add(v[8], x355, S::mul_add(S::neg(c_q9), x363, s_q9 * x335));
+        let x367 = v[8] - S::mul_add(S::splat(0.00000000020510342851533115), x337, x326);
+        let x368 = S::mul_add(x355, x356, x364);
+        let x369 = S::mul_add(x355, x355, x367 * x367);
+        let x370 = S::mul_add(S::neg(x356), x367, x365);
+        let x371 = S::splat(0.00214) * x367;
+        let x372 = S::mul_add(
             x367,
-            Self::mul_add(x356, -36.18604050126307, 0.00214 * x355),
+            S::splat(36.18604050126307),
+            x356 * S::splat(63.36336825),
         );
-        let x374 = Self::mul_add(
+        let x373 = S::mul_add(
+            S::splat(69.99836825),
+            x367,
+            S::mul_add(x356, S::splat(-36.18604050126307), S::splat(0.00214) * x355),
+        );
+        let x374 = S::mul_add(
             x361,
-            81.53205,
-            Self::mul_add(0.00214, x364, -Self::mul_add(x356, x373, x367 * x372)),
-        );
-        let x375 = Self::mul_add(
-            x362,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
+            S::splat(81.53205),
+            S::mul_add(
+                S::splat(0.00214),
                 x364,
-                Self::mul_add(x366, -36.18604050126307, 0.00214 * x365),
-            ) + Self::mul_add(x355, x372, x356 * x371),
+                S::neg(S::mul_add(x356, x373, x367 * x372)),
+            ),
         );
-        let x376 = Self::mul_add(-s_q10, x356, c_q10 * x355);
-        let x377 = Self::mul_add(c_q10, x356, s_q10 * x355);
-        let x378 = Self::mul_add(0.87, x368, x362);
-        let x379 = Self::mul_add(-0.87, x369, Self::mul_add(c_q9, x360, s_q9 * x357));
-        let x380 = Self::mul_add(0.87, x370, x361);
-        let x381 = Self::mul_add(-s_q10, x379, c_q10 * x378);
-        let x382 = Self::mul_add(-v[9], x377, Self::mul_add(-s_q10, x366, c_q10 * x365));
-        let x383 = Self::mul_add(v[9], x376, Self::mul_add(c_q10, x366, s_q10 * x365));
+        let x375 = S::mul_add(
+            x362,
+            S::splat(81.53205),
+            S::mul_add(
+                S::splat(69.99836825),
+                x364,
+                S::mul_add(x366, S::splat(-36.18604050126307), S::splat(0.00214) * x365),
+            ) + S::mul_add(x355, x372, x356 * x371),
+        );
+        let x376 = S::mul_add(S::neg(s_q10), x356, c_q10 * x355);
+        let x377 = S::mul_add(c_q10, x356, s_q10 * x355);
+        let x378 = S::mul_add(S::splat(0.87), x368, x362);
+        let x379 = S::mul_add(
+            S::splat(-0.87),
+            x369,
+            S::mul_add(c_q9, x360, s_q9 * x357),
+        );
+        let x380 = S::mul_add(S::splat(0.87), x370, x361);
+        let x381 = S::mul_add(S::neg(s_q10), x379, c_q10 * x378);
+        let x382 = S::mul_add(
+            S::neg(v[9]),
+            x377,
+            S::mul_add(S::neg(s_q10), x366, c_q10 * x365),
+        );
+        let x383 = S::mul_add(v[9], x376, S::mul_add(c_q10, x366, s_q10 * x365));
         let x384 = v[9] + x367;
-        let x385 = Self::mul_add(x376, x377, x364);
+        let x385 = S::mul_add(x376, x377, x364);
         let x386 = x376 * x376;
-        let x387 = Self::mul_add(x384, x384, x386);
+        let x387 = S::mul_add(x384, x384, x386);
         let x388 = x377 * x384;
         let x389 = x382 - x388;
-        let x390 = x384 * 0.6328;
-        let x391 = Self::mul_add(x384, 24.35164200091464, x377 * 24.4950615);
-        let x392 = Self::mul_add(
-            28.2393615,
+        let x390 = x384 * S::splat(0.6328);
+        let x391 = S::mul_add(
             x384,
-            Self::mul_add(x377, -24.351642000914637, x376 * 0.6328),
+            S::splat(24.35164200091464),
+            x377 * S::splat(24.4950615),
         );
-        let x393 = Self::mul_add(
+        let x392 = S::mul_add(
+            S::splat(28.2393615),
+            x384,
+            S::mul_add(x377, S::splat(-24.351642000914637), x376 * S::splat(0.6328)),
+        );
+        let x393 = S::mul_add(
             x380,
-            45.1584,
-            Self::mul_add(x364, 0.6328, -Self::mul_add(x377, x392, x384 * x391)),
-        );
-        let x394 = Self::mul_add(
-            x381,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
+            S::splat(45.1584),
+            S::mul_add(
                 x364,
-                Self::mul_add(x383, -24.351642000914637, x382 * 0.6328),
-            ) + Self::mul_add(x376, x391, x377 * x390),
+                S::splat(0.6328),
+                S::neg(S::mul_add(x377, x392, x384 * x391)),
+            ),
         );
-        let x395 = Self::mul_add(-s_q11, x377, c_q11 * x376);
-        let x396 = Self::mul_add(c_q11, x377, s_q11 * x376);
+        let x394 = S::mul_add(
+            x381,
+            S::splat(45.1584),
+            S::mul_add(
+                S::splat(28.2393615),
+                x364,
+                S::mul_add(x383, S::splat(-24.351642000914637), x382 * S::splat(0.6328)),
+            ) + S::mul_add(x376, x391, x377 * x390),
+        );
+        let x395 = S::mul_add(S::neg(s_q11), x377, c_q11 * x376);
+        let x396 = S::mul_add(c_q11, x377, s_q11 * x376);
         let x397 = x381
-            + Self::mul_add(-0.275, Self::mul_add(-x376, x384, x383), 0.63 * x385);
-        let x398 = Self::mul_add(c_q10, x379, s_q10 * x378)
-            - Self::mul_add(-0.275, x382 + x388, 0.63 * x387);
+            + S::mul_add(
+                S::splat(-0.275),
+                S::mul_add(S::neg(x376), x384, x383),
+                S::splat(0.63) * x385,
+            );
+        let x398 = S::mul_add(c_q10, x379, s_q10 * x378)
+            - S::mul_add(S::splat(-0.275), x382 + x388, S::splat(0.63) * x387);
         let x399 = x380
-            + Self::mul_add(0.275, Self::mul_add(x377, x377, x386), 0.63 * x389);
-        let x400 = Self::mul_add(-s_q11, x398, c_q11 * x397);
-        let x401 = Self::mul_add(
-            -v[10],
+            + S::mul_add(
+                S::splat(0.275),
+                S::mul_add(x377, x377, x386),
+                S::splat(0.63) * x389,
+            );
+        let x400 = S::mul_add(S::neg(s_q11), x398, c_q11 * x397);
+        let x401 = S::mul_add(
+            S::neg(v[10]),
             x396,
-            Self::mul_add(-s_q11, x383, c_q11 * x382),
+            S::mul_add(S::neg(s_q11), x383, c_q11 * x382),
         );
-        let x402 = Self::mul_add(v[10], x395, Self::mul_add(c_q11, x383, s_q11 * x382));
+        let x402 = S::mul_add(v[10], x395, S::mul_add(c_q11, x383, s_q11 * x382));
         let x403 = v[10] + x384;
         let x404 = x395 * x395;
         let x405 = x396 * x403;
-        let x406 = x403 * 0.01675;
-        let x407 = Self::mul_add(x403, -2.5482240005325645, x396 * 3.8891049197628025);
-        let x408 = Self::mul_add(
-            -3.970314919762802,
+        let x406 = x403 * S::splat(0.01675);
+        let x407 = S::mul_add(
             x403,
-            Self::mul_add(x396, -2.5482240005325645, x395 * 0.01675),
+            S::splat(-2.5482240005325645),
+            x396 * S::splat(3.8891049197628025),
         );
-        let x409 = Self::mul_add(
+        let x408 = S::mul_add(
+            S::splat(-3.970314919762802),
+            x403,
+            S::mul_add(x396, S::splat(-2.5482240005325645), x395 * S::splat(0.01675)),
+        );
+        let x409 = S::mul_add(
             x399,
-            7.078399999258757,
-            Self::mul_add(x364, 0.01675, Self::mul_add(-x396, x408, x403 * x407)),
-        );
-        let x410 = Self::mul_add(
-            x400,
-            7.078399999258757,
-            Self::mul_add(
-                -3.970314919762802,
+            S::splat(7.078399999258757),
+            S::mul_add(
                 x364,
-                Self::mul_add(x402, -2.5482240005325645, x401 * 0.01675),
-            ) + Self::mul_add(-x395, x407, x396 * x406),
+                S::splat(0.01675),
+                S::mul_add(S::neg(x396), x408, x403 * x407),
+            ),
         );
-        let x411 = Self::mul_add(0.00000000020510342851533115, x396, x403);
-        let x412 = Self::mul_add(s_q12, x411, c_q12 * x395);
-        let x413 = Self::mul_add(-c_q12, x411, s_q12 * x395);
-        let x414 = Self::mul_add(-0.36, Self::mul_add(-x395, x403, x402), x400);
-        let x415 = Self::mul_add(
-            0.36,
+        let x410 = S::mul_add(
+            x400,
+            S::splat(7.078399999258757),
+            S::mul_add(
+                S::splat(-3.970314919762802),
+                x364,
+                S::mul_add(x402, S::splat(-2.5482240005325645), x401 * S::splat(0.01675)),
+            ) + S::mul_add(S::neg(x395), x407, x396 * x406),
+        );
+        let x411 = S::mul_add(S::splat(0.00000000020510342851533115), x396, x403);
+        let x412 = S::mul_add(s_q12, x411, c_q12 * x395);
+        let x413 = S::mul_add(S::neg(c_q12), x411, s_q12 * x395);
+        let x414 = S::mul_add(
+            S::splat(-0.36),
+            S::mul_add(S::neg(x395), x403, x402),
+            x400,
+        );
+        let x415 = S::mul_add(
+            S::splat(0.36),
             x401 + x405,
-            Self::mul_add(c_q11, x398, s_q11 * x397),
+            S::mul_add(c_q11, x398, s_q11 * x397),
         );
-        let x416 = Self::mul_add(0.36, Self::mul_add(x396, x396, x404), x399);
-        let x417 = Self::mul_add(-0.00000000020510342851533115, x415, x416);
-        let x418 = Self::mul_add(0.00000000020510342851533115, x416, x415);
-        let x419 = Self::mul_add(-s_q12, x417, c_q12 * x414);
-        let x420 = Self::mul_add(c_q12, x417, s_q12 * x414);
-        let x421 = Self::mul_add(0.00000000020510342851533115, x402, x364);
-        let x422 = Self::mul_add(-0.00000000020510342851533115, x364, x402);
-        let x423 = Self::mul_add(-v[11], x413, Self::mul_add(s_q12, x421, c_q12 * x401));
-        let x424 = Self::mul_add(v[11], x412, Self::mul_add(-c_q12, x421, s_q12 * x401));
-        let x425 = v[11] + Self::mul_add(-0.00000000020510342851533115, x403, x396);
+        let x416 = S::mul_add(S::splat(0.36), S::mul_add(x396, x396, x404), x399);
+        let x417 = S::mul_add(S::splat(-0.00000000020510342851533115), x415, x416);
+        let x418 = S::mul_add(S::splat(0.00000000020510342851533115), x416, x415);
+        let x419 = S::mul_add(S::neg(s_q12), x417, c_q12 * x414);
+        let x420 = S::mul_add(c_q12, x417, s_q12 * x414);
+        let x421 = S::mul_add(S::splat(0.00000000020510342851533115), x402, x364);
+        let x422 = S::mul_add(S::splat(-0.00000000020510342851533115), x364, x402);
+        let x423 = S::mul_add(
+            S::neg(v[11]),
+            x413,
+            S::mul_add(s_q12, x421, c_q12 * x401),
+        );
+        let x424 = S::mul_add(
+            v[11],
+            x412,
+            S::mul_add(S::neg(c_q12), x421, s_q12 * x401),
+        );
+        let x425 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x403, x396);
         let x426 = x413 * x413;
         let x427 = x425 * x425;
         let x428 = x426 + x427;
@@ -3639,1092 +4474,1265 @@ impl FreeFloating7 {
         let x432 = x412 * x412;
         let x433 = x413 * x425;
         let x434 = x424 + x430;
-        let x435 = Self::mul_add(x425, 2.741639999592316, 1.9877000000000002 * x413);
-        let x436 = Self::mul_add(
-            0.809539999555672,
+        let x435 = S::mul_add(
             x425,
-            Self::mul_add(-5.252920330000002, x413, 1.9877000000000002 * x412),
+            S::splat(2.741639999592316),
+            S::splat(1.9877000000000002) * x413,
         );
-        let x437 = Self::mul_add(
-            -9.740442170000001,
+        let x436 = S::mul_add(
+            S::splat(0.809539999555672),
             x425,
-            Self::mul_add(0.809539999555672, x413, x412 * 2.7416399995923166),
-        );
-        let x438 = Self::mul_add(
-            17.135250000000003,
-            x418,
-            Self::mul_add(
-                0.809539999555672,
-                x422,
-                Self::mul_add(-5.252920330000002, x424, 1.9877000000000002 * x423),
-            ) - Self::mul_add(-x412, x437, x425 * x435),
-        );
-        let x439 = Self::mul_add(0.00000000020510342851533115, x413, x425);
-        let x440 = Self::mul_add(s_q13, x439, c_q13 * x412);
-        let x441 = Self::mul_add(-c_q13, x439, s_q13 * x412);
-        let x442 = x420 + Self::mul_add(-0.16, x423 + x433, 0.55 * x431);
-        let x443 = x418 - Self::mul_add(-0.16, x426 + x432, 0.55 * x434);
-        let x444 = Self::mul_add(0.00000000020510342851533115, x424, x422);
-        let x445 = Self::mul_add(-0.00000000020510342851533115, x422, x424);
-        let x446 = Self::mul_add(-v[12], x441, Self::mul_add(s_q13, x444, c_q13 * x423));
-        let x447 = Self::mul_add(v[12], x440, Self::mul_add(-c_q13, x444, s_q13 * x423));
-        let x448 = v[12] + Self::mul_add(-0.00000000020510342851533115, x425, x413);
-        let x449 = 4.806620000000001 * Self::mul_add(x440, x441, x445);
-        let x450 = 4.806620000000001 * Self::mul_add(x440, x440, x448 * x448);
-        let x451 = 4.806620000000001 * Self::mul_add(-x441, x448, x446);
-        let x452 = Self::mul_add(0.0145, x448, 0.000781 * x441);
-        let x453 = Self::mul_add(
-            -0.9614610000000001,
-            x448,
-            Self::mul_add(1.2025609200000003, x441, 0.000781 * x440),
-        );
-        let x454 = Self::mul_add(
-            -1.4135609200000003,
-            x448,
-            Self::mul_add(-0.9614610000000001, x441, 0.0145 * x440),
-        );
-        let x455 = Self::mul_add(
-            -0.9614610000000001,
-            x445,
-            Self::mul_add(1.2025609200000003, x447, 0.000781 * x446),
-        ) - Self::mul_add(-x440, x454, x448 * x452);
-        let x456 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x443, x442),
-            Self::mul_add(0.0145, x445, 0.000781 * x447)
-                + Self::mul_add(-x441, x454, x448 * x453),
-        );
-        let x457 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(0.00000000020510342851533115, x442, x443),
-                c_q13 * (x419 + Self::mul_add(0.16, x424 - x430, 0.55 * x428)),
+            S::mul_add(
+                S::splat(-5.252920330000002),
+                x413,
+                S::splat(1.9877000000000002) * x412,
             ),
-            Self::mul_add(
-                -1.4135609200000003,
-                x445,
-                Self::mul_add(-0.9614610000000001, x447, 0.0145 * x446),
-            ) + Self::mul_add(-x440, x453, x441 * x452),
         );
-        let x458 = Self::mul_add(-s_q13, x450, c_q13 * x449);
-        let x459 = Self::mul_add(c_q13, x450, s_q13 * x449);
-        let x460 = Self::mul_add(-0.00000000020510342851533115, x459, x451);
-        let x461 = Self::mul_add(0.00000000020510342851533115, x451, x459);
-        let x462 = Self::mul_add(-c_q13, x455, s_q13 * x456);
-        let x463 = Self::mul_add(
-            -3.6140000000000003,
-            x422 + x429,
-            17.135250000000003 * x428,
-        ) + x458;
-        let x464 = Self::mul_add(
-            3.6140000000000003,
-            x427 + x432,
-            17.135250000000003 * x431,
-        ) - x460;
-        let x465 = Self::mul_add(
-            -3.6140000000000003,
-            x423 - x433,
-            17.135250000000003 * x434,
-        ) - x461;
-        let x466 = Self::mul_add(
-            -3.6140000000000003,
+        let x437 = S::mul_add(
+            S::splat(-9.740442170000001),
+            x425,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x413,
+                x412 * S::splat(2.7416399995923166),
+            ),
+        );
+        let x438 = S::mul_add(
+            S::splat(17.135250000000003),
             x418,
-            Self::mul_add(x422, 2.741639999592316, 1.9877000000000002 * x424)
-                + Self::mul_add(-x413, x437, x425 * x436),
-        ) + Self::mul_add(-0.16, x460, Self::mul_add(s_q13, x455, c_q13 * x456));
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x422,
+                S::mul_add(
+                    S::splat(-5.252920330000002),
+                    x424,
+                    S::splat(1.9877000000000002) * x423,
+                ),
+            ) - S::mul_add(S::neg(x412), x437, x425 * x435),
+        );
+        let x439 = S::mul_add(S::splat(0.00000000020510342851533115), x413, x425);
+        let x440 = S::mul_add(s_q13, x439, c_q13 * x412);
+        let x441 = S::mul_add(S::neg(c_q13), x439, s_q13 * x412);
+        let x442 = x420
+            + S::mul_add(S::splat(-0.16), x423 + x433, S::splat(0.55) * x431);
+        let x443 = x418
+            - S::mul_add(S::splat(-0.16), x426 + x432, S::splat(0.55) * x434);
+        let x444 = S::mul_add(S::splat(0.00000000020510342851533115), x424, x422);
+        let x445 = S::mul_add(S::splat(-0.00000000020510342851533115), x422, x424);
+        let x446 = S::mul_add(
+            S::neg(v[12]),
+            x441,
+            S::mul_add(s_q13, x444, c_q13 * x423),
+        );
+        let x447 = S::mul_add(
+            v[12],
+            x440,
+            S::mul_add(S::neg(c_q13), x444, s_q13 * x423),
+        );
+        let x448 = v[12]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x425, x413);
+        let x449 = S::splat(4.806620000000001) * S::mul_add(x440, x441, x445);
+        let x450 = S::splat(4.806620000000001) * S::mul_add(x440, x440, x448 * x448);
+        let x451 = S::splat(4.806620000000001) * S::mul_add(S::neg(x441), x448, x446);
+        let x452 = S::mul_add(S::splat(0.0145), x448, S::splat(0.000781) * x441);
+        let x453 = S::mul_add(
+            S::splat(-0.9614610000000001),
+            x448,
+            S::mul_add(S::splat(1.2025609200000003), x441, S::splat(0.000781) * x440),
+        );
+        let x454 = S::mul_add(
+            S::splat(-1.4135609200000003),
+            x448,
+            S::mul_add(S::splat(-0.9614610000000001), x441, S::splat(0.0145) * x440),
+        );
+        let x455 = S::mul_add(
+            S::splat(-0.9614610000000001),
+            x445,
+            S::mul_add(S::splat(1.2025609200000003), x447, S::splat(0.000781) * x446),
+        ) - S::mul_add(S::neg(x440), x454, x448 * x452);
+        let x456 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x443, x442),
+            S::mul_add(S::splat(0.0145), x445, S::splat(0.000781) * x447)
+                + S::mul_add(S::neg(x441), x454, x448 * x453),
+        );
+        let x457 = S::mul_add(
+            S::splat(-4.806620000000001),
+            S::mul_add(
+                s_q13,
+                S::mul_add(S::splat(0.00000000020510342851533115), x442, x443),
+                c_q13
+                    * (x419
+                        + S::mul_add(S::splat(0.16), x424 - x430, S::splat(0.55) * x428)),
+            ),
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x445,
+                S::mul_add(S::splat(-0.9614610000000001), x447, S::splat(0.0145) * x446),
+            ) + S::mul_add(S::neg(x440), x453, x441 * x452),
+        );
+        let x458 = S::mul_add(S::neg(s_q13), x450, c_q13 * x449);
+        let x459 = S::mul_add(c_q13, x450, s_q13 * x449);
+        let x460 = S::mul_add(S::splat(-0.00000000020510342851533115), x459, x451);
+        let x461 = S::mul_add(S::splat(0.00000000020510342851533115), x451, x459);
+        let x462 = S::mul_add(S::neg(c_q13), x455, s_q13 * x456);
+        let x463 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x422 + x429,
+            S::splat(17.135250000000003) * x428,
+        ) + x458;
+        let x464 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x427 + x432,
+            S::splat(17.135250000000003) * x431,
+        ) - x460;
+        let x465 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x423 - x433,
+            S::splat(17.135250000000003) * x434,
+        ) - x461;
+        let x466 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x418,
+            S::mul_add(
+                x422,
+                S::splat(2.741639999592316),
+                S::splat(1.9877000000000002) * x424,
+            ) + S::mul_add(S::neg(x413), x437, x425 * x436),
+        ) + S::mul_add(S::splat(-0.16), x460, S::mul_add(s_q13, x455, c_q13 * x456));
         let x467 = x438
-            + (Self::mul_add(0.00000000020510342851533115, x462, x457)
-                - Self::mul_add(-0.55, x461, 0.16 * x458));
-        let x468 = Self::mul_add(
-            -9.740442170000001,
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x462, x457)
+                - S::mul_add(S::splat(-0.55), x461, S::splat(0.16) * x458));
+        let x468 = S::mul_add(
+            S::splat(-9.740442170000001),
             x422,
-            Self::mul_add(0.809539999555672, x424, x423 * 2.7416399995923166),
-        ) + Self::mul_add(-x412, x436, x413 * x435)
-            + Self::mul_add(-17.135250000000003, x420, 3.6140000000000003 * x419)
-            + Self::mul_add(
-                0.55,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x424,
+                x423 * S::splat(2.7416399995923166),
+            ),
+        ) + S::mul_add(S::neg(x412), x436, x413 * x435)
+            + S::mul_add(
+                S::splat(-17.135250000000003),
+                x420,
+                S::splat(3.6140000000000003) * x419,
+            )
+            + S::mul_add(
+                S::splat(0.55),
                 x460,
-                Self::mul_add(-0.00000000020510342851533115, x457, x462),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x457, x462),
             );
-        let x469 = Self::mul_add(s_q12, x464, c_q12 * x463);
-        let x470 = Self::mul_add(-c_q12, x464, s_q12 * x463);
-        let x471 = Self::mul_add(-0.00000000020510342851533115, x470, x465);
-        let x472 = Self::mul_add(-c_q12, x467, s_q12 * x466);
-        let x473 = Self::mul_add(
-            Self::mul_add(x395, x396, x364),
-            7.078399999258757,
-            -x469,
+        let x469 = S::mul_add(s_q12, x464, c_q12 * x463);
+        let x470 = S::mul_add(S::neg(c_q12), x464, s_q12 * x463);
+        let x471 = S::mul_add(S::splat(-0.00000000020510342851533115), x470, x465);
+        let x472 = S::mul_add(S::neg(c_q12), x467, s_q12 * x466);
+        let x473 = S::mul_add(
+            S::mul_add(x395, x396, x364),
+            S::splat(7.078399999258757),
+            S::neg(x469),
         );
-        let x474 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x403, x403, x404),
-            -x471,
+        let x474 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x403, x403, x404),
+            S::neg(x471),
         );
-        let x475 = Self::mul_add(
-            7.078399999258757,
+        let x475 = S::mul_add(
+            S::splat(7.078399999258757),
             x401 - x405,
-            Self::mul_add(0.00000000020510342851533115, x465, x470),
+            S::mul_add(S::splat(0.00000000020510342851533115), x465, x470),
         );
         let x476 = x409
-            + Self::mul_add(0.36, x471, Self::mul_add(s_q12, x467, c_q12 * x466));
-        let x477 = Self::mul_add(x364, -2.5482240005325645, x402 * 3.8891049197628025)
-            - Self::mul_add(-x395, x408, x403 * x406)
-            + Self::mul_add(
-                0.36,
+            + S::mul_add(S::splat(0.36), x471, S::mul_add(s_q12, x467, c_q12 * x466));
+        let x477 = S::mul_add(
+            x364,
+            S::splat(-2.5482240005325645),
+            x402 * S::splat(3.8891049197628025),
+        ) - S::mul_add(S::neg(x395), x408, x403 * x406)
+            + S::mul_add(
+                S::splat(0.36),
                 x469,
-                Self::mul_add(0.00000000020510342851533115, x472, x468),
+                S::mul_add(S::splat(0.00000000020510342851533115), x472, x468),
             );
-        let x478 = x410 + Self::mul_add(-0.00000000020510342851533115, x468, x472);
-        let x479 = Self::mul_add(-s_q11, x474, c_q11 * x473);
-        let x480 = Self::mul_add(c_q11, x474, s_q11 * x473);
-        let x481 = Self::mul_add(x385, 45.1584, -x479);
-        let x482 = Self::mul_add(45.1584, x387, -x480);
-        let x483 = Self::mul_add(45.1584, x389, -x475);
+        let x478 = x410
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x468, x472);
+        let x479 = S::mul_add(S::neg(s_q11), x474, c_q11 * x473);
+        let x480 = S::mul_add(c_q11, x474, s_q11 * x473);
+        let x481 = S::mul_add(x385, S::splat(45.1584), S::neg(x479));
+        let x482 = S::mul_add(S::splat(45.1584), x387, S::neg(x480));
+        let x483 = S::mul_add(S::splat(45.1584), x389, S::neg(x475));
         let x484 = x393
-            - (Self::mul_add(s_q11, x477, c_q11 * x476)
-                - Self::mul_add(-0.63, x475, 0.275 * x480));
-        let x485 = Self::mul_add(x364, 24.35164200091464, x383 * 24.4950615)
-            + Self::mul_add(-x376, x392, x384 * x390)
-            - Self::mul_add(0.275, x479, Self::mul_add(-c_q11, x477, s_q11 * x476));
-        let x486 = x394 - Self::mul_add(0.63, x479, x478);
-        let x487 = Self::mul_add(-s_q10, x482, c_q10 * x481);
-        let x488 = Self::mul_add(x368, 81.53205, x487);
-        let x489 = Self::mul_add(
-            81.53205,
+            - (S::mul_add(s_q11, x477, c_q11 * x476)
+                - S::mul_add(S::splat(-0.63), x475, S::splat(0.275) * x480));
+        let x485 = S::mul_add(
+            x364,
+            S::splat(24.35164200091464),
+            x383 * S::splat(24.4950615),
+        ) + S::mul_add(S::neg(x376), x392, x384 * x390)
+            - S::mul_add(
+                S::splat(0.275),
+                x479,
+                S::mul_add(S::neg(c_q11), x477, s_q11 * x476),
+            );
+        let x486 = x394 - S::mul_add(S::splat(0.63), x479, x478);
+        let x487 = S::mul_add(S::neg(s_q10), x482, c_q10 * x481);
+        let x488 = S::mul_add(x368, S::splat(81.53205), x487);
+        let x489 = S::mul_add(
+            S::splat(81.53205),
             x369,
-            Self::mul_add(c_q10, x482, s_q10 * x481),
+            S::mul_add(c_q10, x482, s_q10 * x481),
         );
-        let x490 = Self::mul_add(81.53205, x370, x483);
+        let x490 = S::mul_add(S::splat(81.53205), x370, x483);
         let x491 = x374
-            + Self::mul_add(0.87, x483, Self::mul_add(-s_q10, x485, c_q10 * x484));
-        let x492 = Self::mul_add(x364, 36.18604050126307, x366 * 63.36336825)
-            + Self::mul_add(-x355, x373, x367 * x371)
-            + Self::mul_add(c_q10, x485, s_q10 * x484);
-        let x493 = x375 + Self::mul_add(0.87, x487, x486);
-        let x494 = Self::mul_add(-s_q9, x489, c_q9 * x488);
-        let x495 = Self::mul_add(c_q9, x489, s_q9 * x488);
-        let x496 = Self::mul_add(0.00000000020510342851533115, x495, x490);
-        let x497 = Self::mul_add(-0.00000000020510342851533115, x490, x495);
-        let x498 = Self::mul_add(c_q9, x492, s_q9 * x491);
-        let x499 = Self::mul_add(
-            -12.701650001451807,
+            + S::mul_add(
+                S::splat(0.87),
+                x483,
+                S::mul_add(S::neg(s_q10), x485, c_q10 * x484),
+            );
+        let x492 = S::mul_add(
+            x364,
+            S::splat(36.18604050126307),
+            x366 * S::splat(63.36336825),
+        ) + S::mul_add(S::neg(x355), x373, x367 * x371)
+            + S::mul_add(c_q10, x485, s_q10 * x484);
+        let x493 = x375 + S::mul_add(S::splat(0.87), x487, x486);
+        let x494 = S::mul_add(S::neg(s_q9), x489, c_q9 * x488);
+        let x495 = S::mul_add(c_q9, x489, s_q9 * x488);
+        let x496 = S::mul_add(S::splat(0.00000000020510342851533115), x495, x490);
+        let x497 = S::mul_add(S::splat(-0.00000000020510342851533115), x490, x495);
+        let x498 = S::mul_add(c_q9, x492, s_q9 * x491);
+        let x499 = S::mul_add(
+            S::splat(-12.701650001451807),
             x342,
-            0.0000000059257457049506905 * x340,
+            S::splat(0.0000000059257457049506905) * x340,
         ) - x494;
-        let x500 = Self::mul_add(
-            12.701650001451807,
+        let x500 = S::mul_add(
+            S::splat(12.701650001451807),
             x346,
-            0.0000000059257457049506905 * x344,
+            S::splat(0.0000000059257457049506905) * x344,
         ) + x496;
-        let x501 = Self::mul_add(
-            12.701650001451807,
+        let x501 = S::mul_add(
+            S::splat(12.701650001451807),
             x349,
-            0.0000000059257457049506905 * x348,
+            S::splat(0.0000000059257457049506905) * x348,
         ) - x497;
-        let x502 = Self::mul_add(
-            12.701650001451807,
+        let x502 = S::mul_add(
+            S::splat(12.701650001451807),
             x331,
-            Self::mul_add(
-                0.0021399976297017177,
+            S::mul_add(
+                S::splat(0.0021399976297017177),
                 x316,
-                x336 * 0.0000000005683321144643007,
-            ) + Self::mul_add(x326, x352, x337 * x351),
+                x336 * S::splat(0.0000000005683321144643007),
+            ) + S::mul_add(x326, x352, x337 * x351),
         )
-            + (Self::mul_add(-s_q9, x492, c_q9 * x491)
-                - Self::mul_add(-0.275, x497, 0.4 * x496));
+            + (S::mul_add(S::neg(s_q9), x492, c_q9 * x491)
+                - S::mul_add(S::splat(-0.275), x497, S::splat(0.4) * x496));
         let x503 = x353
-            - (Self::mul_add(-0.00000000020510342851533115, x498, x493)
-                - Self::mul_add(-0.00000000005640344284171607, x497, 0.4 * x494));
-        let x504 = Self::mul_add(
-            108.1389699208081,
+            - (S::mul_add(S::splat(-0.00000000020510342851533115), x498, x493)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x497,
+                    S::splat(0.4) * x494,
+                ));
+        let x504 = S::mul_add(
+            S::splat(108.1389699208081),
             x316,
-            Self::mul_add(x336, 5.080660022992536, 0.0021399976297017177 * x335),
-        ) - Self::mul_add(-x325, x351, x326 * x350)
-            + Self::mul_add(0.0000000059257457049506905, x333, 12.701650001451807 * x332)
-            + (Self::mul_add(0.00000000020510342851533115, x493, x498)
-                - Self::mul_add(-0.00000000005640344284171607, x496, 0.275 * x494));
-        let x505 = Self::mul_add(-s_q8, x500, c_q8 * x499);
-        let x506 = Self::mul_add(c_q8, x500, s_q8 * x499);
-        let x507 = Self::mul_add(0.00000000020510342851533115, x506, x501);
-        let x508 = Self::mul_add(-c_q8, x503, s_q8 * x502);
-        let x509 = Self::mul_add(x303 * x304, 48.0240000085309, x505);
-        let x510 = Self::mul_add(
-            48.0240000085309,
-            Self::mul_add(x317, x317, x318),
+            S::mul_add(
+                x336,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x335,
+            ),
+        ) - S::mul_add(S::neg(x325), x351, x326 * x350)
+            + S::mul_add(
+                S::splat(0.0000000059257457049506905),
+                x333,
+                S::splat(12.701650001451807) * x332,
+            )
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x493, x498)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x496,
+                    S::splat(0.275) * x494,
+                ));
+        let x505 = S::mul_add(S::neg(s_q8), x500, c_q8 * x499);
+        let x506 = S::mul_add(c_q8, x500, s_q8 * x499);
+        let x507 = S::mul_add(S::splat(0.00000000020510342851533115), x506, x501);
+        let x508 = S::mul_add(S::neg(c_q8), x503, s_q8 * x502);
+        let x509 = S::mul_add(x303 * x304, S::splat(48.0240000085309), x505);
+        let x510 = S::mul_add(
+            S::splat(48.0240000085309),
+            S::mul_add(x317, x317, x318),
             x507,
         );
-        let x511 = Self::mul_add(
-            48.0240000085309,
+        let x511 = S::mul_add(
+            S::splat(48.0240000085309),
             x315 + x319,
-            -Self::mul_add(-0.00000000020510342851533115, x501, x506),
+            S::neg(S::mul_add(S::splat(-0.00000000020510342851533115), x501, x506)),
         );
         let x512 = x323
-            - Self::mul_add(0.35, x507, Self::mul_add(s_q8, x503, c_q8 * x502));
-        let x513 = Self::mul_add(x316, 125.18476992763283, 0.07309 * x315)
-            + Self::mul_add(x303, x322, x317 * x320)
-            - Self::mul_add(
-                -0.35,
+            - S::mul_add(S::splat(0.35), x507, S::mul_add(s_q8, x503, c_q8 * x502));
+        let x513 = S::mul_add(
+            x316,
+            S::splat(125.18476992763283),
+            S::splat(0.07309) * x315,
+        ) + S::mul_add(x303, x322, x317 * x320)
+            - S::mul_add(
+                S::splat(-0.35),
                 x505,
-                Self::mul_add(0.00000000020510342851533115, x508, x504),
+                S::mul_add(S::splat(0.00000000020510342851533115), x508, x504),
             );
-        let x514 = Self::mul_add(
+        let x514 = S::mul_add(
             x314,
-            -48.0240000085309,
-            Self::mul_add(-16.807689977165428, x316, 0.1132 * x315)
-                + Self::mul_add(-x303, x321, x304 * x320),
-        ) + Self::mul_add(-0.00000000020510342851533115, x504, x508);
-        let x515 = Self::mul_add(-c_q7, x510, s_q7 * x509);
-        let x516 = Self::mul_add(s_q7, x510, c_q7 * x509);
-        let x517 = Self::mul_add(v[5], -117.61766249359756, 1519.7808011559632 * v[3]);
-        let x518 = 1591.635376155963 * v[4];
-        let x519 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+            S::splat(-48.0240000085309),
+            S::mul_add(S::splat(-16.807689977165428), x316, S::splat(0.1132) * x315)
+                + S::mul_add(S::neg(x303), x321, x304 * x320),
+        ) + S::mul_add(S::splat(-0.00000000020510342851533115), x504, x508);
+        let x515 = S::mul_add(S::neg(c_q7), x510, s_q7 * x509);
+        let x516 = S::mul_add(s_q7, x510, c_q7 * x509);
+        let x517 = S::mul_add(
+            v[5],
+            S::splat(-117.61766249359756),
+            S::splat(1519.7808011559632) * v[3],
+        );
+        let x518 = S::splat(1591.635376155963) * v[4];
+        let x519 = S::mul_add(
+            S::splat(-1271.854575),
+            v[5],
+            v[3] * S::splat(117.61766249359758),
+        );
         let x520 = x515
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x300,
-                Self::mul_add(-180.9502499901501, x308, 110.5455 * x306),
+                S::mul_add(S::splat(-180.9502499901501), x308, S::splat(110.5455) * x306),
             );
         let x521 = x516
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x301,
-                Self::mul_add(180.9502499901501, x309, 110.5455 * x307),
+                S::mul_add(S::splat(180.9502499901501), x309, S::splat(110.5455) * x307),
             );
         let x522 = x511
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x302,
-                -Self::mul_add(-180.9502499901501, x310, 110.5455 * x308),
+                S::neg(
+                    S::mul_add(
+                        S::splat(-180.9502499901501),
+                        x310,
+                        S::splat(110.5455) * x308,
+                    ),
+                ),
             );
-        let x523 = x168 * 0.0008546497218115156;
-        let x524 = x160 * 0.0008546497218115156;
-        let x525 = x173 * 0.0008546497218115156;
-        let x526 = x187 * 0.0008546497218115156;
-        let x527 = x204 * 0.0008546497218115156;
-        let x528 = x226 * 0.0008546497218115156;
-        let x529 = x258 * 0.0008546497218115156;
-        let x530 = x298 * 0.0008546497218115156;
-        let x531 = x167 * 0.0008546497218115156;
-        let x532 = x161 * 0.0008546497218115156;
-        let x533 = x174 * 0.0008546497218115156;
-        let x534 = x188 * 0.0008546497218115156;
-        let x535 = x205 * 0.0008546497218115156;
-        let x536 = x227 * 0.0008546497218115156;
-        let x537 = x259 * 0.0008546497218115156;
-        let x538 = x299 * 0.0008546497218115156;
-        let x539 = x140 * 0.0008546497218115156;
-        let x540 = x182 * 0.0008546497218115156;
-        let x541 = x199 * 0.0008546497218115156;
-        let x542 = x221 * 0.0008546497218115156;
-        let x543 = x253 * 0.0008546497218115156;
-        let x544 = x293 * 0.0008546497218115156;
+        let x523 = x168 * S::splat(0.0008546497218115156);
+        let x524 = x160 * S::splat(0.0008546497218115156);
+        let x525 = x173 * S::splat(0.0008546497218115156);
+        let x526 = x187 * S::splat(0.0008546497218115156);
+        let x527 = x204 * S::splat(0.0008546497218115156);
+        let x528 = x226 * S::splat(0.0008546497218115156);
+        let x529 = x258 * S::splat(0.0008546497218115156);
+        let x530 = x298 * S::splat(0.0008546497218115156);
+        let x531 = x167 * S::splat(0.0008546497218115156);
+        let x532 = x161 * S::splat(0.0008546497218115156);
+        let x533 = x174 * S::splat(0.0008546497218115156);
+        let x534 = x188 * S::splat(0.0008546497218115156);
+        let x535 = x205 * S::splat(0.0008546497218115156);
+        let x536 = x227 * S::splat(0.0008546497218115156);
+        let x537 = x259 * S::splat(0.0008546497218115156);
+        let x538 = x299 * S::splat(0.0008546497218115156);
+        let x539 = x140 * S::splat(0.0008546497218115156);
+        let x540 = x182 * S::splat(0.0008546497218115156);
+        let x541 = x199 * S::splat(0.0008546497218115156);
+        let x542 = x221 * S::splat(0.0008546497218115156);
+        let x543 = x253 * S::splat(0.0008546497218115156);
+        let x544 = x293 * S::splat(0.0008546497218115156);
         let x545 = x168 * x523;
         let x546 = x160 * x524;
-        let x547 = 1.0
-            / (1519.7808011559632 + (x162 + (x152 + x159 + x162)) - x545 - x546);
-        let x548 = Self::mul_add(
-            -x160,
+        let x547 = S::splat(1.0)
+            / (S::splat(1519.7808011559632) + (x162 + (x152 + x159 + x162)) - x545
+                - x546);
+        let x548 = S::mul_add(
+            S::neg(x160),
             x531,
-            Self::mul_add(0.65, x160, x150 + Self::mul_add(-x155, x158, x156 * x157)),
+            S::mul_add(
+                S::splat(0.65),
+                x160,
+                x150 + S::mul_add(S::neg(x155), x158, x156 * x157),
+            ),
         );
         let x549 = x547 * x548;
-        let x550 = Self::mul_add(
+        let x550 = S::mul_add(
             x168,
             x531,
-            -117.61766249359756 - Self::mul_add(0.65, x146, x165),
+            S::splat(-117.61766249359756) - S::mul_add(S::splat(0.65), x146, x165),
         );
         let x551 = x547 * x550;
-        let x552 = Self::mul_add(x168, x532, x165);
+        let x552 = S::mul_add(x168, x532, x165);
         let x553 = x547 * x552;
-        let x554 = Self::mul_add(
+        let x554 = S::mul_add(
             x168,
             x533,
-            Self::mul_add(-0.75, x174, Self::mul_add(-c_q7, x172, s_q7 * x171)),
+            S::mul_add(
+                S::splat(-0.75),
+                x174,
+                S::mul_add(S::neg(c_q7), x172, s_q7 * x171),
+            ),
         );
-        let x555 = Self::mul_add(x160, x539, x554);
+        let x555 = S::mul_add(x160, x539, x554);
         let x556 = x547 * x555;
-        let x557 = Self::mul_add(
-            -x168,
+        let x557 = S::mul_add(
+            S::neg(x168),
             x534,
-            Self::mul_add(0.75, x188, Self::mul_add(-c_q7, x186, s_q7 * x185)),
+            S::mul_add(S::splat(0.75), x188, S::mul_add(S::neg(c_q7), x186, s_q7 * x185)),
         );
-        let x558 = Self::mul_add(x160, x540, x557);
+        let x558 = S::mul_add(x160, x540, x557);
         let x559 = x547 * x558;
-        let x560 = Self::mul_add(
-            -x168,
+        let x560 = S::mul_add(
+            S::neg(x168),
             x535,
-            Self::mul_add(0.75, x205, Self::mul_add(-c_q7, x203, s_q7 * x202)),
+            S::mul_add(S::splat(0.75), x205, S::mul_add(S::neg(c_q7), x203, s_q7 * x202)),
         );
-        let x561 = Self::mul_add(x160, x541, x560);
+        let x561 = S::mul_add(x160, x541, x560);
         let x562 = x547 * x561;
-        let x563 = Self::mul_add(
+        let x563 = S::mul_add(
             x168,
             x536,
-            Self::mul_add(-0.75, x227, Self::mul_add(-c_q7, x225, s_q7 * x224)),
+            S::mul_add(
+                S::splat(-0.75),
+                x227,
+                S::mul_add(S::neg(c_q7), x225, s_q7 * x224),
+            ),
         );
-        let x564 = Self::mul_add(x160, x542, x563);
+        let x564 = S::mul_add(x160, x542, x563);
         let x565 = x547 * x564;
-        let x566 = Self::mul_add(
+        let x566 = S::mul_add(
             x168,
             x537,
-            Self::mul_add(-0.75, x259, Self::mul_add(-c_q7, x257, s_q7 * x256)),
+            S::mul_add(
+                S::splat(-0.75),
+                x259,
+                S::mul_add(S::neg(c_q7), x257, s_q7 * x256),
+            ),
         );
-        let x567 = Self::mul_add(-x160, x543, x566);
+        let x567 = S::mul_add(S::neg(x160), x543, x566);
         let x568 = x547 * x567;
-        let x569 = Self::mul_add(
-            -x168,
+        let x569 = S::mul_add(
+            S::neg(x168),
             x538,
-            Self::mul_add(0.75, x299, Self::mul_add(-c_q7, x297, s_q7 * x296)),
+            S::mul_add(S::splat(0.75), x299, S::mul_add(S::neg(c_q7), x297, s_q7 * x296)),
         );
-        let x570 = Self::mul_add(x160, x544, x569);
+        let x570 = S::mul_add(x160, x544, x569);
         let x571 = x547 * x570;
         let x572 = x167 * x531;
-        let x573 = 1.0
-            / Self::mul_add(
-                -x548,
+        let x573 = S::splat(1.0)
+            / S::mul_add(
+                S::neg(x548),
                 x549,
-                1591.635376155963 + (x164 + (x148 - x159 + x164)) - x545 - x572,
+                S::splat(1591.635376155963) + (x164 + (x148 - x159 + x164)) - x545 - x572,
             );
-        let x574 = Self::mul_add(
+        let x574 = S::mul_add(
             x168,
             x524,
-            Self::mul_add(-0.75, x160, Self::mul_add(-s_q7, x153, c_q7 * x151)),
+            S::mul_add(
+                S::splat(-0.75),
+                x160,
+                S::mul_add(S::neg(s_q7), x153, c_q7 * x151),
+            ),
         );
-        let x575 = Self::mul_add(x548, x551, x574);
+        let x575 = S::mul_add(x548, x551, x574);
         let x576 = x573 * x575;
-        let x577 = Self::mul_add(-x548, x553, x574);
+        let x577 = S::mul_add(S::neg(x548), x553, x574);
         let x578 = x573 * x577;
-        let x579 = Self::mul_add(
+        let x579 = S::mul_add(
             x167,
             x539,
-            Self::mul_add(
-                -x168,
+            S::mul_add(
+                S::neg(x168),
                 x525,
-                Self::mul_add(s_q7, x172, c_q7 * x171)
-                    + Self::mul_add(-0.65, x140, 0.75 * x173),
+                S::mul_add(s_q7, x172, c_q7 * x171)
+                    + S::mul_add(S::splat(-0.65), x140, S::splat(0.75) * x173),
             ),
         );
-        let x580 = Self::mul_add(-x548, x556, x579);
+        let x580 = S::mul_add(S::neg(x548), x556, x579);
         let x581 = x573 * x580;
-        let x582 = Self::mul_add(
+        let x582 = S::mul_add(
             x167,
             x540,
-            Self::mul_add(
+            S::mul_add(
                 x168,
                 x526,
-                Self::mul_add(s_q7, x186, c_q7 * x185)
-                    - Self::mul_add(0.65, x182, 0.75 * x187),
+                S::mul_add(s_q7, x186, c_q7 * x185)
+                    - S::mul_add(S::splat(0.65), x182, S::splat(0.75) * x187),
             ),
         );
-        let x583 = Self::mul_add(-x548, x559, x582);
+        let x583 = S::mul_add(S::neg(x548), x559, x582);
         let x584 = x573 * x583;
-        let x585 = Self::mul_add(
+        let x585 = S::mul_add(
             x167,
             x541,
-            Self::mul_add(
+            S::mul_add(
                 x168,
                 x527,
-                Self::mul_add(s_q7, x203, c_q7 * x202)
-                    - Self::mul_add(0.65, x199, 0.75 * x204),
+                S::mul_add(s_q7, x203, c_q7 * x202)
+                    - S::mul_add(S::splat(0.65), x199, S::splat(0.75) * x204),
             ),
         );
-        let x586 = Self::mul_add(-x548, x562, x585);
+        let x586 = S::mul_add(S::neg(x548), x562, x585);
         let x587 = x573 * x586;
-        let x588 = Self::mul_add(
+        let x588 = S::mul_add(
             x167,
             x542,
-            Self::mul_add(
-                -x168,
+            S::mul_add(
+                S::neg(x168),
                 x528,
-                Self::mul_add(s_q7, x225, c_q7 * x224)
-                    + Self::mul_add(-0.65, x221, 0.75 * x226),
+                S::mul_add(s_q7, x225, c_q7 * x224)
+                    + S::mul_add(S::splat(-0.65), x221, S::splat(0.75) * x226),
             ),
         );
-        let x589 = Self::mul_add(-x548, x565, x588);
+        let x589 = S::mul_add(S::neg(x548), x565, x588);
         let x590 = x573 * x589;
-        let x591 = Self::mul_add(
-            -x167,
+        let x591 = S::mul_add(
+            S::neg(x167),
             x543,
-            Self::mul_add(
-                -x168,
+            S::mul_add(
+                S::neg(x168),
                 x529,
-                Self::mul_add(s_q7, x257, c_q7 * x256)
-                    + Self::mul_add(0.65, x253, 0.75 * x258),
+                S::mul_add(s_q7, x257, c_q7 * x256)
+                    + S::mul_add(S::splat(0.65), x253, S::splat(0.75) * x258),
             ),
         );
-        let x592 = Self::mul_add(-x548, x568, x591);
+        let x592 = S::mul_add(S::neg(x548), x568, x591);
         let x593 = x573 * x592;
-        let x594 = Self::mul_add(
+        let x594 = S::mul_add(
             x167,
             x544,
-            Self::mul_add(
+            S::mul_add(
                 x168,
                 x530,
-                Self::mul_add(s_q7, x297, c_q7 * x296)
-                    - Self::mul_add(0.65, x293, 0.75 * x298),
+                S::mul_add(s_q7, x297, c_q7 * x296)
+                    - S::mul_add(S::splat(0.65), x293, S::splat(0.75) * x298),
             ),
         );
-        let x595 = Self::mul_add(-x548, x571, x594);
+        let x595 = S::mul_add(S::neg(x548), x571, x594);
         let x596 = x573 * x595;
-        let x597 = 1.0
-            / Self::mul_add(
+        let x597 = S::splat(1.0)
+            / S::mul_add(
                 x575,
                 x576,
-                Self::mul_add(x550, x551, x572 - (1271.854575 - (x163 - x166) - x546)),
+                S::mul_add(
+                    x550,
+                    x551,
+                    x572 - (S::splat(1271.854575) - (x163 - x166) - x546),
+                ),
             );
-        let x598 = Self::mul_add(
-            -x575,
+        let x598 = S::mul_add(
+            S::neg(x575),
             x578,
-            Self::mul_add(x550, x553, Self::mul_add(x167, x532, x166 - x546)),
+            S::mul_add(x550, x553, S::mul_add(x167, x532, x166 - x546)),
         );
         let x599 = x597 * x598;
         let x600 = x160 * x525;
-        let x601 = Self::mul_add(
+        let x601 = S::mul_add(
             x550,
             x556,
-            Self::mul_add(x167, x533, Self::mul_add(-0.65, x174, x170) + x600),
+            S::mul_add(x167, x533, S::mul_add(S::splat(-0.65), x174, x170) + x600),
         );
-        let x602 = Self::mul_add(-x575, x581, x601);
+        let x602 = S::mul_add(S::neg(x575), x581, x601);
         let x603 = x597 * x602;
         let x604 = x160 * x526;
-        let x605 = Self::mul_add(
+        let x605 = S::mul_add(
             x550,
             x559,
-            Self::mul_add(-x167, x534, Self::mul_add(0.65, x188, x184) - x604),
+            S::mul_add(S::neg(x167), x534, S::mul_add(S::splat(0.65), x188, x184) - x604),
         );
-        let x606 = Self::mul_add(-x575, x584, x605);
+        let x606 = S::mul_add(S::neg(x575), x584, x605);
         let x607 = x597 * x606;
         let x608 = x160 * x527;
-        let x609 = Self::mul_add(
+        let x609 = S::mul_add(
             x550,
             x562,
-            Self::mul_add(-x167, x535, Self::mul_add(0.65, x205, x201) - x608),
+            S::mul_add(S::neg(x167), x535, S::mul_add(S::splat(0.65), x205, x201) - x608),
         );
-        let x610 = Self::mul_add(-x575, x587, x609);
+        let x610 = S::mul_add(S::neg(x575), x587, x609);
         let x611 = x597 * x610;
         let x612 = x160 * x528;
-        let x613 = Self::mul_add(
+        let x613 = S::mul_add(
             x550,
             x565,
-            Self::mul_add(x167, x536, Self::mul_add(-0.65, x227, x223) + x612),
+            S::mul_add(x167, x536, S::mul_add(S::splat(-0.65), x227, x223) + x612),
         );
-        let x614 = Self::mul_add(-x575, x590, x613);
+        let x614 = S::mul_add(S::neg(x575), x590, x613);
         let x615 = x597 * x614;
         let x616 = x160 * x529;
-        let x617 = Self::mul_add(
+        let x617 = S::mul_add(
             x550,
             x568,
-            Self::mul_add(x167, x537, Self::mul_add(-0.65, x259, x255) + x616),
+            S::mul_add(x167, x537, S::mul_add(S::splat(-0.65), x259, x255) + x616),
         );
-        let x618 = Self::mul_add(-x575, x593, x617);
+        let x618 = S::mul_add(S::neg(x575), x593, x617);
         let x619 = x597 * x618;
         let x620 = x160 * x530;
-        let x621 = Self::mul_add(
+        let x621 = S::mul_add(
             x550,
             x571,
-            Self::mul_add(-x167, x538, Self::mul_add(0.65, x299, x295) - x620),
+            S::mul_add(S::neg(x167), x538, S::mul_add(S::splat(0.65), x299, x295) - x620),
         );
-        let x622 = Self::mul_add(-x575, x596, x621);
+        let x622 = S::mul_add(S::neg(x575), x596, x621);
         let x623 = x597 * x622;
-        let x624 = Self::mul_add(
-            -x577,
+        let x624 = S::mul_add(
+            S::neg(x577),
             x578,
-            Self::mul_add(-x552, x553, Self::mul_add(-x161, x532, x154 - x546)),
+            S::mul_add(S::neg(x552), x553, S::mul_add(S::neg(x161), x532, x154 - x546)),
         );
-        let x625 = 1.0 / Self::mul_add(x598, x599, x624);
-        let x626 = Self::mul_add(
-            -x577,
+        let x625 = S::splat(1.0) / S::mul_add(x598, x599, x624);
+        let x626 = S::mul_add(
+            S::neg(x577),
             x581,
-            Self::mul_add(-x552, x556, Self::mul_add(-x161, x533, x170 + x600)),
+            S::mul_add(S::neg(x552), x556, S::mul_add(S::neg(x161), x533, x170 + x600)),
         );
-        let x627 = Self::mul_add(x598, x603, x626);
+        let x627 = S::mul_add(x598, x603, x626);
         let x628 = x625 * x627;
-        let x629 = Self::mul_add(
-            -x577,
+        let x629 = S::mul_add(
+            S::neg(x577),
             x584,
-            Self::mul_add(-x552, x559, Self::mul_add(x161, x534, x184 - x604)),
+            S::mul_add(S::neg(x552), x559, S::mul_add(x161, x534, x184 - x604)),
         );
-        let x630 = Self::mul_add(x598, x607, x629);
+        let x630 = S::mul_add(x598, x607, x629);
         let x631 = x625 * x630;
-        let x632 = Self::mul_add(
-            -x577,
+        let x632 = S::mul_add(
+            S::neg(x577),
             x587,
-            Self::mul_add(-x552, x562, Self::mul_add(x161, x535, x201 - x608)),
+            S::mul_add(S::neg(x552), x562, S::mul_add(x161, x535, x201 - x608)),
         );
-        let x633 = Self::mul_add(x598, x611, x632);
+        let x633 = S::mul_add(x598, x611, x632);
         let x634 = x625 * x633;
-        let x635 = Self::mul_add(
-            -x577,
+        let x635 = S::mul_add(
+            S::neg(x577),
             x590,
-            Self::mul_add(-x552, x565, Self::mul_add(-x161, x536, x223 + x612)),
+            S::mul_add(S::neg(x552), x565, S::mul_add(S::neg(x161), x536, x223 + x612)),
         );
-        let x636 = Self::mul_add(x598, x615, x635);
+        let x636 = S::mul_add(x598, x615, x635);
         let x637 = x625 * x636;
-        let x638 = Self::mul_add(
-            -x577,
+        let x638 = S::mul_add(
+            S::neg(x577),
             x593,
-            Self::mul_add(-x552, x568, Self::mul_add(-x161, x537, x255 + x616)),
+            S::mul_add(S::neg(x552), x568, S::mul_add(S::neg(x161), x537, x255 + x616)),
         );
-        let x639 = Self::mul_add(x598, x619, x638);
+        let x639 = S::mul_add(x598, x619, x638);
         let x640 = x625 * x639;
-        let x641 = Self::mul_add(
-            -x577,
+        let x641 = S::mul_add(
+            S::neg(x577),
             x596,
-            Self::mul_add(-x552, x571, Self::mul_add(x161, x538, x295 - x620)),
+            S::mul_add(S::neg(x552), x571, S::mul_add(x161, x538, x295 - x620)),
         );
-        let x642 = Self::mul_add(x598, x623, x641);
+        let x642 = S::mul_add(x598, x623, x641);
         let x643 = x625 * x642;
-        let x644 = Self::mul_add(
-            -x140,
+        let x644 = S::mul_add(
+            S::neg(x140),
             x539,
-            Self::mul_add(-x174, x533, Self::mul_add(-x173, x525, x130)),
+            S::mul_add(S::neg(x174), x533, S::mul_add(S::neg(x173), x525, x130)),
         );
-        let x645 = Self::mul_add(
+        let x645 = S::mul_add(
             x602,
             x603,
-            Self::mul_add(-x580, x581, Self::mul_add(-x555, x556, x644)),
+            S::mul_add(S::neg(x580), x581, S::mul_add(S::neg(x555), x556, x644)),
         );
-        let x646 = 1.0 / Self::mul_add(-x627, x628, x645);
-        let x647 = Self::mul_add(
-            -x140,
+        let x646 = S::splat(1.0) / S::mul_add(S::neg(x627), x628, x645);
+        let x647 = S::mul_add(
+            S::neg(x140),
             x540,
-            Self::mul_add(x174, x534, Self::mul_add(x173, x526, x178)),
+            S::mul_add(x174, x534, S::mul_add(x173, x526, x178)),
         );
-        let x648 = Self::mul_add(
+        let x648 = S::mul_add(
             x602,
             x607,
-            Self::mul_add(-x580, x584, Self::mul_add(-x555, x559, x647)),
+            S::mul_add(S::neg(x580), x584, S::mul_add(S::neg(x555), x559, x647)),
         );
-        let x649 = Self::mul_add(-x627, x631, x648);
+        let x649 = S::mul_add(S::neg(x627), x631, x648);
         let x650 = x646 * x649;
-        let x651 = Self::mul_add(
-            -x140,
+        let x651 = S::mul_add(
+            S::neg(x140),
             x541,
-            Self::mul_add(x174, x535, Self::mul_add(x173, x527, x195)),
+            S::mul_add(x174, x535, S::mul_add(x173, x527, x195)),
         );
-        let x652 = Self::mul_add(
+        let x652 = S::mul_add(
             x602,
             x611,
-            Self::mul_add(-x580, x587, Self::mul_add(-x555, x562, x651)),
+            S::mul_add(S::neg(x580), x587, S::mul_add(S::neg(x555), x562, x651)),
         );
-        let x653 = Self::mul_add(-x627, x634, x652);
+        let x653 = S::mul_add(S::neg(x627), x634, x652);
         let x654 = x646 * x653;
-        let x655 = Self::mul_add(
-            -x140,
+        let x655 = S::mul_add(
+            S::neg(x140),
             x542,
-            Self::mul_add(-x174, x536, Self::mul_add(-x173, x528, x217)),
+            S::mul_add(S::neg(x174), x536, S::mul_add(S::neg(x173), x528, x217)),
         );
-        let x656 = Self::mul_add(
+        let x656 = S::mul_add(
             x602,
             x615,
-            Self::mul_add(-x580, x590, Self::mul_add(-x555, x565, x655)),
+            S::mul_add(S::neg(x580), x590, S::mul_add(S::neg(x555), x565, x655)),
         );
-        let x657 = Self::mul_add(-x627, x637, x656);
+        let x657 = S::mul_add(S::neg(x627), x637, x656);
         let x658 = x646 * x657;
-        let x659 = Self::mul_add(
+        let x659 = S::mul_add(
             x140,
             x543,
-            Self::mul_add(-x174, x537, Self::mul_add(-x173, x529, x249)),
+            S::mul_add(S::neg(x174), x537, S::mul_add(S::neg(x173), x529, x249)),
         );
-        let x660 = Self::mul_add(
+        let x660 = S::mul_add(
             x602,
             x619,
-            Self::mul_add(-x580, x593, Self::mul_add(-x555, x568, x659)),
+            S::mul_add(S::neg(x580), x593, S::mul_add(S::neg(x555), x568, x659)),
         );
-        let x661 = Self::mul_add(-x627, x640, x660);
+        let x661 = S::mul_add(S::neg(x627), x640, x660);
         let x662 = x646 * x661;
-        let x663 = Self::mul_add(
-            -x140,
+        let x663 = S::mul_add(
+            S::neg(x140),
             x544,
-            Self::mul_add(x174, x538, Self::mul_add(x173, x530, x289)),
+            S::mul_add(x174, x538, S::mul_add(x173, x530, x289)),
         );
-        let x664 = Self::mul_add(
+        let x664 = S::mul_add(
             x602,
             x623,
-            Self::mul_add(-x580, x596, Self::mul_add(-x555, x571, x663)),
+            S::mul_add(S::neg(x580), x596, S::mul_add(S::neg(x555), x571, x663)),
         );
-        let x665 = Self::mul_add(-x627, x643, x664);
+        let x665 = S::mul_add(S::neg(x627), x643, x664);
         let x666 = x646 * x665;
-        let x667 = Self::mul_add(
-            -x182,
+        let x667 = S::mul_add(
+            S::neg(x182),
             x540,
-            Self::mul_add(-x188, x534, Self::mul_add(-x187, x526, x95)),
+            S::mul_add(S::neg(x188), x534, S::mul_add(S::neg(x187), x526, x95)),
         );
-        let x668 = Self::mul_add(
+        let x668 = S::mul_add(
             x606,
             x607,
-            Self::mul_add(-x583, x584, Self::mul_add(-x558, x559, x667)),
+            S::mul_add(S::neg(x583), x584, S::mul_add(S::neg(x558), x559, x667)),
         );
-        let x669 = 1.0 / Self::mul_add(-x649, x650, Self::mul_add(-x630, x631, x668));
-        let x670 = Self::mul_add(
-            -x182,
+        let x669 = S::splat(1.0)
+            / S::mul_add(S::neg(x649), x650, S::mul_add(S::neg(x630), x631, x668));
+        let x670 = S::mul_add(
+            S::neg(x182),
             x541,
-            Self::mul_add(-x188, x535, Self::mul_add(-x187, x527, x89)),
+            S::mul_add(S::neg(x188), x535, S::mul_add(S::neg(x187), x527, x89)),
         );
-        let x671 = Self::mul_add(
+        let x671 = S::mul_add(
             x606,
             x611,
-            Self::mul_add(-x583, x587, Self::mul_add(-x558, x562, x670)),
+            S::mul_add(S::neg(x583), x587, S::mul_add(S::neg(x558), x562, x670)),
         );
-        let x672 = Self::mul_add(-x649, x654, Self::mul_add(-x630, x634, x671));
+        let x672 = S::mul_add(S::neg(x649), x654, S::mul_add(S::neg(x630), x634, x671));
         let x673 = x669 * x672;
-        let x674 = Self::mul_add(
+        let x674 = S::mul_add(
             x182,
             x542,
-            Self::mul_add(-x188, x536, Self::mul_add(-x187, x528, x210)),
+            S::mul_add(S::neg(x188), x536, S::mul_add(S::neg(x187), x528, x210)),
         );
-        let x675 = Self::mul_add(
-            -x606,
+        let x675 = S::mul_add(
+            S::neg(x606),
             x615,
-            Self::mul_add(x583, x590, Self::mul_add(x558, x565, x674)),
+            S::mul_add(x583, x590, S::mul_add(x558, x565, x674)),
         );
-        let x676 = Self::mul_add(x649, x658, Self::mul_add(x630, x637, x675));
+        let x676 = S::mul_add(x649, x658, S::mul_add(x630, x637, x675));
         let x677 = x669 * x676;
-        let x678 = Self::mul_add(
-            -x182,
+        let x678 = S::mul_add(
+            S::neg(x182),
             x543,
-            Self::mul_add(-x188, x537, Self::mul_add(-x187, x529, x241)),
+            S::mul_add(S::neg(x188), x537, S::mul_add(S::neg(x187), x529, x241)),
         );
-        let x679 = Self::mul_add(
-            -x606,
+        let x679 = S::mul_add(
+            S::neg(x606),
             x619,
-            Self::mul_add(x583, x593, Self::mul_add(x558, x568, x678)),
+            S::mul_add(x583, x593, S::mul_add(x558, x568, x678)),
         );
-        let x680 = Self::mul_add(x649, x662, Self::mul_add(x630, x640, x679));
+        let x680 = S::mul_add(x649, x662, S::mul_add(x630, x640, x679));
         let x681 = x669 * x680;
-        let x682 = Self::mul_add(
+        let x682 = S::mul_add(
             x182,
             x544,
-            Self::mul_add(x188, x538, Self::mul_add(x187, x530, x281)),
+            S::mul_add(x188, x538, S::mul_add(x187, x530, x281)),
         );
-        let x683 = Self::mul_add(
-            -x606,
+        let x683 = S::mul_add(
+            S::neg(x606),
             x623,
-            Self::mul_add(x583, x596, Self::mul_add(x558, x571, x682)),
+            S::mul_add(x583, x596, S::mul_add(x558, x571, x682)),
         );
-        let x684 = Self::mul_add(x649, x666, Self::mul_add(x630, x643, x683));
+        let x684 = S::mul_add(x649, x666, S::mul_add(x630, x643, x683));
         let x685 = x669 * x684;
-        let x686 = Self::mul_add(
-            -x199,
+        let x686 = S::mul_add(
+            S::neg(x199),
             x541,
-            Self::mul_add(-x205, x535, Self::mul_add(-x204, x527, x75)),
+            S::mul_add(S::neg(x205), x535, S::mul_add(S::neg(x204), x527, x75)),
         );
-        let x687 = Self::mul_add(
+        let x687 = S::mul_add(
             x610,
             x611,
-            Self::mul_add(-x586, x587, Self::mul_add(-x561, x562, x686)),
+            S::mul_add(S::neg(x586), x587, S::mul_add(S::neg(x561), x562, x686)),
         );
-        let x688 = Self::mul_add(
-            -x672,
+        let x688 = S::mul_add(
+            S::neg(x672),
             x673,
-            Self::mul_add(-x653, x654, Self::mul_add(-x633, x634, x687)),
+            S::mul_add(S::neg(x653), x654, S::mul_add(S::neg(x633), x634, x687)),
         );
-        let x689 = 1.0 / x688;
-        let x690 = Self::mul_add(
+        let x689 = S::splat(1.0) / x688;
+        let x690 = S::mul_add(
             x199,
             x542,
-            Self::mul_add(-x205, x536, Self::mul_add(-x204, x528, x69)),
+            S::mul_add(S::neg(x205), x536, S::mul_add(S::neg(x204), x528, x69)),
         );
-        let x691 = Self::mul_add(
-            -x610,
+        let x691 = S::mul_add(
+            S::neg(x610),
             x615,
-            Self::mul_add(x586, x590, Self::mul_add(x561, x565, x690)),
+            S::mul_add(x586, x590, S::mul_add(x561, x565, x690)),
         );
-        let x692 = Self::mul_add(
-            -x672,
+        let x692 = S::mul_add(
+            S::neg(x672),
             x677,
-            Self::mul_add(x653, x658, Self::mul_add(x633, x637, x691)),
+            S::mul_add(x653, x658, S::mul_add(x633, x637, x691)),
         );
         let x693 = x689 * x692;
-        let x694 = Self::mul_add(
-            -x199,
+        let x694 = S::mul_add(
+            S::neg(x199),
             x543,
-            Self::mul_add(-x205, x537, Self::mul_add(-x204, x529, x236)),
+            S::mul_add(S::neg(x205), x537, S::mul_add(S::neg(x204), x529, x236)),
         );
-        let x695 = Self::mul_add(
-            -x610,
+        let x695 = S::mul_add(
+            S::neg(x610),
             x619,
-            Self::mul_add(x586, x593, Self::mul_add(x561, x568, x694)),
+            S::mul_add(x586, x593, S::mul_add(x561, x568, x694)),
         );
-        let x696 = Self::mul_add(
-            -x672,
+        let x696 = S::mul_add(
+            S::neg(x672),
             x681,
-            Self::mul_add(x653, x662, Self::mul_add(x633, x640, x695)),
+            S::mul_add(x653, x662, S::mul_add(x633, x640, x695)),
         );
         let x697 = x689 * x696;
-        let x698 = Self::mul_add(
+        let x698 = S::mul_add(
             x199,
             x544,
-            Self::mul_add(x205, x538, Self::mul_add(x204, x530, x276)),
+            S::mul_add(x205, x538, S::mul_add(x204, x530, x276)),
         );
-        let x699 = Self::mul_add(
-            -x610,
+        let x699 = S::mul_add(
+            S::neg(x610),
             x623,
-            Self::mul_add(x586, x596, Self::mul_add(x561, x571, x698)),
+            S::mul_add(x586, x596, S::mul_add(x561, x571, x698)),
         );
-        let x700 = Self::mul_add(
-            -x672,
+        let x700 = S::mul_add(
+            S::neg(x672),
             x685,
-            Self::mul_add(x653, x666, Self::mul_add(x633, x643, x699)),
+            S::mul_add(x653, x666, S::mul_add(x633, x643, x699)),
         );
         let x701 = x689 * x700;
-        let x702 = Self::mul_add(
-            -x221,
+        let x702 = S::mul_add(
+            S::neg(x221),
             x542,
-            Self::mul_add(-x227, x536, Self::mul_add(-x226, x528, x55)),
+            S::mul_add(S::neg(x227), x536, S::mul_add(S::neg(x226), x528, x55)),
         );
-        let x703 = Self::mul_add(
+        let x703 = S::mul_add(
             x614,
             x615,
-            Self::mul_add(-x589, x590, Self::mul_add(-x564, x565, x702)),
+            S::mul_add(S::neg(x589), x590, S::mul_add(S::neg(x564), x565, x702)),
         );
-        let x704 = Self::mul_add(
-            -x676,
+        let x704 = S::mul_add(
+            S::neg(x676),
             x677,
-            Self::mul_add(-x657, x658, Self::mul_add(-x636, x637, x703)),
+            S::mul_add(S::neg(x657), x658, S::mul_add(S::neg(x636), x637, x703)),
         );
-        let x705 = 1.0 / Self::mul_add(-x692, x693, x704);
-        let x706 = Self::mul_add(
+        let x705 = S::splat(1.0) / S::mul_add(S::neg(x692), x693, x704);
+        let x706 = S::mul_add(
             x221,
             x543,
-            Self::mul_add(-x227, x537, Self::mul_add(-x226, x529, x229)),
+            S::mul_add(S::neg(x227), x537, S::mul_add(S::neg(x226), x529, x229)),
         );
-        let x707 = Self::mul_add(
+        let x707 = S::mul_add(
             x614,
             x619,
-            Self::mul_add(-x589, x593, Self::mul_add(-x564, x568, x706)),
+            S::mul_add(S::neg(x589), x593, S::mul_add(S::neg(x564), x568, x706)),
         );
-        let x708 = Self::mul_add(
-            -x676,
+        let x708 = S::mul_add(
+            S::neg(x676),
             x681,
-            Self::mul_add(-x657, x662, Self::mul_add(-x636, x640, x707)),
+            S::mul_add(S::neg(x657), x662, S::mul_add(S::neg(x636), x640, x707)),
         );
-        let x709 = Self::mul_add(-x692, x697, x708);
+        let x709 = S::mul_add(S::neg(x692), x697, x708);
         let x710 = x705 * x709;
-        let x711 = Self::mul_add(
-            -x221,
+        let x711 = S::mul_add(
+            S::neg(x221),
             x544,
-            Self::mul_add(x227, x538, Self::mul_add(x226, x530, x269)),
+            S::mul_add(x227, x538, S::mul_add(x226, x530, x269)),
         );
-        let x712 = Self::mul_add(
+        let x712 = S::mul_add(
             x614,
             x623,
-            Self::mul_add(-x589, x596, Self::mul_add(-x564, x571, x711)),
+            S::mul_add(S::neg(x589), x596, S::mul_add(S::neg(x564), x571, x711)),
         );
-        let x713 = Self::mul_add(
-            -x676,
+        let x713 = S::mul_add(
+            S::neg(x676),
             x685,
-            Self::mul_add(-x657, x666, Self::mul_add(-x636, x643, x712)),
+            S::mul_add(S::neg(x657), x666, S::mul_add(S::neg(x636), x643, x712)),
         );
-        let x714 = Self::mul_add(-x692, x701, x713);
+        let x714 = S::mul_add(S::neg(x692), x701, x713);
         let x715 = x705 * x714;
-        let x716 = Self::mul_add(
-            -x253,
+        let x716 = S::mul_add(
+            S::neg(x253),
             x543,
-            Self::mul_add(-x259, x537, Self::mul_add(-x258, x529, x31)),
+            S::mul_add(S::neg(x259), x537, S::mul_add(S::neg(x258), x529, x31)),
         );
-        let x717 = Self::mul_add(
+        let x717 = S::mul_add(
             x618,
             x619,
-            Self::mul_add(-x592, x593, Self::mul_add(-x567, x568, x716)),
+            S::mul_add(S::neg(x592), x593, S::mul_add(S::neg(x567), x568, x716)),
         );
-        let x718 = Self::mul_add(
-            -x680,
+        let x718 = S::mul_add(
+            S::neg(x680),
             x681,
-            Self::mul_add(-x661, x662, Self::mul_add(-x639, x640, x717)),
+            S::mul_add(S::neg(x661), x662, S::mul_add(S::neg(x639), x640, x717)),
         );
-        let x719 = 1.0 / Self::mul_add(-x709, x710, Self::mul_add(-x696, x697, x718));
-        let x720 = Self::mul_add(
+        let x719 = S::splat(1.0)
+            / S::mul_add(S::neg(x709), x710, S::mul_add(S::neg(x696), x697, x718));
+        let x720 = S::mul_add(
             x253,
             x544,
-            Self::mul_add(x259, x538, Self::mul_add(x258, x530, x263)),
+            S::mul_add(x259, x538, S::mul_add(x258, x530, x263)),
         );
-        let x721 = Self::mul_add(
+        let x721 = S::mul_add(
             x618,
             x623,
-            Self::mul_add(-x592, x596, Self::mul_add(-x567, x571, x720)),
+            S::mul_add(S::neg(x592), x596, S::mul_add(S::neg(x567), x571, x720)),
         );
-        let x722 = Self::mul_add(
-            -x680,
+        let x722 = S::mul_add(
+            S::neg(x680),
             x685,
-            Self::mul_add(-x661, x666, Self::mul_add(-x639, x643, x721)),
+            S::mul_add(S::neg(x661), x666, S::mul_add(S::neg(x639), x643, x721)),
         );
-        let x723 = Self::mul_add(-x709, x715, Self::mul_add(-x696, x701, x722));
+        let x723 = S::mul_add(S::neg(x709), x715, S::mul_add(S::neg(x696), x701, x722));
         let x724 = x719 * x723;
-        let x725 = Self::mul_add(
-            -x293,
+        let x725 = S::mul_add(
+            S::neg(x293),
             x544,
-            Self::mul_add(-x299, x538, Self::mul_add(-x298, x530, 1.4135609200000003)),
+            S::mul_add(
+                S::neg(x299),
+                x538,
+                S::mul_add(S::neg(x298), x530, S::splat(1.4135609200000003)),
+            ),
         );
-        let x726 = Self::mul_add(
+        let x726 = S::mul_add(
             x622,
             x623,
-            Self::mul_add(-x595, x596, Self::mul_add(-x570, x571, x725)),
+            S::mul_add(S::neg(x595), x596, S::mul_add(S::neg(x570), x571, x725)),
         );
-        let x727 = Self::mul_add(
-            -x684,
+        let x727 = S::mul_add(
+            S::neg(x684),
             x685,
-            Self::mul_add(-x665, x666, Self::mul_add(-x642, x643, x726)),
+            S::mul_add(S::neg(x665), x666, S::mul_add(S::neg(x642), x643, x726)),
         );
-        let x728 = Self::mul_add(
-            -x723,
+        let x728 = S::mul_add(
+            S::neg(x723),
             x724,
-            Self::mul_add(-x714, x715, Self::mul_add(-x700, x701, x727)),
+            S::mul_add(S::neg(x714), x715, S::mul_add(S::neg(x700), x701, x727)),
         );
-        let x729 = 1.0 / x728;
-        let x730 = Self::mul_add(
+        let x729 = S::splat(1.0) / x728;
+        let x730 = S::mul_add(
             x521,
             x523,
-            Self::mul_add(-0.75, x516, Self::mul_add(-c_q7, x513, s_q7 * x512))
-                + Self::mul_add(
-                    180.9502499901501,
+            S::mul_add(
+                S::splat(-0.75),
+                x516,
+                S::mul_add(S::neg(c_q7), x513, s_q7 * x512),
+            )
+                + S::mul_add(
+                    S::splat(180.9502499901501),
                     x301,
-                    Self::mul_add(v[4], x519, v[5] * x518),
+                    S::mul_add(v[4], x519, v[5] * x518),
                 ),
         );
-        let x731 = Self::mul_add(x522, x524, x730);
-        let x732 = Self::mul_add(
+        let x731 = S::mul_add(x522, x524, x730);
+        let x732 = S::mul_add(
             x522,
             x531,
-            Self::mul_add(
-                -x520,
+            S::mul_add(
+                S::neg(x520),
                 x523,
-                Self::mul_add(s_q7, x513, c_q7 * x512)
-                    + Self::mul_add(-0.65, x511, 0.75 * x515)
-                    + (Self::mul_add(v[3], x519, v[5] * x517)
-                        - Self::mul_add(-110.5455, x302, 180.9502499901501 * x300)),
+                S::mul_add(s_q7, x513, c_q7 * x512)
+                    + S::mul_add(S::splat(-0.65), x511, S::splat(0.75) * x515)
+                    + (S::mul_add(v[3], x519, v[5] * x517)
+                        - S::mul_add(
+                            S::splat(-110.5455),
+                            x302,
+                            S::splat(180.9502499901501) * x300,
+                        )),
             ),
         );
-        let x733 = Self::mul_add(-x549, x731, x732);
+        let x733 = S::mul_add(S::neg(x549), x731, x732);
         let x734 = x520 * x524;
-        let x735 = Self::mul_add(
-            -x521,
+        let x735 = S::mul_add(
+            S::neg(x521),
             x531,
-            Self::mul_add(0.65, x516, x514)
-                + Self::mul_add(-110.5455, x301, Self::mul_add(-v[3], x518, v[4] * x517))
-                - x734,
+            S::mul_add(S::splat(0.65), x516, x514)
+                + S::mul_add(
+                    S::splat(-110.5455),
+                    x301,
+                    S::mul_add(S::neg(v[3]), x518, v[4] * x517),
+                ) - x734,
         );
-        let x736 = Self::mul_add(x576, x733, Self::mul_add(-x551, x731, x735));
-        let x737 = Self::mul_add(
+        let x736 = S::mul_add(x576, x733, S::mul_add(S::neg(x551), x731, x735));
+        let x737 = S::mul_add(
             x578,
             x733,
-            Self::mul_add(x553, x731, Self::mul_add(x521, x532, tau[0] + x514 - x734)),
+            S::mul_add(x553, x731, S::mul_add(x521, x532, tau[0] + x514 - x734)),
         );
-        let x738 = Self::mul_add(x599, x736, x737);
-        let x739 = Self::mul_add(
+        let x738 = S::mul_add(x599, x736, x737);
+        let x739 = S::mul_add(
             x522,
             x539,
-            Self::mul_add(x521, x533, Self::mul_add(x520, x525, tau[1] + x504)),
+            S::mul_add(x521, x533, S::mul_add(x520, x525, tau[1] + x504)),
         );
-        let x740 = Self::mul_add(
+        let x740 = S::mul_add(
             x603,
             x736,
-            Self::mul_add(x581, x733, Self::mul_add(x556, x731, x739)),
+            S::mul_add(x581, x733, S::mul_add(x556, x731, x739)),
         );
-        let x741 = Self::mul_add(-x628, x738, x740);
-        let x742 = Self::mul_add(
+        let x741 = S::mul_add(S::neg(x628), x738, x740);
+        let x742 = S::mul_add(
             x522,
             x540,
-            Self::mul_add(-x521, x534, Self::mul_add(-x520, x526, tau[2] - x493)),
+            S::mul_add(S::neg(x521), x534, S::mul_add(S::neg(x520), x526, tau[2] - x493)),
         );
-        let x743 = Self::mul_add(
+        let x743 = S::mul_add(
             x607,
             x736,
-            Self::mul_add(x584, x733, Self::mul_add(x559, x731, x742)),
+            S::mul_add(x584, x733, S::mul_add(x559, x731, x742)),
         );
-        let x744 = Self::mul_add(-x650, x741, Self::mul_add(-x631, x738, x743));
-        let x745 = Self::mul_add(
+        let x744 = S::mul_add(S::neg(x650), x741, S::mul_add(S::neg(x631), x738, x743));
+        let x745 = S::mul_add(
             x522,
             x541,
-            Self::mul_add(-x521, x535, Self::mul_add(-x520, x527, tau[3] - x486)),
+            S::mul_add(S::neg(x521), x535, S::mul_add(S::neg(x520), x527, tau[3] - x486)),
         );
-        let x746 = Self::mul_add(
+        let x746 = S::mul_add(
             x611,
             x736,
-            Self::mul_add(x587, x733, Self::mul_add(x562, x731, x745)),
+            S::mul_add(x587, x733, S::mul_add(x562, x731, x745)),
         );
-        let x747 = Self::mul_add(
-            -x673,
+        let x747 = S::mul_add(
+            S::neg(x673),
             x744,
-            Self::mul_add(-x654, x741, Self::mul_add(-x634, x738, x746)),
+            S::mul_add(S::neg(x654), x741, S::mul_add(S::neg(x634), x738, x746)),
         );
-        let x748 = Self::mul_add(
-            -x522,
+        let x748 = S::mul_add(
+            S::neg(x522),
             x542,
-            Self::mul_add(-x521, x536, Self::mul_add(-x520, x528, tau[4] + x478)),
+            S::mul_add(S::neg(x521), x536, S::mul_add(S::neg(x520), x528, tau[4] + x478)),
         );
-        let x749 = Self::mul_add(
-            -x615,
+        let x749 = S::mul_add(
+            S::neg(x615),
             x736,
-            Self::mul_add(-x590, x733, Self::mul_add(-x565, x731, x748)),
+            S::mul_add(S::neg(x590), x733, S::mul_add(S::neg(x565), x731, x748)),
         );
-        let x750 = Self::mul_add(
-            -x677,
+        let x750 = S::mul_add(
+            S::neg(x677),
             x744,
-            Self::mul_add(x658, x741, Self::mul_add(x637, x738, x749)),
+            S::mul_add(x658, x741, S::mul_add(x637, x738, x749)),
         );
-        let x751 = Self::mul_add(-x693, x747, x750);
-        let x752 = Self::mul_add(
+        let x751 = S::mul_add(S::neg(x693), x747, x750);
+        let x752 = S::mul_add(
             x522,
             x543,
-            Self::mul_add(-x521, x537, Self::mul_add(-x520, x529, tau[5] + x468)),
+            S::mul_add(S::neg(x521), x537, S::mul_add(S::neg(x520), x529, tau[5] + x468)),
         );
-        let x753 = Self::mul_add(
-            -x619,
+        let x753 = S::mul_add(
+            S::neg(x619),
             x736,
-            Self::mul_add(-x593, x733, Self::mul_add(-x568, x731, x752)),
+            S::mul_add(S::neg(x593), x733, S::mul_add(S::neg(x568), x731, x752)),
         );
-        let x754 = Self::mul_add(
-            -x681,
+        let x754 = S::mul_add(
+            S::neg(x681),
             x744,
-            Self::mul_add(x662, x741, Self::mul_add(x640, x738, x753)),
+            S::mul_add(x662, x741, S::mul_add(x640, x738, x753)),
         );
-        let x755 = Self::mul_add(-x710, x751, Self::mul_add(-x697, x747, x754));
-        let x756 = Self::mul_add(
+        let x755 = S::mul_add(S::neg(x710), x751, S::mul_add(S::neg(x697), x747, x754));
+        let x756 = S::mul_add(
             x522,
             x544,
-            Self::mul_add(-x521, x538, Self::mul_add(-x520, x530, tau[6] + x457)),
+            S::mul_add(S::neg(x521), x538, S::mul_add(S::neg(x520), x530, tau[6] + x457)),
         );
-        let x757 = Self::mul_add(
+        let x757 = S::mul_add(
             x623,
             x736,
-            Self::mul_add(x596, x733, Self::mul_add(x571, x731, x756)),
+            S::mul_add(x596, x733, S::mul_add(x571, x731, x756)),
         );
-        let x758 = Self::mul_add(
+        let x758 = S::mul_add(
             x685,
             x744,
-            Self::mul_add(-x666, x741, Self::mul_add(-x643, x738, x757)),
+            S::mul_add(S::neg(x666), x741, S::mul_add(S::neg(x643), x738, x757)),
         );
-        let x759 = Self::mul_add(
+        let x759 = S::mul_add(
             x724,
             x755,
-            Self::mul_add(x715, x751, Self::mul_add(x701, x747, x758)),
+            S::mul_add(x715, x751, S::mul_add(x701, x747, x758)),
         );
         let x760 = x729 * x759;
-        let x761 = Self::mul_add(x724, x760, x719 * x755);
-        let x762 = Self::mul_add(x715, x760, Self::mul_add(-x710, x761, x705 * x751));
-        let x763 = Self::mul_add(
+        let x761 = S::mul_add(x724, x760, x719 * x755);
+        let x762 = S::mul_add(x715, x760, S::mul_add(S::neg(x710), x761, x705 * x751));
+        let x763 = S::mul_add(
             x701,
             x760,
-            Self::mul_add(-x697, x761, Self::mul_add(-x693, x762, x689 * x747)),
+            S::mul_add(S::neg(x697), x761, S::mul_add(S::neg(x693), x762, x689 * x747)),
         );
-        let x764 = Self::mul_add(
-            -x681,
+        let x764 = S::mul_add(
+            S::neg(x681),
             x761,
-            Self::mul_add(-x677, x762, Self::mul_add(-x673, x763, x669 * x744)),
+            S::mul_add(S::neg(x677), x762, S::mul_add(S::neg(x673), x763, x669 * x744)),
         );
-        let x765 = Self::mul_add(x685, x760, x764);
-        let x766 = Self::mul_add(
+        let x765 = S::mul_add(x685, x760, x764);
+        let x766 = S::mul_add(
             x658,
             x762,
-            Self::mul_add(-x654, x763, Self::mul_add(-x650, x765, x646 * x741)),
+            S::mul_add(S::neg(x654), x763, S::mul_add(S::neg(x650), x765, x646 * x741)),
         );
-        let x767 = Self::mul_add(-x666, x760, Self::mul_add(x662, x761, x766));
-        let x768 = Self::mul_add(
-            -x634,
+        let x767 = S::mul_add(S::neg(x666), x760, S::mul_add(x662, x761, x766));
+        let x768 = S::mul_add(
+            S::neg(x634),
             x763,
-            Self::mul_add(-x631, x765, Self::mul_add(-x628, x767, x625 * x738)),
+            S::mul_add(S::neg(x631), x765, S::mul_add(S::neg(x628), x767, x625 * x738)),
         );
-        let x769 = Self::mul_add(
-            -x643,
+        let x769 = S::mul_add(
+            S::neg(x643),
             x760,
-            Self::mul_add(x640, x761, Self::mul_add(x637, x762, x768)),
+            S::mul_add(x640, x761, S::mul_add(x637, x762, x768)),
         );
-        let x770 = Self::mul_add(
-            -x607,
+        let x770 = S::mul_add(
+            S::neg(x607),
             x765,
-            Self::mul_add(-x603, x767, Self::mul_add(-x599, x769, x597 * x736)),
+            S::mul_add(S::neg(x603), x767, S::mul_add(S::neg(x599), x769, x597 * x736)),
         );
-        let x771 = Self::mul_add(
+        let x771 = S::mul_add(
             x619,
             x761,
-            Self::mul_add(x615, x762, Self::mul_add(-x611, x763, x770)),
+            S::mul_add(x615, x762, S::mul_add(S::neg(x611), x763, x770)),
         );
-        let x772 = Self::mul_add(-x623, x760, x771);
-        let x773 = -x772;
-        let x774 = Self::mul_add(
+        let x772 = S::mul_add(S::neg(x623), x760, x771);
+        let x773 = S::neg(x772);
+        let x774 = S::mul_add(
             x581,
             x767,
-            Self::mul_add(x578, x769, Self::mul_add(-x576, x772, x573 * x733)),
+            S::mul_add(x578, x769, S::mul_add(S::neg(x576), x772, x573 * x733)),
         );
-        let x775 = Self::mul_add(
-            -x590,
+        let x775 = S::mul_add(
+            S::neg(x590),
             x762,
-            Self::mul_add(x587, x763, Self::mul_add(x584, x765, x774)),
+            S::mul_add(x587, x763, S::mul_add(x584, x765, x774)),
         );
-        let x776 = Self::mul_add(x596, x760, Self::mul_add(-x593, x761, x775));
-        let x777 = -x776;
-        let x778 = Self::mul_add(
+        let x776 = S::mul_add(x596, x760, S::mul_add(S::neg(x593), x761, x775));
+        let x777 = S::neg(x776);
+        let x778 = S::mul_add(
             x553,
             x769,
-            Self::mul_add(x551, x772, Self::mul_add(-x549, x776, x547 * x731)),
+            S::mul_add(x551, x772, S::mul_add(S::neg(x549), x776, x547 * x731)),
         );
-        let x779 = Self::mul_add(
+        let x779 = S::mul_add(
             x562,
             x763,
-            Self::mul_add(x559, x765, Self::mul_add(x556, x767, x778)),
+            S::mul_add(x559, x765, S::mul_add(x556, x767, x778)),
         );
-        let x780 = Self::mul_add(
+        let x780 = S::mul_add(
             x571,
             x760,
-            Self::mul_add(-x568, x761, Self::mul_add(-x565, x762, x779)),
+            S::mul_add(S::neg(x568), x761, S::mul_add(S::neg(x565), x762, x779)),
         );
-        let x781 = Self::mul_add(
+        let x781 = S::mul_add(
             x539,
             x767,
-            Self::mul_add(
+            S::mul_add(
                 x531,
                 x776,
-                Self::mul_add(x524, x780, x522 * 0.0008546497218115156),
+                S::mul_add(x524, x780, x522 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x782 = Self::mul_add(
-            -x542,
+        let x782 = S::mul_add(
+            S::neg(x542),
             x762,
-            Self::mul_add(x541, x763, Self::mul_add(x540, x765, x781)),
+            S::mul_add(x541, x763, S::mul_add(x540, x765, x781)),
         );
-        let x783 = -Self::mul_add(x544, x760, Self::mul_add(x543, x761, x782));
-        let x784 = Self::mul_add(
+        let x783 = S::neg(S::mul_add(x544, x760, S::mul_add(x543, x761, x782)));
+        let x784 = S::mul_add(
             x532,
             x769,
-            Self::mul_add(
+            S::mul_add(
                 x531,
                 x772,
-                Self::mul_add(x523, x780, x521 * 0.0008546497218115156),
+                S::mul_add(x523, x780, x521 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x785 = Self::mul_add(
-            -x535,
+        let x785 = S::mul_add(
+            S::neg(x535),
             x763,
-            Self::mul_add(-x534, x765, Self::mul_add(x533, x767, x784)),
+            S::mul_add(S::neg(x534), x765, S::mul_add(x533, x767, x784)),
         );
-        let x786 = Self::mul_add(
-            -x538,
+        let x786 = S::mul_add(
+            S::neg(x538),
             x760,
-            Self::mul_add(-x537, x761, Self::mul_add(-x536, x762, x785)),
+            S::mul_add(S::neg(x537), x761, S::mul_add(S::neg(x536), x762, x785)),
         );
-        let x787 = Self::mul_add(
-            -x524,
+        let x787 = S::mul_add(
+            S::neg(x524),
             x769,
-            Self::mul_add(
+            S::mul_add(
                 x524,
                 x772,
-                Self::mul_add(-x523, x776, x520 * 0.0008546497218115156),
+                S::mul_add(S::neg(x523), x776, x520 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x788 = Self::mul_add(
-            -x527,
+        let x788 = S::mul_add(
+            S::neg(x527),
             x763,
-            Self::mul_add(-x526, x765, Self::mul_add(x525, x767, x787)),
+            S::mul_add(S::neg(x526), x765, S::mul_add(x525, x767, x787)),
         );
-        let x789 = Self::mul_add(
-            -x530,
+        let x789 = S::mul_add(
+            S::neg(x530),
             x760,
-            Self::mul_add(-x529, x761, Self::mul_add(-x528, x762, x788)),
+            S::mul_add(S::neg(x529), x761, S::mul_add(S::neg(x528), x762, x788)),
         );
-        let x790 = -x789;
+        let x790 = S::neg(x789);
         [x790, x786, x783, x780, x777, x773, x769, x767, x765, x763, x762, x761, x760]
+    }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -4734,529 +5742,678 @@ impl FreeFloating7 {
         q: &[::core::primitive::f64; 14],
         v: &[::core::primitive::f64; 13],
     ) -> ([[::core::primitive::f64; 13]; 13], [::core::primitive::f64; 13]) {
+        Self::mass_matrix_and_nonlinear_effects_lanes::<::core::primitive::f64>(q, v)
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 14], v: &[S; 13]) -> ([[S; 13]; 13], [S; 13]) {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
-            q[8] + 1.5707963265897933,
-            q[9] + 1.5707963267948966,
+            q[8] + S::splat(1.5707963265897933),
+            q[9] + S::splat(1.5707963267948966),
             q[10],
             q[11],
-            q[12] - 1.5707963267948966,
-            q[13] - 1.5707963267948966,
+            q[12] - S::splat(1.5707963267948966),
+            q[13] - S::splat(1.5707963267948966),
         ]);
         let x7 = s_q13 * s_q13;
         let x8 = s_q13 * c_q13;
-        let x9 = Self::mul_add(x8, 0.001562, x7 * 1.2025609200000003);
-        let x10 = -1.2025609200000003 + x9;
-        let x11 = 0.000781 + Self::mul_add(x7, -0.001562, x8 * 1.2025609200000003);
-        let x12 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x13 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x14 = 4.806620000000001 * s_q13;
-        let x15 = 4.806620000000001 * c_q13;
-        let x16 = 1.4135609200000003 - x10;
+        let x9 = S::mul_add(x8, S::splat(0.001562), x7 * S::splat(1.2025609200000003));
+        let x10 = S::splat(-1.2025609200000003) + x9;
+        let x11 = S::splat(0.000781)
+            + S::mul_add(x7, S::splat(-0.001562), x8 * S::splat(1.2025609200000003));
+        let x12 = S::mul_add(
+            s_q13,
+            S::splat(-0.9614610000000001),
+            c_q13 * S::splat(0.0145),
+        );
+        let x13 = S::mul_add(
+            c_q13,
+            S::splat(0.9614610000000001),
+            s_q13 * S::splat(0.0145),
+        );
+        let x14 = S::splat(4.806620000000001) * s_q13;
+        let x15 = S::splat(4.806620000000001) * c_q13;
+        let x16 = S::splat(1.4135609200000003) - x10;
         let x17 = x13 + x13;
-        let x18 = Self::mul_add(-0.00000000020510342851533115, x17, x16);
-        let x19 = 0.00000000020510342851533115 * x15;
-        let x20 = 0.16 * x15;
-        let x21 = 0.55 * x14;
+        let x18 = S::mul_add(S::splat(-0.00000000020510342851533115), x17, x16);
+        let x19 = S::splat(0.00000000020510342851533115) * x15;
+        let x20 = S::splat(0.16) * x15;
+        let x21 = S::splat(0.55) * x14;
         let x22 = x20 - x21;
         let x23 = x20 - (x9 - x20);
-        let x24 = Self::mul_add(
-            0.55,
+        let x24 = S::mul_add(
+            S::splat(0.55),
             x15,
-            -Self::mul_add(
-                0.16,
-                x14,
-                Self::mul_add(0.00000000020510342851533115, x12, x11),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.16),
+                    x14,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x12, x11),
+                ),
             ),
         );
-        let x25 = 17.135250000000003 - x14;
-        let x26 = -3.6140000000000003 - x19;
-        let x27 = 1.9877000000000002
-            + Self::mul_add(
-                0.55,
+        let x25 = S::splat(17.135250000000003) - x14;
+        let x26 = S::splat(-3.6140000000000003) - x19;
+        let x27 = S::splat(1.9877000000000002)
+            + S::mul_add(
+                S::splat(0.55),
                 x19,
-                Self::mul_add(-0.00000000020510342851533115, x11, x12),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x11, x12),
             );
-        let x28 = -2.741639999592316 - x24;
-        let x29 = 5.252920330000002 + (x22 + (x10 + x18 + x22));
-        let x30 = 0.809539999555672
-            - Self::mul_add(
-                -0.16,
+        let x28 = S::splat(-2.741639999592316) - x24;
+        let x29 = S::splat(5.252920330000002) + (x22 + (x10 + x18 + x22));
+        let x30 = S::splat(0.809539999555672)
+            - S::mul_add(
+                S::splat(-0.16),
                 x19,
-                x13 - Self::mul_add(0.00000000020510342851533115, x16, x17),
+                x13 - S::mul_add(S::splat(0.00000000020510342851533115), x16, x17),
             );
-        let x31 = 9.740442170000001 - (x21 - (1.4135609200000003 - x18 - x21));
+        let x31 = S::splat(9.740442170000001)
+            - (x21 - (S::splat(1.4135609200000003) - x18 - x21));
         let x32 = s_q12 * s_q12;
         let x33 = s_q12 * c_q12;
         let x34 = x23 - x29;
         let x35 = x27 + x27;
-        let x36 = Self::mul_add(x33, x35, x32 * x34);
+        let x36 = S::mul_add(x33, x35, x32 * x34);
         let x37 = x29 + x36;
-        let x38 = x27 + Self::mul_add(-x32, x35, x33 * x34);
-        let x39 = Self::mul_add(-s_q12, x30, c_q12 * x28);
-        let x40 = Self::mul_add(c_q12, x30, s_q12 * x28);
-        let x41 = Self::mul_add(-s_q12, x26, c_q12 * x25);
-        let x42 = Self::mul_add(c_q12, x26, s_q12 * x25);
+        let x38 = x27 + S::mul_add(S::neg(x32), x35, x33 * x34);
+        let x39 = S::mul_add(S::neg(s_q12), x30, c_q12 * x28);
+        let x40 = S::mul_add(c_q12, x30, s_q12 * x28);
+        let x41 = S::mul_add(S::neg(s_q12), x26, c_q12 * x25);
+        let x42 = S::mul_add(c_q12, x26, s_q12 * x25);
         let x43 = x31 - x37;
         let x44 = x40 + x40;
-        let x45 = Self::mul_add(0.00000000020510342851533115, x44, x43);
-        let x46 = Self::mul_add(0.00000000020510342851533115, x38, x39);
-        let x47 = Self::mul_add(0.00000000020510342851533115, x42, x15);
+        let x45 = S::mul_add(S::splat(0.00000000020510342851533115), x44, x43);
+        let x46 = S::mul_add(S::splat(0.00000000020510342851533115), x38, x39);
+        let x47 = S::mul_add(S::splat(0.00000000020510342851533115), x42, x15);
         let x48 = x19 - x42;
-        let x49 = x48 * 0.36;
+        let x49 = x48 * S::splat(0.36);
         let x50 = x49 + (x23 - x36 + x49);
-        let x51 = -7.078399999258757 - x47;
-        let x52 = -0.01675
-            + Self::mul_add(
+        let x51 = S::splat(-7.078399999258757) - x47;
+        let x52 = S::splat(-0.01675)
+            + S::mul_add(
                 x41,
-                0.36,
-                Self::mul_add(-0.00000000020510342851533115, x39, x38),
+                S::splat(0.36),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x39, x38),
             );
-        let x53 = -3.8891049197628025 + (x49 + (x37 + x45 + x49));
-        let x54 = -2.5482240005325645
-            + Self::mul_add(
+        let x53 = S::splat(-3.8891049197628025) + (x49 + (x37 + x45 + x49));
+        let x54 = S::splat(-2.5482240005325645)
+            + S::mul_add(
                 x47,
-                -0.36,
-                x40 - Self::mul_add(-0.00000000020510342851533115, x43, x44),
+                S::splat(-0.36),
+                x40 - S::mul_add(S::splat(-0.00000000020510342851533115), x43, x44),
             );
-        let x55 = 3.970314919762802 + (x31 - x45);
+        let x55 = S::splat(3.970314919762802) + (x31 - x45);
         let x56 = s_q11 * s_q11;
         let x57 = s_q11 * c_q11;
         let x58 = x50 - x53;
         let x59 = x46 + x46;
-        let x60 = Self::mul_add(-x57, x59, x56 * x58);
-        let x61 = Self::mul_add(-s_q11, x51, c_q11 * x41);
-        let x62 = Self::mul_add(c_q11, x51, s_q11 * x41);
-        let x63 = 0.275 * x48;
-        let x64 = x62 * 0.63;
+        let x60 = S::mul_add(S::neg(x57), x59, x56 * x58);
+        let x61 = S::mul_add(S::neg(s_q11), x51, c_q11 * x41);
+        let x62 = S::mul_add(c_q11, x51, s_q11 * x41);
+        let x63 = S::splat(0.275) * x48;
+        let x64 = x62 * S::splat(0.63);
         let x65 = x63 + x64;
-        let x66 = Self::mul_add(x61, 0.63, x46 - Self::mul_add(x56, x59, x57 * x58));
-        let x67 = Self::mul_add(0.275, x61, Self::mul_add(-s_q11, x54, c_q11 * x52));
-        let x68 = Self::mul_add(0.275, x62, Self::mul_add(c_q11, x54, s_q11 * x52));
+        let x66 = S::mul_add(x61, S::splat(0.63), x46 - S::mul_add(x56, x59, x57 * x58));
+        let x67 = S::mul_add(
+            S::splat(0.275),
+            x61,
+            S::mul_add(S::neg(s_q11), x54, c_q11 * x52),
+        );
+        let x68 = S::mul_add(S::splat(0.275), x62, S::mul_add(c_q11, x54, s_q11 * x52));
         let x69 = x55 + x64;
         let x70 = x65 + (x50 - x60 + x65);
-        let x71 = -45.1584 - x62;
-        let x72 = -0.6328 - x67;
-        let x73 = -24.4950615 + (x63 + (x53 + x60 + x63));
-        let x74 = -24.35164200091464 - Self::mul_add(x48, 0.63, x68);
-        let x75 = 28.2393615 + (x64 + x69);
+        let x71 = S::splat(-45.1584) - x62;
+        let x72 = S::splat(-0.6328) - x67;
+        let x73 = S::splat(-24.4950615) + (x63 + (x53 + x60 + x63));
+        let x74 = S::splat(-24.35164200091464) - S::mul_add(x48, S::splat(0.63), x68);
+        let x75 = S::splat(28.2393615) + (x64 + x69);
         let x76 = s_q10 * s_q10;
         let x77 = s_q10 * c_q10;
         let x78 = x70 - x73;
         let x79 = x66 + x66;
-        let x80 = Self::mul_add(-x77, x79, x76 * x78);
-        let x81 = Self::mul_add(-s_q10, x74, c_q10 * x72);
-        let x82 = Self::mul_add(c_q10, x74, s_q10 * x72);
+        let x80 = S::mul_add(S::neg(x77), x79, x76 * x78);
+        let x81 = S::mul_add(S::neg(s_q10), x74, c_q10 * x72);
+        let x82 = S::mul_add(c_q10, x74, s_q10 * x72);
         let x83 = c_q10 * x61;
-        let x84 = Self::mul_add(s_q10, x71, x83);
+        let x84 = S::mul_add(s_q10, x71, x83);
         let x85 = s_q10 * x61;
-        let x86 = Self::mul_add(-c_q10, x71, x85);
-        let x87 = x86 * 0.87;
-        let x88 = Self::mul_add(x84, 0.87, x66 - Self::mul_add(x76, x79, x77 * x78));
+        let x86 = S::mul_add(S::neg(c_q10), x71, x85);
+        let x87 = x86 * S::splat(0.87);
+        let x88 = S::mul_add(x84, S::splat(0.87), x66 - S::mul_add(x76, x79, x77 * x78));
         let x89 = x75 + x87;
         let x90 = x87 + (x70 - x80 + x87);
-        let x91 = -81.53205 - x86;
-        let x92 = -0.00214 + x81;
-        let x93 = -63.36336825 + (x73 + x80);
-        let x94 = -36.18604050126307 + Self::mul_add(x48, -0.87, x82);
-        let x95 = 69.99836825 + (x87 + x89);
+        let x91 = S::splat(-81.53205) - x86;
+        let x92 = S::splat(-0.00214) + x81;
+        let x93 = S::splat(-63.36336825) + (x73 + x80);
+        let x94 = S::splat(-36.18604050126307) + S::mul_add(x48, S::splat(-0.87), x82);
+        let x95 = S::splat(69.99836825) + (x87 + x89);
         let x96 = s_q9 * s_q9;
         let x97 = s_q9 * c_q9;
         let x98 = x90 - x93;
         let x99 = x88 + x88;
-        let x100 = Self::mul_add(-x97, x99, x96 * x98);
+        let x100 = S::mul_add(S::neg(x97), x99, x96 * x98);
         let x101 = x93 + x100;
-        let x102 = x88 - Self::mul_add(x96, x99, x97 * x98);
-        let x103 = Self::mul_add(-s_q9, x94, c_q9 * x92);
-        let x104 = Self::mul_add(c_q9, x94, s_q9 * x92);
+        let x102 = x88 - S::mul_add(x96, x99, x97 * x98);
+        let x103 = S::mul_add(S::neg(s_q9), x94, c_q9 * x92);
+        let x104 = S::mul_add(c_q9, x94, s_q9 * x92);
         let x105 = c_q9 * x84;
-        let x106 = Self::mul_add(s_q9, x91, x105);
+        let x106 = S::mul_add(s_q9, x91, x105);
         let x107 = s_q9 * x84;
-        let x108 = Self::mul_add(-c_q9, x91, x107);
+        let x108 = S::mul_add(S::neg(c_q9), x91, x107);
         let x109 = x95 - x101;
         let x110 = x104 + x104;
-        let x111 = Self::mul_add(0.00000000020510342851533115, x110, x109);
-        let x112 = Self::mul_add(0.00000000020510342851533115, x108, x48);
-        let x113 = Self::mul_add(-0.00000000020510342851533115, x48, x108);
-        let x114 = 0.4 * x113;
-        let x115 = 0.275 * x112;
+        let x111 = S::mul_add(S::splat(0.00000000020510342851533115), x110, x109);
+        let x112 = S::mul_add(S::splat(0.00000000020510342851533115), x108, x48);
+        let x113 = S::mul_add(S::splat(-0.00000000020510342851533115), x48, x108);
+        let x114 = S::splat(0.4) * x113;
+        let x115 = S::splat(0.275) * x112;
         let x116 = x114 + x115;
-        let x117 = 0.275 * x106;
-        let x118 = 0.00000000005640344284171607 * x106;
+        let x117 = S::splat(0.275) * x106;
+        let x118 = S::splat(0.00000000005640344284171607) * x106;
         let x119 = x114 + x118;
         let x120 = x115 + x118;
         let x121 = x116 - (x90 - x100 - x116);
-        let x122 = Self::mul_add(
-            0.00000000005640344284171607,
+        let x122 = S::mul_add(
+            S::splat(0.00000000005640344284171607),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x106,
-                Self::mul_add(0.00000000020510342851533115, x103, x102),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x106,
+                    S::mul_add(S::splat(0.00000000020510342851533115), x103, x102),
+                ),
             ),
         );
-        let x123 = Self::mul_add(
-            0.275,
+        let x123 = S::mul_add(
+            S::splat(0.275),
             x113,
-            -Self::mul_add(
-                -0.4,
-                x112,
-                x104 - Self::mul_add(-0.00000000020510342851533115, x109, x110),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.4),
+                    x112,
+                    x104
+                        - S::mul_add(S::splat(-0.00000000020510342851533115), x109, x110),
+                ),
             ),
         );
-        let x124 = 0.0000000059257457049506905 - x106;
-        let x125 = 12.701650001451807 + x112;
-        let x126 = -0.0000000005683321144643007
-            - Self::mul_add(
-                0.00000000005640344284171607,
+        let x124 = S::splat(0.0000000059257457049506905) - x106;
+        let x125 = S::splat(12.701650001451807) + x112;
+        let x126 = S::splat(-0.0000000005683321144643007)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
                 x112,
-                Self::mul_add(-0.00000000020510342851533115, x102, x103) + x117,
+                S::mul_add(S::splat(-0.00000000020510342851533115), x102, x103) + x117,
             );
-        let x127 = 0.0021399976297017177 + x122;
-        let x128 = -106.50196992080811 - (x119 - (x101 + x111 - x119));
-        let x129 = -5.080660022992534 - x123;
-        let x130 = 108.1389699208081 - (x120 - (x95 - x111 - x120));
+        let x127 = S::splat(0.0021399976297017177) + x122;
+        let x128 = S::splat(-106.50196992080811) - (x119 - (x101 + x111 - x119));
+        let x129 = S::splat(-5.080660022992534) - x123;
+        let x130 = S::splat(108.1389699208081) - (x120 - (x95 - x111 - x120));
         let x131 = s_q8 * s_q8;
         let x132 = s_q8 * c_q8;
         let x133 = x121 + x128;
         let x134 = x126 + x126;
-        let x135 = Self::mul_add(-x132, x134, x131 * x133);
+        let x135 = S::mul_add(S::neg(x132), x134, x131 * x133);
         let x136 = x128 - x135;
-        let x137 = x126 - Self::mul_add(x131, x134, x132 * x133);
-        let x138 = Self::mul_add(-s_q8, x129, c_q8 * x127);
-        let x139 = Self::mul_add(c_q8, x129, s_q8 * x127);
-        let x140 = Self::mul_add(-s_q8, x125, c_q8 * x124);
-        let x141 = Self::mul_add(c_q8, x125, s_q8 * x124);
+        let x137 = x126 - S::mul_add(x131, x134, x132 * x133);
+        let x138 = S::mul_add(S::neg(s_q8), x129, c_q8 * x127);
+        let x139 = S::mul_add(c_q8, x129, s_q8 * x127);
+        let x140 = S::mul_add(S::neg(s_q8), x125, c_q8 * x124);
+        let x141 = S::mul_add(c_q8, x125, s_q8 * x124);
         let x142 = x130 - x136;
         let x143 = x139 + x139;
-        let x144 = Self::mul_add(0.00000000020510342851533115, x143, x142);
-        let x145 = Self::mul_add(-0.00000000020510342851533115, x141, x113);
-        let x146 = Self::mul_add(0.00000000020510342851533115, x113, x141);
-        let x147 = 0.35 * x146;
+        let x144 = S::mul_add(S::splat(0.00000000020510342851533115), x143, x142);
+        let x145 = S::mul_add(S::splat(-0.00000000020510342851533115), x141, x113);
+        let x146 = S::mul_add(S::splat(0.00000000020510342851533115), x113, x141);
+        let x147 = S::splat(0.35) * x146;
         let x148 = x147 - (x121 - x135 - x147);
-        let x149 = -48.0240000085309 + x145;
-        let x150 = 0.07309 - Self::mul_add(0.00000000020510342851533115, x137, x138);
-        let x151 = 0.1132
-            + Self::mul_add(
-                -0.35,
+        let x149 = S::splat(-48.0240000085309) + x145;
+        let x150 = S::splat(0.07309)
+            - S::mul_add(S::splat(0.00000000020510342851533115), x137, x138);
+        let x151 = S::splat(0.1132)
+            + S::mul_add(
+                S::splat(-0.35),
                 x140,
-                Self::mul_add(-0.00000000020510342851533115, x138, x137),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x138, x137),
             );
-        let x152 = -125.18476992763283 + (x147 + (x136 + x144 + x147));
-        let x153 = 16.807689977165428
-            + Self::mul_add(
-                -0.35,
+        let x152 = S::splat(-125.18476992763283) + (x147 + (x136 + x144 + x147));
+        let x153 = S::splat(16.807689977165428)
+            + S::mul_add(
+                S::splat(-0.35),
                 x145,
-                x139 - Self::mul_add(-0.00000000020510342851533115, x142, x143),
+                x139 - S::mul_add(S::splat(-0.00000000020510342851533115), x142, x143),
             );
-        let x154 = 127.22056992763282 + (x130 - x144);
+        let x154 = S::splat(127.22056992763282) + (x130 - x144);
         let x155 = s_q7 * s_q7;
         let x156 = s_q7 * c_q7;
         let x157 = x148 - x152;
         let x158 = x150 + x150;
-        let x159 = Self::mul_add(x156, x158, x155 * x157);
-        let x160 = Self::mul_add(-s_q7, x149, c_q7 * x140);
-        let x161 = Self::mul_add(c_q7, x149, s_q7 * x140);
-        let x162 = -x161;
-        let x163 = -x160;
-        let x164 = 0.75 * x146;
-        let x165 = 0.65 * x161;
+        let x159 = S::mul_add(x156, x158, x155 * x157);
+        let x160 = S::mul_add(S::neg(s_q7), x149, c_q7 * x140);
+        let x161 = S::mul_add(c_q7, x149, s_q7 * x140);
+        let x162 = S::neg(x161);
+        let x163 = S::neg(x160);
+        let x164 = S::splat(0.75) * x146;
+        let x165 = S::splat(0.65) * x161;
         let x166 = x164 - x165;
-        let x167 = Self::mul_add(-0.75, x161, Self::mul_add(c_q7, x153, s_q7 * x151));
-        let x168 = -x167;
-        let x169 = -Self::mul_add(
-            0.65,
+        let x167 = S::mul_add(
+            S::splat(-0.75),
+            x161,
+            S::mul_add(c_q7, x153, s_q7 * x151),
+        );
+        let x168 = S::neg(x167);
+        let x169 = S::neg(
+            S::mul_add(
+                S::splat(0.65),
+                x160,
+                x150 + S::mul_add(S::neg(x155), x158, x156 * x157),
+            ),
+        );
+        let x170 = S::mul_add(
+            S::splat(-0.75),
             x160,
-            x150 + Self::mul_add(-x155, x158, x156 * x157),
+            S::mul_add(S::neg(s_q7), x153, c_q7 * x151),
         );
-        let x170 = Self::mul_add(-0.75, x160, Self::mul_add(-s_q7, x153, c_q7 * x151));
         let x171 = x154 - x165;
-        let x172 = 110.5455 - x161;
-        let x173 = 180.9502499901501 + x146;
-        let x174 = 1519.7808011559632 + (x164 + (x152 + x159 + x164));
-        let x175 = -117.61766249359756 - Self::mul_add(0.65, x146, x167);
-        let x176 = 1591.635376155963 + (x166 + (x148 - x159 + x166));
-        let x177 = 1271.854575 - (x165 - x171);
-        let x178 = -x173;
-        let x179 = -x172;
-        let x180 = 0.00000000020510342851533115 * x140;
-        let x181 = Self::mul_add(-0.00000000020510342851533115, x130, x139);
-        let x182 = Self::mul_add(0.35, x180, x138);
-        let x183 = Self::mul_add(
-            0.35,
+        let x172 = S::splat(110.5455) - x161;
+        let x173 = S::splat(180.9502499901501) + x146;
+        let x174 = S::splat(1519.7808011559632) + (x164 + (x152 + x159 + x164));
+        let x175 = S::splat(-117.61766249359756)
+            - S::mul_add(S::splat(0.65), x146, x167);
+        let x176 = S::splat(1591.635376155963) + (x166 + (x148 - x159 + x166));
+        let x177 = S::splat(1271.854575) - (x165 - x171);
+        let x178 = S::neg(x173);
+        let x179 = S::neg(x172);
+        let x180 = S::splat(0.00000000020510342851533115) * x140;
+        let x181 = S::mul_add(S::splat(-0.00000000020510342851533115), x130, x139);
+        let x182 = S::mul_add(S::splat(0.35), x180, x138);
+        let x183 = S::mul_add(
+            S::splat(0.35),
             x141,
-            Self::mul_add(0.00000000020510342851533115, x139, x130),
+            S::mul_add(S::splat(0.00000000020510342851533115), x139, x130),
         );
-        let x184 = Self::mul_add(c_q7, x180, s_q7 * x141);
-        let x185 = Self::mul_add(-s_q7, x180, c_q7 * x141);
-        let x186 = -x185;
-        let x187 = -Self::mul_add(-0.75, x185, Self::mul_add(-c_q7, x183, s_q7 * x182));
-        let x188 = Self::mul_add(s_q7, x183, c_q7 * x182)
-            + Self::mul_add(-0.65, x140, 0.75 * x184);
-        let x189 = Self::mul_add(-0.65, x185, x181);
-        let x190 = 0.00000000020510342851533115 * x106;
-        let x191 = x103 + Self::mul_add(-0.4, x190, x117);
-        let x192 = Self::mul_add(0.00000000020510342851533115, x104, x95)
-            - Self::mul_add(0.4, x108, x118);
-        let x193 = Self::mul_add(-0.00000000020510342851533115, x95, x104)
-            + Self::mul_add(0.00000000005640344284171607, x190, 0.275 * x108);
-        let x194 = Self::mul_add(-s_q8, x190, c_q8 * x108);
-        let x195 = Self::mul_add(c_q8, x190, s_q8 * x108);
-        let x196 = Self::mul_add(-0.00000000020510342851533115, x195, x106);
+        let x184 = S::mul_add(c_q7, x180, s_q7 * x141);
+        let x185 = S::mul_add(S::neg(s_q7), x180, c_q7 * x141);
+        let x186 = S::neg(x185);
+        let x187 = S::neg(
+            S::mul_add(
+                S::splat(-0.75),
+                x185,
+                S::mul_add(S::neg(c_q7), x183, s_q7 * x182),
+            ),
+        );
+        let x188 = S::mul_add(s_q7, x183, c_q7 * x182)
+            + S::mul_add(S::splat(-0.65), x140, S::splat(0.75) * x184);
+        let x189 = S::mul_add(S::splat(-0.65), x185, x181);
+        let x190 = S::splat(0.00000000020510342851533115) * x106;
+        let x191 = x103 + S::mul_add(S::splat(-0.4), x190, x117);
+        let x192 = S::mul_add(S::splat(0.00000000020510342851533115), x104, x95)
+            - S::mul_add(S::splat(0.4), x108, x118);
+        let x193 = S::mul_add(S::splat(-0.00000000020510342851533115), x95, x104)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x190,
+                S::splat(0.275) * x108,
+            );
+        let x194 = S::mul_add(S::neg(s_q8), x190, c_q8 * x108);
+        let x195 = S::mul_add(c_q8, x190, s_q8 * x108);
+        let x196 = S::mul_add(S::splat(-0.00000000020510342851533115), x195, x106);
         let x197 = x190 + x195;
-        let x198 = Self::mul_add(-c_q8, x192, s_q8 * x191);
-        let x199 = Self::mul_add(-0.00000000020510342851533115, x193, x198);
-        let x200 = Self::mul_add(-0.35, x196, Self::mul_add(s_q8, x192, c_q8 * x191));
-        let x201 = Self::mul_add(
-            -0.35,
+        let x198 = S::mul_add(S::neg(c_q8), x192, s_q8 * x191);
+        let x199 = S::mul_add(S::splat(-0.00000000020510342851533115), x193, x198);
+        let x200 = S::mul_add(
+            S::splat(-0.35),
+            x196,
+            S::mul_add(s_q8, x192, c_q8 * x191),
+        );
+        let x201 = S::mul_add(
+            S::splat(-0.35),
             x194,
-            Self::mul_add(0.00000000020510342851533115, x198, x193),
+            S::mul_add(S::splat(0.00000000020510342851533115), x198, x193),
         );
-        let x202 = Self::mul_add(c_q7, x196, s_q7 * x194);
-        let x203 = -x202;
-        let x204 = Self::mul_add(-s_q7, x196, c_q7 * x194);
-        let x205 = -Self::mul_add(0.75, x204, Self::mul_add(-c_q7, x201, s_q7 * x200));
-        let x206 = Self::mul_add(s_q7, x201, c_q7 * x200)
-            - Self::mul_add(0.65, x197, 0.75 * x202);
-        let x207 = Self::mul_add(0.65, x204, x199);
-        let x208 = Self::mul_add(c_q9, x86, x107);
-        let x209 = Self::mul_add(-s_q9, x86, x105);
-        let x210 = 0.00000000020510342851533115 * x209;
-        let x211 = Self::mul_add(c_q9, x82, s_q9 * x81);
-        let x212 = Self::mul_add(-s_q9, x82, c_q9 * x81)
-            - Self::mul_add(-0.275, x209, 0.4 * x210);
-        let x213 = Self::mul_add(0.00000000020510342851533115, x211, x89)
-            - Self::mul_add(0.00000000005640344284171607, x209, 0.4 * x208);
-        let x214 = Self::mul_add(-0.00000000020510342851533115, x89, x211)
-            + Self::mul_add(0.00000000005640344284171607, x210, 0.275 * x208);
-        let x215 = Self::mul_add(-s_q8, x210, c_q8 * x208);
-        let x216 = Self::mul_add(c_q8, x210, s_q8 * x208);
-        let x217 = Self::mul_add(-0.00000000020510342851533115, x216, x209);
+        let x202 = S::mul_add(c_q7, x196, s_q7 * x194);
+        let x203 = S::neg(x202);
+        let x204 = S::mul_add(S::neg(s_q7), x196, c_q7 * x194);
+        let x205 = S::neg(
+            S::mul_add(S::splat(0.75), x204, S::mul_add(S::neg(c_q7), x201, s_q7 * x200)),
+        );
+        let x206 = S::mul_add(s_q7, x201, c_q7 * x200)
+            - S::mul_add(S::splat(0.65), x197, S::splat(0.75) * x202);
+        let x207 = S::mul_add(S::splat(0.65), x204, x199);
+        let x208 = S::mul_add(c_q9, x86, x107);
+        let x209 = S::mul_add(S::neg(s_q9), x86, x105);
+        let x210 = S::splat(0.00000000020510342851533115) * x209;
+        let x211 = S::mul_add(c_q9, x82, s_q9 * x81);
+        let x212 = S::mul_add(S::neg(s_q9), x82, c_q9 * x81)
+            - S::mul_add(S::splat(-0.275), x209, S::splat(0.4) * x210);
+        let x213 = S::mul_add(S::splat(0.00000000020510342851533115), x211, x89)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x209,
+                S::splat(0.4) * x208,
+            );
+        let x214 = S::mul_add(S::splat(-0.00000000020510342851533115), x89, x211)
+            + S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x210,
+                S::splat(0.275) * x208,
+            );
+        let x215 = S::mul_add(S::neg(s_q8), x210, c_q8 * x208);
+        let x216 = S::mul_add(c_q8, x210, s_q8 * x208);
+        let x217 = S::mul_add(S::splat(-0.00000000020510342851533115), x216, x209);
         let x218 = x210 + x216;
-        let x219 = Self::mul_add(-c_q8, x213, s_q8 * x212);
-        let x220 = Self::mul_add(-0.00000000020510342851533115, x214, x219);
-        let x221 = Self::mul_add(-0.35, x217, Self::mul_add(s_q8, x213, c_q8 * x212));
-        let x222 = Self::mul_add(
-            -0.35,
+        let x219 = S::mul_add(S::neg(c_q8), x213, s_q8 * x212);
+        let x220 = S::mul_add(S::splat(-0.00000000020510342851533115), x214, x219);
+        let x221 = S::mul_add(
+            S::splat(-0.35),
+            x217,
+            S::mul_add(s_q8, x213, c_q8 * x212),
+        );
+        let x222 = S::mul_add(
+            S::splat(-0.35),
             x215,
-            Self::mul_add(0.00000000020510342851533115, x219, x214),
+            S::mul_add(S::splat(0.00000000020510342851533115), x219, x214),
         );
-        let x223 = Self::mul_add(c_q7, x217, s_q7 * x215);
-        let x224 = -x223;
-        let x225 = Self::mul_add(-s_q7, x217, c_q7 * x215);
-        let x226 = -Self::mul_add(0.75, x225, Self::mul_add(-c_q7, x222, s_q7 * x221));
-        let x227 = Self::mul_add(s_q7, x222, c_q7 * x221)
-            - Self::mul_add(0.65, x218, 0.75 * x223);
-        let x228 = Self::mul_add(0.65, x225, x220);
-        let x229 = Self::mul_add(c_q10, x62, x85);
-        let x230 = Self::mul_add(-s_q10, x62, x83);
-        let x231 = Self::mul_add(-s_q10, x68, c_q10 * x67);
-        let x232 = Self::mul_add(c_q10, x68, s_q10 * x67);
-        let x233 = Self::mul_add(0.87, x229, x69);
-        let x234 = Self::mul_add(s_q9, x230, c_q9 * x229);
-        let x235 = Self::mul_add(-c_q9, x230, s_q9 * x229);
-        let x236 = 0.00000000020510342851533115 * x235;
-        let x237 = Self::mul_add(c_q9, x232, s_q9 * x231);
-        let x238 = Self::mul_add(-s_q9, x232, c_q9 * x231)
-            - Self::mul_add(-0.275, x235, 0.4 * x236);
-        let x239 = Self::mul_add(-0.00000000020510342851533115, x237, x233)
-            - Self::mul_add(-0.00000000005640344284171607, x235, 0.4 * x234);
-        let x240 = Self::mul_add(0.00000000020510342851533115, x233, x237)
-            - Self::mul_add(-0.00000000005640344284171607, x236, 0.275 * x234);
-        let x241 = -x240;
-        let x242 = Self::mul_add(s_q8, x236, c_q8 * x234);
-        let x243 = Self::mul_add(-c_q8, x236, s_q8 * x234);
-        let x244 = Self::mul_add(0.00000000020510342851533115, x243, x235);
+        let x223 = S::mul_add(c_q7, x217, s_q7 * x215);
+        let x224 = S::neg(x223);
+        let x225 = S::mul_add(S::neg(s_q7), x217, c_q7 * x215);
+        let x226 = S::neg(
+            S::mul_add(S::splat(0.75), x225, S::mul_add(S::neg(c_q7), x222, s_q7 * x221)),
+        );
+        let x227 = S::mul_add(s_q7, x222, c_q7 * x221)
+            - S::mul_add(S::splat(0.65), x218, S::splat(0.75) * x223);
+        let x228 = S::mul_add(S::splat(0.65), x225, x220);
+        let x229 = S::mul_add(c_q10, x62, x85);
+        let x230 = S::mul_add(S::neg(s_q10), x62, x83);
+        let x231 = S::mul_add(S::neg(s_q10), x68, c_q10 * x67);
+        let x232 = S::mul_add(c_q10, x68, s_q10 * x67);
+        let x233 = S::mul_add(S::splat(0.87), x229, x69);
+        let x234 = S::mul_add(s_q9, x230, c_q9 * x229);
+        let x235 = S::mul_add(S::neg(c_q9), x230, s_q9 * x229);
+        let x236 = S::splat(0.00000000020510342851533115) * x235;
+        let x237 = S::mul_add(c_q9, x232, s_q9 * x231);
+        let x238 = S::mul_add(S::neg(s_q9), x232, c_q9 * x231)
+            - S::mul_add(S::splat(-0.275), x235, S::splat(0.4) * x236);
+        let x239 = S::mul_add(S::splat(-0.00000000020510342851533115), x237, x233)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x235,
+                S::splat(0.4) * x234,
+            );
+        let x240 = S::mul_add(S::splat(0.00000000020510342851533115), x233, x237)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x236,
+                S::splat(0.275) * x234,
+            );
+        let x241 = S::neg(x240);
+        let x242 = S::mul_add(s_q8, x236, c_q8 * x234);
+        let x243 = S::mul_add(S::neg(c_q8), x236, s_q8 * x234);
+        let x244 = S::mul_add(S::splat(0.00000000020510342851533115), x243, x235);
         let x245 = x236 - x243;
-        let x246 = -x245;
-        let x247 = Self::mul_add(c_q8, x239, s_q8 * x238);
-        let x248 = Self::mul_add(-0.00000000020510342851533115, x240, x247);
-        let x249 = -x248;
-        let x250 = Self::mul_add(-0.35, x244, Self::mul_add(-s_q8, x239, c_q8 * x238));
-        let x251 = Self::mul_add(
-            0.35,
+        let x246 = S::neg(x245);
+        let x247 = S::mul_add(c_q8, x239, s_q8 * x238);
+        let x248 = S::mul_add(S::splat(-0.00000000020510342851533115), x240, x247);
+        let x249 = S::neg(x248);
+        let x250 = S::mul_add(
+            S::splat(-0.35),
+            x244,
+            S::mul_add(S::neg(s_q8), x239, c_q8 * x238),
+        );
+        let x251 = S::mul_add(
+            S::splat(0.35),
             x242,
-            Self::mul_add(0.00000000020510342851533115, x247, x240),
+            S::mul_add(S::splat(0.00000000020510342851533115), x247, x240),
         );
-        let x252 = Self::mul_add(-c_q7, x244, s_q7 * x242);
-        let x253 = -x252;
-        let x254 = Self::mul_add(s_q7, x244, c_q7 * x242);
-        let x255 = Self::mul_add(-0.75, x254, Self::mul_add(-c_q7, x251, s_q7 * x250));
-        let x256 = -(Self::mul_add(s_q7, x251, c_q7 * x250)
-            + Self::mul_add(-0.65, x245, 0.75 * x252));
-        let x257 = -Self::mul_add(-0.65, x254, x248);
-        let x258 = 0.00000000020510342851533115 * x41;
-        let x259 = Self::mul_add(-0.00000000020510342851533115, x31, x40);
-        let x260 = Self::mul_add(-0.36, x258, x39);
-        let x261 = Self::mul_add(
+        let x252 = S::mul_add(S::neg(c_q7), x244, s_q7 * x242);
+        let x253 = S::neg(x252);
+        let x254 = S::mul_add(s_q7, x244, c_q7 * x242);
+        let x255 = S::mul_add(
+            S::splat(-0.75),
+            x254,
+            S::mul_add(S::neg(c_q7), x251, s_q7 * x250),
+        );
+        let x256 = S::neg(
+            S::mul_add(s_q7, x251, c_q7 * x250)
+                + S::mul_add(S::splat(-0.65), x245, S::splat(0.75) * x252),
+        );
+        let x257 = S::neg(S::mul_add(S::splat(-0.65), x254, x248));
+        let x258 = S::splat(0.00000000020510342851533115) * x41;
+        let x259 = S::mul_add(S::splat(-0.00000000020510342851533115), x31, x40);
+        let x260 = S::mul_add(S::splat(-0.36), x258, x39);
+        let x261 = S::mul_add(
             x42,
-            -0.36,
-            Self::mul_add(0.00000000020510342851533115, x40, x31),
+            S::splat(-0.36),
+            S::mul_add(S::splat(0.00000000020510342851533115), x40, x31),
         );
-        let x262 = Self::mul_add(-s_q11, x258, c_q11 * x42);
-        let x263 = Self::mul_add(c_q11, x258, s_q11 * x42);
-        let x264 = Self::mul_add(s_q11, x261, c_q11 * x260)
-            - Self::mul_add(x41, -0.63, 0.275 * x263);
-        let x265 = Self::mul_add(0.275, x262, Self::mul_add(-c_q11, x261, s_q11 * x260));
-        let x266 = Self::mul_add(0.63, x262, x259);
-        let x267 = Self::mul_add(-s_q10, x263, c_q10 * x262);
-        let x268 = Self::mul_add(c_q10, x263, s_q10 * x262);
-        let x269 = Self::mul_add(c_q10, x265, s_q10 * x264);
-        let x270 = Self::mul_add(x41, 0.87, Self::mul_add(-s_q10, x265, c_q10 * x264));
-        let x271 = Self::mul_add(0.87, x267, x266);
-        let x272 = Self::mul_add(-s_q9, x268, c_q9 * x267);
-        let x273 = Self::mul_add(c_q9, x268, s_q9 * x267);
-        let x274 = Self::mul_add(0.00000000020510342851533115, x273, x41);
+        let x262 = S::mul_add(S::neg(s_q11), x258, c_q11 * x42);
+        let x263 = S::mul_add(c_q11, x258, s_q11 * x42);
+        let x264 = S::mul_add(s_q11, x261, c_q11 * x260)
+            - S::mul_add(x41, S::splat(-0.63), S::splat(0.275) * x263);
+        let x265 = S::mul_add(
+            S::splat(0.275),
+            x262,
+            S::mul_add(S::neg(c_q11), x261, s_q11 * x260),
+        );
+        let x266 = S::mul_add(S::splat(0.63), x262, x259);
+        let x267 = S::mul_add(S::neg(s_q10), x263, c_q10 * x262);
+        let x268 = S::mul_add(c_q10, x263, s_q10 * x262);
+        let x269 = S::mul_add(c_q10, x265, s_q10 * x264);
+        let x270 = S::mul_add(
+            x41,
+            S::splat(0.87),
+            S::mul_add(S::neg(s_q10), x265, c_q10 * x264),
+        );
+        let x271 = S::mul_add(S::splat(0.87), x267, x266);
+        let x272 = S::mul_add(S::neg(s_q9), x268, c_q9 * x267);
+        let x273 = S::mul_add(c_q9, x268, s_q9 * x267);
+        let x274 = S::mul_add(S::splat(0.00000000020510342851533115), x273, x41);
         let x275 = x258 - x273;
-        let x276 = Self::mul_add(c_q9, x269, s_q9 * x270);
-        let x277 = Self::mul_add(-s_q9, x269, c_q9 * x270)
-            - Self::mul_add(0.275, x275, 0.4 * x274);
-        let x278 = Self::mul_add(-0.00000000020510342851533115, x276, x271)
-            - Self::mul_add(0.00000000005640344284171607, x275, 0.4 * x272);
-        let x279 = Self::mul_add(0.00000000020510342851533115, x271, x276)
-            - Self::mul_add(-0.00000000005640344284171607, x274, 0.275 * x272);
-        let x280 = -x279;
-        let x281 = Self::mul_add(s_q8, x274, c_q8 * x272);
-        let x282 = Self::mul_add(-c_q8, x274, s_q8 * x272);
-        let x283 = Self::mul_add(-0.00000000020510342851533115, x282, x275);
-        let x284 = Self::mul_add(0.00000000020510342851533115, x275, x282);
-        let x285 = Self::mul_add(c_q8, x278, s_q8 * x277);
-        let x286 = Self::mul_add(-0.00000000020510342851533115, x279, x285);
-        let x287 = -x286;
-        let x288 = Self::mul_add(0.35, x283, Self::mul_add(-s_q8, x278, c_q8 * x277));
-        let x289 = Self::mul_add(
-            0.35,
+        let x276 = S::mul_add(c_q9, x269, s_q9 * x270);
+        let x277 = S::mul_add(S::neg(s_q9), x269, c_q9 * x270)
+            - S::mul_add(S::splat(0.275), x275, S::splat(0.4) * x274);
+        let x278 = S::mul_add(S::splat(-0.00000000020510342851533115), x276, x271)
+            - S::mul_add(
+                S::splat(0.00000000005640344284171607),
+                x275,
+                S::splat(0.4) * x272,
+            );
+        let x279 = S::mul_add(S::splat(0.00000000020510342851533115), x271, x276)
+            - S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x274,
+                S::splat(0.275) * x272,
+            );
+        let x280 = S::neg(x279);
+        let x281 = S::mul_add(s_q8, x274, c_q8 * x272);
+        let x282 = S::mul_add(S::neg(c_q8), x274, s_q8 * x272);
+        let x283 = S::mul_add(S::splat(-0.00000000020510342851533115), x282, x275);
+        let x284 = S::mul_add(S::splat(0.00000000020510342851533115), x275, x282);
+        let x285 = S::mul_add(c_q8, x278, s_q8 * x277);
+        let x286 = S::mul_add(S::splat(-0.00000000020510342851533115), x279, x285);
+        let x287 = S::neg(x286);
+        let x288 = S::mul_add(
+            S::splat(0.35),
+            x283,
+            S::mul_add(S::neg(s_q8), x278, c_q8 * x277),
+        );
+        let x289 = S::mul_add(
+            S::splat(0.35),
             x281,
-            Self::mul_add(0.00000000020510342851533115, x285, x279),
+            S::mul_add(S::splat(0.00000000020510342851533115), x285, x279),
         );
-        let x290 = Self::mul_add(c_q7, x283, s_q7 * x281);
-        let x291 = -x290;
-        let x292 = Self::mul_add(-s_q7, x283, c_q7 * x281);
-        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-c_q7, x289, s_q7 * x288));
-        let x294 = -(Self::mul_add(s_q7, x289, c_q7 * x288)
-            + Self::mul_add(0.65, x284, 0.75 * x290));
-        let x295 = -Self::mul_add(-0.65, x292, x286);
-        let x296 = 0.00000000020510342851533115 * x14;
-        let x297 = Self::mul_add(0.16, x296, x12);
+        let x290 = S::mul_add(c_q7, x283, s_q7 * x281);
+        let x291 = S::neg(x290);
+        let x292 = S::mul_add(S::neg(s_q7), x283, c_q7 * x281);
+        let x293 = S::mul_add(
+            S::splat(-0.75),
+            x292,
+            S::mul_add(S::neg(c_q7), x289, s_q7 * x288),
+        );
+        let x294 = S::neg(
+            S::mul_add(s_q7, x289, c_q7 * x288)
+                + S::mul_add(S::splat(0.65), x284, S::splat(0.75) * x290),
+        );
+        let x295 = S::neg(S::mul_add(S::splat(-0.65), x292, x286));
+        let x296 = S::splat(0.00000000020510342851533115) * x14;
+        let x297 = S::mul_add(S::splat(0.16), x296, x12);
         let x298 = x22
-            + Self::mul_add(-0.00000000020510342851533115, x13, 1.4135609200000003);
-        let x299 = Self::mul_add(-0.55, x296, x13 - -0.0000000002899261911072858);
-        let x300 = -x299;
-        let x301 = Self::mul_add(s_q12, x296, c_q12 * x15);
-        let x302 = Self::mul_add(-c_q12, x296, s_q12 * x15);
-        let x303 = Self::mul_add(0.00000000020510342851533115, x302, x14);
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x13,
+                S::splat(1.4135609200000003),
+            );
+        let x299 = S::mul_add(
+            S::splat(-0.55),
+            x296,
+            x13 - S::splat(-0.0000000002899261911072858),
+        );
+        let x300 = S::neg(x299);
+        let x301 = S::mul_add(s_q12, x296, c_q12 * x15);
+        let x302 = S::mul_add(S::neg(c_q12), x296, s_q12 * x15);
+        let x303 = S::mul_add(S::splat(0.00000000020510342851533115), x302, x14);
         let x304 = x296 - x302;
-        let x305 = Self::mul_add(c_q12, x298, s_q12 * x297);
-        let x306 = Self::mul_add(-0.00000000020510342851533115, x299, x305);
-        let x307 = -x306;
-        let x308 = Self::mul_add(-0.36, x303, Self::mul_add(-s_q12, x298, c_q12 * x297));
-        let x309 = Self::mul_add(
-            0.36,
+        let x305 = S::mul_add(c_q12, x298, s_q12 * x297);
+        let x306 = S::mul_add(S::splat(-0.00000000020510342851533115), x299, x305);
+        let x307 = S::neg(x306);
+        let x308 = S::mul_add(
+            S::splat(-0.36),
+            x303,
+            S::mul_add(S::neg(s_q12), x298, c_q12 * x297),
+        );
+        let x309 = S::mul_add(
+            S::splat(0.36),
             x301,
-            Self::mul_add(0.00000000020510342851533115, x305, x299),
+            S::mul_add(S::splat(0.00000000020510342851533115), x305, x299),
         );
-        let x310 = Self::mul_add(s_q11, x303, c_q11 * x301);
-        let x311 = Self::mul_add(-c_q11, x303, s_q11 * x301);
-        let x312 = Self::mul_add(s_q11, x309, c_q11 * x308)
-            + Self::mul_add(-0.63, x304, 0.275 * x311);
-        let x313 = Self::mul_add(
-            -0.275,
+        let x310 = S::mul_add(s_q11, x303, c_q11 * x301);
+        let x311 = S::mul_add(S::neg(c_q11), x303, s_q11 * x301);
+        let x312 = S::mul_add(s_q11, x309, c_q11 * x308)
+            + S::mul_add(S::splat(-0.63), x304, S::splat(0.275) * x311);
+        let x313 = S::mul_add(
+            S::splat(-0.275),
             x310,
-            Self::mul_add(-c_q11, x309, s_q11 * x308),
+            S::mul_add(S::neg(c_q11), x309, s_q11 * x308),
         );
-        let x314 = Self::mul_add(-0.63, x310, x306);
-        let x315 = -x314;
-        let x316 = Self::mul_add(-s_q10, x311, c_q10 * x310);
-        let x317 = Self::mul_add(c_q10, x311, s_q10 * x310);
-        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
-        let x319 = Self::mul_add(-0.87, x304, Self::mul_add(-s_q10, x313, c_q10 * x312));
-        let x320 = Self::mul_add(-0.87, x316, x314);
-        let x321 = -x320;
-        let x322 = Self::mul_add(-s_q9, x317, c_q9 * x316);
-        let x323 = Self::mul_add(c_q9, x317, s_q9 * x316);
-        let x324 = Self::mul_add(0.00000000020510342851533115, x323, x304);
-        let x325 = Self::mul_add(-0.00000000020510342851533115, x304, x323);
-        let x326 = Self::mul_add(c_q9, x318, s_q9 * x319);
-        let x327 = Self::mul_add(-s_q9, x318, c_q9 * x319)
-            + Self::mul_add(-0.275, x325, 0.4 * x324);
-        let x328 = Self::mul_add(-0.00000000020510342851533115, x326, x320)
-            + Self::mul_add(-0.00000000005640344284171607, x325, 0.4 * x322);
-        let x329 = Self::mul_add(0.00000000020510342851533115, x320, x326)
-            + Self::mul_add(-0.00000000005640344284171607, x324, 0.275 * x322);
-        let x330 = Self::mul_add(s_q8, x324, c_q8 * x322);
-        let x331 = Self::mul_add(-c_q8, x324, s_q8 * x322);
-        let x332 = Self::mul_add(0.00000000020510342851533115, x331, x325);
-        let x333 = Self::mul_add(-0.00000000020510342851533115, x325, x331);
-        let x334 = Self::mul_add(c_q8, x328, s_q8 * x327);
-        let x335 = Self::mul_add(-0.00000000020510342851533115, x329, x334);
-        let x336 = Self::mul_add(0.35, x332, Self::mul_add(-s_q8, x328, c_q8 * x327));
-        let x337 = Self::mul_add(
-            -0.35,
+        let x314 = S::mul_add(S::splat(-0.63), x310, x306);
+        let x315 = S::neg(x314);
+        let x316 = S::mul_add(S::neg(s_q10), x311, c_q10 * x310);
+        let x317 = S::mul_add(c_q10, x311, s_q10 * x310);
+        let x318 = S::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = S::mul_add(
+            S::splat(-0.87),
+            x304,
+            S::mul_add(S::neg(s_q10), x313, c_q10 * x312),
+        );
+        let x320 = S::mul_add(S::splat(-0.87), x316, x314);
+        let x321 = S::neg(x320);
+        let x322 = S::mul_add(S::neg(s_q9), x317, c_q9 * x316);
+        let x323 = S::mul_add(c_q9, x317, s_q9 * x316);
+        let x324 = S::mul_add(S::splat(0.00000000020510342851533115), x323, x304);
+        let x325 = S::mul_add(S::splat(-0.00000000020510342851533115), x304, x323);
+        let x326 = S::mul_add(c_q9, x318, s_q9 * x319);
+        let x327 = S::mul_add(S::neg(s_q9), x318, c_q9 * x319)
+            + S::mul_add(S::splat(-0.275), x325, S::splat(0.4) * x324);
+        let x328 = S::mul_add(S::splat(-0.00000000020510342851533115), x326, x320)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x325,
+                S::splat(0.4) * x322,
+            );
+        let x329 = S::mul_add(S::splat(0.00000000020510342851533115), x320, x326)
+            + S::mul_add(
+                S::splat(-0.00000000005640344284171607),
+                x324,
+                S::splat(0.275) * x322,
+            );
+        let x330 = S::mul_add(s_q8, x324, c_q8 * x322);
+        let x331 = S::mul_add(S::neg(c_q8), x324, s_q8 * x322);
+        let x332 = S::mul_add(S::splat(0.00000000020510342851533115), x331, x325);
+        let x333 = S::mul_add(S::splat(-0.00000000020510342851533115), x325, x331);
+        let x334 = S::mul_add(c_q8, x328, s_q8 * x327);
+        let x335 = S::mul_add(S::splat(-0.00000000020510342851533115), x329, x334);
+        let x336 = S::mul_add(
+            S::splat(0.35),
+            x332,
+            S::mul_add(S::neg(s_q8), x328, c_q8 * x327),
+        );
+        let x337 = S::mul_add(
+            S::splat(-0.35),
             x330,
-            Self::mul_add(0.00000000020510342851533115, x334, x329),
+            S::mul_add(S::splat(0.00000000020510342851533115), x334, x329),
         );
-        let x338 = Self::mul_add(-c_q7, x332, s_q7 * x330);
-        let x339 = -x338;
-        let x340 = Self::mul_add(s_q7, x332, c_q7 * x330);
-        let x341 = -Self::mul_add(0.75, x340, Self::mul_add(-c_q7, x337, s_q7 * x336));
-        let x342 = Self::mul_add(s_q7, x337, c_q7 * x336)
-            - Self::mul_add(0.65, x333, 0.75 * x338);
-        let x343 = Self::mul_add(0.65, x340, x335);
-        let x344 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x345 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x346 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x347 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x348 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x338 = S::mul_add(S::neg(c_q7), x332, s_q7 * x330);
+        let x339 = S::neg(x338);
+        let x340 = S::mul_add(s_q7, x332, c_q7 * x330);
+        let x341 = S::neg(
+            S::mul_add(S::splat(0.75), x340, S::mul_add(S::neg(c_q7), x337, s_q7 * x336)),
+        );
+        let x342 = S::mul_add(s_q7, x337, c_q7 * x336)
+            - S::mul_add(S::splat(0.65), x333, S::splat(0.75) * x338);
+        let x343 = S::mul_add(S::splat(0.65), x340, x335);
+        let x344 = S::mul_add(S::neg(v[2]), v[4], v[1] * v[5]);
+        let x345 = S::mul_add(S::neg(v[2]), v[3], v[0] * v[5]);
+        let x346 = S::mul_add(S::neg(v[1]), v[3], v[0] * v[4]);
+        let x347 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x348 = S::mul_add(v[4], s_q7, v[3] * c_q7);
         let x349 = v[4] * v[4];
-        let x350 = Self::mul_add(v[5], v[5], x349);
+        let x350 = S::mul_add(v[5], v[5], x349);
         let x351 = v[3] * v[4];
         let x352 = v[3] * v[5];
         let x353 = v[4] * v[5];
-        let x354 = Self::mul_add(v[3], v[3], x349);
-        let x355 = x344 + Self::mul_add(-0.75, x352, 0.65 * x350);
-        let x356 = x345 + Self::mul_add(0.75, x353, 0.65 * x351);
-        let x357 = x346 - Self::mul_add(-0.75, x354, 0.65 * x352);
-        let x358 = Self::mul_add(c_q7, x356, s_q7 * x355);
+        let x354 = S::mul_add(v[3], v[3], x349);
+        let x355 = x344 + S::mul_add(S::splat(-0.75), x352, S::splat(0.65) * x350);
+        let x356 = x345 + S::mul_add(S::splat(0.75), x353, S::splat(0.65) * x351);
+        let x357 = x346 - S::mul_add(S::splat(-0.75), x354, S::splat(0.65) * x352);
+        let x358 = S::mul_add(c_q7, x356, s_q7 * x355);
         let x359 = v[6] * x348;
         let x360 = v[6] * x347;
         let x361 = v[5] + v[6];
         let x362 = x347 * x347;
         let x363 = x348 * x361;
-        let x364 = Self::mul_add(-0.1132, x361, 0.07309 * x348);
-        let x365 = Self::mul_add(
-            -16.807689977165428,
+        let x364 = S::mul_add(S::splat(-0.1132), x361, S::splat(0.07309) * x348);
+        let x365 = S::mul_add(
+            S::splat(-16.807689977165428),
             x361,
-            Self::mul_add(x348, -125.18476992763283, 0.07309 * x347),
+            S::mul_add(x348, S::splat(-125.18476992763283), S::splat(0.07309) * x347),
         );
-        let x366 = Self::mul_add(
-            -127.22056992763282,
+        let x366 = S::mul_add(
+            S::splat(-127.22056992763282),
             x361,
-            Self::mul_add(16.807689977165428, x348, 0.1132 * x347),
+            S::mul_add(S::splat(16.807689977165428), x348, S::splat(0.1132) * x347),
         );
-        let x367 = Self::mul_add(
+        let x367 = S::mul_add(
             x357,
-            48.0240000085309,
-            Self::mul_add(0.07309, x360, Self::mul_add(x348, x366, x361 * x365)),
+            S::splat(48.0240000085309),
+            S::mul_add(S::splat(0.07309), x360, S::mul_add(x348, x366, x361 * x365)),
         );
-        let x368 = Self::mul_add(0.00000000020510342851533115, x348, x361);
-        let x369 = Self::mul_add(-s_q8, x368, c_q8 * x347);
-        let x370 = Self::mul_add(c_q8, x368, s_q8 * x347);
-        let x371 = Self::mul_add(0.35, Self::mul_add(-x347, x361, x360), x358);
-        let x372 = Self::mul_add(
-            0.35,
+        let x368 = S::mul_add(S::splat(0.00000000020510342851533115), x348, x361);
+        let x369 = S::mul_add(S::neg(s_q8), x368, c_q8 * x347);
+        let x370 = S::mul_add(c_q8, x368, s_q8 * x347);
+        let x371 = S::mul_add(
+            S::splat(0.35),
+            S::mul_add(S::neg(x347), x361, x360),
+            x358,
+        );
+        let x372 = S::mul_add(
+            S::splat(0.35),
             x359 - x363,
-            Self::mul_add(-s_q7, x356, c_q7 * x355),
+            S::mul_add(S::neg(s_q7), x356, c_q7 * x355),
         );
-        let x373 = Self::mul_add(0.35, Self::mul_add(x348, x348, x362), x357);
-        let x374 = Self::mul_add(0.00000000020510342851533115, x372, x373);
-        let x375 = Self::mul_add(-0.00000000020510342851533115, x373, x372);
-        let x376 = Self::mul_add(-s_q8, x374, c_q8 * x371);
-        let x377 = Self::mul_add(c_q8, x374, s_q8 * x371);
-        let x378 = 0.00000000020510342851533115 * x360;
-        let x379 = Self::mul_add(-v[7], x370, Self::mul_add(s_q8, x378, c_q8 * x359));
-        let x380 = Self::mul_add(v[7], x369, Self::mul_add(-c_q8, x378, s_q8 * x359));
-        let x381 = v[7] + Self::mul_add(-0.00000000020510342851533115, x361, x348);
+        let x373 = S::mul_add(S::splat(0.35), S::mul_add(x348, x348, x362), x357);
+        let x374 = S::mul_add(S::splat(0.00000000020510342851533115), x372, x373);
+        let x375 = S::mul_add(S::splat(-0.00000000020510342851533115), x373, x372);
+        let x376 = S::mul_add(S::neg(s_q8), x374, c_q8 * x371);
+        let x377 = S::mul_add(c_q8, x374, s_q8 * x371);
+        let x378 = S::splat(0.00000000020510342851533115) * x360;
+        let x379 = S::mul_add(S::neg(v[7]), x370, S::mul_add(s_q8, x378, c_q8 * x359));
+        let x380 = S::mul_add(v[7], x369, S::mul_add(S::neg(c_q8), x378, s_q8 * x359));
+        let x381 = v[7]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x361, x348);
         let x382 = x370 * x370;
         let x383 = x381 * x381;
         let x384 = x382 + x383;
@@ -5269,180 +6426,253 @@ impl FreeFloating7 {
         let x391 = x370 * x381;
         let x392 = x380 + x387;
         let x393 = x379 - x391;
-        let x394 = Self::mul_add(
-            -0.0021399976297017177,
+        let x394 = S::mul_add(
+            S::splat(-0.0021399976297017177),
             x381,
-            x370 * 0.0000000005683321144643007,
+            x370 * S::splat(0.0000000005683321144643007),
         );
-        let x395 = Self::mul_add(
+        let x395 = S::mul_add(
             x381,
-            -5.080660022992534,
-            Self::mul_add(x370, -106.50196992080811, x369 * 0.0000000005683321144643007),
+            S::splat(-5.080660022992534),
+            S::mul_add(
+                x370,
+                S::splat(-106.50196992080811),
+                x369 * S::splat(0.0000000005683321144643007),
+            ),
         );
-        let x396 = Self::mul_add(
-            -108.1389699208081,
+        let x396 = S::mul_add(
+            S::splat(-108.1389699208081),
             x381,
-            Self::mul_add(x370, 5.080660022992536, 0.0021399976297017177 * x369),
+            S::mul_add(
+                x370,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x369,
+            ),
         );
-        let x397 = Self::mul_add(
-            0.0000000059257457049506905,
+        let x397 = S::mul_add(
+            S::splat(0.0000000059257457049506905),
             x375,
-            Self::mul_add(
+            S::mul_add(
                 x360,
-                5.080660022992534,
-                Self::mul_add(
+                S::splat(5.080660022992534),
+                S::mul_add(
                     x380,
-                    -106.50196992080811,
-                    x379 * 0.0000000005683321144643007,
+                    S::splat(-106.50196992080811),
+                    x379 * S::splat(0.0000000005683321144643007),
                 ),
-            ) - Self::mul_add(x369, x396, x381 * x394),
+            ) - S::mul_add(x369, x396, x381 * x394),
         );
-        let x398 = Self::mul_add(-0.00000000020510342851533115, x370, x381);
-        let x399 = Self::mul_add(-s_q9, x398, c_q9 * x369);
-        let x400 = Self::mul_add(c_q9, x398, s_q9 * x369);
+        let x398 = S::mul_add(S::splat(-0.00000000020510342851533115), x370, x381);
+        let x399 = S::mul_add(S::neg(s_q9), x398, c_q9 * x369);
+        let x400 = S::mul_add(c_q9, x398, s_q9 * x369);
         let x401 = x376
-            - Self::mul_add(
-                -0.4,
+            - S::mul_add(
+                S::splat(-0.4),
                 x380 - x387,
-                Self::mul_add(0.275, x386, 0.00000000005640344284171607 * x384),
+                S::mul_add(
+                    S::splat(0.275),
+                    x386,
+                    S::splat(0.00000000005640344284171607) * x384,
+                ),
             );
         let x402 = x377
-            + Self::mul_add(
-                -0.4,
+            + S::mul_add(
+                S::splat(-0.4),
                 x379 + x391,
-                Self::mul_add(-0.275, x390, 0.00000000005640344284171607 * x388),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x390,
+                    S::splat(0.00000000005640344284171607) * x388,
+                ),
             );
         let x403 = x375
-            + Self::mul_add(
-                0.4,
+            + S::mul_add(
+                S::splat(0.4),
                 x382 + x389,
-                Self::mul_add(-0.275, x393, 0.00000000005640344284171607 * x392),
+                S::mul_add(
+                    S::splat(-0.275),
+                    x393,
+                    S::splat(0.00000000005640344284171607) * x392,
+                ),
             );
-        let x404 = Self::mul_add(-0.00000000020510342851533115, x402, x403);
-        let x405 = Self::mul_add(0.00000000020510342851533115, x403, x402);
-        let x406 = Self::mul_add(-s_q9, x404, c_q9 * x401);
-        let x407 = Self::mul_add(0.00000000020510342851533115, x380, x360);
+        let x404 = S::mul_add(S::splat(-0.00000000020510342851533115), x402, x403);
+        let x405 = S::mul_add(S::splat(0.00000000020510342851533115), x403, x402);
+        let x406 = S::mul_add(S::neg(s_q9), x404, c_q9 * x401);
+        let x407 = S::mul_add(S::splat(0.00000000020510342851533115), x380, x360);
         let x408 = x378 - x380;
-        let x409 = Self::mul_add(-v[8], x400, Self::mul_add(s_q9, x407, c_q9 * x379));
-        let x410 = Self::mul_add(v[8], x399, Self::mul_add(-c_q9, x407, s_q9 * x379));
-        let x411 = v[8] - Self::mul_add(0.00000000020510342851533115, x381, x370);
-        let x412 = Self::mul_add(x399, x400, x408);
-        let x413 = Self::mul_add(x399, x399, x411 * x411);
-        let x414 = Self::mul_add(-x400, x411, x409);
-        let x415 = 0.00214 * x411;
-        let x416 = Self::mul_add(x411, 36.18604050126307, x400 * 63.36336825);
-        let x417 = Self::mul_add(
-            69.99836825,
+        let x409 = S::mul_add(S::neg(v[8]), x400, S::mul_add(s_q9, x407, c_q9 * x379));
+        let x410 = S::mul_add(v[8], x399, S::mul_add(S::neg(c_q9), x407, s_q9 * x379));
+        let x411 = v[8] - S::mul_add(S::splat(0.00000000020510342851533115), x381, x370);
+        let x412 = S::mul_add(x399, x400, x408);
+        let x413 = S::mul_add(x399, x399, x411 * x411);
+        let x414 = S::mul_add(S::neg(x400), x411, x409);
+        let x415 = S::splat(0.00214) * x411;
+        let x416 = S::mul_add(
             x411,
-            Self::mul_add(x400, -36.18604050126307, 0.00214 * x399),
+            S::splat(36.18604050126307),
+            x400 * S::splat(63.36336825),
         );
-        let x418 = Self::mul_add(
+        let x417 = S::mul_add(
+            S::splat(69.99836825),
+            x411,
+            S::mul_add(x400, S::splat(-36.18604050126307), S::splat(0.00214) * x399),
+        );
+        let x418 = S::mul_add(
             x405,
-            81.53205,
-            Self::mul_add(0.00214, x408, -Self::mul_add(x400, x417, x411 * x416)),
-        );
-        let x419 = Self::mul_add(
-            x406,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
+            S::splat(81.53205),
+            S::mul_add(
+                S::splat(0.00214),
                 x408,
-                Self::mul_add(x410, -36.18604050126307, 0.00214 * x409),
-            ) + Self::mul_add(x399, x416, x400 * x415),
+                S::neg(S::mul_add(x400, x417, x411 * x416)),
+            ),
         );
-        let x420 = Self::mul_add(-s_q10, x400, c_q10 * x399);
-        let x421 = Self::mul_add(c_q10, x400, s_q10 * x399);
-        let x422 = Self::mul_add(0.87, x412, x406);
-        let x423 = Self::mul_add(-0.87, x413, Self::mul_add(c_q9, x404, s_q9 * x401));
-        let x424 = Self::mul_add(0.87, x414, x405);
-        let x425 = Self::mul_add(-s_q10, x423, c_q10 * x422);
-        let x426 = Self::mul_add(-v[9], x421, Self::mul_add(-s_q10, x410, c_q10 * x409));
-        let x427 = Self::mul_add(v[9], x420, Self::mul_add(c_q10, x410, s_q10 * x409));
+        let x419 = S::mul_add(
+            x406,
+            S::splat(81.53205),
+            S::mul_add(
+                S::splat(69.99836825),
+                x408,
+                S::mul_add(x410, S::splat(-36.18604050126307), S::splat(0.00214) * x409),
+            ) + S::mul_add(x399, x416, x400 * x415),
+        );
+        let x420 = S::mul_add(S::neg(s_q10), x400, c_q10 * x399);
+        let x421 = S::mul_add(c_q10, x400, s_q10 * x399);
+        let x422 = S::mul_add(S::splat(0.87), x412, x406);
+        let x423 = S::mul_add(
+            S::splat(-0.87),
+            x413,
+            S::mul_add(c_q9, x404, s_q9 * x401),
+        );
+        let x424 = S::mul_add(S::splat(0.87), x414, x405);
+        let x425 = S::mul_add(S::neg(s_q10), x423, c_q10 * x422);
+        let x426 = S::mul_add(
+            S::neg(v[9]),
+            x421,
+            S::mul_add(S::neg(s_q10), x410, c_q10 * x409),
+        );
+        let x427 = S::mul_add(v[9], x420, S::mul_add(c_q10, x410, s_q10 * x409));
         let x428 = v[9] + x411;
-        let x429 = Self::mul_add(x420, x421, x408);
+        let x429 = S::mul_add(x420, x421, x408);
         let x430 = x420 * x420;
-        let x431 = Self::mul_add(x428, x428, x430);
+        let x431 = S::mul_add(x428, x428, x430);
         let x432 = x421 * x428;
         let x433 = x426 - x432;
-        let x434 = x428 * 0.6328;
-        let x435 = Self::mul_add(x428, 24.35164200091464, x421 * 24.4950615);
-        let x436 = Self::mul_add(
-            28.2393615,
+        let x434 = x428 * S::splat(0.6328);
+        let x435 = S::mul_add(
             x428,
-            Self::mul_add(x421, -24.351642000914637, x420 * 0.6328),
+            S::splat(24.35164200091464),
+            x421 * S::splat(24.4950615),
         );
-        let x437 = Self::mul_add(
+        let x436 = S::mul_add(
+            S::splat(28.2393615),
+            x428,
+            S::mul_add(x421, S::splat(-24.351642000914637), x420 * S::splat(0.6328)),
+        );
+        let x437 = S::mul_add(
             x424,
-            45.1584,
-            Self::mul_add(x408, 0.6328, -Self::mul_add(x421, x436, x428 * x435)),
-        );
-        let x438 = Self::mul_add(
-            x425,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
+            S::splat(45.1584),
+            S::mul_add(
                 x408,
-                Self::mul_add(x427, -24.351642000914637, x426 * 0.6328),
-            ) + Self::mul_add(x420, x435, x421 * x434),
+                S::splat(0.6328),
+                S::neg(S::mul_add(x421, x436, x428 * x435)),
+            ),
         );
-        let x439 = Self::mul_add(-s_q11, x421, c_q11 * x420);
-        let x440 = Self::mul_add(c_q11, x421, s_q11 * x420);
+        let x438 = S::mul_add(
+            x425,
+            S::splat(45.1584),
+            S::mul_add(
+                S::splat(28.2393615),
+                x408,
+                S::mul_add(x427, S::splat(-24.351642000914637), x426 * S::splat(0.6328)),
+            ) + S::mul_add(x420, x435, x421 * x434),
+        );
+        let x439 = S::mul_add(S::neg(s_q11), x421, c_q11 * x420);
+        let x440 = S::mul_add(c_q11, x421, s_q11 * x420);
         let x441 = x425
-            + Self::mul_add(-0.275, Self::mul_add(-x420, x428, x427), 0.63 * x429);
-        let x442 = Self::mul_add(c_q10, x423, s_q10 * x422)
-            - Self::mul_add(-0.275, x426 + x432, 0.63 * x431);
+            + S::mul_add(
+                S::splat(-0.275),
+                S::mul_add(S::neg(x420), x428, x427),
+                S::splat(0.63) * x429,
+            );
+        let x442 = S::mul_add(c_q10, x423, s_q10 * x422)
+            - S::mul_add(S::splat(-0.275), x426 + x432, S::splat(0.63) * x431);
         let x443 = x424
-            + Self::mul_add(0.275, Self::mul_add(x421, x421, x430), 0.63 * x433);
-        let x444 = Self::mul_add(-s_q11, x442, c_q11 * x441);
-        let x445 = Self::mul_add(
-            -v[10],
+            + S::mul_add(
+                S::splat(0.275),
+                S::mul_add(x421, x421, x430),
+                S::splat(0.63) * x433,
+            );
+        let x444 = S::mul_add(S::neg(s_q11), x442, c_q11 * x441);
+        let x445 = S::mul_add(
+            S::neg(v[10]),
             x440,
-            Self::mul_add(-s_q11, x427, c_q11 * x426),
+            S::mul_add(S::neg(s_q11), x427, c_q11 * x426),
         );
-        let x446 = Self::mul_add(v[10], x439, Self::mul_add(c_q11, x427, s_q11 * x426));
+        let x446 = S::mul_add(v[10], x439, S::mul_add(c_q11, x427, s_q11 * x426));
         let x447 = v[10] + x428;
         let x448 = x439 * x439;
         let x449 = x440 * x447;
-        let x450 = x447 * 0.01675;
-        let x451 = Self::mul_add(x447, -2.5482240005325645, x440 * 3.8891049197628025);
-        let x452 = Self::mul_add(
-            -3.970314919762802,
+        let x450 = x447 * S::splat(0.01675);
+        let x451 = S::mul_add(
             x447,
-            Self::mul_add(x440, -2.5482240005325645, x439 * 0.01675),
+            S::splat(-2.5482240005325645),
+            x440 * S::splat(3.8891049197628025),
         );
-        let x453 = Self::mul_add(
+        let x452 = S::mul_add(
+            S::splat(-3.970314919762802),
+            x447,
+            S::mul_add(x440, S::splat(-2.5482240005325645), x439 * S::splat(0.01675)),
+        );
+        let x453 = S::mul_add(
             x443,
-            7.078399999258757,
-            Self::mul_add(x408, 0.01675, Self::mul_add(-x440, x452, x447 * x451)),
-        );
-        let x454 = Self::mul_add(
-            x444,
-            7.078399999258757,
-            Self::mul_add(
-                -3.970314919762802,
+            S::splat(7.078399999258757),
+            S::mul_add(
                 x408,
-                Self::mul_add(x446, -2.5482240005325645, x445 * 0.01675),
-            ) + Self::mul_add(-x439, x451, x440 * x450),
+                S::splat(0.01675),
+                S::mul_add(S::neg(x440), x452, x447 * x451),
+            ),
         );
-        let x455 = Self::mul_add(0.00000000020510342851533115, x440, x447);
-        let x456 = Self::mul_add(s_q12, x455, c_q12 * x439);
-        let x457 = Self::mul_add(-c_q12, x455, s_q12 * x439);
-        let x458 = Self::mul_add(-0.36, Self::mul_add(-x439, x447, x446), x444);
-        let x459 = Self::mul_add(
-            0.36,
+        let x454 = S::mul_add(
+            x444,
+            S::splat(7.078399999258757),
+            S::mul_add(
+                S::splat(-3.970314919762802),
+                x408,
+                S::mul_add(x446, S::splat(-2.5482240005325645), x445 * S::splat(0.01675)),
+            ) + S::mul_add(S::neg(x439), x451, x440 * x450),
+        );
+        let x455 = S::mul_add(S::splat(0.00000000020510342851533115), x440, x447);
+        let x456 = S::mul_add(s_q12, x455, c_q12 * x439);
+        let x457 = S::mul_add(S::neg(c_q12), x455, s_q12 * x439);
+        let x458 = S::mul_add(
+            S::splat(-0.36),
+            S::mul_add(S::neg(x439), x447, x446),
+            x444,
+        );
+        let x459 = S::mul_add(
+            S::splat(0.36),
             x445 + x449,
-            Self::mul_add(c_q11, x442, s_q11 * x441),
+            S::mul_add(c_q11, x442, s_q11 * x441),
         );
-        let x460 = Self::mul_add(0.36, Self::mul_add(x440, x440, x448), x443);
-        let x461 = Self::mul_add(-0.00000000020510342851533115, x459, x460);
-        let x462 = Self::mul_add(0.00000000020510342851533115, x460, x459);
-        let x463 = Self::mul_add(-s_q12, x461, c_q12 * x458);
-        let x464 = Self::mul_add(c_q12, x461, s_q12 * x458);
-        let x465 = Self::mul_add(0.00000000020510342851533115, x446, x408);
-        let x466 = Self::mul_add(-0.00000000020510342851533115, x408, x446);
-        let x467 = Self::mul_add(-v[11], x457, Self::mul_add(s_q12, x465, c_q12 * x445));
-        let x468 = Self::mul_add(v[11], x456, Self::mul_add(-c_q12, x465, s_q12 * x445));
-        let x469 = v[11] + Self::mul_add(-0.00000000020510342851533115, x447, x440);
+        let x460 = S::mul_add(S::splat(0.36), S::mul_add(x440, x440, x448), x443);
+        let x461 = S::mul_add(S::splat(-0.00000000020510342851533115), x459, x460);
+        let x462 = S::mul_add(S::splat(0.00000000020510342851533115), x460, x459);
+        let x463 = S::mul_add(S::neg(s_q12), x461, c_q12 * x458);
+        let x464 = S::mul_add(c_q12, x461, s_q12 * x458);
+        let x465 = S::mul_add(S::splat(0.00000000020510342851533115), x446, x408);
+        let x466 = S::mul_add(S::splat(-0.00000000020510342851533115), x408, x446);
+        let x467 = S::mul_add(
+            S::neg(v[11]),
+            x457,
+            S::mul_add(s_q12, x465, c_q12 * x445),
+        );
+        let x468 = S::mul_add(
+            v[11],
+            x456,
+            S::mul_add(S::neg(c_q12), x465, s_q12 * x445),
+        );
+        let x469 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x447, x440);
         let x470 = x457 * x457;
         let x471 = x469 * x469;
         let x472 = x470 + x471;
@@ -5452,288 +6682,401 @@ impl FreeFloating7 {
         let x476 = x456 * x456;
         let x477 = x457 * x469;
         let x478 = x468 + x474;
-        let x479 = Self::mul_add(x469, 2.741639999592316, 1.9877000000000002 * x457);
-        let x480 = Self::mul_add(
-            0.809539999555672,
+        let x479 = S::mul_add(
             x469,
-            Self::mul_add(-5.252920330000002, x457, 1.9877000000000002 * x456),
+            S::splat(2.741639999592316),
+            S::splat(1.9877000000000002) * x457,
         );
-        let x481 = Self::mul_add(
-            -9.740442170000001,
+        let x480 = S::mul_add(
+            S::splat(0.809539999555672),
             x469,
-            Self::mul_add(0.809539999555672, x457, x456 * 2.7416399995923166),
-        );
-        let x482 = Self::mul_add(
-            17.135250000000003,
-            x462,
-            Self::mul_add(
-                0.809539999555672,
-                x466,
-                Self::mul_add(-5.252920330000002, x468, 1.9877000000000002 * x467),
-            ) - Self::mul_add(-x456, x481, x469 * x479),
-        );
-        let x483 = Self::mul_add(0.00000000020510342851533115, x457, x469);
-        let x484 = Self::mul_add(s_q13, x483, c_q13 * x456);
-        let x485 = Self::mul_add(-c_q13, x483, s_q13 * x456);
-        let x486 = x464 + Self::mul_add(-0.16, x467 + x477, 0.55 * x475);
-        let x487 = x462 - Self::mul_add(-0.16, x470 + x476, 0.55 * x478);
-        let x488 = Self::mul_add(0.00000000020510342851533115, x468, x466);
-        let x489 = Self::mul_add(-0.00000000020510342851533115, x466, x468);
-        let x490 = Self::mul_add(-v[12], x485, Self::mul_add(s_q13, x488, c_q13 * x467));
-        let x491 = Self::mul_add(v[12], x484, Self::mul_add(-c_q13, x488, s_q13 * x467));
-        let x492 = v[12] + Self::mul_add(-0.00000000020510342851533115, x469, x457);
-        let x493 = 4.806620000000001 * Self::mul_add(x484, x485, x489);
-        let x494 = 4.806620000000001 * Self::mul_add(x484, x484, x492 * x492);
-        let x495 = 4.806620000000001 * Self::mul_add(-x485, x492, x490);
-        let x496 = Self::mul_add(0.0145, x492, 0.000781 * x485);
-        let x497 = Self::mul_add(
-            -0.9614610000000001,
-            x492,
-            Self::mul_add(1.2025609200000003, x485, 0.000781 * x484),
-        );
-        let x498 = Self::mul_add(
-            -1.4135609200000003,
-            x492,
-            Self::mul_add(-0.9614610000000001, x485, 0.0145 * x484),
-        );
-        let x499 = Self::mul_add(
-            -0.9614610000000001,
-            x489,
-            Self::mul_add(1.2025609200000003, x491, 0.000781 * x490),
-        ) - Self::mul_add(-x484, x498, x492 * x496);
-        let x500 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x487, x486),
-            Self::mul_add(0.0145, x489, 0.000781 * x491)
-                + Self::mul_add(-x485, x498, x492 * x497),
-        );
-        let x501 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(0.00000000020510342851533115, x486, x487),
-                c_q13 * (x463 + Self::mul_add(0.16, x468 - x474, 0.55 * x472)),
+            S::mul_add(
+                S::splat(-5.252920330000002),
+                x457,
+                S::splat(1.9877000000000002) * x456,
             ),
-            Self::mul_add(
-                -1.4135609200000003,
-                x489,
-                Self::mul_add(-0.9614610000000001, x491, 0.0145 * x490),
-            ) + Self::mul_add(-x484, x497, x485 * x496),
         );
-        let x502 = -x501;
-        let x503 = Self::mul_add(-s_q13, x494, c_q13 * x493);
-        let x504 = Self::mul_add(c_q13, x494, s_q13 * x493);
-        let x505 = Self::mul_add(-0.00000000020510342851533115, x504, x495);
-        let x506 = Self::mul_add(0.00000000020510342851533115, x495, x504);
-        let x507 = Self::mul_add(-c_q13, x499, s_q13 * x500);
-        let x508 = Self::mul_add(
-            -3.6140000000000003,
-            x466 + x473,
-            17.135250000000003 * x472,
-        ) + x503;
-        let x509 = Self::mul_add(
-            3.6140000000000003,
-            x471 + x476,
-            17.135250000000003 * x475,
-        ) - x505;
-        let x510 = Self::mul_add(
-            -3.6140000000000003,
-            x467 - x477,
-            17.135250000000003 * x478,
-        ) - x506;
-        let x511 = Self::mul_add(
-            -3.6140000000000003,
+        let x481 = S::mul_add(
+            S::splat(-9.740442170000001),
+            x469,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x457,
+                x456 * S::splat(2.7416399995923166),
+            ),
+        );
+        let x482 = S::mul_add(
+            S::splat(17.135250000000003),
             x462,
-            Self::mul_add(x466, 2.741639999592316, 1.9877000000000002 * x468)
-                + Self::mul_add(-x457, x481, x469 * x480),
-        ) + Self::mul_add(-0.16, x505, Self::mul_add(s_q13, x499, c_q13 * x500));
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x466,
+                S::mul_add(
+                    S::splat(-5.252920330000002),
+                    x468,
+                    S::splat(1.9877000000000002) * x467,
+                ),
+            ) - S::mul_add(S::neg(x456), x481, x469 * x479),
+        );
+        let x483 = S::mul_add(S::splat(0.00000000020510342851533115), x457, x469);
+        let x484 = S::mul_add(s_q13, x483, c_q13 * x456);
+        let x485 = S::mul_add(S::neg(c_q13), x483, s_q13 * x456);
+        let x486 = x464
+            + S::mul_add(S::splat(-0.16), x467 + x477, S::splat(0.55) * x475);
+        let x487 = x462
+            - S::mul_add(S::splat(-0.16), x470 + x476, S::splat(0.55) * x478);
+        let x488 = S::mul_add(S::splat(0.00000000020510342851533115), x468, x466);
+        let x489 = S::mul_add(S::splat(-0.00000000020510342851533115), x466, x468);
+        let x490 = S::mul_add(
+            S::neg(v[12]),
+            x485,
+            S::mul_add(s_q13, x488, c_q13 * x467),
+        );
+        let x491 = S::mul_add(
+            v[12],
+            x484,
+            S::mul_add(S::neg(c_q13), x488, s_q13 * x467),
+        );
+        let x492 = v[12]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x469, x457);
+        let x493 = S::splat(4.806620000000001) * S::mul_add(x484, x485, x489);
+        let x494 = S::splat(4.806620000000001) * S::mul_add(x484, x484, x492 * x492);
+        let x495 = S::splat(4.806620000000001) * S::mul_add(S::neg(x485), x492, x490);
+        let x496 = S::mul_add(S::splat(0.0145), x492, S::splat(0.000781) * x485);
+        let x497 = S::mul_add(
+            S::splat(-0.9614610000000001),
+            x492,
+            S::mul_add(S::splat(1.2025609200000003), x485, S::splat(0.000781) * x484),
+        );
+        let x498 = S::mul_add(
+            S::splat(-1.4135609200000003),
+            x492,
+            S::mul_add(S::splat(-0.9614610000000001), x485, S::splat(0.0145) * x484),
+        );
+        let x499 = S::mul_add(
+            S::splat(-0.9614610000000001),
+            x489,
+            S::mul_add(S::splat(1.2025609200000003), x491, S::splat(0.000781) * x490),
+        ) - S::mul_add(S::neg(x484), x498, x492 * x496);
+        let x500 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x487, x486),
+            S::mul_add(S::splat(0.0145), x489, S::splat(0.000781) * x491)
+                + S::mul_add(S::neg(x485), x498, x492 * x497),
+        );
+        let x501 = S::mul_add(
+            S::splat(-4.806620000000001),
+            S::mul_add(
+                s_q13,
+                S::mul_add(S::splat(0.00000000020510342851533115), x486, x487),
+                c_q13
+                    * (x463
+                        + S::mul_add(S::splat(0.16), x468 - x474, S::splat(0.55) * x472)),
+            ),
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x489,
+                S::mul_add(S::splat(-0.9614610000000001), x491, S::splat(0.0145) * x490),
+            ) + S::mul_add(S::neg(x484), x497, x485 * x496),
+        );
+        let x502 = S::neg(x501);
+        let x503 = S::mul_add(S::neg(s_q13), x494, c_q13 * x493);
+        let x504 = S::mul_add(c_q13, x494, s_q13 * x493);
+        let x505 = S::mul_add(S::splat(-0.00000000020510342851533115), x504, x495);
+        let x506 = S::mul_add(S::splat(0.00000000020510342851533115), x495, x504);
+        let x507 = S::mul_add(S::neg(c_q13), x499, s_q13 * x500);
+        let x508 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x466 + x473,
+            S::splat(17.135250000000003) * x472,
+        ) + x503;
+        let x509 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x471 + x476,
+            S::splat(17.135250000000003) * x475,
+        ) - x505;
+        let x510 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x467 - x477,
+            S::splat(17.135250000000003) * x478,
+        ) - x506;
+        let x511 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x462,
+            S::mul_add(
+                x466,
+                S::splat(2.741639999592316),
+                S::splat(1.9877000000000002) * x468,
+            ) + S::mul_add(S::neg(x457), x481, x469 * x480),
+        ) + S::mul_add(S::splat(-0.16), x505, S::mul_add(s_q13, x499, c_q13 * x500));
         let x512 = x482
-            + (Self::mul_add(0.00000000020510342851533115, x507, x501)
-                - Self::mul_add(-0.55, x506, 0.16 * x503));
-        let x513 = Self::mul_add(
-            -9.740442170000001,
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x507, x501)
+                - S::mul_add(S::splat(-0.55), x506, S::splat(0.16) * x503));
+        let x513 = S::mul_add(
+            S::splat(-9.740442170000001),
             x466,
-            Self::mul_add(0.809539999555672, x468, x467 * 2.7416399995923166),
-        ) + Self::mul_add(-x456, x480, x457 * x479)
-            + Self::mul_add(-17.135250000000003, x464, 3.6140000000000003 * x463)
-            + Self::mul_add(
-                0.55,
+            S::mul_add(
+                S::splat(0.809539999555672),
+                x468,
+                x467 * S::splat(2.7416399995923166),
+            ),
+        ) + S::mul_add(S::neg(x456), x480, x457 * x479)
+            + S::mul_add(
+                S::splat(-17.135250000000003),
+                x464,
+                S::splat(3.6140000000000003) * x463,
+            )
+            + S::mul_add(
+                S::splat(0.55),
                 x505,
-                Self::mul_add(-0.00000000020510342851533115, x501, x507),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x501, x507),
             );
-        let x514 = -x513;
-        let x515 = Self::mul_add(s_q12, x509, c_q12 * x508);
-        let x516 = Self::mul_add(-c_q12, x509, s_q12 * x508);
-        let x517 = Self::mul_add(-0.00000000020510342851533115, x516, x510);
-        let x518 = Self::mul_add(-c_q12, x512, s_q12 * x511);
-        let x519 = Self::mul_add(
-            Self::mul_add(x439, x440, x408),
-            7.078399999258757,
-            -x515,
+        let x514 = S::neg(x513);
+        let x515 = S::mul_add(s_q12, x509, c_q12 * x508);
+        let x516 = S::mul_add(S::neg(c_q12), x509, s_q12 * x508);
+        let x517 = S::mul_add(S::splat(-0.00000000020510342851533115), x516, x510);
+        let x518 = S::mul_add(S::neg(c_q12), x512, s_q12 * x511);
+        let x519 = S::mul_add(
+            S::mul_add(x439, x440, x408),
+            S::splat(7.078399999258757),
+            S::neg(x515),
         );
-        let x520 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x447, x447, x448),
-            -x517,
+        let x520 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x447, x447, x448),
+            S::neg(x517),
         );
-        let x521 = Self::mul_add(
-            7.078399999258757,
+        let x521 = S::mul_add(
+            S::splat(7.078399999258757),
             x445 - x449,
-            Self::mul_add(0.00000000020510342851533115, x510, x516),
+            S::mul_add(S::splat(0.00000000020510342851533115), x510, x516),
         );
         let x522 = x453
-            + Self::mul_add(0.36, x517, Self::mul_add(s_q12, x512, c_q12 * x511));
-        let x523 = Self::mul_add(x408, -2.5482240005325645, x446 * 3.8891049197628025)
-            - Self::mul_add(-x439, x452, x447 * x450)
-            + Self::mul_add(
-                0.36,
+            + S::mul_add(S::splat(0.36), x517, S::mul_add(s_q12, x512, c_q12 * x511));
+        let x523 = S::mul_add(
+            x408,
+            S::splat(-2.5482240005325645),
+            x446 * S::splat(3.8891049197628025),
+        ) - S::mul_add(S::neg(x439), x452, x447 * x450)
+            + S::mul_add(
+                S::splat(0.36),
                 x515,
-                Self::mul_add(0.00000000020510342851533115, x518, x513),
+                S::mul_add(S::splat(0.00000000020510342851533115), x518, x513),
             );
-        let x524 = x454 + Self::mul_add(-0.00000000020510342851533115, x513, x518);
-        let x525 = -x524;
-        let x526 = Self::mul_add(-s_q11, x520, c_q11 * x519);
-        let x527 = Self::mul_add(c_q11, x520, s_q11 * x519);
-        let x528 = Self::mul_add(x429, 45.1584, -x526);
-        let x529 = Self::mul_add(45.1584, x431, -x527);
-        let x530 = Self::mul_add(45.1584, x433, -x521);
+        let x524 = x454
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x513, x518);
+        let x525 = S::neg(x524);
+        let x526 = S::mul_add(S::neg(s_q11), x520, c_q11 * x519);
+        let x527 = S::mul_add(c_q11, x520, s_q11 * x519);
+        let x528 = S::mul_add(x429, S::splat(45.1584), S::neg(x526));
+        let x529 = S::mul_add(S::splat(45.1584), x431, S::neg(x527));
+        let x530 = S::mul_add(S::splat(45.1584), x433, S::neg(x521));
         let x531 = x437
-            - (Self::mul_add(s_q11, x523, c_q11 * x522)
-                - Self::mul_add(-0.63, x521, 0.275 * x527));
-        let x532 = Self::mul_add(x408, 24.35164200091464, x427 * 24.4950615)
-            + Self::mul_add(-x420, x436, x428 * x434)
-            - Self::mul_add(0.275, x526, Self::mul_add(-c_q11, x523, s_q11 * x522));
-        let x533 = x438 - Self::mul_add(0.63, x526, x524);
-        let x534 = Self::mul_add(-s_q10, x529, c_q10 * x528);
-        let x535 = Self::mul_add(x412, 81.53205, x534);
-        let x536 = Self::mul_add(
-            81.53205,
+            - (S::mul_add(s_q11, x523, c_q11 * x522)
+                - S::mul_add(S::splat(-0.63), x521, S::splat(0.275) * x527));
+        let x532 = S::mul_add(
+            x408,
+            S::splat(24.35164200091464),
+            x427 * S::splat(24.4950615),
+        ) + S::mul_add(S::neg(x420), x436, x428 * x434)
+            - S::mul_add(
+                S::splat(0.275),
+                x526,
+                S::mul_add(S::neg(c_q11), x523, s_q11 * x522),
+            );
+        let x533 = x438 - S::mul_add(S::splat(0.63), x526, x524);
+        let x534 = S::mul_add(S::neg(s_q10), x529, c_q10 * x528);
+        let x535 = S::mul_add(x412, S::splat(81.53205), x534);
+        let x536 = S::mul_add(
+            S::splat(81.53205),
             x413,
-            Self::mul_add(c_q10, x529, s_q10 * x528),
+            S::mul_add(c_q10, x529, s_q10 * x528),
         );
-        let x537 = Self::mul_add(81.53205, x414, x530);
+        let x537 = S::mul_add(S::splat(81.53205), x414, x530);
         let x538 = x418
-            + Self::mul_add(0.87, x530, Self::mul_add(-s_q10, x532, c_q10 * x531));
-        let x539 = Self::mul_add(x408, 36.18604050126307, x410 * 63.36336825)
-            + Self::mul_add(-x399, x417, x411 * x415)
-            + Self::mul_add(c_q10, x532, s_q10 * x531);
-        let x540 = x419 + Self::mul_add(0.87, x534, x533);
-        let x541 = Self::mul_add(-s_q9, x536, c_q9 * x535);
-        let x542 = Self::mul_add(c_q9, x536, s_q9 * x535);
-        let x543 = Self::mul_add(0.00000000020510342851533115, x542, x537);
-        let x544 = Self::mul_add(-0.00000000020510342851533115, x537, x542);
-        let x545 = Self::mul_add(c_q9, x539, s_q9 * x538);
-        let x546 = Self::mul_add(
-            -12.701650001451807,
+            + S::mul_add(
+                S::splat(0.87),
+                x530,
+                S::mul_add(S::neg(s_q10), x532, c_q10 * x531),
+            );
+        let x539 = S::mul_add(
+            x408,
+            S::splat(36.18604050126307),
+            x410 * S::splat(63.36336825),
+        ) + S::mul_add(S::neg(x399), x417, x411 * x415)
+            + S::mul_add(c_q10, x532, s_q10 * x531);
+        let x540 = x419 + S::mul_add(S::splat(0.87), x534, x533);
+        let x541 = S::mul_add(S::neg(s_q9), x536, c_q9 * x535);
+        let x542 = S::mul_add(c_q9, x536, s_q9 * x535);
+        let x543 = S::mul_add(S::splat(0.00000000020510342851533115), x542, x537);
+        let x544 = S::mul_add(S::splat(-0.00000000020510342851533115), x537, x542);
+        let x545 = S::mul_add(c_q9, x539, s_q9 * x538);
+        let x546 = S::mul_add(
+            S::splat(-12.701650001451807),
             x386,
-            0.0000000059257457049506905 * x384,
+            S::splat(0.0000000059257457049506905) * x384,
         ) - x541;
-        let x547 = Self::mul_add(
-            12.701650001451807,
+        let x547 = S::mul_add(
+            S::splat(12.701650001451807),
             x390,
-            0.0000000059257457049506905 * x388,
+            S::splat(0.0000000059257457049506905) * x388,
         ) + x543;
-        let x548 = Self::mul_add(
-            12.701650001451807,
+        let x548 = S::mul_add(
+            S::splat(12.701650001451807),
             x393,
-            0.0000000059257457049506905 * x392,
+            S::splat(0.0000000059257457049506905) * x392,
         ) - x544;
-        let x549 = Self::mul_add(
-            12.701650001451807,
+        let x549 = S::mul_add(
+            S::splat(12.701650001451807),
             x375,
-            Self::mul_add(
-                0.0021399976297017177,
+            S::mul_add(
+                S::splat(0.0021399976297017177),
                 x360,
-                x380 * 0.0000000005683321144643007,
-            ) + Self::mul_add(x370, x396, x381 * x395),
+                x380 * S::splat(0.0000000005683321144643007),
+            ) + S::mul_add(x370, x396, x381 * x395),
         )
-            + (Self::mul_add(-s_q9, x539, c_q9 * x538)
-                - Self::mul_add(-0.275, x544, 0.4 * x543));
+            + (S::mul_add(S::neg(s_q9), x539, c_q9 * x538)
+                - S::mul_add(S::splat(-0.275), x544, S::splat(0.4) * x543));
         let x550 = x397
-            - (Self::mul_add(-0.00000000020510342851533115, x545, x540)
-                - Self::mul_add(-0.00000000005640344284171607, x544, 0.4 * x541));
-        let x551 = Self::mul_add(
-            108.1389699208081,
+            - (S::mul_add(S::splat(-0.00000000020510342851533115), x545, x540)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x544,
+                    S::splat(0.4) * x541,
+                ));
+        let x551 = S::mul_add(
+            S::splat(108.1389699208081),
             x360,
-            Self::mul_add(x380, 5.080660022992536, 0.0021399976297017177 * x379),
-        ) - Self::mul_add(-x369, x395, x370 * x394)
-            + Self::mul_add(0.0000000059257457049506905, x377, 12.701650001451807 * x376)
-            + (Self::mul_add(0.00000000020510342851533115, x540, x545)
-                - Self::mul_add(-0.00000000005640344284171607, x543, 0.275 * x541));
-        let x552 = -x551;
-        let x553 = Self::mul_add(-s_q8, x547, c_q8 * x546);
-        let x554 = Self::mul_add(c_q8, x547, s_q8 * x546);
-        let x555 = Self::mul_add(0.00000000020510342851533115, x554, x548);
-        let x556 = Self::mul_add(-c_q8, x550, s_q8 * x549);
-        let x557 = Self::mul_add(x347 * x348, 48.0240000085309, x553);
-        let x558 = Self::mul_add(
-            48.0240000085309,
-            Self::mul_add(x361, x361, x362),
+            S::mul_add(
+                x380,
+                S::splat(5.080660022992536),
+                S::splat(0.0021399976297017177) * x379,
+            ),
+        ) - S::mul_add(S::neg(x369), x395, x370 * x394)
+            + S::mul_add(
+                S::splat(0.0000000059257457049506905),
+                x377,
+                S::splat(12.701650001451807) * x376,
+            )
+            + (S::mul_add(S::splat(0.00000000020510342851533115), x540, x545)
+                - S::mul_add(
+                    S::splat(-0.00000000005640344284171607),
+                    x543,
+                    S::splat(0.275) * x541,
+                ));
+        let x552 = S::neg(x551);
+        let x553 = S::mul_add(S::neg(s_q8), x547, c_q8 * x546);
+        let x554 = S::mul_add(c_q8, x547, s_q8 * x546);
+        let x555 = S::mul_add(S::splat(0.00000000020510342851533115), x554, x548);
+        let x556 = S::mul_add(S::neg(c_q8), x550, s_q8 * x549);
+        let x557 = S::mul_add(x347 * x348, S::splat(48.0240000085309), x553);
+        let x558 = S::mul_add(
+            S::splat(48.0240000085309),
+            S::mul_add(x361, x361, x362),
             x555,
         );
-        let x559 = Self::mul_add(
-            48.0240000085309,
+        let x559 = S::mul_add(
+            S::splat(48.0240000085309),
             x359 + x363,
-            -Self::mul_add(-0.00000000020510342851533115, x548, x554),
+            S::neg(S::mul_add(S::splat(-0.00000000020510342851533115), x548, x554)),
         );
         let x560 = x367
-            - Self::mul_add(0.35, x555, Self::mul_add(s_q8, x550, c_q8 * x549));
-        let x561 = Self::mul_add(x360, 125.18476992763283, 0.07309 * x359)
-            + Self::mul_add(x347, x366, x361 * x364)
-            - Self::mul_add(
-                -0.35,
+            - S::mul_add(S::splat(0.35), x555, S::mul_add(s_q8, x550, c_q8 * x549));
+        let x561 = S::mul_add(
+            x360,
+            S::splat(125.18476992763283),
+            S::splat(0.07309) * x359,
+        ) + S::mul_add(x347, x366, x361 * x364)
+            - S::mul_add(
+                S::splat(-0.35),
                 x553,
-                Self::mul_add(0.00000000020510342851533115, x556, x551),
+                S::mul_add(S::splat(0.00000000020510342851533115), x556, x551),
             );
-        let x562 = Self::mul_add(
+        let x562 = S::mul_add(
             x358,
-            -48.0240000085309,
-            Self::mul_add(-16.807689977165428, x360, 0.1132 * x359)
-                + Self::mul_add(-x347, x365, x348 * x364),
-        ) + Self::mul_add(-0.00000000020510342851533115, x551, x556);
-        let x563 = -x562;
-        let x564 = Self::mul_add(-c_q7, x558, s_q7 * x557);
-        let x565 = Self::mul_add(s_q7, x558, c_q7 * x557);
-        let x566 = Self::mul_add(v[5], -117.61766249359756, 1519.7808011559632 * v[3]);
-        let x567 = 1591.635376155963 * v[4];
-        let x568 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+            S::splat(-48.0240000085309),
+            S::mul_add(S::splat(-16.807689977165428), x360, S::splat(0.1132) * x359)
+                + S::mul_add(S::neg(x347), x365, x348 * x364),
+        ) + S::mul_add(S::splat(-0.00000000020510342851533115), x551, x556);
+        let x563 = S::neg(x562);
+        let x564 = S::mul_add(S::neg(c_q7), x558, s_q7 * x557);
+        let x565 = S::mul_add(s_q7, x558, c_q7 * x557);
+        let x566 = S::mul_add(
+            v[5],
+            S::splat(-117.61766249359756),
+            S::splat(1519.7808011559632) * v[3],
+        );
+        let x567 = S::splat(1591.635376155963) * v[4];
+        let x568 = S::mul_add(
+            S::splat(-1271.854575),
+            v[5],
+            v[3] * S::splat(117.61766249359758),
+        );
         let x569 = x564
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x344,
-                Self::mul_add(-180.9502499901501, x352, 110.5455 * x350),
+                S::mul_add(S::splat(-180.9502499901501), x352, S::splat(110.5455) * x350),
             );
-        let x570 = -(x565
-            - Self::mul_add(
-                1170.07,
-                x345,
-                Self::mul_add(180.9502499901501, x353, 110.5455 * x351),
-            ));
+        let x570 = S::neg(
+            x565
+                - S::mul_add(
+                    S::splat(1170.07),
+                    x345,
+                    S::mul_add(
+                        S::splat(180.9502499901501),
+                        x353,
+                        S::splat(110.5455) * x351,
+                    ),
+                ),
+        );
         let x571 = x559
-            - Self::mul_add(
-                1170.07,
+            - S::mul_add(
+                S::splat(1170.07),
                 x346,
-                -Self::mul_add(-180.9502499901501, x354, 110.5455 * x352),
+                S::neg(
+                    S::mul_add(
+                        S::splat(-180.9502499901501),
+                        x354,
+                        S::splat(110.5455) * x352,
+                    ),
+                ),
             );
-        let x572 = -(Self::mul_add(-0.75, x565, Self::mul_add(-c_q7, x561, s_q7 * x560))
-            + Self::mul_add(
-                180.9502499901501,
-                x345,
-                Self::mul_add(v[4], x568, v[5] * x567),
-            ));
-        let x573 = Self::mul_add(s_q7, x561, c_q7 * x560)
-            + Self::mul_add(-0.65, x559, 0.75 * x564)
-            + (Self::mul_add(v[3], x568, v[5] * x566)
-                - Self::mul_add(-110.5455, x346, 180.9502499901501 * x344));
-        let x574 = -(Self::mul_add(0.65, x565, x562)
-            + Self::mul_add(-110.5455, x345, Self::mul_add(-v[3], x567, v[4] * x566)));
+        let x572 = S::neg(
+            S::mul_add(
+                S::splat(-0.75),
+                x565,
+                S::mul_add(S::neg(c_q7), x561, s_q7 * x560),
+            )
+                + S::mul_add(
+                    S::splat(180.9502499901501),
+                    x345,
+                    S::mul_add(v[4], x568, v[5] * x567),
+                ),
+        );
+        let x573 = S::mul_add(s_q7, x561, c_q7 * x560)
+            + S::mul_add(S::splat(-0.65), x559, S::splat(0.75) * x564)
+            + (S::mul_add(v[3], x568, v[5] * x566)
+                - S::mul_add(
+                    S::splat(-110.5455),
+                    x346,
+                    S::splat(180.9502499901501) * x344,
+                ));
+        let x574 = S::neg(
+            S::mul_add(S::splat(0.65), x565, x562)
+                + S::mul_add(
+                    S::splat(-110.5455),
+                    x345,
+                    S::mul_add(S::neg(v[3]), x567, v[4] * x566),
+                ),
+        );
         (
             [
                 [
-                    1170.07,
-                    0.0,
-                    0.0,
-                    0.0,
+                    S::splat(1170.07),
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(0.0),
                     x173,
                     x163,
                     x163,
@@ -5745,11 +7088,11 @@ impl FreeFloating7 {
                     x339,
                 ],
                 [
-                    0.0,
-                    1170.07,
-                    0.0,
+                    S::splat(0.0),
+                    S::splat(1170.07),
+                    S::splat(0.0),
                     x178,
-                    0.0,
+                    S::splat(0.0),
                     x172,
                     x162,
                     x186,
@@ -5760,13 +7103,13 @@ impl FreeFloating7 {
                     x340,
                 ],
                 [
-                    0.0,
-                    0.0,
-                    1170.07,
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(1170.07),
                     x160,
                     x179,
-                    0.0,
-                    0.0,
+                    S::splat(0.0),
+                    S::splat(0.0),
                     x140,
                     x197,
                     x218,
@@ -5775,7 +7118,7 @@ impl FreeFloating7 {
                     x333,
                 ],
                 [
-                    0.0,
+                    S::splat(0.0),
                     x178,
                     x160,
                     x174,
@@ -5791,7 +7134,7 @@ impl FreeFloating7 {
                 ],
                 [
                     x173,
-                    0.0,
+                    S::splat(0.0),
                     x179,
                     x169,
                     x176,
@@ -5807,7 +7150,7 @@ impl FreeFloating7 {
                 [
                     x163,
                     x172,
-                    0.0,
+                    S::splat(0.0),
                     x175,
                     x170,
                     x177,
@@ -5822,7 +7165,7 @@ impl FreeFloating7 {
                 [
                     x163,
                     x162,
-                    0.0,
+                    S::splat(0.0),
                     x168,
                     x170,
                     x171,
@@ -5922,7 +7265,7 @@ impl FreeFloating7 {
                     x315,
                     x307,
                     x300,
-                    1.4135609200000003,
+                    S::splat(1.4135609200000003),
                 ],
             ],
             [
@@ -5942,6 +7285,40 @@ impl FreeFloating7 {
             ],
         )
     }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [([[::core::primitive::f64; 13]; 13], [::core::primitive::f64; 13])],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
+    }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
     /// Methods: mass matrix `crba`, nonlinear effects `newton-euler`, forward `ldlt`: 1463 mul, 1350 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
@@ -5952,8 +7329,17 @@ impl FreeFloating7 {
         tau: &[::core::primitive::f64; 7],
         f_ext: &[[::core::primitive::f64; 6]; 8],
     ) -> [::core::primitive::f64; 13] {
+        Self::forward_dynamics_with_wrenches_lanes::<
+            ::core::primitive::f64,
+        >(q, v, tau, f_ext)
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 14], v: &[S; 13], tau: &[S; 7], f_ext: &[[S; 6]; 8]) -> [S; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
             q[8],
             q[9],
@@ -5962,487 +7348,598 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = 0.00000000020510342851533115 * c_q9;
-        let x8 = 0.00000000020510342851533115 * s_q9;
+        let x7 = S::splat(0.00000000020510342851533115) * c_q9;
+        let x8 = S::splat(0.00000000020510342851533115) * s_q9;
         let x9 = x7 - x8;
         let x10 = x7 + x8;
         let x11 = s_q13 * s_q13;
         let x12 = s_q13 * c_q13;
-        let x13 = Self::mul_add(x12, 0.001562, x11 * 1.2025609200000003);
-        let x14 = 0.000781 + Self::mul_add(x11, -0.001562, x12 * 1.2025609200000003);
-        let x15 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
-        let x16 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x17 = 4.806620000000001 * s_q13;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 1.4135609200000003 + x13;
+        let x13 = S::mul_add(
+            x12,
+            S::splat(0.001562),
+            x11 * S::splat(1.2025609200000003),
+        );
+        let x14 = S::splat(0.000781)
+            + S::mul_add(x11, S::splat(-0.001562), x12 * S::splat(1.2025609200000003));
+        let x15 = S::mul_add(
+            s_q13,
+            S::splat(-0.9614610000000001),
+            c_q13 * S::splat(0.0145),
+        );
+        let x16 = S::mul_add(
+            c_q13,
+            S::splat(0.9614610000000001),
+            s_q13 * S::splat(0.0145),
+        );
+        let x17 = S::splat(4.806620000000001) * s_q13;
+        let x18 = S::splat(4.806620000000001) * c_q13;
+        let x19 = S::splat(1.4135609200000003) + x13;
         let x20 = x15 + x15;
-        let x21 = Self::mul_add(0.00000000020510342851533115, x20, x19);
-        let x22 = 0.00000000020510342851533115 * x17;
-        let x23 = 0.16 * x17;
-        let x24 = 0.55 * x18;
+        let x21 = S::mul_add(S::splat(0.00000000020510342851533115), x20, x19);
+        let x22 = S::splat(0.00000000020510342851533115) * x17;
+        let x23 = S::splat(0.16) * x17;
+        let x24 = S::splat(0.55) * x18;
         let x25 = x23 + x24;
         let x26 = x25 - (x13 - x21 - x25);
-        let x27 = Self::mul_add(
-            0.55,
+        let x27 = S::mul_add(
+            S::splat(0.55),
             x17,
-            Self::mul_add(
-                0.16,
+            S::mul_add(
+                S::splat(0.16),
                 x18,
-                Self::mul_add(-0.00000000020510342851533115, x16, x14),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x16, x14),
             ),
         );
-        let x28 = 3.6140000000000003 + x22;
-        let x29 = 17.135250000000003 + x18;
-        let x30 = -1.9877000000000002
-            - Self::mul_add(
-                0.55,
+        let x28 = S::splat(3.6140000000000003) + x22;
+        let x29 = S::splat(17.135250000000003) + x18;
+        let x30 = S::splat(-1.9877000000000002)
+            - S::mul_add(
+                S::splat(0.55),
                 x22,
-                Self::mul_add(0.00000000020510342851533115, x14, x16),
+                S::mul_add(S::splat(0.00000000020510342851533115), x14, x16),
             );
-        let x31 = -0.809539999555672
-            - Self::mul_add(
-                0.16,
+        let x31 = S::splat(-0.809539999555672)
+            - S::mul_add(
+                S::splat(0.16),
                 x22,
-                x15 - Self::mul_add(-0.00000000020510342851533115, x19, x20),
+                x15 - S::mul_add(S::splat(-0.00000000020510342851533115), x19, x20),
             );
-        let x32 = -5.252920330000002 + (x23 + (-1.2025609200000003 + x13 + x23));
-        let x33 = -2.741639999592316 - x27;
-        let x34 = 9.740442170000001 + (x24 + (1.4135609200000003 - x21 + x24));
+        let x32 = S::splat(-5.252920330000002)
+            + (x23 + (S::splat(-1.2025609200000003) + x13 + x23));
+        let x33 = S::splat(-2.741639999592316) - x27;
+        let x34 = S::splat(9.740442170000001)
+            + (x24 + (S::splat(1.4135609200000003) - x21 + x24));
         let x35 = s_q12 * s_q12;
         let x36 = s_q12 * c_q12;
         let x37 = x26 - x32;
         let x38 = x30 + x30;
-        let x39 = Self::mul_add(x36, x38, x35 * x37);
+        let x39 = S::mul_add(x36, x38, x35 * x37);
         let x40 = x32 + x39;
-        let x41 = x30 + Self::mul_add(-x35, x38, x36 * x37);
-        let x42 = Self::mul_add(-s_q12, x33, c_q12 * x31);
-        let x43 = Self::mul_add(c_q12, x33, s_q12 * x31);
-        let x44 = Self::mul_add(-s_q12, x29, c_q12 * x28);
-        let x45 = Self::mul_add(c_q12, x29, s_q12 * x28);
+        let x41 = x30 + S::mul_add(S::neg(x35), x38, x36 * x37);
+        let x42 = S::mul_add(S::neg(s_q12), x33, c_q12 * x31);
+        let x43 = S::mul_add(c_q12, x33, s_q12 * x31);
+        let x44 = S::mul_add(S::neg(s_q12), x29, c_q12 * x28);
+        let x45 = S::mul_add(c_q12, x29, s_q12 * x28);
         let x46 = x34 - x40;
         let x47 = x43 + x43;
-        let x48 = Self::mul_add(-0.00000000020510342851533115, x47, x46);
-        let x49 = Self::mul_add(-0.00000000020510342851533115, x41, x42);
-        let x50 = Self::mul_add(-0.00000000020510342851533115, x45, x17);
+        let x48 = S::mul_add(S::splat(-0.00000000020510342851533115), x47, x46);
+        let x49 = S::mul_add(S::splat(-0.00000000020510342851533115), x41, x42);
+        let x50 = S::mul_add(S::splat(-0.00000000020510342851533115), x45, x17);
         let x51 = x22 + x45;
-        let x52 = x51 * 0.36;
+        let x52 = x51 * S::splat(0.36);
         let x53 = x52 + (x26 - x39 + x52);
-        let x54 = 7.078399999258757 + x50;
-        let x55 = 0.01675
-            - Self::mul_add(
+        let x54 = S::splat(7.078399999258757) + x50;
+        let x55 = S::splat(0.01675)
+            - S::mul_add(
                 x44,
-                -0.36,
-                Self::mul_add(0.00000000020510342851533115, x42, x41),
+                S::splat(-0.36),
+                S::mul_add(S::splat(0.00000000020510342851533115), x42, x41),
             );
-        let x56 = -9.142025249762803 + (x52 + (x40 + x48 + x52));
-        let x57 = 2.5482240016099564
-            + Self::mul_add(
+        let x56 = S::splat(-9.142025249762803) + (x52 + (x40 + x48 + x52));
+        let x57 = S::splat(2.5482240016099564)
+            + S::mul_add(
                 x50,
-                0.36,
-                x43 - Self::mul_add(0.00000000020510342851533115, x46, x47),
+                S::splat(0.36),
+                x43 - S::mul_add(S::splat(0.00000000020510342851533115), x46, x47),
             );
-        let x58 = 9.223235249762805 + (x34 - x48);
+        let x58 = S::splat(9.223235249762805) + (x34 - x48);
         let x59 = s_q11 * s_q11;
         let x60 = s_q11 * c_q11;
         let x61 = x53 - x56;
         let x62 = x49 + x49;
-        let x63 = Self::mul_add(x60, x62, x59 * x61);
-        let x64 = Self::mul_add(-s_q11, x54, c_q11 * x44);
-        let x65 = Self::mul_add(c_q11, x54, s_q11 * x44);
-        let x66 = 0.275 * x51;
-        let x67 = x65 * 0.63;
+        let x63 = S::mul_add(x60, x62, x59 * x61);
+        let x64 = S::mul_add(S::neg(s_q11), x54, c_q11 * x44);
+        let x65 = S::mul_add(c_q11, x54, s_q11 * x44);
+        let x66 = S::splat(0.275) * x51;
+        let x67 = x65 * S::splat(0.63);
         let x68 = x66 - x67;
-        let x69 = Self::mul_add(x64, 0.63, x49 + Self::mul_add(-x59, x62, x60 * x61));
-        let x70 = Self::mul_add(0.275, x64, Self::mul_add(-s_q11, x57, c_q11 * x55));
-        let x71 = Self::mul_add(0.275, x65, Self::mul_add(c_q11, x57, s_q11 * x55));
+        let x69 = S::mul_add(
+            x64,
+            S::splat(0.63),
+            x49 + S::mul_add(S::neg(x59), x62, x60 * x61),
+        );
+        let x70 = S::mul_add(
+            S::splat(0.275),
+            x64,
+            S::mul_add(S::neg(s_q11), x57, c_q11 * x55),
+        );
+        let x71 = S::mul_add(S::splat(0.275), x65, S::mul_add(c_q11, x57, s_q11 * x55));
         let x72 = x58 - x67;
         let x73 = x68 + (x53 - x63 + x68);
-        let x74 = -45.1584 + x65;
-        let x75 = -0.6328 + x70;
-        let x76 = -24.4950615 + (x66 + (x56 + x63 + x66));
-        let x77 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x71);
-        let x78 = 28.2393615 - (x67 - x72);
+        let x74 = S::splat(-45.1584) + x65;
+        let x75 = S::splat(-0.6328) + x70;
+        let x76 = S::splat(-24.4950615) + (x66 + (x56 + x63 + x66));
+        let x77 = S::splat(-24.35164200091464)
+            - S::mul_add(x51, S::splat(0.63), S::neg(x71));
+        let x78 = S::splat(28.2393615) - (x67 - x72);
         let x79 = s_q10 * s_q10;
         let x80 = s_q10 * c_q10;
         let x81 = x73 - x76;
         let x82 = x69 + x69;
-        let x83 = Self::mul_add(x80, x82, x79 * x81);
-        let x84 = Self::mul_add(-s_q10, x77, c_q10 * x75);
-        let x85 = Self::mul_add(c_q10, x77, s_q10 * x75);
+        let x83 = S::mul_add(x80, x82, x79 * x81);
+        let x84 = S::mul_add(S::neg(s_q10), x77, c_q10 * x75);
+        let x85 = S::mul_add(c_q10, x77, s_q10 * x75);
         let x86 = c_q10 * x64;
-        let x87 = Self::mul_add(-s_q10, x74, x86);
+        let x87 = S::mul_add(S::neg(s_q10), x74, x86);
         let x88 = s_q10 * x64;
-        let x89 = Self::mul_add(c_q10, x74, x88);
-        let x90 = x89 * 0.87;
-        let x91 = Self::mul_add(x87, 0.87, x69 + Self::mul_add(-x79, x82, x80 * x81));
+        let x89 = S::mul_add(c_q10, x74, x88);
+        let x90 = x89 * S::splat(0.87);
+        let x91 = S::mul_add(
+            x87,
+            S::splat(0.87),
+            x69 + S::mul_add(S::neg(x79), x82, x80 * x81),
+        );
         let x92 = x78 - x90;
         let x93 = x90 - (x73 - x83 - x90);
-        let x94 = -81.53205 + x89;
-        let x95 = -0.00214 + x84;
-        let x96 = -63.36336825000001 + (x76 + x83);
-        let x97 = -36.18604050126307 + Self::mul_add(x51, -0.87, x85);
-        let x98 = 69.99836825 - (x90 - x92);
+        let x94 = S::splat(-81.53205) + x89;
+        let x95 = S::splat(-0.00214) + x84;
+        let x96 = S::splat(-63.36336825000001) + (x76 + x83);
+        let x97 = S::splat(-36.18604050126307) + S::mul_add(x51, S::splat(-0.87), x85);
+        let x98 = S::splat(69.99836825) - (x90 - x92);
         let x99 = s_q9 * s_q9;
         let x100 = s_q9 * c_q9;
         let x101 = x93 + x96;
         let x102 = x91 + x91;
-        let x103 = Self::mul_add(-x100, x102, x99 * x101);
+        let x103 = S::mul_add(S::neg(x100), x102, x99 * x101);
         let x104 = x93 - x103;
         let x105 = x96 - x103;
-        let x106 = x91 - Self::mul_add(x99, x102, x100 * x101);
-        let x107 = Self::mul_add(-s_q9, x97, c_q9 * x95);
-        let x108 = Self::mul_add(c_q9, x97, s_q9 * x95);
+        let x106 = x91 - S::mul_add(x99, x102, x100 * x101);
+        let x107 = S::mul_add(S::neg(s_q9), x97, c_q9 * x95);
+        let x108 = S::mul_add(c_q9, x97, s_q9 * x95);
         let x109 = c_q9 * x87;
-        let x110 = Self::mul_add(-s_q9, x94, x109);
+        let x110 = S::mul_add(S::neg(s_q9), x94, x109);
         let x111 = s_q9 * x87;
-        let x112 = Self::mul_add(c_q9, x94, x111);
-        let x113 = 0.00000000020510342851533115 * x51;
+        let x112 = S::mul_add(c_q9, x94, x111);
+        let x113 = S::splat(0.00000000020510342851533115) * x51;
         let x114 = x112 - x113;
-        let x115 = 0.00000000020510342851533115 * x112;
-        let x116 = x51 - Self::mul_add(0.00000000020510342851533115, x110, -x115);
+        let x115 = S::splat(0.00000000020510342851533115) * x112;
+        let x116 = x51
+            - S::mul_add(S::splat(0.00000000020510342851533115), x110, S::neg(x115));
         let x117 = x110 + x113;
-        let x118 = 0.00000000020510342851533115 * x107;
+        let x118 = S::splat(0.00000000020510342851533115) * x107;
         let x119 = x106 + x118;
-        let x120 = 0.00000000020510342851533115 * x108;
+        let x120 = S::splat(0.00000000020510342851533115) * x108;
         let x121 = x105 + x120;
-        let x122 = 0.00000000020510342851533115 * x98;
+        let x122 = S::splat(0.00000000020510342851533115) * x98;
         let x123 = x108 + x122;
-        let x124 = 0.00000000020510342851533115 * x106;
-        let x125 = x107 - Self::mul_add(0.00000000020510342851533115, x104, x124);
+        let x124 = S::splat(0.00000000020510342851533115) * x106;
+        let x125 = x107 - S::mul_add(S::splat(0.00000000020510342851533115), x104, x124);
         let x126 = x98 + (x118 - x120);
         let x127 = x107 - x122;
-        let x128 = 0.00000000020510342851533115 * x123;
-        let x129 = 0.4 * x117;
-        let x130 = 0.275 * x116;
+        let x128 = S::splat(0.00000000020510342851533115) * x123;
+        let x129 = S::splat(0.4) * x117;
+        let x130 = S::splat(0.275) * x116;
         let x131 = x129 - x130;
         let x132 = x131 + (x121 + x128 + x131);
-        let x133 = Self::mul_add(
-            0.275,
+        let x133 = S::mul_add(
+            S::splat(0.275),
             x117,
-            -Self::mul_add(
-                0.4,
-                x116,
-                Self::mul_add(-0.00000000020510342851533115, x126, x125),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.4),
+                    x116,
+                    S::mul_add(S::splat(-0.00000000020510342851533115), x126, x125),
+                ),
             ),
         );
-        let x134 = -0.000000008530897668050218 + x114;
-        let x135 = -12.701650001451807 - x116;
-        let x136 = -0.0000000234896432582596
-            + Self::mul_add(
-                -0.275,
+        let x134 = S::splat(-0.000000008530897668050218) + x114;
+        let x135 = S::splat(-12.701650001451807) - x116;
+        let x136 = S::splat(-0.0000000234896432582596)
+            + S::mul_add(
+                S::splat(-0.275),
                 x114,
                 x123
-                    + Self::mul_add(
-                        -0.00000000020510342851533115,
+                    + S::mul_add(
+                        S::splat(-0.00000000020510342851533115),
                         x121,
-                        0.00000000020510342851533115 * x119,
+                        S::splat(0.00000000020510342851533115) * x119,
                     ),
             );
-        let x137 = -0.002139996587640933 + Self::mul_add(-0.4, x114, x119 - x128);
-        let x138 = -111.7548902508081
+        let x137 = S::splat(-0.002139996587640933)
+            + S::mul_add(S::splat(-0.4), x114, x119 - x128);
+        let x138 = S::splat(-111.7548902508081)
             + (x129
                 + (x126
-                    + Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x108 + Self::mul_add(-0.00000000020510342851533115, x105, x124),
-                        0.00000000020510342851533115 * x125,
+                    + S::mul_add(
+                        S::splat(-0.00000000020510342851533115),
+                        x108
+                            + S::mul_add(
+                                S::splat(-0.00000000020510342851533115),
+                                x105,
+                                x124,
+                            ),
+                        S::splat(0.00000000020510342851533115) * x125,
                     ) + x129));
-        let x139 = 5.080660024070365 - x133;
-        let x140 = 113.3918902508081
+        let x139 = S::splat(5.080660024070365) - x133;
+        let x140 = S::splat(113.3918902508081)
             - (x130
-                + (Self::mul_add(0.00000000020510342851533115, x127, x104 + x118)
+                + (S::mul_add(S::splat(0.00000000020510342851533115), x127, x104 + x118)
                     + x130));
         let x141 = s_q8 * s_q8;
         let x142 = s_q8 * c_q8;
         let x143 = x132 - x138;
         let x144 = x136 + x136;
-        let x145 = Self::mul_add(x142, x144, x141 * x143);
+        let x145 = S::mul_add(x142, x144, x141 * x143);
         let x146 = x132 - x145;
-        let x147 = x136 + Self::mul_add(-x141, x144, x142 * x143);
-        let x148 = Self::mul_add(-s_q8, x139, c_q8 * x137);
-        let x149 = Self::mul_add(c_q8, x139, s_q8 * x137);
-        let x150 = Self::mul_add(-s_q8, x135, c_q8 * x134);
-        let x151 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x147 = x136 + S::mul_add(S::neg(x141), x144, x142 * x143);
+        let x148 = S::mul_add(S::neg(s_q8), x139, c_q8 * x137);
+        let x149 = S::mul_add(c_q8, x139, s_q8 * x137);
+        let x150 = S::mul_add(S::neg(s_q8), x135, c_q8 * x134);
+        let x151 = S::mul_add(c_q8, x135, s_q8 * x134);
         let x152 = x140 - x146;
         let x153 = x148 + x148;
-        let x154 = Self::mul_add(-0.00000000020510342851533115, x153, x152);
-        let x155 = Self::mul_add(0.00000000020510342851533115, x117, x150);
-        let x156 = Self::mul_add(-0.00000000020510342851533115, x150, x117);
-        let x157 = 0.35 * x155;
+        let x154 = S::mul_add(S::splat(-0.00000000020510342851533115), x153, x152);
+        let x155 = S::mul_add(S::splat(0.00000000020510342851533115), x117, x150);
+        let x156 = S::mul_add(S::splat(-0.00000000020510342851533115), x150, x117);
+        let x157 = S::splat(0.35) * x155;
         let x158 = x157 - (x146 + x154 - x157);
-        let x159 = 48.0240000085309 + x156;
-        let x160 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x147, x149);
-        let x161 = -16.80768997608804
-            + Self::mul_add(
-                -0.35,
+        let x159 = S::splat(48.0240000085309) + x156;
+        let x160 = S::splat(-0.07309)
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x147, x149);
+        let x161 = S::splat(-16.80768997608804)
+            + S::mul_add(
+                S::splat(-0.35),
                 x156,
-                x148 - Self::mul_add(0.00000000020510342851533115, x152, x153),
+                x148 - S::mul_add(S::splat(0.00000000020510342851533115), x152, x153),
             );
-        let x162 = 130.43769025763282 - (x157 - (x138 + x145 - x157));
-        let x163 = 0.1132
-            - Self::mul_add(
-                0.35,
+        let x162 = S::splat(130.43769025763282) - (x157 - (x138 + x145 - x157));
+        let x163 = S::splat(0.1132)
+            - S::mul_add(
+                S::splat(0.35),
                 x151,
-                Self::mul_add(0.00000000020510342851533115, x149, x147),
+                S::mul_add(S::splat(0.00000000020510342851533115), x149, x147),
             );
-        let x164 = 132.47349025763282 + (x140 - x154);
+        let x164 = S::splat(132.47349025763282) + (x140 - x154);
         let x165 = s_q7 * s_q7;
         let x166 = s_q7 * c_q7;
         let x167 = x158 + x162;
         let x168 = x160 + x160;
-        let x169 = Self::mul_add(-x166, x168, x165 * x167);
-        let x170 = Self::mul_add(-s_q7, x151, c_q7 * x159);
-        let x171 = Self::mul_add(c_q7, x151, s_q7 * x159);
-        let x172 = 0.75 * x155;
-        let x173 = 0.65 * x170;
+        let x169 = S::mul_add(S::neg(x166), x168, x165 * x167);
+        let x170 = S::mul_add(S::neg(s_q7), x151, c_q7 * x159);
+        let x171 = S::mul_add(c_q7, x151, s_q7 * x159);
+        let x172 = S::splat(0.75) * x155;
+        let x173 = S::splat(0.65) * x170;
         let x174 = x172 - x173;
-        let x175 = Self::mul_add(-0.75, x170, Self::mul_add(-s_q7, x163, c_q7 * x161));
+        let x175 = S::mul_add(
+            S::splat(-0.75),
+            x170,
+            S::mul_add(S::neg(s_q7), x163, c_q7 * x161),
+        );
         let x176 = x164 + x173;
-        let x177 = 110.5455 + x170;
-        let x178 = 180.9502499901501 - x155;
-        let x179 = 0.00000000020510342851533115 * x151;
-        let x180 = Self::mul_add(0.00000000020510342851533115, x140, x148);
-        let x181 = Self::mul_add(
-            -0.35,
+        let x177 = S::splat(110.5455) + x170;
+        let x178 = S::splat(180.9502499901501) - x155;
+        let x179 = S::splat(0.00000000020510342851533115) * x151;
+        let x180 = S::mul_add(S::splat(0.00000000020510342851533115), x140, x148);
+        let x181 = S::mul_add(
+            S::splat(-0.35),
             x150,
-            Self::mul_add(-0.00000000020510342851533115, x148, x140),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x148, x140),
         );
-        let x182 = Self::mul_add(0.35, x179, x149);
-        let x183 = Self::mul_add(-s_q7, x150, c_q7 * x179);
-        let x184 = Self::mul_add(c_q7, x150, s_q7 * x179);
+        let x182 = S::mul_add(S::splat(0.35), x179, x149);
+        let x183 = S::mul_add(S::neg(s_q7), x150, c_q7 * x179);
+        let x184 = S::mul_add(c_q7, x150, s_q7 * x179);
         let x185 = x10 * x87;
-        let x186 = Self::mul_add(x9, x94, x185);
-        let x187 = x123 + Self::mul_add(-0.275, x112, 0.4 * x186);
-        let x188 = Self::mul_add(0.4, x110, x98 + Self::mul_add(-x10, x97, x9 * x95));
-        let x189 = Self::mul_add(-0.275, x110, x127);
-        let x190 = Self::mul_add(s_q8, x186, c_q8 * x110);
-        let x191 = Self::mul_add(-c_q8, x186, s_q8 * x110);
+        let x186 = S::mul_add(x9, x94, x185);
+        let x187 = x123 + S::mul_add(S::splat(-0.275), x112, S::splat(0.4) * x186);
+        let x188 = S::mul_add(
+            S::splat(0.4),
+            x110,
+            x98 + S::mul_add(S::neg(x10), x97, x9 * x95),
+        );
+        let x189 = S::mul_add(S::splat(-0.275), x110, x127);
+        let x190 = S::mul_add(s_q8, x186, c_q8 * x110);
+        let x191 = S::mul_add(S::neg(c_q8), x186, s_q8 * x110);
         let x192 = x115 - x190;
-        let x193 = Self::mul_add(0.00000000020510342851533115, x190, x112);
-        let x194 = Self::mul_add(-s_q8, x188, c_q8 * x187);
-        let x195 = Self::mul_add(0.00000000020510342851533115, x189, x194);
-        let x196 = Self::mul_add(
-            -0.35,
+        let x193 = S::mul_add(S::splat(0.00000000020510342851533115), x190, x112);
+        let x194 = S::mul_add(S::neg(s_q8), x188, c_q8 * x187);
+        let x195 = S::mul_add(S::splat(0.00000000020510342851533115), x189, x194);
+        let x196 = S::mul_add(
+            S::splat(-0.35),
             x191,
-            Self::mul_add(-0.00000000020510342851533115, x194, x189),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x194, x189),
         );
-        let x197 = Self::mul_add(-0.35, x193, Self::mul_add(c_q8, x188, s_q8 * x187));
-        let x198 = Self::mul_add(s_q7, x191, c_q7 * x193);
-        let x199 = Self::mul_add(-c_q7, x191, s_q7 * x193);
-        let x200 = Self::mul_add(-s_q9, x89, x109);
-        let x201 = Self::mul_add(x9, x89, x185);
-        let x202 = Self::mul_add(c_q9, x89, x111);
-        let x203 = 0.00000000020510342851533115 * x92;
-        let x204 = Self::mul_add(c_q9, x85, s_q9 * x84) + x203
-            + Self::mul_add(-0.275, x202, 0.4 * x201);
-        let x205 = Self::mul_add(0.4, x200, x92 + Self::mul_add(-x10, x85, x9 * x84));
-        let x206 = Self::mul_add(
-            0.275,
+        let x197 = S::mul_add(
+            S::splat(-0.35),
+            x193,
+            S::mul_add(c_q8, x188, s_q8 * x187),
+        );
+        let x198 = S::mul_add(s_q7, x191, c_q7 * x193);
+        let x199 = S::mul_add(S::neg(c_q7), x191, s_q7 * x193);
+        let x200 = S::mul_add(S::neg(s_q9), x89, x109);
+        let x201 = S::mul_add(x9, x89, x185);
+        let x202 = S::mul_add(c_q9, x89, x111);
+        let x203 = S::splat(0.00000000020510342851533115) * x92;
+        let x204 = S::mul_add(c_q9, x85, s_q9 * x84) + x203
+            + S::mul_add(S::splat(-0.275), x202, S::splat(0.4) * x201);
+        let x205 = S::mul_add(
+            S::splat(0.4),
             x200,
-            x203 - Self::mul_add(-s_q9, x85, c_q9 * x84),
+            x92 + S::mul_add(S::neg(x10), x85, x9 * x84),
         );
-        let x207 = Self::mul_add(s_q8, x201, c_q8 * x200);
-        let x208 = Self::mul_add(-c_q8, x201, s_q8 * x200);
-        let x209 = Self::mul_add(-0.00000000020510342851533115, x202, x207);
-        let x210 = Self::mul_add(0.00000000020510342851533115, x207, x202);
-        let x211 = Self::mul_add(-s_q8, x205, c_q8 * x204);
-        let x212 = Self::mul_add(-0.00000000020510342851533115, x206, x211);
-        let x213 = Self::mul_add(
-            0.35,
+        let x206 = S::mul_add(
+            S::splat(0.275),
+            x200,
+            x203 - S::mul_add(S::neg(s_q9), x85, c_q9 * x84),
+        );
+        let x207 = S::mul_add(s_q8, x201, c_q8 * x200);
+        let x208 = S::mul_add(S::neg(c_q8), x201, s_q8 * x200);
+        let x209 = S::mul_add(S::splat(-0.00000000020510342851533115), x202, x207);
+        let x210 = S::mul_add(S::splat(0.00000000020510342851533115), x207, x202);
+        let x211 = S::mul_add(S::neg(s_q8), x205, c_q8 * x204);
+        let x212 = S::mul_add(S::splat(-0.00000000020510342851533115), x206, x211);
+        let x213 = S::mul_add(
+            S::splat(0.35),
             x208,
-            Self::mul_add(0.00000000020510342851533115, x211, x206),
+            S::mul_add(S::splat(0.00000000020510342851533115), x211, x206),
         );
-        let x214 = Self::mul_add(-0.35, x210, Self::mul_add(c_q8, x205, s_q8 * x204));
-        let x215 = Self::mul_add(s_q7, x208, c_q7 * x210);
-        let x216 = Self::mul_add(-c_q7, x208, s_q7 * x210);
-        let x217 = Self::mul_add(c_q10, x65, x88);
-        let x218 = Self::mul_add(-s_q10, x65, x86);
-        let x219 = Self::mul_add(-s_q10, x71, c_q10 * x70);
-        let x220 = Self::mul_add(c_q10, x71, s_q10 * x70);
-        let x221 = Self::mul_add(-0.87, x217, x72);
-        let x222 = Self::mul_add(-c_q9, x218, s_q9 * x217);
-        let x223 = Self::mul_add(x10, x218, x9 * x217);
-        let x224 = Self::mul_add(s_q9, x218, c_q9 * x217);
-        let x225 = 0.00000000020510342851533115 * x221;
-        let x226 = Self::mul_add(c_q9, x220, s_q9 * x219) + x225
-            + Self::mul_add(-0.275, x224, 0.4 * x223);
-        let x227 = Self::mul_add(
-            -0.4,
+        let x214 = S::mul_add(
+            S::splat(-0.35),
+            x210,
+            S::mul_add(c_q8, x205, s_q8 * x204),
+        );
+        let x215 = S::mul_add(s_q7, x208, c_q7 * x210);
+        let x216 = S::mul_add(S::neg(c_q7), x208, s_q7 * x210);
+        let x217 = S::mul_add(c_q10, x65, x88);
+        let x218 = S::mul_add(S::neg(s_q10), x65, x86);
+        let x219 = S::mul_add(S::neg(s_q10), x71, c_q10 * x70);
+        let x220 = S::mul_add(c_q10, x71, s_q10 * x70);
+        let x221 = S::mul_add(S::splat(-0.87), x217, x72);
+        let x222 = S::mul_add(S::neg(c_q9), x218, s_q9 * x217);
+        let x223 = S::mul_add(x10, x218, x9 * x217);
+        let x224 = S::mul_add(s_q9, x218, c_q9 * x217);
+        let x225 = S::splat(0.00000000020510342851533115) * x221;
+        let x226 = S::mul_add(c_q9, x220, s_q9 * x219) + x225
+            + S::mul_add(S::splat(-0.275), x224, S::splat(0.4) * x223);
+        let x227 = S::mul_add(
+            S::splat(-0.4),
             x222,
-            x221 + Self::mul_add(-x10, x220, x9 * x219),
+            x221 + S::mul_add(S::neg(x10), x220, x9 * x219),
         );
-        let x228 = Self::mul_add(
-            -0.275,
+        let x228 = S::mul_add(
+            S::splat(-0.275),
             x222,
-            x225 - Self::mul_add(-s_q9, x220, c_q9 * x219),
+            x225 - S::mul_add(S::neg(s_q9), x220, c_q9 * x219),
         );
-        let x229 = Self::mul_add(-s_q8, x223, c_q8 * x222);
-        let x230 = Self::mul_add(c_q8, x223, s_q8 * x222);
-        let x231 = Self::mul_add(0.00000000020510342851533115, x224, x229);
-        let x232 = Self::mul_add(-0.00000000020510342851533115, x229, x224);
-        let x233 = Self::mul_add(-s_q8, x227, c_q8 * x226);
-        let x234 = Self::mul_add(-0.00000000020510342851533115, x228, x233);
-        let x235 = Self::mul_add(
-            -0.35,
+        let x229 = S::mul_add(S::neg(s_q8), x223, c_q8 * x222);
+        let x230 = S::mul_add(c_q8, x223, s_q8 * x222);
+        let x231 = S::mul_add(S::splat(0.00000000020510342851533115), x224, x229);
+        let x232 = S::mul_add(S::splat(-0.00000000020510342851533115), x229, x224);
+        let x233 = S::mul_add(S::neg(s_q8), x227, c_q8 * x226);
+        let x234 = S::mul_add(S::splat(-0.00000000020510342851533115), x228, x233);
+        let x235 = S::mul_add(
+            S::splat(-0.35),
             x230,
-            Self::mul_add(0.00000000020510342851533115, x233, x228),
+            S::mul_add(S::splat(0.00000000020510342851533115), x233, x228),
         );
-        let x236 = Self::mul_add(-0.35, x232, Self::mul_add(c_q8, x227, s_q8 * x226));
-        let x237 = Self::mul_add(-s_q7, x230, c_q7 * x232);
-        let x238 = Self::mul_add(c_q7, x230, s_q7 * x232);
-        let x239 = 0.00000000020510342851533115 * x44;
-        let x240 = Self::mul_add(0.00000000020510342851533115, x34, x43);
-        let x241 = Self::mul_add(-0.36, x239, x42);
-        let x242 = Self::mul_add(
+        let x236 = S::mul_add(
+            S::splat(-0.35),
+            x232,
+            S::mul_add(c_q8, x227, s_q8 * x226),
+        );
+        let x237 = S::mul_add(S::neg(s_q7), x230, c_q7 * x232);
+        let x238 = S::mul_add(c_q7, x230, s_q7 * x232);
+        let x239 = S::splat(0.00000000020510342851533115) * x44;
+        let x240 = S::mul_add(S::splat(0.00000000020510342851533115), x34, x43);
+        let x241 = S::mul_add(S::splat(-0.36), x239, x42);
+        let x242 = S::mul_add(
             x45,
-            0.36,
-            Self::mul_add(-0.00000000020510342851533115, x43, x34),
+            S::splat(0.36),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x43, x34),
         );
-        let x243 = Self::mul_add(-s_q11, x239, c_q11 * x45);
-        let x244 = Self::mul_add(c_q11, x239, s_q11 * x45);
-        let x245 = Self::mul_add(-s_q11, x242, c_q11 * x241)
-            - Self::mul_add(x44, -0.63, 0.275 * x244);
-        let x246 = Self::mul_add(0.275, x243, Self::mul_add(c_q11, x242, s_q11 * x241));
-        let x247 = Self::mul_add(0.63, x243, x240);
-        let x248 = Self::mul_add(-s_q10, x244, c_q10 * x243);
-        let x249 = Self::mul_add(c_q10, x244, s_q10 * x243);
-        let x250 = Self::mul_add(c_q10, x246, s_q10 * x245);
-        let x251 = Self::mul_add(x44, 0.87, Self::mul_add(-s_q10, x246, c_q10 * x245));
-        let x252 = Self::mul_add(0.87, x248, x247);
-        let x253 = x239 + Self::mul_add(c_q9, x249, s_q9 * x248);
-        let x254 = x44 + Self::mul_add(-x10, x249, x9 * x248);
-        let x255 = x239 - Self::mul_add(-s_q9, x249, c_q9 * x248);
-        let x256 = 0.00000000020510342851533115 * x252;
-        let x257 = Self::mul_add(c_q9, x250, s_q9 * x251) - x256
-            + Self::mul_add(0.275, x255, 0.4 * x254);
-        let x258 = Self::mul_add(0.4, x253, x252 - Self::mul_add(-x10, x250, x9 * x251));
-        let x259 = Self::mul_add(
-            0.275,
+        let x243 = S::mul_add(S::neg(s_q11), x239, c_q11 * x45);
+        let x244 = S::mul_add(c_q11, x239, s_q11 * x45);
+        let x245 = S::mul_add(S::neg(s_q11), x242, c_q11 * x241)
+            - S::mul_add(x44, S::splat(-0.63), S::splat(0.275) * x244);
+        let x246 = S::mul_add(
+            S::splat(0.275),
+            x243,
+            S::mul_add(c_q11, x242, s_q11 * x241),
+        );
+        let x247 = S::mul_add(S::splat(0.63), x243, x240);
+        let x248 = S::mul_add(S::neg(s_q10), x244, c_q10 * x243);
+        let x249 = S::mul_add(c_q10, x244, s_q10 * x243);
+        let x250 = S::mul_add(c_q10, x246, s_q10 * x245);
+        let x251 = S::mul_add(
+            x44,
+            S::splat(0.87),
+            S::mul_add(S::neg(s_q10), x246, c_q10 * x245),
+        );
+        let x252 = S::mul_add(S::splat(0.87), x248, x247);
+        let x253 = x239 + S::mul_add(c_q9, x249, s_q9 * x248);
+        let x254 = x44 + S::mul_add(S::neg(x10), x249, x9 * x248);
+        let x255 = x239 - S::mul_add(S::neg(s_q9), x249, c_q9 * x248);
+        let x256 = S::splat(0.00000000020510342851533115) * x252;
+        let x257 = S::mul_add(c_q9, x250, s_q9 * x251) - x256
+            + S::mul_add(S::splat(0.275), x255, S::splat(0.4) * x254);
+        let x258 = S::mul_add(
+            S::splat(0.4),
             x253,
-            x256 + Self::mul_add(-s_q9, x250, c_q9 * x251),
+            x252 - S::mul_add(S::neg(x10), x250, x9 * x251),
         );
-        let x260 = Self::mul_add(-s_q8, x254, c_q8 * x253);
-        let x261 = Self::mul_add(c_q8, x254, s_q8 * x253);
-        let x262 = Self::mul_add(-0.00000000020510342851533115, x255, x260);
-        let x263 = Self::mul_add(0.00000000020510342851533115, x260, x255);
-        let x264 = Self::mul_add(s_q8, x258, c_q8 * x257);
-        let x265 = Self::mul_add(0.00000000020510342851533115, x259, x264);
-        let x266 = Self::mul_add(
-            0.35,
+        let x259 = S::mul_add(
+            S::splat(0.275),
+            x253,
+            x256 + S::mul_add(S::neg(s_q9), x250, c_q9 * x251),
+        );
+        let x260 = S::mul_add(S::neg(s_q8), x254, c_q8 * x253);
+        let x261 = S::mul_add(c_q8, x254, s_q8 * x253);
+        let x262 = S::mul_add(S::splat(-0.00000000020510342851533115), x255, x260);
+        let x263 = S::mul_add(S::splat(0.00000000020510342851533115), x260, x255);
+        let x264 = S::mul_add(s_q8, x258, c_q8 * x257);
+        let x265 = S::mul_add(S::splat(0.00000000020510342851533115), x259, x264);
+        let x266 = S::mul_add(
+            S::splat(0.35),
             x261,
-            Self::mul_add(-0.00000000020510342851533115, x264, x259),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x264, x259),
         );
-        let x267 = Self::mul_add(0.35, x263, Self::mul_add(-c_q8, x258, s_q8 * x257));
-        let x268 = Self::mul_add(s_q7, x261, c_q7 * x263);
-        let x269 = Self::mul_add(-c_q7, x261, s_q7 * x263);
-        let x270 = 0.00000000020510342851533115 * x18;
+        let x267 = S::mul_add(
+            S::splat(0.35),
+            x263,
+            S::mul_add(S::neg(c_q8), x258, s_q8 * x257),
+        );
+        let x268 = S::mul_add(s_q7, x261, c_q7 * x263);
+        let x269 = S::mul_add(S::neg(c_q7), x261, s_q7 * x263);
+        let x270 = S::splat(0.00000000020510342851533115) * x18;
         let x271 = x25
-            + Self::mul_add(0.00000000020510342851533115, x15, 1.4135609200000003);
-        let x272 = Self::mul_add(-0.16, x270, x16);
-        let x273 = Self::mul_add(-0.55, x270, x15 + -0.0000000002899261911072858);
-        let x274 = Self::mul_add(s_q12, x17, c_q12 * x270);
-        let x275 = Self::mul_add(-c_q12, x17, s_q12 * x270);
-        let x276 = Self::mul_add(-0.00000000020510342851533115, x275, x18);
+            + S::mul_add(
+                S::splat(0.00000000020510342851533115),
+                x15,
+                S::splat(1.4135609200000003),
+            );
+        let x272 = S::mul_add(S::splat(-0.16), x270, x16);
+        let x273 = S::mul_add(
+            S::splat(-0.55),
+            x270,
+            x15 + S::splat(-0.0000000002899261911072858),
+        );
+        let x274 = S::mul_add(s_q12, x17, c_q12 * x270);
+        let x275 = S::mul_add(S::neg(c_q12), x17, s_q12 * x270);
+        let x276 = S::mul_add(S::splat(-0.00000000020510342851533115), x275, x18);
         let x277 = x270 + x275;
-        let x278 = Self::mul_add(-c_q12, x272, s_q12 * x271);
-        let x279 = Self::mul_add(0.00000000020510342851533115, x273, x278);
-        let x280 = Self::mul_add(0.36, x276, Self::mul_add(s_q12, x272, c_q12 * x271));
-        let x281 = Self::mul_add(
-            -0.36,
+        let x278 = S::mul_add(S::neg(c_q12), x272, s_q12 * x271);
+        let x279 = S::mul_add(S::splat(0.00000000020510342851533115), x273, x278);
+        let x280 = S::mul_add(
+            S::splat(0.36),
+            x276,
+            S::mul_add(s_q12, x272, c_q12 * x271),
+        );
+        let x281 = S::mul_add(
+            S::splat(-0.36),
             x274,
-            Self::mul_add(-0.00000000020510342851533115, x278, x273),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x278, x273),
         );
-        let x282 = Self::mul_add(-s_q11, x276, c_q11 * x274);
-        let x283 = Self::mul_add(c_q11, x276, s_q11 * x274);
-        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
-            + Self::mul_add(0.63, x277, 0.275 * x283);
-        let x285 = Self::mul_add(-0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
-        let x286 = Self::mul_add(-0.63, x282, x279);
-        let x287 = Self::mul_add(-s_q10, x283, c_q10 * x282);
-        let x288 = Self::mul_add(c_q10, x283, s_q10 * x282);
-        let x289 = Self::mul_add(c_q10, x285, s_q10 * x284);
-        let x290 = Self::mul_add(0.87, x277, Self::mul_add(-s_q10, x285, c_q10 * x284));
-        let x291 = Self::mul_add(-0.87, x287, x286);
-        let x292 = 0.00000000020510342851533115 * x277;
-        let x293 = Self::mul_add(c_q9, x288, s_q9 * x287) - x292;
-        let x294 = x277 - Self::mul_add(-x10, x288, x9 * x287);
-        let x295 = x292 + Self::mul_add(-s_q9, x288, c_q9 * x287);
-        let x296 = 0.00000000020510342851533115 * x291;
-        let x297 = Self::mul_add(c_q9, x289, s_q9 * x290) - x296
-            + Self::mul_add(0.275, x295, 0.4 * x294);
-        let x298 = Self::mul_add(
-            -0.4,
+        let x282 = S::mul_add(S::neg(s_q11), x276, c_q11 * x274);
+        let x283 = S::mul_add(c_q11, x276, s_q11 * x274);
+        let x284 = S::mul_add(S::neg(s_q11), x281, c_q11 * x280)
+            + S::mul_add(S::splat(0.63), x277, S::splat(0.275) * x283);
+        let x285 = S::mul_add(
+            S::splat(-0.275),
+            x282,
+            S::mul_add(c_q11, x281, s_q11 * x280),
+        );
+        let x286 = S::mul_add(S::splat(-0.63), x282, x279);
+        let x287 = S::mul_add(S::neg(s_q10), x283, c_q10 * x282);
+        let x288 = S::mul_add(c_q10, x283, s_q10 * x282);
+        let x289 = S::mul_add(c_q10, x285, s_q10 * x284);
+        let x290 = S::mul_add(
+            S::splat(0.87),
+            x277,
+            S::mul_add(S::neg(s_q10), x285, c_q10 * x284),
+        );
+        let x291 = S::mul_add(S::splat(-0.87), x287, x286);
+        let x292 = S::splat(0.00000000020510342851533115) * x277;
+        let x293 = S::mul_add(c_q9, x288, s_q9 * x287) - x292;
+        let x294 = x277 - S::mul_add(S::neg(x10), x288, x9 * x287);
+        let x295 = x292 + S::mul_add(S::neg(s_q9), x288, c_q9 * x287);
+        let x296 = S::splat(0.00000000020510342851533115) * x291;
+        let x297 = S::mul_add(c_q9, x289, s_q9 * x290) - x296
+            + S::mul_add(S::splat(0.275), x295, S::splat(0.4) * x294);
+        let x298 = S::mul_add(
+            S::splat(-0.4),
             x293,
-            x291 - Self::mul_add(-x10, x289, x9 * x290),
+            x291 - S::mul_add(S::neg(x10), x289, x9 * x290),
         );
-        let x299 = Self::mul_add(
-            -0.275,
+        let x299 = S::mul_add(
+            S::splat(-0.275),
             x293,
-            x296 + Self::mul_add(-s_q9, x289, c_q9 * x290),
+            x296 + S::mul_add(S::neg(s_q9), x289, c_q9 * x290),
         );
-        let x300 = Self::mul_add(s_q8, x294, c_q8 * x293);
-        let x301 = Self::mul_add(-c_q8, x294, s_q8 * x293);
-        let x302 = Self::mul_add(0.00000000020510342851533115, x295, x300);
-        let x303 = Self::mul_add(-0.00000000020510342851533115, x300, x295);
-        let x304 = Self::mul_add(s_q8, x298, c_q8 * x297);
-        let x305 = Self::mul_add(0.00000000020510342851533115, x299, x304);
-        let x306 = Self::mul_add(
-            -0.35,
+        let x300 = S::mul_add(s_q8, x294, c_q8 * x293);
+        let x301 = S::mul_add(S::neg(c_q8), x294, s_q8 * x293);
+        let x302 = S::mul_add(S::splat(0.00000000020510342851533115), x295, x300);
+        let x303 = S::mul_add(S::splat(-0.00000000020510342851533115), x300, x295);
+        let x304 = S::mul_add(s_q8, x298, c_q8 * x297);
+        let x305 = S::mul_add(S::splat(0.00000000020510342851533115), x299, x304);
+        let x306 = S::mul_add(
+            S::splat(-0.35),
             x301,
-            Self::mul_add(-0.00000000020510342851533115, x304, x299),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x304, x299),
         );
-        let x307 = Self::mul_add(0.35, x303, Self::mul_add(-c_q8, x298, s_q8 * x297));
-        let x308 = Self::mul_add(-s_q7, x301, c_q7 * x303);
-        let x309 = Self::mul_add(c_q7, x301, s_q7 * x303);
-        let x310 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x311 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x312 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x313 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x314 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x307 = S::mul_add(
+            S::splat(0.35),
+            x303,
+            S::mul_add(S::neg(c_q8), x298, s_q8 * x297),
+        );
+        let x308 = S::mul_add(S::neg(s_q7), x301, c_q7 * x303);
+        let x309 = S::mul_add(c_q7, x301, s_q7 * x303);
+        let x310 = S::mul_add(S::neg(v[2]), v[4], v[1] * v[5]);
+        let x311 = S::mul_add(S::neg(v[2]), v[3], v[0] * v[5]);
+        let x312 = S::mul_add(S::neg(v[1]), v[3], v[0] * v[4]);
+        let x313 = S::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x314 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
         let x315 = v[4] * v[4];
-        let x316 = Self::mul_add(v[5], v[5], x315);
+        let x316 = S::mul_add(v[5], v[5], x315);
         let x317 = v[3] * v[4];
         let x318 = v[3] * v[5];
         let x319 = v[4] * v[5];
-        let x320 = Self::mul_add(v[3], v[3], x315);
-        let x321 = x310 + Self::mul_add(-0.75, x318, 0.65 * x316);
-        let x322 = x311 + Self::mul_add(0.75, x319, 0.65 * x317);
-        let x323 = x312 - Self::mul_add(-0.75, x320, 0.65 * x318);
-        let x324 = Self::mul_add(c_q7, x322, s_q7 * x321);
+        let x320 = S::mul_add(v[3], v[3], x315);
+        let x321 = x310 + S::mul_add(S::splat(-0.75), x318, S::splat(0.65) * x316);
+        let x322 = x311 + S::mul_add(S::splat(0.75), x319, S::splat(0.65) * x317);
+        let x323 = x312 - S::mul_add(S::splat(-0.75), x320, S::splat(0.65) * x318);
+        let x324 = S::mul_add(c_q7, x322, s_q7 * x321);
         let x325 = v[6] * x314;
         let x326 = v[6] * x313;
         let x327 = v[5] + v[6];
         let x328 = x314 * x314;
         let x329 = x313 * x327;
-        let x330 = Self::mul_add(x327, -16.80768997608804, x314 * 0.07309);
-        let x331 = Self::mul_add(
-            -0.1132,
+        let x330 = S::mul_add(
             x327,
-            Self::mul_add(130.43769025763282, x314, x313 * 0.07309),
+            S::splat(-16.80768997608804),
+            x314 * S::splat(0.07309),
         );
-        let x332 = Self::mul_add(
-            -132.47349025763282,
+        let x331 = S::mul_add(
+            S::splat(-0.1132),
             x327,
-            Self::mul_add(0.1132, x314, x313 * 16.80768997608804),
+            S::mul_add(S::splat(130.43769025763282), x314, x313 * S::splat(0.07309)),
         );
-        let x333 = Self::mul_add(0.00000000020510342851533115, x313, x327);
-        let x334 = Self::mul_add(s_q8, x314, c_q8 * x333);
-        let x335 = Self::mul_add(-c_q8, x314, s_q8 * x333);
-        let x336 = Self::mul_add(
-            0.35,
+        let x332 = S::mul_add(
+            S::splat(-132.47349025763282),
+            x327,
+            S::mul_add(S::splat(0.1132), x314, x313 * S::splat(16.80768997608804)),
+        );
+        let x333 = S::mul_add(S::splat(0.00000000020510342851533115), x313, x327);
+        let x334 = S::mul_add(s_q8, x314, c_q8 * x333);
+        let x335 = S::mul_add(S::neg(c_q8), x314, s_q8 * x333);
+        let x336 = S::mul_add(
+            S::splat(0.35),
             x326 - x329,
-            Self::mul_add(-s_q7, x322, c_q7 * x321),
+            S::mul_add(S::neg(s_q7), x322, c_q7 * x321),
         );
-        let x337 = Self::mul_add(0.35, Self::mul_add(-x314, x327, x325), x324);
-        let x338 = Self::mul_add(0.35, Self::mul_add(x313, x313, x328), x323);
-        let x339 = Self::mul_add(-0.00000000020510342851533115, x338, x336);
-        let x340 = Self::mul_add(0.00000000020510342851533115, x336, x338);
-        let x341 = Self::mul_add(s_q8, x337, c_q8 * x340);
-        let x342 = Self::mul_add(-c_q8, x337, s_q8 * x340);
-        let x343 = 0.00000000020510342851533115 * x325;
-        let x344 = Self::mul_add(v[7], x335, Self::mul_add(-s_q8, x326, c_q8 * x343));
-        let x345 = Self::mul_add(-v[7], x334, Self::mul_add(c_q8, x326, s_q8 * x343));
-        let x346 = v[7] + Self::mul_add(-0.00000000020510342851533115, x327, x313);
+        let x337 = S::mul_add(
+            S::splat(0.35),
+            S::mul_add(S::neg(x314), x327, x325),
+            x324,
+        );
+        let x338 = S::mul_add(S::splat(0.35), S::mul_add(x313, x313, x328), x323);
+        let x339 = S::mul_add(S::splat(-0.00000000020510342851533115), x338, x336);
+        let x340 = S::mul_add(S::splat(0.00000000020510342851533115), x336, x338);
+        let x341 = S::mul_add(s_q8, x337, c_q8 * x340);
+        let x342 = S::mul_add(S::neg(c_q8), x337, s_q8 * x340);
+        let x343 = S::splat(0.00000000020510342851533115) * x325;
+        let x344 = S::mul_add(v[7], x335, S::mul_add(S::neg(s_q8), x326, c_q8 * x343));
+        let x345 = S::mul_add(S::neg(v[7]), x334, S::mul_add(c_q8, x326, s_q8 * x343));
+        let x346 = v[7]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x327, x313);
         let x347 = x335 * x335;
         let x348 = x346 * x346;
         let x349 = x334 * x335;
@@ -6452,175 +7949,247 @@ impl FreeFloating7 {
         let x353 = x348 + x352;
         let x354 = x335 * x346;
         let x355 = x344 + x354;
-        let x356 = Self::mul_add(
+        let x356 = S::mul_add(
             x346,
-            0.002139996587640933,
-            x335 * 0.0000000234896432582596,
+            S::splat(0.002139996587640933),
+            x335 * S::splat(0.0000000234896432582596),
         );
-        let x357 = Self::mul_add(
-            5.080660024070365,
+        let x357 = S::mul_add(
+            S::splat(5.080660024070365),
             x346,
-            Self::mul_add(x335, -111.7548902508081, x334 * 0.0000000234896432582596),
+            S::mul_add(
+                x335,
+                S::splat(-111.7548902508081),
+                x334 * S::splat(0.0000000234896432582596),
+            ),
         );
-        let x358 = Self::mul_add(
-            113.3918902508081,
+        let x358 = S::mul_add(
+            S::splat(113.3918902508081),
             x346,
-            Self::mul_add(5.080660024070366, x335, x334 * 0.002139996587640933),
+            S::mul_add(
+                S::splat(5.080660024070366),
+                x335,
+                x334 * S::splat(0.002139996587640933),
+            ),
         );
-        let x359 = Self::mul_add(
+        let x359 = S::mul_add(
             x339,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
+            S::splat(0.000000008530897668050218),
+            S::mul_add(
+                S::splat(5.080660024070365),
                 x325,
-                Self::mul_add(x345, -111.7548902508081, x344 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x334, x358, x346 * x356),
+                S::mul_add(
+                    x345,
+                    S::splat(-111.7548902508081),
+                    x344 * S::splat(0.0000000234896432582596),
+                ),
+            ) + S::mul_add(S::neg(x334), x358, x346 * x356),
         );
-        let x360 = Self::mul_add(-c_q9, x346, Self::mul_add(-x9, x335, s_q9 * x334));
-        let x361 = Self::mul_add(s_q9, x346, Self::mul_add(x10, x335, c_q9 * x334));
-        let x362 = x341 + Self::mul_add(-0.4, x345 + x351, 0.275 * x350);
-        let x363 = x342 + Self::mul_add(0.4, x344 - x354, 0.275 * x353);
-        let x364 = x339 - Self::mul_add(-0.4, x347 + x352, 0.275 * x355);
-        let x365 = Self::mul_add(-c_q9, x364, Self::mul_add(-x9, x363, s_q9 * x362));
-        let x366 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x360 = S::mul_add(
+            S::neg(c_q9),
+            x346,
+            S::mul_add(S::neg(x9), x335, s_q9 * x334),
+        );
+        let x361 = S::mul_add(s_q9, x346, S::mul_add(x10, x335, c_q9 * x334));
+        let x362 = x341
+            + S::mul_add(S::splat(-0.4), x345 + x351, S::splat(0.275) * x350);
+        let x363 = x342 + S::mul_add(S::splat(0.4), x344 - x354, S::splat(0.275) * x353);
+        let x364 = x339
+            - S::mul_add(S::splat(-0.4), x347 + x352, S::splat(0.275) * x355);
+        let x365 = S::mul_add(
+            S::neg(c_q9),
             x364,
-            Self::mul_add(-0.00000000020510342851533115, x362, x363),
+            S::mul_add(S::neg(x9), x363, s_q9 * x362),
         );
-        let x367 = x343 - Self::mul_add(-0.00000000020510342851533115, x344, x345);
-        let x368 = Self::mul_add(
-            -v[8],
+        let x366 = S::mul_add(
+            S::splat(-0.00000000020510342851533115),
+            x364,
+            S::mul_add(S::splat(-0.00000000020510342851533115), x362, x363),
+        );
+        let x367 = x343
+            - S::mul_add(S::splat(-0.00000000020510342851533115), x344, x345);
+        let x368 = S::mul_add(
+            S::neg(v[8]),
             x361,
-            Self::mul_add(-c_q9, x325, Self::mul_add(-x9, x345, s_q9 * x344)),
+            S::mul_add(S::neg(c_q9), x325, S::mul_add(S::neg(x9), x345, s_q9 * x344)),
         );
-        let x369 = Self::mul_add(
+        let x369 = S::mul_add(
             v[8],
             x360,
-            Self::mul_add(s_q9, x325, Self::mul_add(x10, x345, c_q9 * x344)),
+            S::mul_add(s_q9, x325, S::mul_add(x10, x345, c_q9 * x344)),
         );
         let x370 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
                 x346,
-                Self::mul_add(-0.00000000020510342851533115, x334, x335),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x334, x335),
             );
-        let x371 = Self::mul_add(-x360, x361, x367);
-        let x372 = Self::mul_add(x360, x360, x370 * x370);
-        let x373 = Self::mul_add(-x361, x370, x368);
-        let x374 = x370 * 0.00214;
-        let x375 = Self::mul_add(x370, -36.18604050126307, x361 * 63.36336825000001);
-        let x376 = Self::mul_add(
-            69.99836825,
+        let x371 = S::mul_add(S::neg(x360), x361, x367);
+        let x372 = S::mul_add(x360, x360, x370 * x370);
+        let x373 = S::mul_add(S::neg(x361), x370, x368);
+        let x374 = x370 * S::splat(0.00214);
+        let x375 = S::mul_add(
             x370,
-            Self::mul_add(x361, 36.18604050126307, x360 * 0.00214),
+            S::splat(-36.18604050126307),
+            x361 * S::splat(63.36336825000001),
         );
-        let x377 = Self::mul_add(
+        let x376 = S::mul_add(
+            S::splat(69.99836825),
+            x370,
+            S::mul_add(x361, S::splat(36.18604050126307), x360 * S::splat(0.00214)),
+        );
+        let x377 = S::mul_add(
             x366,
-            -81.53205,
-            Self::mul_add(x367, 0.00214, Self::mul_add(x361, x376, x370 * x375)),
+            S::splat(-81.53205),
+            S::mul_add(x367, S::splat(0.00214), S::mul_add(x361, x376, x370 * x375)),
         );
-        let x378 = Self::mul_add(
+        let x378 = S::mul_add(
             x365,
-            -81.53205,
-            Self::mul_add(
-                -69.99836825,
+            S::splat(-81.53205),
+            S::mul_add(
+                S::splat(-69.99836825),
                 x367,
-                Self::mul_add(x369, 36.18604050126307, x368 * 0.00214),
-            ) + Self::mul_add(x360, x375, x361 * x374),
+                S::mul_add(x369, S::splat(36.18604050126307), x368 * S::splat(0.00214)),
+            ) + S::mul_add(x360, x375, x361 * x374),
         );
-        let x379 = Self::mul_add(s_q10, x361, c_q10 * x360);
-        let x380 = Self::mul_add(-c_q10, x361, s_q10 * x360);
-        let x381 = Self::mul_add(0.87, x371, x365);
-        let x382 = Self::mul_add(
-            0.87,
+        let x379 = S::mul_add(s_q10, x361, c_q10 * x360);
+        let x380 = S::mul_add(S::neg(c_q10), x361, s_q10 * x360);
+        let x381 = S::mul_add(S::splat(0.87), x371, x365);
+        let x382 = S::mul_add(
+            S::splat(0.87),
             x372,
-            Self::mul_add(s_q9, x364, Self::mul_add(x10, x363, c_q9 * x362)),
+            S::mul_add(s_q9, x364, S::mul_add(x10, x363, c_q9 * x362)),
         );
-        let x383 = Self::mul_add(0.87, x373, x366);
-        let x384 = Self::mul_add(s_q10, x382, c_q10 * x381);
-        let x385 = Self::mul_add(v[9], x380, Self::mul_add(s_q10, x369, c_q10 * x368));
-        let x386 = Self::mul_add(-v[9], x379, Self::mul_add(-c_q10, x369, s_q10 * x368));
+        let x383 = S::mul_add(S::splat(0.87), x373, x366);
+        let x384 = S::mul_add(s_q10, x382, c_q10 * x381);
+        let x385 = S::mul_add(v[9], x380, S::mul_add(s_q10, x369, c_q10 * x368));
+        let x386 = S::mul_add(
+            S::neg(v[9]),
+            x379,
+            S::mul_add(S::neg(c_q10), x369, s_q10 * x368),
+        );
         let x387 = v[9] + x370;
-        let x388 = Self::mul_add(x379, x380, x367);
+        let x388 = S::mul_add(x379, x380, x367);
         let x389 = x379 * x379;
-        let x390 = Self::mul_add(x387, x387, x389);
+        let x390 = S::mul_add(x387, x387, x389);
         let x391 = x380 * x387;
         let x392 = x385 + x391;
-        let x393 = x387 * 0.6328;
-        let x394 = Self::mul_add(x387, 24.35164200091464, x380 * 24.4950615);
-        let x395 = Self::mul_add(
-            28.2393615,
+        let x393 = x387 * S::splat(0.6328);
+        let x394 = S::mul_add(
             x387,
-            Self::mul_add(x380, -24.351642000914637, x379 * 0.6328),
+            S::splat(24.35164200091464),
+            x380 * S::splat(24.4950615),
         );
-        let x396 = Self::mul_add(
+        let x395 = S::mul_add(
+            S::splat(28.2393615),
+            x387,
+            S::mul_add(x380, S::splat(-24.351642000914637), x379 * S::splat(0.6328)),
+        );
+        let x396 = S::mul_add(
             x383,
-            -45.1584,
-            Self::mul_add(x367, 0.6328, -Self::mul_add(x380, x395, x387 * x394)),
-        );
-        let x397 = Self::mul_add(
-            x384,
-            -45.1584,
-            Self::mul_add(
-                -28.2393615,
+            S::splat(-45.1584),
+            S::mul_add(
                 x367,
-                Self::mul_add(x386, -24.351642000914637, x385 * 0.6328),
-            ) - Self::mul_add(x379, x394, x380 * x393),
+                S::splat(0.6328),
+                S::neg(S::mul_add(x380, x395, x387 * x394)),
+            ),
         );
-        let x398 = Self::mul_add(-s_q11, x380, c_q11 * x379);
-        let x399 = Self::mul_add(c_q11, x380, s_q11 * x379);
+        let x397 = S::mul_add(
+            x384,
+            S::splat(-45.1584),
+            S::mul_add(
+                S::splat(-28.2393615),
+                x367,
+                S::mul_add(x386, S::splat(-24.351642000914637), x385 * S::splat(0.6328)),
+            ) - S::mul_add(x379, x394, x380 * x393),
+        );
+        let x398 = S::mul_add(S::neg(s_q11), x380, c_q11 * x379);
+        let x399 = S::mul_add(c_q11, x380, s_q11 * x379);
         let x400 = x384
-            + Self::mul_add(0.275, Self::mul_add(x379, x387, x386), 0.63 * x388);
-        let x401 = Self::mul_add(-c_q10, x382, s_q10 * x381)
-            - Self::mul_add(0.275, x385 - x391, 0.63 * x390);
+            + S::mul_add(
+                S::splat(0.275),
+                S::mul_add(x379, x387, x386),
+                S::splat(0.63) * x388,
+            );
+        let x401 = S::mul_add(S::neg(c_q10), x382, s_q10 * x381)
+            - S::mul_add(S::splat(0.275), x385 - x391, S::splat(0.63) * x390);
         let x402 = x383
-            + Self::mul_add(-0.275, Self::mul_add(x380, x380, x389), 0.63 * x392);
-        let x403 = Self::mul_add(-s_q11, x401, c_q11 * x400);
-        let x404 = Self::mul_add(v[10], x399, Self::mul_add(-s_q11, x386, c_q11 * x385));
-        let x405 = Self::mul_add(-v[10], x398, Self::mul_add(c_q11, x386, s_q11 * x385));
+            + S::mul_add(
+                S::splat(-0.275),
+                S::mul_add(x380, x380, x389),
+                S::splat(0.63) * x392,
+            );
+        let x403 = S::mul_add(S::neg(s_q11), x401, c_q11 * x400);
+        let x404 = S::mul_add(
+            v[10],
+            x399,
+            S::mul_add(S::neg(s_q11), x386, c_q11 * x385),
+        );
+        let x405 = S::mul_add(
+            S::neg(v[10]),
+            x398,
+            S::mul_add(c_q11, x386, s_q11 * x385),
+        );
         let x406 = v[10] + x387;
         let x407 = x398 * x398;
         let x408 = x399 * x406;
-        let x409 = 0.01675 * x406;
-        let x410 = Self::mul_add(-2.5482240016099564, x406, x399 * 9.142025249762803);
-        let x411 = Self::mul_add(
-            -9.223235249762805,
+        let x409 = S::splat(0.01675) * x406;
+        let x410 = S::mul_add(
+            S::splat(-2.5482240016099564),
             x406,
-            Self::mul_add(-2.5482240016099564, x399, 0.01675 * x398),
+            x399 * S::splat(9.142025249762803),
         );
-        let x412 = Self::mul_add(
-            -7.078399999258757,
+        let x411 = S::mul_add(
+            S::splat(-9.223235249762805),
+            x406,
+            S::mul_add(S::splat(-2.5482240016099564), x399, S::splat(0.01675) * x398),
+        );
+        let x412 = S::mul_add(
+            S::splat(-7.078399999258757),
             x402,
-            Self::mul_add(0.01675, x367, Self::mul_add(-x399, x411, x406 * x410)),
-        );
-        let x413 = Self::mul_add(
-            -7.078399999258757,
-            x403,
-            Self::mul_add(
-                9.223235249762805,
+            S::mul_add(
+                S::splat(0.01675),
                 x367,
-                Self::mul_add(-2.5482240016099564, x405, 0.01675 * x404),
-            ) - Self::mul_add(-x398, x410, x399 * x409),
+                S::mul_add(S::neg(x399), x411, x406 * x410),
+            ),
         );
-        let x414 = Self::mul_add(0.00000000020510342851533115, x399, x406);
-        let x415 = Self::mul_add(s_q12, x414, c_q12 * x398);
-        let x416 = Self::mul_add(-c_q12, x414, s_q12 * x398);
-        let x417 = Self::mul_add(0.36, Self::mul_add(x398, x406, x405), x403);
-        let x418 = Self::mul_add(
-            -0.36,
+        let x413 = S::mul_add(
+            S::splat(-7.078399999258757),
+            x403,
+            S::mul_add(
+                S::splat(9.223235249762805),
+                x367,
+                S::mul_add(S::splat(-2.5482240016099564), x405, S::splat(0.01675) * x404),
+            ) - S::mul_add(S::neg(x398), x410, x399 * x409),
+        );
+        let x414 = S::mul_add(S::splat(0.00000000020510342851533115), x399, x406);
+        let x415 = S::mul_add(s_q12, x414, c_q12 * x398);
+        let x416 = S::mul_add(S::neg(c_q12), x414, s_q12 * x398);
+        let x417 = S::mul_add(S::splat(0.36), S::mul_add(x398, x406, x405), x403);
+        let x418 = S::mul_add(
+            S::splat(-0.36),
             x404 - x408,
-            Self::mul_add(c_q11, x401, s_q11 * x400),
+            S::mul_add(c_q11, x401, s_q11 * x400),
         );
-        let x419 = Self::mul_add(-0.36, Self::mul_add(x399, x399, x407), x402);
-        let x420 = Self::mul_add(0.00000000020510342851533115, x418, x419);
-        let x421 = Self::mul_add(-0.00000000020510342851533115, x419, x418);
-        let x422 = Self::mul_add(s_q12, x420, c_q12 * x417);
-        let x423 = Self::mul_add(-c_q12, x420, s_q12 * x417);
-        let x424 = Self::mul_add(-0.00000000020510342851533115, x405, x367);
-        let x425 = Self::mul_add(0.00000000020510342851533115, x367, x405);
-        let x426 = Self::mul_add(v[11], x416, Self::mul_add(-s_q12, x424, c_q12 * x404));
-        let x427 = Self::mul_add(-v[11], x415, Self::mul_add(c_q12, x424, s_q12 * x404));
-        let x428 = v[11] + Self::mul_add(-0.00000000020510342851533115, x406, x399);
+        let x419 = S::mul_add(S::splat(-0.36), S::mul_add(x399, x399, x407), x402);
+        let x420 = S::mul_add(S::splat(0.00000000020510342851533115), x418, x419);
+        let x421 = S::mul_add(S::splat(-0.00000000020510342851533115), x419, x418);
+        let x422 = S::mul_add(s_q12, x420, c_q12 * x417);
+        let x423 = S::mul_add(S::neg(c_q12), x420, s_q12 * x417);
+        let x424 = S::mul_add(S::splat(-0.00000000020510342851533115), x405, x367);
+        let x425 = S::mul_add(S::splat(0.00000000020510342851533115), x367, x405);
+        let x426 = S::mul_add(
+            v[11],
+            x416,
+            S::mul_add(S::neg(s_q12), x424, c_q12 * x404),
+        );
+        let x427 = S::mul_add(
+            S::neg(v[11]),
+            x415,
+            S::mul_add(c_q12, x424, s_q12 * x404),
+        );
+        let x428 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x406, x399);
         let x429 = x416 * x416;
         let x430 = x428 * x428;
         let x431 = x415 * x416;
@@ -6630,1122 +8199,1300 @@ impl FreeFloating7 {
         let x435 = x430 + x434;
         let x436 = x416 * x428;
         let x437 = x426 + x436;
-        let x438 = Self::mul_add(x428, 0.809539999555672, x416 * 1.9877000000000002);
-        let x439 = Self::mul_add(
+        let x438 = S::mul_add(
             x428,
-            -2.741639999592316,
-            Self::mul_add(x416, -5.252920330000002, x415 * 1.9877000000000002),
+            S::splat(0.809539999555672),
+            x416 * S::splat(1.9877000000000002),
         );
-        let x440 = Self::mul_add(
-            9.740442170000001,
+        let x439 = S::mul_add(
             x428,
-            Self::mul_add(x416, -2.7416399995923166, x415 * 0.809539999555672),
-        );
-        let x441 = Self::mul_add(
-            -3.6140000000000003,
-            x421,
-            Self::mul_add(
-                x425,
-                -2.741639999592316,
-                Self::mul_add(x427, -5.252920330000002, x426 * 1.9877000000000002),
-            ) + Self::mul_add(-x415, x440, x428 * x438),
-        );
-        let x442 = Self::mul_add(-0.00000000020510342851533115, x415, x428);
-        let x443 = Self::mul_add(-s_q13, x416, c_q13 * x442);
-        let x444 = Self::mul_add(c_q13, x416, s_q13 * x442);
-        let x445 = x422 + Self::mul_add(-0.16, x427 + x433, 0.55 * x432);
-        let x446 = x421 - Self::mul_add(-0.16, x429 + x434, 0.55 * x437);
-        let x447 = Self::mul_add(0.00000000020510342851533115, x425, x426);
-        let x448 = Self::mul_add(-0.00000000020510342851533115, x426, x425);
-        let x449 = Self::mul_add(v[12], x444, Self::mul_add(-s_q13, x427, c_q13 * x448));
-        let x450 = Self::mul_add(-v[12], x443, Self::mul_add(c_q13, x427, s_q13 * x448));
-        let x451 = v[12] - Self::mul_add(0.00000000020510342851533115, x428, x415);
-        let x452 = Self::mul_add(-0.0145, x451, 0.000781 * x444);
-        let x453 = Self::mul_add(
-            0.9614610000000001,
-            x451,
-            Self::mul_add(1.2025609200000003, x444, 0.000781 * x443),
-        );
-        let x454 = Self::mul_add(
-            1.4135609200000003,
-            x451,
-            Self::mul_add(-0.9614610000000001, x444, 0.0145 * x443),
-        );
-        let x455 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(
-                -s_q13,
-                x423 + Self::mul_add(0.16, x426 - x436, 0.55 * x435),
-                c_q13 * Self::mul_add(-0.00000000020510342851533115, x445, x446),
+            S::splat(-2.741639999592316),
+            S::mul_add(
+                x416,
+                S::splat(-5.252920330000002),
+                x415 * S::splat(1.9877000000000002),
             ),
-            Self::mul_add(
-                -1.4135609200000003,
-                x447,
-                Self::mul_add(-0.9614610000000001, x450, 0.0145 * x449),
-            ) + Self::mul_add(-x443, x453, x444 * x452),
         );
-        let x456 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x443, x444, x447),
+        let x440 = S::mul_add(
+            S::splat(9.740442170000001),
+            x428,
+            S::mul_add(
+                x416,
+                S::splat(-2.7416399995923166),
+                x415 * S::splat(0.809539999555672),
+            ),
+        );
+        let x441 = S::mul_add(
+            S::splat(-3.6140000000000003),
+            x421,
+            S::mul_add(
+                x425,
+                S::splat(-2.741639999592316),
+                S::mul_add(
+                    x427,
+                    S::splat(-5.252920330000002),
+                    x426 * S::splat(1.9877000000000002),
+                ),
+            ) + S::mul_add(S::neg(x415), x440, x428 * x438),
+        );
+        let x442 = S::mul_add(S::splat(-0.00000000020510342851533115), x415, x428);
+        let x443 = S::mul_add(S::neg(s_q13), x416, c_q13 * x442);
+        let x444 = S::mul_add(c_q13, x416, s_q13 * x442);
+        let x445 = x422
+            + S::mul_add(S::splat(-0.16), x427 + x433, S::splat(0.55) * x432);
+        let x446 = x421
+            - S::mul_add(S::splat(-0.16), x429 + x434, S::splat(0.55) * x437);
+        let x447 = S::mul_add(S::splat(0.00000000020510342851533115), x425, x426);
+        let x448 = S::mul_add(S::splat(-0.00000000020510342851533115), x426, x425);
+        let x449 = S::mul_add(
+            v[12],
+            x444,
+            S::mul_add(S::neg(s_q13), x427, c_q13 * x448),
+        );
+        let x450 = S::mul_add(
+            S::neg(v[12]),
+            x443,
+            S::mul_add(c_q13, x427, s_q13 * x448),
+        );
+        let x451 = v[12]
+            - S::mul_add(S::splat(0.00000000020510342851533115), x428, x415);
+        let x452 = S::mul_add(S::splat(-0.0145), x451, S::splat(0.000781) * x444);
+        let x453 = S::mul_add(
+            S::splat(0.9614610000000001),
+            x451,
+            S::mul_add(S::splat(1.2025609200000003), x444, S::splat(0.000781) * x443),
+        );
+        let x454 = S::mul_add(
+            S::splat(1.4135609200000003),
+            x451,
+            S::mul_add(S::splat(-0.9614610000000001), x444, S::splat(0.0145) * x443),
+        );
+        let x455 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(
+                S::neg(s_q13),
+                x423 + S::mul_add(S::splat(0.16), x426 - x436, S::splat(0.55) * x435),
+                c_q13 * S::mul_add(S::splat(-0.00000000020510342851533115), x445, x446),
+            ),
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x447,
+                S::mul_add(S::splat(-0.9614610000000001), x450, S::splat(0.0145) * x449),
+            ) + S::mul_add(S::neg(x443), x453, x444 * x452),
+        );
+        let x456 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(x443, x444, x447),
             f_ext[7][0],
         );
-        let x457 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x443, x443, x451 * x451),
+        let x457 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(x443, x443, x451 * x451),
             f_ext[7][1],
         );
-        let x458 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(x444, x451, x449),
+        let x458 = S::mul_add(
+            S::splat(-4.806620000000001),
+            S::mul_add(x444, x451, x449),
             f_ext[7][2],
         );
         let x459 = f_ext[7][3]
-            + Self::mul_add(
-                -4.806620000000001,
-                Self::mul_add(0.00000000020510342851533115, x446, x445),
-                Self::mul_add(0.0145, x447, 0.000781 * x450)
-                    - Self::mul_add(x444, x454, x451 * x453),
+            + S::mul_add(
+                S::splat(-4.806620000000001),
+                S::mul_add(S::splat(0.00000000020510342851533115), x446, x445),
+                S::mul_add(S::splat(0.0145), x447, S::splat(0.000781) * x450)
+                    - S::mul_add(x444, x454, x451 * x453),
             );
         let x460 = f_ext[7][4]
-            - (Self::mul_add(
-                -0.9614610000000001,
+            - (S::mul_add(
+                S::splat(-0.9614610000000001),
                 x447,
-                Self::mul_add(1.2025609200000003, x450, 0.000781 * x449),
-            ) + Self::mul_add(x443, x454, x451 * x452));
+                S::mul_add(S::splat(1.2025609200000003), x450, S::splat(0.000781) * x449),
+            ) + S::mul_add(x443, x454, x451 * x452));
         let x461 = f_ext[7][5] + x455;
-        let x462 = Self::mul_add(-s_q13, x457, c_q13 * x456);
-        let x463 = Self::mul_add(c_q13, x457, s_q13 * x456);
-        let x464 = Self::mul_add(0.00000000020510342851533115, x458, x462);
-        let x465 = Self::mul_add(-0.00000000020510342851533115, x462, x458);
-        let x466 = Self::mul_add(-s_q13, x460, c_q13 * x459);
+        let x462 = S::mul_add(S::neg(s_q13), x457, c_q13 * x456);
+        let x463 = S::mul_add(c_q13, x457, s_q13 * x456);
+        let x464 = S::mul_add(S::splat(0.00000000020510342851533115), x458, x462);
+        let x465 = S::mul_add(S::splat(-0.00000000020510342851533115), x462, x458);
+        let x466 = S::mul_add(S::neg(s_q13), x460, c_q13 * x459);
         let x467 = f_ext[6][0]
-            + Self::mul_add(
-                -17.135250000000003,
+            + S::mul_add(
+                S::splat(-17.135250000000003),
                 x432,
-                3.6140000000000003 * (x429 + x430),
+                S::splat(3.6140000000000003) * (x429 + x430),
             ) + x465;
         let x468 = f_ext[6][1]
-            + Self::mul_add(17.135250000000003, x435, 3.6140000000000003 * (x425 + x431))
-            + x463;
+            + S::mul_add(
+                S::splat(17.135250000000003),
+                x435,
+                S::splat(3.6140000000000003) * (x425 + x431),
+            ) + x463;
         let x469 = f_ext[6][2]
-            - Self::mul_add(17.135250000000003, x437, 3.6140000000000003 * (x427 - x433))
-            - x464;
+            - S::mul_add(
+                S::splat(17.135250000000003),
+                x437,
+                S::splat(3.6140000000000003) * (x427 - x433),
+            ) - x464;
         let x470 = f_ext[6][3]
-            - Self::mul_add(
-                -17.135250000000003,
+            - S::mul_add(
+                S::splat(-17.135250000000003),
                 x421,
-                Self::mul_add(x425, 0.809539999555672, x427 * 1.9877000000000002)
-                    - Self::mul_add(-x416, x440, x428 * x439),
+                S::mul_add(
+                    x425,
+                    S::splat(0.809539999555672),
+                    x427 * S::splat(1.9877000000000002),
+                ) - S::mul_add(S::neg(x416), x440, x428 * x439),
             )
-            + (Self::mul_add(-0.00000000020510342851533115, x466, x461)
-                - Self::mul_add(0.55, x464, 0.16 * x463));
+            + (S::mul_add(S::splat(-0.00000000020510342851533115), x466, x461)
+                - S::mul_add(S::splat(0.55), x464, S::splat(0.16) * x463));
         let x471 = f_ext[6][4] + x441
-            + Self::mul_add(0.16, x465, Self::mul_add(c_q13, x460, s_q13 * x459));
+            + S::mul_add(S::splat(0.16), x465, S::mul_add(c_q13, x460, s_q13 * x459));
         let x472 = f_ext[6][5]
-            + (Self::mul_add(
-                9.740442170000001,
+            + (S::mul_add(
+                S::splat(9.740442170000001),
                 x425,
-                Self::mul_add(x427, -2.7416399995923166, x426 * 0.809539999555672),
-            ) - Self::mul_add(-x415, x439, x416 * x438)
-                + Self::mul_add(3.6140000000000003, x423, 17.135250000000003 * x422))
-            - Self::mul_add(
-                0.55,
+                S::mul_add(
+                    x427,
+                    S::splat(-2.7416399995923166),
+                    x426 * S::splat(0.809539999555672),
+                ),
+            ) - S::mul_add(S::neg(x415), x439, x416 * x438)
+                + S::mul_add(
+                    S::splat(3.6140000000000003),
+                    x423,
+                    S::splat(17.135250000000003) * x422,
+                ))
+            - S::mul_add(
+                S::splat(0.55),
                 x465,
-                Self::mul_add(0.00000000020510342851533115, x461, x466),
+                S::mul_add(S::splat(0.00000000020510342851533115), x461, x466),
             );
-        let x473 = Self::mul_add(-s_q12, x468, c_q12 * x467);
-        let x474 = Self::mul_add(c_q12, x468, s_q12 * x467);
-        let x475 = Self::mul_add(-0.00000000020510342851533115, x474, x469);
-        let x476 = Self::mul_add(c_q12, x471, s_q12 * x470);
-        let x477 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x398, x399, x367),
+        let x473 = S::mul_add(S::neg(s_q12), x468, c_q12 * x467);
+        let x474 = S::mul_add(c_q12, x468, s_q12 * x467);
+        let x475 = S::mul_add(S::splat(-0.00000000020510342851533115), x474, x469);
+        let x476 = S::mul_add(c_q12, x471, s_q12 * x470);
+        let x477 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x398, x399, x367),
             f_ext[5][0],
         ) + x473;
-        let x478 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x406, x406, x407),
+        let x478 = S::mul_add(
+            S::splat(7.078399999258757),
+            S::mul_add(x406, x406, x407),
             f_ext[5][1],
         ) + x475;
-        let x479 = Self::mul_add(-7.078399999258757, x404 + x408, f_ext[5][2])
-            - Self::mul_add(0.00000000020510342851533115, x469, x474);
+        let x479 = S::mul_add(S::splat(-7.078399999258757), x404 + x408, f_ext[5][2])
+            - S::mul_add(S::splat(0.00000000020510342851533115), x469, x474);
         let x480 = f_ext[5][3] - x412
-            + Self::mul_add(0.36, x475, Self::mul_add(-s_q12, x471, c_q12 * x470));
+            + S::mul_add(
+                S::splat(0.36),
+                x475,
+                S::mul_add(S::neg(s_q12), x471, c_q12 * x470),
+            );
         let x481 = f_ext[5][4]
-            - (Self::mul_add(2.5482240016099564, x367, x405 * 9.142025249762803)
-                + Self::mul_add(-x398, x411, x406 * x409))
-            + Self::mul_add(
-                -0.36,
+            - (S::mul_add(
+                S::splat(2.5482240016099564),
+                x367,
+                x405 * S::splat(9.142025249762803),
+            ) + S::mul_add(S::neg(x398), x411, x406 * x409))
+            + S::mul_add(
+                S::splat(-0.36),
                 x473,
-                Self::mul_add(-0.00000000020510342851533115, x476, x472),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x476, x472),
             );
         let x482 = f_ext[5][5] - x413
-            - Self::mul_add(0.00000000020510342851533115, x472, x476);
-        let x483 = Self::mul_add(-s_q11, x478, c_q11 * x477);
-        let x484 = Self::mul_add(c_q11, x478, s_q11 * x477);
-        let x485 = Self::mul_add(x388, -45.1584, f_ext[4][0]) + x483;
-        let x486 = Self::mul_add(-45.1584, x390, f_ext[4][1]) + x484;
-        let x487 = Self::mul_add(45.1584, x392, f_ext[4][2]) + x479;
+            - S::mul_add(S::splat(0.00000000020510342851533115), x472, x476);
+        let x483 = S::mul_add(S::neg(s_q11), x478, c_q11 * x477);
+        let x484 = S::mul_add(c_q11, x478, s_q11 * x477);
+        let x485 = S::mul_add(x388, S::splat(-45.1584), f_ext[4][0]) + x483;
+        let x486 = S::mul_add(S::splat(-45.1584), x390, f_ext[4][1]) + x484;
+        let x487 = S::mul_add(S::splat(45.1584), x392, f_ext[4][2]) + x479;
         let x488 = f_ext[4][3] + x396
-            + (Self::mul_add(-s_q11, x481, c_q11 * x480)
-                + Self::mul_add(-0.63, x479, 0.275 * x484));
+            + (S::mul_add(S::neg(s_q11), x481, c_q11 * x480)
+                + S::mul_add(S::splat(-0.63), x479, S::splat(0.275) * x484));
         let x489 = f_ext[4][4]
-            - (Self::mul_add(x367, -24.35164200091464, x386 * 24.4950615)
-                - Self::mul_add(-x379, x395, x387 * x393))
-            + Self::mul_add(-0.275, x483, Self::mul_add(c_q11, x481, s_q11 * x480));
-        let x490 = f_ext[4][5] + x397 + Self::mul_add(0.63, x483, x482);
-        let x491 = Self::mul_add(-s_q10, x486, c_q10 * x485);
-        let x492 = Self::mul_add(x371, -81.53205, f_ext[3][0]) + x491;
-        let x493 = Self::mul_add(-81.53205, x372, f_ext[3][1])
-            + Self::mul_add(c_q10, x486, s_q10 * x485);
-        let x494 = Self::mul_add(81.53205, x373, f_ext[3][2]) + x487;
+            - (S::mul_add(
+                x367,
+                S::splat(-24.35164200091464),
+                x386 * S::splat(24.4950615),
+            ) - S::mul_add(S::neg(x379), x395, x387 * x393))
+            + S::mul_add(S::splat(-0.275), x483, S::mul_add(c_q11, x481, s_q11 * x480));
+        let x490 = f_ext[4][5] + x397 + S::mul_add(S::splat(0.63), x483, x482);
+        let x491 = S::mul_add(S::neg(s_q10), x486, c_q10 * x485);
+        let x492 = S::mul_add(x371, S::splat(-81.53205), f_ext[3][0]) + x491;
+        let x493 = S::mul_add(S::splat(-81.53205), x372, f_ext[3][1])
+            + S::mul_add(c_q10, x486, s_q10 * x485);
+        let x494 = S::mul_add(S::splat(81.53205), x373, f_ext[3][2]) + x487;
         let x495 = f_ext[3][3] + x377
-            + Self::mul_add(-0.87, x487, Self::mul_add(-s_q10, x489, c_q10 * x488));
+            + S::mul_add(
+                S::splat(-0.87),
+                x487,
+                S::mul_add(S::neg(s_q10), x489, c_q10 * x488),
+            );
         let x496 = f_ext[3][4]
-            + (Self::mul_add(x367, 36.18604050126307, x369 * 63.36336825000001)
-                + Self::mul_add(-x360, x376, x370 * x374))
-            + Self::mul_add(c_q10, x489, s_q10 * x488);
-        let x497 = f_ext[3][5] + x378 + Self::mul_add(0.87, x491, x490);
-        let x498 = 0.00000000020510342851533115 * x494;
-        let x499 = Self::mul_add(c_q9, x493, s_q9 * x492) + x498;
-        let x500 = x494 + Self::mul_add(-x10, x493, x9 * x492);
-        let x501 = x498 - Self::mul_add(-s_q9, x493, c_q9 * x492);
-        let x502 = 0.00000000020510342851533115 * x497;
+            + (S::mul_add(
+                x367,
+                S::splat(36.18604050126307),
+                x369 * S::splat(63.36336825000001),
+            ) + S::mul_add(S::neg(x360), x376, x370 * x374))
+            + S::mul_add(c_q10, x489, s_q10 * x488);
+        let x497 = f_ext[3][5] + x378 + S::mul_add(S::splat(0.87), x491, x490);
+        let x498 = S::splat(0.00000000020510342851533115) * x494;
+        let x499 = S::mul_add(c_q9, x493, s_q9 * x492) + x498;
+        let x500 = x494 + S::mul_add(S::neg(x10), x493, x9 * x492);
+        let x501 = x498 - S::mul_add(S::neg(s_q9), x493, c_q9 * x492);
+        let x502 = S::splat(0.00000000020510342851533115) * x497;
         let x503 = f_ext[2][0]
-            - Self::mul_add(
+            - S::mul_add(
                 x350,
-                -12.701650001451807,
-                (x347 + x348) * 0.000000008530897668050218,
+                S::splat(-12.701650001451807),
+                (x347 + x348) * S::splat(0.000000008530897668050218),
             ) + x499;
         let x504 = f_ext[2][1]
-            - Self::mul_add(
-                12.701650001451807,
+            - S::mul_add(
+                S::splat(12.701650001451807),
                 x353,
-                0.000000008530897668050218 * (x325 + x349),
+                S::splat(0.000000008530897668050218) * (x325 + x349),
             ) + x500;
         let x505 = f_ext[2][2]
-            + Self::mul_add(
-                12.701650001451807,
+            + S::mul_add(
+                S::splat(12.701650001451807),
                 x355,
-                0.000000008530897668050218 * (x345 - x351),
+                S::splat(0.000000008530897668050218) * (x345 - x351),
             ) - x501;
         let x506 = f_ext[2][3]
-            - Self::mul_add(
+            - S::mul_add(
                 x339,
-                12.701650001451807,
-                Self::mul_add(
+                S::splat(12.701650001451807),
+                S::mul_add(
                     x325,
-                    0.002139996587640933,
-                    x345 * 0.0000000234896432582596,
-                ) - Self::mul_add(-x335, x358, x346 * x357),
+                    S::splat(0.002139996587640933),
+                    x345 * S::splat(0.0000000234896432582596),
+                ) - S::mul_add(S::neg(x335), x358, x346 * x357),
             )
-            + (Self::mul_add(c_q9, x496, s_q9 * x495) + x502
-                - Self::mul_add(0.275, x501, 0.4 * x500));
+            + (S::mul_add(c_q9, x496, s_q9 * x495) + x502
+                - S::mul_add(S::splat(0.275), x501, S::splat(0.4) * x500));
         let x507 = f_ext[2][4] + x359
-            + Self::mul_add(0.4, x499, x497 + Self::mul_add(-x10, x496, x9 * x495));
+            + S::mul_add(
+                S::splat(0.4),
+                x499,
+                x497 + S::mul_add(S::neg(x10), x496, x9 * x495),
+            );
         let x508 = f_ext[2][5]
-            + (Self::mul_add(
-                113.3918902508081,
+            + (S::mul_add(
+                S::splat(113.3918902508081),
                 x325,
-                Self::mul_add(5.080660024070366, x345, x344 * 0.002139996587640933),
-            ) - Self::mul_add(-x334, x357, x335 * x356)
-                - Self::mul_add(
+                S::mul_add(
+                    S::splat(5.080660024070366),
+                    x345,
+                    x344 * S::splat(0.002139996587640933),
+                ),
+            ) - S::mul_add(S::neg(x334), x357, x335 * x356)
+                - S::mul_add(
                     x342,
-                    0.000000008530897668050218,
-                    x341 * 12.701650001451807,
+                    S::splat(0.000000008530897668050218),
+                    x341 * S::splat(12.701650001451807),
                 ))
-            - Self::mul_add(0.275, x499, x502 - Self::mul_add(-s_q9, x496, c_q9 * x495));
-        let x509 = Self::mul_add(-s_q8, x504, c_q8 * x503);
-        let x510 = Self::mul_add(c_q8, x504, s_q8 * x503);
-        let x511 = Self::mul_add(-0.00000000020510342851533115, x509, x505);
-        let x512 = Self::mul_add(-s_q8, x507, c_q8 * x506);
-        let x513 = Self::mul_add(
-            48.0240000085309,
-            Self::mul_add(x327, x327, x328),
+            - S::mul_add(
+                S::splat(0.275),
+                x499,
+                x502 - S::mul_add(S::neg(s_q9), x496, c_q9 * x495),
+            );
+        let x509 = S::mul_add(S::neg(s_q8), x504, c_q8 * x503);
+        let x510 = S::mul_add(c_q8, x504, s_q8 * x503);
+        let x511 = S::mul_add(S::splat(-0.00000000020510342851533115), x509, x505);
+        let x512 = S::mul_add(S::neg(s_q8), x507, c_q8 * x506);
+        let x513 = S::mul_add(
+            S::splat(48.0240000085309),
+            S::mul_add(x327, x327, x328),
             f_ext[1][0],
         ) + x511;
-        let x514 = Self::mul_add(48.0240000085309, x313 * x314, f_ext[1][1]) + x510;
-        let x515 = Self::mul_add(-48.0240000085309, x326 + x329, f_ext[1][2])
-            - Self::mul_add(0.00000000020510342851533115, x505, x509);
+        let x514 = S::mul_add(S::splat(48.0240000085309), x313 * x314, f_ext[1][1])
+            + x510;
+        let x515 = S::mul_add(S::splat(-48.0240000085309), x326 + x329, f_ext[1][2])
+            - S::mul_add(S::splat(0.00000000020510342851533115), x505, x509);
         let x516 = f_ext[1][3]
-            - Self::mul_add(x326, 0.07309, Self::mul_add(x314, x332, x327 * x331))
-            + Self::mul_add(
-                -0.35,
+            - S::mul_add(x326, S::splat(0.07309), S::mul_add(x314, x332, x327 * x331))
+            + S::mul_add(
+                S::splat(-0.35),
                 x510,
-                Self::mul_add(-0.00000000020510342851533115, x512, x508),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x512, x508),
             );
         let x517 = f_ext[1][4]
-            - Self::mul_add(
-                48.0240000085309,
+            - S::mul_add(
+                S::splat(48.0240000085309),
                 x323,
-                Self::mul_add(-130.43769025763282, x326, x325 * 0.07309)
-                    + Self::mul_add(x313, x332, x327 * x330),
-            ) + Self::mul_add(0.35, x511, Self::mul_add(c_q8, x507, s_q8 * x506));
+                S::mul_add(S::splat(-130.43769025763282), x326, x325 * S::splat(0.07309))
+                    + S::mul_add(x313, x332, x327 * x330),
+            ) + S::mul_add(S::splat(0.35), x511, S::mul_add(c_q8, x507, s_q8 * x506));
         let x518 = f_ext[1][5]
-            - Self::mul_add(
-                48.0240000085309,
+            - S::mul_add(
+                S::splat(48.0240000085309),
                 x324,
-                Self::mul_add(-0.1132, x326, x325 * 16.80768997608804)
-                    + Self::mul_add(-x313, x331, x314 * x330),
-            ) - Self::mul_add(0.00000000020510342851533115, x508, x512);
-        let x519 = Self::mul_add(-s_q7, x514, c_q7 * x513);
-        let x520 = Self::mul_add(c_q7, x514, s_q7 * x513);
-        let x521 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x522 = 1466.4506062283303 * v[4];
-        let x523 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+                S::mul_add(S::splat(-0.1132), x326, x325 * S::splat(16.80768997608804))
+                    + S::mul_add(S::neg(x313), x331, x314 * x330),
+            ) - S::mul_add(S::splat(0.00000000020510342851533115), x508, x512);
+        let x519 = S::mul_add(S::neg(s_q7), x514, c_q7 * x513);
+        let x520 = S::mul_add(c_q7, x514, s_q7 * x513);
+        let x521 = S::mul_add(
+            v[5],
+            S::splat(-117.61766249359756),
+            S::splat(1394.5960312283303) * v[3],
+        );
+        let x522 = S::splat(1466.4506062283303) * v[4];
+        let x523 = S::mul_add(
+            S::splat(-1271.854575),
+            v[5],
+            v[3] * S::splat(117.61766249359758),
+        );
         let x524 = x519
             + (f_ext[0][0]
-                + Self::mul_add(
-                    1170.07,
+                + S::mul_add(
+                    S::splat(1170.07),
                     x310,
-                    Self::mul_add(-180.9502499901501, x318, 110.5455 * x316),
+                    S::mul_add(
+                        S::splat(-180.9502499901501),
+                        x318,
+                        S::splat(110.5455) * x316,
+                    ),
                 ));
         let x525 = x520
             + (f_ext[0][1]
-                - Self::mul_add(
-                    1170.07,
+                - S::mul_add(
+                    S::splat(1170.07),
                     x311,
-                    Self::mul_add(180.9502499901501, x319, 110.5455 * x317),
+                    S::mul_add(
+                        S::splat(180.9502499901501),
+                        x319,
+                        S::splat(110.5455) * x317,
+                    ),
                 ));
         let x526 = x515
             + (f_ext[0][2]
-                + Self::mul_add(
-                    1170.07,
+                + S::mul_add(
+                    S::splat(1170.07),
                     x312,
-                    -Self::mul_add(-180.9502499901501, x320, 110.5455 * x318),
+                    S::neg(
+                        S::mul_add(
+                            S::splat(-180.9502499901501),
+                            x320,
+                            S::splat(110.5455) * x318,
+                        ),
+                    ),
                 ));
-        let x527 = x178 * 0.0008546497218115156;
-        let x528 = x171 * 0.0008546497218115156;
-        let x529 = x183 * 0.0008546497218115156;
-        let x530 = x198 * 0.0008546497218115156;
-        let x531 = x215 * 0.0008546497218115156;
-        let x532 = x237 * 0.0008546497218115156;
-        let x533 = x268 * 0.0008546497218115156;
-        let x534 = x308 * 0.0008546497218115156;
-        let x535 = x177 * 0.0008546497218115156;
-        let x536 = x170 * 0.0008546497218115156;
-        let x537 = x184 * 0.0008546497218115156;
-        let x538 = x199 * 0.0008546497218115156;
-        let x539 = x216 * 0.0008546497218115156;
-        let x540 = x238 * 0.0008546497218115156;
-        let x541 = x269 * 0.0008546497218115156;
-        let x542 = x309 * 0.0008546497218115156;
-        let x543 = x151 * 0.0008546497218115156;
-        let x544 = x192 * 0.0008546497218115156;
-        let x545 = x209 * 0.0008546497218115156;
-        let x546 = x231 * 0.0008546497218115156;
-        let x547 = x262 * 0.0008546497218115156;
-        let x548 = x302 * 0.0008546497218115156;
+        let x527 = x178 * S::splat(0.0008546497218115156);
+        let x528 = x171 * S::splat(0.0008546497218115156);
+        let x529 = x183 * S::splat(0.0008546497218115156);
+        let x530 = x198 * S::splat(0.0008546497218115156);
+        let x531 = x215 * S::splat(0.0008546497218115156);
+        let x532 = x237 * S::splat(0.0008546497218115156);
+        let x533 = x268 * S::splat(0.0008546497218115156);
+        let x534 = x308 * S::splat(0.0008546497218115156);
+        let x535 = x177 * S::splat(0.0008546497218115156);
+        let x536 = x170 * S::splat(0.0008546497218115156);
+        let x537 = x184 * S::splat(0.0008546497218115156);
+        let x538 = x199 * S::splat(0.0008546497218115156);
+        let x539 = x216 * S::splat(0.0008546497218115156);
+        let x540 = x238 * S::splat(0.0008546497218115156);
+        let x541 = x269 * S::splat(0.0008546497218115156);
+        let x542 = x309 * S::splat(0.0008546497218115156);
+        let x543 = x151 * S::splat(0.0008546497218115156);
+        let x544 = x192 * S::splat(0.0008546497218115156);
+        let x545 = x209 * S::splat(0.0008546497218115156);
+        let x546 = x231 * S::splat(0.0008546497218115156);
+        let x547 = x262 * S::splat(0.0008546497218115156);
+        let x548 = x302 * S::splat(0.0008546497218115156);
         let x549 = x178 * x527;
         let x550 = x171 * x528;
-        let x551 = 1.0
-            / (1394.5960312283303 - (x172 + (x158 - x169 + x172)) - x549 - x550);
-        let x552 = Self::mul_add(
+        let x551 = S::splat(1.0)
+            / (S::splat(1394.5960312283303) - (x172 + (x158 - x169 + x172)) - x549
+                - x550);
+        let x552 = S::mul_add(
             x171,
             x535,
-            Self::mul_add(-0.65, x171, x160 - Self::mul_add(x165, x168, x166 * x167)),
+            S::mul_add(S::splat(-0.65), x171, x160 - S::mul_add(x165, x168, x166 * x167)),
         );
         let x553 = x551 * x552;
-        let x554 = Self::mul_add(
+        let x554 = S::mul_add(
             x178,
             x535,
-            -117.61766249359756 + Self::mul_add(0.65, x155, x175),
+            S::splat(-117.61766249359756) + S::mul_add(S::splat(0.65), x155, x175),
         );
         let x555 = x551 * x554;
-        let x556 = Self::mul_add(x178, x536, x175);
+        let x556 = S::mul_add(x178, x536, x175);
         let x557 = x551 * x556;
-        let x558 = Self::mul_add(
+        let x558 = S::mul_add(
             x178,
             x537,
-            Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x182, c_q7 * x181)),
+            S::mul_add(
+                S::splat(-0.75),
+                x184,
+                S::mul_add(S::neg(s_q7), x182, c_q7 * x181),
+            ),
         );
-        let x559 = Self::mul_add(-x171, x543, x558);
+        let x559 = S::mul_add(S::neg(x171), x543, x558);
         let x560 = x551 * x559;
-        let x561 = Self::mul_add(
-            -x178,
+        let x561 = S::mul_add(
+            S::neg(x178),
             x538,
-            Self::mul_add(0.75, x199, Self::mul_add(-s_q7, x197, c_q7 * x196)),
+            S::mul_add(S::splat(0.75), x199, S::mul_add(S::neg(s_q7), x197, c_q7 * x196)),
         );
-        let x562 = Self::mul_add(-x171, x544, x561);
+        let x562 = S::mul_add(S::neg(x171), x544, x561);
         let x563 = x551 * x562;
-        let x564 = Self::mul_add(
+        let x564 = S::mul_add(
             x178,
             x539,
-            Self::mul_add(-0.75, x216, Self::mul_add(s_q7, x214, c_q7 * x213)),
+            S::mul_add(S::splat(-0.75), x216, S::mul_add(s_q7, x214, c_q7 * x213)),
         );
-        let x565 = Self::mul_add(-x171, x545, x564);
+        let x565 = S::mul_add(S::neg(x171), x545, x564);
         let x566 = x551 * x565;
-        let x567 = Self::mul_add(
+        let x567 = S::mul_add(
             x178,
             x540,
-            Self::mul_add(-0.75, x238, Self::mul_add(s_q7, x236, c_q7 * x235)),
+            S::mul_add(S::splat(-0.75), x238, S::mul_add(s_q7, x236, c_q7 * x235)),
         );
-        let x568 = Self::mul_add(x171, x546, x567);
+        let x568 = S::mul_add(x171, x546, x567);
         let x569 = x551 * x568;
-        let x570 = Self::mul_add(
+        let x570 = S::mul_add(
             x178,
             x541,
-            Self::mul_add(-0.75, x269, Self::mul_add(-s_q7, x267, c_q7 * x266)),
+            S::mul_add(
+                S::splat(-0.75),
+                x269,
+                S::mul_add(S::neg(s_q7), x267, c_q7 * x266),
+            ),
         );
-        let x571 = Self::mul_add(-x171, x547, x570);
+        let x571 = S::mul_add(S::neg(x171), x547, x570);
         let x572 = x551 * x571;
-        let x573 = Self::mul_add(
+        let x573 = S::mul_add(
             x178,
             x542,
-            Self::mul_add(-0.75, x309, Self::mul_add(-s_q7, x307, c_q7 * x306)),
+            S::mul_add(
+                S::splat(-0.75),
+                x309,
+                S::mul_add(S::neg(s_q7), x307, c_q7 * x306),
+            ),
         );
-        let x574 = Self::mul_add(x171, x548, x573);
+        let x574 = S::mul_add(x171, x548, x573);
         let x575 = x551 * x574;
         let x576 = x177 * x535;
-        let x577 = 1.0
-            / Self::mul_add(
-                -x552,
+        let x577 = S::splat(1.0)
+            / S::mul_add(
+                S::neg(x552),
                 x553,
-                1466.4506062283303 - (x174 - (x162 - x169 - x174)) - x549 - x576,
+                S::splat(1466.4506062283303) - (x174 - (x162 - x169 - x174)) - x549
+                    - x576,
             );
-        let x578 = Self::mul_add(
+        let x578 = S::mul_add(
             x178,
             x528,
-            Self::mul_add(-0.75, x171, Self::mul_add(c_q7, x163, s_q7 * x161)),
+            S::mul_add(S::splat(-0.75), x171, S::mul_add(c_q7, x163, s_q7 * x161)),
         );
-        let x579 = Self::mul_add(-x552, x555, x578);
+        let x579 = S::mul_add(S::neg(x552), x555, x578);
         let x580 = x577 * x579;
-        let x581 = Self::mul_add(-x552, x557, x578);
+        let x581 = S::mul_add(S::neg(x552), x557, x578);
         let x582 = x577 * x581;
-        let x583 = Self::mul_add(
+        let x583 = S::mul_add(
             x177,
             x543,
-            Self::mul_add(
-                -x178,
+            S::mul_add(
+                S::neg(x178),
                 x529,
-                Self::mul_add(c_q7, x182, s_q7 * x181)
-                    + Self::mul_add(-0.65, x151, 0.75 * x183),
+                S::mul_add(c_q7, x182, s_q7 * x181)
+                    + S::mul_add(S::splat(-0.65), x151, S::splat(0.75) * x183),
             ),
         );
-        let x584 = Self::mul_add(-x552, x560, x583);
+        let x584 = S::mul_add(S::neg(x552), x560, x583);
         let x585 = x577 * x584;
-        let x586 = Self::mul_add(
+        let x586 = S::mul_add(
             x177,
             x544,
-            Self::mul_add(
+            S::mul_add(
                 x178,
                 x530,
-                Self::mul_add(c_q7, x197, s_q7 * x196)
-                    - Self::mul_add(0.65, x192, 0.75 * x198),
+                S::mul_add(c_q7, x197, s_q7 * x196)
+                    - S::mul_add(S::splat(0.65), x192, S::splat(0.75) * x198),
             ),
         );
-        let x587 = Self::mul_add(-x552, x563, x586);
+        let x587 = S::mul_add(S::neg(x552), x563, x586);
         let x588 = x577 * x587;
-        let x589 = Self::mul_add(
+        let x589 = S::mul_add(
             x177,
             x545,
-            Self::mul_add(
-                -x178,
+            S::mul_add(
+                S::neg(x178),
                 x531,
-                Self::mul_add(-c_q7, x214, s_q7 * x213)
-                    + Self::mul_add(-0.65, x209, 0.75 * x215),
+                S::mul_add(S::neg(c_q7), x214, s_q7 * x213)
+                    + S::mul_add(S::splat(-0.65), x209, S::splat(0.75) * x215),
             ),
         );
-        let x590 = Self::mul_add(-x552, x566, x589);
+        let x590 = S::mul_add(S::neg(x552), x566, x589);
         let x591 = x577 * x590;
-        let x592 = Self::mul_add(
-            -x177,
+        let x592 = S::mul_add(
+            S::neg(x177),
             x546,
-            Self::mul_add(
-                -x178,
+            S::mul_add(
+                S::neg(x178),
                 x532,
-                Self::mul_add(-c_q7, x236, s_q7 * x235)
-                    + Self::mul_add(0.65, x231, 0.75 * x237),
+                S::mul_add(S::neg(c_q7), x236, s_q7 * x235)
+                    + S::mul_add(S::splat(0.65), x231, S::splat(0.75) * x237),
             ),
         );
-        let x593 = Self::mul_add(-x552, x569, x592);
+        let x593 = S::mul_add(S::neg(x552), x569, x592);
         let x594 = x577 * x593;
-        let x595 = Self::mul_add(
+        let x595 = S::mul_add(
             x177,
             x547,
-            Self::mul_add(
-                -x178,
+            S::mul_add(
+                S::neg(x178),
                 x533,
-                Self::mul_add(c_q7, x267, s_q7 * x266)
-                    + Self::mul_add(-0.65, x262, 0.75 * x268),
+                S::mul_add(c_q7, x267, s_q7 * x266)
+                    + S::mul_add(S::splat(-0.65), x262, S::splat(0.75) * x268),
             ),
         );
-        let x596 = Self::mul_add(-x552, x572, x595);
+        let x596 = S::mul_add(S::neg(x552), x572, x595);
         let x597 = x577 * x596;
-        let x598 = Self::mul_add(
-            -x177,
+        let x598 = S::mul_add(
+            S::neg(x177),
             x548,
-            Self::mul_add(
-                -x178,
+            S::mul_add(
+                S::neg(x178),
                 x534,
-                Self::mul_add(c_q7, x307, s_q7 * x306)
-                    + Self::mul_add(0.65, x302, 0.75 * x308),
+                S::mul_add(c_q7, x307, s_q7 * x306)
+                    + S::mul_add(S::splat(0.65), x302, S::splat(0.75) * x308),
             ),
         );
-        let x599 = Self::mul_add(-x552, x575, x598);
+        let x599 = S::mul_add(S::neg(x552), x575, x598);
         let x600 = x577 * x599;
-        let x601 = 1.0
-            / Self::mul_add(
+        let x601 = S::splat(1.0)
+            / S::mul_add(
                 x579,
                 x580,
-                Self::mul_add(x554, x555, x576 - (1271.854575 + (x173 + x176) - x550)),
+                S::mul_add(
+                    x554,
+                    x555,
+                    x576 - (S::splat(1271.854575) + (x173 + x176) - x550),
+                ),
             );
-        let x602 = Self::mul_add(
-            -x579,
+        let x602 = S::mul_add(
+            S::neg(x579),
             x582,
-            Self::mul_add(-x554, x557, Self::mul_add(-x177, x536, x176 - x550)),
+            S::mul_add(S::neg(x554), x557, S::mul_add(S::neg(x177), x536, x176 - x550)),
         );
         let x603 = x601 * x602;
         let x604 = x171 * x529;
-        let x605 = Self::mul_add(
+        let x605 = S::mul_add(
             x554,
             x560,
-            Self::mul_add(x177, x537, Self::mul_add(-0.65, x184, x180) - x604),
+            S::mul_add(x177, x537, S::mul_add(S::splat(-0.65), x184, x180) - x604),
         );
-        let x606 = Self::mul_add(x579, x585, x605);
+        let x606 = S::mul_add(x579, x585, x605);
         let x607 = x601 * x606;
         let x608 = x171 * x530;
-        let x609 = Self::mul_add(
+        let x609 = S::mul_add(
             x554,
             x563,
-            Self::mul_add(-x177, x538, Self::mul_add(0.65, x199, x195) + x608),
+            S::mul_add(S::neg(x177), x538, S::mul_add(S::splat(0.65), x199, x195) + x608),
         );
-        let x610 = Self::mul_add(x579, x588, x609);
+        let x610 = S::mul_add(x579, x588, x609);
         let x611 = x601 * x610;
         let x612 = x171 * x531;
-        let x613 = Self::mul_add(
-            -x554,
+        let x613 = S::mul_add(
+            S::neg(x554),
             x566,
-            Self::mul_add(-x177, x539, Self::mul_add(0.65, x216, x212) + x612),
+            S::mul_add(S::neg(x177), x539, S::mul_add(S::splat(0.65), x216, x212) + x612),
         );
-        let x614 = Self::mul_add(-x579, x591, x613);
+        let x614 = S::mul_add(S::neg(x579), x591, x613);
         let x615 = x601 * x614;
         let x616 = x171 * x532;
-        let x617 = Self::mul_add(
-            -x554,
+        let x617 = S::mul_add(
+            S::neg(x554),
             x569,
-            Self::mul_add(-x177, x540, Self::mul_add(0.65, x238, x234) + x616),
+            S::mul_add(S::neg(x177), x540, S::mul_add(S::splat(0.65), x238, x234) + x616),
         );
-        let x618 = Self::mul_add(-x579, x594, x617);
+        let x618 = S::mul_add(S::neg(x579), x594, x617);
         let x619 = x601 * x618;
         let x620 = x171 * x533;
-        let x621 = Self::mul_add(
+        let x621 = S::mul_add(
             x554,
             x572,
-            Self::mul_add(x177, x541, Self::mul_add(-0.65, x269, x265) - x620),
+            S::mul_add(x177, x541, S::mul_add(S::splat(-0.65), x269, x265) - x620),
         );
-        let x622 = Self::mul_add(x579, x597, x621);
+        let x622 = S::mul_add(x579, x597, x621);
         let x623 = x601 * x622;
         let x624 = x171 * x534;
-        let x625 = Self::mul_add(
+        let x625 = S::mul_add(
             x554,
             x575,
-            Self::mul_add(x177, x542, Self::mul_add(-0.65, x309, x305) - x624),
+            S::mul_add(x177, x542, S::mul_add(S::splat(-0.65), x309, x305) - x624),
         );
-        let x626 = Self::mul_add(x579, x600, x625);
+        let x626 = S::mul_add(x579, x600, x625);
         let x627 = x601 * x626;
-        let x628 = Self::mul_add(
-            -x581,
+        let x628 = S::mul_add(
+            S::neg(x581),
             x582,
-            Self::mul_add(-x556, x557, Self::mul_add(-x170, x536, x164 - x550)),
+            S::mul_add(S::neg(x556), x557, S::mul_add(S::neg(x170), x536, x164 - x550)),
         );
-        let x629 = 1.0 / Self::mul_add(x602, x603, x628);
-        let x630 = Self::mul_add(
+        let x629 = S::splat(1.0) / S::mul_add(x602, x603, x628);
+        let x630 = S::mul_add(
             x581,
             x585,
-            Self::mul_add(x556, x560, Self::mul_add(x170, x537, x180 - x604)),
+            S::mul_add(x556, x560, S::mul_add(x170, x537, x180 - x604)),
         );
-        let x631 = Self::mul_add(x602, x607, x630);
+        let x631 = S::mul_add(x602, x607, x630);
         let x632 = x629 * x631;
-        let x633 = Self::mul_add(
+        let x633 = S::mul_add(
             x581,
             x588,
-            Self::mul_add(x556, x563, Self::mul_add(-x170, x538, x195 + x608)),
+            S::mul_add(x556, x563, S::mul_add(S::neg(x170), x538, x195 + x608)),
         );
-        let x634 = Self::mul_add(x602, x611, x633);
+        let x634 = S::mul_add(x602, x611, x633);
         let x635 = x629 * x634;
-        let x636 = Self::mul_add(
-            -x581,
+        let x636 = S::mul_add(
+            S::neg(x581),
             x591,
-            Self::mul_add(-x556, x566, Self::mul_add(-x170, x539, x212 + x612)),
+            S::mul_add(S::neg(x556), x566, S::mul_add(S::neg(x170), x539, x212 + x612)),
         );
-        let x637 = Self::mul_add(x602, x615, x636);
+        let x637 = S::mul_add(x602, x615, x636);
         let x638 = x629 * x637;
-        let x639 = Self::mul_add(
-            -x581,
+        let x639 = S::mul_add(
+            S::neg(x581),
             x594,
-            Self::mul_add(-x556, x569, Self::mul_add(-x170, x540, x234 + x616)),
+            S::mul_add(S::neg(x556), x569, S::mul_add(S::neg(x170), x540, x234 + x616)),
         );
-        let x640 = Self::mul_add(x602, x619, x639);
+        let x640 = S::mul_add(x602, x619, x639);
         let x641 = x629 * x640;
-        let x642 = Self::mul_add(
+        let x642 = S::mul_add(
             x581,
             x597,
-            Self::mul_add(x556, x572, Self::mul_add(x170, x541, x265 - x620)),
+            S::mul_add(x556, x572, S::mul_add(x170, x541, x265 - x620)),
         );
-        let x643 = Self::mul_add(x602, x623, x642);
+        let x643 = S::mul_add(x602, x623, x642);
         let x644 = x629 * x643;
-        let x645 = Self::mul_add(
+        let x645 = S::mul_add(
             x581,
             x600,
-            Self::mul_add(x556, x575, Self::mul_add(x170, x542, x305 - x624)),
+            S::mul_add(x556, x575, S::mul_add(x170, x542, x305 - x624)),
         );
-        let x646 = Self::mul_add(x602, x627, x645);
+        let x646 = S::mul_add(x602, x627, x645);
         let x647 = x629 * x646;
-        let x648 = Self::mul_add(
-            -x151,
+        let x648 = S::mul_add(
+            S::neg(x151),
             x543,
-            Self::mul_add(-x184, x537, Self::mul_add(-x183, x529, x140)),
+            S::mul_add(S::neg(x184), x537, S::mul_add(S::neg(x183), x529, x140)),
         );
-        let x649 = Self::mul_add(
+        let x649 = S::mul_add(
             x606,
             x607,
-            Self::mul_add(-x584, x585, Self::mul_add(-x559, x560, x648)),
+            S::mul_add(S::neg(x584), x585, S::mul_add(S::neg(x559), x560, x648)),
         );
-        let x650 = 1.0 / Self::mul_add(-x631, x632, x649);
-        let x651 = Self::mul_add(
-            -x151,
+        let x650 = S::splat(1.0) / S::mul_add(S::neg(x631), x632, x649);
+        let x651 = S::mul_add(
+            S::neg(x151),
             x544,
-            Self::mul_add(x184, x538, Self::mul_add(x183, x530, x189)),
+            S::mul_add(x184, x538, S::mul_add(x183, x530, x189)),
         );
-        let x652 = Self::mul_add(
+        let x652 = S::mul_add(
             x606,
             x611,
-            Self::mul_add(-x584, x588, Self::mul_add(-x559, x563, x651)),
+            S::mul_add(S::neg(x584), x588, S::mul_add(S::neg(x559), x563, x651)),
         );
-        let x653 = Self::mul_add(-x631, x635, x652);
+        let x653 = S::mul_add(S::neg(x631), x635, x652);
         let x654 = x650 * x653;
-        let x655 = Self::mul_add(
-            -x151,
+        let x655 = S::mul_add(
+            S::neg(x151),
             x545,
-            Self::mul_add(-x184, x539, Self::mul_add(-x183, x531, x206)),
+            S::mul_add(S::neg(x184), x539, S::mul_add(S::neg(x183), x531, x206)),
         );
-        let x656 = Self::mul_add(
-            -x606,
+        let x656 = S::mul_add(
+            S::neg(x606),
             x615,
-            Self::mul_add(-x584, x591, Self::mul_add(-x559, x566, x655)),
+            S::mul_add(S::neg(x584), x591, S::mul_add(S::neg(x559), x566, x655)),
         );
-        let x657 = Self::mul_add(x631, x638, x656);
+        let x657 = S::mul_add(x631, x638, x656);
         let x658 = x650 * x657;
-        let x659 = Self::mul_add(
+        let x659 = S::mul_add(
             x151,
             x546,
-            Self::mul_add(-x184, x540, Self::mul_add(-x183, x532, x228)),
+            S::mul_add(S::neg(x184), x540, S::mul_add(S::neg(x183), x532, x228)),
         );
-        let x660 = Self::mul_add(
-            -x606,
+        let x660 = S::mul_add(
+            S::neg(x606),
             x619,
-            Self::mul_add(-x584, x594, Self::mul_add(-x559, x569, x659)),
+            S::mul_add(S::neg(x584), x594, S::mul_add(S::neg(x559), x569, x659)),
         );
-        let x661 = Self::mul_add(x631, x641, x660);
+        let x661 = S::mul_add(x631, x641, x660);
         let x662 = x650 * x661;
-        let x663 = Self::mul_add(
-            -x151,
+        let x663 = S::mul_add(
+            S::neg(x151),
             x547,
-            Self::mul_add(-x184, x541, Self::mul_add(-x183, x533, x259)),
+            S::mul_add(S::neg(x184), x541, S::mul_add(S::neg(x183), x533, x259)),
         );
-        let x664 = Self::mul_add(
+        let x664 = S::mul_add(
             x606,
             x623,
-            Self::mul_add(-x584, x597, Self::mul_add(-x559, x572, x663)),
+            S::mul_add(S::neg(x584), x597, S::mul_add(S::neg(x559), x572, x663)),
         );
-        let x665 = Self::mul_add(-x631, x644, x664);
+        let x665 = S::mul_add(S::neg(x631), x644, x664);
         let x666 = x650 * x665;
-        let x667 = Self::mul_add(
+        let x667 = S::mul_add(
             x151,
             x548,
-            Self::mul_add(-x184, x542, Self::mul_add(-x183, x534, x299)),
+            S::mul_add(S::neg(x184), x542, S::mul_add(S::neg(x183), x534, x299)),
         );
-        let x668 = Self::mul_add(
+        let x668 = S::mul_add(
             x606,
             x627,
-            Self::mul_add(-x584, x600, Self::mul_add(-x559, x575, x667)),
+            S::mul_add(S::neg(x584), x600, S::mul_add(S::neg(x559), x575, x667)),
         );
-        let x669 = Self::mul_add(-x631, x647, x668);
+        let x669 = S::mul_add(S::neg(x631), x647, x668);
         let x670 = x650 * x669;
-        let x671 = Self::mul_add(
-            -x192,
+        let x671 = S::mul_add(
+            S::neg(x192),
             x544,
-            Self::mul_add(-x199, x538, Self::mul_add(-x198, x530, x98)),
+            S::mul_add(S::neg(x199), x538, S::mul_add(S::neg(x198), x530, x98)),
         );
-        let x672 = Self::mul_add(
+        let x672 = S::mul_add(
             x610,
             x611,
-            Self::mul_add(-x587, x588, Self::mul_add(-x562, x563, x671)),
+            S::mul_add(S::neg(x587), x588, S::mul_add(S::neg(x562), x563, x671)),
         );
-        let x673 = 1.0 / Self::mul_add(-x653, x654, Self::mul_add(-x634, x635, x672));
-        let x674 = Self::mul_add(
+        let x673 = S::splat(1.0)
+            / S::mul_add(S::neg(x653), x654, S::mul_add(S::neg(x634), x635, x672));
+        let x674 = S::mul_add(
             x192,
             x545,
-            Self::mul_add(-x199, x539, Self::mul_add(-x198, x531, x92)),
+            S::mul_add(S::neg(x199), x539, S::mul_add(S::neg(x198), x531, x92)),
         );
-        let x675 = Self::mul_add(
+        let x675 = S::mul_add(
             x610,
             x615,
-            Self::mul_add(x587, x591, Self::mul_add(x562, x566, x674)),
+            S::mul_add(x587, x591, S::mul_add(x562, x566, x674)),
         );
-        let x676 = Self::mul_add(x653, x658, Self::mul_add(-x634, x638, x675));
+        let x676 = S::mul_add(x653, x658, S::mul_add(S::neg(x634), x638, x675));
         let x677 = x673 * x676;
-        let x678 = Self::mul_add(
-            -x192,
+        let x678 = S::mul_add(
+            S::neg(x192),
             x546,
-            Self::mul_add(-x199, x540, Self::mul_add(-x198, x532, x221)),
+            S::mul_add(S::neg(x199), x540, S::mul_add(S::neg(x198), x532, x221)),
         );
-        let x679 = Self::mul_add(
+        let x679 = S::mul_add(
             x610,
             x619,
-            Self::mul_add(x587, x594, Self::mul_add(x562, x569, x678)),
+            S::mul_add(x587, x594, S::mul_add(x562, x569, x678)),
         );
-        let x680 = Self::mul_add(x653, x662, Self::mul_add(-x634, x641, x679));
+        let x680 = S::mul_add(x653, x662, S::mul_add(S::neg(x634), x641, x679));
         let x681 = x673 * x680;
-        let x682 = Self::mul_add(
+        let x682 = S::mul_add(
             x192,
             x547,
-            Self::mul_add(-x199, x541, Self::mul_add(-x198, x533, x252)),
+            S::mul_add(S::neg(x199), x541, S::mul_add(S::neg(x198), x533, x252)),
         );
-        let x683 = Self::mul_add(
-            -x610,
+        let x683 = S::mul_add(
+            S::neg(x610),
             x623,
-            Self::mul_add(x587, x597, Self::mul_add(x562, x572, x682)),
+            S::mul_add(x587, x597, S::mul_add(x562, x572, x682)),
         );
-        let x684 = Self::mul_add(x653, x666, Self::mul_add(x634, x644, x683));
+        let x684 = S::mul_add(x653, x666, S::mul_add(x634, x644, x683));
         let x685 = x673 * x684;
-        let x686 = Self::mul_add(
-            -x192,
+        let x686 = S::mul_add(
+            S::neg(x192),
             x548,
-            Self::mul_add(-x199, x542, Self::mul_add(-x198, x534, x291)),
+            S::mul_add(S::neg(x199), x542, S::mul_add(S::neg(x198), x534, x291)),
         );
-        let x687 = Self::mul_add(
-            -x610,
+        let x687 = S::mul_add(
+            S::neg(x610),
             x627,
-            Self::mul_add(x587, x600, Self::mul_add(x562, x575, x686)),
+            S::mul_add(x587, x600, S::mul_add(x562, x575, x686)),
         );
-        let x688 = Self::mul_add(x653, x670, Self::mul_add(x634, x647, x687));
+        let x688 = S::mul_add(x653, x670, S::mul_add(x634, x647, x687));
         let x689 = x673 * x688;
-        let x690 = Self::mul_add(
-            -x209,
+        let x690 = S::mul_add(
+            S::neg(x209),
             x545,
-            Self::mul_add(-x216, x539, Self::mul_add(-x215, x531, x78)),
+            S::mul_add(S::neg(x216), x539, S::mul_add(S::neg(x215), x531, x78)),
         );
-        let x691 = Self::mul_add(
+        let x691 = S::mul_add(
             x614,
             x615,
-            Self::mul_add(-x590, x591, Self::mul_add(-x565, x566, x690)),
+            S::mul_add(S::neg(x590), x591, S::mul_add(S::neg(x565), x566, x690)),
         );
-        let x692 = Self::mul_add(
-            -x676,
+        let x692 = S::mul_add(
+            S::neg(x676),
             x677,
-            Self::mul_add(-x657, x658, Self::mul_add(-x637, x638, x691)),
+            S::mul_add(S::neg(x657), x658, S::mul_add(S::neg(x637), x638, x691)),
         );
-        let x693 = 1.0 / x692;
-        let x694 = Self::mul_add(
+        let x693 = S::splat(1.0) / x692;
+        let x694 = S::mul_add(
             x209,
             x546,
-            Self::mul_add(-x216, x540, Self::mul_add(-x215, x532, x72)),
+            S::mul_add(S::neg(x216), x540, S::mul_add(S::neg(x215), x532, x72)),
         );
-        let x695 = Self::mul_add(
+        let x695 = S::mul_add(
             x614,
             x619,
-            Self::mul_add(-x590, x594, Self::mul_add(-x565, x569, x694)),
+            S::mul_add(S::neg(x590), x594, S::mul_add(S::neg(x565), x569, x694)),
         );
-        let x696 = Self::mul_add(
-            -x676,
+        let x696 = S::mul_add(
+            S::neg(x676),
             x681,
-            Self::mul_add(-x657, x662, Self::mul_add(-x637, x641, x695)),
+            S::mul_add(S::neg(x657), x662, S::mul_add(S::neg(x637), x641, x695)),
         );
         let x697 = x693 * x696;
-        let x698 = Self::mul_add(
-            -x209,
+        let x698 = S::mul_add(
+            S::neg(x209),
             x547,
-            Self::mul_add(-x216, x541, Self::mul_add(-x215, x533, x247)),
+            S::mul_add(S::neg(x216), x541, S::mul_add(S::neg(x215), x533, x247)),
         );
-        let x699 = Self::mul_add(
-            -x614,
+        let x699 = S::mul_add(
+            S::neg(x614),
             x623,
-            Self::mul_add(-x590, x597, Self::mul_add(-x565, x572, x698)),
+            S::mul_add(S::neg(x590), x597, S::mul_add(S::neg(x565), x572, x698)),
         );
-        let x700 = Self::mul_add(
-            -x676,
+        let x700 = S::mul_add(
+            S::neg(x676),
             x685,
-            Self::mul_add(-x657, x666, Self::mul_add(x637, x644, x699)),
+            S::mul_add(S::neg(x657), x666, S::mul_add(x637, x644, x699)),
         );
         let x701 = x693 * x700;
-        let x702 = Self::mul_add(
+        let x702 = S::mul_add(
             x209,
             x548,
-            Self::mul_add(-x216, x542, Self::mul_add(-x215, x534, x286)),
+            S::mul_add(S::neg(x216), x542, S::mul_add(S::neg(x215), x534, x286)),
         );
-        let x703 = Self::mul_add(
-            -x614,
+        let x703 = S::mul_add(
+            S::neg(x614),
             x627,
-            Self::mul_add(-x590, x600, Self::mul_add(-x565, x575, x702)),
+            S::mul_add(S::neg(x590), x600, S::mul_add(S::neg(x565), x575, x702)),
         );
-        let x704 = Self::mul_add(
-            -x676,
+        let x704 = S::mul_add(
+            S::neg(x676),
             x689,
-            Self::mul_add(-x657, x670, Self::mul_add(x637, x647, x703)),
+            S::mul_add(S::neg(x657), x670, S::mul_add(x637, x647, x703)),
         );
         let x705 = x693 * x704;
-        let x706 = Self::mul_add(
-            -x231,
+        let x706 = S::mul_add(
+            S::neg(x231),
             x546,
-            Self::mul_add(-x238, x540, Self::mul_add(-x237, x532, x58)),
+            S::mul_add(S::neg(x238), x540, S::mul_add(S::neg(x237), x532, x58)),
         );
-        let x707 = Self::mul_add(
+        let x707 = S::mul_add(
             x618,
             x619,
-            Self::mul_add(-x593, x594, Self::mul_add(-x568, x569, x706)),
+            S::mul_add(S::neg(x593), x594, S::mul_add(S::neg(x568), x569, x706)),
         );
-        let x708 = Self::mul_add(
-            -x680,
+        let x708 = S::mul_add(
+            S::neg(x680),
             x681,
-            Self::mul_add(-x661, x662, Self::mul_add(-x640, x641, x707)),
+            S::mul_add(S::neg(x661), x662, S::mul_add(S::neg(x640), x641, x707)),
         );
-        let x709 = 1.0 / Self::mul_add(-x696, x697, x708);
-        let x710 = Self::mul_add(
+        let x709 = S::splat(1.0) / S::mul_add(S::neg(x696), x697, x708);
+        let x710 = S::mul_add(
             x231,
             x547,
-            Self::mul_add(-x238, x541, Self::mul_add(-x237, x533, x240)),
+            S::mul_add(S::neg(x238), x541, S::mul_add(S::neg(x237), x533, x240)),
         );
-        let x711 = Self::mul_add(
-            -x618,
+        let x711 = S::mul_add(
+            S::neg(x618),
             x623,
-            Self::mul_add(-x593, x597, Self::mul_add(-x568, x572, x710)),
+            S::mul_add(S::neg(x593), x597, S::mul_add(S::neg(x568), x572, x710)),
         );
-        let x712 = Self::mul_add(
-            -x680,
+        let x712 = S::mul_add(
+            S::neg(x680),
             x685,
-            Self::mul_add(-x661, x666, Self::mul_add(x640, x644, x711)),
+            S::mul_add(S::neg(x661), x666, S::mul_add(x640, x644, x711)),
         );
-        let x713 = Self::mul_add(-x696, x701, x712);
+        let x713 = S::mul_add(S::neg(x696), x701, x712);
         let x714 = x709 * x713;
-        let x715 = Self::mul_add(
-            -x231,
+        let x715 = S::mul_add(
+            S::neg(x231),
             x548,
-            Self::mul_add(-x238, x542, Self::mul_add(-x237, x534, x279)),
+            S::mul_add(S::neg(x238), x542, S::mul_add(S::neg(x237), x534, x279)),
         );
-        let x716 = Self::mul_add(
-            -x618,
+        let x716 = S::mul_add(
+            S::neg(x618),
             x627,
-            Self::mul_add(-x593, x600, Self::mul_add(-x568, x575, x715)),
+            S::mul_add(S::neg(x593), x600, S::mul_add(S::neg(x568), x575, x715)),
         );
-        let x717 = Self::mul_add(
-            -x680,
+        let x717 = S::mul_add(
+            S::neg(x680),
             x689,
-            Self::mul_add(-x661, x670, Self::mul_add(x640, x647, x716)),
+            S::mul_add(S::neg(x661), x670, S::mul_add(x640, x647, x716)),
         );
-        let x718 = Self::mul_add(-x696, x705, x717);
+        let x718 = S::mul_add(S::neg(x696), x705, x717);
         let x719 = x709 * x718;
-        let x720 = Self::mul_add(
-            -x262,
+        let x720 = S::mul_add(
+            S::neg(x262),
             x547,
-            Self::mul_add(-x269, x541, Self::mul_add(-x268, x533, x34)),
+            S::mul_add(S::neg(x269), x541, S::mul_add(S::neg(x268), x533, x34)),
         );
-        let x721 = Self::mul_add(
+        let x721 = S::mul_add(
             x622,
             x623,
-            Self::mul_add(-x596, x597, Self::mul_add(-x571, x572, x720)),
+            S::mul_add(S::neg(x596), x597, S::mul_add(S::neg(x571), x572, x720)),
         );
-        let x722 = Self::mul_add(
-            -x684,
+        let x722 = S::mul_add(
+            S::neg(x684),
             x685,
-            Self::mul_add(-x665, x666, Self::mul_add(-x643, x644, x721)),
+            S::mul_add(S::neg(x665), x666, S::mul_add(S::neg(x643), x644, x721)),
         );
-        let x723 = 1.0 / Self::mul_add(-x713, x714, Self::mul_add(-x700, x701, x722));
-        let x724 = Self::mul_add(
+        let x723 = S::splat(1.0)
+            / S::mul_add(S::neg(x713), x714, S::mul_add(S::neg(x700), x701, x722));
+        let x724 = S::mul_add(
             x262,
             x548,
-            Self::mul_add(-x269, x542, Self::mul_add(-x268, x534, x273)),
+            S::mul_add(S::neg(x269), x542, S::mul_add(S::neg(x268), x534, x273)),
         );
-        let x725 = Self::mul_add(
+        let x725 = S::mul_add(
             x622,
             x627,
-            Self::mul_add(-x596, x600, Self::mul_add(-x571, x575, x724)),
+            S::mul_add(S::neg(x596), x600, S::mul_add(S::neg(x571), x575, x724)),
         );
-        let x726 = Self::mul_add(
-            -x684,
+        let x726 = S::mul_add(
+            S::neg(x684),
             x689,
-            Self::mul_add(-x665, x670, Self::mul_add(-x643, x647, x725)),
+            S::mul_add(S::neg(x665), x670, S::mul_add(S::neg(x643), x647, x725)),
         );
-        let x727 = Self::mul_add(-x713, x719, Self::mul_add(-x700, x705, x726));
+        let x727 = S::mul_add(S::neg(x713), x719, S::mul_add(S::neg(x700), x705, x726));
         let x728 = x723 * x727;
-        let x729 = Self::mul_add(
-            -x302,
+        let x729 = S::mul_add(
+            S::neg(x302),
             x548,
-            Self::mul_add(-x309, x542, Self::mul_add(-x308, x534, 1.4135609200000003)),
+            S::mul_add(
+                S::neg(x309),
+                x542,
+                S::mul_add(S::neg(x308), x534, S::splat(1.4135609200000003)),
+            ),
         );
-        let x730 = Self::mul_add(
+        let x730 = S::mul_add(
             x626,
             x627,
-            Self::mul_add(-x599, x600, Self::mul_add(-x574, x575, x729)),
+            S::mul_add(S::neg(x599), x600, S::mul_add(S::neg(x574), x575, x729)),
         );
-        let x731 = Self::mul_add(
-            -x688,
+        let x731 = S::mul_add(
+            S::neg(x688),
             x689,
-            Self::mul_add(-x669, x670, Self::mul_add(-x646, x647, x730)),
+            S::mul_add(S::neg(x669), x670, S::mul_add(S::neg(x646), x647, x730)),
         );
-        let x732 = Self::mul_add(
-            -x727,
+        let x732 = S::mul_add(
+            S::neg(x727),
             x728,
-            Self::mul_add(-x718, x719, Self::mul_add(-x704, x705, x731)),
+            S::mul_add(S::neg(x718), x719, S::mul_add(S::neg(x704), x705, x731)),
         );
-        let x733 = 1.0 / x732;
-        let x734 = Self::mul_add(
+        let x733 = S::splat(1.0) / x732;
+        let x734 = S::mul_add(
             x525,
             x527,
-            Self::mul_add(-0.75, x520, Self::mul_add(-s_q7, x517, c_q7 * x516))
+            S::mul_add(
+                S::splat(-0.75),
+                x520,
+                S::mul_add(S::neg(s_q7), x517, c_q7 * x516),
+            )
                 + (f_ext[0][3]
-                    + Self::mul_add(
-                        180.9502499901501,
+                    + S::mul_add(
+                        S::splat(180.9502499901501),
                         x311,
-                        Self::mul_add(v[4], x523, v[5] * x522),
+                        S::mul_add(v[4], x523, v[5] * x522),
                     )),
         );
-        let x735 = Self::mul_add(-x526, x528, x734);
-        let x736 = Self::mul_add(
+        let x735 = S::mul_add(S::neg(x526), x528, x734);
+        let x736 = S::mul_add(
             x526,
             x535,
-            Self::mul_add(
-                -x524,
+            S::mul_add(
+                S::neg(x524),
                 x527,
-                Self::mul_add(c_q7, x517, s_q7 * x516)
-                    + Self::mul_add(-0.65, x515, 0.75 * x519)
+                S::mul_add(c_q7, x517, s_q7 * x516)
+                    + S::mul_add(S::splat(-0.65), x515, S::splat(0.75) * x519)
                     + (f_ext[0][4]
-                        - (Self::mul_add(v[3], x523, v[5] * x521)
-                            - Self::mul_add(-110.5455, x312, 180.9502499901501 * x310))),
+                        - (S::mul_add(v[3], x523, v[5] * x521)
+                            - S::mul_add(
+                                S::splat(-110.5455),
+                                x312,
+                                S::splat(180.9502499901501) * x310,
+                            ))),
             ),
         );
-        let x737 = Self::mul_add(-x553, x735, x736);
+        let x737 = S::mul_add(S::neg(x553), x735, x736);
         let x738 = x524 * x528;
-        let x739 = Self::mul_add(
-            -x525,
+        let x739 = S::mul_add(
+            S::neg(x525),
             x535,
-            Self::mul_add(0.65, x520, x518)
+            S::mul_add(S::splat(0.65), x520, x518)
                 + (f_ext[0][5]
-                    + Self::mul_add(
-                        -110.5455,
+                    + S::mul_add(
+                        S::splat(-110.5455),
                         x311,
-                        Self::mul_add(-v[3], x522, v[4] * x521),
+                        S::mul_add(S::neg(v[3]), x522, v[4] * x521),
                     )) + x738,
         );
-        let x740 = Self::mul_add(-x580, x737, Self::mul_add(-x555, x735, x739));
-        let x741 = Self::mul_add(
-            -x582,
+        let x740 = S::mul_add(S::neg(x580), x737, S::mul_add(S::neg(x555), x735, x739));
+        let x741 = S::mul_add(
+            S::neg(x582),
             x737,
-            Self::mul_add(-x557, x735, Self::mul_add(-x525, x536, tau[0] + x518 + x738)),
+            S::mul_add(
+                S::neg(x557),
+                x735,
+                S::mul_add(S::neg(x525), x536, tau[0] + x518 + x738),
+            ),
         );
-        let x742 = Self::mul_add(x603, x740, x741);
-        let x743 = Self::mul_add(
-            -x526,
+        let x742 = S::mul_add(x603, x740, x741);
+        let x743 = S::mul_add(
+            S::neg(x526),
             x543,
-            Self::mul_add(-x525, x537, Self::mul_add(-x524, x529, tau[1] + x508)),
+            S::mul_add(S::neg(x525), x537, S::mul_add(S::neg(x524), x529, tau[1] + x508)),
         );
-        let x744 = Self::mul_add(
-            -x607,
+        let x744 = S::mul_add(
+            S::neg(x607),
             x740,
-            Self::mul_add(-x585, x737, Self::mul_add(-x560, x735, x743)),
+            S::mul_add(S::neg(x585), x737, S::mul_add(S::neg(x560), x735, x743)),
         );
-        let x745 = Self::mul_add(x632, x742, x744);
-        let x746 = Self::mul_add(
-            -x526,
+        let x745 = S::mul_add(x632, x742, x744);
+        let x746 = S::mul_add(
+            S::neg(x526),
             x544,
-            Self::mul_add(x525, x538, Self::mul_add(x524, x530, tau[2] + x497)),
+            S::mul_add(x525, x538, S::mul_add(x524, x530, tau[2] + x497)),
         );
-        let x747 = Self::mul_add(
-            -x611,
+        let x747 = S::mul_add(
+            S::neg(x611),
             x740,
-            Self::mul_add(-x588, x737, Self::mul_add(-x563, x735, x746)),
+            S::mul_add(S::neg(x588), x737, S::mul_add(S::neg(x563), x735, x746)),
         );
-        let x748 = Self::mul_add(-x654, x745, Self::mul_add(x635, x742, x747));
-        let x749 = Self::mul_add(
+        let x748 = S::mul_add(S::neg(x654), x745, S::mul_add(x635, x742, x747));
+        let x749 = S::mul_add(
             x526,
             x545,
-            Self::mul_add(x525, x539, Self::mul_add(x524, x531, tau[3] + x490)),
+            S::mul_add(x525, x539, S::mul_add(x524, x531, tau[3] + x490)),
         );
-        let x750 = Self::mul_add(
-            -x615,
+        let x750 = S::mul_add(
+            S::neg(x615),
             x740,
-            Self::mul_add(x591, x737, Self::mul_add(x566, x735, x749)),
+            S::mul_add(x591, x737, S::mul_add(x566, x735, x749)),
         );
-        let x751 = Self::mul_add(
-            -x677,
+        let x751 = S::mul_add(
+            S::neg(x677),
             x748,
-            Self::mul_add(x658, x745, Self::mul_add(x638, x742, x750)),
+            S::mul_add(x658, x745, S::mul_add(x638, x742, x750)),
         );
-        let x752 = Self::mul_add(
-            -x526,
+        let x752 = S::mul_add(
+            S::neg(x526),
             x546,
-            Self::mul_add(x525, x540, Self::mul_add(x524, x532, tau[4] + x482)),
+            S::mul_add(x525, x540, S::mul_add(x524, x532, tau[4] + x482)),
         );
-        let x753 = Self::mul_add(
-            -x619,
+        let x753 = S::mul_add(
+            S::neg(x619),
             x740,
-            Self::mul_add(x594, x737, Self::mul_add(x569, x735, x752)),
+            S::mul_add(x594, x737, S::mul_add(x569, x735, x752)),
         );
-        let x754 = Self::mul_add(
-            -x681,
+        let x754 = S::mul_add(
+            S::neg(x681),
             x748,
-            Self::mul_add(x662, x745, Self::mul_add(x641, x742, x753)),
+            S::mul_add(x662, x745, S::mul_add(x641, x742, x753)),
         );
-        let x755 = Self::mul_add(-x697, x751, x754);
-        let x756 = Self::mul_add(
-            -x526,
+        let x755 = S::mul_add(S::neg(x697), x751, x754);
+        let x756 = S::mul_add(
+            S::neg(x526),
             x547,
-            Self::mul_add(-x525, x541, Self::mul_add(-x524, x533, tau[5] + x472)),
+            S::mul_add(S::neg(x525), x541, S::mul_add(S::neg(x524), x533, tau[5] + x472)),
         );
-        let x757 = Self::mul_add(
-            -x623,
+        let x757 = S::mul_add(
+            S::neg(x623),
             x740,
-            Self::mul_add(-x597, x737, Self::mul_add(-x572, x735, x756)),
+            S::mul_add(S::neg(x597), x737, S::mul_add(S::neg(x572), x735, x756)),
         );
-        let x758 = Self::mul_add(
+        let x758 = S::mul_add(
             x685,
             x748,
-            Self::mul_add(-x666, x745, Self::mul_add(x644, x742, x757)),
+            S::mul_add(S::neg(x666), x745, S::mul_add(x644, x742, x757)),
         );
-        let x759 = Self::mul_add(x714, x755, Self::mul_add(x701, x751, x758));
-        let x760 = Self::mul_add(
+        let x759 = S::mul_add(x714, x755, S::mul_add(x701, x751, x758));
+        let x760 = S::mul_add(
             x526,
             x548,
-            Self::mul_add(-x525, x542, Self::mul_add(-x524, x534, tau[6] + x461)),
+            S::mul_add(S::neg(x525), x542, S::mul_add(S::neg(x524), x534, tau[6] + x461)),
         );
-        let x761 = Self::mul_add(
-            -x627,
+        let x761 = S::mul_add(
+            S::neg(x627),
             x740,
-            Self::mul_add(-x600, x737, Self::mul_add(-x575, x735, x760)),
+            S::mul_add(S::neg(x600), x737, S::mul_add(S::neg(x575), x735, x760)),
         );
-        let x762 = Self::mul_add(
+        let x762 = S::mul_add(
             x689,
             x748,
-            Self::mul_add(-x670, x745, Self::mul_add(x647, x742, x761)),
+            S::mul_add(S::neg(x670), x745, S::mul_add(x647, x742, x761)),
         );
-        let x763 = Self::mul_add(
-            -x728,
+        let x763 = S::mul_add(
+            S::neg(x728),
             x759,
-            Self::mul_add(x719, x755, Self::mul_add(x705, x751, x762)),
+            S::mul_add(x719, x755, S::mul_add(x705, x751, x762)),
         );
         let x764 = x733 * x763;
-        let x765 = Self::mul_add(-x728, x764, x723 * x759);
-        let x766 = Self::mul_add(x719, x764, Self::mul_add(x714, x765, x709 * x755));
-        let x767 = Self::mul_add(
+        let x765 = S::mul_add(S::neg(x728), x764, x723 * x759);
+        let x766 = S::mul_add(x719, x764, S::mul_add(x714, x765, x709 * x755));
+        let x767 = S::mul_add(
             x705,
             x764,
-            Self::mul_add(x701, x765, Self::mul_add(-x697, x766, x693 * x751)),
+            S::mul_add(x701, x765, S::mul_add(S::neg(x697), x766, x693 * x751)),
         );
-        let x768 = Self::mul_add(
+        let x768 = S::mul_add(
             x685,
             x765,
-            Self::mul_add(-x681, x766, Self::mul_add(-x677, x767, x673 * x748)),
+            S::mul_add(S::neg(x681), x766, S::mul_add(S::neg(x677), x767, x673 * x748)),
         );
-        let x769 = Self::mul_add(x689, x764, x768);
-        let x770 = Self::mul_add(
+        let x769 = S::mul_add(x689, x764, x768);
+        let x770 = S::mul_add(
             x662,
             x766,
-            Self::mul_add(x658, x767, Self::mul_add(-x654, x769, x650 * x745)),
+            S::mul_add(x658, x767, S::mul_add(S::neg(x654), x769, x650 * x745)),
         );
-        let x771 = Self::mul_add(-x670, x764, Self::mul_add(-x666, x765, x770));
-        let x772 = Self::mul_add(
+        let x771 = S::mul_add(S::neg(x670), x764, S::mul_add(S::neg(x666), x765, x770));
+        let x772 = S::mul_add(
             x638,
             x767,
-            Self::mul_add(x635, x769, Self::mul_add(x632, x771, x629 * x742)),
+            S::mul_add(x635, x769, S::mul_add(x632, x771, x629 * x742)),
         );
-        let x773 = Self::mul_add(
+        let x773 = S::mul_add(
             x647,
             x764,
-            Self::mul_add(x644, x765, Self::mul_add(x641, x766, x772)),
+            S::mul_add(x644, x765, S::mul_add(x641, x766, x772)),
         );
-        let x774 = Self::mul_add(
+        let x774 = S::mul_add(
             x611,
             x769,
-            Self::mul_add(x607, x771, Self::mul_add(-x603, x773, x601 * x740)),
+            S::mul_add(x607, x771, S::mul_add(S::neg(x603), x773, x601 * x740)),
         );
-        let x775 = Self::mul_add(
+        let x775 = S::mul_add(
             x623,
             x765,
-            Self::mul_add(x619, x766, Self::mul_add(x615, x767, x774)),
+            S::mul_add(x619, x766, S::mul_add(x615, x767, x774)),
         );
-        let x776 = Self::mul_add(x627, x764, x775);
-        let x777 = -x776;
-        let x778 = Self::mul_add(
-            -x585,
+        let x776 = S::mul_add(x627, x764, x775);
+        let x777 = S::neg(x776);
+        let x778 = S::mul_add(
+            S::neg(x585),
             x771,
-            Self::mul_add(-x582, x773, Self::mul_add(x580, x776, x577 * x737)),
+            S::mul_add(S::neg(x582), x773, S::mul_add(x580, x776, x577 * x737)),
         );
-        let x779 = Self::mul_add(
+        let x779 = S::mul_add(
             x594,
             x766,
-            Self::mul_add(x591, x767, Self::mul_add(-x588, x769, x778)),
+            S::mul_add(x591, x767, S::mul_add(S::neg(x588), x769, x778)),
         );
-        let x780 = Self::mul_add(-x600, x764, Self::mul_add(-x597, x765, x779));
-        let x781 = Self::mul_add(
-            -x557,
+        let x780 = S::mul_add(S::neg(x600), x764, S::mul_add(S::neg(x597), x765, x779));
+        let x781 = S::mul_add(
+            S::neg(x557),
             x773,
-            Self::mul_add(x555, x776, Self::mul_add(-x553, x780, x551 * x735)),
+            S::mul_add(x555, x776, S::mul_add(S::neg(x553), x780, x551 * x735)),
         );
-        let x782 = Self::mul_add(
+        let x782 = S::mul_add(
             x566,
             x767,
-            Self::mul_add(-x563, x769, Self::mul_add(-x560, x771, x781)),
+            S::mul_add(S::neg(x563), x769, S::mul_add(S::neg(x560), x771, x781)),
         );
-        let x783 = Self::mul_add(
-            -x575,
+        let x783 = S::mul_add(
+            S::neg(x575),
             x764,
-            Self::mul_add(-x572, x765, Self::mul_add(x569, x766, x782)),
+            S::mul_add(S::neg(x572), x765, S::mul_add(x569, x766, x782)),
         );
-        let x784 = Self::mul_add(
-            -x543,
+        let x784 = S::mul_add(
+            S::neg(x543),
             x771,
-            Self::mul_add(
+            S::mul_add(
                 x535,
                 x780,
-                Self::mul_add(-x528, x783, x526 * 0.0008546497218115156),
+                S::mul_add(S::neg(x528), x783, x526 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x785 = Self::mul_add(
-            -x546,
+        let x785 = S::mul_add(
+            S::neg(x546),
             x766,
-            Self::mul_add(x545, x767, Self::mul_add(-x544, x769, x784)),
+            S::mul_add(x545, x767, S::mul_add(S::neg(x544), x769, x784)),
         );
-        let x786 = Self::mul_add(x548, x764, Self::mul_add(-x547, x765, x785));
-        let x787 = Self::mul_add(
-            -x536,
+        let x786 = S::mul_add(x548, x764, S::mul_add(S::neg(x547), x765, x785));
+        let x787 = S::mul_add(
+            S::neg(x536),
             x773,
-            Self::mul_add(
+            S::mul_add(
                 x535,
                 x776,
-                Self::mul_add(x527, x783, x525 * 0.0008546497218115156),
+                S::mul_add(x527, x783, x525 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x788 = Self::mul_add(
+        let x788 = S::mul_add(
             x539,
             x767,
-            Self::mul_add(x538, x769, Self::mul_add(-x537, x771, x787)),
+            S::mul_add(x538, x769, S::mul_add(S::neg(x537), x771, x787)),
         );
-        let x789 = Self::mul_add(
-            -x542,
+        let x789 = S::mul_add(
+            S::neg(x542),
             x764,
-            Self::mul_add(-x541, x765, Self::mul_add(x540, x766, x788)),
+            S::mul_add(S::neg(x541), x765, S::mul_add(x540, x766, x788)),
         );
-        let x790 = Self::mul_add(
+        let x790 = S::mul_add(
             x528,
             x773,
-            Self::mul_add(
-                -x528,
+            S::mul_add(
+                S::neg(x528),
                 x776,
-                Self::mul_add(-x527, x780, x524 * 0.0008546497218115156),
+                S::mul_add(S::neg(x527), x780, x524 * S::splat(0.0008546497218115156)),
             ),
         );
-        let x791 = Self::mul_add(
+        let x791 = S::mul_add(
             x531,
             x767,
-            Self::mul_add(x530, x769, Self::mul_add(-x529, x771, x790)),
+            S::mul_add(x530, x769, S::mul_add(S::neg(x529), x771, x790)),
         );
-        let x792 = Self::mul_add(
-            -x534,
+        let x792 = S::mul_add(
+            S::neg(x534),
             x764,
-            Self::mul_add(-x533, x765, Self::mul_add(x532, x766, x791)),
+            S::mul_add(S::neg(x533), x765, S::mul_add(x532, x766, x791)),
         );
         [x792, x789, x786, x783, x780, x777, x773, x771, x769, x767, x766, x765, x764]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 8]],
+        out: &mut [[::core::primitive::f64; 13]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
@@ -7755,8 +9502,16 @@ impl FreeFloating7 {
         q: &[::core::primitive::f64; 14],
         v: &[::core::primitive::f64; 13],
     ) -> [::core::primitive::f64; 6] {
+        Self::momentum_lanes::<::core::primitive::f64>(q, v)
+    }
+    /// [`Self::momentum`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn momentum_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 14],
+        v: &[S; 13],
+    ) -> [S; 6] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
             q[8],
             q[9],
@@ -7765,347 +9520,503 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = q[6] * 2.0;
+        let x7 = q[6] * S::splat(2.0);
         let x8 = q[5] * x7;
         let x9 = q[4] * x7;
         let x10 = q[3] * x7;
         let x11 = q[5] * q[5];
         let x12 = q[4] * q[4];
         let x13 = q[3] * q[3];
-        let x14 = 2.0 * (q[3] * q[4]);
-        let x15 = 2.0 * (q[3] * q[5]);
-        let x16 = 2.0 * (q[4] * q[5]);
-        let x17 = Self::mul_add(-2.0, x11 + x12, 1.0);
+        let x14 = S::splat(2.0) * (q[3] * q[4]);
+        let x15 = S::splat(2.0) * (q[3] * q[5]);
+        let x16 = S::splat(2.0) * (q[4] * q[5]);
+        let x17 = S::mul_add(S::splat(-2.0), x11 + x12, S::splat(1.0));
         let x18 = x8 - x14;
         let x19 = x9 + x15;
         let x20 = x8 + x14;
-        let x21 = Self::mul_add(-2.0, x11 + x13, 1.0);
+        let x21 = S::mul_add(S::splat(-2.0), x11 + x13, S::splat(1.0));
         let x22 = x10 - x16;
         let x23 = x9 - x15;
         let x24 = x10 + x16;
-        let x25 = Self::mul_add(-2.0, x12 + x13, 1.0);
-        let x26 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x27 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x28 = Self::mul_add(0.75, v[4], v[0]);
-        let x29 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x30 = Self::mul_add(-0.65, v[4], v[2]);
-        let x31 = Self::mul_add(-c_q7, x29, s_q7 * x28);
+        let x25 = S::mul_add(S::splat(-2.0), x12 + x13, S::splat(1.0));
+        let x26 = S::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x27 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x28 = S::mul_add(S::splat(0.75), v[4], v[0]);
+        let x29 = v[1] - S::mul_add(S::splat(-0.65), v[5], S::splat(0.75) * v[3]);
+        let x30 = S::mul_add(S::splat(-0.65), v[4], v[2]);
+        let x31 = S::mul_add(S::neg(c_q7), x29, s_q7 * x28);
         let x32 = v[5] + v[6];
-        let x33 = 0.00000000020510342851533115 * c_q8;
-        let x34 = 0.00000000020510342851533115 * s_q8;
-        let x35 = Self::mul_add(x32, c_q8, Self::mul_add(x27, s_q8, x26 * x33));
-        let x36 = Self::mul_add(x32, s_q8, Self::mul_add(-x27, c_q8, x26 * x34));
-        let x37 = Self::mul_add(-0.35, x27, Self::mul_add(s_q7, x29, c_q7 * x28));
-        let x38 = Self::mul_add(0.35, x26, x31);
-        let x39 = Self::mul_add(x30, c_q8, Self::mul_add(s_q8, x38, x33 * x37));
-        let x40 = Self::mul_add(x30, s_q8, Self::mul_add(-c_q8, x38, x34 * x37));
-        let x41 = Self::mul_add(-0.00000000020510342851533115, x30, x37);
-        let x42 = v[7] + Self::mul_add(-0.00000000020510342851533115, x32, x26);
-        let x43 = 0.00000000020510342851533115 * c_q9;
-        let x44 = 0.00000000020510342851533115 * s_q9;
+        let x33 = S::splat(0.00000000020510342851533115) * c_q8;
+        let x34 = S::splat(0.00000000020510342851533115) * s_q8;
+        let x35 = S::mul_add(x32, c_q8, S::mul_add(x27, s_q8, x26 * x33));
+        let x36 = S::mul_add(x32, s_q8, S::mul_add(S::neg(x27), c_q8, x26 * x34));
+        let x37 = S::mul_add(S::splat(-0.35), x27, S::mul_add(s_q7, x29, c_q7 * x28));
+        let x38 = S::mul_add(S::splat(0.35), x26, x31);
+        let x39 = S::mul_add(x30, c_q8, S::mul_add(s_q8, x38, x33 * x37));
+        let x40 = S::mul_add(x30, s_q8, S::mul_add(S::neg(c_q8), x38, x34 * x37));
+        let x41 = S::mul_add(S::splat(-0.00000000020510342851533115), x30, x37);
+        let x42 = v[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x32, x26);
+        let x43 = S::splat(0.00000000020510342851533115) * c_q9;
+        let x44 = S::splat(0.00000000020510342851533115) * s_q9;
         let x45 = x43 - x44;
         let x46 = x43 + x44;
-        let x47 = Self::mul_add(-x42, c_q9, Self::mul_add(-x36, x45, x35 * s_q9));
-        let x48 = Self::mul_add(x42, s_q9, Self::mul_add(x36, x46, x35 * c_q9));
-        let x49 = x39 - Self::mul_add(-0.275, x42, 0.4 * x36);
-        let x50 = Self::mul_add(0.4, x35, x40);
-        let x51 = Self::mul_add(-0.275, x35, x41);
-        let x52 = Self::mul_add(-c_q9, x51, Self::mul_add(-x45, x50, s_q9 * x49));
-        let x53 = Self::mul_add(s_q9, x51, Self::mul_add(x46, x50, c_q9 * x49));
-        let x54 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x47 = S::mul_add(
+            S::neg(x42),
+            c_q9,
+            S::mul_add(S::neg(x36), x45, x35 * s_q9),
+        );
+        let x48 = S::mul_add(x42, s_q9, S::mul_add(x36, x46, x35 * c_q9));
+        let x49 = x39 - S::mul_add(S::splat(-0.275), x42, S::splat(0.4) * x36);
+        let x50 = S::mul_add(S::splat(0.4), x35, x40);
+        let x51 = S::mul_add(S::splat(-0.275), x35, x41);
+        let x52 = S::mul_add(
+            S::neg(c_q9),
             x51,
-            Self::mul_add(-0.00000000020510342851533115, x49, x50),
+            S::mul_add(S::neg(x45), x50, s_q9 * x49),
+        );
+        let x53 = S::mul_add(s_q9, x51, S::mul_add(x46, x50, c_q9 * x49));
+        let x54 = S::mul_add(
+            S::splat(-0.00000000020510342851533115),
+            x51,
+            S::mul_add(S::splat(-0.00000000020510342851533115), x49, x50),
         );
         let x55 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
                 x42,
-                Self::mul_add(-0.00000000020510342851533115, x35, x36),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x35, x36),
             );
-        let x56 = Self::mul_add(x48, s_q10, x47 * c_q10);
-        let x57 = Self::mul_add(-x48, c_q10, x47 * s_q10);
-        let x58 = Self::mul_add(x55, -0.87, x52);
-        let x59 = Self::mul_add(x47, 0.87, x54);
-        let x60 = Self::mul_add(x53, s_q10, c_q10 * x58);
+        let x56 = S::mul_add(x48, s_q10, x47 * c_q10);
+        let x57 = S::mul_add(S::neg(x48), c_q10, x47 * s_q10);
+        let x58 = S::mul_add(x55, S::splat(-0.87), x52);
+        let x59 = S::mul_add(x47, S::splat(0.87), x54);
+        let x60 = S::mul_add(x53, s_q10, c_q10 * x58);
         let x61 = v[9] + x55;
-        let x62 = Self::mul_add(-x57, s_q11, x56 * c_q11);
-        let x63 = Self::mul_add(x57, c_q11, x56 * s_q11);
-        let x64 = x60 + Self::mul_add(x61, -0.63, 0.275 * x57);
-        let x65 = Self::mul_add(-0.275, x56, Self::mul_add(-x53, c_q10, s_q10 * x58));
-        let x66 = Self::mul_add(x56, 0.63, x59);
-        let x67 = Self::mul_add(-s_q11, x65, c_q11 * x64);
+        let x62 = S::mul_add(S::neg(x57), s_q11, x56 * c_q11);
+        let x63 = S::mul_add(x57, c_q11, x56 * s_q11);
+        let x64 = x60 + S::mul_add(x61, S::splat(-0.63), S::splat(0.275) * x57);
+        let x65 = S::mul_add(
+            S::splat(-0.275),
+            x56,
+            S::mul_add(S::neg(x53), c_q10, s_q10 * x58),
+        );
+        let x66 = S::mul_add(x56, S::splat(0.63), x59);
+        let x67 = S::mul_add(S::neg(s_q11), x65, c_q11 * x64);
         let x68 = v[10] + x61;
-        let x69 = 0.00000000020510342851533115 * s_q12;
-        let x70 = 0.00000000020510342851533115 * c_q12;
-        let x71 = Self::mul_add(x68, s_q12, Self::mul_add(x63, x69, x62 * c_q12));
-        let x72 = Self::mul_add(-x68, c_q12, Self::mul_add(-x63, x70, x62 * s_q12));
-        let x73 = Self::mul_add(x63, 0.36, x67);
-        let x74 = Self::mul_add(x62, -0.36, Self::mul_add(c_q11, x65, s_q11 * x64));
-        let x75 = Self::mul_add(x66, s_q12, Self::mul_add(x69, x74, c_q12 * x73));
-        let x76 = Self::mul_add(-x66, c_q12, Self::mul_add(-x70, x74, s_q12 * x73));
-        let x77 = Self::mul_add(-0.00000000020510342851533115, x66, x74);
-        let x78 = v[11] + Self::mul_add(-0.00000000020510342851533115, x68, x63);
-        let x79 = 0.00000000020510342851533115 * c_q13;
-        let x80 = 0.00000000020510342851533115 * s_q13;
-        let x81 = Self::mul_add(-x78, c_q13, Self::mul_add(x72, s_q13, x71 * x79));
-        let x82 = Self::mul_add(-x78, s_q13, Self::mul_add(-x72, c_q13, x71 * x80));
-        let x83 = x75 - Self::mul_add(-0.55, x78, 0.16 * x72);
-        let x84 = Self::mul_add(-0.55, x71, x77);
-        let x85 = Self::mul_add(
-            -c_q13,
+        let x69 = S::splat(0.00000000020510342851533115) * s_q12;
+        let x70 = S::splat(0.00000000020510342851533115) * c_q12;
+        let x71 = S::mul_add(x68, s_q12, S::mul_add(x63, x69, x62 * c_q12));
+        let x72 = S::mul_add(
+            S::neg(x68),
+            c_q12,
+            S::mul_add(S::neg(x63), x70, x62 * s_q12),
+        );
+        let x73 = S::mul_add(x63, S::splat(0.36), x67);
+        let x74 = S::mul_add(x62, S::splat(-0.36), S::mul_add(c_q11, x65, s_q11 * x64));
+        let x75 = S::mul_add(x66, s_q12, S::mul_add(x69, x74, c_q12 * x73));
+        let x76 = S::mul_add(
+            S::neg(x66),
+            c_q12,
+            S::mul_add(S::neg(x70), x74, s_q12 * x73),
+        );
+        let x77 = S::mul_add(S::splat(-0.00000000020510342851533115), x66, x74);
+        let x78 = v[11] + S::mul_add(S::splat(-0.00000000020510342851533115), x68, x63);
+        let x79 = S::splat(0.00000000020510342851533115) * c_q13;
+        let x80 = S::splat(0.00000000020510342851533115) * s_q13;
+        let x81 = S::mul_add(S::neg(x78), c_q13, S::mul_add(x72, s_q13, x71 * x79));
+        let x82 = S::mul_add(
+            S::neg(x78),
+            s_q13,
+            S::mul_add(S::neg(x72), c_q13, x71 * x80),
+        );
+        let x83 = x75 - S::mul_add(S::splat(-0.55), x78, S::splat(0.16) * x72);
+        let x84 = S::mul_add(S::splat(-0.55), x71, x77);
+        let x85 = S::mul_add(
+            S::neg(c_q13),
             x84,
-            Self::mul_add(s_q13, Self::mul_add(0.16, x71, x76), x79 * x83),
+            S::mul_add(s_q13, S::mul_add(S::splat(0.16), x71, x76), x79 * x83),
         );
-        let x86 = v[12] - Self::mul_add(0.00000000020510342851533115, x78, x71);
-        let x87 = Self::mul_add(
-            48.0240000085309,
+        let x86 = v[12] - S::mul_add(S::splat(0.00000000020510342851533115), x78, x71);
+        let x87 = S::mul_add(
+            S::splat(48.0240000085309),
             x30,
-            Self::mul_add(
-                -0.1132,
+            S::mul_add(
+                S::splat(-0.1132),
                 x32,
-                Self::mul_add(130.43769025763282, x27, x26 * 0.07309),
+                S::mul_add(S::splat(130.43769025763282), x27, x26 * S::splat(0.07309)),
             ),
         );
-        let x88 = Self::mul_add(
-            48.0240000085309,
+        let x88 = S::mul_add(
+            S::splat(48.0240000085309),
             x31,
-            Self::mul_add(
-                -132.47349025763282,
+            S::mul_add(
+                S::splat(-132.47349025763282),
                 x32,
-                Self::mul_add(0.1132, x27, x26 * 16.80768997608804),
+                S::mul_add(S::splat(0.1132), x27, x26 * S::splat(16.80768997608804)),
             ),
         );
-        let x89 = Self::mul_add(
+        let x89 = S::mul_add(
             x41,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
+            S::splat(0.000000008530897668050218),
+            S::mul_add(
+                S::splat(5.080660024070365),
                 x42,
-                Self::mul_add(x36, -111.7548902508081, x35 * 0.0000000234896432582596),
+                S::mul_add(
+                    x36,
+                    S::splat(-111.7548902508081),
+                    x35 * S::splat(0.0000000234896432582596),
+                ),
             ),
         );
-        let x90 = Self::mul_add(
+        let x90 = S::mul_add(
             x52,
-            -81.53205,
-            Self::mul_add(
-                69.99836825,
+            S::splat(-81.53205),
+            S::mul_add(
+                S::splat(69.99836825),
                 x55,
-                Self::mul_add(x48, 36.18604050126307, x47 * 0.00214),
+                S::mul_add(x48, S::splat(36.18604050126307), x47 * S::splat(0.00214)),
             ),
         );
-        let x91 = Self::mul_add(
+        let x91 = S::mul_add(
             x60,
-            -45.1584,
-            Self::mul_add(
-                28.2393615,
+            S::splat(-45.1584),
+            S::mul_add(
+                S::splat(28.2393615),
                 x61,
-                Self::mul_add(x57, -24.351642000914637, x56 * 0.6328),
+                S::mul_add(x57, S::splat(-24.351642000914637), x56 * S::splat(0.6328)),
             ),
         );
-        let x92 = Self::mul_add(
-            -7.078399999258757,
+        let x92 = S::mul_add(
+            S::splat(-7.078399999258757),
             x67,
-            Self::mul_add(
-                -9.223235249762805,
+            S::mul_add(
+                S::splat(-9.223235249762805),
                 x68,
-                Self::mul_add(-2.5482240016099564, x63, 0.01675 * x62),
+                S::mul_add(S::splat(-2.5482240016099564), x63, S::splat(0.01675) * x62),
             ),
         );
-        let x93 = Self::mul_add(
-            -3.6140000000000003,
+        let x93 = S::mul_add(
+            S::splat(-3.6140000000000003),
             x77,
-            Self::mul_add(
+            S::mul_add(
                 x78,
-                -2.741639999592316,
-                Self::mul_add(x72, -5.252920330000002, x71 * 1.9877000000000002),
+                S::splat(-2.741639999592316),
+                S::mul_add(
+                    x72,
+                    S::splat(-5.252920330000002),
+                    x71 * S::splat(1.9877000000000002),
+                ),
             ),
         );
-        let x94 = Self::mul_add(
+        let x94 = S::mul_add(
             x86,
-            -0.9614610000000001,
-            Self::mul_add(x82, 1.2025609200000003, 0.000781 * x81),
+            S::splat(-0.9614610000000001),
+            S::mul_add(x82, S::splat(1.2025609200000003), S::splat(0.000781) * x81),
         );
-        let x95 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x84, x83),
-            Self::mul_add(x86, 0.0145, 0.000781 * x82),
+        let x95 = S::mul_add(
+            S::splat(4.806620000000001),
+            S::mul_add(S::splat(0.00000000020510342851533115), x84, x83),
+            S::mul_add(x86, S::splat(0.0145), S::splat(0.000781) * x82),
         );
-        let x96 = Self::mul_add(
-            4.806620000000001,
+        let x96 = S::mul_add(
+            S::splat(4.806620000000001),
             x85,
-            Self::mul_add(
-                -1.4135609200000003,
+            S::mul_add(
+                S::splat(-1.4135609200000003),
                 x86,
-                Self::mul_add(x82, -0.9614610000000001, x81 * 0.0145),
+                S::mul_add(x82, S::splat(-0.9614610000000001), x81 * S::splat(0.0145)),
             ),
         );
-        let x97 = 4.806620000000001 * x86;
-        let x98 = 4.806620000000001 * x81;
-        let x99 = Self::mul_add(x79, x97, x98);
+        let x97 = S::splat(4.806620000000001) * x86;
+        let x98 = S::splat(4.806620000000001) * x81;
+        let x99 = S::mul_add(x79, x97, x98);
         let x100 = s_q13 * x97;
-        let x101 = Self::mul_add(-0.00000000020510342851533115, x98, c_q13 * x97);
-        let x102 = Self::mul_add(
-            -0.55,
+        let x101 = S::mul_add(S::splat(-0.00000000020510342851533115), x98, c_q13 * x97);
+        let x102 = S::mul_add(
+            S::splat(-0.55),
             x99,
-            Self::mul_add(
-                0.00000000020510342851533115,
+            S::mul_add(
+                S::splat(0.00000000020510342851533115),
                 x96,
-                Self::mul_add(s_q13, x94, c_q13 * x95),
+                S::mul_add(s_q13, x94, c_q13 * x95),
             ),
         );
-        let x103 = Self::mul_add(
-            -17.135250000000003,
+        let x103 = S::mul_add(
+            S::splat(-17.135250000000003),
             x77,
-            Self::mul_add(x78, 0.809539999555672, x72 * 1.9877000000000002),
+            S::mul_add(
+                x78,
+                S::splat(0.809539999555672),
+                x72 * S::splat(1.9877000000000002),
+            ),
         )
-            + (x96 - Self::mul_add(x80, x94, x79 * x95)
-                - Self::mul_add(0.55, x101, 0.16 * x100));
+            + (x96 - S::mul_add(x80, x94, x79 * x95)
+                - S::mul_add(S::splat(0.55), x101, S::splat(0.16) * x100));
         let x104 = x93
-            - Self::mul_add(-0.16, x99, Self::mul_add(-c_q13, x94, s_q13 * x95));
-        let x105 = Self::mul_add(
-            9.740442170000001,
+            - S::mul_add(
+                S::splat(-0.16),
+                x99,
+                S::mul_add(S::neg(c_q13), x94, s_q13 * x95),
+            );
+        let x105 = S::mul_add(
+            S::splat(9.740442170000001),
             x78,
-            Self::mul_add(x72, -2.7416399995923166, x71 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x76, 17.135250000000003 * x75) + x102;
-        let x106 = Self::mul_add(17.135250000000003, x78, -x99);
-        let x107 = Self::mul_add(3.6140000000000003, x78, -x100);
-        let x108 = Self::mul_add(3.6140000000000003, x72, 17.135250000000003 * x71)
-            - x101;
-        let x109 = Self::mul_add(s_q12, x107, c_q12 * x106);
-        let x110 = x108 - Self::mul_add(-x70, x107, x69 * x106);
-        let x111 = Self::mul_add(7.078399999258757, x66, 0.01675 * x68)
-            - Self::mul_add(0.36, x110, Self::mul_add(s_q12, x104, c_q12 * x103));
-        let x112 = Self::mul_add(-2.5482240016099564, x68, x63 * 9.142025249762803)
-            - Self::mul_add(0.36, x109, x105 + Self::mul_add(-x70, x104, x69 * x103));
-        let x113 = Self::mul_add(7.078399999258757, x68, x109);
-        let x114 = Self::mul_add(
-            7.078399999258757,
+            S::mul_add(
+                x72,
+                S::splat(-2.7416399995923166),
+                x71 * S::splat(0.809539999555672),
+            ),
+        )
+            + S::mul_add(
+                S::splat(3.6140000000000003),
+                x76,
+                S::splat(17.135250000000003) * x75,
+            ) + x102;
+        let x106 = S::mul_add(S::splat(17.135250000000003), x78, S::neg(x99));
+        let x107 = S::mul_add(S::splat(3.6140000000000003), x78, S::neg(x100));
+        let x108 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x72,
+            S::splat(17.135250000000003) * x71,
+        ) - x101;
+        let x109 = S::mul_add(s_q12, x107, c_q12 * x106);
+        let x110 = x108 - S::mul_add(S::neg(x70), x107, x69 * x106);
+        let x111 = S::mul_add(S::splat(7.078399999258757), x66, S::splat(0.01675) * x68)
+            - S::mul_add(S::splat(0.36), x110, S::mul_add(s_q12, x104, c_q12 * x103));
+        let x112 = S::mul_add(
+            S::splat(-2.5482240016099564),
+            x68,
+            x63 * S::splat(9.142025249762803),
+        )
+            - S::mul_add(
+                S::splat(0.36),
+                x109,
+                x105 + S::mul_add(S::neg(x70), x104, x69 * x103),
+            );
+        let x113 = S::mul_add(S::splat(7.078399999258757), x68, x109);
+        let x114 = S::mul_add(
+            S::splat(7.078399999258757),
             x62,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x108,
-                Self::mul_add(-c_q12, x107, s_q12 * x106),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.00000000020510342851533115),
+                    x108,
+                    S::mul_add(S::neg(c_q12), x107, s_q12 * x106),
+                ),
             ),
         );
-        let x115 = Self::mul_add(-s_q11, x110, c_q11 * x113);
-        let x116 = Self::mul_add(c_q11, x110, s_q11 * x113);
-        let x117 = Self::mul_add(
-            0.63,
+        let x115 = S::mul_add(S::neg(s_q11), x110, c_q11 * x113);
+        let x116 = S::mul_add(c_q11, x110, s_q11 * x113);
+        let x117 = S::mul_add(
+            S::splat(0.63),
             x115,
             x92
-                - Self::mul_add(
-                    -0.00000000020510342851533115,
+                - S::mul_add(
+                    S::splat(-0.00000000020510342851533115),
                     x105,
-                    Self::mul_add(-c_q12, x104, s_q12 * x103),
+                    S::mul_add(S::neg(c_q12), x104, s_q12 * x103),
                 ),
         );
-        let x118 = Self::mul_add(x59, 45.1584, x61 * 0.6328)
-            - (Self::mul_add(s_q11, x112, c_q11 * x111)
-                - Self::mul_add(-0.63, x114, 0.275 * x116));
-        let x119 = Self::mul_add(x61, 24.35164200091464, x57 * 24.4950615)
-            - Self::mul_add(0.275, x115, Self::mul_add(-c_q11, x112, s_q11 * x111));
-        let x120 = Self::mul_add(x61, 45.1584, -x115);
-        let x121 = Self::mul_add(x56, 45.1584, -x114);
-        let x122 = Self::mul_add(s_q10, x116, c_q10 * x120);
-        let x123 = Self::mul_add(-c_q10, x116, s_q10 * x120);
-        let x124 = Self::mul_add(x54, 81.53205, x55 * 0.00214)
-            + Self::mul_add(0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118));
-        let x125 = Self::mul_add(x55, -36.18604050126307, x48 * 63.36336825000001)
-            - Self::mul_add(c_q10, x119, s_q10 * x118);
-        let x126 = x90 + Self::mul_add(0.87, x122, x91 - x117);
-        let x127 = Self::mul_add(x55, 81.53205, x122);
-        let x128 = Self::mul_add(x47, 81.53205, x121);
-        let x129 = 0.00000000020510342851533115 * x128;
-        let x130 = Self::mul_add(c_q9, x123, s_q9 * x127) + x129;
-        let x131 = x128 + Self::mul_add(-x46, x123, x45 * x127);
-        let x132 = x129 - Self::mul_add(-s_q9, x123, c_q9 * x127);
-        let x133 = 0.00000000020510342851533115 * x126;
-        let x134 = Self::mul_add(
-            x41,
-            12.701650001451807,
-            Self::mul_add(x42, 0.002139996587640933, x36 * 0.0000000234896432582596),
+        let x118 = S::mul_add(x59, S::splat(45.1584), x61 * S::splat(0.6328))
+            - (S::mul_add(s_q11, x112, c_q11 * x111)
+                - S::mul_add(S::splat(-0.63), x114, S::splat(0.275) * x116));
+        let x119 = S::mul_add(
+            x61,
+            S::splat(24.35164200091464),
+            x57 * S::splat(24.4950615),
         )
-            + (Self::mul_add(-c_q9, x125, s_q9 * x124) - x133
-                + Self::mul_add(0.275, x132, 0.4 * x131));
+            - S::mul_add(
+                S::splat(0.275),
+                x115,
+                S::mul_add(S::neg(c_q11), x112, s_q11 * x111),
+            );
+        let x120 = S::mul_add(x61, S::splat(45.1584), S::neg(x115));
+        let x121 = S::mul_add(x56, S::splat(45.1584), S::neg(x114));
+        let x122 = S::mul_add(s_q10, x116, c_q10 * x120);
+        let x123 = S::mul_add(S::neg(c_q10), x116, s_q10 * x120);
+        let x124 = S::mul_add(x54, S::splat(81.53205), x55 * S::splat(0.00214))
+            + S::mul_add(
+                S::splat(0.87),
+                x121,
+                S::mul_add(S::neg(s_q10), x119, c_q10 * x118),
+            );
+        let x125 = S::mul_add(
+            x55,
+            S::splat(-36.18604050126307),
+            x48 * S::splat(63.36336825000001),
+        ) - S::mul_add(c_q10, x119, s_q10 * x118);
+        let x126 = x90 + S::mul_add(S::splat(0.87), x122, x91 - x117);
+        let x127 = S::mul_add(x55, S::splat(81.53205), x122);
+        let x128 = S::mul_add(x47, S::splat(81.53205), x121);
+        let x129 = S::splat(0.00000000020510342851533115) * x128;
+        let x130 = S::mul_add(c_q9, x123, s_q9 * x127) + x129;
+        let x131 = x128 + S::mul_add(S::neg(x46), x123, x45 * x127);
+        let x132 = x129 - S::mul_add(S::neg(s_q9), x123, c_q9 * x127);
+        let x133 = S::splat(0.00000000020510342851533115) * x126;
+        let x134 = S::mul_add(
+            x41,
+            S::splat(12.701650001451807),
+            S::mul_add(
+                x42,
+                S::splat(0.002139996587640933),
+                x36 * S::splat(0.0000000234896432582596),
+            ),
+        )
+            + (S::mul_add(S::neg(c_q9), x125, s_q9 * x124) - x133
+                + S::mul_add(S::splat(0.275), x132, S::splat(0.4) * x131));
         let x135 = x89
-            + Self::mul_add(0.4, x130, x126 - Self::mul_add(x46, x125, x45 * x124));
-        let x136 = Self::mul_add(
-            113.3918902508081,
+            + S::mul_add(S::splat(0.4), x130, x126 - S::mul_add(x46, x125, x45 * x124));
+        let x136 = S::mul_add(
+            S::splat(113.3918902508081),
             x42,
-            Self::mul_add(5.080660024070366, x36, x35 * 0.002139996587640933),
-        ) - Self::mul_add(x40, 0.000000008530897668050218, x39 * 12.701650001451807)
-            - Self::mul_add(0.275, x130, x133 + Self::mul_add(s_q9, x125, c_q9 * x124));
-        let x137 = Self::mul_add(x42, 12.701650001451807, x130);
-        let x138 = Self::mul_add(x42, 0.000000008530897668050218, -x131);
-        let x139 = Self::mul_add(
+            S::mul_add(
+                S::splat(5.080660024070366),
+                x36,
+                x35 * S::splat(0.002139996587640933),
+            ),
+        )
+            - S::mul_add(
+                x40,
+                S::splat(0.000000008530897668050218),
+                x39 * S::splat(12.701650001451807),
+            )
+            - S::mul_add(
+                S::splat(0.275),
+                x130,
+                x133 + S::mul_add(s_q9, x125, c_q9 * x124),
+            );
+        let x137 = S::mul_add(x42, S::splat(12.701650001451807), x130);
+        let x138 = S::mul_add(x42, S::splat(0.000000008530897668050218), S::neg(x131));
+        let x139 = S::mul_add(
             x36,
-            0.000000008530897668050218,
-            x35 * 12.701650001451807,
+            S::splat(0.000000008530897668050218),
+            x35 * S::splat(12.701650001451807),
         ) - x132;
-        let x140 = x139 - Self::mul_add(x34, x138, x33 * x137);
-        let x141 = Self::mul_add(-c_q8, x138, s_q8 * x137);
-        let x142 = Self::mul_add(x32, -16.80768997608804, x27 * 0.07309)
-            + Self::mul_add(-0.35, x141, x136 + Self::mul_add(x34, x135, x33 * x134));
+        let x140 = x139 - S::mul_add(x34, x138, x33 * x137);
+        let x141 = S::mul_add(S::neg(c_q8), x138, s_q8 * x137);
+        let x142 = S::mul_add(x32, S::splat(-16.80768997608804), x27 * S::splat(0.07309))
+            + S::mul_add(
+                S::splat(-0.35),
+                x141,
+                x136 + S::mul_add(x34, x135, x33 * x134),
+            );
         let x143 = x87
-            + Self::mul_add(-0.35, x140, Self::mul_add(-c_q8, x135, s_q8 * x134));
-        let x144 = Self::mul_add(48.0240000085309, x32, x141);
-        let x145 = Self::mul_add(
-            48.0240000085309,
+            + S::mul_add(
+                S::splat(-0.35),
+                x140,
+                S::mul_add(S::neg(c_q8), x135, s_q8 * x134),
+            );
+        let x144 = S::mul_add(S::splat(48.0240000085309), x32, x141);
+        let x145 = S::mul_add(
+            S::splat(48.0240000085309),
             x27,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x139,
-                Self::mul_add(s_q8, x138, c_q8 * x137),
+            S::neg(
+                S::mul_add(
+                    S::splat(0.00000000020510342851533115),
+                    x139,
+                    S::mul_add(s_q8, x138, c_q8 * x137),
+                ),
             ),
         );
-        let x146 = Self::mul_add(-s_q7, x144, c_q7 * x140);
-        let x147 = Self::mul_add(c_q7, x144, s_q7 * x140);
-        let x148 = Self::mul_add(
-            -0.65,
+        let x146 = S::mul_add(S::neg(s_q7), x144, c_q7 * x140);
+        let x147 = S::mul_add(c_q7, x144, s_q7 * x140);
+        let x148 = S::mul_add(
+            S::splat(-0.65),
             x147,
             x88
-                - Self::mul_add(
-                    -0.00000000020510342851533115,
+                - S::mul_add(
+                    S::splat(-0.00000000020510342851533115),
                     x136,
-                    Self::mul_add(s_q8, x135, c_q8 * x134),
+                    S::mul_add(s_q8, x135, c_q8 * x134),
                 ),
         );
-        let x149 = Self::mul_add(
-            -180.9502499901501,
+        let x149 = S::mul_add(
+            S::splat(-180.9502499901501),
             v[1],
-            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
-        ) + Self::mul_add(-0.75, x147, Self::mul_add(s_q7, x143, c_q7 * x142));
-        let x150 = Self::mul_add(
-            1466.4506062283303,
+            S::mul_add(
+                v[5],
+                S::splat(-117.61766249359756),
+                S::splat(1394.5960312283303) * v[3],
+            ),
+        ) + S::mul_add(S::splat(-0.75), x147, S::mul_add(s_q7, x143, c_q7 * x142));
+        let x150 = S::mul_add(
+            S::splat(1466.4506062283303),
             v[4],
-            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
+            S::mul_add(S::splat(-110.5455), v[2], S::splat(180.9502499901501) * v[0]),
         )
-            + (Self::mul_add(-c_q7, x143, s_q7 * x142)
-                + Self::mul_add(-0.65, x145, 0.75 * x146));
-        let x151 = Self::mul_add(
-            -110.5455,
+            + (S::mul_add(S::neg(c_q7), x143, s_q7 * x142)
+                + S::mul_add(S::splat(-0.65), x145, S::splat(0.75) * x146));
+        let x151 = S::mul_add(
+            S::splat(-110.5455),
             v[1],
-            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
+            S::mul_add(S::splat(-1271.854575), v[5], v[3] * S::splat(117.61766249359758)),
         ) + x148;
-        let x152 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]) + x146;
-        let x153 = Self::mul_add(
-            1170.07,
+        let x152 = S::mul_add(
+            S::splat(180.9502499901501),
+            v[4],
+            S::splat(1170.07) * v[0],
+        ) + x146;
+        let x153 = S::mul_add(
+            S::splat(1170.07),
             v[1],
-            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
+            S::neg(
+                S::mul_add(S::splat(-110.5455), v[5], S::splat(180.9502499901501) * v[3]),
+            ),
         ) + x147;
-        let x154 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x145;
-        let x155 = Self::mul_add(x19, x154, Self::mul_add(-x18, x153, x17 * x152));
-        let x156 = Self::mul_add(-x22, x154, Self::mul_add(x21, x153, x20 * x152));
-        let x157 = Self::mul_add(-x25, x154, Self::mul_add(-x24, x153, x23 * x152));
-        let x158 = -x157;
-        let x159 = Self::mul_add(-x19, x151, Self::mul_add(-x18, x150, x17 * x149))
-            - Self::mul_add(q[1], x157, q[2] * x156);
-        let x160 = Self::mul_add(x22, x151, Self::mul_add(x21, x150, x20 * x149))
-            + Self::mul_add(q[0], x157, q[2] * x155);
-        let x161 = -(Self::mul_add(x25, x151, Self::mul_add(-x24, x150, x23 * x149))
-            + Self::mul_add(-q[0], x156, q[1] * x155));
+        let x154 = S::mul_add(S::splat(-110.5455), v[4], S::splat(1170.07) * v[2])
+            + x145;
+        let x155 = S::mul_add(x19, x154, S::mul_add(S::neg(x18), x153, x17 * x152));
+        let x156 = S::mul_add(S::neg(x22), x154, S::mul_add(x21, x153, x20 * x152));
+        let x157 = S::mul_add(
+            S::neg(x25),
+            x154,
+            S::mul_add(S::neg(x24), x153, x23 * x152),
+        );
+        let x158 = S::neg(x157);
+        let x159 = S::mul_add(
+            S::neg(x19),
+            x151,
+            S::mul_add(S::neg(x18), x150, x17 * x149),
+        ) - S::mul_add(q[1], x157, q[2] * x156);
+        let x160 = S::mul_add(x22, x151, S::mul_add(x21, x150, x20 * x149))
+            + S::mul_add(q[0], x157, q[2] * x155);
+        let x161 = S::neg(
+            S::mul_add(x25, x151, S::mul_add(S::neg(x24), x150, x23 * x149))
+                + S::mul_add(S::neg(q[0]), x156, q[1] * x155),
+        );
         [x155, x156, x158, x159, x160, x161]
+    }
+    /// [`Self::momentum`] of every state of the slices, `S::LANES` states per call of [`Self::momentum_lanes`]: `out[k]` is `momentum` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn momentum_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::momentum_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                )
+            },
+        );
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
@@ -8116,8 +10027,17 @@ impl FreeFloating7 {
         v: &[::core::primitive::f64; 13],
         a: &[::core::primitive::f64; 13],
     ) -> [::core::primitive::f64; 6] {
+        Self::base_reaction_lanes::<::core::primitive::f64>(q, v, a)
+    }
+    /// [`Self::base_reaction`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn base_reaction_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 14],
+        v: &[S; 13],
+        a: &[S; 13],
+    ) -> [S; 6] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
-        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+        (s_q12, c_q12), (s_q13, c_q13)] = S::sincos_n([
             q[7],
             q[8],
             q[9],
@@ -8126,612 +10046,841 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x9 = Self::mul_add(0.75, v[4], v[0]);
-        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x11 = Self::mul_add(-0.65, v[4], v[2]);
-        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
+        let x7 = S::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x8 = S::mul_add(S::neg(v[4]), c_q7, v[3] * s_q7);
+        let x9 = S::mul_add(S::splat(0.75), v[4], v[0]);
+        let x10 = v[1] - S::mul_add(S::splat(-0.65), v[5], S::splat(0.75) * v[3]);
+        let x11 = S::mul_add(S::splat(-0.65), v[4], v[2]);
+        let x12 = S::mul_add(s_q7, x10, c_q7 * x9);
+        let x13 = S::mul_add(S::neg(c_q7), x10, s_q7 * x9);
         let x14 = v[5] + v[6];
-        let x15 = Self::mul_add(0.75, a[4], a[0]);
-        let x16 = a[1] - Self::mul_add(-0.65, a[5], 0.75 * a[3]);
-        let x17 = Self::mul_add(-0.65, a[4], a[2]);
+        let x15 = S::mul_add(S::splat(0.75), a[4], a[0]);
+        let x16 = a[1] - S::mul_add(S::splat(-0.65), a[5], S::splat(0.75) * a[3]);
+        let x17 = S::mul_add(S::splat(-0.65), a[4], a[2]);
         let x18 = a[5] + a[6];
-        let x19 = Self::mul_add(-v[6], x8, Self::mul_add(a[4], s_q7, a[3] * c_q7));
-        let x20 = Self::mul_add(v[6], x7, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
-        let x21 = Self::mul_add(-v[6], x13, Self::mul_add(s_q7, x16, c_q7 * x15));
-        let x22 = Self::mul_add(v[6], x12, Self::mul_add(-c_q7, x16, s_q7 * x15));
-        let x23 = Self::mul_add(
-            6.1267499999999995,
+        let x19 = S::mul_add(S::neg(v[6]), x8, S::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x20 = S::mul_add(v[6], x7, S::mul_add(S::neg(a[4]), c_q7, a[3] * s_q7));
+        let x21 = S::mul_add(S::neg(v[6]), x13, S::mul_add(s_q7, x16, c_q7 * x15));
+        let x22 = S::mul_add(v[6], x12, S::mul_add(S::neg(c_q7), x16, s_q7 * x15));
+        let x23 = S::mul_add(
+            S::splat(6.1267499999999995),
             x22,
-            Self::mul_add(0.00071, x18, Self::mul_add(x20, 0.07309, 2.29018125 * x19)),
-        );
-        let x24 = Self::mul_add(
-            -6.1267499999999995,
-            x21,
-            Self::mul_add(
-                -0.1132,
+            S::mul_add(
+                S::splat(0.00071),
                 x18,
-                Self::mul_add(1.5853812499999997, x20, x19 * 0.07309),
+                S::mul_add(x20, S::splat(0.07309), S::splat(2.29018125) * x19),
             ),
         );
-        let x25 = Self::mul_add(1.331, x14, Self::mul_add(-0.1132, x8, 0.00071 * x7));
-        let x26 = Self::mul_add(
-            6.1267499999999995,
+        let x24 = S::mul_add(
+            S::splat(-6.1267499999999995),
+            x21,
+            S::mul_add(
+                S::splat(-0.1132),
+                x18,
+                S::mul_add(S::splat(1.5853812499999997), x20, x19 * S::splat(0.07309)),
+            ),
+        );
+        let x25 = S::mul_add(
+            S::splat(1.331),
+            x14,
+            S::mul_add(S::splat(-0.1132), x8, S::splat(0.00071) * x7),
+        );
+        let x26 = S::mul_add(
+            S::splat(6.1267499999999995),
             x13,
-            Self::mul_add(0.00071, x14, Self::mul_add(x8, 0.07309, 2.29018125 * x7)),
-        );
-        let x27 = Self::mul_add(
-            -6.1267499999999995,
-            x12,
-            Self::mul_add(
-                -0.1132,
+            S::mul_add(
+                S::splat(0.00071),
                 x14,
-                Self::mul_add(1.5853812499999997, x8, x7 * 0.07309),
+                S::mul_add(x8, S::splat(0.07309), S::splat(2.29018125) * x7),
             ),
         );
-        let x28 = 35.01 * x11;
-        let x29 = Self::mul_add(-6.1267499999999995, x8, 35.01 * x12);
-        let x30 = Self::mul_add(6.1267499999999995, x7, 35.01 * x13);
-        let x31 = 0.00000000020510342851533115 * c_q8;
-        let x32 = 0.00000000020510342851533115 * s_q8;
-        let x33 = Self::mul_add(x14, c_q8, Self::mul_add(x8, s_q8, x7 * x31));
-        let x34 = Self::mul_add(x14, s_q8, Self::mul_add(-x8, c_q8, x7 * x32));
-        let x35 = Self::mul_add(-0.35, x8, x12);
-        let x36 = Self::mul_add(0.35, x7, x13);
-        let x37 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x36, x31 * x35));
-        let x38 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x36, x32 * x35));
-        let x39 = Self::mul_add(-0.00000000020510342851533115, x11, x35);
-        let x40 = v[7] + Self::mul_add(-0.00000000020510342851533115, x14, x7);
-        let x41 = Self::mul_add(-0.35, x20, x21);
-        let x42 = Self::mul_add(0.35, x19, x22);
-        let x43 = Self::mul_add(-0.00000000020510342851533115, x17, x41);
-        let x44 = a[7] + Self::mul_add(-0.00000000020510342851533115, x18, x19);
-        let x45 = Self::mul_add(
-            -v[7],
-            x34,
-            Self::mul_add(x18, c_q8, Self::mul_add(x20, s_q8, x19 * x31)),
+        let x27 = S::mul_add(
+            S::splat(-6.1267499999999995),
+            x12,
+            S::mul_add(
+                S::splat(-0.1132),
+                x14,
+                S::mul_add(S::splat(1.5853812499999997), x8, x7 * S::splat(0.07309)),
+            ),
         );
-        let x46 = Self::mul_add(
+        let x28 = S::splat(35.01) * x11;
+        let x29 = S::mul_add(S::splat(-6.1267499999999995), x8, S::splat(35.01) * x12);
+        let x30 = S::mul_add(S::splat(6.1267499999999995), x7, S::splat(35.01) * x13);
+        let x31 = S::splat(0.00000000020510342851533115) * c_q8;
+        let x32 = S::splat(0.00000000020510342851533115) * s_q8;
+        let x33 = S::mul_add(x14, c_q8, S::mul_add(x8, s_q8, x7 * x31));
+        let x34 = S::mul_add(x14, s_q8, S::mul_add(S::neg(x8), c_q8, x7 * x32));
+        let x35 = S::mul_add(S::splat(-0.35), x8, x12);
+        let x36 = S::mul_add(S::splat(0.35), x7, x13);
+        let x37 = S::mul_add(x11, c_q8, S::mul_add(s_q8, x36, x31 * x35));
+        let x38 = S::mul_add(x11, s_q8, S::mul_add(S::neg(c_q8), x36, x32 * x35));
+        let x39 = S::mul_add(S::splat(-0.00000000020510342851533115), x11, x35);
+        let x40 = v[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x14, x7);
+        let x41 = S::mul_add(S::splat(-0.35), x20, x21);
+        let x42 = S::mul_add(S::splat(0.35), x19, x22);
+        let x43 = S::mul_add(S::splat(-0.00000000020510342851533115), x17, x41);
+        let x44 = a[7] + S::mul_add(S::splat(-0.00000000020510342851533115), x18, x19);
+        let x45 = S::mul_add(
+            S::neg(v[7]),
+            x34,
+            S::mul_add(x18, c_q8, S::mul_add(x20, s_q8, x19 * x31)),
+        );
+        let x46 = S::mul_add(
             v[7],
             x33,
-            Self::mul_add(x18, s_q8, Self::mul_add(-x20, c_q8, x19 * x32)),
+            S::mul_add(x18, s_q8, S::mul_add(S::neg(x20), c_q8, x19 * x32)),
         );
-        let x47 = Self::mul_add(
-            -v[7],
+        let x47 = S::mul_add(
+            S::neg(v[7]),
             x38,
-            Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x42, x31 * x41)),
+            S::mul_add(x17, c_q8, S::mul_add(s_q8, x42, x31 * x41)),
         );
-        let x48 = Self::mul_add(
+        let x48 = S::mul_add(
             v[7],
             x37,
-            Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x42, x32 * x41)),
+            S::mul_add(x17, s_q8, S::mul_add(S::neg(c_q8), x42, x32 * x41)),
         );
-        let x49 = Self::mul_add(2.359, x40, x33 * 0.00214);
-        let x50 = Self::mul_add(
-            6.0,
+        let x49 = S::mul_add(S::splat(2.359), x40, x33 * S::splat(0.00214));
+        let x50 = S::mul_add(
+            S::splat(6.0),
             x38,
-            Self::mul_add(x40, 0.00214, 3.3000000000000003 * x33),
+            S::mul_add(x40, S::splat(0.00214), S::splat(3.3000000000000003) * x33),
         );
-        let x51 = Self::mul_add(-6.0, x37, 2.5780000000000003 * x34);
-        let x52 = 30.0 * x39;
-        let x53 = Self::mul_add(-6.0, x34, 30.0 * x37);
-        let x54 = Self::mul_add(6.0, x33, 30.0 * x38);
-        let x55 = 0.00000000020510342851533115 * c_q9;
-        let x56 = 0.00000000020510342851533115 * s_q9;
+        let x51 = S::mul_add(S::splat(-6.0), x37, S::splat(2.5780000000000003) * x34);
+        let x52 = S::splat(30.0) * x39;
+        let x53 = S::mul_add(S::splat(-6.0), x34, S::splat(30.0) * x37);
+        let x54 = S::mul_add(S::splat(6.0), x33, S::splat(30.0) * x38);
+        let x55 = S::splat(0.00000000020510342851533115) * c_q9;
+        let x56 = S::splat(0.00000000020510342851533115) * s_q9;
         let x57 = x55 - x56;
         let x58 = x55 + x56;
-        let x59 = Self::mul_add(-x40, c_q9, Self::mul_add(-x34, x57, x33 * s_q9));
-        let x60 = Self::mul_add(x40, s_q9, Self::mul_add(x34, x58, x33 * c_q9));
-        let x61 = x37 - Self::mul_add(-0.275, x40, 0.4 * x34);
-        let x62 = Self::mul_add(0.4, x33, x38);
-        let x63 = Self::mul_add(-0.275, x33, x39);
-        let x64 = Self::mul_add(-c_q9, x63, Self::mul_add(-x57, x62, s_q9 * x61));
-        let x65 = Self::mul_add(s_q9, x63, Self::mul_add(x58, x62, c_q9 * x61));
-        let x66 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x59 = S::mul_add(
+            S::neg(x40),
+            c_q9,
+            S::mul_add(S::neg(x34), x57, x33 * s_q9),
+        );
+        let x60 = S::mul_add(x40, s_q9, S::mul_add(x34, x58, x33 * c_q9));
+        let x61 = x37 - S::mul_add(S::splat(-0.275), x40, S::splat(0.4) * x34);
+        let x62 = S::mul_add(S::splat(0.4), x33, x38);
+        let x63 = S::mul_add(S::splat(-0.275), x33, x39);
+        let x64 = S::mul_add(
+            S::neg(c_q9),
             x63,
-            Self::mul_add(-0.00000000020510342851533115, x61, x62),
+            S::mul_add(S::neg(x57), x62, s_q9 * x61),
+        );
+        let x65 = S::mul_add(s_q9, x63, S::mul_add(x58, x62, c_q9 * x61));
+        let x66 = S::mul_add(
+            S::splat(-0.00000000020510342851533115),
+            x63,
+            S::mul_add(S::splat(-0.00000000020510342851533115), x61, x62),
         );
         let x67 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
                 x40,
-                Self::mul_add(-0.00000000020510342851533115, x33, x34),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x33, x34),
             );
-        let x68 = x47 - Self::mul_add(-0.275, x44, 0.4 * x46);
-        let x69 = Self::mul_add(0.4, x45, x48);
-        let x70 = Self::mul_add(-0.275, x45, x43);
-        let x71 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x68 = x47 - S::mul_add(S::splat(-0.275), x44, S::splat(0.4) * x46);
+        let x69 = S::mul_add(S::splat(0.4), x45, x48);
+        let x70 = S::mul_add(S::splat(-0.275), x45, x43);
+        let x71 = S::mul_add(
+            S::splat(-0.00000000020510342851533115),
             x70,
-            Self::mul_add(-0.00000000020510342851533115, x68, x69),
+            S::mul_add(S::splat(-0.00000000020510342851533115), x68, x69),
         );
         let x72 = a[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
                 x44,
-                Self::mul_add(-0.00000000020510342851533115, x45, x46),
+                S::mul_add(S::splat(-0.00000000020510342851533115), x45, x46),
             );
-        let x73 = Self::mul_add(
+        let x73 = S::mul_add(
             v[8],
             x60,
-            Self::mul_add(-x44, c_q9, Self::mul_add(-x46, x57, x45 * s_q9)),
+            S::mul_add(S::neg(x44), c_q9, S::mul_add(S::neg(x46), x57, x45 * s_q9)),
         );
-        let x74 = Self::mul_add(
-            -v[8],
+        let x74 = S::mul_add(
+            S::neg(v[8]),
             x59,
-            Self::mul_add(x44, s_q9, Self::mul_add(x46, x58, x45 * c_q9)),
+            S::mul_add(x44, s_q9, S::mul_add(x46, x58, x45 * c_q9)),
         );
-        let x75 = Self::mul_add(
+        let x75 = S::mul_add(
             v[8],
             x65,
-            Self::mul_add(-c_q9, x70, Self::mul_add(-x57, x69, s_q9 * x68)),
+            S::mul_add(S::neg(c_q9), x70, S::mul_add(S::neg(x57), x69, s_q9 * x68)),
         );
-        let x76 = Self::mul_add(
-            -v[8],
+        let x76 = S::mul_add(
+            S::neg(v[8]),
             x64,
-            Self::mul_add(s_q9, x70, Self::mul_add(x58, x69, c_q9 * x68)),
+            S::mul_add(s_q9, x70, S::mul_add(x58, x69, c_q9 * x68)),
         );
-        let x77 = 3.378 * x60;
-        let x78 = Self::mul_add(
+        let x77 = S::splat(3.378) * x60;
+        let x78 = S::mul_add(
             x66,
-            9.87015,
-            Self::mul_add(0.00214, x67, 4.395515250000001 * x59),
+            S::splat(9.87015),
+            S::mul_add(S::splat(0.00214), x67, S::splat(4.395515250000001) * x59),
         );
-        let x79 = Self::mul_add(
+        let x79 = S::mul_add(
             x64,
-            -9.87015,
-            Self::mul_add(7.65251525, x67, 0.00214 * x59),
+            S::splat(-9.87015),
+            S::mul_add(S::splat(7.65251525), x67, S::splat(0.00214) * x59),
         );
-        let x80 = 22.69 * x65;
-        let x81 = Self::mul_add(x67, -9.87015, 22.69 * x64);
-        let x82 = Self::mul_add(x59, 9.87015, 22.69 * x66);
-        let x83 = Self::mul_add(x60, s_q10, x59 * c_q10);
-        let x84 = Self::mul_add(-x60, c_q10, x59 * s_q10);
-        let x85 = Self::mul_add(x67, -0.87, x64);
-        let x86 = Self::mul_add(x59, 0.87, x66);
-        let x87 = Self::mul_add(x65, s_q10, c_q10 * x85);
-        let x88 = Self::mul_add(-x65, c_q10, s_q10 * x85);
+        let x80 = S::splat(22.69) * x65;
+        let x81 = S::mul_add(x67, S::splat(-9.87015), S::splat(22.69) * x64);
+        let x82 = S::mul_add(x59, S::splat(9.87015), S::splat(22.69) * x66);
+        let x83 = S::mul_add(x60, s_q10, x59 * c_q10);
+        let x84 = S::mul_add(S::neg(x60), c_q10, x59 * s_q10);
+        let x85 = S::mul_add(x67, S::splat(-0.87), x64);
+        let x86 = S::mul_add(x59, S::splat(0.87), x66);
+        let x87 = S::mul_add(x65, s_q10, c_q10 * x85);
+        let x88 = S::mul_add(S::neg(x65), c_q10, s_q10 * x85);
         let x89 = v[9] + x67;
-        let x90 = Self::mul_add(x72, -0.87, x75);
-        let x91 = Self::mul_add(x73, 0.87, x71);
+        let x90 = S::mul_add(x72, S::splat(-0.87), x75);
+        let x91 = S::mul_add(x73, S::splat(0.87), x71);
         let x92 = a[9] + x72;
-        let x93 = Self::mul_add(-v[9], x84, Self::mul_add(x74, s_q10, x73 * c_q10));
-        let x94 = Self::mul_add(v[9], x83, Self::mul_add(-x74, c_q10, x73 * s_q10));
-        let x95 = Self::mul_add(-v[9], x88, Self::mul_add(x76, s_q10, c_q10 * x90));
-        let x96 = Self::mul_add(v[9], x87, Self::mul_add(-x76, c_q10, s_q10 * x90));
-        let x97 = Self::mul_add(
+        let x93 = S::mul_add(S::neg(v[9]), x84, S::mul_add(x74, s_q10, x73 * c_q10));
+        let x94 = S::mul_add(v[9], x83, S::mul_add(S::neg(x74), c_q10, x73 * s_q10));
+        let x95 = S::mul_add(S::neg(v[9]), x88, S::mul_add(x76, s_q10, c_q10 * x90));
+        let x96 = S::mul_add(v[9], x87, S::mul_add(S::neg(x76), c_q10, s_q10 * x90));
+        let x97 = S::mul_add(
             x95,
-            -6.7347,
-            Self::mul_add(4.0324305, x92, Self::mul_add(x94, -1.8520425, x93 * 0.6328)),
+            S::splat(-6.7347),
+            S::mul_add(
+                S::splat(4.0324305),
+                x92,
+                S::mul_add(x94, S::splat(-1.8520425), x93 * S::splat(0.6328)),
+            ),
         );
-        let x98 = Self::mul_add(x89, 0.6328, 4.170993 * x83)
-            - Self::mul_add(x86, -6.7347, x88 * 5.8795);
-        let x99 = Self::mul_add(
+        let x98 = S::mul_add(x89, S::splat(0.6328), S::splat(4.170993) * x83)
+            - S::mul_add(x86, S::splat(-6.7347), x88 * S::splat(5.8795));
+        let x99 = S::mul_add(
             x87,
-            5.8795,
-            Self::mul_add(x89, -1.8520425, 3.8828625 * x84),
+            S::splat(5.8795),
+            S::mul_add(x89, S::splat(-1.8520425), S::splat(3.8828625) * x84),
         );
-        let x100 = Self::mul_add(
+        let x100 = S::mul_add(
             x87,
-            -6.7347,
-            Self::mul_add(4.0324305, x89, Self::mul_add(x84, -1.8520425, x83 * 0.6328)),
+            S::splat(-6.7347),
+            S::mul_add(
+                S::splat(4.0324305),
+                x89,
+                S::mul_add(x84, S::splat(-1.8520425), x83 * S::splat(0.6328)),
+            ),
         );
-        let x101 = Self::mul_add(21.38, x87, Self::mul_add(x89, -6.7347, x84 * 5.8795));
-        let x102 = Self::mul_add(x83, -5.8795, 21.38 * x88);
-        let x103 = Self::mul_add(x83, 6.7347, 21.38 * x86);
-        let x104 = Self::mul_add(-x84, s_q11, x83 * c_q11);
-        let x105 = Self::mul_add(x84, c_q11, x83 * s_q11);
-        let x106 = x87 + Self::mul_add(x89, -0.63, 0.275 * x84);
-        let x107 = Self::mul_add(-0.275, x83, x88);
-        let x108 = Self::mul_add(x83, 0.63, x86);
-        let x109 = Self::mul_add(-s_q11, x107, c_q11 * x106);
-        let x110 = Self::mul_add(c_q11, x107, s_q11 * x106);
+        let x101 = S::mul_add(
+            S::splat(21.38),
+            x87,
+            S::mul_add(x89, S::splat(-6.7347), x84 * S::splat(5.8795)),
+        );
+        let x102 = S::mul_add(x83, S::splat(-5.8795), S::splat(21.38) * x88);
+        let x103 = S::mul_add(x83, S::splat(6.7347), S::splat(21.38) * x86);
+        let x104 = S::mul_add(S::neg(x84), s_q11, x83 * c_q11);
+        let x105 = S::mul_add(x84, c_q11, x83 * s_q11);
+        let x106 = x87 + S::mul_add(x89, S::splat(-0.63), S::splat(0.275) * x84);
+        let x107 = S::mul_add(S::splat(-0.275), x83, x88);
+        let x108 = S::mul_add(x83, S::splat(0.63), x86);
+        let x109 = S::mul_add(S::neg(s_q11), x107, c_q11 * x106);
+        let x110 = S::mul_add(c_q11, x107, s_q11 * x106);
         let x111 = v[10] + x89;
-        let x112 = x95 + Self::mul_add(x92, -0.63, 0.275 * x94);
-        let x113 = Self::mul_add(-0.275, x93, x96);
-        let x114 = Self::mul_add(x93, 0.63, x91);
+        let x112 = x95 + S::mul_add(x92, S::splat(-0.63), S::splat(0.275) * x94);
+        let x113 = S::mul_add(S::splat(-0.275), x93, x96);
+        let x114 = S::mul_add(x93, S::splat(0.63), x91);
         let x115 = a[10] + x92;
-        let x116 = Self::mul_add(-v[10], x105, Self::mul_add(-x94, s_q11, x93 * c_q11));
-        let x117 = Self::mul_add(v[10], x104, Self::mul_add(x94, c_q11, x93 * s_q11));
-        let x118 = Self::mul_add(
-            -v[10],
-            x110,
-            Self::mul_add(-s_q11, x113, c_q11 * x112),
+        let x116 = S::mul_add(
+            S::neg(v[10]),
+            x105,
+            S::mul_add(S::neg(x94), s_q11, x93 * c_q11),
         );
-        let x119 = Self::mul_add(v[10], x109, Self::mul_add(c_q11, x113, s_q11 * x112));
-        let x120 = Self::mul_add(-0.07271, x111, 0.01675 * x104);
-        let x121 = Self::mul_add(
+        let x117 = S::mul_add(v[10], x104, S::mul_add(x94, c_q11, x93 * s_q11));
+        let x118 = S::mul_add(
+            S::neg(v[10]),
             x110,
-            -3.0149999999999997,
-            Self::mul_add(-0.01675, x111, 0.9304999999999999 * x104),
+            S::mul_add(S::neg(s_q11), x113, c_q11 * x112),
         );
-        let x122 = Self::mul_add(x109, 3.0149999999999997, 0.939 * x105);
-        let x123 = 16.75 * x108;
-        let x124 = Self::mul_add(x105, 3.0149999999999997, 16.75 * x109);
-        let x125 = Self::mul_add(x104, -3.0149999999999997, 16.75 * x110);
-        let x126 = 0.00000000020510342851533115 * s_q12;
-        let x127 = 0.00000000020510342851533115 * c_q12;
-        let x128 = Self::mul_add(x111, s_q12, Self::mul_add(x105, x126, x104 * c_q12));
-        let x129 = Self::mul_add(-x111, c_q12, Self::mul_add(-x105, x127, x104 * s_q12));
-        let x130 = Self::mul_add(x105, 0.36, x109);
-        let x131 = Self::mul_add(x104, -0.36, x110);
-        let x132 = Self::mul_add(x108, s_q12, Self::mul_add(x126, x131, c_q12 * x130));
-        let x133 = Self::mul_add(-x108, c_q12, Self::mul_add(-x127, x131, s_q12 * x130));
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x108, x131);
-        let x135 = v[11] + Self::mul_add(-0.00000000020510342851533115, x111, x105);
-        let x136 = Self::mul_add(x117, 0.36, x118);
-        let x137 = Self::mul_add(x116, -0.36, x119);
-        let x138 = Self::mul_add(-0.00000000020510342851533115, x114, x137);
-        let x139 = a[11] + Self::mul_add(-0.00000000020510342851533115, x115, x117);
-        let x140 = Self::mul_add(
-            -v[11],
+        let x119 = S::mul_add(v[10], x109, S::mul_add(c_q11, x113, s_q11 * x112));
+        let x120 = S::mul_add(S::splat(-0.07271), x111, S::splat(0.01675) * x104);
+        let x121 = S::mul_add(
+            x110,
+            S::splat(-3.0149999999999997),
+            S::mul_add(S::splat(-0.01675), x111, S::splat(0.9304999999999999) * x104),
+        );
+        let x122 = S::mul_add(
+            x109,
+            S::splat(3.0149999999999997),
+            S::splat(0.939) * x105,
+        );
+        let x123 = S::splat(16.75) * x108;
+        let x124 = S::mul_add(
+            x105,
+            S::splat(3.0149999999999997),
+            S::splat(16.75) * x109,
+        );
+        let x125 = S::mul_add(
+            x104,
+            S::splat(-3.0149999999999997),
+            S::splat(16.75) * x110,
+        );
+        let x126 = S::splat(0.00000000020510342851533115) * s_q12;
+        let x127 = S::splat(0.00000000020510342851533115) * c_q12;
+        let x128 = S::mul_add(x111, s_q12, S::mul_add(x105, x126, x104 * c_q12));
+        let x129 = S::mul_add(
+            S::neg(x111),
+            c_q12,
+            S::mul_add(S::neg(x105), x127, x104 * s_q12),
+        );
+        let x130 = S::mul_add(x105, S::splat(0.36), x109);
+        let x131 = S::mul_add(x104, S::splat(-0.36), x110);
+        let x132 = S::mul_add(x108, s_q12, S::mul_add(x126, x131, c_q12 * x130));
+        let x133 = S::mul_add(
+            S::neg(x108),
+            c_q12,
+            S::mul_add(S::neg(x127), x131, s_q12 * x130),
+        );
+        let x134 = S::mul_add(S::splat(-0.00000000020510342851533115), x108, x131);
+        let x135 = v[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x111, x105);
+        let x136 = S::mul_add(x117, S::splat(0.36), x118);
+        let x137 = S::mul_add(x116, S::splat(-0.36), x119);
+        let x138 = S::mul_add(S::splat(-0.00000000020510342851533115), x114, x137);
+        let x139 = a[11]
+            + S::mul_add(S::splat(-0.00000000020510342851533115), x115, x117);
+        let x140 = S::mul_add(
+            S::neg(v[11]),
             x129,
-            Self::mul_add(x115, s_q12, Self::mul_add(x117, x126, x116 * c_q12)),
+            S::mul_add(x115, s_q12, S::mul_add(x117, x126, x116 * c_q12)),
         );
-        let x141 = Self::mul_add(
+        let x141 = S::mul_add(
             v[11],
             x128,
-            Self::mul_add(-x115, c_q12, Self::mul_add(-x117, x127, x116 * s_q12)),
+            S::mul_add(S::neg(x115), c_q12, S::mul_add(S::neg(x117), x127, x116 * s_q12)),
         );
-        let x142 = Self::mul_add(
-            -v[11],
+        let x142 = S::mul_add(
+            S::neg(v[11]),
             x133,
-            Self::mul_add(x114, s_q12, Self::mul_add(x126, x137, c_q12 * x136)),
+            S::mul_add(x114, s_q12, S::mul_add(x126, x137, c_q12 * x136)),
         );
-        let x143 = Self::mul_add(
+        let x143 = S::mul_add(
             v[11],
             x132,
-            Self::mul_add(-x114, c_q12, Self::mul_add(-x127, x137, s_q12 * x136)),
+            S::mul_add(S::neg(x114), c_q12, S::mul_add(S::neg(x127), x137, s_q12 * x136)),
         );
-        let x144 = Self::mul_add(
-            7.196750000000001,
+        let x144 = S::mul_add(
+            S::splat(7.196750000000001),
             x142,
-            Self::mul_add(
-                2.1079062500000005,
+            S::mul_add(
+                S::splat(2.1079062500000005),
                 x139,
-                Self::mul_add(x141, -1.1514800000000003, x140 * 0.2313),
+                S::mul_add(x141, S::splat(-1.1514800000000003), x140 * S::splat(0.2313)),
             ),
         );
-        let x145 = Self::mul_add(x135, 0.2313, 3.2217582500000006 * x128)
-            + Self::mul_add(-7.196750000000001, x134, 4.187200000000001 * x133);
-        let x146 = Self::mul_add(
-            -4.187200000000001,
+        let x145 = S::mul_add(
+            x135,
+            S::splat(0.2313),
+            S::splat(3.2217582500000006) * x128,
+        )
+            + S::mul_add(
+                S::splat(-7.196750000000001),
+                x134,
+                S::splat(4.187200000000001) * x133,
+            );
+        let x146 = S::mul_add(
+            S::splat(-4.187200000000001),
             x132,
-            Self::mul_add(x135, -1.1514800000000003, 1.2686520000000001 * x129),
-        );
-        let x147 = Self::mul_add(
-            7.196750000000001,
-            x132,
-            Self::mul_add(
-                2.1079062500000005,
+            S::mul_add(
                 x135,
-                Self::mul_add(x129, -1.1514800000000003, x128 * 0.2313),
+                S::splat(-1.1514800000000003),
+                S::splat(1.2686520000000001) * x129,
             ),
         );
-        let x148 = Self::mul_add(
-            26.17,
+        let x147 = S::mul_add(
+            S::splat(7.196750000000001),
             x132,
-            -Self::mul_add(-7.196750000000001, x135, 4.187200000000001 * x129),
+            S::mul_add(
+                S::splat(2.1079062500000005),
+                x135,
+                S::mul_add(x129, S::splat(-1.1514800000000003), x128 * S::splat(0.2313)),
+            ),
         );
-        let x149 = Self::mul_add(4.187200000000001, x128, 26.17 * x133);
-        let x150 = Self::mul_add(-7.196750000000001, x128, 26.17 * x134);
-        let x151 = 0.00000000020510342851533115 * c_q13;
-        let x152 = 0.00000000020510342851533115 * s_q13;
-        let x153 = Self::mul_add(-x135, c_q13, Self::mul_add(x129, s_q13, x128 * x151));
-        let x154 = Self::mul_add(-x135, s_q13, Self::mul_add(-x129, c_q13, x128 * x152));
-        let x155 = x132 - Self::mul_add(-0.55, x135, 0.16 * x129);
-        let x156 = Self::mul_add(0.16, x128, x133);
-        let x157 = Self::mul_add(-0.55, x128, x134);
-        let x158 = Self::mul_add(-c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
-        let x159 = Self::mul_add(-s_q13, x157, Self::mul_add(-c_q13, x156, x152 * x155));
-        let x160 = Self::mul_add(0.00000000020510342851533115, x157, x155);
-        let x161 = v[12] - Self::mul_add(0.00000000020510342851533115, x135, x128);
-        let x162 = x142 - Self::mul_add(-0.55, x139, 0.16 * x141);
-        let x163 = Self::mul_add(0.16, x140, x143);
-        let x164 = Self::mul_add(-0.55, x140, x138);
-        let x165 = Self::mul_add(0.00000000020510342851533115, x164, x162);
-        let x166 = a[12] - Self::mul_add(0.00000000020510342851533115, x139, x140);
-        let x167 = Self::mul_add(
-            -v[12],
+        let x148 = S::mul_add(
+            S::splat(26.17),
+            x132,
+            S::neg(
+                S::mul_add(
+                    S::splat(-7.196750000000001),
+                    x135,
+                    S::splat(4.187200000000001) * x129,
+                ),
+            ),
+        );
+        let x149 = S::mul_add(S::splat(4.187200000000001), x128, S::splat(26.17) * x133);
+        let x150 = S::mul_add(
+            S::splat(-7.196750000000001),
+            x128,
+            S::splat(26.17) * x134,
+        );
+        let x151 = S::splat(0.00000000020510342851533115) * c_q13;
+        let x152 = S::splat(0.00000000020510342851533115) * s_q13;
+        let x153 = S::mul_add(S::neg(x135), c_q13, S::mul_add(x129, s_q13, x128 * x151));
+        let x154 = S::mul_add(
+            S::neg(x135),
+            s_q13,
+            S::mul_add(S::neg(x129), c_q13, x128 * x152),
+        );
+        let x155 = x132 - S::mul_add(S::splat(-0.55), x135, S::splat(0.16) * x129);
+        let x156 = S::mul_add(S::splat(0.16), x128, x133);
+        let x157 = S::mul_add(S::splat(-0.55), x128, x134);
+        let x158 = S::mul_add(S::neg(c_q13), x157, S::mul_add(s_q13, x156, x151 * x155));
+        let x159 = S::mul_add(
+            S::neg(s_q13),
+            x157,
+            S::mul_add(S::neg(c_q13), x156, x152 * x155),
+        );
+        let x160 = S::mul_add(S::splat(0.00000000020510342851533115), x157, x155);
+        let x161 = v[12]
+            - S::mul_add(S::splat(0.00000000020510342851533115), x135, x128);
+        let x162 = x142 - S::mul_add(S::splat(-0.55), x139, S::splat(0.16) * x141);
+        let x163 = S::mul_add(S::splat(0.16), x140, x143);
+        let x164 = S::mul_add(S::splat(-0.55), x140, x138);
+        let x165 = S::mul_add(S::splat(0.00000000020510342851533115), x164, x162);
+        let x166 = a[12]
+            - S::mul_add(S::splat(0.00000000020510342851533115), x139, x140);
+        let x167 = S::mul_add(
+            S::neg(v[12]),
             x154,
-            Self::mul_add(-x139, c_q13, Self::mul_add(x141, s_q13, x140 * x151)),
+            S::mul_add(S::neg(x139), c_q13, S::mul_add(x141, s_q13, x140 * x151)),
         );
-        let x168 = Self::mul_add(
+        let x168 = S::mul_add(
             v[12],
             x153,
-            Self::mul_add(-x139, s_q13, Self::mul_add(-x141, c_q13, x140 * x152)),
+            S::mul_add(S::neg(x139), s_q13, S::mul_add(S::neg(x141), c_q13, x140 * x152)),
         );
-        let x169 = Self::mul_add(
-            -v[12],
+        let x169 = S::mul_add(
+            S::neg(v[12]),
             x159,
-            Self::mul_add(-c_q13, x164, Self::mul_add(s_q13, x163, x151 * x162)),
+            S::mul_add(S::neg(c_q13), x164, S::mul_add(s_q13, x163, x151 * x162)),
         );
-        let x170 = Self::mul_add(
+        let x170 = S::mul_add(
             v[12],
             x158,
-            Self::mul_add(-s_q13, x164, Self::mul_add(-c_q13, x163, x152 * x162)),
+            S::mul_add(S::neg(s_q13), x164, S::mul_add(S::neg(c_q13), x163, x152 * x162)),
         );
-        let x171 = Self::mul_add(
-            3.6140000000000003,
+        let x171 = S::mul_add(
+            S::splat(3.6140000000000003),
             x169,
-            Self::mul_add(
+            S::mul_add(
                 x166,
-                -0.9614610000000001,
-                Self::mul_add(-0.9638000000000001, x168, 0.000781 * x167),
+                S::splat(-0.9614610000000001),
+                S::mul_add(
+                    S::splat(-0.9638000000000001),
+                    x168,
+                    S::splat(0.000781) * x167,
+                ),
             ),
         );
-        let x172 = Self::mul_add(
-            4.806620000000001,
+        let x172 = S::mul_add(
+            S::splat(4.806620000000001),
             x169,
-            Self::mul_add(
-                -1.4135609200000003,
+            S::mul_add(
+                S::splat(-1.4135609200000003),
                 x166,
-                Self::mul_add(x168, -0.9614610000000001, x167 * 0.0145),
+                S::mul_add(x168, S::splat(-0.9614610000000001), x167 * S::splat(0.0145)),
             ),
         );
-        let x173 = Self::mul_add(
+        let x173 = S::mul_add(
             x161,
-            -0.0145,
-            Self::mul_add(-0.000781, x154, 2.1663609200000002 * x153),
-        ) + Self::mul_add(-4.806620000000001, x160, 3.6140000000000003 * x159);
-        let x174 = Self::mul_add(
-            3.6140000000000003,
-            x158,
-            Self::mul_add(
-                x161,
-                -0.9614610000000001,
-                Self::mul_add(-0.9638000000000001, x154, 0.000781 * x153),
-            ),
-        );
-        let x175 = Self::mul_add(
-            4.806620000000001,
-            x158,
-            Self::mul_add(
-                -1.4135609200000003,
-                x161,
-                Self::mul_add(x154, -0.9614610000000001, x153 * 0.0145),
-            ),
-        );
-        let x176 = Self::mul_add(
-            18.07,
-            x158,
-            -Self::mul_add(4.806620000000001, x161, 3.6140000000000003 * x154),
-        );
-        let x177 = Self::mul_add(3.6140000000000003, x153, 18.07 * x159);
-        let x178 = Self::mul_add(-4.806620000000001, x153, 18.07 * x160);
-        let x179 = Self::mul_add(
-            x166,
-            -0.0145,
-            Self::mul_add(-0.000781, x168, 2.1663609200000002 * x167),
-        ) + Self::mul_add(-4.806620000000001, x165, 3.6140000000000003 * x170)
-            - (Self::mul_add(-x154, x175, x161 * x174)
-                + Self::mul_add(-x159, x178, x160 * x177));
-        let x180 = x171
-            + (Self::mul_add(x153, x175, x161 * x173)
-                - Self::mul_add(-x158, x178, x160 * x176));
-        let x181 = x172
-            - (Self::mul_add(x153, x174, x154 * x173)
-                + Self::mul_add(-x158, x177, x159 * x176));
-        let x182 = Self::mul_add(
-            18.07,
-            x169,
-            -Self::mul_add(4.806620000000001, x166, 3.6140000000000003 * x168),
-        ) + Self::mul_add(x154, x178, x161 * x177);
-        let x183 = Self::mul_add(3.6140000000000003, x167, 18.07 * x170)
-            - Self::mul_add(x153, x178, x161 * x176);
-        let x184 = Self::mul_add(-4.806620000000001, x167, 18.07 * x165)
-            - Self::mul_add(-x153, x177, x154 * x176);
-        let x185 = x184 + Self::mul_add(x152, x183, x151 * x182);
-        let x186 = Self::mul_add(-c_q13, x183, s_q13 * x182);
-        let x187 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x184,
-            Self::mul_add(s_q13, x183, c_q13 * x182),
-        );
-        let x188 = Self::mul_add(
-            -0.55,
-            x185,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x181,
-                Self::mul_add(-s_q13, x180, c_q13 * x179),
-            ),
-        );
-        let x189 = Self::mul_add(x139, 0.2313, 3.2217582500000006 * x140)
-            + Self::mul_add(-7.196750000000001, x138, 4.187200000000001 * x143)
-            + (Self::mul_add(-x129, x147, x135 * x146)
-                + Self::mul_add(-x133, x150, x134 * x149))
-            + (x181 + Self::mul_add(-x152, x180, x151 * x179)
-                + Self::mul_add(0.55, x187, 0.16 * x186));
-        let x190 = Self::mul_add(
-            -4.187200000000001,
-            x142,
-            Self::mul_add(x139, -1.1514800000000003, 1.2686520000000001 * x141),
+            S::splat(-0.0145),
+            S::mul_add(S::splat(-0.000781), x154, S::splat(2.1663609200000002) * x153),
         )
-            - (Self::mul_add(-x128, x147, x135 * x145)
-                + Self::mul_add(-x132, x150, x134 * x148))
-            + Self::mul_add(-0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
-        let x191 = x144
-            + (Self::mul_add(-x128, x146, x129 * x145)
-                + Self::mul_add(-x132, x149, x133 * x148)) - x188;
-        let x192 = Self::mul_add(
-            26.17,
-            x142,
-            -Self::mul_add(-7.196750000000001, x139, 4.187200000000001 * x141),
-        ) + Self::mul_add(-x129, x150, x135 * x149) + x185;
-        let x193 = Self::mul_add(4.187200000000001, x140, 26.17 * x143)
-            - Self::mul_add(-x128, x150, x135 * x148) + x186;
-        let x194 = Self::mul_add(-7.196750000000001, x140, 26.17 * x138)
-            + Self::mul_add(-x128, x149, x129 * x148) - x187;
-        let x195 = Self::mul_add(s_q12, x193, c_q12 * x192);
-        let x196 = x194 + Self::mul_add(-x127, x193, x126 * x192);
-        let x197 = Self::mul_add(
-            x119,
-            -3.0149999999999997,
-            Self::mul_add(-0.01675, x115, 0.9304999999999999 * x116),
-        )
-            + (Self::mul_add(x105, x120, x111 * x122)
-                + Self::mul_add(-x110, x123, x108 * x125))
-            + Self::mul_add(-0.36, x196, Self::mul_add(s_q12, x190, c_q12 * x189));
-        let x198 = Self::mul_add(x118, 3.0149999999999997, 0.939 * x117)
-            - (Self::mul_add(x104, x120, x111 * x121)
-                + Self::mul_add(-x109, x123, x108 * x124))
-            + Self::mul_add(0.36, x195, x191 + Self::mul_add(-x127, x190, x126 * x189));
-        let x199 = Self::mul_add(x117, 3.0149999999999997, 16.75 * x118)
-            + Self::mul_add(-x105, x123, x111 * x125) + x195;
-        let x200 = Self::mul_add(x116, -3.0149999999999997, 16.75 * x119)
-            - Self::mul_add(-x104, x123, x111 * x124) + x196;
-        let x201 = Self::mul_add(16.75, x114, Self::mul_add(-x104, x125, x105 * x124))
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x194,
-                Self::mul_add(-c_q12, x193, s_q12 * x192),
+            + S::mul_add(
+                S::splat(-4.806620000000001),
+                x160,
+                S::splat(3.6140000000000003) * x159,
             );
-        let x202 = Self::mul_add(s_q11, x200, c_q11 * x199);
-        let x203 = Self::mul_add(-c_q11, x200, s_q11 * x199);
-        let x204 = Self::mul_add(
-            0.63,
+        let x174 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x158,
+            S::mul_add(
+                x161,
+                S::splat(-0.9614610000000001),
+                S::mul_add(
+                    S::splat(-0.9638000000000001),
+                    x154,
+                    S::splat(0.000781) * x153,
+                ),
+            ),
+        );
+        let x175 = S::mul_add(
+            S::splat(4.806620000000001),
+            x158,
+            S::mul_add(
+                S::splat(-1.4135609200000003),
+                x161,
+                S::mul_add(x154, S::splat(-0.9614610000000001), x153 * S::splat(0.0145)),
+            ),
+        );
+        let x176 = S::mul_add(
+            S::splat(18.07),
+            x158,
+            S::neg(
+                S::mul_add(
+                    S::splat(4.806620000000001),
+                    x161,
+                    S::splat(3.6140000000000003) * x154,
+                ),
+            ),
+        );
+        let x177 = S::mul_add(
+            S::splat(3.6140000000000003),
+            x153,
+            S::splat(18.07) * x159,
+        );
+        let x178 = S::mul_add(
+            S::splat(-4.806620000000001),
+            x153,
+            S::splat(18.07) * x160,
+        );
+        let x179 = S::mul_add(
+            x166,
+            S::splat(-0.0145),
+            S::mul_add(S::splat(-0.000781), x168, S::splat(2.1663609200000002) * x167),
+        )
+            + S::mul_add(
+                S::splat(-4.806620000000001),
+                x165,
+                S::splat(3.6140000000000003) * x170,
+            )
+            - (S::mul_add(S::neg(x154), x175, x161 * x174)
+                + S::mul_add(S::neg(x159), x178, x160 * x177));
+        let x180 = x171
+            + (S::mul_add(x153, x175, x161 * x173)
+                - S::mul_add(S::neg(x158), x178, x160 * x176));
+        let x181 = x172
+            - (S::mul_add(x153, x174, x154 * x173)
+                + S::mul_add(S::neg(x158), x177, x159 * x176));
+        let x182 = S::mul_add(
+            S::splat(18.07),
+            x169,
+            S::neg(
+                S::mul_add(
+                    S::splat(4.806620000000001),
+                    x166,
+                    S::splat(3.6140000000000003) * x168,
+                ),
+            ),
+        ) + S::mul_add(x154, x178, x161 * x177);
+        let x183 = S::mul_add(S::splat(3.6140000000000003), x167, S::splat(18.07) * x170)
+            - S::mul_add(x153, x178, x161 * x176);
+        let x184 = S::mul_add(S::splat(-4.806620000000001), x167, S::splat(18.07) * x165)
+            - S::mul_add(S::neg(x153), x177, x154 * x176);
+        let x185 = x184 + S::mul_add(x152, x183, x151 * x182);
+        let x186 = S::mul_add(S::neg(c_q13), x183, s_q13 * x182);
+        let x187 = S::mul_add(
+            S::splat(-0.00000000020510342851533115),
+            x184,
+            S::mul_add(s_q13, x183, c_q13 * x182),
+        );
+        let x188 = S::mul_add(
+            S::splat(-0.55),
+            x185,
+            S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x181,
+                S::mul_add(S::neg(s_q13), x180, c_q13 * x179),
+            ),
+        );
+        let x189 = S::mul_add(
+            x139,
+            S::splat(0.2313),
+            S::splat(3.2217582500000006) * x140,
+        )
+            + S::mul_add(
+                S::splat(-7.196750000000001),
+                x138,
+                S::splat(4.187200000000001) * x143,
+            )
+            + (S::mul_add(S::neg(x129), x147, x135 * x146)
+                + S::mul_add(S::neg(x133), x150, x134 * x149))
+            + (x181 + S::mul_add(S::neg(x152), x180, x151 * x179)
+                + S::mul_add(S::splat(0.55), x187, S::splat(0.16) * x186));
+        let x190 = S::mul_add(
+            S::splat(-4.187200000000001),
+            x142,
+            S::mul_add(
+                x139,
+                S::splat(-1.1514800000000003),
+                S::splat(1.2686520000000001) * x141,
+            ),
+        )
+            - (S::mul_add(S::neg(x128), x147, x135 * x145)
+                + S::mul_add(S::neg(x132), x150, x134 * x148))
+            + S::mul_add(S::splat(-0.16), x185, S::mul_add(c_q13, x180, s_q13 * x179));
+        let x191 = x144
+            + (S::mul_add(S::neg(x128), x146, x129 * x145)
+                + S::mul_add(S::neg(x132), x149, x133 * x148)) - x188;
+        let x192 = S::mul_add(
+            S::splat(26.17),
+            x142,
+            S::neg(
+                S::mul_add(
+                    S::splat(-7.196750000000001),
+                    x139,
+                    S::splat(4.187200000000001) * x141,
+                ),
+            ),
+        ) + S::mul_add(S::neg(x129), x150, x135 * x149) + x185;
+        let x193 = S::mul_add(S::splat(4.187200000000001), x140, S::splat(26.17) * x143)
+            - S::mul_add(S::neg(x128), x150, x135 * x148) + x186;
+        let x194 = S::mul_add(S::splat(-7.196750000000001), x140, S::splat(26.17) * x138)
+            + S::mul_add(S::neg(x128), x149, x129 * x148) - x187;
+        let x195 = S::mul_add(s_q12, x193, c_q12 * x192);
+        let x196 = x194 + S::mul_add(S::neg(x127), x193, x126 * x192);
+        let x197 = S::mul_add(
+            x119,
+            S::splat(-3.0149999999999997),
+            S::mul_add(S::splat(-0.01675), x115, S::splat(0.9304999999999999) * x116),
+        )
+            + (S::mul_add(x105, x120, x111 * x122)
+                + S::mul_add(S::neg(x110), x123, x108 * x125))
+            + S::mul_add(S::splat(-0.36), x196, S::mul_add(s_q12, x190, c_q12 * x189));
+        let x198 = S::mul_add(x118, S::splat(3.0149999999999997), S::splat(0.939) * x117)
+            - (S::mul_add(x104, x120, x111 * x121)
+                + S::mul_add(S::neg(x109), x123, x108 * x124))
+            + S::mul_add(
+                S::splat(0.36),
+                x195,
+                x191 + S::mul_add(S::neg(x127), x190, x126 * x189),
+            );
+        let x199 = S::mul_add(x117, S::splat(3.0149999999999997), S::splat(16.75) * x118)
+            + S::mul_add(S::neg(x105), x123, x111 * x125) + x195;
+        let x200 = S::mul_add(
+            x116,
+            S::splat(-3.0149999999999997),
+            S::splat(16.75) * x119,
+        ) - S::mul_add(S::neg(x104), x123, x111 * x124) + x196;
+        let x201 = S::mul_add(
+            S::splat(16.75),
+            x114,
+            S::mul_add(S::neg(x104), x125, x105 * x124),
+        )
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x194,
+                S::mul_add(S::neg(c_q12), x193, s_q12 * x192),
+            );
+        let x202 = S::mul_add(s_q11, x200, c_q11 * x199);
+        let x203 = S::mul_add(S::neg(c_q11), x200, s_q11 * x199);
+        let x204 = S::mul_add(
+            S::splat(0.63),
             x202,
-            Self::mul_add(-0.07271, x115, 0.01675 * x116)
-                - (Self::mul_add(-x104, x122, x105 * x121)
-                    + Self::mul_add(-x109, x125, x110 * x124))
-                - Self::mul_add(
-                    -0.00000000020510342851533115,
+            S::mul_add(S::splat(-0.07271), x115, S::splat(0.01675) * x116)
+                - (S::mul_add(S::neg(x104), x122, x105 * x121)
+                    + S::mul_add(S::neg(x109), x125, x110 * x124))
+                - S::mul_add(
+                    S::splat(-0.00000000020510342851533115),
                     x191,
-                    Self::mul_add(-c_q12, x190, s_q12 * x189),
+                    S::mul_add(S::neg(c_q12), x190, s_q12 * x189),
                 ),
         );
-        let x205 = Self::mul_add(x92, 0.6328, 4.170993 * x93)
-            - Self::mul_add(x91, -6.7347, x96 * 5.8795)
-            + (Self::mul_add(-x84, x100, x89 * x99)
-                + Self::mul_add(-x88, x103, x86 * x102))
-            + (Self::mul_add(s_q11, x198, c_q11 * x197)
-                + Self::mul_add(0.63, x201, 0.275 * x203));
-        let x206 = Self::mul_add(
+        let x205 = S::mul_add(x92, S::splat(0.6328), S::splat(4.170993) * x93)
+            - S::mul_add(x91, S::splat(-6.7347), x96 * S::splat(5.8795))
+            + (S::mul_add(S::neg(x84), x100, x89 * x99)
+                + S::mul_add(S::neg(x88), x103, x86 * x102))
+            + (S::mul_add(s_q11, x198, c_q11 * x197)
+                + S::mul_add(S::splat(0.63), x201, S::splat(0.275) * x203));
+        let x206 = S::mul_add(
             x95,
-            5.8795,
-            Self::mul_add(x92, -1.8520425, 3.8828625 * x94),
+            S::splat(5.8795),
+            S::mul_add(x92, S::splat(-1.8520425), S::splat(3.8828625) * x94),
         )
-            - (Self::mul_add(-x83, x100, x89 * x98)
-                + Self::mul_add(-x87, x103, x86 * x101))
-            - Self::mul_add(-0.275, x202, Self::mul_add(-c_q11, x198, s_q11 * x197));
-        let x207 = Self::mul_add(21.38, x95, Self::mul_add(x92, -6.7347, x94 * 5.8795))
-            + Self::mul_add(-x84, x103, x89 * x102) + x202;
-        let x208 = Self::mul_add(x93, -5.8795, 21.38 * x96)
-            - Self::mul_add(-x83, x103, x89 * x101) - x203;
-        let x209 = Self::mul_add(x93, 6.7347, 21.38 * x91)
-            + Self::mul_add(-x83, x102, x84 * x101) + x201;
-        let x210 = Self::mul_add(s_q10, x208, c_q10 * x207);
-        let x211 = Self::mul_add(
+            - (S::mul_add(S::neg(x83), x100, x89 * x98)
+                + S::mul_add(S::neg(x87), x103, x86 * x101))
+            - S::mul_add(
+                S::splat(-0.275),
+                x202,
+                S::mul_add(S::neg(c_q11), x198, s_q11 * x197),
+            );
+        let x207 = S::mul_add(
+            S::splat(21.38),
+            x95,
+            S::mul_add(x92, S::splat(-6.7347), x94 * S::splat(5.8795)),
+        ) + S::mul_add(S::neg(x84), x103, x89 * x102) + x202;
+        let x208 = S::mul_add(x93, S::splat(-5.8795), S::splat(21.38) * x96)
+            - S::mul_add(S::neg(x83), x103, x89 * x101) - x203;
+        let x209 = S::mul_add(x93, S::splat(6.7347), S::splat(21.38) * x91)
+            + S::mul_add(S::neg(x83), x102, x84 * x101) + x201;
+        let x210 = S::mul_add(s_q10, x208, c_q10 * x207);
+        let x211 = S::mul_add(
             x71,
-            9.87015,
-            Self::mul_add(0.00214, x72, 4.395515250000001 * x73),
-        ) - (Self::mul_add(-x60, x79, x67 * x77) + Self::mul_add(-x65, x82, x66 * x80))
-            + Self::mul_add(0.87, x209, Self::mul_add(s_q10, x206, c_q10 * x205));
-        let x212 = Self::mul_add(
-            3.378,
+            S::splat(9.87015),
+            S::mul_add(S::splat(0.00214), x72, S::splat(4.395515250000001) * x73),
+        )
+            - (S::mul_add(S::neg(x60), x79, x67 * x77)
+                + S::mul_add(S::neg(x65), x82, x66 * x80))
+            + S::mul_add(S::splat(0.87), x209, S::mul_add(s_q10, x206, c_q10 * x205));
+        let x212 = S::mul_add(
+            S::splat(3.378),
             x74,
-            Self::mul_add(-x59, x79, x67 * x78) + Self::mul_add(-x64, x82, x66 * x81),
-        ) + Self::mul_add(-c_q10, x206, s_q10 * x205);
-        let x213 = Self::mul_add(
+            S::mul_add(S::neg(x59), x79, x67 * x78)
+                + S::mul_add(S::neg(x64), x82, x66 * x81),
+        ) + S::mul_add(S::neg(c_q10), x206, s_q10 * x205);
+        let x213 = S::mul_add(
             x75,
-            -9.87015,
-            Self::mul_add(7.65251525, x72, 0.00214 * x73),
-        ) - (Self::mul_add(-x59, x77, x60 * x78) + Self::mul_add(-x64, x80, x65 * x81))
-            + Self::mul_add(
-                -0.87,
+            S::splat(-9.87015),
+            S::mul_add(S::splat(7.65251525), x72, S::splat(0.00214) * x73),
+        )
+            - (S::mul_add(S::neg(x59), x77, x60 * x78)
+                + S::mul_add(S::neg(x64), x80, x65 * x81))
+            + S::mul_add(
+                S::splat(-0.87),
                 x210,
                 x97
-                    + (Self::mul_add(-x83, x99, x84 * x98)
-                        + Self::mul_add(-x87, x102, x88 * x101)) - x204,
+                    + (S::mul_add(S::neg(x83), x99, x84 * x98)
+                        + S::mul_add(S::neg(x87), x102, x88 * x101)) - x204,
             );
-        let x214 = Self::mul_add(x72, -9.87015, 22.69 * x75)
-            - Self::mul_add(-x60, x82, x67 * x80) + x210;
-        let x215 = Self::mul_add(22.69, x76, Self::mul_add(-x59, x82, x67 * x81))
-            + Self::mul_add(-c_q10, x208, s_q10 * x207);
-        let x216 = Self::mul_add(x73, 9.87015, 22.69 * x71)
-            - Self::mul_add(-x59, x80, x60 * x81) + x209;
-        let x217 = 0.00000000020510342851533115 * x216;
-        let x218 = Self::mul_add(c_q9, x215, s_q9 * x214) - x217;
-        let x219 = x216 - Self::mul_add(-x58, x215, x57 * x214);
-        let x220 = x217 + Self::mul_add(-s_q9, x215, c_q9 * x214);
-        let x221 = 0.00000000020510342851533115 * x213;
-        let x222 = Self::mul_add(
-            6.0,
+        let x214 = S::mul_add(x72, S::splat(-9.87015), S::splat(22.69) * x75)
+            - S::mul_add(S::neg(x60), x82, x67 * x80) + x210;
+        let x215 = S::mul_add(
+            S::splat(22.69),
+            x76,
+            S::mul_add(S::neg(x59), x82, x67 * x81),
+        ) + S::mul_add(S::neg(c_q10), x208, s_q10 * x207);
+        let x216 = S::mul_add(x73, S::splat(9.87015), S::splat(22.69) * x71)
+            - S::mul_add(S::neg(x59), x80, x60 * x81) + x209;
+        let x217 = S::splat(0.00000000020510342851533115) * x216;
+        let x218 = S::mul_add(c_q9, x215, s_q9 * x214) - x217;
+        let x219 = x216 - S::mul_add(S::neg(x58), x215, x57 * x214);
+        let x220 = x217 + S::mul_add(S::neg(s_q9), x215, c_q9 * x214);
+        let x221 = S::splat(0.00000000020510342851533115) * x213;
+        let x222 = S::mul_add(
+            S::splat(6.0),
             x48,
-            Self::mul_add(x44, 0.00214, 3.3000000000000003 * x45),
-        ) + (Self::mul_add(-x34, x49, x40 * x51) + Self::mul_add(-x38, x52, x39 * x54))
-            + (Self::mul_add(c_q9, x212, s_q9 * x211) - x221
-                + Self::mul_add(0.275, x220, 0.4 * x219));
-        let x223 = Self::mul_add(-6.0, x47, 2.5780000000000003 * x46)
-            - (Self::mul_add(-x33, x49, x40 * x50) + Self::mul_add(-x37, x52, x39 * x53))
-            + Self::mul_add(-0.4, x218, x213 - Self::mul_add(-x58, x212, x57 * x211));
-        let x224 = Self::mul_add(2.359, x44, x45 * 0.00214)
-            + (Self::mul_add(-x33, x51, x34 * x50) + Self::mul_add(-x37, x54, x38 * x53))
-            - Self::mul_add(
-                -0.275,
+            S::mul_add(x44, S::splat(0.00214), S::splat(3.3000000000000003) * x45),
+        )
+            + (S::mul_add(S::neg(x34), x49, x40 * x51)
+                + S::mul_add(S::neg(x38), x52, x39 * x54))
+            + (S::mul_add(c_q9, x212, s_q9 * x211) - x221
+                + S::mul_add(S::splat(0.275), x220, S::splat(0.4) * x219));
+        let x223 = S::mul_add(S::splat(-6.0), x47, S::splat(2.5780000000000003) * x46)
+            - (S::mul_add(S::neg(x33), x49, x40 * x50)
+                + S::mul_add(S::neg(x37), x52, x39 * x53))
+            + S::mul_add(
+                S::splat(-0.4),
                 x218,
-                x221 + Self::mul_add(-s_q9, x212, c_q9 * x211),
+                x213 - S::mul_add(S::neg(x58), x212, x57 * x211),
             );
-        let x225 = Self::mul_add(-6.0, x46, 30.0 * x47)
-            + Self::mul_add(-x34, x52, x40 * x54) + x218;
-        let x226 = Self::mul_add(6.0, x45, 30.0 * x48)
-            - Self::mul_add(-x33, x52, x40 * x53) + x219;
-        let x227 = Self::mul_add(30.0, x43, Self::mul_add(-x33, x54, x34 * x53)) - x220;
-        let x228 = x227 + Self::mul_add(x32, x226, x31 * x225);
-        let x229 = Self::mul_add(-c_q8, x226, s_q8 * x225);
+        let x224 = S::mul_add(S::splat(2.359), x44, x45 * S::splat(0.00214))
+            + (S::mul_add(S::neg(x33), x51, x34 * x50)
+                + S::mul_add(S::neg(x37), x54, x38 * x53))
+            - S::mul_add(
+                S::splat(-0.275),
+                x218,
+                x221 + S::mul_add(S::neg(s_q9), x212, c_q9 * x211),
+            );
+        let x225 = S::mul_add(S::splat(-6.0), x46, S::splat(30.0) * x47)
+            + S::mul_add(S::neg(x34), x52, x40 * x54) + x218;
+        let x226 = S::mul_add(S::splat(6.0), x45, S::splat(30.0) * x48)
+            - S::mul_add(S::neg(x33), x52, x40 * x53) + x219;
+        let x227 = S::mul_add(
+            S::splat(30.0),
+            x43,
+            S::mul_add(S::neg(x33), x54, x34 * x53),
+        ) - x220;
+        let x228 = x227 + S::mul_add(x32, x226, x31 * x225);
+        let x229 = S::mul_add(S::neg(c_q8), x226, s_q8 * x225);
         let x230 = x23
-            + (Self::mul_add(-x8, x25, x14 * x27) + Self::mul_add(-x13, x28, x11 * x30))
-            + Self::mul_add(0.35, x229, x224 + Self::mul_add(x32, x223, x31 * x222));
+            + (S::mul_add(S::neg(x8), x25, x14 * x27)
+                + S::mul_add(S::neg(x13), x28, x11 * x30))
+            + S::mul_add(S::splat(0.35), x229, x224 + S::mul_add(x32, x223, x31 * x222));
         let x231 = x24
-            - (Self::mul_add(-x7, x25, x14 * x26) + Self::mul_add(-x12, x28, x11 * x29))
-            + Self::mul_add(-0.35, x228, Self::mul_add(-c_q8, x223, s_q8 * x222));
-        let x232 = Self::mul_add(-6.1267499999999995, x20, 35.01 * x21)
-            + Self::mul_add(-x8, x28, x14 * x30) + x228;
-        let x233 = Self::mul_add(6.1267499999999995, x19, 35.01 * x22)
-            - Self::mul_add(-x7, x28, x14 * x29) + x229;
-        let x234 = Self::mul_add(35.01, x17, Self::mul_add(-x7, x30, x8 * x29))
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x227,
-                Self::mul_add(s_q8, x226, c_q8 * x225),
+            - (S::mul_add(S::neg(x7), x25, x14 * x26)
+                + S::mul_add(S::neg(x12), x28, x11 * x29))
+            + S::mul_add(
+                S::splat(-0.35),
+                x228,
+                S::mul_add(S::neg(c_q8), x223, s_q8 * x222),
             );
-        let x235 = Self::mul_add(s_q7, x233, c_q7 * x232);
-        let x236 = Self::mul_add(-c_q7, x233, s_q7 * x232);
-        let x237 = Self::mul_add(
-            0.65,
+        let x232 = S::mul_add(S::splat(-6.1267499999999995), x20, S::splat(35.01) * x21)
+            + S::mul_add(S::neg(x8), x28, x14 * x30) + x228;
+        let x233 = S::mul_add(S::splat(6.1267499999999995), x19, S::splat(35.01) * x22)
+            - S::mul_add(S::neg(x7), x28, x14 * x29) + x229;
+        let x234 = S::mul_add(
+            S::splat(35.01),
+            x17,
+            S::mul_add(S::neg(x7), x30, x8 * x29),
+        )
+            + S::mul_add(
+                S::splat(-0.00000000020510342851533115),
+                x227,
+                S::mul_add(s_q8, x226, c_q8 * x225),
+            );
+        let x235 = S::mul_add(s_q7, x233, c_q7 * x232);
+        let x236 = S::mul_add(S::neg(c_q7), x233, s_q7 * x232);
+        let x237 = S::mul_add(
+            S::splat(0.65),
             x236,
-            Self::mul_add(1.331, x18, Self::mul_add(-0.1132, x20, 0.00071 * x19))
-                + (Self::mul_add(-x7, x27, x8 * x26)
-                    + Self::mul_add(-x12, x30, x13 * x29))
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
+            S::mul_add(
+                S::splat(1.331),
+                x18,
+                S::mul_add(S::splat(-0.1132), x20, S::splat(0.00071) * x19),
+            )
+                + (S::mul_add(S::neg(x7), x27, x8 * x26)
+                    + S::mul_add(S::neg(x12), x30, x13 * x29))
+                + S::mul_add(
+                    S::splat(-0.00000000020510342851533115),
                     x224,
-                    Self::mul_add(s_q8, x223, c_q8 * x222),
+                    S::mul_add(s_q8, x223, c_q8 * x222),
                 ),
         );
-        let x238 = -x235;
-        let x239 = -x236;
-        let x240 = -x234;
-        let x241 = -Self::mul_add(-0.75, x236, Self::mul_add(s_q7, x231, c_q7 * x230));
-        let x242 = -(Self::mul_add(-c_q7, x231, s_q7 * x230)
-            + Self::mul_add(-0.65, x234, 0.75 * x235));
-        let x243 = -x237;
+        let x238 = S::neg(x235);
+        let x239 = S::neg(x236);
+        let x240 = S::neg(x234);
+        let x241 = S::neg(
+            S::mul_add(S::splat(-0.75), x236, S::mul_add(s_q7, x231, c_q7 * x230)),
+        );
+        let x242 = S::neg(
+            S::mul_add(S::neg(c_q7), x231, s_q7 * x230)
+                + S::mul_add(S::splat(-0.65), x234, S::splat(0.75) * x235),
+        );
+        let x243 = S::neg(x237);
         [x238, x239, x240, x241, x242, x243]
     }
-    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
-    #[inline(always)]
-    fn mul_add(
-        a: ::core::primitive::f64,
-        b: ::core::primitive::f64,
-        c: ::core::primitive::f64,
-    ) -> ::core::primitive::f64 {
-        kanegen_runtime::fma::mul_add(a, b, c)
+    /// [`Self::base_reaction`] of every state of the slices, `S::LANES` states per call of [`Self::base_reaction_lanes`]: `out[k]` is `base_reaction` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn base_reaction_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 14]],
+        v: &[[::core::primitive::f64; 13]],
+        a: &[[::core::primitive::f64; 13]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(v.len()).min(a.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::base_reaction_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(v, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(a, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

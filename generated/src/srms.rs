@@ -9,9 +9,10 @@
 //! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
+//! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 609 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1165,7 +1166,14 @@ impl Srms {
     pub fn mass_matrix(
         q: &[::core::primitive::f64; 6],
     ) -> [[::core::primitive::f64; 6]; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::mass_matrix_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 6],
+    ) -> [[S; 6]; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1174,125 +1182,146 @@ impl Srms {
         ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
-        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
-        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
-        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x7 = S::mul_add(x6, S::splat(0.706), x5 * S::splat(0.9929999999999999));
+        let x8 = S::splat(0.353)
+            + S::mul_add(x5, S::splat(-0.706), x6 * S::splat(0.9929999999999999));
+        let x9 = S::mul_add(S::splat(-0.966), s_q5, S::splat(0.385) * c_q5);
+        let x10 = S::mul_add(S::splat(0.966), c_q5, S::splat(0.385) * s_q5);
+        let x11 = S::splat(34.74691524) + (S::splat(-0.9929999999999999) + x7);
         let x12 = s_q4 * s_q4;
         let x13 = s_q4 * c_q4;
-        let x14 = x7 + -32.43591524;
+        let x14 = x7 + S::splat(-32.43591524);
         let x15 = x9 + x9;
-        let x16 = Self::mul_add(x13, x15, x12 * x14);
-        let x17 = -32.43591524 - x16;
-        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
-        let x20 = s_q4 * 34.45002;
-        let x21 = c_q4 * 34.45002;
-        let x22 = 0.4572 * x21;
+        let x16 = S::mul_add(x13, x15, x12 * x14);
+        let x17 = S::splat(-32.43591524) - x16;
+        let x18 = S::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = S::mul_add(S::neg(c_q4), x10, s_q4 * x8);
+        let x20 = s_q4 * S::splat(34.45002);
+        let x21 = c_q4 * S::splat(34.45002);
+        let x22 = S::splat(0.4572) * x21;
         let x23 = x11 + x22;
-        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
-        let x25 = 41.67378 + x21;
-        let x26 = -15.380963024 + (x22 + x23);
-        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x24 = S::mul_add(
+            S::splat(-0.4572),
+            x20,
+            x9 + S::mul_add(S::neg(x12), x15, x13 * x14),
+        );
+        let x25 = S::splat(41.67378) + x21;
+        let x26 = S::splat(-15.380963024) + (x22 + x23);
+        let x27 = S::splat(54.202167456) + (x22 - (x7 - x16 - x22));
         let x28 = s_q3 * s_q3;
         let x29 = s_q3 * c_q3;
         let x30 = x17 - x26;
         let x31 = x19 + x19;
-        let x32 = Self::mul_add(x29, x31, x28 * x30);
-        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
-        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x32 = S::mul_add(x29, x31, x28 * x30);
+        let x33 = S::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = S::mul_add(S::neg(c_q3), x18, s_q3 * x24);
         let x35 = c_q3 * x25;
         let x36 = s_q3 * x25;
-        let x37 = 0.1524 * x36;
-        let x38 = 7.06 * x35;
-        let x39 = 0.1524 * x20;
+        let x37 = S::splat(0.1524) * x36;
+        let x38 = S::splat(7.06) * x35;
+        let x39 = S::splat(0.1524) * x20;
         let x40 = x37 + x38;
         let x41 = x27 + x40;
         let x42 = x37 + (x17 - x32 + x37);
-        let x43 = Self::mul_add(
-            7.06,
+        let x43 = S::mul_add(
+            S::splat(7.06),
             x36,
-            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x35,
+                    x19 + S::mul_add(S::neg(x28), x31, x29 * x30),
+                ),
+            ),
         );
-        let x44 = 703.3878000000001 + x35;
-        let x45 = 15.183612000000002 + x36;
-        let x46 = -103.41030072000001 - x43;
-        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
-        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
-        let x49 = 0.08 + (x34 - x39);
-        let x50 = 5601.1318504688 + (x40 + x41);
+        let x44 = S::splat(703.3878000000001) + x35;
+        let x45 = S::splat(15.183612000000002) + x36;
+        let x46 = S::splat(-103.41030072000001) - x43;
+        let x47 = S::splat(0.8021) + S::mul_add(S::splat(-7.06), x20, x33);
+        let x48 = S::splat(5594.523885531201) + (x38 + (x26 + x32 + x38));
+        let x49 = S::splat(0.08) + (x34 - x39);
+        let x50 = S::splat(5601.1318504688) + (x40 + x41);
         let x51 = s_q2 * s_q2;
         let x52 = s_q2 * c_q2;
         let x53 = x42 - x48;
         let x54 = x46 + x46;
-        let x55 = Self::mul_add(x52, x54, x51 * x53);
-        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
-        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
-        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
-        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
-        let x60 = 0.1524 * x59;
-        let x61 = 6.377 * x58;
+        let x55 = S::mul_add(x52, x54, x51 * x53);
+        let x56 = S::mul_add(S::neg(s_q2), x49, c_q2 * x47);
+        let x57 = S::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = S::mul_add(S::neg(s_q2), x45, c_q2 * x44);
+        let x59 = S::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = S::splat(0.1524) * x59;
+        let x61 = S::splat(6.377) * x58;
         let x62 = x60 + x61;
         let x63 = x50 + x62;
-        let x64 = Self::mul_add(
-            6.377,
+        let x64 = S::mul_add(
+            S::splat(6.377),
             x59,
-            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x58,
+                    x46 + S::mul_add(S::neg(x51), x54, x52 * x53),
+                ),
+            ),
         );
-        let x65 = -190.97044034 - x64;
-        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
-        let x67 = 8609.573807858 + (x62 + x63);
-        let x68 = -Self::mul_add(
-            c_q1,
-            0.0302 - (x39 - x57),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
+        let x65 = S::splat(-190.97044034) - x64;
+        let x66 = S::splat(8596.210051042) + (x61 + (x48 + x55 + x61));
+        let x67 = S::splat(8609.573807858) + (x62 + x63);
+        let x68 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::splat(0.0302) - (x39 - x57),
+                s_q1 * (S::splat(-1.928) + S::mul_add(S::splat(-6.377), x20, x56)),
+            ),
         );
-        let x69 = 46.90457611680001
+        let x69 = S::splat(46.90457611680001)
             + (x66
-                + Self::mul_add(
+                + S::mul_add(
                     s_q1 * c_q1,
                     x65 + x65,
                     s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
                 ));
-        let x70 = -Self::mul_add(c_q1, x57, s_q1 * x56);
+        let x70 = S::neg(S::mul_add(c_q1, x57, s_q1 * x56));
         let x71 = x41
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(-c_q2, x35, s_q2 * x36),
-                0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
+            + S::mul_add(
+                S::splat(-6.377),
+                S::mul_add(S::neg(c_q2), x35, s_q2 * x36),
+                S::splat(0.1524) * S::mul_add(s_q2, x35, c_q2 * x36),
             );
-        let x72 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(c_q2, x34, s_q2 * x33),
-            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
+        let x72 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(c_q2, x34, s_q2 * x33),
+                s_q1 * S::mul_add(S::neg(s_q2), x34, c_q2 * x33),
+            ),
         );
         let x73 = c_q3 * x20;
         let x74 = s_q3 * x20;
-        let x75 = 0.1524 * x21;
-        let x76 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x75;
-        let x77 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
-        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
+        let x75 = S::splat(0.1524) * x21;
+        let x76 = S::mul_add(S::neg(s_q3), x23, c_q3 * x19) - x75;
+        let x77 = S::mul_add(S::splat(7.06), x21, S::mul_add(c_q3, x23, s_q3 * x19));
+        let x78 = x18 + S::mul_add(S::splat(-7.06), x74, S::splat(0.1524) * x73);
         let x79 = x78
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x74, s_q2 * x73),
-                0.1524 * Self::mul_add(-s_q2, x74, c_q2 * x73),
+            + S::mul_add(
+                S::splat(-6.377),
+                S::mul_add(c_q2, x74, s_q2 * x73),
+                S::splat(0.1524) * S::mul_add(S::neg(s_q2), x74, c_q2 * x73),
             );
-        let x80 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x77, s_q2 * x76)),
-            s_q1 * (x75 - Self::mul_add(-s_q2, x77, c_q2 * x76)),
+        let x80 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(6.377), x21, S::mul_add(c_q2, x77, s_q2 * x76)),
+            s_q1 * (x75 - S::mul_add(S::neg(s_q2), x77, c_q2 * x76)),
         );
-        let x81 = -x80;
-        let x82 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
-        let x83 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x84 = Self::mul_add(-s_q3, x10, c_q3 * x82);
-        let x85 = Self::mul_add(c_q3, x10, s_q3 * x82);
-        let x86 = Self::mul_add(
+        let x81 = S::neg(x80);
+        let x82 = S::mul_add(S::splat(-1.903), c_q4, s_q4 * x9);
+        let x83 = S::mul_add(S::splat(1.903), s_q4, c_q4 * x9);
+        let x84 = S::mul_add(S::neg(s_q3), x10, c_q3 * x82);
+        let x85 = S::mul_add(c_q3, x10, s_q3 * x82);
+        let x86 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x85, s_q2 * x84),
-            s_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
+            S::mul_add(c_q2, x85, s_q2 * x84),
+            s_q1 * S::mul_add(S::neg(s_q2), x85, c_q2 * x84),
         );
         [
             [x69, x68, x70, x72, x81, x86],
@@ -1300,8 +1329,34 @@ impl Srms {
             [x70, x63, x50, x41, x78, x83],
             [x72, x71, x41, x27, x18, x83],
             [x81, x79, x78, x18, x11, x10],
-            [x86, x83, x83, x83, x10, 1.903],
+            [x86, x83, x83, x83, x10, S::splat(1.903)],
         ]
+    }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 6]],
+        out: &mut [[[::core::primitive::f64; 6]; 6]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
@@ -1311,7 +1366,14 @@ impl Srms {
         q: &[::core::primitive::f64; 6],
         qd: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1324,159 +1386,268 @@ impl Srms {
         let x8 = qd[1] * x5;
         let x9 = qd[1] * qd[1];
         let x10 = x5 * x6;
-        let x11 = Self::mul_add(
-            190.97044034,
+        let x11 = S::mul_add(
+            S::splat(190.97044034),
             x6,
-            Self::mul_add(qd[1], -1.928, x5 * 8596.210051042),
+            S::mul_add(qd[1], S::splat(-1.928), x5 * S::splat(8596.210051042)),
         );
-        let x12 = Self::mul_add(
+        let x12 = S::mul_add(
             x6,
-            -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x5 * 1.928),
+            S::splat(-0.0302),
+            S::mul_add(S::splat(8609.573807858), qd[1], x5 * S::splat(1.928)),
         );
-        let x13 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x5);
-        let x14 = Self::mul_add(x6, s_q2, x5 * c_q2);
-        let x15 = Self::mul_add(-x6, c_q2, x5 * s_q2);
-        let x16 = Self::mul_add(x10, -0.1524, 6.377 * Self::mul_add(x6, x6, x9));
-        let x17 = Self::mul_add(x7 + x7, 0.1524, 6.377 * (x8 + x8));
-        let x18 = Self::mul_add(Self::mul_add(x5, x5, x9), -0.1524, 6.377 * x10);
-        let x19 = Self::mul_add(-s_q2, x18, c_q2 * x16);
-        let x20 = Self::mul_add(c_q2, x18, s_q2 * x16);
-        let x21 = Self::mul_add(-qd[2], x15, Self::mul_add(-x8, s_q2, x7 * c_q2));
-        let x22 = Self::mul_add(qd[2], x14, Self::mul_add(x8, c_q2, x7 * s_q2));
+        let x13 = S::mul_add(qd[1], S::splat(0.0302), S::splat(190.97044034000004) * x5);
+        let x14 = S::mul_add(x6, s_q2, x5 * c_q2);
+        let x15 = S::mul_add(S::neg(x6), c_q2, x5 * s_q2);
+        let x16 = S::mul_add(
+            x10,
+            S::splat(-0.1524),
+            S::splat(6.377) * S::mul_add(x6, x6, x9),
+        );
+        let x17 = S::mul_add(x7 + x7, S::splat(0.1524), S::splat(6.377) * (x8 + x8));
+        let x18 = S::mul_add(
+            S::mul_add(x5, x5, x9),
+            S::splat(-0.1524),
+            S::splat(6.377) * x10,
+        );
+        let x19 = S::mul_add(S::neg(s_q2), x18, c_q2 * x16);
+        let x20 = S::mul_add(c_q2, x18, s_q2 * x16);
+        let x21 = S::mul_add(
+            S::neg(qd[2]),
+            x15,
+            S::mul_add(S::neg(x8), s_q2, x7 * c_q2),
+        );
+        let x22 = S::mul_add(qd[2], x14, S::mul_add(x8, c_q2, x7 * s_q2));
         let x23 = qd[1] + qd[2];
         let x24 = x23 * x23;
-        let x25 = Self::mul_add(x15, x15, x24);
+        let x25 = S::mul_add(x15, x15, x24);
         let x26 = x14 * x15;
-        let x27 = Self::mul_add(x14, x23, x22);
-        let x28 = Self::mul_add(-x15, x23, x21);
-        let x29 = Self::mul_add(x14, x14, x24);
-        let x30 = Self::mul_add(
-            -103.41030072000001,
+        let x27 = S::mul_add(x14, x23, x22);
+        let x28 = S::mul_add(S::neg(x15), x23, x21);
+        let x29 = S::mul_add(x14, x14, x24);
+        let x30 = S::mul_add(
+            S::splat(-103.41030072000001),
             x15,
-            Self::mul_add(0.8021, x23, x14 * 5594.523885531201),
+            S::mul_add(S::splat(0.8021), x23, x14 * S::splat(5594.523885531201)),
         );
-        let x31 = Self::mul_add(
-            -0.08,
+        let x31 = S::mul_add(
+            S::splat(-0.08),
             x15,
-            Self::mul_add(-5601.1318504688, x23, 0.8021 * x14),
+            S::mul_add(S::splat(-5601.1318504688), x23, S::splat(0.8021) * x14),
         );
-        let x32 = Self::mul_add(0.08, x23, 103.41030072000002 * x14);
-        let x33 = Self::mul_add(
-            703.3878000000001,
+        let x32 = S::mul_add(S::splat(0.08), x23, S::splat(103.41030072000002) * x14);
+        let x33 = S::mul_add(
+            S::splat(703.3878000000001),
             x17,
-            Self::mul_add(103.41030072000002, x21, Self::mul_add(-x14, x31, x23 * x30)),
+            S::mul_add(
+                S::splat(103.41030072000002),
+                x21,
+                S::mul_add(S::neg(x14), x31, x23 * x30),
+            ),
         );
-        let x34 = Self::mul_add(-x15, s_q3, x14 * c_q3);
-        let x35 = Self::mul_add(x15, c_q3, x14 * s_q3);
-        let x36 = x19 + Self::mul_add(0.1524, x26, 7.06 * x25);
-        let x37 = x17 + Self::mul_add(0.1524, x28, 7.06 * x27);
-        let x38 = x20 - Self::mul_add(0.1524, x29, 7.06 * x26);
-        let x39 = Self::mul_add(c_q3, x38, s_q3 * x36);
-        let x40 = Self::mul_add(-qd[3], x35, Self::mul_add(-x22, s_q3, x21 * c_q3));
-        let x41 = Self::mul_add(qd[3], x34, Self::mul_add(x22, c_q3, x21 * s_q3));
+        let x34 = S::mul_add(S::neg(x15), s_q3, x14 * c_q3);
+        let x35 = S::mul_add(x15, c_q3, x14 * s_q3);
+        let x36 = x19 + S::mul_add(S::splat(0.1524), x26, S::splat(7.06) * x25);
+        let x37 = x17 + S::mul_add(S::splat(0.1524), x28, S::splat(7.06) * x27);
+        let x38 = x20 - S::mul_add(S::splat(0.1524), x29, S::splat(7.06) * x26);
+        let x39 = S::mul_add(c_q3, x38, s_q3 * x36);
+        let x40 = S::mul_add(
+            S::neg(qd[3]),
+            x35,
+            S::mul_add(S::neg(x22), s_q3, x21 * c_q3),
+        );
+        let x41 = S::mul_add(qd[3], x34, S::mul_add(x22, c_q3, x21 * s_q3));
         let x42 = qd[3] + x23;
-        let x43 = Self::mul_add(x35, x35, x42 * x42);
+        let x43 = S::mul_add(x35, x35, x42 * x42);
         let x44 = x34 * x35;
-        let x45 = Self::mul_add(x34, x42, x41);
-        let x46 = x34 * 18.957952216000002;
-        let x47 = 19.863252216000003 * x42;
-        let x48 = Self::mul_add(-x42, s_q4, x34 * c_q4);
-        let x49 = Self::mul_add(x42, c_q4, x34 * s_q4);
-        let x50 = Self::mul_add(
-            -c_q4,
-            Self::mul_add(0.4572, x45, x37),
-            s_q4 * Self::mul_add(0.4572, x43, Self::mul_add(-s_q3, x38, c_q3 * x36)),
+        let x45 = S::mul_add(x34, x42, x41);
+        let x46 = x34 * S::splat(18.957952216000002);
+        let x47 = S::splat(19.863252216000003) * x42;
+        let x48 = S::mul_add(S::neg(x42), s_q4, x34 * c_q4);
+        let x49 = S::mul_add(x42, c_q4, x34 * s_q4);
+        let x50 = S::mul_add(
+            S::neg(c_q4),
+            S::mul_add(S::splat(0.4572), x45, x37),
+            s_q4
+                * S::mul_add(
+                    S::splat(0.4572),
+                    x43,
+                    S::mul_add(S::neg(s_q3), x38, c_q3 * x36),
+                ),
         );
-        let x51 = Self::mul_add(-qd[4], x49, x40 * c_q4);
-        let x52 = Self::mul_add(qd[4], x48, x40 * s_q4);
+        let x51 = S::mul_add(S::neg(qd[4]), x49, x40 * c_q4);
+        let x52 = S::mul_add(qd[4], x48, x40 * s_q4);
         let x53 = qd[4] - x35;
-        let x54 = 34.45002 * Self::mul_add(x53, x53, x49 * x49);
-        let x55 = 34.45002 * Self::mul_add(x48, x49, x41);
-        let x56 = 34.45002 * Self::mul_add(x48, x53, x52);
-        let x57 = 34.33891524 * x49;
-        let x58 = 34.74691524 * x53;
-        let x59 = Self::mul_add(x53, s_q5, x49 * c_q5);
-        let x60 = Self::mul_add(-x53, c_q5, x49 * s_q5);
-        let x61 = Self::mul_add(-qd[5], x60, Self::mul_add(-x41, s_q5, x52 * c_q5));
-        let x62 = Self::mul_add(qd[5], x59, Self::mul_add(x41, c_q5, x52 * s_q5));
-        let x63 = qd[5] - x48;
-        let x64 = Self::mul_add(-0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
-        let x65 = Self::mul_add(-0.353, x60, 0.385 * x63);
-        let x66 = Self::mul_add(
+        let x54 = S::splat(34.45002) * S::mul_add(x53, x53, x49 * x49);
+        let x55 = S::splat(34.45002) * S::mul_add(x48, x49, x41);
+        let x56 = S::splat(34.45002) * S::mul_add(x48, x53, x52);
+        let x57 = S::splat(34.33891524) * x49;
+        let x58 = S::splat(34.74691524) * x53;
+        let x59 = S::mul_add(x53, s_q5, x49 * c_q5);
+        let x60 = S::mul_add(S::neg(x53), c_q5, x49 * s_q5);
+        let x61 = S::mul_add(
+            S::neg(qd[5]),
             x60,
-            0.9929999999999999,
-            Self::mul_add(0.353, x59, 0.966 * x63),
+            S::mul_add(S::neg(x41), s_q5, x52 * c_q5),
         );
-        let x67 = Self::mul_add(0.966, x62, Self::mul_add(-0.385, x61, 1.903 * x51))
-            - Self::mul_add(x59, x66, x60 * x65);
-        let x68 = -x67;
-        let x69 = Self::mul_add(0.353, x62, 0.385 * x51)
-            + Self::mul_add(x63, x66, x60 * x64);
-        let x70 = Self::mul_add(
+        let x62 = S::mul_add(qd[5], x59, S::mul_add(x41, c_q5, x52 * s_q5));
+        let x63 = qd[5] - x48;
+        let x64 = S::mul_add(
+            S::splat(-0.966),
+            x60,
+            S::mul_add(S::splat(0.385), x59, S::splat(1.903) * x63),
+        );
+        let x65 = S::mul_add(S::splat(-0.353), x60, S::splat(0.385) * x63);
+        let x66 = S::mul_add(
+            x60,
+            S::splat(0.9929999999999999),
+            S::mul_add(S::splat(0.353), x59, S::splat(0.966) * x63),
+        );
+        let x67 = S::mul_add(
+            S::splat(0.966),
             x62,
-            -0.9929999999999999,
-            Self::mul_add(-0.353, x61, 0.966 * x51),
-        ) + Self::mul_add(-x63, x65, x59 * x64);
-        let x71 = Self::mul_add(-x49, x58, x53 * x57) + x67;
-        let x72 = Self::mul_add(
-            34.45002,
-            Self::mul_add(-0.4572, x44, x39),
-            Self::mul_add(x48, x58, 34.33891524 * x52),
-        ) - Self::mul_add(-s_q5, x70, c_q5 * x69);
-        let x73 = Self::mul_add(
-            -34.45002,
+            S::mul_add(S::splat(-0.385), x61, S::splat(1.903) * x51),
+        ) - S::mul_add(x59, x66, x60 * x65);
+        let x68 = S::neg(x67);
+        let x69 = S::mul_add(S::splat(0.353), x62, S::splat(0.385) * x51)
+            + S::mul_add(x63, x66, x60 * x64);
+        let x70 = S::mul_add(
+            x62,
+            S::splat(-0.9929999999999999),
+            S::mul_add(S::splat(-0.353), x61, S::splat(0.966) * x51),
+        ) + S::mul_add(S::neg(x63), x65, x59 * x64);
+        let x71 = S::mul_add(S::neg(x49), x58, x53 * x57) + x67;
+        let x72 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(S::splat(-0.4572), x44, x39),
+            S::mul_add(x48, x58, S::splat(34.33891524) * x52),
+        ) - S::mul_add(S::neg(s_q5), x70, c_q5 * x69);
+        let x73 = S::mul_add(
+            S::splat(-34.45002),
             x50,
-            Self::mul_add(x48, x57, 34.74691524 * x41),
-        ) + Self::mul_add(c_q5, x70, s_q5 * x69);
-        let x74 = -x73;
-        let x75 = Self::mul_add(c_q4, x55, s_q4 * x54);
-        let x76 = Self::mul_add(41.67378, x43, Self::mul_add(-s_q4, x55, c_q4 * x54));
-        let x77 = Self::mul_add(41.67378, x45, x75);
-        let x78 = Self::mul_add(41.67378, x44, -x56);
-        let x79 = Self::mul_add(x35, x47, x40 * 18.957952216000002)
-            - Self::mul_add(s_q4, x72, c_q4 * x71);
-        let x80 = Self::mul_add(-41.67378, x39, x35 * x46)
-            + Self::mul_add(-0.4572, x56, Self::mul_add(-c_q4, x72, s_q4 * x71));
-        let x81 = -x80;
-        let x82 = Self::mul_add(41.67378, x37, Self::mul_add(x34, x47, x42 * x46))
-            + Self::mul_add(0.4572, x75, x73);
-        let x83 = Self::mul_add(-s_q3, x78, c_q3 * x76);
-        let x84 = Self::mul_add(c_q3, x78, s_q3 * x76);
-        let x85 = Self::mul_add(x26, 15.183612000000002, 703.3878000000001 * x25) + x83;
-        let x86 = Self::mul_add(15.183612000000002, x28, 703.3878000000001 * x27) + x77;
-        let x87 = Self::mul_add(15.183612000000002, x29, 703.3878000000001 * x26) + x84;
-        let x88 = Self::mul_add(
-            x17,
-            -15.183612000000002,
-            Self::mul_add(-103.41030072000001, x22, x21 * 5594.523885531201)
-                - Self::mul_add(x23, x32, x15 * x31),
-        ) + Self::mul_add(-0.1524, x77, Self::mul_add(-s_q3, x82, c_q3 * x79));
-        let x89 = Self::mul_add(-0.08, x22, 0.8021 * x21)
-            + Self::mul_add(x14, x32, x15 * x30)
-            - Self::mul_add(703.3878000000001, x20, x19 * 15.183612000000002)
-            + (x80 - Self::mul_add(-7.06, x84, 0.1524 * x83));
-        let x90 = -x89;
-        let x91 = x33 + Self::mul_add(7.06, x77, Self::mul_add(c_q3, x82, s_q3 * x79));
-        let x92 = Self::mul_add(x8, 0.0302, x7 * 1.928)
-            + Self::mul_add(-x5, x13, x6 * x11)
-            - (x89
-                - Self::mul_add(
-                    -6.377,
-                    Self::mul_add(c_q2, x87, s_q2 * x85),
-                    0.1524 * Self::mul_add(-s_q2, x87, c_q2 * x85),
-                ));
-        let x93 = Self::mul_add(
-            c_q1,
-            Self::mul_add(190.97044034000004, x7, Self::mul_add(x5, x12, qd[1] * x11))
-                + Self::mul_add(6.377, x86, Self::mul_add(c_q2, x91, s_q2 * x88)),
-            s_q1
-                * (Self::mul_add(-190.97044034, x8, x7 * 8596.210051042)
-                    - Self::mul_add(qd[1], x13, x6 * x12)
-                    + Self::mul_add(-0.1524, x86, Self::mul_add(-s_q2, x91, c_q2 * x88))),
+            S::mul_add(x48, x57, S::splat(34.74691524) * x41),
+        ) + S::mul_add(c_q5, x70, s_q5 * x69);
+        let x74 = S::neg(x73);
+        let x75 = S::mul_add(c_q4, x55, s_q4 * x54);
+        let x76 = S::mul_add(
+            S::splat(41.67378),
+            x43,
+            S::mul_add(S::neg(s_q4), x55, c_q4 * x54),
         );
-        let x94 = -x93;
+        let x77 = S::mul_add(S::splat(41.67378), x45, x75);
+        let x78 = S::mul_add(S::splat(41.67378), x44, S::neg(x56));
+        let x79 = S::mul_add(x35, x47, x40 * S::splat(18.957952216000002))
+            - S::mul_add(s_q4, x72, c_q4 * x71);
+        let x80 = S::mul_add(S::splat(-41.67378), x39, x35 * x46)
+            + S::mul_add(
+                S::splat(-0.4572),
+                x56,
+                S::mul_add(S::neg(c_q4), x72, s_q4 * x71),
+            );
+        let x81 = S::neg(x80);
+        let x82 = S::mul_add(S::splat(41.67378), x37, S::mul_add(x34, x47, x42 * x46))
+            + S::mul_add(S::splat(0.4572), x75, x73);
+        let x83 = S::mul_add(S::neg(s_q3), x78, c_q3 * x76);
+        let x84 = S::mul_add(c_q3, x78, s_q3 * x76);
+        let x85 = S::mul_add(
+            x26,
+            S::splat(15.183612000000002),
+            S::splat(703.3878000000001) * x25,
+        ) + x83;
+        let x86 = S::mul_add(
+            S::splat(15.183612000000002),
+            x28,
+            S::splat(703.3878000000001) * x27,
+        ) + x77;
+        let x87 = S::mul_add(
+            S::splat(15.183612000000002),
+            x29,
+            S::splat(703.3878000000001) * x26,
+        ) + x84;
+        let x88 = S::mul_add(
+            x17,
+            S::splat(-15.183612000000002),
+            S::mul_add(
+                S::splat(-103.41030072000001),
+                x22,
+                x21 * S::splat(5594.523885531201),
+            ) - S::mul_add(x23, x32, x15 * x31),
+        )
+            + S::mul_add(
+                S::splat(-0.1524),
+                x77,
+                S::mul_add(S::neg(s_q3), x82, c_q3 * x79),
+            );
+        let x89 = S::mul_add(S::splat(-0.08), x22, S::splat(0.8021) * x21)
+            + S::mul_add(x14, x32, x15 * x30)
+            - S::mul_add(
+                S::splat(703.3878000000001),
+                x20,
+                x19 * S::splat(15.183612000000002),
+            ) + (x80 - S::mul_add(S::splat(-7.06), x84, S::splat(0.1524) * x83));
+        let x90 = S::neg(x89);
+        let x91 = x33
+            + S::mul_add(S::splat(7.06), x77, S::mul_add(c_q3, x82, s_q3 * x79));
+        let x92 = S::mul_add(x8, S::splat(0.0302), x7 * S::splat(1.928))
+            + S::mul_add(S::neg(x5), x13, x6 * x11)
+            - (x89
+                - S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(c_q2, x87, s_q2 * x85),
+                    S::splat(0.1524) * S::mul_add(S::neg(s_q2), x87, c_q2 * x85),
+                ));
+        let x93 = S::mul_add(
+            c_q1,
+            S::mul_add(
+                S::splat(190.97044034000004),
+                x7,
+                S::mul_add(x5, x12, qd[1] * x11),
+            ) + S::mul_add(S::splat(6.377), x86, S::mul_add(c_q2, x91, s_q2 * x88)),
+            s_q1
+                * (S::mul_add(S::splat(-190.97044034), x8, x7 * S::splat(8596.210051042))
+                    - S::mul_add(qd[1], x13, x6 * x12)
+                    + S::mul_add(
+                        S::splat(-0.1524),
+                        x86,
+                        S::mul_add(S::neg(s_q2), x91, c_q2 * x88),
+                    )),
+        );
+        let x94 = S::neg(x93);
         [x94, x92, x90, x81, x74, x68]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1487,7 +1658,14 @@ impl Srms {
         qd: &[::core::primitive::f64; 6],
         qdd: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::inverse_dynamics_lanes::<::core::primitive::f64>(q, qd, qdd)
+    }
+    /// [`Self::inverse_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], qdd: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1498,192 +1676,276 @@ impl Srms {
         let x6 = qd[0] * c_q1;
         let x7 = qd[1] * x6;
         let x8 = qd[1] * x5;
-        let x9 = Self::mul_add(qdd[0], s_q1, x7);
-        let x10 = Self::mul_add(qdd[0], c_q1, -x8);
+        let x9 = S::mul_add(qdd[0], s_q1, x7);
+        let x10 = S::mul_add(qdd[0], c_q1, S::neg(x8));
         let x11 = qd[1] * qd[1];
         let x12 = x5 * x6;
-        let x13 = Self::mul_add(
-            190.97044034,
+        let x13 = S::mul_add(
+            S::splat(190.97044034),
             x6,
-            Self::mul_add(qd[1], -1.928, x5 * 8596.210051042),
+            S::mul_add(qd[1], S::splat(-1.928), x5 * S::splat(8596.210051042)),
         );
-        let x14 = Self::mul_add(
+        let x14 = S::mul_add(
             x6,
-            -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x5 * 1.928),
+            S::splat(-0.0302),
+            S::mul_add(S::splat(8609.573807858), qd[1], x5 * S::splat(1.928)),
         );
-        let x15 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x5);
-        let x16 = Self::mul_add(x6, s_q2, x5 * c_q2);
-        let x17 = Self::mul_add(-x6, c_q2, x5 * s_q2);
-        let x18 = Self::mul_add(
+        let x15 = S::mul_add(qd[1], S::splat(0.0302), S::splat(190.97044034000004) * x5);
+        let x16 = S::mul_add(x6, s_q2, x5 * c_q2);
+        let x17 = S::mul_add(S::neg(x6), c_q2, x5 * s_q2);
+        let x18 = S::mul_add(
             qdd[1] - x12,
-            0.1524,
-            6.377 * Self::mul_add(x6, x6, x11),
+            S::splat(0.1524),
+            S::splat(6.377) * S::mul_add(x6, x6, x11),
         );
-        let x19 = Self::mul_add(x7 + x9, 0.1524, 6.377 * (x8 - x10));
-        let x20 = Self::mul_add(
-            Self::mul_add(x5, x5, x11),
-            -0.1524,
-            6.377 * (qdd[1] + x12),
+        let x19 = S::mul_add(x7 + x9, S::splat(0.1524), S::splat(6.377) * (x8 - x10));
+        let x20 = S::mul_add(
+            S::mul_add(x5, x5, x11),
+            S::splat(-0.1524),
+            S::splat(6.377) * (qdd[1] + x12),
         );
-        let x21 = Self::mul_add(-s_q2, x20, c_q2 * x18);
-        let x22 = Self::mul_add(c_q2, x20, s_q2 * x18);
-        let x23 = Self::mul_add(-qd[2], x17, Self::mul_add(x10, s_q2, x9 * c_q2));
-        let x24 = Self::mul_add(qd[2], x16, Self::mul_add(-x10, c_q2, x9 * s_q2));
+        let x21 = S::mul_add(S::neg(s_q2), x20, c_q2 * x18);
+        let x22 = S::mul_add(c_q2, x20, s_q2 * x18);
+        let x23 = S::mul_add(S::neg(qd[2]), x17, S::mul_add(x10, s_q2, x9 * c_q2));
+        let x24 = S::mul_add(qd[2], x16, S::mul_add(S::neg(x10), c_q2, x9 * s_q2));
         let x25 = qdd[1] + qdd[2];
         let x26 = qd[1] + qd[2];
         let x27 = x26 * x26;
-        let x28 = Self::mul_add(x17, x17, x27);
+        let x28 = S::mul_add(x17, x17, x27);
         let x29 = x16 * x17;
         let x30 = x25 + x29;
-        let x31 = Self::mul_add(x16, x26, x24);
-        let x32 = Self::mul_add(-x17, x26, x23);
+        let x31 = S::mul_add(x16, x26, x24);
+        let x32 = S::mul_add(S::neg(x17), x26, x23);
         let x33 = x25 - x29;
-        let x34 = Self::mul_add(x16, x16, x27);
-        let x35 = Self::mul_add(
-            -103.41030072000001,
+        let x34 = S::mul_add(x16, x16, x27);
+        let x35 = S::mul_add(
+            S::splat(-103.41030072000001),
             x17,
-            Self::mul_add(0.8021, x26, x16 * 5594.523885531201),
+            S::mul_add(S::splat(0.8021), x26, x16 * S::splat(5594.523885531201)),
         );
-        let x36 = Self::mul_add(
-            -0.08,
+        let x36 = S::mul_add(
+            S::splat(-0.08),
             x17,
-            Self::mul_add(-5601.1318504688, x26, 0.8021 * x16),
+            S::mul_add(S::splat(-5601.1318504688), x26, S::splat(0.8021) * x16),
         );
-        let x37 = Self::mul_add(0.08, x26, 103.41030072000002 * x16);
-        let x38 = Self::mul_add(
+        let x37 = S::mul_add(S::splat(0.08), x26, S::splat(103.41030072000002) * x16);
+        let x38 = S::mul_add(
             x19,
-            -15.183612000000002,
-            Self::mul_add(
-                -103.41030072000001,
+            S::splat(-15.183612000000002),
+            S::mul_add(
+                S::splat(-103.41030072000001),
                 x24,
-                Self::mul_add(0.8021, x25, x23 * 5594.523885531201),
-            ) - Self::mul_add(x26, x37, x17 * x36),
+                S::mul_add(S::splat(0.8021), x25, x23 * S::splat(5594.523885531201)),
+            ) - S::mul_add(x26, x37, x17 * x36),
         );
-        let x39 = Self::mul_add(-x17, s_q3, x16 * c_q3);
-        let x40 = Self::mul_add(x17, c_q3, x16 * s_q3);
-        let x41 = x21 + Self::mul_add(0.1524, x30, 7.06 * x28);
-        let x42 = x19 + Self::mul_add(0.1524, x32, 7.06 * x31);
-        let x43 = x22 + Self::mul_add(-0.1524, x34, 7.06 * x33);
-        let x44 = Self::mul_add(c_q3, x43, s_q3 * x41);
-        let x45 = Self::mul_add(-qd[3], x40, Self::mul_add(-x24, s_q3, x23 * c_q3));
-        let x46 = Self::mul_add(qd[3], x39, Self::mul_add(x24, c_q3, x23 * s_q3));
+        let x39 = S::mul_add(S::neg(x17), s_q3, x16 * c_q3);
+        let x40 = S::mul_add(x17, c_q3, x16 * s_q3);
+        let x41 = x21 + S::mul_add(S::splat(0.1524), x30, S::splat(7.06) * x28);
+        let x42 = x19 + S::mul_add(S::splat(0.1524), x32, S::splat(7.06) * x31);
+        let x43 = x22 + S::mul_add(S::splat(-0.1524), x34, S::splat(7.06) * x33);
+        let x44 = S::mul_add(c_q3, x43, s_q3 * x41);
+        let x45 = S::mul_add(
+            S::neg(qd[3]),
+            x40,
+            S::mul_add(S::neg(x24), s_q3, x23 * c_q3),
+        );
+        let x46 = S::mul_add(qd[3], x39, S::mul_add(x24, c_q3, x23 * s_q3));
         let x47 = qdd[3] + x25;
         let x48 = qd[3] + x26;
-        let x49 = Self::mul_add(x40, x40, x48 * x48);
-        let x50 = Self::mul_add(x39, x48, x46);
-        let x51 = Self::mul_add(-x39, x40, x47);
-        let x52 = x39 * 18.957952216000002;
-        let x53 = 19.863252216000003 * x48;
-        let x54 = Self::mul_add(-x48, s_q4, x39 * c_q4);
-        let x55 = Self::mul_add(x48, c_q4, x39 * s_q4);
-        let x56 = Self::mul_add(
-            -c_q4,
-            Self::mul_add(0.4572, x50, x42),
-            s_q4 * Self::mul_add(0.4572, x49, Self::mul_add(-s_q3, x43, c_q3 * x41)),
+        let x49 = S::mul_add(x40, x40, x48 * x48);
+        let x50 = S::mul_add(x39, x48, x46);
+        let x51 = S::mul_add(S::neg(x39), x40, x47);
+        let x52 = x39 * S::splat(18.957952216000002);
+        let x53 = S::splat(19.863252216000003) * x48;
+        let x54 = S::mul_add(S::neg(x48), s_q4, x39 * c_q4);
+        let x55 = S::mul_add(x48, c_q4, x39 * s_q4);
+        let x56 = S::mul_add(
+            S::neg(c_q4),
+            S::mul_add(S::splat(0.4572), x50, x42),
+            s_q4
+                * S::mul_add(
+                    S::splat(0.4572),
+                    x49,
+                    S::mul_add(S::neg(s_q3), x43, c_q3 * x41),
+                ),
         );
-        let x57 = Self::mul_add(qd[4], x54, Self::mul_add(x47, c_q4, x45 * s_q4));
+        let x57 = S::mul_add(qd[4], x54, S::mul_add(x47, c_q4, x45 * s_q4));
         let x58 = qdd[4] - x46;
         let x59 = qd[4] - x40;
-        let x60 = 34.45002 * Self::mul_add(x59, x59, x55 * x55);
-        let x61 = 34.45002 * Self::mul_add(-x54, x55, x58);
-        let x62 = 34.45002 * Self::mul_add(x54, x59, x57);
-        let x63 = 34.33891524 * x55;
-        let x64 = 34.74691524 * x59;
-        let x65 = Self::mul_add(x59, s_q5, x55 * c_q5);
-        let x66 = Self::mul_add(-x59, c_q5, x55 * s_q5);
-        let x67 = Self::mul_add(-qd[5], x66, Self::mul_add(x58, s_q5, x57 * c_q5));
-        let x68 = Self::mul_add(qd[5], x65, Self::mul_add(-x58, c_q5, x57 * s_q5));
+        let x60 = S::splat(34.45002) * S::mul_add(x59, x59, x55 * x55);
+        let x61 = S::splat(34.45002) * S::mul_add(S::neg(x54), x55, x58);
+        let x62 = S::splat(34.45002) * S::mul_add(x54, x59, x57);
+        let x63 = S::splat(34.33891524) * x55;
+        let x64 = S::splat(34.74691524) * x59;
+        let x65 = S::mul_add(x59, s_q5, x55 * c_q5);
+        let x66 = S::mul_add(S::neg(x59), c_q5, x55 * s_q5);
+        let x67 = S::mul_add(S::neg(qd[5]), x66, S::mul_add(x58, s_q5, x57 * c_q5));
+        let x68 = S::mul_add(qd[5], x65, S::mul_add(S::neg(x58), c_q5, x57 * s_q5));
         let x69 = qdd[5]
-            - Self::mul_add(-qd[4], x55, Self::mul_add(-x47, s_q4, x45 * c_q4));
+            - S::mul_add(S::neg(qd[4]), x55, S::mul_add(S::neg(x47), s_q4, x45 * c_q4));
         let x70 = qd[5] - x54;
-        let x71 = Self::mul_add(-0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
-        let x72 = Self::mul_add(-0.353, x66, 0.385 * x70);
-        let x73 = Self::mul_add(
+        let x71 = S::mul_add(
+            S::splat(-0.966),
             x66,
-            0.9929999999999999,
-            Self::mul_add(0.353, x65, 0.966 * x70),
+            S::mul_add(S::splat(0.385), x65, S::splat(1.903) * x70),
         );
-        let x74 = Self::mul_add(-0.966, x68, Self::mul_add(0.385, x67, 1.903 * x69))
-            + Self::mul_add(x65, x73, x66 * x72);
-        let x75 = Self::mul_add(-0.353, x68, 0.385 * x69)
-            - Self::mul_add(x70, x73, x66 * x71);
-        let x76 = Self::mul_add(
+        let x72 = S::mul_add(S::splat(-0.353), x66, S::splat(0.385) * x70);
+        let x73 = S::mul_add(
+            x66,
+            S::splat(0.9929999999999999),
+            S::mul_add(S::splat(0.353), x65, S::splat(0.966) * x70),
+        );
+        let x74 = S::mul_add(
+            S::splat(-0.966),
             x68,
-            0.9929999999999999,
-            Self::mul_add(0.353, x67, 0.966 * x69),
-        ) - Self::mul_add(-x70, x72, x65 * x71);
-        let x77 = Self::mul_add(-x55, x64, x59 * x63) - x74;
-        let x78 = Self::mul_add(
-            34.45002,
-            Self::mul_add(0.4572, x51, x44),
-            Self::mul_add(x54, x64, 34.33891524 * x57),
-        ) + Self::mul_add(-s_q5, x76, c_q5 * x75);
-        let x79 = Self::mul_add(
-            34.45002,
+            S::mul_add(S::splat(0.385), x67, S::splat(1.903) * x69),
+        ) + S::mul_add(x65, x73, x66 * x72);
+        let x75 = S::mul_add(S::splat(-0.353), x68, S::splat(0.385) * x69)
+            - S::mul_add(x70, x73, x66 * x71);
+        let x76 = S::mul_add(
+            x68,
+            S::splat(0.9929999999999999),
+            S::mul_add(S::splat(0.353), x67, S::splat(0.966) * x69),
+        ) - S::mul_add(S::neg(x70), x72, x65 * x71);
+        let x77 = S::mul_add(S::neg(x55), x64, x59 * x63) - x74;
+        let x78 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(S::splat(0.4572), x51, x44),
+            S::mul_add(x54, x64, S::splat(34.33891524) * x57),
+        ) + S::mul_add(S::neg(s_q5), x76, c_q5 * x75);
+        let x79 = S::mul_add(
+            S::splat(34.45002),
             x56,
-            Self::mul_add(-x54, x63, 34.74691524 * x58),
-        ) + Self::mul_add(c_q5, x76, s_q5 * x75);
-        let x80 = Self::mul_add(-c_q4, x61, s_q4 * x60);
-        let x81 = Self::mul_add(41.67378, x49, Self::mul_add(s_q4, x61, c_q4 * x60));
-        let x82 = Self::mul_add(41.67378, x50, x80);
-        let x83 = Self::mul_add(41.67378, x51, x62);
-        let x84 = Self::mul_add(x40, x53, x45 * 18.957952216000002)
-            - Self::mul_add(s_q4, x78, c_q4 * x77);
-        let x85 = Self::mul_add(
-            41.67378,
+            S::mul_add(S::neg(x54), x63, S::splat(34.74691524) * x58),
+        ) + S::mul_add(c_q5, x76, s_q5 * x75);
+        let x80 = S::mul_add(S::neg(c_q4), x61, s_q4 * x60);
+        let x81 = S::mul_add(S::splat(41.67378), x49, S::mul_add(s_q4, x61, c_q4 * x60));
+        let x82 = S::mul_add(S::splat(41.67378), x50, x80);
+        let x83 = S::mul_add(S::splat(41.67378), x51, x62);
+        let x84 = S::mul_add(x40, x53, x45 * S::splat(18.957952216000002))
+            - S::mul_add(s_q4, x78, c_q4 * x77);
+        let x85 = S::mul_add(
+            S::splat(41.67378),
             x44,
-            Self::mul_add(-x40, x52, 19.863252216000003 * x47),
-        ) - Self::mul_add(-0.4572, x62, Self::mul_add(-c_q4, x78, s_q4 * x77));
-        let x86 = Self::mul_add(41.67378, x42, Self::mul_add(x39, x53, x48 * x52))
-            - Self::mul_add(-0.4572, x80, x79);
-        let x87 = Self::mul_add(s_q3, x83, c_q3 * x81);
-        let x88 = Self::mul_add(-c_q3, x83, s_q3 * x81);
-        let x89 = Self::mul_add(x30, 15.183612000000002, 703.3878000000001 * x28) + x87;
-        let x90 = Self::mul_add(15.183612000000002, x32, 703.3878000000001 * x31) + x82;
-        let x91 = Self::mul_add(-15.183612000000002, x34, 703.3878000000001 * x33) - x88;
+            S::mul_add(S::neg(x40), x52, S::splat(19.863252216000003) * x47),
+        )
+            - S::mul_add(
+                S::splat(-0.4572),
+                x62,
+                S::mul_add(S::neg(c_q4), x78, s_q4 * x77),
+            );
+        let x86 = S::mul_add(S::splat(41.67378), x42, S::mul_add(x39, x53, x48 * x52))
+            - S::mul_add(S::splat(-0.4572), x80, x79);
+        let x87 = S::mul_add(s_q3, x83, c_q3 * x81);
+        let x88 = S::mul_add(S::neg(c_q3), x83, s_q3 * x81);
+        let x89 = S::mul_add(
+            x30,
+            S::splat(15.183612000000002),
+            S::splat(703.3878000000001) * x28,
+        ) + x87;
+        let x90 = S::mul_add(
+            S::splat(15.183612000000002),
+            x32,
+            S::splat(703.3878000000001) * x31,
+        ) + x82;
+        let x91 = S::mul_add(
+            S::splat(-15.183612000000002),
+            x34,
+            S::splat(703.3878000000001) * x33,
+        ) - x88;
         let x92 = x38
-            + Self::mul_add(-0.1524, x82, Self::mul_add(-s_q3, x86, c_q3 * x84));
-        let x93 = Self::mul_add(
-            -0.08,
+            + S::mul_add(
+                S::splat(-0.1524),
+                x82,
+                S::mul_add(S::neg(s_q3), x86, c_q3 * x84),
+            );
+        let x93 = S::mul_add(
+            S::splat(-0.08),
             x24,
-            Self::mul_add(-5601.1318504688, x25, 0.8021 * x23),
-        ) + Self::mul_add(x16, x37, x17 * x35)
-            - Self::mul_add(703.3878000000001, x22, x21 * 15.183612000000002)
-            - (x85 + Self::mul_add(-7.06, x88, 0.1524 * x87));
-        let x94 = -x93;
-        let x95 = Self::mul_add(
-            703.3878000000001,
+            S::mul_add(S::splat(-5601.1318504688), x25, S::splat(0.8021) * x23),
+        ) + S::mul_add(x16, x37, x17 * x35)
+            - S::mul_add(
+                S::splat(703.3878000000001),
+                x22,
+                x21 * S::splat(15.183612000000002),
+            ) - (x85 + S::mul_add(S::splat(-7.06), x88, S::splat(0.1524) * x87));
+        let x94 = S::neg(x93);
+        let x95 = S::mul_add(
+            S::splat(703.3878000000001),
             x19,
-            Self::mul_add(0.08, x25, 103.41030072000002 * x23)
-                + Self::mul_add(-x16, x36, x26 * x35),
-        ) + Self::mul_add(7.06, x82, Self::mul_add(c_q3, x86, s_q3 * x84));
-        let x96 = Self::mul_add(
+            S::mul_add(S::splat(0.08), x25, S::splat(103.41030072000002) * x23)
+                + S::mul_add(S::neg(x16), x36, x26 * x35),
+        ) + S::mul_add(S::splat(7.06), x82, S::mul_add(c_q3, x86, s_q3 * x84));
+        let x96 = S::mul_add(
             x10,
-            -0.0302,
-            Self::mul_add(8609.573807858, qdd[1], x9 * 1.928),
-        ) + Self::mul_add(-x5, x15, x6 * x13)
+            S::splat(-0.0302),
+            S::mul_add(S::splat(8609.573807858), qdd[1], x9 * S::splat(1.928)),
+        ) + S::mul_add(S::neg(x5), x15, x6 * x13)
             - (x93
-                - Self::mul_add(
-                    -6.377,
-                    Self::mul_add(-c_q2, x91, s_q2 * x89),
-                    0.1524 * Self::mul_add(s_q2, x91, c_q2 * x89),
+                - S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(S::neg(c_q2), x91, s_q2 * x89),
+                    S::splat(0.1524) * S::mul_add(s_q2, x91, c_q2 * x89),
                 ));
-        let x97 = Self::mul_add(
+        let x97 = S::mul_add(
             c_q1,
-            Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x9)
-                + Self::mul_add(x5, x14, qd[1] * x13)
-                + Self::mul_add(6.377, x90, Self::mul_add(c_q2, x95, s_q2 * x92)),
+            S::mul_add(qdd[1], S::splat(0.0302), S::splat(190.97044034000004) * x9)
+                + S::mul_add(x5, x14, qd[1] * x13)
+                + S::mul_add(S::splat(6.377), x90, S::mul_add(c_q2, x95, s_q2 * x92)),
             s_q1
-                * (Self::mul_add(
-                    190.97044034,
+                * (S::mul_add(
+                    S::splat(190.97044034),
                     x10,
-                    Self::mul_add(qdd[1], -1.928, x9 * 8596.210051042),
-                ) - Self::mul_add(qd[1], x15, x6 * x14)
-                    + Self::mul_add(-0.1524, x90, Self::mul_add(-s_q2, x95, c_q2 * x92))),
+                    S::mul_add(qdd[1], S::splat(-1.928), x9 * S::splat(8596.210051042)),
+                ) - S::mul_add(qd[1], x15, x6 * x14)
+                    + S::mul_add(
+                        S::splat(-0.1524),
+                        x90,
+                        S::mul_add(S::neg(s_q2), x95, c_q2 * x92),
+                    )),
         );
-        let x98 = Self::mul_add(14222.257549666001, qdd[0], -x97);
+        let x98 = S::mul_add(S::splat(14222.257549666001), qdd[0], S::neg(x97));
         [x98, x96, x94, x85, x79, x74]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        qdd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -1694,7 +1956,14 @@ impl Srms {
         qd: &[::core::primitive::f64; 6],
         tau: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::forward_dynamics_lanes::<::core::primitive::f64>(q, qd, tau)
+    }
+    /// [`Self::forward_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], tau: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1703,104 +1972,121 @@ impl Srms {
         ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
-        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
-        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
-        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x7 = S::mul_add(x6, S::splat(0.706), x5 * S::splat(0.9929999999999999));
+        let x8 = S::splat(0.353)
+            + S::mul_add(x5, S::splat(-0.706), x6 * S::splat(0.9929999999999999));
+        let x9 = S::mul_add(S::splat(-0.966), s_q5, S::splat(0.385) * c_q5);
+        let x10 = S::mul_add(S::splat(0.966), c_q5, S::splat(0.385) * s_q5);
+        let x11 = S::splat(34.74691524) + (S::splat(-0.9929999999999999) + x7);
         let x12 = s_q4 * s_q4;
         let x13 = s_q4 * c_q4;
-        let x14 = x7 + -32.43591524;
+        let x14 = x7 + S::splat(-32.43591524);
         let x15 = x9 + x9;
-        let x16 = Self::mul_add(x13, x15, x12 * x14);
-        let x17 = -32.43591524 - x16;
-        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
-        let x20 = s_q4 * 34.45002;
-        let x21 = c_q4 * 34.45002;
-        let x22 = 0.4572 * x21;
+        let x16 = S::mul_add(x13, x15, x12 * x14);
+        let x17 = S::splat(-32.43591524) - x16;
+        let x18 = S::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = S::mul_add(S::neg(c_q4), x10, s_q4 * x8);
+        let x20 = s_q4 * S::splat(34.45002);
+        let x21 = c_q4 * S::splat(34.45002);
+        let x22 = S::splat(0.4572) * x21;
         let x23 = x11 + x22;
-        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
-        let x25 = 41.67378 + x21;
-        let x26 = -15.380963024 + (x22 + x23);
-        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x24 = S::mul_add(
+            S::splat(-0.4572),
+            x20,
+            x9 + S::mul_add(S::neg(x12), x15, x13 * x14),
+        );
+        let x25 = S::splat(41.67378) + x21;
+        let x26 = S::splat(-15.380963024) + (x22 + x23);
+        let x27 = S::splat(54.202167456) + (x22 - (x7 - x16 - x22));
         let x28 = s_q3 * s_q3;
         let x29 = s_q3 * c_q3;
         let x30 = x17 - x26;
         let x31 = x19 + x19;
-        let x32 = Self::mul_add(x29, x31, x28 * x30);
-        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
-        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x32 = S::mul_add(x29, x31, x28 * x30);
+        let x33 = S::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = S::mul_add(S::neg(c_q3), x18, s_q3 * x24);
         let x35 = c_q3 * x25;
         let x36 = s_q3 * x25;
-        let x37 = 0.1524 * x36;
-        let x38 = 7.06 * x35;
-        let x39 = 0.1524 * x20;
+        let x37 = S::splat(0.1524) * x36;
+        let x38 = S::splat(7.06) * x35;
+        let x39 = S::splat(0.1524) * x20;
         let x40 = x37 + x38;
         let x41 = x27 + x40;
         let x42 = x37 + (x17 - x32 + x37);
-        let x43 = Self::mul_add(
-            7.06,
+        let x43 = S::mul_add(
+            S::splat(7.06),
             x36,
-            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x35,
+                    x19 + S::mul_add(S::neg(x28), x31, x29 * x30),
+                ),
+            ),
         );
-        let x44 = 703.3878000000001 + x35;
-        let x45 = 15.183612000000002 + x36;
-        let x46 = -103.41030072000001 - x43;
-        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
-        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
-        let x49 = 0.08 + (x34 - x39);
-        let x50 = 5601.1318504688 + (x40 + x41);
+        let x44 = S::splat(703.3878000000001) + x35;
+        let x45 = S::splat(15.183612000000002) + x36;
+        let x46 = S::splat(-103.41030072000001) - x43;
+        let x47 = S::splat(0.8021) + S::mul_add(S::splat(-7.06), x20, x33);
+        let x48 = S::splat(5594.523885531201) + (x38 + (x26 + x32 + x38));
+        let x49 = S::splat(0.08) + (x34 - x39);
+        let x50 = S::splat(5601.1318504688) + (x40 + x41);
         let x51 = s_q2 * s_q2;
         let x52 = s_q2 * c_q2;
         let x53 = x42 - x48;
         let x54 = x46 + x46;
-        let x55 = Self::mul_add(x52, x54, x51 * x53);
-        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
-        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
-        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
-        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
-        let x60 = 0.1524 * x59;
-        let x61 = 6.377 * x58;
+        let x55 = S::mul_add(x52, x54, x51 * x53);
+        let x56 = S::mul_add(S::neg(s_q2), x49, c_q2 * x47);
+        let x57 = S::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = S::mul_add(S::neg(s_q2), x45, c_q2 * x44);
+        let x59 = S::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = S::splat(0.1524) * x59;
+        let x61 = S::splat(6.377) * x58;
         let x62 = x60 + x61;
         let x63 = x50 + x62;
-        let x64 = Self::mul_add(
-            6.377,
+        let x64 = S::mul_add(
+            S::splat(6.377),
             x59,
-            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x58,
+                    x46 + S::mul_add(S::neg(x51), x54, x52 * x53),
+                ),
+            ),
         );
-        let x65 = -190.97044034 - x64;
-        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
-        let x67 = Self::mul_add(
+        let x65 = S::splat(-190.97044034) - x64;
+        let x66 = S::splat(8596.210051042) + (x61 + (x48 + x55 + x61));
+        let x67 = S::mul_add(
             c_q1,
-            0.0302 - (x39 - x57),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
+            S::splat(0.0302) - (x39 - x57),
+            s_q1 * (S::splat(-1.928) + S::mul_add(S::splat(-6.377), x20, x56)),
         );
-        let x68 = Self::mul_add(c_q1, x57, s_q1 * x56);
-        let x69 = Self::mul_add(
+        let x68 = S::mul_add(c_q1, x57, s_q1 * x56);
+        let x69 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x34, s_q2 * x33),
-            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
+            S::mul_add(c_q2, x34, s_q2 * x33),
+            s_q1 * S::mul_add(S::neg(s_q2), x34, c_q2 * x33),
         );
         let x70 = c_q3 * x20;
         let x71 = s_q3 * x20;
-        let x72 = 0.1524 * x21;
-        let x73 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x72;
-        let x74 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
-        let x75 = x18 + Self::mul_add(-7.06, x71, 0.1524 * x70);
-        let x76 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x74, s_q2 * x73)),
-            s_q1 * (x72 - Self::mul_add(-s_q2, x74, c_q2 * x73)),
+        let x72 = S::splat(0.1524) * x21;
+        let x73 = S::mul_add(S::neg(s_q3), x23, c_q3 * x19) - x72;
+        let x74 = S::mul_add(S::splat(7.06), x21, S::mul_add(c_q3, x23, s_q3 * x19));
+        let x75 = x18 + S::mul_add(S::splat(-7.06), x71, S::splat(0.1524) * x70);
+        let x76 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(6.377), x21, S::mul_add(c_q2, x74, s_q2 * x73)),
+            s_q1 * (x72 - S::mul_add(S::neg(s_q2), x74, c_q2 * x73)),
         );
-        let x77 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
-        let x78 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x79 = Self::mul_add(-s_q3, x10, c_q3 * x77);
-        let x80 = Self::mul_add(c_q3, x10, s_q3 * x77);
-        let x81 = Self::mul_add(
+        let x77 = S::mul_add(S::splat(-1.903), c_q4, s_q4 * x9);
+        let x78 = S::mul_add(S::splat(1.903), s_q4, c_q4 * x9);
+        let x79 = S::mul_add(S::neg(s_q3), x10, c_q3 * x77);
+        let x80 = S::mul_add(c_q3, x10, s_q3 * x77);
+        let x81 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x80, s_q2 * x79),
-            s_q1 * Self::mul_add(-s_q2, x80, c_q2 * x79),
+            S::mul_add(c_q2, x80, s_q2 * x79),
+            s_q1 * S::mul_add(S::neg(s_q2), x80, c_q2 * x79),
         );
         let x82 = qd[0] * s_q1;
         let x83 = qd[0] * c_q1;
@@ -1808,165 +2094,241 @@ impl Srms {
         let x85 = qd[1] * x82;
         let x86 = qd[1] * qd[1];
         let x87 = x82 * x83;
-        let x88 = Self::mul_add(qd[1], -1.928, x83 * 190.97044034);
-        let x89 = Self::mul_add(
-            0.0302,
+        let x88 = S::mul_add(qd[1], S::splat(-1.928), x83 * S::splat(190.97044034));
+        let x89 = S::mul_add(
+            S::splat(0.0302),
             qd[1],
-            Self::mul_add(-8596.210051042, x83, x82 * 190.97044034000004),
+            S::mul_add(
+                S::splat(-8596.210051042),
+                x83,
+                x82 * S::splat(190.97044034000004),
+            ),
         );
-        let x90 = Self::mul_add(
-            8609.573807858,
+        let x90 = S::mul_add(
+            S::splat(8609.573807858),
             qd[1],
-            Self::mul_add(-0.0302, x83, x82 * 1.928),
+            S::mul_add(S::splat(-0.0302), x83, x82 * S::splat(1.928)),
         );
-        let x91 = Self::mul_add(s_q2, x83, c_q2 * x82);
-        let x92 = Self::mul_add(-c_q2, x83, s_q2 * x82);
-        let x93 = Self::mul_add(-0.1524, x87, 6.377 * Self::mul_add(x83, x83, x86));
-        let x94 = Self::mul_add(-0.1524, Self::mul_add(x82, x82, x86), 6.377 * x87);
-        let x95 = Self::mul_add(0.1524, x84 + x84, 6.377 * (x85 + x85));
-        let x96 = Self::mul_add(-s_q2, x94, c_q2 * x93);
-        let x97 = Self::mul_add(c_q2, x94, s_q2 * x93);
-        let x98 = Self::mul_add(-qd[2], x92, Self::mul_add(-s_q2, x85, c_q2 * x84));
-        let x99 = Self::mul_add(qd[2], x91, Self::mul_add(c_q2, x85, s_q2 * x84));
+        let x91 = S::mul_add(s_q2, x83, c_q2 * x82);
+        let x92 = S::mul_add(S::neg(c_q2), x83, s_q2 * x82);
+        let x93 = S::mul_add(
+            S::splat(-0.1524),
+            x87,
+            S::splat(6.377) * S::mul_add(x83, x83, x86),
+        );
+        let x94 = S::mul_add(
+            S::splat(-0.1524),
+            S::mul_add(x82, x82, x86),
+            S::splat(6.377) * x87,
+        );
+        let x95 = S::mul_add(S::splat(0.1524), x84 + x84, S::splat(6.377) * (x85 + x85));
+        let x96 = S::mul_add(S::neg(s_q2), x94, c_q2 * x93);
+        let x97 = S::mul_add(c_q2, x94, s_q2 * x93);
+        let x98 = S::mul_add(
+            S::neg(qd[2]),
+            x92,
+            S::mul_add(S::neg(s_q2), x85, c_q2 * x84),
+        );
+        let x99 = S::mul_add(qd[2], x91, S::mul_add(c_q2, x85, s_q2 * x84));
         let x100 = qd[1] + qd[2];
         let x101 = x100 * x100;
-        let x102 = Self::mul_add(x92, x92, x101);
+        let x102 = S::mul_add(x92, x92, x101);
         let x103 = x91 * x92;
-        let x104 = Self::mul_add(x91, x91, x101);
-        let x105 = Self::mul_add(x91, x100, x99);
-        let x106 = Self::mul_add(-x92, x100, x98);
-        let x107 = Self::mul_add(-0.8021, x100, x92 * 103.41030072000001);
-        let x108 = Self::mul_add(
-            0.08,
+        let x104 = S::mul_add(x91, x91, x101);
+        let x105 = S::mul_add(x91, x100, x99);
+        let x106 = S::mul_add(S::neg(x92), x100, x98);
+        let x107 = S::mul_add(
+            S::splat(-0.8021),
             x100,
-            Self::mul_add(5594.523885531201, x92, x91 * 103.41030072000002),
+            x92 * S::splat(103.41030072000001),
         );
-        let x109 = Self::mul_add(
-            -5601.1318504688,
+        let x108 = S::mul_add(
+            S::splat(0.08),
             x100,
-            Self::mul_add(-0.08, x92, 0.8021 * x91),
+            S::mul_add(
+                S::splat(5594.523885531201),
+                x92,
+                x91 * S::splat(103.41030072000002),
+            ),
         );
-        let x110 = Self::mul_add(
-            15.183612000000002,
+        let x109 = S::mul_add(
+            S::splat(-5601.1318504688),
+            x100,
+            S::mul_add(S::splat(-0.08), x92, S::splat(0.8021) * x91),
+        );
+        let x110 = S::mul_add(
+            S::splat(15.183612000000002),
             x95,
-            Self::mul_add(x99, 103.41030072000001, Self::mul_add(x92, x109, x100 * x108)),
+            S::mul_add(
+                x99,
+                S::splat(103.41030072000001),
+                S::mul_add(x92, x109, x100 * x108),
+            ),
         );
-        let x111 = Self::mul_add(-s_q3, x92, c_q3 * x91);
-        let x112 = Self::mul_add(c_q3, x92, s_q3 * x91);
-        let x113 = x96 + Self::mul_add(0.1524, x103, 7.06 * x102);
-        let x114 = x97 - Self::mul_add(0.1524, x104, 7.06 * x103);
-        let x115 = x95 + Self::mul_add(0.1524, x106, 7.06 * x105);
-        let x116 = Self::mul_add(c_q3, x114, s_q3 * x113);
-        let x117 = Self::mul_add(-qd[3], x112, Self::mul_add(-s_q3, x99, c_q3 * x98));
-        let x118 = Self::mul_add(qd[3], x111, Self::mul_add(c_q3, x99, s_q3 * x98));
+        let x111 = S::mul_add(S::neg(s_q3), x92, c_q3 * x91);
+        let x112 = S::mul_add(c_q3, x92, s_q3 * x91);
+        let x113 = x96 + S::mul_add(S::splat(0.1524), x103, S::splat(7.06) * x102);
+        let x114 = x97 - S::mul_add(S::splat(0.1524), x104, S::splat(7.06) * x103);
+        let x115 = x95 + S::mul_add(S::splat(0.1524), x106, S::splat(7.06) * x105);
+        let x116 = S::mul_add(c_q3, x114, s_q3 * x113);
+        let x117 = S::mul_add(
+            S::neg(qd[3]),
+            x112,
+            S::mul_add(S::neg(s_q3), x99, c_q3 * x98),
+        );
+        let x118 = S::mul_add(qd[3], x111, S::mul_add(c_q3, x99, s_q3 * x98));
         let x119 = qd[3] + x100;
-        let x120 = Self::mul_add(x119, x119, x112 * x112);
+        let x120 = S::mul_add(x119, x119, x112 * x112);
         let x121 = x111 * x112;
-        let x122 = Self::mul_add(x111, x119, x118);
-        let x123 = x112 * 15.380963024;
-        let x124 = 54.202167456 * x119;
-        let x125 = Self::mul_add(c_q4, x119, s_q4 * x111);
-        let x126 = Self::mul_add(-s_q4, x119, c_q4 * x111);
-        let x127 = Self::mul_add(
-            -c_q4,
-            Self::mul_add(0.4572, x122, x115),
-            s_q4 * Self::mul_add(0.4572, x120, Self::mul_add(-s_q3, x114, c_q3 * x113)),
+        let x122 = S::mul_add(x111, x119, x118);
+        let x123 = x112 * S::splat(15.380963024);
+        let x124 = S::splat(54.202167456) * x119;
+        let x125 = S::mul_add(c_q4, x119, s_q4 * x111);
+        let x126 = S::mul_add(S::neg(s_q4), x119, c_q4 * x111);
+        let x127 = S::mul_add(
+            S::neg(c_q4),
+            S::mul_add(S::splat(0.4572), x122, x115),
+            s_q4
+                * S::mul_add(
+                    S::splat(0.4572),
+                    x120,
+                    S::mul_add(S::neg(s_q3), x114, c_q3 * x113),
+                ),
         );
-        let x128 = Self::mul_add(qd[4], x126, s_q4 * x117);
-        let x129 = Self::mul_add(-qd[4], x125, c_q4 * x117);
+        let x128 = S::mul_add(qd[4], x126, s_q4 * x117);
+        let x129 = S::mul_add(S::neg(qd[4]), x125, c_q4 * x117);
         let x130 = qd[4] - x112;
-        let x131 = 34.45002 * Self::mul_add(x125, x126, x118);
-        let x132 = 34.45002 * Self::mul_add(x125, x125, x130 * x130);
-        let x133 = 34.45002 * Self::mul_add(x126, x130, x128);
-        let x134 = x126 * 34.33891524;
-        let x135 = 34.74691524 * x130;
-        let x136 = Self::mul_add(s_q5, x130, c_q5 * x125);
-        let x137 = Self::mul_add(-c_q5, x130, s_q5 * x125);
-        let x138 = Self::mul_add(-qd[5], x137, Self::mul_add(-s_q5, x118, c_q5 * x128));
-        let x139 = Self::mul_add(qd[5], x136, Self::mul_add(c_q5, x118, s_q5 * x128));
+        let x131 = S::splat(34.45002) * S::mul_add(x125, x126, x118);
+        let x132 = S::splat(34.45002) * S::mul_add(x125, x125, x130 * x130);
+        let x133 = S::splat(34.45002) * S::mul_add(x126, x130, x128);
+        let x134 = x126 * S::splat(34.33891524);
+        let x135 = S::splat(34.74691524) * x130;
+        let x136 = S::mul_add(s_q5, x130, c_q5 * x125);
+        let x137 = S::mul_add(S::neg(c_q5), x130, s_q5 * x125);
+        let x138 = S::mul_add(
+            S::neg(qd[5]),
+            x137,
+            S::mul_add(S::neg(s_q5), x118, c_q5 * x128),
+        );
+        let x139 = S::mul_add(qd[5], x136, S::mul_add(c_q5, x118, s_q5 * x128));
         let x140 = qd[5] - x126;
-        let x141 = Self::mul_add(-0.385, x140, 0.353 * x137);
-        let x142 = Self::mul_add(
-            0.966,
+        let x141 = S::mul_add(S::splat(-0.385), x140, S::splat(0.353) * x137);
+        let x142 = S::mul_add(
+            S::splat(0.966),
             x140,
-            Self::mul_add(0.9929999999999999, x137, 0.353 * x136),
+            S::mul_add(S::splat(0.9929999999999999), x137, S::splat(0.353) * x136),
         );
-        let x143 = Self::mul_add(1.903, x140, Self::mul_add(-0.966, x137, 0.385 * x136));
-        let x144 = Self::mul_add(0.385, x129, 0.353 * x139)
-            + Self::mul_add(x137, x143, x140 * x142);
-        let x145 = Self::mul_add(
-            -0.966,
+        let x143 = S::mul_add(
+            S::splat(1.903),
+            x140,
+            S::mul_add(S::splat(-0.966), x137, S::splat(0.385) * x136),
+        );
+        let x144 = S::mul_add(S::splat(0.385), x129, S::splat(0.353) * x139)
+            + S::mul_add(x137, x143, x140 * x142);
+        let x145 = S::mul_add(
+            S::splat(-0.966),
             x129,
-            Self::mul_add(0.9929999999999999, x139, 0.353 * x138),
-        ) - Self::mul_add(x136, x143, x140 * x141);
-        let x146 = Self::mul_add(-1.903, x129, Self::mul_add(-0.966, x139, 0.385 * x138))
-            - Self::mul_add(-x136, x142, x137 * x141);
-        let x147 = Self::mul_add(
-            34.45002,
-            Self::mul_add(-0.4572, x121, x116),
-            Self::mul_add(x126, x135, x130 * x134),
-        ) - Self::mul_add(s_q5, x145, c_q5 * x144);
-        let x148 = Self::mul_add(x125, x135, x129 * 34.33891524) + x146;
-        let x149 = Self::mul_add(
-            -34.45002,
+            S::mul_add(S::splat(0.9929999999999999), x139, S::splat(0.353) * x138),
+        ) - S::mul_add(x136, x143, x140 * x141);
+        let x146 = S::mul_add(
+            S::splat(-1.903),
+            x129,
+            S::mul_add(S::splat(-0.966), x139, S::splat(0.385) * x138),
+        ) - S::mul_add(S::neg(x136), x142, x137 * x141);
+        let x147 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(S::splat(-0.4572), x121, x116),
+            S::mul_add(x126, x135, x130 * x134),
+        ) - S::mul_add(s_q5, x145, c_q5 * x144);
+        let x148 = S::mul_add(x125, x135, x129 * S::splat(34.33891524)) + x146;
+        let x149 = S::mul_add(
+            S::splat(-34.45002),
             x127,
-            Self::mul_add(x125, x134, 34.74691524 * x118),
-        ) + Self::mul_add(-c_q5, x145, s_q5 * x144);
-        let x150 = Self::mul_add(s_q4, x132, c_q4 * x131);
-        let x151 = Self::mul_add(
-            41.67378,
+            S::mul_add(x125, x134, S::splat(34.74691524) * x118),
+        ) + S::mul_add(S::neg(c_q5), x145, s_q5 * x144);
+        let x150 = S::mul_add(s_q4, x132, c_q4 * x131);
+        let x151 = S::mul_add(
+            S::splat(41.67378),
             x120,
-            -Self::mul_add(-c_q4, x132, s_q4 * x131),
+            S::neg(S::mul_add(S::neg(c_q4), x132, s_q4 * x131)),
         );
-        let x152 = Self::mul_add(41.67378, x121, -x133);
-        let x153 = Self::mul_add(41.67378, x122, x150);
-        let x154 = Self::mul_add(x112, x124, x119 * x123)
-            - Self::mul_add(-c_q4, x148, s_q4 * x147);
-        let x155 = Self::mul_add(
-            -41.67378,
+        let x152 = S::mul_add(S::splat(41.67378), x121, S::neg(x133));
+        let x153 = S::mul_add(S::splat(41.67378), x122, x150);
+        let x154 = S::mul_add(x112, x124, x119 * x123)
+            - S::mul_add(S::neg(c_q4), x148, s_q4 * x147);
+        let x155 = S::mul_add(
+            S::splat(-41.67378),
             x115,
-            Self::mul_add(-x111, x124, x118 * 15.380963024),
-        ) - Self::mul_add(0.4572, x150, x149);
-        let x156 = Self::mul_add(41.67378, x116, x111 * x123)
-            + Self::mul_add(0.4572, x133, Self::mul_add(s_q4, x148, c_q4 * x147));
-        let x157 = Self::mul_add(-s_q3, x152, c_q3 * x151);
-        let x158 = Self::mul_add(c_q3, x152, s_q3 * x151);
-        let x159 = Self::mul_add(15.183612000000002, x103, 703.3878000000001 * x102)
-            + x157;
-        let x160 = Self::mul_add(15.183612000000002, x104, 703.3878000000001 * x103)
-            + x158;
-        let x161 = Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105)
-            + x153;
+            S::mul_add(S::neg(x111), x124, x118 * S::splat(15.380963024)),
+        ) - S::mul_add(S::splat(0.4572), x150, x149);
+        let x156 = S::mul_add(S::splat(41.67378), x116, x111 * x123)
+            + S::mul_add(S::splat(0.4572), x133, S::mul_add(s_q4, x148, c_q4 * x147));
+        let x157 = S::mul_add(S::neg(s_q3), x152, c_q3 * x151);
+        let x158 = S::mul_add(c_q3, x152, s_q3 * x151);
+        let x159 = S::mul_add(
+            S::splat(15.183612000000002),
+            x103,
+            S::splat(703.3878000000001) * x102,
+        ) + x157;
+        let x160 = S::mul_add(
+            S::splat(15.183612000000002),
+            x104,
+            S::splat(703.3878000000001) * x103,
+        ) + x158;
+        let x161 = S::mul_add(
+            S::splat(15.183612000000002),
+            x106,
+            S::splat(703.3878000000001) * x105,
+        ) + x153;
         let x162 = x110
-            - Self::mul_add(-0.1524, x153, Self::mul_add(s_q3, x155, c_q3 * x154));
-        let x163 = Self::mul_add(
-            703.3878000000001,
+            - S::mul_add(S::splat(-0.1524), x153, S::mul_add(s_q3, x155, c_q3 * x154));
+        let x163 = S::mul_add(
+            S::splat(703.3878000000001),
             x95,
-            Self::mul_add(5594.523885531201, x99, x98 * 103.41030072000002)
-                - Self::mul_add(x91, x109, x100 * x107),
-        ) + Self::mul_add(7.06, x153, Self::mul_add(-c_q3, x155, s_q3 * x154));
-        let x164 = Self::mul_add(-0.08, x99, 0.8021 * x98)
-            - Self::mul_add(-x91, x108, x92 * x107)
-            - Self::mul_add(703.3878000000001, x97, 15.183612000000002 * x96)
-            - (x156 + Self::mul_add(-7.06, x158, 0.1524 * x157));
-        let x165 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(8596.210051042, x85, x84 * 190.97044034000004)
-                + Self::mul_add(x82, x90, qd[1] * x88)
-                - Self::mul_add(-6.377, x161, Self::mul_add(-c_q2, x163, s_q2 * x162)),
+            S::mul_add(
+                S::splat(5594.523885531201),
+                x99,
+                x98 * S::splat(103.41030072000002),
+            ) - S::mul_add(x91, x109, x100 * x107),
+        )
+            + S::mul_add(
+                S::splat(7.06),
+                x153,
+                S::mul_add(S::neg(c_q3), x155, s_q3 * x154),
+            );
+        let x164 = S::mul_add(S::splat(-0.08), x99, S::splat(0.8021) * x98)
+            - S::mul_add(S::neg(x91), x108, x92 * x107)
+            - S::mul_add(
+                S::splat(703.3878000000001),
+                x97,
+                S::splat(15.183612000000002) * x96,
+            ) - (x156 + S::mul_add(S::splat(-7.06), x158, S::splat(0.1524) * x157));
+        let x165 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(8596.210051042), x85, x84 * S::splat(190.97044034000004))
+                + S::mul_add(x82, x90, qd[1] * x88)
+                - S::mul_add(
+                    S::splat(-6.377),
+                    x161,
+                    S::mul_add(S::neg(c_q2), x163, s_q2 * x162),
+                ),
             s_q1
-                * (Self::mul_add(x85, 190.97044034, Self::mul_add(x83, x90, qd[1] * x89))
-                    + Self::mul_add(
-                        0.1524,
+                * (S::mul_add(
+                    x85,
+                    S::splat(190.97044034),
+                    S::mul_add(x83, x90, qd[1] * x89),
+                )
+                    + S::mul_add(
+                        S::splat(0.1524),
                         x161,
-                        Self::mul_add(s_q2, x163, c_q2 * x162),
+                        S::mul_add(s_q2, x163, c_q2 * x162),
                     )),
         );
         let x166 = tau[0] - x165;
-        let x167 = 1.0
-            / (46.90457611680001
+        let x167 = S::splat(1.0)
+            / (S::splat(46.90457611680001)
                 + (x66
-                    + Self::mul_add(
+                    + S::mul_add(
                         s_q1 * c_q1,
                         x65 + x65,
                         s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
@@ -1976,128 +2338,181 @@ impl Srms {
         let x170 = x69 * x167;
         let x171 = x76 * x167;
         let x172 = x81 * x167;
-        let x173 = 1.0 / Self::mul_add(-x67, x168, 8609.573807858 + (x62 + x63));
-        let x174 = Self::mul_add(-x67, x169, x63);
+        let x173 = S::splat(1.0)
+            / S::mul_add(S::neg(x67), x168, S::splat(8609.573807858) + (x62 + x63));
+        let x174 = S::mul_add(S::neg(x67), x169, x63);
         let x175 = x173 * x174;
-        let x176 = Self::mul_add(
-            -x67,
+        let x176 = S::mul_add(
+            S::neg(x67),
             x170,
             x41
-                + Self::mul_add(
-                    -6.377,
-                    Self::mul_add(-c_q2, x35, s_q2 * x36),
-                    0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
+                + S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(S::neg(c_q2), x35, s_q2 * x36),
+                    S::splat(0.1524) * S::mul_add(s_q2, x35, c_q2 * x36),
                 ),
         );
         let x177 = x173 * x176;
-        let x178 = Self::mul_add(
-            -x67,
+        let x178 = S::mul_add(
+            S::neg(x67),
             x171,
             x75
-                + Self::mul_add(
-                    -6.377,
-                    Self::mul_add(c_q2, x71, s_q2 * x70),
-                    0.1524 * Self::mul_add(-s_q2, x71, c_q2 * x70),
+                + S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(c_q2, x71, s_q2 * x70),
+                    S::splat(0.1524) * S::mul_add(S::neg(s_q2), x71, c_q2 * x70),
                 ),
         );
         let x179 = x173 * x178;
-        let x180 = Self::mul_add(x67, x172, x78);
+        let x180 = S::mul_add(x67, x172, x78);
         let x181 = x173 * x180;
-        let x182 = 1.0 / Self::mul_add(-x174, x175, Self::mul_add(-x68, x169, x50));
-        let x183 = Self::mul_add(-x174, x177, Self::mul_add(-x68, x170, x41));
+        let x182 = S::splat(1.0)
+            / S::mul_add(S::neg(x174), x175, S::mul_add(S::neg(x68), x169, x50));
+        let x183 = S::mul_add(S::neg(x174), x177, S::mul_add(S::neg(x68), x170, x41));
         let x184 = x182 * x183;
-        let x185 = Self::mul_add(-x174, x179, Self::mul_add(-x68, x171, x75));
+        let x185 = S::mul_add(S::neg(x174), x179, S::mul_add(S::neg(x68), x171, x75));
         let x186 = x182 * x185;
-        let x187 = Self::mul_add(-x174, x181, Self::mul_add(x68, x172, x78));
+        let x187 = S::mul_add(S::neg(x174), x181, S::mul_add(x68, x172, x78));
         let x188 = x182 * x187;
-        let x189 = Self::mul_add(
-            -x183,
+        let x189 = S::mul_add(
+            S::neg(x183),
             x184,
-            Self::mul_add(-x176, x177, Self::mul_add(-x69, x170, x27)),
+            S::mul_add(S::neg(x176), x177, S::mul_add(S::neg(x69), x170, x27)),
         );
-        let x190 = 1.0 / x189;
-        let x191 = Self::mul_add(
-            -x183,
+        let x190 = S::splat(1.0) / x189;
+        let x191 = S::mul_add(
+            S::neg(x183),
             x186,
-            Self::mul_add(-x176, x179, Self::mul_add(-x69, x171, x18)),
+            S::mul_add(S::neg(x176), x179, S::mul_add(S::neg(x69), x171, x18)),
         );
         let x192 = x190 * x191;
-        let x193 = Self::mul_add(
-            -x183,
+        let x193 = S::mul_add(
+            S::neg(x183),
             x188,
-            Self::mul_add(-x176, x181, Self::mul_add(x69, x172, x78)),
+            S::mul_add(S::neg(x176), x181, S::mul_add(x69, x172, x78)),
         );
         let x194 = x190 * x193;
-        let x195 = Self::mul_add(
-            -x185,
+        let x195 = S::mul_add(
+            S::neg(x185),
             x186,
-            Self::mul_add(-x178, x179, Self::mul_add(-x76, x171, x11)),
+            S::mul_add(S::neg(x178), x179, S::mul_add(S::neg(x76), x171, x11)),
         );
-        let x196 = 1.0 / Self::mul_add(-x191, x192, x195);
-        let x197 = Self::mul_add(
-            -x185,
+        let x196 = S::splat(1.0) / S::mul_add(S::neg(x191), x192, x195);
+        let x197 = S::mul_add(
+            S::neg(x185),
             x188,
-            Self::mul_add(-x178, x181, Self::mul_add(x76, x172, x10)),
+            S::mul_add(S::neg(x178), x181, S::mul_add(x76, x172, x10)),
         );
-        let x198 = Self::mul_add(-x191, x194, x197);
+        let x198 = S::mul_add(S::neg(x191), x194, x197);
         let x199 = x196 * x198;
-        let x200 = Self::mul_add(
-            -x187,
+        let x200 = S::mul_add(
+            S::neg(x187),
             x188,
-            Self::mul_add(-x180, x181, Self::mul_add(-x81, x172, 1.903)),
+            S::mul_add(
+                S::neg(x180),
+                x181,
+                S::mul_add(S::neg(x81), x172, S::splat(1.903)),
+            ),
         );
-        let x201 = 1.0 / Self::mul_add(-x198, x199, Self::mul_add(-x193, x194, x200));
-        let x202 = Self::mul_add(
+        let x201 = S::splat(1.0)
+            / S::mul_add(S::neg(x198), x199, S::mul_add(S::neg(x193), x194, x200));
+        let x202 = S::mul_add(
             x166,
             x168,
             tau[1]
-                - (Self::mul_add(0.0302, x85, x84 * 1.928)
-                    + Self::mul_add(-x82, x89, x83 * x88)
+                - (S::mul_add(S::splat(0.0302), x85, x84 * S::splat(1.928))
+                    + S::mul_add(S::neg(x82), x89, x83 * x88)
                     - (x164
-                        - Self::mul_add(
-                            -6.377,
-                            Self::mul_add(c_q2, x160, s_q2 * x159),
-                            0.1524 * Self::mul_add(-s_q2, x160, c_q2 * x159),
+                        - S::mul_add(
+                            S::splat(-6.377),
+                            S::mul_add(c_q2, x160, s_q2 * x159),
+                            S::splat(0.1524)
+                                * S::mul_add(S::neg(s_q2), x160, c_q2 * x159),
                         ))),
         );
-        let x203 = Self::mul_add(-x175, x202, Self::mul_add(x166, x169, tau[2] + x164));
-        let x204 = Self::mul_add(
-            -x184,
+        let x203 = S::mul_add(S::neg(x175), x202, S::mul_add(x166, x169, tau[2] + x164));
+        let x204 = S::mul_add(
+            S::neg(x184),
             x203,
-            Self::mul_add(-x177, x202, Self::mul_add(x166, x170, tau[3] - x156)),
+            S::mul_add(S::neg(x177), x202, S::mul_add(x166, x170, tau[3] - x156)),
         );
-        let x205 = Self::mul_add(
-            -x186,
+        let x205 = S::mul_add(
+            S::neg(x186),
             x203,
-            Self::mul_add(-x179, x202, Self::mul_add(x166, x171, tau[4] + x149)),
+            S::mul_add(S::neg(x179), x202, S::mul_add(x166, x171, tau[4] + x149)),
         );
-        let x206 = Self::mul_add(-x192, x204, x205);
-        let x207 = Self::mul_add(
-            -x188,
+        let x206 = S::mul_add(S::neg(x192), x204, x205);
+        let x207 = S::mul_add(
+            S::neg(x188),
             x203,
-            Self::mul_add(-x181, x202, Self::mul_add(-x166, x172, tau[5] - x146)),
+            S::mul_add(S::neg(x181), x202, S::mul_add(S::neg(x166), x172, tau[5] - x146)),
         );
-        let x208 = x201 * Self::mul_add(-x199, x206, Self::mul_add(-x194, x204, x207));
-        let x209 = Self::mul_add(-x199, x208, x196 * x206);
-        let x210 = Self::mul_add(-x194, x208, Self::mul_add(-x192, x209, x190 * x204));
-        let x211 = Self::mul_add(
-            -x188,
+        let x208 = x201
+            * S::mul_add(S::neg(x199), x206, S::mul_add(S::neg(x194), x204, x207));
+        let x209 = S::mul_add(S::neg(x199), x208, x196 * x206);
+        let x210 = S::mul_add(
+            S::neg(x194),
             x208,
-            Self::mul_add(-x186, x209, Self::mul_add(-x184, x210, x182 * x203)),
+            S::mul_add(S::neg(x192), x209, x190 * x204),
         );
-        let x212 = Self::mul_add(
-            -x179,
+        let x211 = S::mul_add(
+            S::neg(x188),
+            x208,
+            S::mul_add(S::neg(x186), x209, S::mul_add(S::neg(x184), x210, x182 * x203)),
+        );
+        let x212 = S::mul_add(
+            S::neg(x179),
             x209,
-            Self::mul_add(-x177, x210, Self::mul_add(-x175, x211, x173 * x202)),
+            S::mul_add(S::neg(x177), x210, S::mul_add(S::neg(x175), x211, x173 * x202)),
         );
-        let x213 = Self::mul_add(-x181, x208, x212);
-        let x214 = Self::mul_add(
+        let x213 = S::mul_add(S::neg(x181), x208, x212);
+        let x214 = S::mul_add(
             x170,
             x210,
-            Self::mul_add(x169, x211, Self::mul_add(x168, x213, x166 * x167)),
+            S::mul_add(x169, x211, S::mul_add(x168, x213, x166 * x167)),
         );
-        let x215 = Self::mul_add(-x172, x208, Self::mul_add(x171, x209, x214));
+        let x215 = S::mul_add(S::neg(x172), x208, S::mul_add(x171, x209, x214));
         [x215, x213, x211, x210, x209, x208]
+    }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -2107,7 +2522,14 @@ impl Srms {
         q: &[::core::primitive::f64; 6],
         qd: &[::core::primitive::f64; 6],
     ) -> ([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6]) {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::mass_matrix_and_nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6]) -> ([[S; 6]; 6], [S; 6]) {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -2116,125 +2538,146 @@ impl Srms {
         ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
-        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
-        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
-        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x7 = S::mul_add(x6, S::splat(0.706), x5 * S::splat(0.9929999999999999));
+        let x8 = S::splat(0.353)
+            + S::mul_add(x5, S::splat(-0.706), x6 * S::splat(0.9929999999999999));
+        let x9 = S::mul_add(S::splat(-0.966), s_q5, S::splat(0.385) * c_q5);
+        let x10 = S::mul_add(S::splat(0.966), c_q5, S::splat(0.385) * s_q5);
+        let x11 = S::splat(34.74691524) + (S::splat(-0.9929999999999999) + x7);
         let x12 = s_q4 * s_q4;
         let x13 = s_q4 * c_q4;
-        let x14 = x7 + -32.43591524;
+        let x14 = x7 + S::splat(-32.43591524);
         let x15 = x9 + x9;
-        let x16 = Self::mul_add(x13, x15, x12 * x14);
-        let x17 = -32.43591524 - x16;
-        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
-        let x20 = s_q4 * 34.45002;
-        let x21 = c_q4 * 34.45002;
-        let x22 = 0.4572 * x21;
+        let x16 = S::mul_add(x13, x15, x12 * x14);
+        let x17 = S::splat(-32.43591524) - x16;
+        let x18 = S::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = S::mul_add(S::neg(c_q4), x10, s_q4 * x8);
+        let x20 = s_q4 * S::splat(34.45002);
+        let x21 = c_q4 * S::splat(34.45002);
+        let x22 = S::splat(0.4572) * x21;
         let x23 = x11 + x22;
-        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
-        let x25 = 41.67378 + x21;
-        let x26 = -15.380963024 + (x22 + x23);
-        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x24 = S::mul_add(
+            S::splat(-0.4572),
+            x20,
+            x9 + S::mul_add(S::neg(x12), x15, x13 * x14),
+        );
+        let x25 = S::splat(41.67378) + x21;
+        let x26 = S::splat(-15.380963024) + (x22 + x23);
+        let x27 = S::splat(54.202167456) + (x22 - (x7 - x16 - x22));
         let x28 = s_q3 * s_q3;
         let x29 = s_q3 * c_q3;
         let x30 = x17 - x26;
         let x31 = x19 + x19;
-        let x32 = Self::mul_add(x29, x31, x28 * x30);
-        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
-        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x32 = S::mul_add(x29, x31, x28 * x30);
+        let x33 = S::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = S::mul_add(S::neg(c_q3), x18, s_q3 * x24);
         let x35 = c_q3 * x25;
         let x36 = s_q3 * x25;
-        let x37 = 0.1524 * x36;
-        let x38 = 7.06 * x35;
-        let x39 = 0.1524 * x20;
+        let x37 = S::splat(0.1524) * x36;
+        let x38 = S::splat(7.06) * x35;
+        let x39 = S::splat(0.1524) * x20;
         let x40 = x37 + x38;
         let x41 = x27 + x40;
         let x42 = x37 + (x17 - x32 + x37);
-        let x43 = Self::mul_add(
-            7.06,
+        let x43 = S::mul_add(
+            S::splat(7.06),
             x36,
-            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x35,
+                    x19 + S::mul_add(S::neg(x28), x31, x29 * x30),
+                ),
+            ),
         );
-        let x44 = 703.3878000000001 + x35;
-        let x45 = 15.183612000000002 + x36;
-        let x46 = -103.41030072000001 - x43;
-        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
-        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
-        let x49 = 0.08 + (x34 - x39);
-        let x50 = 5601.1318504688 + (x40 + x41);
+        let x44 = S::splat(703.3878000000001) + x35;
+        let x45 = S::splat(15.183612000000002) + x36;
+        let x46 = S::splat(-103.41030072000001) - x43;
+        let x47 = S::splat(0.8021) + S::mul_add(S::splat(-7.06), x20, x33);
+        let x48 = S::splat(5594.523885531201) + (x38 + (x26 + x32 + x38));
+        let x49 = S::splat(0.08) + (x34 - x39);
+        let x50 = S::splat(5601.1318504688) + (x40 + x41);
         let x51 = s_q2 * s_q2;
         let x52 = s_q2 * c_q2;
         let x53 = x42 - x48;
         let x54 = x46 + x46;
-        let x55 = Self::mul_add(x52, x54, x51 * x53);
-        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
-        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
-        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
-        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
-        let x60 = 0.1524 * x59;
-        let x61 = 6.377 * x58;
+        let x55 = S::mul_add(x52, x54, x51 * x53);
+        let x56 = S::mul_add(S::neg(s_q2), x49, c_q2 * x47);
+        let x57 = S::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = S::mul_add(S::neg(s_q2), x45, c_q2 * x44);
+        let x59 = S::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = S::splat(0.1524) * x59;
+        let x61 = S::splat(6.377) * x58;
         let x62 = x60 + x61;
         let x63 = x50 + x62;
-        let x64 = Self::mul_add(
-            6.377,
+        let x64 = S::mul_add(
+            S::splat(6.377),
             x59,
-            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
+            S::neg(
+                S::mul_add(
+                    S::splat(-0.1524),
+                    x58,
+                    x46 + S::mul_add(S::neg(x51), x54, x52 * x53),
+                ),
+            ),
         );
-        let x65 = -190.97044034 - x64;
-        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
-        let x67 = 8609.573807858 + (x62 + x63);
-        let x68 = -Self::mul_add(
-            c_q1,
-            0.0302 - (x39 - x57),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
+        let x65 = S::splat(-190.97044034) - x64;
+        let x66 = S::splat(8596.210051042) + (x61 + (x48 + x55 + x61));
+        let x67 = S::splat(8609.573807858) + (x62 + x63);
+        let x68 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::splat(0.0302) - (x39 - x57),
+                s_q1 * (S::splat(-1.928) + S::mul_add(S::splat(-6.377), x20, x56)),
+            ),
         );
-        let x69 = 46.90457611680001
+        let x69 = S::splat(46.90457611680001)
             + (x66
-                + Self::mul_add(
+                + S::mul_add(
                     s_q1 * c_q1,
                     x65 + x65,
                     s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
                 ));
-        let x70 = -Self::mul_add(c_q1, x57, s_q1 * x56);
+        let x70 = S::neg(S::mul_add(c_q1, x57, s_q1 * x56));
         let x71 = x41
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(-c_q2, x35, s_q2 * x36),
-                0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
+            + S::mul_add(
+                S::splat(-6.377),
+                S::mul_add(S::neg(c_q2), x35, s_q2 * x36),
+                S::splat(0.1524) * S::mul_add(s_q2, x35, c_q2 * x36),
             );
-        let x72 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(c_q2, x34, s_q2 * x33),
-            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
+        let x72 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(c_q2, x34, s_q2 * x33),
+                s_q1 * S::mul_add(S::neg(s_q2), x34, c_q2 * x33),
+            ),
         );
         let x73 = c_q3 * x20;
         let x74 = s_q3 * x20;
-        let x75 = 0.1524 * x21;
-        let x76 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x75;
-        let x77 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
-        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
+        let x75 = S::splat(0.1524) * x21;
+        let x76 = S::mul_add(S::neg(s_q3), x23, c_q3 * x19) - x75;
+        let x77 = S::mul_add(S::splat(7.06), x21, S::mul_add(c_q3, x23, s_q3 * x19));
+        let x78 = x18 + S::mul_add(S::splat(-7.06), x74, S::splat(0.1524) * x73);
         let x79 = x78
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x74, s_q2 * x73),
-                0.1524 * Self::mul_add(-s_q2, x74, c_q2 * x73),
+            + S::mul_add(
+                S::splat(-6.377),
+                S::mul_add(c_q2, x74, s_q2 * x73),
+                S::splat(0.1524) * S::mul_add(S::neg(s_q2), x74, c_q2 * x73),
             );
-        let x80 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x77, s_q2 * x76)),
-            s_q1 * (x75 - Self::mul_add(-s_q2, x77, c_q2 * x76)),
+        let x80 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(6.377), x21, S::mul_add(c_q2, x77, s_q2 * x76)),
+            s_q1 * (x75 - S::mul_add(S::neg(s_q2), x77, c_q2 * x76)),
         );
-        let x81 = -x80;
-        let x82 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
-        let x83 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x84 = Self::mul_add(-s_q3, x10, c_q3 * x82);
-        let x85 = Self::mul_add(c_q3, x10, s_q3 * x82);
-        let x86 = Self::mul_add(
+        let x81 = S::neg(x80);
+        let x82 = S::mul_add(S::splat(-1.903), c_q4, s_q4 * x9);
+        let x83 = S::mul_add(S::splat(1.903), s_q4, c_q4 * x9);
+        let x84 = S::mul_add(S::neg(s_q3), x10, c_q3 * x82);
+        let x85 = S::mul_add(c_q3, x10, s_q3 * x82);
+        let x86 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x85, s_q2 * x84),
-            s_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
+            S::mul_add(c_q2, x85, s_q2 * x84),
+            s_q1 * S::mul_add(S::neg(s_q2), x85, c_q2 * x84),
         );
         let x87 = qd[0] * s_q1;
         let x88 = qd[0] * c_q1;
@@ -2242,172 +2685,248 @@ impl Srms {
         let x90 = qd[1] * x87;
         let x91 = qd[1] * qd[1];
         let x92 = x87 * x88;
-        let x93 = Self::mul_add(qd[1], -1.928, x88 * 190.97044034);
-        let x94 = Self::mul_add(
-            0.0302,
+        let x93 = S::mul_add(qd[1], S::splat(-1.928), x88 * S::splat(190.97044034));
+        let x94 = S::mul_add(
+            S::splat(0.0302),
             qd[1],
-            Self::mul_add(-8596.210051042, x88, x87 * 190.97044034000004),
-        );
-        let x95 = Self::mul_add(
-            8609.573807858,
-            qd[1],
-            Self::mul_add(-0.0302, x88, x87 * 1.928),
-        );
-        let x96 = Self::mul_add(s_q2, x88, c_q2 * x87);
-        let x97 = Self::mul_add(-c_q2, x88, s_q2 * x87);
-        let x98 = Self::mul_add(-0.1524, x92, 6.377 * Self::mul_add(x88, x88, x91));
-        let x99 = Self::mul_add(-0.1524, Self::mul_add(x87, x87, x91), 6.377 * x92);
-        let x100 = Self::mul_add(0.1524, x89 + x89, 6.377 * (x90 + x90));
-        let x101 = Self::mul_add(-s_q2, x99, c_q2 * x98);
-        let x102 = Self::mul_add(c_q2, x99, s_q2 * x98);
-        let x103 = Self::mul_add(-qd[2], x97, Self::mul_add(-s_q2, x90, c_q2 * x89));
-        let x104 = Self::mul_add(qd[2], x96, Self::mul_add(c_q2, x90, s_q2 * x89));
-        let x105 = qd[1] + qd[2];
-        let x106 = x105 * x105;
-        let x107 = Self::mul_add(x97, x97, x106);
-        let x108 = x96 * x97;
-        let x109 = Self::mul_add(x96, x96, x106);
-        let x110 = Self::mul_add(x96, x105, x104);
-        let x111 = Self::mul_add(-x97, x105, x103);
-        let x112 = Self::mul_add(-0.8021, x105, x97 * 103.41030072000001);
-        let x113 = Self::mul_add(
-            0.08,
-            x105,
-            Self::mul_add(5594.523885531201, x97, x96 * 103.41030072000002),
-        );
-        let x114 = Self::mul_add(
-            -5601.1318504688,
-            x105,
-            Self::mul_add(-0.08, x97, 0.8021 * x96),
-        );
-        let x115 = Self::mul_add(
-            15.183612000000002,
-            x100,
-            Self::mul_add(
-                x104,
-                103.41030072000001,
-                Self::mul_add(x97, x114, x105 * x113),
+            S::mul_add(
+                S::splat(-8596.210051042),
+                x88,
+                x87 * S::splat(190.97044034000004),
             ),
         );
-        let x116 = Self::mul_add(-s_q3, x97, c_q3 * x96);
-        let x117 = Self::mul_add(c_q3, x97, s_q3 * x96);
-        let x118 = x101 + Self::mul_add(0.1524, x108, 7.06 * x107);
-        let x119 = x102 - Self::mul_add(0.1524, x109, 7.06 * x108);
-        let x120 = x100 + Self::mul_add(0.1524, x111, 7.06 * x110);
-        let x121 = Self::mul_add(c_q3, x119, s_q3 * x118);
-        let x122 = Self::mul_add(-qd[3], x117, Self::mul_add(-s_q3, x104, c_q3 * x103));
-        let x123 = Self::mul_add(qd[3], x116, Self::mul_add(c_q3, x104, s_q3 * x103));
-        let x124 = qd[3] + x105;
-        let x125 = Self::mul_add(x124, x124, x117 * x117);
-        let x126 = x116 * x117;
-        let x127 = Self::mul_add(x116, x124, x123);
-        let x128 = x117 * 15.380963024;
-        let x129 = 54.202167456 * x124;
-        let x130 = Self::mul_add(c_q4, x124, s_q4 * x116);
-        let x131 = Self::mul_add(-s_q4, x124, c_q4 * x116);
-        let x132 = Self::mul_add(
-            -c_q4,
-            Self::mul_add(0.4572, x127, x120),
-            s_q4 * Self::mul_add(0.4572, x125, Self::mul_add(-s_q3, x119, c_q3 * x118)),
+        let x95 = S::mul_add(
+            S::splat(8609.573807858),
+            qd[1],
+            S::mul_add(S::splat(-0.0302), x88, x87 * S::splat(1.928)),
         );
-        let x133 = Self::mul_add(qd[4], x131, s_q4 * x122);
-        let x134 = Self::mul_add(-qd[4], x130, c_q4 * x122);
-        let x135 = qd[4] - x117;
-        let x136 = 34.45002 * Self::mul_add(x130, x131, x123);
-        let x137 = 34.45002 * Self::mul_add(x130, x130, x135 * x135);
-        let x138 = 34.45002 * Self::mul_add(x131, x135, x133);
-        let x139 = x131 * 34.33891524;
-        let x140 = 34.74691524 * x135;
-        let x141 = Self::mul_add(s_q5, x135, c_q5 * x130);
-        let x142 = Self::mul_add(-c_q5, x135, s_q5 * x130);
-        let x143 = Self::mul_add(-qd[5], x142, Self::mul_add(-s_q5, x123, c_q5 * x133));
-        let x144 = Self::mul_add(qd[5], x141, Self::mul_add(c_q5, x123, s_q5 * x133));
-        let x145 = qd[5] - x131;
-        let x146 = Self::mul_add(-0.385, x145, 0.353 * x142);
-        let x147 = Self::mul_add(
-            0.966,
-            x145,
-            Self::mul_add(0.9929999999999999, x142, 0.353 * x141),
+        let x96 = S::mul_add(s_q2, x88, c_q2 * x87);
+        let x97 = S::mul_add(S::neg(c_q2), x88, s_q2 * x87);
+        let x98 = S::mul_add(
+            S::splat(-0.1524),
+            x92,
+            S::splat(6.377) * S::mul_add(x88, x88, x91),
         );
-        let x148 = Self::mul_add(1.903, x145, Self::mul_add(-0.966, x142, 0.385 * x141));
-        let x149 = Self::mul_add(0.385, x134, 0.353 * x144)
-            + Self::mul_add(x142, x148, x145 * x147);
-        let x150 = Self::mul_add(
-            -0.966,
-            x134,
-            Self::mul_add(0.9929999999999999, x144, 0.353 * x143),
-        ) - Self::mul_add(x141, x148, x145 * x146);
-        let x151 = Self::mul_add(-1.903, x134, Self::mul_add(-0.966, x144, 0.385 * x143))
-            - Self::mul_add(-x141, x147, x142 * x146);
-        let x152 = Self::mul_add(
-            34.45002,
-            Self::mul_add(-0.4572, x126, x121),
-            Self::mul_add(x131, x140, x135 * x139),
-        ) - Self::mul_add(s_q5, x150, c_q5 * x149);
-        let x153 = Self::mul_add(x130, x140, x134 * 34.33891524) + x151;
-        let x154 = Self::mul_add(
-            -34.45002,
-            x132,
-            Self::mul_add(x130, x139, 34.74691524 * x123),
-        ) + Self::mul_add(-c_q5, x150, s_q5 * x149);
-        let x155 = -x154;
-        let x156 = Self::mul_add(s_q4, x137, c_q4 * x136);
-        let x157 = Self::mul_add(
-            41.67378,
-            x125,
-            -Self::mul_add(-c_q4, x137, s_q4 * x136),
+        let x99 = S::mul_add(
+            S::splat(-0.1524),
+            S::mul_add(x87, x87, x91),
+            S::splat(6.377) * x92,
         );
-        let x158 = Self::mul_add(41.67378, x126, -x138);
-        let x159 = Self::mul_add(41.67378, x127, x156);
-        let x160 = Self::mul_add(x117, x129, x124 * x128)
-            - Self::mul_add(-c_q4, x153, s_q4 * x152);
-        let x161 = Self::mul_add(
-            -41.67378,
-            x120,
-            Self::mul_add(-x116, x129, x123 * 15.380963024),
-        ) - Self::mul_add(0.4572, x156, x154);
-        let x162 = Self::mul_add(41.67378, x121, x116 * x128)
-            + Self::mul_add(0.4572, x138, Self::mul_add(s_q4, x153, c_q4 * x152));
-        let x163 = Self::mul_add(-s_q3, x158, c_q3 * x157);
-        let x164 = Self::mul_add(c_q3, x158, s_q3 * x157);
-        let x165 = Self::mul_add(15.183612000000002, x108, 703.3878000000001 * x107)
-            + x163;
-        let x166 = Self::mul_add(15.183612000000002, x109, 703.3878000000001 * x108)
-            + x164;
-        let x167 = Self::mul_add(15.183612000000002, x111, 703.3878000000001 * x110)
-            + x159;
-        let x168 = x115
-            - Self::mul_add(-0.1524, x159, Self::mul_add(s_q3, x161, c_q3 * x160));
-        let x169 = Self::mul_add(
-            703.3878000000001,
+        let x100 = S::mul_add(
+            S::splat(0.1524),
+            x89 + x89,
+            S::splat(6.377) * (x90 + x90),
+        );
+        let x101 = S::mul_add(S::neg(s_q2), x99, c_q2 * x98);
+        let x102 = S::mul_add(c_q2, x99, s_q2 * x98);
+        let x103 = S::mul_add(
+            S::neg(qd[2]),
+            x97,
+            S::mul_add(S::neg(s_q2), x90, c_q2 * x89),
+        );
+        let x104 = S::mul_add(qd[2], x96, S::mul_add(c_q2, x90, s_q2 * x89));
+        let x105 = qd[1] + qd[2];
+        let x106 = x105 * x105;
+        let x107 = S::mul_add(x97, x97, x106);
+        let x108 = x96 * x97;
+        let x109 = S::mul_add(x96, x96, x106);
+        let x110 = S::mul_add(x96, x105, x104);
+        let x111 = S::mul_add(S::neg(x97), x105, x103);
+        let x112 = S::mul_add(
+            S::splat(-0.8021),
+            x105,
+            x97 * S::splat(103.41030072000001),
+        );
+        let x113 = S::mul_add(
+            S::splat(0.08),
+            x105,
+            S::mul_add(
+                S::splat(5594.523885531201),
+                x97,
+                x96 * S::splat(103.41030072000002),
+            ),
+        );
+        let x114 = S::mul_add(
+            S::splat(-5601.1318504688),
+            x105,
+            S::mul_add(S::splat(-0.08), x97, S::splat(0.8021) * x96),
+        );
+        let x115 = S::mul_add(
+            S::splat(15.183612000000002),
             x100,
-            Self::mul_add(5594.523885531201, x104, x103 * 103.41030072000002)
-                - Self::mul_add(x96, x114, x105 * x112),
-        ) + Self::mul_add(7.06, x159, Self::mul_add(-c_q3, x161, s_q3 * x160));
-        let x170 = Self::mul_add(-0.08, x104, 0.8021 * x103)
-            - Self::mul_add(-x96, x113, x97 * x112)
-            - Self::mul_add(703.3878000000001, x102, 15.183612000000002 * x101)
-            - (x162 + Self::mul_add(-7.06, x164, 0.1524 * x163));
-        let x171 = -x170;
-        let x172 = Self::mul_add(0.0302, x90, x89 * 1.928)
-            + Self::mul_add(-x87, x94, x88 * x93)
+            S::mul_add(
+                x104,
+                S::splat(103.41030072000001),
+                S::mul_add(x97, x114, x105 * x113),
+            ),
+        );
+        let x116 = S::mul_add(S::neg(s_q3), x97, c_q3 * x96);
+        let x117 = S::mul_add(c_q3, x97, s_q3 * x96);
+        let x118 = x101 + S::mul_add(S::splat(0.1524), x108, S::splat(7.06) * x107);
+        let x119 = x102 - S::mul_add(S::splat(0.1524), x109, S::splat(7.06) * x108);
+        let x120 = x100 + S::mul_add(S::splat(0.1524), x111, S::splat(7.06) * x110);
+        let x121 = S::mul_add(c_q3, x119, s_q3 * x118);
+        let x122 = S::mul_add(
+            S::neg(qd[3]),
+            x117,
+            S::mul_add(S::neg(s_q3), x104, c_q3 * x103),
+        );
+        let x123 = S::mul_add(qd[3], x116, S::mul_add(c_q3, x104, s_q3 * x103));
+        let x124 = qd[3] + x105;
+        let x125 = S::mul_add(x124, x124, x117 * x117);
+        let x126 = x116 * x117;
+        let x127 = S::mul_add(x116, x124, x123);
+        let x128 = x117 * S::splat(15.380963024);
+        let x129 = S::splat(54.202167456) * x124;
+        let x130 = S::mul_add(c_q4, x124, s_q4 * x116);
+        let x131 = S::mul_add(S::neg(s_q4), x124, c_q4 * x116);
+        let x132 = S::mul_add(
+            S::neg(c_q4),
+            S::mul_add(S::splat(0.4572), x127, x120),
+            s_q4
+                * S::mul_add(
+                    S::splat(0.4572),
+                    x125,
+                    S::mul_add(S::neg(s_q3), x119, c_q3 * x118),
+                ),
+        );
+        let x133 = S::mul_add(qd[4], x131, s_q4 * x122);
+        let x134 = S::mul_add(S::neg(qd[4]), x130, c_q4 * x122);
+        let x135 = qd[4] - x117;
+        let x136 = S::splat(34.45002) * S::mul_add(x130, x131, x123);
+        let x137 = S::splat(34.45002) * S::mul_add(x130, x130, x135 * x135);
+        let x138 = S::splat(34.45002) * S::mul_add(x131, x135, x133);
+        let x139 = x131 * S::splat(34.33891524);
+        let x140 = S::splat(34.74691524) * x135;
+        let x141 = S::mul_add(s_q5, x135, c_q5 * x130);
+        let x142 = S::mul_add(S::neg(c_q5), x135, s_q5 * x130);
+        let x143 = S::mul_add(
+            S::neg(qd[5]),
+            x142,
+            S::mul_add(S::neg(s_q5), x123, c_q5 * x133),
+        );
+        let x144 = S::mul_add(qd[5], x141, S::mul_add(c_q5, x123, s_q5 * x133));
+        let x145 = qd[5] - x131;
+        let x146 = S::mul_add(S::splat(-0.385), x145, S::splat(0.353) * x142);
+        let x147 = S::mul_add(
+            S::splat(0.966),
+            x145,
+            S::mul_add(S::splat(0.9929999999999999), x142, S::splat(0.353) * x141),
+        );
+        let x148 = S::mul_add(
+            S::splat(1.903),
+            x145,
+            S::mul_add(S::splat(-0.966), x142, S::splat(0.385) * x141),
+        );
+        let x149 = S::mul_add(S::splat(0.385), x134, S::splat(0.353) * x144)
+            + S::mul_add(x142, x148, x145 * x147);
+        let x150 = S::mul_add(
+            S::splat(-0.966),
+            x134,
+            S::mul_add(S::splat(0.9929999999999999), x144, S::splat(0.353) * x143),
+        ) - S::mul_add(x141, x148, x145 * x146);
+        let x151 = S::mul_add(
+            S::splat(-1.903),
+            x134,
+            S::mul_add(S::splat(-0.966), x144, S::splat(0.385) * x143),
+        ) - S::mul_add(S::neg(x141), x147, x142 * x146);
+        let x152 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(S::splat(-0.4572), x126, x121),
+            S::mul_add(x131, x140, x135 * x139),
+        ) - S::mul_add(s_q5, x150, c_q5 * x149);
+        let x153 = S::mul_add(x130, x140, x134 * S::splat(34.33891524)) + x151;
+        let x154 = S::mul_add(
+            S::splat(-34.45002),
+            x132,
+            S::mul_add(x130, x139, S::splat(34.74691524) * x123),
+        ) + S::mul_add(S::neg(c_q5), x150, s_q5 * x149);
+        let x155 = S::neg(x154);
+        let x156 = S::mul_add(s_q4, x137, c_q4 * x136);
+        let x157 = S::mul_add(
+            S::splat(41.67378),
+            x125,
+            S::neg(S::mul_add(S::neg(c_q4), x137, s_q4 * x136)),
+        );
+        let x158 = S::mul_add(S::splat(41.67378), x126, S::neg(x138));
+        let x159 = S::mul_add(S::splat(41.67378), x127, x156);
+        let x160 = S::mul_add(x117, x129, x124 * x128)
+            - S::mul_add(S::neg(c_q4), x153, s_q4 * x152);
+        let x161 = S::mul_add(
+            S::splat(-41.67378),
+            x120,
+            S::mul_add(S::neg(x116), x129, x123 * S::splat(15.380963024)),
+        ) - S::mul_add(S::splat(0.4572), x156, x154);
+        let x162 = S::mul_add(S::splat(41.67378), x121, x116 * x128)
+            + S::mul_add(S::splat(0.4572), x138, S::mul_add(s_q4, x153, c_q4 * x152));
+        let x163 = S::mul_add(S::neg(s_q3), x158, c_q3 * x157);
+        let x164 = S::mul_add(c_q3, x158, s_q3 * x157);
+        let x165 = S::mul_add(
+            S::splat(15.183612000000002),
+            x108,
+            S::splat(703.3878000000001) * x107,
+        ) + x163;
+        let x166 = S::mul_add(
+            S::splat(15.183612000000002),
+            x109,
+            S::splat(703.3878000000001) * x108,
+        ) + x164;
+        let x167 = S::mul_add(
+            S::splat(15.183612000000002),
+            x111,
+            S::splat(703.3878000000001) * x110,
+        ) + x159;
+        let x168 = x115
+            - S::mul_add(S::splat(-0.1524), x159, S::mul_add(s_q3, x161, c_q3 * x160));
+        let x169 = S::mul_add(
+            S::splat(703.3878000000001),
+            x100,
+            S::mul_add(
+                S::splat(5594.523885531201),
+                x104,
+                x103 * S::splat(103.41030072000002),
+            ) - S::mul_add(x96, x114, x105 * x112),
+        )
+            + S::mul_add(
+                S::splat(7.06),
+                x159,
+                S::mul_add(S::neg(c_q3), x161, s_q3 * x160),
+            );
+        let x170 = S::mul_add(S::splat(-0.08), x104, S::splat(0.8021) * x103)
+            - S::mul_add(S::neg(x96), x113, x97 * x112)
+            - S::mul_add(
+                S::splat(703.3878000000001),
+                x102,
+                S::splat(15.183612000000002) * x101,
+            ) - (x162 + S::mul_add(S::splat(-7.06), x164, S::splat(0.1524) * x163));
+        let x171 = S::neg(x170);
+        let x172 = S::mul_add(S::splat(0.0302), x90, x89 * S::splat(1.928))
+            + S::mul_add(S::neg(x87), x94, x88 * x93)
             - (x170
-                - Self::mul_add(
-                    -6.377,
-                    Self::mul_add(c_q2, x166, s_q2 * x165),
-                    0.1524 * Self::mul_add(-s_q2, x166, c_q2 * x165),
+                - S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(c_q2, x166, s_q2 * x165),
+                    S::splat(0.1524) * S::mul_add(S::neg(s_q2), x166, c_q2 * x165),
                 ));
-        let x173 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(8596.210051042, x90, x89 * 190.97044034000004)
-                + Self::mul_add(x87, x95, qd[1] * x93)
-                - Self::mul_add(-6.377, x167, Self::mul_add(-c_q2, x169, s_q2 * x168)),
+        let x173 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(8596.210051042), x90, x89 * S::splat(190.97044034000004))
+                + S::mul_add(x87, x95, qd[1] * x93)
+                - S::mul_add(
+                    S::splat(-6.377),
+                    x167,
+                    S::mul_add(S::neg(c_q2), x169, s_q2 * x168),
+                ),
             s_q1
-                * (Self::mul_add(x90, 190.97044034, Self::mul_add(x88, x95, qd[1] * x94))
-                    + Self::mul_add(
-                        0.1524,
+                * (S::mul_add(
+                    x90,
+                    S::splat(190.97044034),
+                    S::mul_add(x88, x95, qd[1] * x94),
+                )
+                    + S::mul_add(
+                        S::splat(0.1524),
                         x167,
-                        Self::mul_add(s_q2, x169, c_q2 * x168),
+                        S::mul_add(s_q2, x169, c_q2 * x168),
                     )),
         );
         (
@@ -2417,10 +2936,44 @@ impl Srms {
                 [x70, x63, x50, x41, x78, x83],
                 [x72, x71, x41, x27, x18, x83],
                 [x81, x79, x78, x18, x11, x10],
-                [x86, x83, x83, x83, x10, 1.903],
+                [x86, x83, x83, x83, x10, S::splat(1.903)],
             ],
             [x173, x172, x171, x162, x155, x151],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -2432,7 +2985,16 @@ impl Srms {
         tau: &[::core::primitive::f64; 6],
         f_ext: &[[::core::primitive::f64; 6]; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::forward_dynamics_with_wrenches_lanes::<
+            ::core::primitive::f64,
+        >(q, qd, tau, f_ext)
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], tau: &[S; 6], f_ext: &[[S; 6]; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -2441,105 +3003,122 @@ impl Srms {
         ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
-        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
-        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
-        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.33891524 - x7;
-        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x7 = S::mul_add(x6, S::splat(0.706), x5 * S::splat(0.9929999999999999));
+        let x8 = S::splat(0.353)
+            + S::mul_add(x5, S::splat(-0.706), x6 * S::splat(0.9929999999999999));
+        let x9 = S::mul_add(S::splat(-0.966), s_q5, S::splat(0.385) * c_q5);
+        let x10 = S::mul_add(S::splat(0.966), c_q5, S::splat(0.385) * s_q5);
+        let x11 = S::splat(34.33891524) - x7;
+        let x12 = S::splat(34.74691524) + (S::splat(-0.9929999999999999) + x7);
         let x13 = s_q4 * s_q4;
         let x14 = s_q4 * c_q4;
-        let x15 = 1.903 - x11;
+        let x15 = S::splat(1.903) - x11;
         let x16 = x9 + x9;
-        let x17 = Self::mul_add(x14, x16, x13 * x15);
-        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
-        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
-        let x20 = 34.45002 * c_q4;
-        let x21 = 34.45002 * s_q4;
-        let x22 = 0.4572 * x20;
-        let x23 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x17 = S::mul_add(x14, x16, x13 * x15);
+        let x18 = S::mul_add(S::neg(s_q4), x8, c_q4 * x10);
+        let x19 = S::mul_add(c_q4, x8, s_q4 * x10);
+        let x20 = S::splat(34.45002) * c_q4;
+        let x21 = S::splat(34.45002) * s_q4;
+        let x22 = S::splat(0.4572) * x20;
+        let x23 = S::mul_add(
+            S::splat(-0.4572),
+            x21,
+            x9 + S::mul_add(S::neg(x13), x16, x14 * x15),
+        );
         let x24 = x12 + x22;
         let x25 = x22 + x24;
-        let x26 = 41.67378 + x20;
-        let x27 = -18.957952216000002 + (1.903 - x17);
-        let x28 = 19.863252216000003 + (x22 + (x11 + x17 + x22));
+        let x26 = S::splat(41.67378) + x20;
+        let x27 = S::splat(-18.957952216000002) + (S::splat(1.903) - x17);
+        let x28 = S::splat(19.863252216000003) + (x22 + (x11 + x17 + x22));
         let x29 = s_q3 * s_q3;
         let x30 = s_q3 * c_q3;
         let x31 = x25 - x27;
         let x32 = x18 + x18;
-        let x33 = Self::mul_add(x30, x32, x29 * x31);
-        let x34 = Self::mul_add(-s_q3, x23, c_q3 * x19);
-        let x35 = Self::mul_add(c_q3, x23, s_q3 * x19);
+        let x33 = S::mul_add(x30, x32, x29 * x31);
+        let x34 = S::mul_add(S::neg(s_q3), x23, c_q3 * x19);
+        let x35 = S::mul_add(c_q3, x23, s_q3 * x19);
         let x36 = s_q3 * x26;
         let x37 = c_q3 * x26;
-        let x38 = x36 * 0.1524;
-        let x39 = 7.06 * x37;
+        let x38 = x36 * S::splat(0.1524);
+        let x39 = S::splat(7.06) * x37;
         let x40 = x38 + x39;
-        let x41 = x21 * 0.1524;
+        let x41 = x21 * S::splat(0.1524);
         let x42 = x28 + x40;
-        let x43 = Self::mul_add(
+        let x43 = S::mul_add(
             x37,
-            0.1524,
-            Self::mul_add(7.06, x36, x18 + Self::mul_add(-x29, x32, x30 * x31)),
+            S::splat(0.1524),
+            S::mul_add(
+                S::splat(7.06),
+                x36,
+                x18 + S::mul_add(S::neg(x29), x32, x30 * x31),
+            ),
         );
         let x44 = x39 + (x25 - x33 + x39);
-        let x45 = 703.3878000000001 + x37;
-        let x46 = -15.183612000000002 - x36;
-        let x47 = -5594.523885531201 + (x38 + (x27 + x33 + x38));
-        let x48 = 0.8021 + Self::mul_add(-7.06, x21, x35);
-        let x49 = 5601.1318504688 + (x40 + x42);
-        let x50 = -0.08 + (x34 + x41);
-        let x51 = 103.41030072000002 + x43;
+        let x45 = S::splat(703.3878000000001) + x37;
+        let x46 = S::splat(-15.183612000000002) - x36;
+        let x47 = S::splat(-5594.523885531201) + (x38 + (x27 + x33 + x38));
+        let x48 = S::splat(0.8021) + S::mul_add(S::splat(-7.06), x21, x35);
+        let x49 = S::splat(5601.1318504688) + (x40 + x42);
+        let x50 = S::splat(-0.08) + (x34 + x41);
+        let x51 = S::splat(103.41030072000002) + x43;
         let x52 = s_q2 * s_q2;
         let x53 = s_q2 * c_q2;
         let x54 = x44 - x47;
         let x55 = x51 + x51;
-        let x56 = Self::mul_add(x53, x55, x52 * x54);
-        let x57 = Self::mul_add(-s_q2, x48, c_q2 * x50);
-        let x58 = Self::mul_add(c_q2, x48, s_q2 * x50);
-        let x59 = Self::mul_add(-s_q2, x45, c_q2 * x46);
-        let x60 = Self::mul_add(c_q2, x45, s_q2 * x46);
-        let x61 = 0.1524 * x59;
-        let x62 = 6.377 * x60;
+        let x56 = S::mul_add(x53, x55, x52 * x54);
+        let x57 = S::mul_add(S::neg(s_q2), x48, c_q2 * x50);
+        let x58 = S::mul_add(c_q2, x48, s_q2 * x50);
+        let x59 = S::mul_add(S::neg(s_q2), x45, c_q2 * x46);
+        let x60 = S::mul_add(c_q2, x45, s_q2 * x46);
+        let x61 = S::splat(0.1524) * x59;
+        let x62 = S::splat(6.377) * x60;
         let x63 = x61 - x62;
         let x64 = x49 - x63;
-        let x65 = Self::mul_add(
-            0.1524,
+        let x65 = S::mul_add(
+            S::splat(0.1524),
             x60,
-            Self::mul_add(-6.377, x59, x51 + Self::mul_add(-x52, x55, x53 * x54)),
+            S::mul_add(
+                S::splat(-6.377),
+                x59,
+                x51 + S::mul_add(S::neg(x52), x55, x53 * x54),
+            ),
         );
         let x66 = x62 + (x44 - x56 + x62);
-        let x67 = 190.97044034000004 + x65;
-        let x68 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x21, x58),
-            c_q1 * (-0.0302 + (x41 + x57)),
+        let x67 = S::splat(190.97044034000004) + x65;
+        let x68 = S::mul_add(
+            S::neg(s_q1),
+            S::splat(-1.928) + S::mul_add(S::splat(-6.377), x21, x58),
+            c_q1 * (S::splat(-0.0302) + (x41 + x57)),
         );
-        let x69 = Self::mul_add(-c_q1, x57, s_q1 * x58);
-        let x70 = Self::mul_add(
+        let x69 = S::mul_add(S::neg(c_q1), x57, s_q1 * x58);
+        let x70 = S::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x34, s_q2 * x35),
-            s_q1 * Self::mul_add(s_q2, x34, c_q2 * x35),
+            S::mul_add(S::neg(c_q2), x34, s_q2 * x35),
+            s_q1 * S::mul_add(s_q2, x34, c_q2 * x35),
         );
         let x71 = c_q3 * x21;
         let x72 = s_q3 * x21;
-        let x73 = x20 * 0.1524;
-        let x74 = Self::mul_add(s_q3, x24, c_q3 * x18) + x73;
-        let x75 = x19 + Self::mul_add(-7.06, x72, 0.1524 * x71);
-        let x76 = Self::mul_add(-7.06, x20, Self::mul_add(-c_q3, x24, s_q3 * x18));
-        let x77 = Self::mul_add(
-            c_q1,
-            Self::mul_add(-6.377, x20, Self::mul_add(c_q2, x76, s_q2 * x74)),
-            s_q1 * (x73 + Self::mul_add(-s_q2, x76, c_q2 * x74)),
+        let x73 = x20 * S::splat(0.1524);
+        let x74 = S::mul_add(s_q3, x24, c_q3 * x18) + x73;
+        let x75 = x19 + S::mul_add(S::splat(-7.06), x72, S::splat(0.1524) * x71);
+        let x76 = S::mul_add(
+            S::splat(-7.06),
+            x20,
+            S::mul_add(S::neg(c_q3), x24, s_q3 * x18),
         );
-        let x78 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x79 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
-        let x80 = Self::mul_add(s_q3, x10, c_q3 * x78);
-        let x81 = Self::mul_add(-c_q3, x10, s_q3 * x78);
-        let x82 = Self::mul_add(
+        let x77 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x81, s_q2 * x80),
-            s_q1 * Self::mul_add(-s_q2, x81, c_q2 * x80),
+            S::mul_add(S::splat(-6.377), x20, S::mul_add(c_q2, x76, s_q2 * x74)),
+            s_q1 * (x73 + S::mul_add(S::neg(s_q2), x76, c_q2 * x74)),
+        );
+        let x78 = S::mul_add(S::neg(s_q4), x9, S::splat(1.903) * c_q4);
+        let x79 = S::mul_add(c_q4, x9, S::splat(1.903) * s_q4);
+        let x80 = S::mul_add(s_q3, x10, c_q3 * x78);
+        let x81 = S::mul_add(S::neg(c_q3), x10, s_q3 * x78);
+        let x82 = S::mul_add(
+            c_q1,
+            S::mul_add(c_q2, x81, s_q2 * x80),
+            s_q1 * S::mul_add(S::neg(s_q2), x81, c_q2 * x80),
         );
         let x83 = qd[0] * s_q1;
         let x84 = qd[0] * c_q1;
@@ -2547,329 +3126,455 @@ impl Srms {
         let x86 = qd[1] * x83;
         let x87 = qd[1] * qd[1];
         let x88 = x83 * x84;
-        let x89 = Self::mul_add(
-            190.97044034,
+        let x89 = S::mul_add(
+            S::splat(190.97044034),
             x84,
-            Self::mul_add(qd[1], -1.928, x83 * 8596.210051042),
+            S::mul_add(qd[1], S::splat(-1.928), x83 * S::splat(8596.210051042)),
         );
-        let x90 = Self::mul_add(
+        let x90 = S::mul_add(
             x84,
-            -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x83 * 1.928),
+            S::splat(-0.0302),
+            S::mul_add(S::splat(8609.573807858), qd[1], x83 * S::splat(1.928)),
         );
-        let x91 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x83);
-        let x92 = Self::mul_add(s_q2, x84, c_q2 * x83);
-        let x93 = Self::mul_add(-c_q2, x84, s_q2 * x83);
-        let x94 = Self::mul_add(-0.1524, x88, 6.377 * Self::mul_add(x84, x84, x87));
-        let x95 = Self::mul_add(0.1524, x85 + x85, 6.377 * (x86 + x86));
-        let x96 = Self::mul_add(-0.1524, Self::mul_add(x83, x83, x87), 6.377 * x88);
-        let x97 = Self::mul_add(-s_q2, x96, c_q2 * x94);
-        let x98 = Self::mul_add(c_q2, x96, s_q2 * x94);
-        let x99 = Self::mul_add(-qd[2], x93, Self::mul_add(-s_q2, x86, c_q2 * x85));
-        let x100 = Self::mul_add(qd[2], x92, Self::mul_add(c_q2, x86, s_q2 * x85));
+        let x91 = S::mul_add(
+            qd[1],
+            S::splat(0.0302),
+            S::splat(190.97044034000004) * x83,
+        );
+        let x92 = S::mul_add(s_q2, x84, c_q2 * x83);
+        let x93 = S::mul_add(S::neg(c_q2), x84, s_q2 * x83);
+        let x94 = S::mul_add(
+            S::splat(-0.1524),
+            x88,
+            S::splat(6.377) * S::mul_add(x84, x84, x87),
+        );
+        let x95 = S::mul_add(S::splat(0.1524), x85 + x85, S::splat(6.377) * (x86 + x86));
+        let x96 = S::mul_add(
+            S::splat(-0.1524),
+            S::mul_add(x83, x83, x87),
+            S::splat(6.377) * x88,
+        );
+        let x97 = S::mul_add(S::neg(s_q2), x96, c_q2 * x94);
+        let x98 = S::mul_add(c_q2, x96, s_q2 * x94);
+        let x99 = S::mul_add(
+            S::neg(qd[2]),
+            x93,
+            S::mul_add(S::neg(s_q2), x86, c_q2 * x85),
+        );
+        let x100 = S::mul_add(qd[2], x92, S::mul_add(c_q2, x86, s_q2 * x85));
         let x101 = qd[1] + qd[2];
         let x102 = x101 * x101;
-        let x103 = Self::mul_add(x93, x93, x102);
+        let x103 = S::mul_add(x93, x93, x102);
         let x104 = x92 * x93;
-        let x105 = Self::mul_add(x92, x101, x100);
-        let x106 = Self::mul_add(-x93, x101, x99);
-        let x107 = Self::mul_add(x92, x92, x102);
-        let x108 = Self::mul_add(
-            -103.41030072000001,
+        let x105 = S::mul_add(x92, x101, x100);
+        let x106 = S::mul_add(S::neg(x93), x101, x99);
+        let x107 = S::mul_add(x92, x92, x102);
+        let x108 = S::mul_add(
+            S::splat(-103.41030072000001),
             x93,
-            Self::mul_add(0.8021, x101, x92 * 5594.523885531201),
+            S::mul_add(S::splat(0.8021), x101, x92 * S::splat(5594.523885531201)),
         );
-        let x109 = Self::mul_add(
-            -0.08,
+        let x109 = S::mul_add(
+            S::splat(-0.08),
             x93,
-            Self::mul_add(-5601.1318504688, x101, 0.8021 * x92),
+            S::mul_add(S::splat(-5601.1318504688), x101, S::splat(0.8021) * x92),
         );
-        let x110 = Self::mul_add(0.08, x101, 103.41030072000002 * x92);
-        let x111 = Self::mul_add(
-            703.3878000000001,
+        let x110 = S::mul_add(S::splat(0.08), x101, S::splat(103.41030072000002) * x92);
+        let x111 = S::mul_add(
+            S::splat(703.3878000000001),
             x95,
-            Self::mul_add(
-                103.41030072000002,
+            S::mul_add(
+                S::splat(103.41030072000002),
                 x99,
-                Self::mul_add(-x92, x109, x101 * x108),
+                S::mul_add(S::neg(x92), x109, x101 * x108),
             ),
         );
-        let x112 = Self::mul_add(-s_q3, x93, c_q3 * x92);
-        let x113 = Self::mul_add(c_q3, x93, s_q3 * x92);
-        let x114 = x97 + Self::mul_add(0.1524, x104, 7.06 * x103);
-        let x115 = x95 + Self::mul_add(0.1524, x106, 7.06 * x105);
-        let x116 = x98 - Self::mul_add(0.1524, x107, 7.06 * x104);
-        let x117 = Self::mul_add(c_q3, x116, s_q3 * x114);
-        let x118 = Self::mul_add(-qd[3], x113, Self::mul_add(-s_q3, x100, c_q3 * x99));
-        let x119 = Self::mul_add(qd[3], x112, Self::mul_add(c_q3, x100, s_q3 * x99));
-        let x120 = qd[3] + x101;
-        let x121 = Self::mul_add(x113, x113, x120 * x120);
-        let x122 = x112 * x113;
-        let x123 = Self::mul_add(x112, x120, x119);
-        let x124 = x112 * 18.957952216000002;
-        let x125 = 19.863252216000003 * x120;
-        let x126 = Self::mul_add(-s_q4, x120, c_q4 * x112);
-        let x127 = Self::mul_add(c_q4, x120, s_q4 * x112);
-        let x128 = Self::mul_add(
-            -c_q4,
-            Self::mul_add(0.4572, x123, x115),
-            s_q4 * Self::mul_add(0.4572, x121, Self::mul_add(-s_q3, x116, c_q3 * x114)),
+        let x112 = S::mul_add(S::neg(s_q3), x93, c_q3 * x92);
+        let x113 = S::mul_add(c_q3, x93, s_q3 * x92);
+        let x114 = x97 + S::mul_add(S::splat(0.1524), x104, S::splat(7.06) * x103);
+        let x115 = x95 + S::mul_add(S::splat(0.1524), x106, S::splat(7.06) * x105);
+        let x116 = x98 - S::mul_add(S::splat(0.1524), x107, S::splat(7.06) * x104);
+        let x117 = S::mul_add(c_q3, x116, s_q3 * x114);
+        let x118 = S::mul_add(
+            S::neg(qd[3]),
+            x113,
+            S::mul_add(S::neg(s_q3), x100, c_q3 * x99),
         );
-        let x129 = Self::mul_add(-qd[4], x127, c_q4 * x118);
-        let x130 = Self::mul_add(qd[4], x126, s_q4 * x118);
+        let x119 = S::mul_add(qd[3], x112, S::mul_add(c_q3, x100, s_q3 * x99));
+        let x120 = qd[3] + x101;
+        let x121 = S::mul_add(x113, x113, x120 * x120);
+        let x122 = x112 * x113;
+        let x123 = S::mul_add(x112, x120, x119);
+        let x124 = x112 * S::splat(18.957952216000002);
+        let x125 = S::splat(19.863252216000003) * x120;
+        let x126 = S::mul_add(S::neg(s_q4), x120, c_q4 * x112);
+        let x127 = S::mul_add(c_q4, x120, s_q4 * x112);
+        let x128 = S::mul_add(
+            S::neg(c_q4),
+            S::mul_add(S::splat(0.4572), x123, x115),
+            s_q4
+                * S::mul_add(
+                    S::splat(0.4572),
+                    x121,
+                    S::mul_add(S::neg(s_q3), x116, c_q3 * x114),
+                ),
+        );
+        let x129 = S::mul_add(S::neg(qd[4]), x127, c_q4 * x118);
+        let x130 = S::mul_add(qd[4], x126, s_q4 * x118);
         let x131 = qd[4] - x113;
-        let x132 = 34.33891524 * x127;
-        let x133 = 34.74691524 * x131;
-        let x134 = Self::mul_add(s_q5, x131, c_q5 * x127);
-        let x135 = Self::mul_add(-c_q5, x131, s_q5 * x127);
-        let x136 = Self::mul_add(-qd[5], x135, Self::mul_add(-s_q5, x119, c_q5 * x130));
-        let x137 = Self::mul_add(qd[5], x134, Self::mul_add(c_q5, x119, s_q5 * x130));
-        let x138 = qd[5] - x126;
-        let x139 = Self::mul_add(-0.966, x135, Self::mul_add(0.385, x134, 1.903 * x138));
-        let x140 = Self::mul_add(-0.353, x135, 0.385 * x138);
-        let x141 = Self::mul_add(
-            0.9929999999999999,
+        let x132 = S::splat(34.33891524) * x127;
+        let x133 = S::splat(34.74691524) * x131;
+        let x134 = S::mul_add(s_q5, x131, c_q5 * x127);
+        let x135 = S::mul_add(S::neg(c_q5), x131, s_q5 * x127);
+        let x136 = S::mul_add(
+            S::neg(qd[5]),
             x135,
-            Self::mul_add(0.353, x134, 0.966 * x138),
+            S::mul_add(S::neg(s_q5), x119, c_q5 * x130),
+        );
+        let x137 = S::mul_add(qd[5], x134, S::mul_add(c_q5, x119, s_q5 * x130));
+        let x138 = qd[5] - x126;
+        let x139 = S::mul_add(
+            S::splat(-0.966),
+            x135,
+            S::mul_add(S::splat(0.385), x134, S::splat(1.903) * x138),
+        );
+        let x140 = S::mul_add(S::splat(-0.353), x135, S::splat(0.385) * x138);
+        let x141 = S::mul_add(
+            S::splat(0.9929999999999999),
+            x135,
+            S::mul_add(S::splat(0.353), x134, S::splat(0.966) * x138),
         );
         let x142 = f_ext[5][3]
-            + (Self::mul_add(0.966, x137, Self::mul_add(-0.385, x136, 1.903 * x129))
-                - Self::mul_add(x134, x141, x135 * x140));
-        let x143 = f_ext[5][4]
-            + (Self::mul_add(0.353, x137, 0.385 * x129)
-                + Self::mul_add(x138, x141, x135 * x139));
-        let x144 = f_ext[5][5]
-            + (Self::mul_add(
-                -0.9929999999999999,
+            + (S::mul_add(
+                S::splat(0.966),
                 x137,
-                Self::mul_add(-0.353, x136, 0.966 * x129),
-            ) + Self::mul_add(-x138, x140, x134 * x139));
-        let x145 = Self::mul_add(-f_ext[5][2], s_q5, f_ext[5][1] * c_q5);
-        let x146 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+                S::mul_add(S::splat(-0.385), x136, S::splat(1.903) * x129),
+            ) - S::mul_add(x134, x141, x135 * x140));
+        let x143 = f_ext[5][4]
+            + (S::mul_add(S::splat(0.353), x137, S::splat(0.385) * x129)
+                + S::mul_add(x138, x141, x135 * x139));
+        let x144 = f_ext[5][5]
+            + (S::mul_add(
+                S::splat(-0.9929999999999999),
+                x137,
+                S::mul_add(S::splat(-0.353), x136, S::splat(0.966) * x129),
+            ) + S::mul_add(S::neg(x138), x140, x134 * x139));
+        let x145 = S::mul_add(S::neg(f_ext[5][2]), s_q5, f_ext[5][1] * c_q5);
+        let x146 = S::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
         let x147 = f_ext[5][0]
-            + Self::mul_add(
-                34.45002,
-                Self::mul_add(x131, x131, x127 * x127),
+            + S::mul_add(
+                S::splat(34.45002),
+                S::mul_add(x131, x131, x127 * x127),
                 f_ext[4][0],
             );
-        let x148 = Self::mul_add(34.45002, Self::mul_add(x126, x127, x119), f_ext[4][1])
-            + x145;
-        let x149 = Self::mul_add(34.45002, Self::mul_add(x126, x131, x130), f_ext[4][2])
-            + x146;
-        let x150 = f_ext[4][3] + Self::mul_add(-x127, x133, x131 * x132) + x142;
+        let x148 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(x126, x127, x119),
+            f_ext[4][1],
+        ) + x145;
+        let x149 = S::mul_add(
+            S::splat(34.45002),
+            S::mul_add(x126, x131, x130),
+            f_ext[4][2],
+        ) + x146;
+        let x150 = f_ext[4][3] + S::mul_add(S::neg(x127), x133, x131 * x132) + x142;
         let x151 = f_ext[4][4]
-            - Self::mul_add(
-                34.45002,
-                Self::mul_add(-0.4572, x122, x117),
-                Self::mul_add(x126, x133, 34.33891524 * x130),
-            ) + Self::mul_add(-0.762, x146, Self::mul_add(-s_q5, x144, c_q5 * x143));
+            - S::mul_add(
+                S::splat(34.45002),
+                S::mul_add(S::splat(-0.4572), x122, x117),
+                S::mul_add(x126, x133, S::splat(34.33891524) * x130),
+            )
+            + S::mul_add(
+                S::splat(-0.762),
+                x146,
+                S::mul_add(S::neg(s_q5), x144, c_q5 * x143),
+            );
         let x152 = f_ext[4][5]
-            + Self::mul_add(
-                -34.45002,
+            + S::mul_add(
+                S::splat(-34.45002),
                 x128,
-                Self::mul_add(x126, x132, 34.74691524 * x119),
-            ) + Self::mul_add(0.762, x145, Self::mul_add(c_q5, x144, s_q5 * x143));
-        let x153 = Self::mul_add(c_q4, x148, s_q4 * x147);
-        let x154 = Self::mul_add(41.67378, x121, f_ext[3][0])
-            + Self::mul_add(-s_q4, x148, c_q4 * x147);
-        let x155 = Self::mul_add(41.67378, x123, f_ext[3][1]) + x153;
-        let x156 = Self::mul_add(-41.67378, x122, f_ext[3][2]) + x149;
-        let x157 = f_ext[3][3] - Self::mul_add(x113, x125, x118 * 18.957952216000002)
-            + Self::mul_add(-s_q4, x151, c_q4 * x150);
-        let x158 = f_ext[3][4] + Self::mul_add(-41.67378, x117, x113 * x124)
-            + Self::mul_add(-0.4572, x149, Self::mul_add(c_q4, x151, s_q4 * x150));
+                S::mul_add(x126, x132, S::splat(34.74691524) * x119),
+            ) + S::mul_add(S::splat(0.762), x145, S::mul_add(c_q5, x144, s_q5 * x143));
+        let x153 = S::mul_add(c_q4, x148, s_q4 * x147);
+        let x154 = S::mul_add(S::splat(41.67378), x121, f_ext[3][0])
+            + S::mul_add(S::neg(s_q4), x148, c_q4 * x147);
+        let x155 = S::mul_add(S::splat(41.67378), x123, f_ext[3][1]) + x153;
+        let x156 = S::mul_add(S::splat(-41.67378), x122, f_ext[3][2]) + x149;
+        let x157 = f_ext[3][3]
+            - S::mul_add(x113, x125, x118 * S::splat(18.957952216000002))
+            + S::mul_add(S::neg(s_q4), x151, c_q4 * x150);
+        let x158 = f_ext[3][4] + S::mul_add(S::splat(-41.67378), x117, x113 * x124)
+            + S::mul_add(S::splat(-0.4572), x149, S::mul_add(c_q4, x151, s_q4 * x150));
         let x159 = f_ext[3][5]
-            + Self::mul_add(41.67378, x115, Self::mul_add(x112, x125, x120 * x124))
-            + Self::mul_add(0.4572, x153, x152);
-        let x160 = Self::mul_add(s_q3, x156, c_q3 * x154);
-        let x161 = Self::mul_add(-c_q3, x156, s_q3 * x154);
+            + S::mul_add(S::splat(41.67378), x115, S::mul_add(x112, x125, x120 * x124))
+            + S::mul_add(S::splat(0.4572), x153, x152);
+        let x160 = S::mul_add(s_q3, x156, c_q3 * x154);
+        let x161 = S::mul_add(S::neg(c_q3), x156, s_q3 * x154);
         let x162 = f_ext[2][0]
-            + Self::mul_add(x104, 15.183612000000002, 703.3878000000001 * x103) + x160;
+            + S::mul_add(
+                x104,
+                S::splat(15.183612000000002),
+                S::splat(703.3878000000001) * x103,
+            ) + x160;
         let x163 = f_ext[2][1]
-            + Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105) + x155;
+            + S::mul_add(
+                S::splat(15.183612000000002),
+                x106,
+                S::splat(703.3878000000001) * x105,
+            ) + x155;
         let x164 = f_ext[2][2]
-            - Self::mul_add(15.183612000000002, x107, 703.3878000000001 * x104) - x161;
+            - S::mul_add(
+                S::splat(15.183612000000002),
+                x107,
+                S::splat(703.3878000000001) * x104,
+            ) - x161;
         let x165 = f_ext[2][3]
-            - Self::mul_add(
+            - S::mul_add(
                 x95,
-                -15.183612000000002,
-                Self::mul_add(-103.41030072000001, x100, x99 * 5594.523885531201)
-                    - Self::mul_add(x101, x110, x93 * x109),
-            ) + Self::mul_add(0.1524, x155, Self::mul_add(s_q3, x159, c_q3 * x157));
+                S::splat(-15.183612000000002),
+                S::mul_add(
+                    S::splat(-103.41030072000001),
+                    x100,
+                    x99 * S::splat(5594.523885531201),
+                ) - S::mul_add(x101, x110, x93 * x109),
+            ) + S::mul_add(S::splat(0.1524), x155, S::mul_add(s_q3, x159, c_q3 * x157));
         let x166 = f_ext[2][4]
-            + (Self::mul_add(-0.08, x100, 0.8021 * x99)
-                + Self::mul_add(x92, x110, x93 * x108)
-                - Self::mul_add(703.3878000000001, x98, x97 * 15.183612000000002))
-            + (x158 - Self::mul_add(-7.06, x161, 0.1524 * x160));
+            + (S::mul_add(S::splat(-0.08), x100, S::splat(0.8021) * x99)
+                + S::mul_add(x92, x110, x93 * x108)
+                - S::mul_add(
+                    S::splat(703.3878000000001),
+                    x98,
+                    x97 * S::splat(15.183612000000002),
+                )) + (x158 - S::mul_add(S::splat(-7.06), x161, S::splat(0.1524) * x160));
         let x167 = f_ext[2][5] + x111
-            - Self::mul_add(-7.06, x155, Self::mul_add(-c_q3, x159, s_q3 * x157));
-        let x168 = Self::mul_add(
-            -c_q1,
+            - S::mul_add(
+                S::splat(-7.06),
+                x155,
+                S::mul_add(S::neg(c_q3), x159, s_q3 * x157),
+            );
+        let x168 = S::mul_add(
+            S::neg(c_q1),
             f_ext[1][5]
-                + Self::mul_add(
-                    190.97044034000004,
+                + S::mul_add(
+                    S::splat(190.97044034000004),
                     x85,
-                    Self::mul_add(x83, x90, qd[1] * x89),
-                ) - Self::mul_add(-6.377, x163, Self::mul_add(-c_q2, x167, s_q2 * x165)),
+                    S::mul_add(x83, x90, qd[1] * x89),
+                )
+                - S::mul_add(
+                    S::splat(-6.377),
+                    x163,
+                    S::mul_add(S::neg(c_q2), x167, s_q2 * x165),
+                ),
             s_q1
                 * (f_ext[1][3]
-                    - (Self::mul_add(-190.97044034, x86, x85 * 8596.210051042)
-                        - Self::mul_add(qd[1], x91, x84 * x90))
-                    + Self::mul_add(
-                        0.1524,
+                    - (S::mul_add(
+                        S::splat(-190.97044034),
+                        x86,
+                        x85 * S::splat(8596.210051042),
+                    ) - S::mul_add(qd[1], x91, x84 * x90))
+                    + S::mul_add(
+                        S::splat(0.1524),
                         x163,
-                        Self::mul_add(s_q2, x167, c_q2 * x165),
+                        S::mul_add(s_q2, x167, c_q2 * x165),
                     )),
         );
         let x169 = tau[0] + (f_ext[0][5] - x168);
-        let x170 = 1.0
-            / (14222.257549666001
+        let x170 = S::splat(1.0)
+            / (S::splat(14222.257549666001)
                 + (x66
-                    - Self::mul_add(
+                    - S::mul_add(
                         s_q1 * c_q1,
                         x67 + x67,
                         s_q1 * s_q1
-                            * (x66 - (-8596.210051042 - (x61 - (x47 + x56 - x61)))),
+                            * (x66
+                                - (S::splat(-8596.210051042) - (x61 - (x47 + x56 - x61)))),
                     )));
         let x171 = x68 * x170;
         let x172 = x69 * x170;
         let x173 = x70 * x170;
         let x174 = x77 * x170;
         let x175 = x82 * x170;
-        let x176 = 1.0 / Self::mul_add(-x68, x171, 8609.573807858 - (x63 - x64));
-        let x177 = Self::mul_add(x68, x172, x64);
+        let x176 = S::splat(1.0)
+            / S::mul_add(S::neg(x68), x171, S::splat(8609.573807858) - (x63 - x64));
+        let x177 = S::mul_add(x68, x172, x64);
         let x178 = x176 * x177;
-        let x179 = Self::mul_add(
+        let x179 = S::mul_add(
             x68,
             x173,
             x42
-                + Self::mul_add(
-                    -6.377,
-                    Self::mul_add(-c_q2, x37, s_q2 * x36),
-                    0.1524 * Self::mul_add(s_q2, x37, c_q2 * x36),
+                + S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(S::neg(c_q2), x37, s_q2 * x36),
+                    S::splat(0.1524) * S::mul_add(s_q2, x37, c_q2 * x36),
                 ),
         );
         let x180 = x176 * x179;
-        let x181 = Self::mul_add(
+        let x181 = S::mul_add(
             x68,
             x174,
             x75
-                + Self::mul_add(
-                    -6.377,
-                    Self::mul_add(c_q2, x72, s_q2 * x71),
-                    0.1524 * Self::mul_add(-s_q2, x72, c_q2 * x71),
+                + S::mul_add(
+                    S::splat(-6.377),
+                    S::mul_add(c_q2, x72, s_q2 * x71),
+                    S::splat(0.1524) * S::mul_add(S::neg(s_q2), x72, c_q2 * x71),
                 ),
         );
         let x182 = x176 * x181;
-        let x183 = Self::mul_add(x68, x175, x79);
+        let x183 = S::mul_add(x68, x175, x79);
         let x184 = x176 * x183;
-        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x69, x172, x49));
-        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x69, x173, x42));
+        let x185 = S::splat(1.0)
+            / S::mul_add(S::neg(x177), x178, S::mul_add(S::neg(x69), x172, x49));
+        let x186 = S::mul_add(S::neg(x177), x180, S::mul_add(S::neg(x69), x173, x42));
         let x187 = x185 * x186;
-        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x69, x174, x75));
+        let x188 = S::mul_add(S::neg(x177), x182, S::mul_add(S::neg(x69), x174, x75));
         let x189 = x185 * x188;
-        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x69, x175, x79));
+        let x190 = S::mul_add(S::neg(x177), x184, S::mul_add(S::neg(x69), x175, x79));
         let x191 = x185 * x190;
-        let x192 = Self::mul_add(
-            -x186,
+        let x192 = S::mul_add(
+            S::neg(x186),
             x187,
-            Self::mul_add(-x179, x180, Self::mul_add(-x70, x173, x28)),
+            S::mul_add(S::neg(x179), x180, S::mul_add(S::neg(x70), x173, x28)),
         );
-        let x193 = 1.0 / x192;
-        let x194 = Self::mul_add(
-            -x186,
+        let x193 = S::splat(1.0) / x192;
+        let x194 = S::mul_add(
+            S::neg(x186),
             x189,
-            Self::mul_add(-x179, x182, Self::mul_add(-x70, x174, x19)),
+            S::mul_add(S::neg(x179), x182, S::mul_add(S::neg(x70), x174, x19)),
         );
         let x195 = x193 * x194;
-        let x196 = Self::mul_add(
-            -x186,
+        let x196 = S::mul_add(
+            S::neg(x186),
             x191,
-            Self::mul_add(-x179, x184, Self::mul_add(-x70, x175, x79)),
+            S::mul_add(S::neg(x179), x184, S::mul_add(S::neg(x70), x175, x79)),
         );
         let x197 = x193 * x196;
-        let x198 = Self::mul_add(
-            -x188,
+        let x198 = S::mul_add(
+            S::neg(x188),
             x189,
-            Self::mul_add(-x181, x182, Self::mul_add(-x77, x174, x12)),
+            S::mul_add(S::neg(x181), x182, S::mul_add(S::neg(x77), x174, x12)),
         );
-        let x199 = 1.0 / Self::mul_add(-x194, x195, x198);
-        let x200 = Self::mul_add(
-            -x188,
+        let x199 = S::splat(1.0) / S::mul_add(S::neg(x194), x195, x198);
+        let x200 = S::mul_add(
+            S::neg(x188),
             x191,
-            Self::mul_add(-x181, x184, Self::mul_add(-x77, x175, x10)),
+            S::mul_add(S::neg(x181), x184, S::mul_add(S::neg(x77), x175, x10)),
         );
-        let x201 = Self::mul_add(-x194, x197, x200);
+        let x201 = S::mul_add(S::neg(x194), x197, x200);
         let x202 = x199 * x201;
-        let x203 = Self::mul_add(
-            -x190,
+        let x203 = S::mul_add(
+            S::neg(x190),
             x191,
-            Self::mul_add(-x183, x184, Self::mul_add(-x82, x175, 1.903)),
+            S::mul_add(
+                S::neg(x183),
+                x184,
+                S::mul_add(S::neg(x82), x175, S::splat(1.903)),
+            ),
         );
-        let x204 = 1.0 / Self::mul_add(-x201, x202, Self::mul_add(-x196, x197, x203));
-        let x205 = Self::mul_add(
-            -x169,
+        let x204 = S::splat(1.0)
+            / S::mul_add(S::neg(x201), x202, S::mul_add(S::neg(x196), x197, x203));
+        let x205 = S::mul_add(
+            S::neg(x169),
             x171,
             tau[1]
                 + (f_ext[1][4]
-                    - (Self::mul_add(x86, 0.0302, x85 * 1.928)
-                        + Self::mul_add(-x83, x91, x84 * x89))
+                    - (S::mul_add(x86, S::splat(0.0302), x85 * S::splat(1.928))
+                        + S::mul_add(S::neg(x83), x91, x84 * x89))
                     + (x166
-                        - Self::mul_add(
-                            -6.377,
-                            Self::mul_add(-c_q2, x164, s_q2 * x162),
-                            0.1524 * Self::mul_add(s_q2, x164, c_q2 * x162),
+                        - S::mul_add(
+                            S::splat(-6.377),
+                            S::mul_add(S::neg(c_q2), x164, s_q2 * x162),
+                            S::splat(0.1524) * S::mul_add(s_q2, x164, c_q2 * x162),
                         ))),
         );
-        let x206 = Self::mul_add(-x178, x205, Self::mul_add(x169, x172, tau[2] + x166));
-        let x207 = Self::mul_add(
-            -x187,
+        let x206 = S::mul_add(S::neg(x178), x205, S::mul_add(x169, x172, tau[2] + x166));
+        let x207 = S::mul_add(
+            S::neg(x187),
             x206,
-            Self::mul_add(-x180, x205, Self::mul_add(x169, x173, tau[3] + x158)),
+            S::mul_add(S::neg(x180), x205, S::mul_add(x169, x173, tau[3] + x158)),
         );
-        let x208 = Self::mul_add(
-            -x189,
+        let x208 = S::mul_add(
+            S::neg(x189),
             x206,
-            Self::mul_add(-x182, x205, Self::mul_add(x169, x174, tau[4] + x152)),
+            S::mul_add(S::neg(x182), x205, S::mul_add(x169, x174, tau[4] + x152)),
         );
-        let x209 = Self::mul_add(-x195, x207, x208);
-        let x210 = Self::mul_add(
-            -x191,
+        let x209 = S::mul_add(S::neg(x195), x207, x208);
+        let x210 = S::mul_add(
+            S::neg(x191),
             x206,
-            Self::mul_add(-x184, x205, Self::mul_add(x169, x175, tau[5] + x142)),
+            S::mul_add(S::neg(x184), x205, S::mul_add(x169, x175, tau[5] + x142)),
         );
-        let x211 = x204 * Self::mul_add(-x202, x209, Self::mul_add(-x197, x207, x210));
-        let x212 = Self::mul_add(-x202, x211, x199 * x209);
-        let x213 = Self::mul_add(-x197, x211, Self::mul_add(-x195, x212, x193 * x207));
-        let x214 = Self::mul_add(
-            -x191,
+        let x211 = x204
+            * S::mul_add(S::neg(x202), x209, S::mul_add(S::neg(x197), x207, x210));
+        let x212 = S::mul_add(S::neg(x202), x211, x199 * x209);
+        let x213 = S::mul_add(
+            S::neg(x197),
             x211,
-            Self::mul_add(-x189, x212, Self::mul_add(-x187, x213, x185 * x206)),
+            S::mul_add(S::neg(x195), x212, x193 * x207),
         );
-        let x215 = Self::mul_add(
-            -x182,
+        let x214 = S::mul_add(
+            S::neg(x191),
+            x211,
+            S::mul_add(S::neg(x189), x212, S::mul_add(S::neg(x187), x213, x185 * x206)),
+        );
+        let x215 = S::mul_add(
+            S::neg(x182),
             x212,
-            Self::mul_add(-x180, x213, Self::mul_add(-x178, x214, x176 * x205)),
+            S::mul_add(S::neg(x180), x213, S::mul_add(S::neg(x178), x214, x176 * x205)),
         );
-        let x216 = Self::mul_add(-x184, x211, x215);
-        let x217 = Self::mul_add(
+        let x216 = S::mul_add(S::neg(x184), x211, x215);
+        let x217 = S::mul_add(
             x173,
             x213,
-            Self::mul_add(x172, x214, Self::mul_add(-x171, x216, x169 * x170)),
+            S::mul_add(x172, x214, S::mul_add(S::neg(x171), x216, x169 * x170)),
         );
-        let x218 = Self::mul_add(x175, x211, Self::mul_add(x174, x212, x217));
+        let x218 = S::mul_add(x175, x211, S::mul_add(x174, x212, x217));
         [x218, x216, x214, x213, x212, x211]
     }
-    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
-    #[inline(always)]
-    fn mul_add(
-        a: ::core::primitive::f64,
-        b: ::core::primitive::f64,
-        c: ::core::primitive::f64,
-    ) -> ::core::primitive::f64 {
-        kanegen_runtime::fma::mul_add(a, b, c)
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        f_ext: &[[[::core::primitive::f64; 6]; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -9,9 +9,10 @@
 //! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4313 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1053, `forward_dynamics_derivatives` 2049, `mass_matrix_inverse` 201), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
+//! Fused multiply-adds where the target has them: 4313 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281, `inverse_dynamics_derivatives` 1053, `forward_dynamics_derivatives` 2049, `mass_matrix_inverse` 201), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1292,146 +1293,198 @@ impl Ssrms {
     pub fn mass_matrix(
         q: &[::core::primitive::f64; 7],
     ) -> [[::core::primitive::f64; 7]; 7] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::mass_matrix_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 7],
+    ) -> [[S; 7]; 7] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
             q[5],
         ]);
-        let x5 = s_q5 * s_q5 * 35.074;
-        let x6 = -35.074 + x5;
-        let x7 = s_q5 * c_q5 * 35.074;
-        let x8 = 179.8829695416 - x5;
-        let x9 = x6 - -129.6173695416;
+        let x5 = s_q5 * s_q5 * S::splat(35.074);
+        let x6 = S::splat(-35.074) + x5;
+        let x7 = s_q5 * c_q5 * S::splat(35.074);
+        let x8 = S::splat(179.8829695416) - x5;
+        let x9 = x6 - S::splat(-129.6173695416);
         let x10 = s_q4 * s_q4 * x9;
         let x11 = x6 - x10;
-        let x12 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x7);
-        let x13 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x7);
-        let x14 = 171.195516 * s_q4;
-        let x15 = 171.195516 * c_q4;
-        let x16 = 7.11 * x14;
-        let x17 = Self::mul_add(-7.11, x15, s_q4 * c_q4 * x9);
+        let x12 = S::mul_add(S::splat(97.44448770720001), s_q4, c_q4 * x7);
+        let x13 = S::mul_add(S::splat(-97.44448770720001), c_q4, s_q4 * x7);
+        let x14 = S::splat(171.195516) * s_q4;
+        let x15 = S::splat(171.195516) * c_q4;
+        let x16 = S::splat(7.11) * x14;
+        let x17 = S::mul_add(S::splat(-7.11), x15, s_q4 * c_q4 * x9);
         let x18 = x8 - x16;
-        let x19 = 3239.4582 - x14;
-        let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
-        let x22 = 24998.827802 - (x16 - x18);
+        let x19 = S::splat(3239.4582) - x14;
+        let x20 = S::splat(1375.0472756800002) - x12;
+        let x21 = S::splat(24989.305802)
+            - (x16 - (S::splat(-129.6173695416) + x10 - x16));
+        let x22 = S::splat(24998.827802) - (x16 - x18);
         let x23 = s_q3 * s_q3;
         let x24 = s_q3 * c_q3;
         let x25 = x11 - x21;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x27 = S::mul_add(x24, x26, x23 * x25);
         let x28 = x11 - x27;
         let x29 = s_q3 * x13;
         let x30 = c_q3 * x13;
         let x31 = s_q3 * x15;
-        let x32 = Self::mul_add(c_q3, x19, -x31);
+        let x32 = S::mul_add(c_q3, x19, S::neg(x31));
         let x33 = c_q3 * x15;
-        let x34 = Self::mul_add(s_q3, x19, x33);
-        let x35 = 7.11 * x32;
-        let x36 = Self::mul_add(x32, 0.475, Self::mul_add(c_q3, x20, x29));
-        let x37 = Self::mul_add(-7.11, x34, x17 + Self::mul_add(-x23, x26, x24 * x25));
-        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(s_q3, x20, -x30));
+        let x34 = S::mul_add(s_q3, x19, x33);
+        let x35 = S::splat(7.11) * x32;
+        let x36 = S::mul_add(x32, S::splat(0.475), S::mul_add(c_q3, x20, x29));
+        let x37 = S::mul_add(
+            S::splat(-7.11),
+            x34,
+            x17 + S::mul_add(S::neg(x23), x26, x24 * x25),
+        );
+        let x38 = S::mul_add(x34, S::splat(0.475), S::mul_add(s_q3, x20, S::neg(x30)));
         let x39 = x22 + x35;
-        let x40 = 5224.5702 + x32;
-        let x41 = 3946.18812068 + x36;
-        let x42 = 39234.474122 + (x35 + (x21 + x27 + x35));
-        let x43 = 39241.404122 + (x35 + x39);
+        let x40 = S::splat(5224.5702) + x32;
+        let x41 = S::splat(3946.18812068) + x36;
+        let x42 = S::splat(39234.474122) + (x35 + (x21 + x27 + x35));
+        let x43 = S::splat(39241.404122) + (x35 + x39);
         let x44 = s_q2 * s_q2;
         let x45 = s_q2 * c_q2;
         let x46 = x28 - x42;
         let x47 = x37 + x37;
-        let x48 = Self::mul_add(x45, x47, x44 * x46);
+        let x48 = S::mul_add(x45, x47, x44 * x46);
         let x49 = x28 - x48;
         let x50 = s_q2 * x38;
         let x51 = c_q2 * x38;
         let x52 = s_q2 * x34;
-        let x53 = Self::mul_add(c_q2, x40, -x52);
+        let x53 = S::mul_add(c_q2, x40, S::neg(x52));
         let x54 = c_q2 * x34;
-        let x55 = Self::mul_add(s_q2, x40, x54);
-        let x56 = Self::mul_add(0.5692, x53, Self::mul_add(c_q2, x41, -x50));
-        let x57 = Self::mul_add(0.5692, x55, Self::mul_add(s_q2, x41, x51));
-        let x58 = 1650.6386721183999 + (x42 + x48);
-        let x59 = 0.7026 * x55;
-        let x60 = Self::mul_add(
-            0.7026,
-            Self::mul_add(1145.5438279999998, s_q1, c_q1 * x53),
-            Self::mul_add(-s_q1, x57, c_q1 * (x37 + Self::mul_add(-x44, x47, x45 * x46))),
+        let x55 = S::mul_add(s_q2, x40, x54);
+        let x56 = S::mul_add(S::splat(0.5692), x53, S::mul_add(c_q2, x41, S::neg(x50)));
+        let x57 = S::mul_add(S::splat(0.5692), x55, S::mul_add(s_q2, x41, x51));
+        let x58 = S::splat(1650.6386721183999) + (x42 + x48);
+        let x59 = S::splat(0.7026) * x55;
+        let x60 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(S::splat(1145.5438279999998), s_q1, c_q1 * x53),
+            S::mul_add(
+                S::neg(s_q1),
+                x57,
+                c_q1 * (x37 + S::mul_add(S::neg(x44), x47, x45 * x46)),
+            ),
         );
-        let x61 = 2232.9683597151998
+        let x61 = S::splat(2232.9683597151998)
             - (x59
                 - (x49
-                    - Self::mul_add(
+                    - S::mul_add(
                         s_q1 * c_q1,
                         x56 + x56,
-                        s_q1 * s_q1 * (x49 - (-1647.2196721184 + x43)),
+                        s_q1 * s_q1 * (x49 - (S::splat(-1647.2196721184) + x43)),
                     ) - x59));
-        let x62 = -x60;
-        let x63 = -x57;
-        let x64 = Self::mul_add(
-            0.7026,
+        let x62 = S::neg(x60);
+        let x63 = S::neg(x57);
+        let x64 = S::mul_add(
+            S::splat(0.7026),
             s_q1 * x55,
-            Self::mul_add(-s_q1, x43, c_q1 * x56),
+            S::mul_add(S::neg(s_q1), x43, c_q1 * x56),
         );
-        let x65 = Self::mul_add(s_q2, x32, x54);
-        let x66 = -Self::mul_add(0.5692, x65, Self::mul_add(s_q2, x36, x51));
-        let x67 = Self::mul_add(
+        let x65 = S::mul_add(s_q2, x32, x54);
+        let x66 = S::neg(S::mul_add(S::splat(0.5692), x65, S::mul_add(s_q2, x36, x51)));
+        let x67 = S::mul_add(
             s_q1,
             x39,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-c_q2, x32, x52),
-                    Self::mul_add(-c_q2, x36, x50),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(S::neg(c_q2), x32, x52),
+                    S::mul_add(S::neg(c_q2), x36, x50),
                 ),
         );
-        let x68 = -Self::mul_add(-0.7026, s_q1 * x65, x67);
-        let x69 = Self::mul_add(-s_q3, x14, x33);
-        let x70 = Self::mul_add(c_q3, x14, x31);
-        let x71 = Self::mul_add(-0.475, x70, Self::mul_add(-c_q3, x12, x29));
-        let x72 = Self::mul_add(-0.475, x69, Self::mul_add(s_q3, x12, x30));
-        let x73 = Self::mul_add(-7.11, x70, x18);
-        let x74 = Self::mul_add(-s_q2, x70, c_q2 * x69);
-        let x75 = -Self::mul_add(0.5692, x74, Self::mul_add(-c_q2, x72, s_q2 * x71));
-        let x76 = Self::mul_add(
-            -s_q1,
+        let x68 = S::neg(S::mul_add(S::splat(-0.7026), s_q1 * x65, x67));
+        let x69 = S::mul_add(S::neg(s_q3), x14, x33);
+        let x70 = S::mul_add(c_q3, x14, x31);
+        let x71 = S::mul_add(S::splat(-0.475), x70, S::mul_add(S::neg(c_q3), x12, x29));
+        let x72 = S::mul_add(S::splat(-0.475), x69, S::mul_add(s_q3, x12, x30));
+        let x73 = S::mul_add(S::splat(-7.11), x70, x18);
+        let x74 = S::mul_add(S::neg(s_q2), x70, c_q2 * x69);
+        let x75 = S::neg(
+            S::mul_add(S::splat(0.5692), x74, S::mul_add(S::neg(c_q2), x72, s_q2 * x71)),
+        );
+        let x76 = S::mul_add(
+            S::neg(s_q1),
             x73,
             c_q1
-                * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x70, s_q2 * x69),
-                    Self::mul_add(s_q2, x72, c_q2 * x71),
+                * S::mul_add(
+                    S::splat(-0.5692),
+                    S::mul_add(c_q2, x70, s_q2 * x69),
+                    S::mul_add(s_q2, x72, c_q2 * x71),
                 ),
         );
-        let x77 = Self::mul_add(0.7026, s_q1 * x74, x76);
-        let x78 = 47.471 * s_q4;
-        let x79 = 47.471 * c_q4;
-        let x80 = Self::mul_add(s_q3, x79, c_q3 * x78);
-        let x81 = Self::mul_add(-c_q3, x79, s_q3 * x78);
-        let x82 = -Self::mul_add(c_q2, x81, s_q2 * x80);
-        let x83 = c_q1 * Self::mul_add(-s_q2, x81, c_q2 * x80);
-        let x84 = 9.336 * c_q5;
-        let x85 = 9.336 * s_q5;
+        let x77 = S::mul_add(S::splat(0.7026), s_q1 * x74, x76);
+        let x78 = S::splat(47.471) * s_q4;
+        let x79 = S::splat(47.471) * c_q4;
+        let x80 = S::mul_add(s_q3, x79, c_q3 * x78);
+        let x81 = S::mul_add(S::neg(c_q3), x79, s_q3 * x78);
+        let x82 = S::neg(S::mul_add(c_q2, x81, s_q2 * x80));
+        let x83 = c_q1 * S::mul_add(S::neg(s_q2), x81, c_q2 * x80);
+        let x84 = S::splat(9.336) * c_q5;
+        let x85 = S::splat(9.336) * s_q5;
         let x86 = c_q4 * x84;
         let x87 = s_q4 * x84;
-        let x88 = Self::mul_add(-s_q3, x87, c_q3 * x86);
-        let x89 = Self::mul_add(c_q3, x87, s_q3 * x86);
-        let x90 = -Self::mul_add(c_q2, x89, s_q2 * x88);
-        let x91 = Self::mul_add(
-            -s_q1,
+        let x88 = S::mul_add(S::neg(s_q3), x87, c_q3 * x86);
+        let x89 = S::mul_add(c_q3, x87, s_q3 * x86);
+        let x90 = S::neg(S::mul_add(c_q2, x89, s_q2 * x88));
+        let x91 = S::mul_add(
+            S::neg(s_q1),
             x85,
-            c_q1 * Self::mul_add(-s_q2, x89, c_q2 * x88),
+            c_q1 * S::mul_add(S::neg(s_q2), x89, c_q2 * x88),
         );
         [
             [x61, x62, x64, x68, x77, x83, x91],
             [x62, x58, x63, x66, x75, x82, x90],
-            [x64, x63, x43, x39, x73, 0.0, x85],
-            [x68, x66, x39, x22, x18, 0.0, x85],
-            [x77, x75, x73, x18, x8, 0.0, x85],
-            [x83, x82, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x91, x90, x85, x85, x85, 0.0, 9.336],
+            [x64, x63, x43, x39, x73, S::splat(0.0), x85],
+            [x68, x66, x39, x22, x18, S::splat(0.0), x85],
+            [x77, x75, x73, x18, x8, S::splat(0.0), x85],
+            [
+                x83,
+                x82,
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(47.471),
+                S::splat(0.0),
+            ],
+            [x91, x90, x85, x85, x85, S::splat(0.0), S::splat(9.336)],
         ]
+    }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 7]],
+        out: &mut [[[::core::primitive::f64; 7]; 7]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
@@ -1441,173 +1494,269 @@ impl Ssrms {
         q: &[::core::primitive::f64; 7],
         qd: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7]) -> [S; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
-        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        (s_q6, c_q6)] = S::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
         let x7 = qd[0] * s_q1;
-        let x8 = qd[0] * qd[0] * 0.7026;
+        let x8 = qd[0] * qd[0] * S::splat(0.7026);
         let x9 = qd[1] * x7;
         let x10 = qd[1] * x6;
         let x11 = x6 * x7;
-        let x12 = Self::mul_add(x6, x6, qd[1] * qd[1]);
-        let x13 = x7 * 1647.2196721184;
-        let x14 = 1650.6386721183999 * qd[1];
-        let x15 = Self::mul_add(-qd[1], s_q2, x6 * c_q2);
-        let x16 = Self::mul_add(qd[1], c_q2, x6 * s_q2);
-        let x17 = 0.5692 * x11;
-        let x18 = 0.5692 * x12;
-        let x19 = Self::mul_add(-0.5692, x9 + x9, x8);
-        let x20 = Self::mul_add(-c_q2, x19, s_q2 * x17);
-        let x21 = Self::mul_add(qd[2], x16, x9 * c_q2);
-        let x22 = Self::mul_add(-qd[2], x15, x9 * s_q2);
+        let x12 = S::mul_add(x6, x6, qd[1] * qd[1]);
+        let x13 = x7 * S::splat(1647.2196721184);
+        let x14 = S::splat(1650.6386721183999) * qd[1];
+        let x15 = S::mul_add(S::neg(qd[1]), s_q2, x6 * c_q2);
+        let x16 = S::mul_add(qd[1], c_q2, x6 * s_q2);
+        let x17 = S::splat(0.5692) * x11;
+        let x18 = S::splat(0.5692) * x12;
+        let x19 = S::mul_add(S::splat(-0.5692), x9 + x9, x8);
+        let x20 = S::mul_add(S::neg(c_q2), x19, s_q2 * x17);
+        let x21 = S::mul_add(qd[2], x16, x9 * c_q2);
+        let x22 = S::mul_add(S::neg(qd[2]), x15, x9 * s_q2);
         let x23 = qd[2] - x7;
         let x24 = x16 * x16;
-        let x25 = Self::mul_add(x23, x23, x24);
+        let x25 = S::mul_add(x23, x23, x24);
         let x26 = x15 * x23;
-        let x27 = Self::mul_add(x15, x16, x10);
+        let x27 = S::mul_add(x15, x16, x10);
         let x28 = x22 - x26;
-        let x29 = 3946.18812068 * x23;
-        let x30 = 39234.474122 * x16;
-        let x31 = Self::mul_add(39241.404122, x23, 3946.1881206800003 * x15);
-        let x32 = Self::mul_add(
-            -5224.5702,
+        let x29 = S::splat(3946.18812068) * x23;
+        let x30 = S::splat(39234.474122) * x16;
+        let x31 = S::mul_add(
+            S::splat(39241.404122),
+            x23,
+            S::splat(3946.1881206800003) * x15,
+        );
+        let x32 = S::mul_add(
+            S::splat(-5224.5702),
             x18,
-            Self::mul_add(39234.474122, x22, Self::mul_add(-x15, x31, x23 * x29)),
-        );
-        let x33 = Self::mul_add(-x16, s_q3, x15 * c_q3);
-        let x34 = Self::mul_add(x16, c_q3, x15 * s_q3);
-        let x35 = Self::mul_add(s_q2, x19, c_q2 * x17)
-            - Self::mul_add(x22 + x26, 0.475, 7.11 * x25);
-        let x36 = x20 + Self::mul_add(Self::mul_add(-x16, x23, x21), 0.475, 7.11 * x27);
-        let x37 = x18 - Self::mul_add(Self::mul_add(x15, x15, x24), -0.475, 7.11 * x28);
-        let x38 = Self::mul_add(c_q3, x36, s_q3 * x35);
-        let x39 = Self::mul_add(qd[3], x34, Self::mul_add(-x22, s_q3, x21 * c_q3));
-        let x40 = Self::mul_add(-qd[3], x33, Self::mul_add(x22, c_q3, x21 * s_q3));
-        let x41 = qd[3] + x23;
-        let x42 = Self::mul_add(x41, x41, x34 * x34);
-        let x43 = Self::mul_add(x33, x34, x10);
-        let x44 = Self::mul_add(-x33, x41, x40);
-        let x45 = 1375.0472756800002 * x41;
-        let x46 = 24989.305802 * x34;
-        let x47 = Self::mul_add(24998.827802, x41, 1375.0472756800002 * x33);
-        let x48 = Self::mul_add(
-            -3239.4582,
-            x37,
-            Self::mul_add(24989.305802, x40, Self::mul_add(-x33, x47, x41 * x45)),
-        );
-        let x49 = Self::mul_add(-x34, s_q4, x33 * c_q4);
-        let x50 = Self::mul_add(x34, c_q4, x33 * s_q4);
-        let x51 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x43, x38),
-            c_q4 * Self::mul_add(-7.11, x42, Self::mul_add(-s_q3, x36, c_q3 * x35)),
-        );
-        let x52 = Self::mul_add(qd[4], x50, Self::mul_add(-x40, s_q4, x39 * c_q4));
-        let x53 = Self::mul_add(-qd[4], x49, Self::mul_add(x40, c_q4, x39 * s_q4));
-        let x54 = qd[4] + x41;
-        let x55 = 171.195516 * Self::mul_add(-x49, x50, x10);
-        let x56 = 171.195516 * Self::mul_add(x49, x49, x54 * x54);
-        let x57 = 171.195516 * Self::mul_add(x50, x54, x52);
-        let x58 = Self::mul_add(97.44448770720001, x54, x50 * 177.0883695416);
-        let x59 = Self::mul_add(-179.8829695416, x54, 97.44448770720001 * x50);
-        let x60 = Self::mul_add(
-            -171.195516,
-            x51,
-            Self::mul_add(
-                x49,
-                x58,
-                Self::mul_add(-179.8829695416, x10, 97.44448770720001 * x53),
+            S::mul_add(
+                S::splat(39234.474122),
+                x22,
+                S::mul_add(S::neg(x15), x31, x23 * x29),
             ),
         );
-        let x61 = Self::mul_add(-x54, c_q5, x49 * s_q5);
-        let x62 = Self::mul_add(x54, s_q5, x49 * c_q5);
-        let x63 = Self::mul_add(qd[5], x61, Self::mul_add(x10, s_q5, x52 * c_q5));
+        let x33 = S::mul_add(S::neg(x16), s_q3, x15 * c_q3);
+        let x34 = S::mul_add(x16, c_q3, x15 * s_q3);
+        let x35 = S::mul_add(s_q2, x19, c_q2 * x17)
+            - S::mul_add(x22 + x26, S::splat(0.475), S::splat(7.11) * x25);
+        let x36 = x20
+            + S::mul_add(
+                S::mul_add(S::neg(x16), x23, x21),
+                S::splat(0.475),
+                S::splat(7.11) * x27,
+            );
+        let x37 = x18
+            - S::mul_add(
+                S::mul_add(x15, x15, x24),
+                S::splat(-0.475),
+                S::splat(7.11) * x28,
+            );
+        let x38 = S::mul_add(c_q3, x36, s_q3 * x35);
+        let x39 = S::mul_add(qd[3], x34, S::mul_add(S::neg(x22), s_q3, x21 * c_q3));
+        let x40 = S::mul_add(S::neg(qd[3]), x33, S::mul_add(x22, c_q3, x21 * s_q3));
+        let x41 = qd[3] + x23;
+        let x42 = S::mul_add(x41, x41, x34 * x34);
+        let x43 = S::mul_add(x33, x34, x10);
+        let x44 = S::mul_add(S::neg(x33), x41, x40);
+        let x45 = S::splat(1375.0472756800002) * x41;
+        let x46 = S::splat(24989.305802) * x34;
+        let x47 = S::mul_add(
+            S::splat(24998.827802),
+            x41,
+            S::splat(1375.0472756800002) * x33,
+        );
+        let x48 = S::mul_add(
+            S::splat(-3239.4582),
+            x37,
+            S::mul_add(
+                S::splat(24989.305802),
+                x40,
+                S::mul_add(S::neg(x33), x47, x41 * x45),
+            ),
+        );
+        let x49 = S::mul_add(S::neg(x34), s_q4, x33 * c_q4);
+        let x50 = S::mul_add(x34, c_q4, x33 * s_q4);
+        let x51 = S::mul_add(
+            S::neg(s_q4),
+            S::mul_add(S::splat(7.11), x43, x38),
+            c_q4
+                * S::mul_add(
+                    S::splat(-7.11),
+                    x42,
+                    S::mul_add(S::neg(s_q3), x36, c_q3 * x35),
+                ),
+        );
+        let x52 = S::mul_add(qd[4], x50, S::mul_add(S::neg(x40), s_q4, x39 * c_q4));
+        let x53 = S::mul_add(S::neg(qd[4]), x49, S::mul_add(x40, c_q4, x39 * s_q4));
+        let x54 = qd[4] + x41;
+        let x55 = S::splat(171.195516) * S::mul_add(S::neg(x49), x50, x10);
+        let x56 = S::splat(171.195516) * S::mul_add(x49, x49, x54 * x54);
+        let x57 = S::splat(171.195516) * S::mul_add(x50, x54, x52);
+        let x58 = S::mul_add(
+            S::splat(97.44448770720001),
+            x54,
+            x50 * S::splat(177.0883695416),
+        );
+        let x59 = S::mul_add(
+            S::splat(-179.8829695416),
+            x54,
+            S::splat(97.44448770720001) * x50,
+        );
+        let x60 = S::mul_add(
+            S::splat(-171.195516),
+            x51,
+            S::mul_add(
+                x49,
+                x58,
+                S::mul_add(
+                    S::splat(-179.8829695416),
+                    x10,
+                    S::splat(97.44448770720001) * x53,
+                ),
+            ),
+        );
+        let x61 = S::mul_add(S::neg(x54), c_q5, x49 * s_q5);
+        let x62 = S::mul_add(x54, s_q5, x49 * c_q5);
+        let x63 = S::mul_add(qd[5], x61, S::mul_add(x10, s_q5, x52 * c_q5));
         let x64 = qd[5] + x50;
-        let x65 = 44.41 * x62;
-        let x66 = 47.471 * x64;
-        let x67 = 9.336 * x63;
-        let x68 = -x67;
-        let x69 = 9.336 * (qd[6] + x62);
-        let x70 = Self::mul_add(x64, c_q6, x61 * s_q6) * x69;
-        let x71 = Self::mul_add(-x64, s_q6, x61 * c_q6) * x69;
-        let x72 = Self::mul_add(x62, x66, x64 * x65)
-            - Self::mul_add(-s_q6, x71, c_q6 * x70);
-        let x73 = Self::mul_add(-x61, x66, 44.41 * x63) - x67;
-        let x74 = Self::mul_add(x61, x65, 47.471 * x53)
-            - Self::mul_add(c_q6, x71, s_q6 * x70);
-        let x75 = -x74;
-        let x76 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-7.11, x44, x37),
-            Self::mul_add(-x50, x59, x54 * x58),
-        ) - Self::mul_add(c_q5, x73, s_q5 * x72);
-        let x77 = Self::mul_add(
-            -x49,
+        let x65 = S::splat(44.41) * x62;
+        let x66 = S::splat(47.471) * x64;
+        let x67 = S::splat(9.336) * x63;
+        let x68 = S::neg(x67);
+        let x69 = S::splat(9.336) * (qd[6] + x62);
+        let x70 = S::mul_add(x64, c_q6, x61 * s_q6) * x69;
+        let x71 = S::mul_add(S::neg(x64), s_q6, x61 * c_q6) * x69;
+        let x72 = S::mul_add(x62, x66, x64 * x65)
+            - S::mul_add(S::neg(s_q6), x71, c_q6 * x70);
+        let x73 = S::mul_add(S::neg(x61), x66, S::splat(44.41) * x63) - x67;
+        let x74 = S::mul_add(x61, x65, S::splat(47.471) * x53)
+            - S::mul_add(c_q6, x71, s_q6 * x70);
+        let x75 = S::neg(x74);
+        let x76 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::splat(-7.11), x44, x37),
+            S::mul_add(S::neg(x50), x59, x54 * x58),
+        ) - S::mul_add(c_q5, x73, s_q5 * x72);
+        let x77 = S::mul_add(
+            S::neg(x49),
             x59,
-            Self::mul_add(97.44448770720001, x10, x53 * 177.0883695416),
+            S::mul_add(S::splat(97.44448770720001), x10, x53 * S::splat(177.0883695416)),
         ) - x74;
-        let x78 = x60 - Self::mul_add(-s_q5, x73, c_q5 * x72);
-        let x79 = Self::mul_add(-c_q4, x56, s_q4 * x55);
-        let x80 = Self::mul_add(3239.4582, x42, -Self::mul_add(s_q4, x56, c_q4 * x55));
-        let x81 = Self::mul_add(3239.4582, x43, -x79);
-        let x82 = Self::mul_add(3239.4582, x44, x57);
-        let x83 = Self::mul_add(
-            1375.0472756800002,
+        let x78 = x60 - S::mul_add(S::neg(s_q5), x73, c_q5 * x72);
+        let x79 = S::mul_add(S::neg(c_q4), x56, s_q4 * x55);
+        let x80 = S::mul_add(
+            S::splat(3239.4582),
+            x42,
+            S::neg(S::mul_add(s_q4, x56, c_q4 * x55)),
+        );
+        let x81 = S::mul_add(S::splat(3239.4582), x43, S::neg(x79));
+        let x82 = S::mul_add(S::splat(3239.4582), x44, x57);
+        let x83 = S::mul_add(
+            S::splat(1375.0472756800002),
             x10,
-            -Self::mul_add(-x34, x47, x41 * x46),
-        ) + Self::mul_add(-s_q4, x77, c_q4 * x76);
-        let x84 = x48 - Self::mul_add(-7.11, x57, Self::mul_add(c_q4, x77, s_q4 * x76));
-        let x85 = Self::mul_add(
-            3239.4582,
+            S::neg(S::mul_add(S::neg(x34), x47, x41 * x46)),
+        ) + S::mul_add(S::neg(s_q4), x77, c_q4 * x76);
+        let x84 = x48
+            - S::mul_add(S::splat(-7.11), x57, S::mul_add(c_q4, x77, s_q4 * x76));
+        let x85 = S::mul_add(
+            S::splat(3239.4582),
             x38,
-            Self::mul_add(24998.827802, x10, 1375.0472756800002 * x39)
-                - Self::mul_add(-x33, x46, x34 * x45),
-        ) - Self::mul_add(7.11, x79, x78);
-        let x86 = -x85;
-        let x87 = Self::mul_add(-s_q3, x81, c_q3 * x80);
-        let x88 = Self::mul_add(c_q3, x81, s_q3 * x80);
-        let x89 = Self::mul_add(5224.5702, x25, x87);
-        let x90 = Self::mul_add(5224.5702, x27, x88);
-        let x91 = Self::mul_add(3946.18812068, x10, -Self::mul_add(-x16, x31, x23 * x30))
-            + Self::mul_add(0.475, x88, Self::mul_add(s_q3, x84, c_q3 * x83));
+            S::mul_add(S::splat(24998.827802), x10, S::splat(1375.0472756800002) * x39)
+                - S::mul_add(S::neg(x33), x46, x34 * x45),
+        ) - S::mul_add(S::splat(7.11), x79, x78);
+        let x86 = S::neg(x85);
+        let x87 = S::mul_add(S::neg(s_q3), x81, c_q3 * x80);
+        let x88 = S::mul_add(c_q3, x81, s_q3 * x80);
+        let x89 = S::mul_add(S::splat(5224.5702), x25, x87);
+        let x90 = S::mul_add(S::splat(5224.5702), x27, x88);
+        let x91 = S::mul_add(
+            S::splat(3946.18812068),
+            x10,
+            S::neg(S::mul_add(S::neg(x16), x31, x23 * x30)),
+        ) + S::mul_add(S::splat(0.475), x88, S::mul_add(s_q3, x84, c_q3 * x83));
         let x92 = x32
-            - (Self::mul_add(-c_q3, x84, s_q3 * x83)
-                - Self::mul_add(7.11, x82, 0.475 * x87));
-        let x93 = Self::mul_add(
-            5224.5702,
+            - (S::mul_add(S::neg(c_q3), x84, s_q3 * x83)
+                - S::mul_add(S::splat(7.11), x82, S::splat(0.475) * x87));
+        let x93 = S::mul_add(
+            S::splat(5224.5702),
             x20,
-            Self::mul_add(39241.404122, x10, 3946.1881206800003 * x21)
-                - Self::mul_add(-x15, x30, x16 * x29),
-        ) + Self::mul_add(7.11, x88, x85);
-        let x94 = -x93;
-        let x95 = Self::mul_add(-s_q2, x90, c_q2 * x89);
-        let x96 = Self::mul_add(
+            S::mul_add(S::splat(39241.404122), x10, S::splat(3946.1881206800003) * x21)
+                - S::mul_add(S::neg(x15), x30, x16 * x29),
+        ) + S::mul_add(S::splat(7.11), x88, x85);
+        let x94 = S::neg(x93);
+        let x95 = S::mul_add(S::neg(s_q2), x90, c_q2 * x89);
+        let x96 = S::mul_add(
             x6,
             x13,
-            Self::mul_add(-0.5692, x95, Self::mul_add(-c_q2, x92, s_q2 * x91)),
+            S::mul_add(S::splat(-0.5692), x95, S::mul_add(S::neg(c_q2), x92, s_q2 * x91)),
         );
-        let x97 = Self::mul_add(
+        let x97 = S::mul_add(
             c_q1,
-            Self::mul_add(1145.5438279999998, x12, -Self::mul_add(5224.5702, x28, x82)),
-            s_q1 * Self::mul_add(1145.5438279999998, x11, -x95),
+            S::mul_add(
+                S::splat(1145.5438279999998),
+                x12,
+                S::neg(S::mul_add(S::splat(5224.5702), x28, x82)),
+            ),
+            s_q1 * S::mul_add(S::splat(1145.5438279999998), x11, S::neg(x95)),
         );
-        let x98 = Self::mul_add(
+        let x98 = S::mul_add(
             s_q1,
-            Self::mul_add(-x6, x14, x10 * 1647.2196721184) - x93,
+            S::mul_add(S::neg(x6), x14, x10 * S::splat(1647.2196721184)) - x93,
             c_q1
-                * (Self::mul_add(
-                    -1145.5438279999998,
+                * (S::mul_add(
+                    S::splat(-1145.5438279999998),
                     x8,
-                    Self::mul_add(x7, x14, qd[1] * x13),
+                    S::mul_add(x7, x14, qd[1] * x13),
                 )
-                    + Self::mul_add(
-                        0.5692,
-                        Self::mul_add(c_q2, x90, s_q2 * x89),
-                        Self::mul_add(s_q2, x92, c_q2 * x91),
+                    + S::mul_add(
+                        S::splat(0.5692),
+                        S::mul_add(c_q2, x90, s_q2 * x89),
+                        S::mul_add(s_q2, x92, c_q2 * x91),
                     )),
         );
-        let x99 = -Self::mul_add(0.7026, x97, x98);
+        let x99 = S::neg(S::mul_add(S::splat(0.7026), x97, x98));
         [x99, x96, x94, x86, x78, x75, x68]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1618,180 +1767,294 @@ impl Ssrms {
         qd: &[::core::primitive::f64; 7],
         qdd: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::inverse_dynamics_lanes::<::core::primitive::f64>(q, qd, qdd)
+    }
+    /// [`Self::inverse_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], qdd: &[S; 7]) -> [S; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
-        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        (s_q6, c_q6)] = S::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = qd[0] * c_q1;
         let x7 = qd[0] * s_q1;
-        let x8 = qdd[0] * 0.7026;
-        let x9 = qd[0] * qd[0] * 0.7026;
+        let x8 = qdd[0] * S::splat(0.7026);
+        let x9 = qd[0] * qd[0] * S::splat(0.7026);
         let x10 = s_q1 * x8;
         let x11 = qd[1] * x7;
-        let x12 = Self::mul_add(qdd[0], c_q1, -x11);
-        let x13 = Self::mul_add(qd[1], x6, qdd[0] * s_q1);
-        let x14 = Self::mul_add(x6, x7, qdd[1]);
-        let x15 = Self::mul_add(x6, x6, qd[1] * qd[1]);
-        let x16 = x7 * 1647.2196721184;
-        let x17 = 1650.6386721183999 * qd[1];
-        let x18 = Self::mul_add(-qd[1], s_q2, x6 * c_q2);
-        let x19 = Self::mul_add(qd[1], c_q2, x6 * s_q2);
-        let x20 = Self::mul_add(-0.5692, x14, x10);
-        let x21 = Self::mul_add(-0.5692, x15, c_q1 * x8);
-        let x22 = Self::mul_add(-0.5692, x11 - x12, x9);
-        let x23 = Self::mul_add(c_q2, x22, s_q2 * x20);
-        let x24 = Self::mul_add(-qd[2], x19, Self::mul_add(-qdd[1], s_q2, x12 * c_q2));
-        let x25 = Self::mul_add(qd[2], x18, Self::mul_add(qdd[1], c_q2, x12 * s_q2));
+        let x12 = S::mul_add(qdd[0], c_q1, S::neg(x11));
+        let x13 = S::mul_add(qd[1], x6, qdd[0] * s_q1);
+        let x14 = S::mul_add(x6, x7, qdd[1]);
+        let x15 = S::mul_add(x6, x6, qd[1] * qd[1]);
+        let x16 = x7 * S::splat(1647.2196721184);
+        let x17 = S::splat(1650.6386721183999) * qd[1];
+        let x18 = S::mul_add(S::neg(qd[1]), s_q2, x6 * c_q2);
+        let x19 = S::mul_add(qd[1], c_q2, x6 * s_q2);
+        let x20 = S::mul_add(S::splat(-0.5692), x14, x10);
+        let x21 = S::mul_add(S::splat(-0.5692), x15, c_q1 * x8);
+        let x22 = S::mul_add(S::splat(-0.5692), x11 - x12, x9);
+        let x23 = S::mul_add(c_q2, x22, s_q2 * x20);
+        let x24 = S::mul_add(
+            S::neg(qd[2]),
+            x19,
+            S::mul_add(S::neg(qdd[1]), s_q2, x12 * c_q2),
+        );
+        let x25 = S::mul_add(qd[2], x18, S::mul_add(qdd[1], c_q2, x12 * s_q2));
         let x26 = qdd[2] - x13;
         let x27 = qd[2] - x7;
         let x28 = x19 * x19;
-        let x29 = Self::mul_add(x27, x27, x28);
+        let x29 = S::mul_add(x27, x27, x28);
         let x30 = x18 * x27;
-        let x31 = Self::mul_add(-x18, x19, x26);
+        let x31 = S::mul_add(S::neg(x18), x19, x26);
         let x32 = x25 + x30;
-        let x33 = 3946.18812068 * x27;
-        let x34 = 39234.474122 * x19;
-        let x35 = Self::mul_add(39241.404122, x27, 3946.1881206800003 * x18);
-        let x36 = Self::mul_add(
-            -5224.5702,
+        let x33 = S::splat(3946.18812068) * x27;
+        let x34 = S::splat(39234.474122) * x19;
+        let x35 = S::mul_add(
+            S::splat(39241.404122),
+            x27,
+            S::splat(3946.1881206800003) * x18,
+        );
+        let x36 = S::mul_add(
+            S::splat(-5224.5702),
             x21,
-            Self::mul_add(39234.474122, x25, -Self::mul_add(-x18, x35, x27 * x33)),
-        );
-        let x37 = Self::mul_add(-x19, s_q3, x18 * c_q3);
-        let x38 = Self::mul_add(x19, c_q3, x18 * s_q3);
-        let x39 = Self::mul_add(-s_q2, x22, c_q2 * x20)
-            + Self::mul_add(x25 - x30, -0.475, 7.11 * x29);
-        let x40 = x23 + Self::mul_add(Self::mul_add(x19, x27, x24), 0.475, 7.11 * x31);
-        let x41 = x21 - Self::mul_add(Self::mul_add(x18, x18, x28), 0.475, 7.11 * x32);
-        let x42 = Self::mul_add(c_q3, x40, s_q3 * x39);
-        let x43 = Self::mul_add(-qd[3], x38, Self::mul_add(-x25, s_q3, x24 * c_q3));
-        let x44 = Self::mul_add(qd[3], x37, Self::mul_add(x25, c_q3, x24 * s_q3));
-        let x45 = qdd[3] + x26;
-        let x46 = qd[3] + x27;
-        let x47 = Self::mul_add(x46, x46, x38 * x38);
-        let x48 = Self::mul_add(-x37, x38, x45);
-        let x49 = Self::mul_add(x37, x46, x44);
-        let x50 = 1375.0472756800002 * x46;
-        let x51 = 24989.305802 * x38;
-        let x52 = Self::mul_add(24998.827802, x46, 1375.0472756800002 * x37);
-        let x53 = Self::mul_add(
-            -3239.4582,
-            x41,
-            Self::mul_add(24989.305802, x44, -Self::mul_add(-x37, x52, x46 * x50)),
-        );
-        let x54 = Self::mul_add(-x38, s_q4, x37 * c_q4);
-        let x55 = Self::mul_add(x38, c_q4, x37 * s_q4);
-        let x56 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x48, x42),
-            c_q4 * Self::mul_add(7.11, x47, Self::mul_add(-s_q3, x40, c_q3 * x39)),
-        );
-        let x57 = Self::mul_add(-qd[4], x55, Self::mul_add(-x44, s_q4, x43 * c_q4));
-        let x58 = Self::mul_add(qd[4], x54, Self::mul_add(x44, c_q4, x43 * s_q4));
-        let x59 = qdd[4] + x45;
-        let x60 = qd[4] + x46;
-        let x61 = 171.195516 * Self::mul_add(x54, x55, x59);
-        let x62 = 171.195516 * Self::mul_add(x54, x54, x60 * x60);
-        let x63 = 171.195516 * Self::mul_add(-x55, x60, x57);
-        let x64 = Self::mul_add(97.44448770720001, x60, x55 * 177.0883695416);
-        let x65 = Self::mul_add(-179.8829695416, x60, 97.44448770720001 * x55);
-        let x66 = Self::mul_add(
-            -171.195516,
-            x56,
-            Self::mul_add(
-                -x54,
-                x64,
-                Self::mul_add(-179.8829695416, x59, 97.44448770720001 * x58),
+            S::mul_add(
+                S::splat(39234.474122),
+                x25,
+                S::neg(S::mul_add(S::neg(x18), x35, x27 * x33)),
             ),
         );
-        let x67 = Self::mul_add(-x60, c_q5, x54 * s_q5);
-        let x68 = Self::mul_add(x60, s_q5, x54 * c_q5);
-        let x69 = Self::mul_add(-qd[5], x67, Self::mul_add(x59, s_q5, x57 * c_q5));
+        let x37 = S::mul_add(S::neg(x19), s_q3, x18 * c_q3);
+        let x38 = S::mul_add(x19, c_q3, x18 * s_q3);
+        let x39 = S::mul_add(S::neg(s_q2), x22, c_q2 * x20)
+            + S::mul_add(x25 - x30, S::splat(-0.475), S::splat(7.11) * x29);
+        let x40 = x23
+            + S::mul_add(
+                S::mul_add(x19, x27, x24),
+                S::splat(0.475),
+                S::splat(7.11) * x31,
+            );
+        let x41 = x21
+            - S::mul_add(
+                S::mul_add(x18, x18, x28),
+                S::splat(0.475),
+                S::splat(7.11) * x32,
+            );
+        let x42 = S::mul_add(c_q3, x40, s_q3 * x39);
+        let x43 = S::mul_add(
+            S::neg(qd[3]),
+            x38,
+            S::mul_add(S::neg(x25), s_q3, x24 * c_q3),
+        );
+        let x44 = S::mul_add(qd[3], x37, S::mul_add(x25, c_q3, x24 * s_q3));
+        let x45 = qdd[3] + x26;
+        let x46 = qd[3] + x27;
+        let x47 = S::mul_add(x46, x46, x38 * x38);
+        let x48 = S::mul_add(S::neg(x37), x38, x45);
+        let x49 = S::mul_add(x37, x46, x44);
+        let x50 = S::splat(1375.0472756800002) * x46;
+        let x51 = S::splat(24989.305802) * x38;
+        let x52 = S::mul_add(
+            S::splat(24998.827802),
+            x46,
+            S::splat(1375.0472756800002) * x37,
+        );
+        let x53 = S::mul_add(
+            S::splat(-3239.4582),
+            x41,
+            S::mul_add(
+                S::splat(24989.305802),
+                x44,
+                S::neg(S::mul_add(S::neg(x37), x52, x46 * x50)),
+            ),
+        );
+        let x54 = S::mul_add(S::neg(x38), s_q4, x37 * c_q4);
+        let x55 = S::mul_add(x38, c_q4, x37 * s_q4);
+        let x56 = S::mul_add(
+            S::neg(s_q4),
+            S::mul_add(S::splat(7.11), x48, x42),
+            c_q4
+                * S::mul_add(
+                    S::splat(7.11),
+                    x47,
+                    S::mul_add(S::neg(s_q3), x40, c_q3 * x39),
+                ),
+        );
+        let x57 = S::mul_add(
+            S::neg(qd[4]),
+            x55,
+            S::mul_add(S::neg(x44), s_q4, x43 * c_q4),
+        );
+        let x58 = S::mul_add(qd[4], x54, S::mul_add(x44, c_q4, x43 * s_q4));
+        let x59 = qdd[4] + x45;
+        let x60 = qd[4] + x46;
+        let x61 = S::splat(171.195516) * S::mul_add(x54, x55, x59);
+        let x62 = S::splat(171.195516) * S::mul_add(x54, x54, x60 * x60);
+        let x63 = S::splat(171.195516) * S::mul_add(S::neg(x55), x60, x57);
+        let x64 = S::mul_add(
+            S::splat(97.44448770720001),
+            x60,
+            x55 * S::splat(177.0883695416),
+        );
+        let x65 = S::mul_add(
+            S::splat(-179.8829695416),
+            x60,
+            S::splat(97.44448770720001) * x55,
+        );
+        let x66 = S::mul_add(
+            S::splat(-171.195516),
+            x56,
+            S::mul_add(
+                S::neg(x54),
+                x64,
+                S::mul_add(
+                    S::splat(-179.8829695416),
+                    x59,
+                    S::splat(97.44448770720001) * x58,
+                ),
+            ),
+        );
+        let x67 = S::mul_add(S::neg(x60), c_q5, x54 * s_q5);
+        let x68 = S::mul_add(x60, s_q5, x54 * c_q5);
+        let x69 = S::mul_add(S::neg(qd[5]), x67, S::mul_add(x59, s_q5, x57 * c_q5));
         let x70 = qd[5] + x55;
-        let x71 = 44.41 * x68;
-        let x72 = 47.471 * x70;
-        let x73 = 9.336 * (qdd[6] + x69);
-        let x74 = 9.336 * (qd[6] + x68);
-        let x75 = Self::mul_add(x70, c_q6, x67 * s_q6) * x74;
-        let x76 = Self::mul_add(-x70, s_q6, x67 * c_q6) * x74;
-        let x77 = Self::mul_add(x68, x72, x70 * x71)
-            - Self::mul_add(-s_q6, x76, c_q6 * x75);
-        let x78 = Self::mul_add(x67, x72, 44.41 * x69) - x73;
-        let x79 = Self::mul_add(-x67, x71, 47.471 * (qdd[5] + x58))
-            + Self::mul_add(c_q6, x76, s_q6 * x75);
-        let x80 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-7.11, x49, x41),
-            Self::mul_add(-x55, x65, x60 * x64),
-        ) - Self::mul_add(-c_q5, x78, s_q5 * x77);
-        let x81 = Self::mul_add(
+        let x71 = S::splat(44.41) * x68;
+        let x72 = S::splat(47.471) * x70;
+        let x73 = S::splat(9.336) * (qdd[6] + x69);
+        let x74 = S::splat(9.336) * (qd[6] + x68);
+        let x75 = S::mul_add(x70, c_q6, x67 * s_q6) * x74;
+        let x76 = S::mul_add(S::neg(x70), s_q6, x67 * c_q6) * x74;
+        let x77 = S::mul_add(x68, x72, x70 * x71)
+            - S::mul_add(S::neg(s_q6), x76, c_q6 * x75);
+        let x78 = S::mul_add(x67, x72, S::splat(44.41) * x69) - x73;
+        let x79 = S::mul_add(S::neg(x67), x71, S::splat(47.471) * (qdd[5] + x58))
+            + S::mul_add(c_q6, x76, s_q6 * x75);
+        let x80 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::splat(-7.11), x49, x41),
+            S::mul_add(S::neg(x55), x65, x60 * x64),
+        ) - S::mul_add(S::neg(c_q5), x78, s_q5 * x77);
+        let x81 = S::mul_add(
             x54,
             x65,
-            Self::mul_add(97.44448770720001, x59, x58 * 177.0883695416),
+            S::mul_add(S::splat(97.44448770720001), x59, x58 * S::splat(177.0883695416)),
         ) - x79;
-        let x82 = x66 + Self::mul_add(s_q5, x78, c_q5 * x77);
-        let x83 = -x82;
-        let x84 = Self::mul_add(c_q4, x62, s_q4 * x61);
-        let x85 = Self::mul_add(3239.4582, x47, Self::mul_add(-s_q4, x62, c_q4 * x61));
-        let x86 = Self::mul_add(3239.4582, x48, -x84);
-        let x87 = Self::mul_add(3239.4582, x49, x63);
-        let x88 = Self::mul_add(
-            1375.0472756800002,
-            x45,
-            Self::mul_add(-x38, x52, x46 * x51),
-        ) - Self::mul_add(s_q4, x81, c_q4 * x80);
-        let x89 = x53 + Self::mul_add(7.11, x63, Self::mul_add(-c_q4, x81, s_q4 * x80));
-        let x90 = Self::mul_add(
-            3239.4582,
-            x42,
-            Self::mul_add(24998.827802, x45, 1375.0472756800002 * x43)
-                + Self::mul_add(-x37, x51, x38 * x50),
-        ) - Self::mul_add(7.11, x84, x82);
-        let x91 = Self::mul_add(s_q3, x86, c_q3 * x85);
-        let x92 = Self::mul_add(-c_q3, x86, s_q3 * x85);
-        let x93 = Self::mul_add(5224.5702, x29, x91);
-        let x94 = Self::mul_add(5224.5702, x31, -x92);
-        let x95 = Self::mul_add(3946.18812068, x26, Self::mul_add(-x19, x35, x27 * x34))
-            + Self::mul_add(-0.475, x92, Self::mul_add(s_q3, x89, c_q3 * x88));
-        let x96 = x36
-            - (Self::mul_add(-c_q3, x89, s_q3 * x88)
-                + Self::mul_add(-7.11, x87, 0.475 * x91));
-        let x97 = Self::mul_add(
-            5224.5702,
-            x23,
-            Self::mul_add(39241.404122, x26, 3946.1881206800003 * x24)
-                + Self::mul_add(-x18, x34, x19 * x33),
-        ) + Self::mul_add(-7.11, x92, x90);
-        let x98 = Self::mul_add(s_q2, x94, c_q2 * x93);
-        let x99 = Self::mul_add(
-            -1145.5438279999998,
-            x10,
-            Self::mul_add(x6, x16, 1650.6386721183999 * qdd[1]),
-        ) - Self::mul_add(0.5692, x98, Self::mul_add(-c_q2, x96, s_q2 * x95));
-        let x100 = Self::mul_add(
-            c_q1,
-            Self::mul_add(1145.5438279999998, x15, Self::mul_add(5224.5702, x32, x87)),
-            s_q1 * Self::mul_add(1145.5438279999998, x14, -x98),
+        let x82 = x66 + S::mul_add(s_q5, x78, c_q5 * x77);
+        let x83 = S::neg(x82);
+        let x84 = S::mul_add(c_q4, x62, s_q4 * x61);
+        let x85 = S::mul_add(
+            S::splat(3239.4582),
+            x47,
+            S::mul_add(S::neg(s_q4), x62, c_q4 * x61),
         );
-        let x101 = Self::mul_add(
+        let x86 = S::mul_add(S::splat(3239.4582), x48, S::neg(x84));
+        let x87 = S::mul_add(S::splat(3239.4582), x49, x63);
+        let x88 = S::mul_add(
+            S::splat(1375.0472756800002),
+            x45,
+            S::mul_add(S::neg(x38), x52, x46 * x51),
+        ) - S::mul_add(s_q4, x81, c_q4 * x80);
+        let x89 = x53
+            + S::mul_add(S::splat(7.11), x63, S::mul_add(S::neg(c_q4), x81, s_q4 * x80));
+        let x90 = S::mul_add(
+            S::splat(3239.4582),
+            x42,
+            S::mul_add(S::splat(24998.827802), x45, S::splat(1375.0472756800002) * x43)
+                + S::mul_add(S::neg(x37), x51, x38 * x50),
+        ) - S::mul_add(S::splat(7.11), x84, x82);
+        let x91 = S::mul_add(s_q3, x86, c_q3 * x85);
+        let x92 = S::mul_add(S::neg(c_q3), x86, s_q3 * x85);
+        let x93 = S::mul_add(S::splat(5224.5702), x29, x91);
+        let x94 = S::mul_add(S::splat(5224.5702), x31, S::neg(x92));
+        let x95 = S::mul_add(
+            S::splat(3946.18812068),
+            x26,
+            S::mul_add(S::neg(x19), x35, x27 * x34),
+        ) + S::mul_add(S::splat(-0.475), x92, S::mul_add(s_q3, x89, c_q3 * x88));
+        let x96 = x36
+            - (S::mul_add(S::neg(c_q3), x89, s_q3 * x88)
+                + S::mul_add(S::splat(-7.11), x87, S::splat(0.475) * x91));
+        let x97 = S::mul_add(
+            S::splat(5224.5702),
+            x23,
+            S::mul_add(S::splat(39241.404122), x26, S::splat(3946.1881206800003) * x24)
+                + S::mul_add(S::neg(x18), x34, x19 * x33),
+        ) + S::mul_add(S::splat(-7.11), x92, x90);
+        let x98 = S::mul_add(s_q2, x94, c_q2 * x93);
+        let x99 = S::mul_add(
+            S::splat(-1145.5438279999998),
+            x10,
+            S::mul_add(x6, x16, S::splat(1650.6386721183999) * qdd[1]),
+        ) - S::mul_add(S::splat(0.5692), x98, S::mul_add(S::neg(c_q2), x96, s_q2 * x95));
+        let x100 = S::mul_add(
+            c_q1,
+            S::mul_add(
+                S::splat(1145.5438279999998),
+                x15,
+                S::mul_add(S::splat(5224.5702), x32, x87),
+            ),
+            s_q1 * S::mul_add(S::splat(1145.5438279999998), x14, S::neg(x98)),
+        );
+        let x101 = S::mul_add(
             s_q1,
-            Self::mul_add(-x6, x17, x13 * 1647.2196721184) + x97,
+            S::mul_add(S::neg(x6), x17, x13 * S::splat(1647.2196721184)) + x97,
             c_q1
-                * (Self::mul_add(
-                    -1145.5438279999998,
+                * (S::mul_add(
+                    S::splat(-1145.5438279999998),
                     x9,
-                    Self::mul_add(x7, x17, qd[1] * x16),
+                    S::mul_add(x7, x17, qd[1] * x16),
                 )
-                    - Self::mul_add(
-                        -0.5692,
-                        Self::mul_add(-c_q2, x94, s_q2 * x93),
-                        Self::mul_add(s_q2, x96, c_q2 * x95),
+                    - S::mul_add(
+                        S::splat(-0.5692),
+                        S::mul_add(S::neg(c_q2), x94, s_q2 * x93),
+                        S::mul_add(s_q2, x96, c_q2 * x95),
                     )),
         );
-        let x102 = Self::mul_add(
-            2232.9683597151998,
+        let x102 = S::mul_add(
+            S::splat(2232.9683597151998),
             qdd[0],
-            -Self::mul_add(0.7026, x100, x101),
+            S::neg(S::mul_add(S::splat(0.7026), x100, x101)),
         );
         [x102, x99, x97, x90, x83, x79, x73]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -1802,299 +2065,360 @@ impl Ssrms {
         qd: &[::core::primitive::f64; 7],
         tau: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::forward_dynamics_lanes::<::core::primitive::f64>(q, qd, tau)
+    }
+    /// [`Self::forward_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], tau: &[S; 7]) -> [S; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
-        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
-        let x6 = s_q5 * s_q5 * 35.074;
-        let x7 = -35.074 + x6;
-        let x8 = s_q5 * c_q5 * 35.074;
-        let x9 = 179.8829695416 - x6;
-        let x10 = x7 - -129.6173695416;
+        (s_q6, c_q6)] = S::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        let x6 = s_q5 * s_q5 * S::splat(35.074);
+        let x7 = S::splat(-35.074) + x6;
+        let x8 = s_q5 * c_q5 * S::splat(35.074);
+        let x9 = S::splat(179.8829695416) - x6;
+        let x10 = x7 - S::splat(-129.6173695416);
         let x11 = s_q4 * s_q4 * x10;
         let x12 = x7 - x11;
-        let x13 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x8);
-        let x14 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x8);
-        let x15 = 171.195516 * s_q4;
-        let x16 = 171.195516 * c_q4;
-        let x17 = 7.11 * x15;
-        let x18 = Self::mul_add(-7.11, x16, s_q4 * c_q4 * x10);
+        let x13 = S::mul_add(S::splat(97.44448770720001), s_q4, c_q4 * x8);
+        let x14 = S::mul_add(S::splat(-97.44448770720001), c_q4, s_q4 * x8);
+        let x15 = S::splat(171.195516) * s_q4;
+        let x16 = S::splat(171.195516) * c_q4;
+        let x17 = S::splat(7.11) * x15;
+        let x18 = S::mul_add(S::splat(-7.11), x16, s_q4 * c_q4 * x10);
         let x19 = x9 - x17;
-        let x20 = 3239.4582 - x15;
-        let x21 = 1375.0472756800002 - x13;
-        let x22 = 24989.305802 - (x17 - (-129.6173695416 + x11 - x17));
-        let x23 = 24998.827802 - (x17 - x19);
+        let x20 = S::splat(3239.4582) - x15;
+        let x21 = S::splat(1375.0472756800002) - x13;
+        let x22 = S::splat(24989.305802)
+            - (x17 - (S::splat(-129.6173695416) + x11 - x17));
+        let x23 = S::splat(24998.827802) - (x17 - x19);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
         let x26 = x12 - x22;
         let x27 = x18 + x18;
-        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x28 = S::mul_add(x25, x27, x24 * x26);
         let x29 = x12 - x28;
         let x30 = s_q3 * x14;
         let x31 = c_q3 * x14;
         let x32 = s_q3 * x16;
-        let x33 = Self::mul_add(c_q3, x20, -x32);
+        let x33 = S::mul_add(c_q3, x20, S::neg(x32));
         let x34 = c_q3 * x16;
-        let x35 = Self::mul_add(s_q3, x20, x34);
-        let x36 = 7.11 * x33;
-        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, x30));
-        let x38 = Self::mul_add(-7.11, x35, x18 + Self::mul_add(-x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, -x31));
+        let x35 = S::mul_add(s_q3, x20, x34);
+        let x36 = S::splat(7.11) * x33;
+        let x37 = S::mul_add(x33, S::splat(0.475), S::mul_add(c_q3, x21, x30));
+        let x38 = S::mul_add(
+            S::splat(-7.11),
+            x35,
+            x18 + S::mul_add(S::neg(x24), x27, x25 * x26),
+        );
+        let x39 = S::mul_add(x35, S::splat(0.475), S::mul_add(s_q3, x21, S::neg(x31)));
         let x40 = x23 + x36;
-        let x41 = 5224.5702 + x33;
-        let x42 = 3946.18812068 + x37;
-        let x43 = 39234.474122 + (x36 + (x22 + x28 + x36));
-        let x44 = 39241.404122 + (x36 + x40);
+        let x41 = S::splat(5224.5702) + x33;
+        let x42 = S::splat(3946.18812068) + x37;
+        let x43 = S::splat(39234.474122) + (x36 + (x22 + x28 + x36));
+        let x44 = S::splat(39241.404122) + (x36 + x40);
         let x45 = s_q2 * s_q2;
         let x46 = s_q2 * c_q2;
         let x47 = x29 - x43;
         let x48 = x38 + x38;
-        let x49 = Self::mul_add(x46, x48, x45 * x47);
+        let x49 = S::mul_add(x46, x48, x45 * x47);
         let x50 = x29 - x49;
         let x51 = s_q2 * x39;
         let x52 = c_q2 * x39;
         let x53 = s_q2 * x35;
-        let x54 = Self::mul_add(c_q2, x41, -x53);
+        let x54 = S::mul_add(c_q2, x41, S::neg(x53));
         let x55 = c_q2 * x35;
-        let x56 = Self::mul_add(s_q2, x41, x55);
-        let x57 = Self::mul_add(0.5692, x54, Self::mul_add(c_q2, x42, -x51));
-        let x58 = Self::mul_add(0.5692, x56, Self::mul_add(s_q2, x42, x52));
-        let x59 = 0.7026 * x56;
-        let x60 = Self::mul_add(
-            0.7026,
-            Self::mul_add(1145.5438279999998, s_q1, c_q1 * x54),
-            Self::mul_add(-s_q1, x58, c_q1 * (x38 + Self::mul_add(-x45, x48, x46 * x47))),
+        let x56 = S::mul_add(s_q2, x41, x55);
+        let x57 = S::mul_add(S::splat(0.5692), x54, S::mul_add(c_q2, x42, S::neg(x51)));
+        let x58 = S::mul_add(S::splat(0.5692), x56, S::mul_add(s_q2, x42, x52));
+        let x59 = S::splat(0.7026) * x56;
+        let x60 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(S::splat(1145.5438279999998), s_q1, c_q1 * x54),
+            S::mul_add(
+                S::neg(s_q1),
+                x58,
+                c_q1 * (x38 + S::mul_add(S::neg(x45), x48, x46 * x47)),
+            ),
         );
-        let x61 = Self::mul_add(
-            0.7026,
+        let x61 = S::mul_add(
+            S::splat(0.7026),
             s_q1 * x56,
-            Self::mul_add(-s_q1, x44, c_q1 * x57),
+            S::mul_add(S::neg(s_q1), x44, c_q1 * x57),
         );
-        let x62 = Self::mul_add(s_q2, x33, x55);
-        let x63 = Self::mul_add(
+        let x62 = S::mul_add(s_q2, x33, x55);
+        let x63 = S::mul_add(
             s_q1,
             x40,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-c_q2, x33, x53),
-                    Self::mul_add(-c_q2, x37, x51),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(S::neg(c_q2), x33, x53),
+                    S::mul_add(S::neg(c_q2), x37, x51),
                 ),
         );
-        let x64 = Self::mul_add(-0.7026, s_q1 * x62, x63);
-        let x65 = Self::mul_add(-s_q3, x15, x34);
-        let x66 = Self::mul_add(c_q3, x15, x32);
-        let x67 = Self::mul_add(-0.475, x66, Self::mul_add(-c_q3, x13, x30));
-        let x68 = Self::mul_add(-0.475, x65, Self::mul_add(s_q3, x13, x31));
-        let x69 = Self::mul_add(-7.11, x66, x19);
-        let x70 = Self::mul_add(-s_q2, x66, c_q2 * x65);
-        let x71 = Self::mul_add(
-            -s_q1,
+        let x64 = S::mul_add(S::splat(-0.7026), s_q1 * x62, x63);
+        let x65 = S::mul_add(S::neg(s_q3), x15, x34);
+        let x66 = S::mul_add(c_q3, x15, x32);
+        let x67 = S::mul_add(S::splat(-0.475), x66, S::mul_add(S::neg(c_q3), x13, x30));
+        let x68 = S::mul_add(S::splat(-0.475), x65, S::mul_add(s_q3, x13, x31));
+        let x69 = S::mul_add(S::splat(-7.11), x66, x19);
+        let x70 = S::mul_add(S::neg(s_q2), x66, c_q2 * x65);
+        let x71 = S::mul_add(
+            S::neg(s_q1),
             x69,
             c_q1
-                * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x66, s_q2 * x65),
-                    Self::mul_add(s_q2, x68, c_q2 * x67),
+                * S::mul_add(
+                    S::splat(-0.5692),
+                    S::mul_add(c_q2, x66, s_q2 * x65),
+                    S::mul_add(s_q2, x68, c_q2 * x67),
                 ),
         );
-        let x72 = Self::mul_add(0.7026, s_q1 * x70, x71);
-        let x73 = 47.471 * s_q4;
-        let x74 = 47.471 * c_q4;
-        let x75 = Self::mul_add(s_q3, x74, c_q3 * x73);
-        let x76 = Self::mul_add(-c_q3, x74, s_q3 * x73);
-        let x77 = c_q1 * Self::mul_add(-s_q2, x76, c_q2 * x75);
-        let x78 = 9.336 * c_q5;
-        let x79 = 9.336 * s_q5;
+        let x72 = S::mul_add(S::splat(0.7026), s_q1 * x70, x71);
+        let x73 = S::splat(47.471) * s_q4;
+        let x74 = S::splat(47.471) * c_q4;
+        let x75 = S::mul_add(s_q3, x74, c_q3 * x73);
+        let x76 = S::mul_add(S::neg(c_q3), x74, s_q3 * x73);
+        let x77 = c_q1 * S::mul_add(S::neg(s_q2), x76, c_q2 * x75);
+        let x78 = S::splat(9.336) * c_q5;
+        let x79 = S::splat(9.336) * s_q5;
         let x80 = c_q4 * x78;
         let x81 = s_q4 * x78;
-        let x82 = Self::mul_add(-s_q3, x81, c_q3 * x80);
-        let x83 = Self::mul_add(c_q3, x81, s_q3 * x80);
-        let x84 = Self::mul_add(
-            -s_q1,
+        let x82 = S::mul_add(S::neg(s_q3), x81, c_q3 * x80);
+        let x83 = S::mul_add(c_q3, x81, s_q3 * x80);
+        let x84 = S::mul_add(
+            S::neg(s_q1),
             x79,
-            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
+            c_q1 * S::mul_add(S::neg(s_q2), x83, c_q2 * x82),
         );
         let x85 = qd[0] * c_q1;
         let x86 = qd[0] * s_q1;
-        let x87 = 0.7026 * (qd[0] * qd[0]);
+        let x87 = S::splat(0.7026) * (qd[0] * qd[0]);
         let x88 = qd[1] * x86;
         let x89 = qd[1] * x85;
         let x90 = x85 * x86;
-        let x91 = Self::mul_add(x85, x85, qd[1] * qd[1]);
-        let x92 = x86 * 1647.2196721184;
-        let x93 = 1650.6386721183999 * qd[1];
-        let x94 = Self::mul_add(-qd[1], s_q2, c_q2 * x85);
-        let x95 = Self::mul_add(qd[1], c_q2, s_q2 * x85);
-        let x96 = 0.5692 * x90;
-        let x97 = 0.5692 * x91;
-        let x98 = Self::mul_add(-0.5692, x88 + x88, x87);
-        let x99 = Self::mul_add(-c_q2, x98, s_q2 * x96);
-        let x100 = Self::mul_add(qd[2], x95, c_q2 * x88);
-        let x101 = Self::mul_add(-qd[2], x94, s_q2 * x88);
+        let x91 = S::mul_add(x85, x85, qd[1] * qd[1]);
+        let x92 = x86 * S::splat(1647.2196721184);
+        let x93 = S::splat(1650.6386721183999) * qd[1];
+        let x94 = S::mul_add(S::neg(qd[1]), s_q2, c_q2 * x85);
+        let x95 = S::mul_add(qd[1], c_q2, s_q2 * x85);
+        let x96 = S::splat(0.5692) * x90;
+        let x97 = S::splat(0.5692) * x91;
+        let x98 = S::mul_add(S::splat(-0.5692), x88 + x88, x87);
+        let x99 = S::mul_add(S::neg(c_q2), x98, s_q2 * x96);
+        let x100 = S::mul_add(qd[2], x95, c_q2 * x88);
+        let x101 = S::mul_add(S::neg(qd[2]), x94, s_q2 * x88);
         let x102 = qd[2] - x86;
         let x103 = x95 * x95;
-        let x104 = Self::mul_add(x102, x102, x103);
+        let x104 = S::mul_add(x102, x102, x103);
         let x105 = x94 * x102;
-        let x106 = Self::mul_add(x94, x95, x89);
+        let x106 = S::mul_add(x94, x95, x89);
         let x107 = x101 - x105;
-        let x108 = 3946.18812068 * x102;
-        let x109 = 39234.474122 * x95;
-        let x110 = Self::mul_add(39241.404122, x102, 3946.1881206800003 * x94);
-        let x111 = Self::mul_add(
-            -5224.5702,
+        let x108 = S::splat(3946.18812068) * x102;
+        let x109 = S::splat(39234.474122) * x95;
+        let x110 = S::mul_add(
+            S::splat(39241.404122),
+            x102,
+            S::splat(3946.1881206800003) * x94,
+        );
+        let x111 = S::mul_add(
+            S::splat(-5224.5702),
             x97,
-            Self::mul_add(39234.474122, x101, Self::mul_add(-x94, x110, x102 * x108)),
+            S::mul_add(
+                S::splat(39234.474122),
+                x101,
+                S::mul_add(S::neg(x94), x110, x102 * x108),
+            ),
         );
-        let x112 = Self::mul_add(-s_q3, x95, c_q3 * x94);
-        let x113 = Self::mul_add(c_q3, x95, s_q3 * x94);
-        let x114 = Self::mul_add(s_q2, x98, c_q2 * x96)
-            - Self::mul_add(0.475, x101 + x105, 7.11 * x104);
+        let x112 = S::mul_add(S::neg(s_q3), x95, c_q3 * x94);
+        let x113 = S::mul_add(c_q3, x95, s_q3 * x94);
+        let x114 = S::mul_add(s_q2, x98, c_q2 * x96)
+            - S::mul_add(S::splat(0.475), x101 + x105, S::splat(7.11) * x104);
         let x115 = x99
-            + Self::mul_add(0.475, Self::mul_add(-x95, x102, x100), 7.11 * x106);
+            + S::mul_add(
+                S::splat(0.475),
+                S::mul_add(S::neg(x95), x102, x100),
+                S::splat(7.11) * x106,
+            );
         let x116 = x97
-            - Self::mul_add(-0.475, Self::mul_add(x94, x94, x103), 7.11 * x107);
-        let x117 = Self::mul_add(c_q3, x115, s_q3 * x114);
-        let x118 = Self::mul_add(qd[3], x113, Self::mul_add(-s_q3, x101, c_q3 * x100));
-        let x119 = Self::mul_add(-qd[3], x112, Self::mul_add(c_q3, x101, s_q3 * x100));
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x94, x94, x103),
+                S::splat(7.11) * x107,
+            );
+        let x117 = S::mul_add(c_q3, x115, s_q3 * x114);
+        let x118 = S::mul_add(qd[3], x113, S::mul_add(S::neg(s_q3), x101, c_q3 * x100));
+        let x119 = S::mul_add(S::neg(qd[3]), x112, S::mul_add(c_q3, x101, s_q3 * x100));
         let x120 = qd[3] + x102;
-        let x121 = Self::mul_add(x120, x120, x113 * x113);
-        let x122 = Self::mul_add(x112, x113, x89);
-        let x123 = Self::mul_add(-x112, x120, x119);
-        let x124 = 1375.0472756800002 * x120;
-        let x125 = 24989.305802 * x113;
-        let x126 = Self::mul_add(24998.827802, x120, 1375.0472756800002 * x112);
-        let x127 = Self::mul_add(
-            -3239.4582,
+        let x121 = S::mul_add(x120, x120, x113 * x113);
+        let x122 = S::mul_add(x112, x113, x89);
+        let x123 = S::mul_add(S::neg(x112), x120, x119);
+        let x124 = S::splat(1375.0472756800002) * x120;
+        let x125 = S::splat(24989.305802) * x113;
+        let x126 = S::mul_add(
+            S::splat(24998.827802),
+            x120,
+            S::splat(1375.0472756800002) * x112,
+        );
+        let x127 = S::mul_add(
+            S::splat(-3239.4582),
             x116,
-            Self::mul_add(24989.305802, x119, Self::mul_add(-x112, x126, x120 * x124)),
+            S::mul_add(
+                S::splat(24989.305802),
+                x119,
+                S::mul_add(S::neg(x112), x126, x120 * x124),
+            ),
         );
-        let x128 = Self::mul_add(-s_q4, x113, c_q4 * x112);
-        let x129 = Self::mul_add(c_q4, x113, s_q4 * x112);
-        let x130 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x122, x117),
-            c_q4 * Self::mul_add(-7.11, x121, Self::mul_add(-s_q3, x115, c_q3 * x114)),
+        let x128 = S::mul_add(S::neg(s_q4), x113, c_q4 * x112);
+        let x129 = S::mul_add(c_q4, x113, s_q4 * x112);
+        let x130 = S::mul_add(
+            S::neg(s_q4),
+            S::mul_add(S::splat(7.11), x122, x117),
+            c_q4
+                * S::mul_add(
+                    S::splat(-7.11),
+                    x121,
+                    S::mul_add(S::neg(s_q3), x115, c_q3 * x114),
+                ),
         );
-        let x131 = Self::mul_add(qd[4], x129, Self::mul_add(-s_q4, x119, c_q4 * x118));
-        let x132 = Self::mul_add(-qd[4], x128, Self::mul_add(c_q4, x119, s_q4 * x118));
+        let x131 = S::mul_add(qd[4], x129, S::mul_add(S::neg(s_q4), x119, c_q4 * x118));
+        let x132 = S::mul_add(S::neg(qd[4]), x128, S::mul_add(c_q4, x119, s_q4 * x118));
         let x133 = qd[4] + x120;
-        let x134 = 171.195516 * Self::mul_add(-x128, x129, x89);
-        let x135 = 171.195516 * Self::mul_add(x128, x128, x133 * x133);
-        let x136 = 171.195516 * Self::mul_add(x129, x133, x131);
-        let x137 = Self::mul_add(97.44448770720001, x133, x129 * 177.0883695416);
-        let x138 = Self::mul_add(-179.8829695416, x133, 97.44448770720001 * x129);
-        let x139 = Self::mul_add(
-            -171.195516,
+        let x134 = S::splat(171.195516) * S::mul_add(S::neg(x128), x129, x89);
+        let x135 = S::splat(171.195516) * S::mul_add(x128, x128, x133 * x133);
+        let x136 = S::splat(171.195516) * S::mul_add(x129, x133, x131);
+        let x137 = S::mul_add(
+            S::splat(97.44448770720001),
+            x133,
+            x129 * S::splat(177.0883695416),
+        );
+        let x138 = S::mul_add(
+            S::splat(-179.8829695416),
+            x133,
+            S::splat(97.44448770720001) * x129,
+        );
+        let x139 = S::mul_add(
+            S::splat(-171.195516),
             x130,
-            Self::mul_add(
+            S::mul_add(
                 x128,
                 x137,
-                Self::mul_add(-179.8829695416, x89, 97.44448770720001 * x132),
+                S::mul_add(
+                    S::splat(-179.8829695416),
+                    x89,
+                    S::splat(97.44448770720001) * x132,
+                ),
             ),
         );
-        let x140 = Self::mul_add(-c_q5, x133, s_q5 * x128);
-        let x141 = Self::mul_add(s_q5, x133, c_q5 * x128);
-        let x142 = Self::mul_add(qd[5], x140, Self::mul_add(s_q5, x89, c_q5 * x131));
+        let x140 = S::mul_add(S::neg(c_q5), x133, s_q5 * x128);
+        let x141 = S::mul_add(s_q5, x133, c_q5 * x128);
+        let x142 = S::mul_add(qd[5], x140, S::mul_add(s_q5, x89, c_q5 * x131));
         let x143 = qd[5] + x129;
-        let x144 = 44.41 * x141;
-        let x145 = 47.471 * x143;
-        let x146 = 9.336 * x142;
-        let x147 = 9.336 * (qd[6] + x141);
-        let x148 = Self::mul_add(c_q6, x143, s_q6 * x140) * x147;
-        let x149 = Self::mul_add(-s_q6, x143, c_q6 * x140) * x147;
-        let x150 = Self::mul_add(x141, x145, x143 * x144)
-            - Self::mul_add(-s_q6, x149, c_q6 * x148);
-        let x151 = Self::mul_add(-x140, x145, 44.41 * x142) - x146;
-        let x152 = Self::mul_add(x140, x144, 47.471 * x132)
-            - Self::mul_add(c_q6, x149, s_q6 * x148);
-        let x153 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-7.11, x123, x116),
-            Self::mul_add(-x129, x138, x133 * x137),
-        ) - Self::mul_add(c_q5, x151, s_q5 * x150);
-        let x154 = Self::mul_add(
-            -x128,
+        let x144 = S::splat(44.41) * x141;
+        let x145 = S::splat(47.471) * x143;
+        let x146 = S::splat(9.336) * x142;
+        let x147 = S::splat(9.336) * (qd[6] + x141);
+        let x148 = S::mul_add(c_q6, x143, s_q6 * x140) * x147;
+        let x149 = S::mul_add(S::neg(s_q6), x143, c_q6 * x140) * x147;
+        let x150 = S::mul_add(x141, x145, x143 * x144)
+            - S::mul_add(S::neg(s_q6), x149, c_q6 * x148);
+        let x151 = S::mul_add(S::neg(x140), x145, S::splat(44.41) * x142) - x146;
+        let x152 = S::mul_add(x140, x144, S::splat(47.471) * x132)
+            - S::mul_add(c_q6, x149, s_q6 * x148);
+        let x153 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::splat(-7.11), x123, x116),
+            S::mul_add(S::neg(x129), x138, x133 * x137),
+        ) - S::mul_add(c_q5, x151, s_q5 * x150);
+        let x154 = S::mul_add(
+            S::neg(x128),
             x138,
-            Self::mul_add(97.44448770720001, x89, x132 * 177.0883695416),
+            S::mul_add(S::splat(97.44448770720001), x89, x132 * S::splat(177.0883695416)),
         ) - x152;
-        let x155 = x139 - Self::mul_add(-s_q5, x151, c_q5 * x150);
-        let x156 = Self::mul_add(-c_q4, x135, s_q4 * x134);
-        let x157 = Self::mul_add(
-            3239.4582,
+        let x155 = x139 - S::mul_add(S::neg(s_q5), x151, c_q5 * x150);
+        let x156 = S::mul_add(S::neg(c_q4), x135, s_q4 * x134);
+        let x157 = S::mul_add(
+            S::splat(3239.4582),
             x121,
-            -Self::mul_add(s_q4, x135, c_q4 * x134),
+            S::neg(S::mul_add(s_q4, x135, c_q4 * x134)),
         );
-        let x158 = Self::mul_add(3239.4582, x122, -x156);
-        let x159 = Self::mul_add(3239.4582, x123, x136);
-        let x160 = Self::mul_add(
-            1375.0472756800002,
+        let x158 = S::mul_add(S::splat(3239.4582), x122, S::neg(x156));
+        let x159 = S::mul_add(S::splat(3239.4582), x123, x136);
+        let x160 = S::mul_add(
+            S::splat(1375.0472756800002),
             x89,
-            -Self::mul_add(-x113, x126, x120 * x125),
-        ) + Self::mul_add(-s_q4, x154, c_q4 * x153);
+            S::neg(S::mul_add(S::neg(x113), x126, x120 * x125)),
+        ) + S::mul_add(S::neg(s_q4), x154, c_q4 * x153);
         let x161 = x127
-            - Self::mul_add(-7.11, x136, Self::mul_add(c_q4, x154, s_q4 * x153));
-        let x162 = Self::mul_add(
-            3239.4582,
+            - S::mul_add(S::splat(-7.11), x136, S::mul_add(c_q4, x154, s_q4 * x153));
+        let x162 = S::mul_add(
+            S::splat(3239.4582),
             x117,
-            Self::mul_add(24998.827802, x89, 1375.0472756800002 * x118)
-                - Self::mul_add(-x112, x125, x113 * x124),
-        ) - Self::mul_add(7.11, x156, x155);
-        let x163 = Self::mul_add(-s_q3, x158, c_q3 * x157);
-        let x164 = Self::mul_add(c_q3, x158, s_q3 * x157);
-        let x165 = Self::mul_add(5224.5702, x104, x163);
-        let x166 = Self::mul_add(5224.5702, x106, x164);
-        let x167 = Self::mul_add(
-            3946.18812068,
+            S::mul_add(S::splat(24998.827802), x89, S::splat(1375.0472756800002) * x118)
+                - S::mul_add(S::neg(x112), x125, x113 * x124),
+        ) - S::mul_add(S::splat(7.11), x156, x155);
+        let x163 = S::mul_add(S::neg(s_q3), x158, c_q3 * x157);
+        let x164 = S::mul_add(c_q3, x158, s_q3 * x157);
+        let x165 = S::mul_add(S::splat(5224.5702), x104, x163);
+        let x166 = S::mul_add(S::splat(5224.5702), x106, x164);
+        let x167 = S::mul_add(
+            S::splat(3946.18812068),
             x89,
-            -Self::mul_add(-x95, x110, x102 * x109),
-        ) + Self::mul_add(0.475, x164, Self::mul_add(s_q3, x161, c_q3 * x160));
+            S::neg(S::mul_add(S::neg(x95), x110, x102 * x109)),
+        ) + S::mul_add(S::splat(0.475), x164, S::mul_add(s_q3, x161, c_q3 * x160));
         let x168 = x111
-            - (Self::mul_add(-c_q3, x161, s_q3 * x160)
-                - Self::mul_add(7.11, x159, 0.475 * x163));
-        let x169 = Self::mul_add(
-            5224.5702,
+            - (S::mul_add(S::neg(c_q3), x161, s_q3 * x160)
+                - S::mul_add(S::splat(7.11), x159, S::splat(0.475) * x163));
+        let x169 = S::mul_add(
+            S::splat(5224.5702),
             x99,
-            Self::mul_add(39241.404122, x89, 3946.1881206800003 * x100)
-                - Self::mul_add(-x94, x109, x95 * x108),
-        ) + Self::mul_add(7.11, x164, x162);
-        let x170 = Self::mul_add(-s_q2, x166, c_q2 * x165);
-        let x171 = Self::mul_add(
+            S::mul_add(S::splat(39241.404122), x89, S::splat(3946.1881206800003) * x100)
+                - S::mul_add(S::neg(x94), x109, x95 * x108),
+        ) + S::mul_add(S::splat(7.11), x164, x162);
+        let x170 = S::mul_add(S::neg(s_q2), x166, c_q2 * x165);
+        let x171 = S::mul_add(
             x85,
             x92,
-            Self::mul_add(-0.5692, x170, Self::mul_add(-c_q2, x168, s_q2 * x167)),
-        );
-        let x172 = Self::mul_add(
-            c_q1,
-            Self::mul_add(
-                1145.5438279999998,
-                x91,
-                -Self::mul_add(5224.5702, x107, x159),
+            S::mul_add(
+                S::splat(-0.5692),
+                x170,
+                S::mul_add(S::neg(c_q2), x168, s_q2 * x167),
             ),
-            s_q1 * Self::mul_add(1145.5438279999998, x90, -x170),
         );
-        let x173 = Self::mul_add(
+        let x172 = S::mul_add(
+            c_q1,
+            S::mul_add(
+                S::splat(1145.5438279999998),
+                x91,
+                S::neg(S::mul_add(S::splat(5224.5702), x107, x159)),
+            ),
+            s_q1 * S::mul_add(S::splat(1145.5438279999998), x90, S::neg(x170)),
+        );
+        let x173 = S::mul_add(
             s_q1,
-            Self::mul_add(-x85, x93, x89 * 1647.2196721184) - x169,
+            S::mul_add(S::neg(x85), x93, x89 * S::splat(1647.2196721184)) - x169,
             c_q1
-                * (Self::mul_add(
-                    -1145.5438279999998,
+                * (S::mul_add(
+                    S::splat(-1145.5438279999998),
                     x87,
-                    Self::mul_add(x86, x93, qd[1] * x92),
+                    S::mul_add(x86, x93, qd[1] * x92),
                 )
-                    + Self::mul_add(
-                        0.5692,
-                        Self::mul_add(c_q2, x166, s_q2 * x165),
-                        Self::mul_add(s_q2, x168, c_q2 * x167),
+                    + S::mul_add(
+                        S::splat(0.5692),
+                        S::mul_add(c_q2, x166, s_q2 * x165),
+                        S::mul_add(s_q2, x168, c_q2 * x167),
                     )),
         );
-        let x174 = tau[0] + Self::mul_add(0.7026, x172, x173);
-        let x175 = 1.0
-            / (2232.9683597151998
+        let x174 = tau[0] + S::mul_add(S::splat(0.7026), x172, x173);
+        let x175 = S::splat(1.0)
+            / (S::splat(2232.9683597151998)
                 - (x59
                     - (x50
-                        - Self::mul_add(
+                        - S::mul_add(
                             s_q1 * c_q1,
                             x57 + x57,
-                            s_q1 * s_q1 * (x50 - (-1647.2196721184 + x44)),
+                            s_q1 * s_q1 * (x50 - (S::splat(-1647.2196721184) + x44)),
                         ) - x59)));
         let x176 = x60 * x175;
         let x177 = x61 * x175;
@@ -2102,157 +2426,208 @@ impl Ssrms {
         let x179 = x72 * x175;
         let x180 = x77 * x175;
         let x181 = x84 * x175;
-        let x182 = 1.0 / Self::mul_add(-x60, x176, 1650.6386721183999 + (x43 + x49));
-        let x183 = Self::mul_add(-x60, x177, x58);
+        let x182 = S::splat(1.0)
+            / S::mul_add(S::neg(x60), x176, S::splat(1650.6386721183999) + (x43 + x49));
+        let x183 = S::mul_add(S::neg(x60), x177, x58);
         let x184 = x182 * x183;
-        let x185 = Self::mul_add(
+        let x185 = S::mul_add(
             x60,
             x178,
-            Self::mul_add(0.5692, x62, Self::mul_add(s_q2, x37, x52)),
+            S::mul_add(S::splat(0.5692), x62, S::mul_add(s_q2, x37, x52)),
         );
         let x186 = x182 * x185;
-        let x187 = Self::mul_add(
-            -x60,
+        let x187 = S::mul_add(
+            S::neg(x60),
             x179,
-            Self::mul_add(0.5692, x70, Self::mul_add(-c_q2, x68, s_q2 * x67)),
+            S::mul_add(S::splat(0.5692), x70, S::mul_add(S::neg(c_q2), x68, s_q2 * x67)),
         );
         let x188 = x182 * x187;
-        let x189 = Self::mul_add(-x60, x180, Self::mul_add(c_q2, x76, s_q2 * x75));
+        let x189 = S::mul_add(S::neg(x60), x180, S::mul_add(c_q2, x76, s_q2 * x75));
         let x190 = x182 * x189;
-        let x191 = Self::mul_add(-x60, x181, Self::mul_add(c_q2, x83, s_q2 * x82));
+        let x191 = S::mul_add(S::neg(x60), x181, S::mul_add(c_q2, x83, s_q2 * x82));
         let x192 = x182 * x191;
-        let x193 = 1.0 / Self::mul_add(-x183, x184, Self::mul_add(-x61, x177, x44));
-        let x194 = Self::mul_add(-x183, x186, Self::mul_add(x61, x178, x40));
+        let x193 = S::splat(1.0)
+            / S::mul_add(S::neg(x183), x184, S::mul_add(S::neg(x61), x177, x44));
+        let x194 = S::mul_add(S::neg(x183), x186, S::mul_add(x61, x178, x40));
         let x195 = x193 * x194;
-        let x196 = Self::mul_add(-x183, x188, Self::mul_add(-x61, x179, x69));
+        let x196 = S::mul_add(S::neg(x183), x188, S::mul_add(S::neg(x61), x179, x69));
         let x197 = x193 * x196;
-        let x198 = Self::mul_add(x183, x190, x61 * x180);
+        let x198 = S::mul_add(x183, x190, x61 * x180);
         let x199 = x193 * x198;
-        let x200 = Self::mul_add(-x183, x192, Self::mul_add(-x61, x181, x79));
+        let x200 = S::mul_add(S::neg(x183), x192, S::mul_add(S::neg(x61), x181, x79));
         let x201 = x193 * x200;
-        let x202 = Self::mul_add(
-            -x194,
+        let x202 = S::mul_add(
+            S::neg(x194),
             x195,
-            Self::mul_add(-x185, x186, Self::mul_add(-x64, x178, x23)),
+            S::mul_add(S::neg(x185), x186, S::mul_add(S::neg(x64), x178, x23)),
         );
-        let x203 = 1.0 / x202;
-        let x204 = Self::mul_add(
-            -x194,
+        let x203 = S::splat(1.0) / x202;
+        let x204 = S::mul_add(
+            S::neg(x194),
             x197,
-            Self::mul_add(-x185, x188, Self::mul_add(x64, x179, x19)),
+            S::mul_add(S::neg(x185), x188, S::mul_add(x64, x179, x19)),
         );
         let x205 = x203 * x204;
-        let x206 = Self::mul_add(x194, x199, Self::mul_add(-x185, x190, x64 * x180));
+        let x206 = S::mul_add(x194, x199, S::mul_add(S::neg(x185), x190, x64 * x180));
         let x207 = x203 * x206;
-        let x208 = Self::mul_add(
-            -x194,
+        let x208 = S::mul_add(
+            S::neg(x194),
             x201,
-            Self::mul_add(-x185, x192, Self::mul_add(x64, x181, x79)),
+            S::mul_add(S::neg(x185), x192, S::mul_add(x64, x181, x79)),
         );
         let x209 = x203 * x208;
-        let x210 = Self::mul_add(
-            -x196,
+        let x210 = S::mul_add(
+            S::neg(x196),
             x197,
-            Self::mul_add(-x187, x188, Self::mul_add(-x72, x179, x9)),
+            S::mul_add(S::neg(x187), x188, S::mul_add(S::neg(x72), x179, x9)),
         );
-        let x211 = 1.0 / Self::mul_add(-x204, x205, x210);
-        let x212 = Self::mul_add(
+        let x211 = S::splat(1.0) / S::mul_add(S::neg(x204), x205, x210);
+        let x212 = S::mul_add(
             x204,
             x207,
-            Self::mul_add(-x196, x199, Self::mul_add(x187, x190, x72 * x180)),
+            S::mul_add(S::neg(x196), x199, S::mul_add(x187, x190, x72 * x180)),
         );
         let x213 = x211 * x212;
-        let x214 = Self::mul_add(
-            -x196,
+        let x214 = S::mul_add(
+            S::neg(x196),
             x201,
-            Self::mul_add(-x187, x192, Self::mul_add(-x72, x181, x79)),
+            S::mul_add(S::neg(x187), x192, S::mul_add(S::neg(x72), x181, x79)),
         );
-        let x215 = Self::mul_add(-x204, x209, x214);
+        let x215 = S::mul_add(S::neg(x204), x209, x214);
         let x216 = x211 * x215;
-        let x217 = Self::mul_add(
-            -x198,
+        let x217 = S::mul_add(
+            S::neg(x198),
             x199,
-            Self::mul_add(-x189, x190, Self::mul_add(-x77, x180, 47.471)),
+            S::mul_add(
+                S::neg(x189),
+                x190,
+                S::mul_add(S::neg(x77), x180, S::splat(47.471)),
+            ),
         );
-        let x218 = 1.0 / Self::mul_add(-x212, x213, Self::mul_add(-x206, x207, x217));
-        let x219 = Self::mul_add(
+        let x218 = S::splat(1.0)
+            / S::mul_add(S::neg(x212), x213, S::mul_add(S::neg(x206), x207, x217));
+        let x219 = S::mul_add(
             x206,
             x209,
-            Self::mul_add(-x198, x201, Self::mul_add(x189, x192, x77 * x181)),
+            S::mul_add(S::neg(x198), x201, S::mul_add(x189, x192, x77 * x181)),
         );
-        let x220 = Self::mul_add(-x212, x216, x219);
+        let x220 = S::mul_add(S::neg(x212), x216, x219);
         let x221 = x218 * x220;
-        let x222 = Self::mul_add(
-            -x200,
+        let x222 = S::mul_add(
+            S::neg(x200),
             x201,
-            Self::mul_add(-x191, x192, Self::mul_add(-x84, x181, 9.336)),
+            S::mul_add(
+                S::neg(x191),
+                x192,
+                S::mul_add(S::neg(x84), x181, S::splat(9.336)),
+            ),
         );
-        let x223 = Self::mul_add(
-            -x220,
+        let x223 = S::mul_add(
+            S::neg(x220),
             x221,
-            Self::mul_add(-x215, x216, Self::mul_add(-x208, x209, x222)),
+            S::mul_add(S::neg(x215), x216, S::mul_add(S::neg(x208), x209, x222)),
         );
-        let x224 = 1.0 / x223;
-        let x225 = Self::mul_add(x174, x176, tau[1] - x171);
-        let x226 = Self::mul_add(x184, x225, Self::mul_add(-x174, x177, tau[2] + x169));
-        let x227 = Self::mul_add(
-            -x195,
+        let x224 = S::splat(1.0) / x223;
+        let x225 = S::mul_add(x174, x176, tau[1] - x171);
+        let x226 = S::mul_add(x184, x225, S::mul_add(S::neg(x174), x177, tau[2] + x169));
+        let x227 = S::mul_add(
+            S::neg(x195),
             x226,
-            Self::mul_add(x186, x225, Self::mul_add(x174, x178, tau[3] + x162)),
+            S::mul_add(x186, x225, S::mul_add(x174, x178, tau[3] + x162)),
         );
-        let x228 = Self::mul_add(
-            -x197,
+        let x228 = S::mul_add(
+            S::neg(x197),
             x226,
-            Self::mul_add(x188, x225, Self::mul_add(-x174, x179, tau[4] - x155)),
+            S::mul_add(x188, x225, S::mul_add(S::neg(x174), x179, tau[4] - x155)),
         );
-        let x229 = Self::mul_add(-x205, x227, x228);
-        let x230 = Self::mul_add(
+        let x229 = S::mul_add(S::neg(x205), x227, x228);
+        let x230 = S::mul_add(
             x199,
             x226,
-            Self::mul_add(x190, x225, Self::mul_add(-x174, x180, tau[5] + x152)),
+            S::mul_add(x190, x225, S::mul_add(S::neg(x174), x180, tau[5] + x152)),
         );
-        let x231 = Self::mul_add(x213, x229, Self::mul_add(-x207, x227, x230));
-        let x232 = Self::mul_add(
-            -x201,
+        let x231 = S::mul_add(x213, x229, S::mul_add(S::neg(x207), x227, x230));
+        let x232 = S::mul_add(
+            S::neg(x201),
             x226,
-            Self::mul_add(x192, x225, Self::mul_add(-x174, x181, tau[6] + x146)),
+            S::mul_add(x192, x225, S::mul_add(S::neg(x174), x181, tau[6] + x146)),
         );
-        let x233 = Self::mul_add(
+        let x233 = S::mul_add(
             x221,
             x231,
-            Self::mul_add(-x216, x229, Self::mul_add(-x209, x227, x232)),
+            S::mul_add(S::neg(x216), x229, S::mul_add(S::neg(x209), x227, x232)),
         );
         let x234 = x224 * x233;
-        let x235 = Self::mul_add(x221, x234, x218 * x231);
-        let x236 = Self::mul_add(-x216, x234, Self::mul_add(x213, x235, x211 * x229));
-        let x237 = Self::mul_add(
-            -x209,
+        let x235 = S::mul_add(x221, x234, x218 * x231);
+        let x236 = S::mul_add(S::neg(x216), x234, S::mul_add(x213, x235, x211 * x229));
+        let x237 = S::mul_add(
+            S::neg(x209),
             x234,
-            Self::mul_add(-x207, x235, Self::mul_add(-x205, x236, x203 * x227)),
+            S::mul_add(S::neg(x207), x235, S::mul_add(S::neg(x205), x236, x203 * x227)),
         );
-        let x238 = Self::mul_add(
+        let x238 = S::mul_add(
             x199,
             x235,
-            Self::mul_add(-x197, x236, Self::mul_add(-x195, x237, x193 * x226)),
+            S::mul_add(S::neg(x197), x236, S::mul_add(S::neg(x195), x237, x193 * x226)),
         );
-        let x239 = Self::mul_add(-x201, x234, x238);
-        let x240 = Self::mul_add(
+        let x239 = S::mul_add(S::neg(x201), x234, x238);
+        let x240 = S::mul_add(
             x188,
             x236,
-            Self::mul_add(x186, x237, Self::mul_add(x184, x239, x182 * x225)),
+            S::mul_add(x186, x237, S::mul_add(x184, x239, x182 * x225)),
         );
-        let x241 = Self::mul_add(x192, x234, Self::mul_add(x190, x235, x240));
-        let x242 = Self::mul_add(
+        let x241 = S::mul_add(x192, x234, S::mul_add(x190, x235, x240));
+        let x242 = S::mul_add(
             x178,
             x237,
-            Self::mul_add(-x177, x239, Self::mul_add(x176, x241, x174 * x175)),
+            S::mul_add(S::neg(x177), x239, S::mul_add(x176, x241, x174 * x175)),
         );
-        let x243 = Self::mul_add(
-            -x181,
+        let x243 = S::mul_add(
+            S::neg(x181),
             x234,
-            Self::mul_add(-x180, x235, Self::mul_add(-x179, x236, x242)),
+            S::mul_add(S::neg(x180), x235, S::mul_add(S::neg(x179), x236, x242)),
         );
         [x243, x241, x239, x237, x236, x235, x234]
+    }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -2262,322 +2637,427 @@ impl Ssrms {
         q: &[::core::primitive::f64; 7],
         qd: &[::core::primitive::f64; 7],
     ) -> ([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7]) {
+        Self::mass_matrix_and_nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7]) -> ([[S; 7]; 7], [S; 7]) {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
-        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
-        let x6 = s_q5 * s_q5 * 35.074;
-        let x7 = -35.074 + x6;
-        let x8 = s_q5 * c_q5 * 35.074;
-        let x9 = 179.8829695416 - x6;
-        let x10 = x7 - -129.6173695416;
+        (s_q6, c_q6)] = S::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        let x6 = s_q5 * s_q5 * S::splat(35.074);
+        let x7 = S::splat(-35.074) + x6;
+        let x8 = s_q5 * c_q5 * S::splat(35.074);
+        let x9 = S::splat(179.8829695416) - x6;
+        let x10 = x7 - S::splat(-129.6173695416);
         let x11 = s_q4 * s_q4 * x10;
         let x12 = x7 - x11;
-        let x13 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x8);
-        let x14 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x8);
-        let x15 = 171.195516 * s_q4;
-        let x16 = 171.195516 * c_q4;
-        let x17 = 7.11 * x15;
-        let x18 = Self::mul_add(-7.11, x16, s_q4 * c_q4 * x10);
+        let x13 = S::mul_add(S::splat(97.44448770720001), s_q4, c_q4 * x8);
+        let x14 = S::mul_add(S::splat(-97.44448770720001), c_q4, s_q4 * x8);
+        let x15 = S::splat(171.195516) * s_q4;
+        let x16 = S::splat(171.195516) * c_q4;
+        let x17 = S::splat(7.11) * x15;
+        let x18 = S::mul_add(S::splat(-7.11), x16, s_q4 * c_q4 * x10);
         let x19 = x9 - x17;
-        let x20 = 3239.4582 - x15;
-        let x21 = 1375.0472756800002 - x13;
-        let x22 = 24989.305802 - (x17 - (-129.6173695416 + x11 - x17));
-        let x23 = 24998.827802 - (x17 - x19);
+        let x20 = S::splat(3239.4582) - x15;
+        let x21 = S::splat(1375.0472756800002) - x13;
+        let x22 = S::splat(24989.305802)
+            - (x17 - (S::splat(-129.6173695416) + x11 - x17));
+        let x23 = S::splat(24998.827802) - (x17 - x19);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
         let x26 = x12 - x22;
         let x27 = x18 + x18;
-        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x28 = S::mul_add(x25, x27, x24 * x26);
         let x29 = x12 - x28;
         let x30 = s_q3 * x14;
         let x31 = c_q3 * x14;
         let x32 = s_q3 * x16;
-        let x33 = Self::mul_add(c_q3, x20, -x32);
+        let x33 = S::mul_add(c_q3, x20, S::neg(x32));
         let x34 = c_q3 * x16;
-        let x35 = Self::mul_add(s_q3, x20, x34);
-        let x36 = 7.11 * x33;
-        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, x30));
-        let x38 = Self::mul_add(-7.11, x35, x18 + Self::mul_add(-x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, -x31));
+        let x35 = S::mul_add(s_q3, x20, x34);
+        let x36 = S::splat(7.11) * x33;
+        let x37 = S::mul_add(x33, S::splat(0.475), S::mul_add(c_q3, x21, x30));
+        let x38 = S::mul_add(
+            S::splat(-7.11),
+            x35,
+            x18 + S::mul_add(S::neg(x24), x27, x25 * x26),
+        );
+        let x39 = S::mul_add(x35, S::splat(0.475), S::mul_add(s_q3, x21, S::neg(x31)));
         let x40 = x23 + x36;
-        let x41 = 5224.5702 + x33;
-        let x42 = 3946.18812068 + x37;
-        let x43 = 39234.474122 + (x36 + (x22 + x28 + x36));
-        let x44 = 39241.404122 + (x36 + x40);
+        let x41 = S::splat(5224.5702) + x33;
+        let x42 = S::splat(3946.18812068) + x37;
+        let x43 = S::splat(39234.474122) + (x36 + (x22 + x28 + x36));
+        let x44 = S::splat(39241.404122) + (x36 + x40);
         let x45 = s_q2 * s_q2;
         let x46 = s_q2 * c_q2;
         let x47 = x29 - x43;
         let x48 = x38 + x38;
-        let x49 = Self::mul_add(x46, x48, x45 * x47);
+        let x49 = S::mul_add(x46, x48, x45 * x47);
         let x50 = x29 - x49;
         let x51 = s_q2 * x39;
         let x52 = c_q2 * x39;
         let x53 = s_q2 * x35;
-        let x54 = Self::mul_add(c_q2, x41, -x53);
+        let x54 = S::mul_add(c_q2, x41, S::neg(x53));
         let x55 = c_q2 * x35;
-        let x56 = Self::mul_add(s_q2, x41, x55);
-        let x57 = Self::mul_add(0.5692, x54, Self::mul_add(c_q2, x42, -x51));
-        let x58 = Self::mul_add(0.5692, x56, Self::mul_add(s_q2, x42, x52));
-        let x59 = 1650.6386721183999 + (x43 + x49);
-        let x60 = 0.7026 * x56;
-        let x61 = Self::mul_add(
-            0.7026,
-            Self::mul_add(1145.5438279999998, s_q1, c_q1 * x54),
-            Self::mul_add(-s_q1, x58, c_q1 * (x38 + Self::mul_add(-x45, x48, x46 * x47))),
+        let x56 = S::mul_add(s_q2, x41, x55);
+        let x57 = S::mul_add(S::splat(0.5692), x54, S::mul_add(c_q2, x42, S::neg(x51)));
+        let x58 = S::mul_add(S::splat(0.5692), x56, S::mul_add(s_q2, x42, x52));
+        let x59 = S::splat(1650.6386721183999) + (x43 + x49);
+        let x60 = S::splat(0.7026) * x56;
+        let x61 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(S::splat(1145.5438279999998), s_q1, c_q1 * x54),
+            S::mul_add(
+                S::neg(s_q1),
+                x58,
+                c_q1 * (x38 + S::mul_add(S::neg(x45), x48, x46 * x47)),
+            ),
         );
-        let x62 = 2232.9683597151998
+        let x62 = S::splat(2232.9683597151998)
             - (x60
                 - (x50
-                    - Self::mul_add(
+                    - S::mul_add(
                         s_q1 * c_q1,
                         x57 + x57,
-                        s_q1 * s_q1 * (x50 - (-1647.2196721184 + x44)),
+                        s_q1 * s_q1 * (x50 - (S::splat(-1647.2196721184) + x44)),
                     ) - x60));
-        let x63 = -x61;
-        let x64 = -x58;
-        let x65 = Self::mul_add(
-            0.7026,
+        let x63 = S::neg(x61);
+        let x64 = S::neg(x58);
+        let x65 = S::mul_add(
+            S::splat(0.7026),
             s_q1 * x56,
-            Self::mul_add(-s_q1, x44, c_q1 * x57),
+            S::mul_add(S::neg(s_q1), x44, c_q1 * x57),
         );
-        let x66 = Self::mul_add(s_q2, x33, x55);
-        let x67 = -Self::mul_add(0.5692, x66, Self::mul_add(s_q2, x37, x52));
-        let x68 = Self::mul_add(
+        let x66 = S::mul_add(s_q2, x33, x55);
+        let x67 = S::neg(S::mul_add(S::splat(0.5692), x66, S::mul_add(s_q2, x37, x52)));
+        let x68 = S::mul_add(
             s_q1,
             x40,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-c_q2, x33, x53),
-                    Self::mul_add(-c_q2, x37, x51),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(S::neg(c_q2), x33, x53),
+                    S::mul_add(S::neg(c_q2), x37, x51),
                 ),
         );
-        let x69 = -Self::mul_add(-0.7026, s_q1 * x66, x68);
-        let x70 = Self::mul_add(-s_q3, x15, x34);
-        let x71 = Self::mul_add(c_q3, x15, x32);
-        let x72 = Self::mul_add(-0.475, x71, Self::mul_add(-c_q3, x13, x30));
-        let x73 = Self::mul_add(-0.475, x70, Self::mul_add(s_q3, x13, x31));
-        let x74 = Self::mul_add(-7.11, x71, x19);
-        let x75 = Self::mul_add(-s_q2, x71, c_q2 * x70);
-        let x76 = -Self::mul_add(0.5692, x75, Self::mul_add(-c_q2, x73, s_q2 * x72));
-        let x77 = Self::mul_add(
-            -s_q1,
+        let x69 = S::neg(S::mul_add(S::splat(-0.7026), s_q1 * x66, x68));
+        let x70 = S::mul_add(S::neg(s_q3), x15, x34);
+        let x71 = S::mul_add(c_q3, x15, x32);
+        let x72 = S::mul_add(S::splat(-0.475), x71, S::mul_add(S::neg(c_q3), x13, x30));
+        let x73 = S::mul_add(S::splat(-0.475), x70, S::mul_add(s_q3, x13, x31));
+        let x74 = S::mul_add(S::splat(-7.11), x71, x19);
+        let x75 = S::mul_add(S::neg(s_q2), x71, c_q2 * x70);
+        let x76 = S::neg(
+            S::mul_add(S::splat(0.5692), x75, S::mul_add(S::neg(c_q2), x73, s_q2 * x72)),
+        );
+        let x77 = S::mul_add(
+            S::neg(s_q1),
             x74,
             c_q1
-                * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x71, s_q2 * x70),
-                    Self::mul_add(s_q2, x73, c_q2 * x72),
+                * S::mul_add(
+                    S::splat(-0.5692),
+                    S::mul_add(c_q2, x71, s_q2 * x70),
+                    S::mul_add(s_q2, x73, c_q2 * x72),
                 ),
         );
-        let x78 = Self::mul_add(0.7026, s_q1 * x75, x77);
-        let x79 = 47.471 * s_q4;
-        let x80 = 47.471 * c_q4;
-        let x81 = Self::mul_add(s_q3, x80, c_q3 * x79);
-        let x82 = Self::mul_add(-c_q3, x80, s_q3 * x79);
-        let x83 = -Self::mul_add(c_q2, x82, s_q2 * x81);
-        let x84 = c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x81);
-        let x85 = 9.336 * c_q5;
-        let x86 = 9.336 * s_q5;
+        let x78 = S::mul_add(S::splat(0.7026), s_q1 * x75, x77);
+        let x79 = S::splat(47.471) * s_q4;
+        let x80 = S::splat(47.471) * c_q4;
+        let x81 = S::mul_add(s_q3, x80, c_q3 * x79);
+        let x82 = S::mul_add(S::neg(c_q3), x80, s_q3 * x79);
+        let x83 = S::neg(S::mul_add(c_q2, x82, s_q2 * x81));
+        let x84 = c_q1 * S::mul_add(S::neg(s_q2), x82, c_q2 * x81);
+        let x85 = S::splat(9.336) * c_q5;
+        let x86 = S::splat(9.336) * s_q5;
         let x87 = c_q4 * x85;
         let x88 = s_q4 * x85;
-        let x89 = Self::mul_add(-s_q3, x88, c_q3 * x87);
-        let x90 = Self::mul_add(c_q3, x88, s_q3 * x87);
-        let x91 = -Self::mul_add(c_q2, x90, s_q2 * x89);
-        let x92 = Self::mul_add(
-            -s_q1,
+        let x89 = S::mul_add(S::neg(s_q3), x88, c_q3 * x87);
+        let x90 = S::mul_add(c_q3, x88, s_q3 * x87);
+        let x91 = S::neg(S::mul_add(c_q2, x90, s_q2 * x89));
+        let x92 = S::mul_add(
+            S::neg(s_q1),
             x86,
-            c_q1 * Self::mul_add(-s_q2, x90, c_q2 * x89),
+            c_q1 * S::mul_add(S::neg(s_q2), x90, c_q2 * x89),
         );
         let x93 = qd[0] * c_q1;
         let x94 = qd[0] * s_q1;
-        let x95 = 0.7026 * (qd[0] * qd[0]);
+        let x95 = S::splat(0.7026) * (qd[0] * qd[0]);
         let x96 = qd[1] * x94;
         let x97 = qd[1] * x93;
         let x98 = x93 * x94;
-        let x99 = Self::mul_add(x93, x93, qd[1] * qd[1]);
-        let x100 = x94 * 1647.2196721184;
-        let x101 = 1650.6386721183999 * qd[1];
-        let x102 = Self::mul_add(-qd[1], s_q2, c_q2 * x93);
-        let x103 = Self::mul_add(qd[1], c_q2, s_q2 * x93);
-        let x104 = 0.5692 * x98;
-        let x105 = 0.5692 * x99;
-        let x106 = Self::mul_add(-0.5692, x96 + x96, x95);
-        let x107 = Self::mul_add(-c_q2, x106, s_q2 * x104);
-        let x108 = Self::mul_add(qd[2], x103, c_q2 * x96);
-        let x109 = Self::mul_add(-qd[2], x102, s_q2 * x96);
+        let x99 = S::mul_add(x93, x93, qd[1] * qd[1]);
+        let x100 = x94 * S::splat(1647.2196721184);
+        let x101 = S::splat(1650.6386721183999) * qd[1];
+        let x102 = S::mul_add(S::neg(qd[1]), s_q2, c_q2 * x93);
+        let x103 = S::mul_add(qd[1], c_q2, s_q2 * x93);
+        let x104 = S::splat(0.5692) * x98;
+        let x105 = S::splat(0.5692) * x99;
+        let x106 = S::mul_add(S::splat(-0.5692), x96 + x96, x95);
+        let x107 = S::mul_add(S::neg(c_q2), x106, s_q2 * x104);
+        let x108 = S::mul_add(qd[2], x103, c_q2 * x96);
+        let x109 = S::mul_add(S::neg(qd[2]), x102, s_q2 * x96);
         let x110 = qd[2] - x94;
         let x111 = x103 * x103;
-        let x112 = Self::mul_add(x110, x110, x111);
+        let x112 = S::mul_add(x110, x110, x111);
         let x113 = x102 * x110;
-        let x114 = Self::mul_add(x102, x103, x97);
+        let x114 = S::mul_add(x102, x103, x97);
         let x115 = x109 - x113;
-        let x116 = 3946.18812068 * x110;
-        let x117 = 39234.474122 * x103;
-        let x118 = Self::mul_add(39241.404122, x110, 3946.1881206800003 * x102);
-        let x119 = Self::mul_add(
-            -5224.5702,
+        let x116 = S::splat(3946.18812068) * x110;
+        let x117 = S::splat(39234.474122) * x103;
+        let x118 = S::mul_add(
+            S::splat(39241.404122),
+            x110,
+            S::splat(3946.1881206800003) * x102,
+        );
+        let x119 = S::mul_add(
+            S::splat(-5224.5702),
             x105,
-            Self::mul_add(39234.474122, x109, Self::mul_add(-x102, x118, x110 * x116)),
+            S::mul_add(
+                S::splat(39234.474122),
+                x109,
+                S::mul_add(S::neg(x102), x118, x110 * x116),
+            ),
         );
-        let x120 = Self::mul_add(-s_q3, x103, c_q3 * x102);
-        let x121 = Self::mul_add(c_q3, x103, s_q3 * x102);
-        let x122 = Self::mul_add(s_q2, x106, c_q2 * x104)
-            - Self::mul_add(0.475, x109 + x113, 7.11 * x112);
+        let x120 = S::mul_add(S::neg(s_q3), x103, c_q3 * x102);
+        let x121 = S::mul_add(c_q3, x103, s_q3 * x102);
+        let x122 = S::mul_add(s_q2, x106, c_q2 * x104)
+            - S::mul_add(S::splat(0.475), x109 + x113, S::splat(7.11) * x112);
         let x123 = x107
-            + Self::mul_add(0.475, Self::mul_add(-x103, x110, x108), 7.11 * x114);
+            + S::mul_add(
+                S::splat(0.475),
+                S::mul_add(S::neg(x103), x110, x108),
+                S::splat(7.11) * x114,
+            );
         let x124 = x105
-            - Self::mul_add(-0.475, Self::mul_add(x102, x102, x111), 7.11 * x115);
-        let x125 = Self::mul_add(c_q3, x123, s_q3 * x122);
-        let x126 = Self::mul_add(qd[3], x121, Self::mul_add(-s_q3, x109, c_q3 * x108));
-        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(c_q3, x109, s_q3 * x108));
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x102, x102, x111),
+                S::splat(7.11) * x115,
+            );
+        let x125 = S::mul_add(c_q3, x123, s_q3 * x122);
+        let x126 = S::mul_add(qd[3], x121, S::mul_add(S::neg(s_q3), x109, c_q3 * x108));
+        let x127 = S::mul_add(S::neg(qd[3]), x120, S::mul_add(c_q3, x109, s_q3 * x108));
         let x128 = qd[3] + x110;
-        let x129 = Self::mul_add(x128, x128, x121 * x121);
-        let x130 = Self::mul_add(x120, x121, x97);
-        let x131 = Self::mul_add(-x120, x128, x127);
-        let x132 = 1375.0472756800002 * x128;
-        let x133 = 24989.305802 * x121;
-        let x134 = Self::mul_add(24998.827802, x128, 1375.0472756800002 * x120);
-        let x135 = Self::mul_add(
-            -3239.4582,
+        let x129 = S::mul_add(x128, x128, x121 * x121);
+        let x130 = S::mul_add(x120, x121, x97);
+        let x131 = S::mul_add(S::neg(x120), x128, x127);
+        let x132 = S::splat(1375.0472756800002) * x128;
+        let x133 = S::splat(24989.305802) * x121;
+        let x134 = S::mul_add(
+            S::splat(24998.827802),
+            x128,
+            S::splat(1375.0472756800002) * x120,
+        );
+        let x135 = S::mul_add(
+            S::splat(-3239.4582),
             x124,
-            Self::mul_add(24989.305802, x127, Self::mul_add(-x120, x134, x128 * x132)),
+            S::mul_add(
+                S::splat(24989.305802),
+                x127,
+                S::mul_add(S::neg(x120), x134, x128 * x132),
+            ),
         );
-        let x136 = Self::mul_add(-s_q4, x121, c_q4 * x120);
-        let x137 = Self::mul_add(c_q4, x121, s_q4 * x120);
-        let x138 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x130, x125),
-            c_q4 * Self::mul_add(-7.11, x129, Self::mul_add(-s_q3, x123, c_q3 * x122)),
+        let x136 = S::mul_add(S::neg(s_q4), x121, c_q4 * x120);
+        let x137 = S::mul_add(c_q4, x121, s_q4 * x120);
+        let x138 = S::mul_add(
+            S::neg(s_q4),
+            S::mul_add(S::splat(7.11), x130, x125),
+            c_q4
+                * S::mul_add(
+                    S::splat(-7.11),
+                    x129,
+                    S::mul_add(S::neg(s_q3), x123, c_q3 * x122),
+                ),
         );
-        let x139 = Self::mul_add(qd[4], x137, Self::mul_add(-s_q4, x127, c_q4 * x126));
-        let x140 = Self::mul_add(-qd[4], x136, Self::mul_add(c_q4, x127, s_q4 * x126));
+        let x139 = S::mul_add(qd[4], x137, S::mul_add(S::neg(s_q4), x127, c_q4 * x126));
+        let x140 = S::mul_add(S::neg(qd[4]), x136, S::mul_add(c_q4, x127, s_q4 * x126));
         let x141 = qd[4] + x128;
-        let x142 = 171.195516 * Self::mul_add(-x136, x137, x97);
-        let x143 = 171.195516 * Self::mul_add(x136, x136, x141 * x141);
-        let x144 = 171.195516 * Self::mul_add(x137, x141, x139);
-        let x145 = Self::mul_add(97.44448770720001, x141, x137 * 177.0883695416);
-        let x146 = Self::mul_add(-179.8829695416, x141, 97.44448770720001 * x137);
-        let x147 = Self::mul_add(
-            -171.195516,
+        let x142 = S::splat(171.195516) * S::mul_add(S::neg(x136), x137, x97);
+        let x143 = S::splat(171.195516) * S::mul_add(x136, x136, x141 * x141);
+        let x144 = S::splat(171.195516) * S::mul_add(x137, x141, x139);
+        let x145 = S::mul_add(
+            S::splat(97.44448770720001),
+            x141,
+            x137 * S::splat(177.0883695416),
+        );
+        let x146 = S::mul_add(
+            S::splat(-179.8829695416),
+            x141,
+            S::splat(97.44448770720001) * x137,
+        );
+        let x147 = S::mul_add(
+            S::splat(-171.195516),
             x138,
-            Self::mul_add(
+            S::mul_add(
                 x136,
                 x145,
-                Self::mul_add(-179.8829695416, x97, 97.44448770720001 * x140),
+                S::mul_add(
+                    S::splat(-179.8829695416),
+                    x97,
+                    S::splat(97.44448770720001) * x140,
+                ),
             ),
         );
-        let x148 = Self::mul_add(-c_q5, x141, s_q5 * x136);
-        let x149 = Self::mul_add(s_q5, x141, c_q5 * x136);
-        let x150 = Self::mul_add(qd[5], x148, Self::mul_add(s_q5, x97, c_q5 * x139));
+        let x148 = S::mul_add(S::neg(c_q5), x141, s_q5 * x136);
+        let x149 = S::mul_add(s_q5, x141, c_q5 * x136);
+        let x150 = S::mul_add(qd[5], x148, S::mul_add(s_q5, x97, c_q5 * x139));
         let x151 = qd[5] + x137;
-        let x152 = 44.41 * x149;
-        let x153 = 47.471 * x151;
-        let x154 = 9.336 * x150;
-        let x155 = -x154;
-        let x156 = 9.336 * (qd[6] + x149);
-        let x157 = Self::mul_add(c_q6, x151, s_q6 * x148) * x156;
-        let x158 = Self::mul_add(-s_q6, x151, c_q6 * x148) * x156;
-        let x159 = Self::mul_add(x149, x153, x151 * x152)
-            - Self::mul_add(-s_q6, x158, c_q6 * x157);
-        let x160 = Self::mul_add(-x148, x153, 44.41 * x150) - x154;
-        let x161 = Self::mul_add(x148, x152, 47.471 * x140)
-            - Self::mul_add(c_q6, x158, s_q6 * x157);
-        let x162 = -x161;
-        let x163 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-7.11, x131, x124),
-            Self::mul_add(-x137, x146, x141 * x145),
-        ) - Self::mul_add(c_q5, x160, s_q5 * x159);
-        let x164 = Self::mul_add(
-            -x136,
+        let x152 = S::splat(44.41) * x149;
+        let x153 = S::splat(47.471) * x151;
+        let x154 = S::splat(9.336) * x150;
+        let x155 = S::neg(x154);
+        let x156 = S::splat(9.336) * (qd[6] + x149);
+        let x157 = S::mul_add(c_q6, x151, s_q6 * x148) * x156;
+        let x158 = S::mul_add(S::neg(s_q6), x151, c_q6 * x148) * x156;
+        let x159 = S::mul_add(x149, x153, x151 * x152)
+            - S::mul_add(S::neg(s_q6), x158, c_q6 * x157);
+        let x160 = S::mul_add(S::neg(x148), x153, S::splat(44.41) * x150) - x154;
+        let x161 = S::mul_add(x148, x152, S::splat(47.471) * x140)
+            - S::mul_add(c_q6, x158, s_q6 * x157);
+        let x162 = S::neg(x161);
+        let x163 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::splat(-7.11), x131, x124),
+            S::mul_add(S::neg(x137), x146, x141 * x145),
+        ) - S::mul_add(c_q5, x160, s_q5 * x159);
+        let x164 = S::mul_add(
+            S::neg(x136),
             x146,
-            Self::mul_add(97.44448770720001, x97, x140 * 177.0883695416),
+            S::mul_add(S::splat(97.44448770720001), x97, x140 * S::splat(177.0883695416)),
         ) - x161;
-        let x165 = x147 - Self::mul_add(-s_q5, x160, c_q5 * x159);
-        let x166 = Self::mul_add(-c_q4, x143, s_q4 * x142);
-        let x167 = Self::mul_add(
-            3239.4582,
+        let x165 = x147 - S::mul_add(S::neg(s_q5), x160, c_q5 * x159);
+        let x166 = S::mul_add(S::neg(c_q4), x143, s_q4 * x142);
+        let x167 = S::mul_add(
+            S::splat(3239.4582),
             x129,
-            -Self::mul_add(s_q4, x143, c_q4 * x142),
+            S::neg(S::mul_add(s_q4, x143, c_q4 * x142)),
         );
-        let x168 = Self::mul_add(3239.4582, x130, -x166);
-        let x169 = Self::mul_add(3239.4582, x131, x144);
-        let x170 = Self::mul_add(
-            1375.0472756800002,
+        let x168 = S::mul_add(S::splat(3239.4582), x130, S::neg(x166));
+        let x169 = S::mul_add(S::splat(3239.4582), x131, x144);
+        let x170 = S::mul_add(
+            S::splat(1375.0472756800002),
             x97,
-            -Self::mul_add(-x121, x134, x128 * x133),
-        ) + Self::mul_add(-s_q4, x164, c_q4 * x163);
+            S::neg(S::mul_add(S::neg(x121), x134, x128 * x133)),
+        ) + S::mul_add(S::neg(s_q4), x164, c_q4 * x163);
         let x171 = x135
-            - Self::mul_add(-7.11, x144, Self::mul_add(c_q4, x164, s_q4 * x163));
-        let x172 = Self::mul_add(
-            3239.4582,
+            - S::mul_add(S::splat(-7.11), x144, S::mul_add(c_q4, x164, s_q4 * x163));
+        let x172 = S::mul_add(
+            S::splat(3239.4582),
             x125,
-            Self::mul_add(24998.827802, x97, 1375.0472756800002 * x126)
-                - Self::mul_add(-x120, x133, x121 * x132),
-        ) - Self::mul_add(7.11, x166, x165);
-        let x173 = -x172;
-        let x174 = Self::mul_add(-s_q3, x168, c_q3 * x167);
-        let x175 = Self::mul_add(c_q3, x168, s_q3 * x167);
-        let x176 = Self::mul_add(5224.5702, x112, x174);
-        let x177 = Self::mul_add(5224.5702, x114, x175);
-        let x178 = Self::mul_add(
-            3946.18812068,
+            S::mul_add(S::splat(24998.827802), x97, S::splat(1375.0472756800002) * x126)
+                - S::mul_add(S::neg(x120), x133, x121 * x132),
+        ) - S::mul_add(S::splat(7.11), x166, x165);
+        let x173 = S::neg(x172);
+        let x174 = S::mul_add(S::neg(s_q3), x168, c_q3 * x167);
+        let x175 = S::mul_add(c_q3, x168, s_q3 * x167);
+        let x176 = S::mul_add(S::splat(5224.5702), x112, x174);
+        let x177 = S::mul_add(S::splat(5224.5702), x114, x175);
+        let x178 = S::mul_add(
+            S::splat(3946.18812068),
             x97,
-            -Self::mul_add(-x103, x118, x110 * x117),
-        ) + Self::mul_add(0.475, x175, Self::mul_add(s_q3, x171, c_q3 * x170));
+            S::neg(S::mul_add(S::neg(x103), x118, x110 * x117)),
+        ) + S::mul_add(S::splat(0.475), x175, S::mul_add(s_q3, x171, c_q3 * x170));
         let x179 = x119
-            - (Self::mul_add(-c_q3, x171, s_q3 * x170)
-                - Self::mul_add(7.11, x169, 0.475 * x174));
-        let x180 = Self::mul_add(
-            5224.5702,
+            - (S::mul_add(S::neg(c_q3), x171, s_q3 * x170)
+                - S::mul_add(S::splat(7.11), x169, S::splat(0.475) * x174));
+        let x180 = S::mul_add(
+            S::splat(5224.5702),
             x107,
-            Self::mul_add(39241.404122, x97, 3946.1881206800003 * x108)
-                - Self::mul_add(-x102, x117, x103 * x116),
-        ) + Self::mul_add(7.11, x175, x172);
-        let x181 = -x180;
-        let x182 = Self::mul_add(-s_q2, x177, c_q2 * x176);
-        let x183 = Self::mul_add(
+            S::mul_add(S::splat(39241.404122), x97, S::splat(3946.1881206800003) * x108)
+                - S::mul_add(S::neg(x102), x117, x103 * x116),
+        ) + S::mul_add(S::splat(7.11), x175, x172);
+        let x181 = S::neg(x180);
+        let x182 = S::mul_add(S::neg(s_q2), x177, c_q2 * x176);
+        let x183 = S::mul_add(
             x93,
             x100,
-            Self::mul_add(-0.5692, x182, Self::mul_add(-c_q2, x179, s_q2 * x178)),
-        );
-        let x184 = Self::mul_add(
-            c_q1,
-            Self::mul_add(
-                1145.5438279999998,
-                x99,
-                -Self::mul_add(5224.5702, x115, x169),
+            S::mul_add(
+                S::splat(-0.5692),
+                x182,
+                S::mul_add(S::neg(c_q2), x179, s_q2 * x178),
             ),
-            s_q1 * Self::mul_add(1145.5438279999998, x98, -x182),
         );
-        let x185 = Self::mul_add(
+        let x184 = S::mul_add(
+            c_q1,
+            S::mul_add(
+                S::splat(1145.5438279999998),
+                x99,
+                S::neg(S::mul_add(S::splat(5224.5702), x115, x169)),
+            ),
+            s_q1 * S::mul_add(S::splat(1145.5438279999998), x98, S::neg(x182)),
+        );
+        let x185 = S::mul_add(
             s_q1,
-            Self::mul_add(-x93, x101, x97 * 1647.2196721184) - x180,
+            S::mul_add(S::neg(x93), x101, x97 * S::splat(1647.2196721184)) - x180,
             c_q1
-                * (Self::mul_add(
-                    -1145.5438279999998,
+                * (S::mul_add(
+                    S::splat(-1145.5438279999998),
                     x95,
-                    Self::mul_add(x94, x101, qd[1] * x100),
+                    S::mul_add(x94, x101, qd[1] * x100),
                 )
-                    + Self::mul_add(
-                        0.5692,
-                        Self::mul_add(c_q2, x177, s_q2 * x176),
-                        Self::mul_add(s_q2, x179, c_q2 * x178),
+                    + S::mul_add(
+                        S::splat(0.5692),
+                        S::mul_add(c_q2, x177, s_q2 * x176),
+                        S::mul_add(s_q2, x179, c_q2 * x178),
                     )),
         );
-        let x186 = -Self::mul_add(0.7026, x184, x185);
+        let x186 = S::neg(S::mul_add(S::splat(0.7026), x184, x185));
         (
             [
                 [x62, x63, x65, x69, x78, x84, x92],
                 [x63, x59, x64, x67, x76, x83, x91],
-                [x65, x64, x44, x40, x74, 0.0, x86],
-                [x69, x67, x40, x23, x19, 0.0, x86],
-                [x78, x76, x74, x19, x9, 0.0, x86],
-                [x84, x83, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x92, x91, x86, x86, x86, 0.0, 9.336],
+                [x65, x64, x44, x40, x74, S::splat(0.0), x86],
+                [x69, x67, x40, x23, x19, S::splat(0.0), x86],
+                [x78, x76, x74, x19, x9, S::splat(0.0), x86],
+                [
+                    x84,
+                    x83,
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(47.471),
+                    S::splat(0.0),
+                ],
+                [x92, x91, x86, x86, x86, S::splat(0.0), S::splat(9.336)],
             ],
             [x186, x183, x181, x173, x165, x162, x155],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -2589,332 +3069,413 @@ impl Ssrms {
         tau: &[::core::primitive::f64; 7],
         f_ext: &[[::core::primitive::f64; 6]; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::forward_dynamics_with_wrenches_lanes::<
+            ::core::primitive::f64,
+        >(q, qd, tau, f_ext)
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], tau: &[S; 7], f_ext: &[[S; 6]; 7]) -> [S; 7] {
         let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
-        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
-        let x6 = s_q5 * s_q5 * 35.074;
-        let x7 = s_q5 * c_q5 * 35.074;
-        let x8 = 132.6783695416 + (9.336 + x6);
-        let x9 = 135.4729695416 + (44.41 - x6);
-        let x10 = 47.471 - x8;
+        (s_q6, c_q6)] = S::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        let x6 = s_q5 * s_q5 * S::splat(35.074);
+        let x7 = s_q5 * c_q5 * S::splat(35.074);
+        let x8 = S::splat(132.6783695416) + (S::splat(9.336) + x6);
+        let x9 = S::splat(135.4729695416) + (S::splat(44.41) - x6);
+        let x10 = S::splat(47.471) - x8;
         let x11 = s_q4 * s_q4 * x10;
-        let x12 = Self::mul_add(-s_q4, x7, c_q4 * 97.44448770720001);
-        let x13 = Self::mul_add(c_q4, x7, s_q4 * 97.44448770720001);
-        let x14 = c_q4 * 171.195516;
-        let x15 = s_q4 * 171.195516;
-        let x16 = 7.11 * x15;
+        let x12 = S::mul_add(S::neg(s_q4), x7, c_q4 * S::splat(97.44448770720001));
+        let x13 = S::mul_add(c_q4, x7, s_q4 * S::splat(97.44448770720001));
+        let x14 = c_q4 * S::splat(171.195516);
+        let x15 = s_q4 * S::splat(171.195516);
+        let x16 = S::splat(7.11) * x15;
         let x17 = x9 - x16;
-        let x18 = Self::mul_add(7.11, x14, s_q4 * c_q4 * x10);
-        let x19 = x16 - (47.471 - x11 - x16);
-        let x20 = 3239.4582 - x15;
-        let x21 = -24989.305802 + (x8 + x11);
-        let x22 = 1375.0472756800002 - x13;
-        let x23 = 24998.827802 - (x16 - x17);
+        let x18 = S::mul_add(S::splat(7.11), x14, s_q4 * c_q4 * x10);
+        let x19 = x16 - (S::splat(47.471) - x11 - x16);
+        let x20 = S::splat(3239.4582) - x15;
+        let x21 = S::splat(-24989.305802) + (x8 + x11);
+        let x22 = S::splat(1375.0472756800002) - x13;
+        let x23 = S::splat(24998.827802) - (x16 - x17);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
         let x26 = x19 + x21;
         let x27 = x18 + x18;
-        let x28 = Self::mul_add(-x25, x27, x24 * x26);
+        let x28 = S::mul_add(S::neg(x25), x27, x24 * x26);
         let x29 = c_q3 * x12;
         let x30 = s_q3 * x12;
         let x31 = c_q3 * x14;
-        let x32 = Self::mul_add(s_q3, x20, x31);
+        let x32 = S::mul_add(s_q3, x20, x31);
         let x33 = s_q3 * x14;
-        let x34 = Self::mul_add(-c_q3, x20, x33);
-        let x35 = 7.11 * x34;
-        let x36 = Self::mul_add(x34, 0.475, Self::mul_add(-c_q3, x22, x30));
+        let x34 = S::mul_add(S::neg(c_q3), x20, x33);
+        let x35 = S::splat(7.11) * x34;
+        let x36 = S::mul_add(x34, S::splat(0.475), S::mul_add(S::neg(c_q3), x22, x30));
         let x37 = x23 - x35;
-        let x38 = Self::mul_add(7.11, x32, x18 - Self::mul_add(x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x32, 0.475, Self::mul_add(s_q3, x22, x29));
+        let x38 = S::mul_add(S::splat(7.11), x32, x18 - S::mul_add(x24, x27, x25 * x26));
+        let x39 = S::mul_add(x32, S::splat(0.475), S::mul_add(s_q3, x22, x29));
         let x40 = x35 + (x19 - x28 + x35);
-        let x41 = 5224.5702 - x34;
-        let x42 = -39234.47412200001 + (x21 - x28);
-        let x43 = 3946.18812068 - x36;
-        let x44 = 39241.404122 - (x35 - x37);
+        let x41 = S::splat(5224.5702) - x34;
+        let x42 = S::splat(-39234.47412200001) + (x21 - x28);
+        let x43 = S::splat(3946.18812068) - x36;
+        let x44 = S::splat(39241.404122) - (x35 - x37);
         let x45 = s_q2 * s_q2;
         let x46 = s_q2 * c_q2;
         let x47 = x40 + x42;
         let x48 = x38 + x38;
-        let x49 = Self::mul_add(-x46, x48, x45 * x47);
+        let x49 = S::mul_add(S::neg(x46), x48, x45 * x47);
         let x50 = x42 - x49;
         let x51 = c_q2 * x39;
         let x52 = s_q2 * x39;
         let x53 = c_q2 * x32;
-        let x54 = Self::mul_add(s_q2, x41, x53);
+        let x54 = S::mul_add(s_q2, x41, x53);
         let x55 = s_q2 * x32;
-        let x56 = Self::mul_add(-c_q2, x41, x55);
-        let x57 = Self::mul_add(0.5692, x56, Self::mul_add(-c_q2, x43, x52));
-        let x58 = Self::mul_add(0.5692, x54, Self::mul_add(s_q2, x43, x51));
-        let x59 = 0.7026 * x54;
-        let x60 = Self::mul_add(
-            0.7026,
-            Self::mul_add(s_q1, -1145.5438279999998, c_q1 * x56),
-            Self::mul_add(s_q1, x58, c_q1 * (x38 - Self::mul_add(x45, x48, x46 * x47))),
+        let x56 = S::mul_add(S::neg(c_q2), x41, x55);
+        let x57 = S::mul_add(S::splat(0.5692), x56, S::mul_add(S::neg(c_q2), x43, x52));
+        let x58 = S::mul_add(S::splat(0.5692), x54, S::mul_add(s_q2, x43, x51));
+        let x59 = S::splat(0.7026) * x54;
+        let x60 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(s_q1, S::splat(-1145.5438279999998), c_q1 * x56),
+            S::mul_add(s_q1, x58, c_q1 * (x38 - S::mul_add(x45, x48, x46 * x47))),
         );
-        let x61 = Self::mul_add(
-            -0.7026,
+        let x61 = S::mul_add(
+            S::splat(-0.7026),
             s_q1 * x54,
-            Self::mul_add(s_q1, x44, c_q1 * x57),
+            S::mul_add(s_q1, x44, c_q1 * x57),
         );
-        let x62 = Self::mul_add(-s_q2, x34, x53);
-        let x63 = Self::mul_add(
+        let x62 = S::mul_add(S::neg(s_q2), x34, x53);
+        let x63 = S::mul_add(
             s_q1,
             x37,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(c_q2, x34, x55),
-                    Self::mul_add(c_q2, x36, x52),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(c_q2, x34, x55),
+                    S::mul_add(c_q2, x36, x52),
                 ),
         );
-        let x64 = Self::mul_add(-0.7026, s_q1 * x62, x63);
-        let x65 = Self::mul_add(-s_q3, x15, x31);
-        let x66 = Self::mul_add(c_q3, x15, x33);
-        let x67 = Self::mul_add(0.475, x66, Self::mul_add(c_q3, x13, x30));
-        let x68 = Self::mul_add(-7.11, x66, x17);
-        let x69 = Self::mul_add(0.475, x65, Self::mul_add(-s_q3, x13, x29));
-        let x70 = Self::mul_add(-s_q2, x66, c_q2 * x65);
-        let x71 = Self::mul_add(
+        let x64 = S::mul_add(S::splat(-0.7026), s_q1 * x62, x63);
+        let x65 = S::mul_add(S::neg(s_q3), x15, x31);
+        let x66 = S::mul_add(c_q3, x15, x33);
+        let x67 = S::mul_add(S::splat(0.475), x66, S::mul_add(c_q3, x13, x30));
+        let x68 = S::mul_add(S::splat(-7.11), x66, x17);
+        let x69 = S::mul_add(S::splat(0.475), x65, S::mul_add(S::neg(s_q3), x13, x29));
+        let x70 = S::mul_add(S::neg(s_q2), x66, c_q2 * x65);
+        let x71 = S::mul_add(
             s_q1,
             x68,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(c_q2, x66, s_q2 * x65),
-                    Self::mul_add(s_q2, x69, c_q2 * x67),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(c_q2, x66, s_q2 * x65),
+                    S::mul_add(s_q2, x69, c_q2 * x67),
                 ),
         );
-        let x72 = Self::mul_add(-0.7026, s_q1 * x70, x71);
-        let x73 = 47.471 * s_q4;
-        let x74 = 47.471 * c_q4;
-        let x75 = Self::mul_add(s_q3, x74, c_q3 * x73);
-        let x76 = Self::mul_add(-c_q3, x74, s_q3 * x73);
-        let x77 = c_q1 * Self::mul_add(-s_q2, x76, c_q2 * x75);
-        let x78 = 9.336 * c_q5;
-        let x79 = 9.336 * s_q5;
+        let x72 = S::mul_add(S::splat(-0.7026), s_q1 * x70, x71);
+        let x73 = S::splat(47.471) * s_q4;
+        let x74 = S::splat(47.471) * c_q4;
+        let x75 = S::mul_add(s_q3, x74, c_q3 * x73);
+        let x76 = S::mul_add(S::neg(c_q3), x74, s_q3 * x73);
+        let x77 = c_q1 * S::mul_add(S::neg(s_q2), x76, c_q2 * x75);
+        let x78 = S::splat(9.336) * c_q5;
+        let x79 = S::splat(9.336) * s_q5;
         let x80 = c_q4 * x78;
         let x81 = s_q4 * x78;
-        let x82 = Self::mul_add(-s_q3, x81, c_q3 * x80);
-        let x83 = Self::mul_add(c_q3, x81, s_q3 * x80);
-        let x84 = Self::mul_add(
-            -s_q1,
+        let x82 = S::mul_add(S::neg(s_q3), x81, c_q3 * x80);
+        let x83 = S::mul_add(c_q3, x81, s_q3 * x80);
+        let x84 = S::mul_add(
+            S::neg(s_q1),
             x79,
-            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
+            c_q1 * S::mul_add(S::neg(s_q2), x83, c_q2 * x82),
         );
         let x85 = qd[0] * c_q1;
         let x86 = qd[0] * s_q1;
-        let x87 = 0.7026 * (qd[0] * qd[0]);
+        let x87 = S::splat(0.7026) * (qd[0] * qd[0]);
         let x88 = qd[1] * x86;
         let x89 = qd[1] * x85;
         let x90 = x85 * x86;
-        let x91 = Self::mul_add(x85, x85, qd[1] * qd[1]);
-        let x92 = x86 * 65693.9112265768;
-        let x93 = 65697.3302265768 * qd[1];
-        let x94 = Self::mul_add(-qd[1], s_q2, c_q2 * x85);
-        let x95 = Self::mul_add(qd[1], c_q2, s_q2 * x85);
-        let x96 = 0.5692 * x90;
-        let x97 = 0.5692 * x91;
-        let x98 = Self::mul_add(-0.5692, x88 + x88, x87);
-        let x99 = Self::mul_add(-c_q2, x98, s_q2 * x96);
-        let x100 = Self::mul_add(qd[2], x95, c_q2 * x88);
-        let x101 = Self::mul_add(-qd[2], x94, s_q2 * x88);
+        let x91 = S::mul_add(x85, x85, qd[1] * qd[1]);
+        let x92 = x86 * S::splat(65693.9112265768);
+        let x93 = S::splat(65697.3302265768) * qd[1];
+        let x94 = S::mul_add(S::neg(qd[1]), s_q2, c_q2 * x85);
+        let x95 = S::mul_add(qd[1], c_q2, s_q2 * x85);
+        let x96 = S::splat(0.5692) * x90;
+        let x97 = S::splat(0.5692) * x91;
+        let x98 = S::mul_add(S::splat(-0.5692), x88 + x88, x87);
+        let x99 = S::mul_add(S::neg(c_q2), x98, s_q2 * x96);
+        let x100 = S::mul_add(qd[2], x95, c_q2 * x88);
+        let x101 = S::mul_add(S::neg(qd[2]), x94, s_q2 * x88);
         let x102 = qd[2] - x86;
         let x103 = x95 * x95;
-        let x104 = Self::mul_add(x102, x102, x103);
+        let x104 = S::mul_add(x102, x102, x103);
         let x105 = x94 * x102;
         let x106 = x101 - x105;
-        let x107 = Self::mul_add(x94, x95, x89);
-        let x108 = Self::mul_add(-3946.18812068, x102, x94 * 39234.47412200001);
-        let x109 = Self::mul_add(39241.404122, x102, 3946.1881206800003 * x94);
-        let x110 = Self::mul_add(
-            5224.5702,
+        let x107 = S::mul_add(x94, x95, x89);
+        let x108 = S::mul_add(
+            S::splat(-3946.18812068),
+            x102,
+            x94 * S::splat(39234.47412200001),
+        );
+        let x109 = S::mul_add(
+            S::splat(39241.404122),
+            x102,
+            S::splat(3946.1881206800003) * x94,
+        );
+        let x110 = S::mul_add(
+            S::splat(5224.5702),
             x99,
-            Self::mul_add(
+            S::mul_add(
                 x95,
                 x108,
-                Self::mul_add(39241.404122, x89, 3946.1881206800003 * x100),
+                S::mul_add(
+                    S::splat(39241.404122),
+                    x89,
+                    S::splat(3946.1881206800003) * x100,
+                ),
             ),
         );
-        let x111 = Self::mul_add(-s_q3, x95, c_q3 * x94);
-        let x112 = Self::mul_add(c_q3, x95, s_q3 * x94);
-        let x113 = Self::mul_add(s_q2, x98, c_q2 * x96)
-            - Self::mul_add(0.475, x101 + x105, 7.11 * x104);
+        let x111 = S::mul_add(S::neg(s_q3), x95, c_q3 * x94);
+        let x112 = S::mul_add(c_q3, x95, s_q3 * x94);
+        let x113 = S::mul_add(s_q2, x98, c_q2 * x96)
+            - S::mul_add(S::splat(0.475), x101 + x105, S::splat(7.11) * x104);
         let x114 = x97
-            - Self::mul_add(-0.475, Self::mul_add(x94, x94, x103), 7.11 * x106);
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x94, x94, x103),
+                S::splat(7.11) * x106,
+            );
         let x115 = x99
-            + Self::mul_add(0.475, Self::mul_add(-x95, x102, x100), 7.11 * x107);
-        let x116 = Self::mul_add(c_q3, x115, s_q3 * x113);
-        let x117 = Self::mul_add(qd[3], x112, Self::mul_add(-s_q3, x101, c_q3 * x100));
-        let x118 = Self::mul_add(-qd[3], x111, Self::mul_add(c_q3, x101, s_q3 * x100));
+            + S::mul_add(
+                S::splat(0.475),
+                S::mul_add(S::neg(x95), x102, x100),
+                S::splat(7.11) * x107,
+            );
+        let x116 = S::mul_add(c_q3, x115, s_q3 * x113);
+        let x117 = S::mul_add(qd[3], x112, S::mul_add(S::neg(s_q3), x101, c_q3 * x100));
+        let x118 = S::mul_add(S::neg(qd[3]), x111, S::mul_add(c_q3, x101, s_q3 * x100));
         let x119 = qd[3] + x102;
-        let x120 = Self::mul_add(x112, x112, x119 * x119);
-        let x121 = Self::mul_add(-x111, x119, x118);
-        let x122 = Self::mul_add(x111, x112, x89);
-        let x123 = Self::mul_add(-1375.0472756800002, x119, x111 * 24989.305802);
-        let x124 = Self::mul_add(24998.827802, x119, 1375.0472756800002 * x111);
-        let x125 = Self::mul_add(
-            3239.4582,
+        let x120 = S::mul_add(x112, x112, x119 * x119);
+        let x121 = S::mul_add(S::neg(x111), x119, x118);
+        let x122 = S::mul_add(x111, x112, x89);
+        let x123 = S::mul_add(
+            S::splat(-1375.0472756800002),
+            x119,
+            x111 * S::splat(24989.305802),
+        );
+        let x124 = S::mul_add(
+            S::splat(24998.827802),
+            x119,
+            S::splat(1375.0472756800002) * x111,
+        );
+        let x125 = S::mul_add(
+            S::splat(3239.4582),
             x116,
-            Self::mul_add(
+            S::mul_add(
                 x112,
                 x123,
-                Self::mul_add(24998.827802, x89, 1375.0472756800002 * x117),
+                S::mul_add(
+                    S::splat(24998.827802),
+                    x89,
+                    S::splat(1375.0472756800002) * x117,
+                ),
             ),
         );
-        let x126 = Self::mul_add(-s_q4, x112, c_q4 * x111);
-        let x127 = Self::mul_add(c_q4, x112, s_q4 * x111);
-        let x128 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x122, x116),
-            c_q4 * Self::mul_add(-7.11, x120, Self::mul_add(-s_q3, x115, c_q3 * x113)),
+        let x126 = S::mul_add(S::neg(s_q4), x112, c_q4 * x111);
+        let x127 = S::mul_add(c_q4, x112, s_q4 * x111);
+        let x128 = S::mul_add(
+            S::neg(s_q4),
+            S::mul_add(S::splat(7.11), x122, x116),
+            c_q4
+                * S::mul_add(
+                    S::splat(-7.11),
+                    x120,
+                    S::mul_add(S::neg(s_q3), x115, c_q3 * x113),
+                ),
         );
-        let x129 = Self::mul_add(qd[4], x127, Self::mul_add(-s_q4, x118, c_q4 * x117));
-        let x130 = Self::mul_add(-qd[4], x126, Self::mul_add(c_q4, x118, s_q4 * x117));
+        let x129 = S::mul_add(qd[4], x127, S::mul_add(S::neg(s_q4), x118, c_q4 * x117));
+        let x130 = S::mul_add(S::neg(qd[4]), x126, S::mul_add(c_q4, x118, s_q4 * x117));
         let x131 = qd[4] + x119;
-        let x132 = 132.6783695416 * x126;
-        let x133 = Self::mul_add(-97.44448770720001, x127, 135.4729695416 * x131);
-        let x134 = 97.44448770720001 * x131;
-        let x135 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-7.11, x121, x114),
-            Self::mul_add(132.6783695416, x129, Self::mul_add(x131, x134, x127 * x133)),
+        let x132 = S::splat(132.6783695416) * x126;
+        let x133 = S::mul_add(
+            S::splat(-97.44448770720001),
+            x127,
+            S::splat(135.4729695416) * x131,
         );
-        let x136 = Self::mul_add(s_q5, x131, c_q5 * x126);
-        let x137 = Self::mul_add(-c_q5, x131, s_q5 * x126);
+        let x134 = S::splat(97.44448770720001) * x131;
+        let x135 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::splat(-7.11), x121, x114),
+            S::mul_add(
+                S::splat(132.6783695416),
+                x129,
+                S::mul_add(x131, x134, x127 * x133),
+            ),
+        );
+        let x136 = S::mul_add(s_q5, x131, c_q5 * x126);
+        let x137 = S::mul_add(S::neg(c_q5), x131, s_q5 * x126);
         let x138 = qd[5] + x127;
-        let x139 = 44.41 * x137;
-        let x140 = 47.471 * x138;
-        let x141 = Self::mul_add(
-            -x136,
+        let x139 = S::splat(44.41) * x137;
+        let x140 = S::splat(47.471) * x138;
+        let x141 = S::mul_add(
+            S::neg(x136),
             x140,
-            44.41 * Self::mul_add(-qd[5], x136, Self::mul_add(-c_q5, x89, s_q5 * x129)),
+            S::splat(44.41)
+                * S::mul_add(
+                    S::neg(qd[5]),
+                    x136,
+                    S::mul_add(S::neg(c_q5), x89, s_q5 * x129),
+                ),
         );
-        let x142 = 9.336 * (qd[6] + x136);
-        let x143 = Self::mul_add(
-            9.336,
-            Self::mul_add(qd[5], x137, Self::mul_add(s_q5, x89, c_q5 * x129)),
+        let x142 = S::splat(9.336) * (qd[6] + x136);
+        let x143 = S::mul_add(
+            S::splat(9.336),
+            S::mul_add(qd[5], x137, S::mul_add(s_q5, x89, c_q5 * x129)),
             f_ext[6][3],
         );
-        let x144 = Self::mul_add(
-            -Self::mul_add(c_q6, x138, s_q6 * x137),
+        let x144 = S::mul_add(
+            S::neg(S::mul_add(c_q6, x138, s_q6 * x137)),
             x142,
             f_ext[6][4],
         );
-        let x145 = Self::mul_add(
-            -Self::mul_add(-s_q6, x138, c_q6 * x137),
+        let x145 = S::mul_add(
+            S::neg(S::mul_add(S::neg(s_q6), x138, c_q6 * x137)),
             x142,
             f_ext[6][5],
         );
-        let x146 = Self::mul_add(-f_ext[6][2], s_q6, f_ext[6][1] * c_q6);
+        let x146 = S::mul_add(S::neg(f_ext[6][2]), s_q6, f_ext[6][1] * c_q6);
         let x147 = f_ext[5][0] + f_ext[6][0];
         let x148 = f_ext[5][1] + x146;
-        let x149 = f_ext[5][2] + Self::mul_add(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
-        let x150 = f_ext[5][3] - Self::mul_add(-x137, x140, x138 * x139)
-            + Self::mul_add(0.7026, x146, x143);
+        let x149 = f_ext[5][2] + S::mul_add(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x150 = f_ext[5][3] - S::mul_add(S::neg(x137), x140, x138 * x139)
+            + S::mul_add(S::splat(0.7026), x146, x143);
         let x151 = f_ext[5][4] - x141
-            + Self::mul_add(
-                -0.7026,
+            + S::mul_add(
+                S::splat(-0.7026),
                 f_ext[6][0],
-                Self::mul_add(-s_q6, x145, c_q6 * x144),
+                S::mul_add(S::neg(s_q6), x145, c_q6 * x144),
             );
-        let x152 = f_ext[5][5] + Self::mul_add(x136, x139, 47.471 * x130)
-            + Self::mul_add(c_q6, x145, s_q6 * x144);
-        let x153 = Self::mul_add(-s_q5, x148, c_q5 * x147);
-        let x154 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-x126, x127, x89),
+        let x152 = f_ext[5][5] + S::mul_add(x136, x139, S::splat(47.471) * x130)
+            + S::mul_add(c_q6, x145, s_q6 * x144);
+        let x153 = S::mul_add(S::neg(s_q5), x148, c_q5 * x147);
+        let x154 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::neg(x126), x127, x89),
             f_ext[4][0],
         ) + x153;
-        let x155 = Self::mul_add(
-            171.195516,
-            Self::mul_add(x127, x131, x129),
+        let x155 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(x127, x131, x129),
             f_ext[4][1],
-        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
-        let x156 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(x126, x126, x131 * x131),
+        ) + S::mul_add(c_q5, x148, s_q5 * x147);
+        let x156 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(x126, x126, x131 * x131),
             f_ext[4][2],
         ) + x149;
         let x157 = f_ext[4][3] + x135
-            + Self::mul_add(-0.5692, x149, Self::mul_add(-s_q5, x151, c_q5 * x150));
+            + S::mul_add(
+                S::splat(-0.5692),
+                x149,
+                S::mul_add(S::neg(s_q5), x151, c_q5 * x150),
+            );
         let x158 = f_ext[4][4]
-            + Self::mul_add(
-                171.195516,
+            + S::mul_add(
+                S::splat(171.195516),
                 x128,
-                Self::mul_add(-97.44448770720001, x130, 135.4729695416 * x89)
-                    - Self::mul_add(x126, x134, x127 * x132),
-            ) + Self::mul_add(c_q5, x151, s_q5 * x150);
+                S::mul_add(
+                    S::splat(-97.44448770720001),
+                    x130,
+                    S::splat(135.4729695416) * x89,
+                ) - S::mul_add(x126, x134, x127 * x132),
+            ) + S::mul_add(c_q5, x151, s_q5 * x150);
         let x159 = f_ext[4][5]
-            - Self::mul_add(
-                97.44448770720001,
+            - S::mul_add(
+                S::splat(97.44448770720001),
                 x89,
-                -Self::mul_add(-x126, x133, x131 * x132),
-            ) + Self::mul_add(0.5692, x153, x152);
-        let x160 = Self::mul_add(-c_q4, x156, s_q4 * x154);
-        let x161 = Self::mul_add(3239.4582, x120, f_ext[3][0])
-            + Self::mul_add(s_q4, x156, c_q4 * x154);
-        let x162 = Self::mul_add(3239.4582, x121, f_ext[3][1]) + x155;
-        let x163 = Self::mul_add(-3239.4582, x122, f_ext[3][2]) - x160;
+                S::neg(S::mul_add(S::neg(x126), x133, x131 * x132)),
+            ) + S::mul_add(S::splat(0.5692), x153, x152);
+        let x160 = S::mul_add(S::neg(c_q4), x156, s_q4 * x154);
+        let x161 = S::mul_add(S::splat(3239.4582), x120, f_ext[3][0])
+            + S::mul_add(s_q4, x156, c_q4 * x154);
+        let x162 = S::mul_add(S::splat(3239.4582), x121, f_ext[3][1]) + x155;
+        let x163 = S::mul_add(S::splat(-3239.4582), x122, f_ext[3][2]) - x160;
         let x164 = f_ext[3][3]
-            - Self::mul_add(
-                -x112,
+            - S::mul_add(
+                S::neg(x112),
                 x124,
-                Self::mul_add(-1375.0472756800002, x89, x117 * 24989.305802),
-            ) + Self::mul_add(s_q4, x159, c_q4 * x157);
-        let x165 = f_ext[3][4] + x125 + Self::mul_add(7.11, x160, x158);
+                S::mul_add(
+                    S::splat(-1375.0472756800002),
+                    x89,
+                    x117 * S::splat(24989.305802),
+                ),
+            ) + S::mul_add(s_q4, x159, c_q4 * x157);
+        let x165 = f_ext[3][4] + x125 + S::mul_add(S::splat(7.11), x160, x158);
         let x166 = f_ext[3][5]
-            - Self::mul_add(3239.4582, x114, Self::mul_add(x111, x124, x119 * x123))
-            - Self::mul_add(-7.11, x155, Self::mul_add(-c_q4, x159, s_q4 * x157));
-        let x167 = Self::mul_add(s_q3, x163, c_q3 * x161);
-        let x168 = Self::mul_add(-c_q3, x163, s_q3 * x161);
-        let x169 = Self::mul_add(5224.5702, x104, f_ext[2][0]) + x167;
-        let x170 = Self::mul_add(-5224.5702, x107, f_ext[2][2]) - x168;
+            - S::mul_add(S::splat(3239.4582), x114, S::mul_add(x111, x124, x119 * x123))
+            - S::mul_add(
+                S::splat(-7.11),
+                x155,
+                S::mul_add(S::neg(c_q4), x159, s_q4 * x157),
+            );
+        let x167 = S::mul_add(s_q3, x163, c_q3 * x161);
+        let x168 = S::mul_add(S::neg(c_q3), x163, s_q3 * x161);
+        let x169 = S::mul_add(S::splat(5224.5702), x104, f_ext[2][0]) + x167;
+        let x170 = S::mul_add(S::splat(-5224.5702), x107, f_ext[2][2]) - x168;
         let x171 = f_ext[2][3]
-            - Self::mul_add(
-                -x95,
+            - S::mul_add(
+                S::neg(x95),
                 x109,
-                Self::mul_add(-3946.18812068, x89, x100 * 39234.47412200001),
-            ) + Self::mul_add(0.475, x168, Self::mul_add(s_q3, x166, c_q3 * x164));
-        let x172 = f_ext[2][4] + x110 + Self::mul_add(7.11, x168, x165);
+                S::mul_add(
+                    S::splat(-3946.18812068),
+                    x89,
+                    x100 * S::splat(39234.47412200001),
+                ),
+            ) + S::mul_add(S::splat(0.475), x168, S::mul_add(s_q3, x166, c_q3 * x164));
+        let x172 = f_ext[2][4] + x110 + S::mul_add(S::splat(7.11), x168, x165);
         let x173 = f_ext[2][5]
-            - Self::mul_add(5224.5702, x97, Self::mul_add(x94, x109, x102 * x108))
-            - (Self::mul_add(-c_q3, x166, s_q3 * x164)
-                - Self::mul_add(7.11, x162, 0.475 * x167));
-        let x174 = Self::mul_add(s_q2, x170, c_q2 * x169);
-        let x175 = Self::mul_add(
-            -s_q1,
-            f_ext[1][4] - Self::mul_add(-x85, x93, x89 * 65693.9112265768) + x172,
+            - S::mul_add(S::splat(5224.5702), x97, S::mul_add(x94, x109, x102 * x108))
+            - (S::mul_add(S::neg(c_q3), x166, s_q3 * x164)
+                - S::mul_add(S::splat(7.11), x162, S::splat(0.475) * x167));
+        let x174 = S::mul_add(s_q2, x170, c_q2 * x169);
+        let x175 = S::mul_add(
+            S::neg(s_q1),
+            f_ext[1][4] - S::mul_add(S::neg(x85), x93, x89 * S::splat(65693.9112265768))
+                + x172,
             c_q1
                 * (f_ext[1][3]
-                    + Self::mul_add(
-                        -1145.5438279999998,
+                    + S::mul_add(
+                        S::splat(-1145.5438279999998),
                         x87,
-                        Self::mul_add(x86, x93, qd[1] * x92),
+                        S::mul_add(x86, x93, qd[1] * x92),
                     )
-                    + Self::mul_add(
-                        0.5692,
-                        Self::mul_add(-c_q2, x170, s_q2 * x169),
-                        Self::mul_add(s_q2, x173, c_q2 * x171),
+                    + S::mul_add(
+                        S::splat(0.5692),
+                        S::mul_add(S::neg(c_q2), x170, s_q2 * x169),
+                        S::mul_add(s_q2, x173, c_q2 * x171),
                     )),
         );
-        let x176 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(
+        let x176 = S::mul_add(
+            S::splat(-0.7026),
+            S::mul_add(
                 c_q1,
-                Self::mul_add(-1145.5438279999998, x91, f_ext[1][1])
-                    + (Self::mul_add(5224.5702, x106, f_ext[2][1]) + x162),
-                s_q1 * (Self::mul_add(-1145.5438279999998, x90, f_ext[1][0]) + x174),
+                S::mul_add(S::splat(-1145.5438279999998), x91, f_ext[1][1])
+                    + (S::mul_add(S::splat(5224.5702), x106, f_ext[2][1]) + x162),
+                s_q1
+                    * (S::mul_add(S::splat(-1145.5438279999998), x90, f_ext[1][0])
+                        + x174),
             ),
             x175,
         );
         let x177 = tau[0] + (f_ext[0][3] + x176);
-        let x178 = 1.0
-            / (66279.65991417361
+        let x178 = S::splat(1.0)
+            / (S::splat(66279.65991417361)
                 - (x59
                     - (x50
-                        - Self::mul_add(
-                            -(s_q1 * c_q1),
+                        - S::mul_add(
+                            S::neg(s_q1 * c_q1),
                             x57 + x57,
-                            s_q1 * s_q1 * (x50 - (-65693.9112265768 + x44)),
+                            s_q1 * s_q1 * (x50 - (S::splat(-65693.9112265768) + x44)),
                         ) - x59)));
         let x179 = x60 * x178;
         let x180 = x61 * x178;
@@ -2922,167 +3483,232 @@ impl Ssrms {
         let x182 = x72 * x178;
         let x183 = x77 * x178;
         let x184 = x84 * x178;
-        let x185 = 1.0 / Self::mul_add(-x60, x179, 65697.3302265768 - (x40 - x49));
-        let x186 = Self::mul_add(-x60, x180, x58);
+        let x185 = S::splat(1.0)
+            / S::mul_add(S::neg(x60), x179, S::splat(65697.3302265768) - (x40 - x49));
+        let x186 = S::mul_add(S::neg(x60), x180, x58);
         let x187 = x185 * x186;
-        let x188 = Self::mul_add(
-            -x60,
+        let x188 = S::mul_add(
+            S::neg(x60),
             x181,
-            Self::mul_add(0.5692, x62, Self::mul_add(-s_q2, x36, x51)),
+            S::mul_add(S::splat(0.5692), x62, S::mul_add(S::neg(s_q2), x36, x51)),
         );
         let x189 = x185 * x188;
-        let x190 = Self::mul_add(
+        let x190 = S::mul_add(
             x60,
             x182,
-            Self::mul_add(-0.5692, x70, Self::mul_add(-c_q2, x69, s_q2 * x67)),
+            S::mul_add(S::splat(-0.5692), x70, S::mul_add(S::neg(c_q2), x69, s_q2 * x67)),
         );
         let x191 = x185 * x190;
-        let x192 = Self::mul_add(x60, x183, Self::mul_add(c_q2, x76, s_q2 * x75));
+        let x192 = S::mul_add(x60, x183, S::mul_add(c_q2, x76, s_q2 * x75));
         let x193 = x185 * x192;
-        let x194 = Self::mul_add(x60, x184, Self::mul_add(c_q2, x83, s_q2 * x82));
+        let x194 = S::mul_add(x60, x184, S::mul_add(c_q2, x83, s_q2 * x82));
         let x195 = x185 * x194;
-        let x196 = 1.0 / Self::mul_add(-x186, x187, Self::mul_add(-x61, x180, x44));
-        let x197 = Self::mul_add(-x186, x189, Self::mul_add(-x61, x181, x37));
+        let x196 = S::splat(1.0)
+            / S::mul_add(S::neg(x186), x187, S::mul_add(S::neg(x61), x180, x44));
+        let x197 = S::mul_add(S::neg(x186), x189, S::mul_add(S::neg(x61), x181, x37));
         let x198 = x196 * x197;
-        let x199 = Self::mul_add(x186, x191, Self::mul_add(-x61, x182, x68));
+        let x199 = S::mul_add(x186, x191, S::mul_add(S::neg(x61), x182, x68));
         let x200 = x196 * x199;
-        let x201 = Self::mul_add(-x186, x193, x61 * x183);
+        let x201 = S::mul_add(S::neg(x186), x193, x61 * x183);
         let x202 = x196 * x201;
-        let x203 = Self::mul_add(-x186, x195, Self::mul_add(x61, x184, x79));
+        let x203 = S::mul_add(S::neg(x186), x195, S::mul_add(x61, x184, x79));
         let x204 = x196 * x203;
-        let x205 = Self::mul_add(
-            -x197,
+        let x205 = S::mul_add(
+            S::neg(x197),
             x198,
-            Self::mul_add(-x188, x189, Self::mul_add(-x64, x181, x23)),
+            S::mul_add(S::neg(x188), x189, S::mul_add(S::neg(x64), x181, x23)),
         );
-        let x206 = 1.0 / x205;
-        let x207 = Self::mul_add(
-            -x197,
+        let x206 = S::splat(1.0) / x205;
+        let x207 = S::mul_add(
+            S::neg(x197),
             x200,
-            Self::mul_add(x188, x191, Self::mul_add(-x64, x182, x17)),
+            S::mul_add(x188, x191, S::mul_add(S::neg(x64), x182, x17)),
         );
         let x208 = x206 * x207;
-        let x209 = Self::mul_add(-x197, x202, Self::mul_add(-x188, x193, x64 * x183));
+        let x209 = S::mul_add(
+            S::neg(x197),
+            x202,
+            S::mul_add(S::neg(x188), x193, x64 * x183),
+        );
         let x210 = x206 * x209;
-        let x211 = Self::mul_add(
-            -x197,
+        let x211 = S::mul_add(
+            S::neg(x197),
             x204,
-            Self::mul_add(-x188, x195, Self::mul_add(x64, x184, x79)),
+            S::mul_add(S::neg(x188), x195, S::mul_add(x64, x184, x79)),
         );
         let x212 = x206 * x211;
-        let x213 = Self::mul_add(
-            -x199,
+        let x213 = S::mul_add(
+            S::neg(x199),
             x200,
-            Self::mul_add(-x190, x191, Self::mul_add(-x72, x182, x9)),
+            S::mul_add(S::neg(x190), x191, S::mul_add(S::neg(x72), x182, x9)),
         );
-        let x214 = 1.0 / Self::mul_add(-x207, x208, x213);
-        let x215 = Self::mul_add(
-            -x207,
+        let x214 = S::splat(1.0) / S::mul_add(S::neg(x207), x208, x213);
+        let x215 = S::mul_add(
+            S::neg(x207),
             x210,
-            Self::mul_add(-x199, x202, Self::mul_add(x190, x193, x72 * x183)),
+            S::mul_add(S::neg(x199), x202, S::mul_add(x190, x193, x72 * x183)),
         );
         let x216 = x214 * x215;
-        let x217 = Self::mul_add(
-            -x199,
+        let x217 = S::mul_add(
+            S::neg(x199),
             x204,
-            Self::mul_add(x190, x195, Self::mul_add(x72, x184, x79)),
+            S::mul_add(x190, x195, S::mul_add(x72, x184, x79)),
         );
-        let x218 = Self::mul_add(-x207, x212, x217);
+        let x218 = S::mul_add(S::neg(x207), x212, x217);
         let x219 = x214 * x218;
-        let x220 = Self::mul_add(
-            -x201,
+        let x220 = S::mul_add(
+            S::neg(x201),
             x202,
-            Self::mul_add(-x192, x193, Self::mul_add(-x77, x183, 47.471)),
+            S::mul_add(
+                S::neg(x192),
+                x193,
+                S::mul_add(S::neg(x77), x183, S::splat(47.471)),
+            ),
         );
-        let x221 = 1.0 / Self::mul_add(-x215, x216, Self::mul_add(-x209, x210, x220));
-        let x222 = Self::mul_add(
+        let x221 = S::splat(1.0)
+            / S::mul_add(S::neg(x215), x216, S::mul_add(S::neg(x209), x210, x220));
+        let x222 = S::mul_add(
             x209,
             x212,
-            Self::mul_add(x201, x204, Self::mul_add(x192, x195, x77 * x184)),
+            S::mul_add(x201, x204, S::mul_add(x192, x195, x77 * x184)),
         );
-        let x223 = Self::mul_add(x215, x219, x222);
+        let x223 = S::mul_add(x215, x219, x222);
         let x224 = x221 * x223;
-        let x225 = Self::mul_add(
-            -x203,
+        let x225 = S::mul_add(
+            S::neg(x203),
             x204,
-            Self::mul_add(-x194, x195, Self::mul_add(-x84, x184, 9.336)),
+            S::mul_add(
+                S::neg(x194),
+                x195,
+                S::mul_add(S::neg(x84), x184, S::splat(9.336)),
+            ),
         );
-        let x226 = Self::mul_add(
-            -x223,
+        let x226 = S::mul_add(
+            S::neg(x223),
             x224,
-            Self::mul_add(-x218, x219, Self::mul_add(-x211, x212, x225)),
+            S::mul_add(S::neg(x218), x219, S::mul_add(S::neg(x211), x212, x225)),
         );
-        let x227 = 1.0 / x226;
-        let x228 = Self::mul_add(
-            -x177,
+        let x227 = S::splat(1.0) / x226;
+        let x228 = S::mul_add(
+            S::neg(x177),
             x179,
             tau[1]
-                + (Self::mul_add(-x85, x92, f_ext[1][5])
-                    - Self::mul_add(
-                        -0.5692,
+                + (S::mul_add(S::neg(x85), x92, f_ext[1][5])
+                    - S::mul_add(
+                        S::splat(-0.5692),
                         x174,
-                        Self::mul_add(-c_q2, x173, s_q2 * x171),
+                        S::mul_add(S::neg(c_q2), x173, s_q2 * x171),
                     )),
         );
-        let x229 = Self::mul_add(x187, x228, Self::mul_add(x177, x180, tau[2] + x172));
-        let x230 = Self::mul_add(
-            -x198,
+        let x229 = S::mul_add(x187, x228, S::mul_add(x177, x180, tau[2] + x172));
+        let x230 = S::mul_add(
+            S::neg(x198),
             x229,
-            Self::mul_add(x189, x228, Self::mul_add(x177, x181, tau[3] + x165)),
+            S::mul_add(x189, x228, S::mul_add(x177, x181, tau[3] + x165)),
         );
-        let x231 = Self::mul_add(
-            -x200,
+        let x231 = S::mul_add(
+            S::neg(x200),
             x229,
-            Self::mul_add(-x191, x228, Self::mul_add(x177, x182, tau[4] + x158)),
+            S::mul_add(S::neg(x191), x228, S::mul_add(x177, x182, tau[4] + x158)),
         );
-        let x232 = Self::mul_add(-x208, x230, x231);
-        let x233 = Self::mul_add(
-            -x202,
+        let x232 = S::mul_add(S::neg(x208), x230, x231);
+        let x233 = S::mul_add(
+            S::neg(x202),
             x229,
-            Self::mul_add(x193, x228, Self::mul_add(-x177, x183, tau[5] + x152)),
+            S::mul_add(x193, x228, S::mul_add(S::neg(x177), x183, tau[5] + x152)),
         );
-        let x234 = Self::mul_add(-x216, x232, Self::mul_add(-x210, x230, x233));
-        let x235 = Self::mul_add(
-            -x204,
+        let x234 = S::mul_add(S::neg(x216), x232, S::mul_add(S::neg(x210), x230, x233));
+        let x235 = S::mul_add(
+            S::neg(x204),
             x229,
-            Self::mul_add(x195, x228, Self::mul_add(-x177, x184, tau[6] + x143)),
+            S::mul_add(x195, x228, S::mul_add(S::neg(x177), x184, tau[6] + x143)),
         );
-        let x236 = Self::mul_add(
+        let x236 = S::mul_add(
             x224,
             x234,
-            Self::mul_add(-x219, x232, Self::mul_add(-x212, x230, x235)),
+            S::mul_add(S::neg(x219), x232, S::mul_add(S::neg(x212), x230, x235)),
         );
         let x237 = x227 * x236;
-        let x238 = Self::mul_add(x224, x237, x221 * x234);
-        let x239 = Self::mul_add(-x219, x237, Self::mul_add(-x216, x238, x214 * x232));
-        let x240 = Self::mul_add(
-            -x212,
+        let x238 = S::mul_add(x224, x237, x221 * x234);
+        let x239 = S::mul_add(
+            S::neg(x219),
             x237,
-            Self::mul_add(-x210, x238, Self::mul_add(-x208, x239, x206 * x230)),
+            S::mul_add(S::neg(x216), x238, x214 * x232),
         );
-        let x241 = Self::mul_add(
-            -x202,
+        let x240 = S::mul_add(
+            S::neg(x212),
+            x237,
+            S::mul_add(S::neg(x210), x238, S::mul_add(S::neg(x208), x239, x206 * x230)),
+        );
+        let x241 = S::mul_add(
+            S::neg(x202),
             x238,
-            Self::mul_add(-x200, x239, Self::mul_add(-x198, x240, x196 * x229)),
+            S::mul_add(S::neg(x200), x239, S::mul_add(S::neg(x198), x240, x196 * x229)),
         );
-        let x242 = Self::mul_add(-x204, x237, x241);
-        let x243 = Self::mul_add(
-            -x191,
+        let x242 = S::mul_add(S::neg(x204), x237, x241);
+        let x243 = S::mul_add(
+            S::neg(x191),
             x239,
-            Self::mul_add(x189, x240, Self::mul_add(x187, x242, x185 * x228)),
+            S::mul_add(x189, x240, S::mul_add(x187, x242, x185 * x228)),
         );
-        let x244 = Self::mul_add(x195, x237, Self::mul_add(x193, x238, x243));
-        let x245 = Self::mul_add(
+        let x244 = S::mul_add(x195, x237, S::mul_add(x193, x238, x243));
+        let x245 = S::mul_add(
             x181,
             x240,
-            Self::mul_add(x180, x242, Self::mul_add(-x179, x244, x177 * x178)),
+            S::mul_add(x180, x242, S::mul_add(S::neg(x179), x244, x177 * x178)),
         );
-        let x246 = Self::mul_add(
-            -x184,
+        let x246 = S::mul_add(
+            S::neg(x184),
             x237,
-            Self::mul_add(-x183, x238, Self::mul_add(x182, x239, x245)),
+            S::mul_add(S::neg(x183), x238, S::mul_add(x182, x239, x245)),
         );
         [x246, x244, x242, x240, x239, x238, x237]
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics (Carpentier & Mansard, RSS 2018; Pinocchio's `computeRNEADerivatives`): row `i` = `τ_i`, column `j` = `∂/∂` speed `j`.
     ///
@@ -3093,70 +3719,76 @@ impl Ssrms {
         qd: &[::core::primitive::f64; 7],
         qdd: &[::core::primitive::f64; 7],
     ) -> ([[::core::primitive::f64; 7]; 7], [[::core::primitive::f64; 7]; 7]) {
+        Self::inverse_dynamics_derivatives_lanes::<::core::primitive::f64>(q, qd, qdd)
+    }
+    /// [`Self::inverse_dynamics_derivatives`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_derivatives_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], qdd: &[S; 7]) -> ([[S; 7]; 7], [[S; 7]; 7]) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5)] = Self::sincos_n([q[0], q[1], q[2], q[3], q[4], q[5]]);
+        (s_q5, c_q5)] = S::sincos_n([q[0], q[1], q[2], q[3], q[4], q[5]]);
         let x6 = c_q0 * s_q1;
         let x7 = s_q0 * s_q1;
         let x8 = c_q0 * c_q1;
         let x9 = s_q0 * c_q1;
-        let x10 = 0.7026 * s_q0;
-        let x11 = 0.7026 * c_q0;
-        let x12 = Self::mul_add(-c_q0, x10, s_q0 * x11);
-        let x13 = 1.3589 * c_q0;
-        let x14 = 1.3589 * s_q0;
-        let x15 = s_q1 * 1145.5438279999998;
-        let x16 = x8 * 1145.5438279999998;
-        let x17 = x9 * 1145.5438279999998;
-        let x18 = s_q1 * 65693.9112265768;
-        let x19 = x8 * 65693.9112265768;
-        let x20 = 65697.3302265768 * s_q0;
-        let x21 = x9 * 65693.9112265768;
-        let x22 = 65697.3302265768 * c_q0;
+        let x10 = S::splat(0.7026) * s_q0;
+        let x11 = S::splat(0.7026) * c_q0;
+        let x12 = S::mul_add(S::neg(c_q0), x10, s_q0 * x11);
+        let x13 = S::splat(1.3589) * c_q0;
+        let x14 = S::splat(1.3589) * s_q0;
+        let x15 = s_q1 * S::splat(1145.5438279999998);
+        let x16 = x8 * S::splat(1145.5438279999998);
+        let x17 = x9 * S::splat(1145.5438279999998);
+        let x18 = s_q1 * S::splat(65693.9112265768);
+        let x19 = x8 * S::splat(65693.9112265768);
+        let x20 = S::splat(65697.3302265768) * s_q0;
+        let x21 = x9 * S::splat(65693.9112265768);
+        let x22 = S::splat(65697.3302265768) * c_q0;
         let x23 = x11 * x17;
         let x24 = x10 * x16;
         let x25 = x23 - x24;
         let x26 = x10 * x15;
         let x27 = x11 * x15;
-        let x28 = 1.3589 * x16;
-        let x29 = 1.3589 * x15;
+        let x28 = S::splat(1.3589) * x16;
+        let x29 = S::splat(1.3589) * x15;
         let x30 = x23 - x29;
         let x31 = x11 * x16;
-        let x32 = 1.3589 * x17;
+        let x32 = S::splat(1.3589) * x17;
         let x33 = x10 * x17;
         let x34 = x24 + x29;
-        let x35 = x25 + Self::mul_add(s_q1, x18, x25);
-        let x36 = x28 + Self::mul_add(x8, x18, x26);
-        let x37 = x32 + Self::mul_add(x9, x18, -x27);
-        let x38 = x26 + Self::mul_add(s_q1, x19, x28);
-        let x39 = x30 + (Self::mul_add(-s_q0, x20, x8 * x19) + x30);
-        let x40 = x33 + (Self::mul_add(c_q0, x20, x9 * x19) - x31);
-        let x41 = x27 - Self::mul_add(s_q1, x21, x32);
-        let x42 = x31 - (Self::mul_add(s_q0, x22, x8 * x21) + x33);
-        let x43 = x34 - (Self::mul_add(-c_q0, x22, x9 * x21) - x34);
+        let x35 = x25 + S::mul_add(s_q1, x18, x25);
+        let x36 = x28 + S::mul_add(x8, x18, x26);
+        let x37 = x32 + S::mul_add(x9, x18, S::neg(x27));
+        let x38 = x26 + S::mul_add(s_q1, x19, x28);
+        let x39 = x30 + (S::mul_add(S::neg(s_q0), x20, x8 * x19) + x30);
+        let x40 = x33 + (S::mul_add(c_q0, x20, x9 * x19) - x31);
+        let x41 = x27 - S::mul_add(s_q1, x21, x32);
+        let x42 = x31 - (S::mul_add(s_q0, x22, x8 * x21) + x33);
+        let x43 = x34 - (S::mul_add(S::neg(c_q0), x22, x9 * x21) - x34);
         let x44 = qd[1] * s_q0;
         let x45 = qd[1] * c_q0;
         let x46 = qd[1] * x12;
         let x47 = qd[1] * x13;
         let x48 = qd[1] * x14;
-        let x49 = Self::mul_add(-c_q0, x44, s_q0 * x45);
+        let x49 = S::mul_add(S::neg(c_q0), x44, s_q0 * x45);
         let x50 = qd[0] * c_q0;
         let x51 = qd[0] * s_q0;
         let x52 = qd[0] * x14;
         let x53 = qd[0] * x13;
-        let x54 = Self::mul_add(x14, x44, x13 * x45)
-            - Self::mul_add(c_q0, x47, s_q0 * x48);
-        let x55 = Self::mul_add(-c_q0, x46, Self::mul_add(x12, x45, x52));
-        let x56 = Self::mul_add(-s_q0, x46, Self::mul_add(x12, x44, -x53));
-        let x57 = Self::mul_add(qd[1], x49, qdd[0]);
-        let x58 = Self::mul_add(qd[1], x50, qdd[1] * s_q0);
-        let x59 = Self::mul_add(-qd[1], x51, qdd[1] * c_q0);
-        let x60 = Self::mul_add(qd[1], x54, qdd[1] * x12);
-        let x61 = Self::mul_add(-qd[1], x55, qdd[1] * x13);
-        let x62 = Self::mul_add(-qd[1], x56, qdd[1] * x14);
-        let x63 = Self::mul_add(-qd[0], x51, qdd[0] * c_q0);
-        let x64 = Self::mul_add(qd[0], x50, qdd[0] * s_q0);
-        let x65 = Self::mul_add(qd[0], x53, qdd[0] * x14);
-        let x66 = Self::mul_add(-qd[0], x52, qdd[0] * x13);
+        let x54 = S::mul_add(x14, x44, x13 * x45) - S::mul_add(c_q0, x47, s_q0 * x48);
+        let x55 = S::mul_add(S::neg(c_q0), x46, S::mul_add(x12, x45, x52));
+        let x56 = S::mul_add(S::neg(s_q0), x46, S::mul_add(x12, x44, S::neg(x53)));
+        let x57 = S::mul_add(qd[1], x49, qdd[0]);
+        let x58 = S::mul_add(qd[1], x50, qdd[1] * s_q0);
+        let x59 = S::mul_add(S::neg(qd[1]), x51, qdd[1] * c_q0);
+        let x60 = S::mul_add(qd[1], x54, qdd[1] * x12);
+        let x61 = S::mul_add(S::neg(qd[1]), x55, qdd[1] * x13);
+        let x62 = S::mul_add(S::neg(qd[1]), x56, qdd[1] * x14);
+        let x63 = S::mul_add(S::neg(qd[0]), x51, qdd[0] * c_q0);
+        let x64 = S::mul_add(qd[0], x50, qdd[0] * s_q0);
+        let x65 = S::mul_add(qd[0], x53, qdd[0] * x14);
+        let x66 = S::mul_add(S::neg(qd[0]), x52, qdd[0] * x13);
         let x67 = x50 + x50;
         let x68 = x51 + x51;
         let x69 = x52 + x55;
@@ -3173,41 +3805,57 @@ impl Ssrms {
         let x80 = x15 * x48;
         let x81 = x16 * x46;
         let x82 = x15 * x47;
-        let x83 = Self::mul_add(qd[0], x35, x71) - x72 + (x77 - x78);
-        let x84 = Self::mul_add(x39, x44, x73) - x74 - (x79 - x80);
-        let x85 = Self::mul_add(-x43, x45, x75 + x76) - (x81 - x82);
-        let x86 = Self::mul_add(x16, x45, x17 * x44);
-        let x87 = Self::mul_add(x15, x45, qd[0] * x17);
-        let x88 = Self::mul_add(-x15, x44, qd[0] * x16);
-        let x89 = Self::mul_add(-x41, x44, x38 * x45);
-        let x90 = Self::mul_add(-qd[0], x42, x36 * x45);
-        let x91 = Self::mul_add(-qd[0], x40, x37 * x44);
+        let x83 = S::mul_add(qd[0], x35, x71) - x72 + (x77 - x78);
+        let x84 = S::mul_add(x39, x44, x73) - x74 - (x79 - x80);
+        let x85 = S::mul_add(S::neg(x43), x45, x75 + x76) - (x81 - x82);
+        let x86 = S::mul_add(x16, x45, x17 * x44);
+        let x87 = S::mul_add(x15, x45, qd[0] * x17);
+        let x88 = S::mul_add(S::neg(x15), x44, qd[0] * x16);
+        let x89 = S::mul_add(S::neg(x41), x44, x38 * x45);
+        let x90 = S::mul_add(S::neg(qd[0]), x42, x36 * x45);
+        let x91 = S::mul_add(S::neg(qd[0]), x40, x37 * x44);
         let x92 = x15 * x46;
         let x93 = x16 * x47;
         let x94 = x17 * x48;
         let x95 = x92 + x93 + x94;
         let x96 = x95 + x95;
         let x97 = c_q1 * c_q2;
-        let x98 = Self::mul_add(s_q0, s_q2, x6 * c_q2);
-        let x99 = Self::mul_add(-c_q0, s_q2, x7 * c_q2);
+        let x98 = S::mul_add(s_q0, s_q2, x6 * c_q2);
+        let x99 = S::mul_add(S::neg(c_q0), s_q2, x7 * c_q2);
         let x100 = c_q1 * s_q2;
-        let x101 = Self::mul_add(-s_q0, c_q2, x6 * s_q2);
-        let x102 = Self::mul_add(c_q0, c_q2, x7 * s_q2);
-        let x103 = Self::mul_add(s_q1, 0.5692, 1.3589);
-        let x104 = Self::mul_add(x8, 0.5692, x10);
-        let x105 = Self::mul_add(x9, -0.5692, x11);
-        let x106 = Self::mul_add(x9, x104, x8 * x105);
-        let x107 = Self::mul_add(x9, x103, s_q1 * x105);
-        let x108 = Self::mul_add(-x8, x103, s_q1 * x104);
-        let x109 = 5224.5702 * x97;
-        let x110 = 5224.5702 * x98;
-        let x111 = 5224.5702 * x99;
-        let x112 = Self::mul_add(3946.1881206800003, s_q1, x97 * 39234.47412200001);
-        let x113 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x97);
-        let x114 = Self::mul_add(-3946.1881206800003, x8, x98 * 39234.47412200001);
-        let x115 = Self::mul_add(39241.404122, x8, 3946.18812068 * x98);
-        let x116 = Self::mul_add(-3946.1881206800003, x9, x99 * 39234.47412200001);
-        let x117 = Self::mul_add(39241.404122, x9, 3946.18812068 * x99);
+        let x101 = S::mul_add(S::neg(s_q0), c_q2, x6 * s_q2);
+        let x102 = S::mul_add(c_q0, c_q2, x7 * s_q2);
+        let x103 = S::mul_add(s_q1, S::splat(0.5692), S::splat(1.3589));
+        let x104 = S::mul_add(x8, S::splat(0.5692), x10);
+        let x105 = S::mul_add(x9, S::splat(-0.5692), x11);
+        let x106 = S::mul_add(x9, x104, x8 * x105);
+        let x107 = S::mul_add(x9, x103, s_q1 * x105);
+        let x108 = S::mul_add(S::neg(x8), x103, s_q1 * x104);
+        let x109 = S::splat(5224.5702) * x97;
+        let x110 = S::splat(5224.5702) * x98;
+        let x111 = S::splat(5224.5702) * x99;
+        let x112 = S::mul_add(
+            S::splat(3946.1881206800003),
+            s_q1,
+            x97 * S::splat(39234.47412200001),
+        );
+        let x113 = S::mul_add(
+            S::splat(-39241.404122),
+            s_q1,
+            S::splat(3946.18812068) * x97,
+        );
+        let x114 = S::mul_add(
+            S::splat(-3946.1881206800003),
+            x8,
+            x98 * S::splat(39234.47412200001),
+        );
+        let x115 = S::mul_add(S::splat(39241.404122), x8, S::splat(3946.18812068) * x98);
+        let x116 = S::mul_add(
+            S::splat(-3946.1881206800003),
+            x9,
+            x99 * S::splat(39234.47412200001),
+        );
+        let x117 = S::mul_add(S::splat(39241.404122), x9, S::splat(3946.18812068) * x99);
         let x118 = x105 * x111;
         let x119 = x104 * x110;
         let x120 = x118 - x119;
@@ -3220,63 +3868,65 @@ impl Ssrms {
         let x127 = x103 * x111;
         let x128 = x104 * x111;
         let x129 = x119 - x124;
-        let x130 = x120 - (Self::mul_add(s_q1, x113, x97 * x112) - x120);
-        let x131 = x123 + (Self::mul_add(-x8, x113, x98 * x112) - x121);
-        let x132 = x127 + (Self::mul_add(-x9, x113, x99 * x112) + x122);
-        let x133 = x121 - (Self::mul_add(s_q1, x115, x97 * x114) + x123);
-        let x134 = x125 - (Self::mul_add(-x8, x115, x98 * x114) - x125);
-        let x135 = x128 - (Self::mul_add(-x9, x115, x99 * x114) + x126);
-        let x136 = x122 + (Self::mul_add(s_q1, x117, x97 * x116) + x127);
-        let x137 = x126 + (Self::mul_add(-x8, x117, x98 * x116) - x128);
-        let x138 = x129 + (Self::mul_add(-x9, x117, x99 * x116) + x129);
-        let x139 = Self::mul_add(-qd[2], s_q1, qd[0]);
-        let x140 = Self::mul_add(-qd[2], x8, x44);
-        let x141 = Self::mul_add(qd[2], x9, x45);
-        let x142 = Self::mul_add(-qd[2], x106, x46);
-        let x143 = Self::mul_add(qd[2], x107, x47);
-        let x144 = Self::mul_add(qd[2], x108, x48);
-        let x145 = Self::mul_add(x9, x140, x8 * x141);
-        let x146 = Self::mul_add(x9, x139, s_q1 * x141);
-        let x147 = Self::mul_add(-x8, x139, s_q1 * x140);
-        let x148 = Self::mul_add(-x9, x143, x8 * x144);
-        let x149 = Self::mul_add(-x9, x142, s_q1 * x144);
-        let x150 = Self::mul_add(-x8, x142, s_q1 * x143);
-        let x151 = Self::mul_add(x108, x140, x107 * x141) + x148;
-        let x152 = Self::mul_add(-x108, x139, x106 * x141) - x149;
-        let x153 = Self::mul_add(x107, x139, x106 * x140) + x150;
-        let x154 = Self::mul_add(-qd[2], x145, Self::mul_add(-qdd[2], s_q1, x57));
-        let x155 = Self::mul_add(qd[2], x146, Self::mul_add(-qdd[2], x8, x58));
-        let x156 = Self::mul_add(-qd[2], x147, Self::mul_add(qdd[2], x9, x59));
-        let x157 = Self::mul_add(qd[2], x151, Self::mul_add(-qdd[2], x106, x60));
-        let x158 = Self::mul_add(qd[2], x152, Self::mul_add(qdd[2], x107, x61));
-        let x159 = Self::mul_add(qd[2], x153, Self::mul_add(qdd[2], x108, x62));
-        let x160 = Self::mul_add(x9, x44, x8 * x45);
-        let x161 = Self::mul_add(qd[0], x9, s_q1 * x45);
-        let x162 = Self::mul_add(-qd[0], x8, s_q1 * x44);
-        let x163 = Self::mul_add(x44, x108, x45 * x107)
-            + Self::mul_add(-x9, x47, x8 * x48);
-        let x164 = Self::mul_add(-qd[0], x108, x45 * x106)
-            - Self::mul_add(-x9, x46, s_q1 * x48);
-        let x165 = Self::mul_add(qd[0], x107, x44 * x106)
-            + Self::mul_add(-x8, x46, s_q1 * x47);
-        let x166 = Self::mul_add(x9, x58, x8 * x59)
-            - Self::mul_add(x44, x162, x45 * x161);
-        let x167 = Self::mul_add(x9, x57, s_q1 * x59)
-            + Self::mul_add(-qd[0], x162, x45 * x160);
-        let x168 = Self::mul_add(-x8, x57, s_q1 * x58)
-            + Self::mul_add(qd[0], x161, x44 * x160);
-        let x169 = Self::mul_add(x58, x108, x59 * x107)
-            + Self::mul_add(-x9, x61, x8 * x62)
-            + (Self::mul_add(x44, x165, x45 * x164)
-                - Self::mul_add(-x47, x162, x48 * x161));
-        let x170 = Self::mul_add(-x57, x108, x59 * x106)
-            - Self::mul_add(-x9, x60, s_q1 * x62)
-            - (Self::mul_add(qd[0], x165, x45 * x163)
-                + Self::mul_add(x46, x162, x48 * x160));
-        let x171 = Self::mul_add(x57, x107, x58 * x106)
-            + Self::mul_add(-x8, x60, s_q1 * x61)
-            - (Self::mul_add(-qd[0], x164, x44 * x163)
-                - Self::mul_add(x46, x161, x47 * x160));
+        let x130 = x120 - (S::mul_add(s_q1, x113, x97 * x112) - x120);
+        let x131 = x123 + (S::mul_add(S::neg(x8), x113, x98 * x112) - x121);
+        let x132 = x127 + (S::mul_add(S::neg(x9), x113, x99 * x112) + x122);
+        let x133 = x121 - (S::mul_add(s_q1, x115, x97 * x114) + x123);
+        let x134 = x125 - (S::mul_add(S::neg(x8), x115, x98 * x114) - x125);
+        let x135 = x128 - (S::mul_add(S::neg(x9), x115, x99 * x114) + x126);
+        let x136 = x122 + (S::mul_add(s_q1, x117, x97 * x116) + x127);
+        let x137 = x126 + (S::mul_add(S::neg(x8), x117, x98 * x116) - x128);
+        let x138 = x129 + (S::mul_add(S::neg(x9), x117, x99 * x116) + x129);
+        let x139 = S::mul_add(S::neg(qd[2]), s_q1, qd[0]);
+        let x140 = S::mul_add(S::neg(qd[2]), x8, x44);
+        let x141 = S::mul_add(qd[2], x9, x45);
+        let x142 = S::mul_add(S::neg(qd[2]), x106, x46);
+        let x143 = S::mul_add(qd[2], x107, x47);
+        let x144 = S::mul_add(qd[2], x108, x48);
+        let x145 = S::mul_add(x9, x140, x8 * x141);
+        let x146 = S::mul_add(x9, x139, s_q1 * x141);
+        let x147 = S::mul_add(S::neg(x8), x139, s_q1 * x140);
+        let x148 = S::mul_add(S::neg(x9), x143, x8 * x144);
+        let x149 = S::mul_add(S::neg(x9), x142, s_q1 * x144);
+        let x150 = S::mul_add(S::neg(x8), x142, s_q1 * x143);
+        let x151 = S::mul_add(x108, x140, x107 * x141) + x148;
+        let x152 = S::mul_add(S::neg(x108), x139, x106 * x141) - x149;
+        let x153 = S::mul_add(x107, x139, x106 * x140) + x150;
+        let x154 = S::mul_add(
+            S::neg(qd[2]),
+            x145,
+            S::mul_add(S::neg(qdd[2]), s_q1, x57),
+        );
+        let x155 = S::mul_add(qd[2], x146, S::mul_add(S::neg(qdd[2]), x8, x58));
+        let x156 = S::mul_add(S::neg(qd[2]), x147, S::mul_add(qdd[2], x9, x59));
+        let x157 = S::mul_add(qd[2], x151, S::mul_add(S::neg(qdd[2]), x106, x60));
+        let x158 = S::mul_add(qd[2], x152, S::mul_add(qdd[2], x107, x61));
+        let x159 = S::mul_add(qd[2], x153, S::mul_add(qdd[2], x108, x62));
+        let x160 = S::mul_add(x9, x44, x8 * x45);
+        let x161 = S::mul_add(qd[0], x9, s_q1 * x45);
+        let x162 = S::mul_add(S::neg(qd[0]), x8, s_q1 * x44);
+        let x163 = S::mul_add(x44, x108, x45 * x107)
+            + S::mul_add(S::neg(x9), x47, x8 * x48);
+        let x164 = S::mul_add(S::neg(qd[0]), x108, x45 * x106)
+            - S::mul_add(S::neg(x9), x46, s_q1 * x48);
+        let x165 = S::mul_add(qd[0], x107, x44 * x106)
+            + S::mul_add(S::neg(x8), x46, s_q1 * x47);
+        let x166 = S::mul_add(x9, x58, x8 * x59) - S::mul_add(x44, x162, x45 * x161);
+        let x167 = S::mul_add(x9, x57, s_q1 * x59)
+            + S::mul_add(S::neg(qd[0]), x162, x45 * x160);
+        let x168 = S::mul_add(S::neg(x8), x57, s_q1 * x58)
+            + S::mul_add(qd[0], x161, x44 * x160);
+        let x169 = S::mul_add(x58, x108, x59 * x107)
+            + S::mul_add(S::neg(x9), x61, x8 * x62)
+            + (S::mul_add(x44, x165, x45 * x164)
+                - S::mul_add(S::neg(x47), x162, x48 * x161));
+        let x170 = S::mul_add(S::neg(x57), x108, x59 * x106)
+            - S::mul_add(S::neg(x9), x60, s_q1 * x62)
+            - (S::mul_add(qd[0], x165, x45 * x163) + S::mul_add(x46, x162, x48 * x160));
+        let x171 = S::mul_add(x57, x107, x58 * x106)
+            + S::mul_add(S::neg(x8), x60, s_q1 * x61)
+            - (S::mul_add(S::neg(qd[0]), x164, x44 * x163)
+                - S::mul_add(x46, x161, x47 * x160));
         let x172 = x145 + x160;
         let x173 = x146 + x161;
         let x174 = x147 + x162;
@@ -3295,41 +3945,65 @@ impl Ssrms {
         let x187 = x109 * x144;
         let x188 = x110 * x142;
         let x189 = x109 * x143;
-        let x190 = Self::mul_add(x130, x139, x178) - x179 + (x184 - x185);
-        let x191 = Self::mul_add(-x134, x140, x180) + x181 + (x186 + x187);
-        let x192 = Self::mul_add(x138, x141, x182 - x183) + (x188 + x189);
-        let x193 = Self::mul_add(x110, x141, x111 * x140);
-        let x194 = Self::mul_add(-x109, x141, x111 * x139);
-        let x195 = Self::mul_add(x109, x140, x110 * x139);
-        let x196 = Self::mul_add(-x136, x140, x133 * x141);
-        let x197 = Self::mul_add(-x137, x139, x131 * x141);
-        let x198 = Self::mul_add(-x135, x139, x132 * x140);
+        let x190 = S::mul_add(x130, x139, x178) - x179 + (x184 - x185);
+        let x191 = S::mul_add(S::neg(x134), x140, x180) + x181 + (x186 + x187);
+        let x192 = S::mul_add(x138, x141, x182 - x183) + (x188 + x189);
+        let x193 = S::mul_add(x110, x141, x111 * x140);
+        let x194 = S::mul_add(S::neg(x109), x141, x111 * x139);
+        let x195 = S::mul_add(x109, x140, x110 * x139);
+        let x196 = S::mul_add(S::neg(x136), x140, x133 * x141);
+        let x197 = S::mul_add(S::neg(x137), x139, x131 * x141);
+        let x198 = S::mul_add(S::neg(x135), x139, x132 * x140);
         let x199 = x109 * x142;
         let x200 = x110 * x143;
         let x201 = x111 * x144;
         let x202 = x199 - x200 - x201;
         let x203 = x202 + x202;
-        let x204 = Self::mul_add(-x100, s_q3, x97 * c_q3);
-        let x205 = Self::mul_add(-x101, s_q3, x98 * c_q3);
-        let x206 = Self::mul_add(-x102, s_q3, x99 * c_q3);
-        let x207 = Self::mul_add(x100, c_q3, x97 * s_q3);
-        let x208 = Self::mul_add(x101, c_q3, x98 * s_q3);
-        let x209 = Self::mul_add(x102, c_q3, x99 * s_q3);
-        let x210 = x103 + Self::mul_add(s_q1, 0.475, 7.11 * x97);
-        let x211 = x104 - Self::mul_add(x8, -0.475, 7.11 * x98);
-        let x212 = x105 + Self::mul_add(x9, -0.475, 7.11 * x99);
-        let x213 = Self::mul_add(x9, x211, x8 * x212);
-        let x214 = Self::mul_add(x9, x210, s_q1 * x212);
-        let x215 = Self::mul_add(-x8, x210, s_q1 * x211);
-        let x216 = 3239.4582 * x204;
-        let x217 = 3239.4582 * x205;
-        let x218 = 3239.4582 * x206;
-        let x219 = Self::mul_add(1375.0472756800002, s_q1, x204 * 24989.305802);
-        let x220 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x204);
-        let x221 = Self::mul_add(-1375.0472756800002, x8, x205 * 24989.305802);
-        let x222 = Self::mul_add(24998.827802, x8, 1375.0472756800002 * x205);
-        let x223 = Self::mul_add(-1375.0472756800002, x9, x206 * 24989.305802);
-        let x224 = Self::mul_add(24998.827802, x9, 1375.0472756800002 * x206);
+        let x204 = S::mul_add(S::neg(x100), s_q3, x97 * c_q3);
+        let x205 = S::mul_add(S::neg(x101), s_q3, x98 * c_q3);
+        let x206 = S::mul_add(S::neg(x102), s_q3, x99 * c_q3);
+        let x207 = S::mul_add(x100, c_q3, x97 * s_q3);
+        let x208 = S::mul_add(x101, c_q3, x98 * s_q3);
+        let x209 = S::mul_add(x102, c_q3, x99 * s_q3);
+        let x210 = x103 + S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x97);
+        let x211 = x104 - S::mul_add(x8, S::splat(-0.475), S::splat(7.11) * x98);
+        let x212 = x105 + S::mul_add(x9, S::splat(-0.475), S::splat(7.11) * x99);
+        let x213 = S::mul_add(x9, x211, x8 * x212);
+        let x214 = S::mul_add(x9, x210, s_q1 * x212);
+        let x215 = S::mul_add(S::neg(x8), x210, s_q1 * x211);
+        let x216 = S::splat(3239.4582) * x204;
+        let x217 = S::splat(3239.4582) * x205;
+        let x218 = S::splat(3239.4582) * x206;
+        let x219 = S::mul_add(
+            S::splat(1375.0472756800002),
+            s_q1,
+            x204 * S::splat(24989.305802),
+        );
+        let x220 = S::mul_add(
+            S::splat(-24998.827802),
+            s_q1,
+            S::splat(1375.0472756800002) * x204,
+        );
+        let x221 = S::mul_add(
+            S::splat(-1375.0472756800002),
+            x8,
+            x205 * S::splat(24989.305802),
+        );
+        let x222 = S::mul_add(
+            S::splat(24998.827802),
+            x8,
+            S::splat(1375.0472756800002) * x205,
+        );
+        let x223 = S::mul_add(
+            S::splat(-1375.0472756800002),
+            x9,
+            x206 * S::splat(24989.305802),
+        );
+        let x224 = S::mul_add(
+            S::splat(24998.827802),
+            x9,
+            S::splat(1375.0472756800002) * x206,
+        );
         let x225 = x212 * x218;
         let x226 = x211 * x217;
         let x227 = x225 - x226;
@@ -3342,57 +4016,60 @@ impl Ssrms {
         let x234 = x210 * x218;
         let x235 = x211 * x218;
         let x236 = x226 - x231;
-        let x237 = x227 - (Self::mul_add(s_q1, x220, x204 * x219) - x227);
-        let x238 = x230 + (Self::mul_add(-x8, x220, x205 * x219) - x228);
-        let x239 = x234 + (Self::mul_add(-x9, x220, x206 * x219) + x229);
-        let x240 = x228 - (Self::mul_add(s_q1, x222, x204 * x221) + x230);
-        let x241 = x232 - (Self::mul_add(-x8, x222, x205 * x221) - x232);
-        let x242 = x235 - (Self::mul_add(-x9, x222, x206 * x221) + x233);
-        let x243 = x229 + (Self::mul_add(s_q1, x224, x204 * x223) + x234);
-        let x244 = x233 + (Self::mul_add(-x8, x224, x205 * x223) - x235);
-        let x245 = x236 + (Self::mul_add(-x9, x224, x206 * x223) + x236);
-        let x246 = Self::mul_add(-qd[3], s_q1, x139);
-        let x247 = Self::mul_add(-qd[3], x8, x140);
-        let x248 = Self::mul_add(qd[3], x9, x141);
-        let x249 = Self::mul_add(-qd[3], x213, x142);
-        let x250 = Self::mul_add(qd[3], x214, x143);
-        let x251 = Self::mul_add(qd[3], x215, x144);
-        let x252 = Self::mul_add(x9, x247, x8 * x248);
-        let x253 = Self::mul_add(x9, x246, s_q1 * x248);
-        let x254 = Self::mul_add(-x8, x246, s_q1 * x247);
-        let x255 = Self::mul_add(-x9, x250, x8 * x251);
-        let x256 = Self::mul_add(-x9, x249, s_q1 * x251);
-        let x257 = Self::mul_add(-x8, x249, s_q1 * x250);
-        let x258 = Self::mul_add(x215, x247, x214 * x248) + x255;
-        let x259 = Self::mul_add(-x215, x246, x213 * x248) - x256;
-        let x260 = Self::mul_add(x214, x246, x213 * x247) + x257;
-        let x261 = Self::mul_add(-qd[3], x252, Self::mul_add(-qdd[3], s_q1, x154));
-        let x262 = Self::mul_add(qd[3], x253, Self::mul_add(-qdd[3], x8, x155));
-        let x263 = Self::mul_add(-qd[3], x254, Self::mul_add(qdd[3], x9, x156));
-        let x264 = Self::mul_add(qd[3], x258, Self::mul_add(-qdd[3], x213, x157));
-        let x265 = Self::mul_add(qd[3], x259, Self::mul_add(qdd[3], x214, x158));
-        let x266 = Self::mul_add(qd[3], x260, Self::mul_add(qdd[3], x215, x159));
-        let x267 = x148 + Self::mul_add(x140, x215, x141 * x214);
-        let x268 = x149 - Self::mul_add(-x139, x215, x141 * x213);
-        let x269 = x150 + Self::mul_add(x139, x214, x140 * x213);
-        let x270 = Self::mul_add(x9, x155, x8 * x156)
-            - Self::mul_add(x140, x147, x141 * x146);
-        let x271 = Self::mul_add(x9, x154, s_q1 * x156)
-            + Self::mul_add(-x139, x147, x141 * x145);
-        let x272 = Self::mul_add(-x8, x154, s_q1 * x155)
-            + Self::mul_add(x139, x146, x140 * x145);
-        let x273 = Self::mul_add(x155, x215, x156 * x214)
-            + Self::mul_add(-x9, x158, x8 * x159)
-            - (Self::mul_add(-x140, x269, x141 * x268)
-                + Self::mul_add(-x143, x147, x144 * x146));
-        let x274 = Self::mul_add(-x154, x215, x156 * x213)
-            - Self::mul_add(-x9, x157, s_q1 * x159)
-            - (Self::mul_add(x139, x269, x141 * x267)
-                + Self::mul_add(x142, x147, x144 * x145));
-        let x275 = Self::mul_add(x154, x214, x155 * x213)
-            + Self::mul_add(-x8, x157, s_q1 * x158)
-            - (Self::mul_add(x139, x268, x140 * x267)
-                - Self::mul_add(x142, x146, x143 * x145));
+        let x237 = x227 - (S::mul_add(s_q1, x220, x204 * x219) - x227);
+        let x238 = x230 + (S::mul_add(S::neg(x8), x220, x205 * x219) - x228);
+        let x239 = x234 + (S::mul_add(S::neg(x9), x220, x206 * x219) + x229);
+        let x240 = x228 - (S::mul_add(s_q1, x222, x204 * x221) + x230);
+        let x241 = x232 - (S::mul_add(S::neg(x8), x222, x205 * x221) - x232);
+        let x242 = x235 - (S::mul_add(S::neg(x9), x222, x206 * x221) + x233);
+        let x243 = x229 + (S::mul_add(s_q1, x224, x204 * x223) + x234);
+        let x244 = x233 + (S::mul_add(S::neg(x8), x224, x205 * x223) - x235);
+        let x245 = x236 + (S::mul_add(S::neg(x9), x224, x206 * x223) + x236);
+        let x246 = S::mul_add(S::neg(qd[3]), s_q1, x139);
+        let x247 = S::mul_add(S::neg(qd[3]), x8, x140);
+        let x248 = S::mul_add(qd[3], x9, x141);
+        let x249 = S::mul_add(S::neg(qd[3]), x213, x142);
+        let x250 = S::mul_add(qd[3], x214, x143);
+        let x251 = S::mul_add(qd[3], x215, x144);
+        let x252 = S::mul_add(x9, x247, x8 * x248);
+        let x253 = S::mul_add(x9, x246, s_q1 * x248);
+        let x254 = S::mul_add(S::neg(x8), x246, s_q1 * x247);
+        let x255 = S::mul_add(S::neg(x9), x250, x8 * x251);
+        let x256 = S::mul_add(S::neg(x9), x249, s_q1 * x251);
+        let x257 = S::mul_add(S::neg(x8), x249, s_q1 * x250);
+        let x258 = S::mul_add(x215, x247, x214 * x248) + x255;
+        let x259 = S::mul_add(S::neg(x215), x246, x213 * x248) - x256;
+        let x260 = S::mul_add(x214, x246, x213 * x247) + x257;
+        let x261 = S::mul_add(
+            S::neg(qd[3]),
+            x252,
+            S::mul_add(S::neg(qdd[3]), s_q1, x154),
+        );
+        let x262 = S::mul_add(qd[3], x253, S::mul_add(S::neg(qdd[3]), x8, x155));
+        let x263 = S::mul_add(S::neg(qd[3]), x254, S::mul_add(qdd[3], x9, x156));
+        let x264 = S::mul_add(qd[3], x258, S::mul_add(S::neg(qdd[3]), x213, x157));
+        let x265 = S::mul_add(qd[3], x259, S::mul_add(qdd[3], x214, x158));
+        let x266 = S::mul_add(qd[3], x260, S::mul_add(qdd[3], x215, x159));
+        let x267 = x148 + S::mul_add(x140, x215, x141 * x214);
+        let x268 = x149 - S::mul_add(S::neg(x139), x215, x141 * x213);
+        let x269 = x150 + S::mul_add(x139, x214, x140 * x213);
+        let x270 = S::mul_add(x9, x155, x8 * x156) - S::mul_add(x140, x147, x141 * x146);
+        let x271 = S::mul_add(x9, x154, s_q1 * x156)
+            + S::mul_add(S::neg(x139), x147, x141 * x145);
+        let x272 = S::mul_add(S::neg(x8), x154, s_q1 * x155)
+            + S::mul_add(x139, x146, x140 * x145);
+        let x273 = S::mul_add(x155, x215, x156 * x214)
+            + S::mul_add(S::neg(x9), x158, x8 * x159)
+            - (S::mul_add(S::neg(x140), x269, x141 * x268)
+                + S::mul_add(S::neg(x143), x147, x144 * x146));
+        let x274 = S::mul_add(S::neg(x154), x215, x156 * x213)
+            - S::mul_add(S::neg(x9), x157, s_q1 * x159)
+            - (S::mul_add(x139, x269, x141 * x267)
+                + S::mul_add(x142, x147, x144 * x145));
+        let x275 = S::mul_add(x154, x214, x155 * x213)
+            + S::mul_add(S::neg(x8), x157, s_q1 * x158)
+            - (S::mul_add(x139, x268, x140 * x267)
+                - S::mul_add(x142, x146, x143 * x145));
         let x276 = x145 + x252;
         let x277 = x146 + x253;
         let x278 = x147 + x254;
@@ -3411,44 +4088,56 @@ impl Ssrms {
         let x291 = x216 * x251;
         let x292 = x217 * x249;
         let x293 = x216 * x250;
-        let x294 = Self::mul_add(x237, x246, x282) - x283 + (x288 - x289);
-        let x295 = Self::mul_add(-x241, x247, x284) + x285 + (x290 + x291);
-        let x296 = Self::mul_add(x245, x248, x286 - x287) + (x292 + x293);
-        let x297 = Self::mul_add(x217, x248, x218 * x247);
-        let x298 = Self::mul_add(-x216, x248, x218 * x246);
-        let x299 = Self::mul_add(x216, x247, x217 * x246);
-        let x300 = Self::mul_add(-x243, x247, x240 * x248);
-        let x301 = Self::mul_add(-x244, x246, x238 * x248);
-        let x302 = Self::mul_add(-x242, x246, x239 * x247);
+        let x294 = S::mul_add(x237, x246, x282) - x283 + (x288 - x289);
+        let x295 = S::mul_add(S::neg(x241), x247, x284) + x285 + (x290 + x291);
+        let x296 = S::mul_add(x245, x248, x286 - x287) + (x292 + x293);
+        let x297 = S::mul_add(x217, x248, x218 * x247);
+        let x298 = S::mul_add(S::neg(x216), x248, x218 * x246);
+        let x299 = S::mul_add(x216, x247, x217 * x246);
+        let x300 = S::mul_add(S::neg(x243), x247, x240 * x248);
+        let x301 = S::mul_add(S::neg(x244), x246, x238 * x248);
+        let x302 = S::mul_add(S::neg(x242), x246, x239 * x247);
         let x303 = x216 * x249;
         let x304 = x217 * x250;
         let x305 = x218 * x251;
         let x306 = x303 - x304 - x305;
         let x307 = x306 + x306;
-        let x308 = Self::mul_add(-x207, s_q4, x204 * c_q4);
-        let x309 = Self::mul_add(-x208, s_q4, x205 * c_q4);
-        let x310 = Self::mul_add(-x209, s_q4, x206 * c_q4);
-        let x311 = Self::mul_add(x207, c_q4, x204 * s_q4);
-        let x312 = Self::mul_add(x208, c_q4, x205 * s_q4);
-        let x313 = Self::mul_add(x209, c_q4, x206 * s_q4);
-        let x314 = Self::mul_add(7.11, x204, x210);
-        let x315 = Self::mul_add(-7.11, x205, x211);
-        let x316 = Self::mul_add(7.11, x206, x212);
-        let x317 = Self::mul_add(x9, x315, x8 * x316);
-        let x318 = Self::mul_add(x9, x314, s_q1 * x316);
-        let x319 = Self::mul_add(-x8, x314, s_q1 * x315);
-        let x320 = x311 * 171.195516;
-        let x321 = x312 * 171.195516;
-        let x322 = x313 * 171.195516;
-        let x323 = 132.6783695416 * x308;
-        let x324 = Self::mul_add(x311, 97.44448770720001, 135.4729695416 * s_q1);
-        let x325 = s_q1 * 97.44448770720001;
-        let x326 = 132.6783695416 * x309;
-        let x327 = Self::mul_add(x312, -97.44448770720001, 135.4729695416 * x8);
-        let x328 = x8 * 97.44448770720001;
-        let x329 = 132.6783695416 * x310;
-        let x330 = Self::mul_add(x313, -97.44448770720001, 135.4729695416 * x9);
-        let x331 = x9 * 97.44448770720001;
+        let x308 = S::mul_add(S::neg(x207), s_q4, x204 * c_q4);
+        let x309 = S::mul_add(S::neg(x208), s_q4, x205 * c_q4);
+        let x310 = S::mul_add(S::neg(x209), s_q4, x206 * c_q4);
+        let x311 = S::mul_add(x207, c_q4, x204 * s_q4);
+        let x312 = S::mul_add(x208, c_q4, x205 * s_q4);
+        let x313 = S::mul_add(x209, c_q4, x206 * s_q4);
+        let x314 = S::mul_add(S::splat(7.11), x204, x210);
+        let x315 = S::mul_add(S::splat(-7.11), x205, x211);
+        let x316 = S::mul_add(S::splat(7.11), x206, x212);
+        let x317 = S::mul_add(x9, x315, x8 * x316);
+        let x318 = S::mul_add(x9, x314, s_q1 * x316);
+        let x319 = S::mul_add(S::neg(x8), x314, s_q1 * x315);
+        let x320 = x311 * S::splat(171.195516);
+        let x321 = x312 * S::splat(171.195516);
+        let x322 = x313 * S::splat(171.195516);
+        let x323 = S::splat(132.6783695416) * x308;
+        let x324 = S::mul_add(
+            x311,
+            S::splat(97.44448770720001),
+            S::splat(135.4729695416) * s_q1,
+        );
+        let x325 = s_q1 * S::splat(97.44448770720001);
+        let x326 = S::splat(132.6783695416) * x309;
+        let x327 = S::mul_add(
+            x312,
+            S::splat(-97.44448770720001),
+            S::splat(135.4729695416) * x8,
+        );
+        let x328 = x8 * S::splat(97.44448770720001);
+        let x329 = S::splat(132.6783695416) * x310;
+        let x330 = S::mul_add(
+            x313,
+            S::splat(-97.44448770720001),
+            S::splat(135.4729695416) * x9,
+        );
+        let x331 = x9 * S::splat(97.44448770720001);
         let x332 = x316 * x322;
         let x333 = x315 * x321;
         let x334 = x332 - x333;
@@ -3462,67 +4151,76 @@ impl Ssrms {
         let x342 = x315 * x322;
         let x343 = x333 - x338;
         let x344 = x334
-            - (Self::mul_add(x311, x325, Self::mul_add(s_q1, x324, x308 * x323)) - x334);
+            - (S::mul_add(x311, x325, S::mul_add(s_q1, x324, x308 * x323)) - x334);
         let x345 = x337
-            + (Self::mul_add(x312, x325, Self::mul_add(-x8, x324, x309 * x323)) - x335);
+            + (S::mul_add(x312, x325, S::mul_add(S::neg(x8), x324, x309 * x323)) - x335);
         let x346 = x341
-            + (Self::mul_add(x313, x325, Self::mul_add(-x9, x324, x310 * x323)) + x336);
+            + (S::mul_add(x313, x325, S::mul_add(S::neg(x9), x324, x310 * x323)) + x336);
         let x347 = x335
-            - (Self::mul_add(-x311, x328, Self::mul_add(-s_q1, x327, x308 * x326))
-                + x337);
+            - (S::mul_add(
+                S::neg(x311),
+                x328,
+                S::mul_add(S::neg(s_q1), x327, x308 * x326),
+            ) + x337);
         let x348 = x339
-            - (Self::mul_add(-x312, x328, Self::mul_add(x8, x327, x309 * x326)) - x339);
+            - (S::mul_add(S::neg(x312), x328, S::mul_add(x8, x327, x309 * x326)) - x339);
         let x349 = x342
-            - (Self::mul_add(-x313, x328, Self::mul_add(x9, x327, x310 * x326)) + x340);
+            - (S::mul_add(S::neg(x313), x328, S::mul_add(x9, x327, x310 * x326)) + x340);
         let x350 = x336
-            + (Self::mul_add(-x311, x331, Self::mul_add(-s_q1, x330, x308 * x329))
-                + x341);
+            + (S::mul_add(
+                S::neg(x311),
+                x331,
+                S::mul_add(S::neg(s_q1), x330, x308 * x329),
+            ) + x341);
         let x351 = x340
-            + (Self::mul_add(-x312, x331, Self::mul_add(x8, x330, x309 * x329)) - x342);
+            + (S::mul_add(S::neg(x312), x331, S::mul_add(x8, x330, x309 * x329)) - x342);
         let x352 = x343
-            + (Self::mul_add(-x313, x331, Self::mul_add(x9, x330, x310 * x329)) + x343);
-        let x353 = Self::mul_add(-qd[4], s_q1, x246);
-        let x354 = Self::mul_add(-qd[4], x8, x247);
-        let x355 = Self::mul_add(qd[4], x9, x248);
-        let x356 = Self::mul_add(-qd[4], x317, x249);
-        let x357 = Self::mul_add(qd[4], x318, x250);
-        let x358 = Self::mul_add(qd[4], x319, x251);
-        let x359 = Self::mul_add(x9, x354, x8 * x355);
-        let x360 = Self::mul_add(x9, x353, s_q1 * x355);
-        let x361 = Self::mul_add(-x8, x353, s_q1 * x354);
-        let x362 = Self::mul_add(x319, x354, x318 * x355)
-            + Self::mul_add(-x9, x357, x8 * x358);
-        let x363 = Self::mul_add(-x319, x353, x317 * x355)
-            - Self::mul_add(-x9, x356, s_q1 * x358);
-        let x364 = Self::mul_add(x318, x353, x317 * x354)
-            + Self::mul_add(-x8, x356, s_q1 * x357);
-        let x365 = Self::mul_add(-qd[4], x359, Self::mul_add(-qdd[4], s_q1, x261));
-        let x366 = Self::mul_add(qd[4], x360, Self::mul_add(-qdd[4], x8, x262));
-        let x367 = Self::mul_add(-qd[4], x361, Self::mul_add(qdd[4], x9, x263));
-        let x368 = Self::mul_add(qd[4], x362, Self::mul_add(-qdd[4], x317, x264));
-        let x369 = Self::mul_add(qd[4], x363, Self::mul_add(qdd[4], x318, x265));
-        let x370 = Self::mul_add(qd[4], x364, Self::mul_add(qdd[4], x319, x266));
-        let x371 = x255 + Self::mul_add(x247, x319, x248 * x318);
-        let x372 = x256 - Self::mul_add(-x246, x319, x248 * x317);
-        let x373 = x257 + Self::mul_add(x246, x318, x247 * x317);
-        let x374 = Self::mul_add(x9, x262, x8 * x263)
-            - Self::mul_add(x247, x254, x248 * x253);
-        let x375 = Self::mul_add(x9, x261, s_q1 * x263)
-            + Self::mul_add(-x246, x254, x248 * x252);
-        let x376 = Self::mul_add(-x8, x261, s_q1 * x262)
-            + Self::mul_add(x246, x253, x247 * x252);
-        let x377 = Self::mul_add(x262, x319, x263 * x318)
-            + Self::mul_add(-x9, x265, x8 * x266)
-            - (Self::mul_add(-x247, x373, x248 * x372)
-                + Self::mul_add(-x250, x254, x251 * x253));
-        let x378 = Self::mul_add(-x261, x319, x263 * x317)
-            - Self::mul_add(-x9, x264, s_q1 * x266)
-            - (Self::mul_add(x246, x373, x248 * x371)
-                + Self::mul_add(x249, x254, x251 * x252));
-        let x379 = Self::mul_add(x261, x318, x262 * x317)
-            + Self::mul_add(-x8, x264, s_q1 * x265)
-            - (Self::mul_add(x246, x372, x247 * x371)
-                - Self::mul_add(x249, x253, x250 * x252));
+            + (S::mul_add(S::neg(x313), x331, S::mul_add(x9, x330, x310 * x329)) + x343);
+        let x353 = S::mul_add(S::neg(qd[4]), s_q1, x246);
+        let x354 = S::mul_add(S::neg(qd[4]), x8, x247);
+        let x355 = S::mul_add(qd[4], x9, x248);
+        let x356 = S::mul_add(S::neg(qd[4]), x317, x249);
+        let x357 = S::mul_add(qd[4], x318, x250);
+        let x358 = S::mul_add(qd[4], x319, x251);
+        let x359 = S::mul_add(x9, x354, x8 * x355);
+        let x360 = S::mul_add(x9, x353, s_q1 * x355);
+        let x361 = S::mul_add(S::neg(x8), x353, s_q1 * x354);
+        let x362 = S::mul_add(x319, x354, x318 * x355)
+            + S::mul_add(S::neg(x9), x357, x8 * x358);
+        let x363 = S::mul_add(S::neg(x319), x353, x317 * x355)
+            - S::mul_add(S::neg(x9), x356, s_q1 * x358);
+        let x364 = S::mul_add(x318, x353, x317 * x354)
+            + S::mul_add(S::neg(x8), x356, s_q1 * x357);
+        let x365 = S::mul_add(
+            S::neg(qd[4]),
+            x359,
+            S::mul_add(S::neg(qdd[4]), s_q1, x261),
+        );
+        let x366 = S::mul_add(qd[4], x360, S::mul_add(S::neg(qdd[4]), x8, x262));
+        let x367 = S::mul_add(S::neg(qd[4]), x361, S::mul_add(qdd[4], x9, x263));
+        let x368 = S::mul_add(qd[4], x362, S::mul_add(S::neg(qdd[4]), x317, x264));
+        let x369 = S::mul_add(qd[4], x363, S::mul_add(qdd[4], x318, x265));
+        let x370 = S::mul_add(qd[4], x364, S::mul_add(qdd[4], x319, x266));
+        let x371 = x255 + S::mul_add(x247, x319, x248 * x318);
+        let x372 = x256 - S::mul_add(S::neg(x246), x319, x248 * x317);
+        let x373 = x257 + S::mul_add(x246, x318, x247 * x317);
+        let x374 = S::mul_add(x9, x262, x8 * x263) - S::mul_add(x247, x254, x248 * x253);
+        let x375 = S::mul_add(x9, x261, s_q1 * x263)
+            + S::mul_add(S::neg(x246), x254, x248 * x252);
+        let x376 = S::mul_add(S::neg(x8), x261, s_q1 * x262)
+            + S::mul_add(x246, x253, x247 * x252);
+        let x377 = S::mul_add(x262, x319, x263 * x318)
+            + S::mul_add(S::neg(x9), x265, x8 * x266)
+            - (S::mul_add(S::neg(x247), x373, x248 * x372)
+                + S::mul_add(S::neg(x250), x254, x251 * x253));
+        let x378 = S::mul_add(S::neg(x261), x319, x263 * x317)
+            - S::mul_add(S::neg(x9), x264, s_q1 * x266)
+            - (S::mul_add(x246, x373, x248 * x371)
+                + S::mul_add(x249, x254, x251 * x252));
+        let x379 = S::mul_add(x261, x318, x262 * x317)
+            + S::mul_add(S::neg(x8), x264, s_q1 * x265)
+            - (S::mul_add(x246, x372, x247 * x371)
+                - S::mul_add(x249, x253, x250 * x252));
         let x380 = x252 + x359;
         let x381 = x253 + x360;
         let x382 = x254 + x361;
@@ -3541,83 +4239,87 @@ impl Ssrms {
         let x395 = x320 * x358;
         let x396 = x321 * x356;
         let x397 = x320 * x357;
-        let x398 = Self::mul_add(x344, x353, x386) - x387 + (x392 - x393);
-        let x399 = Self::mul_add(-x348, x354, x388) + x389 + (x394 + x395);
-        let x400 = Self::mul_add(x352, x355, x390 - x391) + (x396 + x397);
-        let x401 = Self::mul_add(x321, x355, x322 * x354);
-        let x402 = Self::mul_add(-x320, x355, x322 * x353);
-        let x403 = Self::mul_add(x320, x354, x321 * x353);
-        let x404 = Self::mul_add(x321, x367, x322 * x366)
-            - Self::mul_add(-x354, x403, x355 * x402);
-        let x405 = Self::mul_add(-x320, x367, x322 * x365)
-            + Self::mul_add(x353, x403, x355 * x401);
-        let x406 = Self::mul_add(x320, x366, x321 * x365)
-            - Self::mul_add(x353, x402, x354 * x401);
-        let x407 = Self::mul_add(-x350, x354, x347 * x355);
-        let x408 = Self::mul_add(-x351, x353, x345 * x355);
-        let x409 = Self::mul_add(-x349, x353, x346 * x354);
+        let x398 = S::mul_add(x344, x353, x386) - x387 + (x392 - x393);
+        let x399 = S::mul_add(S::neg(x348), x354, x388) + x389 + (x394 + x395);
+        let x400 = S::mul_add(x352, x355, x390 - x391) + (x396 + x397);
+        let x401 = S::mul_add(x321, x355, x322 * x354);
+        let x402 = S::mul_add(S::neg(x320), x355, x322 * x353);
+        let x403 = S::mul_add(x320, x354, x321 * x353);
+        let x404 = S::mul_add(x321, x367, x322 * x366)
+            - S::mul_add(S::neg(x354), x403, x355 * x402);
+        let x405 = S::mul_add(S::neg(x320), x367, x322 * x365)
+            + S::mul_add(x353, x403, x355 * x401);
+        let x406 = S::mul_add(x320, x366, x321 * x365)
+            - S::mul_add(x353, x402, x354 * x401);
+        let x407 = S::mul_add(S::neg(x350), x354, x347 * x355);
+        let x408 = S::mul_add(S::neg(x351), x353, x345 * x355);
+        let x409 = S::mul_add(S::neg(x349), x353, x346 * x354);
         let x410 = x320 * x356;
         let x411 = x321 * x357;
         let x412 = x322 * x358;
         let x413 = x410 - x411 - x412;
         let x414 = x413 + x413;
-        let x415 = Self::mul_add(-s_q1, s_q5, x308 * c_q5);
-        let x416 = Self::mul_add(x8, s_q5, x309 * c_q5);
-        let x417 = Self::mul_add(x9, s_q5, x310 * c_q5);
-        let x418 = Self::mul_add(s_q1, c_q5, x308 * s_q5);
-        let x419 = Self::mul_add(-x8, c_q5, x309 * s_q5);
-        let x420 = Self::mul_add(-x9, c_q5, x310 * s_q5);
-        let x421 = 44.41 * x418;
-        let x422 = 47.471 * x311;
-        let x423 = 44.41 * x419;
-        let x424 = 47.471 * x312;
-        let x425 = 44.41 * x420;
-        let x426 = 47.471 * x313;
-        let x427 = Self::mul_add(x311, x422, x418 * x421);
-        let x428 = Self::mul_add(x312, x422, x419 * x421);
-        let x429 = Self::mul_add(x313, x422, x420 * x421);
-        let x430 = Self::mul_add(x311, x424, x418 * x423);
-        let x431 = Self::mul_add(x312, x424, x419 * x423);
-        let x432 = Self::mul_add(x313, x424, x420 * x423);
-        let x433 = Self::mul_add(x311, x426, x418 * x425);
-        let x434 = Self::mul_add(x312, x426, x419 * x425);
-        let x435 = Self::mul_add(x313, x426, x420 * x425);
-        let x436 = Self::mul_add(qd[5], x311, x353);
-        let x437 = Self::mul_add(-qd[5], x312, x354);
-        let x438 = Self::mul_add(qd[5], x313, x355);
-        let x439 = Self::mul_add(x313, x437, x312 * x438);
-        let x440 = Self::mul_add(-x313, x436, x311 * x438);
-        let x441 = Self::mul_add(x312, x436, x311 * x437);
-        let x442 = Self::mul_add(-qd[5], x439, Self::mul_add(qdd[5], x311, x365));
-        let x443 = Self::mul_add(-qd[5], x440, Self::mul_add(-qdd[5], x312, x366));
-        let x444 = Self::mul_add(qd[5], x441, Self::mul_add(qdd[5], x313, x367));
-        let x445 = Self::mul_add(x313, x354, x312 * x355);
-        let x446 = Self::mul_add(-x313, x353, x311 * x355);
-        let x447 = Self::mul_add(x312, x353, x311 * x354);
-        let x448 = Self::mul_add(x313, x366, x312 * x367)
-            + Self::mul_add(x354, x447, x355 * x446);
-        let x449 = Self::mul_add(-x313, x365, x311 * x367)
-            - Self::mul_add(x353, x447, x355 * x445);
-        let x450 = Self::mul_add(x312, x365, x311 * x366)
-            - Self::mul_add(-x353, x446, x354 * x445);
+        let x415 = S::mul_add(S::neg(s_q1), s_q5, x308 * c_q5);
+        let x416 = S::mul_add(x8, s_q5, x309 * c_q5);
+        let x417 = S::mul_add(x9, s_q5, x310 * c_q5);
+        let x418 = S::mul_add(s_q1, c_q5, x308 * s_q5);
+        let x419 = S::mul_add(S::neg(x8), c_q5, x309 * s_q5);
+        let x420 = S::mul_add(S::neg(x9), c_q5, x310 * s_q5);
+        let x421 = S::splat(44.41) * x418;
+        let x422 = S::splat(47.471) * x311;
+        let x423 = S::splat(44.41) * x419;
+        let x424 = S::splat(47.471) * x312;
+        let x425 = S::splat(44.41) * x420;
+        let x426 = S::splat(47.471) * x313;
+        let x427 = S::mul_add(x311, x422, x418 * x421);
+        let x428 = S::mul_add(x312, x422, x419 * x421);
+        let x429 = S::mul_add(x313, x422, x420 * x421);
+        let x430 = S::mul_add(x311, x424, x418 * x423);
+        let x431 = S::mul_add(x312, x424, x419 * x423);
+        let x432 = S::mul_add(x313, x424, x420 * x423);
+        let x433 = S::mul_add(x311, x426, x418 * x425);
+        let x434 = S::mul_add(x312, x426, x419 * x425);
+        let x435 = S::mul_add(x313, x426, x420 * x425);
+        let x436 = S::mul_add(qd[5], x311, x353);
+        let x437 = S::mul_add(S::neg(qd[5]), x312, x354);
+        let x438 = S::mul_add(qd[5], x313, x355);
+        let x439 = S::mul_add(x313, x437, x312 * x438);
+        let x440 = S::mul_add(S::neg(x313), x436, x311 * x438);
+        let x441 = S::mul_add(x312, x436, x311 * x437);
+        let x442 = S::mul_add(S::neg(qd[5]), x439, S::mul_add(qdd[5], x311, x365));
+        let x443 = S::mul_add(
+            S::neg(qd[5]),
+            x440,
+            S::mul_add(S::neg(qdd[5]), x312, x366),
+        );
+        let x444 = S::mul_add(qd[5], x441, S::mul_add(qdd[5], x313, x367));
+        let x445 = S::mul_add(x313, x354, x312 * x355);
+        let x446 = S::mul_add(S::neg(x313), x353, x311 * x355);
+        let x447 = S::mul_add(x312, x353, x311 * x354);
+        let x448 = S::mul_add(x313, x366, x312 * x367)
+            + S::mul_add(x354, x447, x355 * x446);
+        let x449 = S::mul_add(S::neg(x313), x365, x311 * x367)
+            - S::mul_add(x353, x447, x355 * x445);
+        let x450 = S::mul_add(x312, x365, x311 * x366)
+            - S::mul_add(S::neg(x353), x446, x354 * x445);
         let x451 = x439 + x445;
         let x452 = x440 + x446;
         let x453 = x441 + x447;
         let x454 = x428 * x437;
         let x455 = x429 * x438;
-        let x456 = Self::mul_add(x427, x436, -x454) + x455;
+        let x456 = S::mul_add(x427, x436, S::neg(x454)) + x455;
         let x457 = x430 * x436;
         let x458 = x432 * x438;
-        let x459 = Self::mul_add(-x431, x437, x457) + x458;
+        let x459 = S::mul_add(S::neg(x431), x437, x457) + x458;
         let x460 = x433 * x436;
         let x461 = x434 * x437;
-        let x462 = Self::mul_add(x435, x438, x460 - x461);
-        let x463 = Self::mul_add(x433, x437, x430 * x438);
-        let x464 = Self::mul_add(-x434, x436, x428 * x438);
-        let x465 = Self::mul_add(x432, x436, x429 * x437);
-        let x466 = 9.336 * x415;
-        let x467 = 9.336 * x416;
-        let x468 = 9.336 * x417;
+        let x462 = S::mul_add(x435, x438, x460 - x461);
+        let x463 = S::mul_add(x433, x437, x430 * x438);
+        let x464 = S::mul_add(S::neg(x434), x436, x428 * x438);
+        let x465 = S::mul_add(x432, x436, x429 * x437);
+        let x466 = S::splat(9.336) * x415;
+        let x467 = S::splat(9.336) * x416;
+        let x468 = S::splat(9.336) * x417;
         let x469 = x415 * x466;
         let x470 = x416 * x466;
         let x471 = x417 * x466;
@@ -3627,94 +4329,125 @@ impl Ssrms {
         let x475 = x415 * x468;
         let x476 = x416 * x468;
         let x477 = x417 * x468;
-        let x478 = Self::mul_add(qd[6], x415, x436);
-        let x479 = Self::mul_add(-qd[6], x416, x437);
-        let x480 = Self::mul_add(qd[6], x417, x438);
-        let x481 = Self::mul_add(x417, x479, x416 * x480);
-        let x482 = Self::mul_add(-x417, x478, x415 * x480);
-        let x483 = Self::mul_add(x416, x478, x415 * x479);
-        let x484 = Self::mul_add(-qd[6], x481, Self::mul_add(qdd[6], x415, x442));
-        let x485 = Self::mul_add(-qd[6], x482, Self::mul_add(-qdd[6], x416, x443));
-        let x486 = Self::mul_add(qd[6], x483, Self::mul_add(qdd[6], x417, x444));
-        let x487 = Self::mul_add(x417, x437, x416 * x438);
-        let x488 = Self::mul_add(-x417, x436, x415 * x438);
-        let x489 = Self::mul_add(x416, x436, x415 * x437);
-        let x490 = Self::mul_add(x417, x443, x416 * x444)
-            + Self::mul_add(x437, x489, x438 * x488);
-        let x491 = Self::mul_add(-x417, x442, x415 * x444)
-            - Self::mul_add(x436, x489, x438 * x487);
-        let x492 = Self::mul_add(x416, x442, x415 * x443)
-            - Self::mul_add(-x436, x488, x437 * x487);
+        let x478 = S::mul_add(qd[6], x415, x436);
+        let x479 = S::mul_add(S::neg(qd[6]), x416, x437);
+        let x480 = S::mul_add(qd[6], x417, x438);
+        let x481 = S::mul_add(x417, x479, x416 * x480);
+        let x482 = S::mul_add(S::neg(x417), x478, x415 * x480);
+        let x483 = S::mul_add(x416, x478, x415 * x479);
+        let x484 = S::mul_add(S::neg(qd[6]), x481, S::mul_add(qdd[6], x415, x442));
+        let x485 = S::mul_add(
+            S::neg(qd[6]),
+            x482,
+            S::mul_add(S::neg(qdd[6]), x416, x443),
+        );
+        let x486 = S::mul_add(qd[6], x483, S::mul_add(qdd[6], x417, x444));
+        let x487 = S::mul_add(x417, x437, x416 * x438);
+        let x488 = S::mul_add(S::neg(x417), x436, x415 * x438);
+        let x489 = S::mul_add(x416, x436, x415 * x437);
+        let x490 = S::mul_add(x417, x443, x416 * x444)
+            + S::mul_add(x437, x489, x438 * x488);
+        let x491 = S::mul_add(S::neg(x417), x442, x415 * x444)
+            - S::mul_add(x436, x489, x438 * x487);
+        let x492 = S::mul_add(x416, x442, x415 * x443)
+            - S::mul_add(S::neg(x436), x488, x437 * x487);
         let x493 = x481 + x487;
         let x494 = x482 + x488;
         let x495 = x483 + x489;
         let x496 = x470 * x479;
         let x497 = x471 * x480;
-        let x498 = Self::mul_add(x469, x478, -x496) + x497;
+        let x498 = S::mul_add(x469, x478, S::neg(x496)) + x497;
         let x499 = x472 * x478;
         let x500 = x474 * x480;
-        let x501 = Self::mul_add(-x473, x479, x499) + x500;
+        let x501 = S::mul_add(S::neg(x473), x479, x499) + x500;
         let x502 = x475 * x478;
         let x503 = x476 * x479;
-        let x504 = Self::mul_add(x477, x480, x502 - x503);
-        let x505 = Self::mul_add(x471, x486, Self::mul_add(-x470, x485, x469 * x484))
-            - Self::mul_add(x479, x504, x480 * x501);
-        let x506 = Self::mul_add(x474, x486, Self::mul_add(-x473, x485, x472 * x484))
-            + Self::mul_add(-x478, x504, x480 * x498);
-        let x507 = Self::mul_add(x477, x486, Self::mul_add(-x476, x485, x475 * x484))
-            + Self::mul_add(x478, x501, x479 * x498);
-        let x508 = Self::mul_add(x475, x479, x472 * x480);
-        let x509 = Self::mul_add(-x476, x478, x470 * x480);
-        let x510 = Self::mul_add(x474, x478, x471 * x479);
+        let x504 = S::mul_add(x477, x480, x502 - x503);
+        let x505 = S::mul_add(x471, x486, S::mul_add(S::neg(x470), x485, x469 * x484))
+            - S::mul_add(x479, x504, x480 * x501);
+        let x506 = S::mul_add(x474, x486, S::mul_add(S::neg(x473), x485, x472 * x484))
+            + S::mul_add(S::neg(x478), x504, x480 * x498);
+        let x507 = S::mul_add(x477, x486, S::mul_add(S::neg(x476), x485, x475 * x484))
+            + S::mul_add(x478, x501, x479 * x498);
+        let x508 = S::mul_add(x475, x479, x472 * x480);
+        let x509 = S::mul_add(S::neg(x476), x478, x470 * x480);
+        let x510 = S::mul_add(x474, x478, x471 * x479);
         let x511 = x508 + x508;
-        let x512 = Self::mul_add(-x469, x480, x502) + Self::mul_add(x473, x480, x503);
-        let x513 = Self::mul_add(x469, x479, x499) - Self::mul_add(x477, x479, x500);
+        let x512 = S::mul_add(S::neg(x469), x480, x502) + S::mul_add(x473, x480, x503);
+        let x513 = S::mul_add(x469, x479, x499) - S::mul_add(x477, x479, x500);
         let x514 = x509 + x509;
-        let x515 = Self::mul_add(x473, x478, x496) + Self::mul_add(-x477, x478, x497);
+        let x515 = S::mul_add(x473, x478, x496) + S::mul_add(S::neg(x477), x478, x497);
         let x516 = x510 + x510;
-        let x517 = Self::mul_add(x417, x471, Self::mul_add(x416, x470, x415 * x469));
-        let x518 = Self::mul_add(x417, x474, Self::mul_add(x416, x473, x415 * x472));
-        let x519 = Self::mul_add(x417, x477, Self::mul_add(x416, x476, x415 * x475));
-        let x520 = Self::mul_add(-x417, x513, Self::mul_add(x416, x512, x415 * x511));
-        let x521 = Self::mul_add(-x417, x515, Self::mul_add(-x416, x514, x415 * x512));
-        let x522 = Self::mul_add(x417, x516, Self::mul_add(x416, x515, x415 * x513));
-        let x523 = Self::mul_add(-x416, x504, x417 * x501);
-        let x524 = Self::mul_add(-x415, x504, x417 * x498);
-        let x525 = Self::mul_add(-x415, x501, x416 * x498);
+        let x517 = S::mul_add(x417, x471, S::mul_add(x416, x470, x415 * x469));
+        let x518 = S::mul_add(x417, x474, S::mul_add(x416, x473, x415 * x472));
+        let x519 = S::mul_add(x417, x477, S::mul_add(x416, x476, x415 * x475));
+        let x520 = S::mul_add(S::neg(x417), x513, S::mul_add(x416, x512, x415 * x511));
+        let x521 = S::mul_add(
+            S::neg(x417),
+            x515,
+            S::mul_add(S::neg(x416), x514, x415 * x512),
+        );
+        let x522 = S::mul_add(x417, x516, S::mul_add(x416, x515, x415 * x513));
+        let x523 = S::mul_add(S::neg(x416), x504, x417 * x501);
+        let x524 = S::mul_add(S::neg(x415), x504, x417 * x498);
+        let x525 = S::mul_add(S::neg(x415), x501, x416 * x498);
         let x526 = x520 - x523;
-        let x527 = -x526;
+        let x527 = S::neg(x526);
         let x528 = x521 + x524;
         let x529 = x522 + x525;
-        let x530 = Self::mul_add(-x416, x507, x417 * x506)
-            + Self::mul_add(-x471, x492, Self::mul_add(-x470, x491, x469 * x490))
-            + (Self::mul_add(-x488, x504, x489 * x501)
-                - Self::mul_add(x489, x513, Self::mul_add(-x488, x512, x487 * x511)));
-        let x531 = -x530;
-        let x532 = Self::mul_add(-x415, x507, x417 * x505)
-            - Self::mul_add(-x474, x492, Self::mul_add(-x473, x491, x472 * x490))
-            + (Self::mul_add(x487, x504, x489 * x498)
-                + Self::mul_add(x489, x515, Self::mul_add(x488, x514, x487 * x512)));
-        let x533 = Self::mul_add(-x415, x506, x416 * x505)
-            + Self::mul_add(-x477, x492, Self::mul_add(-x476, x491, x475 * x490))
-            + (Self::mul_add(x487, x501, x488 * x498)
-                + Self::mul_add(-x489, x516, Self::mul_add(-x488, x515, x487 * x513)));
-        let x534 = Self::mul_add(-x471, x495, Self::mul_add(-x470, x494, x469 * x493))
-            + (x520 + x523);
-        let x535 = -x534;
-        let x536 = Self::mul_add(-x474, x495, Self::mul_add(-x473, x494, x472 * x493))
-            + (x521 - x524);
-        let x537 = Self::mul_add(-x477, x495, Self::mul_add(-x476, x494, x475 * x493))
-            - (x522 - x525);
-        let x538 = -Self::mul_add(c_q0, x533, s_q0 * x532);
-        let x539 = Self::mul_add(-c_q0, x537, s_q0 * x536);
-        let x540 = Self::mul_add(-x9, x533, Self::mul_add(x8, x532, s_q1 * x530));
-        let x541 = Self::mul_add(-x9, x537, Self::mul_add(-x8, x536, s_q1 * x534));
-        let x542 = -Self::mul_add(x313, x533, Self::mul_add(-x312, x532, x311 * x530));
-        let x543 = -Self::mul_add(x313, x537, Self::mul_add(x312, x536, x311 * x534));
-        let x544 = -(Self::mul_add(-x492, x519, Self::mul_add(-x491, x518, x490 * x517))
-            - Self::mul_add(x489, x529, Self::mul_add(-x488, x528, x487 * x526)));
-        let x545 = -(Self::mul_add(-x495, x519, Self::mul_add(-x494, x518, x493 * x517))
-            + Self::mul_add(-x417, x529, Self::mul_add(x416, x528, x415 * x526)));
+        let x530 = S::mul_add(S::neg(x416), x507, x417 * x506)
+            + S::mul_add(S::neg(x471), x492, S::mul_add(S::neg(x470), x491, x469 * x490))
+            + (S::mul_add(S::neg(x488), x504, x489 * x501)
+                - S::mul_add(x489, x513, S::mul_add(S::neg(x488), x512, x487 * x511)));
+        let x531 = S::neg(x530);
+        let x532 = S::mul_add(S::neg(x415), x507, x417 * x505)
+            - S::mul_add(S::neg(x474), x492, S::mul_add(S::neg(x473), x491, x472 * x490))
+            + (S::mul_add(x487, x504, x489 * x498)
+                + S::mul_add(x489, x515, S::mul_add(x488, x514, x487 * x512)));
+        let x533 = S::mul_add(S::neg(x415), x506, x416 * x505)
+            + S::mul_add(S::neg(x477), x492, S::mul_add(S::neg(x476), x491, x475 * x490))
+            + (S::mul_add(x487, x501, x488 * x498)
+                + S::mul_add(
+                    S::neg(x489),
+                    x516,
+                    S::mul_add(S::neg(x488), x515, x487 * x513),
+                ));
+        let x534 = S::mul_add(
+            S::neg(x471),
+            x495,
+            S::mul_add(S::neg(x470), x494, x469 * x493),
+        ) + (x520 + x523);
+        let x535 = S::neg(x534);
+        let x536 = S::mul_add(
+            S::neg(x474),
+            x495,
+            S::mul_add(S::neg(x473), x494, x472 * x493),
+        ) + (x521 - x524);
+        let x537 = S::mul_add(
+            S::neg(x477),
+            x495,
+            S::mul_add(S::neg(x476), x494, x475 * x493),
+        ) - (x522 - x525);
+        let x538 = S::neg(S::mul_add(c_q0, x533, s_q0 * x532));
+        let x539 = S::mul_add(S::neg(c_q0), x537, s_q0 * x536);
+        let x540 = S::mul_add(S::neg(x9), x533, S::mul_add(x8, x532, s_q1 * x530));
+        let x541 = S::mul_add(
+            S::neg(x9),
+            x537,
+            S::mul_add(S::neg(x8), x536, s_q1 * x534),
+        );
+        let x542 = S::neg(
+            S::mul_add(x313, x533, S::mul_add(S::neg(x312), x532, x311 * x530)),
+        );
+        let x543 = S::neg(S::mul_add(x313, x537, S::mul_add(x312, x536, x311 * x534)));
+        let x544 = S::neg(
+            S::mul_add(S::neg(x492), x519, S::mul_add(S::neg(x491), x518, x490 * x517))
+                - S::mul_add(x489, x529, S::mul_add(S::neg(x488), x528, x487 * x526)),
+        );
+        let x545 = S::neg(
+            S::mul_add(S::neg(x495), x519, S::mul_add(S::neg(x494), x518, x493 * x517))
+                + S::mul_add(S::neg(x417), x529, S::mul_add(x416, x528, x415 * x526)),
+        );
         let x546 = x427 + x469;
         let x547 = x428 + x470;
         let x548 = x429 + x471;
@@ -3728,65 +4461,93 @@ impl Ssrms {
         let x556 = x459 + x501;
         let x557 = x462 + x504;
         let x558 = x463 + x463 + x511;
-        let x559 = Self::mul_add(-x427, x438, x460) + Self::mul_add(x431, x438, x461)
+        let x559 = S::mul_add(S::neg(x427), x438, x460) + S::mul_add(x431, x438, x461)
             + x512;
-        let x560 = Self::mul_add(x427, x437, x457) - Self::mul_add(x435, x437, x458)
-            + x513;
+        let x560 = S::mul_add(x427, x437, x457) - S::mul_add(x435, x437, x458) + x513;
         let x561 = x464 + x464 + x514;
-        let x562 = Self::mul_add(x431, x436, x454) + Self::mul_add(-x435, x436, x455)
+        let x562 = S::mul_add(x431, x436, x454) + S::mul_add(S::neg(x435), x436, x455)
             + x515;
         let x563 = x465 + x465 + x516;
-        let x564 = Self::mul_add(x429, x444, Self::mul_add(-x428, x443, x427 * x442))
-            - Self::mul_add(x437, x462, x438 * x459) + x505;
-        let x565 = Self::mul_add(x432, x444, Self::mul_add(-x431, x443, x430 * x442))
-            + Self::mul_add(-x436, x462, x438 * x456) + x506;
-        let x566 = Self::mul_add(x435, x444, Self::mul_add(-x434, x443, x433 * x442))
-            + Self::mul_add(x436, x459, x437 * x456) + x507;
-        let x567 = Self::mul_add(x313, x548, Self::mul_add(x312, x547, x311 * x546));
-        let x568 = Self::mul_add(x313, x551, Self::mul_add(x312, x550, x311 * x549));
-        let x569 = Self::mul_add(x313, x554, Self::mul_add(x312, x553, x311 * x552));
-        let x570 = Self::mul_add(-x313, x560, Self::mul_add(x312, x559, x311 * x558));
-        let x571 = Self::mul_add(-x313, x562, Self::mul_add(-x312, x561, x311 * x559));
-        let x572 = Self::mul_add(x313, x563, Self::mul_add(x312, x562, x311 * x560));
-        let x573 = Self::mul_add(-x312, x557, x313 * x556);
-        let x574 = Self::mul_add(-x311, x557, x313 * x555);
-        let x575 = Self::mul_add(-x311, x556, x312 * x555);
+        let x564 = S::mul_add(x429, x444, S::mul_add(S::neg(x428), x443, x427 * x442))
+            - S::mul_add(x437, x462, x438 * x459) + x505;
+        let x565 = S::mul_add(x432, x444, S::mul_add(S::neg(x431), x443, x430 * x442))
+            + S::mul_add(S::neg(x436), x462, x438 * x456) + x506;
+        let x566 = S::mul_add(x435, x444, S::mul_add(S::neg(x434), x443, x433 * x442))
+            + S::mul_add(x436, x459, x437 * x456) + x507;
+        let x567 = S::mul_add(x313, x548, S::mul_add(x312, x547, x311 * x546));
+        let x568 = S::mul_add(x313, x551, S::mul_add(x312, x550, x311 * x549));
+        let x569 = S::mul_add(x313, x554, S::mul_add(x312, x553, x311 * x552));
+        let x570 = S::mul_add(S::neg(x313), x560, S::mul_add(x312, x559, x311 * x558));
+        let x571 = S::mul_add(
+            S::neg(x313),
+            x562,
+            S::mul_add(S::neg(x312), x561, x311 * x559),
+        );
+        let x572 = S::mul_add(x313, x563, S::mul_add(x312, x562, x311 * x560));
+        let x573 = S::mul_add(S::neg(x312), x557, x313 * x556);
+        let x574 = S::mul_add(S::neg(x311), x557, x313 * x555);
+        let x575 = S::mul_add(S::neg(x311), x556, x312 * x555);
         let x576 = x570 - x573;
-        let x577 = -x576;
+        let x577 = S::neg(x576);
         let x578 = x571 + x574;
         let x579 = x572 + x575;
-        let x580 = Self::mul_add(-x312, x566, x313 * x565)
-            + Self::mul_add(-x450, x548, Self::mul_add(-x449, x547, x448 * x546))
-            + (Self::mul_add(-x446, x557, x447 * x556)
-                - Self::mul_add(x447, x560, Self::mul_add(-x446, x559, x445 * x558)));
-        let x581 = -x580;
-        let x582 = Self::mul_add(-x311, x566, x313 * x564)
-            - Self::mul_add(-x450, x551, Self::mul_add(-x449, x550, x448 * x549))
-            + (Self::mul_add(x445, x557, x447 * x555)
-                + Self::mul_add(x447, x562, Self::mul_add(x446, x561, x445 * x559)));
-        let x583 = Self::mul_add(-x311, x565, x312 * x564)
-            + Self::mul_add(-x450, x554, Self::mul_add(-x449, x553, x448 * x552))
-            + (Self::mul_add(x445, x556, x446 * x555)
-                + Self::mul_add(-x447, x563, Self::mul_add(-x446, x562, x445 * x560)));
-        let x584 = Self::mul_add(-x453, x548, Self::mul_add(-x452, x547, x451 * x546))
-            + (x570 + x573);
-        let x585 = -x584;
-        let x586 = Self::mul_add(-x453, x551, Self::mul_add(-x452, x550, x451 * x549))
-            + (x571 - x574);
-        let x587 = Self::mul_add(-x453, x554, Self::mul_add(-x452, x553, x451 * x552))
-            - (x572 - x575);
-        let x588 = -Self::mul_add(c_q0, x583, s_q0 * x582);
-        let x589 = Self::mul_add(-c_q0, x587, s_q0 * x586);
-        let x590 = Self::mul_add(-x9, x583, Self::mul_add(x8, x582, s_q1 * x580));
-        let x591 = Self::mul_add(-x9, x587, Self::mul_add(-x8, x586, s_q1 * x584));
-        let x592 = -(Self::mul_add(-x450, x569, Self::mul_add(-x449, x568, x448 * x567))
-            - Self::mul_add(x447, x579, Self::mul_add(-x446, x578, x445 * x576)));
-        let x593 = -(Self::mul_add(-x453, x569, Self::mul_add(-x452, x568, x451 * x567))
-            + Self::mul_add(-x313, x579, Self::mul_add(x312, x578, x311 * x576)));
-        let x594 = -(Self::mul_add(-x450, x519, Self::mul_add(-x449, x518, x448 * x517))
-            - Self::mul_add(x447, x529, Self::mul_add(-x446, x528, x445 * x526)));
-        let x595 = -(Self::mul_add(-x453, x519, Self::mul_add(-x452, x518, x451 * x517))
-            + Self::mul_add(-x313, x529, Self::mul_add(x312, x528, x311 * x526)));
+        let x580 = S::mul_add(S::neg(x312), x566, x313 * x565)
+            + S::mul_add(S::neg(x450), x548, S::mul_add(S::neg(x449), x547, x448 * x546))
+            + (S::mul_add(S::neg(x446), x557, x447 * x556)
+                - S::mul_add(x447, x560, S::mul_add(S::neg(x446), x559, x445 * x558)));
+        let x581 = S::neg(x580);
+        let x582 = S::mul_add(S::neg(x311), x566, x313 * x564)
+            - S::mul_add(S::neg(x450), x551, S::mul_add(S::neg(x449), x550, x448 * x549))
+            + (S::mul_add(x445, x557, x447 * x555)
+                + S::mul_add(x447, x562, S::mul_add(x446, x561, x445 * x559)));
+        let x583 = S::mul_add(S::neg(x311), x565, x312 * x564)
+            + S::mul_add(S::neg(x450), x554, S::mul_add(S::neg(x449), x553, x448 * x552))
+            + (S::mul_add(x445, x556, x446 * x555)
+                + S::mul_add(
+                    S::neg(x447),
+                    x563,
+                    S::mul_add(S::neg(x446), x562, x445 * x560),
+                ));
+        let x584 = S::mul_add(
+            S::neg(x453),
+            x548,
+            S::mul_add(S::neg(x452), x547, x451 * x546),
+        ) + (x570 + x573);
+        let x585 = S::neg(x584);
+        let x586 = S::mul_add(
+            S::neg(x453),
+            x551,
+            S::mul_add(S::neg(x452), x550, x451 * x549),
+        ) + (x571 - x574);
+        let x587 = S::mul_add(
+            S::neg(x453),
+            x554,
+            S::mul_add(S::neg(x452), x553, x451 * x552),
+        ) - (x572 - x575);
+        let x588 = S::neg(S::mul_add(c_q0, x583, s_q0 * x582));
+        let x589 = S::mul_add(S::neg(c_q0), x587, s_q0 * x586);
+        let x590 = S::mul_add(S::neg(x9), x583, S::mul_add(x8, x582, s_q1 * x580));
+        let x591 = S::mul_add(
+            S::neg(x9),
+            x587,
+            S::mul_add(S::neg(x8), x586, s_q1 * x584),
+        );
+        let x592 = S::neg(
+            S::mul_add(S::neg(x450), x569, S::mul_add(S::neg(x449), x568, x448 * x567))
+                - S::mul_add(x447, x579, S::mul_add(S::neg(x446), x578, x445 * x576)),
+        );
+        let x593 = S::neg(
+            S::mul_add(S::neg(x453), x569, S::mul_add(S::neg(x452), x568, x451 * x567))
+                + S::mul_add(S::neg(x313), x579, S::mul_add(x312, x578, x311 * x576)),
+        );
+        let x594 = S::neg(
+            S::mul_add(S::neg(x450), x519, S::mul_add(S::neg(x449), x518, x448 * x517))
+                - S::mul_add(x447, x529, S::mul_add(S::neg(x446), x528, x445 * x526)),
+        );
+        let x595 = S::neg(
+            S::mul_add(S::neg(x453), x519, S::mul_add(S::neg(x452), x518, x451 * x517))
+                + S::mul_add(S::neg(x313), x529, S::mul_add(x312, x528, x311 * x526)),
+        );
         let x596 = x344 - x546;
         let x597 = x345 + x547;
         let x598 = x346 + x548;
@@ -3802,141 +4563,167 @@ impl Ssrms {
         let x608 = x414 - (x410 + (x410 + (x407 + x407))) + x558;
         let x609 = x397
             - (x396
-                - (Self::mul_add(x344, x355, x390) + Self::mul_add(-x348, x355, x391)))
+                - (S::mul_add(x344, x355, x390) + S::mul_add(S::neg(x348), x355, x391)))
             + x559;
         let x610 = x395
             - (x394
-                - (Self::mul_add(x344, x354, x388) - Self::mul_add(-x352, x354, x389)))
+                - (S::mul_add(x344, x354, x388) - S::mul_add(S::neg(x352), x354, x389)))
             - x560;
         let x611 = x414 + (x411 + (x411 - (x408 + x408))) - x561;
         let x612 = x393
             + (x392
-                - (Self::mul_add(-x348, x353, x386) + Self::mul_add(-x352, x353, x387)))
-            - x562;
+                - (S::mul_add(S::neg(x348), x353, x386)
+                    + S::mul_add(S::neg(x352), x353, x387))) - x562;
         let x613 = x414 + (x412 + (x412 - (x409 + x409))) - x563;
-        let x614 = Self::mul_add(-x346, x367, Self::mul_add(x345, x366, x344 * x365))
-            + Self::mul_add(-x321, x370, x322 * x369)
-            - (Self::mul_add(-x354, x400, x355 * x399)
-                + Self::mul_add(x357, x403, x358 * x402)) - x564;
-        let x615 = Self::mul_add(x349, x367, Self::mul_add(-x348, x366, x347 * x365))
-            + Self::mul_add(x320, x370, x322 * x368)
-            + (Self::mul_add(x353, x400, x355 * x398)
-                + Self::mul_add(-x356, x403, x358 * x401)) - x565;
-        let x616 = Self::mul_add(x352, x367, Self::mul_add(-x351, x366, x350 * x365))
-            + Self::mul_add(x320, x369, x321 * x368)
-            - (Self::mul_add(x353, x399, x354 * x398)
-                - Self::mul_add(x356, x402, x357 * x401)) + x566;
-        let x617 = Self::mul_add(x9, x598, Self::mul_add(x8, x597, s_q1 * x596))
-            - Self::mul_add(-x319, x321, x318 * x322);
-        let x618 = Self::mul_add(-x9, x601, Self::mul_add(-x8, x600, s_q1 * x599))
-            + Self::mul_add(-x319, x320, x317 * x322);
-        let x619 = Self::mul_add(-x9, x604, Self::mul_add(-x8, x603, s_q1 * x602))
-            + Self::mul_add(-x318, x320, x317 * x321);
-        let x620 = Self::mul_add(-x9, x321, x8 * x322);
-        let x621 = Self::mul_add(x9, x320, s_q1 * x322);
-        let x622 = Self::mul_add(x8, x320, s_q1 * x321);
-        let x623 = Self::mul_add(x319, x402, x318 * x403);
-        let x624 = Self::mul_add(x319, x401, x317 * x403);
-        let x625 = Self::mul_add(-x318, x401, x317 * x402);
-        let x626 = Self::mul_add(-x9, x610, Self::mul_add(-x8, x609, s_q1 * x608))
-            - x623;
-        let x627 = Self::mul_add(-x9, x612, Self::mul_add(-x8, x611, s_q1 * x609))
-            + x624;
-        let x628 = Self::mul_add(-x9, x613, Self::mul_add(-x8, x612, s_q1 * x610))
-            + x625;
-        let x629 = Self::mul_add(x9, x402, x8 * x403);
-        let x630 = Self::mul_add(-x9, x401, s_q1 * x403);
-        let x631 = Self::mul_add(x8, x401, s_q1 * x402);
-        let x632 = x623 + Self::mul_add(x8, x607, x9 * x606);
-        let x633 = x624 + Self::mul_add(-s_q1, x607, x9 * x605);
-        let x634 = x625 - Self::mul_add(s_q1, x606, x8 * x605);
+        let x614 = S::mul_add(S::neg(x346), x367, S::mul_add(x345, x366, x344 * x365))
+            + S::mul_add(S::neg(x321), x370, x322 * x369)
+            - (S::mul_add(S::neg(x354), x400, x355 * x399)
+                + S::mul_add(x357, x403, x358 * x402)) - x564;
+        let x615 = S::mul_add(x349, x367, S::mul_add(S::neg(x348), x366, x347 * x365))
+            + S::mul_add(x320, x370, x322 * x368)
+            + (S::mul_add(x353, x400, x355 * x398)
+                + S::mul_add(S::neg(x356), x403, x358 * x401)) - x565;
+        let x616 = S::mul_add(x352, x367, S::mul_add(S::neg(x351), x366, x350 * x365))
+            + S::mul_add(x320, x369, x321 * x368)
+            - (S::mul_add(x353, x399, x354 * x398) - S::mul_add(x356, x402, x357 * x401))
+            + x566;
+        let x617 = S::mul_add(x9, x598, S::mul_add(x8, x597, s_q1 * x596))
+            - S::mul_add(S::neg(x319), x321, x318 * x322);
+        let x618 = S::mul_add(
+            S::neg(x9),
+            x601,
+            S::mul_add(S::neg(x8), x600, s_q1 * x599),
+        ) + S::mul_add(S::neg(x319), x320, x317 * x322);
+        let x619 = S::mul_add(
+            S::neg(x9),
+            x604,
+            S::mul_add(S::neg(x8), x603, s_q1 * x602),
+        ) + S::mul_add(S::neg(x318), x320, x317 * x321);
+        let x620 = S::mul_add(S::neg(x9), x321, x8 * x322);
+        let x621 = S::mul_add(x9, x320, s_q1 * x322);
+        let x622 = S::mul_add(x8, x320, s_q1 * x321);
+        let x623 = S::mul_add(x319, x402, x318 * x403);
+        let x624 = S::mul_add(x319, x401, x317 * x403);
+        let x625 = S::mul_add(S::neg(x318), x401, x317 * x402);
+        let x626 = S::mul_add(
+            S::neg(x9),
+            x610,
+            S::mul_add(S::neg(x8), x609, s_q1 * x608),
+        ) - x623;
+        let x627 = S::mul_add(
+            S::neg(x9),
+            x612,
+            S::mul_add(S::neg(x8), x611, s_q1 * x609),
+        ) + x624;
+        let x628 = S::mul_add(
+            S::neg(x9),
+            x613,
+            S::mul_add(S::neg(x8), x612, s_q1 * x610),
+        ) + x625;
+        let x629 = S::mul_add(x9, x402, x8 * x403);
+        let x630 = S::mul_add(S::neg(x9), x401, s_q1 * x403);
+        let x631 = S::mul_add(x8, x401, s_q1 * x402);
+        let x632 = x623 + S::mul_add(x8, x607, x9 * x606);
+        let x633 = x624 + S::mul_add(S::neg(s_q1), x607, x9 * x605);
+        let x634 = x625 - S::mul_add(s_q1, x606, x8 * x605);
         let x635 = x626 - x632;
         let x636 = x627 + x633;
         let x637 = x628 + x634;
-        let x638 = Self::mul_add(-x372, x403, x373 * x402);
-        let x639 = Self::mul_add(-x371, x403, x373 * x401);
-        let x640 = Self::mul_add(-x371, x402, x372 * x401);
-        let x641 = Self::mul_add(x253, x403, x254 * x402);
-        let x642 = Self::mul_add(x252, x403, x254 * x401);
-        let x643 = Self::mul_add(-x252, x402, x253 * x401);
-        let x644 = Self::mul_add(x8, x616, x9 * x615)
-            + Self::mul_add(x318, x406, x319 * x405)
-            + (Self::mul_add(-x376, x598, Self::mul_add(-x375, x597, x374 * x596))
-                - Self::mul_add(-x321, x379, x322 * x378))
-            - (Self::mul_add(x253, x607, x254 * x606) - x638
-                + (x638
-                    - Self::mul_add(
-                        x254,
-                        x610,
-                        Self::mul_add(x253, x609, x252 * x608),
-                    )));
-        let x645 = Self::mul_add(-s_q1, x616, x9 * x614)
-            + Self::mul_add(x317, x406, x319 * x404)
-            - (Self::mul_add(x376, x601, Self::mul_add(x375, x600, x374 * x599))
-                - Self::mul_add(x320, x379, x322 * x377))
-            - (Self::mul_add(x252, x607, x254 * x605) - x639
-                + (x639
-                    + Self::mul_add(
-                        x254,
-                        x612,
-                        Self::mul_add(x253, x611, x252 * x609),
-                    )));
-        let x646 = Self::mul_add(s_q1, x615, x8 * x614)
-            + Self::mul_add(-x317, x405, x318 * x404)
-            - (Self::mul_add(x376, x604, Self::mul_add(x375, x603, x374 * x602))
-                - Self::mul_add(x320, x378, x321 * x377))
-            - (Self::mul_add(-x252, x606, x253 * x605) + x640
-                - (x640
-                    + Self::mul_add(
-                        x254,
-                        x613,
-                        Self::mul_add(x253, x612, x252 * x610),
-                    )));
-        let x647 = Self::mul_add(x8, x406, x9 * x405)
-            - Self::mul_add(-x321, x376, x322 * x375) - (x641 + x641);
-        let x648 = Self::mul_add(-s_q1, x406, x9 * x404)
-            - Self::mul_add(-x320, x376, x322 * x374) - (x642 + x642);
-        let x649 = Self::mul_add(s_q1, x405, x8 * x404)
-            - Self::mul_add(-x320, x375, x321 * x374) - (x643 + x643);
-        let x650 = Self::mul_add(-x382, x598, Self::mul_add(-x381, x597, x380 * x596))
-            - Self::mul_add(-x321, x385, x322 * x384) + (x626 + x632);
-        let x651 = Self::mul_add(x382, x601, Self::mul_add(x381, x600, x380 * x599))
-            - Self::mul_add(x320, x385, x322 * x383) + (x627 - x633);
-        let x652 = Self::mul_add(x382, x604, Self::mul_add(x381, x603, x380 * x602))
-            - Self::mul_add(x320, x384, x321 * x383) - (x628 - x634);
-        let x653 = Self::mul_add(-x321, x382, x322 * x381) - (x629 + x629);
-        let x654 = Self::mul_add(-x320, x382, x322 * x380) + (x630 + x630);
-        let x655 = Self::mul_add(-x320, x381, x321 * x380) - (x631 + x631);
-        let x656 = Self::mul_add(c_q0, x646, s_q0 * x645)
-            - Self::mul_add(-x14, x649, Self::mul_add(x13, x648, x12 * x647));
-        let x657 = -(Self::mul_add(c_q0, x652, s_q0 * x651)
-            - Self::mul_add(-x14, x655, Self::mul_add(x13, x654, x12 * x653)));
-        let x658 = Self::mul_add(-x9, x646, Self::mul_add(x8, x645, s_q1 * x644));
-        let x659 = -(x658
-            - Self::mul_add(x108, x649, Self::mul_add(-x107, x648, x106 * x647)));
-        let x660 = Self::mul_add(x9, x652, Self::mul_add(-x8, x651, s_q1 * x650));
-        let x661 = -(x660
-            + Self::mul_add(x108, x655, Self::mul_add(-x107, x654, x106 * x653)));
-        let x662 = -(x658
-            - Self::mul_add(x215, x649, Self::mul_add(-x214, x648, x213 * x647)));
-        let x663 = -(x660
-            + Self::mul_add(x215, x655, Self::mul_add(-x214, x654, x213 * x653)));
-        let x664 = -(Self::mul_add(-x376, x619, Self::mul_add(x375, x618, x374 * x617))
-            + Self::mul_add(x379, x622, Self::mul_add(-x378, x621, x377 * x620))
-            + Self::mul_add(x254, x637, Self::mul_add(x253, x636, x252 * x635)));
-        let x665 = Self::mul_add(-x9, x637, Self::mul_add(-x8, x636, s_q1 * x635));
-        let x666 = -(Self::mul_add(-x382, x619, Self::mul_add(x381, x618, x380 * x617))
-            + Self::mul_add(x385, x622, Self::mul_add(-x384, x621, x383 * x620)) + x665);
-        let x667 = -(Self::mul_add(x376, x569, Self::mul_add(x375, x568, x374 * x567))
-            - Self::mul_add(-x254, x579, Self::mul_add(x253, x578, x252 * x576)));
-        let x668 = Self::mul_add(x9, x579, Self::mul_add(-x8, x578, s_q1 * x576));
-        let x669 = -(Self::mul_add(x382, x569, Self::mul_add(x381, x568, x380 * x567))
-            - x668);
-        let x670 = -(Self::mul_add(x376, x519, Self::mul_add(x375, x518, x374 * x517))
-            - Self::mul_add(-x254, x529, Self::mul_add(x253, x528, x252 * x526)));
-        let x671 = Self::mul_add(x9, x529, Self::mul_add(-x8, x528, s_q1 * x526));
-        let x672 = -(Self::mul_add(x382, x519, Self::mul_add(x381, x518, x380 * x517))
-            - x671);
+        let x638 = S::mul_add(S::neg(x372), x403, x373 * x402);
+        let x639 = S::mul_add(S::neg(x371), x403, x373 * x401);
+        let x640 = S::mul_add(S::neg(x371), x402, x372 * x401);
+        let x641 = S::mul_add(x253, x403, x254 * x402);
+        let x642 = S::mul_add(x252, x403, x254 * x401);
+        let x643 = S::mul_add(S::neg(x252), x402, x253 * x401);
+        let x644 = S::mul_add(x8, x616, x9 * x615) + S::mul_add(x318, x406, x319 * x405)
+            + (S::mul_add(
+                S::neg(x376),
+                x598,
+                S::mul_add(S::neg(x375), x597, x374 * x596),
+            ) - S::mul_add(S::neg(x321), x379, x322 * x378))
+            - (S::mul_add(x253, x607, x254 * x606) - x638
+                + (x638 - S::mul_add(x254, x610, S::mul_add(x253, x609, x252 * x608))));
+        let x645 = S::mul_add(S::neg(s_q1), x616, x9 * x614)
+            + S::mul_add(x317, x406, x319 * x404)
+            - (S::mul_add(x376, x601, S::mul_add(x375, x600, x374 * x599))
+                - S::mul_add(x320, x379, x322 * x377))
+            - (S::mul_add(x252, x607, x254 * x605) - x639
+                + (x639 + S::mul_add(x254, x612, S::mul_add(x253, x611, x252 * x609))));
+        let x646 = S::mul_add(s_q1, x615, x8 * x614)
+            + S::mul_add(S::neg(x317), x405, x318 * x404)
+            - (S::mul_add(x376, x604, S::mul_add(x375, x603, x374 * x602))
+                - S::mul_add(x320, x378, x321 * x377))
+            - (S::mul_add(S::neg(x252), x606, x253 * x605) + x640
+                - (x640 + S::mul_add(x254, x613, S::mul_add(x253, x612, x252 * x610))));
+        let x647 = S::mul_add(x8, x406, x9 * x405)
+            - S::mul_add(S::neg(x321), x376, x322 * x375) - (x641 + x641);
+        let x648 = S::mul_add(S::neg(s_q1), x406, x9 * x404)
+            - S::mul_add(S::neg(x320), x376, x322 * x374) - (x642 + x642);
+        let x649 = S::mul_add(s_q1, x405, x8 * x404)
+            - S::mul_add(S::neg(x320), x375, x321 * x374) - (x643 + x643);
+        let x650 = S::mul_add(
+            S::neg(x382),
+            x598,
+            S::mul_add(S::neg(x381), x597, x380 * x596),
+        ) - S::mul_add(S::neg(x321), x385, x322 * x384) + (x626 + x632);
+        let x651 = S::mul_add(x382, x601, S::mul_add(x381, x600, x380 * x599))
+            - S::mul_add(x320, x385, x322 * x383) + (x627 - x633);
+        let x652 = S::mul_add(x382, x604, S::mul_add(x381, x603, x380 * x602))
+            - S::mul_add(x320, x384, x321 * x383) - (x628 - x634);
+        let x653 = S::mul_add(S::neg(x321), x382, x322 * x381) - (x629 + x629);
+        let x654 = S::mul_add(S::neg(x320), x382, x322 * x380) + (x630 + x630);
+        let x655 = S::mul_add(S::neg(x320), x381, x321 * x380) - (x631 + x631);
+        let x656 = S::mul_add(c_q0, x646, s_q0 * x645)
+            - S::mul_add(S::neg(x14), x649, S::mul_add(x13, x648, x12 * x647));
+        let x657 = S::neg(
+            S::mul_add(c_q0, x652, s_q0 * x651)
+                - S::mul_add(S::neg(x14), x655, S::mul_add(x13, x654, x12 * x653)),
+        );
+        let x658 = S::mul_add(S::neg(x9), x646, S::mul_add(x8, x645, s_q1 * x644));
+        let x659 = S::neg(
+            x658 - S::mul_add(x108, x649, S::mul_add(S::neg(x107), x648, x106 * x647)),
+        );
+        let x660 = S::mul_add(x9, x652, S::mul_add(S::neg(x8), x651, s_q1 * x650));
+        let x661 = S::neg(
+            x660 + S::mul_add(x108, x655, S::mul_add(S::neg(x107), x654, x106 * x653)),
+        );
+        let x662 = S::neg(
+            x658 - S::mul_add(x215, x649, S::mul_add(S::neg(x214), x648, x213 * x647)),
+        );
+        let x663 = S::neg(
+            x660 + S::mul_add(x215, x655, S::mul_add(S::neg(x214), x654, x213 * x653)),
+        );
+        let x664 = S::neg(
+            S::mul_add(S::neg(x376), x619, S::mul_add(x375, x618, x374 * x617))
+                + S::mul_add(x379, x622, S::mul_add(S::neg(x378), x621, x377 * x620))
+                + S::mul_add(x254, x637, S::mul_add(x253, x636, x252 * x635)),
+        );
+        let x665 = S::mul_add(
+            S::neg(x9),
+            x637,
+            S::mul_add(S::neg(x8), x636, s_q1 * x635),
+        );
+        let x666 = S::neg(
+            S::mul_add(S::neg(x382), x619, S::mul_add(x381, x618, x380 * x617))
+                + S::mul_add(x385, x622, S::mul_add(S::neg(x384), x621, x383 * x620))
+                + x665,
+        );
+        let x667 = S::neg(
+            S::mul_add(x376, x569, S::mul_add(x375, x568, x374 * x567))
+                - S::mul_add(S::neg(x254), x579, S::mul_add(x253, x578, x252 * x576)),
+        );
+        let x668 = S::mul_add(x9, x579, S::mul_add(S::neg(x8), x578, s_q1 * x576));
+        let x669 = S::neg(
+            S::mul_add(x382, x569, S::mul_add(x381, x568, x380 * x567)) - x668,
+        );
+        let x670 = S::neg(
+            S::mul_add(x376, x519, S::mul_add(x375, x518, x374 * x517))
+                - S::mul_add(S::neg(x254), x529, S::mul_add(x253, x528, x252 * x526)),
+        );
+        let x671 = S::mul_add(x9, x529, S::mul_add(S::neg(x8), x528, s_q1 * x526));
+        let x672 = S::neg(
+            S::mul_add(x382, x519, S::mul_add(x381, x518, x380 * x517)) - x671,
+        );
         let x673 = x216 - x320;
         let x674 = x217 - x321;
         let x675 = x218 - x322;
@@ -3958,148 +4745,169 @@ impl Ssrms {
         let x691 = x307 - (x303 + (x303 + (x300 + x300))) - x608;
         let x692 = x293
             - (x292
-                - (Self::mul_add(x237, x248, x286) + Self::mul_add(-x241, x248, x287)))
+                - (S::mul_add(x237, x248, x286) + S::mul_add(S::neg(x241), x248, x287)))
             - x609;
         let x693 = x291
             - (x290
-                - (Self::mul_add(x237, x247, x284) - Self::mul_add(-x245, x247, x285)))
+                - (S::mul_add(x237, x247, x284) - S::mul_add(S::neg(x245), x247, x285)))
             - x610;
         let x694 = x307 + (x304 + (x304 - (x301 + x301))) - x611;
         let x695 = x289
             + (x288
-                - (Self::mul_add(-x241, x246, x282) + Self::mul_add(-x245, x246, x283)))
-            - x612;
+                - (S::mul_add(S::neg(x241), x246, x282)
+                    + S::mul_add(S::neg(x245), x246, x283))) - x612;
         let x696 = x307 + (x305 + (x305 - (x302 + x302))) - x613;
-        let x697 = Self::mul_add(-x239, x263, Self::mul_add(x238, x262, x237 * x261))
-            + Self::mul_add(-x217, x266, x218 * x265)
-            - (Self::mul_add(-x247, x296, x248 * x295)
-                + Self::mul_add(x250, x299, x251 * x298)) - x614;
-        let x698 = Self::mul_add(x242, x263, Self::mul_add(-x241, x262, x240 * x261))
-            + Self::mul_add(x216, x266, x218 * x264)
-            + (Self::mul_add(x246, x296, x248 * x294)
-                + Self::mul_add(-x249, x299, x251 * x297)) - x615;
-        let x699 = Self::mul_add(x245, x263, Self::mul_add(-x244, x262, x243 * x261))
-            + Self::mul_add(x216, x265, x217 * x264)
-            - (Self::mul_add(x246, x295, x247 * x294)
-                - Self::mul_add(x249, x298, x250 * x297)) - x616;
-        let x700 = Self::mul_add(x217, x263, x218 * x262)
-            - Self::mul_add(-x247, x299, x248 * x298) - x404;
-        let x701 = Self::mul_add(-x216, x263, x218 * x261)
-            + Self::mul_add(x246, x299, x248 * x297) - x405;
-        let x702 = Self::mul_add(x216, x262, x217 * x261)
-            - Self::mul_add(x246, x298, x247 * x297) - x406;
-        let x703 = Self::mul_add(x9, x678, Self::mul_add(x8, x677, s_q1 * x676))
-            - Self::mul_add(-x215, x674, x214 * x675);
-        let x704 = Self::mul_add(-x9, x681, Self::mul_add(-x8, x680, s_q1 * x679))
-            + Self::mul_add(-x215, x673, x213 * x675);
-        let x705 = Self::mul_add(-x9, x684, Self::mul_add(-x8, x683, s_q1 * x682))
-            + Self::mul_add(-x214, x673, x213 * x674);
-        let x706 = Self::mul_add(-x9, x674, x8 * x675);
-        let x707 = Self::mul_add(x9, x673, s_q1 * x675);
-        let x708 = Self::mul_add(x8, x673, s_q1 * x674);
-        let x709 = Self::mul_add(x215, x689, x214 * x690);
-        let x710 = Self::mul_add(x215, x688, x213 * x690);
-        let x711 = Self::mul_add(-x214, x688, x213 * x689);
-        let x712 = Self::mul_add(-x9, x693, Self::mul_add(-x8, x692, s_q1 * x691))
-            - x709;
-        let x713 = Self::mul_add(-x9, x695, Self::mul_add(-x8, x694, s_q1 * x692))
-            + x710;
-        let x714 = Self::mul_add(-x9, x696, Self::mul_add(-x8, x695, s_q1 * x693))
-            + x711;
-        let x715 = Self::mul_add(x9, x689, x8 * x690);
-        let x716 = Self::mul_add(-x9, x688, s_q1 * x690);
-        let x717 = Self::mul_add(x8, x688, s_q1 * x689);
-        let x718 = x709 + Self::mul_add(x8, x687, x9 * x686);
-        let x719 = x710 + Self::mul_add(-s_q1, x687, x9 * x685);
-        let x720 = x711 - Self::mul_add(s_q1, x686, x8 * x685);
+        let x697 = S::mul_add(S::neg(x239), x263, S::mul_add(x238, x262, x237 * x261))
+            + S::mul_add(S::neg(x217), x266, x218 * x265)
+            - (S::mul_add(S::neg(x247), x296, x248 * x295)
+                + S::mul_add(x250, x299, x251 * x298)) - x614;
+        let x698 = S::mul_add(x242, x263, S::mul_add(S::neg(x241), x262, x240 * x261))
+            + S::mul_add(x216, x266, x218 * x264)
+            + (S::mul_add(x246, x296, x248 * x294)
+                + S::mul_add(S::neg(x249), x299, x251 * x297)) - x615;
+        let x699 = S::mul_add(x245, x263, S::mul_add(S::neg(x244), x262, x243 * x261))
+            + S::mul_add(x216, x265, x217 * x264)
+            - (S::mul_add(x246, x295, x247 * x294) - S::mul_add(x249, x298, x250 * x297))
+            - x616;
+        let x700 = S::mul_add(x217, x263, x218 * x262)
+            - S::mul_add(S::neg(x247), x299, x248 * x298) - x404;
+        let x701 = S::mul_add(S::neg(x216), x263, x218 * x261)
+            + S::mul_add(x246, x299, x248 * x297) - x405;
+        let x702 = S::mul_add(x216, x262, x217 * x261)
+            - S::mul_add(x246, x298, x247 * x297) - x406;
+        let x703 = S::mul_add(x9, x678, S::mul_add(x8, x677, s_q1 * x676))
+            - S::mul_add(S::neg(x215), x674, x214 * x675);
+        let x704 = S::mul_add(
+            S::neg(x9),
+            x681,
+            S::mul_add(S::neg(x8), x680, s_q1 * x679),
+        ) + S::mul_add(S::neg(x215), x673, x213 * x675);
+        let x705 = S::mul_add(
+            S::neg(x9),
+            x684,
+            S::mul_add(S::neg(x8), x683, s_q1 * x682),
+        ) + S::mul_add(S::neg(x214), x673, x213 * x674);
+        let x706 = S::mul_add(S::neg(x9), x674, x8 * x675);
+        let x707 = S::mul_add(x9, x673, s_q1 * x675);
+        let x708 = S::mul_add(x8, x673, s_q1 * x674);
+        let x709 = S::mul_add(x215, x689, x214 * x690);
+        let x710 = S::mul_add(x215, x688, x213 * x690);
+        let x711 = S::mul_add(S::neg(x214), x688, x213 * x689);
+        let x712 = S::mul_add(
+            S::neg(x9),
+            x693,
+            S::mul_add(S::neg(x8), x692, s_q1 * x691),
+        ) - x709;
+        let x713 = S::mul_add(
+            S::neg(x9),
+            x695,
+            S::mul_add(S::neg(x8), x694, s_q1 * x692),
+        ) + x710;
+        let x714 = S::mul_add(
+            S::neg(x9),
+            x696,
+            S::mul_add(S::neg(x8), x695, s_q1 * x693),
+        ) + x711;
+        let x715 = S::mul_add(x9, x689, x8 * x690);
+        let x716 = S::mul_add(S::neg(x9), x688, s_q1 * x690);
+        let x717 = S::mul_add(x8, x688, s_q1 * x689);
+        let x718 = x709 + S::mul_add(x8, x687, x9 * x686);
+        let x719 = x710 + S::mul_add(S::neg(s_q1), x687, x9 * x685);
+        let x720 = x711 - S::mul_add(s_q1, x686, x8 * x685);
         let x721 = x712 - x718;
-        let x722 = -x721;
+        let x722 = S::neg(x721);
         let x723 = x713 + x719;
         let x724 = x714 + x720;
-        let x725 = Self::mul_add(-x268, x690, x269 * x689);
-        let x726 = Self::mul_add(-x267, x690, x269 * x688);
-        let x727 = Self::mul_add(-x267, x689, x268 * x688);
-        let x728 = Self::mul_add(x146, x690, x147 * x689);
-        let x729 = Self::mul_add(x145, x690, x147 * x688);
-        let x730 = Self::mul_add(-x145, x689, x146 * x688);
-        let x731 = Self::mul_add(x8, x699, x9 * x698)
-            + Self::mul_add(x214, x702, x215 * x701)
-            + (Self::mul_add(-x272, x678, Self::mul_add(-x271, x677, x270 * x676))
-                - Self::mul_add(-x275, x674, x274 * x675))
-            - (Self::mul_add(x146, x687, x147 * x686) - x725
-                + (x725
-                    - Self::mul_add(
-                        x147,
-                        x693,
-                        Self::mul_add(x146, x692, x145 * x691),
-                    )));
-        let x732 = -x731;
-        let x733 = Self::mul_add(-s_q1, x699, x9 * x697)
-            + Self::mul_add(x213, x702, x215 * x700)
-            - (Self::mul_add(x272, x681, Self::mul_add(x271, x680, x270 * x679))
-                - Self::mul_add(x275, x673, x273 * x675))
-            - (Self::mul_add(x145, x687, x147 * x685) - x726
-                + (x726
-                    + Self::mul_add(
-                        x147,
-                        x695,
-                        Self::mul_add(x146, x694, x145 * x692),
-                    )));
-        let x734 = Self::mul_add(s_q1, x698, x8 * x697)
-            + Self::mul_add(-x213, x701, x214 * x700)
-            - (Self::mul_add(x272, x684, Self::mul_add(x271, x683, x270 * x682))
-                - Self::mul_add(x274, x673, x273 * x674))
-            - (Self::mul_add(-x145, x686, x146 * x685) + x727
-                - (x727
-                    + Self::mul_add(
-                        x147,
-                        x696,
-                        Self::mul_add(x146, x695, x145 * x693),
-                    )));
-        let x735 = Self::mul_add(x8, x702, x9 * x701)
-            - Self::mul_add(-x272, x674, x271 * x675) - (x728 + x728);
-        let x736 = Self::mul_add(-s_q1, x702, x9 * x700)
-            - Self::mul_add(-x272, x673, x270 * x675) - (x729 + x729);
-        let x737 = Self::mul_add(s_q1, x701, x8 * x700)
-            - Self::mul_add(-x271, x673, x270 * x674) - (x730 + x730);
-        let x738 = Self::mul_add(-x278, x678, Self::mul_add(-x277, x677, x276 * x676))
-            - Self::mul_add(-x281, x674, x280 * x675) + (x712 + x718);
-        let x739 = -x738;
-        let x740 = Self::mul_add(x278, x681, Self::mul_add(x277, x680, x276 * x679))
-            - Self::mul_add(x281, x673, x279 * x675) + (x713 - x719);
-        let x741 = Self::mul_add(x278, x684, Self::mul_add(x277, x683, x276 * x682))
-            - Self::mul_add(x280, x673, x279 * x674) - (x714 - x720);
-        let x742 = Self::mul_add(-x278, x674, x277 * x675) - (x715 + x715);
-        let x743 = Self::mul_add(-x278, x673, x276 * x675) + (x716 + x716);
-        let x744 = Self::mul_add(-x277, x673, x276 * x674) - (x717 + x717);
-        let x745 = -(Self::mul_add(c_q0, x734, s_q0 * x733)
-            - Self::mul_add(-x14, x737, Self::mul_add(x13, x736, x12 * x735)));
-        let x746 = Self::mul_add(c_q0, x741, s_q0 * x740)
-            - Self::mul_add(-x14, x744, Self::mul_add(x13, x743, x12 * x742));
-        let x747 = Self::mul_add(-x9, x734, Self::mul_add(x8, x733, s_q1 * x731))
-            - Self::mul_add(x108, x737, Self::mul_add(-x107, x736, x106 * x735));
-        let x748 = Self::mul_add(x9, x741, Self::mul_add(-x8, x740, s_q1 * x738))
-            + Self::mul_add(x108, x744, Self::mul_add(-x107, x743, x106 * x742));
-        let x749 = Self::mul_add(-x272, x705, Self::mul_add(x271, x704, x270 * x703))
-            + Self::mul_add(x275, x708, Self::mul_add(-x274, x707, x273 * x706))
-            + Self::mul_add(x147, x724, Self::mul_add(x146, x723, x145 * x721));
-        let x750 = Self::mul_add(-x9, x724, Self::mul_add(-x8, x723, s_q1 * x721));
-        let x751 = Self::mul_add(-x278, x705, Self::mul_add(x277, x704, x276 * x703))
-            + Self::mul_add(x281, x708, Self::mul_add(-x280, x707, x279 * x706)) + x750;
-        let x752 = -(Self::mul_add(-x272, x619, Self::mul_add(x271, x618, x270 * x617))
-            + Self::mul_add(x275, x622, Self::mul_add(-x274, x621, x273 * x620))
-            + Self::mul_add(x147, x637, Self::mul_add(x146, x636, x145 * x635)));
-        let x753 = -(x665
-            + (Self::mul_add(-x278, x619, Self::mul_add(x277, x618, x276 * x617))
-                + Self::mul_add(x281, x622, Self::mul_add(-x280, x621, x279 * x620))));
-        let x754 = -(Self::mul_add(x272, x569, Self::mul_add(x271, x568, x270 * x567))
-            - Self::mul_add(-x147, x579, Self::mul_add(x146, x578, x145 * x576)));
-        let x755 = x668
-            - Self::mul_add(x278, x569, Self::mul_add(x277, x568, x276 * x567));
-        let x756 = -(Self::mul_add(x272, x519, Self::mul_add(x271, x518, x270 * x517))
-            - Self::mul_add(-x147, x529, Self::mul_add(x146, x528, x145 * x526)));
-        let x757 = x671
-            - Self::mul_add(x278, x519, Self::mul_add(x277, x518, x276 * x517));
+        let x725 = S::mul_add(S::neg(x268), x690, x269 * x689);
+        let x726 = S::mul_add(S::neg(x267), x690, x269 * x688);
+        let x727 = S::mul_add(S::neg(x267), x689, x268 * x688);
+        let x728 = S::mul_add(x146, x690, x147 * x689);
+        let x729 = S::mul_add(x145, x690, x147 * x688);
+        let x730 = S::mul_add(S::neg(x145), x689, x146 * x688);
+        let x731 = S::mul_add(x8, x699, x9 * x698) + S::mul_add(x214, x702, x215 * x701)
+            + (S::mul_add(
+                S::neg(x272),
+                x678,
+                S::mul_add(S::neg(x271), x677, x270 * x676),
+            ) - S::mul_add(S::neg(x275), x674, x274 * x675))
+            - (S::mul_add(x146, x687, x147 * x686) - x725
+                + (x725 - S::mul_add(x147, x693, S::mul_add(x146, x692, x145 * x691))));
+        let x732 = S::neg(x731);
+        let x733 = S::mul_add(S::neg(s_q1), x699, x9 * x697)
+            + S::mul_add(x213, x702, x215 * x700)
+            - (S::mul_add(x272, x681, S::mul_add(x271, x680, x270 * x679))
+                - S::mul_add(x275, x673, x273 * x675))
+            - (S::mul_add(x145, x687, x147 * x685) - x726
+                + (x726 + S::mul_add(x147, x695, S::mul_add(x146, x694, x145 * x692))));
+        let x734 = S::mul_add(s_q1, x698, x8 * x697)
+            + S::mul_add(S::neg(x213), x701, x214 * x700)
+            - (S::mul_add(x272, x684, S::mul_add(x271, x683, x270 * x682))
+                - S::mul_add(x274, x673, x273 * x674))
+            - (S::mul_add(S::neg(x145), x686, x146 * x685) + x727
+                - (x727 + S::mul_add(x147, x696, S::mul_add(x146, x695, x145 * x693))));
+        let x735 = S::mul_add(x8, x702, x9 * x701)
+            - S::mul_add(S::neg(x272), x674, x271 * x675) - (x728 + x728);
+        let x736 = S::mul_add(S::neg(s_q1), x702, x9 * x700)
+            - S::mul_add(S::neg(x272), x673, x270 * x675) - (x729 + x729);
+        let x737 = S::mul_add(s_q1, x701, x8 * x700)
+            - S::mul_add(S::neg(x271), x673, x270 * x674) - (x730 + x730);
+        let x738 = S::mul_add(
+            S::neg(x278),
+            x678,
+            S::mul_add(S::neg(x277), x677, x276 * x676),
+        ) - S::mul_add(S::neg(x281), x674, x280 * x675) + (x712 + x718);
+        let x739 = S::neg(x738);
+        let x740 = S::mul_add(x278, x681, S::mul_add(x277, x680, x276 * x679))
+            - S::mul_add(x281, x673, x279 * x675) + (x713 - x719);
+        let x741 = S::mul_add(x278, x684, S::mul_add(x277, x683, x276 * x682))
+            - S::mul_add(x280, x673, x279 * x674) - (x714 - x720);
+        let x742 = S::mul_add(S::neg(x278), x674, x277 * x675) - (x715 + x715);
+        let x743 = S::mul_add(S::neg(x278), x673, x276 * x675) + (x716 + x716);
+        let x744 = S::mul_add(S::neg(x277), x673, x276 * x674) - (x717 + x717);
+        let x745 = S::neg(
+            S::mul_add(c_q0, x734, s_q0 * x733)
+                - S::mul_add(S::neg(x14), x737, S::mul_add(x13, x736, x12 * x735)),
+        );
+        let x746 = S::mul_add(c_q0, x741, s_q0 * x740)
+            - S::mul_add(S::neg(x14), x744, S::mul_add(x13, x743, x12 * x742));
+        let x747 = S::mul_add(S::neg(x9), x734, S::mul_add(x8, x733, s_q1 * x731))
+            - S::mul_add(x108, x737, S::mul_add(S::neg(x107), x736, x106 * x735));
+        let x748 = S::mul_add(x9, x741, S::mul_add(S::neg(x8), x740, s_q1 * x738))
+            + S::mul_add(x108, x744, S::mul_add(S::neg(x107), x743, x106 * x742));
+        let x749 = S::mul_add(S::neg(x272), x705, S::mul_add(x271, x704, x270 * x703))
+            + S::mul_add(x275, x708, S::mul_add(S::neg(x274), x707, x273 * x706))
+            + S::mul_add(x147, x724, S::mul_add(x146, x723, x145 * x721));
+        let x750 = S::mul_add(
+            S::neg(x9),
+            x724,
+            S::mul_add(S::neg(x8), x723, s_q1 * x721),
+        );
+        let x751 = S::mul_add(S::neg(x278), x705, S::mul_add(x277, x704, x276 * x703))
+            + S::mul_add(x281, x708, S::mul_add(S::neg(x280), x707, x279 * x706)) + x750;
+        let x752 = S::neg(
+            S::mul_add(S::neg(x272), x619, S::mul_add(x271, x618, x270 * x617))
+                + S::mul_add(x275, x622, S::mul_add(S::neg(x274), x621, x273 * x620))
+                + S::mul_add(x147, x637, S::mul_add(x146, x636, x145 * x635)),
+        );
+        let x753 = S::neg(
+            x665
+                + (S::mul_add(S::neg(x278), x619, S::mul_add(x277, x618, x276 * x617))
+                    + S::mul_add(
+                        x281,
+                        x622,
+                        S::mul_add(S::neg(x280), x621, x279 * x620),
+                    )),
+        );
+        let x754 = S::neg(
+            S::mul_add(x272, x569, S::mul_add(x271, x568, x270 * x567))
+                - S::mul_add(S::neg(x147), x579, S::mul_add(x146, x578, x145 * x576)),
+        );
+        let x755 = x668 - S::mul_add(x278, x569, S::mul_add(x277, x568, x276 * x567));
+        let x756 = S::neg(
+            S::mul_add(x272, x519, S::mul_add(x271, x518, x270 * x517))
+                - S::mul_add(S::neg(x147), x529, S::mul_add(x146, x528, x145 * x526)),
+        );
+        let x757 = x671 - S::mul_add(x278, x519, S::mul_add(x277, x518, x276 * x517));
         let x758 = x109 + x673;
         let x759 = x110 + x674;
         let x760 = x111 + x675;
@@ -4121,167 +4929,190 @@ impl Ssrms {
         let x776 = x203 - (x199 + (x199 + (x196 + x196))) + x691;
         let x777 = x189
             - (x188
-                - (Self::mul_add(x130, x141, x182) + Self::mul_add(-x134, x141, x183)))
+                - (S::mul_add(x130, x141, x182) + S::mul_add(S::neg(x134), x141, x183)))
             + x692;
         let x778 = x187
             - (x186
-                - (Self::mul_add(x130, x140, x180) - Self::mul_add(-x138, x140, x181)))
+                - (S::mul_add(x130, x140, x180) - S::mul_add(S::neg(x138), x140, x181)))
             + x693;
         let x779 = x203 + (x200 + (x200 - (x197 + x197))) + x694;
         let x780 = x185
             + (x184
-                - (Self::mul_add(-x134, x139, x178) + Self::mul_add(-x138, x139, x179)))
-            + x695;
+                - (S::mul_add(S::neg(x134), x139, x178)
+                    + S::mul_add(S::neg(x138), x139, x179))) + x695;
         let x781 = x203 + (x201 + (x201 - (x198 + x198))) + x696;
-        let x782 = Self::mul_add(-x132, x156, Self::mul_add(x131, x155, x130 * x154))
-            + Self::mul_add(-x110, x159, x111 * x158)
-            - (Self::mul_add(-x140, x192, x141 * x191)
-                + Self::mul_add(x143, x195, x144 * x194)) + x697;
-        let x783 = Self::mul_add(x135, x156, Self::mul_add(-x134, x155, x133 * x154))
-            + Self::mul_add(x109, x159, x111 * x157)
-            + (Self::mul_add(x139, x192, x141 * x190)
-                + Self::mul_add(-x142, x195, x144 * x193)) + x698;
-        let x784 = Self::mul_add(x138, x156, Self::mul_add(-x137, x155, x136 * x154))
-            + Self::mul_add(x109, x158, x110 * x157)
-            - (Self::mul_add(x139, x191, x140 * x190)
-                - Self::mul_add(x142, x194, x143 * x193)) + x699;
-        let x785 = Self::mul_add(x110, x156, x111 * x155)
-            - Self::mul_add(-x140, x195, x141 * x194) + x700;
-        let x786 = Self::mul_add(-x109, x156, x111 * x154)
-            + Self::mul_add(x139, x195, x141 * x193) + x701;
-        let x787 = Self::mul_add(x109, x155, x110 * x154)
-            - Self::mul_add(x139, x194, x140 * x193) + x702;
-        let x788 = Self::mul_add(x9, x763, Self::mul_add(x8, x762, s_q1 * x761))
-            - Self::mul_add(-x108, x759, x107 * x760);
-        let x789 = Self::mul_add(-x9, x766, Self::mul_add(-x8, x765, s_q1 * x764))
-            + Self::mul_add(-x108, x758, x106 * x760);
-        let x790 = Self::mul_add(-x9, x769, Self::mul_add(-x8, x768, s_q1 * x767))
-            + Self::mul_add(-x107, x758, x106 * x759);
-        let x791 = Self::mul_add(-x9, x759, x8 * x760);
-        let x792 = Self::mul_add(x9, x758, s_q1 * x760);
-        let x793 = Self::mul_add(x8, x758, s_q1 * x759);
-        let x794 = Self::mul_add(x108, x774, x107 * x775);
-        let x795 = Self::mul_add(x108, x773, x106 * x775);
-        let x796 = Self::mul_add(-x107, x773, x106 * x774);
-        let x797 = Self::mul_add(-x9, x778, Self::mul_add(-x8, x777, s_q1 * x776))
-            - x794;
-        let x798 = Self::mul_add(-x9, x780, Self::mul_add(-x8, x779, s_q1 * x777))
-            + x795;
-        let x799 = Self::mul_add(-x9, x781, Self::mul_add(-x8, x780, s_q1 * x778))
-            + x796;
-        let x800 = Self::mul_add(x9, x774, x8 * x775);
-        let x801 = Self::mul_add(-x9, x773, s_q1 * x775);
-        let x802 = Self::mul_add(x8, x773, s_q1 * x774);
-        let x803 = x794 + Self::mul_add(x8, x772, x9 * x771);
-        let x804 = x795 + Self::mul_add(-s_q1, x772, x9 * x770);
-        let x805 = x796 - Self::mul_add(s_q1, x771, x8 * x770);
+        let x782 = S::mul_add(S::neg(x132), x156, S::mul_add(x131, x155, x130 * x154))
+            + S::mul_add(S::neg(x110), x159, x111 * x158)
+            - (S::mul_add(S::neg(x140), x192, x141 * x191)
+                + S::mul_add(x143, x195, x144 * x194)) + x697;
+        let x783 = S::mul_add(x135, x156, S::mul_add(S::neg(x134), x155, x133 * x154))
+            + S::mul_add(x109, x159, x111 * x157)
+            + (S::mul_add(x139, x192, x141 * x190)
+                + S::mul_add(S::neg(x142), x195, x144 * x193)) + x698;
+        let x784 = S::mul_add(x138, x156, S::mul_add(S::neg(x137), x155, x136 * x154))
+            + S::mul_add(x109, x158, x110 * x157)
+            - (S::mul_add(x139, x191, x140 * x190) - S::mul_add(x142, x194, x143 * x193))
+            + x699;
+        let x785 = S::mul_add(x110, x156, x111 * x155)
+            - S::mul_add(S::neg(x140), x195, x141 * x194) + x700;
+        let x786 = S::mul_add(S::neg(x109), x156, x111 * x154)
+            + S::mul_add(x139, x195, x141 * x193) + x701;
+        let x787 = S::mul_add(x109, x155, x110 * x154)
+            - S::mul_add(x139, x194, x140 * x193) + x702;
+        let x788 = S::mul_add(x9, x763, S::mul_add(x8, x762, s_q1 * x761))
+            - S::mul_add(S::neg(x108), x759, x107 * x760);
+        let x789 = S::mul_add(
+            S::neg(x9),
+            x766,
+            S::mul_add(S::neg(x8), x765, s_q1 * x764),
+        ) + S::mul_add(S::neg(x108), x758, x106 * x760);
+        let x790 = S::mul_add(
+            S::neg(x9),
+            x769,
+            S::mul_add(S::neg(x8), x768, s_q1 * x767),
+        ) + S::mul_add(S::neg(x107), x758, x106 * x759);
+        let x791 = S::mul_add(S::neg(x9), x759, x8 * x760);
+        let x792 = S::mul_add(x9, x758, s_q1 * x760);
+        let x793 = S::mul_add(x8, x758, s_q1 * x759);
+        let x794 = S::mul_add(x108, x774, x107 * x775);
+        let x795 = S::mul_add(x108, x773, x106 * x775);
+        let x796 = S::mul_add(S::neg(x107), x773, x106 * x774);
+        let x797 = S::mul_add(
+            S::neg(x9),
+            x778,
+            S::mul_add(S::neg(x8), x777, s_q1 * x776),
+        ) - x794;
+        let x798 = S::mul_add(
+            S::neg(x9),
+            x780,
+            S::mul_add(S::neg(x8), x779, s_q1 * x777),
+        ) + x795;
+        let x799 = S::mul_add(
+            S::neg(x9),
+            x781,
+            S::mul_add(S::neg(x8), x780, s_q1 * x778),
+        ) + x796;
+        let x800 = S::mul_add(x9, x774, x8 * x775);
+        let x801 = S::mul_add(S::neg(x9), x773, s_q1 * x775);
+        let x802 = S::mul_add(x8, x773, s_q1 * x774);
+        let x803 = x794 + S::mul_add(x8, x772, x9 * x771);
+        let x804 = x795 + S::mul_add(S::neg(s_q1), x772, x9 * x770);
+        let x805 = x796 - S::mul_add(s_q1, x771, x8 * x770);
         let x806 = x797 - x803;
-        let x807 = -x806;
+        let x807 = S::neg(x806);
         let x808 = x798 + x804;
         let x809 = x799 + x805;
-        let x810 = Self::mul_add(x164, x775, x165 * x774);
-        let x811 = Self::mul_add(-x163, x775, x165 * x773);
-        let x812 = Self::mul_add(x163, x774, x164 * x773);
-        let x813 = Self::mul_add(x161, x775, x162 * x774);
-        let x814 = Self::mul_add(x160, x775, x162 * x773);
-        let x815 = Self::mul_add(-x160, x774, x161 * x773);
-        let x816 = -(Self::mul_add(x8, x784, x9 * x783)
-            + Self::mul_add(x107, x787, x108 * x786)
-            + (Self::mul_add(-x168, x763, Self::mul_add(-x167, x762, x166 * x761))
-                - Self::mul_add(-x171, x759, x170 * x760))
-            - (Self::mul_add(x161, x772, x162 * x771) - x810
-                + (x810
-                    - Self::mul_add(
-                        x162,
-                        x778,
-                        Self::mul_add(x161, x777, x160 * x776),
-                    ))));
-        let x817 = -(Self::mul_add(-x174, x763, Self::mul_add(-x173, x762, x172 * x761))
-            - Self::mul_add(-x177, x759, x176 * x760) + (x797 + x803));
-        let x818 = Self::mul_add(
+        let x810 = S::mul_add(x164, x775, x165 * x774);
+        let x811 = S::mul_add(S::neg(x163), x775, x165 * x773);
+        let x812 = S::mul_add(x163, x774, x164 * x773);
+        let x813 = S::mul_add(x161, x775, x162 * x774);
+        let x814 = S::mul_add(x160, x775, x162 * x773);
+        let x815 = S::mul_add(S::neg(x160), x774, x161 * x773);
+        let x816 = S::neg(
+            S::mul_add(x8, x784, x9 * x783) + S::mul_add(x107, x787, x108 * x786)
+                + (S::mul_add(
+                    S::neg(x168),
+                    x763,
+                    S::mul_add(S::neg(x167), x762, x166 * x761),
+                ) - S::mul_add(S::neg(x171), x759, x170 * x760))
+                - (S::mul_add(x161, x772, x162 * x771) - x810
+                    + (x810
+                        - S::mul_add(x162, x778, S::mul_add(x161, x777, x160 * x776)))),
+        );
+        let x817 = S::neg(
+            S::mul_add(S::neg(x174), x763, S::mul_add(S::neg(x173), x762, x172 * x761))
+                - S::mul_add(S::neg(x177), x759, x176 * x760) + (x797 + x803),
+        );
+        let x818 = S::mul_add(
             c_q0,
-            Self::mul_add(s_q1, x783, x8 * x782)
-                + Self::mul_add(-x106, x786, x107 * x785)
-                - (Self::mul_add(x168, x769, Self::mul_add(x167, x768, x166 * x767))
-                    - Self::mul_add(x170, x758, x169 * x759))
-                - (Self::mul_add(-x160, x771, x161 * x770) - x812
+            S::mul_add(s_q1, x783, x8 * x782)
+                + S::mul_add(S::neg(x106), x786, x107 * x785)
+                - (S::mul_add(x168, x769, S::mul_add(x167, x768, x166 * x767))
+                    - S::mul_add(x170, x758, x169 * x759))
+                - (S::mul_add(S::neg(x160), x771, x161 * x770) - x812
                     + (x812
-                        - Self::mul_add(
-                            x162,
-                            x781,
-                            Self::mul_add(x161, x780, x160 * x778),
-                        ))),
+                        - S::mul_add(x162, x781, S::mul_add(x161, x780, x160 * x778)))),
             s_q0
-                * (Self::mul_add(-s_q1, x784, x9 * x782)
-                    + Self::mul_add(x106, x787, x108 * x785)
-                    - (Self::mul_add(x168, x766, Self::mul_add(x167, x765, x166 * x764))
-                        - Self::mul_add(x171, x758, x169 * x760))
-                    - (Self::mul_add(x160, x772, x162 * x770) - x811
+                * (S::mul_add(S::neg(s_q1), x784, x9 * x782)
+                    + S::mul_add(x106, x787, x108 * x785)
+                    - (S::mul_add(x168, x766, S::mul_add(x167, x765, x166 * x764))
+                        - S::mul_add(x171, x758, x169 * x760))
+                    - (S::mul_add(x160, x772, x162 * x770) - x811
                         + (x811
-                            + Self::mul_add(
+                            + S::mul_add(
                                 x162,
                                 x780,
-                                Self::mul_add(x161, x779, x160 * x777),
+                                S::mul_add(x161, x779, x160 * x777),
                             )))),
         );
-        let x819 = Self::mul_add(
-            -x14,
-            Self::mul_add(s_q1, x786, x8 * x785)
-                - Self::mul_add(-x167, x758, x166 * x759) - (x815 + x815),
-            Self::mul_add(
+        let x819 = S::mul_add(
+            S::neg(x14),
+            S::mul_add(s_q1, x786, x8 * x785)
+                - S::mul_add(S::neg(x167), x758, x166 * x759) - (x815 + x815),
+            S::mul_add(
                 x13,
-                Self::mul_add(-s_q1, x787, x9 * x785)
-                    - Self::mul_add(-x168, x758, x166 * x760) - (x814 + x814),
+                S::mul_add(S::neg(s_q1), x787, x9 * x785)
+                    - S::mul_add(S::neg(x168), x758, x166 * x760) - (x814 + x814),
                 x12
-                    * (Self::mul_add(x8, x787, x9 * x786)
-                        - Self::mul_add(-x168, x759, x167 * x760) - (x813 + x813)),
+                    * (S::mul_add(x8, x787, x9 * x786)
+                        - S::mul_add(S::neg(x168), x759, x167 * x760) - (x813 + x813)),
             ),
         );
-        let x820 = -(x818 - x819);
-        let x821 = Self::mul_add(
+        let x820 = S::neg(x818 - x819);
+        let x821 = S::mul_add(
             c_q0,
-            Self::mul_add(x174, x769, Self::mul_add(x173, x768, x172 * x767))
-                - Self::mul_add(x176, x758, x175 * x759) - (x799 - x805),
+            S::mul_add(x174, x769, S::mul_add(x173, x768, x172 * x767))
+                - S::mul_add(x176, x758, x175 * x759) - (x799 - x805),
             s_q0
-                * (Self::mul_add(x174, x766, Self::mul_add(x173, x765, x172 * x764))
-                    - Self::mul_add(x177, x758, x175 * x760) + (x798 - x804)),
+                * (S::mul_add(x174, x766, S::mul_add(x173, x765, x172 * x764))
+                    - S::mul_add(x177, x758, x175 * x760) + (x798 - x804)),
         );
-        let x822 = Self::mul_add(
-            -x14,
-            Self::mul_add(-x173, x758, x172 * x759) - (x802 + x802),
-            Self::mul_add(
+        let x822 = S::mul_add(
+            S::neg(x14),
+            S::mul_add(S::neg(x173), x758, x172 * x759) - (x802 + x802),
+            S::mul_add(
                 x13,
-                Self::mul_add(-x174, x758, x172 * x760) + (x801 + x801),
-                x12 * (Self::mul_add(-x174, x759, x173 * x760) - (x800 + x800)),
+                S::mul_add(S::neg(x174), x758, x172 * x760) + (x801 + x801),
+                x12 * (S::mul_add(S::neg(x174), x759, x173 * x760) - (x800 + x800)),
             ),
         );
         let x823 = x821 - x822;
-        let x824 = Self::mul_add(-x168, x790, Self::mul_add(x167, x789, x166 * x788))
-            + Self::mul_add(x171, x793, Self::mul_add(-x170, x792, x169 * x791))
-            + Self::mul_add(x162, x809, Self::mul_add(x161, x808, x160 * x806));
-        let x825 = Self::mul_add(-x174, x790, Self::mul_add(x173, x789, x172 * x788))
-            + Self::mul_add(x177, x793, Self::mul_add(-x176, x792, x175 * x791))
-            + Self::mul_add(-x9, x809, Self::mul_add(-x8, x808, s_q1 * x806));
-        let x826 = Self::mul_add(-x168, x705, Self::mul_add(x167, x704, x166 * x703))
-            + Self::mul_add(x171, x708, Self::mul_add(-x170, x707, x169 * x706))
-            + Self::mul_add(x162, x724, Self::mul_add(x161, x723, x160 * x721));
+        let x824 = S::mul_add(S::neg(x168), x790, S::mul_add(x167, x789, x166 * x788))
+            + S::mul_add(x171, x793, S::mul_add(S::neg(x170), x792, x169 * x791))
+            + S::mul_add(x162, x809, S::mul_add(x161, x808, x160 * x806));
+        let x825 = S::mul_add(S::neg(x174), x790, S::mul_add(x173, x789, x172 * x788))
+            + S::mul_add(x177, x793, S::mul_add(S::neg(x176), x792, x175 * x791))
+            + S::mul_add(S::neg(x9), x809, S::mul_add(S::neg(x8), x808, s_q1 * x806));
+        let x826 = S::mul_add(S::neg(x168), x705, S::mul_add(x167, x704, x166 * x703))
+            + S::mul_add(x171, x708, S::mul_add(S::neg(x170), x707, x169 * x706))
+            + S::mul_add(x162, x724, S::mul_add(x161, x723, x160 * x721));
         let x827 = x750
-            + (Self::mul_add(-x174, x705, Self::mul_add(x173, x704, x172 * x703))
-                + Self::mul_add(x177, x708, Self::mul_add(-x176, x707, x175 * x706)));
-        let x828 = -(Self::mul_add(-x168, x619, Self::mul_add(x167, x618, x166 * x617))
-            + Self::mul_add(x171, x622, Self::mul_add(-x170, x621, x169 * x620))
-            + Self::mul_add(x162, x637, Self::mul_add(x161, x636, x160 * x635)));
-        let x829 = -(x665
-            + (Self::mul_add(-x174, x619, Self::mul_add(x173, x618, x172 * x617))
-                + Self::mul_add(x177, x622, Self::mul_add(-x176, x621, x175 * x620))));
-        let x830 = -(Self::mul_add(x168, x569, Self::mul_add(x167, x568, x166 * x567))
-            - Self::mul_add(-x162, x579, Self::mul_add(x161, x578, x160 * x576)));
-        let x831 = x668
-            - Self::mul_add(x174, x569, Self::mul_add(x173, x568, x172 * x567));
-        let x832 = -(Self::mul_add(x168, x519, Self::mul_add(x167, x518, x166 * x517))
-            - Self::mul_add(-x162, x529, Self::mul_add(x161, x528, x160 * x526)));
-        let x833 = x671
-            - Self::mul_add(x174, x519, Self::mul_add(x173, x518, x172 * x517));
+            + (S::mul_add(S::neg(x174), x705, S::mul_add(x173, x704, x172 * x703))
+                + S::mul_add(x177, x708, S::mul_add(S::neg(x176), x707, x175 * x706)));
+        let x828 = S::neg(
+            S::mul_add(S::neg(x168), x619, S::mul_add(x167, x618, x166 * x617))
+                + S::mul_add(x171, x622, S::mul_add(S::neg(x170), x621, x169 * x620))
+                + S::mul_add(x162, x637, S::mul_add(x161, x636, x160 * x635)),
+        );
+        let x829 = S::neg(
+            x665
+                + (S::mul_add(S::neg(x174), x619, S::mul_add(x173, x618, x172 * x617))
+                    + S::mul_add(
+                        x177,
+                        x622,
+                        S::mul_add(S::neg(x176), x621, x175 * x620),
+                    )),
+        );
+        let x830 = S::neg(
+            S::mul_add(x168, x569, S::mul_add(x167, x568, x166 * x567))
+                - S::mul_add(S::neg(x162), x579, S::mul_add(x161, x578, x160 * x576)),
+        );
+        let x831 = x668 - S::mul_add(x174, x569, S::mul_add(x173, x568, x172 * x567));
+        let x832 = S::neg(
+            S::mul_add(x168, x519, S::mul_add(x167, x518, x166 * x517))
+                - S::mul_add(S::neg(x162), x529, S::mul_add(x161, x528, x160 * x526)),
+        );
+        let x833 = x671 - S::mul_add(x174, x519, S::mul_add(x173, x518, x172 * x517));
         let x834 = x15 + x758;
         let x835 = x16 - x759;
         let x836 = x17 - x760;
@@ -4295,122 +5126,138 @@ impl Ssrms {
         let x844 = x88 - x775;
         let x845 = x96 - (x92 + (x92 + (x89 + x89))) + x776;
         let x846 = x82
-            + (x81 + (Self::mul_add(-x35, x45, x75) - Self::mul_add(-x39, x45, x76)))
-            + x777;
+            + (x81
+                + (S::mul_add(S::neg(x35), x45, x75)
+                    - S::mul_add(S::neg(x39), x45, x76))) + x777;
         let x847 = x80
-            + (x79 + (Self::mul_add(-x35, x44, x73) + Self::mul_add(-x43, x44, x74)))
-            + x778;
+            + (x79
+                + (S::mul_add(S::neg(x35), x44, x73)
+                    + S::mul_add(S::neg(x43), x44, x74))) + x778;
         let x848 = x78
-            + (x77 - (Self::mul_add(-qd[0], x39, x71) + Self::mul_add(-qd[0], x43, x72)))
-            - x780;
-        let x849 = Self::mul_add(-c_q0, x40 - x766, s_q0 * (x39 - x765))
-            - Self::mul_add(-x14, x834, x12 * x836);
-        let x850 = Self::mul_add(-c_q0, x43 - x769, s_q0 * (x42 - x768))
-            - Self::mul_add(-x13, x834, x12 * x835);
+            + (x77
+                - (S::mul_add(S::neg(qd[0]), x39, x71)
+                    + S::mul_add(S::neg(qd[0]), x43, x72))) - x780;
+        let x849 = S::mul_add(S::neg(c_q0), x40 - x766, s_q0 * (x39 - x765))
+            - S::mul_add(S::neg(x14), x834, x12 * x836);
+        let x850 = S::mul_add(S::neg(c_q0), x43 - x769, s_q0 * (x42 - x768))
+            - S::mul_add(S::neg(x13), x834, x12 * x835);
         let x851 = c_q0 * x834;
         let x852 = s_q0 * x834;
-        let x853 = Self::mul_add(x14, x843, x13 * x844);
-        let x854 = Self::mul_add(-x14, x842, x12 * x844);
-        let x855 = Self::mul_add(x13, x842, x12 * x843);
-        let x856 = Self::mul_add(-c_q0, x847, s_q0 * x846) + x853;
-        let x857 = x853 - Self::mul_add(-s_q0, x841, c_q0 * x840);
-        let x858 = -(x856 + x857);
-        let x859 = Self::mul_add(
+        let x853 = S::mul_add(x14, x843, x13 * x844);
+        let x854 = S::mul_add(S::neg(x14), x842, x12 * x844);
+        let x855 = S::mul_add(x13, x842, x12 * x843);
+        let x856 = S::mul_add(S::neg(c_q0), x847, s_q0 * x846) + x853;
+        let x857 = x853 - S::mul_add(S::neg(s_q0), x841, c_q0 * x840);
+        let x858 = S::neg(x856 + x857);
+        let x859 = S::mul_add(
             c_q0,
             x848,
             s_q0 * (x96 - (x93 + (x93 - (x90 + x90))) + x779),
-        ) + x854 + Self::mul_add(-c_q0, x839, x854);
-        let x860 = Self::mul_add(
+        ) + x854 + S::mul_add(S::neg(c_q0), x839, x854);
+        let x860 = S::mul_add(
             c_q0,
             x96 - (x94 + (x94 - (x91 + x91))) + x781,
             s_q0 * x848,
-        ) - x855 - Self::mul_add(-s_q0, x839, x855);
-        let x861 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(-x43, x59, Self::mul_add(x42, x58, x41 * x57))
-                - Self::mul_add(-x15, x61, x16 * x60)
-                + (Self::mul_add(-qd[0], x84, x44 * x83)
-                    - Self::mul_add(x46, x87, x47 * x86)) + x784,
+        ) - x855 - S::mul_add(S::neg(s_q0), x839, x855);
+        let x861 = S::mul_add(
+            S::neg(s_q0),
+            S::mul_add(S::neg(x43), x59, S::mul_add(x42, x58, x41 * x57))
+                - S::mul_add(S::neg(x15), x61, x16 * x60)
+                + (S::mul_add(S::neg(qd[0]), x84, x44 * x83)
+                    - S::mul_add(x46, x87, x47 * x86)) + x784,
             c_q0
-                * (Self::mul_add(-x40, x59, Self::mul_add(x39, x58, x38 * x57))
-                    - Self::mul_add(-x15, x62, x17 * x60)
-                    - (Self::mul_add(-qd[0], x85, x45 * x83)
-                        + Self::mul_add(-x46, x88, x48 * x86)) + x783),
+                * (S::mul_add(S::neg(x40), x59, S::mul_add(x39, x58, x38 * x57))
+                    - S::mul_add(S::neg(x15), x62, x17 * x60)
+                    - (S::mul_add(S::neg(qd[0]), x85, x45 * x83)
+                        + S::mul_add(S::neg(x46), x88, x48 * x86)) + x783),
         );
-        let x862 = Self::mul_add(-x52, x844, x53 * x843);
-        let x863 = -(x861
-            - Self::mul_add(
-                x13,
-                Self::mul_add(-x15, x58, x16 * x57)
-                    - Self::mul_add(qd[0], x87, x44 * x86) - x787,
-                x14
-                    * (Self::mul_add(x15, x59, x17 * x57)
-                        + Self::mul_add(qd[0], x88, x45 * x86) - x786),
-            )
-            + (Self::mul_add(x64, x838, x63 * x837)
-                - Self::mul_add(x66, x835, x65 * x836))
-            - (Self::mul_add(x50, x841, x51 * x840) + x862
-                - (x862 + Self::mul_add(x51, x847, x50 * x846))));
-        let x864 = -(Self::mul_add(
-            x68,
-            x838,
-            Self::mul_add(x67, x837, x49 * (x35 - x761)),
-        ) - Self::mul_add(x70, x835, x69 * x836) + (x856 - x857));
-        let x865 = -(Self::mul_add(-x64, x850, x63 * x849)
-            - Self::mul_add(-x66, x852, x65 * x851)
-            - Self::mul_add(-x51, x860, x50 * x859));
-        let x866 = Self::mul_add(
-            -x68,
+        let x862 = S::mul_add(S::neg(x52), x844, x53 * x843);
+        let x863 = S::neg(
+            x861
+                - S::mul_add(
+                    x13,
+                    S::mul_add(S::neg(x15), x58, x16 * x57)
+                        - S::mul_add(qd[0], x87, x44 * x86) - x787,
+                    x14
+                        * (S::mul_add(x15, x59, x17 * x57)
+                            + S::mul_add(qd[0], x88, x45 * x86) - x786),
+                )
+                + (S::mul_add(x64, x838, x63 * x837) - S::mul_add(x66, x835, x65 * x836))
+                - (S::mul_add(x50, x841, x51 * x840) + x862
+                    - (x862 + S::mul_add(x51, x847, x50 * x846))),
+        );
+        let x864 = S::neg(
+            S::mul_add(x68, x838, S::mul_add(x67, x837, x49 * (x35 - x761)))
+                - S::mul_add(x70, x835, x69 * x836) + (x856 - x857),
+        );
+        let x865 = S::neg(
+            S::mul_add(S::neg(x64), x850, x63 * x849)
+                - S::mul_add(S::neg(x66), x852, x65 * x851)
+                - S::mul_add(S::neg(x51), x860, x50 * x859),
+        );
+        let x866 = S::mul_add(
+            S::neg(x68),
             x850,
-            Self::mul_add(
+            S::mul_add(
                 x67,
                 x849,
                 x49
-                    * (Self::mul_add(-c_q0, x838, s_q0 * x837)
-                        + Self::mul_add(-x14, x835, x13 * x836)),
+                    * (S::mul_add(S::neg(c_q0), x838, s_q0 * x837)
+                        + S::mul_add(S::neg(x14), x835, x13 * x836)),
             ),
         );
-        let x867 = Self::mul_add(
-            -x70,
+        let x867 = S::mul_add(
+            S::neg(x70),
             x852,
-            Self::mul_add(x69, x851, x54 * Self::mul_add(c_q0, x835, s_q0 * x836)),
+            S::mul_add(x69, x851, x54 * S::mul_add(c_q0, x835, s_q0 * x836)),
         );
-        let x868 = -(x866 - x867 - Self::mul_add(c_q0, x860, s_q0 * x859));
-        let x869 = Self::mul_add(-x64, x790, x63 * x789)
-            + Self::mul_add(x66, x793, x65 * x792)
-            + Self::mul_add(x51, x809, x50 * x808);
-        let x870 = -(Self::mul_add(x68, x790, Self::mul_add(-x67, x789, x49 * x788))
-            - Self::mul_add(x70, x793, Self::mul_add(x69, x792, x54 * x791))
-            - Self::mul_add(-c_q0, x809, s_q0 * x808));
-        let x871 = Self::mul_add(-x64, x705, x63 * x704)
-            + Self::mul_add(x66, x708, x65 * x707)
-            + Self::mul_add(x51, x724, x50 * x723);
-        let x872 = -(Self::mul_add(x68, x705, Self::mul_add(-x67, x704, x49 * x703))
-            - Self::mul_add(x70, x708, Self::mul_add(x69, x707, x54 * x706))
-            - Self::mul_add(-c_q0, x724, s_q0 * x723));
-        let x873 = -(Self::mul_add(-x64, x619, x63 * x618)
-            + Self::mul_add(x66, x622, x65 * x621)
-            + Self::mul_add(x51, x637, x50 * x636));
-        let x874 = Self::mul_add(x68, x619, Self::mul_add(-x67, x618, x49 * x617))
-            - Self::mul_add(x70, x622, Self::mul_add(x69, x621, x54 * x620))
-            - Self::mul_add(-c_q0, x637, s_q0 * x636);
-        let x875 = -(Self::mul_add(x64, x569, x63 * x568)
-            - Self::mul_add(-x51, x579, x50 * x578));
-        let x876 = Self::mul_add(-x68, x569, Self::mul_add(-x67, x568, x49 * x567))
-            + Self::mul_add(c_q0, x579, s_q0 * x578);
-        let x877 = -(Self::mul_add(x64, x519, x63 * x518)
-            - Self::mul_add(-x51, x529, x50 * x528));
-        let x878 = Self::mul_add(-x68, x519, Self::mul_add(-x67, x518, x49 * x517))
-            + Self::mul_add(c_q0, x529, s_q0 * x528);
+        let x868 = S::neg(x866 - x867 - S::mul_add(c_q0, x860, s_q0 * x859));
+        let x869 = S::mul_add(S::neg(x64), x790, x63 * x789)
+            + S::mul_add(x66, x793, x65 * x792) + S::mul_add(x51, x809, x50 * x808);
+        let x870 = S::neg(
+            S::mul_add(x68, x790, S::mul_add(S::neg(x67), x789, x49 * x788))
+                - S::mul_add(x70, x793, S::mul_add(x69, x792, x54 * x791))
+                - S::mul_add(S::neg(c_q0), x809, s_q0 * x808),
+        );
+        let x871 = S::mul_add(S::neg(x64), x705, x63 * x704)
+            + S::mul_add(x66, x708, x65 * x707) + S::mul_add(x51, x724, x50 * x723);
+        let x872 = S::neg(
+            S::mul_add(x68, x705, S::mul_add(S::neg(x67), x704, x49 * x703))
+                - S::mul_add(x70, x708, S::mul_add(x69, x707, x54 * x706))
+                - S::mul_add(S::neg(c_q0), x724, s_q0 * x723),
+        );
+        let x873 = S::neg(
+            S::mul_add(S::neg(x64), x619, x63 * x618) + S::mul_add(x66, x622, x65 * x621)
+                + S::mul_add(x51, x637, x50 * x636),
+        );
+        let x874 = S::mul_add(x68, x619, S::mul_add(S::neg(x67), x618, x49 * x617))
+            - S::mul_add(x70, x622, S::mul_add(x69, x621, x54 * x620))
+            - S::mul_add(S::neg(c_q0), x637, s_q0 * x636);
+        let x875 = S::neg(
+            S::mul_add(x64, x569, x63 * x568) - S::mul_add(S::neg(x51), x579, x50 * x578),
+        );
+        let x876 = S::mul_add(
+            S::neg(x68),
+            x569,
+            S::mul_add(S::neg(x67), x568, x49 * x567),
+        ) + S::mul_add(c_q0, x579, s_q0 * x578);
+        let x877 = S::neg(
+            S::mul_add(x64, x519, x63 * x518) - S::mul_add(S::neg(x51), x529, x50 * x528),
+        );
+        let x878 = S::mul_add(
+            S::neg(x68),
+            x519,
+            S::mul_add(S::neg(x67), x518, x49 * x517),
+        ) + S::mul_add(c_q0, x529, s_q0 * x528);
         (
             [
-                [0.0, x863, x816, x732, x644, x581, x531],
-                [0.0, x865, x820, x745, x656, x588, x538],
-                [0.0, x869, x824, x747, x659, x590, x540],
-                [0.0, x871, x826, x749, x662, x590, x540],
-                [0.0, x873, x828, x752, x664, x590, x540],
-                [0.0, x875, x830, x754, x667, x592, x542],
-                [0.0, x877, x832, x756, x670, x594, x544],
+                [S::splat(0.0), x863, x816, x732, x644, x581, x531],
+                [S::splat(0.0), x865, x820, x745, x656, x588, x538],
+                [S::splat(0.0), x869, x824, x747, x659, x590, x540],
+                [S::splat(0.0), x871, x826, x749, x662, x590, x540],
+                [S::splat(0.0), x873, x828, x752, x664, x590, x540],
+                [S::splat(0.0), x875, x830, x754, x667, x592, x542],
+                [S::splat(0.0), x877, x832, x756, x670, x594, x544],
             ],
             [
                 [x845, x864, x817, x739, x650, x585, x535],
@@ -4422,6 +5269,46 @@ impl Ssrms {
                 [x527, x878, x833, x757, x672, x595, x545],
             ],
         )
+    }
+    /// [`Self::inverse_dynamics_derivatives`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_derivatives_lanes`]: `out[k]` is `inverse_dynamics_derivatives` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_derivatives_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [[::core::primitive::f64; 7]; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_derivatives_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at the drives `tau` (`−M⁻¹ ∂τ/∂x` at `q̈ = FD(q, q̇, τ)`; Pinocchio's `computeABADerivatives`): row `i` = output `i`, column `j` = `∂/∂` speed `j`.
     ///
@@ -4436,8 +5323,15 @@ impl Ssrms {
         [[::core::primitive::f64; 7]; 7],
         [[::core::primitive::f64; 7]; 7],
     ) {
+        Self::forward_dynamics_derivatives_lanes::<::core::primitive::f64>(q, qd, tau)
+    }
+    /// [`Self::forward_dynamics_derivatives`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_derivatives_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], tau: &[S; 7]) -> ([[S; 7]; 7], [[S; 7]; 7], [[S; 7]; 7]) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -4446,124 +5340,133 @@ impl Ssrms {
             q[5],
             q[6],
         ]);
-        let x7 = s_q5 * s_q5 * 35.074;
-        let x8 = -35.074 + x7;
-        let x9 = s_q5 * c_q5 * 35.074;
-        let x10 = 179.8829695416 - x7;
-        let x11 = x8 - -129.6173695416;
+        let x7 = s_q5 * s_q5 * S::splat(35.074);
+        let x8 = S::splat(-35.074) + x7;
+        let x9 = s_q5 * c_q5 * S::splat(35.074);
+        let x10 = S::splat(179.8829695416) - x7;
+        let x11 = x8 - S::splat(-129.6173695416);
         let x12 = s_q4 * s_q4 * x11;
         let x13 = x8 - x12;
-        let x14 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x9);
-        let x15 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x9);
-        let x16 = 171.195516 * s_q4;
-        let x17 = 171.195516 * c_q4;
-        let x18 = 7.11 * x16;
-        let x19 = Self::mul_add(-7.11, x17, s_q4 * c_q4 * x11);
+        let x14 = S::mul_add(S::splat(97.44448770720001), s_q4, c_q4 * x9);
+        let x15 = S::mul_add(S::splat(-97.44448770720001), c_q4, s_q4 * x9);
+        let x16 = S::splat(171.195516) * s_q4;
+        let x17 = S::splat(171.195516) * c_q4;
+        let x18 = S::splat(7.11) * x16;
+        let x19 = S::mul_add(S::splat(-7.11), x17, s_q4 * c_q4 * x11);
         let x20 = x10 - x18;
-        let x21 = 3239.4582 - x16;
-        let x22 = 1375.0472756800002 - x14;
-        let x23 = 24989.305802 - (x18 - (-129.6173695416 + x12 - x18));
-        let x24 = 24998.827802 - (x18 - x20);
+        let x21 = S::splat(3239.4582) - x16;
+        let x22 = S::splat(1375.0472756800002) - x14;
+        let x23 = S::splat(24989.305802)
+            - (x18 - (S::splat(-129.6173695416) + x12 - x18));
+        let x24 = S::splat(24998.827802) - (x18 - x20);
         let x25 = s_q3 * s_q3;
         let x26 = s_q3 * c_q3;
         let x27 = x13 - x23;
         let x28 = x19 + x19;
-        let x29 = Self::mul_add(x26, x28, x25 * x27);
+        let x29 = S::mul_add(x26, x28, x25 * x27);
         let x30 = x13 - x29;
         let x31 = s_q3 * x15;
         let x32 = c_q3 * x15;
         let x33 = s_q3 * x17;
-        let x34 = Self::mul_add(c_q3, x21, -x33);
+        let x34 = S::mul_add(c_q3, x21, S::neg(x33));
         let x35 = c_q3 * x17;
-        let x36 = Self::mul_add(s_q3, x21, x35);
-        let x37 = 7.11 * x34;
-        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(c_q3, x22, x31));
-        let x39 = Self::mul_add(-7.11, x36, x19 + Self::mul_add(-x25, x28, x26 * x27));
-        let x40 = Self::mul_add(x36, 0.475, Self::mul_add(s_q3, x22, -x32));
+        let x36 = S::mul_add(s_q3, x21, x35);
+        let x37 = S::splat(7.11) * x34;
+        let x38 = S::mul_add(x34, S::splat(0.475), S::mul_add(c_q3, x22, x31));
+        let x39 = S::mul_add(
+            S::splat(-7.11),
+            x36,
+            x19 + S::mul_add(S::neg(x25), x28, x26 * x27),
+        );
+        let x40 = S::mul_add(x36, S::splat(0.475), S::mul_add(s_q3, x22, S::neg(x32)));
         let x41 = x24 + x37;
-        let x42 = 5224.5702 + x34;
-        let x43 = 3946.18812068 + x38;
-        let x44 = 39234.474122 + (x37 + (x23 + x29 + x37));
-        let x45 = 39241.404122 + (x37 + x41);
+        let x42 = S::splat(5224.5702) + x34;
+        let x43 = S::splat(3946.18812068) + x38;
+        let x44 = S::splat(39234.474122) + (x37 + (x23 + x29 + x37));
+        let x45 = S::splat(39241.404122) + (x37 + x41);
         let x46 = s_q2 * s_q2;
         let x47 = s_q2 * c_q2;
         let x48 = x30 - x44;
         let x49 = x39 + x39;
-        let x50 = Self::mul_add(x47, x49, x46 * x48);
+        let x50 = S::mul_add(x47, x49, x46 * x48);
         let x51 = x30 - x50;
         let x52 = s_q2 * x40;
         let x53 = c_q2 * x40;
         let x54 = s_q2 * x36;
-        let x55 = Self::mul_add(c_q2, x42, -x54);
+        let x55 = S::mul_add(c_q2, x42, S::neg(x54));
         let x56 = c_q2 * x36;
-        let x57 = Self::mul_add(s_q2, x42, x56);
-        let x58 = Self::mul_add(0.5692, x55, Self::mul_add(c_q2, x43, -x52));
-        let x59 = Self::mul_add(0.5692, x57, Self::mul_add(s_q2, x43, x53));
-        let x60 = 1145.5438279999998 * s_q1;
-        let x61 = 0.7026 * x57;
-        let x62 = Self::mul_add(
-            0.7026,
-            Self::mul_add(c_q1, x55, x60),
-            Self::mul_add(-s_q1, x59, c_q1 * (x39 + Self::mul_add(-x46, x49, x47 * x48))),
+        let x57 = S::mul_add(s_q2, x42, x56);
+        let x58 = S::mul_add(S::splat(0.5692), x55, S::mul_add(c_q2, x43, S::neg(x52)));
+        let x59 = S::mul_add(S::splat(0.5692), x57, S::mul_add(s_q2, x43, x53));
+        let x60 = S::splat(1145.5438279999998) * s_q1;
+        let x61 = S::splat(0.7026) * x57;
+        let x62 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(c_q1, x55, x60),
+            S::mul_add(
+                S::neg(s_q1),
+                x59,
+                c_q1 * (x39 + S::mul_add(S::neg(x46), x49, x47 * x48)),
+            ),
         );
-        let x63 = Self::mul_add(
-            0.7026,
+        let x63 = S::mul_add(
+            S::splat(0.7026),
             s_q1 * x57,
-            Self::mul_add(-s_q1, x45, c_q1 * x58),
+            S::mul_add(S::neg(s_q1), x45, c_q1 * x58),
         );
-        let x64 = Self::mul_add(s_q2, x34, x56);
-        let x65 = Self::mul_add(
+        let x64 = S::mul_add(s_q2, x34, x56);
+        let x65 = S::mul_add(
             s_q1,
             x41,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-c_q2, x34, x54),
-                    Self::mul_add(-c_q2, x38, x52),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(S::neg(c_q2), x34, x54),
+                    S::mul_add(S::neg(c_q2), x38, x52),
                 ),
         );
-        let x66 = Self::mul_add(-0.7026, s_q1 * x64, x65);
-        let x67 = Self::mul_add(-s_q3, x16, x35);
-        let x68 = Self::mul_add(c_q3, x16, x33);
-        let x69 = Self::mul_add(-0.475, x68, Self::mul_add(-c_q3, x14, x31));
-        let x70 = Self::mul_add(-0.475, x67, Self::mul_add(s_q3, x14, x32));
-        let x71 = Self::mul_add(-7.11, x68, x20);
-        let x72 = Self::mul_add(-s_q2, x68, c_q2 * x67);
-        let x73 = Self::mul_add(
-            -s_q1,
+        let x66 = S::mul_add(S::splat(-0.7026), s_q1 * x64, x65);
+        let x67 = S::mul_add(S::neg(s_q3), x16, x35);
+        let x68 = S::mul_add(c_q3, x16, x33);
+        let x69 = S::mul_add(S::splat(-0.475), x68, S::mul_add(S::neg(c_q3), x14, x31));
+        let x70 = S::mul_add(S::splat(-0.475), x67, S::mul_add(s_q3, x14, x32));
+        let x71 = S::mul_add(S::splat(-7.11), x68, x20);
+        let x72 = S::mul_add(S::neg(s_q2), x68, c_q2 * x67);
+        let x73 = S::mul_add(
+            S::neg(s_q1),
             x71,
             c_q1
-                * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x68, s_q2 * x67),
-                    Self::mul_add(s_q2, x70, c_q2 * x69),
+                * S::mul_add(
+                    S::splat(-0.5692),
+                    S::mul_add(c_q2, x68, s_q2 * x67),
+                    S::mul_add(s_q2, x70, c_q2 * x69),
                 ),
         );
-        let x74 = Self::mul_add(0.7026, s_q1 * x72, x73);
-        let x75 = 47.471 * s_q4;
-        let x76 = 47.471 * c_q4;
-        let x77 = Self::mul_add(s_q3, x76, c_q3 * x75);
-        let x78 = Self::mul_add(-c_q3, x76, s_q3 * x75);
-        let x79 = c_q1 * Self::mul_add(-s_q2, x78, c_q2 * x77);
-        let x80 = 9.336 * c_q5;
-        let x81 = 9.336 * s_q5;
+        let x74 = S::mul_add(S::splat(0.7026), s_q1 * x72, x73);
+        let x75 = S::splat(47.471) * s_q4;
+        let x76 = S::splat(47.471) * c_q4;
+        let x77 = S::mul_add(s_q3, x76, c_q3 * x75);
+        let x78 = S::mul_add(S::neg(c_q3), x76, s_q3 * x75);
+        let x79 = c_q1 * S::mul_add(S::neg(s_q2), x78, c_q2 * x77);
+        let x80 = S::splat(9.336) * c_q5;
+        let x81 = S::splat(9.336) * s_q5;
         let x82 = c_q4 * x80;
         let x83 = s_q4 * x80;
-        let x84 = Self::mul_add(-s_q3, x83, c_q3 * x82);
-        let x85 = Self::mul_add(c_q3, x83, s_q3 * x82);
-        let x86 = Self::mul_add(
-            -s_q1,
+        let x84 = S::mul_add(S::neg(s_q3), x83, c_q3 * x82);
+        let x85 = S::mul_add(c_q3, x83, s_q3 * x82);
+        let x86 = S::mul_add(
+            S::neg(s_q1),
             x81,
-            c_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
+            c_q1 * S::mul_add(S::neg(s_q2), x85, c_q2 * x84),
         );
-        let x87 = 1.0
-            / (2232.9683597151998
+        let x87 = S::splat(1.0)
+            / (S::splat(2232.9683597151998)
                 - (x61
                     - (x51
-                        - Self::mul_add(
+                        - S::mul_add(
                             s_q1 * c_q1,
                             x58 + x58,
-                            s_q1 * s_q1 * (x51 - (-1647.2196721184 + x45)),
+                            s_q1 * s_q1 * (x51 - (S::splat(-1647.2196721184) + x45)),
                         ) - x61)));
         let x88 = x62 * x87;
         let x89 = x63 * x87;
@@ -4571,643 +5474,702 @@ impl Ssrms {
         let x91 = x74 * x87;
         let x92 = x79 * x87;
         let x93 = x86 * x87;
-        let x94 = 1.0 / Self::mul_add(-x62, x88, 1650.6386721183999 + (x44 + x50));
-        let x95 = Self::mul_add(-x62, x89, x59);
+        let x94 = S::splat(1.0)
+            / S::mul_add(S::neg(x62), x88, S::splat(1650.6386721183999) + (x44 + x50));
+        let x95 = S::mul_add(S::neg(x62), x89, x59);
         let x96 = x94 * x95;
-        let x97 = Self::mul_add(
+        let x97 = S::mul_add(
             x62,
             x90,
-            Self::mul_add(0.5692, x64, Self::mul_add(s_q2, x38, x53)),
+            S::mul_add(S::splat(0.5692), x64, S::mul_add(s_q2, x38, x53)),
         );
         let x98 = x94 * x97;
-        let x99 = Self::mul_add(
-            -x62,
+        let x99 = S::mul_add(
+            S::neg(x62),
             x91,
-            Self::mul_add(0.5692, x72, Self::mul_add(-c_q2, x70, s_q2 * x69)),
+            S::mul_add(S::splat(0.5692), x72, S::mul_add(S::neg(c_q2), x70, s_q2 * x69)),
         );
         let x100 = x94 * x99;
-        let x101 = Self::mul_add(-x62, x92, Self::mul_add(c_q2, x78, s_q2 * x77));
+        let x101 = S::mul_add(S::neg(x62), x92, S::mul_add(c_q2, x78, s_q2 * x77));
         let x102 = x94 * x101;
-        let x103 = Self::mul_add(-x62, x93, Self::mul_add(c_q2, x85, s_q2 * x84));
+        let x103 = S::mul_add(S::neg(x62), x93, S::mul_add(c_q2, x85, s_q2 * x84));
         let x104 = x94 * x103;
-        let x105 = 1.0 / Self::mul_add(-x95, x96, Self::mul_add(-x63, x89, x45));
-        let x106 = Self::mul_add(-x95, x98, Self::mul_add(x63, x90, x41));
+        let x105 = S::splat(1.0)
+            / S::mul_add(S::neg(x95), x96, S::mul_add(S::neg(x63), x89, x45));
+        let x106 = S::mul_add(S::neg(x95), x98, S::mul_add(x63, x90, x41));
         let x107 = x105 * x106;
-        let x108 = Self::mul_add(-x95, x100, Self::mul_add(-x63, x91, x71));
+        let x108 = S::mul_add(S::neg(x95), x100, S::mul_add(S::neg(x63), x91, x71));
         let x109 = x105 * x108;
-        let x110 = Self::mul_add(x95, x102, x63 * x92);
+        let x110 = S::mul_add(x95, x102, x63 * x92);
         let x111 = x105 * x110;
-        let x112 = Self::mul_add(-x95, x104, Self::mul_add(-x63, x93, x81));
+        let x112 = S::mul_add(S::neg(x95), x104, S::mul_add(S::neg(x63), x93, x81));
         let x113 = x105 * x112;
-        let x114 = Self::mul_add(
-            -x106,
+        let x114 = S::mul_add(
+            S::neg(x106),
             x107,
-            Self::mul_add(-x97, x98, Self::mul_add(-x66, x90, x24)),
+            S::mul_add(S::neg(x97), x98, S::mul_add(S::neg(x66), x90, x24)),
         );
-        let x115 = 1.0 / x114;
-        let x116 = Self::mul_add(
-            -x106,
+        let x115 = S::splat(1.0) / x114;
+        let x116 = S::mul_add(
+            S::neg(x106),
             x109,
-            Self::mul_add(-x97, x100, Self::mul_add(x66, x91, x20)),
+            S::mul_add(S::neg(x97), x100, S::mul_add(x66, x91, x20)),
         );
         let x117 = x115 * x116;
-        let x118 = Self::mul_add(x106, x111, Self::mul_add(-x97, x102, x66 * x92));
+        let x118 = S::mul_add(x106, x111, S::mul_add(S::neg(x97), x102, x66 * x92));
         let x119 = x115 * x118;
-        let x120 = Self::mul_add(
-            -x106,
+        let x120 = S::mul_add(
+            S::neg(x106),
             x113,
-            Self::mul_add(-x97, x104, Self::mul_add(x66, x93, x81)),
+            S::mul_add(S::neg(x97), x104, S::mul_add(x66, x93, x81)),
         );
         let x121 = x115 * x120;
-        let x122 = Self::mul_add(
-            -x108,
+        let x122 = S::mul_add(
+            S::neg(x108),
             x109,
-            Self::mul_add(-x99, x100, Self::mul_add(-x74, x91, x10)),
+            S::mul_add(S::neg(x99), x100, S::mul_add(S::neg(x74), x91, x10)),
         );
-        let x123 = 1.0 / Self::mul_add(-x116, x117, x122);
-        let x124 = Self::mul_add(
+        let x123 = S::splat(1.0) / S::mul_add(S::neg(x116), x117, x122);
+        let x124 = S::mul_add(
             x116,
             x119,
-            Self::mul_add(-x108, x111, Self::mul_add(x99, x102, x74 * x92)),
+            S::mul_add(S::neg(x108), x111, S::mul_add(x99, x102, x74 * x92)),
         );
         let x125 = x123 * x124;
-        let x126 = Self::mul_add(
-            -x108,
+        let x126 = S::mul_add(
+            S::neg(x108),
             x113,
-            Self::mul_add(-x99, x104, Self::mul_add(-x74, x93, x81)),
+            S::mul_add(S::neg(x99), x104, S::mul_add(S::neg(x74), x93, x81)),
         );
-        let x127 = Self::mul_add(-x116, x121, x126);
+        let x127 = S::mul_add(S::neg(x116), x121, x126);
         let x128 = x123 * x127;
-        let x129 = Self::mul_add(
-            -x110,
+        let x129 = S::mul_add(
+            S::neg(x110),
             x111,
-            Self::mul_add(-x101, x102, Self::mul_add(-x79, x92, 47.471)),
+            S::mul_add(
+                S::neg(x101),
+                x102,
+                S::mul_add(S::neg(x79), x92, S::splat(47.471)),
+            ),
         );
-        let x130 = 1.0 / Self::mul_add(-x124, x125, Self::mul_add(-x118, x119, x129));
-        let x131 = Self::mul_add(
+        let x130 = S::splat(1.0)
+            / S::mul_add(S::neg(x124), x125, S::mul_add(S::neg(x118), x119, x129));
+        let x131 = S::mul_add(
             x118,
             x121,
-            Self::mul_add(-x110, x113, Self::mul_add(x101, x104, x79 * x93)),
+            S::mul_add(S::neg(x110), x113, S::mul_add(x101, x104, x79 * x93)),
         );
-        let x132 = Self::mul_add(-x124, x128, x131);
+        let x132 = S::mul_add(S::neg(x124), x128, x131);
         let x133 = x130 * x132;
-        let x134 = Self::mul_add(
-            -x112,
+        let x134 = S::mul_add(
+            S::neg(x112),
             x113,
-            Self::mul_add(-x103, x104, Self::mul_add(-x86, x93, 9.336)),
+            S::mul_add(S::neg(x103), x104, S::mul_add(S::neg(x86), x93, S::splat(9.336))),
         );
-        let x135 = Self::mul_add(
-            -x132,
+        let x135 = S::mul_add(
+            S::neg(x132),
             x133,
-            Self::mul_add(-x127, x128, Self::mul_add(-x120, x121, x134)),
+            S::mul_add(S::neg(x127), x128, S::mul_add(S::neg(x120), x121, x134)),
         );
-        let x136 = 1.0 / x135;
-        let x137 = Self::mul_add(-x88, x96, x89);
-        let x138 = Self::mul_add(x107, x137, Self::mul_add(x88, x98, x90));
-        let x139 = Self::mul_add(
+        let x136 = S::splat(1.0) / x135;
+        let x137 = S::mul_add(S::neg(x88), x96, x89);
+        let x138 = S::mul_add(x107, x137, S::mul_add(x88, x98, x90));
+        let x139 = S::mul_add(
             x117,
             x138,
-            Self::mul_add(-x109, x137, Self::mul_add(-x88, x100, x91)),
+            S::mul_add(S::neg(x109), x137, S::mul_add(S::neg(x88), x100, x91)),
         );
-        let x140 = Self::mul_add(
+        let x140 = S::mul_add(
             x119,
             x138,
-            Self::mul_add(x111, x137, Self::mul_add(-x88, x102, x92)),
+            S::mul_add(x111, x137, S::mul_add(S::neg(x88), x102, x92)),
         );
-        let x141 = Self::mul_add(x125, x139, x140);
-        let x142 = Self::mul_add(
+        let x141 = S::mul_add(x125, x139, x140);
+        let x142 = S::mul_add(
             x121,
             x138,
-            Self::mul_add(-x113, x137, Self::mul_add(-x88, x104, x93)),
+            S::mul_add(S::neg(x113), x137, S::mul_add(S::neg(x88), x104, x93)),
         );
-        let x143 = x136 * Self::mul_add(x133, x141, Self::mul_add(-x128, x139, x142));
-        let x144 = -x143;
-        let x145 = Self::mul_add(x133, x143, x130 * x141);
-        let x146 = -x145;
-        let x147 = Self::mul_add(-x128, x143, Self::mul_add(x125, x145, x123 * x139));
-        let x148 = -x147;
-        let x149 = Self::mul_add(
+        let x143 = x136 * S::mul_add(x133, x141, S::mul_add(S::neg(x128), x139, x142));
+        let x144 = S::neg(x143);
+        let x145 = S::mul_add(x133, x143, x130 * x141);
+        let x146 = S::neg(x145);
+        let x147 = S::mul_add(S::neg(x128), x143, S::mul_add(x125, x145, x123 * x139));
+        let x148 = S::neg(x147);
+        let x149 = S::mul_add(
             x121,
             x143,
-            Self::mul_add(x119, x145, Self::mul_add(x117, x147, x115 * x138)),
+            S::mul_add(x119, x145, S::mul_add(x117, x147, x115 * x138)),
         );
-        let x150 = Self::mul_add(
+        let x150 = S::mul_add(
             x111,
             x145,
-            Self::mul_add(-x109, x147, Self::mul_add(x107, x149, x105 * x137)),
+            S::mul_add(S::neg(x109), x147, S::mul_add(x107, x149, x105 * x137)),
         );
-        let x151 = Self::mul_add(-x113, x143, x150);
-        let x152 = -x151;
-        let x153 = Self::mul_add(
-            -x100,
+        let x151 = S::mul_add(S::neg(x113), x143, x150);
+        let x152 = S::neg(x151);
+        let x153 = S::mul_add(
+            S::neg(x100),
             x147,
-            Self::mul_add(x98, x149, Self::mul_add(-x96, x151, x88 * x94)),
+            S::mul_add(x98, x149, S::mul_add(S::neg(x96), x151, x88 * x94)),
         );
-        let x154 = Self::mul_add(-x104, x143, Self::mul_add(-x102, x145, x153));
-        let x155 = Self::mul_add(
+        let x154 = S::mul_add(S::neg(x104), x143, S::mul_add(S::neg(x102), x145, x153));
+        let x155 = S::mul_add(
             x90,
             x149,
-            Self::mul_add(x89, x151, Self::mul_add(x88, x154, x87)),
+            S::mul_add(x89, x151, S::mul_add(x88, x154, x87)),
         );
-        let x156 = Self::mul_add(
+        let x156 = S::mul_add(
             x93,
             x143,
-            Self::mul_add(x92, x145, Self::mul_add(x91, x147, x155)),
+            S::mul_add(x92, x145, S::mul_add(x91, x147, x155)),
         );
-        let x157 = Self::mul_add(-x96, x107, x98);
-        let x158 = Self::mul_add(-x117, x157, Self::mul_add(-x96, x109, x100));
-        let x159 = Self::mul_add(
+        let x157 = S::mul_add(S::neg(x96), x107, x98);
+        let x158 = S::mul_add(S::neg(x117), x157, S::mul_add(S::neg(x96), x109, x100));
+        let x159 = S::mul_add(
             x125,
             x158,
-            Self::mul_add(-x119, x157, Self::mul_add(x96, x111, x102)),
+            S::mul_add(S::neg(x119), x157, S::mul_add(x96, x111, x102)),
         );
-        let x160 = Self::mul_add(
-            -x128,
+        let x160 = S::mul_add(
+            S::neg(x128),
             x158,
-            Self::mul_add(-x121, x157, Self::mul_add(-x96, x113, x104)),
+            S::mul_add(S::neg(x121), x157, S::mul_add(S::neg(x96), x113, x104)),
         );
-        let x161 = x136 * Self::mul_add(x133, x159, x160);
-        let x162 = Self::mul_add(x133, x161, x130 * x159);
-        let x163 = Self::mul_add(-x128, x161, Self::mul_add(x125, x162, x123 * x158));
-        let x164 = Self::mul_add(
-            -x121,
+        let x161 = x136 * S::mul_add(x133, x159, x160);
+        let x162 = S::mul_add(x133, x161, x130 * x159);
+        let x163 = S::mul_add(S::neg(x128), x161, S::mul_add(x125, x162, x123 * x158));
+        let x164 = S::mul_add(
+            S::neg(x121),
             x161,
-            Self::mul_add(-x119, x162, Self::mul_add(-x117, x163, x115 * x157)),
+            S::mul_add(S::neg(x119), x162, S::mul_add(S::neg(x117), x163, x115 * x157)),
         );
-        let x165 = Self::mul_add(
+        let x165 = S::mul_add(
             x111,
             x162,
-            Self::mul_add(-x109, x163, Self::mul_add(-x107, x164, x96 * x105)),
+            S::mul_add(S::neg(x109), x163, S::mul_add(S::neg(x107), x164, x96 * x105)),
         );
-        let x166 = Self::mul_add(-x113, x161, x165);
-        let x167 = Self::mul_add(
+        let x166 = S::mul_add(S::neg(x113), x161, x165);
+        let x167 = S::mul_add(
             x100,
             x163,
-            Self::mul_add(x98, x164, Self::mul_add(x96, x166, x94)),
+            S::mul_add(x98, x164, S::mul_add(x96, x166, x94)),
         );
-        let x168 = Self::mul_add(x104, x161, Self::mul_add(x102, x162, x167));
-        let x169 = Self::mul_add(
-            -x91,
+        let x168 = S::mul_add(x104, x161, S::mul_add(x102, x162, x167));
+        let x169 = S::mul_add(
+            S::neg(x91),
             x163,
-            Self::mul_add(x90, x164, Self::mul_add(-x89, x166, x88 * x168)),
+            S::mul_add(x90, x164, S::mul_add(S::neg(x89), x166, x88 * x168)),
         );
-        let x170 = Self::mul_add(-x93, x161, Self::mul_add(-x92, x162, x169));
-        let x171 = Self::mul_add(-x107, x117, x109);
-        let x172 = Self::mul_add(-x125, x171, Self::mul_add(x107, x119, x111));
-        let x173 = Self::mul_add(
-            -x133,
+        let x170 = S::mul_add(S::neg(x93), x161, S::mul_add(S::neg(x92), x162, x169));
+        let x171 = S::mul_add(S::neg(x107), x117, x109);
+        let x172 = S::mul_add(S::neg(x125), x171, S::mul_add(x107, x119, x111));
+        let x173 = S::mul_add(
+            S::neg(x133),
             x172,
-            Self::mul_add(-x128, x171, Self::mul_add(-x107, x121, x113)),
+            S::mul_add(S::neg(x128), x171, S::mul_add(S::neg(x107), x121, x113)),
         );
         let x174 = x136 * x173;
-        let x175 = -x174;
-        let x176 = Self::mul_add(-x133, x174, x130 * x172);
-        let x177 = Self::mul_add(-x128, x174, Self::mul_add(-x125, x176, x123 * x171));
-        let x178 = -x177;
-        let x179 = Self::mul_add(
-            -x121,
+        let x175 = S::neg(x174);
+        let x176 = S::mul_add(S::neg(x133), x174, x130 * x172);
+        let x177 = S::mul_add(
+            S::neg(x128),
             x174,
-            Self::mul_add(x119, x176, Self::mul_add(-x117, x177, x107 * x115)),
+            S::mul_add(S::neg(x125), x176, x123 * x171),
         );
-        let x180 = -x179;
-        let x181 = Self::mul_add(
+        let x178 = S::neg(x177);
+        let x179 = S::mul_add(
+            S::neg(x121),
+            x174,
+            S::mul_add(x119, x176, S::mul_add(S::neg(x117), x177, x107 * x115)),
+        );
+        let x180 = S::neg(x179);
+        let x181 = S::mul_add(
             x111,
             x176,
-            Self::mul_add(x109, x177, Self::mul_add(x107, x179, x105)),
+            S::mul_add(x109, x177, S::mul_add(x107, x179, x105)),
         );
-        let x182 = Self::mul_add(x113, x174, x181);
-        let x183 = Self::mul_add(
+        let x182 = S::mul_add(x113, x174, x181);
+        let x183 = S::mul_add(
             x102,
             x176,
-            Self::mul_add(-x100, x177, Self::mul_add(-x98, x179, x96 * x182)),
+            S::mul_add(S::neg(x100), x177, S::mul_add(S::neg(x98), x179, x96 * x182)),
         );
-        let x184 = Self::mul_add(-x104, x174, x183);
-        let x185 = Self::mul_add(
+        let x184 = S::mul_add(S::neg(x104), x174, x183);
+        let x185 = S::mul_add(
             x91,
             x177,
-            Self::mul_add(-x90, x179, Self::mul_add(-x89, x182, x88 * x184)),
+            S::mul_add(S::neg(x90), x179, S::mul_add(S::neg(x89), x182, x88 * x184)),
         );
-        let x186 = Self::mul_add(x93, x174, Self::mul_add(-x92, x176, x185));
-        let x187 = Self::mul_add(x117, x125, x119);
-        let x188 = x136 * Self::mul_add(x133, x187, Self::mul_add(-x117, x128, x121));
-        let x189 = -x188;
-        let x190 = Self::mul_add(x133, x188, x130 * x187);
-        let x191 = -x190;
-        let x192 = Self::mul_add(-x128, x188, Self::mul_add(x125, x190, x117 * x123));
-        let x193 = -x192;
-        let x194 = Self::mul_add(
+        let x186 = S::mul_add(x93, x174, S::mul_add(S::neg(x92), x176, x185));
+        let x187 = S::mul_add(x117, x125, x119);
+        let x188 = x136 * S::mul_add(x133, x187, S::mul_add(S::neg(x117), x128, x121));
+        let x189 = S::neg(x188);
+        let x190 = S::mul_add(x133, x188, x130 * x187);
+        let x191 = S::neg(x190);
+        let x192 = S::mul_add(S::neg(x128), x188, S::mul_add(x125, x190, x117 * x123));
+        let x193 = S::neg(x192);
+        let x194 = S::mul_add(
             x121,
             x188,
-            Self::mul_add(x119, x190, Self::mul_add(x117, x192, x115)),
+            S::mul_add(x119, x190, S::mul_add(x117, x192, x115)),
         );
-        let x195 = Self::mul_add(
-            -x113,
+        let x195 = S::mul_add(
+            S::neg(x113),
             x188,
-            Self::mul_add(x111, x190, Self::mul_add(-x109, x192, x107 * x194)),
+            S::mul_add(x111, x190, S::mul_add(S::neg(x109), x192, x107 * x194)),
         );
-        let x196 = -x195;
-        let x197 = Self::mul_add(
+        let x196 = S::neg(x195);
+        let x197 = S::mul_add(
             x102,
             x190,
-            Self::mul_add(x100, x192, Self::mul_add(-x98, x194, x96 * x195)),
+            S::mul_add(x100, x192, S::mul_add(S::neg(x98), x194, x96 * x195)),
         );
-        let x198 = Self::mul_add(x104, x188, x197);
-        let x199 = -x198;
-        let x200 = Self::mul_add(
-            -x91,
+        let x198 = S::mul_add(x104, x188, x197);
+        let x199 = S::neg(x198);
+        let x200 = S::mul_add(
+            S::neg(x91),
             x192,
-            Self::mul_add(-x90, x194, Self::mul_add(-x89, x195, x88 * x198)),
+            S::mul_add(S::neg(x90), x194, S::mul_add(S::neg(x89), x195, x88 * x198)),
         );
-        let x201 = Self::mul_add(-x93, x188, Self::mul_add(-x92, x190, x200));
-        let x202 = -x201;
-        let x203 = x136 * Self::mul_add(-x125, x133, x128);
-        let x204 = -x203;
-        let x205 = Self::mul_add(-x133, x203, x125 * x130);
-        let x206 = Self::mul_add(x128, x203, Self::mul_add(x125, x205, x123));
-        let x207 = Self::mul_add(-x121, x203, Self::mul_add(x119, x205, x117 * x206));
-        let x208 = -x207;
-        let x209 = Self::mul_add(
+        let x201 = S::mul_add(S::neg(x93), x188, S::mul_add(S::neg(x92), x190, x200));
+        let x202 = S::neg(x201);
+        let x203 = x136 * S::mul_add(S::neg(x125), x133, x128);
+        let x204 = S::neg(x203);
+        let x205 = S::mul_add(S::neg(x133), x203, x125 * x130);
+        let x206 = S::mul_add(x128, x203, S::mul_add(x125, x205, x123));
+        let x207 = S::mul_add(S::neg(x121), x203, S::mul_add(x119, x205, x117 * x206));
+        let x208 = S::neg(x207);
+        let x209 = S::mul_add(
             x113,
             x203,
-            Self::mul_add(x111, x205, Self::mul_add(-x109, x206, x107 * x207)),
+            S::mul_add(x111, x205, S::mul_add(S::neg(x109), x206, x107 * x207)),
         );
-        let x210 = Self::mul_add(
+        let x210 = S::mul_add(
             x102,
             x205,
-            Self::mul_add(x100, x206, Self::mul_add(-x98, x207, x96 * x209)),
+            S::mul_add(x100, x206, S::mul_add(S::neg(x98), x207, x96 * x209)),
         );
-        let x211 = Self::mul_add(-x104, x203, x210);
-        let x212 = Self::mul_add(
-            -x91,
+        let x211 = S::mul_add(S::neg(x104), x203, x210);
+        let x212 = S::mul_add(
+            S::neg(x91),
             x206,
-            Self::mul_add(-x90, x207, Self::mul_add(-x89, x209, x88 * x211)),
+            S::mul_add(S::neg(x90), x207, S::mul_add(S::neg(x89), x209, x88 * x211)),
         );
-        let x213 = Self::mul_add(x93, x203, Self::mul_add(-x92, x205, x212));
+        let x213 = S::mul_add(x93, x203, S::mul_add(S::neg(x92), x205, x212));
         let x214 = x133 * x136;
-        let x215 = Self::mul_add(x133, x214, x130);
-        let x216 = Self::mul_add(-x128, x214, x125 * x215);
-        let x217 = Self::mul_add(x121, x214, Self::mul_add(x119, x215, x117 * x216));
-        let x218 = -x217;
-        let x219 = Self::mul_add(
-            -x113,
+        let x215 = S::mul_add(x133, x214, x130);
+        let x216 = S::mul_add(S::neg(x128), x214, x125 * x215);
+        let x217 = S::mul_add(x121, x214, S::mul_add(x119, x215, x117 * x216));
+        let x218 = S::neg(x217);
+        let x219 = S::mul_add(
+            S::neg(x113),
             x214,
-            Self::mul_add(x111, x215, Self::mul_add(-x109, x216, x107 * x217)),
+            S::mul_add(x111, x215, S::mul_add(S::neg(x109), x216, x107 * x217)),
         );
-        let x220 = Self::mul_add(
+        let x220 = S::mul_add(
             x102,
             x215,
-            Self::mul_add(x100, x216, Self::mul_add(-x98, x217, x96 * x219)),
+            S::mul_add(x100, x216, S::mul_add(S::neg(x98), x217, x96 * x219)),
         );
-        let x221 = Self::mul_add(x104, x214, x220);
-        let x222 = Self::mul_add(
-            -x91,
+        let x221 = S::mul_add(x104, x214, x220);
+        let x222 = S::mul_add(
+            S::neg(x91),
             x216,
-            Self::mul_add(-x90, x217, Self::mul_add(-x89, x219, x88 * x221)),
+            S::mul_add(S::neg(x90), x217, S::mul_add(S::neg(x89), x219, x88 * x221)),
         );
-        let x223 = Self::mul_add(-x93, x214, Self::mul_add(-x92, x215, x222));
-        let x224 = Self::mul_add(-x128, x136, x125 * x214);
-        let x225 = Self::mul_add(x121, x136, Self::mul_add(x119, x214, x117 * x224));
-        let x226 = -x225;
-        let x227 = Self::mul_add(
-            -x113,
+        let x223 = S::mul_add(S::neg(x93), x214, S::mul_add(S::neg(x92), x215, x222));
+        let x224 = S::mul_add(S::neg(x128), x136, x125 * x214);
+        let x225 = S::mul_add(x121, x136, S::mul_add(x119, x214, x117 * x224));
+        let x226 = S::neg(x225);
+        let x227 = S::mul_add(
+            S::neg(x113),
             x136,
-            Self::mul_add(x111, x214, Self::mul_add(-x109, x224, x107 * x225)),
+            S::mul_add(x111, x214, S::mul_add(S::neg(x109), x224, x107 * x225)),
         );
-        let x228 = Self::mul_add(
+        let x228 = S::mul_add(
             x102,
             x214,
-            Self::mul_add(x100, x224, Self::mul_add(-x98, x225, x96 * x227)),
+            S::mul_add(x100, x224, S::mul_add(S::neg(x98), x225, x96 * x227)),
         );
-        let x229 = Self::mul_add(x104, x136, x228);
-        let x230 = Self::mul_add(
-            -x91,
+        let x229 = S::mul_add(x104, x136, x228);
+        let x230 = S::mul_add(
+            S::neg(x91),
             x224,
-            Self::mul_add(-x90, x225, Self::mul_add(-x89, x227, x88 * x229)),
+            S::mul_add(S::neg(x90), x225, S::mul_add(S::neg(x89), x227, x88 * x229)),
         );
-        let x231 = Self::mul_add(-x93, x136, Self::mul_add(-x92, x214, x230));
+        let x231 = S::mul_add(S::neg(x93), x136, S::mul_add(S::neg(x92), x214, x230));
         let x232 = qd[0] * c_q1;
         let x233 = qd[0] * s_q1;
-        let x234 = qd[0] * 0.7026;
+        let x234 = qd[0] * S::splat(0.7026);
         let x235 = s_q1 * x234;
         let x236 = c_q1 * x234;
         let x237 = qd[1] * x233;
         let x238 = qd[1] * x232;
         let x239 = qd[1] * x236;
         let x240 = qd[1] * x235;
-        let x241 = x233 * 1647.2196721184;
-        let x242 = Self::mul_add(-1145.5438279999998, x235, 1650.6386721183999 * qd[1]);
-        let x243 = 1145.5438279999998 * qd[1];
-        let x244 = 1145.5438279999998 * x232;
-        let x245 = Self::mul_add(-qd[1], s_q2, c_q2 * x232);
-        let x246 = Self::mul_add(qd[1], c_q2, s_q2 * x232);
-        let x247 = 0.5692 * x232;
-        let x248 = Self::mul_add(-0.5692, qd[1], x235);
-        let x249 = Self::mul_add(-s_q2, x247, c_q2 * x248);
-        let x250 = Self::mul_add(c_q2, x247, s_q2 * x248);
+        let x241 = x233 * S::splat(1647.2196721184);
+        let x242 = S::mul_add(
+            S::splat(-1145.5438279999998),
+            x235,
+            S::splat(1650.6386721183999) * qd[1],
+        );
+        let x243 = S::splat(1145.5438279999998) * qd[1];
+        let x244 = S::splat(1145.5438279999998) * x232;
+        let x245 = S::mul_add(S::neg(qd[1]), s_q2, c_q2 * x232);
+        let x246 = S::mul_add(qd[1], c_q2, s_q2 * x232);
+        let x247 = S::splat(0.5692) * x232;
+        let x248 = S::mul_add(S::splat(-0.5692), qd[1], x235);
+        let x249 = S::mul_add(S::neg(s_q2), x247, c_q2 * x248);
+        let x250 = S::mul_add(c_q2, x247, s_q2 * x248);
         let x251 = qd[2] - x233;
-        let x252 = 0.5692 * x237;
-        let x253 = Self::mul_add(qd[2], x246, c_q2 * x237);
-        let x254 = Self::mul_add(-qd[2], x245, s_q2 * x237);
-        let x255 = Self::mul_add(qd[2], x249, Self::mul_add(-c_q2, x252, s_q2 * x239));
-        let x256 = 3946.18812068 * x251;
-        let x257 = Self::mul_add(-5224.5702, x236, 39234.474122 * x246);
-        let x258 = Self::mul_add(
-            5224.5702,
+        let x252 = S::splat(0.5692) * x237;
+        let x253 = S::mul_add(qd[2], x246, c_q2 * x237);
+        let x254 = S::mul_add(S::neg(qd[2]), x245, s_q2 * x237);
+        let x255 = S::mul_add(qd[2], x249, S::mul_add(S::neg(c_q2), x252, s_q2 * x239));
+        let x256 = S::splat(3946.18812068) * x251;
+        let x257 = S::mul_add(S::splat(-5224.5702), x236, S::splat(39234.474122) * x246);
+        let x258 = S::mul_add(
+            S::splat(5224.5702),
             x250,
-            Self::mul_add(39241.404122, x251, 3946.1881206800003 * x245),
+            S::mul_add(S::splat(39241.404122), x251, S::splat(3946.1881206800003) * x245),
         );
-        let x259 = 5224.5702 * x251;
-        let x260 = 5224.5702 * x246;
-        let x261 = Self::mul_add(-s_q3, x246, c_q3 * x245);
-        let x262 = Self::mul_add(c_q3, x246, s_q3 * x245);
-        let x263 = Self::mul_add(-0.475, x246, x249);
-        let x264 = x250 + Self::mul_add(7.11, x251, 0.475 * x245);
-        let x265 = Self::mul_add(-7.11, x246, x236);
-        let x266 = Self::mul_add(-s_q3, x264, c_q3 * x263);
-        let x267 = Self::mul_add(c_q3, x264, s_q3 * x263);
+        let x259 = S::splat(5224.5702) * x251;
+        let x260 = S::splat(5224.5702) * x246;
+        let x261 = S::mul_add(S::neg(s_q3), x246, c_q3 * x245);
+        let x262 = S::mul_add(c_q3, x246, s_q3 * x245);
+        let x263 = S::mul_add(S::splat(-0.475), x246, x249);
+        let x264 = x250 + S::mul_add(S::splat(7.11), x251, S::splat(0.475) * x245);
+        let x265 = S::mul_add(S::splat(-7.11), x246, x236);
+        let x266 = S::mul_add(S::neg(s_q3), x264, c_q3 * x263);
+        let x267 = S::mul_add(c_q3, x264, s_q3 * x263);
         let x268 = qd[3] + x251;
-        let x269 = 7.11 * x238;
-        let x270 = Self::mul_add(
-            0.475,
+        let x269 = S::splat(7.11) * x238;
+        let x270 = S::mul_add(
+            S::splat(0.475),
             x254,
-            Self::mul_add(-qd[2], x250, Self::mul_add(s_q2, x252, c_q2 * x239)),
+            S::mul_add(S::neg(qd[2]), x250, S::mul_add(s_q2, x252, c_q2 * x239)),
         );
-        let x271 = x255 - Self::mul_add(0.475, x253, x269);
-        let x272 = Self::mul_add(-7.11, x254, x240);
-        let x273 = Self::mul_add(qd[3], x262, Self::mul_add(-s_q3, x254, c_q3 * x253));
-        let x274 = Self::mul_add(-qd[3], x261, Self::mul_add(c_q3, x254, s_q3 * x253));
-        let x275 = Self::mul_add(qd[3], x266, Self::mul_add(c_q3, x271, s_q3 * x270));
-        let x276 = 1375.0472756800002 * x268;
-        let x277 = Self::mul_add(-3239.4582, x265, 24989.305802 * x262);
-        let x278 = Self::mul_add(
-            3239.4582,
+        let x271 = x255 - S::mul_add(S::splat(0.475), x253, x269);
+        let x272 = S::mul_add(S::splat(-7.11), x254, x240);
+        let x273 = S::mul_add(qd[3], x262, S::mul_add(S::neg(s_q3), x254, c_q3 * x253));
+        let x274 = S::mul_add(S::neg(qd[3]), x261, S::mul_add(c_q3, x254, s_q3 * x253));
+        let x275 = S::mul_add(qd[3], x266, S::mul_add(c_q3, x271, s_q3 * x270));
+        let x276 = S::splat(1375.0472756800002) * x268;
+        let x277 = S::mul_add(S::splat(-3239.4582), x265, S::splat(24989.305802) * x262);
+        let x278 = S::mul_add(
+            S::splat(3239.4582),
             x267,
-            Self::mul_add(24998.827802, x268, 1375.0472756800002 * x261),
+            S::mul_add(S::splat(24998.827802), x268, S::splat(1375.0472756800002) * x261),
         );
-        let x279 = 3239.4582 * x268;
-        let x280 = 3239.4582 * x262;
-        let x281 = Self::mul_add(-s_q4, x262, c_q4 * x261);
-        let x282 = Self::mul_add(c_q4, x262, s_q4 * x261);
-        let x283 = Self::mul_add(7.11, x268, x267);
-        let x284 = Self::mul_add(-7.11, x262, x265);
-        let x285 = Self::mul_add(-s_q4, x283, c_q4 * x266);
-        let x286 = Self::mul_add(c_q4, x283, s_q4 * x266);
+        let x279 = S::splat(3239.4582) * x268;
+        let x280 = S::splat(3239.4582) * x262;
+        let x281 = S::mul_add(S::neg(s_q4), x262, c_q4 * x261);
+        let x282 = S::mul_add(c_q4, x262, s_q4 * x261);
+        let x283 = S::mul_add(S::splat(7.11), x268, x267);
+        let x284 = S::mul_add(S::splat(-7.11), x262, x265);
+        let x285 = S::mul_add(S::neg(s_q4), x283, c_q4 * x266);
+        let x286 = S::mul_add(c_q4, x283, s_q4 * x266);
         let x287 = qd[4] + x268;
-        let x288 = Self::mul_add(
+        let x288 = S::mul_add(
             s_q4,
             x269 - x275,
-            c_q4 * Self::mul_add(-qd[3], x267, Self::mul_add(-s_q3, x271, c_q3 * x270)),
+            c_q4
+                * S::mul_add(
+                    S::neg(qd[3]),
+                    x267,
+                    S::mul_add(S::neg(s_q3), x271, c_q3 * x270),
+                ),
         );
-        let x289 = Self::mul_add(qd[4], x282, Self::mul_add(-s_q4, x274, c_q4 * x273));
-        let x290 = Self::mul_add(-qd[4], x281, Self::mul_add(c_q4, x274, s_q4 * x273));
-        let x291 = Self::mul_add(97.44448770720001, x287, x282 * 177.0883695416);
-        let x292 = 171.195516 * x284;
-        let x293 = Self::mul_add(
-            -171.195516,
+        let x289 = S::mul_add(qd[4], x282, S::mul_add(S::neg(s_q4), x274, c_q4 * x273));
+        let x290 = S::mul_add(S::neg(qd[4]), x281, S::mul_add(c_q4, x274, s_q4 * x273));
+        let x291 = S::mul_add(
+            S::splat(97.44448770720001),
+            x287,
+            x282 * S::splat(177.0883695416),
+        );
+        let x292 = S::splat(171.195516) * x284;
+        let x293 = S::mul_add(
+            S::splat(-171.195516),
             x285,
-            Self::mul_add(-179.8829695416, x287, 97.44448770720001 * x282),
+            S::mul_add(
+                S::splat(-179.8829695416),
+                x287,
+                S::splat(97.44448770720001) * x282,
+            ),
         );
-        let x294 = 171.195516 * x287;
-        let x295 = 171.195516 * x281;
-        let x296 = Self::mul_add(x281, x295, x287 * x294);
-        let x297 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-7.11, x274, x272),
-            -Self::mul_add(-x286, x295, Self::mul_add(-x282, x293, x287 * x291)),
+        let x294 = S::splat(171.195516) * x287;
+        let x295 = S::splat(171.195516) * x281;
+        let x296 = S::mul_add(x281, x295, x287 * x294);
+        let x297 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::splat(-7.11), x274, x272),
+            S::neg(
+                S::mul_add(
+                    S::neg(x286),
+                    x295,
+                    S::mul_add(S::neg(x282), x293, x287 * x291),
+                ),
+            ),
         );
-        let x298 = Self::mul_add(-x282, x295, 171.195516 * x238);
-        let x299 = Self::mul_add(x282, x294, 171.195516 * x289);
-        let x300 = Self::mul_add(-c_q5, x287, s_q5 * x281);
-        let x301 = Self::mul_add(s_q5, x287, c_q5 * x281);
+        let x298 = S::mul_add(S::neg(x282), x295, S::splat(171.195516) * x238);
+        let x299 = S::mul_add(x282, x294, S::splat(171.195516) * x289);
+        let x300 = S::mul_add(S::neg(c_q5), x287, s_q5 * x281);
+        let x301 = S::mul_add(s_q5, x287, c_q5 * x281);
         let x302 = qd[5] + x282;
-        let x303 = Self::mul_add(qd[5], x300, Self::mul_add(s_q5, x238, c_q5 * x289));
-        let x304 = 44.41 * x301;
-        let x305 = 47.471 * x302;
-        let x306 = 9.336 * x303;
-        let x307 = 9.336 * (qd[6] + x301);
-        let x308 = Self::mul_add(c_q6, x302, s_q6 * x300) * x307;
-        let x309 = Self::mul_add(-s_q6, x302, c_q6 * x300) * x307;
-        let x310 = Self::mul_add(x301, x305, x302 * x304)
-            - Self::mul_add(-s_q6, x309, c_q6 * x308);
-        let x311 = Self::mul_add(-x300, x305, 44.41 * x303) - x306;
-        let x312 = Self::mul_add(x300, x304, 47.471 * x290)
-            - Self::mul_add(c_q6, x309, s_q6 * x308);
-        let x313 = x297 + Self::mul_add(c_q5, x311, s_q5 * x310);
-        let x314 = Self::mul_add(97.44448770720001, x238, x290 * 177.0883695416)
-            + (Self::mul_add(-x281, x293, x287 * x292)
-                - Self::mul_add(x285, x295, x284 * x294)) - x312;
-        let x315 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-qd[4], x286, x288),
-            Self::mul_add(-179.8829695416, x238, 97.44448770720001 * x290),
-        ) - Self::mul_add(-x286, x294, Self::mul_add(-x281, x291, x282 * x292))
-            - Self::mul_add(-s_q5, x311, c_q5 * x310);
-        let x316 = Self::mul_add(-c_q4, x296, s_q4 * x298);
-        let x317 = Self::mul_add(
-            1375.0472756800002,
+        let x303 = S::mul_add(qd[5], x300, S::mul_add(s_q5, x238, c_q5 * x289));
+        let x304 = S::splat(44.41) * x301;
+        let x305 = S::splat(47.471) * x302;
+        let x306 = S::splat(9.336) * x303;
+        let x307 = S::splat(9.336) * (qd[6] + x301);
+        let x308 = S::mul_add(c_q6, x302, s_q6 * x300) * x307;
+        let x309 = S::mul_add(S::neg(s_q6), x302, c_q6 * x300) * x307;
+        let x310 = S::mul_add(x301, x305, x302 * x304)
+            - S::mul_add(S::neg(s_q6), x309, c_q6 * x308);
+        let x311 = S::mul_add(S::neg(x300), x305, S::splat(44.41) * x303) - x306;
+        let x312 = S::mul_add(x300, x304, S::splat(47.471) * x290)
+            - S::mul_add(c_q6, x309, s_q6 * x308);
+        let x313 = x297 + S::mul_add(c_q5, x311, s_q5 * x310);
+        let x314 = S::mul_add(
+            S::splat(97.44448770720001),
             x238,
-            -(Self::mul_add(-x262, x278, x268 * x277)
-                + Self::mul_add(x267, x280, x265 * x279)),
-        ) - Self::mul_add(s_q4, x314, c_q4 * x313);
-        let x318 = Self::mul_add(-3239.4582, x272, 24989.305802 * x274)
-            + Self::mul_add(x266, x280, Self::mul_add(-x261, x278, x268 * x276))
-            + Self::mul_add(7.11, x299, Self::mul_add(-c_q4, x314, s_q4 * x313));
-        let x319 = Self::mul_add(
-            -3239.4582,
+            x290 * S::splat(177.0883695416),
+        )
+            + (S::mul_add(S::neg(x281), x293, x287 * x292)
+                - S::mul_add(x285, x295, x284 * x294)) - x312;
+        let x315 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::neg(qd[4]), x286, x288),
+            S::mul_add(
+                S::splat(-179.8829695416),
+                x238,
+                S::splat(97.44448770720001) * x290,
+            ),
+        ) - S::mul_add(S::neg(x286), x294, S::mul_add(S::neg(x281), x291, x282 * x292))
+            - S::mul_add(S::neg(s_q5), x311, c_q5 * x310);
+        let x316 = S::mul_add(S::neg(c_q4), x296, s_q4 * x298);
+        let x317 = S::mul_add(
+            S::splat(1375.0472756800002),
+            x238,
+            S::neg(
+                S::mul_add(S::neg(x262), x278, x268 * x277)
+                    + S::mul_add(x267, x280, x265 * x279),
+            ),
+        ) - S::mul_add(s_q4, x314, c_q4 * x313);
+        let x318 = S::mul_add(S::splat(-3239.4582), x272, S::splat(24989.305802) * x274)
+            + S::mul_add(x266, x280, S::mul_add(S::neg(x261), x278, x268 * x276))
+            + S::mul_add(
+                S::splat(7.11),
+                x299,
+                S::mul_add(S::neg(c_q4), x314, s_q4 * x313),
+            );
+        let x319 = S::mul_add(
+            S::splat(-3239.4582),
             x275,
-            Self::mul_add(24998.827802, x238, 1375.0472756800002 * x273),
-        ) - Self::mul_add(-x266, x279, Self::mul_add(-x261, x277, x262 * x276))
-            - Self::mul_add(7.11, x316, x315);
-        let x320 = Self::mul_add(x262, x280, x268 * x279)
-            - Self::mul_add(s_q4, x296, c_q4 * x298);
-        let x321 = Self::mul_add(x261, x280, 3239.4582 * x238) - x316;
-        let x322 = Self::mul_add(-x261, x279, 3239.4582 * x274) + x299;
-        let x323 = Self::mul_add(-s_q3, x321, c_q3 * x320);
-        let x324 = Self::mul_add(c_q3, x321, s_q3 * x320);
-        let x325 = Self::mul_add(
-            3946.18812068,
+            S::mul_add(S::splat(24998.827802), x238, S::splat(1375.0472756800002) * x273),
+        ) - S::mul_add(S::neg(x266), x279, S::mul_add(S::neg(x261), x277, x262 * x276))
+            - S::mul_add(S::splat(7.11), x316, x315);
+        let x320 = S::mul_add(x262, x280, x268 * x279)
+            - S::mul_add(s_q4, x296, c_q4 * x298);
+        let x321 = S::mul_add(x261, x280, S::splat(3239.4582) * x238) - x316;
+        let x322 = S::mul_add(S::neg(x261), x279, S::splat(3239.4582) * x274) + x299;
+        let x323 = S::mul_add(S::neg(s_q3), x321, c_q3 * x320);
+        let x324 = S::mul_add(c_q3, x321, s_q3 * x320);
+        let x325 = S::mul_add(
+            S::splat(3946.18812068),
             x238,
-            -(Self::mul_add(-x246, x258, x251 * x257)
-                + Self::mul_add(x250, x260, x236 * x259)),
-        ) + Self::mul_add(0.475, x324, Self::mul_add(s_q3, x318, c_q3 * x317));
-        let x326 = Self::mul_add(-5224.5702, x240, 39234.474122 * x254)
-            + Self::mul_add(x249, x260, Self::mul_add(-x245, x258, x251 * x256))
-            - (Self::mul_add(-c_q3, x318, s_q3 * x317)
-                - Self::mul_add(7.11, x322, 0.475 * x323));
-        let x327 = Self::mul_add(
-            -5224.5702,
+            S::neg(
+                S::mul_add(S::neg(x246), x258, x251 * x257)
+                    + S::mul_add(x250, x260, x236 * x259),
+            ),
+        ) + S::mul_add(S::splat(0.475), x324, S::mul_add(s_q3, x318, c_q3 * x317));
+        let x326 = S::mul_add(S::splat(-5224.5702), x240, S::splat(39234.474122) * x254)
+            + S::mul_add(x249, x260, S::mul_add(S::neg(x245), x258, x251 * x256))
+            - (S::mul_add(S::neg(c_q3), x318, s_q3 * x317)
+                - S::mul_add(S::splat(7.11), x322, S::splat(0.475) * x323));
+        let x327 = S::mul_add(
+            S::splat(-5224.5702),
             x255,
-            Self::mul_add(39241.404122, x238, 3946.1881206800003 * x253),
-        ) - Self::mul_add(-x249, x259, Self::mul_add(-x245, x257, x246 * x256))
-            + Self::mul_add(7.11, x324, x319);
-        let x328 = Self::mul_add(x246, x260, x251 * x259) + x323;
-        let x329 = Self::mul_add(x245, x260, 5224.5702 * x238) + x324;
-        let x330 = Self::mul_add(-s_q2, x329, c_q2 * x328);
-        let x331 = Self::mul_add(
+            S::mul_add(S::splat(39241.404122), x238, S::splat(3946.1881206800003) * x253),
+        ) - S::mul_add(S::neg(x249), x259, S::mul_add(S::neg(x245), x257, x246 * x256))
+            + S::mul_add(S::splat(7.11), x324, x319);
+        let x328 = S::mul_add(x246, x260, x251 * x259) + x323;
+        let x329 = S::mul_add(x245, x260, S::splat(5224.5702) * x238) + x324;
+        let x330 = S::mul_add(S::neg(s_q2), x329, c_q2 * x328);
+        let x331 = S::mul_add(
             s_q1,
-            Self::mul_add(x238, 1647.2196721184, -Self::mul_add(x235, x244, x232 * x242))
-                - x327,
+            S::mul_add(
+                x238,
+                S::splat(1647.2196721184),
+                S::neg(S::mul_add(x235, x244, x232 * x242)),
+            ) - x327,
             c_q1
-                * (Self::mul_add(-x236, x244, Self::mul_add(x233, x242, qd[1] * x241))
-                    + Self::mul_add(
-                        0.5692,
-                        Self::mul_add(c_q2, x329, s_q2 * x328),
-                        Self::mul_add(s_q2, x326, c_q2 * x325),
+                * (S::mul_add(S::neg(x236), x244, S::mul_add(x233, x242, qd[1] * x241))
+                    + S::mul_add(
+                        S::splat(0.5692),
+                        S::mul_add(c_q2, x329, s_q2 * x328),
+                        S::mul_add(s_q2, x326, c_q2 * x325),
                     )),
         );
-        let x332 = Self::mul_add(
-            0.7026,
-            Self::mul_add(
+        let x332 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(
                 c_q1,
-                Self::mul_add(x232, x244, qd[1] * x243)
-                    - (Self::mul_add(-x245, x259, 5224.5702 * x254) + x322),
-                s_q1 * Self::mul_add(x233, x244, -x330),
+                S::mul_add(x232, x244, qd[1] * x243)
+                    - (S::mul_add(S::neg(x245), x259, S::splat(5224.5702) * x254)
+                        + x322),
+                s_q1 * S::mul_add(x233, x244, S::neg(x330)),
             ),
             x331,
         );
         let x333 = tau[0] + x332;
         let x334 = tau[1]
-            + (Self::mul_add(
-                1145.5438279999998,
+            + (S::mul_add(
+                S::splat(1145.5438279999998),
                 x239,
-                -Self::mul_add(x236, x243, x232 * x241),
-            ) - Self::mul_add(-0.5692, x330, Self::mul_add(-c_q2, x326, s_q2 * x325)));
+                S::neg(S::mul_add(x236, x243, x232 * x241)),
+            )
+                - S::mul_add(
+                    S::splat(-0.5692),
+                    x330,
+                    S::mul_add(S::neg(c_q2), x326, s_q2 * x325),
+                ));
         let x335 = tau[2] + x327;
         let x336 = tau[3] + x319;
         let x337 = tau[4] - x315;
         let x338 = tau[5] + x312;
         let x339 = tau[6] + x306;
-        let x340 = Self::mul_add(
+        let x340 = S::mul_add(
             x149,
             x336,
-            Self::mul_add(-x151, x335, Self::mul_add(x154, x334, x156 * x333)),
+            S::mul_add(S::neg(x151), x335, S::mul_add(x154, x334, x156 * x333)),
         );
-        let x341 = Self::mul_add(
-            -x143,
+        let x341 = S::mul_add(
+            S::neg(x143),
             x339,
-            Self::mul_add(-x145, x338, Self::mul_add(-x147, x337, x340)),
+            S::mul_add(S::neg(x145), x338, S::mul_add(S::neg(x147), x337, x340)),
         );
-        let x342 = Self::mul_add(
+        let x342 = S::mul_add(
             x164,
             x336,
-            Self::mul_add(x166, x335, Self::mul_add(x168, x334, x170 * x333)),
+            S::mul_add(x166, x335, S::mul_add(x168, x334, x170 * x333)),
         );
-        let x343 = Self::mul_add(
+        let x343 = S::mul_add(
             x161,
             x339,
-            Self::mul_add(x162, x338, Self::mul_add(x163, x337, x342)),
+            S::mul_add(x162, x338, S::mul_add(x163, x337, x342)),
         );
-        let x344 = Self::mul_add(
-            -x179,
+        let x344 = S::mul_add(
+            S::neg(x179),
             x336,
-            Self::mul_add(x182, x335, Self::mul_add(x184, x334, x186 * x333)),
+            S::mul_add(x182, x335, S::mul_add(x184, x334, x186 * x333)),
         );
-        let x345 = Self::mul_add(
-            -x174,
+        let x345 = S::mul_add(
+            S::neg(x174),
             x339,
-            Self::mul_add(x176, x338, Self::mul_add(-x177, x337, x344)),
+            S::mul_add(x176, x338, S::mul_add(S::neg(x177), x337, x344)),
         );
-        let x346 = Self::mul_add(
-            -x194,
+        let x346 = S::mul_add(
+            S::neg(x194),
             x336,
-            Self::mul_add(x195, x335, Self::mul_add(x198, x334, x201 * x333)),
+            S::mul_add(x195, x335, S::mul_add(x198, x334, x201 * x333)),
         );
-        let x347 = Self::mul_add(
+        let x347 = S::mul_add(
             x188,
             x339,
-            Self::mul_add(x190, x338, Self::mul_add(x192, x337, x346)),
+            S::mul_add(x190, x338, S::mul_add(x192, x337, x346)),
         );
-        let x348 = Self::mul_add(
-            -x207,
+        let x348 = S::mul_add(
+            S::neg(x207),
             x336,
-            Self::mul_add(x209, x335, Self::mul_add(x211, x334, x213 * x333)),
+            S::mul_add(x209, x335, S::mul_add(x211, x334, x213 * x333)),
         );
-        let x349 = Self::mul_add(
-            -x203,
+        let x349 = S::mul_add(
+            S::neg(x203),
             x339,
-            Self::mul_add(x205, x338, Self::mul_add(x206, x337, x348)),
+            S::mul_add(x205, x338, S::mul_add(x206, x337, x348)),
         );
-        let x350 = Self::mul_add(
-            -x217,
+        let x350 = S::mul_add(
+            S::neg(x217),
             x336,
-            Self::mul_add(x219, x335, Self::mul_add(x221, x334, x223 * x333)),
+            S::mul_add(x219, x335, S::mul_add(x221, x334, x223 * x333)),
         );
-        let x351 = Self::mul_add(
+        let x351 = S::mul_add(
             x214,
             x339,
-            Self::mul_add(x215, x338, Self::mul_add(x216, x337, x350)),
+            S::mul_add(x215, x338, S::mul_add(x216, x337, x350)),
         );
-        let x352 = Self::mul_add(
-            -x225,
+        let x352 = S::mul_add(
+            S::neg(x225),
             x336,
-            Self::mul_add(x227, x335, Self::mul_add(x229, x334, x231 * x333)),
+            S::mul_add(x227, x335, S::mul_add(x229, x334, x231 * x333)),
         );
-        let x353 = Self::mul_add(
+        let x353 = S::mul_add(
             x136,
             x339,
-            Self::mul_add(x214, x338, Self::mul_add(x224, x337, x352)),
+            S::mul_add(x214, x338, S::mul_add(x224, x337, x352)),
         );
         let x354 = c_q0 * s_q1;
         let x355 = s_q0 * s_q1;
         let x356 = c_q0 * c_q1;
         let x357 = s_q0 * c_q1;
-        let x358 = s_q0 * 0.7026;
-        let x359 = c_q0 * 0.7026;
-        let x360 = Self::mul_add(-c_q0, x358, s_q0 * x359);
-        let x361 = 1.3589 * c_q0;
-        let x362 = 1.3589 * s_q0;
-        let x363 = 1145.5438279999998 * x356;
-        let x364 = 1145.5438279999998 * x357;
-        let x365 = s_q1 * 1647.2196721184;
-        let x366 = 1647.2196721184 * x356;
-        let x367 = 1650.6386721183999 * s_q0;
-        let x368 = 1647.2196721184 * x357;
-        let x369 = 1650.6386721183999 * c_q0;
+        let x358 = s_q0 * S::splat(0.7026);
+        let x359 = c_q0 * S::splat(0.7026);
+        let x360 = S::mul_add(S::neg(c_q0), x358, s_q0 * x359);
+        let x361 = S::splat(1.3589) * c_q0;
+        let x362 = S::splat(1.3589) * s_q0;
+        let x363 = S::splat(1145.5438279999998) * x356;
+        let x364 = S::splat(1145.5438279999998) * x357;
+        let x365 = s_q1 * S::splat(1647.2196721184);
+        let x366 = S::splat(1647.2196721184) * x356;
+        let x367 = S::splat(1650.6386721183999) * s_q0;
+        let x368 = S::splat(1647.2196721184) * x357;
+        let x369 = S::splat(1650.6386721183999) * c_q0;
         let x370 = x359 * x364;
         let x371 = x358 * x363;
         let x372 = x370 - x371;
         let x373 = x60 * x358;
         let x374 = x60 * x359;
-        let x375 = 1.3589 * x363;
-        let x376 = 1.3589 * x60;
+        let x375 = S::splat(1.3589) * x363;
+        let x376 = S::splat(1.3589) * x60;
         let x377 = x370 - x376;
         let x378 = x359 * x363;
-        let x379 = 1.3589 * x364;
+        let x379 = S::splat(1.3589) * x364;
         let x380 = x358 * x364;
         let x381 = x371 + x376;
-        let x382 = x372 + Self::mul_add(s_q1, x365, x372);
-        let x383 = x375 + Self::mul_add(x356, x365, x373);
-        let x384 = x379 + Self::mul_add(x357, x365, -x374);
-        let x385 = x373 + Self::mul_add(s_q1, x366, x375);
-        let x386 = x377 + (Self::mul_add(-s_q0, x367, x356 * x366) + x377);
-        let x387 = x380 + (Self::mul_add(c_q0, x367, x357 * x366) - x378);
-        let x388 = x374 - Self::mul_add(s_q1, x368, x379);
-        let x389 = x378 - (Self::mul_add(s_q0, x369, x356 * x368) + x380);
-        let x390 = x381 - (Self::mul_add(-c_q0, x369, x357 * x368) - x381);
+        let x382 = x372 + S::mul_add(s_q1, x365, x372);
+        let x383 = x375 + S::mul_add(x356, x365, x373);
+        let x384 = x379 + S::mul_add(x357, x365, S::neg(x374));
+        let x385 = x373 + S::mul_add(s_q1, x366, x375);
+        let x386 = x377 + (S::mul_add(S::neg(s_q0), x367, x356 * x366) + x377);
+        let x387 = x380 + (S::mul_add(c_q0, x367, x357 * x366) - x378);
+        let x388 = x374 - S::mul_add(s_q1, x368, x379);
+        let x389 = x378 - (S::mul_add(s_q0, x369, x356 * x368) + x380);
+        let x390 = x381 - (S::mul_add(S::neg(c_q0), x369, x357 * x368) - x381);
         let x391 = qd[1] * s_q0;
         let x392 = qd[1] * c_q0;
         let x393 = qd[1] * x360;
         let x394 = qd[1] * x361;
         let x395 = qd[1] * x362;
-        let x396 = Self::mul_add(-c_q0, x391, s_q0 * x392);
+        let x396 = S::mul_add(S::neg(c_q0), x391, s_q0 * x392);
         let x397 = qd[0] * c_q0;
         let x398 = qd[0] * s_q0;
         let x399 = qd[0] * x362;
         let x400 = qd[0] * x361;
-        let x401 = Self::mul_add(x362, x391, x361 * x392)
-            - Self::mul_add(c_q0, x394, s_q0 * x395);
-        let x402 = Self::mul_add(-c_q0, x393, Self::mul_add(x360, x392, x399));
-        let x403 = Self::mul_add(-s_q0, x393, Self::mul_add(x360, x391, -x400));
-        let x404 = Self::mul_add(qd[1], x396, x341);
-        let x405 = Self::mul_add(qd[1], x397, s_q0 * x343);
-        let x406 = Self::mul_add(-qd[1], x398, c_q0 * x343);
-        let x407 = Self::mul_add(qd[1], x401, x343 * x360);
-        let x408 = Self::mul_add(-qd[1], x402, x343 * x361);
-        let x409 = Self::mul_add(-qd[1], x403, x343 * x362);
-        let x410 = Self::mul_add(-qd[0], x398, c_q0 * x341);
-        let x411 = Self::mul_add(qd[0], x397, s_q0 * x341);
-        let x412 = Self::mul_add(qd[0], x400, x341 * x362);
-        let x413 = Self::mul_add(-qd[0], x399, x341 * x361);
+        let x401 = S::mul_add(x362, x391, x361 * x392)
+            - S::mul_add(c_q0, x394, s_q0 * x395);
+        let x402 = S::mul_add(S::neg(c_q0), x393, S::mul_add(x360, x392, x399));
+        let x403 = S::mul_add(S::neg(s_q0), x393, S::mul_add(x360, x391, S::neg(x400)));
+        let x404 = S::mul_add(qd[1], x396, x341);
+        let x405 = S::mul_add(qd[1], x397, s_q0 * x343);
+        let x406 = S::mul_add(S::neg(qd[1]), x398, c_q0 * x343);
+        let x407 = S::mul_add(qd[1], x401, x343 * x360);
+        let x408 = S::mul_add(S::neg(qd[1]), x402, x343 * x361);
+        let x409 = S::mul_add(S::neg(qd[1]), x403, x343 * x362);
+        let x410 = S::mul_add(S::neg(qd[0]), x398, c_q0 * x341);
+        let x411 = S::mul_add(qd[0], x397, s_q0 * x341);
+        let x412 = S::mul_add(qd[0], x400, x341 * x362);
+        let x413 = S::mul_add(S::neg(qd[0]), x399, x341 * x361);
         let x414 = x397 + x397;
         let x415 = x398 + x398;
         let x416 = x399 + x402;
@@ -5224,44 +6186,56 @@ impl Ssrms {
         let x427 = x60 * x395;
         let x428 = x363 * x393;
         let x429 = x60 * x394;
-        let x430 = Self::mul_add(qd[0], x382, x418) - x419 + (x424 - x425);
-        let x431 = Self::mul_add(x386, x391, x420) - x421 - (x426 - x427);
-        let x432 = Self::mul_add(-x390, x392, x422 + x423) - (x428 - x429);
-        let x433 = Self::mul_add(x363, x392, x364 * x391);
-        let x434 = Self::mul_add(x60, x392, qd[0] * x364);
-        let x435 = Self::mul_add(-x60, x391, qd[0] * x363);
-        let x436 = Self::mul_add(-x388, x391, x385 * x392);
-        let x437 = Self::mul_add(-qd[0], x389, x383 * x392);
-        let x438 = Self::mul_add(-qd[0], x387, x384 * x391);
+        let x430 = S::mul_add(qd[0], x382, x418) - x419 + (x424 - x425);
+        let x431 = S::mul_add(x386, x391, x420) - x421 - (x426 - x427);
+        let x432 = S::mul_add(S::neg(x390), x392, x422 + x423) - (x428 - x429);
+        let x433 = S::mul_add(x363, x392, x364 * x391);
+        let x434 = S::mul_add(x60, x392, qd[0] * x364);
+        let x435 = S::mul_add(S::neg(x60), x391, qd[0] * x363);
+        let x436 = S::mul_add(S::neg(x388), x391, x385 * x392);
+        let x437 = S::mul_add(S::neg(qd[0]), x389, x383 * x392);
+        let x438 = S::mul_add(S::neg(qd[0]), x387, x384 * x391);
         let x439 = x60 * x393;
         let x440 = x363 * x394;
         let x441 = x364 * x395;
         let x442 = x439 + x440 + x441;
         let x443 = x442 + x442;
         let x444 = c_q1 * c_q2;
-        let x445 = Self::mul_add(s_q0, s_q2, c_q2 * x354);
-        let x446 = Self::mul_add(-c_q0, s_q2, c_q2 * x355);
+        let x445 = S::mul_add(s_q0, s_q2, c_q2 * x354);
+        let x446 = S::mul_add(S::neg(c_q0), s_q2, c_q2 * x355);
         let x447 = c_q1 * s_q2;
-        let x448 = Self::mul_add(-s_q0, c_q2, s_q2 * x354);
-        let x449 = Self::mul_add(c_q0, c_q2, s_q2 * x355);
-        let x450 = Self::mul_add(0.5692, s_q1, 1.3589);
-        let x451 = Self::mul_add(0.5692, x356, x358);
-        let x452 = Self::mul_add(-0.5692, x357, x359);
-        let x453 = Self::mul_add(x357, x451, x356 * x452);
-        let x454 = Self::mul_add(x357, x450, s_q1 * x452);
-        let x455 = Self::mul_add(-x356, x450, s_q1 * x451);
-        let x456 = 5224.5702 * x444;
-        let x457 = 5224.5702 * x445;
-        let x458 = 5224.5702 * x446;
-        let x459 = 3946.1881206800003 * s_q1;
-        let x460 = 39234.474122 * x447;
-        let x461 = Self::mul_add(-39241.404122, s_q1, 3946.18812068 * x444);
-        let x462 = 3946.1881206800003 * x356;
-        let x463 = 39234.474122 * x448;
-        let x464 = Self::mul_add(39241.404122, x356, 3946.18812068 * x445);
-        let x465 = 3946.1881206800003 * x357;
-        let x466 = 39234.474122 * x449;
-        let x467 = Self::mul_add(39241.404122, x357, 3946.18812068 * x446);
+        let x448 = S::mul_add(S::neg(s_q0), c_q2, s_q2 * x354);
+        let x449 = S::mul_add(c_q0, c_q2, s_q2 * x355);
+        let x450 = S::mul_add(S::splat(0.5692), s_q1, S::splat(1.3589));
+        let x451 = S::mul_add(S::splat(0.5692), x356, x358);
+        let x452 = S::mul_add(S::splat(-0.5692), x357, x359);
+        let x453 = S::mul_add(x357, x451, x356 * x452);
+        let x454 = S::mul_add(x357, x450, s_q1 * x452);
+        let x455 = S::mul_add(S::neg(x356), x450, s_q1 * x451);
+        let x456 = S::splat(5224.5702) * x444;
+        let x457 = S::splat(5224.5702) * x445;
+        let x458 = S::splat(5224.5702) * x446;
+        let x459 = S::splat(3946.1881206800003) * s_q1;
+        let x460 = S::splat(39234.474122) * x447;
+        let x461 = S::mul_add(
+            S::splat(-39241.404122),
+            s_q1,
+            S::splat(3946.18812068) * x444,
+        );
+        let x462 = S::splat(3946.1881206800003) * x356;
+        let x463 = S::splat(39234.474122) * x448;
+        let x464 = S::mul_add(
+            S::splat(39241.404122),
+            x356,
+            S::splat(3946.18812068) * x445,
+        );
+        let x465 = S::splat(3946.1881206800003) * x357;
+        let x466 = S::splat(39234.474122) * x449;
+        let x467 = S::mul_add(
+            S::splat(39241.404122),
+            x357,
+            S::splat(3946.18812068) * x446,
+        );
         let x468 = x452 * x458;
         let x469 = x451 * x457;
         let x470 = x468 - x469;
@@ -5275,76 +6249,82 @@ impl Ssrms {
         let x478 = x451 * x458;
         let x479 = x469 - x474;
         let x480 = x470
-            - (Self::mul_add(s_q1, x461, Self::mul_add(-x447, x460, x444 * x459))
+            - (S::mul_add(s_q1, x461, S::mul_add(S::neg(x447), x460, x444 * x459))
                 - x470);
         let x481 = x473
-            + (Self::mul_add(-x356, x461, Self::mul_add(-x448, x460, x445 * x459))
-                - x471);
+            + (S::mul_add(
+                S::neg(x356),
+                x461,
+                S::mul_add(S::neg(x448), x460, x445 * x459),
+            ) - x471);
         let x482 = x477
-            + (Self::mul_add(-x357, x461, Self::mul_add(-x449, x460, x446 * x459))
-                + x472);
+            + (S::mul_add(
+                S::neg(x357),
+                x461,
+                S::mul_add(S::neg(x449), x460, x446 * x459),
+            ) + x472);
         let x483 = x471
-            + (Self::mul_add(-s_q1, x464, Self::mul_add(x447, x463, x444 * x462))
+            + (S::mul_add(S::neg(s_q1), x464, S::mul_add(x447, x463, x444 * x462))
                 - x473);
         let x484 = x475
-            + (Self::mul_add(x356, x464, Self::mul_add(x448, x463, x445 * x462)) + x475);
+            + (S::mul_add(x356, x464, S::mul_add(x448, x463, x445 * x462)) + x475);
         let x485 = x478
-            + (Self::mul_add(x357, x464, Self::mul_add(x449, x463, x446 * x462)) - x476);
+            + (S::mul_add(x357, x464, S::mul_add(x449, x463, x446 * x462)) - x476);
         let x486 = x472
-            - (Self::mul_add(-s_q1, x467, Self::mul_add(x447, x466, x444 * x465))
+            - (S::mul_add(S::neg(s_q1), x467, S::mul_add(x447, x466, x444 * x465))
                 - x477);
         let x487 = x476
-            - (Self::mul_add(x356, x467, Self::mul_add(x448, x466, x445 * x465)) + x478);
+            - (S::mul_add(x356, x467, S::mul_add(x448, x466, x445 * x465)) + x478);
         let x488 = x479
-            - (Self::mul_add(x357, x467, Self::mul_add(x449, x466, x446 * x465)) - x479);
-        let x489 = Self::mul_add(-qd[2], s_q1, qd[0]);
-        let x490 = Self::mul_add(-qd[2], x356, x391);
-        let x491 = Self::mul_add(qd[2], x357, x392);
-        let x492 = Self::mul_add(-qd[2], x453, x393);
-        let x493 = Self::mul_add(qd[2], x454, x394);
-        let x494 = Self::mul_add(qd[2], x455, x395);
-        let x495 = Self::mul_add(x357, x490, x356 * x491);
-        let x496 = Self::mul_add(x357, x489, s_q1 * x491);
-        let x497 = Self::mul_add(-x356, x489, s_q1 * x490);
-        let x498 = Self::mul_add(-x357, x493, x356 * x494);
-        let x499 = Self::mul_add(-x357, x492, s_q1 * x494);
-        let x500 = Self::mul_add(-x356, x492, s_q1 * x493);
-        let x501 = Self::mul_add(x455, x490, x454 * x491) + x498;
-        let x502 = Self::mul_add(-x455, x489, x453 * x491) - x499;
-        let x503 = Self::mul_add(x454, x489, x453 * x490) + x500;
-        let x504 = Self::mul_add(-qd[2], x495, Self::mul_add(-s_q1, x345, x404));
-        let x505 = Self::mul_add(qd[2], x496, Self::mul_add(-x345, x356, x405));
-        let x506 = Self::mul_add(-qd[2], x497, Self::mul_add(x345, x357, x406));
-        let x507 = Self::mul_add(qd[2], x501, Self::mul_add(-x345, x453, x407));
-        let x508 = Self::mul_add(qd[2], x502, Self::mul_add(x345, x454, x408));
-        let x509 = Self::mul_add(qd[2], x503, Self::mul_add(x345, x455, x409));
-        let x510 = Self::mul_add(x357, x391, x356 * x392);
-        let x511 = Self::mul_add(qd[0], x357, s_q1 * x392);
-        let x512 = Self::mul_add(-qd[0], x356, s_q1 * x391);
-        let x513 = Self::mul_add(x391, x455, x392 * x454)
-            + Self::mul_add(-x357, x394, x356 * x395);
-        let x514 = Self::mul_add(-qd[0], x455, x392 * x453)
-            - Self::mul_add(-x357, x393, s_q1 * x395);
-        let x515 = Self::mul_add(qd[0], x454, x391 * x453)
-            + Self::mul_add(-x356, x393, s_q1 * x394);
-        let x516 = Self::mul_add(x357, x405, x356 * x406)
-            - Self::mul_add(x391, x512, x392 * x511);
-        let x517 = Self::mul_add(x357, x404, s_q1 * x406)
-            + Self::mul_add(-qd[0], x512, x392 * x510);
-        let x518 = Self::mul_add(-x356, x404, s_q1 * x405)
-            + Self::mul_add(qd[0], x511, x391 * x510);
-        let x519 = Self::mul_add(x405, x455, x406 * x454)
-            + Self::mul_add(-x357, x408, x356 * x409)
-            + (Self::mul_add(x391, x515, x392 * x514)
-                - Self::mul_add(-x394, x512, x395 * x511));
-        let x520 = Self::mul_add(-x404, x455, x406 * x453)
-            - Self::mul_add(-x357, x407, s_q1 * x409)
-            - (Self::mul_add(qd[0], x515, x392 * x513)
-                + Self::mul_add(x393, x512, x395 * x510));
-        let x521 = Self::mul_add(x404, x454, x405 * x453)
-            + Self::mul_add(-x356, x407, s_q1 * x408)
-            - (Self::mul_add(-qd[0], x514, x391 * x513)
-                - Self::mul_add(x393, x511, x394 * x510));
+            - (S::mul_add(x357, x467, S::mul_add(x449, x466, x446 * x465)) - x479);
+        let x489 = S::mul_add(S::neg(qd[2]), s_q1, qd[0]);
+        let x490 = S::mul_add(S::neg(qd[2]), x356, x391);
+        let x491 = S::mul_add(qd[2], x357, x392);
+        let x492 = S::mul_add(S::neg(qd[2]), x453, x393);
+        let x493 = S::mul_add(qd[2], x454, x394);
+        let x494 = S::mul_add(qd[2], x455, x395);
+        let x495 = S::mul_add(x357, x490, x356 * x491);
+        let x496 = S::mul_add(x357, x489, s_q1 * x491);
+        let x497 = S::mul_add(S::neg(x356), x489, s_q1 * x490);
+        let x498 = S::mul_add(S::neg(x357), x493, x356 * x494);
+        let x499 = S::mul_add(S::neg(x357), x492, s_q1 * x494);
+        let x500 = S::mul_add(S::neg(x356), x492, s_q1 * x493);
+        let x501 = S::mul_add(x455, x490, x454 * x491) + x498;
+        let x502 = S::mul_add(S::neg(x455), x489, x453 * x491) - x499;
+        let x503 = S::mul_add(x454, x489, x453 * x490) + x500;
+        let x504 = S::mul_add(S::neg(qd[2]), x495, S::mul_add(S::neg(s_q1), x345, x404));
+        let x505 = S::mul_add(qd[2], x496, S::mul_add(S::neg(x345), x356, x405));
+        let x506 = S::mul_add(S::neg(qd[2]), x497, S::mul_add(x345, x357, x406));
+        let x507 = S::mul_add(qd[2], x501, S::mul_add(S::neg(x345), x453, x407));
+        let x508 = S::mul_add(qd[2], x502, S::mul_add(x345, x454, x408));
+        let x509 = S::mul_add(qd[2], x503, S::mul_add(x345, x455, x409));
+        let x510 = S::mul_add(x357, x391, x356 * x392);
+        let x511 = S::mul_add(qd[0], x357, s_q1 * x392);
+        let x512 = S::mul_add(S::neg(qd[0]), x356, s_q1 * x391);
+        let x513 = S::mul_add(x391, x455, x392 * x454)
+            + S::mul_add(S::neg(x357), x394, x356 * x395);
+        let x514 = S::mul_add(S::neg(qd[0]), x455, x392 * x453)
+            - S::mul_add(S::neg(x357), x393, s_q1 * x395);
+        let x515 = S::mul_add(qd[0], x454, x391 * x453)
+            + S::mul_add(S::neg(x356), x393, s_q1 * x394);
+        let x516 = S::mul_add(x357, x405, x356 * x406)
+            - S::mul_add(x391, x512, x392 * x511);
+        let x517 = S::mul_add(x357, x404, s_q1 * x406)
+            + S::mul_add(S::neg(qd[0]), x512, x392 * x510);
+        let x518 = S::mul_add(S::neg(x356), x404, s_q1 * x405)
+            + S::mul_add(qd[0], x511, x391 * x510);
+        let x519 = S::mul_add(x405, x455, x406 * x454)
+            + S::mul_add(S::neg(x357), x408, x356 * x409)
+            + (S::mul_add(x391, x515, x392 * x514)
+                - S::mul_add(S::neg(x394), x512, x395 * x511));
+        let x520 = S::mul_add(S::neg(x404), x455, x406 * x453)
+            - S::mul_add(S::neg(x357), x407, s_q1 * x409)
+            - (S::mul_add(qd[0], x515, x392 * x513)
+                + S::mul_add(x393, x512, x395 * x510));
+        let x521 = S::mul_add(x404, x454, x405 * x453)
+            + S::mul_add(S::neg(x356), x407, s_q1 * x408)
+            - (S::mul_add(S::neg(qd[0]), x514, x391 * x513)
+                - S::mul_add(x393, x511, x394 * x510));
         let x522 = x495 + x510;
         let x523 = x496 + x511;
         let x524 = x497 + x512;
@@ -5363,44 +6343,56 @@ impl Ssrms {
         let x537 = x456 * x494;
         let x538 = x457 * x492;
         let x539 = x456 * x493;
-        let x540 = Self::mul_add(x480, x489, x528) - x529 + (x534 - x535);
-        let x541 = Self::mul_add(-x484, x490, x530) + x531 + (x536 + x537);
-        let x542 = Self::mul_add(x488, x491, x532 - x533) + (x538 + x539);
-        let x543 = Self::mul_add(x457, x491, x458 * x490);
-        let x544 = Self::mul_add(-x456, x491, x458 * x489);
-        let x545 = Self::mul_add(x456, x490, x457 * x489);
-        let x546 = Self::mul_add(-x486, x490, x483 * x491);
-        let x547 = Self::mul_add(-x487, x489, x481 * x491);
-        let x548 = Self::mul_add(-x485, x489, x482 * x490);
+        let x540 = S::mul_add(x480, x489, x528) - x529 + (x534 - x535);
+        let x541 = S::mul_add(S::neg(x484), x490, x530) + x531 + (x536 + x537);
+        let x542 = S::mul_add(x488, x491, x532 - x533) + (x538 + x539);
+        let x543 = S::mul_add(x457, x491, x458 * x490);
+        let x544 = S::mul_add(S::neg(x456), x491, x458 * x489);
+        let x545 = S::mul_add(x456, x490, x457 * x489);
+        let x546 = S::mul_add(S::neg(x486), x490, x483 * x491);
+        let x547 = S::mul_add(S::neg(x487), x489, x481 * x491);
+        let x548 = S::mul_add(S::neg(x485), x489, x482 * x490);
         let x549 = x456 * x492;
         let x550 = x457 * x493;
         let x551 = x458 * x494;
         let x552 = x549 - x550 - x551;
         let x553 = x552 + x552;
-        let x554 = Self::mul_add(-s_q3, x447, c_q3 * x444);
-        let x555 = Self::mul_add(-s_q3, x448, c_q3 * x445);
-        let x556 = Self::mul_add(-s_q3, x449, c_q3 * x446);
-        let x557 = Self::mul_add(c_q3, x447, s_q3 * x444);
-        let x558 = Self::mul_add(c_q3, x448, s_q3 * x445);
-        let x559 = Self::mul_add(c_q3, x449, s_q3 * x446);
-        let x560 = x450 + Self::mul_add(s_q1, 0.475, 7.11 * x444);
-        let x561 = x451 - Self::mul_add(-0.475, x356, 7.11 * x445);
-        let x562 = x452 + Self::mul_add(-0.475, x357, 7.11 * x446);
-        let x563 = Self::mul_add(x357, x561, x356 * x562);
-        let x564 = Self::mul_add(x357, x560, s_q1 * x562);
-        let x565 = Self::mul_add(-x356, x560, s_q1 * x561);
-        let x566 = 3239.4582 * x554;
-        let x567 = 3239.4582 * x555;
-        let x568 = 3239.4582 * x556;
-        let x569 = 1375.0472756800002 * s_q1;
-        let x570 = 24989.305802 * x557;
-        let x571 = Self::mul_add(-24998.827802, s_q1, 1375.0472756800002 * x554);
-        let x572 = 1375.0472756800002 * x356;
-        let x573 = 24989.305802 * x558;
-        let x574 = Self::mul_add(24998.827802, x356, 1375.0472756800002 * x555);
-        let x575 = 1375.0472756800002 * x357;
-        let x576 = 24989.305802 * x559;
-        let x577 = Self::mul_add(24998.827802, x357, 1375.0472756800002 * x556);
+        let x554 = S::mul_add(S::neg(s_q3), x447, c_q3 * x444);
+        let x555 = S::mul_add(S::neg(s_q3), x448, c_q3 * x445);
+        let x556 = S::mul_add(S::neg(s_q3), x449, c_q3 * x446);
+        let x557 = S::mul_add(c_q3, x447, s_q3 * x444);
+        let x558 = S::mul_add(c_q3, x448, s_q3 * x445);
+        let x559 = S::mul_add(c_q3, x449, s_q3 * x446);
+        let x560 = x450 + S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x444);
+        let x561 = x451 - S::mul_add(S::splat(-0.475), x356, S::splat(7.11) * x445);
+        let x562 = x452 + S::mul_add(S::splat(-0.475), x357, S::splat(7.11) * x446);
+        let x563 = S::mul_add(x357, x561, x356 * x562);
+        let x564 = S::mul_add(x357, x560, s_q1 * x562);
+        let x565 = S::mul_add(S::neg(x356), x560, s_q1 * x561);
+        let x566 = S::splat(3239.4582) * x554;
+        let x567 = S::splat(3239.4582) * x555;
+        let x568 = S::splat(3239.4582) * x556;
+        let x569 = S::splat(1375.0472756800002) * s_q1;
+        let x570 = S::splat(24989.305802) * x557;
+        let x571 = S::mul_add(
+            S::splat(-24998.827802),
+            s_q1,
+            S::splat(1375.0472756800002) * x554,
+        );
+        let x572 = S::splat(1375.0472756800002) * x356;
+        let x573 = S::splat(24989.305802) * x558;
+        let x574 = S::mul_add(
+            S::splat(24998.827802),
+            x356,
+            S::splat(1375.0472756800002) * x555,
+        );
+        let x575 = S::splat(1375.0472756800002) * x357;
+        let x576 = S::splat(24989.305802) * x559;
+        let x577 = S::mul_add(
+            S::splat(24998.827802),
+            x357,
+            S::splat(1375.0472756800002) * x556,
+        );
         let x578 = x562 * x568;
         let x579 = x561 * x567;
         let x580 = x578 - x579;
@@ -5414,70 +6406,76 @@ impl Ssrms {
         let x588 = x561 * x568;
         let x589 = x579 - x584;
         let x590 = x580
-            - (Self::mul_add(s_q1, x571, Self::mul_add(-x557, x570, x554 * x569))
+            - (S::mul_add(s_q1, x571, S::mul_add(S::neg(x557), x570, x554 * x569))
                 - x580);
         let x591 = x583
-            + (Self::mul_add(-x356, x571, Self::mul_add(-x558, x570, x555 * x569))
-                - x581);
+            + (S::mul_add(
+                S::neg(x356),
+                x571,
+                S::mul_add(S::neg(x558), x570, x555 * x569),
+            ) - x581);
         let x592 = x587
-            + (Self::mul_add(-x357, x571, Self::mul_add(-x559, x570, x556 * x569))
-                + x582);
+            + (S::mul_add(
+                S::neg(x357),
+                x571,
+                S::mul_add(S::neg(x559), x570, x556 * x569),
+            ) + x582);
         let x593 = x581
-            + (Self::mul_add(-s_q1, x574, Self::mul_add(x557, x573, x554 * x572))
+            + (S::mul_add(S::neg(s_q1), x574, S::mul_add(x557, x573, x554 * x572))
                 - x583);
         let x594 = x585
-            + (Self::mul_add(x356, x574, Self::mul_add(x558, x573, x555 * x572)) + x585);
+            + (S::mul_add(x356, x574, S::mul_add(x558, x573, x555 * x572)) + x585);
         let x595 = x588
-            + (Self::mul_add(x357, x574, Self::mul_add(x559, x573, x556 * x572)) - x586);
+            + (S::mul_add(x357, x574, S::mul_add(x559, x573, x556 * x572)) - x586);
         let x596 = x582
-            - (Self::mul_add(-s_q1, x577, Self::mul_add(x557, x576, x554 * x575))
+            - (S::mul_add(S::neg(s_q1), x577, S::mul_add(x557, x576, x554 * x575))
                 - x587);
         let x597 = x586
-            - (Self::mul_add(x356, x577, Self::mul_add(x558, x576, x555 * x575)) + x588);
+            - (S::mul_add(x356, x577, S::mul_add(x558, x576, x555 * x575)) + x588);
         let x598 = x589
-            - (Self::mul_add(x357, x577, Self::mul_add(x559, x576, x556 * x575)) - x589);
-        let x599 = Self::mul_add(-qd[3], s_q1, x489);
-        let x600 = Self::mul_add(-qd[3], x356, x490);
-        let x601 = Self::mul_add(qd[3], x357, x491);
-        let x602 = Self::mul_add(-qd[3], x563, x492);
-        let x603 = Self::mul_add(qd[3], x564, x493);
-        let x604 = Self::mul_add(qd[3], x565, x494);
-        let x605 = Self::mul_add(x357, x600, x356 * x601);
-        let x606 = Self::mul_add(x357, x599, s_q1 * x601);
-        let x607 = Self::mul_add(-x356, x599, s_q1 * x600);
-        let x608 = Self::mul_add(-x357, x603, x356 * x604);
-        let x609 = Self::mul_add(-x357, x602, s_q1 * x604);
-        let x610 = Self::mul_add(-x356, x602, s_q1 * x603);
-        let x611 = Self::mul_add(x565, x600, x564 * x601) + x608;
-        let x612 = Self::mul_add(-x565, x599, x563 * x601) - x609;
-        let x613 = Self::mul_add(x564, x599, x563 * x600) + x610;
-        let x614 = Self::mul_add(-qd[3], x605, Self::mul_add(s_q1, x347, x504));
-        let x615 = Self::mul_add(qd[3], x606, Self::mul_add(x347, x356, x505));
-        let x616 = Self::mul_add(-qd[3], x607, Self::mul_add(-x347, x357, x506));
-        let x617 = Self::mul_add(qd[3], x611, Self::mul_add(x347, x563, x507));
-        let x618 = Self::mul_add(qd[3], x612, Self::mul_add(-x347, x564, x508));
-        let x619 = Self::mul_add(qd[3], x613, Self::mul_add(-x347, x565, x509));
-        let x620 = x498 + Self::mul_add(x490, x565, x491 * x564);
-        let x621 = x499 - Self::mul_add(-x489, x565, x491 * x563);
-        let x622 = x500 + Self::mul_add(x489, x564, x490 * x563);
-        let x623 = Self::mul_add(x357, x505, x356 * x506)
-            - Self::mul_add(x490, x497, x491 * x496);
-        let x624 = Self::mul_add(x357, x504, s_q1 * x506)
-            + Self::mul_add(-x489, x497, x491 * x495);
-        let x625 = Self::mul_add(-x356, x504, s_q1 * x505)
-            + Self::mul_add(x489, x496, x490 * x495);
-        let x626 = Self::mul_add(x505, x565, x506 * x564)
-            + Self::mul_add(-x357, x508, x356 * x509)
-            - (Self::mul_add(-x490, x622, x491 * x621)
-                + Self::mul_add(-x493, x497, x494 * x496));
-        let x627 = Self::mul_add(-x504, x565, x506 * x563)
-            - Self::mul_add(-x357, x507, s_q1 * x509)
-            - (Self::mul_add(x489, x622, x491 * x620)
-                + Self::mul_add(x492, x497, x494 * x495));
-        let x628 = Self::mul_add(x504, x564, x505 * x563)
-            + Self::mul_add(-x356, x507, s_q1 * x508)
-            - (Self::mul_add(x489, x621, x490 * x620)
-                - Self::mul_add(x492, x496, x493 * x495));
+            - (S::mul_add(x357, x577, S::mul_add(x559, x576, x556 * x575)) - x589);
+        let x599 = S::mul_add(S::neg(qd[3]), s_q1, x489);
+        let x600 = S::mul_add(S::neg(qd[3]), x356, x490);
+        let x601 = S::mul_add(qd[3], x357, x491);
+        let x602 = S::mul_add(S::neg(qd[3]), x563, x492);
+        let x603 = S::mul_add(qd[3], x564, x493);
+        let x604 = S::mul_add(qd[3], x565, x494);
+        let x605 = S::mul_add(x357, x600, x356 * x601);
+        let x606 = S::mul_add(x357, x599, s_q1 * x601);
+        let x607 = S::mul_add(S::neg(x356), x599, s_q1 * x600);
+        let x608 = S::mul_add(S::neg(x357), x603, x356 * x604);
+        let x609 = S::mul_add(S::neg(x357), x602, s_q1 * x604);
+        let x610 = S::mul_add(S::neg(x356), x602, s_q1 * x603);
+        let x611 = S::mul_add(x565, x600, x564 * x601) + x608;
+        let x612 = S::mul_add(S::neg(x565), x599, x563 * x601) - x609;
+        let x613 = S::mul_add(x564, x599, x563 * x600) + x610;
+        let x614 = S::mul_add(S::neg(qd[3]), x605, S::mul_add(s_q1, x347, x504));
+        let x615 = S::mul_add(qd[3], x606, S::mul_add(x347, x356, x505));
+        let x616 = S::mul_add(S::neg(qd[3]), x607, S::mul_add(S::neg(x347), x357, x506));
+        let x617 = S::mul_add(qd[3], x611, S::mul_add(x347, x563, x507));
+        let x618 = S::mul_add(qd[3], x612, S::mul_add(S::neg(x347), x564, x508));
+        let x619 = S::mul_add(qd[3], x613, S::mul_add(S::neg(x347), x565, x509));
+        let x620 = x498 + S::mul_add(x490, x565, x491 * x564);
+        let x621 = x499 - S::mul_add(S::neg(x489), x565, x491 * x563);
+        let x622 = x500 + S::mul_add(x489, x564, x490 * x563);
+        let x623 = S::mul_add(x357, x505, x356 * x506)
+            - S::mul_add(x490, x497, x491 * x496);
+        let x624 = S::mul_add(x357, x504, s_q1 * x506)
+            + S::mul_add(S::neg(x489), x497, x491 * x495);
+        let x625 = S::mul_add(S::neg(x356), x504, s_q1 * x505)
+            + S::mul_add(x489, x496, x490 * x495);
+        let x626 = S::mul_add(x505, x565, x506 * x564)
+            + S::mul_add(S::neg(x357), x508, x356 * x509)
+            - (S::mul_add(S::neg(x490), x622, x491 * x621)
+                + S::mul_add(S::neg(x493), x497, x494 * x496));
+        let x627 = S::mul_add(S::neg(x504), x565, x506 * x563)
+            - S::mul_add(S::neg(x357), x507, s_q1 * x509)
+            - (S::mul_add(x489, x622, x491 * x620)
+                + S::mul_add(x492, x497, x494 * x495));
+        let x628 = S::mul_add(x504, x564, x505 * x563)
+            + S::mul_add(S::neg(x356), x507, s_q1 * x508)
+            - (S::mul_add(x489, x621, x490 * x620)
+                - S::mul_add(x492, x496, x493 * x495));
         let x629 = x495 + x605;
         let x630 = x496 + x606;
         let x631 = x497 + x607;
@@ -5496,38 +6494,62 @@ impl Ssrms {
         let x644 = x566 * x604;
         let x645 = x567 * x602;
         let x646 = x566 * x603;
-        let x647 = Self::mul_add(x590, x599, x635) - x636 + (x641 - x642);
-        let x648 = Self::mul_add(-x594, x600, x637) + x638 + (x643 + x644);
-        let x649 = Self::mul_add(x598, x601, x639 - x640) + (x645 + x646);
-        let x650 = Self::mul_add(x567, x601, x568 * x600);
-        let x651 = Self::mul_add(-x566, x601, x568 * x599);
-        let x652 = Self::mul_add(x566, x600, x567 * x599);
-        let x653 = Self::mul_add(-x596, x600, x593 * x601);
-        let x654 = Self::mul_add(-x597, x599, x591 * x601);
-        let x655 = Self::mul_add(-x595, x599, x592 * x600);
+        let x647 = S::mul_add(x590, x599, x635) - x636 + (x641 - x642);
+        let x648 = S::mul_add(S::neg(x594), x600, x637) + x638 + (x643 + x644);
+        let x649 = S::mul_add(x598, x601, x639 - x640) + (x645 + x646);
+        let x650 = S::mul_add(x567, x601, x568 * x600);
+        let x651 = S::mul_add(S::neg(x566), x601, x568 * x599);
+        let x652 = S::mul_add(x566, x600, x567 * x599);
+        let x653 = S::mul_add(S::neg(x596), x600, x593 * x601);
+        let x654 = S::mul_add(S::neg(x597), x599, x591 * x601);
+        let x655 = S::mul_add(S::neg(x595), x599, x592 * x600);
         let x656 = x566 * x602;
         let x657 = x567 * x603;
         let x658 = x568 * x604;
         let x659 = x656 - x657 - x658;
         let x660 = x659 + x659;
-        let x661 = Self::mul_add(c_q4, x557, s_q4 * x554);
-        let x662 = Self::mul_add(c_q4, x558, s_q4 * x555);
-        let x663 = Self::mul_add(c_q4, x559, s_q4 * x556);
-        let x664 = Self::mul_add(7.11, x554, x560);
-        let x665 = Self::mul_add(-7.11, x555, x561);
-        let x666 = Self::mul_add(7.11, x556, x562);
-        let x667 = Self::mul_add(x357, x665, x356 * x666);
-        let x668 = Self::mul_add(x357, x664, s_q1 * x666);
-        let x669 = Self::mul_add(-x356, x664, s_q1 * x665);
-        let x670 = 171.195516 * x661;
-        let x671 = 171.195516 * x662;
-        let x672 = 171.195516 * x663;
-        let x673 = Self::mul_add(-97.44448770720001, s_q1, 177.0883695416 * x661);
-        let x674 = Self::mul_add(179.8829695416, s_q1, 97.44448770720001 * x661);
-        let x675 = Self::mul_add(97.44448770720001, x356, 177.0883695416 * x662);
-        let x676 = Self::mul_add(-179.8829695416, x356, 97.44448770720001 * x662);
-        let x677 = Self::mul_add(97.44448770720001, x357, 177.0883695416 * x663);
-        let x678 = Self::mul_add(-179.8829695416, x357, 97.44448770720001 * x663);
+        let x661 = S::mul_add(c_q4, x557, s_q4 * x554);
+        let x662 = S::mul_add(c_q4, x558, s_q4 * x555);
+        let x663 = S::mul_add(c_q4, x559, s_q4 * x556);
+        let x664 = S::mul_add(S::splat(7.11), x554, x560);
+        let x665 = S::mul_add(S::splat(-7.11), x555, x561);
+        let x666 = S::mul_add(S::splat(7.11), x556, x562);
+        let x667 = S::mul_add(x357, x665, x356 * x666);
+        let x668 = S::mul_add(x357, x664, s_q1 * x666);
+        let x669 = S::mul_add(S::neg(x356), x664, s_q1 * x665);
+        let x670 = S::splat(171.195516) * x661;
+        let x671 = S::splat(171.195516) * x662;
+        let x672 = S::splat(171.195516) * x663;
+        let x673 = S::mul_add(
+            S::splat(-97.44448770720001),
+            s_q1,
+            S::splat(177.0883695416) * x661,
+        );
+        let x674 = S::mul_add(
+            S::splat(179.8829695416),
+            s_q1,
+            S::splat(97.44448770720001) * x661,
+        );
+        let x675 = S::mul_add(
+            S::splat(97.44448770720001),
+            x356,
+            S::splat(177.0883695416) * x662,
+        );
+        let x676 = S::mul_add(
+            S::splat(-179.8829695416),
+            x356,
+            S::splat(97.44448770720001) * x662,
+        );
+        let x677 = S::mul_add(
+            S::splat(97.44448770720001),
+            x357,
+            S::splat(177.0883695416) * x663,
+        );
+        let x678 = S::mul_add(
+            S::splat(-179.8829695416),
+            x357,
+            S::splat(97.44448770720001) * x663,
+        );
         let x679 = x666 * x672;
         let x680 = x665 * x671;
         let x681 = x679 - x680;
@@ -5540,57 +6562,57 @@ impl Ssrms {
         let x688 = x664 * x672;
         let x689 = x665 * x672;
         let x690 = x680 - x685;
-        let x691 = x681 + (Self::mul_add(-s_q1, x674, x661 * x673) + x681);
-        let x692 = x684 - (Self::mul_add(x356, x674, x662 * x673) + x682);
-        let x693 = x688 - (Self::mul_add(x357, x674, x663 * x673) - x683);
-        let x694 = x682 + (Self::mul_add(-s_q1, x676, x661 * x675) - x684);
-        let x695 = x686 + (Self::mul_add(x356, x676, x662 * x675) + x686);
-        let x696 = x689 + (Self::mul_add(x357, x676, x663 * x675) - x687);
-        let x697 = x683 - (Self::mul_add(-s_q1, x678, x661 * x677) - x688);
-        let x698 = x687 - (Self::mul_add(x356, x678, x662 * x677) + x689);
-        let x699 = x690 - (Self::mul_add(x357, x678, x663 * x677) - x690);
-        let x700 = Self::mul_add(-qd[4], s_q1, x599);
-        let x701 = Self::mul_add(-qd[4], x356, x600);
-        let x702 = Self::mul_add(qd[4], x357, x601);
-        let x703 = Self::mul_add(-qd[4], x667, x602);
-        let x704 = Self::mul_add(qd[4], x668, x603);
-        let x705 = Self::mul_add(qd[4], x669, x604);
-        let x706 = Self::mul_add(x357, x701, x356 * x702);
-        let x707 = Self::mul_add(x357, x700, s_q1 * x702);
-        let x708 = Self::mul_add(-x356, x700, s_q1 * x701);
-        let x709 = Self::mul_add(x669, x701, x668 * x702)
-            + Self::mul_add(-x357, x704, x356 * x705);
-        let x710 = Self::mul_add(-x669, x700, x667 * x702)
-            - Self::mul_add(-x357, x703, s_q1 * x705);
-        let x711 = Self::mul_add(x668, x700, x667 * x701)
-            + Self::mul_add(-x356, x703, s_q1 * x704);
-        let x712 = Self::mul_add(-qd[4], x706, Self::mul_add(-s_q1, x349, x614));
-        let x713 = Self::mul_add(qd[4], x707, Self::mul_add(-x349, x356, x615));
-        let x714 = Self::mul_add(-qd[4], x708, Self::mul_add(x349, x357, x616));
-        let x715 = Self::mul_add(qd[4], x709, Self::mul_add(-x349, x667, x617));
-        let x716 = Self::mul_add(qd[4], x710, Self::mul_add(x349, x668, x618));
-        let x717 = Self::mul_add(qd[4], x711, Self::mul_add(x349, x669, x619));
-        let x718 = x608 + Self::mul_add(x600, x669, x601 * x668);
-        let x719 = x609 - Self::mul_add(-x599, x669, x601 * x667);
-        let x720 = x610 + Self::mul_add(x599, x668, x600 * x667);
-        let x721 = Self::mul_add(x357, x615, x356 * x616)
-            - Self::mul_add(x600, x607, x601 * x606);
-        let x722 = Self::mul_add(x357, x614, s_q1 * x616)
-            + Self::mul_add(-x599, x607, x601 * x605);
-        let x723 = Self::mul_add(-x356, x614, s_q1 * x615)
-            + Self::mul_add(x599, x606, x600 * x605);
-        let x724 = Self::mul_add(x615, x669, x616 * x668)
-            + Self::mul_add(-x357, x618, x356 * x619)
-            - (Self::mul_add(-x600, x720, x601 * x719)
-                + Self::mul_add(-x603, x607, x604 * x606));
-        let x725 = Self::mul_add(-x614, x669, x616 * x667)
-            - Self::mul_add(-x357, x617, s_q1 * x619)
-            - (Self::mul_add(x599, x720, x601 * x718)
-                + Self::mul_add(x602, x607, x604 * x605));
-        let x726 = Self::mul_add(x614, x668, x615 * x667)
-            + Self::mul_add(-x356, x617, s_q1 * x618)
-            - (Self::mul_add(x599, x719, x600 * x718)
-                - Self::mul_add(x602, x606, x603 * x605));
+        let x691 = x681 + (S::mul_add(S::neg(s_q1), x674, x661 * x673) + x681);
+        let x692 = x684 - (S::mul_add(x356, x674, x662 * x673) + x682);
+        let x693 = x688 - (S::mul_add(x357, x674, x663 * x673) - x683);
+        let x694 = x682 + (S::mul_add(S::neg(s_q1), x676, x661 * x675) - x684);
+        let x695 = x686 + (S::mul_add(x356, x676, x662 * x675) + x686);
+        let x696 = x689 + (S::mul_add(x357, x676, x663 * x675) - x687);
+        let x697 = x683 - (S::mul_add(S::neg(s_q1), x678, x661 * x677) - x688);
+        let x698 = x687 - (S::mul_add(x356, x678, x662 * x677) + x689);
+        let x699 = x690 - (S::mul_add(x357, x678, x663 * x677) - x690);
+        let x700 = S::mul_add(S::neg(qd[4]), s_q1, x599);
+        let x701 = S::mul_add(S::neg(qd[4]), x356, x600);
+        let x702 = S::mul_add(qd[4], x357, x601);
+        let x703 = S::mul_add(S::neg(qd[4]), x667, x602);
+        let x704 = S::mul_add(qd[4], x668, x603);
+        let x705 = S::mul_add(qd[4], x669, x604);
+        let x706 = S::mul_add(x357, x701, x356 * x702);
+        let x707 = S::mul_add(x357, x700, s_q1 * x702);
+        let x708 = S::mul_add(S::neg(x356), x700, s_q1 * x701);
+        let x709 = S::mul_add(x669, x701, x668 * x702)
+            + S::mul_add(S::neg(x357), x704, x356 * x705);
+        let x710 = S::mul_add(S::neg(x669), x700, x667 * x702)
+            - S::mul_add(S::neg(x357), x703, s_q1 * x705);
+        let x711 = S::mul_add(x668, x700, x667 * x701)
+            + S::mul_add(S::neg(x356), x703, s_q1 * x704);
+        let x712 = S::mul_add(S::neg(qd[4]), x706, S::mul_add(S::neg(s_q1), x349, x614));
+        let x713 = S::mul_add(qd[4], x707, S::mul_add(S::neg(x349), x356, x615));
+        let x714 = S::mul_add(S::neg(qd[4]), x708, S::mul_add(x349, x357, x616));
+        let x715 = S::mul_add(qd[4], x709, S::mul_add(S::neg(x349), x667, x617));
+        let x716 = S::mul_add(qd[4], x710, S::mul_add(x349, x668, x618));
+        let x717 = S::mul_add(qd[4], x711, S::mul_add(x349, x669, x619));
+        let x718 = x608 + S::mul_add(x600, x669, x601 * x668);
+        let x719 = x609 - S::mul_add(S::neg(x599), x669, x601 * x667);
+        let x720 = x610 + S::mul_add(x599, x668, x600 * x667);
+        let x721 = S::mul_add(x357, x615, x356 * x616)
+            - S::mul_add(x600, x607, x601 * x606);
+        let x722 = S::mul_add(x357, x614, s_q1 * x616)
+            + S::mul_add(S::neg(x599), x607, x601 * x605);
+        let x723 = S::mul_add(S::neg(x356), x614, s_q1 * x615)
+            + S::mul_add(x599, x606, x600 * x605);
+        let x724 = S::mul_add(x615, x669, x616 * x668)
+            + S::mul_add(S::neg(x357), x618, x356 * x619)
+            - (S::mul_add(S::neg(x600), x720, x601 * x719)
+                + S::mul_add(S::neg(x603), x607, x604 * x606));
+        let x725 = S::mul_add(S::neg(x614), x669, x616 * x667)
+            - S::mul_add(S::neg(x357), x617, s_q1 * x619)
+            - (S::mul_add(x599, x720, x601 * x718)
+                + S::mul_add(x602, x607, x604 * x605));
+        let x726 = S::mul_add(x614, x668, x615 * x667)
+            + S::mul_add(S::neg(x356), x617, s_q1 * x618)
+            - (S::mul_add(x599, x719, x600 * x718)
+                - S::mul_add(x602, x606, x603 * x605));
         let x727 = x605 + x706;
         let x728 = x606 + x707;
         let x729 = x607 + x708;
@@ -5609,92 +6631,92 @@ impl Ssrms {
         let x742 = x670 * x705;
         let x743 = x671 * x703;
         let x744 = x670 * x704;
-        let x745 = Self::mul_add(x691, x700, x733) - x734 + (x739 - x740);
-        let x746 = Self::mul_add(-x695, x701, x735) + x736 + (x741 + x742);
-        let x747 = Self::mul_add(x699, x702, x737 - x738) + (x743 + x744);
-        let x748 = Self::mul_add(x671, x702, x672 * x701);
-        let x749 = Self::mul_add(-x670, x702, x672 * x700);
-        let x750 = Self::mul_add(x670, x701, x671 * x700);
-        let x751 = Self::mul_add(x671, x714, x672 * x713)
-            - Self::mul_add(-x701, x750, x702 * x749);
-        let x752 = Self::mul_add(-x670, x714, x672 * x712)
-            + Self::mul_add(x700, x750, x702 * x748);
-        let x753 = Self::mul_add(x670, x713, x671 * x712)
-            - Self::mul_add(x700, x749, x701 * x748);
-        let x754 = Self::mul_add(-x697, x701, x694 * x702);
-        let x755 = Self::mul_add(-x698, x700, x692 * x702);
-        let x756 = Self::mul_add(-x696, x700, x693 * x701);
+        let x745 = S::mul_add(x691, x700, x733) - x734 + (x739 - x740);
+        let x746 = S::mul_add(S::neg(x695), x701, x735) + x736 + (x741 + x742);
+        let x747 = S::mul_add(x699, x702, x737 - x738) + (x743 + x744);
+        let x748 = S::mul_add(x671, x702, x672 * x701);
+        let x749 = S::mul_add(S::neg(x670), x702, x672 * x700);
+        let x750 = S::mul_add(x670, x701, x671 * x700);
+        let x751 = S::mul_add(x671, x714, x672 * x713)
+            - S::mul_add(S::neg(x701), x750, x702 * x749);
+        let x752 = S::mul_add(S::neg(x670), x714, x672 * x712)
+            + S::mul_add(x700, x750, x702 * x748);
+        let x753 = S::mul_add(x670, x713, x671 * x712)
+            - S::mul_add(x700, x749, x701 * x748);
+        let x754 = S::mul_add(S::neg(x697), x701, x694 * x702);
+        let x755 = S::mul_add(S::neg(x698), x700, x692 * x702);
+        let x756 = S::mul_add(S::neg(x696), x700, x693 * x701);
         let x757 = x670 * x703;
         let x758 = x671 * x704;
         let x759 = x672 * x705;
         let x760 = x757 - x758 - x759;
         let x761 = x760 + x760;
-        let x762 = Self::mul_add(
-            -s_q1,
+        let x762 = S::mul_add(
+            S::neg(s_q1),
             s_q5,
-            c_q5 * Self::mul_add(-s_q4, x557, c_q4 * x554),
+            c_q5 * S::mul_add(S::neg(s_q4), x557, c_q4 * x554),
         );
-        let x763 = Self::mul_add(
+        let x763 = S::mul_add(
             s_q5,
             x356,
-            c_q5 * Self::mul_add(-s_q4, x558, c_q4 * x555),
+            c_q5 * S::mul_add(S::neg(s_q4), x558, c_q4 * x555),
         );
-        let x764 = Self::mul_add(
+        let x764 = S::mul_add(
             s_q5,
             x357,
-            c_q5 * Self::mul_add(-s_q4, x559, c_q4 * x556),
+            c_q5 * S::mul_add(S::neg(s_q4), x559, c_q4 * x556),
         );
-        let x765 = 44.41 * x762;
-        let x766 = 47.471 * x661;
-        let x767 = 44.41 * x763;
-        let x768 = 47.471 * x662;
-        let x769 = 44.41 * x764;
-        let x770 = 47.471 * x663;
-        let x771 = Self::mul_add(-x661, x766, x762 * x765);
-        let x772 = Self::mul_add(-x662, x766, x763 * x765);
-        let x773 = Self::mul_add(-x663, x766, x764 * x765);
-        let x774 = Self::mul_add(-x661, x768, x762 * x767);
-        let x775 = Self::mul_add(-x662, x768, x763 * x767);
-        let x776 = Self::mul_add(-x663, x768, x764 * x767);
-        let x777 = Self::mul_add(-x661, x770, x762 * x769);
-        let x778 = Self::mul_add(-x662, x770, x763 * x769);
-        let x779 = Self::mul_add(-x663, x770, x764 * x769);
-        let x780 = Self::mul_add(qd[5], x661, x700);
-        let x781 = Self::mul_add(-qd[5], x662, x701);
-        let x782 = Self::mul_add(qd[5], x663, x702);
-        let x783 = Self::mul_add(x663, x781, x662 * x782);
-        let x784 = Self::mul_add(-x663, x780, x661 * x782);
-        let x785 = Self::mul_add(x662, x780, x661 * x781);
-        let x786 = Self::mul_add(-qd[5], x783, Self::mul_add(x351, x661, x712));
-        let x787 = Self::mul_add(-qd[5], x784, Self::mul_add(-x351, x662, x713));
-        let x788 = Self::mul_add(qd[5], x785, Self::mul_add(x351, x663, x714));
-        let x789 = Self::mul_add(x663, x701, x662 * x702);
-        let x790 = Self::mul_add(-x663, x700, x661 * x702);
-        let x791 = Self::mul_add(x662, x700, x661 * x701);
-        let x792 = Self::mul_add(x663, x713, x662 * x714)
-            + Self::mul_add(x701, x791, x702 * x790);
-        let x793 = Self::mul_add(-x663, x712, x661 * x714)
-            - Self::mul_add(x700, x791, x702 * x789);
-        let x794 = Self::mul_add(x662, x712, x661 * x713)
-            - Self::mul_add(-x700, x790, x701 * x789);
+        let x765 = S::splat(44.41) * x762;
+        let x766 = S::splat(47.471) * x661;
+        let x767 = S::splat(44.41) * x763;
+        let x768 = S::splat(47.471) * x662;
+        let x769 = S::splat(44.41) * x764;
+        let x770 = S::splat(47.471) * x663;
+        let x771 = S::mul_add(S::neg(x661), x766, x762 * x765);
+        let x772 = S::mul_add(S::neg(x662), x766, x763 * x765);
+        let x773 = S::mul_add(S::neg(x663), x766, x764 * x765);
+        let x774 = S::mul_add(S::neg(x661), x768, x762 * x767);
+        let x775 = S::mul_add(S::neg(x662), x768, x763 * x767);
+        let x776 = S::mul_add(S::neg(x663), x768, x764 * x767);
+        let x777 = S::mul_add(S::neg(x661), x770, x762 * x769);
+        let x778 = S::mul_add(S::neg(x662), x770, x763 * x769);
+        let x779 = S::mul_add(S::neg(x663), x770, x764 * x769);
+        let x780 = S::mul_add(qd[5], x661, x700);
+        let x781 = S::mul_add(S::neg(qd[5]), x662, x701);
+        let x782 = S::mul_add(qd[5], x663, x702);
+        let x783 = S::mul_add(x663, x781, x662 * x782);
+        let x784 = S::mul_add(S::neg(x663), x780, x661 * x782);
+        let x785 = S::mul_add(x662, x780, x661 * x781);
+        let x786 = S::mul_add(S::neg(qd[5]), x783, S::mul_add(x351, x661, x712));
+        let x787 = S::mul_add(S::neg(qd[5]), x784, S::mul_add(S::neg(x351), x662, x713));
+        let x788 = S::mul_add(qd[5], x785, S::mul_add(x351, x663, x714));
+        let x789 = S::mul_add(x663, x701, x662 * x702);
+        let x790 = S::mul_add(S::neg(x663), x700, x661 * x702);
+        let x791 = S::mul_add(x662, x700, x661 * x701);
+        let x792 = S::mul_add(x663, x713, x662 * x714)
+            + S::mul_add(x701, x791, x702 * x790);
+        let x793 = S::mul_add(S::neg(x663), x712, x661 * x714)
+            - S::mul_add(x700, x791, x702 * x789);
+        let x794 = S::mul_add(x662, x712, x661 * x713)
+            - S::mul_add(S::neg(x700), x790, x701 * x789);
         let x795 = x783 + x789;
         let x796 = x784 + x790;
         let x797 = x785 + x791;
         let x798 = x772 * x781;
         let x799 = x773 * x782;
-        let x800 = Self::mul_add(x771, x780, -x798) + x799;
+        let x800 = S::mul_add(x771, x780, S::neg(x798)) + x799;
         let x801 = x774 * x780;
         let x802 = x776 * x782;
-        let x803 = Self::mul_add(-x775, x781, x801) + x802;
+        let x803 = S::mul_add(S::neg(x775), x781, x801) + x802;
         let x804 = x777 * x780;
         let x805 = x778 * x781;
-        let x806 = Self::mul_add(x779, x782, x804 - x805);
-        let x807 = Self::mul_add(x777, x781, x774 * x782);
-        let x808 = Self::mul_add(-x778, x780, x772 * x782);
-        let x809 = Self::mul_add(x776, x780, x773 * x781);
-        let x810 = 9.336 * x762;
-        let x811 = 9.336 * x763;
-        let x812 = 9.336 * x764;
+        let x806 = S::mul_add(x779, x782, x804 - x805);
+        let x807 = S::mul_add(x777, x781, x774 * x782);
+        let x808 = S::mul_add(S::neg(x778), x780, x772 * x782);
+        let x809 = S::mul_add(x776, x780, x773 * x781);
+        let x810 = S::splat(9.336) * x762;
+        let x811 = S::splat(9.336) * x763;
+        let x812 = S::splat(9.336) * x764;
         let x813 = x762 * x810;
         let x814 = x763 * x810;
         let x815 = x764 * x810;
@@ -5704,91 +6726,118 @@ impl Ssrms {
         let x819 = x762 * x812;
         let x820 = x763 * x812;
         let x821 = x764 * x812;
-        let x822 = Self::mul_add(qd[6], x762, x780);
-        let x823 = Self::mul_add(-qd[6], x763, x781);
-        let x824 = Self::mul_add(qd[6], x764, x782);
-        let x825 = Self::mul_add(x764, x823, x763 * x824);
-        let x826 = Self::mul_add(-x764, x822, x762 * x824);
-        let x827 = Self::mul_add(x763, x822, x762 * x823);
-        let x828 = Self::mul_add(-qd[6], x825, Self::mul_add(x353, x762, x786));
-        let x829 = Self::mul_add(-qd[6], x826, Self::mul_add(-x353, x763, x787));
-        let x830 = Self::mul_add(qd[6], x827, Self::mul_add(x353, x764, x788));
-        let x831 = Self::mul_add(x764, x781, x763 * x782);
-        let x832 = Self::mul_add(-x764, x780, x762 * x782);
-        let x833 = Self::mul_add(x763, x780, x762 * x781);
-        let x834 = Self::mul_add(x764, x787, x763 * x788)
-            + Self::mul_add(x781, x833, x782 * x832);
-        let x835 = Self::mul_add(-x764, x786, x762 * x788)
-            - Self::mul_add(x780, x833, x782 * x831);
-        let x836 = Self::mul_add(x763, x786, x762 * x787)
-            - Self::mul_add(-x780, x832, x781 * x831);
+        let x822 = S::mul_add(qd[6], x762, x780);
+        let x823 = S::mul_add(S::neg(qd[6]), x763, x781);
+        let x824 = S::mul_add(qd[6], x764, x782);
+        let x825 = S::mul_add(x764, x823, x763 * x824);
+        let x826 = S::mul_add(S::neg(x764), x822, x762 * x824);
+        let x827 = S::mul_add(x763, x822, x762 * x823);
+        let x828 = S::mul_add(S::neg(qd[6]), x825, S::mul_add(x353, x762, x786));
+        let x829 = S::mul_add(S::neg(qd[6]), x826, S::mul_add(S::neg(x353), x763, x787));
+        let x830 = S::mul_add(qd[6], x827, S::mul_add(x353, x764, x788));
+        let x831 = S::mul_add(x764, x781, x763 * x782);
+        let x832 = S::mul_add(S::neg(x764), x780, x762 * x782);
+        let x833 = S::mul_add(x763, x780, x762 * x781);
+        let x834 = S::mul_add(x764, x787, x763 * x788)
+            + S::mul_add(x781, x833, x782 * x832);
+        let x835 = S::mul_add(S::neg(x764), x786, x762 * x788)
+            - S::mul_add(x780, x833, x782 * x831);
+        let x836 = S::mul_add(x763, x786, x762 * x787)
+            - S::mul_add(S::neg(x780), x832, x781 * x831);
         let x837 = x825 + x831;
         let x838 = x826 + x832;
         let x839 = x827 + x833;
         let x840 = x814 * x823;
         let x841 = x815 * x824;
-        let x842 = Self::mul_add(x813, x822, -x840) + x841;
+        let x842 = S::mul_add(x813, x822, S::neg(x840)) + x841;
         let x843 = x816 * x822;
         let x844 = x818 * x824;
-        let x845 = Self::mul_add(-x817, x823, x843) + x844;
+        let x845 = S::mul_add(S::neg(x817), x823, x843) + x844;
         let x846 = x819 * x822;
         let x847 = x820 * x823;
-        let x848 = Self::mul_add(x821, x824, x846 - x847);
-        let x849 = Self::mul_add(x815, x830, Self::mul_add(-x814, x829, x813 * x828))
-            - Self::mul_add(x823, x848, x824 * x845);
-        let x850 = Self::mul_add(x818, x830, Self::mul_add(-x817, x829, x816 * x828))
-            + Self::mul_add(-x822, x848, x824 * x842);
-        let x851 = Self::mul_add(x821, x830, Self::mul_add(-x820, x829, x819 * x828))
-            + Self::mul_add(x822, x845, x823 * x842);
-        let x852 = Self::mul_add(x819, x823, x816 * x824);
-        let x853 = Self::mul_add(-x820, x822, x814 * x824);
-        let x854 = Self::mul_add(x818, x822, x815 * x823);
+        let x848 = S::mul_add(x821, x824, x846 - x847);
+        let x849 = S::mul_add(x815, x830, S::mul_add(S::neg(x814), x829, x813 * x828))
+            - S::mul_add(x823, x848, x824 * x845);
+        let x850 = S::mul_add(x818, x830, S::mul_add(S::neg(x817), x829, x816 * x828))
+            + S::mul_add(S::neg(x822), x848, x824 * x842);
+        let x851 = S::mul_add(x821, x830, S::mul_add(S::neg(x820), x829, x819 * x828))
+            + S::mul_add(x822, x845, x823 * x842);
+        let x852 = S::mul_add(x819, x823, x816 * x824);
+        let x853 = S::mul_add(S::neg(x820), x822, x814 * x824);
+        let x854 = S::mul_add(x818, x822, x815 * x823);
         let x855 = x852 + x852;
-        let x856 = Self::mul_add(-x813, x824, x846) + Self::mul_add(x817, x824, x847);
-        let x857 = Self::mul_add(x813, x823, x843) - Self::mul_add(x821, x823, x844);
+        let x856 = S::mul_add(S::neg(x813), x824, x846) + S::mul_add(x817, x824, x847);
+        let x857 = S::mul_add(x813, x823, x843) - S::mul_add(x821, x823, x844);
         let x858 = x853 + x853;
-        let x859 = Self::mul_add(x817, x822, x840) + Self::mul_add(-x821, x822, x841);
+        let x859 = S::mul_add(x817, x822, x840) + S::mul_add(S::neg(x821), x822, x841);
         let x860 = x854 + x854;
-        let x861 = Self::mul_add(x764, x815, Self::mul_add(x763, x814, x762 * x813));
-        let x862 = Self::mul_add(x764, x818, Self::mul_add(x763, x817, x762 * x816));
-        let x863 = Self::mul_add(x764, x821, Self::mul_add(x763, x820, x762 * x819));
-        let x864 = Self::mul_add(-x764, x857, Self::mul_add(x763, x856, x762 * x855));
-        let x865 = Self::mul_add(-x764, x859, Self::mul_add(-x763, x858, x762 * x856));
-        let x866 = Self::mul_add(x764, x860, Self::mul_add(x763, x859, x762 * x857));
-        let x867 = Self::mul_add(-x763, x848, x764 * x845);
-        let x868 = Self::mul_add(-x762, x848, x764 * x842);
-        let x869 = Self::mul_add(-x762, x845, x763 * x842);
+        let x861 = S::mul_add(x764, x815, S::mul_add(x763, x814, x762 * x813));
+        let x862 = S::mul_add(x764, x818, S::mul_add(x763, x817, x762 * x816));
+        let x863 = S::mul_add(x764, x821, S::mul_add(x763, x820, x762 * x819));
+        let x864 = S::mul_add(S::neg(x764), x857, S::mul_add(x763, x856, x762 * x855));
+        let x865 = S::mul_add(
+            S::neg(x764),
+            x859,
+            S::mul_add(S::neg(x763), x858, x762 * x856),
+        );
+        let x866 = S::mul_add(x764, x860, S::mul_add(x763, x859, x762 * x857));
+        let x867 = S::mul_add(S::neg(x763), x848, x764 * x845);
+        let x868 = S::mul_add(S::neg(x762), x848, x764 * x842);
+        let x869 = S::mul_add(S::neg(x762), x845, x763 * x842);
         let x870 = x864 - x867;
         let x871 = x865 + x868;
         let x872 = x866 + x869;
-        let x873 = Self::mul_add(-x763, x851, x764 * x850)
-            + Self::mul_add(-x815, x836, Self::mul_add(-x814, x835, x813 * x834))
-            + (Self::mul_add(-x832, x848, x833 * x845)
-                - Self::mul_add(x833, x857, Self::mul_add(-x832, x856, x831 * x855)));
-        let x874 = Self::mul_add(-x762, x851, x764 * x849)
-            - Self::mul_add(-x818, x836, Self::mul_add(-x817, x835, x816 * x834))
-            + (Self::mul_add(x831, x848, x833 * x842)
-                + Self::mul_add(x833, x859, Self::mul_add(x832, x858, x831 * x856)));
-        let x875 = Self::mul_add(-x762, x850, x763 * x849)
-            + Self::mul_add(-x821, x836, Self::mul_add(-x820, x835, x819 * x834))
-            + (Self::mul_add(x831, x845, x832 * x842)
-                + Self::mul_add(-x833, x860, Self::mul_add(-x832, x859, x831 * x857)));
-        let x876 = Self::mul_add(-x815, x839, Self::mul_add(-x814, x838, x813 * x837))
-            + (x864 + x867);
-        let x877 = Self::mul_add(-x818, x839, Self::mul_add(-x817, x838, x816 * x837))
-            + (x865 - x868);
-        let x878 = Self::mul_add(-x821, x839, Self::mul_add(-x820, x838, x819 * x837))
-            - (x866 - x869);
-        let x879 = Self::mul_add(c_q0, x875, s_q0 * x874);
-        let x880 = Self::mul_add(-c_q0, x878, s_q0 * x877);
-        let x881 = Self::mul_add(-x357, x875, Self::mul_add(x356, x874, s_q1 * x873));
-        let x882 = Self::mul_add(-x357, x878, Self::mul_add(-x356, x877, s_q1 * x876));
-        let x883 = Self::mul_add(x663, x875, Self::mul_add(-x662, x874, x661 * x873));
-        let x884 = Self::mul_add(x663, x878, Self::mul_add(x662, x877, x661 * x876));
-        let x885 = Self::mul_add(-x836, x863, Self::mul_add(-x835, x862, x834 * x861))
-            - Self::mul_add(x833, x872, Self::mul_add(-x832, x871, x831 * x870));
-        let x886 = Self::mul_add(-x839, x863, Self::mul_add(-x838, x862, x837 * x861))
-            + Self::mul_add(-x764, x872, Self::mul_add(x763, x871, x762 * x870));
+        let x873 = S::mul_add(S::neg(x763), x851, x764 * x850)
+            + S::mul_add(S::neg(x815), x836, S::mul_add(S::neg(x814), x835, x813 * x834))
+            + (S::mul_add(S::neg(x832), x848, x833 * x845)
+                - S::mul_add(x833, x857, S::mul_add(S::neg(x832), x856, x831 * x855)));
+        let x874 = S::mul_add(S::neg(x762), x851, x764 * x849)
+            - S::mul_add(S::neg(x818), x836, S::mul_add(S::neg(x817), x835, x816 * x834))
+            + (S::mul_add(x831, x848, x833 * x842)
+                + S::mul_add(x833, x859, S::mul_add(x832, x858, x831 * x856)));
+        let x875 = S::mul_add(S::neg(x762), x850, x763 * x849)
+            + S::mul_add(S::neg(x821), x836, S::mul_add(S::neg(x820), x835, x819 * x834))
+            + (S::mul_add(x831, x845, x832 * x842)
+                + S::mul_add(
+                    S::neg(x833),
+                    x860,
+                    S::mul_add(S::neg(x832), x859, x831 * x857),
+                ));
+        let x876 = S::mul_add(
+            S::neg(x815),
+            x839,
+            S::mul_add(S::neg(x814), x838, x813 * x837),
+        ) + (x864 + x867);
+        let x877 = S::mul_add(
+            S::neg(x818),
+            x839,
+            S::mul_add(S::neg(x817), x838, x816 * x837),
+        ) + (x865 - x868);
+        let x878 = S::mul_add(
+            S::neg(x821),
+            x839,
+            S::mul_add(S::neg(x820), x838, x819 * x837),
+        ) - (x866 - x869);
+        let x879 = S::mul_add(c_q0, x875, s_q0 * x874);
+        let x880 = S::mul_add(S::neg(c_q0), x878, s_q0 * x877);
+        let x881 = S::mul_add(S::neg(x357), x875, S::mul_add(x356, x874, s_q1 * x873));
+        let x882 = S::mul_add(
+            S::neg(x357),
+            x878,
+            S::mul_add(S::neg(x356), x877, s_q1 * x876),
+        );
+        let x883 = S::mul_add(x663, x875, S::mul_add(S::neg(x662), x874, x661 * x873));
+        let x884 = S::mul_add(x663, x878, S::mul_add(x662, x877, x661 * x876));
+        let x885 = S::mul_add(
+            S::neg(x836),
+            x863,
+            S::mul_add(S::neg(x835), x862, x834 * x861),
+        ) - S::mul_add(x833, x872, S::mul_add(S::neg(x832), x871, x831 * x870));
+        let x886 = S::mul_add(
+            S::neg(x839),
+            x863,
+            S::mul_add(S::neg(x838), x862, x837 * x861),
+        ) + S::mul_add(S::neg(x764), x872, S::mul_add(x763, x871, x762 * x870));
         let x887 = x771 - x813;
         let x888 = x772 - x814;
         let x889 = x773 - x815;
@@ -5802,62 +6851,94 @@ impl Ssrms {
         let x897 = x803 - x845;
         let x898 = x806 - x848;
         let x899 = x807 + x807 - x855;
-        let x900 = Self::mul_add(-x771, x782, x804) + Self::mul_add(x775, x782, x805)
+        let x900 = S::mul_add(S::neg(x771), x782, x804) + S::mul_add(x775, x782, x805)
             - x856;
-        let x901 = Self::mul_add(x771, x781, x801) - Self::mul_add(x779, x781, x802)
-            - x857;
+        let x901 = S::mul_add(x771, x781, x801) - S::mul_add(x779, x781, x802) - x857;
         let x902 = x808 + x808 - x858;
-        let x903 = Self::mul_add(x775, x780, x798) + Self::mul_add(-x779, x780, x799)
+        let x903 = S::mul_add(x775, x780, x798) + S::mul_add(S::neg(x779), x780, x799)
             - x859;
         let x904 = x809 + x809 - x860;
-        let x905 = Self::mul_add(x773, x788, Self::mul_add(-x772, x787, x771 * x786))
-            - Self::mul_add(x781, x806, x782 * x803) - x849;
-        let x906 = Self::mul_add(x776, x788, Self::mul_add(-x775, x787, x774 * x786))
-            + Self::mul_add(-x780, x806, x782 * x800) - x850;
-        let x907 = Self::mul_add(x779, x788, Self::mul_add(-x778, x787, x777 * x786))
-            + Self::mul_add(x780, x803, x781 * x800) - x851;
-        let x908 = Self::mul_add(x663, x889, Self::mul_add(x662, x888, x661 * x887));
-        let x909 = Self::mul_add(x663, x892, Self::mul_add(x662, x891, x661 * x890));
-        let x910 = Self::mul_add(x663, x895, Self::mul_add(x662, x894, x661 * x893));
-        let x911 = Self::mul_add(-x663, x901, Self::mul_add(x662, x900, x661 * x899));
-        let x912 = Self::mul_add(-x663, x903, Self::mul_add(-x662, x902, x661 * x900));
-        let x913 = Self::mul_add(x663, x904, Self::mul_add(x662, x903, x661 * x901));
-        let x914 = Self::mul_add(-x662, x898, x663 * x897);
-        let x915 = Self::mul_add(-x661, x898, x663 * x896);
-        let x916 = Self::mul_add(-x661, x897, x662 * x896);
+        let x905 = S::mul_add(x773, x788, S::mul_add(S::neg(x772), x787, x771 * x786))
+            - S::mul_add(x781, x806, x782 * x803) - x849;
+        let x906 = S::mul_add(x776, x788, S::mul_add(S::neg(x775), x787, x774 * x786))
+            + S::mul_add(S::neg(x780), x806, x782 * x800) - x850;
+        let x907 = S::mul_add(x779, x788, S::mul_add(S::neg(x778), x787, x777 * x786))
+            + S::mul_add(x780, x803, x781 * x800) - x851;
+        let x908 = S::mul_add(x663, x889, S::mul_add(x662, x888, x661 * x887));
+        let x909 = S::mul_add(x663, x892, S::mul_add(x662, x891, x661 * x890));
+        let x910 = S::mul_add(x663, x895, S::mul_add(x662, x894, x661 * x893));
+        let x911 = S::mul_add(S::neg(x663), x901, S::mul_add(x662, x900, x661 * x899));
+        let x912 = S::mul_add(
+            S::neg(x663),
+            x903,
+            S::mul_add(S::neg(x662), x902, x661 * x900),
+        );
+        let x913 = S::mul_add(x663, x904, S::mul_add(x662, x903, x661 * x901));
+        let x914 = S::mul_add(S::neg(x662), x898, x663 * x897);
+        let x915 = S::mul_add(S::neg(x661), x898, x663 * x896);
+        let x916 = S::mul_add(S::neg(x661), x897, x662 * x896);
         let x917 = x911 - x914;
         let x918 = x912 + x915;
         let x919 = x913 + x916;
-        let x920 = Self::mul_add(-x662, x907, x663 * x906)
-            + Self::mul_add(-x794, x889, Self::mul_add(-x793, x888, x792 * x887))
-            + (Self::mul_add(-x790, x898, x791 * x897)
-                - Self::mul_add(x791, x901, Self::mul_add(-x790, x900, x789 * x899)));
-        let x921 = Self::mul_add(-x661, x907, x663 * x905)
-            - Self::mul_add(-x794, x892, Self::mul_add(-x793, x891, x792 * x890))
-            + (Self::mul_add(x789, x898, x791 * x896)
-                + Self::mul_add(x791, x903, Self::mul_add(x790, x902, x789 * x900)));
-        let x922 = Self::mul_add(-x661, x906, x662 * x905)
-            + Self::mul_add(-x794, x895, Self::mul_add(-x793, x894, x792 * x893))
-            + (Self::mul_add(x789, x897, x790 * x896)
-                + Self::mul_add(-x791, x904, Self::mul_add(-x790, x903, x789 * x901)));
-        let x923 = Self::mul_add(-x797, x889, Self::mul_add(-x796, x888, x795 * x887))
-            + (x911 + x914);
-        let x924 = Self::mul_add(-x797, x892, Self::mul_add(-x796, x891, x795 * x890))
-            + (x912 - x915);
-        let x925 = Self::mul_add(-x797, x895, Self::mul_add(-x796, x894, x795 * x893))
-            - (x913 - x916);
-        let x926 = Self::mul_add(c_q0, x922, s_q0 * x921);
-        let x927 = Self::mul_add(-c_q0, x925, s_q0 * x924);
-        let x928 = Self::mul_add(-x357, x922, Self::mul_add(x356, x921, s_q1 * x920));
-        let x929 = Self::mul_add(-x357, x925, Self::mul_add(-x356, x924, s_q1 * x923));
-        let x930 = Self::mul_add(-x794, x910, Self::mul_add(-x793, x909, x792 * x908))
-            - Self::mul_add(x791, x919, Self::mul_add(-x790, x918, x789 * x917));
-        let x931 = Self::mul_add(-x797, x910, Self::mul_add(-x796, x909, x795 * x908))
-            + Self::mul_add(-x663, x919, Self::mul_add(x662, x918, x661 * x917));
-        let x932 = Self::mul_add(-x794, x863, Self::mul_add(-x793, x862, x792 * x861))
-            - Self::mul_add(x791, x872, Self::mul_add(-x790, x871, x789 * x870));
-        let x933 = Self::mul_add(-x797, x863, Self::mul_add(-x796, x862, x795 * x861))
-            + Self::mul_add(-x663, x872, Self::mul_add(x662, x871, x661 * x870));
+        let x920 = S::mul_add(S::neg(x662), x907, x663 * x906)
+            + S::mul_add(S::neg(x794), x889, S::mul_add(S::neg(x793), x888, x792 * x887))
+            + (S::mul_add(S::neg(x790), x898, x791 * x897)
+                - S::mul_add(x791, x901, S::mul_add(S::neg(x790), x900, x789 * x899)));
+        let x921 = S::mul_add(S::neg(x661), x907, x663 * x905)
+            - S::mul_add(S::neg(x794), x892, S::mul_add(S::neg(x793), x891, x792 * x890))
+            + (S::mul_add(x789, x898, x791 * x896)
+                + S::mul_add(x791, x903, S::mul_add(x790, x902, x789 * x900)));
+        let x922 = S::mul_add(S::neg(x661), x906, x662 * x905)
+            + S::mul_add(S::neg(x794), x895, S::mul_add(S::neg(x793), x894, x792 * x893))
+            + (S::mul_add(x789, x897, x790 * x896)
+                + S::mul_add(
+                    S::neg(x791),
+                    x904,
+                    S::mul_add(S::neg(x790), x903, x789 * x901),
+                ));
+        let x923 = S::mul_add(
+            S::neg(x797),
+            x889,
+            S::mul_add(S::neg(x796), x888, x795 * x887),
+        ) + (x911 + x914);
+        let x924 = S::mul_add(
+            S::neg(x797),
+            x892,
+            S::mul_add(S::neg(x796), x891, x795 * x890),
+        ) + (x912 - x915);
+        let x925 = S::mul_add(
+            S::neg(x797),
+            x895,
+            S::mul_add(S::neg(x796), x894, x795 * x893),
+        ) - (x913 - x916);
+        let x926 = S::mul_add(c_q0, x922, s_q0 * x921);
+        let x927 = S::mul_add(S::neg(c_q0), x925, s_q0 * x924);
+        let x928 = S::mul_add(S::neg(x357), x922, S::mul_add(x356, x921, s_q1 * x920));
+        let x929 = S::mul_add(
+            S::neg(x357),
+            x925,
+            S::mul_add(S::neg(x356), x924, s_q1 * x923),
+        );
+        let x930 = S::mul_add(
+            S::neg(x794),
+            x910,
+            S::mul_add(S::neg(x793), x909, x792 * x908),
+        ) - S::mul_add(x791, x919, S::mul_add(S::neg(x790), x918, x789 * x917));
+        let x931 = S::mul_add(
+            S::neg(x797),
+            x910,
+            S::mul_add(S::neg(x796), x909, x795 * x908),
+        ) + S::mul_add(S::neg(x663), x919, S::mul_add(x662, x918, x661 * x917));
+        let x932 = S::mul_add(
+            S::neg(x794),
+            x863,
+            S::mul_add(S::neg(x793), x862, x792 * x861),
+        ) - S::mul_add(x791, x872, S::mul_add(S::neg(x790), x871, x789 * x870));
+        let x933 = S::mul_add(
+            S::neg(x797),
+            x863,
+            S::mul_add(S::neg(x796), x862, x795 * x861),
+        ) + S::mul_add(S::neg(x663), x872, S::mul_add(x662, x871, x661 * x870));
         let x934 = x691 + x887;
         let x935 = x692 - x888;
         let x936 = x693 - x889;
@@ -5873,141 +6954,150 @@ impl Ssrms {
         let x946 = x761 - (x757 + (x757 + (x754 + x754))) - x899;
         let x947 = x744
             - (x743
-                - (Self::mul_add(x691, x702, x737) + Self::mul_add(-x695, x702, x738)))
+                - (S::mul_add(x691, x702, x737) + S::mul_add(S::neg(x695), x702, x738)))
             - x900;
         let x948 = x742
             - (x741
-                - (Self::mul_add(x691, x701, x735) - Self::mul_add(-x699, x701, x736)))
+                - (S::mul_add(x691, x701, x735) - S::mul_add(S::neg(x699), x701, x736)))
             + x901;
         let x949 = x761 + (x758 + (x758 - (x755 + x755))) + x902;
         let x950 = x740
             + (x739
-                - (Self::mul_add(-x695, x700, x733) + Self::mul_add(-x699, x700, x734)))
-            + x903;
+                - (S::mul_add(S::neg(x695), x700, x733)
+                    + S::mul_add(S::neg(x699), x700, x734))) + x903;
         let x951 = x761 + (x759 + (x759 - (x756 + x756))) + x904;
-        let x952 = Self::mul_add(-x693, x714, Self::mul_add(x692, x713, x691 * x712))
-            + Self::mul_add(-x671, x717, x672 * x716)
-            - (Self::mul_add(-x701, x747, x702 * x746)
-                + Self::mul_add(x704, x750, x705 * x749)) + x905;
-        let x953 = Self::mul_add(x696, x714, Self::mul_add(-x695, x713, x694 * x712))
-            + Self::mul_add(x670, x717, x672 * x715)
-            + (Self::mul_add(x700, x747, x702 * x745)
-                + Self::mul_add(-x703, x750, x705 * x748)) + x906;
-        let x954 = Self::mul_add(x699, x714, Self::mul_add(-x698, x713, x697 * x712))
-            + Self::mul_add(x670, x716, x671 * x715)
-            - (Self::mul_add(x700, x746, x701 * x745)
-                - Self::mul_add(x703, x749, x704 * x748)) - x907;
-        let x955 = Self::mul_add(x357, x936, Self::mul_add(x356, x935, s_q1 * x934))
-            - Self::mul_add(-x669, x671, x668 * x672);
-        let x956 = Self::mul_add(-x357, x939, Self::mul_add(-x356, x938, s_q1 * x937))
-            + Self::mul_add(-x669, x670, x667 * x672);
-        let x957 = Self::mul_add(-x357, x942, Self::mul_add(-x356, x941, s_q1 * x940))
-            + Self::mul_add(-x668, x670, x667 * x671);
-        let x958 = Self::mul_add(-x357, x671, x356 * x672);
-        let x959 = Self::mul_add(x357, x670, s_q1 * x672);
-        let x960 = Self::mul_add(x356, x670, s_q1 * x671);
-        let x961 = Self::mul_add(x669, x749, x668 * x750);
-        let x962 = Self::mul_add(x669, x748, x667 * x750);
-        let x963 = Self::mul_add(-x668, x748, x667 * x749);
-        let x964 = Self::mul_add(-x357, x948, Self::mul_add(-x356, x947, s_q1 * x946))
-            - x961;
-        let x965 = Self::mul_add(-x357, x950, Self::mul_add(-x356, x949, s_q1 * x947))
-            + x962;
-        let x966 = Self::mul_add(-x357, x951, Self::mul_add(-x356, x950, s_q1 * x948))
-            + x963;
-        let x967 = Self::mul_add(x357, x749, x356 * x750);
-        let x968 = Self::mul_add(-x357, x748, s_q1 * x750);
-        let x969 = Self::mul_add(x356, x748, s_q1 * x749);
-        let x970 = x961 + Self::mul_add(x356, x945, x357 * x944);
-        let x971 = x962 + Self::mul_add(-s_q1, x945, x357 * x943);
-        let x972 = x963 - Self::mul_add(s_q1, x944, x356 * x943);
+        let x952 = S::mul_add(S::neg(x693), x714, S::mul_add(x692, x713, x691 * x712))
+            + S::mul_add(S::neg(x671), x717, x672 * x716)
+            - (S::mul_add(S::neg(x701), x747, x702 * x746)
+                + S::mul_add(x704, x750, x705 * x749)) + x905;
+        let x953 = S::mul_add(x696, x714, S::mul_add(S::neg(x695), x713, x694 * x712))
+            + S::mul_add(x670, x717, x672 * x715)
+            + (S::mul_add(x700, x747, x702 * x745)
+                + S::mul_add(S::neg(x703), x750, x705 * x748)) + x906;
+        let x954 = S::mul_add(x699, x714, S::mul_add(S::neg(x698), x713, x697 * x712))
+            + S::mul_add(x670, x716, x671 * x715)
+            - (S::mul_add(x700, x746, x701 * x745) - S::mul_add(x703, x749, x704 * x748))
+            - x907;
+        let x955 = S::mul_add(x357, x936, S::mul_add(x356, x935, s_q1 * x934))
+            - S::mul_add(S::neg(x669), x671, x668 * x672);
+        let x956 = S::mul_add(
+            S::neg(x357),
+            x939,
+            S::mul_add(S::neg(x356), x938, s_q1 * x937),
+        ) + S::mul_add(S::neg(x669), x670, x667 * x672);
+        let x957 = S::mul_add(
+            S::neg(x357),
+            x942,
+            S::mul_add(S::neg(x356), x941, s_q1 * x940),
+        ) + S::mul_add(S::neg(x668), x670, x667 * x671);
+        let x958 = S::mul_add(S::neg(x357), x671, x356 * x672);
+        let x959 = S::mul_add(x357, x670, s_q1 * x672);
+        let x960 = S::mul_add(x356, x670, s_q1 * x671);
+        let x961 = S::mul_add(x669, x749, x668 * x750);
+        let x962 = S::mul_add(x669, x748, x667 * x750);
+        let x963 = S::mul_add(S::neg(x668), x748, x667 * x749);
+        let x964 = S::mul_add(
+            S::neg(x357),
+            x948,
+            S::mul_add(S::neg(x356), x947, s_q1 * x946),
+        ) - x961;
+        let x965 = S::mul_add(
+            S::neg(x357),
+            x950,
+            S::mul_add(S::neg(x356), x949, s_q1 * x947),
+        ) + x962;
+        let x966 = S::mul_add(
+            S::neg(x357),
+            x951,
+            S::mul_add(S::neg(x356), x950, s_q1 * x948),
+        ) + x963;
+        let x967 = S::mul_add(x357, x749, x356 * x750);
+        let x968 = S::mul_add(S::neg(x357), x748, s_q1 * x750);
+        let x969 = S::mul_add(x356, x748, s_q1 * x749);
+        let x970 = x961 + S::mul_add(x356, x945, x357 * x944);
+        let x971 = x962 + S::mul_add(S::neg(s_q1), x945, x357 * x943);
+        let x972 = x963 - S::mul_add(s_q1, x944, x356 * x943);
         let x973 = x964 - x970;
         let x974 = x965 + x971;
         let x975 = x966 + x972;
-        let x976 = Self::mul_add(-x719, x750, x720 * x749);
-        let x977 = Self::mul_add(-x718, x750, x720 * x748);
-        let x978 = Self::mul_add(-x718, x749, x719 * x748);
-        let x979 = Self::mul_add(x606, x750, x607 * x749);
-        let x980 = Self::mul_add(x605, x750, x607 * x748);
-        let x981 = Self::mul_add(-x605, x749, x606 * x748);
-        let x982 = Self::mul_add(x356, x954, x357 * x953)
-            + Self::mul_add(x668, x753, x669 * x752)
-            + (Self::mul_add(-x723, x936, Self::mul_add(-x722, x935, x721 * x934))
-                - Self::mul_add(-x671, x726, x672 * x725))
-            - (Self::mul_add(x606, x945, x607 * x944) - x976
-                + (x976
-                    - Self::mul_add(
-                        x607,
-                        x948,
-                        Self::mul_add(x606, x947, x605 * x946),
-                    )));
-        let x983 = Self::mul_add(-s_q1, x954, x357 * x952)
-            + Self::mul_add(x667, x753, x669 * x751)
-            - (Self::mul_add(x723, x939, Self::mul_add(x722, x938, x721 * x937))
-                - Self::mul_add(x670, x726, x672 * x724))
-            - (Self::mul_add(x605, x945, x607 * x943) - x977
-                + (x977
-                    + Self::mul_add(
-                        x607,
-                        x950,
-                        Self::mul_add(x606, x949, x605 * x947),
-                    )));
-        let x984 = Self::mul_add(s_q1, x953, x356 * x952)
-            + Self::mul_add(-x667, x752, x668 * x751)
-            - (Self::mul_add(x723, x942, Self::mul_add(x722, x941, x721 * x940))
-                - Self::mul_add(x670, x725, x671 * x724))
-            - (Self::mul_add(-x605, x944, x606 * x943) + x978
-                - (x978
-                    + Self::mul_add(
-                        x607,
-                        x951,
-                        Self::mul_add(x606, x950, x605 * x948),
-                    )));
-        let x985 = Self::mul_add(x356, x753, x357 * x752)
-            - Self::mul_add(-x671, x723, x672 * x722) - (x979 + x979);
-        let x986 = Self::mul_add(-s_q1, x753, x357 * x751)
-            - Self::mul_add(-x670, x723, x672 * x721) - (x980 + x980);
-        let x987 = Self::mul_add(s_q1, x752, x356 * x751)
-            - Self::mul_add(-x670, x722, x671 * x721) - (x981 + x981);
-        let x988 = Self::mul_add(-x729, x936, Self::mul_add(-x728, x935, x727 * x934))
-            - Self::mul_add(-x671, x732, x672 * x731) + (x964 + x970);
-        let x989 = Self::mul_add(x729, x939, Self::mul_add(x728, x938, x727 * x937))
-            - Self::mul_add(x670, x732, x672 * x730) + (x965 - x971);
-        let x990 = Self::mul_add(x729, x942, Self::mul_add(x728, x941, x727 * x940))
-            - Self::mul_add(x670, x731, x671 * x730) - (x966 - x972);
-        let x991 = Self::mul_add(-x671, x729, x672 * x728) - (x967 + x967);
-        let x992 = Self::mul_add(-x670, x729, x672 * x727) + (x968 + x968);
-        let x993 = Self::mul_add(-x670, x728, x671 * x727) - (x969 + x969);
-        let x994 = Self::mul_add(c_q0, x984, s_q0 * x983)
-            - Self::mul_add(-x362, x987, Self::mul_add(x361, x986, x360 * x985));
-        let x995 = Self::mul_add(c_q0, x990, s_q0 * x989)
-            - Self::mul_add(-x362, x993, Self::mul_add(x361, x992, x360 * x991));
-        let x996 = Self::mul_add(-x357, x984, Self::mul_add(x356, x983, s_q1 * x982));
+        let x976 = S::mul_add(S::neg(x719), x750, x720 * x749);
+        let x977 = S::mul_add(S::neg(x718), x750, x720 * x748);
+        let x978 = S::mul_add(S::neg(x718), x749, x719 * x748);
+        let x979 = S::mul_add(x606, x750, x607 * x749);
+        let x980 = S::mul_add(x605, x750, x607 * x748);
+        let x981 = S::mul_add(S::neg(x605), x749, x606 * x748);
+        let x982 = S::mul_add(x356, x954, x357 * x953)
+            + S::mul_add(x668, x753, x669 * x752)
+            + (S::mul_add(
+                S::neg(x723),
+                x936,
+                S::mul_add(S::neg(x722), x935, x721 * x934),
+            ) - S::mul_add(S::neg(x671), x726, x672 * x725))
+            - (S::mul_add(x606, x945, x607 * x944) - x976
+                + (x976 - S::mul_add(x607, x948, S::mul_add(x606, x947, x605 * x946))));
+        let x983 = S::mul_add(S::neg(s_q1), x954, x357 * x952)
+            + S::mul_add(x667, x753, x669 * x751)
+            - (S::mul_add(x723, x939, S::mul_add(x722, x938, x721 * x937))
+                - S::mul_add(x670, x726, x672 * x724))
+            - (S::mul_add(x605, x945, x607 * x943) - x977
+                + (x977 + S::mul_add(x607, x950, S::mul_add(x606, x949, x605 * x947))));
+        let x984 = S::mul_add(s_q1, x953, x356 * x952)
+            + S::mul_add(S::neg(x667), x752, x668 * x751)
+            - (S::mul_add(x723, x942, S::mul_add(x722, x941, x721 * x940))
+                - S::mul_add(x670, x725, x671 * x724))
+            - (S::mul_add(S::neg(x605), x944, x606 * x943) + x978
+                - (x978 + S::mul_add(x607, x951, S::mul_add(x606, x950, x605 * x948))));
+        let x985 = S::mul_add(x356, x753, x357 * x752)
+            - S::mul_add(S::neg(x671), x723, x672 * x722) - (x979 + x979);
+        let x986 = S::mul_add(S::neg(s_q1), x753, x357 * x751)
+            - S::mul_add(S::neg(x670), x723, x672 * x721) - (x980 + x980);
+        let x987 = S::mul_add(s_q1, x752, x356 * x751)
+            - S::mul_add(S::neg(x670), x722, x671 * x721) - (x981 + x981);
+        let x988 = S::mul_add(
+            S::neg(x729),
+            x936,
+            S::mul_add(S::neg(x728), x935, x727 * x934),
+        ) - S::mul_add(S::neg(x671), x732, x672 * x731) + (x964 + x970);
+        let x989 = S::mul_add(x729, x939, S::mul_add(x728, x938, x727 * x937))
+            - S::mul_add(x670, x732, x672 * x730) + (x965 - x971);
+        let x990 = S::mul_add(x729, x942, S::mul_add(x728, x941, x727 * x940))
+            - S::mul_add(x670, x731, x671 * x730) - (x966 - x972);
+        let x991 = S::mul_add(S::neg(x671), x729, x672 * x728) - (x967 + x967);
+        let x992 = S::mul_add(S::neg(x670), x729, x672 * x727) + (x968 + x968);
+        let x993 = S::mul_add(S::neg(x670), x728, x671 * x727) - (x969 + x969);
+        let x994 = S::mul_add(c_q0, x984, s_q0 * x983)
+            - S::mul_add(S::neg(x362), x987, S::mul_add(x361, x986, x360 * x985));
+        let x995 = S::mul_add(c_q0, x990, s_q0 * x989)
+            - S::mul_add(S::neg(x362), x993, S::mul_add(x361, x992, x360 * x991));
+        let x996 = S::mul_add(S::neg(x357), x984, S::mul_add(x356, x983, s_q1 * x982));
         let x997 = x996
-            - Self::mul_add(x455, x987, Self::mul_add(-x454, x986, x453 * x985));
-        let x998 = Self::mul_add(x357, x990, Self::mul_add(-x356, x989, s_q1 * x988));
+            - S::mul_add(x455, x987, S::mul_add(S::neg(x454), x986, x453 * x985));
+        let x998 = S::mul_add(x357, x990, S::mul_add(S::neg(x356), x989, s_q1 * x988));
         let x999 = x998
-            + Self::mul_add(x455, x993, Self::mul_add(-x454, x992, x453 * x991));
+            + S::mul_add(x455, x993, S::mul_add(S::neg(x454), x992, x453 * x991));
         let x1000 = x996
-            - Self::mul_add(x565, x987, Self::mul_add(-x564, x986, x563 * x985));
+            - S::mul_add(x565, x987, S::mul_add(S::neg(x564), x986, x563 * x985));
         let x1001 = x998
-            + Self::mul_add(x565, x993, Self::mul_add(-x564, x992, x563 * x991));
-        let x1002 = Self::mul_add(-x723, x957, Self::mul_add(x722, x956, x721 * x955))
-            + Self::mul_add(x726, x960, Self::mul_add(-x725, x959, x724 * x958))
-            + Self::mul_add(x607, x975, Self::mul_add(x606, x974, x605 * x973));
-        let x1003 = Self::mul_add(-x357, x975, Self::mul_add(-x356, x974, s_q1 * x973));
-        let x1004 = Self::mul_add(-x729, x957, Self::mul_add(x728, x956, x727 * x955))
-            + Self::mul_add(x732, x960, Self::mul_add(-x731, x959, x730 * x958)) + x1003;
-        let x1005 = Self::mul_add(x723, x910, Self::mul_add(x722, x909, x721 * x908))
-            - Self::mul_add(-x607, x919, Self::mul_add(x606, x918, x605 * x917));
-        let x1006 = Self::mul_add(x357, x919, Self::mul_add(-x356, x918, s_q1 * x917));
-        let x1007 = Self::mul_add(x729, x910, Self::mul_add(x728, x909, x727 * x908))
-            - x1006;
-        let x1008 = Self::mul_add(x723, x863, Self::mul_add(x722, x862, x721 * x861))
-            - Self::mul_add(-x607, x872, Self::mul_add(x606, x871, x605 * x870));
-        let x1009 = Self::mul_add(x357, x872, Self::mul_add(-x356, x871, s_q1 * x870));
-        let x1010 = Self::mul_add(x729, x863, Self::mul_add(x728, x862, x727 * x861))
-            - x1009;
+            + S::mul_add(x565, x993, S::mul_add(S::neg(x564), x992, x563 * x991));
+        let x1002 = S::mul_add(S::neg(x723), x957, S::mul_add(x722, x956, x721 * x955))
+            + S::mul_add(x726, x960, S::mul_add(S::neg(x725), x959, x724 * x958))
+            + S::mul_add(x607, x975, S::mul_add(x606, x974, x605 * x973));
+        let x1003 = S::mul_add(
+            S::neg(x357),
+            x975,
+            S::mul_add(S::neg(x356), x974, s_q1 * x973),
+        );
+        let x1004 = S::mul_add(S::neg(x729), x957, S::mul_add(x728, x956, x727 * x955))
+            + S::mul_add(x732, x960, S::mul_add(S::neg(x731), x959, x730 * x958))
+            + x1003;
+        let x1005 = S::mul_add(x723, x910, S::mul_add(x722, x909, x721 * x908))
+            - S::mul_add(S::neg(x607), x919, S::mul_add(x606, x918, x605 * x917));
+        let x1006 = S::mul_add(x357, x919, S::mul_add(S::neg(x356), x918, s_q1 * x917));
+        let x1007 = S::mul_add(x729, x910, S::mul_add(x728, x909, x727 * x908)) - x1006;
+        let x1008 = S::mul_add(x723, x863, S::mul_add(x722, x862, x721 * x861))
+            - S::mul_add(S::neg(x607), x872, S::mul_add(x606, x871, x605 * x870));
+        let x1009 = S::mul_add(x357, x872, S::mul_add(S::neg(x356), x871, s_q1 * x870));
+        let x1010 = S::mul_add(x729, x863, S::mul_add(x728, x862, x727 * x861)) - x1009;
         let x1011 = x566 - x670;
         let x1012 = x567 - x671;
         let x1013 = x568 - x672;
@@ -6029,168 +7119,169 @@ impl Ssrms {
         let x1029 = x660 - (x656 + (x656 + (x653 + x653))) - x946;
         let x1030 = x646
             - (x645
-                - (Self::mul_add(x590, x601, x639) + Self::mul_add(-x594, x601, x640)))
+                - (S::mul_add(x590, x601, x639) + S::mul_add(S::neg(x594), x601, x640)))
             - x947;
         let x1031 = x644
             - (x643
-                - (Self::mul_add(x590, x600, x637) - Self::mul_add(-x598, x600, x638)))
+                - (S::mul_add(x590, x600, x637) - S::mul_add(S::neg(x598), x600, x638)))
             - x948;
         let x1032 = x660 + (x657 + (x657 - (x654 + x654))) - x949;
         let x1033 = x642
             + (x641
-                - (Self::mul_add(-x594, x599, x635) + Self::mul_add(-x598, x599, x636)))
-            - x950;
+                - (S::mul_add(S::neg(x594), x599, x635)
+                    + S::mul_add(S::neg(x598), x599, x636))) - x950;
         let x1034 = x660 + (x658 + (x658 - (x655 + x655))) - x951;
-        let x1035 = Self::mul_add(-x592, x616, Self::mul_add(x591, x615, x590 * x614))
-            + Self::mul_add(-x567, x619, x568 * x618)
-            - (Self::mul_add(-x600, x649, x601 * x648)
-                + Self::mul_add(x603, x652, x604 * x651)) - x952;
-        let x1036 = Self::mul_add(x595, x616, Self::mul_add(-x594, x615, x593 * x614))
-            + Self::mul_add(x566, x619, x568 * x617)
-            + (Self::mul_add(x599, x649, x601 * x647)
-                + Self::mul_add(-x602, x652, x604 * x650)) - x953;
-        let x1037 = Self::mul_add(x598, x616, Self::mul_add(-x597, x615, x596 * x614))
-            + Self::mul_add(x566, x618, x567 * x617)
-            - (Self::mul_add(x599, x648, x600 * x647)
-                - Self::mul_add(x602, x651, x603 * x650)) - x954;
-        let x1038 = Self::mul_add(x567, x616, x568 * x615)
-            - Self::mul_add(-x600, x652, x601 * x651) - x751;
-        let x1039 = Self::mul_add(-x566, x616, x568 * x614)
-            + Self::mul_add(x599, x652, x601 * x650) - x752;
-        let x1040 = Self::mul_add(x566, x615, x567 * x614)
-            - Self::mul_add(x599, x651, x600 * x650) - x753;
-        let x1041 = Self::mul_add(x357, x1016, Self::mul_add(x356, x1015, s_q1 * x1014))
-            - Self::mul_add(-x565, x1012, x564 * x1013);
-        let x1042 = Self::mul_add(
-            -x357,
+        let x1035 = S::mul_add(S::neg(x592), x616, S::mul_add(x591, x615, x590 * x614))
+            + S::mul_add(S::neg(x567), x619, x568 * x618)
+            - (S::mul_add(S::neg(x600), x649, x601 * x648)
+                + S::mul_add(x603, x652, x604 * x651)) - x952;
+        let x1036 = S::mul_add(x595, x616, S::mul_add(S::neg(x594), x615, x593 * x614))
+            + S::mul_add(x566, x619, x568 * x617)
+            + (S::mul_add(x599, x649, x601 * x647)
+                + S::mul_add(S::neg(x602), x652, x604 * x650)) - x953;
+        let x1037 = S::mul_add(x598, x616, S::mul_add(S::neg(x597), x615, x596 * x614))
+            + S::mul_add(x566, x618, x567 * x617)
+            - (S::mul_add(x599, x648, x600 * x647) - S::mul_add(x602, x651, x603 * x650))
+            - x954;
+        let x1038 = S::mul_add(x567, x616, x568 * x615)
+            - S::mul_add(S::neg(x600), x652, x601 * x651) - x751;
+        let x1039 = S::mul_add(S::neg(x566), x616, x568 * x614)
+            + S::mul_add(x599, x652, x601 * x650) - x752;
+        let x1040 = S::mul_add(x566, x615, x567 * x614)
+            - S::mul_add(x599, x651, x600 * x650) - x753;
+        let x1041 = S::mul_add(x357, x1016, S::mul_add(x356, x1015, s_q1 * x1014))
+            - S::mul_add(S::neg(x565), x1012, x564 * x1013);
+        let x1042 = S::mul_add(
+            S::neg(x357),
             x1019,
-            Self::mul_add(-x356, x1018, s_q1 * x1017),
-        ) + Self::mul_add(-x565, x1011, x563 * x1013);
-        let x1043 = Self::mul_add(
-            -x357,
+            S::mul_add(S::neg(x356), x1018, s_q1 * x1017),
+        ) + S::mul_add(S::neg(x565), x1011, x563 * x1013);
+        let x1043 = S::mul_add(
+            S::neg(x357),
             x1022,
-            Self::mul_add(-x356, x1021, s_q1 * x1020),
-        ) + Self::mul_add(-x564, x1011, x563 * x1012);
-        let x1044 = Self::mul_add(-x357, x1012, x356 * x1013);
-        let x1045 = Self::mul_add(x357, x1011, s_q1 * x1013);
-        let x1046 = Self::mul_add(x356, x1011, s_q1 * x1012);
-        let x1047 = Self::mul_add(x565, x1027, x564 * x1028);
-        let x1048 = Self::mul_add(x565, x1026, x563 * x1028);
-        let x1049 = Self::mul_add(-x564, x1026, x563 * x1027);
-        let x1050 = Self::mul_add(
-            -x357,
+            S::mul_add(S::neg(x356), x1021, s_q1 * x1020),
+        ) + S::mul_add(S::neg(x564), x1011, x563 * x1012);
+        let x1044 = S::mul_add(S::neg(x357), x1012, x356 * x1013);
+        let x1045 = S::mul_add(x357, x1011, s_q1 * x1013);
+        let x1046 = S::mul_add(x356, x1011, s_q1 * x1012);
+        let x1047 = S::mul_add(x565, x1027, x564 * x1028);
+        let x1048 = S::mul_add(x565, x1026, x563 * x1028);
+        let x1049 = S::mul_add(S::neg(x564), x1026, x563 * x1027);
+        let x1050 = S::mul_add(
+            S::neg(x357),
             x1031,
-            Self::mul_add(-x356, x1030, s_q1 * x1029),
+            S::mul_add(S::neg(x356), x1030, s_q1 * x1029),
         ) - x1047;
-        let x1051 = Self::mul_add(
-            -x357,
+        let x1051 = S::mul_add(
+            S::neg(x357),
             x1033,
-            Self::mul_add(-x356, x1032, s_q1 * x1030),
+            S::mul_add(S::neg(x356), x1032, s_q1 * x1030),
         ) + x1048;
-        let x1052 = Self::mul_add(
-            -x357,
+        let x1052 = S::mul_add(
+            S::neg(x357),
             x1034,
-            Self::mul_add(-x356, x1033, s_q1 * x1031),
+            S::mul_add(S::neg(x356), x1033, s_q1 * x1031),
         ) + x1049;
-        let x1053 = Self::mul_add(x357, x1027, x356 * x1028);
-        let x1054 = Self::mul_add(-x357, x1026, s_q1 * x1028);
-        let x1055 = Self::mul_add(x356, x1026, s_q1 * x1027);
-        let x1056 = x1047 + Self::mul_add(x356, x1025, x357 * x1024);
-        let x1057 = x1048 + Self::mul_add(-s_q1, x1025, x357 * x1023);
-        let x1058 = x1049 - Self::mul_add(s_q1, x1024, x356 * x1023);
+        let x1053 = S::mul_add(x357, x1027, x356 * x1028);
+        let x1054 = S::mul_add(S::neg(x357), x1026, s_q1 * x1028);
+        let x1055 = S::mul_add(x356, x1026, s_q1 * x1027);
+        let x1056 = x1047 + S::mul_add(x356, x1025, x357 * x1024);
+        let x1057 = x1048 + S::mul_add(S::neg(s_q1), x1025, x357 * x1023);
+        let x1058 = x1049 - S::mul_add(s_q1, x1024, x356 * x1023);
         let x1059 = x1050 - x1056;
         let x1060 = x1051 + x1057;
         let x1061 = x1052 + x1058;
-        let x1062 = Self::mul_add(-x621, x1028, x622 * x1027);
-        let x1063 = Self::mul_add(-x620, x1028, x622 * x1026);
-        let x1064 = Self::mul_add(-x620, x1027, x621 * x1026);
-        let x1065 = Self::mul_add(x496, x1028, x497 * x1027);
-        let x1066 = Self::mul_add(x495, x1028, x497 * x1026);
-        let x1067 = Self::mul_add(-x495, x1027, x496 * x1026);
-        let x1068 = Self::mul_add(x356, x1037, x357 * x1036)
-            + Self::mul_add(x564, x1040, x565 * x1039)
-            + (Self::mul_add(-x625, x1016, Self::mul_add(-x624, x1015, x623 * x1014))
-                - Self::mul_add(-x628, x1012, x627 * x1013))
-            - (Self::mul_add(x496, x1025, x497 * x1024) - x1062
+        let x1062 = S::mul_add(S::neg(x621), x1028, x622 * x1027);
+        let x1063 = S::mul_add(S::neg(x620), x1028, x622 * x1026);
+        let x1064 = S::mul_add(S::neg(x620), x1027, x621 * x1026);
+        let x1065 = S::mul_add(x496, x1028, x497 * x1027);
+        let x1066 = S::mul_add(x495, x1028, x497 * x1026);
+        let x1067 = S::mul_add(S::neg(x495), x1027, x496 * x1026);
+        let x1068 = S::mul_add(x356, x1037, x357 * x1036)
+            + S::mul_add(x564, x1040, x565 * x1039)
+            + (S::mul_add(
+                S::neg(x625),
+                x1016,
+                S::mul_add(S::neg(x624), x1015, x623 * x1014),
+            ) - S::mul_add(S::neg(x628), x1012, x627 * x1013))
+            - (S::mul_add(x496, x1025, x497 * x1024) - x1062
                 + (x1062
-                    - Self::mul_add(
-                        x497,
-                        x1031,
-                        Self::mul_add(x496, x1030, x495 * x1029),
-                    )));
-        let x1069 = Self::mul_add(-s_q1, x1037, x357 * x1035)
-            + Self::mul_add(x563, x1040, x565 * x1038)
-            - (Self::mul_add(x625, x1019, Self::mul_add(x624, x1018, x623 * x1017))
-                - Self::mul_add(x628, x1011, x626 * x1013))
-            - (Self::mul_add(x495, x1025, x497 * x1023) - x1063
+                    - S::mul_add(x497, x1031, S::mul_add(x496, x1030, x495 * x1029))));
+        let x1069 = S::mul_add(S::neg(s_q1), x1037, x357 * x1035)
+            + S::mul_add(x563, x1040, x565 * x1038)
+            - (S::mul_add(x625, x1019, S::mul_add(x624, x1018, x623 * x1017))
+                - S::mul_add(x628, x1011, x626 * x1013))
+            - (S::mul_add(x495, x1025, x497 * x1023) - x1063
                 + (x1063
-                    + Self::mul_add(
-                        x497,
-                        x1033,
-                        Self::mul_add(x496, x1032, x495 * x1030),
-                    )));
-        let x1070 = Self::mul_add(s_q1, x1036, x356 * x1035)
-            + Self::mul_add(-x563, x1039, x564 * x1038)
-            - (Self::mul_add(x625, x1022, Self::mul_add(x624, x1021, x623 * x1020))
-                - Self::mul_add(x627, x1011, x626 * x1012))
-            - (Self::mul_add(-x495, x1024, x496 * x1023) + x1064
+                    + S::mul_add(x497, x1033, S::mul_add(x496, x1032, x495 * x1030))));
+        let x1070 = S::mul_add(s_q1, x1036, x356 * x1035)
+            + S::mul_add(S::neg(x563), x1039, x564 * x1038)
+            - (S::mul_add(x625, x1022, S::mul_add(x624, x1021, x623 * x1020))
+                - S::mul_add(x627, x1011, x626 * x1012))
+            - (S::mul_add(S::neg(x495), x1024, x496 * x1023) + x1064
                 - (x1064
-                    + Self::mul_add(
-                        x497,
-                        x1034,
-                        Self::mul_add(x496, x1033, x495 * x1031),
-                    )));
-        let x1071 = Self::mul_add(x356, x1040, x357 * x1039)
-            - Self::mul_add(-x625, x1012, x624 * x1013) - (x1065 + x1065);
-        let x1072 = Self::mul_add(-s_q1, x1040, x357 * x1038)
-            - Self::mul_add(-x625, x1011, x623 * x1013) - (x1066 + x1066);
-        let x1073 = Self::mul_add(s_q1, x1039, x356 * x1038)
-            - Self::mul_add(-x624, x1011, x623 * x1012) - (x1067 + x1067);
-        let x1074 = Self::mul_add(
-            -x631,
+                    + S::mul_add(x497, x1034, S::mul_add(x496, x1033, x495 * x1031))));
+        let x1071 = S::mul_add(x356, x1040, x357 * x1039)
+            - S::mul_add(S::neg(x625), x1012, x624 * x1013) - (x1065 + x1065);
+        let x1072 = S::mul_add(S::neg(s_q1), x1040, x357 * x1038)
+            - S::mul_add(S::neg(x625), x1011, x623 * x1013) - (x1066 + x1066);
+        let x1073 = S::mul_add(s_q1, x1039, x356 * x1038)
+            - S::mul_add(S::neg(x624), x1011, x623 * x1012) - (x1067 + x1067);
+        let x1074 = S::mul_add(
+            S::neg(x631),
             x1016,
-            Self::mul_add(-x630, x1015, x629 * x1014),
-        ) - Self::mul_add(-x634, x1012, x633 * x1013) + (x1050 + x1056);
-        let x1075 = Self::mul_add(x631, x1019, Self::mul_add(x630, x1018, x629 * x1017))
-            - Self::mul_add(x634, x1011, x632 * x1013) + (x1051 - x1057);
-        let x1076 = Self::mul_add(x631, x1022, Self::mul_add(x630, x1021, x629 * x1020))
-            - Self::mul_add(x633, x1011, x632 * x1012) - (x1052 - x1058);
-        let x1077 = Self::mul_add(-x631, x1012, x630 * x1013) - (x1053 + x1053);
-        let x1078 = Self::mul_add(-x631, x1011, x629 * x1013) + (x1054 + x1054);
-        let x1079 = Self::mul_add(-x630, x1011, x629 * x1012) - (x1055 + x1055);
-        let x1080 = Self::mul_add(c_q0, x1070, s_q0 * x1069)
-            - Self::mul_add(-x362, x1073, Self::mul_add(x361, x1072, x360 * x1071));
-        let x1081 = Self::mul_add(c_q0, x1076, s_q0 * x1075)
-            - Self::mul_add(-x362, x1079, Self::mul_add(x361, x1078, x360 * x1077));
-        let x1082 = Self::mul_add(-x357, x1070, Self::mul_add(x356, x1069, s_q1 * x1068))
-            - Self::mul_add(x455, x1073, Self::mul_add(-x454, x1072, x453 * x1071));
-        let x1083 = Self::mul_add(x357, x1076, Self::mul_add(-x356, x1075, s_q1 * x1074))
-            + Self::mul_add(x455, x1079, Self::mul_add(-x454, x1078, x453 * x1077));
-        let x1084 = Self::mul_add(-x625, x1043, Self::mul_add(x624, x1042, x623 * x1041))
-            + Self::mul_add(x628, x1046, Self::mul_add(-x627, x1045, x626 * x1044))
-            + Self::mul_add(x497, x1061, Self::mul_add(x496, x1060, x495 * x1059));
-        let x1085 = Self::mul_add(
-            -x357,
+            S::mul_add(S::neg(x630), x1015, x629 * x1014),
+        ) - S::mul_add(S::neg(x634), x1012, x633 * x1013) + (x1050 + x1056);
+        let x1075 = S::mul_add(x631, x1019, S::mul_add(x630, x1018, x629 * x1017))
+            - S::mul_add(x634, x1011, x632 * x1013) + (x1051 - x1057);
+        let x1076 = S::mul_add(x631, x1022, S::mul_add(x630, x1021, x629 * x1020))
+            - S::mul_add(x633, x1011, x632 * x1012) - (x1052 - x1058);
+        let x1077 = S::mul_add(S::neg(x631), x1012, x630 * x1013) - (x1053 + x1053);
+        let x1078 = S::mul_add(S::neg(x631), x1011, x629 * x1013) + (x1054 + x1054);
+        let x1079 = S::mul_add(S::neg(x630), x1011, x629 * x1012) - (x1055 + x1055);
+        let x1080 = S::mul_add(c_q0, x1070, s_q0 * x1069)
+            - S::mul_add(S::neg(x362), x1073, S::mul_add(x361, x1072, x360 * x1071));
+        let x1081 = S::mul_add(c_q0, x1076, s_q0 * x1075)
+            - S::mul_add(S::neg(x362), x1079, S::mul_add(x361, x1078, x360 * x1077));
+        let x1082 = S::mul_add(
+            S::neg(x357),
+            x1070,
+            S::mul_add(x356, x1069, s_q1 * x1068),
+        ) - S::mul_add(x455, x1073, S::mul_add(S::neg(x454), x1072, x453 * x1071));
+        let x1083 = S::mul_add(
+            x357,
+            x1076,
+            S::mul_add(S::neg(x356), x1075, s_q1 * x1074),
+        ) + S::mul_add(x455, x1079, S::mul_add(S::neg(x454), x1078, x453 * x1077));
+        let x1084 = S::mul_add(
+            S::neg(x625),
+            x1043,
+            S::mul_add(x624, x1042, x623 * x1041),
+        ) + S::mul_add(x628, x1046, S::mul_add(S::neg(x627), x1045, x626 * x1044))
+            + S::mul_add(x497, x1061, S::mul_add(x496, x1060, x495 * x1059));
+        let x1085 = S::mul_add(
+            S::neg(x357),
             x1061,
-            Self::mul_add(-x356, x1060, s_q1 * x1059),
+            S::mul_add(S::neg(x356), x1060, s_q1 * x1059),
         );
-        let x1086 = Self::mul_add(-x631, x1043, Self::mul_add(x630, x1042, x629 * x1041))
-            + Self::mul_add(x634, x1046, Self::mul_add(-x633, x1045, x632 * x1044))
+        let x1086 = S::mul_add(
+            S::neg(x631),
+            x1043,
+            S::mul_add(x630, x1042, x629 * x1041),
+        ) + S::mul_add(x634, x1046, S::mul_add(S::neg(x633), x1045, x632 * x1044))
             + x1085;
-        let x1087 = Self::mul_add(-x625, x957, Self::mul_add(x624, x956, x623 * x955))
-            + Self::mul_add(x628, x960, Self::mul_add(-x627, x959, x626 * x958))
-            + Self::mul_add(x497, x975, Self::mul_add(x496, x974, x495 * x973));
+        let x1087 = S::mul_add(S::neg(x625), x957, S::mul_add(x624, x956, x623 * x955))
+            + S::mul_add(x628, x960, S::mul_add(S::neg(x627), x959, x626 * x958))
+            + S::mul_add(x497, x975, S::mul_add(x496, x974, x495 * x973));
         let x1088 = x1003
-            + (Self::mul_add(-x631, x957, Self::mul_add(x630, x956, x629 * x955))
-                + Self::mul_add(x634, x960, Self::mul_add(-x633, x959, x632 * x958)));
-        let x1089 = Self::mul_add(x625, x910, Self::mul_add(x624, x909, x623 * x908))
-            - Self::mul_add(-x497, x919, Self::mul_add(x496, x918, x495 * x917));
-        let x1090 = x1006
-            - Self::mul_add(x631, x910, Self::mul_add(x630, x909, x629 * x908));
-        let x1091 = Self::mul_add(x625, x863, Self::mul_add(x624, x862, x623 * x861))
-            - Self::mul_add(-x497, x872, Self::mul_add(x496, x871, x495 * x870));
-        let x1092 = x1009
-            - Self::mul_add(x631, x863, Self::mul_add(x630, x862, x629 * x861));
+            + (S::mul_add(S::neg(x631), x957, S::mul_add(x630, x956, x629 * x955))
+                + S::mul_add(x634, x960, S::mul_add(S::neg(x633), x959, x632 * x958)));
+        let x1089 = S::mul_add(x625, x910, S::mul_add(x624, x909, x623 * x908))
+            - S::mul_add(S::neg(x497), x919, S::mul_add(x496, x918, x495 * x917));
+        let x1090 = x1006 - S::mul_add(x631, x910, S::mul_add(x630, x909, x629 * x908));
+        let x1091 = S::mul_add(x625, x863, S::mul_add(x624, x862, x623 * x861))
+            - S::mul_add(S::neg(x497), x872, S::mul_add(x496, x871, x495 * x870));
+        let x1092 = x1009 - S::mul_add(x631, x863, S::mul_add(x630, x862, x629 * x861));
         let x1093 = x456 + x1011;
         let x1094 = x457 + x1012;
         let x1095 = x458 + x1013;
@@ -6212,187 +7303,199 @@ impl Ssrms {
         let x1111 = x553 - (x549 + (x549 + (x546 + x546))) + x1029;
         let x1112 = x539
             - (x538
-                - (Self::mul_add(x480, x491, x532) + Self::mul_add(-x484, x491, x533)))
+                - (S::mul_add(x480, x491, x532) + S::mul_add(S::neg(x484), x491, x533)))
             + x1030;
         let x1113 = x537
             - (x536
-                - (Self::mul_add(x480, x490, x530) - Self::mul_add(-x488, x490, x531)))
+                - (S::mul_add(x480, x490, x530) - S::mul_add(S::neg(x488), x490, x531)))
             + x1031;
         let x1114 = x553 + (x550 + (x550 - (x547 + x547))) + x1032;
         let x1115 = x535
             + (x534
-                - (Self::mul_add(-x484, x489, x528) + Self::mul_add(-x488, x489, x529)))
-            + x1033;
+                - (S::mul_add(S::neg(x484), x489, x528)
+                    + S::mul_add(S::neg(x488), x489, x529))) + x1033;
         let x1116 = x553 + (x551 + (x551 - (x548 + x548))) + x1034;
-        let x1117 = Self::mul_add(-x482, x506, Self::mul_add(x481, x505, x480 * x504))
-            + Self::mul_add(-x457, x509, x458 * x508)
-            - (Self::mul_add(-x490, x542, x491 * x541)
-                + Self::mul_add(x493, x545, x494 * x544)) + x1035;
-        let x1118 = Self::mul_add(x485, x506, Self::mul_add(-x484, x505, x483 * x504))
-            + Self::mul_add(x456, x509, x458 * x507)
-            + (Self::mul_add(x489, x542, x491 * x540)
-                + Self::mul_add(-x492, x545, x494 * x543)) + x1036;
-        let x1119 = Self::mul_add(x488, x506, Self::mul_add(-x487, x505, x486 * x504))
-            + Self::mul_add(x456, x508, x457 * x507)
-            - (Self::mul_add(x489, x541, x490 * x540)
-                - Self::mul_add(x492, x544, x493 * x543)) + x1037;
-        let x1120 = Self::mul_add(x457, x506, x458 * x505)
-            - Self::mul_add(-x490, x545, x491 * x544) + x1038;
-        let x1121 = Self::mul_add(-x456, x506, x458 * x504)
-            + Self::mul_add(x489, x545, x491 * x543) + x1039;
-        let x1122 = Self::mul_add(x456, x505, x457 * x504)
-            - Self::mul_add(x489, x544, x490 * x543) + x1040;
-        let x1123 = Self::mul_add(x357, x1098, Self::mul_add(x356, x1097, s_q1 * x1096))
-            - Self::mul_add(-x455, x1094, x454 * x1095);
-        let x1124 = Self::mul_add(
-            -x357,
+        let x1117 = S::mul_add(S::neg(x482), x506, S::mul_add(x481, x505, x480 * x504))
+            + S::mul_add(S::neg(x457), x509, x458 * x508)
+            - (S::mul_add(S::neg(x490), x542, x491 * x541)
+                + S::mul_add(x493, x545, x494 * x544)) + x1035;
+        let x1118 = S::mul_add(x485, x506, S::mul_add(S::neg(x484), x505, x483 * x504))
+            + S::mul_add(x456, x509, x458 * x507)
+            + (S::mul_add(x489, x542, x491 * x540)
+                + S::mul_add(S::neg(x492), x545, x494 * x543)) + x1036;
+        let x1119 = S::mul_add(x488, x506, S::mul_add(S::neg(x487), x505, x486 * x504))
+            + S::mul_add(x456, x508, x457 * x507)
+            - (S::mul_add(x489, x541, x490 * x540) - S::mul_add(x492, x544, x493 * x543))
+            + x1037;
+        let x1120 = S::mul_add(x457, x506, x458 * x505)
+            - S::mul_add(S::neg(x490), x545, x491 * x544) + x1038;
+        let x1121 = S::mul_add(S::neg(x456), x506, x458 * x504)
+            + S::mul_add(x489, x545, x491 * x543) + x1039;
+        let x1122 = S::mul_add(x456, x505, x457 * x504)
+            - S::mul_add(x489, x544, x490 * x543) + x1040;
+        let x1123 = S::mul_add(x357, x1098, S::mul_add(x356, x1097, s_q1 * x1096))
+            - S::mul_add(S::neg(x455), x1094, x454 * x1095);
+        let x1124 = S::mul_add(
+            S::neg(x357),
             x1101,
-            Self::mul_add(-x356, x1100, s_q1 * x1099),
-        ) + Self::mul_add(-x455, x1093, x453 * x1095);
-        let x1125 = Self::mul_add(
-            -x357,
+            S::mul_add(S::neg(x356), x1100, s_q1 * x1099),
+        ) + S::mul_add(S::neg(x455), x1093, x453 * x1095);
+        let x1125 = S::mul_add(
+            S::neg(x357),
             x1104,
-            Self::mul_add(-x356, x1103, s_q1 * x1102),
-        ) + Self::mul_add(-x454, x1093, x453 * x1094);
-        let x1126 = Self::mul_add(-x357, x1094, x356 * x1095);
-        let x1127 = Self::mul_add(x357, x1093, s_q1 * x1095);
-        let x1128 = Self::mul_add(x356, x1093, s_q1 * x1094);
-        let x1129 = Self::mul_add(x455, x1109, x454 * x1110);
-        let x1130 = Self::mul_add(x455, x1108, x453 * x1110);
-        let x1131 = Self::mul_add(-x454, x1108, x453 * x1109);
-        let x1132 = Self::mul_add(
-            -x357,
+            S::mul_add(S::neg(x356), x1103, s_q1 * x1102),
+        ) + S::mul_add(S::neg(x454), x1093, x453 * x1094);
+        let x1126 = S::mul_add(S::neg(x357), x1094, x356 * x1095);
+        let x1127 = S::mul_add(x357, x1093, s_q1 * x1095);
+        let x1128 = S::mul_add(x356, x1093, s_q1 * x1094);
+        let x1129 = S::mul_add(x455, x1109, x454 * x1110);
+        let x1130 = S::mul_add(x455, x1108, x453 * x1110);
+        let x1131 = S::mul_add(S::neg(x454), x1108, x453 * x1109);
+        let x1132 = S::mul_add(
+            S::neg(x357),
             x1113,
-            Self::mul_add(-x356, x1112, s_q1 * x1111),
+            S::mul_add(S::neg(x356), x1112, s_q1 * x1111),
         ) - x1129;
-        let x1133 = Self::mul_add(
-            -x357,
+        let x1133 = S::mul_add(
+            S::neg(x357),
             x1115,
-            Self::mul_add(-x356, x1114, s_q1 * x1112),
+            S::mul_add(S::neg(x356), x1114, s_q1 * x1112),
         ) + x1130;
-        let x1134 = Self::mul_add(
-            -x357,
+        let x1134 = S::mul_add(
+            S::neg(x357),
             x1116,
-            Self::mul_add(-x356, x1115, s_q1 * x1113),
+            S::mul_add(S::neg(x356), x1115, s_q1 * x1113),
         ) + x1131;
-        let x1135 = Self::mul_add(x357, x1109, x356 * x1110);
-        let x1136 = Self::mul_add(-x357, x1108, s_q1 * x1110);
-        let x1137 = Self::mul_add(x356, x1108, s_q1 * x1109);
-        let x1138 = x1129 + Self::mul_add(x356, x1107, x357 * x1106);
-        let x1139 = x1130 + Self::mul_add(-s_q1, x1107, x357 * x1105);
-        let x1140 = x1131 - Self::mul_add(s_q1, x1106, x356 * x1105);
+        let x1135 = S::mul_add(x357, x1109, x356 * x1110);
+        let x1136 = S::mul_add(S::neg(x357), x1108, s_q1 * x1110);
+        let x1137 = S::mul_add(x356, x1108, s_q1 * x1109);
+        let x1138 = x1129 + S::mul_add(x356, x1107, x357 * x1106);
+        let x1139 = x1130 + S::mul_add(S::neg(s_q1), x1107, x357 * x1105);
+        let x1140 = x1131 - S::mul_add(s_q1, x1106, x356 * x1105);
         let x1141 = x1132 - x1138;
         let x1142 = x1133 + x1139;
         let x1143 = x1134 + x1140;
-        let x1144 = Self::mul_add(x514, x1110, x515 * x1109);
-        let x1145 = Self::mul_add(-x513, x1110, x515 * x1108);
-        let x1146 = Self::mul_add(x513, x1109, x514 * x1108);
-        let x1147 = Self::mul_add(x511, x1110, x512 * x1109);
-        let x1148 = Self::mul_add(x510, x1110, x512 * x1108);
-        let x1149 = Self::mul_add(-x510, x1109, x511 * x1108);
-        let x1150 = Self::mul_add(x356, x1119, x357 * x1118)
-            + Self::mul_add(x454, x1122, x455 * x1121)
-            + (Self::mul_add(-x518, x1098, Self::mul_add(-x517, x1097, x516 * x1096))
-                - Self::mul_add(-x521, x1094, x520 * x1095))
-            - (Self::mul_add(x511, x1107, x512 * x1106) - x1144
+        let x1144 = S::mul_add(x514, x1110, x515 * x1109);
+        let x1145 = S::mul_add(S::neg(x513), x1110, x515 * x1108);
+        let x1146 = S::mul_add(x513, x1109, x514 * x1108);
+        let x1147 = S::mul_add(x511, x1110, x512 * x1109);
+        let x1148 = S::mul_add(x510, x1110, x512 * x1108);
+        let x1149 = S::mul_add(S::neg(x510), x1109, x511 * x1108);
+        let x1150 = S::mul_add(x356, x1119, x357 * x1118)
+            + S::mul_add(x454, x1122, x455 * x1121)
+            + (S::mul_add(
+                S::neg(x518),
+                x1098,
+                S::mul_add(S::neg(x517), x1097, x516 * x1096),
+            ) - S::mul_add(S::neg(x521), x1094, x520 * x1095))
+            - (S::mul_add(x511, x1107, x512 * x1106) - x1144
                 + (x1144
-                    - Self::mul_add(
-                        x512,
-                        x1113,
-                        Self::mul_add(x511, x1112, x510 * x1111),
-                    )));
-        let x1151 = Self::mul_add(
-            -x524,
+                    - S::mul_add(x512, x1113, S::mul_add(x511, x1112, x510 * x1111))));
+        let x1151 = S::mul_add(
+            S::neg(x524),
             x1098,
-            Self::mul_add(-x523, x1097, x522 * x1096),
-        ) - Self::mul_add(-x527, x1094, x526 * x1095) + (x1132 + x1138);
-        let x1152 = Self::mul_add(
+            S::mul_add(S::neg(x523), x1097, x522 * x1096),
+        ) - S::mul_add(S::neg(x527), x1094, x526 * x1095) + (x1132 + x1138);
+        let x1152 = S::mul_add(
             c_q0,
-            Self::mul_add(s_q1, x1118, x356 * x1117)
-                + Self::mul_add(-x453, x1121, x454 * x1120)
-                - (Self::mul_add(x518, x1104, Self::mul_add(x517, x1103, x516 * x1102))
-                    - Self::mul_add(x520, x1093, x519 * x1094))
-                - (Self::mul_add(-x510, x1106, x511 * x1105) - x1146
+            S::mul_add(s_q1, x1118, x356 * x1117)
+                + S::mul_add(S::neg(x453), x1121, x454 * x1120)
+                - (S::mul_add(x518, x1104, S::mul_add(x517, x1103, x516 * x1102))
+                    - S::mul_add(x520, x1093, x519 * x1094))
+                - (S::mul_add(S::neg(x510), x1106, x511 * x1105) - x1146
                     + (x1146
-                        - Self::mul_add(
+                        - S::mul_add(
                             x512,
                             x1116,
-                            Self::mul_add(x511, x1115, x510 * x1113),
+                            S::mul_add(x511, x1115, x510 * x1113),
                         ))),
             s_q0
-                * (Self::mul_add(-s_q1, x1119, x357 * x1117)
-                    + Self::mul_add(x453, x1122, x455 * x1120)
-                    - (Self::mul_add(
-                        x518,
-                        x1101,
-                        Self::mul_add(x517, x1100, x516 * x1099),
-                    ) - Self::mul_add(x521, x1093, x519 * x1095))
-                    - (Self::mul_add(x510, x1107, x512 * x1105) - x1145
+                * (S::mul_add(S::neg(s_q1), x1119, x357 * x1117)
+                    + S::mul_add(x453, x1122, x455 * x1120)
+                    - (S::mul_add(x518, x1101, S::mul_add(x517, x1100, x516 * x1099))
+                        - S::mul_add(x521, x1093, x519 * x1095))
+                    - (S::mul_add(x510, x1107, x512 * x1105) - x1145
                         + (x1145
-                            + Self::mul_add(
+                            + S::mul_add(
                                 x512,
                                 x1115,
-                                Self::mul_add(x511, x1114, x510 * x1112),
+                                S::mul_add(x511, x1114, x510 * x1112),
                             )))),
         );
-        let x1153 = Self::mul_add(
-            -x362,
-            Self::mul_add(s_q1, x1121, x356 * x1120)
-                - Self::mul_add(-x517, x1093, x516 * x1094) - (x1149 + x1149),
-            Self::mul_add(
+        let x1153 = S::mul_add(
+            S::neg(x362),
+            S::mul_add(s_q1, x1121, x356 * x1120)
+                - S::mul_add(S::neg(x517), x1093, x516 * x1094) - (x1149 + x1149),
+            S::mul_add(
                 x361,
-                Self::mul_add(-s_q1, x1122, x357 * x1120)
-                    - Self::mul_add(-x518, x1093, x516 * x1095) - (x1148 + x1148),
+                S::mul_add(S::neg(s_q1), x1122, x357 * x1120)
+                    - S::mul_add(S::neg(x518), x1093, x516 * x1095) - (x1148 + x1148),
                 x360
-                    * (Self::mul_add(x356, x1122, x357 * x1121)
-                        - Self::mul_add(-x518, x1094, x517 * x1095) - (x1147 + x1147)),
+                    * (S::mul_add(x356, x1122, x357 * x1121)
+                        - S::mul_add(S::neg(x518), x1094, x517 * x1095)
+                        - (x1147 + x1147)),
             ),
         );
         let x1154 = x1152 - x1153;
-        let x1155 = Self::mul_add(
+        let x1155 = S::mul_add(
             c_q0,
-            Self::mul_add(x524, x1104, Self::mul_add(x523, x1103, x522 * x1102))
-                - Self::mul_add(x526, x1093, x525 * x1094) - (x1134 - x1140),
+            S::mul_add(x524, x1104, S::mul_add(x523, x1103, x522 * x1102))
+                - S::mul_add(x526, x1093, x525 * x1094) - (x1134 - x1140),
             s_q0
-                * (Self::mul_add(x524, x1101, Self::mul_add(x523, x1100, x522 * x1099))
-                    - Self::mul_add(x527, x1093, x525 * x1095) + (x1133 - x1139)),
+                * (S::mul_add(x524, x1101, S::mul_add(x523, x1100, x522 * x1099))
+                    - S::mul_add(x527, x1093, x525 * x1095) + (x1133 - x1139)),
         );
-        let x1156 = Self::mul_add(
-            -x362,
-            Self::mul_add(-x523, x1093, x522 * x1094) - (x1137 + x1137),
-            Self::mul_add(
+        let x1156 = S::mul_add(
+            S::neg(x362),
+            S::mul_add(S::neg(x523), x1093, x522 * x1094) - (x1137 + x1137),
+            S::mul_add(
                 x361,
-                Self::mul_add(-x524, x1093, x522 * x1095) + (x1136 + x1136),
-                x360 * (Self::mul_add(-x524, x1094, x523 * x1095) - (x1135 + x1135)),
+                S::mul_add(S::neg(x524), x1093, x522 * x1095) + (x1136 + x1136),
+                x360 * (S::mul_add(S::neg(x524), x1094, x523 * x1095) - (x1135 + x1135)),
             ),
         );
         let x1157 = x1155 - x1156;
-        let x1158 = Self::mul_add(-x518, x1125, Self::mul_add(x517, x1124, x516 * x1123))
-            + Self::mul_add(x521, x1128, Self::mul_add(-x520, x1127, x519 * x1126))
-            + Self::mul_add(x512, x1143, Self::mul_add(x511, x1142, x510 * x1141));
-        let x1159 = Self::mul_add(-x524, x1125, Self::mul_add(x523, x1124, x522 * x1123))
-            + Self::mul_add(x527, x1128, Self::mul_add(-x526, x1127, x525 * x1126))
-            + Self::mul_add(-x357, x1143, Self::mul_add(-x356, x1142, s_q1 * x1141));
-        let x1160 = Self::mul_add(-x518, x1043, Self::mul_add(x517, x1042, x516 * x1041))
-            + Self::mul_add(x521, x1046, Self::mul_add(-x520, x1045, x519 * x1044))
-            + Self::mul_add(x512, x1061, Self::mul_add(x511, x1060, x510 * x1059));
+        let x1158 = S::mul_add(
+            S::neg(x518),
+            x1125,
+            S::mul_add(x517, x1124, x516 * x1123),
+        ) + S::mul_add(x521, x1128, S::mul_add(S::neg(x520), x1127, x519 * x1126))
+            + S::mul_add(x512, x1143, S::mul_add(x511, x1142, x510 * x1141));
+        let x1159 = S::mul_add(
+            S::neg(x524),
+            x1125,
+            S::mul_add(x523, x1124, x522 * x1123),
+        ) + S::mul_add(x527, x1128, S::mul_add(S::neg(x526), x1127, x525 * x1126))
+            + S::mul_add(
+                S::neg(x357),
+                x1143,
+                S::mul_add(S::neg(x356), x1142, s_q1 * x1141),
+            );
+        let x1160 = S::mul_add(
+            S::neg(x518),
+            x1043,
+            S::mul_add(x517, x1042, x516 * x1041),
+        ) + S::mul_add(x521, x1046, S::mul_add(S::neg(x520), x1045, x519 * x1044))
+            + S::mul_add(x512, x1061, S::mul_add(x511, x1060, x510 * x1059));
         let x1161 = x1085
-            + (Self::mul_add(-x524, x1043, Self::mul_add(x523, x1042, x522 * x1041))
-                + Self::mul_add(x527, x1046, Self::mul_add(-x526, x1045, x525 * x1044)));
-        let x1162 = Self::mul_add(-x518, x957, Self::mul_add(x517, x956, x516 * x955))
-            + Self::mul_add(x521, x960, Self::mul_add(-x520, x959, x519 * x958))
-            + Self::mul_add(x512, x975, Self::mul_add(x511, x974, x510 * x973));
+            + (S::mul_add(S::neg(x524), x1043, S::mul_add(x523, x1042, x522 * x1041))
+                + S::mul_add(
+                    x527,
+                    x1046,
+                    S::mul_add(S::neg(x526), x1045, x525 * x1044),
+                ));
+        let x1162 = S::mul_add(S::neg(x518), x957, S::mul_add(x517, x956, x516 * x955))
+            + S::mul_add(x521, x960, S::mul_add(S::neg(x520), x959, x519 * x958))
+            + S::mul_add(x512, x975, S::mul_add(x511, x974, x510 * x973));
         let x1163 = x1003
-            + (Self::mul_add(-x524, x957, Self::mul_add(x523, x956, x522 * x955))
-                + Self::mul_add(x527, x960, Self::mul_add(-x526, x959, x525 * x958)));
-        let x1164 = Self::mul_add(x518, x910, Self::mul_add(x517, x909, x516 * x908))
-            - Self::mul_add(-x512, x919, Self::mul_add(x511, x918, x510 * x917));
-        let x1165 = x1006
-            - Self::mul_add(x524, x910, Self::mul_add(x523, x909, x522 * x908));
-        let x1166 = Self::mul_add(x518, x863, Self::mul_add(x517, x862, x516 * x861))
-            - Self::mul_add(-x512, x872, Self::mul_add(x511, x871, x510 * x870));
-        let x1167 = x1009
-            - Self::mul_add(x524, x863, Self::mul_add(x523, x862, x522 * x861));
+            + (S::mul_add(S::neg(x524), x957, S::mul_add(x523, x956, x522 * x955))
+                + S::mul_add(x527, x960, S::mul_add(S::neg(x526), x959, x525 * x958)));
+        let x1164 = S::mul_add(x518, x910, S::mul_add(x517, x909, x516 * x908))
+            - S::mul_add(S::neg(x512), x919, S::mul_add(x511, x918, x510 * x917));
+        let x1165 = x1006 - S::mul_add(x524, x910, S::mul_add(x523, x909, x522 * x908));
+        let x1166 = S::mul_add(x518, x863, S::mul_add(x517, x862, x516 * x861))
+            - S::mul_add(S::neg(x512), x872, S::mul_add(x511, x871, x510 * x870));
+        let x1167 = x1009 - S::mul_add(x524, x863, S::mul_add(x523, x862, x522 * x861));
         let x1168 = x60 + x1093;
         let x1169 = x363 - x1094;
         let x1170 = x364 - x1095;
@@ -6407,1072 +7510,1155 @@ impl Ssrms {
         let x1179 = x443 - (x439 + (x439 + (x436 + x436))) + x1111;
         let x1180 = x429
             + (x428
-                + (Self::mul_add(-x382, x392, x422) - Self::mul_add(-x386, x392, x423)))
-            + x1112;
+                + (S::mul_add(S::neg(x382), x392, x422)
+                    - S::mul_add(S::neg(x386), x392, x423))) + x1112;
         let x1181 = x427
             + (x426
-                + (Self::mul_add(-x382, x391, x420) + Self::mul_add(-x390, x391, x421)))
-            + x1113;
+                + (S::mul_add(S::neg(x382), x391, x420)
+                    + S::mul_add(S::neg(x390), x391, x421))) + x1113;
         let x1182 = x425
             + (x424
-                - (Self::mul_add(-qd[0], x386, x418)
-                    + Self::mul_add(-qd[0], x390, x419))) - x1115;
-        let x1183 = Self::mul_add(-c_q0, x387 - x1101, s_q0 * (x386 - x1100))
-            - Self::mul_add(-x362, x1168, x360 * x1170);
-        let x1184 = Self::mul_add(-c_q0, x390 - x1104, s_q0 * (x389 - x1103))
-            - Self::mul_add(-x361, x1168, x360 * x1169);
+                - (S::mul_add(S::neg(qd[0]), x386, x418)
+                    + S::mul_add(S::neg(qd[0]), x390, x419))) - x1115;
+        let x1183 = S::mul_add(S::neg(c_q0), x387 - x1101, s_q0 * (x386 - x1100))
+            - S::mul_add(S::neg(x362), x1168, x360 * x1170);
+        let x1184 = S::mul_add(S::neg(c_q0), x390 - x1104, s_q0 * (x389 - x1103))
+            - S::mul_add(S::neg(x361), x1168, x360 * x1169);
         let x1185 = c_q0 * x1168;
         let x1186 = s_q0 * x1168;
-        let x1187 = Self::mul_add(x362, x1177, x361 * x1178);
-        let x1188 = Self::mul_add(-x362, x1176, x360 * x1178);
-        let x1189 = Self::mul_add(x361, x1176, x360 * x1177);
-        let x1190 = Self::mul_add(-c_q0, x1181, s_q0 * x1180) + x1187;
-        let x1191 = x1187 - Self::mul_add(-s_q0, x1175, c_q0 * x1174);
+        let x1187 = S::mul_add(x362, x1177, x361 * x1178);
+        let x1188 = S::mul_add(S::neg(x362), x1176, x360 * x1178);
+        let x1189 = S::mul_add(x361, x1176, x360 * x1177);
+        let x1190 = S::mul_add(S::neg(c_q0), x1181, s_q0 * x1180) + x1187;
+        let x1191 = x1187 - S::mul_add(S::neg(s_q0), x1175, c_q0 * x1174);
         let x1192 = x1190 + x1191;
-        let x1193 = Self::mul_add(
+        let x1193 = S::mul_add(
             c_q0,
             x1182,
             s_q0 * (x443 - (x440 + (x440 - (x437 + x437))) + x1114),
-        ) + x1188 + Self::mul_add(-c_q0, x1173, x1188);
-        let x1194 = Self::mul_add(
+        ) + x1188 + S::mul_add(S::neg(c_q0), x1173, x1188);
+        let x1194 = S::mul_add(
             c_q0,
             x443 - (x441 + (x441 - (x438 + x438))) + x1116,
             s_q0 * x1182,
-        ) - x1189 - Self::mul_add(-s_q0, x1173, x1189);
-        let x1195 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(-x390, x406, Self::mul_add(x389, x405, x388 * x404))
-                - Self::mul_add(-x60, x408, x363 * x407)
-                + (Self::mul_add(-qd[0], x431, x391 * x430)
-                    - Self::mul_add(x393, x434, x394 * x433)) + x1119,
+        ) - x1189 - S::mul_add(S::neg(s_q0), x1173, x1189);
+        let x1195 = S::mul_add(
+            S::neg(s_q0),
+            S::mul_add(S::neg(x390), x406, S::mul_add(x389, x405, x388 * x404))
+                - S::mul_add(S::neg(x60), x408, x363 * x407)
+                + (S::mul_add(S::neg(qd[0]), x431, x391 * x430)
+                    - S::mul_add(x393, x434, x394 * x433)) + x1119,
             c_q0
-                * (Self::mul_add(-x387, x406, Self::mul_add(x386, x405, x385 * x404))
-                    - Self::mul_add(-x60, x409, x364 * x407)
-                    - (Self::mul_add(-qd[0], x432, x392 * x430)
-                        + Self::mul_add(-x393, x435, x395 * x433)) + x1118),
+                * (S::mul_add(S::neg(x387), x406, S::mul_add(x386, x405, x385 * x404))
+                    - S::mul_add(S::neg(x60), x409, x364 * x407)
+                    - (S::mul_add(S::neg(qd[0]), x432, x392 * x430)
+                        + S::mul_add(S::neg(x393), x435, x395 * x433)) + x1118),
         );
-        let x1196 = Self::mul_add(-x399, x1178, x400 * x1177);
+        let x1196 = S::mul_add(S::neg(x399), x1178, x400 * x1177);
         let x1197 = x1195
-            - Self::mul_add(
+            - S::mul_add(
                 x361,
-                Self::mul_add(-x60, x405, x363 * x404)
-                    - Self::mul_add(qd[0], x434, x391 * x433) - x1122,
+                S::mul_add(S::neg(x60), x405, x363 * x404)
+                    - S::mul_add(qd[0], x434, x391 * x433) - x1122,
                 x362
-                    * (Self::mul_add(x60, x406, x364 * x404)
-                        + Self::mul_add(qd[0], x435, x392 * x433) - x1121),
+                    * (S::mul_add(x60, x406, x364 * x404)
+                        + S::mul_add(qd[0], x435, x392 * x433) - x1121),
             )
-            + (Self::mul_add(x411, x1172, x410 * x1171)
-                - Self::mul_add(x413, x1169, x412 * x1170))
-            - (Self::mul_add(x397, x1175, x398 * x1174) + x1196
-                - (x1196 + Self::mul_add(x398, x1181, x397 * x1180)));
-        let x1198 = Self::mul_add(
+            + (S::mul_add(x411, x1172, x410 * x1171)
+                - S::mul_add(x413, x1169, x412 * x1170))
+            - (S::mul_add(x397, x1175, x398 * x1174) + x1196
+                - (x1196 + S::mul_add(x398, x1181, x397 * x1180)));
+        let x1198 = S::mul_add(
             x415,
             x1172,
-            Self::mul_add(x414, x1171, x396 * (x382 - x1096)),
-        ) - Self::mul_add(x417, x1169, x416 * x1170) + (x1190 - x1191);
-        let x1199 = Self::mul_add(-x411, x1184, x410 * x1183)
-            - Self::mul_add(-x413, x1186, x412 * x1185)
-            - Self::mul_add(-x398, x1194, x397 * x1193);
-        let x1200 = Self::mul_add(
-            -x415,
+            S::mul_add(x414, x1171, x396 * (x382 - x1096)),
+        ) - S::mul_add(x417, x1169, x416 * x1170) + (x1190 - x1191);
+        let x1199 = S::mul_add(S::neg(x411), x1184, x410 * x1183)
+            - S::mul_add(S::neg(x413), x1186, x412 * x1185)
+            - S::mul_add(S::neg(x398), x1194, x397 * x1193);
+        let x1200 = S::mul_add(
+            S::neg(x415),
             x1184,
-            Self::mul_add(
+            S::mul_add(
                 x414,
                 x1183,
                 x396
-                    * (Self::mul_add(-c_q0, x1172, s_q0 * x1171)
-                        + Self::mul_add(-x362, x1169, x361 * x1170)),
+                    * (S::mul_add(S::neg(c_q0), x1172, s_q0 * x1171)
+                        + S::mul_add(S::neg(x362), x1169, x361 * x1170)),
             ),
         );
-        let x1201 = Self::mul_add(
-            -x417,
+        let x1201 = S::mul_add(
+            S::neg(x417),
             x1186,
-            Self::mul_add(x416, x1185, x401 * Self::mul_add(c_q0, x1169, s_q0 * x1170)),
+            S::mul_add(x416, x1185, x401 * S::mul_add(c_q0, x1169, s_q0 * x1170)),
         );
-        let x1202 = x1200 - x1201 - Self::mul_add(c_q0, x1194, s_q0 * x1193);
-        let x1203 = Self::mul_add(-x411, x1125, x410 * x1124)
-            + Self::mul_add(x413, x1128, x412 * x1127)
-            + Self::mul_add(x398, x1143, x397 * x1142);
-        let x1204 = Self::mul_add(x415, x1125, Self::mul_add(-x414, x1124, x396 * x1123))
-            - Self::mul_add(x417, x1128, Self::mul_add(x416, x1127, x401 * x1126))
-            - Self::mul_add(-c_q0, x1143, s_q0 * x1142);
-        let x1205 = Self::mul_add(-x411, x1043, x410 * x1042)
-            + Self::mul_add(x413, x1046, x412 * x1045)
-            + Self::mul_add(x398, x1061, x397 * x1060);
-        let x1206 = Self::mul_add(x415, x1043, Self::mul_add(-x414, x1042, x396 * x1041))
-            - Self::mul_add(x417, x1046, Self::mul_add(x416, x1045, x401 * x1044))
-            - Self::mul_add(-c_q0, x1061, s_q0 * x1060);
-        let x1207 = Self::mul_add(-x411, x957, x410 * x956)
-            + Self::mul_add(x413, x960, x412 * x959)
-            + Self::mul_add(x398, x975, x397 * x974);
-        let x1208 = Self::mul_add(x415, x957, Self::mul_add(-x414, x956, x396 * x955))
-            - Self::mul_add(x417, x960, Self::mul_add(x416, x959, x401 * x958))
-            - Self::mul_add(-c_q0, x975, s_q0 * x974);
-        let x1209 = Self::mul_add(x411, x910, x410 * x909)
-            - Self::mul_add(-x398, x919, x397 * x918);
-        let x1210 = Self::mul_add(-x415, x910, Self::mul_add(-x414, x909, x396 * x908))
-            + Self::mul_add(c_q0, x919, s_q0 * x918);
-        let x1211 = Self::mul_add(x411, x863, x410 * x862)
-            - Self::mul_add(-x398, x872, x397 * x871);
-        let x1212 = Self::mul_add(-x415, x863, Self::mul_add(-x414, x862, x396 * x861))
-            + Self::mul_add(c_q0, x872, s_q0 * x871);
-        let x1213 = Self::mul_add(
-            -x149,
+        let x1202 = x1200 - x1201 - S::mul_add(c_q0, x1194, s_q0 * x1193);
+        let x1203 = S::mul_add(S::neg(x411), x1125, x410 * x1124)
+            + S::mul_add(x413, x1128, x412 * x1127)
+            + S::mul_add(x398, x1143, x397 * x1142);
+        let x1204 = S::mul_add(
+            x415,
+            x1125,
+            S::mul_add(S::neg(x414), x1124, x396 * x1123),
+        ) - S::mul_add(x417, x1128, S::mul_add(x416, x1127, x401 * x1126))
+            - S::mul_add(S::neg(c_q0), x1143, s_q0 * x1142);
+        let x1205 = S::mul_add(S::neg(x411), x1043, x410 * x1042)
+            + S::mul_add(x413, x1046, x412 * x1045)
+            + S::mul_add(x398, x1061, x397 * x1060);
+        let x1206 = S::mul_add(
+            x415,
+            x1043,
+            S::mul_add(S::neg(x414), x1042, x396 * x1041),
+        ) - S::mul_add(x417, x1046, S::mul_add(x416, x1045, x401 * x1044))
+            - S::mul_add(S::neg(c_q0), x1061, s_q0 * x1060);
+        let x1207 = S::mul_add(S::neg(x411), x957, x410 * x956)
+            + S::mul_add(x413, x960, x412 * x959) + S::mul_add(x398, x975, x397 * x974);
+        let x1208 = S::mul_add(x415, x957, S::mul_add(S::neg(x414), x956, x396 * x955))
+            - S::mul_add(x417, x960, S::mul_add(x416, x959, x401 * x958))
+            - S::mul_add(S::neg(c_q0), x975, s_q0 * x974);
+        let x1209 = S::mul_add(x411, x910, x410 * x909)
+            - S::mul_add(S::neg(x398), x919, x397 * x918);
+        let x1210 = S::mul_add(
+            S::neg(x415),
+            x910,
+            S::mul_add(S::neg(x414), x909, x396 * x908),
+        ) + S::mul_add(c_q0, x919, s_q0 * x918);
+        let x1211 = S::mul_add(x411, x863, x410 * x862)
+            - S::mul_add(S::neg(x398), x872, x397 * x871);
+        let x1212 = S::mul_add(
+            S::neg(x415),
+            x863,
+            S::mul_add(S::neg(x414), x862, x396 * x861),
+        ) + S::mul_add(c_q0, x872, s_q0 * x871);
+        let x1213 = S::mul_add(
+            S::neg(x149),
             x1205,
-            Self::mul_add(x151, x1203, Self::mul_add(x154, x1199, x156 * x1197)),
+            S::mul_add(x151, x1203, S::mul_add(x154, x1199, x156 * x1197)),
         );
-        let x1214 = Self::mul_add(
-            -x143,
+        let x1214 = S::mul_add(
+            S::neg(x143),
             x1211,
-            Self::mul_add(x145, x1209, Self::mul_add(-x147, x1207, x1213)),
+            S::mul_add(x145, x1209, S::mul_add(S::neg(x147), x1207, x1213)),
         );
-        let x1215 = Self::mul_add(
-            -x149,
+        let x1215 = S::mul_add(
+            S::neg(x149),
             x1160,
-            Self::mul_add(x151, x1158, Self::mul_add(x154, x1154, x156 * x1150)),
+            S::mul_add(x151, x1158, S::mul_add(x154, x1154, x156 * x1150)),
         );
-        let x1216 = Self::mul_add(
-            -x143,
+        let x1216 = S::mul_add(
+            S::neg(x143),
             x1166,
-            Self::mul_add(x145, x1164, Self::mul_add(-x147, x1162, x1215)),
+            S::mul_add(x145, x1164, S::mul_add(S::neg(x147), x1162, x1215)),
         );
-        let x1217 = Self::mul_add(
-            -x149,
+        let x1217 = S::mul_add(
+            S::neg(x149),
             x1084,
-            Self::mul_add(x151, x1082, Self::mul_add(x154, x1080, x156 * x1068)),
+            S::mul_add(x151, x1082, S::mul_add(x154, x1080, x156 * x1068)),
         );
-        let x1218 = Self::mul_add(
-            -x143,
+        let x1218 = S::mul_add(
+            S::neg(x143),
             x1091,
-            Self::mul_add(x145, x1089, Self::mul_add(-x147, x1087, x1217)),
+            S::mul_add(x145, x1089, S::mul_add(S::neg(x147), x1087, x1217)),
         );
-        let x1219 = Self::mul_add(
-            -x149,
+        let x1219 = S::mul_add(
+            S::neg(x149),
             x1000,
-            Self::mul_add(x151, x997, Self::mul_add(x154, x994, x156 * x982)),
+            S::mul_add(x151, x997, S::mul_add(x154, x994, x156 * x982)),
         );
-        let x1220 = Self::mul_add(
+        let x1220 = S::mul_add(
             x143,
             x1008,
-            Self::mul_add(-x145, x1005, Self::mul_add(x147, x1002, x1219)),
+            S::mul_add(S::neg(x145), x1005, S::mul_add(x147, x1002, x1219)),
         );
-        let x1221 = -x1220;
-        let x1222 = Self::mul_add(
-            -x149,
+        let x1221 = S::neg(x1220);
+        let x1222 = S::mul_add(
+            S::neg(x149),
             x928,
-            Self::mul_add(x151, x928, Self::mul_add(x154, x926, x156 * x920)),
+            S::mul_add(x151, x928, S::mul_add(x154, x926, x156 * x920)),
         );
-        let x1223 = Self::mul_add(
+        let x1223 = S::mul_add(
             x143,
             x932,
-            Self::mul_add(-x145, x930, Self::mul_add(x147, x928, x1222)),
+            S::mul_add(S::neg(x145), x930, S::mul_add(x147, x928, x1222)),
         );
-        let x1224 = -x1223;
-        let x1225 = Self::mul_add(
-            -x149,
+        let x1224 = S::neg(x1223);
+        let x1225 = S::mul_add(
+            S::neg(x149),
             x881,
-            Self::mul_add(x151, x881, Self::mul_add(x154, x879, x156 * x873)),
+            S::mul_add(x151, x881, S::mul_add(x154, x879, x156 * x873)),
         );
-        let x1226 = Self::mul_add(
-            -x143,
+        let x1226 = S::mul_add(
+            S::neg(x143),
             x885,
-            Self::mul_add(-x145, x883, Self::mul_add(x147, x881, x1225)),
+            S::mul_add(S::neg(x145), x883, S::mul_add(x147, x881, x1225)),
         );
-        let x1227 = Self::mul_add(
-            -x164,
+        let x1227 = S::mul_add(
+            S::neg(x164),
             x1205,
-            Self::mul_add(-x166, x1203, Self::mul_add(x168, x1199, x170 * x1197)),
+            S::mul_add(S::neg(x166), x1203, S::mul_add(x168, x1199, x170 * x1197)),
         );
-        let x1228 = Self::mul_add(
+        let x1228 = S::mul_add(
             x161,
             x1211,
-            Self::mul_add(-x162, x1209, Self::mul_add(x163, x1207, x1227)),
+            S::mul_add(S::neg(x162), x1209, S::mul_add(x163, x1207, x1227)),
         );
-        let x1229 = Self::mul_add(
-            -x164,
+        let x1229 = S::mul_add(
+            S::neg(x164),
             x1160,
-            Self::mul_add(-x166, x1158, Self::mul_add(x168, x1154, x170 * x1150)),
+            S::mul_add(S::neg(x166), x1158, S::mul_add(x168, x1154, x170 * x1150)),
         );
-        let x1230 = Self::mul_add(
+        let x1230 = S::mul_add(
             x161,
             x1166,
-            Self::mul_add(-x162, x1164, Self::mul_add(x163, x1162, x1229)),
+            S::mul_add(S::neg(x162), x1164, S::mul_add(x163, x1162, x1229)),
         );
-        let x1231 = Self::mul_add(
-            -x164,
+        let x1231 = S::mul_add(
+            S::neg(x164),
             x1084,
-            Self::mul_add(-x166, x1082, Self::mul_add(x168, x1080, x170 * x1068)),
+            S::mul_add(S::neg(x166), x1082, S::mul_add(x168, x1080, x170 * x1068)),
         );
-        let x1232 = Self::mul_add(
+        let x1232 = S::mul_add(
             x161,
             x1091,
-            Self::mul_add(-x162, x1089, Self::mul_add(x163, x1087, x1231)),
+            S::mul_add(S::neg(x162), x1089, S::mul_add(x163, x1087, x1231)),
         );
-        let x1233 = Self::mul_add(
-            -x164,
+        let x1233 = S::mul_add(
+            S::neg(x164),
             x1000,
-            Self::mul_add(-x166, x997, Self::mul_add(x168, x994, x170 * x982)),
+            S::mul_add(S::neg(x166), x997, S::mul_add(x168, x994, x170 * x982)),
         );
-        let x1234 = Self::mul_add(
-            -x161,
+        let x1234 = S::mul_add(
+            S::neg(x161),
             x1008,
-            Self::mul_add(x162, x1005, Self::mul_add(-x163, x1002, x1233)),
+            S::mul_add(x162, x1005, S::mul_add(S::neg(x163), x1002, x1233)),
         );
-        let x1235 = -x1234;
-        let x1236 = Self::mul_add(
-            -x164,
+        let x1235 = S::neg(x1234);
+        let x1236 = S::mul_add(
+            S::neg(x164),
             x928,
-            Self::mul_add(-x166, x928, Self::mul_add(x168, x926, x170 * x920)),
+            S::mul_add(S::neg(x166), x928, S::mul_add(x168, x926, x170 * x920)),
         );
-        let x1237 = Self::mul_add(
-            -x161,
+        let x1237 = S::mul_add(
+            S::neg(x161),
             x932,
-            Self::mul_add(x162, x930, Self::mul_add(-x163, x928, x1236)),
+            S::mul_add(x162, x930, S::mul_add(S::neg(x163), x928, x1236)),
         );
-        let x1238 = -x1237;
-        let x1239 = Self::mul_add(
-            -x164,
+        let x1238 = S::neg(x1237);
+        let x1239 = S::mul_add(
+            S::neg(x164),
             x881,
-            Self::mul_add(-x166, x881, Self::mul_add(x168, x879, x170 * x873)),
+            S::mul_add(S::neg(x166), x881, S::mul_add(x168, x879, x170 * x873)),
         );
-        let x1240 = Self::mul_add(
+        let x1240 = S::mul_add(
             x161,
             x885,
-            Self::mul_add(x162, x883, Self::mul_add(-x163, x881, x1239)),
+            S::mul_add(x162, x883, S::mul_add(S::neg(x163), x881, x1239)),
         );
-        let x1241 = Self::mul_add(
+        let x1241 = S::mul_add(
             x179,
             x1205,
-            Self::mul_add(-x182, x1203, Self::mul_add(x184, x1199, x186 * x1197)),
+            S::mul_add(S::neg(x182), x1203, S::mul_add(x184, x1199, x186 * x1197)),
         );
-        let x1242 = Self::mul_add(
-            -x174,
+        let x1242 = S::mul_add(
+            S::neg(x174),
             x1211,
-            Self::mul_add(-x176, x1209, Self::mul_add(-x177, x1207, x1241)),
+            S::mul_add(S::neg(x176), x1209, S::mul_add(S::neg(x177), x1207, x1241)),
         );
-        let x1243 = Self::mul_add(
+        let x1243 = S::mul_add(
             x179,
             x1160,
-            Self::mul_add(-x182, x1158, Self::mul_add(x184, x1154, x186 * x1150)),
+            S::mul_add(S::neg(x182), x1158, S::mul_add(x184, x1154, x186 * x1150)),
         );
-        let x1244 = Self::mul_add(
-            -x174,
+        let x1244 = S::mul_add(
+            S::neg(x174),
             x1166,
-            Self::mul_add(-x176, x1164, Self::mul_add(-x177, x1162, x1243)),
+            S::mul_add(S::neg(x176), x1164, S::mul_add(S::neg(x177), x1162, x1243)),
         );
-        let x1245 = Self::mul_add(
+        let x1245 = S::mul_add(
             x179,
             x1084,
-            Self::mul_add(-x182, x1082, Self::mul_add(x184, x1080, x186 * x1068)),
+            S::mul_add(S::neg(x182), x1082, S::mul_add(x184, x1080, x186 * x1068)),
         );
-        let x1246 = Self::mul_add(
-            -x174,
+        let x1246 = S::mul_add(
+            S::neg(x174),
             x1091,
-            Self::mul_add(-x176, x1089, Self::mul_add(-x177, x1087, x1245)),
+            S::mul_add(S::neg(x176), x1089, S::mul_add(S::neg(x177), x1087, x1245)),
         );
-        let x1247 = Self::mul_add(
+        let x1247 = S::mul_add(
             x179,
             x1000,
-            Self::mul_add(-x182, x997, Self::mul_add(x184, x994, x186 * x982)),
+            S::mul_add(S::neg(x182), x997, S::mul_add(x184, x994, x186 * x982)),
         );
-        let x1248 = Self::mul_add(
+        let x1248 = S::mul_add(
             x174,
             x1008,
-            Self::mul_add(x176, x1005, Self::mul_add(x177, x1002, x1247)),
+            S::mul_add(x176, x1005, S::mul_add(x177, x1002, x1247)),
         );
-        let x1249 = -x1248;
-        let x1250 = Self::mul_add(
+        let x1249 = S::neg(x1248);
+        let x1250 = S::mul_add(
             x179,
             x928,
-            Self::mul_add(-x182, x928, Self::mul_add(x184, x926, x186 * x920)),
+            S::mul_add(S::neg(x182), x928, S::mul_add(x184, x926, x186 * x920)),
         );
-        let x1251 = Self::mul_add(
+        let x1251 = S::mul_add(
             x174,
             x932,
-            Self::mul_add(x176, x930, Self::mul_add(x177, x928, x1250)),
+            S::mul_add(x176, x930, S::mul_add(x177, x928, x1250)),
         );
-        let x1252 = -x1251;
-        let x1253 = Self::mul_add(
+        let x1252 = S::neg(x1251);
+        let x1253 = S::mul_add(
             x179,
             x881,
-            Self::mul_add(-x182, x881, Self::mul_add(x184, x879, x186 * x873)),
+            S::mul_add(S::neg(x182), x881, S::mul_add(x184, x879, x186 * x873)),
         );
-        let x1254 = Self::mul_add(
-            -x174,
+        let x1254 = S::mul_add(
+            S::neg(x174),
             x885,
-            Self::mul_add(x176, x883, Self::mul_add(x177, x881, x1253)),
+            S::mul_add(x176, x883, S::mul_add(x177, x881, x1253)),
         );
-        let x1255 = Self::mul_add(
+        let x1255 = S::mul_add(
             x194,
             x1205,
-            Self::mul_add(-x195, x1203, Self::mul_add(x198, x1199, x201 * x1197)),
+            S::mul_add(S::neg(x195), x1203, S::mul_add(x198, x1199, x201 * x1197)),
         );
-        let x1256 = Self::mul_add(
+        let x1256 = S::mul_add(
             x188,
             x1211,
-            Self::mul_add(-x190, x1209, Self::mul_add(x192, x1207, x1255)),
+            S::mul_add(S::neg(x190), x1209, S::mul_add(x192, x1207, x1255)),
         );
-        let x1257 = -x1256;
-        let x1258 = Self::mul_add(
+        let x1257 = S::neg(x1256);
+        let x1258 = S::mul_add(
             x194,
             x1160,
-            Self::mul_add(-x195, x1158, Self::mul_add(x198, x1154, x201 * x1150)),
+            S::mul_add(S::neg(x195), x1158, S::mul_add(x198, x1154, x201 * x1150)),
         );
-        let x1259 = Self::mul_add(
+        let x1259 = S::mul_add(
             x188,
             x1166,
-            Self::mul_add(-x190, x1164, Self::mul_add(x192, x1162, x1258)),
+            S::mul_add(S::neg(x190), x1164, S::mul_add(x192, x1162, x1258)),
         );
-        let x1260 = -x1259;
-        let x1261 = Self::mul_add(
+        let x1260 = S::neg(x1259);
+        let x1261 = S::mul_add(
             x194,
             x1084,
-            Self::mul_add(-x195, x1082, Self::mul_add(x198, x1080, x201 * x1068)),
+            S::mul_add(S::neg(x195), x1082, S::mul_add(x198, x1080, x201 * x1068)),
         );
-        let x1262 = Self::mul_add(
+        let x1262 = S::mul_add(
             x188,
             x1091,
-            Self::mul_add(-x190, x1089, Self::mul_add(x192, x1087, x1261)),
+            S::mul_add(S::neg(x190), x1089, S::mul_add(x192, x1087, x1261)),
         );
-        let x1263 = -x1262;
-        let x1264 = Self::mul_add(
+        let x1263 = S::neg(x1262);
+        let x1264 = S::mul_add(
             x194,
             x1000,
-            Self::mul_add(-x195, x997, Self::mul_add(x198, x994, x201 * x982)),
+            S::mul_add(S::neg(x195), x997, S::mul_add(x198, x994, x201 * x982)),
         );
-        let x1265 = Self::mul_add(
-            -x188,
+        let x1265 = S::mul_add(
+            S::neg(x188),
             x1008,
-            Self::mul_add(x190, x1005, Self::mul_add(-x192, x1002, x1264)),
+            S::mul_add(x190, x1005, S::mul_add(S::neg(x192), x1002, x1264)),
         );
-        let x1266 = Self::mul_add(
+        let x1266 = S::mul_add(
             x194,
             x928,
-            Self::mul_add(-x195, x928, Self::mul_add(x198, x926, x201 * x920)),
+            S::mul_add(S::neg(x195), x928, S::mul_add(x198, x926, x201 * x920)),
         );
-        let x1267 = Self::mul_add(
-            -x188,
+        let x1267 = S::mul_add(
+            S::neg(x188),
             x932,
-            Self::mul_add(x190, x930, Self::mul_add(-x192, x928, x1266)),
+            S::mul_add(x190, x930, S::mul_add(S::neg(x192), x928, x1266)),
         );
-        let x1268 = Self::mul_add(
+        let x1268 = S::mul_add(
             x194,
             x881,
-            Self::mul_add(-x195, x881, Self::mul_add(x198, x879, x201 * x873)),
+            S::mul_add(S::neg(x195), x881, S::mul_add(x198, x879, x201 * x873)),
         );
-        let x1269 = Self::mul_add(
+        let x1269 = S::mul_add(
             x188,
             x885,
-            Self::mul_add(x190, x883, Self::mul_add(-x192, x881, x1268)),
+            S::mul_add(x190, x883, S::mul_add(S::neg(x192), x881, x1268)),
         );
-        let x1270 = -x1269;
-        let x1271 = Self::mul_add(
+        let x1270 = S::neg(x1269);
+        let x1271 = S::mul_add(
             x207,
             x1205,
-            Self::mul_add(-x209, x1203, Self::mul_add(x211, x1199, x213 * x1197)),
+            S::mul_add(S::neg(x209), x1203, S::mul_add(x211, x1199, x213 * x1197)),
         );
-        let x1272 = Self::mul_add(
-            -x203,
+        let x1272 = S::mul_add(
+            S::neg(x203),
             x1211,
-            Self::mul_add(-x205, x1209, Self::mul_add(x206, x1207, x1271)),
+            S::mul_add(S::neg(x205), x1209, S::mul_add(x206, x1207, x1271)),
         );
-        let x1273 = Self::mul_add(
+        let x1273 = S::mul_add(
             x207,
             x1160,
-            Self::mul_add(-x209, x1158, Self::mul_add(x211, x1154, x213 * x1150)),
+            S::mul_add(S::neg(x209), x1158, S::mul_add(x211, x1154, x213 * x1150)),
         );
-        let x1274 = Self::mul_add(
-            -x203,
+        let x1274 = S::mul_add(
+            S::neg(x203),
             x1166,
-            Self::mul_add(-x205, x1164, Self::mul_add(x206, x1162, x1273)),
+            S::mul_add(S::neg(x205), x1164, S::mul_add(x206, x1162, x1273)),
         );
-        let x1275 = Self::mul_add(
+        let x1275 = S::mul_add(
             x207,
             x1084,
-            Self::mul_add(-x209, x1082, Self::mul_add(x211, x1080, x213 * x1068)),
+            S::mul_add(S::neg(x209), x1082, S::mul_add(x211, x1080, x213 * x1068)),
         );
-        let x1276 = Self::mul_add(
-            -x203,
+        let x1276 = S::mul_add(
+            S::neg(x203),
             x1091,
-            Self::mul_add(-x205, x1089, Self::mul_add(x206, x1087, x1275)),
+            S::mul_add(S::neg(x205), x1089, S::mul_add(x206, x1087, x1275)),
         );
-        let x1277 = Self::mul_add(
+        let x1277 = S::mul_add(
             x207,
             x1000,
-            Self::mul_add(-x209, x997, Self::mul_add(x211, x994, x213 * x982)),
+            S::mul_add(S::neg(x209), x997, S::mul_add(x211, x994, x213 * x982)),
         );
-        let x1278 = Self::mul_add(
+        let x1278 = S::mul_add(
             x203,
             x1008,
-            Self::mul_add(x205, x1005, Self::mul_add(-x206, x1002, x1277)),
+            S::mul_add(x205, x1005, S::mul_add(S::neg(x206), x1002, x1277)),
         );
-        let x1279 = -x1278;
-        let x1280 = Self::mul_add(
+        let x1279 = S::neg(x1278);
+        let x1280 = S::mul_add(
             x207,
             x928,
-            Self::mul_add(-x209, x928, Self::mul_add(x211, x926, x213 * x920)),
+            S::mul_add(S::neg(x209), x928, S::mul_add(x211, x926, x213 * x920)),
         );
-        let x1281 = Self::mul_add(
+        let x1281 = S::mul_add(
             x203,
             x932,
-            Self::mul_add(x205, x930, Self::mul_add(-x206, x928, x1280)),
+            S::mul_add(x205, x930, S::mul_add(S::neg(x206), x928, x1280)),
         );
-        let x1282 = -x1281;
-        let x1283 = Self::mul_add(
+        let x1282 = S::neg(x1281);
+        let x1283 = S::mul_add(
             x207,
             x881,
-            Self::mul_add(-x209, x881, Self::mul_add(x211, x879, x213 * x873)),
+            S::mul_add(S::neg(x209), x881, S::mul_add(x211, x879, x213 * x873)),
         );
-        let x1284 = Self::mul_add(
-            -x203,
+        let x1284 = S::mul_add(
+            S::neg(x203),
             x885,
-            Self::mul_add(x205, x883, Self::mul_add(-x206, x881, x1283)),
+            S::mul_add(x205, x883, S::mul_add(S::neg(x206), x881, x1283)),
         );
-        let x1285 = Self::mul_add(
+        let x1285 = S::mul_add(
             x217,
             x1205,
-            Self::mul_add(-x219, x1203, Self::mul_add(x221, x1199, x223 * x1197)),
+            S::mul_add(S::neg(x219), x1203, S::mul_add(x221, x1199, x223 * x1197)),
         );
-        let x1286 = Self::mul_add(
+        let x1286 = S::mul_add(
             x214,
             x1211,
-            Self::mul_add(-x215, x1209, Self::mul_add(x216, x1207, x1285)),
+            S::mul_add(S::neg(x215), x1209, S::mul_add(x216, x1207, x1285)),
         );
-        let x1287 = Self::mul_add(
+        let x1287 = S::mul_add(
             x217,
             x1160,
-            Self::mul_add(-x219, x1158, Self::mul_add(x221, x1154, x223 * x1150)),
+            S::mul_add(S::neg(x219), x1158, S::mul_add(x221, x1154, x223 * x1150)),
         );
-        let x1288 = Self::mul_add(
+        let x1288 = S::mul_add(
             x214,
             x1166,
-            Self::mul_add(-x215, x1164, Self::mul_add(x216, x1162, x1287)),
+            S::mul_add(S::neg(x215), x1164, S::mul_add(x216, x1162, x1287)),
         );
-        let x1289 = Self::mul_add(
+        let x1289 = S::mul_add(
             x217,
             x1084,
-            Self::mul_add(-x219, x1082, Self::mul_add(x221, x1080, x223 * x1068)),
+            S::mul_add(S::neg(x219), x1082, S::mul_add(x221, x1080, x223 * x1068)),
         );
-        let x1290 = Self::mul_add(
+        let x1290 = S::mul_add(
             x214,
             x1091,
-            Self::mul_add(-x215, x1089, Self::mul_add(x216, x1087, x1289)),
+            S::mul_add(S::neg(x215), x1089, S::mul_add(x216, x1087, x1289)),
         );
-        let x1291 = Self::mul_add(
+        let x1291 = S::mul_add(
             x217,
             x1000,
-            Self::mul_add(-x219, x997, Self::mul_add(x221, x994, x223 * x982)),
+            S::mul_add(S::neg(x219), x997, S::mul_add(x221, x994, x223 * x982)),
         );
-        let x1292 = Self::mul_add(
-            -x214,
+        let x1292 = S::mul_add(
+            S::neg(x214),
             x1008,
-            Self::mul_add(x215, x1005, Self::mul_add(-x216, x1002, x1291)),
+            S::mul_add(x215, x1005, S::mul_add(S::neg(x216), x1002, x1291)),
         );
-        let x1293 = -x1292;
-        let x1294 = Self::mul_add(
+        let x1293 = S::neg(x1292);
+        let x1294 = S::mul_add(
             x217,
             x928,
-            Self::mul_add(-x219, x928, Self::mul_add(x221, x926, x223 * x920)),
+            S::mul_add(S::neg(x219), x928, S::mul_add(x221, x926, x223 * x920)),
         );
-        let x1295 = Self::mul_add(
-            -x214,
+        let x1295 = S::mul_add(
+            S::neg(x214),
             x932,
-            Self::mul_add(x215, x930, Self::mul_add(-x216, x928, x1294)),
+            S::mul_add(x215, x930, S::mul_add(S::neg(x216), x928, x1294)),
         );
-        let x1296 = -x1295;
-        let x1297 = Self::mul_add(
+        let x1296 = S::neg(x1295);
+        let x1297 = S::mul_add(
             x217,
             x881,
-            Self::mul_add(-x219, x881, Self::mul_add(x221, x879, x223 * x873)),
+            S::mul_add(S::neg(x219), x881, S::mul_add(x221, x879, x223 * x873)),
         );
-        let x1298 = Self::mul_add(
+        let x1298 = S::mul_add(
             x214,
             x885,
-            Self::mul_add(x215, x883, Self::mul_add(-x216, x881, x1297)),
+            S::mul_add(x215, x883, S::mul_add(S::neg(x216), x881, x1297)),
         );
-        let x1299 = Self::mul_add(
+        let x1299 = S::mul_add(
             x225,
             x1205,
-            Self::mul_add(-x227, x1203, Self::mul_add(x229, x1199, x231 * x1197)),
+            S::mul_add(S::neg(x227), x1203, S::mul_add(x229, x1199, x231 * x1197)),
         );
-        let x1300 = Self::mul_add(
+        let x1300 = S::mul_add(
             x136,
             x1211,
-            Self::mul_add(-x214, x1209, Self::mul_add(x224, x1207, x1299)),
+            S::mul_add(S::neg(x214), x1209, S::mul_add(x224, x1207, x1299)),
         );
-        let x1301 = Self::mul_add(
+        let x1301 = S::mul_add(
             x225,
             x1160,
-            Self::mul_add(-x227, x1158, Self::mul_add(x229, x1154, x231 * x1150)),
+            S::mul_add(S::neg(x227), x1158, S::mul_add(x229, x1154, x231 * x1150)),
         );
-        let x1302 = Self::mul_add(
+        let x1302 = S::mul_add(
             x136,
             x1166,
-            Self::mul_add(-x214, x1164, Self::mul_add(x224, x1162, x1301)),
+            S::mul_add(S::neg(x214), x1164, S::mul_add(x224, x1162, x1301)),
         );
-        let x1303 = Self::mul_add(
+        let x1303 = S::mul_add(
             x225,
             x1084,
-            Self::mul_add(-x227, x1082, Self::mul_add(x229, x1080, x231 * x1068)),
+            S::mul_add(S::neg(x227), x1082, S::mul_add(x229, x1080, x231 * x1068)),
         );
-        let x1304 = Self::mul_add(
+        let x1304 = S::mul_add(
             x136,
             x1091,
-            Self::mul_add(-x214, x1089, Self::mul_add(x224, x1087, x1303)),
+            S::mul_add(S::neg(x214), x1089, S::mul_add(x224, x1087, x1303)),
         );
-        let x1305 = Self::mul_add(
+        let x1305 = S::mul_add(
             x225,
             x1000,
-            Self::mul_add(-x227, x997, Self::mul_add(x229, x994, x231 * x982)),
+            S::mul_add(S::neg(x227), x997, S::mul_add(x229, x994, x231 * x982)),
         );
-        let x1306 = Self::mul_add(
-            -x136,
+        let x1306 = S::mul_add(
+            S::neg(x136),
             x1008,
-            Self::mul_add(x214, x1005, Self::mul_add(-x224, x1002, x1305)),
+            S::mul_add(x214, x1005, S::mul_add(S::neg(x224), x1002, x1305)),
         );
-        let x1307 = -x1306;
-        let x1308 = Self::mul_add(
+        let x1307 = S::neg(x1306);
+        let x1308 = S::mul_add(
             x225,
             x928,
-            Self::mul_add(-x227, x928, Self::mul_add(x229, x926, x231 * x920)),
+            S::mul_add(S::neg(x227), x928, S::mul_add(x229, x926, x231 * x920)),
         );
-        let x1309 = Self::mul_add(
-            -x136,
+        let x1309 = S::mul_add(
+            S::neg(x136),
             x932,
-            Self::mul_add(x214, x930, Self::mul_add(-x224, x928, x1308)),
+            S::mul_add(x214, x930, S::mul_add(S::neg(x224), x928, x1308)),
         );
-        let x1310 = -x1309;
-        let x1311 = Self::mul_add(
+        let x1310 = S::neg(x1309);
+        let x1311 = S::mul_add(
             x225,
             x881,
-            Self::mul_add(-x227, x881, Self::mul_add(x229, x879, x231 * x873)),
+            S::mul_add(S::neg(x227), x881, S::mul_add(x229, x879, x231 * x873)),
         );
-        let x1312 = Self::mul_add(
+        let x1312 = S::mul_add(
             x136,
             x885,
-            Self::mul_add(x214, x883, Self::mul_add(-x224, x881, x1311)),
+            S::mul_add(x214, x883, S::mul_add(S::neg(x224), x881, x1311)),
         );
-        let x1313 = Self::mul_add(
-            -x149,
+        let x1313 = S::mul_add(
+            S::neg(x149),
             x1059,
-            Self::mul_add(x151, x1141, Self::mul_add(-x154, x1192, x156 * x1179)),
+            S::mul_add(x151, x1141, S::mul_add(S::neg(x154), x1192, x156 * x1179)),
         );
-        let x1314 = Self::mul_add(
+        let x1314 = S::mul_add(
             x143,
             x870,
-            Self::mul_add(-x145, x917, Self::mul_add(-x147, x973, x1313)),
+            S::mul_add(S::neg(x145), x917, S::mul_add(S::neg(x147), x973, x1313)),
         );
-        let x1315 = -x1314;
-        let x1316 = Self::mul_add(
+        let x1315 = S::neg(x1314);
+        let x1316 = S::mul_add(
             x149,
             x1206,
-            Self::mul_add(-x151, x1204, Self::mul_add(x154, x1202, x156 * x1198)),
+            S::mul_add(S::neg(x151), x1204, S::mul_add(x154, x1202, x156 * x1198)),
         );
-        let x1317 = Self::mul_add(
+        let x1317 = S::mul_add(
             x143,
             x1212,
-            Self::mul_add(-x145, x1210, Self::mul_add(x147, x1208, x1316)),
+            S::mul_add(S::neg(x145), x1210, S::mul_add(x147, x1208, x1316)),
         );
-        let x1318 = Self::mul_add(
-            -x149,
+        let x1318 = S::mul_add(
+            S::neg(x149),
             x1161,
-            Self::mul_add(x151, x1159, Self::mul_add(-x154, x1157, x156 * x1151)),
+            S::mul_add(x151, x1159, S::mul_add(S::neg(x154), x1157, x156 * x1151)),
         );
-        let x1319 = Self::mul_add(
+        let x1319 = S::mul_add(
             x143,
             x1167,
-            Self::mul_add(-x145, x1165, Self::mul_add(-x147, x1163, x1318)),
+            S::mul_add(S::neg(x145), x1165, S::mul_add(S::neg(x147), x1163, x1318)),
         );
-        let x1320 = Self::mul_add(
-            -x149,
+        let x1320 = S::mul_add(
+            S::neg(x149),
             x1086,
-            Self::mul_add(x151, x1083, Self::mul_add(-x154, x1081, x156 * x1074)),
+            S::mul_add(x151, x1083, S::mul_add(S::neg(x154), x1081, x156 * x1074)),
         );
-        let x1321 = Self::mul_add(
+        let x1321 = S::mul_add(
             x143,
             x1092,
-            Self::mul_add(-x145, x1090, Self::mul_add(-x147, x1088, x1320)),
+            S::mul_add(S::neg(x145), x1090, S::mul_add(S::neg(x147), x1088, x1320)),
         );
-        let x1322 = Self::mul_add(
-            -x149,
+        let x1322 = S::mul_add(
+            S::neg(x149),
             x1001,
-            Self::mul_add(x151, x999, Self::mul_add(-x154, x995, x156 * x988)),
+            S::mul_add(x151, x999, S::mul_add(S::neg(x154), x995, x156 * x988)),
         );
-        let x1323 = Self::mul_add(
+        let x1323 = S::mul_add(
             x143,
             x1010,
-            Self::mul_add(-x145, x1007, Self::mul_add(x147, x1004, x1322)),
+            S::mul_add(S::neg(x145), x1007, S::mul_add(x147, x1004, x1322)),
         );
-        let x1324 = -x1323;
-        let x1325 = Self::mul_add(
-            -x149,
+        let x1324 = S::neg(x1323);
+        let x1325 = S::mul_add(
+            S::neg(x149),
             x929,
-            Self::mul_add(x151, x929, Self::mul_add(-x154, x927, x156 * x923)),
+            S::mul_add(x151, x929, S::mul_add(S::neg(x154), x927, x156 * x923)),
         );
-        let x1326 = Self::mul_add(
+        let x1326 = S::mul_add(
             x143,
             x933,
-            Self::mul_add(-x145, x931, Self::mul_add(x147, x929, x1325)),
+            S::mul_add(S::neg(x145), x931, S::mul_add(x147, x929, x1325)),
         );
-        let x1327 = -x1326;
-        let x1328 = Self::mul_add(
-            -x149,
+        let x1327 = S::neg(x1326);
+        let x1328 = S::mul_add(
+            S::neg(x149),
             x882,
-            Self::mul_add(x151, x882, Self::mul_add(-x154, x880, x156 * x876)),
+            S::mul_add(x151, x882, S::mul_add(S::neg(x154), x880, x156 * x876)),
         );
-        let x1329 = Self::mul_add(
-            -x143,
+        let x1329 = S::mul_add(
+            S::neg(x143),
             x886,
-            Self::mul_add(-x145, x884, Self::mul_add(x147, x882, x1328)),
+            S::mul_add(S::neg(x145), x884, S::mul_add(x147, x882, x1328)),
         );
-        let x1330 = Self::mul_add(
-            -x164,
+        let x1330 = S::mul_add(
+            S::neg(x164),
             x1059,
-            Self::mul_add(-x166, x1141, Self::mul_add(-x168, x1192, x170 * x1179)),
+            S::mul_add(
+                S::neg(x166),
+                x1141,
+                S::mul_add(S::neg(x168), x1192, x170 * x1179),
+            ),
         );
-        let x1331 = Self::mul_add(
-            -x161,
+        let x1331 = S::mul_add(
+            S::neg(x161),
             x870,
-            Self::mul_add(x162, x917, Self::mul_add(x163, x973, x1330)),
+            S::mul_add(x162, x917, S::mul_add(x163, x973, x1330)),
         );
-        let x1332 = -x1331;
-        let x1333 = Self::mul_add(
+        let x1332 = S::neg(x1331);
+        let x1333 = S::mul_add(
             x164,
             x1206,
-            Self::mul_add(x166, x1204, Self::mul_add(x168, x1202, x170 * x1198)),
+            S::mul_add(x166, x1204, S::mul_add(x168, x1202, x170 * x1198)),
         );
-        let x1334 = Self::mul_add(
-            -x161,
+        let x1334 = S::mul_add(
+            S::neg(x161),
             x1212,
-            Self::mul_add(x162, x1210, Self::mul_add(-x163, x1208, x1333)),
+            S::mul_add(x162, x1210, S::mul_add(S::neg(x163), x1208, x1333)),
         );
-        let x1335 = Self::mul_add(
-            -x164,
+        let x1335 = S::mul_add(
+            S::neg(x164),
             x1161,
-            Self::mul_add(-x166, x1159, Self::mul_add(-x168, x1157, x170 * x1151)),
+            S::mul_add(
+                S::neg(x166),
+                x1159,
+                S::mul_add(S::neg(x168), x1157, x170 * x1151),
+            ),
         );
-        let x1336 = Self::mul_add(
-            -x161,
+        let x1336 = S::mul_add(
+            S::neg(x161),
             x1167,
-            Self::mul_add(x162, x1165, Self::mul_add(x163, x1163, x1335)),
+            S::mul_add(x162, x1165, S::mul_add(x163, x1163, x1335)),
         );
-        let x1337 = Self::mul_add(
-            -x164,
+        let x1337 = S::mul_add(
+            S::neg(x164),
             x1086,
-            Self::mul_add(-x166, x1083, Self::mul_add(-x168, x1081, x170 * x1074)),
+            S::mul_add(
+                S::neg(x166),
+                x1083,
+                S::mul_add(S::neg(x168), x1081, x170 * x1074),
+            ),
         );
-        let x1338 = Self::mul_add(
-            -x161,
+        let x1338 = S::mul_add(
+            S::neg(x161),
             x1092,
-            Self::mul_add(x162, x1090, Self::mul_add(x163, x1088, x1337)),
+            S::mul_add(x162, x1090, S::mul_add(x163, x1088, x1337)),
         );
-        let x1339 = Self::mul_add(
-            -x164,
+        let x1339 = S::mul_add(
+            S::neg(x164),
             x1001,
-            Self::mul_add(-x166, x999, Self::mul_add(-x168, x995, x170 * x988)),
+            S::mul_add(S::neg(x166), x999, S::mul_add(S::neg(x168), x995, x170 * x988)),
         );
-        let x1340 = Self::mul_add(
-            -x161,
+        let x1340 = S::mul_add(
+            S::neg(x161),
             x1010,
-            Self::mul_add(x162, x1007, Self::mul_add(-x163, x1004, x1339)),
+            S::mul_add(x162, x1007, S::mul_add(S::neg(x163), x1004, x1339)),
         );
-        let x1341 = -x1340;
-        let x1342 = Self::mul_add(
-            -x164,
+        let x1341 = S::neg(x1340);
+        let x1342 = S::mul_add(
+            S::neg(x164),
             x929,
-            Self::mul_add(-x166, x929, Self::mul_add(-x168, x927, x170 * x923)),
+            S::mul_add(S::neg(x166), x929, S::mul_add(S::neg(x168), x927, x170 * x923)),
         );
-        let x1343 = Self::mul_add(
-            -x161,
+        let x1343 = S::mul_add(
+            S::neg(x161),
             x933,
-            Self::mul_add(x162, x931, Self::mul_add(-x163, x929, x1342)),
+            S::mul_add(x162, x931, S::mul_add(S::neg(x163), x929, x1342)),
         );
-        let x1344 = -x1343;
-        let x1345 = Self::mul_add(
-            -x164,
+        let x1344 = S::neg(x1343);
+        let x1345 = S::mul_add(
+            S::neg(x164),
             x882,
-            Self::mul_add(-x166, x882, Self::mul_add(-x168, x880, x170 * x876)),
+            S::mul_add(S::neg(x166), x882, S::mul_add(S::neg(x168), x880, x170 * x876)),
         );
-        let x1346 = Self::mul_add(
+        let x1346 = S::mul_add(
             x161,
             x886,
-            Self::mul_add(x162, x884, Self::mul_add(-x163, x882, x1345)),
+            S::mul_add(x162, x884, S::mul_add(S::neg(x163), x882, x1345)),
         );
-        let x1347 = Self::mul_add(
+        let x1347 = S::mul_add(
             x179,
             x1059,
-            Self::mul_add(-x182, x1141, Self::mul_add(-x184, x1192, x186 * x1179)),
+            S::mul_add(
+                S::neg(x182),
+                x1141,
+                S::mul_add(S::neg(x184), x1192, x186 * x1179),
+            ),
         );
-        let x1348 = Self::mul_add(
+        let x1348 = S::mul_add(
             x174,
             x870,
-            Self::mul_add(x176, x917, Self::mul_add(-x177, x973, x1347)),
+            S::mul_add(x176, x917, S::mul_add(S::neg(x177), x973, x1347)),
         );
-        let x1349 = -x1348;
-        let x1350 = Self::mul_add(
-            -x179,
+        let x1349 = S::neg(x1348);
+        let x1350 = S::mul_add(
+            S::neg(x179),
             x1206,
-            Self::mul_add(x182, x1204, Self::mul_add(x184, x1202, x186 * x1198)),
+            S::mul_add(x182, x1204, S::mul_add(x184, x1202, x186 * x1198)),
         );
-        let x1351 = Self::mul_add(
+        let x1351 = S::mul_add(
             x174,
             x1212,
-            Self::mul_add(x176, x1210, Self::mul_add(x177, x1208, x1350)),
+            S::mul_add(x176, x1210, S::mul_add(x177, x1208, x1350)),
         );
-        let x1352 = Self::mul_add(
+        let x1352 = S::mul_add(
             x179,
             x1161,
-            Self::mul_add(-x182, x1159, Self::mul_add(-x184, x1157, x186 * x1151)),
+            S::mul_add(
+                S::neg(x182),
+                x1159,
+                S::mul_add(S::neg(x184), x1157, x186 * x1151),
+            ),
         );
-        let x1353 = Self::mul_add(
+        let x1353 = S::mul_add(
             x174,
             x1167,
-            Self::mul_add(x176, x1165, Self::mul_add(-x177, x1163, x1352)),
+            S::mul_add(x176, x1165, S::mul_add(S::neg(x177), x1163, x1352)),
         );
-        let x1354 = Self::mul_add(
+        let x1354 = S::mul_add(
             x179,
             x1086,
-            Self::mul_add(-x182, x1083, Self::mul_add(-x184, x1081, x186 * x1074)),
+            S::mul_add(
+                S::neg(x182),
+                x1083,
+                S::mul_add(S::neg(x184), x1081, x186 * x1074),
+            ),
         );
-        let x1355 = Self::mul_add(
+        let x1355 = S::mul_add(
             x174,
             x1092,
-            Self::mul_add(x176, x1090, Self::mul_add(-x177, x1088, x1354)),
+            S::mul_add(x176, x1090, S::mul_add(S::neg(x177), x1088, x1354)),
         );
-        let x1356 = Self::mul_add(
+        let x1356 = S::mul_add(
             x179,
             x1001,
-            Self::mul_add(-x182, x999, Self::mul_add(-x184, x995, x186 * x988)),
+            S::mul_add(S::neg(x182), x999, S::mul_add(S::neg(x184), x995, x186 * x988)),
         );
-        let x1357 = Self::mul_add(
+        let x1357 = S::mul_add(
             x174,
             x1010,
-            Self::mul_add(x176, x1007, Self::mul_add(x177, x1004, x1356)),
+            S::mul_add(x176, x1007, S::mul_add(x177, x1004, x1356)),
         );
-        let x1358 = -x1357;
-        let x1359 = Self::mul_add(
+        let x1358 = S::neg(x1357);
+        let x1359 = S::mul_add(
             x179,
             x929,
-            Self::mul_add(-x182, x929, Self::mul_add(-x184, x927, x186 * x923)),
+            S::mul_add(S::neg(x182), x929, S::mul_add(S::neg(x184), x927, x186 * x923)),
         );
-        let x1360 = Self::mul_add(
+        let x1360 = S::mul_add(
             x174,
             x933,
-            Self::mul_add(x176, x931, Self::mul_add(x177, x929, x1359)),
+            S::mul_add(x176, x931, S::mul_add(x177, x929, x1359)),
         );
-        let x1361 = -x1360;
-        let x1362 = Self::mul_add(
+        let x1361 = S::neg(x1360);
+        let x1362 = S::mul_add(
             x179,
             x882,
-            Self::mul_add(-x182, x882, Self::mul_add(-x184, x880, x186 * x876)),
+            S::mul_add(S::neg(x182), x882, S::mul_add(S::neg(x184), x880, x186 * x876)),
         );
-        let x1363 = Self::mul_add(
-            -x174,
+        let x1363 = S::mul_add(
+            S::neg(x174),
             x886,
-            Self::mul_add(x176, x884, Self::mul_add(x177, x882, x1362)),
+            S::mul_add(x176, x884, S::mul_add(x177, x882, x1362)),
         );
-        let x1364 = Self::mul_add(
+        let x1364 = S::mul_add(
             x194,
             x1059,
-            Self::mul_add(-x195, x1141, Self::mul_add(-x198, x1192, x201 * x1179)),
+            S::mul_add(
+                S::neg(x195),
+                x1141,
+                S::mul_add(S::neg(x198), x1192, x201 * x1179),
+            ),
         );
-        let x1365 = Self::mul_add(
-            -x188,
+        let x1365 = S::mul_add(
+            S::neg(x188),
             x870,
-            Self::mul_add(x190, x917, Self::mul_add(x192, x973, x1364)),
+            S::mul_add(x190, x917, S::mul_add(x192, x973, x1364)),
         );
-        let x1366 = Self::mul_add(
-            -x194,
+        let x1366 = S::mul_add(
+            S::neg(x194),
             x1206,
-            Self::mul_add(x195, x1204, Self::mul_add(x198, x1202, x201 * x1198)),
+            S::mul_add(x195, x1204, S::mul_add(x198, x1202, x201 * x1198)),
         );
-        let x1367 = Self::mul_add(
-            -x188,
+        let x1367 = S::mul_add(
+            S::neg(x188),
             x1212,
-            Self::mul_add(x190, x1210, Self::mul_add(-x192, x1208, x1366)),
+            S::mul_add(x190, x1210, S::mul_add(S::neg(x192), x1208, x1366)),
         );
-        let x1368 = -x1367;
-        let x1369 = Self::mul_add(
+        let x1368 = S::neg(x1367);
+        let x1369 = S::mul_add(
             x194,
             x1161,
-            Self::mul_add(-x195, x1159, Self::mul_add(-x198, x1157, x201 * x1151)),
+            S::mul_add(
+                S::neg(x195),
+                x1159,
+                S::mul_add(S::neg(x198), x1157, x201 * x1151),
+            ),
         );
-        let x1370 = Self::mul_add(
-            -x188,
+        let x1370 = S::mul_add(
+            S::neg(x188),
             x1167,
-            Self::mul_add(x190, x1165, Self::mul_add(x192, x1163, x1369)),
+            S::mul_add(x190, x1165, S::mul_add(x192, x1163, x1369)),
         );
-        let x1371 = -x1370;
-        let x1372 = Self::mul_add(
+        let x1371 = S::neg(x1370);
+        let x1372 = S::mul_add(
             x194,
             x1086,
-            Self::mul_add(-x195, x1083, Self::mul_add(-x198, x1081, x201 * x1074)),
+            S::mul_add(
+                S::neg(x195),
+                x1083,
+                S::mul_add(S::neg(x198), x1081, x201 * x1074),
+            ),
         );
-        let x1373 = Self::mul_add(
-            -x188,
+        let x1373 = S::mul_add(
+            S::neg(x188),
             x1092,
-            Self::mul_add(x190, x1090, Self::mul_add(x192, x1088, x1372)),
+            S::mul_add(x190, x1090, S::mul_add(x192, x1088, x1372)),
         );
-        let x1374 = -x1373;
-        let x1375 = Self::mul_add(
+        let x1374 = S::neg(x1373);
+        let x1375 = S::mul_add(
             x194,
             x1001,
-            Self::mul_add(-x195, x999, Self::mul_add(-x198, x995, x201 * x988)),
+            S::mul_add(S::neg(x195), x999, S::mul_add(S::neg(x198), x995, x201 * x988)),
         );
-        let x1376 = Self::mul_add(
-            -x188,
+        let x1376 = S::mul_add(
+            S::neg(x188),
             x1010,
-            Self::mul_add(x190, x1007, Self::mul_add(-x192, x1004, x1375)),
+            S::mul_add(x190, x1007, S::mul_add(S::neg(x192), x1004, x1375)),
         );
-        let x1377 = Self::mul_add(
+        let x1377 = S::mul_add(
             x194,
             x929,
-            Self::mul_add(-x195, x929, Self::mul_add(-x198, x927, x201 * x923)),
+            S::mul_add(S::neg(x195), x929, S::mul_add(S::neg(x198), x927, x201 * x923)),
         );
-        let x1378 = Self::mul_add(
-            -x188,
+        let x1378 = S::mul_add(
+            S::neg(x188),
             x933,
-            Self::mul_add(x190, x931, Self::mul_add(-x192, x929, x1377)),
+            S::mul_add(x190, x931, S::mul_add(S::neg(x192), x929, x1377)),
         );
-        let x1379 = Self::mul_add(
+        let x1379 = S::mul_add(
             x194,
             x882,
-            Self::mul_add(-x195, x882, Self::mul_add(-x198, x880, x201 * x876)),
+            S::mul_add(S::neg(x195), x882, S::mul_add(S::neg(x198), x880, x201 * x876)),
         );
-        let x1380 = Self::mul_add(
+        let x1380 = S::mul_add(
             x188,
             x886,
-            Self::mul_add(x190, x884, Self::mul_add(-x192, x882, x1379)),
+            S::mul_add(x190, x884, S::mul_add(S::neg(x192), x882, x1379)),
         );
-        let x1381 = -x1380;
-        let x1382 = Self::mul_add(
+        let x1381 = S::neg(x1380);
+        let x1382 = S::mul_add(
             x207,
             x1059,
-            Self::mul_add(-x209, x1141, Self::mul_add(-x211, x1192, x213 * x1179)),
+            S::mul_add(
+                S::neg(x209),
+                x1141,
+                S::mul_add(S::neg(x211), x1192, x213 * x1179),
+            ),
         );
-        let x1383 = Self::mul_add(
+        let x1383 = S::mul_add(
             x203,
             x870,
-            Self::mul_add(x205, x917, Self::mul_add(x206, x973, x1382)),
+            S::mul_add(x205, x917, S::mul_add(x206, x973, x1382)),
         );
-        let x1384 = -x1383;
-        let x1385 = Self::mul_add(
-            -x207,
+        let x1384 = S::neg(x1383);
+        let x1385 = S::mul_add(
+            S::neg(x207),
             x1206,
-            Self::mul_add(x209, x1204, Self::mul_add(x211, x1202, x213 * x1198)),
+            S::mul_add(x209, x1204, S::mul_add(x211, x1202, x213 * x1198)),
         );
-        let x1386 = Self::mul_add(
+        let x1386 = S::mul_add(
             x203,
             x1212,
-            Self::mul_add(x205, x1210, Self::mul_add(-x206, x1208, x1385)),
+            S::mul_add(x205, x1210, S::mul_add(S::neg(x206), x1208, x1385)),
         );
-        let x1387 = Self::mul_add(
+        let x1387 = S::mul_add(
             x207,
             x1161,
-            Self::mul_add(-x209, x1159, Self::mul_add(-x211, x1157, x213 * x1151)),
+            S::mul_add(
+                S::neg(x209),
+                x1159,
+                S::mul_add(S::neg(x211), x1157, x213 * x1151),
+            ),
         );
-        let x1388 = Self::mul_add(
+        let x1388 = S::mul_add(
             x203,
             x1167,
-            Self::mul_add(x205, x1165, Self::mul_add(x206, x1163, x1387)),
+            S::mul_add(x205, x1165, S::mul_add(x206, x1163, x1387)),
         );
-        let x1389 = Self::mul_add(
+        let x1389 = S::mul_add(
             x207,
             x1086,
-            Self::mul_add(-x209, x1083, Self::mul_add(-x211, x1081, x213 * x1074)),
+            S::mul_add(
+                S::neg(x209),
+                x1083,
+                S::mul_add(S::neg(x211), x1081, x213 * x1074),
+            ),
         );
-        let x1390 = Self::mul_add(
+        let x1390 = S::mul_add(
             x203,
             x1092,
-            Self::mul_add(x205, x1090, Self::mul_add(x206, x1088, x1389)),
+            S::mul_add(x205, x1090, S::mul_add(x206, x1088, x1389)),
         );
-        let x1391 = Self::mul_add(
+        let x1391 = S::mul_add(
             x207,
             x1001,
-            Self::mul_add(-x209, x999, Self::mul_add(-x211, x995, x213 * x988)),
+            S::mul_add(S::neg(x209), x999, S::mul_add(S::neg(x211), x995, x213 * x988)),
         );
-        let x1392 = Self::mul_add(
+        let x1392 = S::mul_add(
             x203,
             x1010,
-            Self::mul_add(x205, x1007, Self::mul_add(-x206, x1004, x1391)),
+            S::mul_add(x205, x1007, S::mul_add(S::neg(x206), x1004, x1391)),
         );
-        let x1393 = -x1392;
-        let x1394 = Self::mul_add(
+        let x1393 = S::neg(x1392);
+        let x1394 = S::mul_add(
             x207,
             x929,
-            Self::mul_add(-x209, x929, Self::mul_add(-x211, x927, x213 * x923)),
+            S::mul_add(S::neg(x209), x929, S::mul_add(S::neg(x211), x927, x213 * x923)),
         );
-        let x1395 = Self::mul_add(
+        let x1395 = S::mul_add(
             x203,
             x933,
-            Self::mul_add(x205, x931, Self::mul_add(-x206, x929, x1394)),
+            S::mul_add(x205, x931, S::mul_add(S::neg(x206), x929, x1394)),
         );
-        let x1396 = -x1395;
-        let x1397 = Self::mul_add(
+        let x1396 = S::neg(x1395);
+        let x1397 = S::mul_add(
             x207,
             x882,
-            Self::mul_add(-x209, x882, Self::mul_add(-x211, x880, x213 * x876)),
+            S::mul_add(S::neg(x209), x882, S::mul_add(S::neg(x211), x880, x213 * x876)),
         );
-        let x1398 = Self::mul_add(
-            -x203,
+        let x1398 = S::mul_add(
+            S::neg(x203),
             x886,
-            Self::mul_add(x205, x884, Self::mul_add(-x206, x882, x1397)),
+            S::mul_add(x205, x884, S::mul_add(S::neg(x206), x882, x1397)),
         );
-        let x1399 = Self::mul_add(
+        let x1399 = S::mul_add(
             x217,
             x1059,
-            Self::mul_add(-x219, x1141, Self::mul_add(-x221, x1192, x223 * x1179)),
+            S::mul_add(
+                S::neg(x219),
+                x1141,
+                S::mul_add(S::neg(x221), x1192, x223 * x1179),
+            ),
         );
-        let x1400 = Self::mul_add(
-            -x214,
+        let x1400 = S::mul_add(
+            S::neg(x214),
             x870,
-            Self::mul_add(x215, x917, Self::mul_add(x216, x973, x1399)),
+            S::mul_add(x215, x917, S::mul_add(x216, x973, x1399)),
         );
-        let x1401 = -x1400;
-        let x1402 = Self::mul_add(
-            -x217,
+        let x1401 = S::neg(x1400);
+        let x1402 = S::mul_add(
+            S::neg(x217),
             x1206,
-            Self::mul_add(x219, x1204, Self::mul_add(x221, x1202, x223 * x1198)),
+            S::mul_add(x219, x1204, S::mul_add(x221, x1202, x223 * x1198)),
         );
-        let x1403 = Self::mul_add(
-            -x214,
+        let x1403 = S::mul_add(
+            S::neg(x214),
             x1212,
-            Self::mul_add(x215, x1210, Self::mul_add(-x216, x1208, x1402)),
+            S::mul_add(x215, x1210, S::mul_add(S::neg(x216), x1208, x1402)),
         );
-        let x1404 = Self::mul_add(
+        let x1404 = S::mul_add(
             x217,
             x1161,
-            Self::mul_add(-x219, x1159, Self::mul_add(-x221, x1157, x223 * x1151)),
+            S::mul_add(
+                S::neg(x219),
+                x1159,
+                S::mul_add(S::neg(x221), x1157, x223 * x1151),
+            ),
         );
-        let x1405 = Self::mul_add(
-            -x214,
+        let x1405 = S::mul_add(
+            S::neg(x214),
             x1167,
-            Self::mul_add(x215, x1165, Self::mul_add(x216, x1163, x1404)),
+            S::mul_add(x215, x1165, S::mul_add(x216, x1163, x1404)),
         );
-        let x1406 = Self::mul_add(
+        let x1406 = S::mul_add(
             x217,
             x1086,
-            Self::mul_add(-x219, x1083, Self::mul_add(-x221, x1081, x223 * x1074)),
+            S::mul_add(
+                S::neg(x219),
+                x1083,
+                S::mul_add(S::neg(x221), x1081, x223 * x1074),
+            ),
         );
-        let x1407 = Self::mul_add(
-            -x214,
+        let x1407 = S::mul_add(
+            S::neg(x214),
             x1092,
-            Self::mul_add(x215, x1090, Self::mul_add(x216, x1088, x1406)),
+            S::mul_add(x215, x1090, S::mul_add(x216, x1088, x1406)),
         );
-        let x1408 = Self::mul_add(
+        let x1408 = S::mul_add(
             x217,
             x1001,
-            Self::mul_add(-x219, x999, Self::mul_add(-x221, x995, x223 * x988)),
+            S::mul_add(S::neg(x219), x999, S::mul_add(S::neg(x221), x995, x223 * x988)),
         );
-        let x1409 = Self::mul_add(
-            -x214,
+        let x1409 = S::mul_add(
+            S::neg(x214),
             x1010,
-            Self::mul_add(x215, x1007, Self::mul_add(-x216, x1004, x1408)),
+            S::mul_add(x215, x1007, S::mul_add(S::neg(x216), x1004, x1408)),
         );
-        let x1410 = -x1409;
-        let x1411 = Self::mul_add(
+        let x1410 = S::neg(x1409);
+        let x1411 = S::mul_add(
             x217,
             x929,
-            Self::mul_add(-x219, x929, Self::mul_add(-x221, x927, x223 * x923)),
+            S::mul_add(S::neg(x219), x929, S::mul_add(S::neg(x221), x927, x223 * x923)),
         );
-        let x1412 = Self::mul_add(
-            -x214,
+        let x1412 = S::mul_add(
+            S::neg(x214),
             x933,
-            Self::mul_add(x215, x931, Self::mul_add(-x216, x929, x1411)),
+            S::mul_add(x215, x931, S::mul_add(S::neg(x216), x929, x1411)),
         );
-        let x1413 = -x1412;
-        let x1414 = Self::mul_add(
+        let x1413 = S::neg(x1412);
+        let x1414 = S::mul_add(
             x217,
             x882,
-            Self::mul_add(-x219, x882, Self::mul_add(-x221, x880, x223 * x876)),
+            S::mul_add(S::neg(x219), x882, S::mul_add(S::neg(x221), x880, x223 * x876)),
         );
-        let x1415 = Self::mul_add(
+        let x1415 = S::mul_add(
             x214,
             x886,
-            Self::mul_add(x215, x884, Self::mul_add(-x216, x882, x1414)),
+            S::mul_add(x215, x884, S::mul_add(S::neg(x216), x882, x1414)),
         );
-        let x1416 = Self::mul_add(
+        let x1416 = S::mul_add(
             x225,
             x1059,
-            Self::mul_add(-x227, x1141, Self::mul_add(-x229, x1192, x231 * x1179)),
+            S::mul_add(
+                S::neg(x227),
+                x1141,
+                S::mul_add(S::neg(x229), x1192, x231 * x1179),
+            ),
         );
-        let x1417 = Self::mul_add(
-            -x136,
+        let x1417 = S::mul_add(
+            S::neg(x136),
             x870,
-            Self::mul_add(x214, x917, Self::mul_add(x224, x973, x1416)),
+            S::mul_add(x214, x917, S::mul_add(x224, x973, x1416)),
         );
-        let x1418 = -x1417;
-        let x1419 = Self::mul_add(
-            -x225,
+        let x1418 = S::neg(x1417);
+        let x1419 = S::mul_add(
+            S::neg(x225),
             x1206,
-            Self::mul_add(x227, x1204, Self::mul_add(x229, x1202, x231 * x1198)),
+            S::mul_add(x227, x1204, S::mul_add(x229, x1202, x231 * x1198)),
         );
-        let x1420 = Self::mul_add(
-            -x136,
+        let x1420 = S::mul_add(
+            S::neg(x136),
             x1212,
-            Self::mul_add(x214, x1210, Self::mul_add(-x224, x1208, x1419)),
+            S::mul_add(x214, x1210, S::mul_add(S::neg(x224), x1208, x1419)),
         );
-        let x1421 = Self::mul_add(
+        let x1421 = S::mul_add(
             x225,
             x1161,
-            Self::mul_add(-x227, x1159, Self::mul_add(-x229, x1157, x231 * x1151)),
+            S::mul_add(
+                S::neg(x227),
+                x1159,
+                S::mul_add(S::neg(x229), x1157, x231 * x1151),
+            ),
         );
-        let x1422 = Self::mul_add(
-            -x136,
+        let x1422 = S::mul_add(
+            S::neg(x136),
             x1167,
-            Self::mul_add(x214, x1165, Self::mul_add(x224, x1163, x1421)),
+            S::mul_add(x214, x1165, S::mul_add(x224, x1163, x1421)),
         );
-        let x1423 = Self::mul_add(
+        let x1423 = S::mul_add(
             x225,
             x1086,
-            Self::mul_add(-x227, x1083, Self::mul_add(-x229, x1081, x231 * x1074)),
+            S::mul_add(
+                S::neg(x227),
+                x1083,
+                S::mul_add(S::neg(x229), x1081, x231 * x1074),
+            ),
         );
-        let x1424 = Self::mul_add(
-            -x136,
+        let x1424 = S::mul_add(
+            S::neg(x136),
             x1092,
-            Self::mul_add(x214, x1090, Self::mul_add(x224, x1088, x1423)),
+            S::mul_add(x214, x1090, S::mul_add(x224, x1088, x1423)),
         );
-        let x1425 = Self::mul_add(
+        let x1425 = S::mul_add(
             x225,
             x1001,
-            Self::mul_add(-x227, x999, Self::mul_add(-x229, x995, x231 * x988)),
+            S::mul_add(S::neg(x227), x999, S::mul_add(S::neg(x229), x995, x231 * x988)),
         );
-        let x1426 = Self::mul_add(
-            -x136,
+        let x1426 = S::mul_add(
+            S::neg(x136),
             x1010,
-            Self::mul_add(x214, x1007, Self::mul_add(-x224, x1004, x1425)),
+            S::mul_add(x214, x1007, S::mul_add(S::neg(x224), x1004, x1425)),
         );
-        let x1427 = -x1426;
-        let x1428 = Self::mul_add(
+        let x1427 = S::neg(x1426);
+        let x1428 = S::mul_add(
             x225,
             x929,
-            Self::mul_add(-x227, x929, Self::mul_add(-x229, x927, x231 * x923)),
+            S::mul_add(S::neg(x227), x929, S::mul_add(S::neg(x229), x927, x231 * x923)),
         );
-        let x1429 = Self::mul_add(
-            -x136,
+        let x1429 = S::mul_add(
+            S::neg(x136),
             x933,
-            Self::mul_add(x214, x931, Self::mul_add(-x224, x929, x1428)),
+            S::mul_add(x214, x931, S::mul_add(S::neg(x224), x929, x1428)),
         );
-        let x1430 = -x1429;
-        let x1431 = Self::mul_add(
+        let x1430 = S::neg(x1429);
+        let x1431 = S::mul_add(
             x225,
             x882,
-            Self::mul_add(-x227, x882, Self::mul_add(-x229, x880, x231 * x876)),
+            S::mul_add(S::neg(x227), x882, S::mul_add(S::neg(x229), x880, x231 * x876)),
         );
-        let x1432 = Self::mul_add(
+        let x1432 = S::mul_add(
             x136,
             x886,
-            Self::mul_add(x214, x884, Self::mul_add(-x224, x882, x1431)),
+            S::mul_add(x214, x884, S::mul_add(S::neg(x224), x882, x1431)),
         );
         (
             [
-                [0.0, x1214, x1216, x1218, x1221, x1224, x1226],
-                [0.0, x1228, x1230, x1232, x1235, x1238, x1240],
-                [0.0, x1242, x1244, x1246, x1249, x1252, x1254],
-                [0.0, x1257, x1260, x1263, x1265, x1267, x1270],
-                [0.0, x1272, x1274, x1276, x1279, x1282, x1284],
-                [0.0, x1286, x1288, x1290, x1293, x1296, x1298],
-                [0.0, x1300, x1302, x1304, x1307, x1310, x1312],
+                [S::splat(0.0), x1214, x1216, x1218, x1221, x1224, x1226],
+                [S::splat(0.0), x1228, x1230, x1232, x1235, x1238, x1240],
+                [S::splat(0.0), x1242, x1244, x1246, x1249, x1252, x1254],
+                [S::splat(0.0), x1257, x1260, x1263, x1265, x1267, x1270],
+                [S::splat(0.0), x1272, x1274, x1276, x1279, x1282, x1284],
+                [S::splat(0.0), x1286, x1288, x1290, x1293, x1296, x1298],
+                [S::splat(0.0), x1300, x1302, x1304, x1307, x1310, x1312],
             ],
             [
                 [x1315, x1317, x1319, x1321, x1324, x1327, x1329],
@@ -7494,6 +8680,50 @@ impl Ssrms {
             ],
         )
     }
+    /// [`Self::forward_dynamics_derivatives`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_derivatives_lanes`]: `out[k]` is `forward_dynamics_derivatives` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_derivatives_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [(
+            [[::core::primitive::f64; 7]; 7],
+            [[::core::primitive::f64; 7]; 7],
+            [[::core::primitive::f64; 7]; 7],
+        )],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_derivatives_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
+    }
     /// The inverse of the joint-space inertia matrix, `M(q)⁻¹` (symmetric, both triangles written), from the LDLᵀ factors of `M`.
     ///
     /// : 309 mul, 240 add, 7 div, 0 sqrt, 5 sincos (emitted), of which 201 fused where the target has FMA.
@@ -7501,130 +8731,146 @@ impl Ssrms {
     pub fn mass_matrix_inverse(
         q: &[::core::primitive::f64; 7],
     ) -> [[::core::primitive::f64; 7]; 7] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::mass_matrix_inverse_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix_inverse`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_inverse_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7]) -> [[S; 7]; 7] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
             q[5],
         ]);
-        let x5 = s_q5 * s_q5 * 35.074;
-        let x6 = -35.074 + x5;
-        let x7 = s_q5 * c_q5 * 35.074;
-        let x8 = 179.8829695416 - x5;
-        let x9 = x6 - -129.6173695416;
+        let x5 = s_q5 * s_q5 * S::splat(35.074);
+        let x6 = S::splat(-35.074) + x5;
+        let x7 = s_q5 * c_q5 * S::splat(35.074);
+        let x8 = S::splat(179.8829695416) - x5;
+        let x9 = x6 - S::splat(-129.6173695416);
         let x10 = s_q4 * s_q4 * x9;
         let x11 = x6 - x10;
-        let x12 = Self::mul_add(97.44448770720001, s_q4, c_q4 * x7);
-        let x13 = Self::mul_add(-97.44448770720001, c_q4, s_q4 * x7);
-        let x14 = 171.195516 * s_q4;
-        let x15 = 171.195516 * c_q4;
-        let x16 = 7.11 * x14;
-        let x17 = Self::mul_add(-7.11, x15, s_q4 * c_q4 * x9);
+        let x12 = S::mul_add(S::splat(97.44448770720001), s_q4, c_q4 * x7);
+        let x13 = S::mul_add(S::splat(-97.44448770720001), c_q4, s_q4 * x7);
+        let x14 = S::splat(171.195516) * s_q4;
+        let x15 = S::splat(171.195516) * c_q4;
+        let x16 = S::splat(7.11) * x14;
+        let x17 = S::mul_add(S::splat(-7.11), x15, s_q4 * c_q4 * x9);
         let x18 = x8 - x16;
-        let x19 = 3239.4582 - x14;
-        let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
-        let x22 = 24998.827802 - (x16 - x18);
+        let x19 = S::splat(3239.4582) - x14;
+        let x20 = S::splat(1375.0472756800002) - x12;
+        let x21 = S::splat(24989.305802)
+            - (x16 - (S::splat(-129.6173695416) + x10 - x16));
+        let x22 = S::splat(24998.827802) - (x16 - x18);
         let x23 = s_q3 * s_q3;
         let x24 = s_q3 * c_q3;
         let x25 = x11 - x21;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x27 = S::mul_add(x24, x26, x23 * x25);
         let x28 = x11 - x27;
         let x29 = s_q3 * x13;
         let x30 = c_q3 * x13;
         let x31 = s_q3 * x15;
-        let x32 = Self::mul_add(c_q3, x19, -x31);
+        let x32 = S::mul_add(c_q3, x19, S::neg(x31));
         let x33 = c_q3 * x15;
-        let x34 = Self::mul_add(s_q3, x19, x33);
-        let x35 = 7.11 * x32;
-        let x36 = Self::mul_add(x32, 0.475, Self::mul_add(c_q3, x20, x29));
-        let x37 = Self::mul_add(-7.11, x34, x17 + Self::mul_add(-x23, x26, x24 * x25));
-        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(s_q3, x20, -x30));
+        let x34 = S::mul_add(s_q3, x19, x33);
+        let x35 = S::splat(7.11) * x32;
+        let x36 = S::mul_add(x32, S::splat(0.475), S::mul_add(c_q3, x20, x29));
+        let x37 = S::mul_add(
+            S::splat(-7.11),
+            x34,
+            x17 + S::mul_add(S::neg(x23), x26, x24 * x25),
+        );
+        let x38 = S::mul_add(x34, S::splat(0.475), S::mul_add(s_q3, x20, S::neg(x30)));
         let x39 = x22 + x35;
-        let x40 = 5224.5702 + x32;
-        let x41 = 3946.18812068 + x36;
-        let x42 = 39234.474122 + (x35 + (x21 + x27 + x35));
-        let x43 = 39241.404122 + (x35 + x39);
+        let x40 = S::splat(5224.5702) + x32;
+        let x41 = S::splat(3946.18812068) + x36;
+        let x42 = S::splat(39234.474122) + (x35 + (x21 + x27 + x35));
+        let x43 = S::splat(39241.404122) + (x35 + x39);
         let x44 = s_q2 * s_q2;
         let x45 = s_q2 * c_q2;
         let x46 = x28 - x42;
         let x47 = x37 + x37;
-        let x48 = Self::mul_add(x45, x47, x44 * x46);
+        let x48 = S::mul_add(x45, x47, x44 * x46);
         let x49 = x28 - x48;
         let x50 = s_q2 * x38;
         let x51 = c_q2 * x38;
         let x52 = s_q2 * x34;
-        let x53 = Self::mul_add(c_q2, x40, -x52);
+        let x53 = S::mul_add(c_q2, x40, S::neg(x52));
         let x54 = c_q2 * x34;
-        let x55 = Self::mul_add(s_q2, x40, x54);
-        let x56 = Self::mul_add(0.5692, x53, Self::mul_add(c_q2, x41, -x50));
-        let x57 = Self::mul_add(0.5692, x55, Self::mul_add(s_q2, x41, x51));
-        let x58 = 0.7026 * x55;
-        let x59 = Self::mul_add(
-            0.7026,
-            Self::mul_add(1145.5438279999998, s_q1, c_q1 * x53),
-            Self::mul_add(-s_q1, x57, c_q1 * (x37 + Self::mul_add(-x44, x47, x45 * x46))),
+        let x55 = S::mul_add(s_q2, x40, x54);
+        let x56 = S::mul_add(S::splat(0.5692), x53, S::mul_add(c_q2, x41, S::neg(x50)));
+        let x57 = S::mul_add(S::splat(0.5692), x55, S::mul_add(s_q2, x41, x51));
+        let x58 = S::splat(0.7026) * x55;
+        let x59 = S::mul_add(
+            S::splat(0.7026),
+            S::mul_add(S::splat(1145.5438279999998), s_q1, c_q1 * x53),
+            S::mul_add(
+                S::neg(s_q1),
+                x57,
+                c_q1 * (x37 + S::mul_add(S::neg(x44), x47, x45 * x46)),
+            ),
         );
-        let x60 = Self::mul_add(
-            0.7026,
+        let x60 = S::mul_add(
+            S::splat(0.7026),
             s_q1 * x55,
-            Self::mul_add(-s_q1, x43, c_q1 * x56),
+            S::mul_add(S::neg(s_q1), x43, c_q1 * x56),
         );
-        let x61 = Self::mul_add(s_q2, x32, x54);
-        let x62 = Self::mul_add(
+        let x61 = S::mul_add(s_q2, x32, x54);
+        let x62 = S::mul_add(
             s_q1,
             x39,
             c_q1
-                * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-c_q2, x32, x52),
-                    Self::mul_add(-c_q2, x36, x50),
+                * S::mul_add(
+                    S::splat(0.5692),
+                    S::mul_add(S::neg(c_q2), x32, x52),
+                    S::mul_add(S::neg(c_q2), x36, x50),
                 ),
         );
-        let x63 = Self::mul_add(-0.7026, s_q1 * x61, x62);
-        let x64 = Self::mul_add(-s_q3, x14, x33);
-        let x65 = Self::mul_add(c_q3, x14, x31);
-        let x66 = Self::mul_add(-0.475, x65, Self::mul_add(-c_q3, x12, x29));
-        let x67 = Self::mul_add(-0.475, x64, Self::mul_add(s_q3, x12, x30));
-        let x68 = Self::mul_add(-7.11, x65, x18);
-        let x69 = Self::mul_add(-s_q2, x65, c_q2 * x64);
-        let x70 = Self::mul_add(
-            -s_q1,
+        let x63 = S::mul_add(S::splat(-0.7026), s_q1 * x61, x62);
+        let x64 = S::mul_add(S::neg(s_q3), x14, x33);
+        let x65 = S::mul_add(c_q3, x14, x31);
+        let x66 = S::mul_add(S::splat(-0.475), x65, S::mul_add(S::neg(c_q3), x12, x29));
+        let x67 = S::mul_add(S::splat(-0.475), x64, S::mul_add(s_q3, x12, x30));
+        let x68 = S::mul_add(S::splat(-7.11), x65, x18);
+        let x69 = S::mul_add(S::neg(s_q2), x65, c_q2 * x64);
+        let x70 = S::mul_add(
+            S::neg(s_q1),
             x68,
             c_q1
-                * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x65, s_q2 * x64),
-                    Self::mul_add(s_q2, x67, c_q2 * x66),
+                * S::mul_add(
+                    S::splat(-0.5692),
+                    S::mul_add(c_q2, x65, s_q2 * x64),
+                    S::mul_add(s_q2, x67, c_q2 * x66),
                 ),
         );
-        let x71 = Self::mul_add(0.7026, s_q1 * x69, x70);
-        let x72 = 47.471 * s_q4;
-        let x73 = 47.471 * c_q4;
-        let x74 = Self::mul_add(s_q3, x73, c_q3 * x72);
-        let x75 = Self::mul_add(-c_q3, x73, s_q3 * x72);
-        let x76 = c_q1 * Self::mul_add(-s_q2, x75, c_q2 * x74);
-        let x77 = 9.336 * c_q5;
-        let x78 = 9.336 * s_q5;
+        let x71 = S::mul_add(S::splat(0.7026), s_q1 * x69, x70);
+        let x72 = S::splat(47.471) * s_q4;
+        let x73 = S::splat(47.471) * c_q4;
+        let x74 = S::mul_add(s_q3, x73, c_q3 * x72);
+        let x75 = S::mul_add(S::neg(c_q3), x73, s_q3 * x72);
+        let x76 = c_q1 * S::mul_add(S::neg(s_q2), x75, c_q2 * x74);
+        let x77 = S::splat(9.336) * c_q5;
+        let x78 = S::splat(9.336) * s_q5;
         let x79 = c_q4 * x77;
         let x80 = s_q4 * x77;
-        let x81 = Self::mul_add(-s_q3, x80, c_q3 * x79);
-        let x82 = Self::mul_add(c_q3, x80, s_q3 * x79);
-        let x83 = Self::mul_add(
-            -s_q1,
+        let x81 = S::mul_add(S::neg(s_q3), x80, c_q3 * x79);
+        let x82 = S::mul_add(c_q3, x80, s_q3 * x79);
+        let x83 = S::mul_add(
+            S::neg(s_q1),
             x78,
-            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x81),
+            c_q1 * S::mul_add(S::neg(s_q2), x82, c_q2 * x81),
         );
-        let x84 = 1.0
-            / (2232.9683597151998
+        let x84 = S::splat(1.0)
+            / (S::splat(2232.9683597151998)
                 - (x58
                     - (x49
-                        - Self::mul_add(
+                        - S::mul_add(
                             s_q1 * c_q1,
                             x56 + x56,
-                            s_q1 * s_q1 * (x49 - (-1647.2196721184 + x43)),
+                            s_q1 * s_q1 * (x49 - (S::splat(-1647.2196721184) + x43)),
                         ) - x58)));
         let x85 = x59 * x84;
         let x86 = x60 * x84;
@@ -7632,223 +8878,230 @@ impl Ssrms {
         let x88 = x71 * x84;
         let x89 = x76 * x84;
         let x90 = x83 * x84;
-        let x91 = 1.0 / Self::mul_add(-x59, x85, 1650.6386721183999 + (x42 + x48));
-        let x92 = Self::mul_add(-x59, x86, x57);
+        let x91 = S::splat(1.0)
+            / S::mul_add(S::neg(x59), x85, S::splat(1650.6386721183999) + (x42 + x48));
+        let x92 = S::mul_add(S::neg(x59), x86, x57);
         let x93 = x91 * x92;
-        let x94 = Self::mul_add(
+        let x94 = S::mul_add(
             x59,
             x87,
-            Self::mul_add(0.5692, x61, Self::mul_add(s_q2, x36, x51)),
+            S::mul_add(S::splat(0.5692), x61, S::mul_add(s_q2, x36, x51)),
         );
         let x95 = x91 * x94;
-        let x96 = Self::mul_add(
-            -x59,
+        let x96 = S::mul_add(
+            S::neg(x59),
             x88,
-            Self::mul_add(0.5692, x69, Self::mul_add(-c_q2, x67, s_q2 * x66)),
+            S::mul_add(S::splat(0.5692), x69, S::mul_add(S::neg(c_q2), x67, s_q2 * x66)),
         );
         let x97 = x91 * x96;
-        let x98 = Self::mul_add(-x59, x89, Self::mul_add(c_q2, x75, s_q2 * x74));
+        let x98 = S::mul_add(S::neg(x59), x89, S::mul_add(c_q2, x75, s_q2 * x74));
         let x99 = x91 * x98;
-        let x100 = Self::mul_add(-x59, x90, Self::mul_add(c_q2, x82, s_q2 * x81));
+        let x100 = S::mul_add(S::neg(x59), x90, S::mul_add(c_q2, x82, s_q2 * x81));
         let x101 = x91 * x100;
-        let x102 = 1.0 / Self::mul_add(-x92, x93, Self::mul_add(-x60, x86, x43));
-        let x103 = Self::mul_add(-x92, x95, Self::mul_add(x60, x87, x39));
+        let x102 = S::splat(1.0)
+            / S::mul_add(S::neg(x92), x93, S::mul_add(S::neg(x60), x86, x43));
+        let x103 = S::mul_add(S::neg(x92), x95, S::mul_add(x60, x87, x39));
         let x104 = x102 * x103;
-        let x105 = Self::mul_add(-x92, x97, Self::mul_add(-x60, x88, x68));
+        let x105 = S::mul_add(S::neg(x92), x97, S::mul_add(S::neg(x60), x88, x68));
         let x106 = x102 * x105;
-        let x107 = Self::mul_add(x92, x99, x60 * x89);
+        let x107 = S::mul_add(x92, x99, x60 * x89);
         let x108 = x102 * x107;
-        let x109 = Self::mul_add(-x92, x101, Self::mul_add(-x60, x90, x78));
+        let x109 = S::mul_add(S::neg(x92), x101, S::mul_add(S::neg(x60), x90, x78));
         let x110 = x102 * x109;
-        let x111 = Self::mul_add(
-            -x103,
+        let x111 = S::mul_add(
+            S::neg(x103),
             x104,
-            Self::mul_add(-x94, x95, Self::mul_add(-x63, x87, x22)),
+            S::mul_add(S::neg(x94), x95, S::mul_add(S::neg(x63), x87, x22)),
         );
-        let x112 = 1.0 / x111;
-        let x113 = Self::mul_add(
-            -x103,
+        let x112 = S::splat(1.0) / x111;
+        let x113 = S::mul_add(
+            S::neg(x103),
             x106,
-            Self::mul_add(-x94, x97, Self::mul_add(x63, x88, x18)),
+            S::mul_add(S::neg(x94), x97, S::mul_add(x63, x88, x18)),
         );
         let x114 = x112 * x113;
-        let x115 = Self::mul_add(x103, x108, Self::mul_add(-x94, x99, x63 * x89));
+        let x115 = S::mul_add(x103, x108, S::mul_add(S::neg(x94), x99, x63 * x89));
         let x116 = x112 * x115;
-        let x117 = Self::mul_add(
-            -x103,
+        let x117 = S::mul_add(
+            S::neg(x103),
             x110,
-            Self::mul_add(-x94, x101, Self::mul_add(x63, x90, x78)),
+            S::mul_add(S::neg(x94), x101, S::mul_add(x63, x90, x78)),
         );
         let x118 = x112 * x117;
-        let x119 = Self::mul_add(
-            -x105,
+        let x119 = S::mul_add(
+            S::neg(x105),
             x106,
-            Self::mul_add(-x96, x97, Self::mul_add(-x71, x88, x8)),
+            S::mul_add(S::neg(x96), x97, S::mul_add(S::neg(x71), x88, x8)),
         );
-        let x120 = 1.0 / Self::mul_add(-x113, x114, x119);
-        let x121 = Self::mul_add(
+        let x120 = S::splat(1.0) / S::mul_add(S::neg(x113), x114, x119);
+        let x121 = S::mul_add(
             x113,
             x116,
-            Self::mul_add(-x105, x108, Self::mul_add(x96, x99, x71 * x89)),
+            S::mul_add(S::neg(x105), x108, S::mul_add(x96, x99, x71 * x89)),
         );
         let x122 = x120 * x121;
-        let x123 = Self::mul_add(
-            -x105,
+        let x123 = S::mul_add(
+            S::neg(x105),
             x110,
-            Self::mul_add(-x96, x101, Self::mul_add(-x71, x90, x78)),
+            S::mul_add(S::neg(x96), x101, S::mul_add(S::neg(x71), x90, x78)),
         );
-        let x124 = Self::mul_add(-x113, x118, x123);
+        let x124 = S::mul_add(S::neg(x113), x118, x123);
         let x125 = x120 * x124;
-        let x126 = Self::mul_add(
-            -x107,
+        let x126 = S::mul_add(
+            S::neg(x107),
             x108,
-            Self::mul_add(-x98, x99, Self::mul_add(-x76, x89, 47.471)),
+            S::mul_add(S::neg(x98), x99, S::mul_add(S::neg(x76), x89, S::splat(47.471))),
         );
-        let x127 = 1.0 / Self::mul_add(-x121, x122, Self::mul_add(-x115, x116, x126));
-        let x128 = Self::mul_add(
+        let x127 = S::splat(1.0)
+            / S::mul_add(S::neg(x121), x122, S::mul_add(S::neg(x115), x116, x126));
+        let x128 = S::mul_add(
             x115,
             x118,
-            Self::mul_add(-x107, x110, Self::mul_add(x98, x101, x76 * x90)),
+            S::mul_add(S::neg(x107), x110, S::mul_add(x98, x101, x76 * x90)),
         );
-        let x129 = Self::mul_add(-x121, x125, x128);
+        let x129 = S::mul_add(S::neg(x121), x125, x128);
         let x130 = x127 * x129;
-        let x131 = Self::mul_add(
-            -x109,
+        let x131 = S::mul_add(
+            S::neg(x109),
             x110,
-            Self::mul_add(-x100, x101, Self::mul_add(-x83, x90, 9.336)),
+            S::mul_add(S::neg(x100), x101, S::mul_add(S::neg(x83), x90, S::splat(9.336))),
         );
-        let x132 = Self::mul_add(
-            -x129,
+        let x132 = S::mul_add(
+            S::neg(x129),
             x130,
-            Self::mul_add(-x124, x125, Self::mul_add(-x117, x118, x131)),
+            S::mul_add(S::neg(x124), x125, S::mul_add(S::neg(x117), x118, x131)),
         );
-        let x133 = 1.0 / x132;
-        let x134 = Self::mul_add(-x85, x93, x86);
-        let x135 = Self::mul_add(x104, x134, Self::mul_add(x85, x95, x87));
-        let x136 = Self::mul_add(
+        let x133 = S::splat(1.0) / x132;
+        let x134 = S::mul_add(S::neg(x85), x93, x86);
+        let x135 = S::mul_add(x104, x134, S::mul_add(x85, x95, x87));
+        let x136 = S::mul_add(
             x114,
             x135,
-            Self::mul_add(-x106, x134, Self::mul_add(-x85, x97, x88)),
+            S::mul_add(S::neg(x106), x134, S::mul_add(S::neg(x85), x97, x88)),
         );
-        let x137 = Self::mul_add(
+        let x137 = S::mul_add(
             x116,
             x135,
-            Self::mul_add(x108, x134, Self::mul_add(-x85, x99, x89)),
+            S::mul_add(x108, x134, S::mul_add(S::neg(x85), x99, x89)),
         );
-        let x138 = Self::mul_add(x122, x136, x137);
-        let x139 = Self::mul_add(
+        let x138 = S::mul_add(x122, x136, x137);
+        let x139 = S::mul_add(
             x118,
             x135,
-            Self::mul_add(-x110, x134, Self::mul_add(-x85, x101, x90)),
+            S::mul_add(S::neg(x110), x134, S::mul_add(S::neg(x85), x101, x90)),
         );
-        let x140 = x133 * Self::mul_add(x130, x138, Self::mul_add(-x125, x136, x139));
-        let x141 = -x140;
-        let x142 = Self::mul_add(x130, x140, x127 * x138);
-        let x143 = -x142;
-        let x144 = Self::mul_add(-x125, x140, Self::mul_add(x122, x142, x120 * x136));
-        let x145 = -x144;
-        let x146 = Self::mul_add(
+        let x140 = x133 * S::mul_add(x130, x138, S::mul_add(S::neg(x125), x136, x139));
+        let x141 = S::neg(x140);
+        let x142 = S::mul_add(x130, x140, x127 * x138);
+        let x143 = S::neg(x142);
+        let x144 = S::mul_add(S::neg(x125), x140, S::mul_add(x122, x142, x120 * x136));
+        let x145 = S::neg(x144);
+        let x146 = S::mul_add(
             x118,
             x140,
-            Self::mul_add(x116, x142, Self::mul_add(x114, x144, x112 * x135)),
+            S::mul_add(x116, x142, S::mul_add(x114, x144, x112 * x135)),
         );
-        let x147 = Self::mul_add(
+        let x147 = S::mul_add(
             x108,
             x142,
-            Self::mul_add(-x106, x144, Self::mul_add(x104, x146, x102 * x134)),
+            S::mul_add(S::neg(x106), x144, S::mul_add(x104, x146, x102 * x134)),
         );
-        let x148 = Self::mul_add(-x110, x140, x147);
-        let x149 = -x148;
-        let x150 = Self::mul_add(
-            -x97,
+        let x148 = S::mul_add(S::neg(x110), x140, x147);
+        let x149 = S::neg(x148);
+        let x150 = S::mul_add(
+            S::neg(x97),
             x144,
-            Self::mul_add(x95, x146, Self::mul_add(-x93, x148, x85 * x91)),
+            S::mul_add(x95, x146, S::mul_add(S::neg(x93), x148, x85 * x91)),
         );
-        let x151 = Self::mul_add(-x101, x140, Self::mul_add(-x99, x142, x150));
-        let x152 = Self::mul_add(
+        let x151 = S::mul_add(S::neg(x101), x140, S::mul_add(S::neg(x99), x142, x150));
+        let x152 = S::mul_add(
             x87,
             x146,
-            Self::mul_add(x86, x148, Self::mul_add(x85, x151, x84)),
+            S::mul_add(x86, x148, S::mul_add(x85, x151, x84)),
         );
-        let x153 = Self::mul_add(
+        let x153 = S::mul_add(
             x90,
             x140,
-            Self::mul_add(x89, x142, Self::mul_add(x88, x144, x152)),
+            S::mul_add(x89, x142, S::mul_add(x88, x144, x152)),
         );
-        let x154 = Self::mul_add(-x93, x104, x95);
-        let x155 = Self::mul_add(-x114, x154, Self::mul_add(-x93, x106, x97));
-        let x156 = Self::mul_add(
+        let x154 = S::mul_add(S::neg(x93), x104, x95);
+        let x155 = S::mul_add(S::neg(x114), x154, S::mul_add(S::neg(x93), x106, x97));
+        let x156 = S::mul_add(
             x122,
             x155,
-            Self::mul_add(-x116, x154, Self::mul_add(x93, x108, x99)),
+            S::mul_add(S::neg(x116), x154, S::mul_add(x93, x108, x99)),
         );
-        let x157 = Self::mul_add(
-            -x125,
+        let x157 = S::mul_add(
+            S::neg(x125),
             x155,
-            Self::mul_add(-x118, x154, Self::mul_add(-x93, x110, x101)),
+            S::mul_add(S::neg(x118), x154, S::mul_add(S::neg(x93), x110, x101)),
         );
-        let x158 = x133 * Self::mul_add(x130, x156, x157);
-        let x159 = Self::mul_add(x130, x158, x127 * x156);
-        let x160 = Self::mul_add(-x125, x158, Self::mul_add(x122, x159, x120 * x155));
-        let x161 = Self::mul_add(
-            -x118,
+        let x158 = x133 * S::mul_add(x130, x156, x157);
+        let x159 = S::mul_add(x130, x158, x127 * x156);
+        let x160 = S::mul_add(S::neg(x125), x158, S::mul_add(x122, x159, x120 * x155));
+        let x161 = S::mul_add(
+            S::neg(x118),
             x158,
-            Self::mul_add(-x116, x159, Self::mul_add(-x114, x160, x112 * x154)),
+            S::mul_add(S::neg(x116), x159, S::mul_add(S::neg(x114), x160, x112 * x154)),
         );
-        let x162 = Self::mul_add(
+        let x162 = S::mul_add(
             x108,
             x159,
-            Self::mul_add(-x106, x160, Self::mul_add(-x104, x161, x93 * x102)),
+            S::mul_add(S::neg(x106), x160, S::mul_add(S::neg(x104), x161, x93 * x102)),
         );
-        let x163 = Self::mul_add(-x110, x158, x162);
-        let x164 = Self::mul_add(
+        let x163 = S::mul_add(S::neg(x110), x158, x162);
+        let x164 = S::mul_add(
             x97,
             x160,
-            Self::mul_add(x95, x161, Self::mul_add(x93, x163, x91)),
+            S::mul_add(x95, x161, S::mul_add(x93, x163, x91)),
         );
-        let x165 = Self::mul_add(x101, x158, Self::mul_add(x99, x159, x164));
-        let x166 = Self::mul_add(-x104, x114, x106);
-        let x167 = Self::mul_add(-x122, x166, Self::mul_add(x104, x116, x108));
-        let x168 = Self::mul_add(
-            -x130,
+        let x165 = S::mul_add(x101, x158, S::mul_add(x99, x159, x164));
+        let x166 = S::mul_add(S::neg(x104), x114, x106);
+        let x167 = S::mul_add(S::neg(x122), x166, S::mul_add(x104, x116, x108));
+        let x168 = S::mul_add(
+            S::neg(x130),
             x167,
-            Self::mul_add(-x125, x166, Self::mul_add(-x104, x118, x110)),
+            S::mul_add(S::neg(x125), x166, S::mul_add(S::neg(x104), x118, x110)),
         );
         let x169 = x133 * x168;
-        let x170 = -x169;
-        let x171 = Self::mul_add(-x130, x169, x127 * x167);
-        let x172 = Self::mul_add(-x125, x169, Self::mul_add(-x122, x171, x120 * x166));
-        let x173 = -x172;
-        let x174 = Self::mul_add(
-            -x118,
+        let x170 = S::neg(x169);
+        let x171 = S::mul_add(S::neg(x130), x169, x127 * x167);
+        let x172 = S::mul_add(
+            S::neg(x125),
             x169,
-            Self::mul_add(x116, x171, Self::mul_add(-x114, x172, x104 * x112)),
+            S::mul_add(S::neg(x122), x171, x120 * x166),
         );
-        let x175 = -x174;
-        let x176 = Self::mul_add(
+        let x173 = S::neg(x172);
+        let x174 = S::mul_add(
+            S::neg(x118),
+            x169,
+            S::mul_add(x116, x171, S::mul_add(S::neg(x114), x172, x104 * x112)),
+        );
+        let x175 = S::neg(x174);
+        let x176 = S::mul_add(
             x108,
             x171,
-            Self::mul_add(x106, x172, Self::mul_add(x104, x174, x102)),
+            S::mul_add(x106, x172, S::mul_add(x104, x174, x102)),
         );
-        let x177 = Self::mul_add(x110, x169, x176);
-        let x178 = Self::mul_add(x114, x122, x116);
-        let x179 = x133 * Self::mul_add(x130, x178, Self::mul_add(-x114, x125, x118));
-        let x180 = -x179;
-        let x181 = Self::mul_add(x130, x179, x127 * x178);
-        let x182 = -x181;
-        let x183 = Self::mul_add(-x125, x179, Self::mul_add(x122, x181, x114 * x120));
-        let x184 = -x183;
-        let x185 = Self::mul_add(
+        let x177 = S::mul_add(x110, x169, x176);
+        let x178 = S::mul_add(x114, x122, x116);
+        let x179 = x133 * S::mul_add(x130, x178, S::mul_add(S::neg(x114), x125, x118));
+        let x180 = S::neg(x179);
+        let x181 = S::mul_add(x130, x179, x127 * x178);
+        let x182 = S::neg(x181);
+        let x183 = S::mul_add(S::neg(x125), x179, S::mul_add(x122, x181, x114 * x120));
+        let x184 = S::neg(x183);
+        let x185 = S::mul_add(
             x118,
             x179,
-            Self::mul_add(x116, x181, Self::mul_add(x114, x183, x112)),
+            S::mul_add(x116, x181, S::mul_add(x114, x183, x112)),
         );
-        let x186 = x133 * Self::mul_add(-x122, x130, x125);
-        let x187 = -x186;
-        let x188 = Self::mul_add(-x130, x186, x122 * x127);
-        let x189 = Self::mul_add(x125, x186, Self::mul_add(x122, x188, x120));
+        let x186 = x133 * S::mul_add(S::neg(x122), x130, x125);
+        let x187 = S::neg(x186);
+        let x188 = S::mul_add(S::neg(x130), x186, x122 * x127);
+        let x189 = S::mul_add(x125, x186, S::mul_add(x122, x188, x120));
         let x190 = x130 * x133;
-        let x191 = Self::mul_add(x130, x190, x127);
+        let x191 = S::mul_add(x130, x190, x127);
         [
             [x153, x151, x149, x146, x145, x143, x141],
             [x151, x165, x163, x161, x160, x159, x158],
@@ -7859,16 +9112,30 @@ impl Ssrms {
             [x141, x158, x170, x180, x187, x190, x133],
         ]
     }
-    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
-    #[inline(always)]
-    fn mul_add(
-        a: ::core::primitive::f64,
-        b: ::core::primitive::f64,
-        c: ::core::primitive::f64,
-    ) -> ::core::primitive::f64 {
-        kanegen_runtime::fma::mul_add(a, b, c)
+    /// [`Self::mass_matrix_inverse`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_inverse_lanes`]: `out[k]` is `mass_matrix_inverse` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_inverse_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[[::core::primitive::f64; 7]], out: &mut [[[::core::primitive::f64; 7]; 7]]) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_inverse_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -9,9 +9,10 @@
 //! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 691 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 190), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
+//! Fused multiply-adds where the target has them: 691 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 190), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 395 emitted operations in M + c, within the 4000 limit). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -1165,99 +1166,151 @@ impl Ssrms6 {
     pub fn mass_matrix(
         q: &[::core::primitive::f64; 6],
     ) -> [[::core::primitive::f64; 6]; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4)] = Self::sincos_n([
+        Self::mass_matrix_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 6],
+    ) -> [[S; 6]; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
         ]);
-        let x4 = s_q4 * s_q4 * 35.074;
-        let x5 = -35.074 + x4;
-        let x6 = s_q4 * c_q4 * 35.074;
-        let x7 = 179.8829695416 - x4;
-        let x8 = x5 - -129.6173695416;
+        let x4 = s_q4 * s_q4 * S::splat(35.074);
+        let x5 = S::splat(-35.074) + x4;
+        let x6 = s_q4 * c_q4 * S::splat(35.074);
+        let x7 = S::splat(179.8829695416) - x4;
+        let x8 = x5 - S::splat(-129.6173695416);
         let x9 = s_q3 * s_q3 * x8;
         let x10 = x5 - x9;
-        let x11 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x6);
-        let x12 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x6);
-        let x13 = 171.195516 * s_q3;
-        let x14 = 171.195516 * c_q3;
-        let x15 = 7.11 * x13;
-        let x16 = Self::mul_add(-7.11, x14, s_q3 * c_q3 * x8);
+        let x11 = S::mul_add(S::splat(97.44448770720001), s_q3, c_q3 * x6);
+        let x12 = S::mul_add(S::splat(-97.44448770720001), c_q3, s_q3 * x6);
+        let x13 = S::splat(171.195516) * s_q3;
+        let x14 = S::splat(171.195516) * c_q3;
+        let x15 = S::splat(7.11) * x13;
+        let x16 = S::mul_add(S::splat(-7.11), x14, s_q3 * c_q3 * x8);
         let x17 = x7 - x15;
-        let x18 = 3239.4582 - x13;
-        let x19 = 1375.0472756800002 - x11;
-        let x20 = 24989.305802 - (x15 - (-129.6173695416 + x9 - x15));
-        let x21 = 24998.827802 - (x15 - x17);
+        let x18 = S::splat(3239.4582) - x13;
+        let x19 = S::splat(1375.0472756800002) - x11;
+        let x20 = S::splat(24989.305802)
+            - (x15 - (S::splat(-129.6173695416) + x9 - x15));
+        let x21 = S::splat(24998.827802) - (x15 - x17);
         let x22 = s_q2 * s_q2;
         let x23 = s_q2 * c_q2;
         let x24 = x10 - x20;
         let x25 = x16 + x16;
-        let x26 = Self::mul_add(x23, x25, x22 * x24);
+        let x26 = S::mul_add(x23, x25, x22 * x24);
         let x27 = s_q2 * x12;
         let x28 = c_q2 * x12;
         let x29 = s_q2 * x14;
-        let x30 = Self::mul_add(c_q2, x18, -x29);
+        let x30 = S::mul_add(c_q2, x18, S::neg(x29));
         let x31 = c_q2 * x14;
-        let x32 = Self::mul_add(s_q2, x18, x31);
-        let x33 = 7.11 * x30;
-        let x34 = Self::mul_add(x30, 0.475, Self::mul_add(c_q2, x19, x27));
-        let x35 = Self::mul_add(-7.11, x32, x16 + Self::mul_add(-x22, x25, x23 * x24));
+        let x32 = S::mul_add(s_q2, x18, x31);
+        let x33 = S::splat(7.11) * x30;
+        let x34 = S::mul_add(x30, S::splat(0.475), S::mul_add(c_q2, x19, x27));
+        let x35 = S::mul_add(
+            S::splat(-7.11),
+            x32,
+            x16 + S::mul_add(S::neg(x22), x25, x23 * x24),
+        );
         let x36 = x21 + x33;
-        let x37 = 39234.474122 + (x33 + (x20 + x26 + x33));
-        let x38 = 39241.404122 + (x33 + x36);
-        let x39 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(s_q2, x19, -x28));
+        let x37 = S::splat(39234.474122) + (x33 + (x20 + x26 + x33));
+        let x38 = S::splat(39241.404122) + (x33 + x36);
+        let x39 = c_q1
+            * S::mul_add(x32, S::splat(0.475), S::mul_add(s_q2, x19, S::neg(x28)));
         let x40 = c_q1 * x32;
-        let x41 = 1650.6386721183999
+        let x41 = S::splat(1650.6386721183999)
             + (x37
-                + Self::mul_add(
-                    s_q1 * c_q1,
-                    x35 + x35,
-                    s_q1 * s_q1 * (x10 - x26 - x37),
-                ));
-        let x42 = -Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, 5224.5702 + x30, x40),
-            Self::mul_add(s_q1, 3946.18812068 + x34, x39),
+                + S::mul_add(s_q1 * c_q1, x35 + x35, s_q1 * s_q1 * (x10 - x26 - x37)));
+        let x42 = S::neg(
+            S::mul_add(
+                S::splat(0.5692),
+                S::mul_add(s_q1, S::splat(5224.5702) + x30, x40),
+                S::mul_add(s_q1, S::splat(3946.18812068) + x34, x39),
+            ),
         );
-        let x43 = -Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, x30, x40),
-            Self::mul_add(s_q1, x34, x39),
+        let x43 = S::neg(
+            S::mul_add(
+                S::splat(0.5692),
+                S::mul_add(s_q1, x30, x40),
+                S::mul_add(s_q1, x34, x39),
+            ),
         );
-        let x44 = Self::mul_add(-s_q2, x13, x31);
-        let x45 = Self::mul_add(c_q2, x13, x29);
-        let x46 = Self::mul_add(-7.11, x45, x17);
-        let x47 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-0.475, x44, Self::mul_add(s_q2, x11, x28)),
-            s_q1 * Self::mul_add(-0.475, x45, Self::mul_add(-c_q2, x11, x27)),
+        let x44 = S::mul_add(S::neg(s_q2), x13, x31);
+        let x45 = S::mul_add(c_q2, x13, x29);
+        let x46 = S::mul_add(S::splat(-7.11), x45, x17);
+        let x47 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(-0.475), x44, S::mul_add(s_q2, x11, x28)),
+            s_q1 * S::mul_add(S::splat(-0.475), x45, S::mul_add(S::neg(c_q2), x11, x27)),
         );
-        let x48 = -Self::mul_add(0.5692, Self::mul_add(-s_q1, x45, c_q1 * x44), x47);
-        let x49 = 47.471 * s_q3;
-        let x50 = 47.471 * c_q3;
-        let x51 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(-c_q2, x50, s_q2 * x49),
-            s_q1 * Self::mul_add(s_q2, x50, c_q2 * x49),
+        let x48 = S::neg(
+            S::mul_add(S::splat(0.5692), S::mul_add(S::neg(s_q1), x45, c_q1 * x44), x47),
         );
-        let x52 = 9.336 * c_q4;
-        let x53 = 9.336 * s_q4;
+        let x49 = S::splat(47.471) * s_q3;
+        let x50 = S::splat(47.471) * c_q3;
+        let x51 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(S::neg(c_q2), x50, s_q2 * x49),
+                s_q1 * S::mul_add(s_q2, x50, c_q2 * x49),
+            ),
+        );
+        let x52 = S::splat(9.336) * c_q4;
+        let x53 = S::splat(9.336) * s_q4;
         let x54 = c_q3 * x52;
         let x55 = s_q3 * x52;
-        let x56 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(c_q2, x55, s_q2 * x54),
-            s_q1 * Self::mul_add(-s_q2, x55, c_q2 * x54),
+        let x56 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(c_q2, x55, s_q2 * x54),
+                s_q1 * S::mul_add(S::neg(s_q2), x55, c_q2 * x54),
+            ),
         );
         [
             [x41, x42, x43, x48, x51, x56],
-            [x42, x38, x36, x46, 0.0, x53],
-            [x43, x36, x21, x17, 0.0, x53],
-            [x48, x46, x17, x7, 0.0, x53],
-            [x51, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x56, x53, x53, x53, 0.0, 9.336],
+            [x42, x38, x36, x46, S::splat(0.0), x53],
+            [x43, x36, x21, x17, S::splat(0.0), x53],
+            [x48, x46, x17, x7, S::splat(0.0), x53],
+            [
+                x51,
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(0.0),
+                S::splat(47.471),
+                S::splat(0.0),
+            ],
+            [x56, x53, x53, x53, S::splat(0.0), S::splat(9.336)],
         ]
+    }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 6]],
+        out: &mut [[[::core::primitive::f64; 6]; 6]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
@@ -1267,7 +1320,14 @@ impl Ssrms6 {
         q: &[::core::primitive::f64; 6],
         qd: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1276,115 +1336,214 @@ impl Ssrms6 {
         ]);
         let x5 = qd[0] * s_q1;
         let x6 = qd[0] * c_q1;
-        let x7 = qd[0] * qd[0] * 0.5692;
+        let x7 = qd[0] * qd[0] * S::splat(0.5692);
         let x8 = qd[1] * x6;
         let x9 = qd[1] * x5;
         let x10 = x6 * x6;
-        let x11 = Self::mul_add(qd[1], qd[1], x10);
+        let x11 = S::mul_add(qd[1], qd[1], x10);
         let x12 = x5 * x6;
-        let x13 = Self::mul_add(3946.18812068, qd[1], x5 * 39234.47412200001);
-        let x14 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x5);
-        let x15 = Self::mul_add(x6, s_q2, x5 * c_q2);
-        let x16 = Self::mul_add(-x6, c_q2, x5 * s_q2);
-        let x17 = 7.11 * x11;
-        let x18 = 7.11 * x12;
+        let x13 = S::mul_add(
+            S::splat(3946.18812068),
+            qd[1],
+            x5 * S::splat(39234.47412200001),
+        );
+        let x14 = S::mul_add(
+            S::splat(-39241.404122),
+            qd[1],
+            S::splat(3946.1881206800003) * x5,
+        );
+        let x15 = S::mul_add(x6, s_q2, x5 * c_q2);
+        let x16 = S::mul_add(S::neg(x6), c_q2, x5 * s_q2);
+        let x17 = S::splat(7.11) * x11;
+        let x18 = S::splat(7.11) * x12;
         let x19 = x7
-            - Self::mul_add(Self::mul_add(x5, x5, x10), -0.475, 7.11 * (x9 + x9));
-        let x20 = Self::mul_add(c_q2, x18, s_q2 * x17);
-        let x21 = Self::mul_add(-qd[2], x16, Self::mul_add(-x9, s_q2, x8 * c_q2));
-        let x22 = Self::mul_add(qd[2], x15, Self::mul_add(x9, c_q2, x8 * s_q2));
+            - S::mul_add(
+                S::mul_add(x5, x5, x10),
+                S::splat(-0.475),
+                S::splat(7.11) * (x9 + x9),
+            );
+        let x20 = S::mul_add(c_q2, x18, s_q2 * x17);
+        let x21 = S::mul_add(
+            S::neg(qd[2]),
+            x16,
+            S::mul_add(S::neg(x9), s_q2, x8 * c_q2),
+        );
+        let x22 = S::mul_add(qd[2], x15, S::mul_add(x9, c_q2, x8 * s_q2));
         let x23 = qd[1] + qd[2];
-        let x24 = Self::mul_add(x16, x16, x23 * x23);
+        let x24 = S::mul_add(x16, x16, x23 * x23);
         let x25 = x15 * x16;
-        let x26 = Self::mul_add(x15, x23, x22);
-        let x27 = Self::mul_add(1375.0472756800002, x23, x15 * 24989.305802);
-        let x28 = Self::mul_add(-24998.827802, x23, 1375.0472756800002 * x15);
-        let x29 = Self::mul_add(-x16, s_q3, x15 * c_q3);
-        let x30 = Self::mul_add(x16, c_q3, x15 * s_q3);
-        let x31 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-7.11, x25, x20),
-            c_q3 * Self::mul_add(7.11, x24, Self::mul_add(-s_q2, x18, c_q2 * x17)),
+        let x26 = S::mul_add(x15, x23, x22);
+        let x27 = S::mul_add(
+            S::splat(1375.0472756800002),
+            x23,
+            x15 * S::splat(24989.305802),
         );
-        let x32 = Self::mul_add(-qd[3], x30, Self::mul_add(-x22, s_q3, x21 * c_q3));
-        let x33 = Self::mul_add(qd[3], x29, Self::mul_add(x22, c_q3, x21 * s_q3));
+        let x28 = S::mul_add(
+            S::splat(-24998.827802),
+            x23,
+            S::splat(1375.0472756800002) * x15,
+        );
+        let x29 = S::mul_add(S::neg(x16), s_q3, x15 * c_q3);
+        let x30 = S::mul_add(x16, c_q3, x15 * s_q3);
+        let x31 = S::mul_add(
+            S::neg(s_q3),
+            S::mul_add(S::splat(-7.11), x25, x20),
+            c_q3
+                * S::mul_add(
+                    S::splat(7.11),
+                    x24,
+                    S::mul_add(S::neg(s_q2), x18, c_q2 * x17),
+                ),
+        );
+        let x32 = S::mul_add(
+            S::neg(qd[3]),
+            x30,
+            S::mul_add(S::neg(x22), s_q3, x21 * c_q3),
+        );
+        let x33 = S::mul_add(qd[3], x29, S::mul_add(x22, c_q3, x21 * s_q3));
         let x34 = qd[3] + x23;
-        let x35 = x29 * x30 * 171.195516;
-        let x36 = 171.195516 * Self::mul_add(-x30, x34, x32);
-        let x37 = 171.195516 * Self::mul_add(x29, x29, x34 * x34);
-        let x38 = 132.6783695416 * x29;
-        let x39 = Self::mul_add(x30, 97.44448770720001, 135.4729695416 * x34);
-        let x40 = x34 * 97.44448770720001;
-        let x41 = Self::mul_add(
-            Self::mul_add(-7.11, x26, x19),
-            -171.195516,
-            Self::mul_add(132.6783695416, x32, -Self::mul_add(-x34, x40, x30 * x39)),
+        let x35 = x29 * x30 * S::splat(171.195516);
+        let x36 = S::splat(171.195516) * S::mul_add(S::neg(x30), x34, x32);
+        let x37 = S::splat(171.195516) * S::mul_add(x29, x29, x34 * x34);
+        let x38 = S::splat(132.6783695416) * x29;
+        let x39 = S::mul_add(
+            x30,
+            S::splat(97.44448770720001),
+            S::splat(135.4729695416) * x34,
         );
-        let x42 = Self::mul_add(
+        let x40 = x34 * S::splat(97.44448770720001);
+        let x41 = S::mul_add(
+            S::mul_add(S::splat(-7.11), x26, x19),
+            S::splat(-171.195516),
+            S::mul_add(
+                S::splat(132.6783695416),
+                x32,
+                S::neg(S::mul_add(S::neg(x34), x40, x30 * x39)),
+            ),
+        );
+        let x42 = S::mul_add(
             x31,
-            171.195516,
-            Self::mul_add(x33, 97.44448770720001, Self::mul_add(-x29, x40, x30 * x38)),
+            S::splat(171.195516),
+            S::mul_add(
+                x33,
+                S::splat(97.44448770720001),
+                S::mul_add(S::neg(x29), x40, x30 * x38),
+            ),
         );
-        let x43 = Self::mul_add(-x34, s_q4, x29 * c_q4);
-        let x44 = Self::mul_add(x34, c_q4, x29 * s_q4);
+        let x43 = S::mul_add(S::neg(x34), s_q4, x29 * c_q4);
+        let x44 = S::mul_add(x34, c_q4, x29 * s_q4);
         let x45 = qd[4] - x30;
-        let x46 = 44.41 * x44;
-        let x47 = 47.471 * x45;
-        let x48 = 9.336 * Self::mul_add(-qd[4], x44, x32 * c_q4);
-        let x49 = -x48;
-        let x50 = 9.336 * (qd[5] - x43);
-        let x51 = Self::mul_add(-x45, c_q5, x44 * s_q5) * x50;
-        let x52 = Self::mul_add(x45, s_q5, x44 * c_q5) * x50;
-        let x53 = Self::mul_add(-x44, x47, x45 * x46) + x48;
-        let x54 = Self::mul_add(x43, x47, 44.41 * Self::mul_add(qd[4], x43, x32 * s_q4))
-            - Self::mul_add(-s_q5, x52, c_q5 * x51);
-        let x55 = Self::mul_add(x43, x46, 47.471 * x33)
-            + Self::mul_add(c_q5, x52, s_q5 * x51);
-        let x56 = -x55;
-        let x57 = x41 + Self::mul_add(s_q4, x54, c_q4 * x53);
-        let x58 = x42 - Self::mul_add(-c_q4, x54, s_q4 * x53);
-        let x59 = Self::mul_add(-x29, x39, x34 * x38) - x55;
-        let x60 = Self::mul_add(c_q3, x37, s_q3 * x35);
-        let x61 = Self::mul_add(3239.4582, x24, Self::mul_add(-s_q3, x37, c_q3 * x35));
-        let x62 = Self::mul_add(3239.4582, x25, x60);
-        let x63 = Self::mul_add(-x16, x28, x21 * 24989.305802)
-            - Self::mul_add(-s_q3, x59, c_q3 * x57);
-        let x64 = Self::mul_add(
-            -3239.4582,
+        let x46 = S::splat(44.41) * x44;
+        let x47 = S::splat(47.471) * x45;
+        let x48 = S::splat(9.336) * S::mul_add(S::neg(qd[4]), x44, x32 * c_q4);
+        let x49 = S::neg(x48);
+        let x50 = S::splat(9.336) * (qd[5] - x43);
+        let x51 = S::mul_add(S::neg(x45), c_q5, x44 * s_q5) * x50;
+        let x52 = S::mul_add(x45, s_q5, x44 * c_q5) * x50;
+        let x53 = S::mul_add(S::neg(x44), x47, x45 * x46) + x48;
+        let x54 = S::mul_add(
+            x43,
+            x47,
+            S::splat(44.41) * S::mul_add(qd[4], x43, x32 * s_q4),
+        ) - S::mul_add(S::neg(s_q5), x52, c_q5 * x51);
+        let x55 = S::mul_add(x43, x46, S::splat(47.471) * x33)
+            + S::mul_add(c_q5, x52, s_q5 * x51);
+        let x56 = S::neg(x55);
+        let x57 = x41 + S::mul_add(s_q4, x54, c_q4 * x53);
+        let x58 = x42 - S::mul_add(S::neg(c_q4), x54, s_q4 * x53);
+        let x59 = S::mul_add(S::neg(x29), x39, x34 * x38) - x55;
+        let x60 = S::mul_add(c_q3, x37, s_q3 * x35);
+        let x61 = S::mul_add(
+            S::splat(3239.4582),
+            x24,
+            S::mul_add(S::neg(s_q3), x37, c_q3 * x35),
+        );
+        let x62 = S::mul_add(S::splat(3239.4582), x25, x60);
+        let x63 = S::mul_add(S::neg(x16), x28, x21 * S::splat(24989.305802))
+            - S::mul_add(S::neg(s_q3), x59, c_q3 * x57);
+        let x64 = S::mul_add(
+            S::splat(-3239.4582),
             x20,
-            Self::mul_add(x16, x27, 1375.0472756800002 * x21),
-        ) - Self::mul_add(-7.11, x60, x58);
-        let x65 = -x64;
-        let x66 = Self::mul_add(-3239.4582, x19, Self::mul_add(-x15, x28, x23 * x27))
-            - Self::mul_add(-7.11, x36, Self::mul_add(c_q3, x59, s_q3 * x57));
-        let x67 = Self::mul_add(-s_q2, x62, c_q2 * x61);
-        let x68 = Self::mul_add(c_q2, x62, s_q2 * x61);
-        let x69 = -(Self::mul_add(-x6, x13, 3946.1881206800003 * x8)
-            + Self::mul_add(7.11, x68, x64));
-        let x70 = Self::mul_add(
+            S::mul_add(x16, x27, S::splat(1375.0472756800002) * x21),
+        ) - S::mul_add(S::splat(-7.11), x60, x58);
+        let x65 = S::neg(x64);
+        let x66 = S::mul_add(
+            S::splat(-3239.4582),
+            x19,
+            S::mul_add(S::neg(x15), x28, x23 * x27),
+        ) - S::mul_add(S::splat(-7.11), x36, S::mul_add(c_q3, x59, s_q3 * x57));
+        let x67 = S::mul_add(S::neg(s_q2), x62, c_q2 * x61);
+        let x68 = S::mul_add(c_q2, x62, s_q2 * x61);
+        let x69 = S::neg(
+            S::mul_add(S::neg(x6), x13, S::splat(3946.1881206800003) * x8)
+                + S::mul_add(S::splat(7.11), x68, x64),
+        );
+        let x70 = S::mul_add(
             c_q1,
-            Self::mul_add(-5224.5702, x7, Self::mul_add(-x5, x14, qd[1] * x13))
-                + (Self::mul_add(c_q2, x66, s_q2 * x63)
-                    + Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x26, x36),
-                        0.475 * x67,
+            S::mul_add(
+                S::splat(-5224.5702),
+                x7,
+                S::mul_add(S::neg(x5), x14, qd[1] * x13),
+            )
+                + (S::mul_add(c_q2, x66, s_q2 * x63)
+                    + S::mul_add(
+                        S::splat(7.11),
+                        S::mul_add(S::splat(3239.4582), x26, x36),
+                        S::splat(0.475) * x67,
                     )),
             s_q1
-                * (Self::mul_add(x6, x14, x8 * 39234.47412200001)
-                    + Self::mul_add(-0.475, x68, Self::mul_add(-s_q2, x66, c_q2 * x63))),
+                * (S::mul_add(x6, x14, x8 * S::splat(39234.47412200001))
+                    + S::mul_add(
+                        S::splat(-0.475),
+                        x68,
+                        S::mul_add(S::neg(s_q2), x66, c_q2 * x63),
+                    )),
         );
-        let x71 = Self::mul_add(
-            0.5692,
-            Self::mul_add(
+        let x71 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x12, -x68),
-                c_q1 * Self::mul_add(5224.5702, x11, x67),
+                S::mul_add(S::splat(5224.5702), x12, S::neg(x68)),
+                c_q1 * S::mul_add(S::splat(5224.5702), x11, x67),
             ),
             x70,
         );
-        let x72 = -x71;
+        let x72 = S::neg(x71);
         [x72, x69, x65, x58, x56, x49]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1395,7 +1554,14 @@ impl Ssrms6 {
         qd: &[::core::primitive::f64; 6],
         qdd: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::inverse_dynamics_lanes::<::core::primitive::f64>(q, qd, qdd)
+    }
+    /// [`Self::inverse_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], qdd: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
@@ -1404,148 +1570,252 @@ impl Ssrms6 {
         ]);
         let x5 = qd[0] * s_q1;
         let x6 = qd[0] * c_q1;
-        let x7 = 0.5692 * qdd[0];
-        let x8 = 0.5692 * (qd[0] * qd[0]);
+        let x7 = S::splat(0.5692) * qdd[0];
+        let x8 = S::splat(0.5692) * (qd[0] * qd[0]);
         let x9 = s_q1 * x7;
         let x10 = qd[1] * x6;
         let x11 = qd[1] * x5;
-        let x12 = Self::mul_add(qdd[0], s_q1, x10);
-        let x13 = Self::mul_add(qdd[0], c_q1, -x11);
+        let x12 = S::mul_add(qdd[0], s_q1, x10);
+        let x13 = S::mul_add(qdd[0], c_q1, S::neg(x11));
         let x14 = x6 * x6;
-        let x15 = Self::mul_add(qd[1], qd[1], x14);
-        let x16 = Self::mul_add(x5, x6, qdd[1]);
-        let x17 = 3946.18812068 * qd[1];
-        let x18 = 39234.474122 * x6;
-        let x19 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x5);
-        let x20 = Self::mul_add(
-            5224.5702,
+        let x15 = S::mul_add(qd[1], qd[1], x14);
+        let x16 = S::mul_add(x5, x6, qdd[1]);
+        let x17 = S::splat(3946.18812068) * qd[1];
+        let x18 = S::splat(39234.474122) * x6;
+        let x19 = S::mul_add(
+            S::splat(-39241.404122),
+            qd[1],
+            S::splat(3946.1881206800003) * x5,
+        );
+        let x20 = S::mul_add(
+            S::splat(5224.5702),
             x8,
-            Self::mul_add(39234.474122, x13, -Self::mul_add(-x5, x19, qd[1] * x17)),
-        );
-        let x21 = Self::mul_add(x6, s_q2, x5 * c_q2);
-        let x22 = Self::mul_add(-x6, c_q2, x5 * s_q2);
-        let x23 = Self::mul_add(c_q1, x7, -Self::mul_add(x11 + x13, -0.475, 7.11 * x15));
-        let x24 = x9 - Self::mul_add(x10 - x12, 0.475, 7.11 * x16);
-        let x25 = x8
-            - Self::mul_add(Self::mul_add(x5, x5, x14), -0.475, 7.11 * (x11 - x13));
-        let x26 = Self::mul_add(c_q2, x24, s_q2 * x23);
-        let x27 = Self::mul_add(-qd[2], x22, Self::mul_add(x13, s_q2, x12 * c_q2));
-        let x28 = Self::mul_add(qd[2], x21, Self::mul_add(-x13, c_q2, x12 * s_q2));
-        let x29 = qdd[1] + qdd[2];
-        let x30 = qd[1] + qd[2];
-        let x31 = Self::mul_add(x30, x30, x22 * x22);
-        let x32 = Self::mul_add(-x21, x22, x29);
-        let x33 = Self::mul_add(x21, x30, x28);
-        let x34 = 1375.0472756800002 * x30;
-        let x35 = 24989.305802 * x22;
-        let x36 = Self::mul_add(-24998.827802, x30, 1375.0472756800002 * x21);
-        let x37 = Self::mul_add(
-            -3239.4582,
-            x25,
-            Self::mul_add(24989.305802, x28, Self::mul_add(-x21, x36, x30 * x34)),
-        );
-        let x38 = Self::mul_add(-x22, s_q3, x21 * c_q3);
-        let x39 = Self::mul_add(x22, c_q3, x21 * s_q3);
-        let x40 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-7.11, x32, x26),
-            c_q3 * Self::mul_add(-7.11, x31, Self::mul_add(-s_q2, x24, c_q2 * x23)),
-        );
-        let x41 = Self::mul_add(-qd[3], x39, Self::mul_add(-x28, s_q3, x27 * c_q3));
-        let x42 = Self::mul_add(qd[3], x38, Self::mul_add(x28, c_q3, x27 * s_q3));
-        let x43 = qdd[3] + x29;
-        let x44 = qd[3] + x30;
-        let x45 = 171.195516 * Self::mul_add(x38, x39, x43);
-        let x46 = 171.195516 * Self::mul_add(x38, x38, x44 * x44);
-        let x47 = 171.195516 * Self::mul_add(-x39, x44, x41);
-        let x48 = Self::mul_add(-97.44448770720001, x44, x39 * 177.0883695416);
-        let x49 = Self::mul_add(179.8829695416, x44, 97.44448770720001 * x39);
-        let x50 = Self::mul_add(
-            -171.195516,
-            x40,
-            Self::mul_add(
-                x38,
-                x48,
-                Self::mul_add(179.8829695416, x43, 97.44448770720001 * x42),
+            S::mul_add(
+                S::splat(39234.474122),
+                x13,
+                S::neg(S::mul_add(S::neg(x5), x19, qd[1] * x17)),
             ),
         );
-        let x51 = Self::mul_add(x44, c_q4, x38 * s_q4);
-        let x52 = Self::mul_add(-x44, s_q4, x38 * c_q4);
-        let x53 = Self::mul_add(-qd[4], x51, Self::mul_add(-x43, s_q4, x41 * c_q4));
+        let x21 = S::mul_add(x6, s_q2, x5 * c_q2);
+        let x22 = S::mul_add(S::neg(x6), c_q2, x5 * s_q2);
+        let x23 = S::mul_add(
+            c_q1,
+            x7,
+            S::neg(S::mul_add(x11 + x13, S::splat(-0.475), S::splat(7.11) * x15)),
+        );
+        let x24 = x9 - S::mul_add(x10 - x12, S::splat(0.475), S::splat(7.11) * x16);
+        let x25 = x8
+            - S::mul_add(
+                S::mul_add(x5, x5, x14),
+                S::splat(-0.475),
+                S::splat(7.11) * (x11 - x13),
+            );
+        let x26 = S::mul_add(c_q2, x24, s_q2 * x23);
+        let x27 = S::mul_add(S::neg(qd[2]), x22, S::mul_add(x13, s_q2, x12 * c_q2));
+        let x28 = S::mul_add(qd[2], x21, S::mul_add(S::neg(x13), c_q2, x12 * s_q2));
+        let x29 = qdd[1] + qdd[2];
+        let x30 = qd[1] + qd[2];
+        let x31 = S::mul_add(x30, x30, x22 * x22);
+        let x32 = S::mul_add(S::neg(x21), x22, x29);
+        let x33 = S::mul_add(x21, x30, x28);
+        let x34 = S::splat(1375.0472756800002) * x30;
+        let x35 = S::splat(24989.305802) * x22;
+        let x36 = S::mul_add(
+            S::splat(-24998.827802),
+            x30,
+            S::splat(1375.0472756800002) * x21,
+        );
+        let x37 = S::mul_add(
+            S::splat(-3239.4582),
+            x25,
+            S::mul_add(
+                S::splat(24989.305802),
+                x28,
+                S::mul_add(S::neg(x21), x36, x30 * x34),
+            ),
+        );
+        let x38 = S::mul_add(S::neg(x22), s_q3, x21 * c_q3);
+        let x39 = S::mul_add(x22, c_q3, x21 * s_q3);
+        let x40 = S::mul_add(
+            S::neg(s_q3),
+            S::mul_add(S::splat(-7.11), x32, x26),
+            c_q3
+                * S::mul_add(
+                    S::splat(-7.11),
+                    x31,
+                    S::mul_add(S::neg(s_q2), x24, c_q2 * x23),
+                ),
+        );
+        let x41 = S::mul_add(
+            S::neg(qd[3]),
+            x39,
+            S::mul_add(S::neg(x28), s_q3, x27 * c_q3),
+        );
+        let x42 = S::mul_add(qd[3], x38, S::mul_add(x28, c_q3, x27 * s_q3));
+        let x43 = qdd[3] + x29;
+        let x44 = qd[3] + x30;
+        let x45 = S::splat(171.195516) * S::mul_add(x38, x39, x43);
+        let x46 = S::splat(171.195516) * S::mul_add(x38, x38, x44 * x44);
+        let x47 = S::splat(171.195516) * S::mul_add(S::neg(x39), x44, x41);
+        let x48 = S::mul_add(
+            S::splat(-97.44448770720001),
+            x44,
+            x39 * S::splat(177.0883695416),
+        );
+        let x49 = S::mul_add(
+            S::splat(179.8829695416),
+            x44,
+            S::splat(97.44448770720001) * x39,
+        );
+        let x50 = S::mul_add(
+            S::splat(-171.195516),
+            x40,
+            S::mul_add(
+                x38,
+                x48,
+                S::mul_add(
+                    S::splat(179.8829695416),
+                    x43,
+                    S::splat(97.44448770720001) * x42,
+                ),
+            ),
+        );
+        let x51 = S::mul_add(x44, c_q4, x38 * s_q4);
+        let x52 = S::mul_add(S::neg(x44), s_q4, x38 * c_q4);
+        let x53 = S::mul_add(
+            S::neg(qd[4]),
+            x51,
+            S::mul_add(S::neg(x43), s_q4, x41 * c_q4),
+        );
         let x54 = qd[4] - x39;
-        let x55 = 44.41 * x52;
-        let x56 = 47.471 * x54;
-        let x57 = 9.336 * (qdd[5] - x53);
-        let x58 = 9.336 * (qd[5] - x52);
-        let x59 = Self::mul_add(-x54, c_q5, x51 * s_q5) * x58;
-        let x60 = Self::mul_add(x54, s_q5, x51 * c_q5) * x58;
-        let x61 = Self::mul_add(x52, x56, x54 * x55)
-            - Self::mul_add(-s_q5, x60, c_q5 * x59);
-        let x62 = Self::mul_add(x51, x56, 44.41 * x53) + x57;
-        let x63 = Self::mul_add(-x51, x55, 47.471 * (qdd[4] - x42))
-            - Self::mul_add(c_q5, x60, s_q5 * x59);
-        let x64 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-7.11, x33, x25),
-            Self::mul_add(x39, x49, x44 * x48),
-        ) - Self::mul_add(-c_q4, x62, s_q4 * x61);
-        let x65 = Self::mul_add(
-            -x38,
+        let x55 = S::splat(44.41) * x52;
+        let x56 = S::splat(47.471) * x54;
+        let x57 = S::splat(9.336) * (qdd[5] - x53);
+        let x58 = S::splat(9.336) * (qd[5] - x52);
+        let x59 = S::mul_add(S::neg(x54), c_q5, x51 * s_q5) * x58;
+        let x60 = S::mul_add(x54, s_q5, x51 * c_q5) * x58;
+        let x61 = S::mul_add(x52, x56, x54 * x55)
+            - S::mul_add(S::neg(s_q5), x60, c_q5 * x59);
+        let x62 = S::mul_add(x51, x56, S::splat(44.41) * x53) + x57;
+        let x63 = S::mul_add(S::neg(x51), x55, S::splat(47.471) * (qdd[4] - x42))
+            - S::mul_add(c_q5, x60, s_q5 * x59);
+        let x64 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::splat(-7.11), x33, x25),
+            S::mul_add(x39, x49, x44 * x48),
+        ) - S::mul_add(S::neg(c_q4), x62, s_q4 * x61);
+        let x65 = S::mul_add(
+            S::neg(x38),
             x49,
-            Self::mul_add(-97.44448770720001, x43, x42 * 177.0883695416),
+            S::mul_add(S::splat(-97.44448770720001), x43, x42 * S::splat(177.0883695416)),
         ) + x63;
-        let x66 = x50 + Self::mul_add(s_q4, x62, c_q4 * x61);
-        let x67 = Self::mul_add(c_q3, x46, s_q3 * x45);
-        let x68 = Self::mul_add(3239.4582, x31, Self::mul_add(-s_q3, x46, c_q3 * x45));
-        let x69 = Self::mul_add(3239.4582, x32, -x67);
-        let x70 = Self::mul_add(
-            1375.0472756800002,
+        let x66 = x50 + S::mul_add(s_q4, x62, c_q4 * x61);
+        let x67 = S::mul_add(c_q3, x46, s_q3 * x45);
+        let x68 = S::mul_add(
+            S::splat(3239.4582),
+            x31,
+            S::mul_add(S::neg(s_q3), x46, c_q3 * x45),
+        );
+        let x69 = S::mul_add(S::splat(3239.4582), x32, S::neg(x67));
+        let x70 = S::mul_add(
+            S::splat(1375.0472756800002),
             x29,
-            -Self::mul_add(x22, x36, x30 * x35),
-        ) + Self::mul_add(s_q3, x65, c_q3 * x64);
-        let x71 = x37 + Self::mul_add(7.11, x47, Self::mul_add(-c_q3, x65, s_q3 * x64));
-        let x72 = Self::mul_add(
-            3239.4582,
+            S::neg(S::mul_add(x22, x36, x30 * x35)),
+        ) + S::mul_add(s_q3, x65, c_q3 * x64);
+        let x71 = x37
+            + S::mul_add(S::splat(7.11), x47, S::mul_add(S::neg(c_q3), x65, s_q3 * x64));
+        let x72 = S::mul_add(
+            S::splat(3239.4582),
             x26,
-            Self::mul_add(-24998.827802, x29, 1375.0472756800002 * x27)
-                + Self::mul_add(x21, x35, x22 * x34),
-        ) - Self::mul_add(-7.11, x67, x66);
-        let x73 = -x72;
-        let x74 = Self::mul_add(s_q2, x69, c_q2 * x68);
-        let x75 = Self::mul_add(-c_q2, x69, s_q2 * x68);
-        let x76 = -(Self::mul_add(
-            5224.5702,
-            x9,
-            Self::mul_add(-39241.404122, qdd[1], 3946.1881206800003 * x12)
-                - Self::mul_add(x5, x18, x6 * x17),
-        ) + Self::mul_add(7.11, x75, x72));
-        let x77 = Self::mul_add(
-            -c_q1,
+            S::mul_add(S::splat(-24998.827802), x29, S::splat(1375.0472756800002) * x27)
+                + S::mul_add(x21, x35, x22 * x34),
+        ) - S::mul_add(S::splat(-7.11), x67, x66);
+        let x73 = S::neg(x72);
+        let x74 = S::mul_add(s_q2, x69, c_q2 * x68);
+        let x75 = S::mul_add(S::neg(c_q2), x69, s_q2 * x68);
+        let x76 = S::neg(
+            S::mul_add(
+                S::splat(5224.5702),
+                x9,
+                S::mul_add(
+                    S::splat(-39241.404122),
+                    qdd[1],
+                    S::splat(3946.1881206800003) * x12,
+                ) - S::mul_add(x5, x18, x6 * x17),
+            ) + S::mul_add(S::splat(7.11), x75, x72),
+        );
+        let x77 = S::mul_add(
+            S::neg(c_q1),
             x20
-                - (Self::mul_add(c_q2, x71, s_q2 * x70)
-                    + Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x33, x47),
-                        0.475 * x74,
+                - (S::mul_add(c_q2, x71, s_q2 * x70)
+                    + S::mul_add(
+                        S::splat(7.11),
+                        S::mul_add(S::splat(3239.4582), x33, x47),
+                        S::splat(0.475) * x74,
                     )),
             s_q1
-                * (Self::mul_add(
-                    3946.18812068,
+                * (S::mul_add(
+                    S::splat(3946.18812068),
                     qdd[1],
-                    Self::mul_add(x6, x19, qd[1] * x18),
-                ) + Self::mul_add(-0.475, x75, Self::mul_add(-s_q2, x71, c_q2 * x70))),
+                    S::mul_add(x6, x19, qd[1] * x18),
+                )
+                    + S::mul_add(
+                        S::splat(-0.475),
+                        x75,
+                        S::mul_add(S::neg(s_q2), x71, c_q2 * x70),
+                    )),
         );
-        let x78 = Self::mul_add(
-            0.5692,
-            Self::mul_add(
+        let x78 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x16, -x75),
-                c_q1 * Self::mul_add(5224.5702, x15, x74),
+                S::mul_add(S::splat(5224.5702), x16, S::neg(x75)),
+                c_q1 * S::mul_add(S::splat(5224.5702), x15, x74),
             ),
             x77,
         );
-        let x79 = Self::mul_add(1650.6386721183999, qdd[0], -x78);
+        let x79 = S::mul_add(S::splat(1650.6386721183999), qdd[0], S::neg(x78));
         [x79, x76, x73, x66, x63, x57]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        qdd: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -1556,203 +1826,276 @@ impl Ssrms6 {
         qd: &[::core::primitive::f64; 6],
         tau: &[::core::primitive::f64; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::forward_dynamics_lanes::<::core::primitive::f64>(q, qd, tau)
+    }
+    /// [`Self::forward_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], tau: &[S; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
             q[5],
         ]);
-        let x5 = s_q4 * s_q4 * 35.074;
-        let x6 = -35.074 + x5;
-        let x7 = s_q4 * c_q4 * 35.074;
-        let x8 = 179.8829695416 - x5;
-        let x9 = x6 - -129.6173695416;
+        let x5 = s_q4 * s_q4 * S::splat(35.074);
+        let x6 = S::splat(-35.074) + x5;
+        let x7 = s_q4 * c_q4 * S::splat(35.074);
+        let x8 = S::splat(179.8829695416) - x5;
+        let x9 = x6 - S::splat(-129.6173695416);
         let x10 = s_q3 * s_q3 * x9;
         let x11 = x6 - x10;
-        let x12 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x7);
-        let x13 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x7);
-        let x14 = 171.195516 * s_q3;
-        let x15 = 171.195516 * c_q3;
-        let x16 = 7.11 * x14;
-        let x17 = Self::mul_add(-7.11, x15, s_q3 * c_q3 * x9);
+        let x12 = S::mul_add(S::splat(97.44448770720001), s_q3, c_q3 * x7);
+        let x13 = S::mul_add(S::splat(-97.44448770720001), c_q3, s_q3 * x7);
+        let x14 = S::splat(171.195516) * s_q3;
+        let x15 = S::splat(171.195516) * c_q3;
+        let x16 = S::splat(7.11) * x14;
+        let x17 = S::mul_add(S::splat(-7.11), x15, s_q3 * c_q3 * x9);
         let x18 = x8 - x16;
-        let x19 = 3239.4582 - x14;
-        let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
-        let x22 = 24998.827802 - (x16 - x18);
+        let x19 = S::splat(3239.4582) - x14;
+        let x20 = S::splat(1375.0472756800002) - x12;
+        let x21 = S::splat(24989.305802)
+            - (x16 - (S::splat(-129.6173695416) + x10 - x16));
+        let x22 = S::splat(24998.827802) - (x16 - x18);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
         let x25 = x11 - x21;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x27 = S::mul_add(x24, x26, x23 * x25);
         let x28 = s_q2 * x13;
         let x29 = c_q2 * x13;
         let x30 = s_q2 * x15;
-        let x31 = Self::mul_add(c_q2, x19, -x30);
+        let x31 = S::mul_add(c_q2, x19, S::neg(x30));
         let x32 = c_q2 * x15;
-        let x33 = Self::mul_add(s_q2, x19, x32);
-        let x34 = 7.11 * x31;
-        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, x28));
-        let x36 = Self::mul_add(-7.11, x33, x17 + Self::mul_add(-x23, x26, x24 * x25));
+        let x33 = S::mul_add(s_q2, x19, x32);
+        let x34 = S::splat(7.11) * x31;
+        let x35 = S::mul_add(x31, S::splat(0.475), S::mul_add(c_q2, x20, x28));
+        let x36 = S::mul_add(
+            S::splat(-7.11),
+            x33,
+            x17 + S::mul_add(S::neg(x23), x26, x24 * x25),
+        );
         let x37 = x22 + x34;
-        let x38 = 39234.474122 + (x34 + (x21 + x27 + x34));
-        let x39 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, -x29));
+        let x38 = S::splat(39234.474122) + (x34 + (x21 + x27 + x34));
+        let x39 = c_q1
+            * S::mul_add(x33, S::splat(0.475), S::mul_add(s_q2, x20, S::neg(x29)));
         let x40 = c_q1 * x33;
-        let x41 = Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, 5224.5702 + x31, x40),
-            Self::mul_add(s_q1, 3946.18812068 + x35, x39),
+        let x41 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(s_q1, S::splat(5224.5702) + x31, x40),
+            S::mul_add(s_q1, S::splat(3946.18812068) + x35, x39),
         );
-        let x42 = Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, x31, x40),
-            Self::mul_add(s_q1, x35, x39),
+        let x42 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(s_q1, x31, x40),
+            S::mul_add(s_q1, x35, x39),
         );
-        let x43 = Self::mul_add(-s_q2, x14, x32);
-        let x44 = Self::mul_add(c_q2, x14, x30);
-        let x45 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-0.475, x43, Self::mul_add(s_q2, x12, x29)),
-            s_q1 * Self::mul_add(-0.475, x44, Self::mul_add(-c_q2, x12, x28)),
+        let x43 = S::mul_add(S::neg(s_q2), x14, x32);
+        let x44 = S::mul_add(c_q2, x14, x30);
+        let x45 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(-0.475), x43, S::mul_add(s_q2, x12, x29)),
+            s_q1 * S::mul_add(S::splat(-0.475), x44, S::mul_add(S::neg(c_q2), x12, x28)),
         );
-        let x46 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x44, c_q1 * x43), x45);
-        let x47 = 47.471 * s_q3;
-        let x48 = 47.471 * c_q3;
-        let x49 = Self::mul_add(
+        let x46 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(S::neg(s_q1), x44, c_q1 * x43),
+            x45,
+        );
+        let x47 = S::splat(47.471) * s_q3;
+        let x48 = S::splat(47.471) * c_q3;
+        let x49 = S::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x48, s_q2 * x47),
-            s_q1 * Self::mul_add(s_q2, x48, c_q2 * x47),
+            S::mul_add(S::neg(c_q2), x48, s_q2 * x47),
+            s_q1 * S::mul_add(s_q2, x48, c_q2 * x47),
         );
-        let x50 = 9.336 * c_q4;
-        let x51 = 9.336 * s_q4;
+        let x50 = S::splat(9.336) * c_q4;
+        let x51 = S::splat(9.336) * s_q4;
         let x52 = c_q3 * x50;
         let x53 = s_q3 * x50;
-        let x54 = Self::mul_add(
+        let x54 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x53, s_q2 * x52),
-            s_q1 * Self::mul_add(-s_q2, x53, c_q2 * x52),
+            S::mul_add(c_q2, x53, s_q2 * x52),
+            s_q1 * S::mul_add(S::neg(s_q2), x53, c_q2 * x52),
         );
         let x55 = qd[0] * s_q1;
         let x56 = qd[0] * c_q1;
-        let x57 = 0.5692 * (qd[0] * qd[0]);
+        let x57 = S::splat(0.5692) * (qd[0] * qd[0]);
         let x58 = qd[1] * x56;
         let x59 = qd[1] * x55;
         let x60 = x56 * x56;
-        let x61 = Self::mul_add(qd[1], qd[1], x60);
+        let x61 = S::mul_add(qd[1], qd[1], x60);
         let x62 = x55 * x56;
-        let x63 = 3946.18812068 * qd[1];
-        let x64 = 39234.474122 * x56;
-        let x65 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x55);
-        let x66 = Self::mul_add(
-            -5224.5702,
+        let x63 = S::splat(3946.18812068) * qd[1];
+        let x64 = S::splat(39234.474122) * x56;
+        let x65 = S::mul_add(
+            S::splat(-39241.404122),
+            qd[1],
+            S::splat(3946.1881206800003) * x55,
+        );
+        let x66 = S::mul_add(
+            S::splat(-5224.5702),
             x57,
-            Self::mul_add(39234.474122, x59, Self::mul_add(-x55, x65, qd[1] * x63)),
+            S::mul_add(
+                S::splat(39234.474122),
+                x59,
+                S::mul_add(S::neg(x55), x65, qd[1] * x63),
+            ),
         );
-        let x67 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x68 = Self::mul_add(-c_q2, x56, s_q2 * x55);
-        let x69 = 7.11 * x61;
-        let x70 = 7.11 * x62;
+        let x67 = S::mul_add(s_q2, x56, c_q2 * x55);
+        let x68 = S::mul_add(S::neg(c_q2), x56, s_q2 * x55);
+        let x69 = S::splat(7.11) * x61;
+        let x70 = S::splat(7.11) * x62;
         let x71 = x57
-            - Self::mul_add(-0.475, Self::mul_add(x55, x55, x60), 7.11 * (x59 + x59));
-        let x72 = Self::mul_add(c_q2, x70, s_q2 * x69);
-        let x73 = Self::mul_add(-qd[2], x68, Self::mul_add(-s_q2, x59, c_q2 * x58));
-        let x74 = Self::mul_add(qd[2], x67, Self::mul_add(c_q2, x59, s_q2 * x58));
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x55, x55, x60),
+                S::splat(7.11) * (x59 + x59),
+            );
+        let x72 = S::mul_add(c_q2, x70, s_q2 * x69);
+        let x73 = S::mul_add(
+            S::neg(qd[2]),
+            x68,
+            S::mul_add(S::neg(s_q2), x59, c_q2 * x58),
+        );
+        let x74 = S::mul_add(qd[2], x67, S::mul_add(c_q2, x59, s_q2 * x58));
         let x75 = qd[1] + qd[2];
-        let x76 = Self::mul_add(x75, x75, x68 * x68);
+        let x76 = S::mul_add(x75, x75, x68 * x68);
         let x77 = x67 * x68;
-        let x78 = Self::mul_add(x67, x75, x74);
-        let x79 = 1375.0472756800002 * x75;
-        let x80 = 24989.305802 * x68;
-        let x81 = Self::mul_add(-24998.827802, x75, 1375.0472756800002 * x67);
-        let x82 = Self::mul_add(
-            -3239.4582,
+        let x78 = S::mul_add(x67, x75, x74);
+        let x79 = S::splat(1375.0472756800002) * x75;
+        let x80 = S::splat(24989.305802) * x68;
+        let x81 = S::mul_add(
+            S::splat(-24998.827802),
+            x75,
+            S::splat(1375.0472756800002) * x67,
+        );
+        let x82 = S::mul_add(
+            S::splat(-3239.4582),
             x71,
-            Self::mul_add(24989.305802, x74, Self::mul_add(-x67, x81, x75 * x79)),
+            S::mul_add(
+                S::splat(24989.305802),
+                x74,
+                S::mul_add(S::neg(x67), x81, x75 * x79),
+            ),
         );
-        let x83 = Self::mul_add(
-            -3239.4582,
+        let x83 = S::mul_add(
+            S::splat(-3239.4582),
             x72,
-            Self::mul_add(1375.0472756800002, x73, Self::mul_add(x67, x80, x68 * x79)),
+            S::mul_add(
+                S::splat(1375.0472756800002),
+                x73,
+                S::mul_add(x67, x80, x68 * x79),
+            ),
         );
-        let x84 = Self::mul_add(-s_q3, x68, c_q3 * x67);
-        let x85 = Self::mul_add(c_q3, x68, s_q3 * x67);
-        let x86 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-7.11, x77, x72),
-            c_q3 * Self::mul_add(7.11, x76, Self::mul_add(-s_q2, x70, c_q2 * x69)),
+        let x84 = S::mul_add(S::neg(s_q3), x68, c_q3 * x67);
+        let x85 = S::mul_add(c_q3, x68, s_q3 * x67);
+        let x86 = S::mul_add(
+            S::neg(s_q3),
+            S::mul_add(S::splat(-7.11), x77, x72),
+            c_q3
+                * S::mul_add(
+                    S::splat(7.11),
+                    x76,
+                    S::mul_add(S::neg(s_q2), x70, c_q2 * x69),
+                ),
         );
-        let x87 = Self::mul_add(-qd[3], x85, Self::mul_add(-s_q3, x74, c_q3 * x73));
-        let x88 = Self::mul_add(qd[3], x84, Self::mul_add(c_q3, x74, s_q3 * x73));
+        let x87 = S::mul_add(
+            S::neg(qd[3]),
+            x85,
+            S::mul_add(S::neg(s_q3), x74, c_q3 * x73),
+        );
+        let x88 = S::mul_add(qd[3], x84, S::mul_add(c_q3, x74, s_q3 * x73));
         let x89 = qd[3] + x75;
-        let x90 = 171.195516 * (x84 * x85);
-        let x91 = 171.195516 * Self::mul_add(x84, x84, x89 * x89);
-        let x92 = 171.195516 * Self::mul_add(-x85, x89, x87);
-        let x93 = Self::mul_add(-97.44448770720001, x89, x85 * 177.0883695416);
-        let x94 = Self::mul_add(179.8829695416, x89, 97.44448770720001 * x85);
-        let x95 = Self::mul_add(c_q4, x89, s_q4 * x84);
-        let x96 = Self::mul_add(-s_q4, x89, c_q4 * x84);
-        let x97 = Self::mul_add(-qd[4], x95, c_q4 * x87);
+        let x90 = S::splat(171.195516) * (x84 * x85);
+        let x91 = S::splat(171.195516) * S::mul_add(x84, x84, x89 * x89);
+        let x92 = S::splat(171.195516) * S::mul_add(S::neg(x85), x89, x87);
+        let x93 = S::mul_add(
+            S::splat(-97.44448770720001),
+            x89,
+            x85 * S::splat(177.0883695416),
+        );
+        let x94 = S::mul_add(
+            S::splat(179.8829695416),
+            x89,
+            S::splat(97.44448770720001) * x85,
+        );
+        let x95 = S::mul_add(c_q4, x89, s_q4 * x84);
+        let x96 = S::mul_add(S::neg(s_q4), x89, c_q4 * x84);
+        let x97 = S::mul_add(S::neg(qd[4]), x95, c_q4 * x87);
         let x98 = qd[4] - x85;
-        let x99 = 44.41 * x96;
-        let x100 = 47.471 * x98;
-        let x101 = 9.336 * x97;
-        let x102 = 9.336 * (qd[5] - x96);
-        let x103 = Self::mul_add(-c_q5, x98, s_q5 * x95) * x102;
-        let x104 = Self::mul_add(s_q5, x98, c_q5 * x95) * x102;
-        let x105 = Self::mul_add(x96, x100, x98 * x99)
-            - Self::mul_add(-s_q5, x104, c_q5 * x103);
-        let x106 = Self::mul_add(x95, x100, 44.41 * x97) - x101;
-        let x107 = Self::mul_add(x95, x99, 47.471 * x88)
-            + Self::mul_add(c_q5, x104, s_q5 * x103);
-        let x108 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-7.11, x78, x71),
-            Self::mul_add(x85, x94, x89 * x93),
-        ) - Self::mul_add(-c_q4, x106, s_q4 * x105);
-        let x109 = Self::mul_add(-x84, x94, x88 * 177.0883695416) - x107;
-        let x110 = Self::mul_add(
-            171.195516,
+        let x99 = S::splat(44.41) * x96;
+        let x100 = S::splat(47.471) * x98;
+        let x101 = S::splat(9.336) * x97;
+        let x102 = S::splat(9.336) * (qd[5] - x96);
+        let x103 = S::mul_add(S::neg(c_q5), x98, s_q5 * x95) * x102;
+        let x104 = S::mul_add(s_q5, x98, c_q5 * x95) * x102;
+        let x105 = S::mul_add(x96, x100, x98 * x99)
+            - S::mul_add(S::neg(s_q5), x104, c_q5 * x103);
+        let x106 = S::mul_add(x95, x100, S::splat(44.41) * x97) - x101;
+        let x107 = S::mul_add(x95, x99, S::splat(47.471) * x88)
+            + S::mul_add(c_q5, x104, s_q5 * x103);
+        let x108 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::splat(-7.11), x78, x71),
+            S::mul_add(x85, x94, x89 * x93),
+        ) - S::mul_add(S::neg(c_q4), x106, s_q4 * x105);
+        let x109 = S::mul_add(S::neg(x84), x94, x88 * S::splat(177.0883695416)) - x107;
+        let x110 = S::mul_add(
+            S::splat(171.195516),
             x86,
-            Self::mul_add(x84, x93, 97.44448770720001 * x88),
-        ) + Self::mul_add(s_q4, x106, c_q4 * x105);
-        let x111 = Self::mul_add(c_q3, x91, s_q3 * x90);
-        let x112 = Self::mul_add(3239.4582, x76, Self::mul_add(-s_q3, x91, c_q3 * x90));
-        let x113 = Self::mul_add(3239.4582, x77, x111);
-        let x114 = Self::mul_add(x68, x81, x75 * x80)
-            - Self::mul_add(s_q3, x109, c_q3 * x108);
+            S::mul_add(x84, x93, S::splat(97.44448770720001) * x88),
+        ) + S::mul_add(s_q4, x106, c_q4 * x105);
+        let x111 = S::mul_add(c_q3, x91, s_q3 * x90);
+        let x112 = S::mul_add(
+            S::splat(3239.4582),
+            x76,
+            S::mul_add(S::neg(s_q3), x91, c_q3 * x90),
+        );
+        let x113 = S::mul_add(S::splat(3239.4582), x77, x111);
+        let x114 = S::mul_add(x68, x81, x75 * x80) - S::mul_add(s_q3, x109, c_q3 * x108);
         let x115 = x82
-            + Self::mul_add(7.11, x92, Self::mul_add(-c_q3, x109, s_q3 * x108));
-        let x116 = x83 - Self::mul_add(-7.11, x111, x110);
-        let x117 = Self::mul_add(-s_q2, x113, c_q2 * x112);
-        let x118 = Self::mul_add(c_q2, x113, s_q2 * x112);
-        let x119 = Self::mul_add(
+            + S::mul_add(
+                S::splat(7.11),
+                x92,
+                S::mul_add(S::neg(c_q3), x109, s_q3 * x108),
+            );
+        let x116 = x83 - S::mul_add(S::splat(-7.11), x111, x110);
+        let x117 = S::mul_add(S::neg(s_q2), x113, c_q2 * x112);
+        let x118 = S::mul_add(c_q2, x113, s_q2 * x112);
+        let x119 = S::mul_add(
             c_q1,
             x66
-                - (Self::mul_add(-c_q2, x115, s_q2 * x114)
-                    - Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x78, x92),
-                        0.475 * x117,
+                - (S::mul_add(S::neg(c_q2), x115, s_q2 * x114)
+                    - S::mul_add(
+                        S::splat(7.11),
+                        S::mul_add(S::splat(3239.4582), x78, x92),
+                        S::splat(0.475) * x117,
                     )),
             s_q1
-                * (Self::mul_add(x56, x65, qd[1] * x64)
-                    - Self::mul_add(0.475, x118, Self::mul_add(s_q2, x115, c_q2 * x114))),
+                * (S::mul_add(x56, x65, qd[1] * x64)
+                    - S::mul_add(
+                        S::splat(0.475),
+                        x118,
+                        S::mul_add(s_q2, x115, c_q2 * x114),
+                    )),
         );
-        let x120 = Self::mul_add(
-            0.5692,
-            Self::mul_add(
+        let x120 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x62, -x118),
-                c_q1 * Self::mul_add(5224.5702, x61, x117),
+                S::mul_add(S::splat(5224.5702), x62, S::neg(x118)),
+                c_q1 * S::mul_add(S::splat(5224.5702), x61, x117),
             ),
             x119,
         );
         let x121 = tau[0] + x120;
-        let x122 = 1.0
-            / (1650.6386721183999
+        let x122 = S::splat(1.0)
+            / (S::splat(1650.6386721183999)
                 + (x38
-                    + Self::mul_add(
+                    + S::mul_add(
                         s_q1 * c_q1,
                         x36 + x36,
                         s_q1 * s_q1 * (x11 - x27 - x38),
@@ -1762,102 +2105,157 @@ impl Ssrms6 {
         let x125 = x46 * x122;
         let x126 = x49 * x122;
         let x127 = x54 * x122;
-        let x128 = 1.0 / Self::mul_add(-x41, x123, 39241.404122 + (x34 + x37));
-        let x129 = Self::mul_add(-x41, x124, x37);
+        let x128 = S::splat(1.0)
+            / S::mul_add(S::neg(x41), x123, S::splat(39241.404122) + (x34 + x37));
+        let x129 = S::mul_add(S::neg(x41), x124, x37);
         let x130 = x128 * x129;
-        let x131 = Self::mul_add(-x41, x125, Self::mul_add(-7.11, x44, x18));
+        let x131 = S::mul_add(S::neg(x41), x125, S::mul_add(S::splat(-7.11), x44, x18));
         let x132 = x128 * x131;
         let x133 = x41 * x126;
         let x134 = x128 * x133;
-        let x135 = Self::mul_add(-x41, x127, x51);
+        let x135 = S::mul_add(S::neg(x41), x127, x51);
         let x136 = x128 * x135;
-        let x137 = 1.0 / Self::mul_add(-x129, x130, Self::mul_add(-x42, x124, x22));
-        let x138 = Self::mul_add(-x129, x132, Self::mul_add(-x42, x125, x18));
+        let x137 = S::splat(1.0)
+            / S::mul_add(S::neg(x129), x130, S::mul_add(S::neg(x42), x124, x22));
+        let x138 = S::mul_add(S::neg(x129), x132, S::mul_add(S::neg(x42), x125, x18));
         let x139 = x137 * x138;
-        let x140 = Self::mul_add(-x129, x134, x42 * x126);
+        let x140 = S::mul_add(S::neg(x129), x134, x42 * x126);
         let x141 = x137 * x140;
-        let x142 = Self::mul_add(-x129, x136, Self::mul_add(-x42, x127, x51));
+        let x142 = S::mul_add(S::neg(x129), x136, S::mul_add(S::neg(x42), x127, x51));
         let x143 = x137 * x142;
-        let x144 = Self::mul_add(
-            -x138,
+        let x144 = S::mul_add(
+            S::neg(x138),
             x139,
-            Self::mul_add(-x131, x132, Self::mul_add(-x46, x125, x8)),
+            S::mul_add(S::neg(x131), x132, S::mul_add(S::neg(x46), x125, x8)),
         );
-        let x145 = 1.0 / x144;
-        let x146 = Self::mul_add(-x138, x141, Self::mul_add(-x131, x134, x46 * x126));
+        let x145 = S::splat(1.0) / x144;
+        let x146 = S::mul_add(
+            S::neg(x138),
+            x141,
+            S::mul_add(S::neg(x131), x134, x46 * x126),
+        );
         let x147 = x145 * x146;
-        let x148 = Self::mul_add(
-            -x138,
+        let x148 = S::mul_add(
+            S::neg(x138),
             x143,
-            Self::mul_add(-x131, x136, Self::mul_add(-x46, x127, x51)),
+            S::mul_add(S::neg(x131), x136, S::mul_add(S::neg(x46), x127, x51)),
         );
         let x149 = x145 * x148;
-        let x150 = Self::mul_add(
-            -x140,
+        let x150 = S::mul_add(
+            S::neg(x140),
             x141,
-            Self::mul_add(-x133, x134, Self::mul_add(-x49, x126, 47.471)),
+            S::mul_add(
+                S::neg(x133),
+                x134,
+                S::mul_add(S::neg(x49), x126, S::splat(47.471)),
+            ),
         );
-        let x151 = 1.0 / Self::mul_add(-x146, x147, x150);
-        let x152 = Self::mul_add(
-            -x146,
+        let x151 = S::splat(1.0) / S::mul_add(S::neg(x146), x147, x150);
+        let x152 = S::mul_add(
+            S::neg(x146),
             x149,
-            Self::mul_add(-x140, x143, Self::mul_add(-x133, x136, x49 * x127)),
+            S::mul_add(S::neg(x140), x143, S::mul_add(S::neg(x133), x136, x49 * x127)),
         );
         let x153 = x151 * x152;
-        let x154 = Self::mul_add(
-            -x142,
+        let x154 = S::mul_add(
+            S::neg(x142),
             x143,
-            Self::mul_add(-x135, x136, Self::mul_add(-x54, x127, 9.336)),
+            S::mul_add(
+                S::neg(x135),
+                x136,
+                S::mul_add(S::neg(x54), x127, S::splat(9.336)),
+            ),
         );
-        let x155 = 1.0 / Self::mul_add(-x152, x153, Self::mul_add(-x148, x149, x154));
-        let x156 = Self::mul_add(
+        let x155 = S::splat(1.0)
+            / S::mul_add(S::neg(x152), x153, S::mul_add(S::neg(x148), x149, x154));
+        let x156 = S::mul_add(
             x121,
             x123,
             tau[1]
-                + (Self::mul_add(
-                    3946.1881206800003,
+                + (S::mul_add(
+                    S::splat(3946.1881206800003),
                     x58,
-                    -Self::mul_add(x55, x64, x56 * x63),
-                ) + Self::mul_add(7.11, x118, x116)),
+                    S::neg(S::mul_add(x55, x64, x56 * x63)),
+                ) + S::mul_add(S::splat(7.11), x118, x116)),
         );
-        let x157 = Self::mul_add(-x130, x156, Self::mul_add(x121, x124, tau[2] + x116));
-        let x158 = Self::mul_add(
-            -x139,
+        let x157 = S::mul_add(S::neg(x130), x156, S::mul_add(x121, x124, tau[2] + x116));
+        let x158 = S::mul_add(
+            S::neg(x139),
             x157,
-            Self::mul_add(-x132, x156, Self::mul_add(x121, x125, tau[3] - x110)),
+            S::mul_add(S::neg(x132), x156, S::mul_add(x121, x125, tau[3] - x110)),
         );
-        let x159 = Self::mul_add(
+        let x159 = S::mul_add(
             x141,
             x157,
-            Self::mul_add(x134, x156, Self::mul_add(x121, x126, tau[4] + x107)),
+            S::mul_add(x134, x156, S::mul_add(x121, x126, tau[4] + x107)),
         );
-        let x160 = Self::mul_add(x147, x158, x159);
-        let x161 = Self::mul_add(
-            -x143,
+        let x160 = S::mul_add(x147, x158, x159);
+        let x161 = S::mul_add(
+            S::neg(x143),
             x157,
-            Self::mul_add(-x136, x156, Self::mul_add(x121, x127, tau[5] + x101)),
+            S::mul_add(S::neg(x136), x156, S::mul_add(x121, x127, tau[5] + x101)),
         );
-        let x162 = x155 * Self::mul_add(x153, x160, Self::mul_add(-x149, x158, x161));
-        let x163 = Self::mul_add(x153, x162, x151 * x160);
-        let x164 = Self::mul_add(-x149, x162, Self::mul_add(x147, x163, x145 * x158));
-        let x165 = Self::mul_add(
-            -x143,
+        let x162 = x155 * S::mul_add(x153, x160, S::mul_add(S::neg(x149), x158, x161));
+        let x163 = S::mul_add(x153, x162, x151 * x160);
+        let x164 = S::mul_add(S::neg(x149), x162, S::mul_add(x147, x163, x145 * x158));
+        let x165 = S::mul_add(
+            S::neg(x143),
             x162,
-            Self::mul_add(x141, x163, Self::mul_add(-x139, x164, x137 * x157)),
+            S::mul_add(x141, x163, S::mul_add(S::neg(x139), x164, x137 * x157)),
         );
-        let x166 = Self::mul_add(
+        let x166 = S::mul_add(
             x134,
             x163,
-            Self::mul_add(-x132, x164, Self::mul_add(-x130, x165, x128 * x156)),
+            S::mul_add(S::neg(x132), x164, S::mul_add(S::neg(x130), x165, x128 * x156)),
         );
-        let x167 = Self::mul_add(-x136, x162, x166);
-        let x168 = Self::mul_add(
+        let x167 = S::mul_add(S::neg(x136), x162, x166);
+        let x168 = S::mul_add(
             x125,
             x164,
-            Self::mul_add(x124, x165, Self::mul_add(x123, x167, x121 * x122)),
+            S::mul_add(x124, x165, S::mul_add(x123, x167, x121 * x122)),
         );
-        let x169 = Self::mul_add(x127, x162, Self::mul_add(x126, x163, x168));
+        let x169 = S::mul_add(x127, x162, S::mul_add(x126, x163, x168));
         [x169, x167, x165, x164, x163, x162]
+    }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -1867,227 +2265,345 @@ impl Ssrms6 {
         q: &[::core::primitive::f64; 6],
         qd: &[::core::primitive::f64; 6],
     ) -> ([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6]) {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::mass_matrix_and_nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6]) -> ([[S; 6]; 6], [S; 6]) {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
             q[5],
         ]);
-        let x5 = s_q4 * s_q4 * 35.074;
-        let x6 = -35.074 + x5;
-        let x7 = s_q4 * c_q4 * 35.074;
-        let x8 = 179.8829695416 - x5;
-        let x9 = x6 - -129.6173695416;
+        let x5 = s_q4 * s_q4 * S::splat(35.074);
+        let x6 = S::splat(-35.074) + x5;
+        let x7 = s_q4 * c_q4 * S::splat(35.074);
+        let x8 = S::splat(179.8829695416) - x5;
+        let x9 = x6 - S::splat(-129.6173695416);
         let x10 = s_q3 * s_q3 * x9;
         let x11 = x6 - x10;
-        let x12 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x7);
-        let x13 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x7);
-        let x14 = 171.195516 * s_q3;
-        let x15 = 171.195516 * c_q3;
-        let x16 = 7.11 * x14;
-        let x17 = Self::mul_add(-7.11, x15, s_q3 * c_q3 * x9);
+        let x12 = S::mul_add(S::splat(97.44448770720001), s_q3, c_q3 * x7);
+        let x13 = S::mul_add(S::splat(-97.44448770720001), c_q3, s_q3 * x7);
+        let x14 = S::splat(171.195516) * s_q3;
+        let x15 = S::splat(171.195516) * c_q3;
+        let x16 = S::splat(7.11) * x14;
+        let x17 = S::mul_add(S::splat(-7.11), x15, s_q3 * c_q3 * x9);
         let x18 = x8 - x16;
-        let x19 = 3239.4582 - x14;
-        let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
-        let x22 = 24998.827802 - (x16 - x18);
+        let x19 = S::splat(3239.4582) - x14;
+        let x20 = S::splat(1375.0472756800002) - x12;
+        let x21 = S::splat(24989.305802)
+            - (x16 - (S::splat(-129.6173695416) + x10 - x16));
+        let x22 = S::splat(24998.827802) - (x16 - x18);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
         let x25 = x11 - x21;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x27 = S::mul_add(x24, x26, x23 * x25);
         let x28 = s_q2 * x13;
         let x29 = c_q2 * x13;
         let x30 = s_q2 * x15;
-        let x31 = Self::mul_add(c_q2, x19, -x30);
+        let x31 = S::mul_add(c_q2, x19, S::neg(x30));
         let x32 = c_q2 * x15;
-        let x33 = Self::mul_add(s_q2, x19, x32);
-        let x34 = 7.11 * x31;
-        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, x28));
-        let x36 = Self::mul_add(-7.11, x33, x17 + Self::mul_add(-x23, x26, x24 * x25));
+        let x33 = S::mul_add(s_q2, x19, x32);
+        let x34 = S::splat(7.11) * x31;
+        let x35 = S::mul_add(x31, S::splat(0.475), S::mul_add(c_q2, x20, x28));
+        let x36 = S::mul_add(
+            S::splat(-7.11),
+            x33,
+            x17 + S::mul_add(S::neg(x23), x26, x24 * x25),
+        );
         let x37 = x22 + x34;
-        let x38 = 39234.474122 + (x34 + (x21 + x27 + x34));
-        let x39 = 39241.404122 + (x34 + x37);
-        let x40 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, -x29));
+        let x38 = S::splat(39234.474122) + (x34 + (x21 + x27 + x34));
+        let x39 = S::splat(39241.404122) + (x34 + x37);
+        let x40 = c_q1
+            * S::mul_add(x33, S::splat(0.475), S::mul_add(s_q2, x20, S::neg(x29)));
         let x41 = c_q1 * x33;
-        let x42 = 1650.6386721183999
+        let x42 = S::splat(1650.6386721183999)
             + (x38
-                + Self::mul_add(
-                    s_q1 * c_q1,
-                    x36 + x36,
-                    s_q1 * s_q1 * (x11 - x27 - x38),
-                ));
-        let x43 = -Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, 5224.5702 + x31, x41),
-            Self::mul_add(s_q1, 3946.18812068 + x35, x40),
+                + S::mul_add(s_q1 * c_q1, x36 + x36, s_q1 * s_q1 * (x11 - x27 - x38)));
+        let x43 = S::neg(
+            S::mul_add(
+                S::splat(0.5692),
+                S::mul_add(s_q1, S::splat(5224.5702) + x31, x41),
+                S::mul_add(s_q1, S::splat(3946.18812068) + x35, x40),
+            ),
         );
-        let x44 = -Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, x31, x41),
-            Self::mul_add(s_q1, x35, x40),
+        let x44 = S::neg(
+            S::mul_add(
+                S::splat(0.5692),
+                S::mul_add(s_q1, x31, x41),
+                S::mul_add(s_q1, x35, x40),
+            ),
         );
-        let x45 = Self::mul_add(-s_q2, x14, x32);
-        let x46 = Self::mul_add(c_q2, x14, x30);
-        let x47 = Self::mul_add(-7.11, x46, x18);
-        let x48 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-0.475, x45, Self::mul_add(s_q2, x12, x29)),
-            s_q1 * Self::mul_add(-0.475, x46, Self::mul_add(-c_q2, x12, x28)),
+        let x45 = S::mul_add(S::neg(s_q2), x14, x32);
+        let x46 = S::mul_add(c_q2, x14, x30);
+        let x47 = S::mul_add(S::splat(-7.11), x46, x18);
+        let x48 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(-0.475), x45, S::mul_add(s_q2, x12, x29)),
+            s_q1 * S::mul_add(S::splat(-0.475), x46, S::mul_add(S::neg(c_q2), x12, x28)),
         );
-        let x49 = -Self::mul_add(0.5692, Self::mul_add(-s_q1, x46, c_q1 * x45), x48);
-        let x50 = 47.471 * s_q3;
-        let x51 = 47.471 * c_q3;
-        let x52 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(-c_q2, x51, s_q2 * x50),
-            s_q1 * Self::mul_add(s_q2, x51, c_q2 * x50),
+        let x49 = S::neg(
+            S::mul_add(S::splat(0.5692), S::mul_add(S::neg(s_q1), x46, c_q1 * x45), x48),
         );
-        let x53 = 9.336 * c_q4;
-        let x54 = 9.336 * s_q4;
+        let x50 = S::splat(47.471) * s_q3;
+        let x51 = S::splat(47.471) * c_q3;
+        let x52 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(S::neg(c_q2), x51, s_q2 * x50),
+                s_q1 * S::mul_add(s_q2, x51, c_q2 * x50),
+            ),
+        );
+        let x53 = S::splat(9.336) * c_q4;
+        let x54 = S::splat(9.336) * s_q4;
         let x55 = c_q3 * x53;
         let x56 = s_q3 * x53;
-        let x57 = -Self::mul_add(
-            c_q1,
-            Self::mul_add(c_q2, x56, s_q2 * x55),
-            s_q1 * Self::mul_add(-s_q2, x56, c_q2 * x55),
+        let x57 = S::neg(
+            S::mul_add(
+                c_q1,
+                S::mul_add(c_q2, x56, s_q2 * x55),
+                s_q1 * S::mul_add(S::neg(s_q2), x56, c_q2 * x55),
+            ),
         );
         let x58 = qd[0] * s_q1;
         let x59 = qd[0] * c_q1;
-        let x60 = 0.5692 * (qd[0] * qd[0]);
+        let x60 = S::splat(0.5692) * (qd[0] * qd[0]);
         let x61 = qd[1] * x59;
         let x62 = qd[1] * x58;
         let x63 = x59 * x59;
-        let x64 = Self::mul_add(qd[1], qd[1], x63);
+        let x64 = S::mul_add(qd[1], qd[1], x63);
         let x65 = x58 * x59;
-        let x66 = 3946.18812068 * qd[1];
-        let x67 = 39234.474122 * x59;
-        let x68 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x58);
-        let x69 = Self::mul_add(
-            -5224.5702,
+        let x66 = S::splat(3946.18812068) * qd[1];
+        let x67 = S::splat(39234.474122) * x59;
+        let x68 = S::mul_add(
+            S::splat(-39241.404122),
+            qd[1],
+            S::splat(3946.1881206800003) * x58,
+        );
+        let x69 = S::mul_add(
+            S::splat(-5224.5702),
             x60,
-            Self::mul_add(39234.474122, x62, Self::mul_add(-x58, x68, qd[1] * x66)),
+            S::mul_add(
+                S::splat(39234.474122),
+                x62,
+                S::mul_add(S::neg(x58), x68, qd[1] * x66),
+            ),
         );
-        let x70 = Self::mul_add(s_q2, x59, c_q2 * x58);
-        let x71 = Self::mul_add(-c_q2, x59, s_q2 * x58);
-        let x72 = 7.11 * x64;
-        let x73 = 7.11 * x65;
+        let x70 = S::mul_add(s_q2, x59, c_q2 * x58);
+        let x71 = S::mul_add(S::neg(c_q2), x59, s_q2 * x58);
+        let x72 = S::splat(7.11) * x64;
+        let x73 = S::splat(7.11) * x65;
         let x74 = x60
-            - Self::mul_add(-0.475, Self::mul_add(x58, x58, x63), 7.11 * (x62 + x62));
-        let x75 = Self::mul_add(c_q2, x73, s_q2 * x72);
-        let x76 = Self::mul_add(-qd[2], x71, Self::mul_add(-s_q2, x62, c_q2 * x61));
-        let x77 = Self::mul_add(qd[2], x70, Self::mul_add(c_q2, x62, s_q2 * x61));
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x58, x58, x63),
+                S::splat(7.11) * (x62 + x62),
+            );
+        let x75 = S::mul_add(c_q2, x73, s_q2 * x72);
+        let x76 = S::mul_add(
+            S::neg(qd[2]),
+            x71,
+            S::mul_add(S::neg(s_q2), x62, c_q2 * x61),
+        );
+        let x77 = S::mul_add(qd[2], x70, S::mul_add(c_q2, x62, s_q2 * x61));
         let x78 = qd[1] + qd[2];
-        let x79 = Self::mul_add(x78, x78, x71 * x71);
+        let x79 = S::mul_add(x78, x78, x71 * x71);
         let x80 = x70 * x71;
-        let x81 = Self::mul_add(x70, x78, x77);
-        let x82 = 1375.0472756800002 * x78;
-        let x83 = 24989.305802 * x71;
-        let x84 = Self::mul_add(-24998.827802, x78, 1375.0472756800002 * x70);
-        let x85 = Self::mul_add(
-            -3239.4582,
+        let x81 = S::mul_add(x70, x78, x77);
+        let x82 = S::splat(1375.0472756800002) * x78;
+        let x83 = S::splat(24989.305802) * x71;
+        let x84 = S::mul_add(
+            S::splat(-24998.827802),
+            x78,
+            S::splat(1375.0472756800002) * x70,
+        );
+        let x85 = S::mul_add(
+            S::splat(-3239.4582),
             x74,
-            Self::mul_add(24989.305802, x77, Self::mul_add(-x70, x84, x78 * x82)),
+            S::mul_add(
+                S::splat(24989.305802),
+                x77,
+                S::mul_add(S::neg(x70), x84, x78 * x82),
+            ),
         );
-        let x86 = Self::mul_add(
-            -3239.4582,
+        let x86 = S::mul_add(
+            S::splat(-3239.4582),
             x75,
-            Self::mul_add(1375.0472756800002, x76, Self::mul_add(x70, x83, x71 * x82)),
+            S::mul_add(
+                S::splat(1375.0472756800002),
+                x76,
+                S::mul_add(x70, x83, x71 * x82),
+            ),
         );
-        let x87 = Self::mul_add(-s_q3, x71, c_q3 * x70);
-        let x88 = Self::mul_add(c_q3, x71, s_q3 * x70);
-        let x89 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-7.11, x80, x75),
-            c_q3 * Self::mul_add(7.11, x79, Self::mul_add(-s_q2, x73, c_q2 * x72)),
+        let x87 = S::mul_add(S::neg(s_q3), x71, c_q3 * x70);
+        let x88 = S::mul_add(c_q3, x71, s_q3 * x70);
+        let x89 = S::mul_add(
+            S::neg(s_q3),
+            S::mul_add(S::splat(-7.11), x80, x75),
+            c_q3
+                * S::mul_add(
+                    S::splat(7.11),
+                    x79,
+                    S::mul_add(S::neg(s_q2), x73, c_q2 * x72),
+                ),
         );
-        let x90 = Self::mul_add(-qd[3], x88, Self::mul_add(-s_q3, x77, c_q3 * x76));
-        let x91 = Self::mul_add(qd[3], x87, Self::mul_add(c_q3, x77, s_q3 * x76));
+        let x90 = S::mul_add(
+            S::neg(qd[3]),
+            x88,
+            S::mul_add(S::neg(s_q3), x77, c_q3 * x76),
+        );
+        let x91 = S::mul_add(qd[3], x87, S::mul_add(c_q3, x77, s_q3 * x76));
         let x92 = qd[3] + x78;
-        let x93 = 171.195516 * (x87 * x88);
-        let x94 = 171.195516 * Self::mul_add(x87, x87, x92 * x92);
-        let x95 = 171.195516 * Self::mul_add(-x88, x92, x90);
-        let x96 = Self::mul_add(-97.44448770720001, x92, x88 * 177.0883695416);
-        let x97 = Self::mul_add(179.8829695416, x92, 97.44448770720001 * x88);
-        let x98 = Self::mul_add(c_q4, x92, s_q4 * x87);
-        let x99 = Self::mul_add(-s_q4, x92, c_q4 * x87);
-        let x100 = Self::mul_add(-qd[4], x98, c_q4 * x90);
+        let x93 = S::splat(171.195516) * (x87 * x88);
+        let x94 = S::splat(171.195516) * S::mul_add(x87, x87, x92 * x92);
+        let x95 = S::splat(171.195516) * S::mul_add(S::neg(x88), x92, x90);
+        let x96 = S::mul_add(
+            S::splat(-97.44448770720001),
+            x92,
+            x88 * S::splat(177.0883695416),
+        );
+        let x97 = S::mul_add(
+            S::splat(179.8829695416),
+            x92,
+            S::splat(97.44448770720001) * x88,
+        );
+        let x98 = S::mul_add(c_q4, x92, s_q4 * x87);
+        let x99 = S::mul_add(S::neg(s_q4), x92, c_q4 * x87);
+        let x100 = S::mul_add(S::neg(qd[4]), x98, c_q4 * x90);
         let x101 = qd[4] - x88;
-        let x102 = 44.41 * x99;
-        let x103 = 47.471 * x101;
-        let x104 = 9.336 * x100;
-        let x105 = -x104;
-        let x106 = 9.336 * (qd[5] - x99);
-        let x107 = Self::mul_add(-c_q5, x101, s_q5 * x98) * x106;
-        let x108 = Self::mul_add(s_q5, x101, c_q5 * x98) * x106;
-        let x109 = Self::mul_add(x99, x103, x101 * x102)
-            - Self::mul_add(-s_q5, x108, c_q5 * x107);
-        let x110 = Self::mul_add(x98, x103, 44.41 * x100) - x104;
-        let x111 = Self::mul_add(x98, x102, 47.471 * x91)
-            + Self::mul_add(c_q5, x108, s_q5 * x107);
-        let x112 = -x111;
-        let x113 = Self::mul_add(
-            171.195516,
-            Self::mul_add(-7.11, x81, x74),
-            Self::mul_add(x88, x97, x92 * x96),
-        ) - Self::mul_add(-c_q4, x110, s_q4 * x109);
-        let x114 = Self::mul_add(-x87, x97, x91 * 177.0883695416) - x111;
-        let x115 = Self::mul_add(
-            171.195516,
+        let x102 = S::splat(44.41) * x99;
+        let x103 = S::splat(47.471) * x101;
+        let x104 = S::splat(9.336) * x100;
+        let x105 = S::neg(x104);
+        let x106 = S::splat(9.336) * (qd[5] - x99);
+        let x107 = S::mul_add(S::neg(c_q5), x101, s_q5 * x98) * x106;
+        let x108 = S::mul_add(s_q5, x101, c_q5 * x98) * x106;
+        let x109 = S::mul_add(x99, x103, x101 * x102)
+            - S::mul_add(S::neg(s_q5), x108, c_q5 * x107);
+        let x110 = S::mul_add(x98, x103, S::splat(44.41) * x100) - x104;
+        let x111 = S::mul_add(x98, x102, S::splat(47.471) * x91)
+            + S::mul_add(c_q5, x108, s_q5 * x107);
+        let x112 = S::neg(x111);
+        let x113 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::splat(-7.11), x81, x74),
+            S::mul_add(x88, x97, x92 * x96),
+        ) - S::mul_add(S::neg(c_q4), x110, s_q4 * x109);
+        let x114 = S::mul_add(S::neg(x87), x97, x91 * S::splat(177.0883695416)) - x111;
+        let x115 = S::mul_add(
+            S::splat(171.195516),
             x89,
-            Self::mul_add(x87, x96, 97.44448770720001 * x91),
-        ) + Self::mul_add(s_q4, x110, c_q4 * x109);
-        let x116 = Self::mul_add(c_q3, x94, s_q3 * x93);
-        let x117 = Self::mul_add(3239.4582, x79, Self::mul_add(-s_q3, x94, c_q3 * x93));
-        let x118 = Self::mul_add(3239.4582, x80, x116);
-        let x119 = Self::mul_add(x71, x84, x78 * x83)
-            - Self::mul_add(s_q3, x114, c_q3 * x113);
+            S::mul_add(x87, x96, S::splat(97.44448770720001) * x91),
+        ) + S::mul_add(s_q4, x110, c_q4 * x109);
+        let x116 = S::mul_add(c_q3, x94, s_q3 * x93);
+        let x117 = S::mul_add(
+            S::splat(3239.4582),
+            x79,
+            S::mul_add(S::neg(s_q3), x94, c_q3 * x93),
+        );
+        let x118 = S::mul_add(S::splat(3239.4582), x80, x116);
+        let x119 = S::mul_add(x71, x84, x78 * x83) - S::mul_add(s_q3, x114, c_q3 * x113);
         let x120 = x85
-            + Self::mul_add(7.11, x95, Self::mul_add(-c_q3, x114, s_q3 * x113));
-        let x121 = x86 - Self::mul_add(-7.11, x116, x115);
-        let x122 = -x121;
-        let x123 = Self::mul_add(-s_q2, x118, c_q2 * x117);
-        let x124 = Self::mul_add(c_q2, x118, s_q2 * x117);
-        let x125 = -(Self::mul_add(
-            3946.1881206800003,
-            x61,
-            -Self::mul_add(x58, x67, x59 * x66),
-        ) + Self::mul_add(7.11, x124, x121));
-        let x126 = Self::mul_add(
+            + S::mul_add(
+                S::splat(7.11),
+                x95,
+                S::mul_add(S::neg(c_q3), x114, s_q3 * x113),
+            );
+        let x121 = x86 - S::mul_add(S::splat(-7.11), x116, x115);
+        let x122 = S::neg(x121);
+        let x123 = S::mul_add(S::neg(s_q2), x118, c_q2 * x117);
+        let x124 = S::mul_add(c_q2, x118, s_q2 * x117);
+        let x125 = S::neg(
+            S::mul_add(
+                S::splat(3946.1881206800003),
+                x61,
+                S::neg(S::mul_add(x58, x67, x59 * x66)),
+            ) + S::mul_add(S::splat(7.11), x124, x121),
+        );
+        let x126 = S::mul_add(
             c_q1,
             x69
-                - (Self::mul_add(-c_q2, x120, s_q2 * x119)
-                    - Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x81, x95),
-                        0.475 * x123,
+                - (S::mul_add(S::neg(c_q2), x120, s_q2 * x119)
+                    - S::mul_add(
+                        S::splat(7.11),
+                        S::mul_add(S::splat(3239.4582), x81, x95),
+                        S::splat(0.475) * x123,
                     )),
             s_q1
-                * (Self::mul_add(x59, x68, qd[1] * x67)
-                    - Self::mul_add(0.475, x124, Self::mul_add(s_q2, x120, c_q2 * x119))),
+                * (S::mul_add(x59, x68, qd[1] * x67)
+                    - S::mul_add(
+                        S::splat(0.475),
+                        x124,
+                        S::mul_add(s_q2, x120, c_q2 * x119),
+                    )),
         );
-        let x127 = Self::mul_add(
-            0.5692,
-            Self::mul_add(
+        let x127 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x65, -x124),
-                c_q1 * Self::mul_add(5224.5702, x64, x123),
+                S::mul_add(S::splat(5224.5702), x65, S::neg(x124)),
+                c_q1 * S::mul_add(S::splat(5224.5702), x64, x123),
             ),
             x126,
         );
-        let x128 = -x127;
+        let x128 = S::neg(x127);
         (
             [
                 [x42, x43, x44, x49, x52, x57],
-                [x43, x39, x37, x47, 0.0, x54],
-                [x44, x37, x22, x18, 0.0, x54],
-                [x49, x47, x18, x8, 0.0, x54],
-                [x52, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x57, x54, x54, x54, 0.0, 9.336],
+                [x43, x39, x37, x47, S::splat(0.0), x54],
+                [x44, x37, x22, x18, S::splat(0.0), x54],
+                [x49, x47, x18, x8, S::splat(0.0), x54],
+                [
+                    x52,
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(0.0),
+                    S::splat(47.471),
+                    S::splat(0.0),
+                ],
+                [x57, x54, x54, x54, S::splat(0.0), S::splat(9.336)],
             ],
             [x128, x125, x122, x115, x112, x105],
         )
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        out: &mut [([[::core::primitive::f64; 6]; 6], [::core::primitive::f64; 6])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
@@ -2099,327 +2615,469 @@ impl Ssrms6 {
         tau: &[::core::primitive::f64; 6],
         f_ext: &[[::core::primitive::f64; 6]; 6],
     ) -> [::core::primitive::f64; 6] {
-        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+        Self::forward_dynamics_with_wrenches_lanes::<
+            ::core::primitive::f64,
+        >(q, qd, tau, f_ext)
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 6], qd: &[S; 6], tau: &[S; 6], f_ext: &[[S; 6]; 6]) -> [S; 6] {
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = S::sincos_n([
             q[1],
             q[2],
             q[3],
             q[4],
             q[5],
         ]);
-        let x5 = s_q4 * s_q4 * 35.074;
-        let x6 = s_q4 * c_q4 * 35.074;
-        let x7 = 132.6783695416 + (9.336 + x5);
-        let x8 = 135.4729695416 + (44.41 - x5);
-        let x9 = 47.471 - x7;
+        let x5 = s_q4 * s_q4 * S::splat(35.074);
+        let x6 = s_q4 * c_q4 * S::splat(35.074);
+        let x7 = S::splat(132.6783695416) + (S::splat(9.336) + x5);
+        let x8 = S::splat(135.4729695416) + (S::splat(44.41) - x5);
+        let x9 = S::splat(47.471) - x7;
         let x10 = s_q3 * s_q3 * x9;
-        let x11 = Self::mul_add(-s_q3, x6, c_q3 * 97.44448770720001);
-        let x12 = Self::mul_add(c_q3, x6, s_q3 * 97.44448770720001);
-        let x13 = c_q3 * 171.195516;
-        let x14 = s_q3 * 171.195516;
-        let x15 = 7.11 * x14;
+        let x11 = S::mul_add(S::neg(s_q3), x6, c_q3 * S::splat(97.44448770720001));
+        let x12 = S::mul_add(c_q3, x6, s_q3 * S::splat(97.44448770720001));
+        let x13 = c_q3 * S::splat(171.195516);
+        let x14 = s_q3 * S::splat(171.195516);
+        let x15 = S::splat(7.11) * x14;
         let x16 = x8 - x15;
-        let x17 = Self::mul_add(7.11, x13, s_q3 * c_q3 * x9);
-        let x18 = x15 - (47.471 - x10 - x15);
-        let x19 = 3239.4582 - x14;
-        let x20 = -24989.305802 + (x7 + x10);
-        let x21 = 1375.0472756800002 - x12;
-        let x22 = 24998.827802 - (x15 - x16);
+        let x17 = S::mul_add(S::splat(7.11), x13, s_q3 * c_q3 * x9);
+        let x18 = x15 - (S::splat(47.471) - x10 - x15);
+        let x19 = S::splat(3239.4582) - x14;
+        let x20 = S::splat(-24989.305802) + (x7 + x10);
+        let x21 = S::splat(1375.0472756800002) - x12;
+        let x22 = S::splat(24998.827802) - (x15 - x16);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
         let x25 = x18 + x20;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(-x24, x26, x23 * x25);
+        let x27 = S::mul_add(S::neg(x24), x26, x23 * x25);
         let x28 = c_q2 * x11;
         let x29 = s_q2 * x11;
         let x30 = c_q2 * x13;
-        let x31 = Self::mul_add(s_q2, x19, x30);
+        let x31 = S::mul_add(s_q2, x19, x30);
         let x32 = s_q2 * x13;
-        let x33 = Self::mul_add(-c_q2, x19, x32);
-        let x34 = 7.11 * x33;
-        let x35 = Self::mul_add(x33, 0.475, Self::mul_add(-c_q2, x21, x29));
+        let x33 = S::mul_add(S::neg(c_q2), x19, x32);
+        let x34 = S::splat(7.11) * x33;
+        let x35 = S::mul_add(x33, S::splat(0.475), S::mul_add(S::neg(c_q2), x21, x29));
         let x36 = x22 - x34;
-        let x37 = Self::mul_add(7.11, x31, x17 - Self::mul_add(x23, x26, x24 * x25));
+        let x37 = S::mul_add(S::splat(7.11), x31, x17 - S::mul_add(x23, x26, x24 * x25));
         let x38 = x34 + (x18 - x27 + x34);
-        let x39 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(s_q2, x21, x28));
+        let x39 = c_q1 * S::mul_add(x31, S::splat(0.475), S::mul_add(s_q2, x21, x28));
         let x40 = c_q1 * x31;
-        let x41 = Self::mul_add(
-            0.5692,
-            Self::mul_add(s_q1, 5224.5702 - x33, x40),
-            Self::mul_add(s_q1, 3946.18812068 - x35, x39),
+        let x41 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(s_q1, S::splat(5224.5702) - x33, x40),
+            S::mul_add(s_q1, S::splat(3946.18812068) - x35, x39),
         );
-        let x42 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x33, x40),
-            Self::mul_add(-s_q1, x35, x39),
+        let x42 = S::mul_add(
+            S::splat(0.5692),
+            S::mul_add(S::neg(s_q1), x33, x40),
+            S::mul_add(S::neg(s_q1), x35, x39),
         );
-        let x43 = Self::mul_add(-s_q2, x14, x30);
-        let x44 = Self::mul_add(c_q2, x14, x32);
-        let x45 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(0.475, x43, Self::mul_add(-s_q2, x12, x28)),
-            s_q1 * Self::mul_add(0.475, x44, Self::mul_add(c_q2, x12, x29)),
+        let x43 = S::mul_add(S::neg(s_q2), x14, x30);
+        let x44 = S::mul_add(c_q2, x14, x32);
+        let x45 = S::mul_add(
+            S::neg(c_q1),
+            S::mul_add(S::splat(0.475), x43, S::mul_add(S::neg(s_q2), x12, x28)),
+            s_q1 * S::mul_add(S::splat(0.475), x44, S::mul_add(c_q2, x12, x29)),
         );
-        let x46 = Self::mul_add(-0.5692, Self::mul_add(-s_q1, x44, c_q1 * x43), x45);
-        let x47 = 47.471 * s_q3;
-        let x48 = 47.471 * c_q3;
-        let x49 = Self::mul_add(
+        let x46 = S::mul_add(
+            S::splat(-0.5692),
+            S::mul_add(S::neg(s_q1), x44, c_q1 * x43),
+            x45,
+        );
+        let x47 = S::splat(47.471) * s_q3;
+        let x48 = S::splat(47.471) * c_q3;
+        let x49 = S::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x48, s_q2 * x47),
-            s_q1 * Self::mul_add(s_q2, x48, c_q2 * x47),
+            S::mul_add(S::neg(c_q2), x48, s_q2 * x47),
+            s_q1 * S::mul_add(s_q2, x48, c_q2 * x47),
         );
-        let x50 = 9.336 * c_q4;
-        let x51 = 9.336 * s_q4;
+        let x50 = S::splat(9.336) * c_q4;
+        let x51 = S::splat(9.336) * s_q4;
         let x52 = c_q3 * x50;
         let x53 = s_q3 * x50;
-        let x54 = Self::mul_add(
+        let x54 = S::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x53, s_q2 * x52),
-            s_q1 * Self::mul_add(-s_q2, x53, c_q2 * x52),
+            S::mul_add(c_q2, x53, s_q2 * x52),
+            s_q1 * S::mul_add(S::neg(s_q2), x53, c_q2 * x52),
         );
         let x55 = qd[0] * s_q1;
         let x56 = qd[0] * c_q1;
-        let x57 = 0.5692 * (qd[0] * qd[0]);
+        let x57 = S::splat(0.5692) * (qd[0] * qd[0]);
         let x58 = qd[1] * x56;
         let x59 = qd[1] * x55;
         let x60 = x56 * x56;
-        let x61 = Self::mul_add(qd[1], qd[1], x60);
+        let x61 = S::mul_add(qd[1], qd[1], x60);
         let x62 = x55 * x56;
-        let x63 = Self::mul_add(3946.18812068, qd[1], x55 * 39234.47412200001);
-        let x64 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x55);
-        let x65 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x66 = Self::mul_add(-c_q2, x56, s_q2 * x55);
-        let x67 = 7.11 * x61;
-        let x68 = 7.11 * x62;
+        let x63 = S::mul_add(
+            S::splat(3946.18812068),
+            qd[1],
+            x55 * S::splat(39234.47412200001),
+        );
+        let x64 = S::mul_add(
+            S::splat(-39241.404122),
+            qd[1],
+            S::splat(3946.1881206800003) * x55,
+        );
+        let x65 = S::mul_add(s_q2, x56, c_q2 * x55);
+        let x66 = S::mul_add(S::neg(c_q2), x56, s_q2 * x55);
+        let x67 = S::splat(7.11) * x61;
+        let x68 = S::splat(7.11) * x62;
         let x69 = x57
-            - Self::mul_add(-0.475, Self::mul_add(x55, x55, x60), 7.11 * (x59 + x59));
-        let x70 = Self::mul_add(c_q2, x68, s_q2 * x67);
-        let x71 = Self::mul_add(-qd[2], x66, Self::mul_add(-s_q2, x59, c_q2 * x58));
-        let x72 = Self::mul_add(qd[2], x65, Self::mul_add(c_q2, x59, s_q2 * x58));
+            - S::mul_add(
+                S::splat(-0.475),
+                S::mul_add(x55, x55, x60),
+                S::splat(7.11) * (x59 + x59),
+            );
+        let x70 = S::mul_add(c_q2, x68, s_q2 * x67);
+        let x71 = S::mul_add(
+            S::neg(qd[2]),
+            x66,
+            S::mul_add(S::neg(s_q2), x59, c_q2 * x58),
+        );
+        let x72 = S::mul_add(qd[2], x65, S::mul_add(c_q2, x59, s_q2 * x58));
         let x73 = qd[1] + qd[2];
-        let x74 = Self::mul_add(x66, x66, x73 * x73);
+        let x74 = S::mul_add(x66, x66, x73 * x73);
         let x75 = x65 * x66;
-        let x76 = Self::mul_add(x65, x73, x72);
-        let x77 = Self::mul_add(1375.0472756800002, x73, x65 * 24989.305802);
-        let x78 = Self::mul_add(-24998.827802, x73, 1375.0472756800002 * x65);
-        let x79 = Self::mul_add(-s_q3, x66, c_q3 * x65);
-        let x80 = Self::mul_add(c_q3, x66, s_q3 * x65);
-        let x81 = Self::mul_add(
-            -s_q3,
-            Self::mul_add(-7.11, x75, x70),
-            c_q3 * Self::mul_add(7.11, x74, Self::mul_add(-s_q2, x68, c_q2 * x67)),
+        let x76 = S::mul_add(x65, x73, x72);
+        let x77 = S::mul_add(
+            S::splat(1375.0472756800002),
+            x73,
+            x65 * S::splat(24989.305802),
         );
-        let x82 = Self::mul_add(-qd[3], x80, Self::mul_add(-s_q3, x72, c_q3 * x71));
-        let x83 = Self::mul_add(qd[3], x79, Self::mul_add(c_q3, x72, s_q3 * x71));
+        let x78 = S::mul_add(
+            S::splat(-24998.827802),
+            x73,
+            S::splat(1375.0472756800002) * x65,
+        );
+        let x79 = S::mul_add(S::neg(s_q3), x66, c_q3 * x65);
+        let x80 = S::mul_add(c_q3, x66, s_q3 * x65);
+        let x81 = S::mul_add(
+            S::neg(s_q3),
+            S::mul_add(S::splat(-7.11), x75, x70),
+            c_q3
+                * S::mul_add(
+                    S::splat(7.11),
+                    x74,
+                    S::mul_add(S::neg(s_q2), x68, c_q2 * x67),
+                ),
+        );
+        let x82 = S::mul_add(
+            S::neg(qd[3]),
+            x80,
+            S::mul_add(S::neg(s_q3), x72, c_q3 * x71),
+        );
+        let x83 = S::mul_add(qd[3], x79, S::mul_add(c_q3, x72, s_q3 * x71));
         let x84 = qd[3] + x73;
-        let x85 = 132.6783695416 * x79;
-        let x86 = Self::mul_add(97.44448770720001, x80, 135.4729695416 * x84);
-        let x87 = 97.44448770720001 * x84;
-        let x88 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(-7.11, x76, x69),
-            Self::mul_add(132.6783695416, x82, -Self::mul_add(-x84, x87, x80 * x86)),
+        let x85 = S::splat(132.6783695416) * x79;
+        let x86 = S::mul_add(
+            S::splat(97.44448770720001),
+            x80,
+            S::splat(135.4729695416) * x84,
         );
-        let x89 = Self::mul_add(
-            171.195516,
+        let x87 = S::splat(97.44448770720001) * x84;
+        let x88 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(S::splat(-7.11), x76, x69),
+            S::mul_add(
+                S::splat(132.6783695416),
+                x82,
+                S::neg(S::mul_add(S::neg(x84), x87, x80 * x86)),
+            ),
+        );
+        let x89 = S::mul_add(
+            S::splat(171.195516),
             x81,
-            Self::mul_add(97.44448770720001, x83, Self::mul_add(-x79, x87, x80 * x85)),
+            S::mul_add(
+                S::splat(97.44448770720001),
+                x83,
+                S::mul_add(S::neg(x79), x87, x80 * x85),
+            ),
         );
-        let x90 = Self::mul_add(-s_q4, x84, c_q4 * x79);
-        let x91 = Self::mul_add(c_q4, x84, s_q4 * x79);
+        let x90 = S::mul_add(S::neg(s_q4), x84, c_q4 * x79);
+        let x91 = S::mul_add(c_q4, x84, s_q4 * x79);
         let x92 = qd[4] - x80;
-        let x93 = 44.41 * x91;
-        let x94 = 47.471 * x92;
-        let x95 = 9.336 * (qd[5] - x90);
-        let x96 = Self::mul_add(
-            9.336,
-            Self::mul_add(-qd[4], x91, c_q4 * x82),
+        let x93 = S::splat(44.41) * x91;
+        let x94 = S::splat(47.471) * x92;
+        let x95 = S::splat(9.336) * (qd[5] - x90);
+        let x96 = S::mul_add(
+            S::splat(9.336),
+            S::mul_add(S::neg(qd[4]), x91, c_q4 * x82),
             f_ext[5][3],
         );
-        let x97 = Self::mul_add(Self::mul_add(-c_q5, x92, s_q5 * x91), x95, f_ext[5][4]);
-        let x98 = Self::mul_add(Self::mul_add(s_q5, x92, c_q5 * x91), x95, f_ext[5][5]);
-        let x99 = Self::mul_add(-f_ext[5][2], s_q5, f_ext[5][1] * c_q5);
+        let x97 = S::mul_add(
+            S::mul_add(S::neg(c_q5), x92, s_q5 * x91),
+            x95,
+            f_ext[5][4],
+        );
+        let x98 = S::mul_add(S::mul_add(s_q5, x92, c_q5 * x91), x95, f_ext[5][5]);
+        let x99 = S::mul_add(S::neg(f_ext[5][2]), s_q5, f_ext[5][1] * c_q5);
         let x100 = f_ext[4][0] + f_ext[5][0];
         let x101 = f_ext[4][1] + x99;
-        let x102 = f_ext[4][2] + Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x103 = f_ext[4][3] + Self::mul_add(-x91, x94, x92 * x93)
-            + Self::mul_add(0.7026, x99, x96);
+        let x102 = f_ext[4][2] + S::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x103 = f_ext[4][3] + S::mul_add(S::neg(x91), x94, x92 * x93)
+            + S::mul_add(S::splat(0.7026), x99, x96);
         let x104 = f_ext[4][4]
-            - Self::mul_add(x90, x94, 44.41 * Self::mul_add(qd[4], x90, s_q4 * x82))
-            + Self::mul_add(-0.7026, f_ext[5][0], Self::mul_add(-s_q5, x98, c_q5 * x97));
-        let x105 = f_ext[4][5] + Self::mul_add(x90, x93, 47.471 * x83)
-            + Self::mul_add(c_q5, x98, s_q5 * x97);
-        let x106 = Self::mul_add(-s_q4, x101, c_q4 * x100);
-        let x107 = Self::mul_add(171.195516, x79 * x80, f_ext[3][0]) + x106;
-        let x108 = Self::mul_add(171.195516, Self::mul_add(-x80, x84, x82), f_ext[3][1])
-            + Self::mul_add(c_q4, x101, s_q4 * x100);
-        let x109 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(x79, x79, x84 * x84),
+            - S::mul_add(x90, x94, S::splat(44.41) * S::mul_add(qd[4], x90, s_q4 * x82))
+            + S::mul_add(
+                S::splat(-0.7026),
+                f_ext[5][0],
+                S::mul_add(S::neg(s_q5), x98, c_q5 * x97),
+            );
+        let x105 = f_ext[4][5] + S::mul_add(x90, x93, S::splat(47.471) * x83)
+            + S::mul_add(c_q5, x98, s_q5 * x97);
+        let x106 = S::mul_add(S::neg(s_q4), x101, c_q4 * x100);
+        let x107 = S::mul_add(S::splat(171.195516), x79 * x80, f_ext[3][0]) + x106;
+        let x108 = S::mul_add(
+            S::splat(171.195516),
+            S::mul_add(S::neg(x80), x84, x82),
+            f_ext[3][1],
+        ) + S::mul_add(c_q4, x101, s_q4 * x100);
+        let x109 = S::mul_add(
+            S::splat(-171.195516),
+            S::mul_add(x79, x79, x84 * x84),
             f_ext[3][2],
         ) + x102;
         let x110 = f_ext[3][3] + x88
-            + Self::mul_add(-0.5692, x102, Self::mul_add(-s_q4, x104, c_q4 * x103));
-        let x111 = f_ext[3][4] - x89 + Self::mul_add(c_q4, x104, s_q4 * x103);
-        let x112 = f_ext[3][5] - Self::mul_add(-x79, x86, x84 * x85)
-            + Self::mul_add(0.5692, x106, x105);
-        let x113 = Self::mul_add(-c_q3, x109, s_q3 * x107);
-        let x114 = Self::mul_add(3239.4582, x74, f_ext[2][0])
-            + Self::mul_add(s_q3, x109, c_q3 * x107);
-        let x115 = Self::mul_add(-3239.4582, x75, f_ext[2][2]) - x113;
-        let x116 = f_ext[2][3] - Self::mul_add(-x66, x78, x71 * 24989.305802)
-            + Self::mul_add(s_q3, x112, c_q3 * x110);
+            + S::mul_add(
+                S::splat(-0.5692),
+                x102,
+                S::mul_add(S::neg(s_q4), x104, c_q4 * x103),
+            );
+        let x111 = f_ext[3][4] - x89 + S::mul_add(c_q4, x104, s_q4 * x103);
+        let x112 = f_ext[3][5] - S::mul_add(S::neg(x79), x86, x84 * x85)
+            + S::mul_add(S::splat(0.5692), x106, x105);
+        let x113 = S::mul_add(S::neg(c_q3), x109, s_q3 * x107);
+        let x114 = S::mul_add(S::splat(3239.4582), x74, f_ext[2][0])
+            + S::mul_add(s_q3, x109, c_q3 * x107);
+        let x115 = S::mul_add(S::splat(-3239.4582), x75, f_ext[2][2]) - x113;
+        let x116 = f_ext[2][3]
+            - S::mul_add(S::neg(x66), x78, x71 * S::splat(24989.305802))
+            + S::mul_add(s_q3, x112, c_q3 * x110);
         let x117 = f_ext[2][4]
-            + Self::mul_add(
-                -3239.4582,
+            + S::mul_add(
+                S::splat(-3239.4582),
                 x70,
-                Self::mul_add(x66, x77, 1375.0472756800002 * x71),
-            ) + Self::mul_add(7.11, x113, x111);
+                S::mul_add(x66, x77, S::splat(1375.0472756800002) * x71),
+            ) + S::mul_add(S::splat(7.11), x113, x111);
         let x118 = f_ext[2][5]
-            + Self::mul_add(-3239.4582, x69, Self::mul_add(-x65, x78, x73 * x77))
-            - Self::mul_add(-7.11, x108, Self::mul_add(-c_q3, x112, s_q3 * x110));
-        let x119 = Self::mul_add(s_q2, x115, c_q2 * x114);
-        let x120 = Self::mul_add(-c_q2, x115, s_q2 * x114);
-        let x121 = Self::mul_add(
-            -c_q1,
+            + S::mul_add(
+                S::splat(-3239.4582),
+                x69,
+                S::mul_add(S::neg(x65), x78, x73 * x77),
+            )
+            - S::mul_add(
+                S::splat(-7.11),
+                x108,
+                S::mul_add(S::neg(c_q3), x112, s_q3 * x110),
+            );
+        let x119 = S::mul_add(s_q2, x115, c_q2 * x114);
+        let x120 = S::mul_add(S::neg(c_q2), x115, s_q2 * x114);
+        let x121 = S::mul_add(
+            S::neg(c_q1),
             f_ext[1][5]
-                + Self::mul_add(-5224.5702, x57, Self::mul_add(-x55, x64, qd[1] * x63))
-                - (Self::mul_add(-c_q2, x118, s_q2 * x116)
-                    - Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x76, f_ext[2][1]) + x108,
-                        0.475 * x119,
+                + S::mul_add(
+                    S::splat(-5224.5702),
+                    x57,
+                    S::mul_add(S::neg(x55), x64, qd[1] * x63),
+                )
+                - (S::mul_add(S::neg(c_q2), x118, s_q2 * x116)
+                    - S::mul_add(
+                        S::splat(7.11),
+                        S::mul_add(S::splat(3239.4582), x76, f_ext[2][1]) + x108,
+                        S::splat(0.475) * x119,
                     )),
             s_q1
-                * (f_ext[1][3] - Self::mul_add(x56, x64, x58 * 39234.47412200001)
-                    + Self::mul_add(0.475, x120, Self::mul_add(s_q2, x118, c_q2 * x116))),
+                * (f_ext[1][3] - S::mul_add(x56, x64, x58 * S::splat(39234.47412200001))
+                    + S::mul_add(
+                        S::splat(0.475),
+                        x120,
+                        S::mul_add(s_q2, x118, c_q2 * x116),
+                    )),
         );
-        let x122 = Self::mul_add(
-            -0.5692,
-            Self::mul_add(
+        let x122 = S::mul_add(
+            S::splat(-0.5692),
+            S::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x62, f_ext[1][2]) - x120,
-                c_q1 * (Self::mul_add(5224.5702, x61, f_ext[1][0]) + x119),
+                S::mul_add(S::splat(5224.5702), x62, f_ext[1][2]) - x120,
+                c_q1 * (S::mul_add(S::splat(5224.5702), x61, f_ext[1][0]) + x119),
             ),
             x121,
         );
         let x123 = tau[0] + (f_ext[0][5] - x122);
-        let x124 = 1.0
-            / (65697.3302265768
+        let x124 = S::splat(1.0)
+            / (S::splat(65697.3302265768)
                 - (x38
-                    - Self::mul_add(
-                        -(s_q1 * c_q1),
+                    - S::mul_add(
+                        S::neg(s_q1 * c_q1),
                         x37 + x37,
-                        s_q1 * s_q1 * (x38 + (-39234.47412200001 + (x20 - x27))),
+                        s_q1 * s_q1
+                            * (x38 + (S::splat(-39234.47412200001) + (x20 - x27))),
                     )));
         let x125 = x41 * x124;
         let x126 = x42 * x124;
         let x127 = x46 * x124;
         let x128 = x49 * x124;
         let x129 = x54 * x124;
-        let x130 = 1.0 / Self::mul_add(-x41, x125, 39241.404122 - (x34 - x36));
-        let x131 = Self::mul_add(-x41, x126, x36);
+        let x130 = S::splat(1.0)
+            / S::mul_add(S::neg(x41), x125, S::splat(39241.404122) - (x34 - x36));
+        let x131 = S::mul_add(S::neg(x41), x126, x36);
         let x132 = x130 * x131;
-        let x133 = Self::mul_add(x41, x127, Self::mul_add(-7.11, x44, x16));
+        let x133 = S::mul_add(x41, x127, S::mul_add(S::splat(-7.11), x44, x16));
         let x134 = x130 * x133;
         let x135 = x41 * x128;
         let x136 = x130 * x135;
-        let x137 = Self::mul_add(-x41, x129, x51);
+        let x137 = S::mul_add(S::neg(x41), x129, x51);
         let x138 = x130 * x137;
-        let x139 = 1.0 / Self::mul_add(-x131, x132, Self::mul_add(-x42, x126, x22));
-        let x140 = Self::mul_add(-x131, x134, Self::mul_add(x42, x127, x16));
+        let x139 = S::splat(1.0)
+            / S::mul_add(S::neg(x131), x132, S::mul_add(S::neg(x42), x126, x22));
+        let x140 = S::mul_add(S::neg(x131), x134, S::mul_add(x42, x127, x16));
         let x141 = x139 * x140;
-        let x142 = Self::mul_add(-x131, x136, x42 * x128);
+        let x142 = S::mul_add(S::neg(x131), x136, x42 * x128);
         let x143 = x139 * x142;
-        let x144 = Self::mul_add(-x131, x138, Self::mul_add(-x42, x129, x51));
+        let x144 = S::mul_add(S::neg(x131), x138, S::mul_add(S::neg(x42), x129, x51));
         let x145 = x139 * x144;
-        let x146 = Self::mul_add(
-            -x140,
+        let x146 = S::mul_add(
+            S::neg(x140),
             x141,
-            Self::mul_add(-x133, x134, Self::mul_add(-x46, x127, x8)),
+            S::mul_add(S::neg(x133), x134, S::mul_add(S::neg(x46), x127, x8)),
         );
-        let x147 = 1.0 / x146;
-        let x148 = Self::mul_add(x140, x143, Self::mul_add(x133, x136, x46 * x128));
+        let x147 = S::splat(1.0) / x146;
+        let x148 = S::mul_add(x140, x143, S::mul_add(x133, x136, x46 * x128));
         let x149 = x147 * x148;
-        let x150 = Self::mul_add(
-            -x140,
+        let x150 = S::mul_add(
+            S::neg(x140),
             x145,
-            Self::mul_add(-x133, x138, Self::mul_add(x46, x129, x51)),
+            S::mul_add(S::neg(x133), x138, S::mul_add(x46, x129, x51)),
         );
         let x151 = x147 * x150;
-        let x152 = Self::mul_add(
-            -x142,
+        let x152 = S::mul_add(
+            S::neg(x142),
             x143,
-            Self::mul_add(-x135, x136, Self::mul_add(-x49, x128, 47.471)),
+            S::mul_add(
+                S::neg(x135),
+                x136,
+                S::mul_add(S::neg(x49), x128, S::splat(47.471)),
+            ),
         );
-        let x153 = 1.0 / Self::mul_add(-x148, x149, x152);
-        let x154 = Self::mul_add(
+        let x153 = S::splat(1.0) / S::mul_add(S::neg(x148), x149, x152);
+        let x154 = S::mul_add(
             x148,
             x151,
-            Self::mul_add(-x142, x145, Self::mul_add(-x135, x138, x49 * x129)),
+            S::mul_add(S::neg(x142), x145, S::mul_add(S::neg(x135), x138, x49 * x129)),
         );
         let x155 = x153 * x154;
-        let x156 = Self::mul_add(
-            -x144,
+        let x156 = S::mul_add(
+            S::neg(x144),
             x145,
-            Self::mul_add(-x137, x138, Self::mul_add(-x54, x129, 9.336)),
+            S::mul_add(
+                S::neg(x137),
+                x138,
+                S::mul_add(S::neg(x54), x129, S::splat(9.336)),
+            ),
         );
-        let x157 = 1.0 / Self::mul_add(-x154, x155, Self::mul_add(-x150, x151, x156));
-        let x158 = Self::mul_add(
+        let x157 = S::splat(1.0)
+            / S::mul_add(S::neg(x154), x155, S::mul_add(S::neg(x150), x151, x156));
+        let x158 = S::mul_add(
             x123,
             x125,
             tau[1]
-                + (f_ext[1][4] + Self::mul_add(-x56, x63, 3946.1881206800003 * x58)
-                    + Self::mul_add(7.11, x120, x117)),
+                + (f_ext[1][4]
+                    + S::mul_add(S::neg(x56), x63, S::splat(3946.1881206800003) * x58)
+                    + S::mul_add(S::splat(7.11), x120, x117)),
         );
-        let x159 = Self::mul_add(-x132, x158, Self::mul_add(x123, x126, tau[2] + x117));
-        let x160 = Self::mul_add(
-            -x141,
+        let x159 = S::mul_add(S::neg(x132), x158, S::mul_add(x123, x126, tau[2] + x117));
+        let x160 = S::mul_add(
+            S::neg(x141),
             x159,
-            Self::mul_add(-x134, x158, Self::mul_add(-x123, x127, tau[3] + x111)),
+            S::mul_add(S::neg(x134), x158, S::mul_add(S::neg(x123), x127, tau[3] + x111)),
         );
-        let x161 = Self::mul_add(
+        let x161 = S::mul_add(
             x143,
             x159,
-            Self::mul_add(x136, x158, Self::mul_add(x123, x128, tau[4] + x105)),
+            S::mul_add(x136, x158, S::mul_add(x123, x128, tau[4] + x105)),
         );
-        let x162 = Self::mul_add(-x149, x160, x161);
-        let x163 = Self::mul_add(
-            -x145,
+        let x162 = S::mul_add(S::neg(x149), x160, x161);
+        let x163 = S::mul_add(
+            S::neg(x145),
             x159,
-            Self::mul_add(-x138, x158, Self::mul_add(x123, x129, tau[5] + x96)),
+            S::mul_add(S::neg(x138), x158, S::mul_add(x123, x129, tau[5] + x96)),
         );
-        let x164 = x157 * Self::mul_add(x155, x162, Self::mul_add(-x151, x160, x163));
-        let x165 = Self::mul_add(x155, x164, x153 * x162);
-        let x166 = Self::mul_add(-x151, x164, Self::mul_add(-x149, x165, x147 * x160));
-        let x167 = Self::mul_add(
-            -x145,
+        let x164 = x157 * S::mul_add(x155, x162, S::mul_add(S::neg(x151), x160, x163));
+        let x165 = S::mul_add(x155, x164, x153 * x162);
+        let x166 = S::mul_add(
+            S::neg(x151),
             x164,
-            Self::mul_add(x143, x165, Self::mul_add(-x141, x166, x139 * x159)),
+            S::mul_add(S::neg(x149), x165, x147 * x160),
         );
-        let x168 = Self::mul_add(
+        let x167 = S::mul_add(
+            S::neg(x145),
+            x164,
+            S::mul_add(x143, x165, S::mul_add(S::neg(x141), x166, x139 * x159)),
+        );
+        let x168 = S::mul_add(
             x136,
             x165,
-            Self::mul_add(-x134, x166, Self::mul_add(-x132, x167, x130 * x158)),
+            S::mul_add(S::neg(x134), x166, S::mul_add(S::neg(x132), x167, x130 * x158)),
         );
-        let x169 = Self::mul_add(-x138, x164, x168);
-        let x170 = Self::mul_add(
-            -x127,
+        let x169 = S::mul_add(S::neg(x138), x164, x168);
+        let x170 = S::mul_add(
+            S::neg(x127),
             x166,
-            Self::mul_add(x126, x167, Self::mul_add(x125, x169, x123 * x124)),
+            S::mul_add(x126, x167, S::mul_add(x125, x169, x123 * x124)),
         );
-        let x171 = Self::mul_add(x129, x164, Self::mul_add(x128, x165, x170));
+        let x171 = S::mul_add(x129, x164, S::mul_add(x128, x165, x170));
         [x171, x169, x167, x166, x165, x164]
     }
-    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
-    #[inline(always)]
-    fn mul_add(
-        a: ::core::primitive::f64,
-        b: ::core::primitive::f64,
-        c: ::core::primitive::f64,
-    ) -> ::core::primitive::f64 {
-        kanegen_runtime::fma::mul_add(a, b, c)
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 6]],
+        qd: &[[::core::primitive::f64; 6]],
+        tau: &[[::core::primitive::f64; 6]],
+        f_ext: &[[[::core::primitive::f64; 6]; 6]],
+        out: &mut [[::core::primitive::f64; 6]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -9,9 +9,10 @@
 //! Inertial parameters: regrouped for the local-frame algorithms as Khalil and Kleinfinger regroup them (what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, nonlinear-effects or forward method; without it each takes the cheapest candidate.
-//! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
+//! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet). Not generated: `inverse_dynamics_derivatives`, `forward_dynamics_derivatives`, `mass_matrix_inverse` (not asked for: `derivatives = false`, `--no-derivatives`).
+//! Lanes: every function `NAME` has a `NAME_lanes<S: Lanes<f64>>` form (`kanegen_runtime::lanes`) taking and returning `S` in place of `f64`: `S::LANES` states per call, one per lane of a SIMD vector (`wide`'s `f64x2`, `f64x4`), each lane's results bit for bit those of `NAME` for that lane's state; `NAME_batch<S>` runs it over slices of states, `S::LANES` at a time. `NAME` is its `NAME_lanes` at `S = f64` (one body).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -287,8 +288,15 @@ impl SsrmsRecurrent {
     pub fn mass_matrix(
         q: &[::core::primitive::f64; 7],
     ) -> [[::core::primitive::f64; 7]; 7] {
+        Self::mass_matrix_lanes::<::core::primitive::f64>(q)
+    }
+    /// [`Self::mass_matrix`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_lanes<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[S; 7],
+    ) -> [[S; 7]; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -297,20 +305,20 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
         let x22 = x10 * x14;
         let x23 = x12 * x14;
@@ -318,99 +326,99 @@ impl SsrmsRecurrent {
         let x25 = x12 * x16;
         let x26 = x10 * x19;
         let x27 = x12 * x19;
-        let x28 = s_q1 * 0.5692;
-        let x29 = x10 * 0.5692;
-        let x30 = x12 * 0.5692;
+        let x28 = s_q1 * S::splat(0.5692);
+        let x29 = x10 * S::splat(0.5692);
+        let x30 = x12 * S::splat(0.5692);
         let x31 = c_q1 * c_q2;
         let x32 = c_q1 * s_q2;
-        let x33 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x34 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x35 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x36 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x37 = Self::mul_add(-49.52, s_q1, 15.41 * x31);
-        let x38 = Self::mul_add(-2094.71, s_q1, 49.52 * x31);
-        let x39 = 2103.19 * x32;
-        let x40 = Self::mul_add(49.52, x10, 15.41 * x33);
-        let x41 = Self::mul_add(2094.71, x10, 49.52 * x33);
-        let x42 = 2103.19 * x34;
-        let x43 = Self::mul_add(49.52, x12, 15.41 * x35);
-        let x44 = Self::mul_add(2094.71, x12, 49.52 * x35);
-        let x45 = 2103.19 * x36;
-        let x46 = Self::mul_add(s_q1, 0.475, 7.11 * x31);
-        let x47 = Self::mul_add(x10, -0.475, 7.11 * x33);
-        let x48 = Self::mul_add(x12, -0.475, 7.11 * x35);
-        let x49 = Self::mul_add(-x32, s_q3, x31 * c_q3);
-        let x50 = Self::mul_add(x32, c_q3, x31 * s_q3);
-        let x51 = Self::mul_add(-x34, s_q3, x33 * c_q3);
-        let x52 = Self::mul_add(x34, c_q3, x33 * s_q3);
-        let x53 = Self::mul_add(-x36, s_q3, x35 * c_q3);
-        let x54 = Self::mul_add(x36, c_q3, x35 * s_q3);
-        let x55 = Self::mul_add(s_q1, 39.95, 9.522 * x49);
-        let x56 = Self::mul_add(1966.28, s_q1, x49 * 39.95);
-        let x57 = 1966.28 * x50;
-        let x58 = Self::mul_add(x10, -39.95, 9.522 * x51);
-        let x59 = Self::mul_add(-1966.28, x10, x51 * 39.95);
-        let x60 = 1966.28 * x52;
-        let x61 = Self::mul_add(x12, -39.95, 9.522 * x53);
-        let x62 = Self::mul_add(-1966.28, x12, x53 * 39.95);
-        let x63 = 1966.28 * x54;
-        let x64 = 7.11 * x49;
-        let x65 = 7.11 * x51;
-        let x66 = 7.11 * x53;
-        let x67 = Self::mul_add(-x50, s_q4, x49 * c_q4);
-        let x68 = Self::mul_add(x50, c_q4, x49 * s_q4);
-        let x69 = Self::mul_add(-x52, s_q4, x51 * c_q4);
-        let x70 = Self::mul_add(x52, c_q4, x51 * s_q4);
-        let x71 = Self::mul_add(-x54, s_q4, x53 * c_q4);
-        let x72 = Self::mul_add(x54, c_q4, x53 * s_q4);
-        let x73 = 8.305 * x67;
-        let x74 = 8.0386 * x68;
-        let x75 = 8.305 * x69;
-        let x76 = 8.0386 * x70;
-        let x77 = 8.305 * x71;
-        let x78 = 8.0386 * x72;
-        let x79 = Self::mul_add(-s_q1, s_q5, x67 * c_q5);
-        let x80 = Self::mul_add(s_q1, c_q5, x67 * s_q5);
-        let x81 = Self::mul_add(x10, s_q5, x69 * c_q5);
-        let x82 = Self::mul_add(-x10, c_q5, x69 * s_q5);
-        let x83 = Self::mul_add(x12, s_q5, x71 * c_q5);
-        let x84 = Self::mul_add(-x12, c_q5, x71 * s_q5);
-        let x85 = 12.13 * x79;
-        let x86 = 12.13 * x80;
-        let x87 = 3.061 * x68;
-        let x88 = 12.13 * x81;
-        let x89 = 12.13 * x82;
-        let x90 = 3.061 * x70;
-        let x91 = 12.13 * x83;
-        let x92 = 12.13 * x84;
-        let x93 = 3.061 * x72;
-        let x94 = 0.7026 * x68;
-        let x95 = 0.7026 * x70;
-        let x96 = 0.7026 * x72;
-        let x97 = Self::mul_add(-x68, s_q6, x80 * c_q6);
-        let x98 = Self::mul_add(x68, c_q6, x80 * s_q6);
-        let x99 = Self::mul_add(-x70, s_q6, x82 * c_q6);
-        let x100 = Self::mul_add(x70, c_q6, x82 * s_q6);
-        let x101 = Self::mul_add(-x72, s_q6, x84 * c_q6);
-        let x102 = Self::mul_add(x72, c_q6, x84 * s_q6);
-        let x103 = 9.336 * x79;
-        let x104 = 44.41 * x97;
-        let x105 = 44.41 * x98;
-        let x106 = 9.336 * x81;
-        let x107 = 44.41 * x99;
-        let x108 = 44.41 * x100;
-        let x109 = 9.336 * x83;
-        let x110 = 44.41 * x101;
-        let x111 = 44.41 * x102;
-        let x112 = Self::mul_add(x98, x105, Self::mul_add(x97, x104, x79 * x103));
-        let x113 = Self::mul_add(x100, x105, Self::mul_add(x99, x104, x81 * x103));
-        let x114 = Self::mul_add(x102, x105, Self::mul_add(x101, x104, x83 * x103));
-        let x115 = Self::mul_add(x98, x108, Self::mul_add(x97, x107, x79 * x106));
-        let x116 = Self::mul_add(x100, x108, Self::mul_add(x99, x107, x81 * x106));
-        let x117 = Self::mul_add(x102, x108, Self::mul_add(x101, x107, x83 * x106));
-        let x118 = Self::mul_add(x98, x111, Self::mul_add(x97, x110, x79 * x109));
-        let x119 = Self::mul_add(x100, x111, Self::mul_add(x99, x110, x81 * x109));
-        let x120 = Self::mul_add(x102, x111, Self::mul_add(x101, x110, x83 * x109));
+        let x33 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x34 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x35 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x36 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x37 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x31);
+        let x38 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x31);
+        let x39 = S::splat(2103.19) * x32;
+        let x40 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x33);
+        let x41 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x33);
+        let x42 = S::splat(2103.19) * x34;
+        let x43 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x35);
+        let x44 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x35);
+        let x45 = S::splat(2103.19) * x36;
+        let x46 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x31);
+        let x47 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x33);
+        let x48 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x35);
+        let x49 = S::mul_add(S::neg(x32), s_q3, x31 * c_q3);
+        let x50 = S::mul_add(x32, c_q3, x31 * s_q3);
+        let x51 = S::mul_add(S::neg(x34), s_q3, x33 * c_q3);
+        let x52 = S::mul_add(x34, c_q3, x33 * s_q3);
+        let x53 = S::mul_add(S::neg(x36), s_q3, x35 * c_q3);
+        let x54 = S::mul_add(x36, c_q3, x35 * s_q3);
+        let x55 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x49);
+        let x56 = S::mul_add(S::splat(1966.28), s_q1, x49 * S::splat(39.95));
+        let x57 = S::splat(1966.28) * x50;
+        let x58 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x51);
+        let x59 = S::mul_add(S::splat(-1966.28), x10, x51 * S::splat(39.95));
+        let x60 = S::splat(1966.28) * x52;
+        let x61 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x53);
+        let x62 = S::mul_add(S::splat(-1966.28), x12, x53 * S::splat(39.95));
+        let x63 = S::splat(1966.28) * x54;
+        let x64 = S::splat(7.11) * x49;
+        let x65 = S::splat(7.11) * x51;
+        let x66 = S::splat(7.11) * x53;
+        let x67 = S::mul_add(S::neg(x50), s_q4, x49 * c_q4);
+        let x68 = S::mul_add(x50, c_q4, x49 * s_q4);
+        let x69 = S::mul_add(S::neg(x52), s_q4, x51 * c_q4);
+        let x70 = S::mul_add(x52, c_q4, x51 * s_q4);
+        let x71 = S::mul_add(S::neg(x54), s_q4, x53 * c_q4);
+        let x72 = S::mul_add(x54, c_q4, x53 * s_q4);
+        let x73 = S::splat(8.305) * x67;
+        let x74 = S::splat(8.0386) * x68;
+        let x75 = S::splat(8.305) * x69;
+        let x76 = S::splat(8.0386) * x70;
+        let x77 = S::splat(8.305) * x71;
+        let x78 = S::splat(8.0386) * x72;
+        let x79 = S::mul_add(S::neg(s_q1), s_q5, x67 * c_q5);
+        let x80 = S::mul_add(s_q1, c_q5, x67 * s_q5);
+        let x81 = S::mul_add(x10, s_q5, x69 * c_q5);
+        let x82 = S::mul_add(S::neg(x10), c_q5, x69 * s_q5);
+        let x83 = S::mul_add(x12, s_q5, x71 * c_q5);
+        let x84 = S::mul_add(S::neg(x12), c_q5, x71 * s_q5);
+        let x85 = S::splat(12.13) * x79;
+        let x86 = S::splat(12.13) * x80;
+        let x87 = S::splat(3.061) * x68;
+        let x88 = S::splat(12.13) * x81;
+        let x89 = S::splat(12.13) * x82;
+        let x90 = S::splat(3.061) * x70;
+        let x91 = S::splat(12.13) * x83;
+        let x92 = S::splat(12.13) * x84;
+        let x93 = S::splat(3.061) * x72;
+        let x94 = S::splat(0.7026) * x68;
+        let x95 = S::splat(0.7026) * x70;
+        let x96 = S::splat(0.7026) * x72;
+        let x97 = S::mul_add(S::neg(x68), s_q6, x80 * c_q6);
+        let x98 = S::mul_add(x68, c_q6, x80 * s_q6);
+        let x99 = S::mul_add(S::neg(x70), s_q6, x82 * c_q6);
+        let x100 = S::mul_add(x70, c_q6, x82 * s_q6);
+        let x101 = S::mul_add(S::neg(x72), s_q6, x84 * c_q6);
+        let x102 = S::mul_add(x72, c_q6, x84 * s_q6);
+        let x103 = S::splat(9.336) * x79;
+        let x104 = S::splat(44.41) * x97;
+        let x105 = S::splat(44.41) * x98;
+        let x106 = S::splat(9.336) * x81;
+        let x107 = S::splat(44.41) * x99;
+        let x108 = S::splat(44.41) * x100;
+        let x109 = S::splat(9.336) * x83;
+        let x110 = S::splat(44.41) * x101;
+        let x111 = S::splat(44.41) * x102;
+        let x112 = S::mul_add(x98, x105, S::mul_add(x97, x104, x79 * x103));
+        let x113 = S::mul_add(x100, x105, S::mul_add(x99, x104, x81 * x103));
+        let x114 = S::mul_add(x102, x105, S::mul_add(x101, x104, x83 * x103));
+        let x115 = S::mul_add(x98, x108, S::mul_add(x97, x107, x79 * x106));
+        let x116 = S::mul_add(x100, x108, S::mul_add(x99, x107, x81 * x106));
+        let x117 = S::mul_add(x102, x108, S::mul_add(x101, x107, x83 * x106));
+        let x118 = S::mul_add(x98, x111, S::mul_add(x97, x110, x79 * x109));
+        let x119 = S::mul_add(x100, x111, S::mul_add(x99, x110, x81 * x109));
+        let x120 = S::mul_add(x102, x111, S::mul_add(x101, x110, x83 * x109));
         let x121 = x28 - x94;
         let x122 = x29 + x95;
         let x123 = x30 + x96;
@@ -437,106 +445,110 @@ impl SsrmsRecurrent {
         let x144 = x30 - x142;
         let x145 = x29 - x47;
         let x146 = x30 - x48;
-        let x147 = 243.66 * x94;
-        let x148 = 243.66 * x95;
-        let x149 = 243.66 * x96;
-        let x150 = 243.66 * x121;
-        let x151 = 243.66 * x122;
-        let x152 = 243.66 * x123;
-        let x153 = 243.66 * x124;
-        let x154 = 243.66 * x125;
-        let x155 = 243.66 * x126;
-        let x156 = 243.66 * x127;
-        let x157 = 243.66 * x128;
-        let x158 = 243.66 * x129;
-        let x159 = 243.66 * (x28 + x127);
-        let x160 = 243.66 * x130;
-        let x161 = 243.66 * x131;
-        let x162 = 243.66 * (x7 + x130);
-        let x163 = 243.66 * (x8 - x131);
-        let x164 = Self::mul_add(x68, x87, Self::mul_add(x80, x86, x79 * x85)) + x112;
-        let x165 = Self::mul_add(x70, x87, Self::mul_add(x82, x86, x81 * x85)) + x113;
-        let x166 = Self::mul_add(x72, x87, Self::mul_add(x84, x86, x83 * x85)) + x114;
-        let x167 = Self::mul_add(x68, x90, Self::mul_add(x80, x89, x79 * x88)) + x115;
-        let x168 = Self::mul_add(x70, x90, Self::mul_add(x82, x89, x81 * x88)) + x116;
-        let x169 = Self::mul_add(x72, x90, Self::mul_add(x84, x89, x83 * x88)) + x117;
-        let x170 = Self::mul_add(x68, x93, Self::mul_add(x80, x92, x79 * x91)) + x118;
-        let x171 = Self::mul_add(x70, x93, Self::mul_add(x82, x92, x81 * x91)) + x119;
-        let x172 = Self::mul_add(x72, x93, Self::mul_add(x84, x92, x83 * x91)) + x120;
-        let x173 = Self::mul_add(x68, x74, Self::mul_add(x67, x73, x21)) + x164;
-        let x174 = Self::mul_add(-x70, x74, Self::mul_add(-x69, x73, x22)) - x165;
-        let x175 = Self::mul_add(-x72, x74, Self::mul_add(-x71, x73, x23)) - x166;
-        let x176 = Self::mul_add(-x68, x76, Self::mul_add(-x67, x75, s_q1 * x16)) - x167;
-        let x177 = Self::mul_add(x70, x76, Self::mul_add(x69, x75, x24)) + x168;
-        let x178 = Self::mul_add(x72, x76, Self::mul_add(x71, x75, x25)) + x169;
-        let x179 = Self::mul_add(-x68, x78, Self::mul_add(-x67, x77, s_q1 * x19)) - x170;
-        let x180 = Self::mul_add(x70, x78, Self::mul_add(x69, x77, x26)) + x171;
-        let x181 = Self::mul_add(x72, x78, Self::mul_add(x71, x77, x27)) + x172;
-        let x182 = Self::mul_add(x50, x57, Self::mul_add(s_q1, x56, x49 * x55)) + x173;
-        let x183 = Self::mul_add(x52, x57, Self::mul_add(-x10, x56, x51 * x55)) - x174;
-        let x184 = Self::mul_add(x54, x57, Self::mul_add(-x12, x56, x53 * x55)) - x175;
-        let x185 = Self::mul_add(x50, x60, Self::mul_add(s_q1, x59, x49 * x58)) - x176;
-        let x186 = Self::mul_add(x52, x60, Self::mul_add(-x10, x59, x51 * x58)) + x177;
-        let x187 = Self::mul_add(x54, x60, Self::mul_add(-x12, x59, x53 * x58)) + x178;
-        let x188 = Self::mul_add(x50, x63, Self::mul_add(s_q1, x62, x49 * x61)) - x179;
-        let x189 = Self::mul_add(x52, x63, Self::mul_add(-x10, x62, x51 * x61)) + x180;
-        let x190 = Self::mul_add(x54, x63, Self::mul_add(-x12, x62, x53 * x61)) + x181;
-        let x191 = Self::mul_add(x32, x39, Self::mul_add(-s_q1, x38, x31 * x37)) + x182;
-        let x192 = Self::mul_add(x34, x39, Self::mul_add(x10, x38, x33 * x37)) + x183;
-        let x193 = Self::mul_add(x36, x39, Self::mul_add(x12, x38, x35 * x37)) + x184;
-        let x194 = Self::mul_add(x32, x42, Self::mul_add(-s_q1, x41, x31 * x40)) + x185;
-        let x195 = Self::mul_add(x34, x42, Self::mul_add(x10, x41, x33 * x40)) + x186;
-        let x196 = Self::mul_add(x36, x42, Self::mul_add(x12, x41, x35 * x40)) + x187;
-        let x197 = Self::mul_add(x32, x45, Self::mul_add(-s_q1, x44, x31 * x43)) + x188;
-        let x198 = Self::mul_add(x34, x45, Self::mul_add(x10, x44, x33 * x43)) + x189;
-        let x199 = Self::mul_add(x36, x45, Self::mul_add(x12, x44, x35 * x43)) + x190;
-        let x200 = Self::mul_add(105.98, x28, x150);
-        let x201 = Self::mul_add(105.98, x29, x151);
-        let x202 = Self::mul_add(105.98, x30, x152);
-        let x203 = Self::mul_add(105.98, x132, x153);
-        let x204 = Self::mul_add(-105.98, x133, x154);
-        let x205 = Self::mul_add(-105.98, x134, x155);
-        let x206 = Self::mul_add(105.98, x64, x203);
-        let x207 = Self::mul_add(105.98, x65, x204);
-        let x208 = Self::mul_add(105.98, x66, x205);
-        let x209 = Self::mul_add(105.98, x135, x156);
-        let x210 = Self::mul_add(105.98, x136, x157);
-        let x211 = Self::mul_add(105.98, x137, x158);
-        let x212 = Self::mul_add(105.98, x140, x209);
-        let x213 = Self::mul_add(105.98, x141, x210);
-        let x214 = Self::mul_add(105.98, x142, x211);
-        let x215 = Self::mul_add(279.2, x46, x212);
-        let x216 = Self::mul_add(279.2, x47, x213);
-        let x217 = Self::mul_add(279.2, x48, x214);
-        let x218 = Self::mul_add(105.98, x28 + x135, x159);
-        let x219 = Self::mul_add(105.98, x138, x160);
-        let x220 = Self::mul_add(105.98, x139, x161);
-        let x221 = Self::mul_add(105.98, x28 + x140, x218);
-        let x222 = Self::mul_add(105.98, x143, x219);
-        let x223 = Self::mul_add(105.98, x144, x220);
-        let x224 = Self::mul_add(279.2, x28 + x46, x221);
-        let x225 = Self::mul_add(279.2, x145, x222);
-        let x226 = Self::mul_add(279.2, x146, x223);
-        let x227 = Self::mul_add(314.88, x29, x225);
-        let x228 = Self::mul_add(314.88, x30, x226);
-        let x229 = Self::mul_add(105.98, x7 + x138, x162);
-        let x230 = Self::mul_add(105.98, x8 - x139, x163);
-        let x231 = Self::mul_add(105.98, x7 + x143, x229);
-        let x232 = Self::mul_add(105.98, x8 - x144, x230);
-        let x233 = Self::mul_add(279.2, x7 + x145, x231);
-        let x234 = Self::mul_add(279.2, x8 - x146, x232);
-        let x235 = Self::mul_add(314.88, x7 + x29, x233);
-        let x236 = Self::mul_add(314.88, x8 - x30, x234);
-        let x237 = Self::mul_add(-x95, x162, x96 * x163);
+        let x147 = S::splat(243.66) * x94;
+        let x148 = S::splat(243.66) * x95;
+        let x149 = S::splat(243.66) * x96;
+        let x150 = S::splat(243.66) * x121;
+        let x151 = S::splat(243.66) * x122;
+        let x152 = S::splat(243.66) * x123;
+        let x153 = S::splat(243.66) * x124;
+        let x154 = S::splat(243.66) * x125;
+        let x155 = S::splat(243.66) * x126;
+        let x156 = S::splat(243.66) * x127;
+        let x157 = S::splat(243.66) * x128;
+        let x158 = S::splat(243.66) * x129;
+        let x159 = S::splat(243.66) * (x28 + x127);
+        let x160 = S::splat(243.66) * x130;
+        let x161 = S::splat(243.66) * x131;
+        let x162 = S::splat(243.66) * (x7 + x130);
+        let x163 = S::splat(243.66) * (x8 - x131);
+        let x164 = S::mul_add(x68, x87, S::mul_add(x80, x86, x79 * x85)) + x112;
+        let x165 = S::mul_add(x70, x87, S::mul_add(x82, x86, x81 * x85)) + x113;
+        let x166 = S::mul_add(x72, x87, S::mul_add(x84, x86, x83 * x85)) + x114;
+        let x167 = S::mul_add(x68, x90, S::mul_add(x80, x89, x79 * x88)) + x115;
+        let x168 = S::mul_add(x70, x90, S::mul_add(x82, x89, x81 * x88)) + x116;
+        let x169 = S::mul_add(x72, x90, S::mul_add(x84, x89, x83 * x88)) + x117;
+        let x170 = S::mul_add(x68, x93, S::mul_add(x80, x92, x79 * x91)) + x118;
+        let x171 = S::mul_add(x70, x93, S::mul_add(x82, x92, x81 * x91)) + x119;
+        let x172 = S::mul_add(x72, x93, S::mul_add(x84, x92, x83 * x91)) + x120;
+        let x173 = S::mul_add(x68, x74, S::mul_add(x67, x73, x21)) + x164;
+        let x174 = S::mul_add(S::neg(x70), x74, S::mul_add(S::neg(x69), x73, x22))
+            - x165;
+        let x175 = S::mul_add(S::neg(x72), x74, S::mul_add(S::neg(x71), x73, x23))
+            - x166;
+        let x176 = S::mul_add(S::neg(x68), x76, S::mul_add(S::neg(x67), x75, s_q1 * x16))
+            - x167;
+        let x177 = S::mul_add(x70, x76, S::mul_add(x69, x75, x24)) + x168;
+        let x178 = S::mul_add(x72, x76, S::mul_add(x71, x75, x25)) + x169;
+        let x179 = S::mul_add(S::neg(x68), x78, S::mul_add(S::neg(x67), x77, s_q1 * x19))
+            - x170;
+        let x180 = S::mul_add(x70, x78, S::mul_add(x69, x77, x26)) + x171;
+        let x181 = S::mul_add(x72, x78, S::mul_add(x71, x77, x27)) + x172;
+        let x182 = S::mul_add(x50, x57, S::mul_add(s_q1, x56, x49 * x55)) + x173;
+        let x183 = S::mul_add(x52, x57, S::mul_add(S::neg(x10), x56, x51 * x55)) - x174;
+        let x184 = S::mul_add(x54, x57, S::mul_add(S::neg(x12), x56, x53 * x55)) - x175;
+        let x185 = S::mul_add(x50, x60, S::mul_add(s_q1, x59, x49 * x58)) - x176;
+        let x186 = S::mul_add(x52, x60, S::mul_add(S::neg(x10), x59, x51 * x58)) + x177;
+        let x187 = S::mul_add(x54, x60, S::mul_add(S::neg(x12), x59, x53 * x58)) + x178;
+        let x188 = S::mul_add(x50, x63, S::mul_add(s_q1, x62, x49 * x61)) - x179;
+        let x189 = S::mul_add(x52, x63, S::mul_add(S::neg(x10), x62, x51 * x61)) + x180;
+        let x190 = S::mul_add(x54, x63, S::mul_add(S::neg(x12), x62, x53 * x61)) + x181;
+        let x191 = S::mul_add(x32, x39, S::mul_add(S::neg(s_q1), x38, x31 * x37)) + x182;
+        let x192 = S::mul_add(x34, x39, S::mul_add(x10, x38, x33 * x37)) + x183;
+        let x193 = S::mul_add(x36, x39, S::mul_add(x12, x38, x35 * x37)) + x184;
+        let x194 = S::mul_add(x32, x42, S::mul_add(S::neg(s_q1), x41, x31 * x40)) + x185;
+        let x195 = S::mul_add(x34, x42, S::mul_add(x10, x41, x33 * x40)) + x186;
+        let x196 = S::mul_add(x36, x42, S::mul_add(x12, x41, x35 * x40)) + x187;
+        let x197 = S::mul_add(x32, x45, S::mul_add(S::neg(s_q1), x44, x31 * x43)) + x188;
+        let x198 = S::mul_add(x34, x45, S::mul_add(x10, x44, x33 * x43)) + x189;
+        let x199 = S::mul_add(x36, x45, S::mul_add(x12, x44, x35 * x43)) + x190;
+        let x200 = S::mul_add(S::splat(105.98), x28, x150);
+        let x201 = S::mul_add(S::splat(105.98), x29, x151);
+        let x202 = S::mul_add(S::splat(105.98), x30, x152);
+        let x203 = S::mul_add(S::splat(105.98), x132, x153);
+        let x204 = S::mul_add(S::splat(-105.98), x133, x154);
+        let x205 = S::mul_add(S::splat(-105.98), x134, x155);
+        let x206 = S::mul_add(S::splat(105.98), x64, x203);
+        let x207 = S::mul_add(S::splat(105.98), x65, x204);
+        let x208 = S::mul_add(S::splat(105.98), x66, x205);
+        let x209 = S::mul_add(S::splat(105.98), x135, x156);
+        let x210 = S::mul_add(S::splat(105.98), x136, x157);
+        let x211 = S::mul_add(S::splat(105.98), x137, x158);
+        let x212 = S::mul_add(S::splat(105.98), x140, x209);
+        let x213 = S::mul_add(S::splat(105.98), x141, x210);
+        let x214 = S::mul_add(S::splat(105.98), x142, x211);
+        let x215 = S::mul_add(S::splat(279.2), x46, x212);
+        let x216 = S::mul_add(S::splat(279.2), x47, x213);
+        let x217 = S::mul_add(S::splat(279.2), x48, x214);
+        let x218 = S::mul_add(S::splat(105.98), x28 + x135, x159);
+        let x219 = S::mul_add(S::splat(105.98), x138, x160);
+        let x220 = S::mul_add(S::splat(105.98), x139, x161);
+        let x221 = S::mul_add(S::splat(105.98), x28 + x140, x218);
+        let x222 = S::mul_add(S::splat(105.98), x143, x219);
+        let x223 = S::mul_add(S::splat(105.98), x144, x220);
+        let x224 = S::mul_add(S::splat(279.2), x28 + x46, x221);
+        let x225 = S::mul_add(S::splat(279.2), x145, x222);
+        let x226 = S::mul_add(S::splat(279.2), x146, x223);
+        let x227 = S::mul_add(S::splat(314.88), x29, x225);
+        let x228 = S::mul_add(S::splat(314.88), x30, x226);
+        let x229 = S::mul_add(S::splat(105.98), x7 + x138, x162);
+        let x230 = S::mul_add(S::splat(105.98), x8 - x139, x163);
+        let x231 = S::mul_add(S::splat(105.98), x7 + x143, x229);
+        let x232 = S::mul_add(S::splat(105.98), x8 - x144, x230);
+        let x233 = S::mul_add(S::splat(279.2), x7 + x145, x231);
+        let x234 = S::mul_add(S::splat(279.2), x8 - x146, x232);
+        let x235 = S::mul_add(S::splat(314.88), x7 + x29, x233);
+        let x236 = S::mul_add(S::splat(314.88), x8 - x30, x234);
+        let x237 = S::mul_add(S::neg(x95), x162, x96 * x163);
         let x238 = x94 * x162;
         let x239 = x94 * x163;
         let x240 = x95 * x159;
         let x241 = x94 * x159;
         let x242 = x96 * x159;
-        let x243 = Self::mul_add(-x96, x161, x241);
+        let x243 = S::mul_add(S::neg(x96), x161, x241);
         let x244 = x95 * x161;
         let x245 = x96 * x160;
-        let x246 = Self::mul_add(-x95, x160, x241);
+        let x246 = S::mul_add(S::neg(x95), x160, x241);
         let x247 = x96 * x158;
         let x248 = x95 * x157;
         let x249 = x247 + x248;
@@ -583,13 +595,13 @@ impl SsrmsRecurrent {
         let x290 = x29 * x204;
         let x291 = x28 * x203;
         let x292 = x261 + (x289 + x290);
-        let x293 = Self::mul_add(-x28, x204, x262);
-        let x294 = Self::mul_add(-x28, x205, x263);
-        let x295 = Self::mul_add(x29, x203, x264);
+        let x293 = S::mul_add(S::neg(x28), x204, x262);
+        let x294 = S::mul_add(S::neg(x28), x205, x263);
+        let x295 = S::mul_add(x29, x203, x264);
         let x296 = x266 + (x289 - x291);
-        let x297 = Self::mul_add(x29, x205, x267);
-        let x298 = Self::mul_add(x30, x203, x268);
-        let x299 = Self::mul_add(x30, x204, x269);
+        let x297 = S::mul_add(x29, x205, x267);
+        let x298 = S::mul_add(x30, x203, x268);
+        let x299 = S::mul_add(x30, x204, x269);
         let x300 = x270 + (x290 - x291);
         let x301 = x66 * x208;
         let x302 = x65 * x207;
@@ -598,431 +610,451 @@ impl SsrmsRecurrent {
         let x305 = x29 * x210;
         let x306 = x28 * x209;
         let x307 = x249 + (x304 + x305);
-        let x308 = Self::mul_add(-x28, x210, x250);
-        let x309 = Self::mul_add(-x28, x211, x251);
-        let x310 = Self::mul_add(x29, x209, x252);
+        let x308 = S::mul_add(S::neg(x28), x210, x250);
+        let x309 = S::mul_add(S::neg(x28), x211, x251);
+        let x310 = S::mul_add(x29, x209, x252);
         let x311 = x254 + (x304 - x306);
-        let x312 = Self::mul_add(x29, x211, x255);
-        let x313 = Self::mul_add(x30, x209, x256);
-        let x314 = Self::mul_add(x30, x210, x257);
+        let x312 = S::mul_add(x29, x211, x255);
+        let x313 = S::mul_add(x30, x209, x256);
+        let x314 = S::mul_add(x30, x210, x257);
         let x315 = x258 + (x305 - x306);
         let x316 = x66 * x214;
         let x317 = x65 * x213;
         let x318 = x64 * x212;
         let x319 = x307 - (x316 + x317);
-        let x320 = Self::mul_add(-x64, x213, x308);
-        let x321 = Self::mul_add(-x64, x214, x309);
-        let x322 = Self::mul_add(-x65, x212, x310);
+        let x320 = S::mul_add(S::neg(x64), x213, x308);
+        let x321 = S::mul_add(S::neg(x64), x214, x309);
+        let x322 = S::mul_add(S::neg(x65), x212, x310);
         let x323 = x311 - (x316 + x318);
-        let x324 = Self::mul_add(-x65, x214, x312);
-        let x325 = Self::mul_add(-x66, x212, x313);
-        let x326 = Self::mul_add(-x66, x213, x314);
+        let x324 = S::mul_add(S::neg(x65), x214, x312);
+        let x325 = S::mul_add(S::neg(x66), x212, x313);
+        let x326 = S::mul_add(S::neg(x66), x213, x314);
         let x327 = x315 - (x317 + x318);
         let x328 = x48 * x217;
         let x329 = x47 * x216;
         let x330 = x46 * x215;
         let x331 = x28 * x218;
-        let x332 = Self::mul_add(x29, x218, x240);
-        let x333 = x243 - Self::mul_add(x30, x220, x331);
-        let x334 = Self::mul_add(x29, x220, x244);
-        let x335 = Self::mul_add(x30, x218, x242);
-        let x336 = Self::mul_add(x30, x219, x245);
-        let x337 = x246 - Self::mul_add(x29, x219, x331);
+        let x332 = S::mul_add(x29, x218, x240);
+        let x333 = x243 - S::mul_add(x30, x220, x331);
+        let x334 = S::mul_add(x29, x220, x244);
+        let x335 = S::mul_add(x30, x218, x242);
+        let x336 = S::mul_add(x30, x219, x245);
+        let x337 = x246 - S::mul_add(x29, x219, x331);
         let x338 = x64 * x221;
-        let x339 = Self::mul_add(-x65, x221, x332);
-        let x340 = x333 + Self::mul_add(x66, x223, -x338);
-        let x341 = Self::mul_add(-x65, x223, x334);
-        let x342 = Self::mul_add(-x66, x221, x335);
-        let x343 = Self::mul_add(-x66, x222, x336);
-        let x344 = x337 + Self::mul_add(x65, x222, -x338);
+        let x339 = S::mul_add(S::neg(x65), x221, x332);
+        let x340 = x333 + S::mul_add(x66, x223, S::neg(x338));
+        let x341 = S::mul_add(S::neg(x65), x223, x334);
+        let x342 = S::mul_add(S::neg(x66), x221, x335);
+        let x343 = S::mul_add(S::neg(x66), x222, x336);
+        let x344 = x337 + S::mul_add(x65, x222, S::neg(x338));
         let x345 = x46 * x224;
-        let x346 = x340 + Self::mul_add(x48, x226, -x345);
-        let x347 = Self::mul_add(-x47, x226, x341);
-        let x348 = Self::mul_add(-x48, x225, x343);
-        let x349 = x344 + Self::mul_add(x47, x225, -x345);
-        let x350 = x28 * Self::mul_add(314.88, x28, x224);
-        let x351 = x237 + Self::mul_add(-x29, x229, x30 * x230);
-        let x352 = Self::mul_add(-x28, x229, x238);
-        let x353 = Self::mul_add(-x28, x230, x239);
-        let x354 = x351 - Self::mul_add(-x65, x231, x66 * x232);
-        let x355 = Self::mul_add(-x64, x231, x352);
-        let x356 = Self::mul_add(-x64, x232, x353);
-        let x357 = x354 - Self::mul_add(-x47, x233, x48 * x234);
-        let x358 = Self::mul_add(-x46, x233, x355);
-        let x359 = Self::mul_add(-x46, x234, x356);
-        let x360 = 12.19 + (Self::mul_add(c_q1, x13, x21) + x191)
-            - (x357 + Self::mul_add(-x29, x235, x30 * x236)
-                - Self::mul_add(
+        let x346 = x340 + S::mul_add(x48, x226, S::neg(x345));
+        let x347 = S::mul_add(S::neg(x47), x226, x341);
+        let x348 = S::mul_add(S::neg(x48), x225, x343);
+        let x349 = x344 + S::mul_add(x47, x225, S::neg(x345));
+        let x350 = x28 * S::mul_add(S::splat(314.88), x28, x224);
+        let x351 = x237 + S::mul_add(S::neg(x29), x229, x30 * x230);
+        let x352 = S::mul_add(S::neg(x28), x229, x238);
+        let x353 = S::mul_add(S::neg(x28), x230, x239);
+        let x354 = x351 - S::mul_add(S::neg(x65), x231, x66 * x232);
+        let x355 = S::mul_add(S::neg(x64), x231, x352);
+        let x356 = S::mul_add(S::neg(x64), x232, x353);
+        let x357 = x354 - S::mul_add(S::neg(x47), x233, x48 * x234);
+        let x358 = S::mul_add(S::neg(x46), x233, x355);
+        let x359 = S::mul_add(S::neg(x46), x234, x356);
+        let x360 = S::splat(12.19) + (S::mul_add(c_q1, x13, x21) + x191)
+            - (x357 + S::mul_add(S::neg(x29), x235, x30 * x236)
+                - S::mul_add(
                     x7,
-                    Self::mul_add(105.98, x7, x235),
-                    x8 * Self::mul_add(105.98, x8, x236),
+                    S::mul_add(S::splat(105.98), x7, x235),
+                    x8 * S::mul_add(S::splat(105.98), x8, x236),
                 ));
-        let x361 = -Self::mul_add(
-            -c_q0,
-            Self::mul_add(x11, x13, -x23) + x193 + Self::mul_add(-x28, x236, x359),
-            s_q0
-                * (Self::mul_add(x9, x13, -x22) + x192 - Self::mul_add(-x28, x235, x358)),
+        let x361 = S::neg(
+            S::mul_add(
+                S::neg(c_q0),
+                S::mul_add(x11, x13, S::neg(x23)) + x193
+                    + S::mul_add(S::neg(x28), x236, x359),
+                s_q0
+                    * (S::mul_add(x9, x13, S::neg(x22)) + x192
+                        - S::mul_add(S::neg(x28), x235, x358)),
+            ),
         );
-        let x362 = -Self::mul_add(
-            -x12,
-            x193 + x359,
-            Self::mul_add(-x10, x192 - x358, s_q1 * (x191 - x357)),
+        let x362 = S::neg(
+            S::mul_add(
+                S::neg(x12),
+                x193 + x359,
+                S::mul_add(S::neg(x10), x192 - x358, s_q1 * (x191 - x357)),
+            ),
         );
-        let x363 = -Self::mul_add(
-            -x12,
-            x184 + x356,
-            Self::mul_add(-x10, x183 - x355, s_q1 * (x182 - x354)),
+        let x363 = S::neg(
+            S::mul_add(
+                S::neg(x12),
+                x184 + x356,
+                S::mul_add(S::neg(x10), x183 - x355, s_q1 * (x182 - x354)),
+            ),
         );
-        let x364 = -Self::mul_add(
-            x12,
-            x175 - x353,
-            Self::mul_add(x10, x174 + x352, s_q1 * (x173 - x351)),
+        let x364 = S::neg(
+            S::mul_add(
+                x12,
+                x175 - x353,
+                S::mul_add(x10, x174 + x352, s_q1 * (x173 - x351)),
+            ),
         );
-        let x365 = Self::mul_add(
+        let x365 = S::mul_add(
             x72,
             x166 + x239,
-            Self::mul_add(x70, x165 - x238, x68 * (x164 - x237)),
+            S::mul_add(x70, x165 - x238, x68 * (x164 - x237)),
         );
-        let x366 = Self::mul_add(x83, x114, Self::mul_add(x81, x113, x79 * x112));
-        let x367 = Self::mul_add(x83, x117, Self::mul_add(x81, x116, x79 * x115));
-        let x368 = Self::mul_add(x83, x120, Self::mul_add(x81, x119, x79 * x118));
-        let x369 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x25)) + x196
-                - Self::mul_add(x29, x228, x347),
+        let x366 = S::mul_add(x83, x114, S::mul_add(x81, x113, x79 * x112));
+        let x367 = S::mul_add(x83, x117, S::mul_add(x81, x116, x79 * x115));
+        let x368 = S::mul_add(x83, x120, S::mul_add(x81, x119, x79 * x118));
+        let x369 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x25)) + x196
+                - S::mul_add(x29, x228, x347),
             s_q0
-                * (Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x24)) + x195
-                    - (x346 - Self::mul_add(x30, x228, x350))),
+                * (S::mul_add(s_q0, x17, S::mul_add(x9, x15, x24)) + x195
+                    - (x346 - S::mul_add(x30, x228, x350))),
         );
-        let x370 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x27)) + x199
-                - (x349 - Self::mul_add(x29, x227, x350)),
+        let x370 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(c_q0, x20, S::mul_add(x11, x18, x27)) + x199
+                - (x349 - S::mul_add(x29, x227, x350)),
             s_q0
-                * (Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x26)) + x198
-                    - Self::mul_add(x30, x227, x348)),
+                * (S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x26)) + x198
+                    - S::mul_add(x30, x227, x348)),
         );
-        let x371 = Self::mul_add(-c_q0, x370, s_q0 * x369);
-        let x372 = Self::mul_add(
-            -x12,
+        let x371 = S::mul_add(S::neg(c_q0), x370, s_q0 * x369);
+        let x372 = S::mul_add(
+            S::neg(x12),
             x196 - x347,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x195 - x346,
-                s_q1 * (x194 + Self::mul_add(-x47, x224, x339)),
+                s_q1 * (x194 + S::mul_add(S::neg(x47), x224, x339)),
             ),
         );
-        let x373 = Self::mul_add(
-            -x12,
+        let x373 = S::mul_add(
+            S::neg(x12),
             x199 - x349,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x198 - x348,
-                s_q1 * (x197 + Self::mul_add(-x48, x224, x342)),
+                s_q1 * (x197 + S::mul_add(S::neg(x48), x224, x342)),
             ),
         );
-        let x374 = Self::mul_add(-c_q0, x373, s_q0 * x372);
-        let x375 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -x12,
+        let x374 = S::mul_add(S::neg(c_q0), x373, s_q0 * x372);
+        let x375 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(x12),
                 x190 - x344,
-                Self::mul_add(-x10, x189 - x343, s_q1 * (x188 + x342)),
+                S::mul_add(S::neg(x10), x189 - x343, s_q1 * (x188 + x342)),
             ),
             s_q0
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x187 - x341,
-                    Self::mul_add(-x10, x186 - x340, s_q1 * (x185 + x339)),
+                    S::mul_add(S::neg(x10), x186 - x340, s_q1 * (x185 + x339)),
                 ),
         );
-        let x376 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x376 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x12,
                 x181 - x337,
-                Self::mul_add(x10, x180 - x336, s_q1 * (x179 - x335)),
+                S::mul_add(x10, x180 - x336, s_q1 * (x179 - x335)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x178 - x334,
-                    Self::mul_add(x10, x177 - x333, s_q1 * (x176 - x332)),
+                    S::mul_add(x10, x177 - x333, s_q1 * (x176 - x332)),
                 ),
         );
-        let x377 = -x376;
-        let x378 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x377 = S::neg(x376);
+        let x378 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x72,
                 x172 - x246,
-                Self::mul_add(x70, x171 - x245, x68 * (x170 + x242)),
+                S::mul_add(x70, x171 - x245, x68 * (x170 + x242)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x72,
                     x169 - x244,
-                    Self::mul_add(x70, x168 - x243, x68 * (x167 + x240)),
+                    S::mul_add(x70, x168 - x243, x68 * (x167 + x240)),
                 ),
         );
-        let x379 = -x378;
-        let x380 = -Self::mul_add(-c_q0, x368, s_q0 * x367);
-        let x381 = Self::mul_add(
-            -x12,
-            x193 + Self::mul_add(-x46, x217, x321),
-            Self::mul_add(
-                -x10,
-                x192 + Self::mul_add(-x46, x216, x320),
+        let x379 = S::neg(x378);
+        let x380 = S::neg(S::mul_add(S::neg(c_q0), x368, s_q0 * x367));
+        let x381 = S::mul_add(
+            S::neg(x12),
+            x193 + S::mul_add(S::neg(x46), x217, x321),
+            S::mul_add(
+                S::neg(x10),
+                x192 + S::mul_add(S::neg(x46), x216, x320),
                 s_q1 * (x191 - (x319 - (x328 + x329))),
             ),
         );
-        let x382 = Self::mul_add(
-            -x12,
-            x196 + Self::mul_add(-x47, x217, x324),
-            Self::mul_add(
-                -x10,
+        let x382 = S::mul_add(
+            S::neg(x12),
+            x196 + S::mul_add(S::neg(x47), x217, x324),
+            S::mul_add(
+                S::neg(x10),
                 x195 - (x323 - (x328 + x330)),
-                s_q1 * (x194 + Self::mul_add(-x47, x215, x322)),
+                s_q1 * (x194 + S::mul_add(S::neg(x47), x215, x322)),
             ),
         );
-        let x383 = Self::mul_add(
-            -x12,
+        let x383 = S::mul_add(
+            S::neg(x12),
             x199 - (x327 - (x329 + x330)),
-            Self::mul_add(
-                -x10,
-                x198 + Self::mul_add(-x48, x216, x326),
-                s_q1 * (x197 + Self::mul_add(-x48, x215, x325)),
+            S::mul_add(
+                S::neg(x10),
+                x198 + S::mul_add(S::neg(x48), x216, x326),
+                s_q1 * (x197 + S::mul_add(S::neg(x48), x215, x325)),
             ),
         );
-        let x384 = Self::mul_add(-x12, x383, Self::mul_add(-x10, x382, s_q1 * x381));
-        let x385 = Self::mul_add(
-            -x10,
-            Self::mul_add(
-                -x12,
+        let x384 = S::mul_add(
+            S::neg(x12),
+            x383,
+            S::mul_add(S::neg(x10), x382, s_q1 * x381),
+        );
+        let x385 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
+                S::neg(x12),
                 x187 + x324,
-                Self::mul_add(-x10, x186 - x323, s_q1 * (x185 + x322)),
+                S::mul_add(S::neg(x10), x186 - x323, s_q1 * (x185 + x322)),
             ),
             s_q1
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x184 + x321,
-                    Self::mul_add(-x10, x183 + x320, s_q1 * (x182 - x319)),
+                    S::mul_add(S::neg(x10), x183 + x320, s_q1 * (x182 - x319)),
                 ),
         );
-        let x386 = Self::mul_add(
-            -x12,
-            Self::mul_add(
-                -x12,
+        let x386 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
+                S::neg(x12),
                 x190 - x327,
-                Self::mul_add(-x10, x189 + x326, s_q1 * (x188 + x325)),
+                S::mul_add(S::neg(x10), x189 + x326, s_q1 * (x188 + x325)),
             ),
             x385,
         );
-        let x387 = Self::mul_add(
+        let x387 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x178 + x312,
-                Self::mul_add(x10, x177 - x311, s_q1 * (x176 - x310)),
+                S::mul_add(x10, x177 - x311, s_q1 * (x176 - x310)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x175 - x309,
-                    Self::mul_add(x10, x174 - x308, s_q1 * (x173 - x307)),
+                    S::mul_add(x10, x174 - x308, s_q1 * (x173 - x307)),
                 ),
         );
-        let x388 = Self::mul_add(
+        let x388 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x181 - x315,
-                Self::mul_add(x10, x180 + x314, s_q1 * (x179 - x313)),
+                S::mul_add(x10, x180 + x314, s_q1 * (x179 - x313)),
             ),
             x387,
         );
-        let x389 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x389 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x72,
                 x169 + x255,
-                Self::mul_add(x70, x168 - x254, x68 * (x167 + x252)),
+                S::mul_add(x70, x168 - x254, x68 * (x167 + x252)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x72,
                     x166 + x251,
-                    Self::mul_add(x70, x165 + x250, x68 * (x164 - x249)),
+                    S::mul_add(x70, x165 + x250, x68 * (x164 - x249)),
                 ),
         );
-        let x390 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x390 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x72,
                 x172 - x258,
-                Self::mul_add(x70, x171 + x257, x68 * (x170 + x256)),
+                S::mul_add(x70, x171 + x257, x68 * (x170 + x256)),
             ),
             x389,
         );
-        let x391 = -x390;
-        let x392 = -Self::mul_add(-x12, x368, Self::mul_add(-x10, x367, s_q1 * x366));
-        let x393 = Self::mul_add(
-            -x12,
-            x184 + Self::mul_add(-x64, x208, x294),
-            Self::mul_add(
-                -x10,
-                x183 + Self::mul_add(-x64, x207, x293),
+        let x391 = S::neg(x390);
+        let x392 = S::neg(
+            S::mul_add(S::neg(x12), x368, S::mul_add(S::neg(x10), x367, s_q1 * x366)),
+        );
+        let x393 = S::mul_add(
+            S::neg(x12),
+            x184 + S::mul_add(S::neg(x64), x208, x294),
+            S::mul_add(
+                S::neg(x10),
+                x183 + S::mul_add(S::neg(x64), x207, x293),
                 s_q1 * (x182 - (x292 - (x301 + x302))),
             ),
         );
-        let x394 = Self::mul_add(
-            -x12,
-            x187 + Self::mul_add(-x65, x208, x297),
-            Self::mul_add(
-                -x10,
+        let x394 = S::mul_add(
+            S::neg(x12),
+            x187 + S::mul_add(S::neg(x65), x208, x297),
+            S::mul_add(
+                S::neg(x10),
                 x186 - (x296 - (x301 + x303)),
-                s_q1 * (x185 + Self::mul_add(-x65, x206, x295)),
+                s_q1 * (x185 + S::mul_add(S::neg(x65), x206, x295)),
             ),
         );
-        let x395 = Self::mul_add(
-            -x12,
+        let x395 = S::mul_add(
+            S::neg(x12),
             x190 - (x300 - (x302 + x303)),
-            Self::mul_add(
-                -x10,
-                x189 + Self::mul_add(-x66, x207, x299),
-                s_q1 * (x188 + Self::mul_add(-x66, x206, x298)),
+            S::mul_add(
+                S::neg(x10),
+                x189 + S::mul_add(S::neg(x66), x207, x299),
+                s_q1 * (x188 + S::mul_add(S::neg(x66), x206, x298)),
             ),
         );
-        let x396 = Self::mul_add(-x12, x395, Self::mul_add(-x10, x394, s_q1 * x393));
-        let x397 = Self::mul_add(
+        let x396 = S::mul_add(
+            S::neg(x12),
+            x395,
+            S::mul_add(S::neg(x10), x394, s_q1 * x393),
+        );
+        let x397 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x178 + x297,
-                Self::mul_add(x10, x177 - x296, s_q1 * (x176 - x295)),
+                S::mul_add(x10, x177 - x296, s_q1 * (x176 - x295)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x175 - x294,
-                    Self::mul_add(x10, x174 - x293, s_q1 * (x173 - x292)),
+                    S::mul_add(x10, x174 - x293, s_q1 * (x173 - x292)),
                 ),
         );
-        let x398 = Self::mul_add(
+        let x398 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x181 - x300,
-                Self::mul_add(x10, x180 + x299, s_q1 * (x179 - x298)),
+                S::mul_add(x10, x180 + x299, s_q1 * (x179 - x298)),
             ),
             x397,
         );
-        let x399 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x399 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x72,
                 x169 + x267,
-                Self::mul_add(x70, x168 - x266, x68 * (x167 + x264)),
+                S::mul_add(x70, x168 - x266, x68 * (x167 + x264)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x72,
                     x166 + x263,
-                    Self::mul_add(x70, x165 + x262, x68 * (x164 - x261)),
+                    S::mul_add(x70, x165 + x262, x68 * (x164 - x261)),
                 ),
         );
-        let x400 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x400 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x72,
                 x172 - x270,
-                Self::mul_add(x70, x171 + x269, x68 * (x170 + x268)),
+                S::mul_add(x70, x171 + x269, x68 * (x170 + x268)),
             ),
             x399,
         );
-        let x401 = -x400;
-        let x402 = Self::mul_add(
+        let x401 = S::neg(x400);
+        let x402 = S::mul_add(
             x12,
-            x175 + Self::mul_add(-x28, x202, x275),
-            Self::mul_add(
+            x175 + S::mul_add(S::neg(x28), x202, x275),
+            S::mul_add(
                 x10,
-                x174 + Self::mul_add(-x28, x201, x274),
+                x174 + S::mul_add(S::neg(x28), x201, x274),
                 s_q1 * (x173 + (x273 + (x286 + x287))),
             ),
         );
-        let x403 = Self::mul_add(
+        let x403 = S::mul_add(
             x12,
-            x178 - Self::mul_add(x29, x202, x279),
-            Self::mul_add(
+            x178 - S::mul_add(x29, x202, x279),
+            S::mul_add(
                 x10,
                 x177 + (x278 + (x286 + x288)),
-                s_q1 * (x176 - Self::mul_add(x29, x200, x276)),
+                s_q1 * (x176 - S::mul_add(x29, x200, x276)),
             ),
         );
-        let x404 = Self::mul_add(
+        let x404 = S::mul_add(
             x12,
             x181 + (x282 + (x287 + x288)),
-            Self::mul_add(
+            S::mul_add(
                 x10,
-                x180 - Self::mul_add(x30, x201, x281),
-                s_q1 * (x179 - Self::mul_add(x30, x200, x280)),
+                x180 - S::mul_add(x30, x201, x281),
+                s_q1 * (x179 - S::mul_add(x30, x200, x280)),
             ),
         );
-        let x405 = Self::mul_add(x12, x404, Self::mul_add(x10, x403, s_q1 * x402));
-        let x406 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x405 = S::mul_add(x12, x404, S::mul_add(x10, x403, s_q1 * x402));
+        let x406 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x72,
                 x169 - x279,
-                Self::mul_add(x70, x168 + x278, x68 * (x167 + x276)),
+                S::mul_add(x70, x168 + x278, x68 * (x167 + x276)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x72,
                     x166 - x275,
-                    Self::mul_add(x70, x165 - x274, x68 * (x164 + x273)),
+                    S::mul_add(x70, x165 - x274, x68 * (x164 + x273)),
                 ),
         );
-        let x407 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x407 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x72,
                 x172 + x282,
-                Self::mul_add(x70, x171 - x281, x68 * (x170 + x280)),
+                S::mul_add(x70, x171 - x281, x68 * (x170 + x280)),
             ),
             x406,
         );
-        let x408 = -x407;
-        let x409 = Self::mul_add(
+        let x408 = S::neg(x407);
+        let x409 = S::mul_add(
             x72,
-            Self::mul_add(-x94, x149, x166),
-            Self::mul_add(
+            S::mul_add(S::neg(x94), x149, x166),
+            S::mul_add(
                 x70,
-                Self::mul_add(-x94, x148, x165),
+                S::mul_add(S::neg(x94), x148, x165),
                 x68 * (x164 + (x283 + x284)),
             ),
         );
-        let x410 = Self::mul_add(
+        let x410 = S::mul_add(
             x72,
-            Self::mul_add(-x95, x149, x169),
-            Self::mul_add(
+            S::mul_add(S::neg(x95), x149, x169),
+            S::mul_add(
                 x70,
                 x168 + (x283 + x285),
-                x68 * Self::mul_add(-x95, x147, x167),
+                x68 * S::mul_add(S::neg(x95), x147, x167),
             ),
         );
-        let x411 = Self::mul_add(
+        let x411 = S::mul_add(
             x72,
             x172 + (x284 + x285),
-            Self::mul_add(
+            S::mul_add(
                 x70,
-                Self::mul_add(-x96, x148, x171),
-                x68 * Self::mul_add(-x96, x147, x170),
+                S::mul_add(S::neg(x96), x148, x171),
+                x68 * S::mul_add(S::neg(x96), x147, x170),
             ),
         );
-        let x412 = Self::mul_add(x72, x411, Self::mul_add(x70, x410, x68 * x409));
-        let x413 = Self::mul_add(x72, x368, Self::mul_add(x70, x367, x68 * x366));
-        let x414 = Self::mul_add(x83, x368, Self::mul_add(x81, x367, x79 * x366));
+        let x412 = S::mul_add(x72, x411, S::mul_add(x70, x410, x68 * x409));
+        let x413 = S::mul_add(x72, x368, S::mul_add(x70, x367, x68 * x366));
+        let x414 = S::mul_add(x83, x368, S::mul_add(x81, x367, x79 * x366));
         [
             [x360, x361, x362, x363, x364, x365, x366],
             [x361, x371, x374, x375, x377, x379, x380],
@@ -1033,6 +1065,32 @@ impl SsrmsRecurrent {
             [x366, x380, x392, x392, x392, x413, x414],
         ]
     }
+    /// [`Self::mass_matrix`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_lanes`]: `out[k]` is `mass_matrix` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_batch<S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>>(
+        q: &[[::core::primitive::f64; 7]],
+        out: &mut [[[::core::primitive::f64; 7]; 7]],
+    ) {
+        let n = out.len().min(q.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                )
+            },
+        );
+    }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: nonlinear effects `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
@@ -1041,8 +1099,15 @@ impl SsrmsRecurrent {
         q: &[::core::primitive::f64; 7],
         qd: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7]) -> [S; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -1051,164 +1116,164 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
         let x22 = x10 * x14;
-        let x23 = Self::mul_add(x9, x13, -x22);
+        let x23 = S::mul_add(x9, x13, S::neg(x22));
         let x24 = x12 * x14;
-        let x25 = Self::mul_add(x11, x13, -x24);
+        let x25 = S::mul_add(x11, x13, S::neg(x24));
         let x26 = s_q1 * x16;
         let x27 = x10 * x16;
-        let x28 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x27));
+        let x28 = S::mul_add(s_q0, x17, S::mul_add(x9, x15, x27));
         let x29 = x12 * x16;
-        let x30 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x29));
+        let x30 = S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x29));
         let x31 = s_q1 * x19;
         let x32 = x10 * x19;
-        let x33 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x32));
+        let x33 = S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x32));
         let x34 = x12 * x19;
-        let x35 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x34));
-        let x36 = s_q1 * 0.5692;
-        let x37 = x10 * 0.5692;
-        let x38 = x12 * 0.5692;
+        let x35 = S::mul_add(c_q0, x20, S::mul_add(x11, x18, x34));
+        let x36 = s_q1 * S::splat(0.5692);
+        let x37 = x10 * S::splat(0.5692);
+        let x38 = x12 * S::splat(0.5692);
         let x39 = c_q1 * c_q2;
         let x40 = c_q1 * s_q2;
-        let x41 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x42 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x43 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x44 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x45 = Self::mul_add(-49.52, s_q1, 15.41 * x39);
-        let x46 = Self::mul_add(-2094.71, s_q1, 49.52 * x39);
-        let x47 = 2103.19 * x40;
-        let x48 = Self::mul_add(49.52, x10, 15.41 * x41);
-        let x49 = Self::mul_add(2094.71, x10, 49.52 * x41);
-        let x50 = 2103.19 * x42;
-        let x51 = Self::mul_add(49.52, x12, 15.41 * x43);
-        let x52 = Self::mul_add(2094.71, x12, 49.52 * x43);
-        let x53 = 2103.19 * x44;
-        let x54 = Self::mul_add(x40, x47, Self::mul_add(-s_q1, x46, x39 * x45));
-        let x55 = Self::mul_add(x42, x47, Self::mul_add(x10, x46, x41 * x45));
-        let x56 = Self::mul_add(x44, x47, Self::mul_add(x12, x46, x43 * x45));
-        let x57 = Self::mul_add(x40, x50, Self::mul_add(-s_q1, x49, x39 * x48));
-        let x58 = Self::mul_add(x42, x50, Self::mul_add(x10, x49, x41 * x48));
-        let x59 = Self::mul_add(x44, x50, Self::mul_add(x12, x49, x43 * x48));
-        let x60 = Self::mul_add(x40, x53, Self::mul_add(-s_q1, x52, x39 * x51));
-        let x61 = Self::mul_add(x42, x53, Self::mul_add(x10, x52, x41 * x51));
-        let x62 = Self::mul_add(x44, x53, Self::mul_add(x12, x52, x43 * x51));
-        let x63 = Self::mul_add(s_q1, 0.475, 7.11 * x39);
-        let x64 = Self::mul_add(x10, -0.475, 7.11 * x41);
-        let x65 = Self::mul_add(x12, -0.475, 7.11 * x43);
-        let x66 = Self::mul_add(-x40, s_q3, x39 * c_q3);
-        let x67 = Self::mul_add(x40, c_q3, x39 * s_q3);
-        let x68 = Self::mul_add(-x42, s_q3, x41 * c_q3);
-        let x69 = Self::mul_add(x42, c_q3, x41 * s_q3);
-        let x70 = Self::mul_add(-x44, s_q3, x43 * c_q3);
-        let x71 = Self::mul_add(x44, c_q3, x43 * s_q3);
-        let x72 = Self::mul_add(s_q1, 39.95, 9.522 * x66);
-        let x73 = Self::mul_add(1966.28, s_q1, x66 * 39.95);
-        let x74 = 1966.28 * x67;
-        let x75 = Self::mul_add(x10, -39.95, 9.522 * x68);
-        let x76 = Self::mul_add(-1966.28, x10, x68 * 39.95);
-        let x77 = 1966.28 * x69;
-        let x78 = Self::mul_add(x12, -39.95, 9.522 * x70);
-        let x79 = Self::mul_add(-1966.28, x12, x70 * 39.95);
-        let x80 = 1966.28 * x71;
-        let x81 = Self::mul_add(x67, x74, Self::mul_add(s_q1, x73, x66 * x72));
-        let x82 = Self::mul_add(x69, x74, Self::mul_add(-x10, x73, x68 * x72));
-        let x83 = Self::mul_add(x71, x74, Self::mul_add(-x12, x73, x70 * x72));
-        let x84 = Self::mul_add(x67, x77, Self::mul_add(s_q1, x76, x66 * x75));
-        let x85 = Self::mul_add(x69, x77, Self::mul_add(-x10, x76, x68 * x75));
-        let x86 = Self::mul_add(x71, x77, Self::mul_add(-x12, x76, x70 * x75));
-        let x87 = Self::mul_add(x67, x80, Self::mul_add(s_q1, x79, x66 * x78));
-        let x88 = Self::mul_add(x69, x80, Self::mul_add(-x10, x79, x68 * x78));
-        let x89 = Self::mul_add(x71, x80, Self::mul_add(-x12, x79, x70 * x78));
-        let x90 = 7.11 * x66;
-        let x91 = 7.11 * x68;
-        let x92 = 7.11 * x70;
-        let x93 = Self::mul_add(-x67, s_q4, x66 * c_q4);
-        let x94 = Self::mul_add(x67, c_q4, x66 * s_q4);
-        let x95 = Self::mul_add(-x69, s_q4, x68 * c_q4);
-        let x96 = Self::mul_add(x69, c_q4, x68 * s_q4);
-        let x97 = Self::mul_add(-x71, s_q4, x70 * c_q4);
-        let x98 = Self::mul_add(x71, c_q4, x70 * s_q4);
-        let x99 = 8.305 * x93;
-        let x100 = 8.0386 * x94;
-        let x101 = 8.305 * x95;
-        let x102 = 8.0386 * x96;
-        let x103 = 8.305 * x97;
-        let x104 = 8.0386 * x98;
-        let x105 = Self::mul_add(x94, x100, Self::mul_add(x93, x99, x21));
-        let x106 = Self::mul_add(-x96, x100, Self::mul_add(-x95, x99, x22));
-        let x107 = Self::mul_add(-x98, x100, Self::mul_add(-x97, x99, x24));
-        let x108 = Self::mul_add(-x94, x102, Self::mul_add(-x93, x101, x26));
-        let x109 = Self::mul_add(x96, x102, Self::mul_add(x95, x101, x27));
-        let x110 = Self::mul_add(x98, x102, Self::mul_add(x97, x101, x29));
-        let x111 = Self::mul_add(-x94, x104, Self::mul_add(-x93, x103, x31));
-        let x112 = Self::mul_add(x96, x104, Self::mul_add(x95, x103, x32));
-        let x113 = Self::mul_add(x98, x104, Self::mul_add(x97, x103, x34));
-        let x114 = Self::mul_add(-s_q1, s_q5, x93 * c_q5);
-        let x115 = Self::mul_add(s_q1, c_q5, x93 * s_q5);
-        let x116 = Self::mul_add(x10, s_q5, x95 * c_q5);
-        let x117 = Self::mul_add(-x10, c_q5, x95 * s_q5);
-        let x118 = Self::mul_add(x12, s_q5, x97 * c_q5);
-        let x119 = Self::mul_add(-x12, c_q5, x97 * s_q5);
-        let x120 = 12.13 * x114;
-        let x121 = 12.13 * x115;
-        let x122 = 3.061 * x94;
-        let x123 = 12.13 * x116;
-        let x124 = 12.13 * x117;
-        let x125 = 3.061 * x96;
-        let x126 = 12.13 * x118;
-        let x127 = 12.13 * x119;
-        let x128 = 3.061 * x98;
-        let x129 = Self::mul_add(x94, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x96, x122, Self::mul_add(x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x98, x122, Self::mul_add(x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x94, x125, Self::mul_add(x115, x124, x114 * x123));
-        let x133 = Self::mul_add(x96, x125, Self::mul_add(x117, x124, x116 * x123));
-        let x134 = Self::mul_add(x98, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x94, x128, Self::mul_add(x115, x127, x114 * x126));
-        let x136 = Self::mul_add(x96, x128, Self::mul_add(x117, x127, x116 * x126));
-        let x137 = Self::mul_add(x98, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = 0.7026 * x94;
-        let x139 = 0.7026 * x96;
-        let x140 = 0.7026 * x98;
-        let x141 = Self::mul_add(-x94, s_q6, x115 * c_q6);
-        let x142 = Self::mul_add(x94, c_q6, x115 * s_q6);
-        let x143 = Self::mul_add(-x96, s_q6, x117 * c_q6);
-        let x144 = Self::mul_add(x96, c_q6, x117 * s_q6);
-        let x145 = Self::mul_add(-x98, s_q6, x119 * c_q6);
-        let x146 = Self::mul_add(x98, c_q6, x119 * s_q6);
-        let x147 = 9.336 * x114;
-        let x148 = 44.41 * x141;
-        let x149 = 44.41 * x142;
-        let x150 = 9.336 * x116;
-        let x151 = 44.41 * x143;
-        let x152 = 44.41 * x144;
-        let x153 = 9.336 * x118;
-        let x154 = 44.41 * x145;
-        let x155 = 44.41 * x146;
-        let x156 = Self::mul_add(x142, x149, Self::mul_add(x141, x148, x114 * x147));
-        let x157 = Self::mul_add(x144, x149, Self::mul_add(x143, x148, x116 * x147));
-        let x158 = Self::mul_add(x146, x149, Self::mul_add(x145, x148, x118 * x147));
-        let x159 = Self::mul_add(x142, x152, Self::mul_add(x141, x151, x114 * x150));
-        let x160 = Self::mul_add(x144, x152, Self::mul_add(x143, x151, x116 * x150));
-        let x161 = Self::mul_add(x146, x152, Self::mul_add(x145, x151, x118 * x150));
-        let x162 = Self::mul_add(x142, x155, Self::mul_add(x141, x154, x114 * x153));
-        let x163 = Self::mul_add(x144, x155, Self::mul_add(x143, x154, x116 * x153));
-        let x164 = Self::mul_add(x146, x155, Self::mul_add(x145, x154, x118 * x153));
+        let x41 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x42 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x43 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x44 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x45 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x39);
+        let x46 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x39);
+        let x47 = S::splat(2103.19) * x40;
+        let x48 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x41);
+        let x49 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x41);
+        let x50 = S::splat(2103.19) * x42;
+        let x51 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x43);
+        let x52 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x43);
+        let x53 = S::splat(2103.19) * x44;
+        let x54 = S::mul_add(x40, x47, S::mul_add(S::neg(s_q1), x46, x39 * x45));
+        let x55 = S::mul_add(x42, x47, S::mul_add(x10, x46, x41 * x45));
+        let x56 = S::mul_add(x44, x47, S::mul_add(x12, x46, x43 * x45));
+        let x57 = S::mul_add(x40, x50, S::mul_add(S::neg(s_q1), x49, x39 * x48));
+        let x58 = S::mul_add(x42, x50, S::mul_add(x10, x49, x41 * x48));
+        let x59 = S::mul_add(x44, x50, S::mul_add(x12, x49, x43 * x48));
+        let x60 = S::mul_add(x40, x53, S::mul_add(S::neg(s_q1), x52, x39 * x51));
+        let x61 = S::mul_add(x42, x53, S::mul_add(x10, x52, x41 * x51));
+        let x62 = S::mul_add(x44, x53, S::mul_add(x12, x52, x43 * x51));
+        let x63 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x39);
+        let x64 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x41);
+        let x65 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x43);
+        let x66 = S::mul_add(S::neg(x40), s_q3, x39 * c_q3);
+        let x67 = S::mul_add(x40, c_q3, x39 * s_q3);
+        let x68 = S::mul_add(S::neg(x42), s_q3, x41 * c_q3);
+        let x69 = S::mul_add(x42, c_q3, x41 * s_q3);
+        let x70 = S::mul_add(S::neg(x44), s_q3, x43 * c_q3);
+        let x71 = S::mul_add(x44, c_q3, x43 * s_q3);
+        let x72 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x66);
+        let x73 = S::mul_add(S::splat(1966.28), s_q1, x66 * S::splat(39.95));
+        let x74 = S::splat(1966.28) * x67;
+        let x75 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x68);
+        let x76 = S::mul_add(S::splat(-1966.28), x10, x68 * S::splat(39.95));
+        let x77 = S::splat(1966.28) * x69;
+        let x78 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x70);
+        let x79 = S::mul_add(S::splat(-1966.28), x12, x70 * S::splat(39.95));
+        let x80 = S::splat(1966.28) * x71;
+        let x81 = S::mul_add(x67, x74, S::mul_add(s_q1, x73, x66 * x72));
+        let x82 = S::mul_add(x69, x74, S::mul_add(S::neg(x10), x73, x68 * x72));
+        let x83 = S::mul_add(x71, x74, S::mul_add(S::neg(x12), x73, x70 * x72));
+        let x84 = S::mul_add(x67, x77, S::mul_add(s_q1, x76, x66 * x75));
+        let x85 = S::mul_add(x69, x77, S::mul_add(S::neg(x10), x76, x68 * x75));
+        let x86 = S::mul_add(x71, x77, S::mul_add(S::neg(x12), x76, x70 * x75));
+        let x87 = S::mul_add(x67, x80, S::mul_add(s_q1, x79, x66 * x78));
+        let x88 = S::mul_add(x69, x80, S::mul_add(S::neg(x10), x79, x68 * x78));
+        let x89 = S::mul_add(x71, x80, S::mul_add(S::neg(x12), x79, x70 * x78));
+        let x90 = S::splat(7.11) * x66;
+        let x91 = S::splat(7.11) * x68;
+        let x92 = S::splat(7.11) * x70;
+        let x93 = S::mul_add(S::neg(x67), s_q4, x66 * c_q4);
+        let x94 = S::mul_add(x67, c_q4, x66 * s_q4);
+        let x95 = S::mul_add(S::neg(x69), s_q4, x68 * c_q4);
+        let x96 = S::mul_add(x69, c_q4, x68 * s_q4);
+        let x97 = S::mul_add(S::neg(x71), s_q4, x70 * c_q4);
+        let x98 = S::mul_add(x71, c_q4, x70 * s_q4);
+        let x99 = S::splat(8.305) * x93;
+        let x100 = S::splat(8.0386) * x94;
+        let x101 = S::splat(8.305) * x95;
+        let x102 = S::splat(8.0386) * x96;
+        let x103 = S::splat(8.305) * x97;
+        let x104 = S::splat(8.0386) * x98;
+        let x105 = S::mul_add(x94, x100, S::mul_add(x93, x99, x21));
+        let x106 = S::mul_add(S::neg(x96), x100, S::mul_add(S::neg(x95), x99, x22));
+        let x107 = S::mul_add(S::neg(x98), x100, S::mul_add(S::neg(x97), x99, x24));
+        let x108 = S::mul_add(S::neg(x94), x102, S::mul_add(S::neg(x93), x101, x26));
+        let x109 = S::mul_add(x96, x102, S::mul_add(x95, x101, x27));
+        let x110 = S::mul_add(x98, x102, S::mul_add(x97, x101, x29));
+        let x111 = S::mul_add(S::neg(x94), x104, S::mul_add(S::neg(x93), x103, x31));
+        let x112 = S::mul_add(x96, x104, S::mul_add(x95, x103, x32));
+        let x113 = S::mul_add(x98, x104, S::mul_add(x97, x103, x34));
+        let x114 = S::mul_add(S::neg(s_q1), s_q5, x93 * c_q5);
+        let x115 = S::mul_add(s_q1, c_q5, x93 * s_q5);
+        let x116 = S::mul_add(x10, s_q5, x95 * c_q5);
+        let x117 = S::mul_add(S::neg(x10), c_q5, x95 * s_q5);
+        let x118 = S::mul_add(x12, s_q5, x97 * c_q5);
+        let x119 = S::mul_add(S::neg(x12), c_q5, x97 * s_q5);
+        let x120 = S::splat(12.13) * x114;
+        let x121 = S::splat(12.13) * x115;
+        let x122 = S::splat(3.061) * x94;
+        let x123 = S::splat(12.13) * x116;
+        let x124 = S::splat(12.13) * x117;
+        let x125 = S::splat(3.061) * x96;
+        let x126 = S::splat(12.13) * x118;
+        let x127 = S::splat(12.13) * x119;
+        let x128 = S::splat(3.061) * x98;
+        let x129 = S::mul_add(x94, x122, S::mul_add(x115, x121, x114 * x120));
+        let x130 = S::mul_add(x96, x122, S::mul_add(x117, x121, x116 * x120));
+        let x131 = S::mul_add(x98, x122, S::mul_add(x119, x121, x118 * x120));
+        let x132 = S::mul_add(x94, x125, S::mul_add(x115, x124, x114 * x123));
+        let x133 = S::mul_add(x96, x125, S::mul_add(x117, x124, x116 * x123));
+        let x134 = S::mul_add(x98, x125, S::mul_add(x119, x124, x118 * x123));
+        let x135 = S::mul_add(x94, x128, S::mul_add(x115, x127, x114 * x126));
+        let x136 = S::mul_add(x96, x128, S::mul_add(x117, x127, x116 * x126));
+        let x137 = S::mul_add(x98, x128, S::mul_add(x119, x127, x118 * x126));
+        let x138 = S::splat(0.7026) * x94;
+        let x139 = S::splat(0.7026) * x96;
+        let x140 = S::splat(0.7026) * x98;
+        let x141 = S::mul_add(S::neg(x94), s_q6, x115 * c_q6);
+        let x142 = S::mul_add(x94, c_q6, x115 * s_q6);
+        let x143 = S::mul_add(S::neg(x96), s_q6, x117 * c_q6);
+        let x144 = S::mul_add(x96, c_q6, x117 * s_q6);
+        let x145 = S::mul_add(S::neg(x98), s_q6, x119 * c_q6);
+        let x146 = S::mul_add(x98, c_q6, x119 * s_q6);
+        let x147 = S::splat(9.336) * x114;
+        let x148 = S::splat(44.41) * x141;
+        let x149 = S::splat(44.41) * x142;
+        let x150 = S::splat(9.336) * x116;
+        let x151 = S::splat(44.41) * x143;
+        let x152 = S::splat(44.41) * x144;
+        let x153 = S::splat(9.336) * x118;
+        let x154 = S::splat(44.41) * x145;
+        let x155 = S::splat(44.41) * x146;
+        let x156 = S::mul_add(x142, x149, S::mul_add(x141, x148, x114 * x147));
+        let x157 = S::mul_add(x144, x149, S::mul_add(x143, x148, x116 * x147));
+        let x158 = S::mul_add(x146, x149, S::mul_add(x145, x148, x118 * x147));
+        let x159 = S::mul_add(x142, x152, S::mul_add(x141, x151, x114 * x150));
+        let x160 = S::mul_add(x144, x152, S::mul_add(x143, x151, x116 * x150));
+        let x161 = S::mul_add(x146, x152, S::mul_add(x145, x151, x118 * x150));
+        let x162 = S::mul_add(x142, x155, S::mul_add(x141, x154, x114 * x153));
+        let x163 = S::mul_add(x144, x155, S::mul_add(x143, x154, x116 * x153));
+        let x164 = S::mul_add(x146, x155, S::mul_add(x145, x154, x118 * x153));
         let x165 = qd[1] * s_q0;
         let x166 = qd[1] * c_q0;
         let x167 = qd[0] * qd[0];
@@ -1224,23 +1289,19 @@ impl SsrmsRecurrent {
         let x177 = x165 * x166;
         let x178 = x36 * (x175 + x176);
         let x179 = x168
-            - Self::mul_add(
-                -x38,
+            - S::mul_add(
+                S::neg(x38),
                 x177,
-                Self::mul_add(-x37, x167 + x175, x36 * (x171 + x171)),
+                S::mul_add(S::neg(x37), x167 + x175, x36 * (x171 + x171)),
             );
         let x180 = x169
-            - Self::mul_add(
-                x38,
-                x167 + x176,
-                Self::mul_add(x37, x177, x36 * (x170 + x170)),
-            );
+            - S::mul_add(x38, x167 + x176, S::mul_add(x37, x177, x36 * (x170 + x170)));
         let x181 = qd[0] - x172;
         let x182 = x165 - x173;
         let x183 = x166 + x174;
-        let x184 = Self::mul_add(x165, x174, x166 * x173);
-        let x185 = x170 + Self::mul_add(qd[0], x174, x166 * x172);
-        let x186 = x171 + Self::mul_add(-qd[0], x173, x165 * x172);
+        let x184 = S::mul_add(x165, x174, x166 * x173);
+        let x185 = x170 + S::mul_add(qd[0], x174, x166 * x172);
+        let x186 = x171 + S::mul_add(S::neg(qd[0]), x173, x165 * x172);
         let x187 = qd[3] * s_q1;
         let x188 = qd[3] * x10;
         let x189 = qd[3] * x12;
@@ -1251,29 +1312,29 @@ impl SsrmsRecurrent {
         let x194 = x181 * x181;
         let x195 = x182 * x183;
         let x196 = x178
-            + Self::mul_add(
+            + S::mul_add(
                 x65,
                 x185 - x193,
-                Self::mul_add(-x64, x186 - x192, x63 * (x190 + x191)),
+                S::mul_add(S::neg(x64), x186 - x192, x63 * (x190 + x191)),
             );
         let x197 = x179
-            - Self::mul_add(
-                -x65,
+            - S::mul_add(
+                S::neg(x65),
                 x184 - x195,
-                Self::mul_add(x64, x190 + x194, x63 * (x186 + x192)),
+                S::mul_add(x64, x190 + x194, x63 * (x186 + x192)),
             );
         let x198 = x180
-            - Self::mul_add(
-                -x65,
+            - S::mul_add(
+                S::neg(x65),
                 x191 + x194,
-                Self::mul_add(-x64, x184 + x195, x63 * (x185 + x193)),
+                S::mul_add(S::neg(x64), x184 + x195, x63 * (x185 + x193)),
             );
         let x199 = x181 - x187;
         let x200 = x182 - x188;
         let x201 = x183 + x189;
-        let x202 = x184 + Self::mul_add(x182, x189, x183 * x188);
-        let x203 = x185 + Self::mul_add(x181, x189, x183 * x187);
-        let x204 = x186 + Self::mul_add(-x181, x188, x182 * x187);
+        let x202 = x184 + S::mul_add(x182, x189, x183 * x188);
+        let x203 = x185 + S::mul_add(x181, x189, x183 * x187);
+        let x204 = x186 + S::mul_add(S::neg(x181), x188, x182 * x187);
         let x205 = qd[4] * s_q1;
         let x206 = qd[4] * x10;
         let x207 = qd[4] * x12;
@@ -1284,29 +1345,29 @@ impl SsrmsRecurrent {
         let x212 = x199 * x199;
         let x213 = x200 * x201;
         let x214 = x196
-            + Self::mul_add(
+            + S::mul_add(
                 x92,
                 x203 - x211,
-                Self::mul_add(-x91, x204 - x210, x90 * (x208 + x209)),
+                S::mul_add(S::neg(x91), x204 - x210, x90 * (x208 + x209)),
             );
         let x215 = x197
-            - Self::mul_add(
-                -x92,
+            - S::mul_add(
+                S::neg(x92),
                 x202 - x213,
-                Self::mul_add(x91, x208 + x212, x90 * (x204 + x210)),
+                S::mul_add(x91, x208 + x212, x90 * (x204 + x210)),
             );
         let x216 = x198
-            - Self::mul_add(
-                -x92,
+            - S::mul_add(
+                S::neg(x92),
                 x209 + x212,
-                Self::mul_add(-x91, x202 + x213, x90 * (x203 + x211)),
+                S::mul_add(S::neg(x91), x202 + x213, x90 * (x203 + x211)),
             );
         let x217 = x199 - x205;
         let x218 = x200 - x206;
         let x219 = x201 + x207;
-        let x220 = x202 + Self::mul_add(x200, x207, x201 * x206);
-        let x221 = x203 + Self::mul_add(x199, x207, x201 * x205);
-        let x222 = x204 + Self::mul_add(-x199, x206, x200 * x205);
+        let x220 = x202 + S::mul_add(x200, x207, x201 * x206);
+        let x221 = x203 + S::mul_add(x199, x207, x201 * x205);
+        let x222 = x204 + S::mul_add(S::neg(x199), x206, x200 * x205);
         let x223 = qd[5] * x94;
         let x224 = qd[5] * x96;
         let x225 = qd[5] * x98;
@@ -1317,29 +1378,29 @@ impl SsrmsRecurrent {
         let x230 = x217 * x217;
         let x231 = x218 * x219;
         let x232 = x214
-            + Self::mul_add(
-                -x38,
+            + S::mul_add(
+                S::neg(x38),
                 x221 - x229,
-                Self::mul_add(x37, x222 - x228, x36 * (x226 + x227)),
+                S::mul_add(x37, x222 - x228, x36 * (x226 + x227)),
             );
         let x233 = x215
-            - Self::mul_add(
+            - S::mul_add(
                 x38,
                 x220 - x231,
-                Self::mul_add(-x37, x226 + x230, x36 * (x222 + x228)),
+                S::mul_add(S::neg(x37), x226 + x230, x36 * (x222 + x228)),
             );
         let x234 = x216
-            - Self::mul_add(
+            - S::mul_add(
                 x38,
                 x227 + x230,
-                Self::mul_add(x37, x220 + x231, x36 * (x221 + x229)),
+                S::mul_add(x37, x220 + x231, x36 * (x221 + x229)),
             );
         let x235 = x217 + x223;
         let x236 = x218 - x224;
         let x237 = x219 + x225;
-        let x238 = x220 + Self::mul_add(x218, x225, x219 * x224);
-        let x239 = x221 - Self::mul_add(-x217, x225, x219 * x223);
-        let x240 = x222 - Self::mul_add(x217, x224, x218 * x223);
+        let x238 = x220 + S::mul_add(x218, x225, x219 * x224);
+        let x239 = x221 - S::mul_add(S::neg(x217), x225, x219 * x223);
+        let x240 = x222 - S::mul_add(x217, x224, x218 * x223);
         let x241 = qd[6] * x114;
         let x242 = qd[6] * x116;
         let x243 = qd[6] * x118;
@@ -1352,138 +1413,189 @@ impl SsrmsRecurrent {
         let x250 = x235 + x241;
         let x251 = x236 - x242;
         let x252 = x237 + x243;
-        let x253 = x238 + Self::mul_add(x236, x243, x237 * x242);
-        let x254 = x239 - Self::mul_add(-x235, x243, x237 * x241);
-        let x255 = x240 - Self::mul_add(x235, x242, x236 * x241);
-        let x256 = Self::mul_add(
+        let x253 = x238 + S::mul_add(x236, x243, x237 * x242);
+        let x254 = x239 - S::mul_add(S::neg(x235), x243, x237 * x241);
+        let x255 = x240 - S::mul_add(x235, x242, x236 * x241);
+        let x256 = S::mul_add(
             x25,
             x166,
-            Self::mul_add(-x23, x165, qd[0] * Self::mul_add(c_q1, x13, x21)),
+            S::mul_add(S::neg(x23), x165, qd[0] * S::mul_add(c_q1, x13, x21)),
         );
-        let x257 = Self::mul_add(
+        let x257 = S::mul_add(
             x30,
             x166,
-            Self::mul_add(-x28, x165, qd[0] * Self::mul_add(c_q1, x15, -x26)),
+            S::mul_add(S::neg(x28), x165, qd[0] * S::mul_add(c_q1, x15, S::neg(x26))),
         );
-        let x258 = Self::mul_add(
+        let x258 = S::mul_add(
             x35,
             x166,
-            Self::mul_add(-x33, x165, qd[0] * Self::mul_add(c_q1, x18, -x31)),
+            S::mul_add(S::neg(x33), x165, qd[0] * S::mul_add(c_q1, x18, S::neg(x31))),
         );
-        let x259 = Self::mul_add(x56, x183, Self::mul_add(-x55, x182, x54 * x181));
-        let x260 = Self::mul_add(x59, x183, Self::mul_add(-x58, x182, x57 * x181));
-        let x261 = Self::mul_add(x62, x183, Self::mul_add(-x61, x182, x60 * x181));
-        let x262 = Self::mul_add(x83, x201, Self::mul_add(-x82, x200, x81 * x199));
-        let x263 = Self::mul_add(x86, x201, Self::mul_add(-x85, x200, x84 * x199));
-        let x264 = Self::mul_add(x89, x201, Self::mul_add(-x88, x200, x87 * x199));
-        let x265 = Self::mul_add(-x107, x219, Self::mul_add(x106, x218, x105 * x217));
-        let x266 = Self::mul_add(-x110, x219, Self::mul_add(x109, x218, x108 * x217));
-        let x267 = Self::mul_add(-x113, x219, Self::mul_add(x112, x218, x111 * x217));
-        let x268 = Self::mul_add(x131, x237, Self::mul_add(-x130, x236, x129 * x235));
-        let x269 = Self::mul_add(x134, x237, Self::mul_add(-x133, x236, x132 * x235));
-        let x270 = Self::mul_add(x137, x237, Self::mul_add(-x136, x236, x135 * x235));
-        let x271 = 243.66
+        let x259 = S::mul_add(x56, x183, S::mul_add(S::neg(x55), x182, x54 * x181));
+        let x260 = S::mul_add(x59, x183, S::mul_add(S::neg(x58), x182, x57 * x181));
+        let x261 = S::mul_add(x62, x183, S::mul_add(S::neg(x61), x182, x60 * x181));
+        let x262 = S::mul_add(x83, x201, S::mul_add(S::neg(x82), x200, x81 * x199));
+        let x263 = S::mul_add(x86, x201, S::mul_add(S::neg(x85), x200, x84 * x199));
+        let x264 = S::mul_add(x89, x201, S::mul_add(S::neg(x88), x200, x87 * x199));
+        let x265 = S::mul_add(S::neg(x107), x219, S::mul_add(x106, x218, x105 * x217));
+        let x266 = S::mul_add(S::neg(x110), x219, S::mul_add(x109, x218, x108 * x217));
+        let x267 = S::mul_add(S::neg(x113), x219, S::mul_add(x112, x218, x111 * x217));
+        let x268 = S::mul_add(x131, x237, S::mul_add(S::neg(x130), x236, x129 * x235));
+        let x269 = S::mul_add(x134, x237, S::mul_add(S::neg(x133), x236, x132 * x235));
+        let x270 = S::mul_add(x137, x237, S::mul_add(S::neg(x136), x236, x135 * x235));
+        let x271 = S::splat(243.66)
             * (x232
-                - Self::mul_add(
+                - S::mul_add(
                     x140,
                     x239 - x247,
-                    Self::mul_add(-x139, x240 - x246, x138 * (x244 + x245)),
+                    S::mul_add(S::neg(x139), x240 - x246, x138 * (x244 + x245)),
                 ));
-        let x272 = 243.66
+        let x272 = S::splat(243.66)
             * (x233
-                + Self::mul_add(
-                    -x140,
+                + S::mul_add(
+                    S::neg(x140),
                     x238 - x249,
-                    Self::mul_add(x139, x244 + x248, x138 * (x240 + x246)),
+                    S::mul_add(x139, x244 + x248, x138 * (x240 + x246)),
                 ));
-        let x273 = 243.66
+        let x273 = S::splat(243.66)
             * (x234
-                + Self::mul_add(
-                    -x140,
+                + S::mul_add(
+                    S::neg(x140),
                     x245 + x248,
-                    Self::mul_add(-x139, x238 + x249, x138 * (x239 + x247)),
+                    S::mul_add(S::neg(x139), x238 + x249, x138 * (x239 + x247)),
                 ));
-        let x274 = Self::mul_add(x158, x252, Self::mul_add(-x157, x251, x156 * x250));
-        let x275 = Self::mul_add(x161, x252, Self::mul_add(-x160, x251, x159 * x250));
-        let x276 = Self::mul_add(x164, x252, Self::mul_add(-x163, x251, x162 * x250));
-        let x277 = Self::mul_add(x158, x255, Self::mul_add(x157, x254, x156 * x253))
-            + Self::mul_add(x251, x276, x252 * x275);
-        let x278 = Self::mul_add(x161, x255, Self::mul_add(x160, x254, x159 * x253))
-            - Self::mul_add(-x250, x276, x252 * x274);
-        let x279 = Self::mul_add(x164, x255, Self::mul_add(x163, x254, x162 * x253))
-            - Self::mul_add(x250, x275, x251 * x274);
-        let x280 = Self::mul_add(105.98, x232, x271);
-        let x281 = Self::mul_add(105.98, x233, x272);
-        let x282 = Self::mul_add(105.98, x234, x273);
-        let x283 = Self::mul_add(105.98, x214, x280);
-        let x284 = Self::mul_add(105.98, x215, x281);
-        let x285 = Self::mul_add(105.98, x216, x282);
-        let x286 = Self::mul_add(279.2, x196, x283);
-        let x287 = Self::mul_add(279.2, x197, x284);
-        let x288 = Self::mul_add(279.2, x198, x285);
-        let x289 = Self::mul_add(314.88, x178, x286);
-        let x290 = Self::mul_add(314.88, x179, x287);
-        let x291 = Self::mul_add(314.88, x180, x288);
-        let x292 = Self::mul_add(x131, x240, Self::mul_add(x130, x239, x129 * x238))
-            + Self::mul_add(x236, x270, x237 * x269) + x277
-            - Self::mul_add(x139, x273, x140 * x272);
-        let x293 = Self::mul_add(x134, x240, Self::mul_add(x133, x239, x132 * x238))
-            - Self::mul_add(-x235, x270, x237 * x268) + x278
-            - Self::mul_add(-x138, x273, x140 * x271);
-        let x294 = Self::mul_add(x137, x240, Self::mul_add(x136, x239, x135 * x238))
-            - Self::mul_add(x235, x269, x236 * x268) + x279
-            + Self::mul_add(x138, x272, x139 * x271);
-        let x295 = Self::mul_add(-x107, x222, Self::mul_add(-x106, x221, x105 * x220))
-            - Self::mul_add(x218, x267, x219 * x266) + x292
-            - Self::mul_add(x37, x282, x38 * x281);
-        let x296 = Self::mul_add(-x110, x222, Self::mul_add(-x109, x221, x108 * x220))
-            + Self::mul_add(x217, x267, x219 * x265) - x293
-            + Self::mul_add(x36, x282, x38 * x280);
-        let x297 = Self::mul_add(-x113, x222, Self::mul_add(-x112, x221, x111 * x220))
-            + Self::mul_add(-x217, x266, x218 * x265) - x294
-            - Self::mul_add(-x36, x281, x37 * x280);
-        let x298 = Self::mul_add(x83, x204, Self::mul_add(x82, x203, x81 * x202))
-            + Self::mul_add(x200, x264, x201 * x263) + x295
-            + Self::mul_add(x91, x285, x92 * x284);
-        let x299 = Self::mul_add(x86, x204, Self::mul_add(x85, x203, x84 * x202))
-            - Self::mul_add(-x199, x264, x201 * x262) - x296
-            + Self::mul_add(-x90, x285, x92 * x283);
-        let x300 = Self::mul_add(x89, x204, Self::mul_add(x88, x203, x87 * x202))
-            - Self::mul_add(x199, x263, x200 * x262) - x297
-            - Self::mul_add(x90, x284, x91 * x283);
-        let x301 = Self::mul_add(x56, x186, Self::mul_add(x55, x185, x54 * x184))
-            + Self::mul_add(x182, x261, x183 * x260) + x298
-            + Self::mul_add(x64, x288, x65 * x287);
-        let x302 = Self::mul_add(x59, x186, Self::mul_add(x58, x185, x57 * x184))
-            - Self::mul_add(-x181, x261, x183 * x259) + x299
-            + Self::mul_add(-x63, x288, x65 * x286);
-        let x303 = Self::mul_add(x62, x186, Self::mul_add(x61, x185, x60 * x184))
-            - Self::mul_add(x181, x260, x182 * x259) + x300
-            - Self::mul_add(x63, x287, x64 * x286);
-        let x304 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(x35, x171, x33 * x170)
-                - Self::mul_add(qd[0], x257, x165 * x256) + x303
-                + Self::mul_add(-x36, x290, x37 * x289),
+        let x274 = S::mul_add(x158, x252, S::mul_add(S::neg(x157), x251, x156 * x250));
+        let x275 = S::mul_add(x161, x252, S::mul_add(S::neg(x160), x251, x159 * x250));
+        let x276 = S::mul_add(x164, x252, S::mul_add(S::neg(x163), x251, x162 * x250));
+        let x277 = S::mul_add(x158, x255, S::mul_add(x157, x254, x156 * x253))
+            + S::mul_add(x251, x276, x252 * x275);
+        let x278 = S::mul_add(x161, x255, S::mul_add(x160, x254, x159 * x253))
+            - S::mul_add(S::neg(x250), x276, x252 * x274);
+        let x279 = S::mul_add(x164, x255, S::mul_add(x163, x254, x162 * x253))
+            - S::mul_add(x250, x275, x251 * x274);
+        let x280 = S::mul_add(S::splat(105.98), x232, x271);
+        let x281 = S::mul_add(S::splat(105.98), x233, x272);
+        let x282 = S::mul_add(S::splat(105.98), x234, x273);
+        let x283 = S::mul_add(S::splat(105.98), x214, x280);
+        let x284 = S::mul_add(S::splat(105.98), x215, x281);
+        let x285 = S::mul_add(S::splat(105.98), x216, x282);
+        let x286 = S::mul_add(S::splat(279.2), x196, x283);
+        let x287 = S::mul_add(S::splat(279.2), x197, x284);
+        let x288 = S::mul_add(S::splat(279.2), x198, x285);
+        let x289 = S::mul_add(S::splat(314.88), x178, x286);
+        let x290 = S::mul_add(S::splat(314.88), x179, x287);
+        let x291 = S::mul_add(S::splat(314.88), x180, x288);
+        let x292 = S::mul_add(x131, x240, S::mul_add(x130, x239, x129 * x238))
+            + S::mul_add(x236, x270, x237 * x269) + x277
+            - S::mul_add(x139, x273, x140 * x272);
+        let x293 = S::mul_add(x134, x240, S::mul_add(x133, x239, x132 * x238))
+            - S::mul_add(S::neg(x235), x270, x237 * x268) + x278
+            - S::mul_add(S::neg(x138), x273, x140 * x271);
+        let x294 = S::mul_add(x137, x240, S::mul_add(x136, x239, x135 * x238))
+            - S::mul_add(x235, x269, x236 * x268) + x279
+            + S::mul_add(x138, x272, x139 * x271);
+        let x295 = S::mul_add(
+            S::neg(x107),
+            x222,
+            S::mul_add(S::neg(x106), x221, x105 * x220),
+        ) - S::mul_add(x218, x267, x219 * x266) + x292
+            - S::mul_add(x37, x282, x38 * x281);
+        let x296 = S::mul_add(
+            S::neg(x110),
+            x222,
+            S::mul_add(S::neg(x109), x221, x108 * x220),
+        ) + S::mul_add(x217, x267, x219 * x265) - x293
+            + S::mul_add(x36, x282, x38 * x280);
+        let x297 = S::mul_add(
+            S::neg(x113),
+            x222,
+            S::mul_add(S::neg(x112), x221, x111 * x220),
+        ) + S::mul_add(S::neg(x217), x266, x218 * x265) - x294
+            - S::mul_add(S::neg(x36), x281, x37 * x280);
+        let x298 = S::mul_add(x83, x204, S::mul_add(x82, x203, x81 * x202))
+            + S::mul_add(x200, x264, x201 * x263) + x295
+            + S::mul_add(x91, x285, x92 * x284);
+        let x299 = S::mul_add(x86, x204, S::mul_add(x85, x203, x84 * x202))
+            - S::mul_add(S::neg(x199), x264, x201 * x262) - x296
+            + S::mul_add(S::neg(x90), x285, x92 * x283);
+        let x300 = S::mul_add(x89, x204, S::mul_add(x88, x203, x87 * x202))
+            - S::mul_add(x199, x263, x200 * x262) - x297
+            - S::mul_add(x90, x284, x91 * x283);
+        let x301 = S::mul_add(x56, x186, S::mul_add(x55, x185, x54 * x184))
+            + S::mul_add(x182, x261, x183 * x260) + x298
+            + S::mul_add(x64, x288, x65 * x287);
+        let x302 = S::mul_add(x59, x186, S::mul_add(x58, x185, x57 * x184))
+            - S::mul_add(S::neg(x181), x261, x183 * x259) + x299
+            + S::mul_add(S::neg(x63), x288, x65 * x286);
+        let x303 = S::mul_add(x62, x186, S::mul_add(x61, x185, x60 * x184))
+            - S::mul_add(x181, x260, x182 * x259) + x300
+            - S::mul_add(x63, x287, x64 * x286);
+        let x304 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(x35, x171, x33 * x170) - S::mul_add(qd[0], x257, x165 * x256)
+                + x303 + S::mul_add(S::neg(x36), x290, x37 * x289),
             s_q0
-                * (Self::mul_add(x30, x171, x28 * x170)
-                    - Self::mul_add(-qd[0], x258, x166 * x256) + x302
-                    - Self::mul_add(x36, x291, x38 * x289)),
+                * (S::mul_add(x30, x171, x28 * x170)
+                    - S::mul_add(S::neg(qd[0]), x258, x166 * x256) + x302
+                    - S::mul_add(x36, x291, x38 * x289)),
         );
-        let x305 = Self::mul_add(-x12, x303, Self::mul_add(-x10, x302, s_q1 * x301));
-        let x306 = Self::mul_add(-x12, x300, Self::mul_add(-x10, x299, s_q1 * x298));
-        let x307 = Self::mul_add(x12, x297, Self::mul_add(x10, x296, s_q1 * x295));
-        let x308 = -(Self::mul_add(x25, x171, x23 * x170)
-            + Self::mul_add(x165, x258, x166 * x257) + x301
-            - Self::mul_add(x37, x291, x38 * x290)
-            + Self::mul_add(
-                -x7,
-                Self::mul_add(105.98, x169, x291),
-                x8 * Self::mul_add(105.98, x168, x290),
-            ));
-        let x309 = -Self::mul_add(x98, x294, Self::mul_add(x96, x293, x94 * x292));
-        let x310 = -Self::mul_add(x118, x279, Self::mul_add(x116, x278, x114 * x277));
+        let x305 = S::mul_add(
+            S::neg(x12),
+            x303,
+            S::mul_add(S::neg(x10), x302, s_q1 * x301),
+        );
+        let x306 = S::mul_add(
+            S::neg(x12),
+            x300,
+            S::mul_add(S::neg(x10), x299, s_q1 * x298),
+        );
+        let x307 = S::mul_add(x12, x297, S::mul_add(x10, x296, s_q1 * x295));
+        let x308 = S::neg(
+            S::mul_add(x25, x171, x23 * x170) + S::mul_add(x165, x258, x166 * x257)
+                + x301 - S::mul_add(x37, x291, x38 * x290)
+                + S::mul_add(
+                    S::neg(x7),
+                    S::mul_add(S::splat(105.98), x169, x291),
+                    x8 * S::mul_add(S::splat(105.98), x168, x290),
+                ),
+        );
+        let x309 = S::neg(S::mul_add(x98, x294, S::mul_add(x96, x293, x94 * x292)));
+        let x310 = S::neg(S::mul_add(x118, x279, S::mul_add(x116, x278, x114 * x277)));
         [x308, x304, x305, x306, x307, x309, x310]
+    }
+    /// [`Self::nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::nonlinear_effects_lanes`]: `out[k]` is `nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1494,8 +1606,15 @@ impl SsrmsRecurrent {
         qd: &[::core::primitive::f64; 7],
         qdd: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::inverse_dynamics_lanes::<::core::primitive::f64>(q, qd, qdd)
+    }
+    /// [`Self::inverse_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn inverse_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], qdd: &[S; 7]) -> [S; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -1504,165 +1623,165 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
-        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x22 = S::mul_add(c_q1, x13, x21);
         let x23 = x10 * x14;
-        let x24 = Self::mul_add(x9, x13, -x23);
+        let x24 = S::mul_add(x9, x13, S::neg(x23));
         let x25 = x12 * x14;
-        let x26 = Self::mul_add(x11, x13, -x25);
+        let x26 = S::mul_add(x11, x13, S::neg(x25));
         let x27 = s_q1 * x16;
         let x28 = x10 * x16;
-        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x29 = S::mul_add(s_q0, x17, S::mul_add(x9, x15, x28));
         let x30 = x12 * x16;
-        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x31 = S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x30));
         let x32 = s_q1 * x19;
         let x33 = x10 * x19;
-        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x34 = S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x33));
         let x35 = x12 * x19;
-        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
-        let x37 = s_q1 * 0.5692;
-        let x38 = x10 * 0.5692;
-        let x39 = x12 * 0.5692;
+        let x36 = S::mul_add(c_q0, x20, S::mul_add(x11, x18, x35));
+        let x37 = s_q1 * S::splat(0.5692);
+        let x38 = x10 * S::splat(0.5692);
+        let x39 = x12 * S::splat(0.5692);
         let x40 = c_q1 * c_q2;
         let x41 = c_q1 * s_q2;
-        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
-        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
-        let x48 = 2103.19 * x41;
-        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
-        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
-        let x51 = 2103.19 * x43;
-        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
-        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
-        let x54 = 2103.19 * x45;
-        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
-        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
-        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
-        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
-        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
-        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
-        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
-        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
-        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
-        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
-        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
-        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
-        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
-        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
-        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
-        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
-        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
-        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
-        let x75 = 1966.28 * x68;
-        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
-        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
-        let x78 = 1966.28 * x70;
-        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
-        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
-        let x81 = 1966.28 * x72;
-        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
-        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
-        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
-        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
-        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
-        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
-        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
-        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
-        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
-        let x91 = 7.11 * x67;
-        let x92 = 7.11 * x69;
-        let x93 = 7.11 * x71;
-        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
-        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
-        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
-        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
-        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
-        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
-        let x100 = 8.305 * x94;
-        let x101 = 8.0386 * x95;
-        let x102 = 8.305 * x96;
-        let x103 = 8.0386 * x97;
-        let x104 = 8.305 * x98;
-        let x105 = 8.0386 * x99;
-        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
-        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
-        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
-        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
-        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
-        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
-        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
-        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
-        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
-        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
-        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
-        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
-        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
-        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
-        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
-        let x121 = 12.13 * x115;
-        let x122 = 12.13 * x116;
-        let x123 = 3.061 * x95;
-        let x124 = 12.13 * x117;
-        let x125 = 12.13 * x118;
-        let x126 = 3.061 * x97;
-        let x127 = 12.13 * x119;
-        let x128 = 12.13 * x120;
-        let x129 = 3.061 * x99;
-        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
-        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
-        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
-        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
-        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
-        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
-        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
-        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
-        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
-        let x139 = 0.7026 * x95;
-        let x140 = 0.7026 * x97;
-        let x141 = 0.7026 * x99;
-        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
-        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
-        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
-        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
-        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
-        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
-        let x148 = 9.336 * x115;
-        let x149 = 44.41 * x142;
-        let x150 = 44.41 * x143;
-        let x151 = 9.336 * x117;
-        let x152 = 44.41 * x144;
-        let x153 = 44.41 * x145;
-        let x154 = 9.336 * x119;
-        let x155 = 44.41 * x146;
-        let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x42 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x44 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x45 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x40);
+        let x47 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x40);
+        let x48 = S::splat(2103.19) * x41;
+        let x49 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x42);
+        let x50 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x42);
+        let x51 = S::splat(2103.19) * x43;
+        let x52 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x44);
+        let x53 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x44);
+        let x54 = S::splat(2103.19) * x45;
+        let x55 = S::mul_add(x41, x48, S::mul_add(S::neg(s_q1), x47, x40 * x46));
+        let x56 = S::mul_add(x43, x48, S::mul_add(x10, x47, x42 * x46));
+        let x57 = S::mul_add(x45, x48, S::mul_add(x12, x47, x44 * x46));
+        let x58 = S::mul_add(x41, x51, S::mul_add(S::neg(s_q1), x50, x40 * x49));
+        let x59 = S::mul_add(x43, x51, S::mul_add(x10, x50, x42 * x49));
+        let x60 = S::mul_add(x45, x51, S::mul_add(x12, x50, x44 * x49));
+        let x61 = S::mul_add(x41, x54, S::mul_add(S::neg(s_q1), x53, x40 * x52));
+        let x62 = S::mul_add(x43, x54, S::mul_add(x10, x53, x42 * x52));
+        let x63 = S::mul_add(x45, x54, S::mul_add(x12, x53, x44 * x52));
+        let x64 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x40);
+        let x65 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x42);
+        let x66 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x44);
+        let x67 = S::mul_add(S::neg(x41), s_q3, x40 * c_q3);
+        let x68 = S::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = S::mul_add(S::neg(x43), s_q3, x42 * c_q3);
+        let x70 = S::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = S::mul_add(S::neg(x45), s_q3, x44 * c_q3);
+        let x72 = S::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x67);
+        let x74 = S::mul_add(S::splat(1966.28), s_q1, x67 * S::splat(39.95));
+        let x75 = S::splat(1966.28) * x68;
+        let x76 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x69);
+        let x77 = S::mul_add(S::splat(-1966.28), x10, x69 * S::splat(39.95));
+        let x78 = S::splat(1966.28) * x70;
+        let x79 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x71);
+        let x80 = S::mul_add(S::splat(-1966.28), x12, x71 * S::splat(39.95));
+        let x81 = S::splat(1966.28) * x72;
+        let x82 = S::mul_add(x68, x75, S::mul_add(s_q1, x74, x67 * x73));
+        let x83 = S::mul_add(x70, x75, S::mul_add(S::neg(x10), x74, x69 * x73));
+        let x84 = S::mul_add(x72, x75, S::mul_add(S::neg(x12), x74, x71 * x73));
+        let x85 = S::mul_add(x68, x78, S::mul_add(s_q1, x77, x67 * x76));
+        let x86 = S::mul_add(x70, x78, S::mul_add(S::neg(x10), x77, x69 * x76));
+        let x87 = S::mul_add(x72, x78, S::mul_add(S::neg(x12), x77, x71 * x76));
+        let x88 = S::mul_add(x68, x81, S::mul_add(s_q1, x80, x67 * x79));
+        let x89 = S::mul_add(x70, x81, S::mul_add(S::neg(x10), x80, x69 * x79));
+        let x90 = S::mul_add(x72, x81, S::mul_add(S::neg(x12), x80, x71 * x79));
+        let x91 = S::splat(7.11) * x67;
+        let x92 = S::splat(7.11) * x69;
+        let x93 = S::splat(7.11) * x71;
+        let x94 = S::mul_add(S::neg(x68), s_q4, x67 * c_q4);
+        let x95 = S::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = S::mul_add(S::neg(x70), s_q4, x69 * c_q4);
+        let x97 = S::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = S::mul_add(S::neg(x72), s_q4, x71 * c_q4);
+        let x99 = S::mul_add(x72, c_q4, x71 * s_q4);
+        let x100 = S::splat(8.305) * x94;
+        let x101 = S::splat(8.0386) * x95;
+        let x102 = S::splat(8.305) * x96;
+        let x103 = S::splat(8.0386) * x97;
+        let x104 = S::splat(8.305) * x98;
+        let x105 = S::splat(8.0386) * x99;
+        let x106 = S::mul_add(x95, x101, S::mul_add(x94, x100, x21));
+        let x107 = S::mul_add(S::neg(x97), x101, S::mul_add(S::neg(x96), x100, x23));
+        let x108 = S::mul_add(S::neg(x99), x101, S::mul_add(S::neg(x98), x100, x25));
+        let x109 = S::mul_add(S::neg(x95), x103, S::mul_add(S::neg(x94), x102, x27));
+        let x110 = S::mul_add(x97, x103, S::mul_add(x96, x102, x28));
+        let x111 = S::mul_add(x99, x103, S::mul_add(x98, x102, x30));
+        let x112 = S::mul_add(S::neg(x95), x105, S::mul_add(S::neg(x94), x104, x32));
+        let x113 = S::mul_add(x97, x105, S::mul_add(x96, x104, x33));
+        let x114 = S::mul_add(x99, x105, S::mul_add(x98, x104, x35));
+        let x115 = S::mul_add(S::neg(s_q1), s_q5, x94 * c_q5);
+        let x116 = S::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = S::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = S::mul_add(S::neg(x10), c_q5, x96 * s_q5);
+        let x119 = S::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = S::mul_add(S::neg(x12), c_q5, x98 * s_q5);
+        let x121 = S::splat(12.13) * x115;
+        let x122 = S::splat(12.13) * x116;
+        let x123 = S::splat(3.061) * x95;
+        let x124 = S::splat(12.13) * x117;
+        let x125 = S::splat(12.13) * x118;
+        let x126 = S::splat(3.061) * x97;
+        let x127 = S::splat(12.13) * x119;
+        let x128 = S::splat(12.13) * x120;
+        let x129 = S::splat(3.061) * x99;
+        let x130 = S::mul_add(x95, x123, S::mul_add(x116, x122, x115 * x121));
+        let x131 = S::mul_add(x97, x123, S::mul_add(x118, x122, x117 * x121));
+        let x132 = S::mul_add(x99, x123, S::mul_add(x120, x122, x119 * x121));
+        let x133 = S::mul_add(x95, x126, S::mul_add(x116, x125, x115 * x124));
+        let x134 = S::mul_add(x97, x126, S::mul_add(x118, x125, x117 * x124));
+        let x135 = S::mul_add(x99, x126, S::mul_add(x120, x125, x119 * x124));
+        let x136 = S::mul_add(x95, x129, S::mul_add(x116, x128, x115 * x127));
+        let x137 = S::mul_add(x97, x129, S::mul_add(x118, x128, x117 * x127));
+        let x138 = S::mul_add(x99, x129, S::mul_add(x120, x128, x119 * x127));
+        let x139 = S::splat(0.7026) * x95;
+        let x140 = S::splat(0.7026) * x97;
+        let x141 = S::splat(0.7026) * x99;
+        let x142 = S::mul_add(S::neg(x95), s_q6, x116 * c_q6);
+        let x143 = S::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = S::mul_add(S::neg(x97), s_q6, x118 * c_q6);
+        let x145 = S::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = S::mul_add(S::neg(x99), s_q6, x120 * c_q6);
+        let x147 = S::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = S::splat(9.336) * x115;
+        let x149 = S::splat(44.41) * x142;
+        let x150 = S::splat(44.41) * x143;
+        let x151 = S::splat(9.336) * x117;
+        let x152 = S::splat(44.41) * x144;
+        let x153 = S::splat(44.41) * x145;
+        let x154 = S::splat(9.336) * x119;
+        let x155 = S::splat(44.41) * x146;
+        let x156 = S::splat(44.41) * x147;
+        let x157 = S::mul_add(x143, x150, S::mul_add(x142, x149, x115 * x148));
+        let x158 = S::mul_add(x145, x150, S::mul_add(x144, x149, x117 * x148));
+        let x159 = S::mul_add(x147, x150, S::mul_add(x146, x149, x119 * x148));
+        let x160 = S::mul_add(x143, x153, S::mul_add(x142, x152, x115 * x151));
+        let x161 = S::mul_add(x145, x153, S::mul_add(x144, x152, x117 * x151));
+        let x162 = S::mul_add(x147, x153, S::mul_add(x146, x152, x119 * x151));
+        let x163 = S::mul_add(x143, x156, S::mul_add(x142, x155, x115 * x154));
+        let x164 = S::mul_add(x145, x156, S::mul_add(x144, x155, x117 * x154));
+        let x165 = S::mul_add(x147, x156, S::mul_add(x146, x155, x119 * x154));
         let x166 = x37 - x139;
         let x167 = x38 + x140;
         let x168 = x39 + x141;
@@ -1689,23 +1808,23 @@ impl SsrmsRecurrent {
         let x189 = x39 - x187;
         let x190 = x38 - x65;
         let x191 = x39 - x66;
-        let x192 = 243.66 * x139;
-        let x193 = 243.66 * x140;
-        let x194 = 243.66 * x141;
-        let x195 = 243.66 * x166;
-        let x196 = 243.66 * x167;
-        let x197 = 243.66 * x168;
-        let x198 = 243.66 * x169;
-        let x199 = 243.66 * x170;
-        let x200 = 243.66 * x171;
-        let x201 = 243.66 * x172;
-        let x202 = 243.66 * x173;
-        let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x37 + x172);
-        let x205 = 243.66 * x175;
-        let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x7 + x175);
-        let x208 = 243.66 * (x8 - x176);
+        let x192 = S::splat(243.66) * x139;
+        let x193 = S::splat(243.66) * x140;
+        let x194 = S::splat(243.66) * x141;
+        let x195 = S::splat(243.66) * x166;
+        let x196 = S::splat(243.66) * x167;
+        let x197 = S::splat(243.66) * x168;
+        let x198 = S::splat(243.66) * x169;
+        let x199 = S::splat(243.66) * x170;
+        let x200 = S::splat(243.66) * x171;
+        let x201 = S::splat(243.66) * x172;
+        let x202 = S::splat(243.66) * x173;
+        let x203 = S::splat(243.66) * x174;
+        let x204 = S::splat(243.66) * (x37 + x172);
+        let x205 = S::splat(243.66) * x175;
+        let x206 = S::splat(243.66) * x176;
+        let x207 = S::splat(243.66) * (x7 + x175);
+        let x208 = S::splat(243.66) * (x8 - x176);
         let x209 = x130 + x157;
         let x210 = x131 + x158;
         let x211 = x132 + x159;
@@ -1742,53 +1861,53 @@ impl SsrmsRecurrent {
         let x242 = x61 + x233;
         let x243 = x62 + x234;
         let x244 = x63 + x235;
-        let x245 = Self::mul_add(105.98, x37, x195);
-        let x246 = Self::mul_add(105.98, x38, x196);
-        let x247 = Self::mul_add(105.98, x39, x197);
-        let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(-105.98, x178, x199);
-        let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x91, x248);
-        let x252 = Self::mul_add(105.98, x92, x249);
-        let x253 = Self::mul_add(105.98, x93, x250);
-        let x254 = Self::mul_add(105.98, x180, x201);
-        let x255 = Self::mul_add(105.98, x181, x202);
-        let x256 = Self::mul_add(105.98, x182, x203);
-        let x257 = Self::mul_add(105.98, x185, x254);
-        let x258 = Self::mul_add(105.98, x186, x255);
-        let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x64, x257);
-        let x261 = Self::mul_add(279.2, x65, x258);
-        let x262 = Self::mul_add(279.2, x66, x259);
-        let x263 = Self::mul_add(105.98, x37 + x180, x204);
-        let x264 = Self::mul_add(105.98, x183, x205);
-        let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x37 + x185, x263);
-        let x267 = Self::mul_add(105.98, x188, x264);
-        let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x37 + x64, x266);
-        let x270 = Self::mul_add(279.2, x190, x267);
-        let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x38, x270);
-        let x273 = Self::mul_add(314.88, x39, x271);
-        let x274 = Self::mul_add(105.98, x7 + x183, x207);
-        let x275 = Self::mul_add(105.98, x8 - x184, x208);
-        let x276 = Self::mul_add(105.98, x7 + x188, x274);
-        let x277 = Self::mul_add(105.98, x8 - x189, x275);
-        let x278 = Self::mul_add(279.2, x7 + x190, x276);
-        let x279 = Self::mul_add(279.2, x8 - x191, x277);
-        let x280 = Self::mul_add(314.88, x7 + x38, x278);
-        let x281 = Self::mul_add(314.88, x8 - x39, x279);
-        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x245 = S::mul_add(S::splat(105.98), x37, x195);
+        let x246 = S::mul_add(S::splat(105.98), x38, x196);
+        let x247 = S::mul_add(S::splat(105.98), x39, x197);
+        let x248 = S::mul_add(S::splat(105.98), x177, x198);
+        let x249 = S::mul_add(S::splat(-105.98), x178, x199);
+        let x250 = S::mul_add(S::splat(-105.98), x179, x200);
+        let x251 = S::mul_add(S::splat(105.98), x91, x248);
+        let x252 = S::mul_add(S::splat(105.98), x92, x249);
+        let x253 = S::mul_add(S::splat(105.98), x93, x250);
+        let x254 = S::mul_add(S::splat(105.98), x180, x201);
+        let x255 = S::mul_add(S::splat(105.98), x181, x202);
+        let x256 = S::mul_add(S::splat(105.98), x182, x203);
+        let x257 = S::mul_add(S::splat(105.98), x185, x254);
+        let x258 = S::mul_add(S::splat(105.98), x186, x255);
+        let x259 = S::mul_add(S::splat(105.98), x187, x256);
+        let x260 = S::mul_add(S::splat(279.2), x64, x257);
+        let x261 = S::mul_add(S::splat(279.2), x65, x258);
+        let x262 = S::mul_add(S::splat(279.2), x66, x259);
+        let x263 = S::mul_add(S::splat(105.98), x37 + x180, x204);
+        let x264 = S::mul_add(S::splat(105.98), x183, x205);
+        let x265 = S::mul_add(S::splat(105.98), x184, x206);
+        let x266 = S::mul_add(S::splat(105.98), x37 + x185, x263);
+        let x267 = S::mul_add(S::splat(105.98), x188, x264);
+        let x268 = S::mul_add(S::splat(105.98), x189, x265);
+        let x269 = S::mul_add(S::splat(279.2), x37 + x64, x266);
+        let x270 = S::mul_add(S::splat(279.2), x190, x267);
+        let x271 = S::mul_add(S::splat(279.2), x191, x268);
+        let x272 = S::mul_add(S::splat(314.88), x38, x270);
+        let x273 = S::mul_add(S::splat(314.88), x39, x271);
+        let x274 = S::mul_add(S::splat(105.98), x7 + x183, x207);
+        let x275 = S::mul_add(S::splat(105.98), x8 - x184, x208);
+        let x276 = S::mul_add(S::splat(105.98), x7 + x188, x274);
+        let x277 = S::mul_add(S::splat(105.98), x8 - x189, x275);
+        let x278 = S::mul_add(S::splat(279.2), x7 + x190, x276);
+        let x279 = S::mul_add(S::splat(279.2), x8 - x191, x277);
+        let x280 = S::mul_add(S::splat(314.88), x7 + x38, x278);
+        let x281 = S::mul_add(S::splat(314.88), x8 - x39, x279);
+        let x282 = S::mul_add(S::neg(x140), x207, x141 * x208);
         let x283 = x139 * x207;
         let x284 = x139 * x208;
         let x285 = x140 * x204;
         let x286 = x139 * x204;
         let x287 = x141 * x204;
-        let x288 = Self::mul_add(-x141, x206, x286);
+        let x288 = S::mul_add(S::neg(x141), x206, x286);
         let x289 = x140 * x206;
         let x290 = x141 * x205;
-        let x291 = Self::mul_add(-x140, x205, x286);
+        let x291 = S::mul_add(S::neg(x140), x205, x286);
         let x292 = x141 * x203;
         let x293 = x140 * x202;
         let x294 = x292 + x293;
@@ -1835,13 +1954,13 @@ impl SsrmsRecurrent {
         let x335 = x38 * x249;
         let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x37, x249, x307);
-        let x339 = Self::mul_add(-x37, x250, x308);
-        let x340 = Self::mul_add(x38, x248, x309);
+        let x338 = S::mul_add(S::neg(x37), x249, x307);
+        let x339 = S::mul_add(S::neg(x37), x250, x308);
+        let x340 = S::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x38, x250, x312);
-        let x343 = Self::mul_add(x39, x248, x313);
-        let x344 = Self::mul_add(x39, x249, x314);
+        let x342 = S::mul_add(x38, x250, x312);
+        let x343 = S::mul_add(x39, x248, x313);
+        let x344 = S::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
         let x346 = x93 * x253;
         let x347 = x92 * x252;
@@ -1850,410 +1969,414 @@ impl SsrmsRecurrent {
         let x350 = x38 * x255;
         let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x37, x255, x295);
-        let x354 = Self::mul_add(-x37, x256, x296);
-        let x355 = Self::mul_add(x38, x254, x297);
+        let x353 = S::mul_add(S::neg(x37), x255, x295);
+        let x354 = S::mul_add(S::neg(x37), x256, x296);
+        let x355 = S::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x38, x256, x300);
-        let x358 = Self::mul_add(x39, x254, x301);
-        let x359 = Self::mul_add(x39, x255, x302);
+        let x357 = S::mul_add(x38, x256, x300);
+        let x358 = S::mul_add(x39, x254, x301);
+        let x359 = S::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
         let x361 = x93 * x259;
         let x362 = x92 * x258;
         let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x91, x258, x353);
-        let x366 = Self::mul_add(-x91, x259, x354);
-        let x367 = Self::mul_add(-x92, x257, x355);
+        let x365 = S::mul_add(S::neg(x91), x258, x353);
+        let x366 = S::mul_add(S::neg(x91), x259, x354);
+        let x367 = S::mul_add(S::neg(x92), x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x92, x259, x357);
-        let x370 = Self::mul_add(-x93, x257, x358);
-        let x371 = Self::mul_add(-x93, x258, x359);
+        let x369 = S::mul_add(S::neg(x92), x259, x357);
+        let x370 = S::mul_add(S::neg(x93), x257, x358);
+        let x371 = S::mul_add(S::neg(x93), x258, x359);
         let x372 = x360 - (x362 + x363);
         let x373 = x66 * x262;
         let x374 = x65 * x261;
         let x375 = x64 * x260;
         let x376 = x37 * x263;
-        let x377 = Self::mul_add(x38, x263, x285);
-        let x378 = x288 - Self::mul_add(x39, x265, x376);
-        let x379 = Self::mul_add(x38, x265, x289);
-        let x380 = Self::mul_add(x39, x263, x287);
-        let x381 = Self::mul_add(x39, x264, x290);
-        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x377 = S::mul_add(x38, x263, x285);
+        let x378 = x288 - S::mul_add(x39, x265, x376);
+        let x379 = S::mul_add(x38, x265, x289);
+        let x380 = S::mul_add(x39, x263, x287);
+        let x381 = S::mul_add(x39, x264, x290);
+        let x382 = x291 - S::mul_add(x38, x264, x376);
         let x383 = x91 * x266;
-        let x384 = Self::mul_add(-x92, x266, x377);
-        let x385 = x378 + Self::mul_add(x93, x268, -x383);
-        let x386 = Self::mul_add(-x92, x268, x379);
-        let x387 = Self::mul_add(-x93, x266, x380);
-        let x388 = Self::mul_add(-x93, x267, x381);
-        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x384 = S::mul_add(S::neg(x92), x266, x377);
+        let x385 = x378 + S::mul_add(x93, x268, S::neg(x383));
+        let x386 = S::mul_add(S::neg(x92), x268, x379);
+        let x387 = S::mul_add(S::neg(x93), x266, x380);
+        let x388 = S::mul_add(S::neg(x93), x267, x381);
+        let x389 = x382 + S::mul_add(x92, x267, S::neg(x383));
         let x390 = x64 * x269;
-        let x391 = x385 + Self::mul_add(x66, x271, -x390);
-        let x392 = Self::mul_add(-x65, x271, x386);
-        let x393 = Self::mul_add(-x66, x270, x388);
-        let x394 = x389 + Self::mul_add(x65, x270, -x390);
-        let x395 = x37 * Self::mul_add(314.88, x37, x269);
-        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
-        let x397 = Self::mul_add(-x37, x274, x283);
-        let x398 = Self::mul_add(-x37, x275, x284);
-        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
-        let x400 = Self::mul_add(-x91, x276, x397);
-        let x401 = Self::mul_add(-x91, x277, x398);
-        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
-        let x403 = Self::mul_add(-x64, x278, x400);
-        let x404 = Self::mul_add(-x64, x279, x401);
-        let x405 = Self::mul_add(
-            -c_q0,
-            x26 + x238 + Self::mul_add(-x37, x281, x404),
-            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
+        let x391 = x385 + S::mul_add(x66, x271, S::neg(x390));
+        let x392 = S::mul_add(S::neg(x65), x271, x386);
+        let x393 = S::mul_add(S::neg(x66), x270, x388);
+        let x394 = x389 + S::mul_add(x65, x270, S::neg(x390));
+        let x395 = x37 * S::mul_add(S::splat(314.88), x37, x269);
+        let x396 = x282 + S::mul_add(S::neg(x38), x274, x39 * x275);
+        let x397 = S::mul_add(S::neg(x37), x274, x283);
+        let x398 = S::mul_add(S::neg(x37), x275, x284);
+        let x399 = x396 - S::mul_add(S::neg(x92), x276, x93 * x277);
+        let x400 = S::mul_add(S::neg(x91), x276, x397);
+        let x401 = S::mul_add(S::neg(x91), x277, x398);
+        let x402 = x399 - S::mul_add(S::neg(x65), x278, x66 * x279);
+        let x403 = S::mul_add(S::neg(x64), x278, x400);
+        let x404 = S::mul_add(S::neg(x64), x279, x401);
+        let x405 = S::mul_add(
+            S::neg(c_q0),
+            x26 + x238 + S::mul_add(S::neg(x37), x281, x404),
+            s_q0 * (x24 + x237 - S::mul_add(S::neg(x37), x280, x403)),
         );
-        let x406 = Self::mul_add(
-            -x12,
+        let x406 = S::mul_add(
+            S::neg(x12),
             x238 + x404,
-            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
+            S::mul_add(S::neg(x10), x237 - x403, s_q1 * (x236 - x402)),
         );
-        let x407 = Self::mul_add(
-            -x12,
+        let x407 = S::mul_add(
+            S::neg(x12),
             x229 + x401,
-            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
+            S::mul_add(S::neg(x10), x228 - x400, s_q1 * (x227 - x399)),
         );
-        let x408 = Self::mul_add(
+        let x408 = S::mul_add(
             x12,
             x220 - x398,
-            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
+            S::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
-        let x409 = Self::mul_add(
+        let x409 = S::mul_add(
             x99,
             x211 + x284,
-            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
+            S::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
-        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
-        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
-        let x413 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -c_q0,
-                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
-                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
+        let x410 = S::mul_add(x119, x159, S::mul_add(x117, x158, x115 * x157));
+        let x411 = S::mul_add(x119, x162, S::mul_add(x117, x161, x115 * x160));
+        let x412 = S::mul_add(x119, x165, S::mul_add(x117, x164, x115 * x163));
+        let x413 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(c_q0),
+                x36 + x244 - (x394 - S::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - S::mul_add(x39, x272, x393)),
             ),
             s_q0
-                * Self::mul_add(
-                    -c_q0,
-                    x31 + x241 - Self::mul_add(x38, x273, x392),
-                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
+                * S::mul_add(
+                    S::neg(c_q0),
+                    x31 + x241 - S::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - S::mul_add(x39, x273, x395))),
                 ),
         );
-        let x414 = Self::mul_add(
-            -x12,
+        let x414 = S::mul_add(
+            S::neg(x12),
             x241 - x392,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x269, x384)),
             ),
         );
-        let x415 = Self::mul_add(
-            -x12,
+        let x415 = S::mul_add(
+            S::neg(x12),
             x244 - x394,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x269, x387)),
             ),
         );
-        let x416 = Self::mul_add(-c_q0, x415, s_q0 * x414);
-        let x417 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -x12,
+        let x416 = S::mul_add(S::neg(c_q0), x415, s_q0 * x414);
+        let x417 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x389,
-                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
+                S::mul_add(S::neg(x10), x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x232 - x386,
-                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
+                    S::mul_add(S::neg(x10), x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
-        let x418 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x418 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x12,
                 x226 - x382,
-                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
+                S::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x223 - x379,
-                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
+                    S::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
-        let x419 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x419 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x99,
                 x217 - x291,
-                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
+                S::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x214 - x289,
-                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
+                    S::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
-        let x420 = Self::mul_add(-c_q0, x412, s_q0 * x411);
-        let x421 = Self::mul_add(
-            -x12,
-            x238 + Self::mul_add(-x64, x262, x366),
-            Self::mul_add(
-                -x10,
-                x237 + Self::mul_add(-x64, x261, x365),
+        let x420 = S::mul_add(S::neg(c_q0), x412, s_q0 * x411);
+        let x421 = S::mul_add(
+            S::neg(x12),
+            x238 + S::mul_add(S::neg(x64), x262, x366),
+            S::mul_add(
+                S::neg(x10),
+                x237 + S::mul_add(S::neg(x64), x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
-        let x422 = Self::mul_add(
-            -x12,
-            x241 + Self::mul_add(-x65, x262, x369),
-            Self::mul_add(
-                -x10,
+        let x422 = S::mul_add(
+            S::neg(x12),
+            x241 + S::mul_add(S::neg(x65), x262, x369),
+            S::mul_add(
+                S::neg(x10),
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x260, x367)),
             ),
         );
-        let x423 = Self::mul_add(
-            -x12,
+        let x423 = S::mul_add(
+            S::neg(x12),
             x244 - (x372 - (x374 + x375)),
-            Self::mul_add(
-                -x10,
-                x243 + Self::mul_add(-x66, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
+            S::mul_add(
+                S::neg(x10),
+                x243 + S::mul_add(S::neg(x66), x261, x371),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x260, x370)),
             ),
         );
-        let x424 = Self::mul_add(
-            -x10,
-            Self::mul_add(
-                -x12,
+        let x424 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
+                S::neg(x12),
                 x232 + x369,
-                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
+                S::mul_add(S::neg(x10), x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x229 + x366,
-                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
+                    S::mul_add(S::neg(x10), x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
-        let x425 = Self::mul_add(
-            -x12,
-            Self::mul_add(
-                -x12,
+        let x425 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x372,
-                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
+                S::mul_add(S::neg(x10), x234 + x371, s_q1 * (x233 + x370)),
             ),
             x424,
         );
-        let x426 = Self::mul_add(
+        let x426 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x357,
-                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
+                S::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x354,
-                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
+                    S::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
-        let x427 = Self::mul_add(
+        let x427 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x360,
-                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
+                S::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x426,
         );
-        let x428 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x428 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x300,
-                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
+                S::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x296,
-                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
+                    S::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
-        let x429 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x429 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x303,
-                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
+                S::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x428,
         );
-        let x430 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
-        let x431 = Self::mul_add(
-            -x12,
-            x229 + Self::mul_add(-x91, x253, x339),
-            Self::mul_add(
-                -x10,
-                x228 + Self::mul_add(-x91, x252, x338),
+        let x430 = S::mul_add(
+            S::neg(x12),
+            x412,
+            S::mul_add(S::neg(x10), x411, s_q1 * x410),
+        );
+        let x431 = S::mul_add(
+            S::neg(x12),
+            x229 + S::mul_add(S::neg(x91), x253, x339),
+            S::mul_add(
+                S::neg(x10),
+                x228 + S::mul_add(S::neg(x91), x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
-        let x432 = Self::mul_add(
-            -x12,
-            x232 + Self::mul_add(-x92, x253, x342),
-            Self::mul_add(
-                -x10,
+        let x432 = S::mul_add(
+            S::neg(x12),
+            x232 + S::mul_add(S::neg(x92), x253, x342),
+            S::mul_add(
+                S::neg(x10),
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
+                s_q1 * (x230 + S::mul_add(S::neg(x92), x251, x340)),
             ),
         );
-        let x433 = Self::mul_add(
-            -x12,
+        let x433 = S::mul_add(
+            S::neg(x12),
             x235 - (x345 - (x347 + x348)),
-            Self::mul_add(
-                -x10,
-                x234 + Self::mul_add(-x93, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
+            S::mul_add(
+                S::neg(x10),
+                x234 + S::mul_add(S::neg(x93), x252, x344),
+                s_q1 * (x233 + S::mul_add(S::neg(x93), x251, x343)),
             ),
         );
-        let x434 = Self::mul_add(
+        let x434 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x342,
-                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
+                S::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x339,
-                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
+                    S::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
-        let x435 = Self::mul_add(
+        let x435 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x345,
-                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
+                S::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x434,
         );
-        let x436 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x436 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x312,
-                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
+                S::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x308,
-                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
+                    S::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
-        let x437 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x437 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x315,
-                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
+                S::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x436,
         );
-        let x438 = Self::mul_add(
+        let x438 = S::mul_add(
             x12,
-            x220 + Self::mul_add(-x37, x247, x320),
-            Self::mul_add(
+            x220 + S::mul_add(S::neg(x37), x247, x320),
+            S::mul_add(
                 x10,
-                x219 + Self::mul_add(-x37, x246, x319),
+                x219 + S::mul_add(S::neg(x37), x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
-        let x439 = Self::mul_add(
+        let x439 = S::mul_add(
             x12,
-            x223 - Self::mul_add(x38, x247, x324),
-            Self::mul_add(
+            x223 - S::mul_add(x38, x247, x324),
+            S::mul_add(
                 x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
+                s_q1 * (x221 - S::mul_add(x38, x245, x321)),
             ),
         );
-        let x440 = Self::mul_add(
+        let x440 = S::mul_add(
             x12,
             x226 + (x327 + (x332 + x333)),
-            Self::mul_add(
+            S::mul_add(
                 x10,
-                x225 - Self::mul_add(x39, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
+                x225 - S::mul_add(x39, x246, x326),
+                s_q1 * (x224 - S::mul_add(x39, x245, x325)),
             ),
         );
-        let x441 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x441 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 - x324,
-                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
+                S::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 - x320,
-                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
+                    S::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
-        let x442 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x442 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 + x327,
-                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
+                S::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x441,
         );
-        let x443 = Self::mul_add(
+        let x443 = S::mul_add(
             x99,
-            Self::mul_add(-x139, x194, x211),
-            Self::mul_add(
+            S::mul_add(S::neg(x139), x194, x211),
+            S::mul_add(
                 x97,
-                Self::mul_add(-x139, x193, x210),
+                S::mul_add(S::neg(x139), x193, x210),
                 x95 * (x209 + (x328 + x329)),
             ),
         );
-        let x444 = Self::mul_add(
+        let x444 = S::mul_add(
             x99,
-            Self::mul_add(-x140, x194, x214),
-            Self::mul_add(
+            S::mul_add(S::neg(x140), x194, x214),
+            S::mul_add(
                 x97,
                 x213 + (x328 + x330),
-                x95 * Self::mul_add(-x140, x192, x212),
+                x95 * S::mul_add(S::neg(x140), x192, x212),
             ),
         );
-        let x445 = Self::mul_add(
+        let x445 = S::mul_add(
             x99,
             x217 + (x329 + x330),
-            Self::mul_add(
+            S::mul_add(
                 x97,
-                Self::mul_add(-x141, x193, x216),
-                x95 * Self::mul_add(-x141, x192, x215),
+                S::mul_add(S::neg(x141), x193, x216),
+                x95 * S::mul_add(S::neg(x141), x192, x215),
             ),
         );
-        let x446 = Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410));
+        let x446 = S::mul_add(x99, x412, S::mul_add(x97, x411, x95 * x410));
         let x447 = qd[1] * s_q0;
         let x448 = qd[1] * c_q0;
         let x449 = qd[0] * qd[0];
@@ -2269,23 +2392,19 @@ impl SsrmsRecurrent {
         let x459 = x447 * x448;
         let x460 = x37 * (x457 + x458);
         let x461 = x450
-            - Self::mul_add(
-                -x39,
+            - S::mul_add(
+                S::neg(x39),
                 x459,
-                Self::mul_add(-x38, x449 + x457, x37 * (x453 + x453)),
+                S::mul_add(S::neg(x38), x449 + x457, x37 * (x453 + x453)),
             );
         let x462 = x451
-            - Self::mul_add(
-                x39,
-                x449 + x458,
-                Self::mul_add(x38, x459, x37 * (x452 + x452)),
-            );
+            - S::mul_add(x39, x449 + x458, S::mul_add(x38, x459, x37 * (x452 + x452)));
         let x463 = qd[0] - x454;
         let x464 = x447 - x455;
         let x465 = x448 + x456;
-        let x466 = Self::mul_add(x447, x456, x448 * x455);
-        let x467 = x452 + Self::mul_add(qd[0], x456, x448 * x454);
-        let x468 = x453 + Self::mul_add(-qd[0], x455, x447 * x454);
+        let x466 = S::mul_add(x447, x456, x448 * x455);
+        let x467 = x452 + S::mul_add(qd[0], x456, x448 * x454);
+        let x468 = x453 + S::mul_add(S::neg(qd[0]), x455, x447 * x454);
         let x469 = qd[3] * s_q1;
         let x470 = qd[3] * x10;
         let x471 = qd[3] * x12;
@@ -2296,29 +2415,29 @@ impl SsrmsRecurrent {
         let x476 = x463 * x463;
         let x477 = x464 * x465;
         let x478 = x460
-            + Self::mul_add(
+            + S::mul_add(
                 x66,
                 x467 - x475,
-                Self::mul_add(-x65, x468 - x474, x64 * (x472 + x473)),
+                S::mul_add(S::neg(x65), x468 - x474, x64 * (x472 + x473)),
             );
         let x479 = x461
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x466 - x477,
-                Self::mul_add(x65, x472 + x476, x64 * (x468 + x474)),
+                S::mul_add(x65, x472 + x476, x64 * (x468 + x474)),
             );
         let x480 = x462
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x473 + x476,
-                Self::mul_add(-x65, x466 + x477, x64 * (x467 + x475)),
+                S::mul_add(S::neg(x65), x466 + x477, x64 * (x467 + x475)),
             );
         let x481 = x463 - x469;
         let x482 = x464 - x470;
         let x483 = x465 + x471;
-        let x484 = x466 + Self::mul_add(x464, x471, x465 * x470);
-        let x485 = x467 + Self::mul_add(x463, x471, x465 * x469);
-        let x486 = x468 + Self::mul_add(-x463, x470, x464 * x469);
+        let x484 = x466 + S::mul_add(x464, x471, x465 * x470);
+        let x485 = x467 + S::mul_add(x463, x471, x465 * x469);
+        let x486 = x468 + S::mul_add(S::neg(x463), x470, x464 * x469);
         let x487 = qd[4] * s_q1;
         let x488 = qd[4] * x10;
         let x489 = qd[4] * x12;
@@ -2329,29 +2448,29 @@ impl SsrmsRecurrent {
         let x494 = x481 * x481;
         let x495 = x482 * x483;
         let x496 = x478
-            + Self::mul_add(
+            + S::mul_add(
                 x93,
                 x485 - x493,
-                Self::mul_add(-x92, x486 - x492, x91 * (x490 + x491)),
+                S::mul_add(S::neg(x92), x486 - x492, x91 * (x490 + x491)),
             );
         let x497 = x479
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x484 - x495,
-                Self::mul_add(x92, x490 + x494, x91 * (x486 + x492)),
+                S::mul_add(x92, x490 + x494, x91 * (x486 + x492)),
             );
         let x498 = x480
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x491 + x494,
-                Self::mul_add(-x92, x484 + x495, x91 * (x485 + x493)),
+                S::mul_add(S::neg(x92), x484 + x495, x91 * (x485 + x493)),
             );
         let x499 = x481 - x487;
         let x500 = x482 - x488;
         let x501 = x483 + x489;
-        let x502 = x484 + Self::mul_add(x482, x489, x483 * x488);
-        let x503 = x485 + Self::mul_add(x481, x489, x483 * x487);
-        let x504 = x486 + Self::mul_add(-x481, x488, x482 * x487);
+        let x502 = x484 + S::mul_add(x482, x489, x483 * x488);
+        let x503 = x485 + S::mul_add(x481, x489, x483 * x487);
+        let x504 = x486 + S::mul_add(S::neg(x481), x488, x482 * x487);
         let x505 = qd[5] * x95;
         let x506 = qd[5] * x97;
         let x507 = qd[5] * x99;
@@ -2362,29 +2481,29 @@ impl SsrmsRecurrent {
         let x512 = x499 * x499;
         let x513 = x500 * x501;
         let x514 = x496
-            + Self::mul_add(
-                -x39,
+            + S::mul_add(
+                S::neg(x39),
                 x503 - x511,
-                Self::mul_add(x38, x504 - x510, x37 * (x508 + x509)),
+                S::mul_add(x38, x504 - x510, x37 * (x508 + x509)),
             );
         let x515 = x497
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x502 - x513,
-                Self::mul_add(-x38, x508 + x512, x37 * (x504 + x510)),
+                S::mul_add(S::neg(x38), x508 + x512, x37 * (x504 + x510)),
             );
         let x516 = x498
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x509 + x512,
-                Self::mul_add(x38, x502 + x513, x37 * (x503 + x511)),
+                S::mul_add(x38, x502 + x513, x37 * (x503 + x511)),
             );
         let x517 = x499 + x505;
         let x518 = x500 - x506;
         let x519 = x501 + x507;
-        let x520 = x502 + Self::mul_add(x500, x507, x501 * x506);
-        let x521 = x503 - Self::mul_add(-x499, x507, x501 * x505);
-        let x522 = x504 - Self::mul_add(x499, x506, x500 * x505);
+        let x520 = x502 + S::mul_add(x500, x507, x501 * x506);
+        let x521 = x503 - S::mul_add(S::neg(x499), x507, x501 * x505);
+        let x522 = x504 - S::mul_add(x499, x506, x500 * x505);
         let x523 = qd[6] * x115;
         let x524 = qd[6] * x117;
         let x525 = qd[6] * x119;
@@ -2397,212 +2516,286 @@ impl SsrmsRecurrent {
         let x532 = x517 + x523;
         let x533 = x518 - x524;
         let x534 = x519 + x525;
-        let x535 = x520 + Self::mul_add(x518, x525, x519 * x524);
-        let x536 = x521 - Self::mul_add(-x517, x525, x519 * x523);
-        let x537 = x522 - Self::mul_add(x517, x524, x518 * x523);
-        let x538 = Self::mul_add(x26, x448, Self::mul_add(-x24, x447, qd[0] * x22));
-        let x539 = Self::mul_add(
+        let x535 = x520 + S::mul_add(x518, x525, x519 * x524);
+        let x536 = x521 - S::mul_add(S::neg(x517), x525, x519 * x523);
+        let x537 = x522 - S::mul_add(x517, x524, x518 * x523);
+        let x538 = S::mul_add(x26, x448, S::mul_add(S::neg(x24), x447, qd[0] * x22));
+        let x539 = S::mul_add(
             x31,
             x448,
-            Self::mul_add(-x29, x447, qd[0] * Self::mul_add(c_q1, x15, -x27)),
+            S::mul_add(S::neg(x29), x447, qd[0] * S::mul_add(c_q1, x15, S::neg(x27))),
         );
-        let x540 = Self::mul_add(
+        let x540 = S::mul_add(
             x36,
             x448,
-            Self::mul_add(-x34, x447, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+            S::mul_add(S::neg(x34), x447, qd[0] * S::mul_add(c_q1, x18, S::neg(x32))),
         );
-        let x541 = Self::mul_add(x57, x465, Self::mul_add(-x56, x464, x55 * x463));
-        let x542 = Self::mul_add(x60, x465, Self::mul_add(-x59, x464, x58 * x463));
-        let x543 = Self::mul_add(x63, x465, Self::mul_add(-x62, x464, x61 * x463));
-        let x544 = Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481));
-        let x545 = Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481));
-        let x546 = Self::mul_add(x90, x483, Self::mul_add(-x89, x482, x88 * x481));
-        let x547 = Self::mul_add(-x108, x501, Self::mul_add(x107, x500, x106 * x499));
-        let x548 = Self::mul_add(-x111, x501, Self::mul_add(x110, x500, x109 * x499));
-        let x549 = Self::mul_add(-x114, x501, Self::mul_add(x113, x500, x112 * x499));
-        let x550 = Self::mul_add(x132, x519, Self::mul_add(-x131, x518, x130 * x517));
-        let x551 = Self::mul_add(x135, x519, Self::mul_add(-x134, x518, x133 * x517));
-        let x552 = Self::mul_add(x138, x519, Self::mul_add(-x137, x518, x136 * x517));
-        let x553 = 243.66
+        let x541 = S::mul_add(x57, x465, S::mul_add(S::neg(x56), x464, x55 * x463));
+        let x542 = S::mul_add(x60, x465, S::mul_add(S::neg(x59), x464, x58 * x463));
+        let x543 = S::mul_add(x63, x465, S::mul_add(S::neg(x62), x464, x61 * x463));
+        let x544 = S::mul_add(x84, x483, S::mul_add(S::neg(x83), x482, x82 * x481));
+        let x545 = S::mul_add(x87, x483, S::mul_add(S::neg(x86), x482, x85 * x481));
+        let x546 = S::mul_add(x90, x483, S::mul_add(S::neg(x89), x482, x88 * x481));
+        let x547 = S::mul_add(S::neg(x108), x501, S::mul_add(x107, x500, x106 * x499));
+        let x548 = S::mul_add(S::neg(x111), x501, S::mul_add(x110, x500, x109 * x499));
+        let x549 = S::mul_add(S::neg(x114), x501, S::mul_add(x113, x500, x112 * x499));
+        let x550 = S::mul_add(x132, x519, S::mul_add(S::neg(x131), x518, x130 * x517));
+        let x551 = S::mul_add(x135, x519, S::mul_add(S::neg(x134), x518, x133 * x517));
+        let x552 = S::mul_add(x138, x519, S::mul_add(S::neg(x137), x518, x136 * x517));
+        let x553 = S::splat(243.66)
             * (x514
-                - Self::mul_add(
+                - S::mul_add(
                     x141,
                     x521 - x529,
-                    Self::mul_add(-x140, x522 - x528, x139 * (x526 + x527)),
+                    S::mul_add(S::neg(x140), x522 - x528, x139 * (x526 + x527)),
                 ));
-        let x554 = 243.66
+        let x554 = S::splat(243.66)
             * (x515
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x520 - x531,
-                    Self::mul_add(x140, x526 + x530, x139 * (x522 + x528)),
+                    S::mul_add(x140, x526 + x530, x139 * (x522 + x528)),
                 ));
-        let x555 = 243.66
+        let x555 = S::splat(243.66)
             * (x516
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x527 + x530,
-                    Self::mul_add(-x140, x520 + x531, x139 * (x521 + x529)),
+                    S::mul_add(S::neg(x140), x520 + x531, x139 * (x521 + x529)),
                 ));
-        let x556 = Self::mul_add(x159, x534, Self::mul_add(-x158, x533, x157 * x532));
-        let x557 = Self::mul_add(x162, x534, Self::mul_add(-x161, x533, x160 * x532));
-        let x558 = Self::mul_add(x165, x534, Self::mul_add(-x164, x533, x163 * x532));
-        let x559 = Self::mul_add(x159, x537, Self::mul_add(x158, x536, x157 * x535))
-            + Self::mul_add(x533, x558, x534 * x557);
-        let x560 = Self::mul_add(x162, x537, Self::mul_add(x161, x536, x160 * x535))
-            - Self::mul_add(-x532, x558, x534 * x556);
-        let x561 = Self::mul_add(x165, x537, Self::mul_add(x164, x536, x163 * x535))
-            - Self::mul_add(x532, x557, x533 * x556);
-        let x562 = Self::mul_add(105.98, x514, x553);
-        let x563 = Self::mul_add(105.98, x515, x554);
-        let x564 = Self::mul_add(105.98, x516, x555);
-        let x565 = Self::mul_add(105.98, x496, x562);
-        let x566 = Self::mul_add(105.98, x497, x563);
-        let x567 = Self::mul_add(105.98, x498, x564);
-        let x568 = Self::mul_add(279.2, x478, x565);
-        let x569 = Self::mul_add(279.2, x479, x566);
-        let x570 = Self::mul_add(279.2, x480, x567);
-        let x571 = Self::mul_add(314.88, x460, x568);
-        let x572 = Self::mul_add(314.88, x461, x569);
-        let x573 = Self::mul_add(314.88, x462, x570);
-        let x574 = Self::mul_add(x132, x522, Self::mul_add(x131, x521, x130 * x520))
-            + Self::mul_add(x518, x552, x519 * x551) + x559
-            - Self::mul_add(x140, x555, x141 * x554);
-        let x575 = Self::mul_add(x135, x522, Self::mul_add(x134, x521, x133 * x520))
-            - Self::mul_add(-x517, x552, x519 * x550) + x560
-            - Self::mul_add(-x139, x555, x141 * x553);
-        let x576 = Self::mul_add(x138, x522, Self::mul_add(x137, x521, x136 * x520))
-            - Self::mul_add(x517, x551, x518 * x550) + x561
-            + Self::mul_add(x139, x554, x140 * x553);
-        let x577 = Self::mul_add(-x108, x504, Self::mul_add(-x107, x503, x106 * x502))
-            - Self::mul_add(x500, x549, x501 * x548) + x574
-            - Self::mul_add(x38, x564, x39 * x563);
-        let x578 = Self::mul_add(-x111, x504, Self::mul_add(-x110, x503, x109 * x502))
-            + Self::mul_add(x499, x549, x501 * x547) - x575
-            + Self::mul_add(x37, x564, x39 * x562);
-        let x579 = Self::mul_add(-x114, x504, Self::mul_add(-x113, x503, x112 * x502))
-            + Self::mul_add(-x499, x548, x500 * x547) - x576
-            - Self::mul_add(-x37, x563, x38 * x562);
-        let x580 = Self::mul_add(x84, x486, Self::mul_add(x83, x485, x82 * x484))
-            + Self::mul_add(x482, x546, x483 * x545) + x577
-            + Self::mul_add(x92, x567, x93 * x566);
-        let x581 = Self::mul_add(x87, x486, Self::mul_add(x86, x485, x85 * x484))
-            - Self::mul_add(-x481, x546, x483 * x544) - x578
-            + Self::mul_add(-x91, x567, x93 * x565);
-        let x582 = Self::mul_add(x90, x486, Self::mul_add(x89, x485, x88 * x484))
-            - Self::mul_add(x481, x545, x482 * x544) - x579
-            - Self::mul_add(x91, x566, x92 * x565);
-        let x583 = Self::mul_add(x57, x468, Self::mul_add(x56, x467, x55 * x466))
-            + Self::mul_add(x464, x543, x465 * x542) + x580
-            + Self::mul_add(x65, x570, x66 * x569);
-        let x584 = Self::mul_add(x60, x468, Self::mul_add(x59, x467, x58 * x466))
-            - Self::mul_add(-x463, x543, x465 * x541) + x581
-            + Self::mul_add(-x64, x570, x66 * x568);
-        let x585 = Self::mul_add(x63, x468, Self::mul_add(x62, x467, x61 * x466))
-            - Self::mul_add(x463, x542, x464 * x541) + x582
-            - Self::mul_add(x64, x569, x65 * x568);
-        let x586 = Self::mul_add(
-            -qdd[1],
+        let x556 = S::mul_add(x159, x534, S::mul_add(S::neg(x158), x533, x157 * x532));
+        let x557 = S::mul_add(x162, x534, S::mul_add(S::neg(x161), x533, x160 * x532));
+        let x558 = S::mul_add(x165, x534, S::mul_add(S::neg(x164), x533, x163 * x532));
+        let x559 = S::mul_add(x159, x537, S::mul_add(x158, x536, x157 * x535))
+            + S::mul_add(x533, x558, x534 * x557);
+        let x560 = S::mul_add(x162, x537, S::mul_add(x161, x536, x160 * x535))
+            - S::mul_add(S::neg(x532), x558, x534 * x556);
+        let x561 = S::mul_add(x165, x537, S::mul_add(x164, x536, x163 * x535))
+            - S::mul_add(x532, x557, x533 * x556);
+        let x562 = S::mul_add(S::splat(105.98), x514, x553);
+        let x563 = S::mul_add(S::splat(105.98), x515, x554);
+        let x564 = S::mul_add(S::splat(105.98), x516, x555);
+        let x565 = S::mul_add(S::splat(105.98), x496, x562);
+        let x566 = S::mul_add(S::splat(105.98), x497, x563);
+        let x567 = S::mul_add(S::splat(105.98), x498, x564);
+        let x568 = S::mul_add(S::splat(279.2), x478, x565);
+        let x569 = S::mul_add(S::splat(279.2), x479, x566);
+        let x570 = S::mul_add(S::splat(279.2), x480, x567);
+        let x571 = S::mul_add(S::splat(314.88), x460, x568);
+        let x572 = S::mul_add(S::splat(314.88), x461, x569);
+        let x573 = S::mul_add(S::splat(314.88), x462, x570);
+        let x574 = S::mul_add(x132, x522, S::mul_add(x131, x521, x130 * x520))
+            + S::mul_add(x518, x552, x519 * x551) + x559
+            - S::mul_add(x140, x555, x141 * x554);
+        let x575 = S::mul_add(x135, x522, S::mul_add(x134, x521, x133 * x520))
+            - S::mul_add(S::neg(x517), x552, x519 * x550) + x560
+            - S::mul_add(S::neg(x139), x555, x141 * x553);
+        let x576 = S::mul_add(x138, x522, S::mul_add(x137, x521, x136 * x520))
+            - S::mul_add(x517, x551, x518 * x550) + x561
+            + S::mul_add(x139, x554, x140 * x553);
+        let x577 = S::mul_add(
+            S::neg(x108),
+            x504,
+            S::mul_add(S::neg(x107), x503, x106 * x502),
+        ) - S::mul_add(x500, x549, x501 * x548) + x574
+            - S::mul_add(x38, x564, x39 * x563);
+        let x578 = S::mul_add(
+            S::neg(x111),
+            x504,
+            S::mul_add(S::neg(x110), x503, x109 * x502),
+        ) + S::mul_add(x499, x549, x501 * x547) - x575
+            + S::mul_add(x37, x564, x39 * x562);
+        let x579 = S::mul_add(
+            S::neg(x114),
+            x504,
+            S::mul_add(S::neg(x113), x503, x112 * x502),
+        ) + S::mul_add(S::neg(x499), x548, x500 * x547) - x576
+            - S::mul_add(S::neg(x37), x563, x38 * x562);
+        let x580 = S::mul_add(x84, x486, S::mul_add(x83, x485, x82 * x484))
+            + S::mul_add(x482, x546, x483 * x545) + x577
+            + S::mul_add(x92, x567, x93 * x566);
+        let x581 = S::mul_add(x87, x486, S::mul_add(x86, x485, x85 * x484))
+            - S::mul_add(S::neg(x481), x546, x483 * x544) - x578
+            + S::mul_add(S::neg(x91), x567, x93 * x565);
+        let x582 = S::mul_add(x90, x486, S::mul_add(x89, x485, x88 * x484))
+            - S::mul_add(x481, x545, x482 * x544) - x579
+            - S::mul_add(x91, x566, x92 * x565);
+        let x583 = S::mul_add(x57, x468, S::mul_add(x56, x467, x55 * x466))
+            + S::mul_add(x464, x543, x465 * x542) + x580
+            + S::mul_add(x65, x570, x66 * x569);
+        let x584 = S::mul_add(x60, x468, S::mul_add(x59, x467, x58 * x466))
+            - S::mul_add(S::neg(x463), x543, x465 * x541) + x581
+            + S::mul_add(S::neg(x64), x570, x66 * x568);
+        let x585 = S::mul_add(x63, x468, S::mul_add(x62, x467, x61 * x466))
+            - S::mul_add(x463, x542, x464 * x541) + x582
+            - S::mul_add(x64, x569, x65 * x568);
+        let x586 = S::mul_add(
+            S::neg(qdd[1]),
             x405,
             qdd[0]
-                * (12.19 + (x22 + x236)
-                    - (x402 + Self::mul_add(-x38, x280, x39 * x281)
-                        - Self::mul_add(
+                * (S::splat(12.19) + (x22 + x236)
+                    - (x402 + S::mul_add(S::neg(x38), x280, x39 * x281)
+                        - S::mul_add(
                             x7,
-                            Self::mul_add(105.98, x7, x280),
-                            x8 * Self::mul_add(105.98, x8, x281),
+                            S::mul_add(S::splat(105.98), x7, x280),
+                            x8 * S::mul_add(S::splat(105.98), x8, x281),
                         ))),
         );
-        let x587 = Self::mul_add(
-            -qdd[4],
+        let x587 = S::mul_add(
+            S::neg(qdd[4]),
             x408,
-            Self::mul_add(-qdd[3], x407, Self::mul_add(-qdd[2], x406, x586)),
+            S::mul_add(S::neg(qdd[3]), x407, S::mul_add(S::neg(qdd[2]), x406, x586)),
         );
-        let x588 = -(Self::mul_add(x26, x453, x24 * x452)
-            + Self::mul_add(x447, x540, x448 * x539) + x583
-            - Self::mul_add(x38, x573, x39 * x572)
-            + Self::mul_add(
-                -x7,
-                Self::mul_add(105.98, x451, x573),
-                x8 * Self::mul_add(105.98, x450, x572),
-            ) - Self::mul_add(qdd[6], x410, Self::mul_add(qdd[5], x409, x587)));
-        let x589 = Self::mul_add(
-            -qdd[3],
+        let x588 = S::neg(
+            S::mul_add(x26, x453, x24 * x452) + S::mul_add(x447, x540, x448 * x539)
+                + x583 - S::mul_add(x38, x573, x39 * x572)
+                + S::mul_add(
+                    S::neg(x7),
+                    S::mul_add(S::splat(105.98), x451, x573),
+                    x8 * S::mul_add(S::splat(105.98), x450, x572),
+                ) - S::mul_add(qdd[6], x410, S::mul_add(qdd[5], x409, x587)),
+        );
+        let x589 = S::mul_add(
+            S::neg(qdd[3]),
             x417,
-            Self::mul_add(-qdd[2], x416, Self::mul_add(-qdd[1], x413, qdd[0] * x405)),
+            S::mul_add(
+                S::neg(qdd[2]),
+                x416,
+                S::mul_add(S::neg(qdd[1]), x413, qdd[0] * x405),
+            ),
         );
-        let x590 = Self::mul_add(
+        let x590 = S::mul_add(
             qdd[6],
             x420,
-            Self::mul_add(qdd[5], x419, Self::mul_add(qdd[4], x418, x589)),
+            S::mul_add(qdd[5], x419, S::mul_add(qdd[4], x418, x589)),
         );
-        let x591 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(x36, x453, x34 * x452)
-                - Self::mul_add(qd[0], x539, x447 * x538) + x585
-                + Self::mul_add(-x37, x572, x38 * x571),
+        let x591 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(x36, x453, x34 * x452) - S::mul_add(qd[0], x539, x447 * x538)
+                + x585 + S::mul_add(S::neg(x37), x572, x38 * x571),
             s_q0
-                * (Self::mul_add(x31, x453, x29 * x452)
-                    - Self::mul_add(-qd[0], x540, x448 * x538) + x584
-                    - Self::mul_add(x37, x573, x39 * x571)),
+                * (S::mul_add(x31, x453, x29 * x452)
+                    - S::mul_add(S::neg(qd[0]), x540, x448 * x538) + x584
+                    - S::mul_add(x37, x573, x39 * x571)),
         ) - x590;
-        let x592 = Self::mul_add(
-            -qdd[2],
-            Self::mul_add(-x12, x423, Self::mul_add(-x10, x422, s_q1 * x421)),
-            Self::mul_add(-qdd[1], x416, qdd[0] * x406),
+        let x592 = S::mul_add(
+            S::neg(qdd[2]),
+            S::mul_add(S::neg(x12), x423, S::mul_add(S::neg(x10), x422, s_q1 * x421)),
+            S::mul_add(S::neg(qdd[1]), x416, qdd[0] * x406),
         );
-        let x593 = Self::mul_add(
+        let x593 = S::mul_add(
             qdd[5],
             x429,
-            Self::mul_add(-qdd[4], x427, Self::mul_add(-qdd[3], x425, x592)),
+            S::mul_add(S::neg(qdd[4]), x427, S::mul_add(S::neg(qdd[3]), x425, x592)),
         );
         let x594 = qdd[6] * x430;
-        let x595 = Self::mul_add(-x12, x585, Self::mul_add(-x10, x584, s_q1 * x583))
-            - (x593 + x594);
-        let x596 = Self::mul_add(
-            -qdd[3],
-            Self::mul_add(-x12, x433, Self::mul_add(-x10, x432, s_q1 * x431)),
-            Self::mul_add(-qdd[2], x425, Self::mul_add(-qdd[1], x417, qdd[0] * x407)),
+        let x595 = S::mul_add(
+            S::neg(x12),
+            x585,
+            S::mul_add(S::neg(x10), x584, s_q1 * x583),
+        ) - (x593 + x594);
+        let x596 = S::mul_add(
+            S::neg(qdd[3]),
+            S::mul_add(S::neg(x12), x433, S::mul_add(S::neg(x10), x432, s_q1 * x431)),
+            S::mul_add(
+                S::neg(qdd[2]),
+                x425,
+                S::mul_add(S::neg(qdd[1]), x417, qdd[0] * x407),
+            ),
         );
-        let x597 = Self::mul_add(-x12, x582, Self::mul_add(-x10, x581, s_q1 * x580))
-            - (x594 + Self::mul_add(qdd[5], x437, Self::mul_add(-qdd[4], x435, x596)));
-        let x598 = Self::mul_add(
-            -qdd[3],
+        let x597 = S::mul_add(
+            S::neg(x12),
+            x582,
+            S::mul_add(S::neg(x10), x581, s_q1 * x580),
+        ) - (x594 + S::mul_add(qdd[5], x437, S::mul_add(S::neg(qdd[4]), x435, x596)));
+        let x598 = S::mul_add(
+            S::neg(qdd[3]),
             x435,
-            Self::mul_add(-qdd[2], x427, Self::mul_add(qdd[1], x418, qdd[0] * x408)),
+            S::mul_add(S::neg(qdd[2]), x427, S::mul_add(qdd[1], x418, qdd[0] * x408)),
         );
-        let x599 = Self::mul_add(
-            -qdd[4],
-            Self::mul_add(x12, x440, Self::mul_add(x10, x439, s_q1 * x438)),
+        let x599 = S::mul_add(
+            S::neg(qdd[4]),
+            S::mul_add(x12, x440, S::mul_add(x10, x439, s_q1 * x438)),
             x598,
         );
-        let x600 = Self::mul_add(x12, x579, Self::mul_add(x10, x578, s_q1 * x577))
-            - (x594 + Self::mul_add(qdd[5], x442, x599));
-        let x601 = Self::mul_add(
-            -qdd[3],
+        let x600 = S::mul_add(x12, x579, S::mul_add(x10, x578, s_q1 * x577))
+            - (x594 + S::mul_add(qdd[5], x442, x599));
+        let x601 = S::mul_add(
+            S::neg(qdd[3]),
             x437,
-            Self::mul_add(-qdd[2], x429, Self::mul_add(-qdd[1], x419, qdd[0] * x409)),
+            S::mul_add(
+                S::neg(qdd[2]),
+                x429,
+                S::mul_add(S::neg(qdd[1]), x419, qdd[0] * x409),
+            ),
         );
-        let x602 = Self::mul_add(
+        let x602 = S::mul_add(
             qdd[5],
-            Self::mul_add(x99, x445, Self::mul_add(x97, x444, x95 * x443)),
-            Self::mul_add(-qdd[4], x442, x601),
+            S::mul_add(x99, x445, S::mul_add(x97, x444, x95 * x443)),
+            S::mul_add(S::neg(qdd[4]), x442, x601),
         );
-        let x603 = -(Self::mul_add(x99, x576, Self::mul_add(x97, x575, x95 * x574))
-            - Self::mul_add(qdd[6], x446, x602));
-        let x604 = Self::mul_add(
-            -qdd[3],
+        let x603 = S::neg(
+            S::mul_add(x99, x576, S::mul_add(x97, x575, x95 * x574))
+                - S::mul_add(qdd[6], x446, x602),
+        );
+        let x604 = S::mul_add(
+            S::neg(qdd[3]),
             x430,
-            Self::mul_add(-qdd[2], x430, Self::mul_add(-qdd[1], x420, qdd[0] * x410)),
+            S::mul_add(
+                S::neg(qdd[2]),
+                x430,
+                S::mul_add(S::neg(qdd[1]), x420, qdd[0] * x410),
+            ),
         );
-        let x605 = Self::mul_add(
+        let x605 = S::mul_add(
             qdd[6],
-            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
-            Self::mul_add(qdd[5], x446, Self::mul_add(-qdd[4], x430, x604)),
+            S::mul_add(x119, x412, S::mul_add(x117, x411, x115 * x410)),
+            S::mul_add(qdd[5], x446, S::mul_add(S::neg(qdd[4]), x430, x604)),
         );
-        let x606 = -(Self::mul_add(x119, x561, Self::mul_add(x117, x560, x115 * x559))
-            - x605);
+        let x606 = S::neg(
+            S::mul_add(x119, x561, S::mul_add(x117, x560, x115 * x559)) - x605,
+        );
         [x588, x591, x595, x597, x600, x603, x606]
+    }
+    /// [`Self::inverse_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::inverse_dynamics_lanes`]: `out[k]` is `inverse_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn inverse_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        qdd: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(qdd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::inverse_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qdd, start, n),
+                )
+            },
+        );
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -2613,8 +2806,15 @@ impl SsrmsRecurrent {
         qd: &[::core::primitive::f64; 7],
         tau: &[::core::primitive::f64; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::forward_dynamics_lanes::<::core::primitive::f64>(q, qd, tau)
+    }
+    /// [`Self::forward_dynamics`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], tau: &[S; 7]) -> [S; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -2623,165 +2823,165 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
-        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x22 = S::mul_add(c_q1, x13, x21);
         let x23 = x10 * x14;
-        let x24 = Self::mul_add(x9, x13, -x23);
+        let x24 = S::mul_add(x9, x13, S::neg(x23));
         let x25 = x12 * x14;
-        let x26 = Self::mul_add(x11, x13, -x25);
+        let x26 = S::mul_add(x11, x13, S::neg(x25));
         let x27 = s_q1 * x16;
         let x28 = x10 * x16;
-        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x29 = S::mul_add(s_q0, x17, S::mul_add(x9, x15, x28));
         let x30 = x12 * x16;
-        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x31 = S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x30));
         let x32 = s_q1 * x19;
         let x33 = x10 * x19;
-        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x34 = S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x33));
         let x35 = x12 * x19;
-        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
-        let x37 = s_q1 * 0.5692;
-        let x38 = x10 * 0.5692;
-        let x39 = x12 * 0.5692;
+        let x36 = S::mul_add(c_q0, x20, S::mul_add(x11, x18, x35));
+        let x37 = s_q1 * S::splat(0.5692);
+        let x38 = x10 * S::splat(0.5692);
+        let x39 = x12 * S::splat(0.5692);
         let x40 = c_q1 * c_q2;
         let x41 = c_q1 * s_q2;
-        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
-        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
-        let x48 = 2103.19 * x41;
-        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
-        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
-        let x51 = 2103.19 * x43;
-        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
-        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
-        let x54 = 2103.19 * x45;
-        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
-        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
-        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
-        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
-        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
-        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
-        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
-        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
-        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
-        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
-        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
-        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
-        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
-        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
-        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
-        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
-        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
-        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
-        let x75 = 1966.28 * x68;
-        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
-        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
-        let x78 = 1966.28 * x70;
-        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
-        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
-        let x81 = 1966.28 * x72;
-        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
-        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
-        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
-        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
-        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
-        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
-        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
-        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
-        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
-        let x91 = 7.11 * x67;
-        let x92 = 7.11 * x69;
-        let x93 = 7.11 * x71;
-        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
-        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
-        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
-        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
-        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
-        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
-        let x100 = 8.305 * x94;
-        let x101 = 8.0386 * x95;
-        let x102 = 8.305 * x96;
-        let x103 = 8.0386 * x97;
-        let x104 = 8.305 * x98;
-        let x105 = 8.0386 * x99;
-        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
-        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
-        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
-        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
-        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
-        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
-        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
-        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
-        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
-        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
-        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
-        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
-        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
-        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
-        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
-        let x121 = 12.13 * x115;
-        let x122 = 12.13 * x116;
-        let x123 = 3.061 * x95;
-        let x124 = 12.13 * x117;
-        let x125 = 12.13 * x118;
-        let x126 = 3.061 * x97;
-        let x127 = 12.13 * x119;
-        let x128 = 12.13 * x120;
-        let x129 = 3.061 * x99;
-        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
-        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
-        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
-        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
-        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
-        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
-        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
-        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
-        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
-        let x139 = 0.7026 * x95;
-        let x140 = 0.7026 * x97;
-        let x141 = 0.7026 * x99;
-        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
-        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
-        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
-        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
-        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
-        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
-        let x148 = 9.336 * x115;
-        let x149 = 44.41 * x142;
-        let x150 = 44.41 * x143;
-        let x151 = 9.336 * x117;
-        let x152 = 44.41 * x144;
-        let x153 = 44.41 * x145;
-        let x154 = 9.336 * x119;
-        let x155 = 44.41 * x146;
-        let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x42 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x44 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x45 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x40);
+        let x47 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x40);
+        let x48 = S::splat(2103.19) * x41;
+        let x49 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x42);
+        let x50 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x42);
+        let x51 = S::splat(2103.19) * x43;
+        let x52 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x44);
+        let x53 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x44);
+        let x54 = S::splat(2103.19) * x45;
+        let x55 = S::mul_add(x41, x48, S::mul_add(S::neg(s_q1), x47, x40 * x46));
+        let x56 = S::mul_add(x43, x48, S::mul_add(x10, x47, x42 * x46));
+        let x57 = S::mul_add(x45, x48, S::mul_add(x12, x47, x44 * x46));
+        let x58 = S::mul_add(x41, x51, S::mul_add(S::neg(s_q1), x50, x40 * x49));
+        let x59 = S::mul_add(x43, x51, S::mul_add(x10, x50, x42 * x49));
+        let x60 = S::mul_add(x45, x51, S::mul_add(x12, x50, x44 * x49));
+        let x61 = S::mul_add(x41, x54, S::mul_add(S::neg(s_q1), x53, x40 * x52));
+        let x62 = S::mul_add(x43, x54, S::mul_add(x10, x53, x42 * x52));
+        let x63 = S::mul_add(x45, x54, S::mul_add(x12, x53, x44 * x52));
+        let x64 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x40);
+        let x65 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x42);
+        let x66 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x44);
+        let x67 = S::mul_add(S::neg(x41), s_q3, x40 * c_q3);
+        let x68 = S::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = S::mul_add(S::neg(x43), s_q3, x42 * c_q3);
+        let x70 = S::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = S::mul_add(S::neg(x45), s_q3, x44 * c_q3);
+        let x72 = S::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x67);
+        let x74 = S::mul_add(S::splat(1966.28), s_q1, x67 * S::splat(39.95));
+        let x75 = S::splat(1966.28) * x68;
+        let x76 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x69);
+        let x77 = S::mul_add(S::splat(-1966.28), x10, x69 * S::splat(39.95));
+        let x78 = S::splat(1966.28) * x70;
+        let x79 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x71);
+        let x80 = S::mul_add(S::splat(-1966.28), x12, x71 * S::splat(39.95));
+        let x81 = S::splat(1966.28) * x72;
+        let x82 = S::mul_add(x68, x75, S::mul_add(s_q1, x74, x67 * x73));
+        let x83 = S::mul_add(x70, x75, S::mul_add(S::neg(x10), x74, x69 * x73));
+        let x84 = S::mul_add(x72, x75, S::mul_add(S::neg(x12), x74, x71 * x73));
+        let x85 = S::mul_add(x68, x78, S::mul_add(s_q1, x77, x67 * x76));
+        let x86 = S::mul_add(x70, x78, S::mul_add(S::neg(x10), x77, x69 * x76));
+        let x87 = S::mul_add(x72, x78, S::mul_add(S::neg(x12), x77, x71 * x76));
+        let x88 = S::mul_add(x68, x81, S::mul_add(s_q1, x80, x67 * x79));
+        let x89 = S::mul_add(x70, x81, S::mul_add(S::neg(x10), x80, x69 * x79));
+        let x90 = S::mul_add(x72, x81, S::mul_add(S::neg(x12), x80, x71 * x79));
+        let x91 = S::splat(7.11) * x67;
+        let x92 = S::splat(7.11) * x69;
+        let x93 = S::splat(7.11) * x71;
+        let x94 = S::mul_add(S::neg(x68), s_q4, x67 * c_q4);
+        let x95 = S::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = S::mul_add(S::neg(x70), s_q4, x69 * c_q4);
+        let x97 = S::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = S::mul_add(S::neg(x72), s_q4, x71 * c_q4);
+        let x99 = S::mul_add(x72, c_q4, x71 * s_q4);
+        let x100 = S::splat(8.305) * x94;
+        let x101 = S::splat(8.0386) * x95;
+        let x102 = S::splat(8.305) * x96;
+        let x103 = S::splat(8.0386) * x97;
+        let x104 = S::splat(8.305) * x98;
+        let x105 = S::splat(8.0386) * x99;
+        let x106 = S::mul_add(x95, x101, S::mul_add(x94, x100, x21));
+        let x107 = S::mul_add(S::neg(x97), x101, S::mul_add(S::neg(x96), x100, x23));
+        let x108 = S::mul_add(S::neg(x99), x101, S::mul_add(S::neg(x98), x100, x25));
+        let x109 = S::mul_add(S::neg(x95), x103, S::mul_add(S::neg(x94), x102, x27));
+        let x110 = S::mul_add(x97, x103, S::mul_add(x96, x102, x28));
+        let x111 = S::mul_add(x99, x103, S::mul_add(x98, x102, x30));
+        let x112 = S::mul_add(S::neg(x95), x105, S::mul_add(S::neg(x94), x104, x32));
+        let x113 = S::mul_add(x97, x105, S::mul_add(x96, x104, x33));
+        let x114 = S::mul_add(x99, x105, S::mul_add(x98, x104, x35));
+        let x115 = S::mul_add(S::neg(s_q1), s_q5, x94 * c_q5);
+        let x116 = S::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = S::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = S::mul_add(S::neg(x10), c_q5, x96 * s_q5);
+        let x119 = S::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = S::mul_add(S::neg(x12), c_q5, x98 * s_q5);
+        let x121 = S::splat(12.13) * x115;
+        let x122 = S::splat(12.13) * x116;
+        let x123 = S::splat(3.061) * x95;
+        let x124 = S::splat(12.13) * x117;
+        let x125 = S::splat(12.13) * x118;
+        let x126 = S::splat(3.061) * x97;
+        let x127 = S::splat(12.13) * x119;
+        let x128 = S::splat(12.13) * x120;
+        let x129 = S::splat(3.061) * x99;
+        let x130 = S::mul_add(x95, x123, S::mul_add(x116, x122, x115 * x121));
+        let x131 = S::mul_add(x97, x123, S::mul_add(x118, x122, x117 * x121));
+        let x132 = S::mul_add(x99, x123, S::mul_add(x120, x122, x119 * x121));
+        let x133 = S::mul_add(x95, x126, S::mul_add(x116, x125, x115 * x124));
+        let x134 = S::mul_add(x97, x126, S::mul_add(x118, x125, x117 * x124));
+        let x135 = S::mul_add(x99, x126, S::mul_add(x120, x125, x119 * x124));
+        let x136 = S::mul_add(x95, x129, S::mul_add(x116, x128, x115 * x127));
+        let x137 = S::mul_add(x97, x129, S::mul_add(x118, x128, x117 * x127));
+        let x138 = S::mul_add(x99, x129, S::mul_add(x120, x128, x119 * x127));
+        let x139 = S::splat(0.7026) * x95;
+        let x140 = S::splat(0.7026) * x97;
+        let x141 = S::splat(0.7026) * x99;
+        let x142 = S::mul_add(S::neg(x95), s_q6, x116 * c_q6);
+        let x143 = S::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = S::mul_add(S::neg(x97), s_q6, x118 * c_q6);
+        let x145 = S::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = S::mul_add(S::neg(x99), s_q6, x120 * c_q6);
+        let x147 = S::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = S::splat(9.336) * x115;
+        let x149 = S::splat(44.41) * x142;
+        let x150 = S::splat(44.41) * x143;
+        let x151 = S::splat(9.336) * x117;
+        let x152 = S::splat(44.41) * x144;
+        let x153 = S::splat(44.41) * x145;
+        let x154 = S::splat(9.336) * x119;
+        let x155 = S::splat(44.41) * x146;
+        let x156 = S::splat(44.41) * x147;
+        let x157 = S::mul_add(x143, x150, S::mul_add(x142, x149, x115 * x148));
+        let x158 = S::mul_add(x145, x150, S::mul_add(x144, x149, x117 * x148));
+        let x159 = S::mul_add(x147, x150, S::mul_add(x146, x149, x119 * x148));
+        let x160 = S::mul_add(x143, x153, S::mul_add(x142, x152, x115 * x151));
+        let x161 = S::mul_add(x145, x153, S::mul_add(x144, x152, x117 * x151));
+        let x162 = S::mul_add(x147, x153, S::mul_add(x146, x152, x119 * x151));
+        let x163 = S::mul_add(x143, x156, S::mul_add(x142, x155, x115 * x154));
+        let x164 = S::mul_add(x145, x156, S::mul_add(x144, x155, x117 * x154));
+        let x165 = S::mul_add(x147, x156, S::mul_add(x146, x155, x119 * x154));
         let x166 = x37 - x139;
         let x167 = x38 + x140;
         let x168 = x39 + x141;
@@ -2808,23 +3008,23 @@ impl SsrmsRecurrent {
         let x189 = x39 - x187;
         let x190 = x38 - x65;
         let x191 = x39 - x66;
-        let x192 = 243.66 * x139;
-        let x193 = 243.66 * x140;
-        let x194 = 243.66 * x141;
-        let x195 = 243.66 * x166;
-        let x196 = 243.66 * x167;
-        let x197 = 243.66 * x168;
-        let x198 = 243.66 * x169;
-        let x199 = 243.66 * x170;
-        let x200 = 243.66 * x171;
-        let x201 = 243.66 * x172;
-        let x202 = 243.66 * x173;
-        let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x37 + x172);
-        let x205 = 243.66 * x175;
-        let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x7 + x175);
-        let x208 = 243.66 * (x8 - x176);
+        let x192 = S::splat(243.66) * x139;
+        let x193 = S::splat(243.66) * x140;
+        let x194 = S::splat(243.66) * x141;
+        let x195 = S::splat(243.66) * x166;
+        let x196 = S::splat(243.66) * x167;
+        let x197 = S::splat(243.66) * x168;
+        let x198 = S::splat(243.66) * x169;
+        let x199 = S::splat(243.66) * x170;
+        let x200 = S::splat(243.66) * x171;
+        let x201 = S::splat(243.66) * x172;
+        let x202 = S::splat(243.66) * x173;
+        let x203 = S::splat(243.66) * x174;
+        let x204 = S::splat(243.66) * (x37 + x172);
+        let x205 = S::splat(243.66) * x175;
+        let x206 = S::splat(243.66) * x176;
+        let x207 = S::splat(243.66) * (x7 + x175);
+        let x208 = S::splat(243.66) * (x8 - x176);
         let x209 = x130 + x157;
         let x210 = x131 + x158;
         let x211 = x132 + x159;
@@ -2861,53 +3061,53 @@ impl SsrmsRecurrent {
         let x242 = x61 + x233;
         let x243 = x62 + x234;
         let x244 = x63 + x235;
-        let x245 = Self::mul_add(105.98, x37, x195);
-        let x246 = Self::mul_add(105.98, x38, x196);
-        let x247 = Self::mul_add(105.98, x39, x197);
-        let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(-105.98, x178, x199);
-        let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x91, x248);
-        let x252 = Self::mul_add(105.98, x92, x249);
-        let x253 = Self::mul_add(105.98, x93, x250);
-        let x254 = Self::mul_add(105.98, x180, x201);
-        let x255 = Self::mul_add(105.98, x181, x202);
-        let x256 = Self::mul_add(105.98, x182, x203);
-        let x257 = Self::mul_add(105.98, x185, x254);
-        let x258 = Self::mul_add(105.98, x186, x255);
-        let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x64, x257);
-        let x261 = Self::mul_add(279.2, x65, x258);
-        let x262 = Self::mul_add(279.2, x66, x259);
-        let x263 = Self::mul_add(105.98, x37 + x180, x204);
-        let x264 = Self::mul_add(105.98, x183, x205);
-        let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x37 + x185, x263);
-        let x267 = Self::mul_add(105.98, x188, x264);
-        let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x37 + x64, x266);
-        let x270 = Self::mul_add(279.2, x190, x267);
-        let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x38, x270);
-        let x273 = Self::mul_add(314.88, x39, x271);
-        let x274 = Self::mul_add(105.98, x7 + x183, x207);
-        let x275 = Self::mul_add(105.98, x8 - x184, x208);
-        let x276 = Self::mul_add(105.98, x7 + x188, x274);
-        let x277 = Self::mul_add(105.98, x8 - x189, x275);
-        let x278 = Self::mul_add(279.2, x7 + x190, x276);
-        let x279 = Self::mul_add(279.2, x8 - x191, x277);
-        let x280 = Self::mul_add(314.88, x7 + x38, x278);
-        let x281 = Self::mul_add(314.88, x8 - x39, x279);
-        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x245 = S::mul_add(S::splat(105.98), x37, x195);
+        let x246 = S::mul_add(S::splat(105.98), x38, x196);
+        let x247 = S::mul_add(S::splat(105.98), x39, x197);
+        let x248 = S::mul_add(S::splat(105.98), x177, x198);
+        let x249 = S::mul_add(S::splat(-105.98), x178, x199);
+        let x250 = S::mul_add(S::splat(-105.98), x179, x200);
+        let x251 = S::mul_add(S::splat(105.98), x91, x248);
+        let x252 = S::mul_add(S::splat(105.98), x92, x249);
+        let x253 = S::mul_add(S::splat(105.98), x93, x250);
+        let x254 = S::mul_add(S::splat(105.98), x180, x201);
+        let x255 = S::mul_add(S::splat(105.98), x181, x202);
+        let x256 = S::mul_add(S::splat(105.98), x182, x203);
+        let x257 = S::mul_add(S::splat(105.98), x185, x254);
+        let x258 = S::mul_add(S::splat(105.98), x186, x255);
+        let x259 = S::mul_add(S::splat(105.98), x187, x256);
+        let x260 = S::mul_add(S::splat(279.2), x64, x257);
+        let x261 = S::mul_add(S::splat(279.2), x65, x258);
+        let x262 = S::mul_add(S::splat(279.2), x66, x259);
+        let x263 = S::mul_add(S::splat(105.98), x37 + x180, x204);
+        let x264 = S::mul_add(S::splat(105.98), x183, x205);
+        let x265 = S::mul_add(S::splat(105.98), x184, x206);
+        let x266 = S::mul_add(S::splat(105.98), x37 + x185, x263);
+        let x267 = S::mul_add(S::splat(105.98), x188, x264);
+        let x268 = S::mul_add(S::splat(105.98), x189, x265);
+        let x269 = S::mul_add(S::splat(279.2), x37 + x64, x266);
+        let x270 = S::mul_add(S::splat(279.2), x190, x267);
+        let x271 = S::mul_add(S::splat(279.2), x191, x268);
+        let x272 = S::mul_add(S::splat(314.88), x38, x270);
+        let x273 = S::mul_add(S::splat(314.88), x39, x271);
+        let x274 = S::mul_add(S::splat(105.98), x7 + x183, x207);
+        let x275 = S::mul_add(S::splat(105.98), x8 - x184, x208);
+        let x276 = S::mul_add(S::splat(105.98), x7 + x188, x274);
+        let x277 = S::mul_add(S::splat(105.98), x8 - x189, x275);
+        let x278 = S::mul_add(S::splat(279.2), x7 + x190, x276);
+        let x279 = S::mul_add(S::splat(279.2), x8 - x191, x277);
+        let x280 = S::mul_add(S::splat(314.88), x7 + x38, x278);
+        let x281 = S::mul_add(S::splat(314.88), x8 - x39, x279);
+        let x282 = S::mul_add(S::neg(x140), x207, x141 * x208);
         let x283 = x139 * x207;
         let x284 = x139 * x208;
         let x285 = x140 * x204;
         let x286 = x139 * x204;
         let x287 = x141 * x204;
-        let x288 = Self::mul_add(-x141, x206, x286);
+        let x288 = S::mul_add(S::neg(x141), x206, x286);
         let x289 = x140 * x206;
         let x290 = x141 * x205;
-        let x291 = Self::mul_add(-x140, x205, x286);
+        let x291 = S::mul_add(S::neg(x140), x205, x286);
         let x292 = x141 * x203;
         let x293 = x140 * x202;
         let x294 = x292 + x293;
@@ -2954,13 +3154,13 @@ impl SsrmsRecurrent {
         let x335 = x38 * x249;
         let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x37, x249, x307);
-        let x339 = Self::mul_add(-x37, x250, x308);
-        let x340 = Self::mul_add(x38, x248, x309);
+        let x338 = S::mul_add(S::neg(x37), x249, x307);
+        let x339 = S::mul_add(S::neg(x37), x250, x308);
+        let x340 = S::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x38, x250, x312);
-        let x343 = Self::mul_add(x39, x248, x313);
-        let x344 = Self::mul_add(x39, x249, x314);
+        let x342 = S::mul_add(x38, x250, x312);
+        let x343 = S::mul_add(x39, x248, x313);
+        let x344 = S::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
         let x346 = x93 * x253;
         let x347 = x92 * x252;
@@ -2969,405 +3169,409 @@ impl SsrmsRecurrent {
         let x350 = x38 * x255;
         let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x37, x255, x295);
-        let x354 = Self::mul_add(-x37, x256, x296);
-        let x355 = Self::mul_add(x38, x254, x297);
+        let x353 = S::mul_add(S::neg(x37), x255, x295);
+        let x354 = S::mul_add(S::neg(x37), x256, x296);
+        let x355 = S::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x38, x256, x300);
-        let x358 = Self::mul_add(x39, x254, x301);
-        let x359 = Self::mul_add(x39, x255, x302);
+        let x357 = S::mul_add(x38, x256, x300);
+        let x358 = S::mul_add(x39, x254, x301);
+        let x359 = S::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
         let x361 = x93 * x259;
         let x362 = x92 * x258;
         let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x91, x258, x353);
-        let x366 = Self::mul_add(-x91, x259, x354);
-        let x367 = Self::mul_add(-x92, x257, x355);
+        let x365 = S::mul_add(S::neg(x91), x258, x353);
+        let x366 = S::mul_add(S::neg(x91), x259, x354);
+        let x367 = S::mul_add(S::neg(x92), x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x92, x259, x357);
-        let x370 = Self::mul_add(-x93, x257, x358);
-        let x371 = Self::mul_add(-x93, x258, x359);
+        let x369 = S::mul_add(S::neg(x92), x259, x357);
+        let x370 = S::mul_add(S::neg(x93), x257, x358);
+        let x371 = S::mul_add(S::neg(x93), x258, x359);
         let x372 = x360 - (x362 + x363);
         let x373 = x66 * x262;
         let x374 = x65 * x261;
         let x375 = x64 * x260;
         let x376 = x37 * x263;
-        let x377 = Self::mul_add(x38, x263, x285);
-        let x378 = x288 - Self::mul_add(x39, x265, x376);
-        let x379 = Self::mul_add(x38, x265, x289);
-        let x380 = Self::mul_add(x39, x263, x287);
-        let x381 = Self::mul_add(x39, x264, x290);
-        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x377 = S::mul_add(x38, x263, x285);
+        let x378 = x288 - S::mul_add(x39, x265, x376);
+        let x379 = S::mul_add(x38, x265, x289);
+        let x380 = S::mul_add(x39, x263, x287);
+        let x381 = S::mul_add(x39, x264, x290);
+        let x382 = x291 - S::mul_add(x38, x264, x376);
         let x383 = x91 * x266;
-        let x384 = Self::mul_add(-x92, x266, x377);
-        let x385 = x378 + Self::mul_add(x93, x268, -x383);
-        let x386 = Self::mul_add(-x92, x268, x379);
-        let x387 = Self::mul_add(-x93, x266, x380);
-        let x388 = Self::mul_add(-x93, x267, x381);
-        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x384 = S::mul_add(S::neg(x92), x266, x377);
+        let x385 = x378 + S::mul_add(x93, x268, S::neg(x383));
+        let x386 = S::mul_add(S::neg(x92), x268, x379);
+        let x387 = S::mul_add(S::neg(x93), x266, x380);
+        let x388 = S::mul_add(S::neg(x93), x267, x381);
+        let x389 = x382 + S::mul_add(x92, x267, S::neg(x383));
         let x390 = x64 * x269;
-        let x391 = x385 + Self::mul_add(x66, x271, -x390);
-        let x392 = Self::mul_add(-x65, x271, x386);
-        let x393 = Self::mul_add(-x66, x270, x388);
-        let x394 = x389 + Self::mul_add(x65, x270, -x390);
-        let x395 = x37 * Self::mul_add(314.88, x37, x269);
-        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
-        let x397 = Self::mul_add(-x37, x274, x283);
-        let x398 = Self::mul_add(-x37, x275, x284);
-        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
-        let x400 = Self::mul_add(-x91, x276, x397);
-        let x401 = Self::mul_add(-x91, x277, x398);
-        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
-        let x403 = Self::mul_add(-x64, x278, x400);
-        let x404 = Self::mul_add(-x64, x279, x401);
-        let x405 = Self::mul_add(
-            -c_q0,
-            x26 + x238 + Self::mul_add(-x37, x281, x404),
-            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
+        let x391 = x385 + S::mul_add(x66, x271, S::neg(x390));
+        let x392 = S::mul_add(S::neg(x65), x271, x386);
+        let x393 = S::mul_add(S::neg(x66), x270, x388);
+        let x394 = x389 + S::mul_add(x65, x270, S::neg(x390));
+        let x395 = x37 * S::mul_add(S::splat(314.88), x37, x269);
+        let x396 = x282 + S::mul_add(S::neg(x38), x274, x39 * x275);
+        let x397 = S::mul_add(S::neg(x37), x274, x283);
+        let x398 = S::mul_add(S::neg(x37), x275, x284);
+        let x399 = x396 - S::mul_add(S::neg(x92), x276, x93 * x277);
+        let x400 = S::mul_add(S::neg(x91), x276, x397);
+        let x401 = S::mul_add(S::neg(x91), x277, x398);
+        let x402 = x399 - S::mul_add(S::neg(x65), x278, x66 * x279);
+        let x403 = S::mul_add(S::neg(x64), x278, x400);
+        let x404 = S::mul_add(S::neg(x64), x279, x401);
+        let x405 = S::mul_add(
+            S::neg(c_q0),
+            x26 + x238 + S::mul_add(S::neg(x37), x281, x404),
+            s_q0 * (x24 + x237 - S::mul_add(S::neg(x37), x280, x403)),
         );
-        let x406 = Self::mul_add(
-            -x12,
+        let x406 = S::mul_add(
+            S::neg(x12),
             x238 + x404,
-            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
+            S::mul_add(S::neg(x10), x237 - x403, s_q1 * (x236 - x402)),
         );
-        let x407 = Self::mul_add(
-            -x12,
+        let x407 = S::mul_add(
+            S::neg(x12),
             x229 + x401,
-            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
+            S::mul_add(S::neg(x10), x228 - x400, s_q1 * (x227 - x399)),
         );
-        let x408 = Self::mul_add(
+        let x408 = S::mul_add(
             x12,
             x220 - x398,
-            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
+            S::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
-        let x409 = Self::mul_add(
+        let x409 = S::mul_add(
             x99,
             x211 + x284,
-            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
+            S::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
-        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
-        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
-        let x413 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -c_q0,
-                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
-                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
+        let x410 = S::mul_add(x119, x159, S::mul_add(x117, x158, x115 * x157));
+        let x411 = S::mul_add(x119, x162, S::mul_add(x117, x161, x115 * x160));
+        let x412 = S::mul_add(x119, x165, S::mul_add(x117, x164, x115 * x163));
+        let x413 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(c_q0),
+                x36 + x244 - (x394 - S::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - S::mul_add(x39, x272, x393)),
             ),
             s_q0
-                * Self::mul_add(
-                    -c_q0,
-                    x31 + x241 - Self::mul_add(x38, x273, x392),
-                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
+                * S::mul_add(
+                    S::neg(c_q0),
+                    x31 + x241 - S::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - S::mul_add(x39, x273, x395))),
                 ),
         );
-        let x414 = Self::mul_add(
-            -x12,
+        let x414 = S::mul_add(
+            S::neg(x12),
             x241 - x392,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x269, x384)),
             ),
         );
-        let x415 = Self::mul_add(
-            -x12,
+        let x415 = S::mul_add(
+            S::neg(x12),
             x244 - x394,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x269, x387)),
             ),
         );
-        let x416 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -x12,
+        let x416 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x389,
-                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
+                S::mul_add(S::neg(x10), x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x232 - x386,
-                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
+                    S::mul_add(S::neg(x10), x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
-        let x417 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x417 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x12,
                 x226 - x382,
-                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
+                S::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x223 - x379,
-                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
+                    S::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
-        let x418 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x418 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x99,
                 x217 - x291,
-                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
+                S::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x214 - x289,
-                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
+                    S::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
-        let x419 = Self::mul_add(
-            -x12,
-            x238 + Self::mul_add(-x64, x262, x366),
-            Self::mul_add(
-                -x10,
-                x237 + Self::mul_add(-x64, x261, x365),
+        let x419 = S::mul_add(
+            S::neg(x12),
+            x238 + S::mul_add(S::neg(x64), x262, x366),
+            S::mul_add(
+                S::neg(x10),
+                x237 + S::mul_add(S::neg(x64), x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
-        let x420 = Self::mul_add(
-            -x12,
-            x241 + Self::mul_add(-x65, x262, x369),
-            Self::mul_add(
-                -x10,
+        let x420 = S::mul_add(
+            S::neg(x12),
+            x241 + S::mul_add(S::neg(x65), x262, x369),
+            S::mul_add(
+                S::neg(x10),
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x260, x367)),
             ),
         );
-        let x421 = Self::mul_add(
-            -x12,
+        let x421 = S::mul_add(
+            S::neg(x12),
             x244 - (x372 - (x374 + x375)),
-            Self::mul_add(
-                -x10,
-                x243 + Self::mul_add(-x66, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
+            S::mul_add(
+                S::neg(x10),
+                x243 + S::mul_add(S::neg(x66), x261, x371),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x260, x370)),
             ),
         );
-        let x422 = Self::mul_add(
-            -x10,
-            Self::mul_add(
-                -x12,
+        let x422 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
+                S::neg(x12),
                 x232 + x369,
-                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
+                S::mul_add(S::neg(x10), x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x229 + x366,
-                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
+                    S::mul_add(S::neg(x10), x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
-        let x423 = Self::mul_add(
-            -x12,
-            Self::mul_add(
-                -x12,
+        let x423 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x372,
-                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
+                S::mul_add(S::neg(x10), x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
-        let x424 = Self::mul_add(
+        let x424 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x357,
-                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
+                S::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x354,
-                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
+                    S::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
-        let x425 = Self::mul_add(
+        let x425 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x360,
-                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
+                S::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
-        let x426 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x426 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x300,
-                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
+                S::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x296,
-                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
+                    S::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
-        let x427 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x427 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x303,
-                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
+                S::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x426,
         );
-        let x428 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
-        let x429 = Self::mul_add(
-            -x12,
-            x229 + Self::mul_add(-x91, x253, x339),
-            Self::mul_add(
-                -x10,
-                x228 + Self::mul_add(-x91, x252, x338),
+        let x428 = S::mul_add(
+            S::neg(x12),
+            x412,
+            S::mul_add(S::neg(x10), x411, s_q1 * x410),
+        );
+        let x429 = S::mul_add(
+            S::neg(x12),
+            x229 + S::mul_add(S::neg(x91), x253, x339),
+            S::mul_add(
+                S::neg(x10),
+                x228 + S::mul_add(S::neg(x91), x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
-        let x430 = Self::mul_add(
-            -x12,
-            x232 + Self::mul_add(-x92, x253, x342),
-            Self::mul_add(
-                -x10,
+        let x430 = S::mul_add(
+            S::neg(x12),
+            x232 + S::mul_add(S::neg(x92), x253, x342),
+            S::mul_add(
+                S::neg(x10),
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
+                s_q1 * (x230 + S::mul_add(S::neg(x92), x251, x340)),
             ),
         );
-        let x431 = Self::mul_add(
-            -x12,
+        let x431 = S::mul_add(
+            S::neg(x12),
             x235 - (x345 - (x347 + x348)),
-            Self::mul_add(
-                -x10,
-                x234 + Self::mul_add(-x93, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
+            S::mul_add(
+                S::neg(x10),
+                x234 + S::mul_add(S::neg(x93), x252, x344),
+                s_q1 * (x233 + S::mul_add(S::neg(x93), x251, x343)),
             ),
         );
-        let x432 = Self::mul_add(
+        let x432 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x342,
-                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
+                S::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x339,
-                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
+                    S::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
-        let x433 = Self::mul_add(
+        let x433 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x345,
-                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
+                S::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
-        let x434 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x434 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x312,
-                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
+                S::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x308,
-                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
+                    S::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
-        let x435 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x435 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x315,
-                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
+                S::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x434,
         );
-        let x436 = Self::mul_add(
+        let x436 = S::mul_add(
             x12,
-            x220 + Self::mul_add(-x37, x247, x320),
-            Self::mul_add(
+            x220 + S::mul_add(S::neg(x37), x247, x320),
+            S::mul_add(
                 x10,
-                x219 + Self::mul_add(-x37, x246, x319),
+                x219 + S::mul_add(S::neg(x37), x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
-        let x437 = Self::mul_add(
+        let x437 = S::mul_add(
             x12,
-            x223 - Self::mul_add(x38, x247, x324),
-            Self::mul_add(
+            x223 - S::mul_add(x38, x247, x324),
+            S::mul_add(
                 x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
+                s_q1 * (x221 - S::mul_add(x38, x245, x321)),
             ),
         );
-        let x438 = Self::mul_add(
+        let x438 = S::mul_add(
             x12,
             x226 + (x327 + (x332 + x333)),
-            Self::mul_add(
+            S::mul_add(
                 x10,
-                x225 - Self::mul_add(x39, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
+                x225 - S::mul_add(x39, x246, x326),
+                s_q1 * (x224 - S::mul_add(x39, x245, x325)),
             ),
         );
-        let x439 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x439 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 - x324,
-                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
+                S::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 - x320,
-                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
+                    S::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
-        let x440 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x440 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 + x327,
-                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
+                S::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x439,
         );
-        let x441 = Self::mul_add(
+        let x441 = S::mul_add(
             x99,
-            Self::mul_add(-x139, x194, x211),
-            Self::mul_add(
+            S::mul_add(S::neg(x139), x194, x211),
+            S::mul_add(
                 x97,
-                Self::mul_add(-x139, x193, x210),
+                S::mul_add(S::neg(x139), x193, x210),
                 x95 * (x209 + (x328 + x329)),
             ),
         );
-        let x442 = Self::mul_add(
+        let x442 = S::mul_add(
             x99,
-            Self::mul_add(-x140, x194, x214),
-            Self::mul_add(
+            S::mul_add(S::neg(x140), x194, x214),
+            S::mul_add(
                 x97,
                 x213 + (x328 + x330),
-                x95 * Self::mul_add(-x140, x192, x212),
+                x95 * S::mul_add(S::neg(x140), x192, x212),
             ),
         );
-        let x443 = Self::mul_add(
+        let x443 = S::mul_add(
             x99,
             x217 + (x329 + x330),
-            Self::mul_add(
+            S::mul_add(
                 x97,
-                Self::mul_add(-x141, x193, x216),
-                x95 * Self::mul_add(-x141, x192, x215),
+                S::mul_add(S::neg(x141), x193, x216),
+                x95 * S::mul_add(S::neg(x141), x192, x215),
             ),
         );
         let x444 = qd[1] * s_q0;
@@ -3385,23 +3589,19 @@ impl SsrmsRecurrent {
         let x456 = x444 * x445;
         let x457 = x37 * (x454 + x455);
         let x458 = x447
-            - Self::mul_add(
-                -x39,
+            - S::mul_add(
+                S::neg(x39),
                 x456,
-                Self::mul_add(-x38, x446 + x454, x37 * (x450 + x450)),
+                S::mul_add(S::neg(x38), x446 + x454, x37 * (x450 + x450)),
             );
         let x459 = x448
-            - Self::mul_add(
-                x39,
-                x446 + x455,
-                Self::mul_add(x38, x456, x37 * (x449 + x449)),
-            );
+            - S::mul_add(x39, x446 + x455, S::mul_add(x38, x456, x37 * (x449 + x449)));
         let x460 = qd[0] - x451;
         let x461 = x444 - x452;
         let x462 = x445 + x453;
-        let x463 = Self::mul_add(x444, x453, x445 * x452);
-        let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
-        let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
+        let x463 = S::mul_add(x444, x453, x445 * x452);
+        let x464 = x449 + S::mul_add(qd[0], x453, x445 * x451);
+        let x465 = x450 + S::mul_add(S::neg(qd[0]), x452, x444 * x451);
         let x466 = qd[3] * s_q1;
         let x467 = qd[3] * x10;
         let x468 = qd[3] * x12;
@@ -3412,29 +3612,29 @@ impl SsrmsRecurrent {
         let x473 = x460 * x460;
         let x474 = x461 * x462;
         let x475 = x457
-            + Self::mul_add(
+            + S::mul_add(
                 x66,
                 x464 - x472,
-                Self::mul_add(-x65, x465 - x471, x64 * (x469 + x470)),
+                S::mul_add(S::neg(x65), x465 - x471, x64 * (x469 + x470)),
             );
         let x476 = x458
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x463 - x474,
-                Self::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
+                S::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
             );
         let x477 = x459
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x470 + x473,
-                Self::mul_add(-x65, x463 + x474, x64 * (x464 + x472)),
+                S::mul_add(S::neg(x65), x463 + x474, x64 * (x464 + x472)),
             );
         let x478 = x460 - x466;
         let x479 = x461 - x467;
         let x480 = x462 + x468;
-        let x481 = x463 + Self::mul_add(x461, x468, x462 * x467);
-        let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
-        let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
+        let x481 = x463 + S::mul_add(x461, x468, x462 * x467);
+        let x482 = x464 + S::mul_add(x460, x468, x462 * x466);
+        let x483 = x465 + S::mul_add(S::neg(x460), x467, x461 * x466);
         let x484 = qd[4] * s_q1;
         let x485 = qd[4] * x10;
         let x486 = qd[4] * x12;
@@ -3445,29 +3645,29 @@ impl SsrmsRecurrent {
         let x491 = x478 * x478;
         let x492 = x479 * x480;
         let x493 = x475
-            + Self::mul_add(
+            + S::mul_add(
                 x93,
                 x482 - x490,
-                Self::mul_add(-x92, x483 - x489, x91 * (x487 + x488)),
+                S::mul_add(S::neg(x92), x483 - x489, x91 * (x487 + x488)),
             );
         let x494 = x476
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x481 - x492,
-                Self::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
+                S::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
             );
         let x495 = x477
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x488 + x491,
-                Self::mul_add(-x92, x481 + x492, x91 * (x482 + x490)),
+                S::mul_add(S::neg(x92), x481 + x492, x91 * (x482 + x490)),
             );
         let x496 = x478 - x484;
         let x497 = x479 - x485;
         let x498 = x480 + x486;
-        let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
-        let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
-        let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
+        let x499 = x481 + S::mul_add(x479, x486, x480 * x485);
+        let x500 = x482 + S::mul_add(x478, x486, x480 * x484);
+        let x501 = x483 + S::mul_add(S::neg(x478), x485, x479 * x484);
         let x502 = qd[5] * x95;
         let x503 = qd[5] * x97;
         let x504 = qd[5] * x99;
@@ -3478,29 +3678,29 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            + Self::mul_add(
-                -x39,
+            + S::mul_add(
+                S::neg(x39),
                 x500 - x508,
-                Self::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
+                S::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
             );
         let x512 = x494
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x499 - x510,
-                Self::mul_add(-x38, x505 + x509, x37 * (x501 + x507)),
+                S::mul_add(S::neg(x38), x505 + x509, x37 * (x501 + x507)),
             );
         let x513 = x495
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x506 + x509,
-                Self::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
+                S::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 - x503;
         let x516 = x498 + x504;
-        let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
-        let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
-        let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
+        let x517 = x499 + S::mul_add(x497, x504, x498 * x503);
+        let x518 = x500 - S::mul_add(S::neg(x496), x504, x498 * x502);
+        let x519 = x501 - S::mul_add(x496, x503, x497 * x502);
         let x520 = qd[6] * x115;
         let x521 = qd[6] * x117;
         let x522 = qd[6] * x119;
@@ -3513,126 +3713,134 @@ impl SsrmsRecurrent {
         let x529 = x514 + x520;
         let x530 = x515 - x521;
         let x531 = x516 + x522;
-        let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
-        let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
-        let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
-        let x535 = Self::mul_add(x26, x445, Self::mul_add(-x24, x444, qd[0] * x22));
-        let x536 = Self::mul_add(
+        let x532 = x517 + S::mul_add(x515, x522, x516 * x521);
+        let x533 = x518 - S::mul_add(S::neg(x514), x522, x516 * x520);
+        let x534 = x519 - S::mul_add(x514, x521, x515 * x520);
+        let x535 = S::mul_add(x26, x445, S::mul_add(S::neg(x24), x444, qd[0] * x22));
+        let x536 = S::mul_add(
             x31,
             x445,
-            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x15, -x27)),
+            S::mul_add(S::neg(x29), x444, qd[0] * S::mul_add(c_q1, x15, S::neg(x27))),
         );
-        let x537 = Self::mul_add(
+        let x537 = S::mul_add(
             x36,
             x445,
-            Self::mul_add(-x34, x444, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+            S::mul_add(S::neg(x34), x444, qd[0] * S::mul_add(c_q1, x18, S::neg(x32))),
         );
-        let x538 = Self::mul_add(x57, x462, Self::mul_add(-x56, x461, x55 * x460));
-        let x539 = Self::mul_add(x60, x462, Self::mul_add(-x59, x461, x58 * x460));
-        let x540 = Self::mul_add(x63, x462, Self::mul_add(-x62, x461, x61 * x460));
-        let x541 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
-        let x542 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
-        let x543 = Self::mul_add(x90, x480, Self::mul_add(-x89, x479, x88 * x478));
-        let x544 = Self::mul_add(-x108, x498, Self::mul_add(x107, x497, x106 * x496));
-        let x545 = Self::mul_add(-x111, x498, Self::mul_add(x110, x497, x109 * x496));
-        let x546 = Self::mul_add(-x114, x498, Self::mul_add(x113, x497, x112 * x496));
-        let x547 = Self::mul_add(x132, x516, Self::mul_add(-x131, x515, x130 * x514));
-        let x548 = Self::mul_add(x135, x516, Self::mul_add(-x134, x515, x133 * x514));
-        let x549 = Self::mul_add(x138, x516, Self::mul_add(-x137, x515, x136 * x514));
-        let x550 = 243.66
+        let x538 = S::mul_add(x57, x462, S::mul_add(S::neg(x56), x461, x55 * x460));
+        let x539 = S::mul_add(x60, x462, S::mul_add(S::neg(x59), x461, x58 * x460));
+        let x540 = S::mul_add(x63, x462, S::mul_add(S::neg(x62), x461, x61 * x460));
+        let x541 = S::mul_add(x84, x480, S::mul_add(S::neg(x83), x479, x82 * x478));
+        let x542 = S::mul_add(x87, x480, S::mul_add(S::neg(x86), x479, x85 * x478));
+        let x543 = S::mul_add(x90, x480, S::mul_add(S::neg(x89), x479, x88 * x478));
+        let x544 = S::mul_add(S::neg(x108), x498, S::mul_add(x107, x497, x106 * x496));
+        let x545 = S::mul_add(S::neg(x111), x498, S::mul_add(x110, x497, x109 * x496));
+        let x546 = S::mul_add(S::neg(x114), x498, S::mul_add(x113, x497, x112 * x496));
+        let x547 = S::mul_add(x132, x516, S::mul_add(S::neg(x131), x515, x130 * x514));
+        let x548 = S::mul_add(x135, x516, S::mul_add(S::neg(x134), x515, x133 * x514));
+        let x549 = S::mul_add(x138, x516, S::mul_add(S::neg(x137), x515, x136 * x514));
+        let x550 = S::splat(243.66)
             * (x511
-                - Self::mul_add(
+                - S::mul_add(
                     x141,
                     x518 - x526,
-                    Self::mul_add(-x140, x519 - x525, x139 * (x523 + x524)),
+                    S::mul_add(S::neg(x140), x519 - x525, x139 * (x523 + x524)),
                 ));
-        let x551 = 243.66
+        let x551 = S::splat(243.66)
             * (x512
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x517 - x528,
-                    Self::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
+                    S::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
                 ));
-        let x552 = 243.66
+        let x552 = S::splat(243.66)
             * (x513
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x524 + x527,
-                    Self::mul_add(-x140, x517 + x528, x139 * (x518 + x526)),
+                    S::mul_add(S::neg(x140), x517 + x528, x139 * (x518 + x526)),
                 ));
-        let x553 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
-        let x554 = Self::mul_add(x162, x531, Self::mul_add(-x161, x530, x160 * x529));
-        let x555 = Self::mul_add(x165, x531, Self::mul_add(-x164, x530, x163 * x529));
-        let x556 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
-            + Self::mul_add(x530, x555, x531 * x554);
-        let x557 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
-            - Self::mul_add(-x529, x555, x531 * x553);
-        let x558 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
-            - Self::mul_add(x529, x554, x530 * x553);
-        let x559 = Self::mul_add(105.98, x511, x550);
-        let x560 = Self::mul_add(105.98, x512, x551);
-        let x561 = Self::mul_add(105.98, x513, x552);
-        let x562 = Self::mul_add(105.98, x493, x559);
-        let x563 = Self::mul_add(105.98, x494, x560);
-        let x564 = Self::mul_add(105.98, x495, x561);
-        let x565 = Self::mul_add(279.2, x475, x562);
-        let x566 = Self::mul_add(279.2, x476, x563);
-        let x567 = Self::mul_add(279.2, x477, x564);
-        let x568 = Self::mul_add(314.88, x457, x565);
-        let x569 = Self::mul_add(314.88, x458, x566);
-        let x570 = Self::mul_add(314.88, x459, x567);
-        let x571 = Self::mul_add(x132, x519, Self::mul_add(x131, x518, x130 * x517))
-            + Self::mul_add(x515, x549, x516 * x548) + x556
-            - Self::mul_add(x140, x552, x141 * x551);
-        let x572 = Self::mul_add(x135, x519, Self::mul_add(x134, x518, x133 * x517))
-            - Self::mul_add(-x514, x549, x516 * x547) + x557
-            - Self::mul_add(-x139, x552, x141 * x550);
-        let x573 = Self::mul_add(x138, x519, Self::mul_add(x137, x518, x136 * x517))
-            - Self::mul_add(x514, x548, x515 * x547) + x558
-            + Self::mul_add(x139, x551, x140 * x550);
-        let x574 = Self::mul_add(-x108, x501, Self::mul_add(-x107, x500, x106 * x499))
-            - Self::mul_add(x497, x546, x498 * x545) + x571
-            - Self::mul_add(x38, x561, x39 * x560);
-        let x575 = Self::mul_add(-x111, x501, Self::mul_add(-x110, x500, x109 * x499))
-            + Self::mul_add(x496, x546, x498 * x544) - x572
-            + Self::mul_add(x37, x561, x39 * x559);
-        let x576 = Self::mul_add(-x114, x501, Self::mul_add(-x113, x500, x112 * x499))
-            + Self::mul_add(-x496, x545, x497 * x544) - x573
-            - Self::mul_add(-x37, x560, x38 * x559);
-        let x577 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
-            + Self::mul_add(x479, x543, x480 * x542) + x574
-            + Self::mul_add(x92, x564, x93 * x563);
-        let x578 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
-            - Self::mul_add(-x478, x543, x480 * x541) - x575
-            + Self::mul_add(-x91, x564, x93 * x562);
-        let x579 = Self::mul_add(x90, x483, Self::mul_add(x89, x482, x88 * x481))
-            - Self::mul_add(x478, x542, x479 * x541) - x576
-            - Self::mul_add(x91, x563, x92 * x562);
-        let x580 = Self::mul_add(x57, x465, Self::mul_add(x56, x464, x55 * x463))
-            + Self::mul_add(x461, x540, x462 * x539) + x577
-            + Self::mul_add(x65, x567, x66 * x566);
-        let x581 = Self::mul_add(x60, x465, Self::mul_add(x59, x464, x58 * x463))
-            - Self::mul_add(-x460, x540, x462 * x538) + x578
-            + Self::mul_add(-x64, x567, x66 * x565);
-        let x582 = Self::mul_add(x63, x465, Self::mul_add(x62, x464, x61 * x463))
-            - Self::mul_add(x460, x539, x461 * x538) + x579
-            - Self::mul_add(x64, x566, x65 * x565);
+        let x553 = S::mul_add(x159, x531, S::mul_add(S::neg(x158), x530, x157 * x529));
+        let x554 = S::mul_add(x162, x531, S::mul_add(S::neg(x161), x530, x160 * x529));
+        let x555 = S::mul_add(x165, x531, S::mul_add(S::neg(x164), x530, x163 * x529));
+        let x556 = S::mul_add(x159, x534, S::mul_add(x158, x533, x157 * x532))
+            + S::mul_add(x530, x555, x531 * x554);
+        let x557 = S::mul_add(x162, x534, S::mul_add(x161, x533, x160 * x532))
+            - S::mul_add(S::neg(x529), x555, x531 * x553);
+        let x558 = S::mul_add(x165, x534, S::mul_add(x164, x533, x163 * x532))
+            - S::mul_add(x529, x554, x530 * x553);
+        let x559 = S::mul_add(S::splat(105.98), x511, x550);
+        let x560 = S::mul_add(S::splat(105.98), x512, x551);
+        let x561 = S::mul_add(S::splat(105.98), x513, x552);
+        let x562 = S::mul_add(S::splat(105.98), x493, x559);
+        let x563 = S::mul_add(S::splat(105.98), x494, x560);
+        let x564 = S::mul_add(S::splat(105.98), x495, x561);
+        let x565 = S::mul_add(S::splat(279.2), x475, x562);
+        let x566 = S::mul_add(S::splat(279.2), x476, x563);
+        let x567 = S::mul_add(S::splat(279.2), x477, x564);
+        let x568 = S::mul_add(S::splat(314.88), x457, x565);
+        let x569 = S::mul_add(S::splat(314.88), x458, x566);
+        let x570 = S::mul_add(S::splat(314.88), x459, x567);
+        let x571 = S::mul_add(x132, x519, S::mul_add(x131, x518, x130 * x517))
+            + S::mul_add(x515, x549, x516 * x548) + x556
+            - S::mul_add(x140, x552, x141 * x551);
+        let x572 = S::mul_add(x135, x519, S::mul_add(x134, x518, x133 * x517))
+            - S::mul_add(S::neg(x514), x549, x516 * x547) + x557
+            - S::mul_add(S::neg(x139), x552, x141 * x550);
+        let x573 = S::mul_add(x138, x519, S::mul_add(x137, x518, x136 * x517))
+            - S::mul_add(x514, x548, x515 * x547) + x558
+            + S::mul_add(x139, x551, x140 * x550);
+        let x574 = S::mul_add(
+            S::neg(x108),
+            x501,
+            S::mul_add(S::neg(x107), x500, x106 * x499),
+        ) - S::mul_add(x497, x546, x498 * x545) + x571
+            - S::mul_add(x38, x561, x39 * x560);
+        let x575 = S::mul_add(
+            S::neg(x111),
+            x501,
+            S::mul_add(S::neg(x110), x500, x109 * x499),
+        ) + S::mul_add(x496, x546, x498 * x544) - x572
+            + S::mul_add(x37, x561, x39 * x559);
+        let x576 = S::mul_add(
+            S::neg(x114),
+            x501,
+            S::mul_add(S::neg(x113), x500, x112 * x499),
+        ) + S::mul_add(S::neg(x496), x545, x497 * x544) - x573
+            - S::mul_add(S::neg(x37), x560, x38 * x559);
+        let x577 = S::mul_add(x84, x483, S::mul_add(x83, x482, x82 * x481))
+            + S::mul_add(x479, x543, x480 * x542) + x574
+            + S::mul_add(x92, x564, x93 * x563);
+        let x578 = S::mul_add(x87, x483, S::mul_add(x86, x482, x85 * x481))
+            - S::mul_add(S::neg(x478), x543, x480 * x541) - x575
+            + S::mul_add(S::neg(x91), x564, x93 * x562);
+        let x579 = S::mul_add(x90, x483, S::mul_add(x89, x482, x88 * x481))
+            - S::mul_add(x478, x542, x479 * x541) - x576
+            - S::mul_add(x91, x563, x92 * x562);
+        let x580 = S::mul_add(x57, x465, S::mul_add(x56, x464, x55 * x463))
+            + S::mul_add(x461, x540, x462 * x539) + x577
+            + S::mul_add(x65, x567, x66 * x566);
+        let x581 = S::mul_add(x60, x465, S::mul_add(x59, x464, x58 * x463))
+            - S::mul_add(S::neg(x460), x540, x462 * x538) + x578
+            + S::mul_add(S::neg(x64), x567, x66 * x565);
+        let x582 = S::mul_add(x63, x465, S::mul_add(x62, x464, x61 * x463))
+            - S::mul_add(x460, x539, x461 * x538) + x579
+            - S::mul_add(x64, x566, x65 * x565);
         let x583 = tau[0]
-            + (Self::mul_add(x26, x450, x24 * x449)
-                + Self::mul_add(x444, x537, x445 * x536) + x580
-                - Self::mul_add(x38, x570, x39 * x569)
-                + Self::mul_add(
-                    -x7,
-                    Self::mul_add(105.98, x448, x570),
-                    x8 * Self::mul_add(105.98, x447, x569),
+            + (S::mul_add(x26, x450, x24 * x449) + S::mul_add(x444, x537, x445 * x536)
+                + x580 - S::mul_add(x38, x570, x39 * x569)
+                + S::mul_add(
+                    S::neg(x7),
+                    S::mul_add(S::splat(105.98), x448, x570),
+                    x8 * S::mul_add(S::splat(105.98), x447, x569),
                 ));
-        let x584 = 1.0
-            / (12.19 + (x22 + x236)
-                - (x402 + Self::mul_add(-x38, x280, x39 * x281)
-                    - Self::mul_add(
+        let x584 = S::splat(1.0)
+            / (S::splat(12.19) + (x22 + x236)
+                - (x402 + S::mul_add(S::neg(x38), x280, x39 * x281)
+                    - S::mul_add(
                         x7,
-                        Self::mul_add(105.98, x7, x280),
-                        x8 * Self::mul_add(105.98, x8, x281),
+                        S::mul_add(S::splat(105.98), x7, x280),
+                        x8 * S::mul_add(S::splat(105.98), x8, x281),
                     )));
         let x585 = x405 * x584;
         let x586 = x406 * x584;
@@ -3640,203 +3848,263 @@ impl SsrmsRecurrent {
         let x588 = x408 * x584;
         let x589 = x409 * x584;
         let x590 = x410 * x584;
-        let x591 = 1.0 / Self::mul_add(-x405, x585, x413);
-        let x592 = Self::mul_add(-x405, x586, Self::mul_add(-c_q0, x415, s_q0 * x414));
-        let x593 = x591 * x592;
-        let x594 = Self::mul_add(-x405, x587, x416);
-        let x595 = x591 * x594;
-        let x596 = Self::mul_add(x405, x588, x417);
-        let x597 = x591 * x596;
-        let x598 = Self::mul_add(-x405, x589, x418);
-        let x599 = x591 * x598;
-        let x600 = Self::mul_add(-x405, x590, Self::mul_add(-c_q0, x412, s_q0 * x411));
-        let x601 = x591 * x600;
-        let x602 = Self::mul_add(
-            -x406,
+        let x591 = S::splat(1.0) / S::mul_add(S::neg(x405), x585, x413);
+        let x592 = S::mul_add(
+            S::neg(x405),
             x586,
-            Self::mul_add(-x12, x421, Self::mul_add(-x10, x420, s_q1 * x419)),
+            S::mul_add(S::neg(c_q0), x415, s_q0 * x414),
         );
-        let x603 = 1.0 / Self::mul_add(-x592, x593, x602);
-        let x604 = Self::mul_add(-x592, x595, Self::mul_add(-x406, x587, x423));
+        let x593 = x591 * x592;
+        let x594 = S::mul_add(S::neg(x405), x587, x416);
+        let x595 = x591 * x594;
+        let x596 = S::mul_add(x405, x588, x417);
+        let x597 = x591 * x596;
+        let x598 = S::mul_add(S::neg(x405), x589, x418);
+        let x599 = x591 * x598;
+        let x600 = S::mul_add(
+            S::neg(x405),
+            x590,
+            S::mul_add(S::neg(c_q0), x412, s_q0 * x411),
+        );
+        let x601 = x591 * x600;
+        let x602 = S::mul_add(
+            S::neg(x406),
+            x586,
+            S::mul_add(S::neg(x12), x421, S::mul_add(S::neg(x10), x420, s_q1 * x419)),
+        );
+        let x603 = S::splat(1.0) / S::mul_add(S::neg(x592), x593, x602);
+        let x604 = S::mul_add(S::neg(x592), x595, S::mul_add(S::neg(x406), x587, x423));
         let x605 = x603 * x604;
-        let x606 = Self::mul_add(x592, x597, Self::mul_add(-x406, x588, x425));
+        let x606 = S::mul_add(x592, x597, S::mul_add(S::neg(x406), x588, x425));
         let x607 = x603 * x606;
-        let x608 = Self::mul_add(-x592, x599, Self::mul_add(-x406, x589, x427));
+        let x608 = S::mul_add(S::neg(x592), x599, S::mul_add(S::neg(x406), x589, x427));
         let x609 = x603 * x608;
-        let x610 = Self::mul_add(-x592, x601, Self::mul_add(-x406, x590, x428));
+        let x610 = S::mul_add(S::neg(x592), x601, S::mul_add(S::neg(x406), x590, x428));
         let x611 = x603 * x610;
-        let x612 = Self::mul_add(
-            -x407,
+        let x612 = S::mul_add(
+            S::neg(x407),
             x587,
-            Self::mul_add(-x12, x431, Self::mul_add(-x10, x430, s_q1 * x429)),
+            S::mul_add(S::neg(x12), x431, S::mul_add(S::neg(x10), x430, s_q1 * x429)),
         );
-        let x613 = 1.0 / Self::mul_add(-x604, x605, Self::mul_add(-x594, x595, x612));
-        let x614 = Self::mul_add(
-            -x604,
+        let x613 = S::splat(1.0)
+            / S::mul_add(S::neg(x604), x605, S::mul_add(S::neg(x594), x595, x612));
+        let x614 = S::mul_add(
+            S::neg(x604),
             x607,
-            Self::mul_add(x594, x597, Self::mul_add(-x407, x588, x433)),
+            S::mul_add(x594, x597, S::mul_add(S::neg(x407), x588, x433)),
         );
         let x615 = x613 * x614;
-        let x616 = Self::mul_add(
-            -x604,
+        let x616 = S::mul_add(
+            S::neg(x604),
             x609,
-            Self::mul_add(-x594, x599, Self::mul_add(-x407, x589, x435)),
+            S::mul_add(S::neg(x594), x599, S::mul_add(S::neg(x407), x589, x435)),
         );
         let x617 = x613 * x616;
-        let x618 = Self::mul_add(
-            -x604,
+        let x618 = S::mul_add(
+            S::neg(x604),
             x611,
-            Self::mul_add(-x594, x601, Self::mul_add(-x407, x590, x428)),
+            S::mul_add(S::neg(x594), x601, S::mul_add(S::neg(x407), x590, x428)),
         );
         let x619 = x613 * x618;
-        let x620 = Self::mul_add(
-            -x408,
+        let x620 = S::mul_add(
+            S::neg(x408),
             x588,
-            Self::mul_add(x12, x438, Self::mul_add(x10, x437, s_q1 * x436)),
+            S::mul_add(x12, x438, S::mul_add(x10, x437, s_q1 * x436)),
         );
-        let x621 = Self::mul_add(
-            -x614,
+        let x621 = S::mul_add(
+            S::neg(x614),
             x615,
-            Self::mul_add(-x606, x607, Self::mul_add(-x596, x597, x620)),
+            S::mul_add(S::neg(x606), x607, S::mul_add(S::neg(x596), x597, x620)),
         );
-        let x622 = 1.0 / x621;
-        let x623 = Self::mul_add(
-            -x606,
+        let x622 = S::splat(1.0) / x621;
+        let x623 = S::mul_add(
+            S::neg(x606),
             x609,
-            Self::mul_add(x596, x599, Self::mul_add(-x408, x589, x440)),
+            S::mul_add(x596, x599, S::mul_add(S::neg(x408), x589, x440)),
         );
-        let x624 = Self::mul_add(-x614, x617, x623);
+        let x624 = S::mul_add(S::neg(x614), x617, x623);
         let x625 = x622 * x624;
-        let x626 = Self::mul_add(
-            -x606,
+        let x626 = S::mul_add(
+            S::neg(x606),
             x611,
-            Self::mul_add(x596, x601, Self::mul_add(-x408, x590, x428)),
+            S::mul_add(x596, x601, S::mul_add(S::neg(x408), x590, x428)),
         );
-        let x627 = Self::mul_add(-x614, x619, x626);
+        let x627 = S::mul_add(S::neg(x614), x619, x626);
         let x628 = x622 * x627;
-        let x629 = Self::mul_add(
-            -x409,
+        let x629 = S::mul_add(
+            S::neg(x409),
             x589,
-            Self::mul_add(x99, x443, Self::mul_add(x97, x442, x95 * x441)),
+            S::mul_add(x99, x443, S::mul_add(x97, x442, x95 * x441)),
         );
-        let x630 = Self::mul_add(
-            -x616,
+        let x630 = S::mul_add(
+            S::neg(x616),
             x617,
-            Self::mul_add(-x608, x609, Self::mul_add(-x598, x599, x629)),
+            S::mul_add(S::neg(x608), x609, S::mul_add(S::neg(x598), x599, x629)),
         );
-        let x631 = 1.0 / Self::mul_add(-x624, x625, x630);
-        let x632 = Self::mul_add(
-            -x409,
+        let x631 = S::splat(1.0) / S::mul_add(S::neg(x624), x625, x630);
+        let x632 = S::mul_add(
+            S::neg(x409),
             x590,
-            Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410)),
+            S::mul_add(x99, x412, S::mul_add(x97, x411, x95 * x410)),
         );
-        let x633 = Self::mul_add(
-            -x616,
+        let x633 = S::mul_add(
+            S::neg(x616),
             x619,
-            Self::mul_add(-x608, x611, Self::mul_add(-x598, x601, x632)),
+            S::mul_add(S::neg(x608), x611, S::mul_add(S::neg(x598), x601, x632)),
         );
-        let x634 = Self::mul_add(-x624, x628, x633);
+        let x634 = S::mul_add(S::neg(x624), x628, x633);
         let x635 = x631 * x634;
-        let x636 = Self::mul_add(
-            -x410,
+        let x636 = S::mul_add(
+            S::neg(x410),
             x590,
-            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
+            S::mul_add(x119, x412, S::mul_add(x117, x411, x115 * x410)),
         );
-        let x637 = Self::mul_add(
-            -x618,
+        let x637 = S::mul_add(
+            S::neg(x618),
             x619,
-            Self::mul_add(-x610, x611, Self::mul_add(-x600, x601, x636)),
+            S::mul_add(S::neg(x610), x611, S::mul_add(S::neg(x600), x601, x636)),
         );
-        let x638 = 1.0 / Self::mul_add(-x634, x635, Self::mul_add(-x627, x628, x637));
-        let x639 = Self::mul_add(
+        let x638 = S::splat(1.0)
+            / S::mul_add(S::neg(x634), x635, S::mul_add(S::neg(x627), x628, x637));
+        let x639 = S::mul_add(
             x583,
             x585,
             tau[1]
-                - Self::mul_add(
-                    -c_q0,
-                    Self::mul_add(x36, x450, x34 * x449)
-                        - Self::mul_add(qd[0], x536, x444 * x535) + x582
-                        + Self::mul_add(-x37, x569, x38 * x568),
+                - S::mul_add(
+                    S::neg(c_q0),
+                    S::mul_add(x36, x450, x34 * x449)
+                        - S::mul_add(qd[0], x536, x444 * x535) + x582
+                        + S::mul_add(S::neg(x37), x569, x38 * x568),
                     s_q0
-                        * (Self::mul_add(x31, x450, x29 * x449)
-                            - Self::mul_add(-qd[0], x537, x445 * x535) + x581
-                            - Self::mul_add(x37, x570, x39 * x568)),
+                        * (S::mul_add(x31, x450, x29 * x449)
+                            - S::mul_add(S::neg(qd[0]), x537, x445 * x535) + x581
+                            - S::mul_add(x37, x570, x39 * x568)),
                 ),
         );
-        let x640 = Self::mul_add(
+        let x640 = S::mul_add(
             x583,
             x586,
-            tau[2] - Self::mul_add(-x12, x582, Self::mul_add(-x10, x581, s_q1 * x580)),
+            tau[2]
+                - S::mul_add(
+                    S::neg(x12),
+                    x582,
+                    S::mul_add(S::neg(x10), x581, s_q1 * x580),
+                ),
         );
-        let x641 = Self::mul_add(-x593, x639, x640);
-        let x642 = Self::mul_add(
+        let x641 = S::mul_add(S::neg(x593), x639, x640);
+        let x642 = S::mul_add(
             x583,
             x587,
-            tau[3] - Self::mul_add(-x12, x579, Self::mul_add(-x10, x578, s_q1 * x577)),
+            tau[3]
+                - S::mul_add(
+                    S::neg(x12),
+                    x579,
+                    S::mul_add(S::neg(x10), x578, s_q1 * x577),
+                ),
         );
-        let x643 = Self::mul_add(-x605, x641, Self::mul_add(-x595, x639, x642));
-        let x644 = Self::mul_add(
+        let x643 = S::mul_add(S::neg(x605), x641, S::mul_add(S::neg(x595), x639, x642));
+        let x644 = S::mul_add(
             x583,
             x588,
-            tau[4] - Self::mul_add(x12, x576, Self::mul_add(x10, x575, s_q1 * x574)),
+            tau[4] - S::mul_add(x12, x576, S::mul_add(x10, x575, s_q1 * x574)),
         );
-        let x645 = Self::mul_add(
-            -x615,
+        let x645 = S::mul_add(
+            S::neg(x615),
             x643,
-            Self::mul_add(-x607, x641, Self::mul_add(x597, x639, x644)),
+            S::mul_add(S::neg(x607), x641, S::mul_add(x597, x639, x644)),
         );
-        let x646 = Self::mul_add(
-            -x583,
+        let x646 = S::mul_add(
+            S::neg(x583),
             x589,
-            tau[5] + Self::mul_add(x99, x573, Self::mul_add(x97, x572, x95 * x571)),
+            tau[5] + S::mul_add(x99, x573, S::mul_add(x97, x572, x95 * x571)),
         );
-        let x647 = Self::mul_add(
+        let x647 = S::mul_add(
             x617,
             x643,
-            Self::mul_add(x609, x641, Self::mul_add(x599, x639, x646)),
+            S::mul_add(x609, x641, S::mul_add(x599, x639, x646)),
         );
-        let x648 = Self::mul_add(x625, x645, x647);
-        let x649 = Self::mul_add(
-            -x583,
+        let x648 = S::mul_add(x625, x645, x647);
+        let x649 = S::mul_add(
+            S::neg(x583),
             x590,
-            tau[6] + Self::mul_add(x119, x558, Self::mul_add(x117, x557, x115 * x556)),
+            tau[6] + S::mul_add(x119, x558, S::mul_add(x117, x557, x115 * x556)),
         );
-        let x650 = Self::mul_add(
+        let x650 = S::mul_add(
             x619,
             x643,
-            Self::mul_add(x611, x641, Self::mul_add(x601, x639, x649)),
+            S::mul_add(x611, x641, S::mul_add(x601, x639, x649)),
         );
-        let x651 = x638 * Self::mul_add(-x635, x648, Self::mul_add(x628, x645, x650));
-        let x652 = Self::mul_add(-x635, x651, x631 * x648);
-        let x653 = Self::mul_add(x628, x651, Self::mul_add(x625, x652, x622 * x645));
-        let x654 = Self::mul_add(
+        let x651 = x638 * S::mul_add(S::neg(x635), x648, S::mul_add(x628, x645, x650));
+        let x652 = S::mul_add(S::neg(x635), x651, x631 * x648);
+        let x653 = S::mul_add(x628, x651, S::mul_add(x625, x652, x622 * x645));
+        let x654 = S::mul_add(
             x619,
             x651,
-            Self::mul_add(x617, x652, Self::mul_add(-x615, x653, x613 * x643)),
+            S::mul_add(x617, x652, S::mul_add(S::neg(x615), x653, x613 * x643)),
         );
-        let x655 = Self::mul_add(
+        let x655 = S::mul_add(
             x609,
             x652,
-            Self::mul_add(-x607, x653, Self::mul_add(-x605, x654, x603 * x641)),
+            S::mul_add(S::neg(x607), x653, S::mul_add(S::neg(x605), x654, x603 * x641)),
         );
-        let x656 = Self::mul_add(x611, x651, x655);
-        let x657 = Self::mul_add(
+        let x656 = S::mul_add(x611, x651, x655);
+        let x657 = S::mul_add(
             x597,
             x653,
-            Self::mul_add(-x595, x654, Self::mul_add(-x593, x656, x591 * x639)),
+            S::mul_add(S::neg(x595), x654, S::mul_add(S::neg(x593), x656, x591 * x639)),
         );
-        let x658 = Self::mul_add(x601, x651, Self::mul_add(x599, x652, x657));
-        let x659 = Self::mul_add(
+        let x658 = S::mul_add(x601, x651, S::mul_add(x599, x652, x657));
+        let x659 = S::mul_add(
             x587,
             x654,
-            Self::mul_add(x586, x656, Self::mul_add(x585, x658, x583 * x584)),
+            S::mul_add(x586, x656, S::mul_add(x585, x658, x583 * x584)),
         );
-        let x660 = Self::mul_add(
-            -x590,
+        let x660 = S::mul_add(
+            S::neg(x590),
             x651,
-            Self::mul_add(-x589, x652, Self::mul_add(x588, x653, x659)),
+            S::mul_add(S::neg(x589), x652, S::mul_add(x588, x653, x659)),
         );
         [x660, x658, x656, x654, x653, x652, x651]
+    }
+    /// [`Self::forward_dynamics`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_lanes`]: `out[k]` is `forward_dynamics` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                )
+            },
+        );
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -3846,8 +4114,15 @@ impl SsrmsRecurrent {
         q: &[::core::primitive::f64; 7],
         qd: &[::core::primitive::f64; 7],
     ) -> ([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7]) {
+        Self::mass_matrix_and_nonlinear_effects_lanes::<::core::primitive::f64>(q, qd)
+    }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7]) -> ([[S; 7]; 7], [S; 7]) {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -3856,165 +4131,165 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
-        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x22 = S::mul_add(c_q1, x13, x21);
         let x23 = x10 * x14;
-        let x24 = Self::mul_add(x9, x13, -x23);
+        let x24 = S::mul_add(x9, x13, S::neg(x23));
         let x25 = x12 * x14;
-        let x26 = Self::mul_add(x11, x13, -x25);
+        let x26 = S::mul_add(x11, x13, S::neg(x25));
         let x27 = s_q1 * x16;
         let x28 = x10 * x16;
-        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x29 = S::mul_add(s_q0, x17, S::mul_add(x9, x15, x28));
         let x30 = x12 * x16;
-        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x31 = S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x30));
         let x32 = s_q1 * x19;
         let x33 = x10 * x19;
-        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x34 = S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x33));
         let x35 = x12 * x19;
-        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
-        let x37 = s_q1 * 0.5692;
-        let x38 = x10 * 0.5692;
-        let x39 = x12 * 0.5692;
+        let x36 = S::mul_add(c_q0, x20, S::mul_add(x11, x18, x35));
+        let x37 = s_q1 * S::splat(0.5692);
+        let x38 = x10 * S::splat(0.5692);
+        let x39 = x12 * S::splat(0.5692);
         let x40 = c_q1 * c_q2;
         let x41 = c_q1 * s_q2;
-        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
-        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
-        let x48 = 2103.19 * x41;
-        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
-        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
-        let x51 = 2103.19 * x43;
-        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
-        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
-        let x54 = 2103.19 * x45;
-        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
-        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
-        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
-        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
-        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
-        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
-        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
-        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
-        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
-        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
-        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
-        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
-        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
-        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
-        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
-        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
-        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
-        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
-        let x75 = 1966.28 * x68;
-        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
-        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
-        let x78 = 1966.28 * x70;
-        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
-        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
-        let x81 = 1966.28 * x72;
-        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
-        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
-        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
-        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
-        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
-        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
-        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
-        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
-        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
-        let x91 = 7.11 * x67;
-        let x92 = 7.11 * x69;
-        let x93 = 7.11 * x71;
-        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
-        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
-        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
-        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
-        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
-        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
-        let x100 = 8.305 * x94;
-        let x101 = 8.0386 * x95;
-        let x102 = 8.305 * x96;
-        let x103 = 8.0386 * x97;
-        let x104 = 8.305 * x98;
-        let x105 = 8.0386 * x99;
-        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
-        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
-        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
-        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
-        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
-        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
-        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
-        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
-        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
-        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
-        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
-        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
-        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
-        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
-        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
-        let x121 = 12.13 * x115;
-        let x122 = 12.13 * x116;
-        let x123 = 3.061 * x95;
-        let x124 = 12.13 * x117;
-        let x125 = 12.13 * x118;
-        let x126 = 3.061 * x97;
-        let x127 = 12.13 * x119;
-        let x128 = 12.13 * x120;
-        let x129 = 3.061 * x99;
-        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
-        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
-        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
-        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
-        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
-        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
-        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
-        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
-        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
-        let x139 = 0.7026 * x95;
-        let x140 = 0.7026 * x97;
-        let x141 = 0.7026 * x99;
-        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
-        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
-        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
-        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
-        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
-        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
-        let x148 = 9.336 * x115;
-        let x149 = 44.41 * x142;
-        let x150 = 44.41 * x143;
-        let x151 = 9.336 * x117;
-        let x152 = 44.41 * x144;
-        let x153 = 44.41 * x145;
-        let x154 = 9.336 * x119;
-        let x155 = 44.41 * x146;
-        let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x42 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x44 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x45 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x40);
+        let x47 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x40);
+        let x48 = S::splat(2103.19) * x41;
+        let x49 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x42);
+        let x50 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x42);
+        let x51 = S::splat(2103.19) * x43;
+        let x52 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x44);
+        let x53 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x44);
+        let x54 = S::splat(2103.19) * x45;
+        let x55 = S::mul_add(x41, x48, S::mul_add(S::neg(s_q1), x47, x40 * x46));
+        let x56 = S::mul_add(x43, x48, S::mul_add(x10, x47, x42 * x46));
+        let x57 = S::mul_add(x45, x48, S::mul_add(x12, x47, x44 * x46));
+        let x58 = S::mul_add(x41, x51, S::mul_add(S::neg(s_q1), x50, x40 * x49));
+        let x59 = S::mul_add(x43, x51, S::mul_add(x10, x50, x42 * x49));
+        let x60 = S::mul_add(x45, x51, S::mul_add(x12, x50, x44 * x49));
+        let x61 = S::mul_add(x41, x54, S::mul_add(S::neg(s_q1), x53, x40 * x52));
+        let x62 = S::mul_add(x43, x54, S::mul_add(x10, x53, x42 * x52));
+        let x63 = S::mul_add(x45, x54, S::mul_add(x12, x53, x44 * x52));
+        let x64 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x40);
+        let x65 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x42);
+        let x66 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x44);
+        let x67 = S::mul_add(S::neg(x41), s_q3, x40 * c_q3);
+        let x68 = S::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = S::mul_add(S::neg(x43), s_q3, x42 * c_q3);
+        let x70 = S::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = S::mul_add(S::neg(x45), s_q3, x44 * c_q3);
+        let x72 = S::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x67);
+        let x74 = S::mul_add(S::splat(1966.28), s_q1, x67 * S::splat(39.95));
+        let x75 = S::splat(1966.28) * x68;
+        let x76 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x69);
+        let x77 = S::mul_add(S::splat(-1966.28), x10, x69 * S::splat(39.95));
+        let x78 = S::splat(1966.28) * x70;
+        let x79 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x71);
+        let x80 = S::mul_add(S::splat(-1966.28), x12, x71 * S::splat(39.95));
+        let x81 = S::splat(1966.28) * x72;
+        let x82 = S::mul_add(x68, x75, S::mul_add(s_q1, x74, x67 * x73));
+        let x83 = S::mul_add(x70, x75, S::mul_add(S::neg(x10), x74, x69 * x73));
+        let x84 = S::mul_add(x72, x75, S::mul_add(S::neg(x12), x74, x71 * x73));
+        let x85 = S::mul_add(x68, x78, S::mul_add(s_q1, x77, x67 * x76));
+        let x86 = S::mul_add(x70, x78, S::mul_add(S::neg(x10), x77, x69 * x76));
+        let x87 = S::mul_add(x72, x78, S::mul_add(S::neg(x12), x77, x71 * x76));
+        let x88 = S::mul_add(x68, x81, S::mul_add(s_q1, x80, x67 * x79));
+        let x89 = S::mul_add(x70, x81, S::mul_add(S::neg(x10), x80, x69 * x79));
+        let x90 = S::mul_add(x72, x81, S::mul_add(S::neg(x12), x80, x71 * x79));
+        let x91 = S::splat(7.11) * x67;
+        let x92 = S::splat(7.11) * x69;
+        let x93 = S::splat(7.11) * x71;
+        let x94 = S::mul_add(S::neg(x68), s_q4, x67 * c_q4);
+        let x95 = S::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = S::mul_add(S::neg(x70), s_q4, x69 * c_q4);
+        let x97 = S::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = S::mul_add(S::neg(x72), s_q4, x71 * c_q4);
+        let x99 = S::mul_add(x72, c_q4, x71 * s_q4);
+        let x100 = S::splat(8.305) * x94;
+        let x101 = S::splat(8.0386) * x95;
+        let x102 = S::splat(8.305) * x96;
+        let x103 = S::splat(8.0386) * x97;
+        let x104 = S::splat(8.305) * x98;
+        let x105 = S::splat(8.0386) * x99;
+        let x106 = S::mul_add(x95, x101, S::mul_add(x94, x100, x21));
+        let x107 = S::mul_add(S::neg(x97), x101, S::mul_add(S::neg(x96), x100, x23));
+        let x108 = S::mul_add(S::neg(x99), x101, S::mul_add(S::neg(x98), x100, x25));
+        let x109 = S::mul_add(S::neg(x95), x103, S::mul_add(S::neg(x94), x102, x27));
+        let x110 = S::mul_add(x97, x103, S::mul_add(x96, x102, x28));
+        let x111 = S::mul_add(x99, x103, S::mul_add(x98, x102, x30));
+        let x112 = S::mul_add(S::neg(x95), x105, S::mul_add(S::neg(x94), x104, x32));
+        let x113 = S::mul_add(x97, x105, S::mul_add(x96, x104, x33));
+        let x114 = S::mul_add(x99, x105, S::mul_add(x98, x104, x35));
+        let x115 = S::mul_add(S::neg(s_q1), s_q5, x94 * c_q5);
+        let x116 = S::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = S::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = S::mul_add(S::neg(x10), c_q5, x96 * s_q5);
+        let x119 = S::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = S::mul_add(S::neg(x12), c_q5, x98 * s_q5);
+        let x121 = S::splat(12.13) * x115;
+        let x122 = S::splat(12.13) * x116;
+        let x123 = S::splat(3.061) * x95;
+        let x124 = S::splat(12.13) * x117;
+        let x125 = S::splat(12.13) * x118;
+        let x126 = S::splat(3.061) * x97;
+        let x127 = S::splat(12.13) * x119;
+        let x128 = S::splat(12.13) * x120;
+        let x129 = S::splat(3.061) * x99;
+        let x130 = S::mul_add(x95, x123, S::mul_add(x116, x122, x115 * x121));
+        let x131 = S::mul_add(x97, x123, S::mul_add(x118, x122, x117 * x121));
+        let x132 = S::mul_add(x99, x123, S::mul_add(x120, x122, x119 * x121));
+        let x133 = S::mul_add(x95, x126, S::mul_add(x116, x125, x115 * x124));
+        let x134 = S::mul_add(x97, x126, S::mul_add(x118, x125, x117 * x124));
+        let x135 = S::mul_add(x99, x126, S::mul_add(x120, x125, x119 * x124));
+        let x136 = S::mul_add(x95, x129, S::mul_add(x116, x128, x115 * x127));
+        let x137 = S::mul_add(x97, x129, S::mul_add(x118, x128, x117 * x127));
+        let x138 = S::mul_add(x99, x129, S::mul_add(x120, x128, x119 * x127));
+        let x139 = S::splat(0.7026) * x95;
+        let x140 = S::splat(0.7026) * x97;
+        let x141 = S::splat(0.7026) * x99;
+        let x142 = S::mul_add(S::neg(x95), s_q6, x116 * c_q6);
+        let x143 = S::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = S::mul_add(S::neg(x97), s_q6, x118 * c_q6);
+        let x145 = S::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = S::mul_add(S::neg(x99), s_q6, x120 * c_q6);
+        let x147 = S::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = S::splat(9.336) * x115;
+        let x149 = S::splat(44.41) * x142;
+        let x150 = S::splat(44.41) * x143;
+        let x151 = S::splat(9.336) * x117;
+        let x152 = S::splat(44.41) * x144;
+        let x153 = S::splat(44.41) * x145;
+        let x154 = S::splat(9.336) * x119;
+        let x155 = S::splat(44.41) * x146;
+        let x156 = S::splat(44.41) * x147;
+        let x157 = S::mul_add(x143, x150, S::mul_add(x142, x149, x115 * x148));
+        let x158 = S::mul_add(x145, x150, S::mul_add(x144, x149, x117 * x148));
+        let x159 = S::mul_add(x147, x150, S::mul_add(x146, x149, x119 * x148));
+        let x160 = S::mul_add(x143, x153, S::mul_add(x142, x152, x115 * x151));
+        let x161 = S::mul_add(x145, x153, S::mul_add(x144, x152, x117 * x151));
+        let x162 = S::mul_add(x147, x153, S::mul_add(x146, x152, x119 * x151));
+        let x163 = S::mul_add(x143, x156, S::mul_add(x142, x155, x115 * x154));
+        let x164 = S::mul_add(x145, x156, S::mul_add(x144, x155, x117 * x154));
+        let x165 = S::mul_add(x147, x156, S::mul_add(x146, x155, x119 * x154));
         let x166 = x37 - x139;
         let x167 = x38 + x140;
         let x168 = x39 + x141;
@@ -4041,23 +4316,23 @@ impl SsrmsRecurrent {
         let x189 = x39 - x187;
         let x190 = x38 - x65;
         let x191 = x39 - x66;
-        let x192 = 243.66 * x139;
-        let x193 = 243.66 * x140;
-        let x194 = 243.66 * x141;
-        let x195 = 243.66 * x166;
-        let x196 = 243.66 * x167;
-        let x197 = 243.66 * x168;
-        let x198 = 243.66 * x169;
-        let x199 = 243.66 * x170;
-        let x200 = 243.66 * x171;
-        let x201 = 243.66 * x172;
-        let x202 = 243.66 * x173;
-        let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x37 + x172);
-        let x205 = 243.66 * x175;
-        let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x7 + x175);
-        let x208 = 243.66 * (x8 - x176);
+        let x192 = S::splat(243.66) * x139;
+        let x193 = S::splat(243.66) * x140;
+        let x194 = S::splat(243.66) * x141;
+        let x195 = S::splat(243.66) * x166;
+        let x196 = S::splat(243.66) * x167;
+        let x197 = S::splat(243.66) * x168;
+        let x198 = S::splat(243.66) * x169;
+        let x199 = S::splat(243.66) * x170;
+        let x200 = S::splat(243.66) * x171;
+        let x201 = S::splat(243.66) * x172;
+        let x202 = S::splat(243.66) * x173;
+        let x203 = S::splat(243.66) * x174;
+        let x204 = S::splat(243.66) * (x37 + x172);
+        let x205 = S::splat(243.66) * x175;
+        let x206 = S::splat(243.66) * x176;
+        let x207 = S::splat(243.66) * (x7 + x175);
+        let x208 = S::splat(243.66) * (x8 - x176);
         let x209 = x130 + x157;
         let x210 = x131 + x158;
         let x211 = x132 + x159;
@@ -4094,53 +4369,53 @@ impl SsrmsRecurrent {
         let x242 = x61 + x233;
         let x243 = x62 + x234;
         let x244 = x63 + x235;
-        let x245 = Self::mul_add(105.98, x37, x195);
-        let x246 = Self::mul_add(105.98, x38, x196);
-        let x247 = Self::mul_add(105.98, x39, x197);
-        let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(-105.98, x178, x199);
-        let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x91, x248);
-        let x252 = Self::mul_add(105.98, x92, x249);
-        let x253 = Self::mul_add(105.98, x93, x250);
-        let x254 = Self::mul_add(105.98, x180, x201);
-        let x255 = Self::mul_add(105.98, x181, x202);
-        let x256 = Self::mul_add(105.98, x182, x203);
-        let x257 = Self::mul_add(105.98, x185, x254);
-        let x258 = Self::mul_add(105.98, x186, x255);
-        let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x64, x257);
-        let x261 = Self::mul_add(279.2, x65, x258);
-        let x262 = Self::mul_add(279.2, x66, x259);
-        let x263 = Self::mul_add(105.98, x37 + x180, x204);
-        let x264 = Self::mul_add(105.98, x183, x205);
-        let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x37 + x185, x263);
-        let x267 = Self::mul_add(105.98, x188, x264);
-        let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x37 + x64, x266);
-        let x270 = Self::mul_add(279.2, x190, x267);
-        let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x38, x270);
-        let x273 = Self::mul_add(314.88, x39, x271);
-        let x274 = Self::mul_add(105.98, x7 + x183, x207);
-        let x275 = Self::mul_add(105.98, x8 - x184, x208);
-        let x276 = Self::mul_add(105.98, x7 + x188, x274);
-        let x277 = Self::mul_add(105.98, x8 - x189, x275);
-        let x278 = Self::mul_add(279.2, x7 + x190, x276);
-        let x279 = Self::mul_add(279.2, x8 - x191, x277);
-        let x280 = Self::mul_add(314.88, x7 + x38, x278);
-        let x281 = Self::mul_add(314.88, x8 - x39, x279);
-        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x245 = S::mul_add(S::splat(105.98), x37, x195);
+        let x246 = S::mul_add(S::splat(105.98), x38, x196);
+        let x247 = S::mul_add(S::splat(105.98), x39, x197);
+        let x248 = S::mul_add(S::splat(105.98), x177, x198);
+        let x249 = S::mul_add(S::splat(-105.98), x178, x199);
+        let x250 = S::mul_add(S::splat(-105.98), x179, x200);
+        let x251 = S::mul_add(S::splat(105.98), x91, x248);
+        let x252 = S::mul_add(S::splat(105.98), x92, x249);
+        let x253 = S::mul_add(S::splat(105.98), x93, x250);
+        let x254 = S::mul_add(S::splat(105.98), x180, x201);
+        let x255 = S::mul_add(S::splat(105.98), x181, x202);
+        let x256 = S::mul_add(S::splat(105.98), x182, x203);
+        let x257 = S::mul_add(S::splat(105.98), x185, x254);
+        let x258 = S::mul_add(S::splat(105.98), x186, x255);
+        let x259 = S::mul_add(S::splat(105.98), x187, x256);
+        let x260 = S::mul_add(S::splat(279.2), x64, x257);
+        let x261 = S::mul_add(S::splat(279.2), x65, x258);
+        let x262 = S::mul_add(S::splat(279.2), x66, x259);
+        let x263 = S::mul_add(S::splat(105.98), x37 + x180, x204);
+        let x264 = S::mul_add(S::splat(105.98), x183, x205);
+        let x265 = S::mul_add(S::splat(105.98), x184, x206);
+        let x266 = S::mul_add(S::splat(105.98), x37 + x185, x263);
+        let x267 = S::mul_add(S::splat(105.98), x188, x264);
+        let x268 = S::mul_add(S::splat(105.98), x189, x265);
+        let x269 = S::mul_add(S::splat(279.2), x37 + x64, x266);
+        let x270 = S::mul_add(S::splat(279.2), x190, x267);
+        let x271 = S::mul_add(S::splat(279.2), x191, x268);
+        let x272 = S::mul_add(S::splat(314.88), x38, x270);
+        let x273 = S::mul_add(S::splat(314.88), x39, x271);
+        let x274 = S::mul_add(S::splat(105.98), x7 + x183, x207);
+        let x275 = S::mul_add(S::splat(105.98), x8 - x184, x208);
+        let x276 = S::mul_add(S::splat(105.98), x7 + x188, x274);
+        let x277 = S::mul_add(S::splat(105.98), x8 - x189, x275);
+        let x278 = S::mul_add(S::splat(279.2), x7 + x190, x276);
+        let x279 = S::mul_add(S::splat(279.2), x8 - x191, x277);
+        let x280 = S::mul_add(S::splat(314.88), x7 + x38, x278);
+        let x281 = S::mul_add(S::splat(314.88), x8 - x39, x279);
+        let x282 = S::mul_add(S::neg(x140), x207, x141 * x208);
         let x283 = x139 * x207;
         let x284 = x139 * x208;
         let x285 = x140 * x204;
         let x286 = x139 * x204;
         let x287 = x141 * x204;
-        let x288 = Self::mul_add(-x141, x206, x286);
+        let x288 = S::mul_add(S::neg(x141), x206, x286);
         let x289 = x140 * x206;
         let x290 = x141 * x205;
-        let x291 = Self::mul_add(-x140, x205, x286);
+        let x291 = S::mul_add(S::neg(x140), x205, x286);
         let x292 = x141 * x203;
         let x293 = x140 * x202;
         let x294 = x292 + x293;
@@ -4187,13 +4462,13 @@ impl SsrmsRecurrent {
         let x335 = x38 * x249;
         let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x37, x249, x307);
-        let x339 = Self::mul_add(-x37, x250, x308);
-        let x340 = Self::mul_add(x38, x248, x309);
+        let x338 = S::mul_add(S::neg(x37), x249, x307);
+        let x339 = S::mul_add(S::neg(x37), x250, x308);
+        let x340 = S::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x38, x250, x312);
-        let x343 = Self::mul_add(x39, x248, x313);
-        let x344 = Self::mul_add(x39, x249, x314);
+        let x342 = S::mul_add(x38, x250, x312);
+        let x343 = S::mul_add(x39, x248, x313);
+        let x344 = S::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
         let x346 = x93 * x253;
         let x347 = x92 * x252;
@@ -4202,427 +4477,445 @@ impl SsrmsRecurrent {
         let x350 = x38 * x255;
         let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x37, x255, x295);
-        let x354 = Self::mul_add(-x37, x256, x296);
-        let x355 = Self::mul_add(x38, x254, x297);
+        let x353 = S::mul_add(S::neg(x37), x255, x295);
+        let x354 = S::mul_add(S::neg(x37), x256, x296);
+        let x355 = S::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x38, x256, x300);
-        let x358 = Self::mul_add(x39, x254, x301);
-        let x359 = Self::mul_add(x39, x255, x302);
+        let x357 = S::mul_add(x38, x256, x300);
+        let x358 = S::mul_add(x39, x254, x301);
+        let x359 = S::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
         let x361 = x93 * x259;
         let x362 = x92 * x258;
         let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x91, x258, x353);
-        let x366 = Self::mul_add(-x91, x259, x354);
-        let x367 = Self::mul_add(-x92, x257, x355);
+        let x365 = S::mul_add(S::neg(x91), x258, x353);
+        let x366 = S::mul_add(S::neg(x91), x259, x354);
+        let x367 = S::mul_add(S::neg(x92), x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x92, x259, x357);
-        let x370 = Self::mul_add(-x93, x257, x358);
-        let x371 = Self::mul_add(-x93, x258, x359);
+        let x369 = S::mul_add(S::neg(x92), x259, x357);
+        let x370 = S::mul_add(S::neg(x93), x257, x358);
+        let x371 = S::mul_add(S::neg(x93), x258, x359);
         let x372 = x360 - (x362 + x363);
         let x373 = x66 * x262;
         let x374 = x65 * x261;
         let x375 = x64 * x260;
         let x376 = x37 * x263;
-        let x377 = Self::mul_add(x38, x263, x285);
-        let x378 = x288 - Self::mul_add(x39, x265, x376);
-        let x379 = Self::mul_add(x38, x265, x289);
-        let x380 = Self::mul_add(x39, x263, x287);
-        let x381 = Self::mul_add(x39, x264, x290);
-        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x377 = S::mul_add(x38, x263, x285);
+        let x378 = x288 - S::mul_add(x39, x265, x376);
+        let x379 = S::mul_add(x38, x265, x289);
+        let x380 = S::mul_add(x39, x263, x287);
+        let x381 = S::mul_add(x39, x264, x290);
+        let x382 = x291 - S::mul_add(x38, x264, x376);
         let x383 = x91 * x266;
-        let x384 = Self::mul_add(-x92, x266, x377);
-        let x385 = x378 + Self::mul_add(x93, x268, -x383);
-        let x386 = Self::mul_add(-x92, x268, x379);
-        let x387 = Self::mul_add(-x93, x266, x380);
-        let x388 = Self::mul_add(-x93, x267, x381);
-        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x384 = S::mul_add(S::neg(x92), x266, x377);
+        let x385 = x378 + S::mul_add(x93, x268, S::neg(x383));
+        let x386 = S::mul_add(S::neg(x92), x268, x379);
+        let x387 = S::mul_add(S::neg(x93), x266, x380);
+        let x388 = S::mul_add(S::neg(x93), x267, x381);
+        let x389 = x382 + S::mul_add(x92, x267, S::neg(x383));
         let x390 = x64 * x269;
-        let x391 = x385 + Self::mul_add(x66, x271, -x390);
-        let x392 = Self::mul_add(-x65, x271, x386);
-        let x393 = Self::mul_add(-x66, x270, x388);
-        let x394 = x389 + Self::mul_add(x65, x270, -x390);
-        let x395 = x37 * Self::mul_add(314.88, x37, x269);
-        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
-        let x397 = Self::mul_add(-x37, x274, x283);
-        let x398 = Self::mul_add(-x37, x275, x284);
-        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
-        let x400 = Self::mul_add(-x91, x276, x397);
-        let x401 = Self::mul_add(-x91, x277, x398);
-        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
-        let x403 = Self::mul_add(-x64, x278, x400);
-        let x404 = Self::mul_add(-x64, x279, x401);
-        let x405 = 12.19 + (x22 + x236)
-            - (x402 + Self::mul_add(-x38, x280, x39 * x281)
-                - Self::mul_add(
+        let x391 = x385 + S::mul_add(x66, x271, S::neg(x390));
+        let x392 = S::mul_add(S::neg(x65), x271, x386);
+        let x393 = S::mul_add(S::neg(x66), x270, x388);
+        let x394 = x389 + S::mul_add(x65, x270, S::neg(x390));
+        let x395 = x37 * S::mul_add(S::splat(314.88), x37, x269);
+        let x396 = x282 + S::mul_add(S::neg(x38), x274, x39 * x275);
+        let x397 = S::mul_add(S::neg(x37), x274, x283);
+        let x398 = S::mul_add(S::neg(x37), x275, x284);
+        let x399 = x396 - S::mul_add(S::neg(x92), x276, x93 * x277);
+        let x400 = S::mul_add(S::neg(x91), x276, x397);
+        let x401 = S::mul_add(S::neg(x91), x277, x398);
+        let x402 = x399 - S::mul_add(S::neg(x65), x278, x66 * x279);
+        let x403 = S::mul_add(S::neg(x64), x278, x400);
+        let x404 = S::mul_add(S::neg(x64), x279, x401);
+        let x405 = S::splat(12.19) + (x22 + x236)
+            - (x402 + S::mul_add(S::neg(x38), x280, x39 * x281)
+                - S::mul_add(
                     x7,
-                    Self::mul_add(105.98, x7, x280),
-                    x8 * Self::mul_add(105.98, x8, x281),
+                    S::mul_add(S::splat(105.98), x7, x280),
+                    x8 * S::mul_add(S::splat(105.98), x8, x281),
                 ));
-        let x406 = -Self::mul_add(
-            -c_q0,
-            x26 + x238 + Self::mul_add(-x37, x281, x404),
-            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
+        let x406 = S::neg(
+            S::mul_add(
+                S::neg(c_q0),
+                x26 + x238 + S::mul_add(S::neg(x37), x281, x404),
+                s_q0 * (x24 + x237 - S::mul_add(S::neg(x37), x280, x403)),
+            ),
         );
-        let x407 = -Self::mul_add(
-            -x12,
-            x238 + x404,
-            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
+        let x407 = S::neg(
+            S::mul_add(
+                S::neg(x12),
+                x238 + x404,
+                S::mul_add(S::neg(x10), x237 - x403, s_q1 * (x236 - x402)),
+            ),
         );
-        let x408 = -Self::mul_add(
-            -x12,
-            x229 + x401,
-            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
+        let x408 = S::neg(
+            S::mul_add(
+                S::neg(x12),
+                x229 + x401,
+                S::mul_add(S::neg(x10), x228 - x400, s_q1 * (x227 - x399)),
+            ),
         );
-        let x409 = -Self::mul_add(
-            x12,
-            x220 - x398,
-            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
+        let x409 = S::neg(
+            S::mul_add(
+                x12,
+                x220 - x398,
+                S::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
+            ),
         );
-        let x410 = Self::mul_add(
+        let x410 = S::mul_add(
             x99,
             x211 + x284,
-            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
+            S::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x411 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
-        let x412 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
-        let x413 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
-        let x414 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -c_q0,
-                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
-                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
+        let x411 = S::mul_add(x119, x159, S::mul_add(x117, x158, x115 * x157));
+        let x412 = S::mul_add(x119, x162, S::mul_add(x117, x161, x115 * x160));
+        let x413 = S::mul_add(x119, x165, S::mul_add(x117, x164, x115 * x163));
+        let x414 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(c_q0),
+                x36 + x244 - (x394 - S::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - S::mul_add(x39, x272, x393)),
             ),
             s_q0
-                * Self::mul_add(
-                    -c_q0,
-                    x31 + x241 - Self::mul_add(x38, x273, x392),
-                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
+                * S::mul_add(
+                    S::neg(c_q0),
+                    x31 + x241 - S::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - S::mul_add(x39, x273, x395))),
                 ),
         );
-        let x415 = Self::mul_add(
-            -x12,
+        let x415 = S::mul_add(
+            S::neg(x12),
             x241 - x392,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x269, x384)),
             ),
         );
-        let x416 = Self::mul_add(
-            -x12,
+        let x416 = S::mul_add(
+            S::neg(x12),
             x244 - x394,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x269, x387)),
             ),
         );
-        let x417 = Self::mul_add(-c_q0, x416, s_q0 * x415);
-        let x418 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -x12,
+        let x417 = S::mul_add(S::neg(c_q0), x416, s_q0 * x415);
+        let x418 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x389,
-                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
+                S::mul_add(S::neg(x10), x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x232 - x386,
-                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
+                    S::mul_add(S::neg(x10), x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
-        let x419 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x419 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x12,
                 x226 - x382,
-                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
+                S::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x223 - x379,
-                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
+                    S::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
-        let x420 = -x419;
-        let x421 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x420 = S::neg(x419);
+        let x421 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x99,
                 x217 - x291,
-                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
+                S::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x214 - x289,
-                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
+                    S::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
-        let x422 = -x421;
-        let x423 = -Self::mul_add(-c_q0, x413, s_q0 * x412);
-        let x424 = Self::mul_add(
-            -x12,
-            x238 + Self::mul_add(-x64, x262, x366),
-            Self::mul_add(
-                -x10,
-                x237 + Self::mul_add(-x64, x261, x365),
+        let x422 = S::neg(x421);
+        let x423 = S::neg(S::mul_add(S::neg(c_q0), x413, s_q0 * x412));
+        let x424 = S::mul_add(
+            S::neg(x12),
+            x238 + S::mul_add(S::neg(x64), x262, x366),
+            S::mul_add(
+                S::neg(x10),
+                x237 + S::mul_add(S::neg(x64), x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
-        let x425 = Self::mul_add(
-            -x12,
-            x241 + Self::mul_add(-x65, x262, x369),
-            Self::mul_add(
-                -x10,
+        let x425 = S::mul_add(
+            S::neg(x12),
+            x241 + S::mul_add(S::neg(x65), x262, x369),
+            S::mul_add(
+                S::neg(x10),
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x260, x367)),
             ),
         );
-        let x426 = Self::mul_add(
-            -x12,
+        let x426 = S::mul_add(
+            S::neg(x12),
             x244 - (x372 - (x374 + x375)),
-            Self::mul_add(
-                -x10,
-                x243 + Self::mul_add(-x66, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
+            S::mul_add(
+                S::neg(x10),
+                x243 + S::mul_add(S::neg(x66), x261, x371),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x260, x370)),
             ),
         );
-        let x427 = Self::mul_add(-x12, x426, Self::mul_add(-x10, x425, s_q1 * x424));
-        let x428 = Self::mul_add(
-            -x10,
-            Self::mul_add(
-                -x12,
+        let x427 = S::mul_add(
+            S::neg(x12),
+            x426,
+            S::mul_add(S::neg(x10), x425, s_q1 * x424),
+        );
+        let x428 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
+                S::neg(x12),
                 x232 + x369,
-                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
+                S::mul_add(S::neg(x10), x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x229 + x366,
-                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
+                    S::mul_add(S::neg(x10), x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
-        let x429 = Self::mul_add(
-            -x12,
-            Self::mul_add(
-                -x12,
+        let x429 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x372,
-                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
+                S::mul_add(S::neg(x10), x234 + x371, s_q1 * (x233 + x370)),
             ),
             x428,
         );
-        let x430 = Self::mul_add(
+        let x430 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x357,
-                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
+                S::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x354,
-                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
+                    S::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
-        let x431 = Self::mul_add(
+        let x431 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x360,
-                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
+                S::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x430,
         );
-        let x432 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x432 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x300,
-                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
+                S::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x296,
-                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
+                    S::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
-        let x433 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x433 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x303,
-                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
+                S::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x432,
         );
-        let x434 = -x433;
-        let x435 = -Self::mul_add(-x12, x413, Self::mul_add(-x10, x412, s_q1 * x411));
-        let x436 = Self::mul_add(
-            -x12,
-            x229 + Self::mul_add(-x91, x253, x339),
-            Self::mul_add(
-                -x10,
-                x228 + Self::mul_add(-x91, x252, x338),
+        let x434 = S::neg(x433);
+        let x435 = S::neg(
+            S::mul_add(S::neg(x12), x413, S::mul_add(S::neg(x10), x412, s_q1 * x411)),
+        );
+        let x436 = S::mul_add(
+            S::neg(x12),
+            x229 + S::mul_add(S::neg(x91), x253, x339),
+            S::mul_add(
+                S::neg(x10),
+                x228 + S::mul_add(S::neg(x91), x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
-        let x437 = Self::mul_add(
-            -x12,
-            x232 + Self::mul_add(-x92, x253, x342),
-            Self::mul_add(
-                -x10,
+        let x437 = S::mul_add(
+            S::neg(x12),
+            x232 + S::mul_add(S::neg(x92), x253, x342),
+            S::mul_add(
+                S::neg(x10),
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
+                s_q1 * (x230 + S::mul_add(S::neg(x92), x251, x340)),
             ),
         );
-        let x438 = Self::mul_add(
-            -x12,
+        let x438 = S::mul_add(
+            S::neg(x12),
             x235 - (x345 - (x347 + x348)),
-            Self::mul_add(
-                -x10,
-                x234 + Self::mul_add(-x93, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
+            S::mul_add(
+                S::neg(x10),
+                x234 + S::mul_add(S::neg(x93), x252, x344),
+                s_q1 * (x233 + S::mul_add(S::neg(x93), x251, x343)),
             ),
         );
-        let x439 = Self::mul_add(-x12, x438, Self::mul_add(-x10, x437, s_q1 * x436));
-        let x440 = Self::mul_add(
+        let x439 = S::mul_add(
+            S::neg(x12),
+            x438,
+            S::mul_add(S::neg(x10), x437, s_q1 * x436),
+        );
+        let x440 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x342,
-                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
+                S::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x339,
-                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
+                    S::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
-        let x441 = Self::mul_add(
+        let x441 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x345,
-                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
+                S::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x440,
         );
-        let x442 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x442 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x312,
-                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
+                S::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x308,
-                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
+                    S::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
-        let x443 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x443 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x315,
-                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
+                S::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x442,
         );
-        let x444 = -x443;
-        let x445 = Self::mul_add(
+        let x444 = S::neg(x443);
+        let x445 = S::mul_add(
             x12,
-            x220 + Self::mul_add(-x37, x247, x320),
-            Self::mul_add(
+            x220 + S::mul_add(S::neg(x37), x247, x320),
+            S::mul_add(
                 x10,
-                x219 + Self::mul_add(-x37, x246, x319),
+                x219 + S::mul_add(S::neg(x37), x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
-        let x446 = Self::mul_add(
+        let x446 = S::mul_add(
             x12,
-            x223 - Self::mul_add(x38, x247, x324),
-            Self::mul_add(
+            x223 - S::mul_add(x38, x247, x324),
+            S::mul_add(
                 x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
+                s_q1 * (x221 - S::mul_add(x38, x245, x321)),
             ),
         );
-        let x447 = Self::mul_add(
+        let x447 = S::mul_add(
             x12,
             x226 + (x327 + (x332 + x333)),
-            Self::mul_add(
+            S::mul_add(
                 x10,
-                x225 - Self::mul_add(x39, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
+                x225 - S::mul_add(x39, x246, x326),
+                s_q1 * (x224 - S::mul_add(x39, x245, x325)),
             ),
         );
-        let x448 = Self::mul_add(x12, x447, Self::mul_add(x10, x446, s_q1 * x445));
-        let x449 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x448 = S::mul_add(x12, x447, S::mul_add(x10, x446, s_q1 * x445));
+        let x449 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 - x324,
-                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
+                S::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 - x320,
-                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
+                    S::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
-        let x450 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x450 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 + x327,
-                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
+                S::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x449,
         );
-        let x451 = -x450;
-        let x452 = Self::mul_add(
+        let x451 = S::neg(x450);
+        let x452 = S::mul_add(
             x99,
-            Self::mul_add(-x139, x194, x211),
-            Self::mul_add(
+            S::mul_add(S::neg(x139), x194, x211),
+            S::mul_add(
                 x97,
-                Self::mul_add(-x139, x193, x210),
+                S::mul_add(S::neg(x139), x193, x210),
                 x95 * (x209 + (x328 + x329)),
             ),
         );
-        let x453 = Self::mul_add(
+        let x453 = S::mul_add(
             x99,
-            Self::mul_add(-x140, x194, x214),
-            Self::mul_add(
+            S::mul_add(S::neg(x140), x194, x214),
+            S::mul_add(
                 x97,
                 x213 + (x328 + x330),
-                x95 * Self::mul_add(-x140, x192, x212),
+                x95 * S::mul_add(S::neg(x140), x192, x212),
             ),
         );
-        let x454 = Self::mul_add(
+        let x454 = S::mul_add(
             x99,
             x217 + (x329 + x330),
-            Self::mul_add(
+            S::mul_add(
                 x97,
-                Self::mul_add(-x141, x193, x216),
-                x95 * Self::mul_add(-x141, x192, x215),
+                S::mul_add(S::neg(x141), x193, x216),
+                x95 * S::mul_add(S::neg(x141), x192, x215),
             ),
         );
-        let x455 = Self::mul_add(x99, x454, Self::mul_add(x97, x453, x95 * x452));
-        let x456 = Self::mul_add(x99, x413, Self::mul_add(x97, x412, x95 * x411));
-        let x457 = Self::mul_add(x119, x413, Self::mul_add(x117, x412, x115 * x411));
+        let x455 = S::mul_add(x99, x454, S::mul_add(x97, x453, x95 * x452));
+        let x456 = S::mul_add(x99, x413, S::mul_add(x97, x412, x95 * x411));
+        let x457 = S::mul_add(x119, x413, S::mul_add(x117, x412, x115 * x411));
         let x458 = qd[1] * s_q0;
         let x459 = qd[1] * c_q0;
         let x460 = qd[0] * qd[0];
@@ -4638,23 +4931,19 @@ impl SsrmsRecurrent {
         let x470 = x458 * x459;
         let x471 = x37 * (x468 + x469);
         let x472 = x461
-            - Self::mul_add(
-                -x39,
+            - S::mul_add(
+                S::neg(x39),
                 x470,
-                Self::mul_add(-x38, x460 + x468, x37 * (x464 + x464)),
+                S::mul_add(S::neg(x38), x460 + x468, x37 * (x464 + x464)),
             );
         let x473 = x462
-            - Self::mul_add(
-                x39,
-                x460 + x469,
-                Self::mul_add(x38, x470, x37 * (x463 + x463)),
-            );
+            - S::mul_add(x39, x460 + x469, S::mul_add(x38, x470, x37 * (x463 + x463)));
         let x474 = qd[0] - x465;
         let x475 = x458 - x466;
         let x476 = x459 + x467;
-        let x477 = Self::mul_add(x458, x467, x459 * x466);
-        let x478 = x463 + Self::mul_add(qd[0], x467, x459 * x465);
-        let x479 = x464 + Self::mul_add(-qd[0], x466, x458 * x465);
+        let x477 = S::mul_add(x458, x467, x459 * x466);
+        let x478 = x463 + S::mul_add(qd[0], x467, x459 * x465);
+        let x479 = x464 + S::mul_add(S::neg(qd[0]), x466, x458 * x465);
         let x480 = qd[3] * s_q1;
         let x481 = qd[3] * x10;
         let x482 = qd[3] * x12;
@@ -4665,29 +4954,29 @@ impl SsrmsRecurrent {
         let x487 = x474 * x474;
         let x488 = x475 * x476;
         let x489 = x471
-            + Self::mul_add(
+            + S::mul_add(
                 x66,
                 x478 - x486,
-                Self::mul_add(-x65, x479 - x485, x64 * (x483 + x484)),
+                S::mul_add(S::neg(x65), x479 - x485, x64 * (x483 + x484)),
             );
         let x490 = x472
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x477 - x488,
-                Self::mul_add(x65, x483 + x487, x64 * (x479 + x485)),
+                S::mul_add(x65, x483 + x487, x64 * (x479 + x485)),
             );
         let x491 = x473
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x484 + x487,
-                Self::mul_add(-x65, x477 + x488, x64 * (x478 + x486)),
+                S::mul_add(S::neg(x65), x477 + x488, x64 * (x478 + x486)),
             );
         let x492 = x474 - x480;
         let x493 = x475 - x481;
         let x494 = x476 + x482;
-        let x495 = x477 + Self::mul_add(x475, x482, x476 * x481);
-        let x496 = x478 + Self::mul_add(x474, x482, x476 * x480);
-        let x497 = x479 + Self::mul_add(-x474, x481, x475 * x480);
+        let x495 = x477 + S::mul_add(x475, x482, x476 * x481);
+        let x496 = x478 + S::mul_add(x474, x482, x476 * x480);
+        let x497 = x479 + S::mul_add(S::neg(x474), x481, x475 * x480);
         let x498 = qd[4] * s_q1;
         let x499 = qd[4] * x10;
         let x500 = qd[4] * x12;
@@ -4698,29 +4987,29 @@ impl SsrmsRecurrent {
         let x505 = x492 * x492;
         let x506 = x493 * x494;
         let x507 = x489
-            + Self::mul_add(
+            + S::mul_add(
                 x93,
                 x496 - x504,
-                Self::mul_add(-x92, x497 - x503, x91 * (x501 + x502)),
+                S::mul_add(S::neg(x92), x497 - x503, x91 * (x501 + x502)),
             );
         let x508 = x490
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x495 - x506,
-                Self::mul_add(x92, x501 + x505, x91 * (x497 + x503)),
+                S::mul_add(x92, x501 + x505, x91 * (x497 + x503)),
             );
         let x509 = x491
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x502 + x505,
-                Self::mul_add(-x92, x495 + x506, x91 * (x496 + x504)),
+                S::mul_add(S::neg(x92), x495 + x506, x91 * (x496 + x504)),
             );
         let x510 = x492 - x498;
         let x511 = x493 - x499;
         let x512 = x494 + x500;
-        let x513 = x495 + Self::mul_add(x493, x500, x494 * x499);
-        let x514 = x496 + Self::mul_add(x492, x500, x494 * x498);
-        let x515 = x497 + Self::mul_add(-x492, x499, x493 * x498);
+        let x513 = x495 + S::mul_add(x493, x500, x494 * x499);
+        let x514 = x496 + S::mul_add(x492, x500, x494 * x498);
+        let x515 = x497 + S::mul_add(S::neg(x492), x499, x493 * x498);
         let x516 = qd[5] * x95;
         let x517 = qd[5] * x97;
         let x518 = qd[5] * x99;
@@ -4731,29 +5020,29 @@ impl SsrmsRecurrent {
         let x523 = x510 * x510;
         let x524 = x511 * x512;
         let x525 = x507
-            + Self::mul_add(
-                -x39,
+            + S::mul_add(
+                S::neg(x39),
                 x514 - x522,
-                Self::mul_add(x38, x515 - x521, x37 * (x519 + x520)),
+                S::mul_add(x38, x515 - x521, x37 * (x519 + x520)),
             );
         let x526 = x508
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x513 - x524,
-                Self::mul_add(-x38, x519 + x523, x37 * (x515 + x521)),
+                S::mul_add(S::neg(x38), x519 + x523, x37 * (x515 + x521)),
             );
         let x527 = x509
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x520 + x523,
-                Self::mul_add(x38, x513 + x524, x37 * (x514 + x522)),
+                S::mul_add(x38, x513 + x524, x37 * (x514 + x522)),
             );
         let x528 = x510 + x516;
         let x529 = x511 - x517;
         let x530 = x512 + x518;
-        let x531 = x513 + Self::mul_add(x511, x518, x512 * x517);
-        let x532 = x514 - Self::mul_add(-x510, x518, x512 * x516);
-        let x533 = x515 - Self::mul_add(x510, x517, x511 * x516);
+        let x531 = x513 + S::mul_add(x511, x518, x512 * x517);
+        let x532 = x514 - S::mul_add(S::neg(x510), x518, x512 * x516);
+        let x533 = x515 - S::mul_add(x510, x517, x511 * x516);
         let x534 = qd[6] * x115;
         let x535 = qd[6] * x117;
         let x536 = qd[6] * x119;
@@ -4766,133 +5055,150 @@ impl SsrmsRecurrent {
         let x543 = x528 + x534;
         let x544 = x529 - x535;
         let x545 = x530 + x536;
-        let x546 = x531 + Self::mul_add(x529, x536, x530 * x535);
-        let x547 = x532 - Self::mul_add(-x528, x536, x530 * x534);
-        let x548 = x533 - Self::mul_add(x528, x535, x529 * x534);
-        let x549 = Self::mul_add(x26, x459, Self::mul_add(-x24, x458, qd[0] * x22));
-        let x550 = Self::mul_add(
+        let x546 = x531 + S::mul_add(x529, x536, x530 * x535);
+        let x547 = x532 - S::mul_add(S::neg(x528), x536, x530 * x534);
+        let x548 = x533 - S::mul_add(x528, x535, x529 * x534);
+        let x549 = S::mul_add(x26, x459, S::mul_add(S::neg(x24), x458, qd[0] * x22));
+        let x550 = S::mul_add(
             x31,
             x459,
-            Self::mul_add(-x29, x458, qd[0] * Self::mul_add(c_q1, x15, -x27)),
+            S::mul_add(S::neg(x29), x458, qd[0] * S::mul_add(c_q1, x15, S::neg(x27))),
         );
-        let x551 = Self::mul_add(
+        let x551 = S::mul_add(
             x36,
             x459,
-            Self::mul_add(-x34, x458, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+            S::mul_add(S::neg(x34), x458, qd[0] * S::mul_add(c_q1, x18, S::neg(x32))),
         );
-        let x552 = Self::mul_add(x57, x476, Self::mul_add(-x56, x475, x55 * x474));
-        let x553 = Self::mul_add(x60, x476, Self::mul_add(-x59, x475, x58 * x474));
-        let x554 = Self::mul_add(x63, x476, Self::mul_add(-x62, x475, x61 * x474));
-        let x555 = Self::mul_add(x84, x494, Self::mul_add(-x83, x493, x82 * x492));
-        let x556 = Self::mul_add(x87, x494, Self::mul_add(-x86, x493, x85 * x492));
-        let x557 = Self::mul_add(x90, x494, Self::mul_add(-x89, x493, x88 * x492));
-        let x558 = Self::mul_add(-x108, x512, Self::mul_add(x107, x511, x106 * x510));
-        let x559 = Self::mul_add(-x111, x512, Self::mul_add(x110, x511, x109 * x510));
-        let x560 = Self::mul_add(-x114, x512, Self::mul_add(x113, x511, x112 * x510));
-        let x561 = Self::mul_add(x132, x530, Self::mul_add(-x131, x529, x130 * x528));
-        let x562 = Self::mul_add(x135, x530, Self::mul_add(-x134, x529, x133 * x528));
-        let x563 = Self::mul_add(x138, x530, Self::mul_add(-x137, x529, x136 * x528));
-        let x564 = 243.66
+        let x552 = S::mul_add(x57, x476, S::mul_add(S::neg(x56), x475, x55 * x474));
+        let x553 = S::mul_add(x60, x476, S::mul_add(S::neg(x59), x475, x58 * x474));
+        let x554 = S::mul_add(x63, x476, S::mul_add(S::neg(x62), x475, x61 * x474));
+        let x555 = S::mul_add(x84, x494, S::mul_add(S::neg(x83), x493, x82 * x492));
+        let x556 = S::mul_add(x87, x494, S::mul_add(S::neg(x86), x493, x85 * x492));
+        let x557 = S::mul_add(x90, x494, S::mul_add(S::neg(x89), x493, x88 * x492));
+        let x558 = S::mul_add(S::neg(x108), x512, S::mul_add(x107, x511, x106 * x510));
+        let x559 = S::mul_add(S::neg(x111), x512, S::mul_add(x110, x511, x109 * x510));
+        let x560 = S::mul_add(S::neg(x114), x512, S::mul_add(x113, x511, x112 * x510));
+        let x561 = S::mul_add(x132, x530, S::mul_add(S::neg(x131), x529, x130 * x528));
+        let x562 = S::mul_add(x135, x530, S::mul_add(S::neg(x134), x529, x133 * x528));
+        let x563 = S::mul_add(x138, x530, S::mul_add(S::neg(x137), x529, x136 * x528));
+        let x564 = S::splat(243.66)
             * (x525
-                - Self::mul_add(
+                - S::mul_add(
                     x141,
                     x532 - x540,
-                    Self::mul_add(-x140, x533 - x539, x139 * (x537 + x538)),
+                    S::mul_add(S::neg(x140), x533 - x539, x139 * (x537 + x538)),
                 ));
-        let x565 = 243.66
+        let x565 = S::splat(243.66)
             * (x526
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x531 - x542,
-                    Self::mul_add(x140, x537 + x541, x139 * (x533 + x539)),
+                    S::mul_add(x140, x537 + x541, x139 * (x533 + x539)),
                 ));
-        let x566 = 243.66
+        let x566 = S::splat(243.66)
             * (x527
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x538 + x541,
-                    Self::mul_add(-x140, x531 + x542, x139 * (x532 + x540)),
+                    S::mul_add(S::neg(x140), x531 + x542, x139 * (x532 + x540)),
                 ));
-        let x567 = Self::mul_add(x159, x545, Self::mul_add(-x158, x544, x157 * x543));
-        let x568 = Self::mul_add(x162, x545, Self::mul_add(-x161, x544, x160 * x543));
-        let x569 = Self::mul_add(x165, x545, Self::mul_add(-x164, x544, x163 * x543));
-        let x570 = Self::mul_add(x159, x548, Self::mul_add(x158, x547, x157 * x546))
-            + Self::mul_add(x544, x569, x545 * x568);
-        let x571 = Self::mul_add(x162, x548, Self::mul_add(x161, x547, x160 * x546))
-            - Self::mul_add(-x543, x569, x545 * x567);
-        let x572 = Self::mul_add(x165, x548, Self::mul_add(x164, x547, x163 * x546))
-            - Self::mul_add(x543, x568, x544 * x567);
-        let x573 = Self::mul_add(105.98, x525, x564);
-        let x574 = Self::mul_add(105.98, x526, x565);
-        let x575 = Self::mul_add(105.98, x527, x566);
-        let x576 = Self::mul_add(105.98, x507, x573);
-        let x577 = Self::mul_add(105.98, x508, x574);
-        let x578 = Self::mul_add(105.98, x509, x575);
-        let x579 = Self::mul_add(279.2, x489, x576);
-        let x580 = Self::mul_add(279.2, x490, x577);
-        let x581 = Self::mul_add(279.2, x491, x578);
-        let x582 = Self::mul_add(314.88, x471, x579);
-        let x583 = Self::mul_add(314.88, x472, x580);
-        let x584 = Self::mul_add(314.88, x473, x581);
-        let x585 = Self::mul_add(x132, x533, Self::mul_add(x131, x532, x130 * x531))
-            + Self::mul_add(x529, x563, x530 * x562) + x570
-            - Self::mul_add(x140, x566, x141 * x565);
-        let x586 = Self::mul_add(x135, x533, Self::mul_add(x134, x532, x133 * x531))
-            - Self::mul_add(-x528, x563, x530 * x561) + x571
-            - Self::mul_add(-x139, x566, x141 * x564);
-        let x587 = Self::mul_add(x138, x533, Self::mul_add(x137, x532, x136 * x531))
-            - Self::mul_add(x528, x562, x529 * x561) + x572
-            + Self::mul_add(x139, x565, x140 * x564);
-        let x588 = Self::mul_add(-x108, x515, Self::mul_add(-x107, x514, x106 * x513))
-            - Self::mul_add(x511, x560, x512 * x559) + x585
-            - Self::mul_add(x38, x575, x39 * x574);
-        let x589 = Self::mul_add(-x111, x515, Self::mul_add(-x110, x514, x109 * x513))
-            + Self::mul_add(x510, x560, x512 * x558) - x586
-            + Self::mul_add(x37, x575, x39 * x573);
-        let x590 = Self::mul_add(-x114, x515, Self::mul_add(-x113, x514, x112 * x513))
-            + Self::mul_add(-x510, x559, x511 * x558) - x587
-            - Self::mul_add(-x37, x574, x38 * x573);
-        let x591 = Self::mul_add(x84, x497, Self::mul_add(x83, x496, x82 * x495))
-            + Self::mul_add(x493, x557, x494 * x556) + x588
-            + Self::mul_add(x92, x578, x93 * x577);
-        let x592 = Self::mul_add(x87, x497, Self::mul_add(x86, x496, x85 * x495))
-            - Self::mul_add(-x492, x557, x494 * x555) - x589
-            + Self::mul_add(-x91, x578, x93 * x576);
-        let x593 = Self::mul_add(x90, x497, Self::mul_add(x89, x496, x88 * x495))
-            - Self::mul_add(x492, x556, x493 * x555) - x590
-            - Self::mul_add(x91, x577, x92 * x576);
-        let x594 = Self::mul_add(x57, x479, Self::mul_add(x56, x478, x55 * x477))
-            + Self::mul_add(x475, x554, x476 * x553) + x591
-            + Self::mul_add(x65, x581, x66 * x580);
-        let x595 = Self::mul_add(x60, x479, Self::mul_add(x59, x478, x58 * x477))
-            - Self::mul_add(-x474, x554, x476 * x552) + x592
-            + Self::mul_add(-x64, x581, x66 * x579);
-        let x596 = Self::mul_add(x63, x479, Self::mul_add(x62, x478, x61 * x477))
-            - Self::mul_add(x474, x553, x475 * x552) + x593
-            - Self::mul_add(x64, x580, x65 * x579);
-        let x597 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(x36, x464, x34 * x463)
-                - Self::mul_add(qd[0], x550, x458 * x549) + x596
-                + Self::mul_add(-x37, x583, x38 * x582),
+        let x567 = S::mul_add(x159, x545, S::mul_add(S::neg(x158), x544, x157 * x543));
+        let x568 = S::mul_add(x162, x545, S::mul_add(S::neg(x161), x544, x160 * x543));
+        let x569 = S::mul_add(x165, x545, S::mul_add(S::neg(x164), x544, x163 * x543));
+        let x570 = S::mul_add(x159, x548, S::mul_add(x158, x547, x157 * x546))
+            + S::mul_add(x544, x569, x545 * x568);
+        let x571 = S::mul_add(x162, x548, S::mul_add(x161, x547, x160 * x546))
+            - S::mul_add(S::neg(x543), x569, x545 * x567);
+        let x572 = S::mul_add(x165, x548, S::mul_add(x164, x547, x163 * x546))
+            - S::mul_add(x543, x568, x544 * x567);
+        let x573 = S::mul_add(S::splat(105.98), x525, x564);
+        let x574 = S::mul_add(S::splat(105.98), x526, x565);
+        let x575 = S::mul_add(S::splat(105.98), x527, x566);
+        let x576 = S::mul_add(S::splat(105.98), x507, x573);
+        let x577 = S::mul_add(S::splat(105.98), x508, x574);
+        let x578 = S::mul_add(S::splat(105.98), x509, x575);
+        let x579 = S::mul_add(S::splat(279.2), x489, x576);
+        let x580 = S::mul_add(S::splat(279.2), x490, x577);
+        let x581 = S::mul_add(S::splat(279.2), x491, x578);
+        let x582 = S::mul_add(S::splat(314.88), x471, x579);
+        let x583 = S::mul_add(S::splat(314.88), x472, x580);
+        let x584 = S::mul_add(S::splat(314.88), x473, x581);
+        let x585 = S::mul_add(x132, x533, S::mul_add(x131, x532, x130 * x531))
+            + S::mul_add(x529, x563, x530 * x562) + x570
+            - S::mul_add(x140, x566, x141 * x565);
+        let x586 = S::mul_add(x135, x533, S::mul_add(x134, x532, x133 * x531))
+            - S::mul_add(S::neg(x528), x563, x530 * x561) + x571
+            - S::mul_add(S::neg(x139), x566, x141 * x564);
+        let x587 = S::mul_add(x138, x533, S::mul_add(x137, x532, x136 * x531))
+            - S::mul_add(x528, x562, x529 * x561) + x572
+            + S::mul_add(x139, x565, x140 * x564);
+        let x588 = S::mul_add(
+            S::neg(x108),
+            x515,
+            S::mul_add(S::neg(x107), x514, x106 * x513),
+        ) - S::mul_add(x511, x560, x512 * x559) + x585
+            - S::mul_add(x38, x575, x39 * x574);
+        let x589 = S::mul_add(
+            S::neg(x111),
+            x515,
+            S::mul_add(S::neg(x110), x514, x109 * x513),
+        ) + S::mul_add(x510, x560, x512 * x558) - x586
+            + S::mul_add(x37, x575, x39 * x573);
+        let x590 = S::mul_add(
+            S::neg(x114),
+            x515,
+            S::mul_add(S::neg(x113), x514, x112 * x513),
+        ) + S::mul_add(S::neg(x510), x559, x511 * x558) - x587
+            - S::mul_add(S::neg(x37), x574, x38 * x573);
+        let x591 = S::mul_add(x84, x497, S::mul_add(x83, x496, x82 * x495))
+            + S::mul_add(x493, x557, x494 * x556) + x588
+            + S::mul_add(x92, x578, x93 * x577);
+        let x592 = S::mul_add(x87, x497, S::mul_add(x86, x496, x85 * x495))
+            - S::mul_add(S::neg(x492), x557, x494 * x555) - x589
+            + S::mul_add(S::neg(x91), x578, x93 * x576);
+        let x593 = S::mul_add(x90, x497, S::mul_add(x89, x496, x88 * x495))
+            - S::mul_add(x492, x556, x493 * x555) - x590
+            - S::mul_add(x91, x577, x92 * x576);
+        let x594 = S::mul_add(x57, x479, S::mul_add(x56, x478, x55 * x477))
+            + S::mul_add(x475, x554, x476 * x553) + x591
+            + S::mul_add(x65, x581, x66 * x580);
+        let x595 = S::mul_add(x60, x479, S::mul_add(x59, x478, x58 * x477))
+            - S::mul_add(S::neg(x474), x554, x476 * x552) + x592
+            + S::mul_add(S::neg(x64), x581, x66 * x579);
+        let x596 = S::mul_add(x63, x479, S::mul_add(x62, x478, x61 * x477))
+            - S::mul_add(x474, x553, x475 * x552) + x593
+            - S::mul_add(x64, x580, x65 * x579);
+        let x597 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(x36, x464, x34 * x463) - S::mul_add(qd[0], x550, x458 * x549)
+                + x596 + S::mul_add(S::neg(x37), x583, x38 * x582),
             s_q0
-                * (Self::mul_add(x31, x464, x29 * x463)
-                    - Self::mul_add(-qd[0], x551, x459 * x549) + x595
-                    - Self::mul_add(x37, x584, x39 * x582)),
+                * (S::mul_add(x31, x464, x29 * x463)
+                    - S::mul_add(S::neg(qd[0]), x551, x459 * x549) + x595
+                    - S::mul_add(x37, x584, x39 * x582)),
         );
-        let x598 = Self::mul_add(-x12, x596, Self::mul_add(-x10, x595, s_q1 * x594));
-        let x599 = Self::mul_add(-x12, x593, Self::mul_add(-x10, x592, s_q1 * x591));
-        let x600 = Self::mul_add(x12, x590, Self::mul_add(x10, x589, s_q1 * x588));
-        let x601 = -(Self::mul_add(x26, x464, x24 * x463)
-            + Self::mul_add(x458, x551, x459 * x550) + x594
-            - Self::mul_add(x38, x584, x39 * x583)
-            + Self::mul_add(
-                -x7,
-                Self::mul_add(105.98, x462, x584),
-                x8 * Self::mul_add(105.98, x461, x583),
-            ));
-        let x602 = -Self::mul_add(x99, x587, Self::mul_add(x97, x586, x95 * x585));
-        let x603 = -Self::mul_add(x119, x572, Self::mul_add(x117, x571, x115 * x570));
+        let x598 = S::mul_add(
+            S::neg(x12),
+            x596,
+            S::mul_add(S::neg(x10), x595, s_q1 * x594),
+        );
+        let x599 = S::mul_add(
+            S::neg(x12),
+            x593,
+            S::mul_add(S::neg(x10), x592, s_q1 * x591),
+        );
+        let x600 = S::mul_add(x12, x590, S::mul_add(x10, x589, s_q1 * x588));
+        let x601 = S::neg(
+            S::mul_add(x26, x464, x24 * x463) + S::mul_add(x458, x551, x459 * x550)
+                + x594 - S::mul_add(x38, x584, x39 * x583)
+                + S::mul_add(
+                    S::neg(x7),
+                    S::mul_add(S::splat(105.98), x462, x584),
+                    x8 * S::mul_add(S::splat(105.98), x461, x583),
+                ),
+        );
+        let x602 = S::neg(S::mul_add(x99, x587, S::mul_add(x97, x586, x95 * x585)));
+        let x603 = S::neg(S::mul_add(x119, x572, S::mul_add(x117, x571, x115 * x570)));
         (
             [
                 [x405, x406, x407, x408, x409, x410, x411],
@@ -4906,6 +5212,40 @@ impl SsrmsRecurrent {
             [x601, x597, x598, x599, x600, x602, x603],
         )
     }
+    /// [`Self::mass_matrix_and_nonlinear_effects`] of every state of the slices, `S::LANES` states per call of [`Self::mass_matrix_and_nonlinear_effects_lanes`]: `out[k]` is `mass_matrix_and_nonlinear_effects` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn mass_matrix_and_nonlinear_effects_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        out: &mut [([[::core::primitive::f64; 7]; 7], [::core::primitive::f64; 7])],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::mass_matrix_and_nonlinear_effects_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                )
+            },
+        );
+    }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
     /// Methods: mass matrix `recurrent`, nonlinear effects `recurrent`, forward `ldlt`: 1242 mul, 1177 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 732 fused where the target has FMA.
@@ -4916,8 +5256,17 @@ impl SsrmsRecurrent {
         tau: &[::core::primitive::f64; 7],
         f_ext: &[[::core::primitive::f64; 6]; 7],
     ) -> [::core::primitive::f64; 7] {
+        Self::forward_dynamics_with_wrenches_lanes::<
+            ::core::primitive::f64,
+        >(q, qd, tau, f_ext)
+    }
+    /// [`Self::forward_dynamics_with_wrenches`] of `S::LANES` states at once, one per lane of `S` (`f64` itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the same straight-line code, each lane's results bit for bit the scalar function's for that lane's state.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches_lanes<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(q: &[S; 7], qd: &[S; 7], tau: &[S; 7], f_ext: &[[S; 6]; 7]) -> [S; 7] {
         let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
-        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+        (s_q5, c_q5), (s_q6, c_q6)] = S::sincos_n([
             q[0],
             q[1],
             q[2],
@@ -4926,165 +5275,165 @@ impl SsrmsRecurrent {
             q[5],
             q[6],
         ]);
-        let x7 = 0.7026 * s_q0;
-        let x8 = 0.7026 * c_q0;
+        let x7 = S::splat(0.7026) * s_q0;
+        let x8 = S::splat(0.7026) * c_q0;
         let x9 = c_q0 * s_q1;
         let x10 = c_q0 * c_q1;
         let x11 = s_q0 * s_q1;
         let x12 = s_q0 * c_q1;
-        let x13 = 8.088 * c_q1;
-        let x14 = 3.061 * s_q1;
-        let x15 = 8.088 * x9;
-        let x16 = 3.061 * x10;
-        let x17 = 8.446 * s_q0;
-        let x18 = 8.088 * x11;
-        let x19 = 3.061 * x12;
-        let x20 = 8.446 * c_q0;
+        let x13 = S::splat(8.088) * c_q1;
+        let x14 = S::splat(3.061) * s_q1;
+        let x15 = S::splat(8.088) * x9;
+        let x16 = S::splat(3.061) * x10;
+        let x17 = S::splat(8.446) * s_q0;
+        let x18 = S::splat(8.088) * x11;
+        let x19 = S::splat(3.061) * x12;
+        let x20 = S::splat(8.446) * c_q0;
         let x21 = s_q1 * x14;
-        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x22 = S::mul_add(c_q1, x13, x21);
         let x23 = x10 * x14;
-        let x24 = Self::mul_add(x9, x13, -x23);
+        let x24 = S::mul_add(x9, x13, S::neg(x23));
         let x25 = x12 * x14;
-        let x26 = Self::mul_add(x11, x13, -x25);
+        let x26 = S::mul_add(x11, x13, S::neg(x25));
         let x27 = s_q1 * x16;
         let x28 = x10 * x16;
-        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x29 = S::mul_add(s_q0, x17, S::mul_add(x9, x15, x28));
         let x30 = x12 * x16;
-        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x31 = S::mul_add(S::neg(c_q0), x17, S::mul_add(x11, x15, x30));
         let x32 = s_q1 * x19;
         let x33 = x10 * x19;
-        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x34 = S::mul_add(S::neg(s_q0), x20, S::mul_add(x9, x18, x33));
         let x35 = x12 * x19;
-        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
-        let x37 = s_q1 * 0.5692;
-        let x38 = x10 * 0.5692;
-        let x39 = x12 * 0.5692;
+        let x36 = S::mul_add(c_q0, x20, S::mul_add(x11, x18, x35));
+        let x37 = s_q1 * S::splat(0.5692);
+        let x38 = x10 * S::splat(0.5692);
+        let x39 = x12 * S::splat(0.5692);
         let x40 = c_q1 * c_q2;
         let x41 = c_q1 * s_q2;
-        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
-        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
-        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
-        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
-        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
-        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
-        let x48 = 2103.19 * x41;
-        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
-        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
-        let x51 = 2103.19 * x43;
-        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
-        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
-        let x54 = 2103.19 * x45;
-        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
-        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
-        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
-        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
-        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
-        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
-        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
-        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
-        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
-        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
-        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
-        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
-        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
-        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
-        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
-        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
-        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
-        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
-        let x75 = 1966.28 * x68;
-        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
-        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
-        let x78 = 1966.28 * x70;
-        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
-        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
-        let x81 = 1966.28 * x72;
-        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
-        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
-        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
-        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
-        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
-        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
-        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
-        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
-        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
-        let x91 = 7.11 * x67;
-        let x92 = 7.11 * x69;
-        let x93 = 7.11 * x71;
-        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
-        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
-        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
-        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
-        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
-        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
-        let x100 = 8.305 * x94;
-        let x101 = 8.0386 * x95;
-        let x102 = 8.305 * x96;
-        let x103 = 8.0386 * x97;
-        let x104 = 8.305 * x98;
-        let x105 = 8.0386 * x99;
-        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
-        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
-        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
-        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
-        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
-        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
-        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
-        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
-        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
-        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
-        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
-        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
-        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
-        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
-        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
-        let x121 = 12.13 * x115;
-        let x122 = 12.13 * x116;
-        let x123 = 3.061 * x95;
-        let x124 = 12.13 * x117;
-        let x125 = 12.13 * x118;
-        let x126 = 3.061 * x97;
-        let x127 = 12.13 * x119;
-        let x128 = 12.13 * x120;
-        let x129 = 3.061 * x99;
-        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
-        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
-        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
-        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
-        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
-        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
-        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
-        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
-        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
-        let x139 = 0.7026 * x95;
-        let x140 = 0.7026 * x97;
-        let x141 = 0.7026 * x99;
-        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
-        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
-        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
-        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
-        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
-        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
-        let x148 = 9.336 * x115;
-        let x149 = 44.41 * x142;
-        let x150 = 44.41 * x143;
-        let x151 = 9.336 * x117;
-        let x152 = 44.41 * x144;
-        let x153 = 44.41 * x145;
-        let x154 = 9.336 * x119;
-        let x155 = 44.41 * x146;
-        let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x42 = S::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = S::mul_add(S::neg(s_q0), c_q2, x9 * s_q2);
+        let x44 = S::mul_add(S::neg(c_q0), s_q2, x11 * c_q2);
+        let x45 = S::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = S::mul_add(S::splat(-49.52), s_q1, S::splat(15.41) * x40);
+        let x47 = S::mul_add(S::splat(-2094.71), s_q1, S::splat(49.52) * x40);
+        let x48 = S::splat(2103.19) * x41;
+        let x49 = S::mul_add(S::splat(49.52), x10, S::splat(15.41) * x42);
+        let x50 = S::mul_add(S::splat(2094.71), x10, S::splat(49.52) * x42);
+        let x51 = S::splat(2103.19) * x43;
+        let x52 = S::mul_add(S::splat(49.52), x12, S::splat(15.41) * x44);
+        let x53 = S::mul_add(S::splat(2094.71), x12, S::splat(49.52) * x44);
+        let x54 = S::splat(2103.19) * x45;
+        let x55 = S::mul_add(x41, x48, S::mul_add(S::neg(s_q1), x47, x40 * x46));
+        let x56 = S::mul_add(x43, x48, S::mul_add(x10, x47, x42 * x46));
+        let x57 = S::mul_add(x45, x48, S::mul_add(x12, x47, x44 * x46));
+        let x58 = S::mul_add(x41, x51, S::mul_add(S::neg(s_q1), x50, x40 * x49));
+        let x59 = S::mul_add(x43, x51, S::mul_add(x10, x50, x42 * x49));
+        let x60 = S::mul_add(x45, x51, S::mul_add(x12, x50, x44 * x49));
+        let x61 = S::mul_add(x41, x54, S::mul_add(S::neg(s_q1), x53, x40 * x52));
+        let x62 = S::mul_add(x43, x54, S::mul_add(x10, x53, x42 * x52));
+        let x63 = S::mul_add(x45, x54, S::mul_add(x12, x53, x44 * x52));
+        let x64 = S::mul_add(s_q1, S::splat(0.475), S::splat(7.11) * x40);
+        let x65 = S::mul_add(x10, S::splat(-0.475), S::splat(7.11) * x42);
+        let x66 = S::mul_add(x12, S::splat(-0.475), S::splat(7.11) * x44);
+        let x67 = S::mul_add(S::neg(x41), s_q3, x40 * c_q3);
+        let x68 = S::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = S::mul_add(S::neg(x43), s_q3, x42 * c_q3);
+        let x70 = S::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = S::mul_add(S::neg(x45), s_q3, x44 * c_q3);
+        let x72 = S::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = S::mul_add(s_q1, S::splat(39.95), S::splat(9.522) * x67);
+        let x74 = S::mul_add(S::splat(1966.28), s_q1, x67 * S::splat(39.95));
+        let x75 = S::splat(1966.28) * x68;
+        let x76 = S::mul_add(x10, S::splat(-39.95), S::splat(9.522) * x69);
+        let x77 = S::mul_add(S::splat(-1966.28), x10, x69 * S::splat(39.95));
+        let x78 = S::splat(1966.28) * x70;
+        let x79 = S::mul_add(x12, S::splat(-39.95), S::splat(9.522) * x71);
+        let x80 = S::mul_add(S::splat(-1966.28), x12, x71 * S::splat(39.95));
+        let x81 = S::splat(1966.28) * x72;
+        let x82 = S::mul_add(x68, x75, S::mul_add(s_q1, x74, x67 * x73));
+        let x83 = S::mul_add(x70, x75, S::mul_add(S::neg(x10), x74, x69 * x73));
+        let x84 = S::mul_add(x72, x75, S::mul_add(S::neg(x12), x74, x71 * x73));
+        let x85 = S::mul_add(x68, x78, S::mul_add(s_q1, x77, x67 * x76));
+        let x86 = S::mul_add(x70, x78, S::mul_add(S::neg(x10), x77, x69 * x76));
+        let x87 = S::mul_add(x72, x78, S::mul_add(S::neg(x12), x77, x71 * x76));
+        let x88 = S::mul_add(x68, x81, S::mul_add(s_q1, x80, x67 * x79));
+        let x89 = S::mul_add(x70, x81, S::mul_add(S::neg(x10), x80, x69 * x79));
+        let x90 = S::mul_add(x72, x81, S::mul_add(S::neg(x12), x80, x71 * x79));
+        let x91 = S::splat(7.11) * x67;
+        let x92 = S::splat(7.11) * x69;
+        let x93 = S::splat(7.11) * x71;
+        let x94 = S::mul_add(S::neg(x68), s_q4, x67 * c_q4);
+        let x95 = S::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = S::mul_add(S::neg(x70), s_q4, x69 * c_q4);
+        let x97 = S::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = S::mul_add(S::neg(x72), s_q4, x71 * c_q4);
+        let x99 = S::mul_add(x72, c_q4, x71 * s_q4);
+        let x100 = S::splat(8.305) * x94;
+        let x101 = S::splat(8.0386) * x95;
+        let x102 = S::splat(8.305) * x96;
+        let x103 = S::splat(8.0386) * x97;
+        let x104 = S::splat(8.305) * x98;
+        let x105 = S::splat(8.0386) * x99;
+        let x106 = S::mul_add(x95, x101, S::mul_add(x94, x100, x21));
+        let x107 = S::mul_add(S::neg(x97), x101, S::mul_add(S::neg(x96), x100, x23));
+        let x108 = S::mul_add(S::neg(x99), x101, S::mul_add(S::neg(x98), x100, x25));
+        let x109 = S::mul_add(S::neg(x95), x103, S::mul_add(S::neg(x94), x102, x27));
+        let x110 = S::mul_add(x97, x103, S::mul_add(x96, x102, x28));
+        let x111 = S::mul_add(x99, x103, S::mul_add(x98, x102, x30));
+        let x112 = S::mul_add(S::neg(x95), x105, S::mul_add(S::neg(x94), x104, x32));
+        let x113 = S::mul_add(x97, x105, S::mul_add(x96, x104, x33));
+        let x114 = S::mul_add(x99, x105, S::mul_add(x98, x104, x35));
+        let x115 = S::mul_add(S::neg(s_q1), s_q5, x94 * c_q5);
+        let x116 = S::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = S::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = S::mul_add(S::neg(x10), c_q5, x96 * s_q5);
+        let x119 = S::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = S::mul_add(S::neg(x12), c_q5, x98 * s_q5);
+        let x121 = S::splat(12.13) * x115;
+        let x122 = S::splat(12.13) * x116;
+        let x123 = S::splat(3.061) * x95;
+        let x124 = S::splat(12.13) * x117;
+        let x125 = S::splat(12.13) * x118;
+        let x126 = S::splat(3.061) * x97;
+        let x127 = S::splat(12.13) * x119;
+        let x128 = S::splat(12.13) * x120;
+        let x129 = S::splat(3.061) * x99;
+        let x130 = S::mul_add(x95, x123, S::mul_add(x116, x122, x115 * x121));
+        let x131 = S::mul_add(x97, x123, S::mul_add(x118, x122, x117 * x121));
+        let x132 = S::mul_add(x99, x123, S::mul_add(x120, x122, x119 * x121));
+        let x133 = S::mul_add(x95, x126, S::mul_add(x116, x125, x115 * x124));
+        let x134 = S::mul_add(x97, x126, S::mul_add(x118, x125, x117 * x124));
+        let x135 = S::mul_add(x99, x126, S::mul_add(x120, x125, x119 * x124));
+        let x136 = S::mul_add(x95, x129, S::mul_add(x116, x128, x115 * x127));
+        let x137 = S::mul_add(x97, x129, S::mul_add(x118, x128, x117 * x127));
+        let x138 = S::mul_add(x99, x129, S::mul_add(x120, x128, x119 * x127));
+        let x139 = S::splat(0.7026) * x95;
+        let x140 = S::splat(0.7026) * x97;
+        let x141 = S::splat(0.7026) * x99;
+        let x142 = S::mul_add(S::neg(x95), s_q6, x116 * c_q6);
+        let x143 = S::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = S::mul_add(S::neg(x97), s_q6, x118 * c_q6);
+        let x145 = S::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = S::mul_add(S::neg(x99), s_q6, x120 * c_q6);
+        let x147 = S::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = S::splat(9.336) * x115;
+        let x149 = S::splat(44.41) * x142;
+        let x150 = S::splat(44.41) * x143;
+        let x151 = S::splat(9.336) * x117;
+        let x152 = S::splat(44.41) * x144;
+        let x153 = S::splat(44.41) * x145;
+        let x154 = S::splat(9.336) * x119;
+        let x155 = S::splat(44.41) * x146;
+        let x156 = S::splat(44.41) * x147;
+        let x157 = S::mul_add(x143, x150, S::mul_add(x142, x149, x115 * x148));
+        let x158 = S::mul_add(x145, x150, S::mul_add(x144, x149, x117 * x148));
+        let x159 = S::mul_add(x147, x150, S::mul_add(x146, x149, x119 * x148));
+        let x160 = S::mul_add(x143, x153, S::mul_add(x142, x152, x115 * x151));
+        let x161 = S::mul_add(x145, x153, S::mul_add(x144, x152, x117 * x151));
+        let x162 = S::mul_add(x147, x153, S::mul_add(x146, x152, x119 * x151));
+        let x163 = S::mul_add(x143, x156, S::mul_add(x142, x155, x115 * x154));
+        let x164 = S::mul_add(x145, x156, S::mul_add(x144, x155, x117 * x154));
+        let x165 = S::mul_add(x147, x156, S::mul_add(x146, x155, x119 * x154));
         let x166 = x37 - x139;
         let x167 = x38 + x140;
         let x168 = x39 + x141;
@@ -5111,23 +5460,23 @@ impl SsrmsRecurrent {
         let x189 = x39 - x187;
         let x190 = x38 - x65;
         let x191 = x39 - x66;
-        let x192 = 243.66 * x139;
-        let x193 = 243.66 * x140;
-        let x194 = 243.66 * x141;
-        let x195 = 243.66 * x166;
-        let x196 = 243.66 * x167;
-        let x197 = 243.66 * x168;
-        let x198 = 243.66 * x169;
-        let x199 = 243.66 * x170;
-        let x200 = 243.66 * x171;
-        let x201 = 243.66 * x172;
-        let x202 = 243.66 * x173;
-        let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x37 + x172);
-        let x205 = 243.66 * x175;
-        let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x7 + x175);
-        let x208 = 243.66 * (x8 - x176);
+        let x192 = S::splat(243.66) * x139;
+        let x193 = S::splat(243.66) * x140;
+        let x194 = S::splat(243.66) * x141;
+        let x195 = S::splat(243.66) * x166;
+        let x196 = S::splat(243.66) * x167;
+        let x197 = S::splat(243.66) * x168;
+        let x198 = S::splat(243.66) * x169;
+        let x199 = S::splat(243.66) * x170;
+        let x200 = S::splat(243.66) * x171;
+        let x201 = S::splat(243.66) * x172;
+        let x202 = S::splat(243.66) * x173;
+        let x203 = S::splat(243.66) * x174;
+        let x204 = S::splat(243.66) * (x37 + x172);
+        let x205 = S::splat(243.66) * x175;
+        let x206 = S::splat(243.66) * x176;
+        let x207 = S::splat(243.66) * (x7 + x175);
+        let x208 = S::splat(243.66) * (x8 - x176);
         let x209 = x130 + x157;
         let x210 = x131 + x158;
         let x211 = x132 + x159;
@@ -5164,53 +5513,53 @@ impl SsrmsRecurrent {
         let x242 = x61 + x233;
         let x243 = x62 + x234;
         let x244 = x63 + x235;
-        let x245 = Self::mul_add(105.98, x37, x195);
-        let x246 = Self::mul_add(105.98, x38, x196);
-        let x247 = Self::mul_add(105.98, x39, x197);
-        let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(-105.98, x178, x199);
-        let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x91, x248);
-        let x252 = Self::mul_add(105.98, x92, x249);
-        let x253 = Self::mul_add(105.98, x93, x250);
-        let x254 = Self::mul_add(105.98, x180, x201);
-        let x255 = Self::mul_add(105.98, x181, x202);
-        let x256 = Self::mul_add(105.98, x182, x203);
-        let x257 = Self::mul_add(105.98, x185, x254);
-        let x258 = Self::mul_add(105.98, x186, x255);
-        let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x64, x257);
-        let x261 = Self::mul_add(279.2, x65, x258);
-        let x262 = Self::mul_add(279.2, x66, x259);
-        let x263 = Self::mul_add(105.98, x37 + x180, x204);
-        let x264 = Self::mul_add(105.98, x183, x205);
-        let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x37 + x185, x263);
-        let x267 = Self::mul_add(105.98, x188, x264);
-        let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x37 + x64, x266);
-        let x270 = Self::mul_add(279.2, x190, x267);
-        let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x38, x270);
-        let x273 = Self::mul_add(314.88, x39, x271);
-        let x274 = Self::mul_add(105.98, x7 + x183, x207);
-        let x275 = Self::mul_add(105.98, x8 - x184, x208);
-        let x276 = Self::mul_add(105.98, x7 + x188, x274);
-        let x277 = Self::mul_add(105.98, x8 - x189, x275);
-        let x278 = Self::mul_add(279.2, x7 + x190, x276);
-        let x279 = Self::mul_add(279.2, x8 - x191, x277);
-        let x280 = Self::mul_add(314.88, x7 + x38, x278);
-        let x281 = Self::mul_add(314.88, x8 - x39, x279);
-        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x245 = S::mul_add(S::splat(105.98), x37, x195);
+        let x246 = S::mul_add(S::splat(105.98), x38, x196);
+        let x247 = S::mul_add(S::splat(105.98), x39, x197);
+        let x248 = S::mul_add(S::splat(105.98), x177, x198);
+        let x249 = S::mul_add(S::splat(-105.98), x178, x199);
+        let x250 = S::mul_add(S::splat(-105.98), x179, x200);
+        let x251 = S::mul_add(S::splat(105.98), x91, x248);
+        let x252 = S::mul_add(S::splat(105.98), x92, x249);
+        let x253 = S::mul_add(S::splat(105.98), x93, x250);
+        let x254 = S::mul_add(S::splat(105.98), x180, x201);
+        let x255 = S::mul_add(S::splat(105.98), x181, x202);
+        let x256 = S::mul_add(S::splat(105.98), x182, x203);
+        let x257 = S::mul_add(S::splat(105.98), x185, x254);
+        let x258 = S::mul_add(S::splat(105.98), x186, x255);
+        let x259 = S::mul_add(S::splat(105.98), x187, x256);
+        let x260 = S::mul_add(S::splat(279.2), x64, x257);
+        let x261 = S::mul_add(S::splat(279.2), x65, x258);
+        let x262 = S::mul_add(S::splat(279.2), x66, x259);
+        let x263 = S::mul_add(S::splat(105.98), x37 + x180, x204);
+        let x264 = S::mul_add(S::splat(105.98), x183, x205);
+        let x265 = S::mul_add(S::splat(105.98), x184, x206);
+        let x266 = S::mul_add(S::splat(105.98), x37 + x185, x263);
+        let x267 = S::mul_add(S::splat(105.98), x188, x264);
+        let x268 = S::mul_add(S::splat(105.98), x189, x265);
+        let x269 = S::mul_add(S::splat(279.2), x37 + x64, x266);
+        let x270 = S::mul_add(S::splat(279.2), x190, x267);
+        let x271 = S::mul_add(S::splat(279.2), x191, x268);
+        let x272 = S::mul_add(S::splat(314.88), x38, x270);
+        let x273 = S::mul_add(S::splat(314.88), x39, x271);
+        let x274 = S::mul_add(S::splat(105.98), x7 + x183, x207);
+        let x275 = S::mul_add(S::splat(105.98), x8 - x184, x208);
+        let x276 = S::mul_add(S::splat(105.98), x7 + x188, x274);
+        let x277 = S::mul_add(S::splat(105.98), x8 - x189, x275);
+        let x278 = S::mul_add(S::splat(279.2), x7 + x190, x276);
+        let x279 = S::mul_add(S::splat(279.2), x8 - x191, x277);
+        let x280 = S::mul_add(S::splat(314.88), x7 + x38, x278);
+        let x281 = S::mul_add(S::splat(314.88), x8 - x39, x279);
+        let x282 = S::mul_add(S::neg(x140), x207, x141 * x208);
         let x283 = x139 * x207;
         let x284 = x139 * x208;
         let x285 = x140 * x204;
         let x286 = x139 * x204;
         let x287 = x141 * x204;
-        let x288 = Self::mul_add(-x141, x206, x286);
+        let x288 = S::mul_add(S::neg(x141), x206, x286);
         let x289 = x140 * x206;
         let x290 = x141 * x205;
-        let x291 = Self::mul_add(-x140, x205, x286);
+        let x291 = S::mul_add(S::neg(x140), x205, x286);
         let x292 = x141 * x203;
         let x293 = x140 * x202;
         let x294 = x292 + x293;
@@ -5257,13 +5606,13 @@ impl SsrmsRecurrent {
         let x335 = x38 * x249;
         let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x37, x249, x307);
-        let x339 = Self::mul_add(-x37, x250, x308);
-        let x340 = Self::mul_add(x38, x248, x309);
+        let x338 = S::mul_add(S::neg(x37), x249, x307);
+        let x339 = S::mul_add(S::neg(x37), x250, x308);
+        let x340 = S::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x38, x250, x312);
-        let x343 = Self::mul_add(x39, x248, x313);
-        let x344 = Self::mul_add(x39, x249, x314);
+        let x342 = S::mul_add(x38, x250, x312);
+        let x343 = S::mul_add(x39, x248, x313);
+        let x344 = S::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
         let x346 = x93 * x253;
         let x347 = x92 * x252;
@@ -5272,405 +5621,409 @@ impl SsrmsRecurrent {
         let x350 = x38 * x255;
         let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x37, x255, x295);
-        let x354 = Self::mul_add(-x37, x256, x296);
-        let x355 = Self::mul_add(x38, x254, x297);
+        let x353 = S::mul_add(S::neg(x37), x255, x295);
+        let x354 = S::mul_add(S::neg(x37), x256, x296);
+        let x355 = S::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x38, x256, x300);
-        let x358 = Self::mul_add(x39, x254, x301);
-        let x359 = Self::mul_add(x39, x255, x302);
+        let x357 = S::mul_add(x38, x256, x300);
+        let x358 = S::mul_add(x39, x254, x301);
+        let x359 = S::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
         let x361 = x93 * x259;
         let x362 = x92 * x258;
         let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x91, x258, x353);
-        let x366 = Self::mul_add(-x91, x259, x354);
-        let x367 = Self::mul_add(-x92, x257, x355);
+        let x365 = S::mul_add(S::neg(x91), x258, x353);
+        let x366 = S::mul_add(S::neg(x91), x259, x354);
+        let x367 = S::mul_add(S::neg(x92), x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x92, x259, x357);
-        let x370 = Self::mul_add(-x93, x257, x358);
-        let x371 = Self::mul_add(-x93, x258, x359);
+        let x369 = S::mul_add(S::neg(x92), x259, x357);
+        let x370 = S::mul_add(S::neg(x93), x257, x358);
+        let x371 = S::mul_add(S::neg(x93), x258, x359);
         let x372 = x360 - (x362 + x363);
         let x373 = x66 * x262;
         let x374 = x65 * x261;
         let x375 = x64 * x260;
         let x376 = x37 * x263;
-        let x377 = Self::mul_add(x38, x263, x285);
-        let x378 = x288 - Self::mul_add(x39, x265, x376);
-        let x379 = Self::mul_add(x38, x265, x289);
-        let x380 = Self::mul_add(x39, x263, x287);
-        let x381 = Self::mul_add(x39, x264, x290);
-        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x377 = S::mul_add(x38, x263, x285);
+        let x378 = x288 - S::mul_add(x39, x265, x376);
+        let x379 = S::mul_add(x38, x265, x289);
+        let x380 = S::mul_add(x39, x263, x287);
+        let x381 = S::mul_add(x39, x264, x290);
+        let x382 = x291 - S::mul_add(x38, x264, x376);
         let x383 = x91 * x266;
-        let x384 = Self::mul_add(-x92, x266, x377);
-        let x385 = x378 + Self::mul_add(x93, x268, -x383);
-        let x386 = Self::mul_add(-x92, x268, x379);
-        let x387 = Self::mul_add(-x93, x266, x380);
-        let x388 = Self::mul_add(-x93, x267, x381);
-        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x384 = S::mul_add(S::neg(x92), x266, x377);
+        let x385 = x378 + S::mul_add(x93, x268, S::neg(x383));
+        let x386 = S::mul_add(S::neg(x92), x268, x379);
+        let x387 = S::mul_add(S::neg(x93), x266, x380);
+        let x388 = S::mul_add(S::neg(x93), x267, x381);
+        let x389 = x382 + S::mul_add(x92, x267, S::neg(x383));
         let x390 = x64 * x269;
-        let x391 = x385 + Self::mul_add(x66, x271, -x390);
-        let x392 = Self::mul_add(-x65, x271, x386);
-        let x393 = Self::mul_add(-x66, x270, x388);
-        let x394 = x389 + Self::mul_add(x65, x270, -x390);
-        let x395 = x37 * Self::mul_add(314.88, x37, x269);
-        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
-        let x397 = Self::mul_add(-x37, x274, x283);
-        let x398 = Self::mul_add(-x37, x275, x284);
-        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
-        let x400 = Self::mul_add(-x91, x276, x397);
-        let x401 = Self::mul_add(-x91, x277, x398);
-        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
-        let x403 = Self::mul_add(-x64, x278, x400);
-        let x404 = Self::mul_add(-x64, x279, x401);
-        let x405 = Self::mul_add(
-            -c_q0,
-            x26 + x238 + Self::mul_add(-x37, x281, x404),
-            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
+        let x391 = x385 + S::mul_add(x66, x271, S::neg(x390));
+        let x392 = S::mul_add(S::neg(x65), x271, x386);
+        let x393 = S::mul_add(S::neg(x66), x270, x388);
+        let x394 = x389 + S::mul_add(x65, x270, S::neg(x390));
+        let x395 = x37 * S::mul_add(S::splat(314.88), x37, x269);
+        let x396 = x282 + S::mul_add(S::neg(x38), x274, x39 * x275);
+        let x397 = S::mul_add(S::neg(x37), x274, x283);
+        let x398 = S::mul_add(S::neg(x37), x275, x284);
+        let x399 = x396 - S::mul_add(S::neg(x92), x276, x93 * x277);
+        let x400 = S::mul_add(S::neg(x91), x276, x397);
+        let x401 = S::mul_add(S::neg(x91), x277, x398);
+        let x402 = x399 - S::mul_add(S::neg(x65), x278, x66 * x279);
+        let x403 = S::mul_add(S::neg(x64), x278, x400);
+        let x404 = S::mul_add(S::neg(x64), x279, x401);
+        let x405 = S::mul_add(
+            S::neg(c_q0),
+            x26 + x238 + S::mul_add(S::neg(x37), x281, x404),
+            s_q0 * (x24 + x237 - S::mul_add(S::neg(x37), x280, x403)),
         );
-        let x406 = Self::mul_add(
-            -x12,
+        let x406 = S::mul_add(
+            S::neg(x12),
             x238 + x404,
-            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
+            S::mul_add(S::neg(x10), x237 - x403, s_q1 * (x236 - x402)),
         );
-        let x407 = Self::mul_add(
-            -x12,
+        let x407 = S::mul_add(
+            S::neg(x12),
             x229 + x401,
-            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
+            S::mul_add(S::neg(x10), x228 - x400, s_q1 * (x227 - x399)),
         );
-        let x408 = Self::mul_add(
+        let x408 = S::mul_add(
             x12,
             x220 - x398,
-            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
+            S::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
-        let x409 = Self::mul_add(
+        let x409 = S::mul_add(
             x99,
             x211 + x284,
-            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
+            S::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
-        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
-        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
-        let x413 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -c_q0,
-                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
-                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
+        let x410 = S::mul_add(x119, x159, S::mul_add(x117, x158, x115 * x157));
+        let x411 = S::mul_add(x119, x162, S::mul_add(x117, x161, x115 * x160));
+        let x412 = S::mul_add(x119, x165, S::mul_add(x117, x164, x115 * x163));
+        let x413 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(c_q0),
+                x36 + x244 - (x394 - S::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - S::mul_add(x39, x272, x393)),
             ),
             s_q0
-                * Self::mul_add(
-                    -c_q0,
-                    x31 + x241 - Self::mul_add(x38, x273, x392),
-                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
+                * S::mul_add(
+                    S::neg(c_q0),
+                    x31 + x241 - S::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - S::mul_add(x39, x273, x395))),
                 ),
         );
-        let x414 = Self::mul_add(
-            -x12,
+        let x414 = S::mul_add(
+            S::neg(x12),
             x241 - x392,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x269, x384)),
             ),
         );
-        let x415 = Self::mul_add(
-            -x12,
+        let x415 = S::mul_add(
+            S::neg(x12),
             x244 - x394,
-            Self::mul_add(
-                -x10,
+            S::mul_add(
+                S::neg(x10),
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x269, x387)),
             ),
         );
-        let x416 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
-                -x12,
+        let x416 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x389,
-                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
+                S::mul_add(S::neg(x10), x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x232 - x386,
-                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
+                    S::mul_add(S::neg(x10), x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
-        let x417 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x417 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x12,
                 x226 - x382,
-                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
+                S::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x223 - x379,
-                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
+                    S::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
-        let x418 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(
+        let x418 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(
                 x99,
                 x217 - x291,
-                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
+                S::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x214 - x289,
-                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
+                    S::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
-        let x419 = Self::mul_add(
-            -x12,
-            x238 + Self::mul_add(-x64, x262, x366),
-            Self::mul_add(
-                -x10,
-                x237 + Self::mul_add(-x64, x261, x365),
+        let x419 = S::mul_add(
+            S::neg(x12),
+            x238 + S::mul_add(S::neg(x64), x262, x366),
+            S::mul_add(
+                S::neg(x10),
+                x237 + S::mul_add(S::neg(x64), x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
-        let x420 = Self::mul_add(
-            -x12,
-            x241 + Self::mul_add(-x65, x262, x369),
-            Self::mul_add(
-                -x10,
+        let x420 = S::mul_add(
+            S::neg(x12),
+            x241 + S::mul_add(S::neg(x65), x262, x369),
+            S::mul_add(
+                S::neg(x10),
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
+                s_q1 * (x239 + S::mul_add(S::neg(x65), x260, x367)),
             ),
         );
-        let x421 = Self::mul_add(
-            -x12,
+        let x421 = S::mul_add(
+            S::neg(x12),
             x244 - (x372 - (x374 + x375)),
-            Self::mul_add(
-                -x10,
-                x243 + Self::mul_add(-x66, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
+            S::mul_add(
+                S::neg(x10),
+                x243 + S::mul_add(S::neg(x66), x261, x371),
+                s_q1 * (x242 + S::mul_add(S::neg(x66), x260, x370)),
             ),
         );
-        let x422 = Self::mul_add(
-            -x10,
-            Self::mul_add(
-                -x12,
+        let x422 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
+                S::neg(x12),
                 x232 + x369,
-                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
+                S::mul_add(S::neg(x10), x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
-                * Self::mul_add(
-                    -x12,
+                * S::mul_add(
+                    S::neg(x12),
                     x229 + x366,
-                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
+                    S::mul_add(S::neg(x10), x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
-        let x423 = Self::mul_add(
-            -x12,
-            Self::mul_add(
-                -x12,
+        let x423 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
+                S::neg(x12),
                 x235 - x372,
-                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
+                S::mul_add(S::neg(x10), x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
-        let x424 = Self::mul_add(
+        let x424 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x357,
-                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
+                S::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x354,
-                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
+                    S::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
-        let x425 = Self::mul_add(
+        let x425 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x360,
-                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
+                S::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
-        let x426 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x426 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x300,
-                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
+                S::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x296,
-                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
+                    S::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
-        let x427 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x427 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x303,
-                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
+                S::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x426,
         );
-        let x428 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
-        let x429 = Self::mul_add(
-            -x12,
-            x229 + Self::mul_add(-x91, x253, x339),
-            Self::mul_add(
-                -x10,
-                x228 + Self::mul_add(-x91, x252, x338),
+        let x428 = S::mul_add(
+            S::neg(x12),
+            x412,
+            S::mul_add(S::neg(x10), x411, s_q1 * x410),
+        );
+        let x429 = S::mul_add(
+            S::neg(x12),
+            x229 + S::mul_add(S::neg(x91), x253, x339),
+            S::mul_add(
+                S::neg(x10),
+                x228 + S::mul_add(S::neg(x91), x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
-        let x430 = Self::mul_add(
-            -x12,
-            x232 + Self::mul_add(-x92, x253, x342),
-            Self::mul_add(
-                -x10,
+        let x430 = S::mul_add(
+            S::neg(x12),
+            x232 + S::mul_add(S::neg(x92), x253, x342),
+            S::mul_add(
+                S::neg(x10),
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
+                s_q1 * (x230 + S::mul_add(S::neg(x92), x251, x340)),
             ),
         );
-        let x431 = Self::mul_add(
-            -x12,
+        let x431 = S::mul_add(
+            S::neg(x12),
             x235 - (x345 - (x347 + x348)),
-            Self::mul_add(
-                -x10,
-                x234 + Self::mul_add(-x93, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
+            S::mul_add(
+                S::neg(x10),
+                x234 + S::mul_add(S::neg(x93), x252, x344),
+                s_q1 * (x233 + S::mul_add(S::neg(x93), x251, x343)),
             ),
         );
-        let x432 = Self::mul_add(
+        let x432 = S::mul_add(
             x10,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x223 + x342,
-                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
+                S::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x12,
                     x220 - x339,
-                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
+                    S::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
-        let x433 = Self::mul_add(
+        let x433 = S::mul_add(
             x12,
-            Self::mul_add(
+            S::mul_add(
                 x12,
                 x226 - x345,
-                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
+                S::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
-        let x434 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x434 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 + x312,
-                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
+                S::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 + x308,
-                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
+                    S::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
-        let x435 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x435 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 - x315,
-                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
+                S::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x434,
         );
-        let x436 = Self::mul_add(
+        let x436 = S::mul_add(
             x12,
-            x220 + Self::mul_add(-x37, x247, x320),
-            Self::mul_add(
+            x220 + S::mul_add(S::neg(x37), x247, x320),
+            S::mul_add(
                 x10,
-                x219 + Self::mul_add(-x37, x246, x319),
+                x219 + S::mul_add(S::neg(x37), x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
-        let x437 = Self::mul_add(
+        let x437 = S::mul_add(
             x12,
-            x223 - Self::mul_add(x38, x247, x324),
-            Self::mul_add(
+            x223 - S::mul_add(x38, x247, x324),
+            S::mul_add(
                 x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
+                s_q1 * (x221 - S::mul_add(x38, x245, x321)),
             ),
         );
-        let x438 = Self::mul_add(
+        let x438 = S::mul_add(
             x12,
             x226 + (x327 + (x332 + x333)),
-            Self::mul_add(
+            S::mul_add(
                 x10,
-                x225 - Self::mul_add(x39, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
+                x225 - S::mul_add(x39, x246, x326),
+                s_q1 * (x224 - S::mul_add(x39, x245, x325)),
             ),
         );
-        let x439 = Self::mul_add(
-            -x10,
-            Self::mul_add(
+        let x439 = S::mul_add(
+            S::neg(x10),
+            S::mul_add(
                 x99,
                 x214 - x324,
-                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
+                S::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
-                * Self::mul_add(
+                * S::mul_add(
                     x99,
                     x211 - x320,
-                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
+                    S::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
-        let x440 = Self::mul_add(
-            -x12,
-            Self::mul_add(
+        let x440 = S::mul_add(
+            S::neg(x12),
+            S::mul_add(
                 x99,
                 x217 + x327,
-                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
+                S::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x439,
         );
-        let x441 = Self::mul_add(
+        let x441 = S::mul_add(
             x99,
-            Self::mul_add(-x139, x194, x211),
-            Self::mul_add(
+            S::mul_add(S::neg(x139), x194, x211),
+            S::mul_add(
                 x97,
-                Self::mul_add(-x139, x193, x210),
+                S::mul_add(S::neg(x139), x193, x210),
                 x95 * (x209 + (x328 + x329)),
             ),
         );
-        let x442 = Self::mul_add(
+        let x442 = S::mul_add(
             x99,
-            Self::mul_add(-x140, x194, x214),
-            Self::mul_add(
+            S::mul_add(S::neg(x140), x194, x214),
+            S::mul_add(
                 x97,
                 x213 + (x328 + x330),
-                x95 * Self::mul_add(-x140, x192, x212),
+                x95 * S::mul_add(S::neg(x140), x192, x212),
             ),
         );
-        let x443 = Self::mul_add(
+        let x443 = S::mul_add(
             x99,
             x217 + (x329 + x330),
-            Self::mul_add(
+            S::mul_add(
                 x97,
-                Self::mul_add(-x141, x193, x216),
-                x95 * Self::mul_add(-x141, x192, x215),
+                S::mul_add(S::neg(x141), x193, x216),
+                x95 * S::mul_add(S::neg(x141), x192, x215),
             ),
         );
         let x444 = qd[1] * s_q0;
@@ -5688,23 +6041,19 @@ impl SsrmsRecurrent {
         let x456 = x444 * x445;
         let x457 = x37 * (x454 + x455);
         let x458 = x447
-            - Self::mul_add(
-                -x39,
+            - S::mul_add(
+                S::neg(x39),
                 x456,
-                Self::mul_add(-x38, x446 + x454, x37 * (x450 + x450)),
+                S::mul_add(S::neg(x38), x446 + x454, x37 * (x450 + x450)),
             );
         let x459 = x448
-            - Self::mul_add(
-                x39,
-                x446 + x455,
-                Self::mul_add(x38, x456, x37 * (x449 + x449)),
-            );
+            - S::mul_add(x39, x446 + x455, S::mul_add(x38, x456, x37 * (x449 + x449)));
         let x460 = qd[0] - x451;
         let x461 = x444 - x452;
         let x462 = x445 + x453;
-        let x463 = Self::mul_add(x444, x453, x445 * x452);
-        let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
-        let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
+        let x463 = S::mul_add(x444, x453, x445 * x452);
+        let x464 = x449 + S::mul_add(qd[0], x453, x445 * x451);
+        let x465 = x450 + S::mul_add(S::neg(qd[0]), x452, x444 * x451);
         let x466 = qd[3] * s_q1;
         let x467 = qd[3] * x10;
         let x468 = qd[3] * x12;
@@ -5715,29 +6064,29 @@ impl SsrmsRecurrent {
         let x473 = x460 * x460;
         let x474 = x461 * x462;
         let x475 = x457
-            + Self::mul_add(
+            + S::mul_add(
                 x66,
                 x464 - x472,
-                Self::mul_add(-x65, x465 - x471, x64 * (x469 + x470)),
+                S::mul_add(S::neg(x65), x465 - x471, x64 * (x469 + x470)),
             );
         let x476 = x458
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x463 - x474,
-                Self::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
+                S::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
             );
         let x477 = x459
-            - Self::mul_add(
-                -x66,
+            - S::mul_add(
+                S::neg(x66),
                 x470 + x473,
-                Self::mul_add(-x65, x463 + x474, x64 * (x464 + x472)),
+                S::mul_add(S::neg(x65), x463 + x474, x64 * (x464 + x472)),
             );
         let x478 = x460 - x466;
         let x479 = x461 - x467;
         let x480 = x462 + x468;
-        let x481 = x463 + Self::mul_add(x461, x468, x462 * x467);
-        let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
-        let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
+        let x481 = x463 + S::mul_add(x461, x468, x462 * x467);
+        let x482 = x464 + S::mul_add(x460, x468, x462 * x466);
+        let x483 = x465 + S::mul_add(S::neg(x460), x467, x461 * x466);
         let x484 = qd[4] * s_q1;
         let x485 = qd[4] * x10;
         let x486 = qd[4] * x12;
@@ -5748,29 +6097,29 @@ impl SsrmsRecurrent {
         let x491 = x478 * x478;
         let x492 = x479 * x480;
         let x493 = x475
-            + Self::mul_add(
+            + S::mul_add(
                 x93,
                 x482 - x490,
-                Self::mul_add(-x92, x483 - x489, x91 * (x487 + x488)),
+                S::mul_add(S::neg(x92), x483 - x489, x91 * (x487 + x488)),
             );
         let x494 = x476
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x481 - x492,
-                Self::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
+                S::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
             );
         let x495 = x477
-            - Self::mul_add(
-                -x93,
+            - S::mul_add(
+                S::neg(x93),
                 x488 + x491,
-                Self::mul_add(-x92, x481 + x492, x91 * (x482 + x490)),
+                S::mul_add(S::neg(x92), x481 + x492, x91 * (x482 + x490)),
             );
         let x496 = x478 - x484;
         let x497 = x479 - x485;
         let x498 = x480 + x486;
-        let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
-        let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
-        let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
+        let x499 = x481 + S::mul_add(x479, x486, x480 * x485);
+        let x500 = x482 + S::mul_add(x478, x486, x480 * x484);
+        let x501 = x483 + S::mul_add(S::neg(x478), x485, x479 * x484);
         let x502 = qd[5] * x95;
         let x503 = qd[5] * x97;
         let x504 = qd[5] * x99;
@@ -5781,29 +6130,29 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            + Self::mul_add(
-                -x39,
+            + S::mul_add(
+                S::neg(x39),
                 x500 - x508,
-                Self::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
+                S::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
             );
         let x512 = x494
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x499 - x510,
-                Self::mul_add(-x38, x505 + x509, x37 * (x501 + x507)),
+                S::mul_add(S::neg(x38), x505 + x509, x37 * (x501 + x507)),
             );
         let x513 = x495
-            - Self::mul_add(
+            - S::mul_add(
                 x39,
                 x506 + x509,
-                Self::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
+                S::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 - x503;
         let x516 = x498 + x504;
-        let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
-        let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
-        let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
+        let x517 = x499 + S::mul_add(x497, x504, x498 * x503);
+        let x518 = x500 - S::mul_add(S::neg(x496), x504, x498 * x502);
+        let x519 = x501 - S::mul_add(x496, x503, x497 * x502);
         let x520 = qd[6] * x115;
         let x521 = qd[6] * x117;
         let x522 = qd[6] * x119;
@@ -5816,223 +6165,223 @@ impl SsrmsRecurrent {
         let x529 = x514 + x520;
         let x530 = x515 - x521;
         let x531 = x516 + x522;
-        let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
-        let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
-        let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
-        let x535 = Self::mul_add(x26, x445, Self::mul_add(-x24, x444, qd[0] * x22));
-        let x536 = Self::mul_add(
+        let x532 = x517 + S::mul_add(x515, x522, x516 * x521);
+        let x533 = x518 - S::mul_add(S::neg(x514), x522, x516 * x520);
+        let x534 = x519 - S::mul_add(x514, x521, x515 * x520);
+        let x535 = S::mul_add(x26, x445, S::mul_add(S::neg(x24), x444, qd[0] * x22));
+        let x536 = S::mul_add(
             x31,
             x445,
-            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x15, -x27)),
+            S::mul_add(S::neg(x29), x444, qd[0] * S::mul_add(c_q1, x15, S::neg(x27))),
         );
-        let x537 = Self::mul_add(
+        let x537 = S::mul_add(
             x36,
             x445,
-            Self::mul_add(-x34, x444, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+            S::mul_add(S::neg(x34), x444, qd[0] * S::mul_add(c_q1, x18, S::neg(x32))),
         );
-        let x538 = Self::mul_add(
-            105.98,
+        let x538 = S::mul_add(
+            S::splat(105.98),
             x447,
-            -Self::mul_add(
-                -f_ext[1][2],
-                s_q0,
-                Self::mul_add(f_ext[1][1], x10, f_ext[1][0] * x9),
+            S::neg(
+                S::mul_add(
+                    S::neg(f_ext[1][2]),
+                    s_q0,
+                    S::mul_add(f_ext[1][1], x10, f_ext[1][0] * x9),
+                ),
             ),
         );
-        let x539 = Self::mul_add(
-            105.98,
+        let x539 = S::mul_add(
+            S::splat(105.98),
             x448,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[1][2],
                 c_q0,
-                Self::mul_add(f_ext[1][1], x12, f_ext[1][0] * x11),
+                S::mul_add(f_ext[1][1], x12, f_ext[1][0] * x11),
             ),
         );
-        let x540 = Self::mul_add(x57, x462, Self::mul_add(-x56, x461, x55 * x460));
-        let x541 = Self::mul_add(x60, x462, Self::mul_add(-x59, x461, x58 * x460));
-        let x542 = Self::mul_add(x63, x462, Self::mul_add(-x62, x461, x61 * x460));
-        let x543 = Self::mul_add(
-            314.88,
+        let x540 = S::mul_add(x57, x462, S::mul_add(S::neg(x56), x461, x55 * x460));
+        let x541 = S::mul_add(x60, x462, S::mul_add(S::neg(x59), x461, x58 * x460));
+        let x542 = S::mul_add(x63, x462, S::mul_add(S::neg(x62), x461, x61 * x460));
+        let x543 = S::mul_add(
+            S::splat(314.88),
             x457,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[2][2],
                 x41,
-                Self::mul_add(-f_ext[2][1], s_q1, f_ext[2][0] * x40),
+                S::mul_add(S::neg(f_ext[2][1]), s_q1, f_ext[2][0] * x40),
             ),
         );
-        let x544 = Self::mul_add(
-            314.88,
+        let x544 = S::mul_add(
+            S::splat(314.88),
             x458,
-            -Self::mul_add(
-                f_ext[2][2],
-                x43,
-                Self::mul_add(f_ext[2][1], x10, f_ext[2][0] * x42),
+            S::neg(
+                S::mul_add(
+                    f_ext[2][2],
+                    x43,
+                    S::mul_add(f_ext[2][1], x10, f_ext[2][0] * x42),
+                ),
             ),
         );
-        let x545 = Self::mul_add(
-            314.88,
+        let x545 = S::mul_add(
+            S::splat(314.88),
             x459,
-            Self::mul_add(
-                f_ext[2][2],
-                x45,
-                Self::mul_add(f_ext[2][1], x12, f_ext[2][0] * x44),
-            ),
+            S::mul_add(f_ext[2][2], x45, S::mul_add(f_ext[2][1], x12, f_ext[2][0] * x44)),
         );
-        let x546 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
-        let x547 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
-        let x548 = Self::mul_add(x90, x480, Self::mul_add(-x89, x479, x88 * x478));
-        let x549 = Self::mul_add(
-            279.2,
+        let x546 = S::mul_add(x84, x480, S::mul_add(S::neg(x83), x479, x82 * x478));
+        let x547 = S::mul_add(x87, x480, S::mul_add(S::neg(x86), x479, x85 * x478));
+        let x548 = S::mul_add(x90, x480, S::mul_add(S::neg(x89), x479, x88 * x478));
+        let x549 = S::mul_add(
+            S::splat(279.2),
             x475,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[3][2],
                 x68,
-                Self::mul_add(-f_ext[3][1], s_q1, f_ext[3][0] * x67),
+                S::mul_add(S::neg(f_ext[3][1]), s_q1, f_ext[3][0] * x67),
             ),
         );
-        let x550 = Self::mul_add(
-            279.2,
+        let x550 = S::mul_add(
+            S::splat(279.2),
             x476,
-            -Self::mul_add(
-                f_ext[3][2],
-                x70,
-                Self::mul_add(f_ext[3][1], x10, f_ext[3][0] * x69),
+            S::neg(
+                S::mul_add(
+                    f_ext[3][2],
+                    x70,
+                    S::mul_add(f_ext[3][1], x10, f_ext[3][0] * x69),
+                ),
             ),
         );
-        let x551 = Self::mul_add(
-            279.2,
+        let x551 = S::mul_add(
+            S::splat(279.2),
             x477,
-            Self::mul_add(
-                f_ext[3][2],
-                x72,
-                Self::mul_add(f_ext[3][1], x12, f_ext[3][0] * x71),
-            ),
+            S::mul_add(f_ext[3][2], x72, S::mul_add(f_ext[3][1], x12, f_ext[3][0] * x71)),
         );
-        let x552 = Self::mul_add(-x108, x498, Self::mul_add(x107, x497, x106 * x496));
-        let x553 = Self::mul_add(-x111, x498, Self::mul_add(x110, x497, x109 * x496));
-        let x554 = Self::mul_add(-x114, x498, Self::mul_add(x113, x497, x112 * x496));
-        let x555 = Self::mul_add(
-            105.98,
+        let x552 = S::mul_add(S::neg(x108), x498, S::mul_add(x107, x497, x106 * x496));
+        let x553 = S::mul_add(S::neg(x111), x498, S::mul_add(x110, x497, x109 * x496));
+        let x554 = S::mul_add(S::neg(x114), x498, S::mul_add(x113, x497, x112 * x496));
+        let x555 = S::mul_add(
+            S::splat(105.98),
             x493,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[4][2],
                 x95,
-                Self::mul_add(-f_ext[4][1], s_q1, f_ext[4][0] * x94),
+                S::mul_add(S::neg(f_ext[4][1]), s_q1, f_ext[4][0] * x94),
             ),
         );
-        let x556 = Self::mul_add(
-            105.98,
+        let x556 = S::mul_add(
+            S::splat(105.98),
             x494,
-            -Self::mul_add(
-                f_ext[4][2],
-                x97,
-                Self::mul_add(f_ext[4][1], x10, f_ext[4][0] * x96),
+            S::neg(
+                S::mul_add(
+                    f_ext[4][2],
+                    x97,
+                    S::mul_add(f_ext[4][1], x10, f_ext[4][0] * x96),
+                ),
             ),
         );
-        let x557 = Self::mul_add(
-            105.98,
+        let x557 = S::mul_add(
+            S::splat(105.98),
             x495,
-            Self::mul_add(
-                f_ext[4][2],
-                x99,
-                Self::mul_add(f_ext[4][1], x12, f_ext[4][0] * x98),
-            ),
+            S::mul_add(f_ext[4][2], x99, S::mul_add(f_ext[4][1], x12, f_ext[4][0] * x98)),
         );
-        let x558 = Self::mul_add(x132, x516, Self::mul_add(-x131, x515, x130 * x514));
-        let x559 = Self::mul_add(x135, x516, Self::mul_add(-x134, x515, x133 * x514));
-        let x560 = Self::mul_add(x138, x516, Self::mul_add(-x137, x515, x136 * x514));
-        let x561 = Self::mul_add(
-            105.98,
+        let x558 = S::mul_add(x132, x516, S::mul_add(S::neg(x131), x515, x130 * x514));
+        let x559 = S::mul_add(x135, x516, S::mul_add(S::neg(x134), x515, x133 * x514));
+        let x560 = S::mul_add(x138, x516, S::mul_add(S::neg(x137), x515, x136 * x514));
+        let x561 = S::mul_add(
+            S::splat(105.98),
             x511,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[5][2],
                 x95,
-                Self::mul_add(-f_ext[5][1], x116, f_ext[5][0] * x115),
+                S::mul_add(S::neg(f_ext[5][1]), x116, f_ext[5][0] * x115),
             ),
         );
-        let x562 = Self::mul_add(
-            105.98,
+        let x562 = S::mul_add(
+            S::splat(105.98),
             x512,
-            -Self::mul_add(
-                f_ext[5][2],
-                x97,
-                Self::mul_add(-f_ext[5][1], x118, f_ext[5][0] * x117),
+            S::neg(
+                S::mul_add(
+                    f_ext[5][2],
+                    x97,
+                    S::mul_add(S::neg(f_ext[5][1]), x118, f_ext[5][0] * x117),
+                ),
             ),
         );
-        let x563 = Self::mul_add(
-            105.98,
+        let x563 = S::mul_add(
+            S::splat(105.98),
             x513,
-            Self::mul_add(
+            S::mul_add(
                 f_ext[5][2],
                 x99,
-                Self::mul_add(-f_ext[5][1], x120, f_ext[5][0] * x119),
+                S::mul_add(S::neg(f_ext[5][1]), x120, f_ext[5][0] * x119),
             ),
         );
-        let x564 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
-        let x565 = Self::mul_add(x162, x531, Self::mul_add(-x161, x530, x160 * x529));
-        let x566 = Self::mul_add(x165, x531, Self::mul_add(-x164, x530, x163 * x529));
-        let x567 = Self::mul_add(
-            243.66,
+        let x564 = S::mul_add(x159, x531, S::mul_add(S::neg(x158), x530, x157 * x529));
+        let x565 = S::mul_add(x162, x531, S::mul_add(S::neg(x161), x530, x160 * x529));
+        let x566 = S::mul_add(x165, x531, S::mul_add(S::neg(x164), x530, x163 * x529));
+        let x567 = S::mul_add(
+            S::splat(243.66),
             x511
-                - Self::mul_add(
+                - S::mul_add(
                     x141,
                     x518 - x526,
-                    Self::mul_add(-x140, x519 - x525, x139 * (x523 + x524)),
+                    S::mul_add(S::neg(x140), x519 - x525, x139 * (x523 + x524)),
                 ),
-            Self::mul_add(
+            S::mul_add(
                 f_ext[6][2],
                 x143,
-                Self::mul_add(-f_ext[6][1], x142, f_ext[6][0] * x115),
+                S::mul_add(S::neg(f_ext[6][1]), x142, f_ext[6][0] * x115),
             ),
         );
-        let x568 = Self::mul_add(
-            243.66,
+        let x568 = S::mul_add(
+            S::splat(243.66),
             x512
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x517 - x528,
-                    Self::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
+                    S::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
                 ),
-            -Self::mul_add(
-                f_ext[6][2],
-                x145,
-                Self::mul_add(-f_ext[6][1], x144, f_ext[6][0] * x117),
+            S::neg(
+                S::mul_add(
+                    f_ext[6][2],
+                    x145,
+                    S::mul_add(S::neg(f_ext[6][1]), x144, f_ext[6][0] * x117),
+                ),
             ),
         );
-        let x569 = Self::mul_add(
-            243.66,
+        let x569 = S::mul_add(
+            S::splat(243.66),
             x513
-                + Self::mul_add(
-                    -x141,
+                + S::mul_add(
+                    S::neg(x141),
                     x524 + x527,
-                    Self::mul_add(-x140, x517 + x528, x139 * (x518 + x526)),
+                    S::mul_add(S::neg(x140), x517 + x528, x139 * (x518 + x526)),
                 ),
-            Self::mul_add(
+            S::mul_add(
                 f_ext[6][2],
                 x147,
-                Self::mul_add(-f_ext[6][1], x146, f_ext[6][0] * x119),
+                S::mul_add(S::neg(f_ext[6][1]), x146, f_ext[6][0] * x119),
             ),
         );
-        let x570 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
-            + Self::mul_add(x530, x566, x531 * x565)
-            + Self::mul_add(
+        let x570 = S::mul_add(x159, x534, S::mul_add(x158, x533, x157 * x532))
+            + S::mul_add(x530, x566, x531 * x565)
+            + S::mul_add(
                 f_ext[6][5],
                 x143,
-                Self::mul_add(-f_ext[6][4], x142, f_ext[6][3] * x115),
+                S::mul_add(S::neg(f_ext[6][4]), x142, f_ext[6][3] * x115),
             );
-        let x571 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
-            - Self::mul_add(-x529, x566, x531 * x564)
-            + Self::mul_add(
+        let x571 = S::mul_add(x162, x534, S::mul_add(x161, x533, x160 * x532))
+            - S::mul_add(S::neg(x529), x566, x531 * x564)
+            + S::mul_add(
                 f_ext[6][5],
                 x145,
-                Self::mul_add(-f_ext[6][4], x144, f_ext[6][3] * x117),
+                S::mul_add(S::neg(f_ext[6][4]), x144, f_ext[6][3] * x117),
             );
-        let x572 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
-            - Self::mul_add(x529, x565, x530 * x564)
-            + Self::mul_add(
+        let x572 = S::mul_add(x165, x534, S::mul_add(x164, x533, x163 * x532))
+            - S::mul_add(x529, x565, x530 * x564)
+            + S::mul_add(
                 f_ext[6][5],
                 x147,
-                Self::mul_add(-f_ext[6][4], x146, f_ext[6][3] * x119),
+                S::mul_add(S::neg(f_ext[6][4]), x146, f_ext[6][3] * x119),
             );
         let x573 = x561 + x567;
         let x574 = x562 + x568;
@@ -6046,122 +6395,130 @@ impl SsrmsRecurrent {
         let x582 = x543 + x579;
         let x583 = x544 + x580;
         let x584 = x545 + x581;
-        let x585 = Self::mul_add(x132, x519, Self::mul_add(x131, x518, x130 * x517))
-            + Self::mul_add(x515, x560, x516 * x559)
-            + Self::mul_add(
+        let x585 = S::mul_add(x132, x519, S::mul_add(x131, x518, x130 * x517))
+            + S::mul_add(x515, x560, x516 * x559)
+            + S::mul_add(
                 f_ext[5][5],
                 x95,
-                Self::mul_add(-f_ext[5][4], x116, f_ext[5][3] * x115),
-            ) + x570 - Self::mul_add(x140, x569, x141 * x568);
-        let x586 = Self::mul_add(x135, x519, Self::mul_add(x134, x518, x133 * x517))
-            - Self::mul_add(-x514, x560, x516 * x558)
-            + Self::mul_add(
+                S::mul_add(S::neg(f_ext[5][4]), x116, f_ext[5][3] * x115),
+            ) + x570 - S::mul_add(x140, x569, x141 * x568);
+        let x586 = S::mul_add(x135, x519, S::mul_add(x134, x518, x133 * x517))
+            - S::mul_add(S::neg(x514), x560, x516 * x558)
+            + S::mul_add(
                 f_ext[5][5],
                 x97,
-                Self::mul_add(-f_ext[5][4], x118, f_ext[5][3] * x117),
-            ) + x571 - Self::mul_add(-x139, x569, x141 * x567);
-        let x587 = Self::mul_add(x138, x519, Self::mul_add(x137, x518, x136 * x517))
-            - Self::mul_add(x514, x559, x515 * x558)
-            + Self::mul_add(
+                S::mul_add(S::neg(f_ext[5][4]), x118, f_ext[5][3] * x117),
+            ) + x571 - S::mul_add(S::neg(x139), x569, x141 * x567);
+        let x587 = S::mul_add(x138, x519, S::mul_add(x137, x518, x136 * x517))
+            - S::mul_add(x514, x559, x515 * x558)
+            + S::mul_add(
                 f_ext[5][5],
                 x99,
-                Self::mul_add(-f_ext[5][4], x120, f_ext[5][3] * x119),
-            ) + x572 + Self::mul_add(x139, x568, x140 * x567);
-        let x588 = Self::mul_add(-x108, x501, Self::mul_add(-x107, x500, x106 * x499))
-            - Self::mul_add(x497, x554, x498 * x553)
-            + Self::mul_add(
+                S::mul_add(S::neg(f_ext[5][4]), x120, f_ext[5][3] * x119),
+            ) + x572 + S::mul_add(x139, x568, x140 * x567);
+        let x588 = S::mul_add(
+            S::neg(x108),
+            x501,
+            S::mul_add(S::neg(x107), x500, x106 * x499),
+        ) - S::mul_add(x497, x554, x498 * x553)
+            + S::mul_add(
                 f_ext[4][5],
                 x95,
-                Self::mul_add(-f_ext[4][4], s_q1, f_ext[4][3] * x94),
-            ) + x585 - Self::mul_add(x38, x575, x39 * x574);
-        let x589 = Self::mul_add(-x111, x501, Self::mul_add(-x110, x500, x109 * x499))
-            + Self::mul_add(x496, x554, x498 * x552)
-            - Self::mul_add(
+                S::mul_add(S::neg(f_ext[4][4]), s_q1, f_ext[4][3] * x94),
+            ) + x585 - S::mul_add(x38, x575, x39 * x574);
+        let x589 = S::mul_add(
+            S::neg(x111),
+            x501,
+            S::mul_add(S::neg(x110), x500, x109 * x499),
+        ) + S::mul_add(x496, x554, x498 * x552)
+            - S::mul_add(
                 f_ext[4][5],
                 x97,
-                Self::mul_add(f_ext[4][4], x10, f_ext[4][3] * x96),
-            ) - x586 + Self::mul_add(x37, x575, x39 * x573);
-        let x590 = Self::mul_add(-x114, x501, Self::mul_add(-x113, x500, x112 * x499))
-            + Self::mul_add(-x496, x553, x497 * x552)
-            - Self::mul_add(
+                S::mul_add(f_ext[4][4], x10, f_ext[4][3] * x96),
+            ) - x586 + S::mul_add(x37, x575, x39 * x573);
+        let x590 = S::mul_add(
+            S::neg(x114),
+            x501,
+            S::mul_add(S::neg(x113), x500, x112 * x499),
+        ) + S::mul_add(S::neg(x496), x553, x497 * x552)
+            - S::mul_add(
                 f_ext[4][5],
                 x99,
-                Self::mul_add(f_ext[4][4], x12, f_ext[4][3] * x98),
-            ) - x587 - Self::mul_add(-x37, x574, x38 * x573);
-        let x591 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
-            + Self::mul_add(x479, x548, x480 * x547)
-            + Self::mul_add(
+                S::mul_add(f_ext[4][4], x12, f_ext[4][3] * x98),
+            ) - x587 - S::mul_add(S::neg(x37), x574, x38 * x573);
+        let x591 = S::mul_add(x84, x483, S::mul_add(x83, x482, x82 * x481))
+            + S::mul_add(x479, x548, x480 * x547)
+            + S::mul_add(
                 f_ext[3][5],
                 x68,
-                Self::mul_add(-f_ext[3][4], s_q1, f_ext[3][3] * x67),
-            ) + x588 + Self::mul_add(x92, x578, x93 * x577);
-        let x592 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
-            - Self::mul_add(-x478, x548, x480 * x546)
-            + Self::mul_add(
+                S::mul_add(S::neg(f_ext[3][4]), s_q1, f_ext[3][3] * x67),
+            ) + x588 + S::mul_add(x92, x578, x93 * x577);
+        let x592 = S::mul_add(x87, x483, S::mul_add(x86, x482, x85 * x481))
+            - S::mul_add(S::neg(x478), x548, x480 * x546)
+            + S::mul_add(
                 f_ext[3][5],
                 x70,
-                Self::mul_add(f_ext[3][4], x10, f_ext[3][3] * x69),
-            ) - x589 + Self::mul_add(-x91, x578, x93 * x576);
-        let x593 = Self::mul_add(x90, x483, Self::mul_add(x89, x482, x88 * x481))
-            - Self::mul_add(x478, x547, x479 * x546)
-            + Self::mul_add(
+                S::mul_add(f_ext[3][4], x10, f_ext[3][3] * x69),
+            ) - x589 + S::mul_add(S::neg(x91), x578, x93 * x576);
+        let x593 = S::mul_add(x90, x483, S::mul_add(x89, x482, x88 * x481))
+            - S::mul_add(x478, x547, x479 * x546)
+            + S::mul_add(
                 f_ext[3][5],
                 x72,
-                Self::mul_add(f_ext[3][4], x12, f_ext[3][3] * x71),
-            ) - x590 - Self::mul_add(x91, x577, x92 * x576);
-        let x594 = Self::mul_add(x57, x465, Self::mul_add(x56, x464, x55 * x463))
-            + Self::mul_add(x461, x542, x462 * x541)
-            + Self::mul_add(
+                S::mul_add(f_ext[3][4], x12, f_ext[3][3] * x71),
+            ) - x590 - S::mul_add(x91, x577, x92 * x576);
+        let x594 = S::mul_add(x57, x465, S::mul_add(x56, x464, x55 * x463))
+            + S::mul_add(x461, x542, x462 * x541)
+            + S::mul_add(
                 f_ext[2][5],
                 x41,
-                Self::mul_add(-f_ext[2][4], s_q1, f_ext[2][3] * x40),
-            ) + x591 + Self::mul_add(x65, x581, x66 * x580);
-        let x595 = Self::mul_add(x60, x465, Self::mul_add(x59, x464, x58 * x463))
-            - Self::mul_add(-x460, x542, x462 * x540)
-            + Self::mul_add(
+                S::mul_add(S::neg(f_ext[2][4]), s_q1, f_ext[2][3] * x40),
+            ) + x591 + S::mul_add(x65, x581, x66 * x580);
+        let x595 = S::mul_add(x60, x465, S::mul_add(x59, x464, x58 * x463))
+            - S::mul_add(S::neg(x460), x542, x462 * x540)
+            + S::mul_add(
                 f_ext[2][5],
                 x43,
-                Self::mul_add(f_ext[2][4], x10, f_ext[2][3] * x42),
-            ) + x592 + Self::mul_add(-x64, x581, x66 * x579);
-        let x596 = Self::mul_add(x63, x465, Self::mul_add(x62, x464, x61 * x463))
-            - Self::mul_add(x460, x541, x461 * x540)
-            + Self::mul_add(
+                S::mul_add(f_ext[2][4], x10, f_ext[2][3] * x42),
+            ) + x592 + S::mul_add(S::neg(x64), x581, x66 * x579);
+        let x596 = S::mul_add(x63, x465, S::mul_add(x62, x464, x61 * x463))
+            - S::mul_add(x460, x541, x461 * x540)
+            + S::mul_add(
                 f_ext[2][5],
                 x45,
-                Self::mul_add(f_ext[2][4], x12, f_ext[2][3] * x44),
-            ) + x593 - Self::mul_add(x64, x580, x65 * x579);
+                S::mul_add(f_ext[2][4], x12, f_ext[2][3] * x44),
+            ) + x593 - S::mul_add(x64, x580, x65 * x579);
         let x597 = tau[0]
             + (f_ext[0][3]
-                + (Self::mul_add(x26, x450, x24 * x449)
-                    + Self::mul_add(x444, x537, x445 * x536)
-                    + Self::mul_add(-f_ext[1][4], s_q1, f_ext[1][3] * c_q1) + x594
-                    - Self::mul_add(x38, x584, x39 * x583))
-                + Self::mul_add(-x7, x539 + x584, x8 * (x538 + x583)));
-        let x598 = Self::mul_add(
-            -c_q0,
-            Self::mul_add(x36, x450, x34 * x449)
-                - Self::mul_add(qd[0], x536, x444 * x535)
-                + Self::mul_add(
+                + (S::mul_add(x26, x450, x24 * x449)
+                    + S::mul_add(x444, x537, x445 * x536)
+                    + S::mul_add(S::neg(f_ext[1][4]), s_q1, f_ext[1][3] * c_q1) + x594
+                    - S::mul_add(x38, x584, x39 * x583))
+                + S::mul_add(S::neg(x7), x539 + x584, x8 * (x538 + x583)));
+        let x598 = S::mul_add(
+            S::neg(c_q0),
+            S::mul_add(x36, x450, x34 * x449) - S::mul_add(qd[0], x536, x444 * x535)
+                + S::mul_add(
                     f_ext[1][5],
                     c_q0,
-                    Self::mul_add(f_ext[1][4], x12, f_ext[1][3] * x11),
-                ) + x596 + Self::mul_add(-x37, x583, x38 * x582),
+                    S::mul_add(f_ext[1][4], x12, f_ext[1][3] * x11),
+                ) + x596 + S::mul_add(S::neg(x37), x583, x38 * x582),
             s_q0
-                * (Self::mul_add(x31, x450, x29 * x449)
-                    - Self::mul_add(-qd[0], x537, x445 * x535)
-                    + Self::mul_add(
-                        -f_ext[1][5],
+                * (S::mul_add(x31, x450, x29 * x449)
+                    - S::mul_add(S::neg(qd[0]), x537, x445 * x535)
+                    + S::mul_add(
+                        S::neg(f_ext[1][5]),
                         s_q0,
-                        Self::mul_add(f_ext[1][4], x10, f_ext[1][3] * x9),
-                    ) + x595 - Self::mul_add(x37, x584, x39 * x582)),
+                        S::mul_add(f_ext[1][4], x10, f_ext[1][3] * x9),
+                    ) + x595 - S::mul_add(x37, x584, x39 * x582)),
         );
-        let x599 = 1.0
-            / (12.19 + (x22 + x236)
-                - (x402 + Self::mul_add(-x38, x280, x39 * x281)
-                    - Self::mul_add(
+        let x599 = S::splat(1.0)
+            / (S::splat(12.19) + (x22 + x236)
+                - (x402 + S::mul_add(S::neg(x38), x280, x39 * x281)
+                    - S::mul_add(
                         x7,
-                        Self::mul_add(105.98, x7, x280),
-                        x8 * Self::mul_add(105.98, x8, x281),
+                        S::mul_add(S::splat(105.98), x7, x280),
+                        x8 * S::mul_add(S::splat(105.98), x8, x281),
                     )));
         let x600 = x405 * x599;
         let x601 = x406 * x599;
@@ -6169,200 +6526,255 @@ impl SsrmsRecurrent {
         let x603 = x408 * x599;
         let x604 = x409 * x599;
         let x605 = x410 * x599;
-        let x606 = 1.0 / Self::mul_add(-x405, x600, x413);
-        let x607 = Self::mul_add(-x405, x601, Self::mul_add(-c_q0, x415, s_q0 * x414));
-        let x608 = x606 * x607;
-        let x609 = Self::mul_add(-x405, x602, x416);
-        let x610 = x606 * x609;
-        let x611 = Self::mul_add(x405, x603, x417);
-        let x612 = x606 * x611;
-        let x613 = Self::mul_add(-x405, x604, x418);
-        let x614 = x606 * x613;
-        let x615 = Self::mul_add(-x405, x605, Self::mul_add(-c_q0, x412, s_q0 * x411));
-        let x616 = x606 * x615;
-        let x617 = Self::mul_add(
-            -x406,
+        let x606 = S::splat(1.0) / S::mul_add(S::neg(x405), x600, x413);
+        let x607 = S::mul_add(
+            S::neg(x405),
             x601,
-            Self::mul_add(-x12, x421, Self::mul_add(-x10, x420, s_q1 * x419)),
+            S::mul_add(S::neg(c_q0), x415, s_q0 * x414),
         );
-        let x618 = 1.0 / Self::mul_add(-x607, x608, x617);
-        let x619 = Self::mul_add(-x607, x610, Self::mul_add(-x406, x602, x423));
+        let x608 = x606 * x607;
+        let x609 = S::mul_add(S::neg(x405), x602, x416);
+        let x610 = x606 * x609;
+        let x611 = S::mul_add(x405, x603, x417);
+        let x612 = x606 * x611;
+        let x613 = S::mul_add(S::neg(x405), x604, x418);
+        let x614 = x606 * x613;
+        let x615 = S::mul_add(
+            S::neg(x405),
+            x605,
+            S::mul_add(S::neg(c_q0), x412, s_q0 * x411),
+        );
+        let x616 = x606 * x615;
+        let x617 = S::mul_add(
+            S::neg(x406),
+            x601,
+            S::mul_add(S::neg(x12), x421, S::mul_add(S::neg(x10), x420, s_q1 * x419)),
+        );
+        let x618 = S::splat(1.0) / S::mul_add(S::neg(x607), x608, x617);
+        let x619 = S::mul_add(S::neg(x607), x610, S::mul_add(S::neg(x406), x602, x423));
         let x620 = x618 * x619;
-        let x621 = Self::mul_add(x607, x612, Self::mul_add(-x406, x603, x425));
+        let x621 = S::mul_add(x607, x612, S::mul_add(S::neg(x406), x603, x425));
         let x622 = x618 * x621;
-        let x623 = Self::mul_add(-x607, x614, Self::mul_add(-x406, x604, x427));
+        let x623 = S::mul_add(S::neg(x607), x614, S::mul_add(S::neg(x406), x604, x427));
         let x624 = x618 * x623;
-        let x625 = Self::mul_add(-x607, x616, Self::mul_add(-x406, x605, x428));
+        let x625 = S::mul_add(S::neg(x607), x616, S::mul_add(S::neg(x406), x605, x428));
         let x626 = x618 * x625;
-        let x627 = Self::mul_add(
-            -x407,
+        let x627 = S::mul_add(
+            S::neg(x407),
             x602,
-            Self::mul_add(-x12, x431, Self::mul_add(-x10, x430, s_q1 * x429)),
+            S::mul_add(S::neg(x12), x431, S::mul_add(S::neg(x10), x430, s_q1 * x429)),
         );
-        let x628 = 1.0 / Self::mul_add(-x619, x620, Self::mul_add(-x609, x610, x627));
-        let x629 = Self::mul_add(
-            -x619,
+        let x628 = S::splat(1.0)
+            / S::mul_add(S::neg(x619), x620, S::mul_add(S::neg(x609), x610, x627));
+        let x629 = S::mul_add(
+            S::neg(x619),
             x622,
-            Self::mul_add(x609, x612, Self::mul_add(-x407, x603, x433)),
+            S::mul_add(x609, x612, S::mul_add(S::neg(x407), x603, x433)),
         );
         let x630 = x628 * x629;
-        let x631 = Self::mul_add(
-            -x619,
+        let x631 = S::mul_add(
+            S::neg(x619),
             x624,
-            Self::mul_add(-x609, x614, Self::mul_add(-x407, x604, x435)),
+            S::mul_add(S::neg(x609), x614, S::mul_add(S::neg(x407), x604, x435)),
         );
         let x632 = x628 * x631;
-        let x633 = Self::mul_add(
-            -x619,
+        let x633 = S::mul_add(
+            S::neg(x619),
             x626,
-            Self::mul_add(-x609, x616, Self::mul_add(-x407, x605, x428)),
+            S::mul_add(S::neg(x609), x616, S::mul_add(S::neg(x407), x605, x428)),
         );
         let x634 = x628 * x633;
-        let x635 = Self::mul_add(
-            -x408,
+        let x635 = S::mul_add(
+            S::neg(x408),
             x603,
-            Self::mul_add(x12, x438, Self::mul_add(x10, x437, s_q1 * x436)),
+            S::mul_add(x12, x438, S::mul_add(x10, x437, s_q1 * x436)),
         );
-        let x636 = Self::mul_add(
-            -x629,
+        let x636 = S::mul_add(
+            S::neg(x629),
             x630,
-            Self::mul_add(-x621, x622, Self::mul_add(-x611, x612, x635)),
+            S::mul_add(S::neg(x621), x622, S::mul_add(S::neg(x611), x612, x635)),
         );
-        let x637 = 1.0 / x636;
-        let x638 = Self::mul_add(
-            -x621,
+        let x637 = S::splat(1.0) / x636;
+        let x638 = S::mul_add(
+            S::neg(x621),
             x624,
-            Self::mul_add(x611, x614, Self::mul_add(-x408, x604, x440)),
+            S::mul_add(x611, x614, S::mul_add(S::neg(x408), x604, x440)),
         );
-        let x639 = Self::mul_add(-x629, x632, x638);
+        let x639 = S::mul_add(S::neg(x629), x632, x638);
         let x640 = x637 * x639;
-        let x641 = Self::mul_add(
-            -x621,
+        let x641 = S::mul_add(
+            S::neg(x621),
             x626,
-            Self::mul_add(x611, x616, Self::mul_add(-x408, x605, x428)),
+            S::mul_add(x611, x616, S::mul_add(S::neg(x408), x605, x428)),
         );
-        let x642 = Self::mul_add(-x629, x634, x641);
+        let x642 = S::mul_add(S::neg(x629), x634, x641);
         let x643 = x637 * x642;
-        let x644 = Self::mul_add(
-            -x409,
+        let x644 = S::mul_add(
+            S::neg(x409),
             x604,
-            Self::mul_add(x99, x443, Self::mul_add(x97, x442, x95 * x441)),
+            S::mul_add(x99, x443, S::mul_add(x97, x442, x95 * x441)),
         );
-        let x645 = Self::mul_add(
-            -x631,
+        let x645 = S::mul_add(
+            S::neg(x631),
             x632,
-            Self::mul_add(-x623, x624, Self::mul_add(-x613, x614, x644)),
+            S::mul_add(S::neg(x623), x624, S::mul_add(S::neg(x613), x614, x644)),
         );
-        let x646 = 1.0 / Self::mul_add(-x639, x640, x645);
-        let x647 = Self::mul_add(
-            -x409,
+        let x646 = S::splat(1.0) / S::mul_add(S::neg(x639), x640, x645);
+        let x647 = S::mul_add(
+            S::neg(x409),
             x605,
-            Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410)),
+            S::mul_add(x99, x412, S::mul_add(x97, x411, x95 * x410)),
         );
-        let x648 = Self::mul_add(
-            -x631,
+        let x648 = S::mul_add(
+            S::neg(x631),
             x634,
-            Self::mul_add(-x623, x626, Self::mul_add(-x613, x616, x647)),
+            S::mul_add(S::neg(x623), x626, S::mul_add(S::neg(x613), x616, x647)),
         );
-        let x649 = Self::mul_add(-x639, x643, x648);
+        let x649 = S::mul_add(S::neg(x639), x643, x648);
         let x650 = x646 * x649;
-        let x651 = Self::mul_add(
-            -x410,
+        let x651 = S::mul_add(
+            S::neg(x410),
             x605,
-            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
+            S::mul_add(x119, x412, S::mul_add(x117, x411, x115 * x410)),
         );
-        let x652 = Self::mul_add(
-            -x633,
+        let x652 = S::mul_add(
+            S::neg(x633),
             x634,
-            Self::mul_add(-x625, x626, Self::mul_add(-x615, x616, x651)),
+            S::mul_add(S::neg(x625), x626, S::mul_add(S::neg(x615), x616, x651)),
         );
-        let x653 = 1.0 / Self::mul_add(-x649, x650, Self::mul_add(-x642, x643, x652));
-        let x654 = Self::mul_add(x597, x600, tau[1] - x598);
-        let x655 = Self::mul_add(
+        let x653 = S::splat(1.0)
+            / S::mul_add(S::neg(x649), x650, S::mul_add(S::neg(x642), x643, x652));
+        let x654 = S::mul_add(x597, x600, tau[1] - x598);
+        let x655 = S::mul_add(
             x597,
             x601,
-            tau[2] - Self::mul_add(-x12, x596, Self::mul_add(-x10, x595, s_q1 * x594)),
+            tau[2]
+                - S::mul_add(
+                    S::neg(x12),
+                    x596,
+                    S::mul_add(S::neg(x10), x595, s_q1 * x594),
+                ),
         );
-        let x656 = Self::mul_add(-x608, x654, x655);
-        let x657 = Self::mul_add(
+        let x656 = S::mul_add(S::neg(x608), x654, x655);
+        let x657 = S::mul_add(
             x597,
             x602,
-            tau[3] - Self::mul_add(-x12, x593, Self::mul_add(-x10, x592, s_q1 * x591)),
+            tau[3]
+                - S::mul_add(
+                    S::neg(x12),
+                    x593,
+                    S::mul_add(S::neg(x10), x592, s_q1 * x591),
+                ),
         );
-        let x658 = Self::mul_add(-x620, x656, Self::mul_add(-x610, x654, x657));
-        let x659 = Self::mul_add(
+        let x658 = S::mul_add(S::neg(x620), x656, S::mul_add(S::neg(x610), x654, x657));
+        let x659 = S::mul_add(
             x597,
             x603,
-            tau[4] - Self::mul_add(x12, x590, Self::mul_add(x10, x589, s_q1 * x588)),
+            tau[4] - S::mul_add(x12, x590, S::mul_add(x10, x589, s_q1 * x588)),
         );
-        let x660 = Self::mul_add(
-            -x630,
+        let x660 = S::mul_add(
+            S::neg(x630),
             x658,
-            Self::mul_add(-x622, x656, Self::mul_add(x612, x654, x659)),
+            S::mul_add(S::neg(x622), x656, S::mul_add(x612, x654, x659)),
         );
-        let x661 = Self::mul_add(
-            -x597,
+        let x661 = S::mul_add(
+            S::neg(x597),
             x604,
-            tau[5] + Self::mul_add(x99, x587, Self::mul_add(x97, x586, x95 * x585)),
+            tau[5] + S::mul_add(x99, x587, S::mul_add(x97, x586, x95 * x585)),
         );
-        let x662 = Self::mul_add(
+        let x662 = S::mul_add(
             x632,
             x658,
-            Self::mul_add(x624, x656, Self::mul_add(x614, x654, x661)),
+            S::mul_add(x624, x656, S::mul_add(x614, x654, x661)),
         );
-        let x663 = Self::mul_add(x640, x660, x662);
-        let x664 = Self::mul_add(
-            -x597,
+        let x663 = S::mul_add(x640, x660, x662);
+        let x664 = S::mul_add(
+            S::neg(x597),
             x605,
-            tau[6] + Self::mul_add(x119, x572, Self::mul_add(x117, x571, x115 * x570)),
+            tau[6] + S::mul_add(x119, x572, S::mul_add(x117, x571, x115 * x570)),
         );
-        let x665 = Self::mul_add(
+        let x665 = S::mul_add(
             x634,
             x658,
-            Self::mul_add(x626, x656, Self::mul_add(x616, x654, x664)),
+            S::mul_add(x626, x656, S::mul_add(x616, x654, x664)),
         );
-        let x666 = x653 * Self::mul_add(-x650, x663, Self::mul_add(x643, x660, x665));
-        let x667 = Self::mul_add(-x650, x666, x646 * x663);
-        let x668 = Self::mul_add(x643, x666, Self::mul_add(x640, x667, x637 * x660));
-        let x669 = Self::mul_add(
+        let x666 = x653 * S::mul_add(S::neg(x650), x663, S::mul_add(x643, x660, x665));
+        let x667 = S::mul_add(S::neg(x650), x666, x646 * x663);
+        let x668 = S::mul_add(x643, x666, S::mul_add(x640, x667, x637 * x660));
+        let x669 = S::mul_add(
             x634,
             x666,
-            Self::mul_add(x632, x667, Self::mul_add(-x630, x668, x628 * x658)),
+            S::mul_add(x632, x667, S::mul_add(S::neg(x630), x668, x628 * x658)),
         );
-        let x670 = Self::mul_add(
+        let x670 = S::mul_add(
             x624,
             x667,
-            Self::mul_add(-x622, x668, Self::mul_add(-x620, x669, x618 * x656)),
+            S::mul_add(S::neg(x622), x668, S::mul_add(S::neg(x620), x669, x618 * x656)),
         );
-        let x671 = Self::mul_add(x626, x666, x670);
-        let x672 = Self::mul_add(
+        let x671 = S::mul_add(x626, x666, x670);
+        let x672 = S::mul_add(
             x612,
             x668,
-            Self::mul_add(-x610, x669, Self::mul_add(-x608, x671, x606 * x654)),
+            S::mul_add(S::neg(x610), x669, S::mul_add(S::neg(x608), x671, x606 * x654)),
         );
-        let x673 = Self::mul_add(x616, x666, Self::mul_add(x614, x667, x672));
-        let x674 = Self::mul_add(
+        let x673 = S::mul_add(x616, x666, S::mul_add(x614, x667, x672));
+        let x674 = S::mul_add(
             x602,
             x669,
-            Self::mul_add(x601, x671, Self::mul_add(x600, x673, x597 * x599)),
+            S::mul_add(x601, x671, S::mul_add(x600, x673, x597 * x599)),
         );
-        let x675 = Self::mul_add(
-            -x605,
+        let x675 = S::mul_add(
+            S::neg(x605),
             x666,
-            Self::mul_add(-x604, x667, Self::mul_add(x603, x668, x674)),
+            S::mul_add(S::neg(x604), x667, S::mul_add(x603, x668, x674)),
         );
         [x675, x673, x671, x669, x668, x667, x666]
     }
-    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
-    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
-    #[inline(always)]
-    fn mul_add(
-        a: ::core::primitive::f64,
-        b: ::core::primitive::f64,
-        c: ::core::primitive::f64,
-    ) -> ::core::primitive::f64 {
-        kanegen_runtime::fma::mul_add(a, b, c)
+    /// [`Self::forward_dynamics_with_wrenches`] of every state of the slices, `S::LANES` states per call of [`Self::forward_dynamics_with_wrenches_lanes`]: `out[k]` is `forward_dynamics_with_wrenches` of the `k`-th entries, for `k` below the shortest slice's length (`out` included; entries of `out` past it are left as they are); a last chunk of fewer states is padded with the last state, whose extra results are discarded.
+    pub fn forward_dynamics_with_wrenches_batch<
+        S: kanegen_runtime::lanes::Lanes<::core::primitive::f64>,
+    >(
+        q: &[[::core::primitive::f64; 7]],
+        qd: &[[::core::primitive::f64; 7]],
+        tau: &[[::core::primitive::f64; 7]],
+        f_ext: &[[[::core::primitive::f64; 6]; 7]],
+        out: &mut [[::core::primitive::f64; 7]],
+    ) {
+        let n = out.len().min(q.len()).min(qd.len()).min(tau.len()).min(f_ext.len());
+        kanegen_runtime::lanes::batch::<
+            ::core::primitive::f64,
+            S,
+            _,
+        >(
+            out,
+            n,
+            |start| {
+                Self::forward_dynamics_with_wrenches_lanes::<
+                    S,
+                >(
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(q, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(qd, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(tau, start, n),
+                    &kanegen_runtime::lanes::gather::<
+                        ::core::primitive::f64,
+                        S,
+                        _,
+                    >(f_ext, start, n),
+                )
+            },
+        );
     }
     /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]

@@ -1,6 +1,6 @@
 //! kanegen's `no_std` runtime: what every other part of kanegen runs on, written once.
 //!
-//! It sits at the bottom of the crate graph and depends on nothing of kanegen's (only `libm`),
+//! It sits at the bottom of the crate graph and depends on nothing of kanegen's (only `libm` and `wide`),
 //! so the simulator (`kanegen-sim`), the run-time path (`kanegen-dynamics`), the code that
 //! `dynamics!` and `scene!` emit (through the facade, `kanegen::runtime`) and the checked-in
 //! generated files (`kanegen-generated`) all call the same code:
@@ -14,6 +14,9 @@
 //! - [`ode`]: the integrators (RK4, Dormand–Prince 5(4), Rodas4, the Lie-group implicit
 //!   midpoint rule) over slices with caller-provided scratch, for the simulator and `scene!`.
 //! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
+//! - [`lanes`]: the [`Lanes`](lanes::Lanes) trait of generated `NAME_lanes` functions, which
+//!   evaluate several states per call on SIMD vector types (`wide`'s), lane by lane bit for bit
+//!   the scalar function.
 //! - [`scene`]: a scene's right-hand side (drives, damping, friction, wrenches, rotor inertia,
 //!   flexible joints, a free-floating base's kinematics) over a dynamics provider, written once
 //!   for the interpreted simulator and `scene!`.
@@ -30,6 +33,7 @@ pub mod composed;
 pub mod coupling;
 pub mod fma;
 pub mod inertia;
+pub mod lanes;
 pub mod ldlt;
 pub mod ode;
 pub mod scalar;
