@@ -385,7 +385,7 @@ fn function_item(
          are discarded."
     );
     let body = body.tokens;
-    let (scalar_body, lanes_body, lanes_doc) = if matches!(fp.kernel, Kernel::Compact(_)) {
+    let (scalar_body, lanes_body, lanes_doc) = if fp.kernel != Kernel::Unrolled {
         let lane_of = arg_names
             .iter()
             .map(|a| quote!(&#rt::lanes::lane::<#fl, S, _>(#a, i)));
@@ -396,8 +396,8 @@ fn function_item(
             },
             format!(
                 " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`{}` \
-                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): the \
-                 compact form evaluates the scalar function lane by lane.",
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): a \
+                 function in loops or composed evaluates the scalar function lane by lane.",
                 opts.float.name(),
                 match opts.float {
                     Float::F64 => "f64x4",
