@@ -106,8 +106,9 @@ fn generated_code_has_gravity_only_when_asked() {
     assert!(!space.contains("fn gravity"));
     assert!(earth.contains("fn gravity"));
     // The gravity function is only in the gravity file, and c differs (g enters c).
+    // The straight-line body is `NAME_lanes`'s (`NAME` calls it).
     let body = |src: &str, f: &str| {
-        let i = src.find(&format!("fn {f}(")).unwrap();
+        let i = src.find(&format!("fn {f}_lanes<")).unwrap();
         src[i..i + src[i..].find("\n    }").unwrap()].to_string()
     };
     assert_ne!(
