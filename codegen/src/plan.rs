@@ -233,19 +233,20 @@ impl Plan {
         if self.compact() {
             return Vec::new();
         }
-        self.functions
-            .iter()
-            .filter(|fp| matches!(fp.kernel, Kernel::Compact(_)))
-            .map(|fp| format!("`{}`", fp.function.name()))
-            .collect()
+        self.named(|k| matches!(k, Kernel::Compact(_)))
     }
 
     /// The composed functions ([`Kernel::Composed`]), as the header names them: `` `name` ``.
     #[must_use]
     pub fn composed(&self) -> Vec<String> {
+        self.named(|k| matches!(k, Kernel::Composed(_)))
+    }
+
+    /// The functions whose kernel is `kind`, as the header names them: `` `name` ``.
+    fn named(&self, kind: impl Fn(Kernel) -> bool) -> Vec<String> {
         self.functions
             .iter()
-            .filter(|fp| matches!(fp.kernel, Kernel::Composed(_)))
+            .filter(|fp| kind(fp.kernel))
             .map(|fp| format!("`{}`", fp.name))
             .collect()
     }
