@@ -56,6 +56,9 @@ kanegen::dynamics!(
     "tests/data/compact/tree10.toml",
     form = "compact"
 );
+// Compact under `auto`, its `mass_matrix_inverse` straight-line (within the derivatives' size
+// rule) beside the compact kernels of the other two.
+kanegen::dynamics!(Chain12Auto, "tests/data/compact/chain12.toml");
 
 const G: [f64; 3] = [0.3, -1.2, -9.81];
 
@@ -220,7 +223,8 @@ fn generated_free_floating_derivatives_equal_the_algorithms() {
 }
 
 /// A compact type's derivatives (`kanegen_runtime::compact::derivatives`) against the
-/// algorithms, as the unrolled types' above.
+/// algorithms, as the unrolled types' above; and an auto-compact type's, whose `M⁻¹` is
+/// straight-line.
 #[test]
 fn compact_derivatives_equal_the_algorithms() {
     let e = check_fixed!(
@@ -231,6 +235,17 @@ fn compact_derivatives_equal_the_algorithms() {
     );
     println!("tree10, compact: {e:.1e}");
     assert!(e < 1e-11, "tree10 compact: {e:e}");
+    let e = check_fixed!(
+        Chain12Auto,
+        12,
+        load("tests/data/compact/chain12.toml"),
+        None::<[f64; 3]>,
+    );
+    println!("chain12, auto (M⁻¹ straight-line): {e:.1e}");
+    assert!(e < 1e-11, "chain12 auto: {e:e}");
+    // `CANDIDATES` lists the straight-line functions only.
+    let straight = |f: &str| Chain12Auto::CANDIDATES.iter().any(|c| c.function == f);
+    assert!(straight("mass_matrix_inverse") && !straight("inverse_dynamics_derivatives"));
 }
 
 /// Against Pinocchio.

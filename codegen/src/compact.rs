@@ -127,6 +127,18 @@ pub fn may_keep_unrolled(opts: &Options, f: Function) -> bool {
         )
 }
 
+/// Whether `f` is `mass_matrix_inverse` in a model that [`decide`] made compact under
+/// [`Form::Auto`]: it keeps its straight-line body (CRBA and the LDLᵀ inverse unrolled) while
+/// that has at most [`DERIVATIVES_AUTO_LIMIT`] emitted operations, sized on prefixes. Its
+/// kernel runs dense `N × N` loops where the traced body drops every zero and one: measured side
+/// by side on a random 12-joint chain (`DERIVS=1 tools/compact/measure.sh auto|compact`, 5,342
+/// emitted operations), 611 ns against 1,250 for the kernel, for a rebuild of 25 s of CPU
+/// against 3 s (what an unrolled model of six or seven joints takes).
+#[must_use]
+pub fn may_keep_inverse_unrolled(opts: &Options, f: Function) -> bool {
+    f == Function::MassMatrixInverse && loops_derivatives(opts)
+}
+
 /// Whether `f` keeps its unrolled body in a model that [`decide`] made compact: it
 /// [`may_keep_unrolled`] and its unrolled body, traced as far as `size`, has at most
 /// [`LINEAR_AUTO_LIMIT`] emitted operations.

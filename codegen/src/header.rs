@@ -90,13 +90,22 @@ fn lanes_line(plan: &Plan, opts: &Options) -> String {
 /// straight-line.
 fn form_line(plan: &Plan) -> String {
     let mut line = plan.decision.line.clone();
-    let kept = plan.kept_unrolled();
+    let kept = plan.kept_unrolled(false);
     if !kept.is_empty() {
         line.push_str(&format!(
             " Straight-line all the same: {} (an O(N) function within {} emitted operations \
              measured faster unrolled).",
             kept.join(", "),
             compact::LINEAR_AUTO_LIMIT
+        ));
+    }
+    let kept = plan.kept_unrolled(true);
+    if !kept.is_empty() {
+        line.push_str(&format!(
+            " Straight-line too: {} (the CRBA and the LDLᵀ inverse unrolled, within {} emitted \
+             operations, measured faster than the dense kernel's loops).",
+            kept.join(", "),
+            compact::DERIVATIVES_AUTO_LIMIT
         ));
     }
     let looped = plan.looped_derivatives();

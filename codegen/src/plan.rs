@@ -256,17 +256,21 @@ impl Plan {
         self.functions.iter().map(|f| &f.choice)
     }
 
-    /// The functions with a compact body that kept their unrolled one (under [`Form::Auto`],
-    /// [`compact::keeps_unrolled`]), as the header names them: `` `name` (ops) ``.
+    /// The functions with a compact body that kept their unrolled one (under [`Form::Auto`]):
+    /// the derivative functions ([`compact::may_keep_inverse_unrolled`]) when `derivatives`,
+    /// else the others ([`compact::keeps_unrolled`]), as the header names them:
+    /// `` `name` (ops) ``.
     #[must_use]
-    pub fn kept_unrolled(&self) -> Vec<String> {
+    pub fn kept_unrolled(&self, derivatives: bool) -> Vec<String> {
         if !self.compact() {
             return Vec::new();
         }
         self.functions
             .iter()
             .filter(|fp| {
-                fp.kernel == Kernel::Unrolled && compact::has_body(fp.function, self.floating())
+                fp.kernel == Kernel::Unrolled
+                    && compact::has_body(fp.function, self.floating())
+                    && fp.function.is_derivative() == derivatives
             })
             .map(|fp| format!("`{}` ({})", fp.function.name(), fp.choice.counts().total()))
             .collect()
@@ -379,6 +383,10 @@ fn plan_body(
         unrolled_derivative(model, subjects, f, mass, opts)?
     } else if decision.form != Form::Compact || !compact::has_body(f, floating) {
         Some(choose_in(model, subjects, f, mass, opts)?)
+    } else if compact::may_keep_inverse_unrolled(opts, f) {
+        let limit = compact::DERIVATIVES_AUTO_LIMIT;
+        let (size, traced) = size_on_prefixes(model, subjects, opts, limit, &[f], mass)?;
+        traced.into_iter().next().filter(|_| !size.above(limit))
     } else if compact::may_keep_unrolled(opts, f) && f.frame().is_some() {
         // A frame function is O(depth) and the prefixes have no frames: traced whole.
         let (choice, graph) = choose_in(model, subjects, f, mass, opts)?;

@@ -421,3 +421,36 @@ fn large_derivatives_of_an_unrolled_model_run_in_loops() {
     let src = generate_file(&model, &o).unwrap().replace([' ', '\n'], "");
     assert!(names.iter().all(|f| !src.contains(&kernel(f))));
 }
+
+/// A compact model keeps `mass_matrix_inverse` straight-line while its body is within
+/// `DERIVATIVES_AUTO_LIMIT` (a 12-joint chain, the header says so with its count), and calls the
+/// kernel above it (16 joints) or when the compact form is forced.
+#[test]
+fn a_compact_model_keeps_a_small_mass_matrix_inverse_straight_line() {
+    use kanegen_codegen::compact::DERIVATIVES_AUTO_LIMIT;
+    let kernel = "kanegen_runtime::compact::derivatives::mass_matrix_inverse(&Self::CX";
+    let o = Options::new("Arm");
+    let model = chain_default(12);
+    let g = generate_items(&model, &o).unwrap();
+    let line = form_line(&g.header);
+    assert!(line.starts_with("Form: compact"), "{line}");
+    let kept = line
+        .split("Straight-line too: `mass_matrix_inverse` (")
+        .nth(1)
+        .and_then(|s| s.split(')').next())
+        .and_then(|s| s.parse::<u64>().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(kept <= DERIVATIVES_AUTO_LIMIT && kept > 1000, "{line}");
+    let src = generate_file(&model, &o).unwrap().replace([' ', '\n'], "");
+    assert!(!src.contains(kernel));
+    assert!(src.contains("kanegen_runtime::compact::derivatives::inverse_dynamics_derivatives("));
+    let big = chain_default(16);
+    let line = form_line(&generate_items(&big, &o).unwrap().header);
+    assert!(!line.contains("Straight-line too"), "{line}");
+    let src = generate_file(&big, &o).unwrap().replace([' ', '\n'], "");
+    assert!(src.contains(kernel));
+    let src = generate_file(&model, &compact_opts())
+        .unwrap()
+        .replace([' ', '\n'], "");
+    assert!(src.contains(kernel));
+}
