@@ -8,7 +8,7 @@
 //! `NV × NV` (`NV = 6 + N`) in Pinocchio's tangent space and the drives act on the last `N`
 //! speeds; with mimic joints everything is in the independent coordinates.
 
-use crate::compact::derivatives::accelerations as solve;
+use crate::compact::derivatives::{accelerations as solve, neg_product};
 use crate::Scalar;
 
 /// `q̈ = M⁻¹ (τ_full − c)`, `τ_full = [0 (NV − N); τ]` (no drive on a free-floating base's own
@@ -39,15 +39,9 @@ pub fn forward_dynamics_derivatives<S: Scalar + Copy, const NV: usize>(
     (dtq, dtv): ([[S; NV]; NV], [[S; NV]; NV]),
 ) -> ([[S; NV]; NV], [[S; NV]; NV], [[S; NV]; NV]) {
     let (mut dq, mut dv) = ([[S::zero(); NV]; NV], [[S::zero(); NV]; NV]);
-    // Row r of −M⁻¹ D: Σ_k −(M⁻¹)_rk D_k, each row of D a fixed-length loop (vectorized).
-    for (r, row) in minv.iter().enumerate() {
-        for (k, &x) in row.iter().enumerate() {
-            for j in 0..NV {
-                dq[r][j] = dq[r][j] - x * dtq[k][j];
-                dv[r][j] = dv[r][j] - x * dtv[k][j];
-            }
-        }
-    }
+    let m = minv.as_flattened();
+    neg_product(m, dtq.as_flattened(), NV, dq.as_flattened_mut());
+    neg_product(m, dtv.as_flattened(), NV, dv.as_flattened_mut());
     (dq, dv, minv)
 }
 

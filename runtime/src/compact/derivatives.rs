@@ -423,12 +423,10 @@ pub fn inverse_in<S: Scalar + Copy>(m: &mut [S], n: usize, d_inv: &mut [S], out:
 /// inner loop runs along rows of `B` and `out` (contiguous: the compiler vectorizes it).
 #[inline(always)]
 pub fn neg_product<S: Scalar + Copy>(a: &[S], b: &[S], n: usize, out: &mut [S]) {
-    for (r, orow) in out.chunks_exact_mut(n.max(1)).take(n).enumerate() {
+    let n = n.max(1);
+    for (orow, arow) in out.chunks_exact_mut(n).zip(a.chunks_exact(n)) {
         orow.fill(S::zero());
-        for k in 0..n {
-            let (Some(&x), Some(brow)) = (a.get(r * n + k), b.get(k * n..k * n + n)) else {
-                continue;
-            };
+        for (&x, brow) in arow.iter().zip(b.chunks_exact(n)) {
             for (o, &y) in orow.iter_mut().zip(brow) {
                 *o = *o - x * y;
             }
