@@ -122,7 +122,8 @@ pub fn derivatives_fit(model: &Model, decision: &Decision, opts: &Options) -> bo
 }
 
 /// The speeds of `model`: `N`, or `6 + N` on a free-floating base.
-fn speeds(model: &Model) -> usize {
+#[must_use]
+pub fn speeds(model: &Model) -> usize {
     model.dof()
         + if model.base_kind() == BaseKind::FreeFloating {
             6

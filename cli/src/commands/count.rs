@@ -122,12 +122,7 @@ pub fn count_with_progress(
         counts.extend(count_lines(model, &[], &[*b], &spec)?);
         progress(mass.len() + k + 1, total);
     }
-    let nv = model.dof()
-        + if model.base_kind() == BaseKind::FreeFloating {
-            6
-        } else {
-            0
-        };
+    let nv = kanegen_codegen::plan::speeds(model);
     let derivatives = if nv <= kanegen_codegen::plan::DERIVATIVES_MAX_NV {
         derivative_lines(model, &spec)?
     } else {
