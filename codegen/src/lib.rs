@@ -41,6 +41,7 @@
 #![warn(missing_docs)]
 
 pub mod api;
+pub mod c;
 pub mod choose;
 pub mod compact;
 pub mod emit;
@@ -130,7 +131,7 @@ fn generate_items_with(
 
 /// What the generated type cannot be made for: joints that move no mass (its forward dynamics
 /// would divide by a singular `M`).
-fn check_generable(model: &Model) -> Result<(), Error> {
+pub(crate) fn check_generable(model: &Model) -> Result<(), Error> {
     model
         .check_forward_dynamics()
         .map_err(|e| Error(e.to_string()))
@@ -479,7 +480,12 @@ fn return_type(shape: Shape, fl: &TokenStream) -> TokenStream {
 /// The two documentation lines of a function: what it computes ([`api::doc`]), then its methods
 /// and counts (emitted; for a compact body, its loops' methods and its kernel's traced counts).
 /// `k`: fused multiply-adds formed.
-fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (String, String) {
+pub(crate) fn function_docs(
+    plan: &Plan,
+    fp: &FunctionPlan,
+    k: u64,
+    opts: &Options,
+) -> (String, String) {
     let choice = &fp.choice;
     let compact = matches!(fp.kernel, Kernel::Compact(_));
     let mut doc1 = format!(
