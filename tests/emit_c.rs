@@ -4,8 +4,9 @@
 //! -Wextra -Werror`, and a driver calling every function at random states prints what the Rust
 //! side computes from the same plan's graphs (each node once, in order, sines and cosines by the
 //! runtime's `sincos_n_unfused`, as the Rust functions compute them) within 1e-15 relative to the
-//! largest entry of the function's result (bit for bit on a target without FMA). SSRMS's header
-//! with `--fma` is checked against the checked-in Rust functions (`kanegen_generated`) directly.
+//! largest entry of the function's result (bit for bit on a target without FMA). SSRMS's header,
+//! plain and with `--fma`, is checked against the checked-in Rust functions (`kanegen_generated`)
+//! themselves; the `float`, payload and libm variants compile warning-free.
 
 mod precondition;
 
@@ -214,24 +215,33 @@ fn driver(plan: &Plan, p: &str, header: &str, states: &[State]) -> String {
     s
 }
 
-/// Compiles `driver.c` beside `header` with `cc -std=c99 -Wall -Wextra -Werror` at `opt`, runs it
-/// and returns the numbers it printed.
-fn compile_and_run(cc: &str, dir: &Path, opt: &str) -> Vec<f64> {
-    let exe = dir.join("driver");
+/// Runs `cc -std=c99 -Wall -Wextra -Werror` with `args`, checking that it succeeds (its stderr
+/// is the failure message).
+fn cc_checked<A: AsRef<std::ffi::OsStr>>(cc: &str, args: impl IntoIterator<Item = A>) {
     let out = Command::new(cc)
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", opt])
-        .arg(dir.join("driver.c"))
-        .arg("-o")
-        .arg(&exe)
-        .arg("-lm")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror"])
+        .args(args)
         .output()
         .unwrap();
     assert!(
         out.status.success(),
-        "{cc} failed in {}:\n{}",
-        dir.display(),
+        "{cc} failed:\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// Compiles `driver.c` in `dir` (beside its header) with [`cc_checked`] and `flags`, runs it and
+/// returns the numbers it printed.
+fn compile_and_run(cc: &str, dir: &Path, flags: &[&str]) -> Vec<f64> {
+    let exe = dir.join("driver");
+    let mut args: Vec<std::ffi::OsString> = flags.iter().map(Into::into).collect();
+    args.extend([
+        dir.join("driver.c").into(),
+        "-o".into(),
+        exe.clone().into(),
+        "-lm".into(),
+    ]);
+    cc_checked(cc, args);
     let run = Command::new(&exe).output().unwrap();
     assert!(run.status.success(), "{} failed", exe.display());
     String::from_utf8(run.stdout)
@@ -248,7 +258,8 @@ struct Case {
     gravity: Option<[f64; 3]>,
     base: Option<BaseKind>,
     allow_nonphysical: bool,
-    /// Optimization level: the 16-joint chain's derivatives take over a minute at `-O2`.
+    /// Optimization level: `-O2` for two arms, `-O0` for the rest to keep the test short (the
+    /// 16-joint chain's derivatives take over a minute at `-O2`).
     opt: &'static str,
 }
 
@@ -259,7 +270,8 @@ const CASES: [Case; 7] = [
         gravity: None,
         base: None,
         allow_nonphysical: false,
-        opt: "-O2",
+        // At `-O2` in `c_output_matches_the_checked_in_rust_functions`.
+        opt: "-O0",
     },
     Case {
         name: "Srms",
@@ -346,7 +358,7 @@ fn check_case(cc: &str, case: &Case) {
     std::fs::write(dir.join(&header), &text).unwrap();
     let states = states(&plan.model, 3, 0x5EED ^ p.len() as u64);
     std::fs::write(dir.join("driver.c"), driver(&plan, &p, &header, &states)).unwrap();
-    let printed = compile_and_run(cc, &dir, case.opt);
+    let printed = compile_and_run(cc, &dir, &[case.opt]);
     let mut at = 0;
     let mut worst: f64 = 0.0;
     for st in &states {
@@ -389,4 +401,175 @@ fn c_output_compiles_and_matches_rust_for_every_example_model() {
             h.join().unwrap();
         }
     });
+}
+
+/// The results of the checked-in Rust functions of one `kanegen_generated` type at one state,
+/// in the order the C driver prints them (the plan's functions, out-parameters flattened).
+type RustFns = fn(&State) -> Vec<(&'static str, Vec<f64>)>;
+
+/// [`RustFns`] of a fixed-base `kanegen_generated` type of 7 joints with every function of
+/// the default options (no gravity, no frames).
+macro_rules! rust_fns {
+    ($ty:ty) => {
+        |st: &State| -> Vec<(&'static str, Vec<f64>)> {
+            let arr = |name: &str| -> [f64; 7] { st[name][..7].try_into().unwrap() };
+            let (q, qd, qdd, tau) = (arr("q"), arr("qd"), arr("qdd"), arr("tau"));
+            let f_ext: [[f64; 6]; 7] =
+                core::array::from_fn(|r| st["f_ext"][6 * r..6 * r + 6].try_into().unwrap());
+            let flat = |m: [[f64; 7]; 7]| m.concat();
+            let (m, c) = <$ty>::mass_matrix_and_nonlinear_effects(&q, &qd);
+            let (dq, dv) = <$ty>::inverse_dynamics_derivatives(&q, &qd, &qdd);
+            let (fq, fv, minv) = <$ty>::forward_dynamics_derivatives(&q, &qd, &tau);
+            vec![
+                ("mass_matrix", flat(<$ty>::mass_matrix(&q))),
+                (
+                    "nonlinear_effects",
+                    <$ty>::nonlinear_effects(&q, &qd).to_vec(),
+                ),
+                (
+                    "inverse_dynamics",
+                    <$ty>::inverse_dynamics(&q, &qd, &qdd).to_vec(),
+                ),
+                (
+                    "forward_dynamics",
+                    <$ty>::forward_dynamics(&q, &qd, &tau).to_vec(),
+                ),
+                (
+                    "mass_matrix_and_nonlinear_effects",
+                    [flat(m), c.to_vec()].concat(),
+                ),
+                (
+                    "forward_dynamics_with_wrenches",
+                    <$ty>::forward_dynamics_with_wrenches(&q, &qd, &tau, &f_ext).to_vec(),
+                ),
+                (
+                    "inverse_dynamics_derivatives",
+                    [flat(dq), flat(dv)].concat(),
+                ),
+                (
+                    "forward_dynamics_derivatives",
+                    [flat(fq), flat(fv), flat(minv)].concat(),
+                ),
+                ("mass_matrix_inverse", flat(<$ty>::mass_matrix_inverse(&q))),
+            ]
+        }
+    };
+}
+
+/// SSRMS's header, plain and with `--fma` (`fma` of `<math.h>` against the Rust `libm::fma`),
+/// from the options of the checked-in files, against the checked-in Rust functions
+/// (`kanegen_generated::ssrms`, `ssrms_fma`) themselves, every function at random states. The C
+/// fuses the products the Rust fuses: with `-march=native` where the Rust is built for FMA
+/// (`S::mul_add` fused there, `PREFIX_mul_add` where `FP_FAST_FMA`).
+#[test]
+fn c_output_matches_the_checked_in_rust_functions() {
+    use kanegen::cli::commands::generate::GENERATED;
+    let Some(cc) = compiler() else { return };
+    let cases: [(&str, RustFns); 2] = [
+        ("Ssrms", rust_fns!(kanegen_generated::ssrms::Ssrms)),
+        (
+            "SsrmsFma",
+            rust_fns!(kanegen_generated::ssrms_fma::SsrmsFma),
+        ),
+    ];
+    let flags: &[&str] = if cfg!(target_feature = "fma") {
+        &["-O2", "-march=native"]
+    } else {
+        &["-O2"]
+    };
+    for (name, rust) in cases {
+        let g = GENERATED.iter().find(|g| g.type_name == name).unwrap();
+        let model = g.model(root()).unwrap();
+        let opts = g.options();
+        let p = c::prefix(name);
+        let text = c::generate(&model, &opts, &p).unwrap();
+        let mut unrolled = opts.clone();
+        unrolled.form = Form::Unrolled;
+        let (plan, _) = Plan::new(&model, &unrolled).unwrap();
+        let dir = scratch(&format!("{p}_rust"));
+        let header = format!("{p}.h");
+        std::fs::write(dir.join(&header), &text).unwrap();
+        let states = states(&plan.model, 3, 0xC0DE);
+        std::fs::write(dir.join("driver.c"), driver(&plan, &p, &header, &states)).unwrap();
+        let printed = compile_and_run(&cc, &dir, flags);
+        let mut at = 0;
+        for st in &states {
+            let want = rust(st);
+            assert_eq!(
+                want.iter().map(|w| w.0).collect::<Vec<_>>(),
+                plan.functions
+                    .iter()
+                    .map(|fp| fp.name.as_str())
+                    .collect::<Vec<_>>(),
+                "{name}: the functions in the order of the plan"
+            );
+            for (function, want) in want {
+                let have = &printed[at..at + want.len()];
+                at += want.len();
+                check(name, function, have, &want);
+            }
+        }
+        assert_eq!(at, printed.len(), "{name}: every printed number read");
+    }
+}
+
+/// A variant of the options: its prefix and what it sets.
+type Variant = (&'static str, fn(&mut Options));
+
+/// The other variants compile warning-free too, every function emitted (its address taken):
+/// `float` code with a runtime payload and gravity; `--fma` with a payload; libm's sine and
+/// cosine. A bad prefix and the compact form are errors, not panics.
+#[test]
+fn c_output_variants_compile() {
+    let Some(cc) = compiler() else { return };
+    let model = kanegen::model::io::load_model(&root().join("models/two_link.toml")).unwrap();
+    let variants: [Variant; 3] = [
+        ("arm_f32", |o| {
+            o.float = kanegen::codegen::Float::F32;
+            o.runtime_payload = true;
+            o.gravity = Some([0.0, 0.0, -9.81]);
+        }),
+        ("arm_fma", |o| {
+            o.fma = true;
+            o.runtime_payload = true;
+        }),
+        ("arm_libm", |o| o.libm_trig = true),
+    ];
+    for (p, set) in variants {
+        let mut opts = Options::new("Arm");
+        set(&mut opts);
+        let text = c::generate(&model, &opts, p).unwrap();
+        opts.form = Form::Unrolled;
+        let (plan, _) = Plan::new(&model, &opts).unwrap();
+        let dir = scratch(p);
+        std::fs::write(dir.join("arm.h"), &text).unwrap();
+        let kept: Vec<String> = plan
+            .functions
+            .iter()
+            .map(|fp| format!("    (void (*)(void)){p}_{},", fp.name))
+            .collect();
+        let tu = format!(
+            "#include \"arm.h\"\nvoid (*const kept[])(void) = {{\n{}\n}};\n",
+            kept.join("\n")
+        );
+        std::fs::write(dir.join("kept.c"), tu).unwrap();
+        let (src, obj) = (dir.join("kept.c"), dir.join("kept.o"));
+        cc_checked(
+            &cc,
+            [
+                "-O2".as_ref(),
+                "-c".as_ref(),
+                src.as_os_str(),
+                "-o".as_ref(),
+                obj.as_os_str(),
+            ],
+        );
+    }
+    let opts = Options::new("Arm");
+    let err = c::generate(&model, &opts, "1arm").unwrap_err();
+    assert!(err.0.contains("not a C identifier"), "{err}");
+    let mut compact = Options::new("Arm");
+    compact.form = Form::Compact;
+    let err = c::generate(&model, &compact, "arm").unwrap_err();
+    assert!(err.0.contains("does not support the compact form"), "{err}");
 }
