@@ -518,7 +518,8 @@ type Variant = (&'static str, fn(&mut Options));
 
 /// The other variants compile warning-free too, every function emitted (its address taken):
 /// `float` code with a runtime payload and gravity; `--fma` with a payload; libm's sine and
-/// cosine. A bad prefix and the compact form are errors, not panics.
+/// cosine. A bad prefix, the compact form and a model past `c::MAX_JOINTS` are errors, not
+/// panics.
 #[test]
 fn c_output_variants_compile() {
     let Some(cc) = compiler() else { return };
@@ -572,4 +573,73 @@ fn c_output_variants_compile() {
     compact.form = Form::Compact;
     let err = c::generate(&model, &compact, "arm").unwrap_err();
     assert!(err.0.contains("does not support the compact form"), "{err}");
+    use kanegen::model::random::{random_chain, ChainSpec};
+    let n = c::MAX_JOINTS + 1;
+    let large = random_chain(
+        &ChainSpec {
+            n,
+            ..Default::default()
+        },
+        1,
+    );
+    let err = c::generate(&large, &opts, "arm").unwrap_err();
+    assert!(err.0.contains(&format!("N = {n} is past the")), "{err}");
+}
+
+/// `kanegen generate --lang c`: the header on stdout, its names from the model's; an unknown
+/// language and a name C cannot take are one-line errors.
+#[test]
+fn the_cli_writes_c() {
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_kanegen"))
+            .args(args)
+            .current_dir(root())
+            .output()
+            .unwrap()
+    };
+    let out = run(&["generate", "models/two_link.toml", "--lang", "c"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.starts_with("// Dynamics of `two_link` (N = 2)"),
+        "{text}"
+    );
+    for f in [
+        "mass_matrix(const double q[2], double m[2][2])",
+        "forward_dynamics(",
+    ] {
+        assert!(
+            text.contains(&format!("static inline void two_link_{f}")),
+            "{f}"
+        );
+    }
+    for (args, want) in [
+        (
+            &["generate", "models/two_link.toml", "--lang", "fortran"][..],
+            "unknown language `fortran`: rust or c",
+        ),
+        (
+            &[
+                "generate",
+                "models/two_link.toml",
+                "--lang",
+                "c",
+                "--name",
+                "9arm",
+            ][..],
+            "C prefix `9arm` is not a C identifier",
+        ),
+    ] {
+        let out = run(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            !out.status.success() && err.contains(want),
+            "{args:?}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+    }
 }

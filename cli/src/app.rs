@@ -235,7 +235,8 @@ struct GenerateArgs {
     #[arg(long)]
     ignore_mimic: bool,
     /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
-    /// caller's stack, and the frame functions stay straight-line).
+    /// caller's stack, and the frame functions stay straight-line); with --lang c, for more than
+    /// 64 joints (straight-line).
     #[arg(long)]
     allow_large: bool,
     /// Output language: rust (default: a module file) or c (a C99 header of `static inline`
@@ -555,7 +556,13 @@ fn generate(a: GenerateArgs, out: &mut dyn Write, interactive: Interactive) -> R
     );
     let code = match a.lang {
         commands::generate::Lang::Rust => commands::generate::generate_checked(&chain, &opts)?,
-        commands::generate::Lang::C => commands::generate::generate_c_checked(&chain, &opts)?,
+        commands::generate::Lang::C => {
+            // Past `c::MAX_JOINTS`, straight-line all the same when asked.
+            if a.allow_large {
+                opts.form = kanegen_codegen::Form::Unrolled;
+            }
+            commands::generate::generate_c_checked(&chain, &opts)?
+        }
     };
     progress.finish();
     match target {
