@@ -230,6 +230,9 @@ impl Syntax for CSyntax {
             // One angle (not an input's): bound in a block of its own.
             let scratch = "sc_unused";
             let decl: Vec<&str> = [sn, cn].iter().filter_map(|n| n.as_deref()).collect();
+            if decl.is_empty() {
+                return s;
+            }
             let _ = writeln!(s, "{IND}{ty} {};", decl.join(", "));
             let (ps, pc) = (
                 sn.as_deref().unwrap_or(scratch),

@@ -65,7 +65,7 @@ pub enum BinOp {
     Div,
 }
 
-/// The printer of one graph's code: what [`GraphEmitter`] writes for each construct, Rust tokens
+/// The printer of one graph's code: what [`emit_graph`] writes for each construct, Rust tokens
 /// ([`RustSyntax`]) or another language's text (`crate::c`). The graph walk — the order, the
 /// inlining, the parentheses, the fused multiply-adds, the hoisted sine–cosine — is the same for
 /// every syntax, so every language performs the same operations in the same order.

@@ -11,7 +11,9 @@
 //! `kanegen_runtime::compact` over the model's tables ([`compact`]). The generated type
 //! is a unit struct with associated constants and functions ([`generate_items`]);
 //! [`generate_file`] wraps it into a formatted module file whose doc header ([`header`]) states
-//! the model, the conventions and every traced candidate's counts.
+//! the model, the conventions and every traced candidate's counts. [`c::generate`] prints the
+//! same plan's graphs, by the same walk ([`emit::emit_graph`] over an [`emit::Syntax`]), as a C99
+//! header instead.
 //!
 //! # Op counts
 //!
