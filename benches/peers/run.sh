@@ -30,6 +30,9 @@
 #                     aba_jac) on all three sides; the kanegen side needs a dynamics! that emits
 #                     inverse_dynamics_derivatives, forward_dynamics_derivatives and
 #                     mass_matrix_inverse. DERIVS=peers: CasADi and Pinocchio only; DERIVS=0: none
+#   KANEGEN_C=1       the "kanegen C" side: `kanegen generate --lang c` behind CasADi's entry points
+#                     (src/kanegen_c), compiled with the same $CC $COPT as CasADi's C and timed by the
+#                     same driver; 0: none
 #   CASADI_SIDE=1     0: no CasADi side (no tracing, no gcc of generated C): Pinocchio and kanegen
 #                     only, e.g. for the run-time path against numeric Pinocchio
 #   TIMING_ONLY=0     1: reuse everything an earlier complete run built in PEERS_WORK (models,
@@ -75,6 +78,7 @@ case $DERIVS in
 esac
 export PEERS_DERIVS
 CASADI_SIDE=${CASADI_SIDE:-1}
+KANEGEN_C=${KANEGEN_C:-1}
 CC=${CC:-gcc}
 CXX=${CXX:-g++}
 COPT=${COPT:-"-O3 -march=native"}
@@ -333,6 +337,53 @@ fi
 fi  # TIMING_ONLY
 label_of_kind() { case $1 in clean) echo default ;; *) echo "$1" ;; esac; }
 
+# ------------------------------------------------------------------ 6b. kanegen's C output
+# The same functions as C (`kanegen generate --lang c`: the same plan and graphs, printed as
+# C99), behind CasADi's entry points (src/kanegen_c), compiled as CasADi's C is (the same $CC
+# and $COPT, alone, no LTO) and timed by the same driver: generator against generator under one
+# compiler. Built in every mode (TIMING_ONLY too): it takes seconds.
+KCMODELS=""
+if [ "$KANEGEN_C" = 1 ]; then
+  stamp "kanegen C: kanegen generate --lang c, then $CC $COPT"
+  rm -rf build/kc
+  KG_BIN=${CARGO_TARGET_DIR:-$KANEGEN_DIR/target}/release/kanegen
+  if (cd "$KANEGEN_DIR" && cargo build --release -q --bin kanegen) > logs/kanegen_bin.log 2>&1; then
+    for m in $NAMES; do
+      d=build/kc/$m
+      mkdir -p "$d"
+      t0=$(now)
+      if ! "$KG_BIN" generate "build/models/$m.urdf" --name Kg --ignore-mimic --no-derivatives --lang c \
+          -o "$d/kg.h" > "logs/kc_generate_$m.log" 2>&1; then
+        echo "kanegen,c,$m,generate,$(since "$t0"),error" >> $COMPILE
+        printf '   %-11s generate failed (logs/kc_generate_%s.log)\n' "$m" "$m"
+        continue
+      fi
+      echo "kanegen,c,$m,generate,$(since "$t0"),ok" >> $COMPILE
+      t0=$(now); rc=0
+      # shellcheck disable=SC2086
+      timeout -k 10 "$CC_TIMEOUT" $CC $COPT -I"$d" -Isrc/kanegen_c -c src/kanegen_c/kanegen_c.c \
+        -o "$d/kanegen_c.o" 2> "logs/cc_${m}_kanegen_c.log" || rc=$?
+      if [ $rc = 0 ]; then
+        tc=$(since "$t0")
+        # shellcheck disable=SC2086
+        $CC $COPT -std=c11 -Wall -DPEERS_WORLD=0 -DPEERS_DERIVS=0 -DPEERS_SIDE='"kanegen"' \
+          -Isrc/kanegen_c -Isrc -c src/driver.c -o "$d/driver.o"
+        $CC "$d/driver.o" "$d/kanegen_c.o" -lm -o "$d/driver"
+        echo "kanegen,c,$m,cc,$tc,ok" >> $COMPILE
+        KCMODELS="$KCMODELS $m"
+        printf '   %-11s %8s s  (%s)\n' "$m" "$tc" "$COPT"
+      else
+        st=$([ $rc = 124 ] || [ $rc = 137 ] && echo timeout || echo error)
+        echo "kanegen,c,$m,cc,$(since "$t0"),$st" >> $COMPILE
+        printf '   %-11s %s after %s s (logs/cc_%s_kanegen_c.log)\n' "$m" "$st" "$(since "$t0")" "$m"
+      fi
+    done
+  else
+    echo "   the kanegen binary did not build (logs/kanegen_bin.log): no kanegen C side"
+  fi
+fi
+has_kc() { [[ " $KCMODELS " == *" $1 "* ]]; }
+
 # ------------------------------------------------------------------ 7. validation
 stamp "validation against Pinocchio numeric (Python), gravity 0"
 rm -f out/dumps/*.json
@@ -343,6 +394,9 @@ for m in $NAMES; do
   for pl in $PIN_LABELS; do
     "build/pin_numeric_$pl" "build/models/$m.model.txt" "build/models/$m.states.txt" "$pl" "$m" dump > "out/dumps/pinocchio.$m.$pl.json"
   done
+  if has_kc "$m"; then
+    "build/kc/$m/driver" "build/models/$m.states.txt" c "$m" dump > "out/dumps/kanegen_c.$m.json"
+  fi
   for k in $KKINDS; do
     [ -n "${KBUILT[$k.$m]:-}" ] || continue
     "build/bin/kanegen_${k}_$m" "$(label_of_kind "$k")" dump > "out/dumps/kanegen.$k.$m.json"
@@ -377,7 +431,12 @@ echo "pass,side,label,model,func,median_ns,min_ns,calls,checksum,wall_median_ns"
 run_casadi() {
   for m in $NAMES; do for lab in ${CLABELS[$m]}; do
     $PIN "build/c/$m/$lab/driver" "build/models/$m.states.txt" "$lab" "$m" time "$ROUNDS" "$CALLS" "$ROUND_US" | sed "s/^/$1,/" >> out/times.csv
-  done; done
+  done
+  # kanegen's C beside CasADi's, by the same driver
+  if has_kc "$m"; then
+    $PIN "build/kc/$m/driver" "build/models/$m.states.txt" c "$m" time "$ROUNDS" "$CALLS" "$ROUND_US" | sed "s/^/$1,/" >> out/times.csv
+  fi
+  done
 }
 run_pinocchio() {
   for m in $NAMES; do for pl in $PIN_LABELS; do

@@ -59,6 +59,11 @@ fn checked_methods(model: &Model, given: Option<Methods>) -> Result<Methods> {
     Ok(methods)
 }
 
+fn parse_lang(s: &str) -> Result<commands::generate::Lang, String> {
+    commands::generate::Lang::from_name(s)
+        .ok_or_else(|| format!("unknown language `{s}`: rust or c"))
+}
+
 fn parse_scalar(s: &str) -> Result<kanegen_codegen::Float, String> {
     kanegen_codegen::Float::from_name(s).ok_or_else(|| format!("unknown scalar `{s}`: f64 or f32"))
 }
@@ -230,9 +235,15 @@ struct GenerateArgs {
     #[arg(long)]
     ignore_mimic: bool,
     /// Generate for more than 1000 joints (the generated functions keep O(N) arrays on the
-    /// caller's stack, and the frame functions stay straight-line).
+    /// caller's stack, and the frame functions stay straight-line); with --lang c, for more than
+    /// 64 joints (straight-line).
     #[arg(long)]
     allow_large: bool,
+    /// Output language: rust (default: a module file) or c (a C99 header of `static inline`
+    /// functions named from --name in snake_case, `ur5_mass_matrix`; straight-line for every
+    /// model; docs/codegen.md).
+    #[arg(long, default_value = "rust", value_parser = parse_lang)]
+    lang: commands::generate::Lang,
 }
 
 // The arguments of `kanegen bench` (its help is the variant's doc).
@@ -543,7 +554,16 @@ fn generate(a: GenerateArgs, out: &mut dyn Write, interactive: Interactive) -> R
             chain.dof()
         ),
     );
-    let code = commands::generate::generate_checked(&chain, &opts)?;
+    let code = match a.lang {
+        commands::generate::Lang::Rust => commands::generate::generate_checked(&chain, &opts)?,
+        commands::generate::Lang::C => {
+            // Past `c::MAX_JOINTS`, straight-line all the same when asked.
+            if a.allow_large {
+                opts.form = kanegen_codegen::Form::Unrolled;
+            }
+            commands::generate::generate_c_checked(&chain, &opts)?
+        }
+    };
     progress.finish();
     match target {
         Some(f) => f.write(code.as_bytes()),

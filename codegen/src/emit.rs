@@ -20,26 +20,178 @@ const P_MUL: u8 = 2;
 const P_NEG: u8 = 3;
 const P_ATOM: u8 = 4;
 
+/// An emitted expression in the code of a [`Syntax`] and how tightly it binds.
 #[derive(Clone)]
-struct Expr {
-    tokens: TokenStream,
-    prec: u8,
+pub struct Expr<C> {
+    /// The code.
+    pub tokens: C,
+    /// Its precedence (higher binds tighter): a sum 1, a product 2, a negation 3, an atom
+    /// (name, literal, call, parenthesized) 4.
+    pub prec: u8,
 }
 
-impl Expr {
-    fn atom(tokens: TokenStream) -> Self {
+impl<C: Clone> Expr<C> {
+    fn atom(tokens: C) -> Self {
         Expr {
             tokens,
             prec: P_ATOM,
         }
     }
-    /// The expression, parenthesized unless it binds at least as tightly as `min`.
-    fn at(&self, min: u8) -> TokenStream {
-        let t = &self.tokens;
+    /// Whether it is an atom (a name, a literal, a call, or parenthesized).
+    #[must_use]
+    pub fn is_atom(&self) -> bool {
+        self.prec >= P_ATOM
+    }
+    /// The expression, parenthesized by `syntax` unless it binds at least as tightly as `min`.
+    fn at<L: Syntax<Code = C>>(&self, syntax: &L, min: u8) -> C {
         if self.prec >= min {
-            t.clone()
+            self.tokens.clone()
         } else {
-            quote!((#t))
+            syntax.paren(self.tokens.clone())
+        }
+    }
+}
+
+/// A binary operator of the graph.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    /// `+`.
+    Add,
+    /// `-`.
+    Sub,
+    /// `*`.
+    Mul,
+    /// `/`.
+    Div,
+}
+
+/// The printer of one graph's code: what [`emit_graph`] writes for each construct, Rust tokens
+/// ([`RustSyntax`]) or another language's text (`crate::c`). The graph walk — the order, the
+/// inlining, the parentheses, the fused multiply-adds, the hoisted sine–cosine — is the same for
+/// every syntax, so every language performs the same operations in the same order.
+pub trait Syntax {
+    /// A piece of code: an expression or a statement.
+    type Code: Clone + core::fmt::Display;
+    /// A constant (an atom).
+    fn constant(&self, x: f64) -> Self::Code;
+    /// The code that reads a trace input (an atom).
+    fn input(&self, input: &Input) -> Self::Code;
+    /// A bound name (an atom).
+    fn name(&self, name: &str) -> Self::Code;
+    /// `(e)`.
+    fn paren(&self, e: Self::Code) -> Self::Code;
+    /// `a op b`, the operands already parenthesized as needed.
+    fn binary(&self, a: Self::Code, op: BinOp, b: Self::Code) -> Self::Code;
+    /// `−e` as an atom.
+    fn neg(&self, e: &Expr<Self::Code>) -> Self::Code;
+    /// `√e` as an atom (`e` is a call argument).
+    fn sqrt(&self, e: Self::Code) -> Self::Code;
+    /// The fused multiply-add `a·b + c` by `fuse`, as an atom.
+    fn fma(&self, fuse: &Fuse, a: Self::Code, b: Self::Code, c: Self::Code) -> Self::Code;
+    /// The statement binding `e` to a new `name`.
+    fn bind(&self, name: &str, e: Self::Code) -> Self::Code;
+    /// The statement binding the sines and cosines of `angles` by the table sine–cosine
+    /// (`fused`: its products fused where the target has FMA): `names[k]` holds the names of
+    /// angle `k`'s sine and cosine, `None` for one that is not used.
+    fn sincos_table(
+        &self,
+        fused: bool,
+        names: &[(Option<String>, Option<String>)],
+        angles: Vec<Self::Code>,
+    ) -> Self::Code;
+    /// The statement binding the sine and/or cosine of `angle` by libm (`sin`, `cos`, or both).
+    fn sincos_libm(&self, sin: Option<&str>, cos: Option<&str>, angle: Self::Code) -> Self::Code;
+}
+
+/// Rust tokens generic over the lane type `S: Lanes<F>` ([module docs](self)).
+#[derive(Clone, Copy, Debug)]
+pub struct RustSyntax {
+    float: Float,
+}
+
+impl Syntax for RustSyntax {
+    type Code = TokenStream;
+    fn constant(&self, x: f64) -> TokenStream {
+        constant(x, self.float).tokens
+    }
+    fn input(&self, input: &Input) -> TokenStream {
+        input_tokens(input)
+    }
+    fn name(&self, name: &str) -> TokenStream {
+        let name = format_ident!("{}", name);
+        quote!(#name)
+    }
+    fn paren(&self, e: TokenStream) -> TokenStream {
+        quote!((#e))
+    }
+    fn binary(&self, a: TokenStream, op: BinOp, b: TokenStream) -> TokenStream {
+        match op {
+            BinOp::Add => quote!(#a + #b),
+            BinOp::Sub => quote!(#a - #b),
+            BinOp::Mul => quote!(#a * #b),
+            BinOp::Div => quote!(#a / #b),
+        }
+    }
+    fn neg(&self, e: &Expr<TokenStream>) -> TokenStream {
+        let e = &e.tokens;
+        quote!(S::neg(#e))
+    }
+    fn sqrt(&self, e: TokenStream) -> TokenStream {
+        quote!(S::sqrt(#e))
+    }
+    fn fma(&self, fuse: &Fuse, a: TokenStream, b: TokenStream, c: TokenStream) -> TokenStream {
+        match fuse {
+            Fuse::Target => quote!(S::mul_add(#a, #b, #c)),
+            Fuse::Libm => quote!(S::fma(#a, #b, #c)),
+            Fuse::Path(path) => quote!(S::fma_with(#a, #b, #c, #path)),
+        }
+    }
+    fn bind(&self, name: &str, e: TokenStream) -> TokenStream {
+        let name = format_ident!("{}", name);
+        quote!(let #name = #e;)
+    }
+    fn sincos_table(
+        &self,
+        fused: bool,
+        names: &[(Option<String>, Option<String>)],
+        angles: Vec<TokenStream>,
+    ) -> TokenStream {
+        let f = if fused {
+            quote!(S::sincos_n)
+        } else {
+            quote!(S::sincos_n_unfused)
+        };
+        let pat = |n: &Option<String>| match n {
+            Some(n) => self.name(n),
+            None => quote!(_),
+        };
+        if let ([(s, c)], [a]) = (names, &angles[..]) {
+            let call = quote!(#f([#a])[0]);
+            return match (s, c) {
+                (Some(_), Some(_)) => {
+                    let (s, c) = (pat(s), pat(c));
+                    quote!(let (#s, #c) = #call;)
+                }
+                (Some(s), None) => self.bind(s, quote!(#call.0)),
+                (None, Some(c)) => self.bind(c, quote!(#call.1)),
+                (None, None) => quote!(),
+            };
+        }
+        let pats = names.iter().map(|(s, c)| {
+            let (s, c) = (pat(s), pat(c));
+            quote!((#s, #c))
+        });
+        quote!(let [#(#pats),*] = #f([#(#angles),*]);)
+    }
+    fn sincos_libm(&self, sin: Option<&str>, cos: Option<&str>, angle: TokenStream) -> TokenStream {
+        match (sin, cos) {
+            (Some(s), Some(c)) => {
+                let (s, c) = (format_ident!("{}", s), format_ident!("{}", c));
+                quote!(let (#s, #c) = S::sincos(#angle);)
+            }
+            (Some(s), None) => self.bind(s, quote!(S::sin(#angle))),
+            (None, Some(c)) => self.bind(c, quote!(S::cos(#angle))),
+            (None, None) => quote!(),
         }
     }
 }
@@ -73,14 +225,14 @@ fn literal(x: f64, float: Float) -> TokenStream {
 }
 
 /// A constant of type `float` in every lane: `S::splat(literal)`.
-fn constant(x: f64, float: Float) -> Expr {
+fn constant(x: f64, float: Float) -> Expr<TokenStream> {
     let lit = literal(x, float);
     Expr::atom(quote!(S::splat(#lit)))
 }
 
 /// How products are fused.
 #[derive(Clone, Debug)]
-enum Fuse {
+pub enum Fuse {
     /// `S::mul_add`: fused where the build targets FMA ([`Options::target_fma`]).
     Target,
     /// `S::fma`: libm's `fma`, always fused ([`Options::fma`]).
@@ -220,31 +372,49 @@ pub fn emit_body_streamed(
     shape: Shape,
     stmt: &mut dyn FnMut(TokenStream),
 ) -> Body {
+    let syntax = RustSyntax {
+        float: emitter.float,
+    };
+    let (out, fmas) = emit_graph(t, emitter, &syntax, stmt);
+    Body {
+        tokens: result_tokens(&out, shape),
+        fmas,
+    }
+}
+
+/// The walk of one traced graph in `syntax`: each statement handed to `stmt` as it is emitted,
+/// then the outputs' expressions (in the trace's order, parenthesized to bind at least as a
+/// negation) and the fused multiply-adds formed. Every syntax gets the same statements in the
+/// same order.
+pub fn emit_graph<L: Syntax>(
+    t: &Traced,
+    emitter: &Emitter,
+    syntax: &L,
+    stmt: &mut dyn FnMut(L::Code),
+) -> (Vec<L::Code>, u64) {
     let sched = t.trace.schedule();
-    let mut g = GraphEmitter::new(t, emitter, &sched);
+    let mut g = GraphEmitter::new(t, emitter, syntax, &sched);
     if emitter.table_sincos {
         g.hoist_sincos(stmt);
     }
     for (id, node) in &sched {
         g.emit_node(*id, node, stmt);
     }
-    let out: Vec<TokenStream> = t
+    let out = t
         .trace
         .outputs()
         .iter()
-        .map(|s| g.exprs[&s.id()].at(P_NEG))
+        .map(|s| g.exprs[&s.id()].at(syntax, P_NEG))
         .collect();
-    Body {
-        tokens: result_tokens(&out, shape),
-        fmas: g.fmas,
-    }
+    (out, g.fmas)
 }
 
 /// The state of emitting one graph in schedule order.
-struct GraphEmitter<'a> {
+struct GraphEmitter<'a, L: Syntax> {
     emitter: &'a Emitter,
-    /// The Rust expression of each input.
-    inputs: Vec<TokenStream>,
+    syntax: &'a L,
+    /// The code of each input.
+    inputs: Vec<L::Code>,
     outputs: HashSet<u32>,
     nodes: HashMap<u32, Node>,
     /// How many nodes read each node.
@@ -257,7 +427,7 @@ struct GraphEmitter<'a> {
     /// not copied. A node its user may look through (a product that fuses, an inlined negation
     /// that a fused call unwraps) builds its own expression from copies, so the user can still
     /// take the operands.
-    exprs: HashMap<u32, Expr>,
+    exprs: HashMap<u32, Expr<L::Code>>,
     /// Fused calls nested in an inlined expression: past `MAX_CALL_NESTING` the expression is
     /// bound to a name, so a long fused sum reads as a few short lines instead of a staircase
     /// (formatted, each level indents every line below it: N = 100 code grew 10× before).
@@ -270,9 +440,9 @@ struct GraphEmitter<'a> {
     fmas: u64,
 }
 
-impl<'a> GraphEmitter<'a> {
+impl<'a, L: Syntax> GraphEmitter<'a, L> {
     /// The uses and the sine–cosine pairs of the scheduled graph.
-    fn new(t: &Traced, emitter: &'a Emitter, sched: &[(u32, Node)]) -> Self {
+    fn new(t: &Traced, emitter: &'a Emitter, syntax: &'a L, sched: &[(u32, Node)]) -> Self {
         let mut uses: HashMap<u32, usize> = HashMap::new();
         let mut trig: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
         for (id, node) in sched {
@@ -295,7 +465,8 @@ impl<'a> GraphEmitter<'a> {
         }
         GraphEmitter {
             emitter,
-            inputs: t.inputs.iter().map(input_tokens).collect(),
+            syntax,
+            inputs: t.inputs.iter().map(|i| syntax.input(i)).collect(),
             outputs: t.trace.outputs().iter().map(|s| s.id()).collect(),
             nodes: sched.iter().copied().collect(),
             uses,
@@ -329,6 +500,11 @@ impl<'a> GraphEmitter<'a> {
 
     fn is_const(&self, s: Sym) -> bool {
         matches!(self.nodes.get(&s.id()), Some(Node::Const(_)))
+    }
+
+    /// A constant in the syntax.
+    fn constant(&self, x: f64) -> L::Code {
+        self.syntax.constant(x)
     }
 
     /// A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
@@ -372,7 +548,7 @@ impl<'a> GraphEmitter<'a> {
     /// an input plus a constant (a joint's angle offset, `JointParams::angle_offset`) used by
     /// them alone, in one `S::sincos_n` at the top, so their polynomials run side by side in
     /// vector registers. The sums are written into the call and not bound apart (`hoisted`).
-    fn hoist_sincos(&mut self, stmt: &mut dyn FnMut(TokenStream)) {
+    fn hoist_sincos(&mut self, stmt: &mut dyn FnMut(L::Code)) {
         let mut args: Vec<(u32, u32, Option<f64>)> = self
             .trig
             .keys()
@@ -383,7 +559,7 @@ impl<'a> GraphEmitter<'a> {
         if args.len() <= 1 {
             return;
         }
-        let mut pats = Vec::new();
+        let mut names = Vec::new();
         let mut xs = Vec::new();
         let mut bases = HashSet::new();
         for (a, i, offset) in args {
@@ -392,55 +568,48 @@ impl<'a> GraphEmitter<'a> {
             if !bases.insert(base.clone()) {
                 base = format!("{base}_{}", self.counter);
             }
-            let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
             let (s, c) = self.trig[&a];
-            let mut bind = |node: Option<u32>, name: &proc_macro2::Ident| match node {
-                Some(n) => {
-                    self.exprs.insert(n, Expr::atom(quote!(#name)));
-                    quote!(#name)
-                }
-                None => quote!(_),
+            let (sn, cn) = (format!("s_{base}"), format!("c_{base}"));
+            let mut bind = |node: Option<u32>, name: String| {
+                node.map(|n| {
+                    self.exprs.insert(n, Expr::atom(self.syntax.name(&name)));
+                    name
+                })
             };
-            let (ps, pc) = (bind(s, &sn), bind(c, &cn));
-            pats.push(quote!((#ps, #pc)));
-            let x = &self.inputs[match self.nodes[&i] {
+            names.push((bind(s, sn), bind(c, cn)));
+            let x = self.inputs[match self.nodes[&i] {
                 Node::Input(k) => k as usize,
                 _ => unreachable!("filtered to inputs"),
-            }];
+            }]
+            .clone();
             xs.push(match offset {
-                None => x.clone(),
+                None => x,
                 Some(c) => {
                     self.hoisted.insert(a);
-                    let lit = constant(c.abs(), self.emitter.float).tokens;
-                    if c.is_sign_negative() {
-                        quote!(#x - #lit)
+                    let lit = self.constant(c.abs());
+                    let op = if c.is_sign_negative() {
+                        BinOp::Sub
                     } else {
-                        quote!(#x + #lit)
-                    }
+                        BinOp::Add
+                    };
+                    self.syntax.binary(x, op, lit)
                 }
             });
         }
-        let f = self.sincos_n();
-        stmt(quote!(let [#(#pats),*] = #f([#(#xs),*]);));
+        stmt(
+            self.syntax
+                .sincos_table(self.emitter.sincos_fused, &names, xs),
+        );
     }
 
-    /// The table sine–cosine of `K` angles: `S::sincos_n`, or `S::sincos_n_unfused`.
-    fn sincos_n(&self) -> TokenStream {
-        if self.emitter.sincos_fused {
-            quote!(S::sincos_n)
-        } else {
-            quote!(S::sincos_n_unfused)
-        }
-    }
-
-    /// Emits node `id`: records its expression, or binds it to a name by a `let`.
-    fn emit_node(&mut self, id: u32, node: &Node, stmt: &mut dyn FnMut(TokenStream)) {
+    /// Emits node `id`: records its expression, or binds it to a name.
+    fn emit_node(&mut self, id: u32, node: &Node, stmt: &mut dyn FnMut(L::Code)) {
         if self.hoisted.contains(&id) {
             return; // written into the `sincos_n` call
         }
         match node {
             Node::Const(x) => {
-                self.exprs.insert(id, constant(*x, self.emitter.float));
+                self.exprs.insert(id, Expr::atom(self.constant(*x)));
                 return;
             }
             Node::Input(i) => {
@@ -463,11 +632,10 @@ impl<'a> GraphEmitter<'a> {
             || matches!(node, Node::Div(..) | Node::Sqrt(..))
             || depth > MAX_CALL_NESTING;
         if bind {
-            let name = format_ident!("x{}", self.counter);
+            let name = format!("x{}", self.counter);
             self.counter += 1;
-            let e = expr.tokens;
-            stmt(quote!(let #name = #e;));
-            self.exprs.insert(id, Expr::atom(quote!(#name)));
+            stmt(self.syntax.bind(&name, expr.tokens));
+            self.exprs.insert(id, Expr::atom(self.syntax.name(&name)));
         } else {
             self.nesting.insert(id, depth);
             self.exprs.insert(id, expr);
@@ -496,51 +664,34 @@ impl<'a> GraphEmitter<'a> {
     /// The sine and/or cosine of `a`, bound by one call when both are used: the table
     /// sine–cosine (a table and short polynomials) takes both at the price of one; libm has `sin`
     /// and `cos` apart.
-    fn emit_trig(&mut self, id: u32, a: Sym, stmt: &mut dyn FnMut(TokenStream)) {
+    fn emit_trig(&mut self, id: u32, a: Sym, stmt: &mut dyn FnMut(L::Code)) {
         if self.exprs.contains_key(&id) {
             return; // bound together with its partner by one sincos
         }
         let arg = self.take(a, false).tokens;
         let base = self.trig_base(a.id());
         self.counter += 1;
-        let (sin_call, cos_call, sincos_call) = if self.emitter.table_sincos {
-            let f = self.sincos_n();
-            (
-                quote!(#f([#arg])[0].0),
-                quote!(#f([#arg])[0].1),
-                quote!(#f([#arg])[0]),
-            )
-        } else {
-            (
-                quote!(S::sin(#arg)),
-                quote!(S::cos(#arg)),
-                quote!(S::sincos(#arg)),
-            )
-        };
-        match self.trig[&a.id()] {
-            (Some(s), Some(c)) => {
-                let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
-                stmt(quote!(let (#sn, #cn) = #sincos_call;));
-                self.exprs.insert(s, Expr::atom(quote!(#sn)));
-                self.exprs.insert(c, Expr::atom(quote!(#cn)));
+        let (s, c) = self.trig[&a.id()];
+        let (sn, cn) = (
+            s.map(|_| format!("s_{base}")),
+            c.map(|_| format!("c_{base}")),
+        );
+        for (node, name) in [(s, &sn), (c, &cn)] {
+            if let (Some(node), Some(name)) = (node, name) {
+                self.exprs.insert(node, Expr::atom(self.syntax.name(name)));
             }
-            (Some(s), None) => {
-                let sn = format_ident!("s_{}", base);
-                stmt(quote!(let #sn = #sin_call;));
-                self.exprs.insert(s, Expr::atom(quote!(#sn)));
-            }
-            (None, Some(c)) => {
-                let cn = format_ident!("c_{}", base);
-                stmt(quote!(let #cn = #cos_call;));
-                self.exprs.insert(c, Expr::atom(quote!(#cn)));
-            }
-            (None, None) => unreachable!("trig node without entry"),
         }
+        stmt(if self.emitter.table_sincos {
+            self.syntax
+                .sincos_table(self.emitter.sincos_fused, &[(sn, cn)], vec![arg])
+        } else {
+            self.syntax.sincos_libm(sn.as_deref(), cn.as_deref(), arg)
+        });
     }
 
     /// The expression of operand `s`: taken out when it is inlined (unless its user looks
     /// through it, `see_through`), copied otherwise.
-    fn take(&mut self, s: Sym, see_through: bool) -> Expr {
+    fn take(&mut self, s: Sym, see_through: bool) -> Expr<L::Code> {
         if !see_through && self.inlined(s) {
             self.exprs
                 .remove(&s.id())
@@ -551,16 +702,16 @@ impl<'a> GraphEmitter<'a> {
     }
 
     /// `−s` as a call argument: constants negated, an inlined negation unwrapped.
-    fn neg(&mut self, s: Sym, see_through: bool) -> TokenStream {
+    fn neg(&mut self, s: Sym, see_through: bool) -> L::Code {
         match self.nodes.get(&s.id()).copied() {
-            Some(Node::Const(x)) => constant(-x, self.emitter.float).tokens,
+            Some(Node::Const(x)) => self.constant(-x),
             Some(Node::Neg(z)) if self.inlined(s) => {
                 self.exprs.remove(&s.id()); // looked through
                 self.take(z, see_through).tokens
             }
             _ => {
-                let e = self.take(s, see_through).tokens;
-                quote!(S::neg(#e))
+                let e = self.take(s, see_through);
+                self.syntax.neg(&e)
             }
         }
     }
@@ -572,22 +723,14 @@ impl<'a> GraphEmitter<'a> {
     }
 
     /// `fma(a, b, c)`, one more fused multiply-add.
-    fn call(&mut self, a: TokenStream, b: TokenStream, c: TokenStream) -> Expr {
+    fn call(&mut self, a: L::Code, b: L::Code, c: L::Code) -> Expr<L::Code> {
         self.fmas += 1;
-        match self
-            .emitter
-            .fma
-            .as_ref()
-            .expect("products fuse only with an fma function")
-        {
-            Fuse::Target => Expr::atom(quote!(S::mul_add(#a, #b, #c))),
-            Fuse::Libm => Expr::atom(quote!(S::fma(#a, #b, #c))),
-            Fuse::Path(path) => Expr::atom(quote!(S::fma_with(#a, #b, #c, #path))),
-        }
+        let fuse = (self.emitter.fma.as_ref()).expect("products fuse only with an fma function");
+        Expr::atom(self.syntax.fma(fuse, a, b, c))
     }
 
     /// The expression of an arithmetic node, with products fused into their users.
-    fn arithmetic(&mut self, id: u32, node: &Node) -> Expr {
+    fn arithmetic(&mut self, id: u32, node: &Node) -> Expr<L::Code> {
         let st = match node {
             Node::Mul(..) => self.emitter.fma.is_some() && self.inlined_id(id),
             Node::Neg(..) => self.emitter.fma.is_some(),
@@ -638,17 +781,17 @@ impl<'a> GraphEmitter<'a> {
                 );
                 self.call(a, b, c)
             }
-            Node::Add(a, b) => self.binary(a, b, st, "+"),
-            Node::Sub(a, b) => self.binary(a, b, st, "-"),
-            Node::Mul(a, b) => self.binary(a, b, st, "*"),
-            Node::Div(a, b) => self.binary(a, b, st, "/"),
+            Node::Add(a, b) => self.binary(a, b, st, BinOp::Add),
+            Node::Sub(a, b) => self.binary(a, b, st, BinOp::Sub),
+            Node::Mul(a, b) => self.binary(a, b, st, BinOp::Mul),
+            Node::Div(a, b) => self.binary(a, b, st, BinOp::Div),
             Node::Neg(a) => {
-                let a = self.take(a, st).tokens;
-                Expr::atom(quote!(S::neg(#a)))
+                let a = self.take(a, st);
+                Expr::atom(self.syntax.neg(&a))
             }
             Node::Sqrt(a) => {
                 let a = self.take(a, st).tokens;
-                Expr::atom(quote!(S::sqrt(#a)))
+                Expr::atom(self.syntax.sqrt(a))
             }
             Node::Const(_) | Node::Input(_) | Node::Sin(_) | Node::Cos(_) => {
                 unreachable!("emitted by emit_node")
@@ -659,19 +802,20 @@ impl<'a> GraphEmitter<'a> {
     /// `a op b` with the parentheses that keep the graph's evaluation order: sums and
     /// differences bind the left operand at `+` and the right at `*`; products and quotients
     /// the left at `*` and the right at unary minus.
-    fn binary(&mut self, a: Sym, b: Sym, st: bool, op: &str) -> Expr {
+    fn binary(&mut self, a: Sym, b: Sym, st: bool, op: BinOp) -> Expr<L::Code> {
         let (left, right, prec) = match op {
-            "+" | "-" => (P_ADD, P_MUL, P_ADD),
-            _ => (P_MUL, P_NEG, P_MUL),
+            BinOp::Add | BinOp::Sub => (P_ADD, P_MUL, P_ADD),
+            BinOp::Mul | BinOp::Div => (P_MUL, P_NEG, P_MUL),
         };
-        let (a, b) = (self.take(a, st).at(left), self.take(b, st).at(right));
-        let tokens = match op {
-            "+" => quote!(#a + #b),
-            "-" => quote!(#a - #b),
-            "*" => quote!(#a * #b),
-            _ => quote!(#a / #b),
-        };
-        Expr { tokens, prec }
+        let syntax = self.syntax;
+        let (a, b) = (
+            self.take(a, st).at(syntax, left),
+            self.take(b, st).at(syntax, right),
+        );
+        Expr {
+            tokens: syntax.binary(a, op, b),
+            prec,
+        }
     }
 }
 

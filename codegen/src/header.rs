@@ -48,9 +48,31 @@ fn joint_list(model: &Model) -> String {
 /// and the counts of every traced candidate. `fmas`: fused multiply-adds per emitted function.
 #[must_use]
 pub fn lines(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
-    let mut h = description(plan, opts, fmas);
+    let mut h = description(plan, opts, fmas, Lang::Rust);
     h.push(form_line(plan));
     h.push(lanes_line(plan, opts));
+    h.extend(count_table(plan));
+    h
+}
+
+/// The language a header describes: the calls it names differ.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Lang<'a> {
+    /// Rust, generic over the lane type `S`.
+    Rust,
+    /// C, its functions and types named `PREFIX_…`.
+    C {
+        /// The prefix.
+        prefix: &'a str,
+    },
+}
+
+/// The header lines of C output ([`crate::c`]): [`lines`] with the calls and types C has, and
+/// no lanes.
+#[must_use]
+pub(crate) fn c_lines(plan: &Plan, opts: &Options, fmas: &[u64], prefix: &str) -> Vec<String> {
+    let mut h = description(plan, opts, fmas, Lang::C { prefix });
+    h.push(form_line(plan));
     h.extend(count_table(plan));
     h
 }
@@ -147,7 +169,7 @@ fn form_line(plan: &Plan) -> String {
 }
 
 /// The model, the conventions, the options and the precision.
-fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
+fn description(plan: &Plan, opts: &Options, fmas: &[u64], lang: Lang) -> Vec<String> {
     let model = &plan.model;
     let snap = &plan.snap;
     let mut h = vec![
@@ -189,10 +211,17 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
             None => "Gravity: none (space).".into(),
         },
         if opts.runtime_payload {
-            format!(
-                "Runtime payload: the last body's mass properties are the argument `payload: &{}`.",
-                opts.payload_name
-            )
+            match lang {
+                Lang::Rust => format!(
+                    "Runtime payload: the last body's mass properties are the argument \
+                     `payload: &{}`.",
+                    opts.payload_name
+                ),
+                Lang::C { prefix } => format!(
+                    "Runtime payload: the last body's mass properties are the argument \
+                     `const {prefix}_payload *payload`."
+                ),
+            }
         } else {
             "Runtime payload: no (every model number is a constant).".into()
         },
@@ -225,13 +254,20 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
         },
     ];
     if opts.table_sincos() && crate::choose::takes_trig(plan.choices()) {
-        h.push(
-            "Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table \
+        h.push(match lang {
+            Lang::Rust => "Sines and cosines: every joint angle's in one `S::sincos_n` (the runtime's table \
              sine–cosine, lane by lane) at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a \
              table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
              `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it)."
                 .into(),
-        );
+            Lang::C { prefix } => format!(
+                "Sines and cosines: every joint angle's in one `{prefix}_sincos_n` at the top of \
+                 each function: the runtime's table sine–cosine (`kanegen_runtime::sincos`, its \
+                 table and constants printed from it), branch-free for |x| < 32768 (a table of \
+                 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `sin` \
+                 and `cos` of <math.h> beyond; within 1 ulp of 1 of libm's."
+            ),
+        });
     }
     let total: u64 = fmas.iter().sum();
     let per = plan
@@ -251,9 +287,13 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
                 .into(),
         });
         h.push(if opts.fma {
-            let call = match &opts.fma_path {
-                Some(path) => format!("`S::fma_with(a, b, c, {path})`, `{path}` on each lane"),
-                None => format!("`S::fma(a, b, c)`, libm's `{}`", opts.float.libm_fn("fma")),
+            let fma = opts.float.libm_fn("fma");
+            let call = match (&opts.fma_path, lang) {
+                (_, Lang::C { .. }) => format!("`{fma}(a, b, c)` of <math.h>"),
+                (Some(path), Lang::Rust) => {
+                    format!("`S::fma_with(a, b, c, {path})`, `{path}` on each lane")
+                }
+                (None, Lang::Rust) => format!("`S::fma(a, b, c)`, libm's `{fma}`"),
             };
             format!(
                 "Fused multiply-adds: {total} ({per}), each {call}: a·b + c rounded once; the \
@@ -264,13 +304,27 @@ fn description(plan: &Plan, opts: &Options, fmas: &[u64]) -> Vec<String> {
         });
     }
     if !opts.fma && opts.target_fma && total > 0 {
-        h.push(format!(
-            "Fused multiply-adds where the target has them: {total} ({per}), each \
-             `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA \
-             (x86-64 with `target_feature = \"fma\"`, e.g. `-C target-cpu=native`; AArch64), \
-             and `a·b + c` otherwise, where the code is bit-identical to unfused code. The \
-             counts below count each as 1 mul + 1 add."
-        ));
+        h.push(match lang {
+            Lang::Rust => format!(
+                "Fused multiply-adds where the target has them: {total} ({per}), each \
+                 `S::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA \
+                 (x86-64 with `target_feature = \"fma\"`, e.g. `-C target-cpu=native`; AArch64), \
+                 and `a·b + c` otherwise, where the code is bit-identical to unfused code. The \
+                 counts below count each as 1 mul + 1 add."
+            ),
+            Lang::C { prefix } => format!(
+                "Fused multiply-adds where the target has them: {total} ({per}), each \
+                 `{prefix}_mul_add(a, b, c)`: `{}(a, b, c)` where <math.h> defines `{}` (the \
+                 target has a fused instruction, e.g. `-march=native` on x86-64 with FMA; \
+                 AArch64), and `a * b + c` otherwise, where the code is bit-identical to \
+                 unfused code. The counts below count each as 1 mul + 1 add.",
+                opts.float.libm_fn("fma"),
+                match opts.float {
+                    Float::F64 => "FP_FAST_FMA",
+                    Float::F32 => "FP_FAST_FMAF",
+                }
+            ),
+        });
     }
     h
 }

@@ -11,7 +11,9 @@
 //! `kanegen_runtime::compact` over the model's tables ([`compact`]). The generated type
 //! is a unit struct with associated constants and functions ([`generate_items`]);
 //! [`generate_file`] wraps it into a formatted module file whose doc header ([`header`]) states
-//! the model, the conventions and every traced candidate's counts.
+//! the model, the conventions and every traced candidate's counts. [`c::generate`] prints the
+//! same plan's graphs, by the same walk ([`emit::emit_graph`] over an [`emit::Syntax`]), as a C99
+//! header instead.
 //!
 //! # Op counts
 //!
@@ -41,6 +43,7 @@
 #![warn(missing_docs)]
 
 pub mod api;
+pub mod c;
 pub mod choose;
 pub mod compact;
 pub mod emit;
@@ -130,7 +133,7 @@ fn generate_items_with(
 
 /// What the generated type cannot be made for: joints that move no mass (its forward dynamics
 /// would divide by a singular `M`).
-fn check_generable(model: &Model) -> Result<(), Error> {
+pub(crate) fn check_generable(model: &Model) -> Result<(), Error> {
     model
         .check_forward_dynamics()
         .map_err(|e| Error(e.to_string()))
@@ -479,7 +482,12 @@ fn return_type(shape: Shape, fl: &TokenStream) -> TokenStream {
 /// The two documentation lines of a function: what it computes ([`api::doc`]), then its methods
 /// and counts (emitted; for a compact body, its loops' methods and its kernel's traced counts).
 /// `k`: fused multiply-adds formed.
-fn function_docs(plan: &Plan, fp: &FunctionPlan, k: u64, opts: &Options) -> (String, String) {
+pub(crate) fn function_docs(
+    plan: &Plan,
+    fp: &FunctionPlan,
+    k: u64,
+    opts: &Options,
+) -> (String, String) {
     let choice = &fp.choice;
     let compact = matches!(fp.kernel, Kernel::Compact(_));
     let mut doc1 = format!(

@@ -179,6 +179,17 @@ pub const ROUND_SHIFT: f64 = 6_755_399_441_055_744.0;
 /// The fast path's range: `|x| < LIMIT` (`|k| ≤ 1.34e6 < 2²¹`).
 pub const LIMIT: f64 = 32768.0;
 
+/// Taylor coefficient of `r³` in `sin r`: `−1/3!`.
+pub const S3: f64 = -1.0 / 6.0;
+/// Taylor coefficient of `r⁵` in `sin r`: `1/5!`.
+pub const S5: f64 = 1.0 / 120.0;
+/// Taylor coefficient of `r²` in `cos r`: `−1/2!`.
+pub const C2: f64 = -0.5;
+/// Taylor coefficient of `r⁴` in `cos r`: `1/4!`.
+pub const C4: f64 = 1.0 / 24.0;
+/// Taylor coefficient of `r⁶` in `cos r`: `−1/6!`.
+pub const C6: f64 = -1.0 / 720.0;
+
 /// `(sin x, cos x)`: [`sincos_n`] of one angle.
 #[inline(always)]
 #[must_use]
@@ -261,12 +272,6 @@ fn ma<const FUSE: bool>(a: f64, b: f64, c: f64) -> f64 {
 #[inline(always)]
 #[allow(clippy::needless_range_loop)] // the lanes' loops are what the compiler vectorizes
 fn lanes<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
-    // Taylor coefficients of sin r (r³, r⁵) and cos r (r², r⁴, r⁶).
-    const S3: f64 = -1.0 / 6.0;
-    const S5: f64 = 1.0 / 120.0;
-    const C2: f64 = -0.5;
-    const C4: f64 = 1.0 / 24.0;
-    const C6: f64 = -1.0 / 720.0;
     let mut fast = true;
     for v in x {
         fast &= v > -LIMIT && v < LIMIT;

@@ -725,6 +725,20 @@ impl Trace {
     /// # Panics
     /// If `inputs.len()` differs from the number of inputs of the trace.
     pub fn eval(&self, inputs: &[f64]) -> Vec<f64> {
+        self.eval_with(inputs, f64::sin, f64::cos)
+    }
+
+    /// [`Trace::eval`] with sines and cosines by `sin` and `cos` (e.g. the generated code's
+    /// table sine–cosine, to reproduce its results bit for bit).
+    ///
+    /// # Panics
+    /// If `inputs.len()` differs from the number of inputs of the trace.
+    pub fn eval_with(
+        &self,
+        inputs: &[f64],
+        sin: impl Fn(f64) -> f64,
+        cos: impl Fn(f64) -> f64,
+    ) -> Vec<f64> {
         assert_eq!(
             inputs.len(),
             self.g.input_names.len(),
@@ -748,8 +762,8 @@ impl Trace {
                 Op::Mul(a, b) => x(a) * x(b),
                 Op::Div(a, b) => x(a) / x(b),
                 Op::Neg(a) => -x(a),
-                Op::Sin(a) => x(a).sin(),
-                Op::Cos(a) => x(a).cos(),
+                Op::Sin(a) => sin(x(a)),
+                Op::Cos(a) => cos(x(a)),
                 Op::Sqrt(a) => x(a).sqrt(),
             };
         }

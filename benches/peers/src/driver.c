@@ -29,6 +29,12 @@
 #include "casadi_gen.h"
 #include "timing.h"
 
+/* The side the rows and the dump name: CasADi's C, or kanegen's C output behind the same entry
+ * points (src/kanegen_c, -DPEERS_SIDE="\"kanegen\""). */
+#ifndef PEERS_SIDE
+#define PEERS_SIDE "casadi"
+#endif
+
 typedef int (*fn_t)(const casadi_real **, casadi_real **, casadi_int *, casadi_real *, int);
 typedef int (*work_t)(casadi_int *, casadi_int *, casadi_int *, casadi_int *);
 
@@ -127,7 +133,7 @@ int main(int argc, char **argv) {
   double *out0 = res[0];
 
   if (!strcmp(mode, "dump")) {
-    printf("{\"side\": \"casadi\", \"label\": \"%s\", \"model\": \"%s\", \"n\": %d, \"samples\": [\n", label, model, n);
+    printf("{\"side\": \"%s\", \"label\": \"%s\", \"model\": \"%s\", \"n\": %d, \"samples\": [\n", PEERS_SIDE, label, model, n);
     for (int k = 0; k < K; ++k) {
       printf("%s{", k ? ",\n" : "");
       for (size_t i = 0; i < NFUNCS; ++i) {
@@ -188,7 +194,7 @@ int main(int argc, char **argv) {
     }
     qsort(ns, (size_t)rounds, sizeof(double), peers_cmp_double);
     qsort(wall, (size_t)rounds, sizeof(double), peers_cmp_double);
-    printf("casadi,%s,%s,%s,%.2f,%.2f,%ld,%.6e,%.2f\n", label, model, trig ? "sincos_n" : FUNCS[i].name,
+    printf("%s,%s,%s,%s,%.2f,%.2f,%ld,%.6e,%.2f\n", PEERS_SIDE, label, model, trig ? "sincos_n" : FUNCS[i].name,
            ns[rounds / 2], ns[0], (long)rounds * calls, chk, wall[rounds / 2]);
     fflush(stdout);
   }

@@ -51,6 +51,16 @@ def ns(side, label, model, func):
     return med.get((side, label, model, func))
 
 
+def ct(side, build, model, step):
+    v = C.get((side, build, model, step))
+    if v is None:
+        return "–"
+    s, st = v
+    if st == "ok-cached":
+        return f"{s:.1f}*"
+    return f"{s:.1f}" if st == "ok" else f"{st} ({s:.0f})"
+
+
 # ------------------------------------------------------------------ compile times
 C = {}
 cp = os.path.join(a.out, "compile_times.csv")
@@ -184,6 +194,29 @@ L.extend([f"- {s}" for s in slower] or ["- nowhere in the headline table."])
 L.append("\n(Ties, within 0.5 %, are not listed. CasADi and Pinocchio at their faster convention.)")
 L.append("")
 
+# ------------------------------------------------------------------ kanegen C beside CasADi C
+R["kanegen_c"] = []
+if any(k[0] == "kanegen" and k[1] == "c" for k in T):
+    L.append("## kanegen C beside CasADi C: one compiler\n")
+    L.append("kanegen's functions printed as C99 (`kanegen generate --lang c`: the same plan, graphs and "
+             "operations as its Rust) behind CasADi's entry points (`src/kanegen_c`), compiled alone with "
+             "the same gcc and flags as CasADi's `cse` C and timed by the same driver in the same passes: "
+             "the generators compared under one compiler. **C ratio = CasADi C ns / kanegen C ns**; "
+             "Rust / C = kanegen Rust (default build) ns / kanegen C ns. LOCAL convention.\n")
+    L.append("| model | n | function | CasADi C ns | kanegen C ns | kanegen Rust ns | C ratio | Rust / C | gcc s: CasADi / kanegen |")
+    L.append("|---|---:|---|---:|---:|---:|---:|---:|---|")
+    for model in models:
+        n = MODELS[model]["n"]
+        for name, key, pk in FUNCS:
+            c, kc, kr = ns("casadi", "cse", model, pk[0]), ns("kanegen", "c", model, key), ns("kanegen", "default", model, key)
+            if kc is None:
+                continue
+            L.append(f"| {model} | {n} | {name} | {fmt_ns(c)} | {fmt_ns(kc)} | {fmt_ns(kr)} | {fmt_ratio(ratio(c, kc))} | "
+                     f"{f'{kr / kc:.2f}' if kr and kc else '–'} | {ct('casadi', 'cse', model, 'cc')} / {ct('kanegen', 'c', model, 'cc')} |")
+            R["kanegen_c"].append({"model": model, "n": n, "function": key, "casadi_c_ns": c, "kanegen_c_ns": kc,
+                                   "kanegen_rust_ns": kr, "kanegen_c_faster_than_casadi_c": ratio(c, kc)})
+    L.append("")
+
 # ------------------------------------------------------------------ derivatives
 R["derivatives"] = []
 if any(ns(s_, l_, m, f) for m in models for _, f, _ in DFUNCS
@@ -276,15 +309,6 @@ L.append("kanegen: `cargo build --release` of the bench crate with **one** `dyna
 L.append("| model | n | kanegen build | kanegen check | kanegen clean | kanegen native (2×) | CasADi trace+codegen | gcc cse | gcc cse_nocontract |")
 L.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
 
-
-def ct(side, build, model, step):
-    v = C.get((side, build, model, step))
-    if v is None:
-        return "–"
-    s, st = v
-    if st == "ok-cached":
-        return f"{s:.1f}*"
-    return f"{s:.1f}" if st == "ok" else f"{st} ({s:.0f})"
 
 
 for model in models:

@@ -83,6 +83,10 @@ for side in ("casadi", "pinocchio"):
         d = json.load(open(f))
         check(side, d["label"], d["model"], d["samples"])
 
+for f in sorted(glob.glob(os.path.join(a.dumpdir, "kanegen_c.*.json"))):
+    d = json.load(open(f))
+    check(d["side"], d["label"], d["model"], d["samples"])
+
 for f in sorted(glob.glob(os.path.join(a.dumpdir, "kanegen.*.json"))):
     d = json.load(open(f))
     for model, m in d["models"].items():

@@ -55,6 +55,63 @@ pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String>
     Ok(code)
 }
 
+/// The language `kanegen generate` writes (`--lang`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Lang {
+    /// A Rust module file ([`generate`]).
+    #[default]
+    Rust,
+    /// A C99 header ([`generate_c`]).
+    C,
+}
+
+impl Lang {
+    /// `rust` or `c`.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "rust" => Some(Lang::Rust),
+            "c" => Some(Lang::C),
+            _ => None,
+        }
+    }
+}
+
+/// The C header for `model` (`kanegen generate --lang c`, [`kanegen_codegen::c`]): its
+/// functions named `PREFIX_…`, the prefix [`Options::type_name`] in `snake_case`.
+///
+/// # Errors
+/// As [`kanegen_codegen::c::generate`].
+pub fn generate_c(model: &Model, opts: &Options) -> Result<String, kanegen_codegen::Error> {
+    kanegen_codegen::c::generate(model, opts, &kanegen_codegen::c::prefix(&opts.type_name))
+}
+
+/// [`generate_c`], refusing code that holds a non-finite constant (`NAN`, `INFINITY`): a model
+/// quantity folded into the code overflowed.
+///
+/// # Errors
+/// As [`generate_c`], or a non-finite constant.
+pub fn generate_c_checked(model: &Model, opts: &Options) -> anyhow::Result<String> {
+    let code = generate_c(model, opts)?;
+    let found = code.lines().enumerate().find_map(|(i, l)| {
+        let l = l.trim_start();
+        if l.starts_with("//") || l.starts_with("/*") {
+            return None;
+        }
+        l.split(|ch: char| !(ch.is_ascii_alphanumeric() || ch == '_'))
+            .find(|w| *w == "NAN" || *w == "INFINITY")
+            .map(|w| (i, w.to_string()))
+    });
+    if let Some((line, token)) = found {
+        anyhow::bail!(
+            "the generated code holds the non-finite constant `{token}` (line {}): a model \
+             quantity folded into the code overflowed",
+            line + 1
+        );
+    }
+    Ok(code)
+}
+
 /// The first non-finite constant of `code` outside comments and the joint-limit tables: its
 /// line (0-based) and its name (`f64::INFINITY`; the code names it by its full path,
 /// `::core::primitive::f64::INFINITY`).
