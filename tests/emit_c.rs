@@ -8,6 +8,7 @@
 //! plain and with `--fma`, is checked against the checked-in Rust functions (`kanegen_generated`)
 //! themselves; the `float`, payload and libm variants compile warning-free.
 
+mod common;
 mod precondition;
 
 use kanegen::codegen::c;
@@ -218,15 +219,10 @@ fn driver(plan: &Plan, p: &str, header: &str, states: &[State]) -> String {
 /// Runs `cc -std=c99 -Wall -Wextra -Werror` with `args`, checking that it succeeds (its stderr
 /// is the failure message).
 fn cc_checked<A: AsRef<std::ffi::OsStr>>(cc: &str, args: impl IntoIterator<Item = A>) {
-    let out = Command::new(cc)
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror"])
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{cc} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    common::succeeded(
+        Command::new(cc)
+            .args(["-std=c99", "-Wall", "-Wextra", "-Werror"])
+            .args(args),
     );
 }
 

@@ -34,14 +34,20 @@ pub fn scene_err(text: &str) -> String {
 /// Runs the `kanegen` binary with `args` in the project root and returns its output, after
 /// checking it succeeded (its stderr is the failure message).
 pub fn kanegen(args: &[&str]) -> std::process::Output {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
+    succeeded(
+        std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
+            .args(args)
+            .current_dir(root()),
+    )
+}
+
+/// Runs `cmd` and returns its output, after checking it succeeded (its stderr is the failure
+/// message).
+pub fn succeeded(cmd: &mut std::process::Command) -> std::process::Output {
+    let out = cmd.output().unwrap();
     assert!(
         out.status.success(),
-        "{}",
+        "{cmd:?} failed:\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
     out
