@@ -25,12 +25,13 @@ v = rng.uniform(-1.0, 1.0, (B, arm.nv))
 tau = rng.uniform(-1.0, 1.0, (B, arm.nv))
 
 
-def best(f, rounds=ROUNDS):
+def best(f, rounds=ROUNDS, clock=time.perf_counter):
+    """(best, median, last result) of `rounds` calls of f, by `clock`."""
     times = []
     for _ in range(rounds):
-        t = time.perf_counter()
+        t = clock()
         out = f()
-        times.append(time.perf_counter() - t)
+        times.append(clock() - t)
     return min(times), sorted(times)[len(times) // 2], out
 
 
@@ -53,3 +54,7 @@ t_pin, med_pin, want = best(lambda: np.array([pin.aba(pm, data, q[k], v[k], tau[
 err = np.abs(qdd - want).max() / np.abs(want).max()
 print(f"Python loop over pinocchio.aba ({pin.__version__}): best {t_pin * 1e3:.1f} ms, median {med_pin * 1e3:.1f} ms")
 print(f"ratio (best / best): {t_pin / t_batch:.1f}x; max |qdd - aba| / max |aba| = {err:.1e}")
+# CPU time (all threads of the process): what each side costs, whatever the machine's load.
+c_batch = best(lambda: arm.forward_dynamics(q, v, tau), clock=time.process_time)[0]
+c_pin = best(lambda: [pin.aba(pm, data, q[k], v[k], tau[k]) for k in range(B)], 3, time.process_time)[0]
+print(f"CPU time per state: kanegen batch {c_batch / B * 1e9:.0f} ns, pinocchio.aba loop {c_pin / B * 1e9:.0f} ns ({c_pin / c_batch:.1f}x)")
