@@ -10,7 +10,7 @@ use pyo3::types::PyTuple;
 use rayon::prelude::*;
 
 /// The most array arguments a function takes.
-const MAX_ARGS: usize = 3;
+pub const MAX_ARGS: usize = 3;
 
 /// An array argument as numpy gives it (any real dtype, converted to `float64`).
 pub type Arg<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
@@ -94,11 +94,16 @@ impl States {
         })
     }
 
-    /// The arguments of state `k` (at most [`MAX_ARGS`]; the rest empty).
-    fn state(&self, k: usize) -> [&[f64]; MAX_ARGS] {
+    /// Whether the arguments are a batch (2-D).
+    pub fn is_batch(&self) -> bool {
+        self.batch.is_some()
+    }
+
+    /// The rows of states `k..k + m` of each argument (at most [`MAX_ARGS`]; the rest empty).
+    fn rows(&self, k: usize, m: usize) -> [&[f64]; MAX_ARGS] {
         let mut out: [&[f64]; MAX_ARGS] = [&[]; MAX_ARGS];
         for ((o, v), &n) in out.iter_mut().zip(&self.values).zip(&self.lens) {
-            *o = &v[k * n..(k + 1) * n];
+            *o = &v[k * n..(k + m) * n];
         }
         out
     }
@@ -117,23 +122,41 @@ impl States {
         init: impl Fn() -> W + Sync + Send,
         f: impl Fn(&mut W, &[&[f64]], &mut [f64]) -> anyhow::Result<()> + Sync + Send,
     ) -> PyResult<Bound<'py, PyAny>> {
+        self.eval_chunked(py, shapes, 1, init, |w, x, o| f(w, &x, o))
+    }
+
+    /// [`States::eval`] with `f` given up to `chunk` states at once: the rows of consecutive
+    /// states of each argument and their outputs' rows.
+    ///
+    /// # Errors
+    /// The first error of `f` (a batch's names its states), as a `KanegenError`.
+    pub fn eval_chunked<'py, W>(
+        &self,
+        py: Python<'py>,
+        shapes: &[&[usize]],
+        chunk: usize,
+        init: impl Fn() -> W + Sync + Send,
+        f: impl Fn(&mut W, [&[f64]; MAX_ARGS], &mut [f64]) -> anyhow::Result<()> + Sync + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let sizes: Vec<usize> = shapes.iter().map(|s| s.iter().product()).collect();
         let size: usize = sizes.iter().sum();
         let states = self.batch.unwrap_or(1);
         let mut out = vec![0.0; states * size];
-        let run = |w: &mut W, k: usize, o: &mut [f64]| {
-            catch(|| f(w, &self.state(k), o)).map_err(|e| match self.batch {
-                Some(_) => e.context(format!("state {k}")),
-                None => e,
+        let run = |w: &mut W, c: usize, o: &mut [f64]| {
+            let (k, m) = (c * chunk, o.len() / size.max(1));
+            catch(|| f(w, self.rows(k, m), o)).map_err(|e| match (self.batch, m) {
+                (None, _) => e,
+                (Some(_), 1) => e.context(format!("state {k}")),
+                (Some(_), _) => e.context(format!("states {k} to {}", k + m - 1)),
             })
         };
         py.allow_threads(|| match self.batch {
             None => run(&mut init(), 0, &mut out),
             Some(_) => out
-                .par_chunks_mut(size.max(1))
-                .with_min_len(64)
+                .par_chunks_mut(chunk * size.max(1))
+                .with_min_len(64 / chunk)
                 .enumerate()
-                .try_for_each_init(&init, |w, (k, o)| run(w, k, o)),
+                .try_for_each_init(&init, |w, (c, o)| run(w, c, o)),
         })
         .map_err(|e| to_py(&e))?;
         let mut arrays = Vec::with_capacity(shapes.len());

@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 mod batch;
+mod lanes;
 mod model;
 
 use anyhow::Context;

@@ -3,6 +3,7 @@
 //! Jacobians), fixed or free-floating base, Pinocchio's layouts.
 
 use crate::batch::{Arg, States};
+use crate::lanes::{self, LaneData, LaneTables};
 use crate::{catch, to_py};
 use anyhow::{bail, Context};
 use kanegen_dynamics::algorithms::derivatives::{self, Matrix};
@@ -25,6 +26,8 @@ struct Core {
     gravity: Option<Vec3<f64>>,
     /// The run-time kernels' tables (fixed base: gravity in them; free-floating: in the loads).
     tables: KernelTables,
+    /// On a fixed base, the tables on four lanes.
+    lanes: Option<LaneTables>,
 }
 
 /// A worker's scratch for forward dynamics: the kernels' data and the loads (drives copied in).
@@ -301,12 +304,14 @@ impl Model {
             BaseKind::Fixed => None,
         };
         let tables = KernelTables::new(&params, gravity.filter(|_| base.is_none()));
+        let lanes = base.is_none().then(|| lanes::lane_tables(&tables));
         Ok(Model {
             core: Core {
                 params,
                 base,
                 gravity: gravity.map(Vec3),
                 tables,
+                lanes,
                 model,
             },
         })
@@ -489,12 +494,26 @@ impl Model {
         let c = &self.core;
         let args = [("q", &q, c.nq()), ("v", &v, c.nv()), ("tau", &tau, c.n())];
         let shapes: &[&[usize]] = &[&[c.nv()]];
-        let out = States::new(&args)?.eval(
-            py,
-            shapes,
-            || c.scratch(),
-            |ws, x, o| c.forward_dynamics(ws, x[0], x[1], x[2], o),
-        );
+        let states = States::new(&args)?;
+        let out = match &c.lanes {
+            // A fixed-base batch: four states per call of the kernels.
+            Some(lt) if states.is_batch() => states.eval_chunked(
+                py,
+                shapes,
+                lanes::LANES,
+                || LaneData::new(c.n()),
+                |d, [q, v, tau], o| {
+                    lanes::forward_dynamics(lt, &c.tables, d, [q, v, tau], o);
+                    Ok(())
+                },
+            ),
+            _ => states.eval(
+                py,
+                shapes,
+                || c.scratch(),
+                |ws, x, o| c.forward_dynamics(ws, x[0], x[1], x[2], o),
+            ),
+        };
         out.map(Bound::unbind)
     }
 
