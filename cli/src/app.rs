@@ -395,8 +395,16 @@ fn say(msg: &str) {
     let _ = writeln!(std::io::stderr(), "{msg}");
 }
 
-/// The model at `model` with the base `--base` gives (the model's own when `None`).
-fn load_with_base(model: &Path, allow_nonphysical: bool, base: Option<BaseKind>) -> Result<Model> {
+/// The model at `model` with the base `--base` gives (the model's own when `None`), with the
+/// error context every command puts on a model ("model `PATH`", then "--base").
+///
+/// # Errors
+/// A file that cannot be read or parsed, an invalid model, or a base it cannot take.
+pub fn load_with_base(
+    model: &Path,
+    allow_nonphysical: bool,
+    base: Option<BaseKind>,
+) -> Result<Model> {
     let chain = load(model, allow_nonphysical)?;
     match base {
         None => Ok(chain),

@@ -8,12 +8,13 @@
 use kanegen_codegen::compact::kernel_counts;
 use kanegen_codegen::compact::tables::{numbers, KernelTables};
 use kanegen_codegen::{generate_items, Form, Options};
+use kanegen_dynamics::kernels::TablesIn as Owned;
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::metrics::rel_err;
 use kanegen_dynamics::{ExternalWrench, LoadFrame, Loads, Methods, Params};
 use kanegen_model::random::{random_chain, random_tree, random_vec, rng, ChainSpec};
 use kanegen_model::Model;
-use kanegen_runtime::compact::{self as k, Tables};
+use kanegen_runtime::compact as k;
 use kanegen_runtime::Scalar;
 use kanegen_trace::Function;
 use std::cell::Cell;
@@ -26,52 +27,6 @@ fn spec(n: usize) -> ChainSpec {
         n,
         prismatic_fraction: 0.3,
         ..Default::default()
-    }
-}
-
-/// The kernels' tables of `t` in scalar `S`, in `Vec`s ([`Owned::tables`]).
-struct Owned<S> {
-    a: Vec<[[S; 3]; 3]>,
-    b: Vec<[[S; 3]; 3]>,
-    c: Vec<[[S; 3]; 3]>,
-    l: Vec<[S; 3]>,
-    slide: Vec<[S; 3]>,
-    s: Vec<[S; 6]>,
-    inertia: Vec<[S; 10]>,
-    ancestor: Option<Vec<bool>>,
-    a0: [S; 6],
-}
-
-impl<S: Scalar + Copy> Owned<S> {
-    fn new(t: &KernelTables, s: impl Fn(f64) -> S) -> Self {
-        let m3 = |m: &[[f64; 3]; 3]| m.map(|r| r.map(&s));
-        Owned {
-            a: t.a.iter().map(m3).collect(),
-            b: t.b.iter().map(m3).collect(),
-            c: t.c.iter().map(m3).collect(),
-            l: t.l.iter().map(|v| v.map(&s)).collect(),
-            slide: t.slide.iter().map(|v| v.map(&s)).collect(),
-            s: t.s.iter().map(|v| v.map(&s)).collect(),
-            inertia: t.inertia.iter().map(|v| v.map(&s)).collect(),
-            ancestor: t.ancestor.clone(),
-            a0: t.a0.map(&s),
-        }
-    }
-
-    fn tables<'a>(&'a self, t: &'a KernelTables) -> Tables<'a, S> {
-        Tables {
-            parent: &t.parent,
-            revolute: &t.revolute,
-            a: &self.a,
-            b: &self.b,
-            c: &self.c,
-            l: &self.l,
-            slide: &self.slide,
-            s: &self.s,
-            inertia: &self.inertia,
-            ancestor: self.ancestor.as_deref(),
-            a0: self.a0,
-        }
     }
 }
 

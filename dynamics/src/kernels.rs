@@ -198,6 +198,57 @@ fn ancestors(parent: &[Option<usize>]) -> Vec<bool> {
     anc
 }
 
+/// The numbers of [`KernelTables`] in another scalar `S` (several states' lanes side by side, a
+/// counting scalar), in `Vec`s; the tables' structure (parents, joint kinds, ancestors) stays
+/// theirs ([`TablesIn::tables`]).
+#[derive(Clone, Debug)]
+pub struct TablesIn<S> {
+    a: Vec<[[S; 3]; 3]>,
+    b: Vec<[[S; 3]; 3]>,
+    c: Vec<[[S; 3]; 3]>,
+    l: Vec<[S; 3]>,
+    slide: Vec<[S; 3]>,
+    s: Vec<[S; 6]>,
+    inertia: Vec<[S; 10]>,
+    a0: [S; 6],
+}
+
+impl<S: kanegen_runtime::Scalar + Copy> TablesIn<S> {
+    /// The numbers of `t`, each mapped by `s`.
+    pub fn new(t: &KernelTables, s: impl Fn(f64) -> S) -> Self {
+        let m3 = |m: &M3| m.map(|r| r.map(&s));
+        TablesIn {
+            a: t.a.iter().map(m3).collect(),
+            b: t.b.iter().map(m3).collect(),
+            c: t.c.iter().map(m3).collect(),
+            l: t.l.iter().map(|v| v.map(&s)).collect(),
+            slide: t.slide.iter().map(|v| v.map(&s)).collect(),
+            s: t.s.iter().map(|v| v.map(&s)).collect(),
+            inertia: t.inertia.iter().map(|v| v.map(&s)).collect(),
+            a0: t.a0.map(&s),
+        }
+    }
+
+    /// The tables as the kernels take them, with the structure of `t` (the tables these numbers
+    /// came from).
+    #[must_use]
+    pub fn tables<'a>(&'a self, t: &'a KernelTables) -> Tables<'a, S> {
+        Tables {
+            parent: &t.parent,
+            revolute: &t.revolute,
+            a: &self.a,
+            b: &self.b,
+            c: &self.c,
+            l: &self.l,
+            slide: &self.slide,
+            s: &self.s,
+            inertia: &self.inertia,
+            ancestor: t.ancestor.as_deref(),
+            a0: self.a0,
+        }
+    }
+}
+
 /// The kernels' per-body scratch for `N` joints in `Vec`s: [`Bodies`] and [`Articulated`], made
 /// once and overwritten by every call (the data of Pinocchio's model/data split).
 #[derive(Clone, Debug)]

@@ -89,6 +89,18 @@ pub fn csv_header(scene: &Scene) -> Vec<String> {
 /// round-trip `{:e}` form.
 #[must_use]
 pub fn csv_row(scene: &Scene, s: &Sample) -> String {
+    let cells: Vec<String> = csv_values(scene, s)
+        .iter()
+        .map(|v| format!("{v:e}"))
+        .collect();
+    let mut out = cells.join(",");
+    out.push('\n');
+    out
+}
+
+/// The numbers of one CSV row of a sample, in the order of [`csv_header`].
+#[must_use]
+pub fn csv_values(scene: &Scene, s: &Sample) -> Vec<f64> {
     let n = scene.dof();
     let x = &s.x;
     let mut row: Vec<f64> = vec![s.t];
@@ -100,10 +112,7 @@ pub fn csv_row(scene: &Scene, s: &Sample) -> String {
     } else {
         row.extend(x);
     }
-    let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
-    let mut out = cells.join(",");
-    out.push('\n');
-    out
+    row
 }
 
 /// The trajectory as CSV text (see [`csv_header`]).
