@@ -429,3 +429,52 @@ fn table_sincos_lanes_are_the_scalar() {
     assert_eq!(sincos_lanes_are_the_scalar::<f64x2, 3>(&angles), n);
     assert_eq!(sincos_lanes_are_the_scalar::<f64x4, 7>(&angles), n);
 }
+
+/// `runtime::par::batch` over a generated batch (feature `rayon`) equals the serial batch bit
+/// for bit, on pools of one, two and three threads, for batch lengths around the chunk sizes.
+#[cfg(feature = "rayon")]
+#[test]
+fn parallel_batches_are_the_serial_batch() {
+    use kanegen::runtime::par;
+    let mut rng = Rng(20);
+    let pools = [1, 2, 3].map(|t| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+    });
+    for n in [0, 1, 5, 8, 17, 64, 203] {
+        let q: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let qd: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let tau: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let mut serial = vec![[0.0; 6]; n];
+        Ur5::forward_dynamics_batch::<f64x4>(&q, &qd, &tau, &mut serial);
+        let mut serial_mc = vec![([[0.0; 6]; 6], [0.0; 6]); n];
+        Ur5::mass_matrix_and_nonlinear_effects_batch::<f64x2>(&q, &qd, &mut serial_mc);
+        for pool in &pools {
+            let mut out = vec![[f64::NAN; 6]; n];
+            pool.install(|| {
+                par::batch(&mut out, |r, out| {
+                    Ur5::forward_dynamics_batch::<f64x4>(
+                        &q[r.clone()],
+                        &qd[r.clone()],
+                        &tau[r],
+                        out,
+                    );
+                });
+            });
+            assert_eq!(format!("{out:?}"), format!("{serial:?}"), "n = {n}");
+            let mut mc = vec![([[f64::NAN; 6]; 6], [f64::NAN; 6]); n];
+            pool.install(|| {
+                par::batch(&mut mc, |r, out| {
+                    Ur5::mass_matrix_and_nonlinear_effects_batch::<f64x2>(
+                        &q[r.clone()],
+                        &qd[r],
+                        out,
+                    );
+                });
+            });
+            assert_eq!(format!("{mc:?}"), format!("{serial_mc:?}"), "n = {n}");
+        }
+    }
+}
