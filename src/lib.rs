@@ -9,7 +9,8 @@
 //! | (none) | [`dynamics!`], [`scene!`] and their runtime support (`libm`, [`ode`]): builds for `#![no_std]` targets |
 //! | `std` | the library crates: [`model`] (robots as plain data, URDF/TOML readers), [`dynamics`] (algorithms generic over the scalar), [`trace`] (the counting tracer, Table 1), [`codegen`] (the emitter), [`sim`] (scenes, integrators) |
 //! | `nalgebra` | [`nalgebra`](crate::nalgebra) conversions of generated arrays (f64 and f32) |
-//! | `cli` (default) | the `kanegen` command line, and [`cli`] |
+//! | `rayon` | `runtime::par`: a generated function's batch (`NAME_batch`) split across threads (needs `std` on the target, not the `std` feature) |
+//! | `cli` (default) | the `kanegen` command line, and [`cli`] (with `std`, `nalgebra`, `rayon`) |
 //!
 //! A `#![no_std]` controller depends on `kanegen = { version = "…", default-features = false }`.
 #![no_std]

@@ -354,3 +354,127 @@ fn batches_are_the_scalar_calls() {
         assert_eq!(out[k], Ur5Compact::mass_matrix(&q[k]));
     }
 }
+
+/// Angles for the table sine–cosine: zeros of both signs, multiples of π/2 and π, the table's
+/// steps `kπ/128` and the points halfway between (where the rounded step changes), tiny and
+/// subnormal values, the fast path's limit ±32768 and its neighbours, NaN and the infinities,
+/// and seeded random angles over [−3, 3), [−200, 200) and up to ±32768.
+fn sincos_angles() -> Vec<f64> {
+    use core::f64::consts::PI;
+    let below = |x: f64| f64::from_bits(x.to_bits() - 1);
+    let mut a = vec![
+        0.0,
+        -0.0,
+        1e-300,
+        -1e-300,
+        5e-324,
+        f64::MIN_POSITIVE,
+        32768.0,
+        -32768.0,
+        below(32768.0),
+        -below(32768.0),
+        32767.99,
+        -32767.99,
+        1e6,
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    for k in -300..=300 {
+        let k = f64::from(k);
+        a.extend([k * PI, k * PI / 2.0, k * PI / 128.0, (k + 0.5) * PI / 128.0]);
+        a.extend([below(((k + 0.5) * PI / 128.0).abs()), 1e4 * k * PI]);
+    }
+    let mut rng = Rng(19);
+    for _ in 0..2000 {
+        let x = rng.next();
+        a.extend([x, x * 200.0 / 3.0, x * 32767.0 / 3.0]);
+    }
+    a
+}
+
+/// `S::sincos_n` and `S::sincos_n_unfused` of `K` angles per lane against the scalar routine
+/// on each lane's `K` angles, bit for bit, over `angles` rotated through the lanes (so some
+/// lanes take the path beyond the limit while others do not); returns the number of calls.
+fn sincos_lanes_are_the_scalar<S: Lanes<f64>, const K: usize>(angles: &[f64]) -> usize {
+    let n = angles.len();
+    let mut calls = 0;
+    for start in (0..n).step_by(3) {
+        let pick = |i: usize, k: usize| angles[(start + 7 * i + 13 * k) % n];
+        let x: [S; K] = core::array::from_fn(|k| S::from_fn(|i| pick(i, k)));
+        let (fused, unfused) = (S::sincos_n(x), S::sincos_n_unfused(x));
+        for i in 0..S::LANES {
+            let xi: [f64; K] = core::array::from_fn(|k| pick(i, k));
+            let (want, want_u) = (f64::sincos_n(xi), f64::sincos_n_unfused(xi));
+            for k in 0..K {
+                let bits = |(s, c): (f64, f64)| (s.to_bits(), c.to_bits());
+                let lane = |(s, c): (S, S)| (s.lane(i), c.lane(i));
+                assert_eq!(bits(lane(fused[k])), bits(want[k]), "{xi:?}, lane {i}");
+                assert_eq!(bits(lane(unfused[k])), bits(want_u[k]), "{xi:?}, lane {i}");
+            }
+        }
+        calls += 1;
+    }
+    calls
+}
+
+/// The table sine–cosine on `f64x2` and `f64x4` (vector arithmetic, the table read per lane) is
+/// the scalar routine on each lane, fused and unfused, for one and several angles per lane.
+#[test]
+fn table_sincos_lanes_are_the_scalar() {
+    let angles = sincos_angles();
+    let n = angles.len().div_ceil(3);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x2, 1>(&angles), n);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x4, 1>(&angles), n);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x2, 3>(&angles), n);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x4, 7>(&angles), n);
+}
+
+/// `runtime::par::batch` over a generated batch (feature `rayon`) equals the serial batch bit
+/// for bit, on pools of one, two and three threads, for batch lengths around the chunk sizes.
+#[cfg(feature = "rayon")]
+#[test]
+fn parallel_batches_are_the_serial_batch() {
+    use kanegen::runtime::par;
+    let mut rng = Rng(20);
+    let pools = [1, 2, 3].map(|t| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+    });
+    for n in [0, 1, 5, 8, 17, 64, 203] {
+        let q: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let qd: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let tau: Vec<[f64; 6]> = (0..n).map(|_| Random::random(&mut rng)).collect();
+        let mut serial = vec![[0.0; 6]; n];
+        Ur5::forward_dynamics_batch::<f64x4>(&q, &qd, &tau, &mut serial);
+        let mut serial_mc = vec![([[0.0; 6]; 6], [0.0; 6]); n];
+        Ur5::mass_matrix_and_nonlinear_effects_batch::<f64x2>(&q, &qd, &mut serial_mc);
+        for pool in &pools {
+            let mut out = vec![[f64::NAN; 6]; n];
+            pool.install(|| {
+                par::batch(&mut out, |r, out| {
+                    Ur5::forward_dynamics_batch::<f64x4>(
+                        &q[r.clone()],
+                        &qd[r.clone()],
+                        &tau[r],
+                        out,
+                    );
+                });
+            });
+            assert_eq!(format!("{out:?}"), format!("{serial:?}"), "n = {n}");
+            let mut mc = vec![([[f64::NAN; 6]; 6], [f64::NAN; 6]); n];
+            pool.install(|| {
+                par::batch(&mut mc, |r, out| {
+                    Ur5::mass_matrix_and_nonlinear_effects_batch::<f64x2>(
+                        &q[r.clone()],
+                        &qd[r],
+                        out,
+                    );
+                });
+            });
+            assert_eq!(format!("{mc:?}"), format!("{serial_mc:?}"), "n = {n}");
+        }
+    }
+}

@@ -309,6 +309,7 @@ fn bench_arguments_are_validated() {
         ["--rounds", "0"],
         ["--calls", "0"],
         ["--rounds", "99999999999"],
+        ["--batch", "0"],
     ] {
         let o = kanegen().arg("bench").args(args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);

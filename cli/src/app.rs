@@ -83,8 +83,9 @@ enum Command {
     Count(CountArgs),
     /// Emit unrolled, allocation-free, no_std Rust for a model (stdout, or -o FILE).
     Generate(GenerateArgs),
-    /// ns per call of the generated SSRMS code against the interpreted algorithms, measured side
-    /// by side in one run (report ratios: the machine is shared and noisy).
+    /// ns per call of the generated SSRMS code against the interpreted algorithms, and states per
+    /// second of the generated functions (one state, lanes, all cores), measured side by side in
+    /// one run (report ratios: the machine is shared and noisy).
     Bench(BenchArgs),
     /// What accuracy costs in time: errors of A, b, q̈ per precision against a double-double
     /// reference with ns per call; integrators' work–precision; each scene effect's cost and
@@ -258,6 +259,9 @@ struct BenchArgs {
     /// Calls per round, 1 to 100000000.
     #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
     calls: u32,
+    /// States per batch of the throughput table (one state, lanes, all cores), 1 to 1000000.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    batch: u32,
 }
 
 // The arguments of `kanegen accuracy` (its help is the variant's doc).
@@ -579,9 +583,10 @@ fn generate(a: GenerateArgs, out: &mut dyn Write, interactive: Interactive) -> R
     }
 }
 
-/// `kanegen bench`: the generated SSRMS code against the interpreted algorithms.
+/// `kanegen bench`: the generated SSRMS code against the interpreted algorithms, and the
+/// generated functions' states per second.
 fn bench(a: BenchArgs, out: &mut dyn Write) -> Result<()> {
-    let r = commands::bench::bench_ssrms(a.rounds as usize, a.calls as usize)?;
+    let r = commands::bench::bench_ssrms(a.rounds as usize, a.calls as usize, a.batch as usize)?;
     if a.json {
         print(out, &json(&r)?)
     } else {

@@ -38,28 +38,23 @@ pub fn measure(
     let states: Vec<(Vec<f64>, Vec<f64>)> = (0..16)
         .map(|_| (random_vec(&mut r, n, 3.0), random_vec(&mut r, n, 0.1)))
         .collect();
-    let k = candidates.len();
-    let mut samples: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); k];
     // Warm-up.
     for c in candidates.iter_mut() {
         for (q, qd) in &states {
             black_box((c.2)(black_box(q), black_box(qd)));
         }
     }
-    for round in 0..rounds {
-        for off in 0..k {
-            let i = (round + off) % k;
-            let f = &mut candidates[i].2;
-            let t0 = Instant::now();
-            let mut acc = 0.0;
-            for call in 0..calls {
-                let (q, qd) = &states[call % states.len()];
-                acc += f(black_box(q), black_box(qd));
-            }
-            black_box(acc);
-            samples[i].push(t0.elapsed().as_nanos() as f64 / calls as f64);
+    let samples = rounds_side_by_side(candidates.len(), rounds, |i| {
+        let f = &mut candidates[i].2;
+        let t0 = Instant::now();
+        let mut acc = 0.0;
+        for call in 0..calls {
+            let (q, qd) = &states[call % states.len()];
+            acc += f(black_box(q), black_box(qd));
         }
-    }
+        black_box(acc);
+        t0.elapsed().as_nanos() as f64 / calls as f64
+    });
     let mut lines: Vec<BenchLine> = candidates
         .iter()
         .zip(samples)
@@ -91,4 +86,21 @@ pub fn measure(
         l.ratio_to_first = l.ns / base;
     }
     lines
+}
+
+/// `rounds` rounds of `k` candidates in rotating order (round `r` starts at candidate `r mod k`):
+/// `run(i)` runs candidate `i` once and returns its measure; the measures per candidate.
+pub fn rounds_side_by_side(
+    k: usize,
+    rounds: usize,
+    mut run: impl FnMut(usize) -> f64,
+) -> Vec<Vec<f64>> {
+    let mut samples: Vec<Vec<f64>> = vec![Vec::with_capacity(rounds); k];
+    for round in 0..rounds {
+        for off in 0..k {
+            let i = (round + off) % k;
+            samples[i].push(run(i));
+        }
+    }
+    samples
 }

@@ -380,15 +380,25 @@ fn function_item(
         })
         .collect();
     let payload_arg_batch = opts.runtime_payload.then(|| quote!(payload: &#payload_ty,));
-    let batch_doc = format!(
-        " [`Self::{name}`] of every state of the slices, `S::LANES` states per call of \
-         [`Self::{lanes_name}`]: `out[k]` is `{name}` of the `k`-th entries, for `k` below the \
-         shortest slice's length (`out` included; entries of `out` past it are left as they \
-         are); a last chunk of fewer states is padded with the last state, whose extra results \
-         are discarded."
-    );
+    let unrolled = fp.kernel == Kernel::Unrolled;
+    let batch_doc = if unrolled {
+        format!(
+            " [`Self::{name}`] of every state of the slices, `S::LANES` states per call of \
+             [`Self::{lanes_name}`]: `out[k]` is `{name}` of the `k`-th entries, for `k` below \
+             the shortest slice's length (`out` included; entries of `out` past it are left as \
+             they are); a last chunk of fewer states is padded with the last state, whose extra \
+             results are discarded."
+        )
+    } else {
+        format!(
+            " [`Self::{name}`] of every state of the slices: `out[k]` is `{name}` of the `k`-th \
+             entries, for `k` below the shortest slice's length (`out` included; entries of \
+             `out` past it are left as they are). A function in loops or composed has no lane \
+             body, so this calls `{name}` once per state whatever `S` is."
+        )
+    };
     let body = body.tokens;
-    let (scalar_body, lanes_body, lanes_doc) = if fp.kernel != Kernel::Unrolled {
+    let (scalar_body, lanes_body, lanes_doc) = if !unrolled {
         let lane_of = arg_names
             .iter()
             .map(|a| quote!(&#rt::lanes::lane::<#fl, S, _>(#a, i)));
@@ -425,6 +435,19 @@ fn function_item(
             ),
         )
     };
+    let batch_body = if unrolled {
+        quote! {
+            #rt::lanes::batch::<#fl, S, _>(out, n, |start| {
+                Self::#lanes_name::<S>(#(&#rt::lanes::gather::<#fl, S, _>(#arg_names, start, n)),* #payload_pass)
+            });
+        }
+    } else {
+        quote! {
+            for (k, o) in out[..n].iter_mut().enumerate() {
+                *o = Self::#name(#(&#arg_names[k]),* #payload_pass);
+            }
+        }
+    };
     Ok(quote! {
         #[doc = #doc1]
         #[doc = ""]
@@ -443,9 +466,7 @@ fn function_item(
         #[doc = #batch_doc]
         pub fn #batch_name<#bound>(#(#batch_args,)* #payload_arg_batch out: &mut [#ret]) {
             let n = out.len() #(.min(#arg_names.len()))*;
-            #rt::lanes::batch::<#fl, S, _>(out, n, |start| {
-                Self::#lanes_name::<S>(#(&#rt::lanes::gather::<#fl, S, _>(#arg_names, start, n)),* #payload_pass)
-            });
+            #batch_body
         }
     })
 }

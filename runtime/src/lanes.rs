@@ -7,7 +7,9 @@
 //! the scalar function computes for that lane's state, bit for bit. [`Lanes`] is what the body
 //! needs of `S`: arithmetic, constants ([`Lanes::splat`]), the generated code's fused
 //! multiply-adds, square roots and sines and cosines, each applied lane by lane with the scalar
-//! routine's rounding (the sines and cosines by the scalar routines themselves).
+//! routine's rounding: the table sine–cosine of `f64` code ([`crate::sincos`]) is one routine,
+//! generic over the lane type, run as vector arithmetic on `f64x2` and `f64x4`; libm's sines and
+//! cosines (and `f32`'s) are the scalar routines applied to each lane.
 //!
 //! Implemented for `f64` and `f32` (one lane) and for `wide`'s [`f64x2`], [`f64x4`],
 //! [`f32x4`] and [`f32x8`]. Negation is [`Lanes::neg`], a sign flip (`wide`'s `-x` is `0 − x`,
@@ -172,7 +174,7 @@ const WIDE_SQRT: bool = cfg!(any(
 /// The `wide` implementations: vector arithmetic where `wide`'s equals the scalar routine lane
 /// by lane, the scalar routine on each lane elsewhere.
 macro_rules! wide_lanes {
-    ($v:ident, $t:ident, $l:literal) => {
+    ($v:ident, $t:ident, $l:literal, $sincos_n:expr, $sincos_n_unfused:expr) => {
         impl Lanes<$t> for $v {
             const LANES: usize = $l;
             #[inline(always)]
@@ -232,17 +234,11 @@ macro_rules! wide_lanes {
             }
             #[inline(always)]
             fn sincos_n<const K: usize>(x: [Self; K]) -> [(Self, Self); K] {
-                let r: [[($t, $t); K]; $l] = core::array::from_fn(|i| {
-                    <$t as Lanes<$t>>::sincos_n(x.map(|v| v.as_array_ref()[i]))
-                });
-                transpose(&r)
+                $sincos_n(x)
             }
             #[inline(always)]
             fn sincos_n_unfused<const K: usize>(x: [Self; K]) -> [(Self, Self); K] {
-                let r: [[($t, $t); K]; $l] = core::array::from_fn(|i| {
-                    <$t as Lanes<$t>>::sincos_n_unfused(x.map(|v| v.as_array_ref()[i]))
-                });
-                transpose(&r)
+                $sincos_n_unfused(x)
             }
         }
     };
@@ -262,11 +258,14 @@ trait Map<F: Copy>: Lanes<F> {
 
 impl<F: Copy, S: Lanes<F>> Map<F> for S {}
 
-/// Each lane's `K` sine–cosine pairs (`r[lane][k]`) as `K` pairs of vectors.
+/// The sine–cosine `f` of `K` angles of one state applied to each lane's angles (`L =
+/// S::LANES`): `K` pairs of vectors.
 #[inline(always)]
-fn transpose<F: Copy, S: Lanes<F>, const K: usize, const L: usize>(
-    r: &[[(F, F); K]; L],
+pub(crate) fn per_lane<F: Copy, S: Lanes<F>, const K: usize, const L: usize>(
+    x: [S; K],
+    f: impl Fn([F; K]) -> [(F, F); K],
 ) -> [(S, S); K] {
+    let r: [[(F, F); K]; L] = core::array::from_fn(|i| f(x.map(|v| v.lane(i))));
     core::array::from_fn(|k| (S::from_fn(|i| r[i][k].0), S::from_fn(|i| r[i][k].1)))
 }
 
@@ -280,10 +279,34 @@ trait Replace<F: Copy>: Lanes<F> {
 
 impl<F: Copy, S: Lanes<F>> Replace<F> for S {}
 
-wide_lanes!(f64x2, f64, 2);
-wide_lanes!(f64x4, f64, 4);
-wide_lanes!(f32x4, f32, 4);
-wide_lanes!(f32x8, f32, 8);
+wide_lanes!(
+    f64x2,
+    f64,
+    2,
+    crate::sincos::lanes::<f64x2, K, true>,
+    crate::sincos::lanes::<f64x2, K, false>
+);
+wide_lanes!(
+    f64x4,
+    f64,
+    4,
+    crate::sincos::lanes::<f64x4, K, true>,
+    crate::sincos::lanes::<f64x4, K, false>
+);
+wide_lanes!(
+    f32x4,
+    f32,
+    4,
+    |x| per_lane::<_, _, K, 4>(x, |x: [f32; K]| x.map(libm::sincosf)),
+    |x| per_lane::<_, _, K, 4>(x, |x: [f32; K]| x.map(libm::sincosf))
+);
+wide_lanes!(
+    f32x8,
+    f32,
+    8,
+    |x| per_lane::<_, _, K, 8>(x, |x: [f32; K]| x.map(libm::sincosf)),
+    |x| per_lane::<_, _, K, 8>(x, |x: [f32; K]| x.map(libm::sincosf))
+);
 
 /// A value of the element type `F` (a number, an array of them, a tuple of those) and its form
 /// over the lane type `S` (each number a lane vector): how functions without a lane body (the

@@ -20,6 +20,8 @@
 //! - [`scene`]: a scene's right-hand side (drives, damping, friction, wrenches, rotor inertia,
 //!   flexible joints, a free-floating base's kinematics) over a dynamics provider, written once
 //!   for the interpreted simulator and `scene!`.
+//! - `par` (feature `rayon`; targets with the standard library): a batch split across threads, each thread running a
+//!   generated `NAME_batch` on its chunk of the states.
 //! - [`ldlt`]: LDLᵀ factorization and solve over slices, allocating nothing.
 //! - [`inertia`]: the parallel-axis shift of a rigid body's inertia.
 #![no_std]
@@ -36,6 +38,8 @@ pub mod inertia;
 pub mod lanes;
 pub mod ldlt;
 pub mod ode;
+#[cfg(feature = "rayon")]
+pub mod par;
 pub mod scalar;
 pub mod scene;
 pub mod sincos;

@@ -22,6 +22,11 @@
 //! `kanegen accuracy` (`docs/accuracy.md`) and bounded by `tests/sincos.rs`: 1 ulp of 1 at most,
 //! and 2 ulp of the value wherever it is at least 1/16.
 //!
+//! The steps are written once, generic over the lane type: [`sincos_n`] is their `f64` case, and
+//! `Lanes::sincos_n` of `f64x2` and `f64x4` ([`crate::lanes`]) runs the same operations on
+//! vectors, the table read lane by lane, so each lane is bit for bit [`sincos_n`] of its angles;
+//! where some lane's angle is beyond the range (or NaN), each lane runs [`sincos_n`] on its own.
+//!
 //! [`sincos_n`] fuses its products by [`crate::fma::mul_add`] (one instruction where the build
 //! targets FMA, else `a·b + c`); [`sincos_n_unfused`] never fuses (code generated with
 //! `fma = true` or `target_fma = false`).
@@ -32,6 +37,9 @@
 //! let [(s, c), _] = sincos_n([1.0, 2.0]);
 //! assert!((s - libm::sin(1.0)).abs() < 1e-15 && (c - libm::cos(1.0)).abs() < 1e-15);
 //! ```
+
+use crate::lanes::{f64x2, f64x4, Lanes};
+use wide::{CmpGt, CmpLt};
 
 /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded (computed in 300-bit arithmetic by
 /// `mpmath`; `tests` checks them against `libm::sin` and each other).
@@ -230,7 +238,7 @@ pub fn sincos_n_unfused<const K: usize>(x: [f64; K]) -> [(f64, f64); K] {
 #[inline(always)]
 fn chunks<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
     if !cfg!(target_feature = "avx512f") || K <= CHUNK {
-        return lanes::<K, FUSE>(x);
+        return lanes::<f64, K, FUSE>(x);
     }
     in_chunks::<K, FUSE>(x)
 }
@@ -247,7 +255,7 @@ fn in_chunks<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
         let m = (K - i).min(CHUNK);
         let mut chunk = [0.0; CHUNK];
         chunk[..m].copy_from_slice(&x[i..i + m]);
-        let r = lanes::<CHUNK, FUSE>(chunk);
+        let r = lanes::<f64, CHUNK, FUSE>(chunk);
         out[i..i + m].copy_from_slice(&r[..m]);
         i += CHUNK;
     }
@@ -257,58 +265,131 @@ fn in_chunks<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
 /// The most angles [`chunks`] hands [`lanes`] at once: one 256-bit register of `f64`.
 const CHUNK: usize = 4;
 
-/// `a·b + c`: [`crate::fma::mul_add`] with `FUSE`, two roundings without.
+/// What steps 1–4 need of a lane type ([`Lanes`]) beyond its arithmetic: the range test, the
+/// table lookup and the path beyond the range. Implemented for `f64` (the scalar routine) and
+/// `wide`'s `f64x2` and `f64x4`, whose [`Lanes::sincos_n`] runs the steps as vector arithmetic,
+/// each lane bit for bit the scalar routine on that lane's angles.
+pub(crate) trait TableLanes: Lanes<f64> {
+    /// Whether every lane of every angle is within `(−LIMIT, LIMIT)` (not NaN).
+    fn within<const K: usize>(x: &[Self; K]) -> bool;
+    /// `(sin(k·π/128), cos(k·π/128))` of each lane, `k` in the low 8 bits of `t`'s lane (the
+    /// rounding shift's sum).
+    fn table(t: Self) -> (Self, Self);
+    /// The sine–cosine where some lane is beyond the range: `libm::sincos` for `f64`, and lane
+    /// by lane the scalar routine (fast or not per lane) for vectors.
+    fn beyond<const K: usize, const FUSE: bool>(x: [Self; K]) -> [(Self, Self); K];
+}
+
+/// `(sin(jπ/128), cos(jπ/128))` of the low 8 bits `j` of `t`'s bits (bit 7 of the index: the
+/// half turn, a sign).
 #[inline(always)]
-fn ma<const FUSE: bool>(a: f64, b: f64, c: f64) -> f64 {
+fn table_pair(t: f64) -> (f64, f64) {
+    let table =
+        |j: usize| f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56));
+    let j = (t.to_bits() & 255) as usize;
+    (table(j), table(j + 64))
+}
+
+impl TableLanes for f64 {
+    #[inline(always)]
+    fn within<const K: usize>(x: &[f64; K]) -> bool {
+        let mut fast = true;
+        for &v in x {
+            fast &= v > -LIMIT && v < LIMIT;
+        }
+        fast
+    }
+    #[inline(always)]
+    fn table(t: f64) -> (f64, f64) {
+        table_pair(t)
+    }
+    #[inline(always)]
+    fn beyond<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
+        x.map(libm::sincos)
+    }
+}
+
+/// [`TableLanes`] of a `wide` vector of `f64`.
+macro_rules! table_lanes {
+    ($v:ident, $l:literal) => {
+        impl TableLanes for $v {
+            #[inline(always)]
+            fn within<const K: usize>(x: &[$v; K]) -> bool {
+                let (lo, hi) = ($v::splat(-LIMIT), $v::splat(LIMIT));
+                let mut fast = $v::splat(f64::from_bits(u64::MAX));
+                for &v in x {
+                    fast = fast & v.cmp_gt(lo) & v.cmp_lt(hi);
+                }
+                fast.all()
+            }
+            #[inline(always)]
+            fn table(t: $v) -> ($v, $v) {
+                let p = t.to_array().map(table_pair);
+                ($v::new(p.map(|p| p.0)), $v::new(p.map(|p| p.1)))
+            }
+            #[inline(always)]
+            fn beyond<const K: usize, const FUSE: bool>(x: [$v; K]) -> [($v, $v); K] {
+                crate::lanes::per_lane::<f64, $v, K, $l>(x, lanes::<f64, K, FUSE>)
+            }
+        }
+    };
+}
+
+table_lanes!(f64x2, 2);
+table_lanes!(f64x4, 4);
+
+/// `a·b + c`: [`Lanes::mul_add`] (fused as [`crate::fma::mul_add`]) with `FUSE`, two roundings
+/// without.
+#[inline(always)]
+fn ma<S: Lanes<f64>, const FUSE: bool>(a: S, b: S, c: S) -> S {
     if FUSE {
-        crate::fma::mul_add(a, b, c)
+        a.mul_add(b, c)
     } else {
         a * b + c
     }
 }
 
-/// Steps 1–4 of the module for `K` angles, products fused by [`ma`]; each step is a loop over the
-/// lanes, so the compiler runs them side by side in vector registers.
+/// Steps 1–4 of the module for `K` angles of `S` (one state each lane), products fused by
+/// [`ma`]; each step is a loop over the angles, so the compiler runs them side by side in vector
+/// registers. The scalar routine is `S = f64`; a vector type's lanes are each that routine.
 #[inline(always)]
-#[allow(clippy::needless_range_loop)] // the lanes' loops are what the compiler vectorizes
-fn lanes<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
-    let mut fast = true;
-    for v in x {
-        fast &= v > -LIMIT && v < LIMIT;
-    }
-    if !fast {
-        return x.map(libm::sincos);
+#[allow(clippy::needless_range_loop)] // the angles' loops are what the compiler vectorizes
+pub(crate) fn lanes<S: TableLanes, const K: usize, const FUSE: bool>(x: [S; K]) -> [(S, S); K] {
+    // Taylor coefficients of sin r (r³, r⁵) and cos r (r², r⁴, r⁶).
+    let c = S::splat;
+    let (s3, s5) = (c(S3), c(S5));
+    let (c2, c4, c6) = (c(C2), c(C4), c(C6));
+    if !S::within(&x) {
+        return S::beyond::<K, FUSE>(x);
     }
     // 1. x = k·π/128 + r, |r| ≤ π/256: k rounded by the 1.5·2⁵² shift, r by Cody and Waite's
     // two-part π/128.
-    let (mut t, mut r) = ([0.0; K], [0.0; K]);
+    let (shift, steps, hi, lo) = (c(ROUND_SHIFT), c(STEPS_PER_RAD), c(STEP_HI), c(STEP_LO));
+    let (mut t, mut r) = ([c(0.0); K], [c(0.0); K]);
     for i in 0..K {
-        t[i] = ma::<FUSE>(x[i], STEPS_PER_RAD, ROUND_SHIFT);
-        let k = t[i] - ROUND_SHIFT;
-        let r_hi = ma::<FUSE>(-k, STEP_HI, x[i]);
-        r[i] = ma::<FUSE>(-k, STEP_LO, r_hi);
+        t[i] = ma::<S, FUSE>(x[i], steps, shift);
+        let k = t[i] - shift;
+        let r_hi = ma::<S, FUSE>(k.neg(), hi, x[i]);
+        r[i] = ma::<S, FUSE>(k.neg(), lo, r_hi);
     }
     // 2. sin r and cos r by their Taylor polynomials.
-    let (mut sin_r, mut cos_r) = ([0.0; K], [0.0; K]);
+    let (mut sin_r, mut cos_r) = ([c(0.0); K], [c(0.0); K]);
     for i in 0..K {
         let r2 = r[i] * r[i];
         let r3 = r[i] * r2;
-        let p_s = ma::<FUSE>(r2, S5, S3);
-        sin_r[i] = ma::<FUSE>(r3, p_s, r[i]);
-        let p_c6 = ma::<FUSE>(r2, C6, C4);
-        let p_c = ma::<FUSE>(r2, p_c6, C2);
-        cos_r[i] = ma::<FUSE>(r2, p_c, 1.0);
+        let p_s = ma::<S, FUSE>(r2, s5, s3);
+        sin_r[i] = ma::<S, FUSE>(r3, p_s, r[i]);
+        let p_c6 = ma::<S, FUSE>(r2, c6, c4);
+        let p_c = ma::<S, FUSE>(r2, p_c6, c2);
+        cos_r[i] = ma::<S, FUSE>(r2, p_c, c(1.0));
     }
-    // 3. sin and cos of k·π/128 (bit 7 of the index: the half turn, a sign); 4. the angle sums.
-    let table =
-        |j: usize| f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56));
-    let mut out = [(0.0, 0.0); K];
+    // 3. sin and cos of k·π/128; 4. the angle sums.
+    let mut out = [(c(0.0), c(0.0)); K];
     for i in 0..K {
-        let j = (t[i].to_bits() & 255) as usize;
-        let (sin_a, cos_a) = (table(j), table(j + 64));
+        let (sin_a, cos_a) = S::table(t[i]);
         out[i] = (
-            ma::<FUSE>(sin_a, cos_r[i], cos_a * sin_r[i]),
-            ma::<FUSE>(cos_a, cos_r[i], -(sin_a * sin_r[i])),
+            ma::<S, FUSE>(sin_a, cos_r[i], cos_a * sin_r[i]),
+            ma::<S, FUSE>(cos_a, cos_r[i], (sin_a * sin_r[i]).neg()),
         )
     }
     out
@@ -347,12 +428,12 @@ mod tests {
             let bits = |r: [(f64, f64); K]| r.map(|(s, c)| (s.to_bits(), c.to_bits()));
             assert_eq!(
                 bits(in_chunks::<K, true>(x)),
-                bits(lanes::<K, true>(x)),
+                bits(lanes::<f64, K, true>(x)),
                 "{x:?}"
             );
             assert_eq!(
                 bits(in_chunks::<K, false>(x)),
-                bits(lanes::<K, false>(x)),
+                bits(lanes::<f64, K, false>(x)),
                 "{x:?}"
             );
         }

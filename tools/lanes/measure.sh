@@ -9,36 +9,18 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
 dir="$root/target/lanes-measure"
-mkdir -p "$dir"
+source "$root/tools/lanes/crate.sh"
 for model in "$@"; do
-  stem="$(basename "${model%.*}")"
-  crate="$dir/${stem}"
-  mkdir -p "$crate/src"
-  cat > "$crate/Cargo.toml" <<TOML
-[package]
-name = "lanes_${stem//[^a-zA-Z0-9_]/_}"
-version = "0.0.0"
-edition = "2021"
-publish = false
-[dependencies]
-kanegen = { path = "$root", default-features = false }
-[profile.release]
-debug = false
-[workspace]
-TOML
-  cat > "$crate/src/main.rs" <<RS
+  lanes_crate "$dir" lanes "" "$model" <<'RS'
 use kanegen::runtime::lanes::{f64x2, f64x4, Lanes};
-kanegen::dynamics!(R, "$(realpath "$model")");
-const N: usize = R::N;
-const B: usize = 256;
 
-/// Lanes \`i..i + L\` of \`x\` as one argument over \`S\`.
+/// Lanes `i..i + L` of `x` as one argument over `S`.
 #[inline(always)]
 fn pack<S: Lanes<f64>>(x: &[[f64; N]], i: usize) -> [S; N] {
     core::array::from_fn(|j| S::from_fn(|l| x[i + l][j]))
 }
 
-/// ns per state of \`f\` over the B states, the median of 5 rounds.
+/// ns per state of `f` over the B states, the median of 5 rounds.
 fn time(mut f: impl FnMut() -> f64) -> f64 {
     let reps = (20_000 / (N * N)).max(20);
     let mut t: Vec<f64> = (0..5)
@@ -119,7 +101,4 @@ fn main() {
     println!("ns/state FD f64 {fd1:.1} f64x2 {fd2:.1} f64x4 {fd4:.1}; M+c f64 {mc1:.1} f64x2 {mc2:.1} f64x4 {mc4:.1}");
 }
 RS
-  export CARGO_TARGET_DIR="$dir/target"
-  (cd "$crate" && cargo build --release -q)
-  echo "$stem $("$CARGO_TARGET_DIR/release/lanes_${stem//[^a-zA-Z0-9_]/_}")"
 done

@@ -1,11 +1,12 @@
 //! `kanegen bench`: nanoseconds per call of generated and interpreted dynamics for SSRMS, measured
-//! side by side in one process run.
+//! side by side in one process run, and states per second of the generated functions over a
+//! batch: one state per call, lanes (`f64x2`, `f64x4`) and all cores.
 //!
 //! These machines are shared and noisy, so absolute numbers mean little; the report is built for
 //! ratios. Every candidate runs in each of many short rounds, in rotating order, and the median
 //! round is reported: a burst of load on the machine hits every candidate of that round alike.
 
-use crate::timing::{measure, BenchLine, Candidate};
+use crate::timing::{measure, rounds_side_by_side, BenchLine, Candidate};
 use serde::Serialize;
 
 /// The report.
@@ -21,6 +22,45 @@ pub struct BenchReport {
     pub calls_per_round: usize,
     /// Results.
     pub results: Vec<BenchLine>,
+    /// States per second of the generated functions over a batch: one state per call, lanes,
+    /// all cores.
+    pub throughput: Throughput,
+}
+
+/// States per second of generated SSRMS functions over one batch of random states, one state
+/// per call, `L` states per call (`NAME_batch::<f64x2>`, `::<f64x4>`) and the lanes on all cores
+/// (`kanegen_runtime::par::batch` over the same batch functions), side by side in one run.
+#[derive(Clone, Debug, Serialize)]
+pub struct Throughput {
+    /// States per batch.
+    pub batch: usize,
+    /// Threads of the parallel batches (`rayon`'s pool: the machine's CPUs).
+    pub threads: usize,
+    /// Rounds per candidate (each a whole batch; the median is reported).
+    pub rounds: usize,
+    /// One line per function.
+    pub lines: Vec<ThroughputLine>,
+}
+
+/// One function's states per second (the median round) in each way.
+#[derive(Clone, Debug, Serialize)]
+pub struct ThroughputLine {
+    /// The generated function.
+    pub function: String,
+    /// One state per call (`NAME` in a loop).
+    pub one_state: f64,
+    /// `NAME_batch::<f64x2>`.
+    pub f64x2: f64,
+    /// `NAME_batch::<f64x4>`.
+    pub f64x4: f64,
+    /// `NAME_batch::<f64x2>` on all cores.
+    pub cores_f64x2: f64,
+    /// `NAME_batch::<f64x4>` on all cores.
+    pub cores_f64x4: f64,
+    /// The better lanes width over one state per call.
+    pub lanes_ratio: f64,
+    /// The better all-cores figure over the better lanes width (one core).
+    pub cores_ratio: f64,
 }
 
 /// Human-readable table.
@@ -37,7 +77,178 @@ pub fn render_text(r: &BenchReport) -> String {
             l.function, l.name, l.ns, l.ns_range[0], l.ns_range[1], l.ratio_to_first
         );
     }
+    let t = &r.throughput;
+    let _ = write!(
+        s,
+        "\nThroughput, {} states per batch, {} threads, {} rounds, median states per second \
+         (lanes ×: the better width over one state; cores ×: the better all-cores over the \
+         better width)\n\n{:<36} {:>10} {:>10} {:>10} {:>12} {:>12} {:>8} {:>8}\n",
+        t.batch,
+        t.threads,
+        t.rounds,
+        "function",
+        "1 state",
+        "f64x2",
+        "f64x4",
+        "cores f64x2",
+        "cores f64x4",
+        "lanes ×",
+        "cores ×"
+    );
+    let m = |x: f64| format!("{:.2}M", x / 1e6);
+    for l in &t.lines {
+        let _ = writeln!(
+            s,
+            "{:<36} {:>10} {:>10} {:>10} {:>12} {:>12} {:>8.2} {:>8.2}",
+            l.function,
+            m(l.one_state),
+            m(l.f64x2),
+            m(l.f64x4),
+            m(l.cores_f64x2),
+            m(l.cores_f64x4),
+            l.lanes_ratio,
+            l.cores_ratio
+        );
+    }
     s
+}
+
+/// One way of evaluating a batch: runs it once over the whole batch.
+type Way<'a> = Box<dyn FnMut() + 'a>;
+
+/// The five ways of [`ThroughputLine`] for generated function `$f` of `$t` (batch form
+/// `$batch`) over the batch's argument slices, each with its own results, `$zero` to start.
+macro_rules! ways {
+    ($t:ty, $f:ident / $batch:ident ($($arg:ident),*), $zero:expr) => {{
+        use kanegen_runtime::lanes::{f64x2, f64x4};
+        use kanegen_runtime::par;
+        use std::hint::black_box;
+        let b = [$($arg.len()),*][0];
+        let ways: Vec<Way<'_>> = vec![
+            Box::new({
+                let mut o = vec![$zero; b];
+                move || {
+                    for (k, o) in o.iter_mut().enumerate() {
+                        *o = <$t>::$f($(&$arg[k]),*);
+                    }
+                    black_box(&o);
+                }
+            }),
+            Box::new({
+                let mut o = vec![$zero; b];
+                move || {
+                    <$t>::$batch::<f64x2>($($arg,)* &mut o);
+                    black_box(&o);
+                }
+            }),
+            Box::new({
+                let mut o = vec![$zero; b];
+                move || {
+                    <$t>::$batch::<f64x4>($($arg,)* &mut o);
+                    black_box(&o);
+                }
+            }),
+            Box::new({
+                let mut o = vec![$zero; b];
+                move || {
+                    par::batch(&mut o, |r, o| <$t>::$batch::<f64x2>($(&$arg[r.clone()],)* o));
+                    black_box(&o);
+                }
+            }),
+            Box::new({
+                let mut o = vec![$zero; b];
+                move || {
+                    par::batch(&mut o, |r, o| <$t>::$batch::<f64x4>($(&$arg[r.clone()],)* o));
+                    black_box(&o);
+                }
+            }),
+        ];
+        (stringify!($f), ways)
+    }};
+}
+
+/// States per second of the generated SSRMS functions `M`, `c`, `(M, c)`, inverse and forward
+/// dynamics and the forward-dynamics derivatives over `batch` random states (at least one), each
+/// way of [`ThroughputLine`] timed over the whole batch in each of `rounds` rounds, side by side
+/// (every way of every function in each round, in rotating order), the median round reported.
+#[must_use]
+pub fn bench_throughput(rounds: usize, batch: usize) -> Throughput {
+    use kanegen_generated::ssrms::Ssrms;
+    use kanegen_model::random::{random_vec, rng};
+    let batch = batch.max(1);
+    let mut r = rng(2027);
+    let mut states = |scale: f64| -> Vec<[f64; 7]> {
+        (0..batch)
+            .map(|_| {
+                let v = random_vec(&mut r, 7, scale);
+                core::array::from_fn(|i| v[i])
+            })
+            .collect()
+    };
+    let (q, qd, tau) = (states(3.0), states(0.1), states(0.1));
+    let (q, qd, tau) = (&q[..], &qd[..], &tau[..]);
+    let (z, m) = ([0.0; 7], [[0.0; 7]; 7]);
+    let mut groups = [
+        ways!(Ssrms, mass_matrix / mass_matrix_batch(q), m),
+        ways!(Ssrms, nonlinear_effects / nonlinear_effects_batch(q, qd), z),
+        ways!(
+            Ssrms,
+            mass_matrix_and_nonlinear_effects / mass_matrix_and_nonlinear_effects_batch(q, qd),
+            (m, z)
+        ),
+        ways!(
+            Ssrms,
+            inverse_dynamics / inverse_dynamics_batch(q, qd, tau),
+            z
+        ),
+        ways!(
+            Ssrms,
+            forward_dynamics / forward_dynamics_batch(q, qd, tau),
+            z
+        ),
+        ways!(
+            Ssrms,
+            forward_dynamics_derivatives / forward_dynamics_derivatives_batch(q, qd, tau),
+            (m, m, m)
+        ),
+    ];
+    let mut all: Vec<&mut Way<'_>> = groups.iter_mut().flat_map(|g| g.1.iter_mut()).collect();
+    for w in &mut all {
+        w(); // warm-up
+    }
+    let samples = rounds_side_by_side(all.len(), rounds, |i| {
+        let t0 = std::time::Instant::now();
+        (all[i])();
+        batch as f64 / t0.elapsed().as_secs_f64()
+    });
+    let median = |mut s: Vec<f64>| {
+        s.sort_by(f64::total_cmp);
+        s[s.len() / 2]
+    };
+    let rates: Vec<f64> = samples.into_iter().map(median).collect();
+    let lines = groups
+        .iter()
+        .zip(rates.chunks(5))
+        .map(|(g, r)| {
+            let lanes = r[1].max(r[2]);
+            ThroughputLine {
+                function: g.0.into(),
+                one_state: r[0],
+                f64x2: r[1],
+                f64x4: r[2],
+                cores_f64x2: r[3],
+                cores_f64x4: r[4],
+                lanes_ratio: lanes / r[0],
+                cores_ratio: r[3].max(r[4]) / lanes,
+            }
+        })
+        .collect();
+    Throughput {
+        batch,
+        threads: kanegen_runtime::par::threads(),
+        rounds,
+        lines,
+    }
 }
 
 /// The SSRMS model the generated code was emitted from (embedded, so the command runs anywhere).
@@ -45,11 +256,12 @@ pub const SSRMS_URDF: &str =
     include_str!("../../../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
 
 /// Generated SSRMS code against the interpreted f64 algorithms, side by side: `M + c` (one
-/// generated call against each preset's `A` and `b`), forward dynamics and inverse dynamics.
+/// generated call against each preset's `A` and `b`), forward dynamics and inverse dynamics;
+/// then the generated functions' throughput over `batch` states ([`bench_throughput`]).
 ///
 /// # Errors
 /// If the embedded model does not parse.
-pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
+pub fn bench_ssrms(rounds: usize, calls: usize, batch: usize) -> anyhow::Result<BenchReport> {
     use kanegen_dynamics::{Loads, Methods, Params};
     use kanegen_generated::ssrms::Ssrms;
     use kanegen_generated::ssrms_recurrent::SsrmsRecurrent;
@@ -151,6 +363,7 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
         rounds,
         calls_per_round: calls,
         results,
+        throughput: bench_throughput(rounds, batch),
     })
 }
 

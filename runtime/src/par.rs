@@ -1,0 +1,105 @@
+//! Batches across threads (feature `rayon`; a target with the standard library): one generic helper that splits a batch's
+//! output into one chunk per thread of `rayon`'s pool and runs a serial batch — a generated
+//! `NAME_batch::<S>` — on each chunk, on the matching ranges of the input slices.
+//!
+//! Every chunk but the last holds a multiple of [`CHUNK_MULTIPLE`] states, so each thread's
+//! batch runs full chunks of lanes for every lane type (1, 2, 4 or 8 lanes); nothing is allocated
+//! per state (the split is `rayon`'s fork–join over the output slice). Each state's result is
+//! computed by the same code as in the serial batch, so the results equal the serial batch's bit
+//! for bit, for any number of threads.
+//!
+//! ```
+//! use kanegen_runtime::par;
+//! let x: Vec<f64> = (0..1000).map(f64::from).collect();
+//! let mut out = vec![0.0; x.len()];
+//! // A serial batch: out[k] = f(x[k]) over the slices it is given.
+//! let square = |x: &[f64], out: &mut [f64]| {
+//!     for (o, x) in out.iter_mut().zip(x) {
+//!         *o = x * x;
+//!     }
+//! };
+//! par::batch(&mut out, |range, out| square(&x[range], out));
+//! assert!(out.iter().zip(&x).all(|(o, x)| *o == x * x));
+//! ```
+
+use core::ops::Range;
+use rayon::prelude::*;
+
+/// The states of every chunk but the last are a multiple of this: the widest lane type's lane
+/// count (`f32x8`), so every lane type's batch runs full chunks of lanes within a thread's chunk.
+pub const CHUNK_MULTIPLE: usize = 8;
+
+/// The states per thread's chunk for a batch of `n` states over `threads` threads: `n / threads`
+/// rounded up to a multiple of [`CHUNK_MULTIPLE`] (0 for an empty batch).
+#[must_use]
+pub fn chunk_len(n: usize, threads: usize) -> usize {
+    n.div_ceil(threads.max(1)).div_ceil(CHUNK_MULTIPLE) * CHUNK_MULTIPLE
+}
+
+/// The threads of the current `rayon` pool, over which [`batch`] splits (the global pool: one
+/// per CPU unless `RAYON_NUM_THREADS` says otherwise).
+#[must_use]
+pub fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
+/// `f(range, chunk)` for chunks of `out` on the threads of the current `rayon` pool, one chunk per
+/// thread ([`chunk_len`] states each): `chunk` is `&mut out[range]`. `f` runs a serial batch on
+/// the inputs' `range`, e.g. for a generated `Ur5`
+/// `|r, out| Ur5::forward_dynamics_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], out)`
+/// (the inputs at least as long as `out`).
+pub fn batch<R: Send>(out: &mut [R], f: impl Fn(Range<usize>, &mut [R]) + Sync) {
+    let len = chunk_len(out.len(), threads());
+    if len == 0 {
+        return;
+    }
+    out.par_chunks_mut(len)
+        .enumerate()
+        .for_each(|(c, chunk)| f(c * len..c * len + chunk.len(), chunk));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Chunks are multiples of 8 states covering the batch with one chunk per thread at most.
+    #[test]
+    fn chunks_cover_the_batch() {
+        assert_eq!(chunk_len(0, 2), 0);
+        assert_eq!(chunk_len(1, 2), 8);
+        assert_eq!(chunk_len(256, 2), 128);
+        assert_eq!(chunk_len(257, 2), 136);
+        assert_eq!(chunk_len(100, 3), 40);
+        assert_eq!(chunk_len(5, 0), 8);
+        for n in 0..200 {
+            for threads in 1..5 {
+                let len = chunk_len(n, threads);
+                assert_eq!(len % CHUNK_MULTIPLE, 0);
+                assert!(n == 0 || len * threads >= n);
+            }
+        }
+    }
+
+    /// Every state's result is written once, at its own index, on a pool of three threads.
+    #[test]
+    fn each_state_once_at_its_index() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        for n in [0, 1, 7, 8, 9, 64, 101] {
+            let mut all = [usize::MAX; 101];
+            let out = &mut all[..n];
+            pool.install(|| {
+                batch(out, |r, out| {
+                    assert_eq!(r.len(), out.len());
+                    for (o, k) in out.iter_mut().zip(r) {
+                        assert_eq!(*o, usize::MAX);
+                        *o = k;
+                    }
+                });
+            });
+            assert!(out.iter().enumerate().all(|(k, o)| *o == k), "n = {n}");
+        }
+    }
+}
