@@ -246,8 +246,8 @@ fn chunks<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
 /// [`chunks`]' chunked path, on any target (tested against [`lanes`] everywhere).
 #[inline(always)]
 fn in_chunks<const K: usize, const FUSE: bool>(x: [f64; K]) -> [(f64, f64); K] {
-    if !x.iter().all(|v| *v > -LIMIT && *v < LIMIT) {
-        return x.map(libm::sincos);
+    if !<f64 as TableLanes>::within(&x) {
+        return <f64 as TableLanes>::beyond::<K, FUSE>(x);
     }
     let mut out = [(0.0, 0.0); K];
     let mut i = 0;
