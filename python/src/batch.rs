@@ -74,7 +74,12 @@ impl States {
                 }
                 Some(_) => {}
             }
-            let v: Vec<f64> = a.as_array().iter().copied().collect();
+            let array = a.as_array();
+            // A contiguous array (the usual case) is one copy; others are walked in order.
+            let v: Vec<f64> = match array.as_slice() {
+                Some(s) => s.to_vec(),
+                None => array.iter().copied().collect(),
+            };
             if let Some(k) = v.iter().position(|x| !x.is_finite()) {
                 let at = match this {
                     Some(_) => format!("[{}, {}]", k / n, k % n),
@@ -159,11 +164,20 @@ impl States {
                 .try_for_each_init(&init, |w, (c, o)| run(w, c, o)),
         })
         .map_err(|e| to_py(&e))?;
+        let dims = |shape: &[usize]| -> Vec<usize> {
+            self.batch
+                .into_iter()
+                .chain(shape.iter().copied())
+                .collect()
+        };
+        if let [shape] = shapes {
+            // One output: the buffer is the array.
+            let a = ArrayD::from_shape_vec(IxDyn(&dims(shape)), out).expect("sizes from the shape");
+            return Ok(a.into_pyarray(py).into_any());
+        }
         let mut arrays = Vec::with_capacity(shapes.len());
         let mut offset = 0;
         for (shape, n) in shapes.iter().zip(&sizes) {
-            let mut dims: Vec<usize> = self.batch.into_iter().collect();
-            dims.extend_from_slice(shape);
             let data: Vec<f64> = (0..states)
                 .flat_map(|k| {
                     out[k * size + offset..k * size + offset + n]
@@ -171,7 +185,8 @@ impl States {
                         .copied()
                 })
                 .collect();
-            let a = ArrayD::from_shape_vec(IxDyn(&dims), data).expect("sizes from the shapes");
+            let a =
+                ArrayD::from_shape_vec(IxDyn(&dims(shape)), data).expect("sizes from the shapes");
             arrays.push(a.into_pyarray(py).into_any());
             offset += n;
         }

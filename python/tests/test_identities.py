@@ -153,6 +153,18 @@ def test_batch_equals_loop(model):
     np.testing.assert_array_equal(model.frame_jacobian(frame, q)[5], model.frame_jacobian(frame, q[5]))
 
 
+def test_strided_and_fortran_order_batches_equal_contiguous_ones(model):
+    q, v, a, tau = random_state(model, np.random.default_rng(11), batch=9)
+    want = model.forward_dynamics(q, v, tau)
+    # Every other row of a doubled batch, and column-major copies: not C-contiguous.
+    doubled = [np.repeat(x, 2, axis=0)[::2] for x in (q, v, tau)]
+    assert not doubled[0].flags["C_CONTIGUOUS"]
+    np.testing.assert_array_equal(model.forward_dynamics(*doubled), want)
+    fortran = [np.asfortranarray(x) for x in (q, v, tau)]
+    np.testing.assert_array_equal(model.forward_dynamics(*fortran), want)
+    np.testing.assert_array_equal(model.mass_matrix(fortran[0]), model.mass_matrix(q))
+
+
 def test_lists_and_integers_are_accepted(root):
     m = kanegen.Model.load(root / "models/two_link.toml")
     np.testing.assert_array_equal(m.mass_matrix([0, 1]), m.mass_matrix(np.array([0.0, 1.0])))
