@@ -23,7 +23,6 @@
 //! ```
 
 use core::ops::Range;
-use rayon::prelude::*;
 
 /// The states of every chunk but the last are a multiple of this: the widest lane type's lane
 /// count (`f32x8`), so every lane type's batch runs full chunks of lanes within a thread's chunk.
@@ -53,9 +52,19 @@ pub fn batch<R: Send>(out: &mut [R], f: impl Fn(Range<usize>, &mut [R]) + Sync) 
     if len == 0 {
         return;
     }
-    out.par_chunks_mut(len)
-        .enumerate()
-        .for_each(|(c, chunk)| f(c * len..c * len + chunk.len(), chunk));
+    let f = &f;
+    let mut chunks = out.chunks_mut(len).enumerate();
+    let first = chunks.next();
+    // The calling thread runs the first chunk itself while the pool's threads take the others
+    // (a scope in place: the caller does not hand its own share to the pool and wait).
+    rayon::in_place_scope(|s| {
+        for (c, chunk) in chunks {
+            s.spawn(move |_| f(c * len..c * len + chunk.len(), chunk));
+        }
+        if let Some((c, chunk)) = first {
+            f(c * len..c * len + chunk.len(), chunk);
+        }
+    });
 }
 
 #[cfg(test)]

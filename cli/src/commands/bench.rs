@@ -167,9 +167,13 @@ macro_rules! ways {
     }};
 }
 
+/// The time over which [`bench_throughput`] calls one way back to back for one sample (s).
+const SAMPLE: f64 = 200e-6;
+
 /// States per second of the generated SSRMS functions `M`, `c`, `(M, c)`, inverse and forward
 /// dynamics and the forward-dynamics derivatives over `batch` random states (at least one), each
-/// way of [`ThroughputLine`] timed over the whole batch in each of `rounds` rounds, side by side
+/// way of [`ThroughputLine`] timed over the whole batch, called back to back for about
+/// [`SAMPLE`] seconds, in each of `rounds` rounds, side by side
 /// (every way of every function in each round, in rotating order), the median round reported.
 #[must_use]
 pub fn bench_throughput(rounds: usize, batch: usize) -> Throughput {
@@ -213,13 +217,25 @@ pub fn bench_throughput(rounds: usize, batch: usize) -> Throughput {
         ),
     ];
     let mut all: Vec<&mut Way<'_>> = groups.iter_mut().flat_map(|g| g.1.iter_mut()).collect();
-    for w in &mut all {
-        w(); // warm-up
-    }
+    // Warm-up, and each way's calls per sample: back to back for about `SAMPLE` seconds, as a
+    // sampler or a horizon calls batch after batch (the pool's threads stay awake between them).
+    let calls: Vec<u32> = all
+        .iter_mut()
+        .map(|w| {
+            w();
+            let t0 = std::time::Instant::now();
+            w();
+            (SAMPLE / t0.elapsed().as_secs_f64().max(1e-9))
+                .ceil()
+                .clamp(1.0, 1e6) as u32
+        })
+        .collect();
     let samples = rounds_side_by_side(all.len(), rounds, |i| {
         let t0 = std::time::Instant::now();
-        (all[i])();
-        batch as f64 / t0.elapsed().as_secs_f64()
+        for _ in 0..calls[i] {
+            (all[i])();
+        }
+        f64::from(calls[i]) * batch as f64 / t0.elapsed().as_secs_f64()
     });
     let median = |mut s: Vec<f64>| {
         s.sort_by(f64::total_cmp);
