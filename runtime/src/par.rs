@@ -4,7 +4,8 @@
 //!
 //! Every chunk but the last holds a multiple of [`CHUNK_MULTIPLE`] states, so each thread's
 //! batch runs full chunks of lanes for every lane type (1, 2, 4 or 8 lanes); nothing is allocated
-//! per state (the split is `rayon`'s fork–join over the output slice). Each state's result is
+//! per state (the split is one `rayon` job per chunk but the caller's, in a scope in place over
+//! the output slice). Each state's result is
 //! computed by the same code as in the serial batch, so the results equal the serial batch's bit
 //! for bit, for any number of threads.
 //!
@@ -43,7 +44,8 @@ pub fn threads() -> usize {
 }
 
 /// `f(range, chunk)` for chunks of `out` on the threads of the current `rayon` pool, one chunk per
-/// thread ([`chunk_len`] states each): `chunk` is `&mut out[range]`. `f` runs a serial batch on
+/// thread ([`chunk_len`] states each), the first on the calling thread: `chunk` is
+/// `&mut out[range]`. `f` runs a serial batch on
 /// the inputs' `range`, e.g. for a generated `Ur5`
 /// `|r, out| Ur5::forward_dynamics_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], out)`
 /// (the inputs at least as long as `out`).
