@@ -2,7 +2,8 @@
 # 256 forward dynamics and 256 forward-dynamics derivatives of one model (GRiD's benchmark:
 # 256 states of a 7-dof arm), µs per 256 states, side by side in one run: one state per call on
 # one core, `NAME_batch::<f64x2>` / `::<f64x4>` on one core, and the same batches split over all
-# cores by `kanegen::runtime::par::batch` (feature `rayon`). ROUNDS rounds (default 400), each
+# cores by `kanegen::runtime::par::batch` (feature `rayon`; the rounds inside `par::install`,
+# on a thread of the pool). ROUNDS rounds (default 400), each
 # running every candidate once in rotating order; the least and the median round are printed.
 # The program first checks that the batches, serial and parallel, are the one-state results bit
 # for bit.
@@ -52,18 +53,23 @@ fn main() {
         }
         black_box((&fd, &dd));
     };
-    for i in 0..10 {
-        run(i); // warm-up
-    }
-    let mut us = vec![Vec::with_capacity(rounds); 10];
-    for round in 0..rounds {
-        for off in 0..10 {
-            let i = (round + off) % 10;
-            let t0 = Instant::now();
-            run(i);
-            us[i].push(t0.elapsed().as_secs_f64() * 1e6);
+    // On a thread of the pool, as a sampler's loop of batches runs (`par::install`).
+    let us = par::install(|| {
+        for i in 0..10 {
+            run(i); // warm-up
         }
-    }
+        let mut us = vec![Vec::with_capacity(rounds); 10];
+        for round in 0..rounds {
+            for off in 0..10 {
+                let i = (round + off) % 10;
+                let t0 = Instant::now();
+                run(i);
+                us[i].push(t0.elapsed().as_secs_f64() * 1e6);
+            }
+        }
+        us
+    });
+    let mut us = us;
     // Every way's results are the one-state results, bit for bit.
     let bits = |x: &dyn std::fmt::Debug| format!("{x:?}");
     assert!(fd.iter().all(|o| bits(o) == bits(&fd[0])), "forward dynamics differ");

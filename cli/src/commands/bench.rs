@@ -114,7 +114,7 @@ pub fn render_text(r: &BenchReport) -> String {
 }
 
 /// One way of evaluating a batch: runs it once over the whole batch.
-type Way<'a> = Box<dyn FnMut() + 'a>;
+type Way<'a> = Box<dyn FnMut() + Send + 'a>;
 
 /// The five ways of [`ThroughputLine`] for generated function `$f` of `$t` (batch form
 /// `$batch`) over the batch's argument slices, each with its own results, `$zero` to start.
@@ -217,25 +217,29 @@ pub fn bench_throughput(rounds: usize, batch: usize) -> Throughput {
         ),
     ];
     let mut all: Vec<&mut Way<'_>> = groups.iter_mut().flat_map(|g| g.1.iter_mut()).collect();
-    // Warm-up, and each way's calls per sample: back to back for about `SAMPLE` seconds, as a
-    // sampler or a horizon calls batch after batch (the pool's threads stay awake between them).
-    let calls: Vec<u32> = all
-        .iter_mut()
-        .map(|w| {
-            w();
+    // On a thread of the pool, as a sampler's loop runs (`par::install`): between batches the
+    // pool's threads stay awake, and the caller waits for them without sleeping.
+    let samples = kanegen_runtime::par::install(|| {
+        // Warm-up, and each way's calls per sample: back to back for about `SAMPLE` seconds, as
+        // a sampler or a horizon calls batch after batch.
+        let calls: Vec<u32> = all
+            .iter_mut()
+            .map(|w| {
+                w();
+                let t0 = std::time::Instant::now();
+                w();
+                (SAMPLE / t0.elapsed().as_secs_f64().max(1e-9))
+                    .ceil()
+                    .clamp(1.0, 1e6) as u32
+            })
+            .collect();
+        rounds_side_by_side(all.len(), rounds, |i| {
             let t0 = std::time::Instant::now();
-            w();
-            (SAMPLE / t0.elapsed().as_secs_f64().max(1e-9))
-                .ceil()
-                .clamp(1.0, 1e6) as u32
+            for _ in 0..calls[i] {
+                (all[i])();
+            }
+            f64::from(calls[i]) * batch as f64 / t0.elapsed().as_secs_f64()
         })
-        .collect();
-    let samples = rounds_side_by_side(all.len(), rounds, |i| {
-        let t0 = std::time::Instant::now();
-        for _ in 0..calls[i] {
-            (all[i])();
-        }
-        f64::from(calls[i]) * batch as f64 / t0.elapsed().as_secs_f64()
     });
     let median = |mut s: Vec<f64>| {
         s.sort_by(f64::total_cmp);
