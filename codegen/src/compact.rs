@@ -399,21 +399,22 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         .parent
         .iter()
         .map(|p| paths::option(p.map(Literal::usize_unsuffixed)));
+    let x = &t.numbers;
     let (a, b, c, l, slide) = (
-        mats(&t.a),
-        mats(&t.b),
-        mats(&t.c),
-        vectors(&t.l),
-        vectors(&t.slide),
+        mats(&x.a),
+        mats(&x.b),
+        mats(&x.c),
+        vectors(&x.l),
+        vectors(&x.slide),
     );
-    let s = t.s.iter().map(|v| vector(float, v));
-    let inertia = t.inertia.iter().map(|v| vector(float, v));
+    let s = x.s.iter().map(|v| vector(float, v));
+    let inertia = x.inertia.iter().map(|v| vector(float, v));
     let revolute = &t.revolute;
     let ancestor = paths::option(t.ancestor.as_ref().map(|flat| {
         let rows = flat.chunks(t.dof().max(1)).map(|r| quote!(#(#r,)*));
         quote!(&[#(#rows)*])
     }));
-    let a0 = vector(float, &t.a0);
+    let a0 = vector(float, &x.a0);
     let base = t.base.as_ref().map(|base| floating_base(&rt, float, base));
     let frames = frames(&rt, float, &t.frames);
     let coupling = model.has_mimics().then(|| coupling(&rt, model));

@@ -34,25 +34,11 @@ pub struct KernelTables {
     pub parent: Vec<Option<usize>>,
     /// Revolute (else prismatic).
     pub revolute: Vec<bool>,
-    /// `A_j`.
-    pub a: Vec<M3>,
-    /// `B_j`.
-    pub b: Vec<M3>,
-    /// `C_j`.
-    pub c: Vec<M3>,
-    /// `l_j`.
-    pub l: Vec<[f64; 3]>,
-    /// `Υ_j u_j` of a prismatic joint.
-    pub slide: Vec<[f64; 3]>,
-    /// `S_j`.
-    pub s: Vec<[f64; 6]>,
-    /// The spatial inertias, `[m, h, Ī upper triangle]`.
-    pub inertia: Vec<[f64; 10]>,
+    /// The numbers: `A`, `B`, `C`, `l`, the slides, `S`, the inertias and `a₀`.
+    pub numbers: TablesIn<f64>,
     /// On a tree, whether joint `j` is joint `i` or one of its ancestors, entry `i N + j` (rows
     /// first); `None` on a chain.
     pub ancestor: Option<Vec<bool>>,
-    /// `a₀ = [0; −g]`.
-    pub a0: [f64; 6],
     /// The model's named frames, in its order.
     pub frames: Vec<Frame<f64>>,
     /// A free-floating base's inertia and gravity (`None`: a fixed base, gravity in `a0`).
@@ -104,15 +90,17 @@ impl KernelTables {
         let mut t = KernelTables {
             parent: Vec::with_capacity(n),
             revolute: Vec::with_capacity(n),
-            a: Vec::with_capacity(n),
-            b: Vec::with_capacity(n),
-            c: Vec::with_capacity(n),
-            l: Vec::with_capacity(n),
-            slide: Vec::with_capacity(n),
-            s: Vec::with_capacity(n),
-            inertia: Vec::with_capacity(n),
+            numbers: TablesIn {
+                a: Vec::with_capacity(n),
+                b: Vec::with_capacity(n),
+                c: Vec::with_capacity(n),
+                l: Vec::with_capacity(n),
+                slide: Vec::with_capacity(n),
+                s: Vec::with_capacity(n),
+                inertia: Vec::with_capacity(n),
+                a0: [0.0; 6],
+            },
             ancestor: None,
-            a0: [0.0; 6],
             frames: p
                 .frames
                 .iter()
@@ -126,13 +114,14 @@ impl KernelTables {
         };
         for jp in &p.joints {
             let (a, b, c, slide, s) = joint_numbers(jp);
-            t.a.push(a);
-            t.b.push(b);
-            t.c.push(c);
-            t.slide.push(slide);
-            t.s.push(s);
-            t.l.push(jp.l.0);
-            t.inertia.push(inertia_row(&jp.inertia));
+            let x = &mut t.numbers;
+            x.a.push(a);
+            x.b.push(b);
+            x.c.push(c);
+            x.slide.push(slide);
+            x.s.push(s);
+            x.l.push(jp.l.0);
+            x.inertia.push(inertia_row(&jp.inertia));
             t.parent.push(jp.parent);
             t.revolute.push(jp.kind == JointKind::Revolute);
         }
@@ -141,7 +130,7 @@ impl KernelTables {
             t.ancestor = Some(ancestors(&t.parent));
         }
         if let Some(g) = gravity {
-            t.a0 = [0.0, 0.0, 0.0, -g[0], -g[1], -g[2]];
+            t.numbers.a0 = [0.0, 0.0, 0.0, -g[0], -g[1], -g[2]];
         }
         t
     }
@@ -167,19 +156,7 @@ impl KernelTables {
     /// The tables as the kernels take them.
     #[must_use]
     pub fn tables(&self) -> Tables<'_, f64> {
-        Tables {
-            parent: &self.parent,
-            revolute: &self.revolute,
-            a: &self.a,
-            b: &self.b,
-            c: &self.c,
-            l: &self.l,
-            slide: &self.slide,
-            s: &self.s,
-            inertia: &self.inertia,
-            ancestor: self.ancestor.as_deref(),
-            a0: self.a0,
-        }
+        self.numbers.tables(self)
     }
 }
 
@@ -203,20 +180,28 @@ fn ancestors(parent: &[Option<usize>]) -> Vec<bool> {
 /// theirs ([`TablesIn::tables`]).
 #[derive(Clone, Debug)]
 pub struct TablesIn<S> {
-    a: Vec<[[S; 3]; 3]>,
-    b: Vec<[[S; 3]; 3]>,
-    c: Vec<[[S; 3]; 3]>,
-    l: Vec<[S; 3]>,
-    slide: Vec<[S; 3]>,
-    s: Vec<[S; 6]>,
-    inertia: Vec<[S; 10]>,
-    a0: [S; 6],
+    /// `A_j`.
+    pub a: Vec<[[S; 3]; 3]>,
+    /// `B_j`.
+    pub b: Vec<[[S; 3]; 3]>,
+    /// `C_j`.
+    pub c: Vec<[[S; 3]; 3]>,
+    /// `l_j`.
+    pub l: Vec<[S; 3]>,
+    /// `Υ_j u_j` of a prismatic joint.
+    pub slide: Vec<[S; 3]>,
+    /// `S_j`.
+    pub s: Vec<[S; 6]>,
+    /// The spatial inertias, `[m, h, Ī upper triangle]`.
+    pub inertia: Vec<[S; 10]>,
+    /// `a₀ = [0; −g]`.
+    pub a0: [S; 6],
 }
 
 impl<S: kanegen_runtime::Scalar + Copy> TablesIn<S> {
     /// The numbers of `t`, each mapped by `s`.
     pub fn new(t: &KernelTables, s: impl Fn(f64) -> S) -> Self {
-        let m3 = |m: &M3| m.map(|r| r.map(&s));
+        let (t, m3) = (&t.numbers, |m: &M3| m.map(|r| r.map(&s)));
         TablesIn {
             a: t.a.iter().map(m3).collect(),
             b: t.b.iter().map(m3).collect(),

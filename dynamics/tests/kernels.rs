@@ -229,6 +229,7 @@ fn floating_kernels_match_the_local_frame_algorithms() {
         let p = Params::<f64>::new(m);
         let t = KernelTables::new(&p, None);
         let tables = t.tables();
+        let inertia = &t.numbers.inertia[..];
         let fb = FloatingBase::from_inertial(&base_inertial(seed));
         let g = [0.4, -0.7, -9.81];
         let base = Base {
@@ -274,16 +275,16 @@ fn floating_kernels_match_the_local_frame_algorithms() {
             assert!(e < 1e-12, "{} {what}: {e:e}", m.name());
             worst = worst.max(e);
         };
-        let mm = fk::mass_matrix::<f64, N, NV>(&tables, &t.inertia, &base, &q, sc);
+        let mm = fk::mass_matrix::<f64, N, NV>(&tables, inertia, &base, &q, sc);
         let want = floating::mass_matrix(MassMatrixMethod::Crba, &p, &fb, &st, &qj);
         agree("M", mm.as_flattened(), &want.concat());
         let c =
-            fk::inverse_dynamics::<f64, N, NV>(&tables, &t.inertia, &base, &q, Some(&nu), None, sc);
+            fk::inverse_dynamics::<f64, N, NV>(&tables, inertia, &base, &q, Some(&nu), None, sc);
         let minus_c = rnea::floating_tau_minus_c(&p, &fb, &st, &qj, &nu[6..], &passive);
         agree("c", &c, &minus_c.iter().map(|x| -x).collect::<Vec<_>>());
         let id = fk::inverse_dynamics::<f64, N, NV>(
             &tables,
-            &t.inertia,
+            inertia,
             &base,
             &q,
             Some(&nu),
@@ -303,12 +304,12 @@ fn floating_kernels_match_the_local_frame_algorithms() {
         );
         agree("inverse dynamics", &id, &want);
         let fd =
-            fk::forward_dynamics::<f64, N, NV>(&tables, &t.inertia, &base, &q, &nu, &tau, None, sc);
+            fk::forward_dynamics::<f64, N, NV>(&tables, inertia, &base, &q, &nu, &tau, None, sc);
         let want = aba::floating(&p, &fb, &st, &qj, &nu[6..], &loads);
         agree("forward dynamics", &fd, &want);
         let fdw = fk::forward_dynamics::<f64, N, NV>(
             &tables,
-            &t.inertia,
+            inertia,
             &base,
             &q,
             &nu,
@@ -329,11 +330,10 @@ fn floating_kernels_match_the_local_frame_algorithms() {
             .collect();
         let want = aba::floating(&p, &fb, &st, &qj, &nu[6..], &with);
         agree("forward dynamics with wrenches", &fdw, &want);
-        let h = fk::momentum::<f64, N>(&tables, &t.inertia, &base, &q, &nu, sc);
+        let h = fk::momentum::<f64, N>(&tables, inertia, &base, &q, &nu, sc);
         let (lin, ang) = momentum::momentum(&p, &fb, &st, &qj, &nu[6..]);
         agree("momentum", &h, &[lin.0, ang.0].concat());
-        let reaction =
-            fk::base_reaction::<f64, N>(&tables, &t.inertia, &base, &q, &nu, &nu_dot, sc);
+        let reaction = fk::base_reaction::<f64, N>(&tables, inertia, &base, &q, &nu, &nu_dot, sc);
         let want = rnea::base_reaction(&p, &st, &qj, &nu[6..], &acc, &nu_dot[6..], &passive);
         agree("base reaction", &reaction, &want);
         for body in std::iter::once(None).chain((0..N).map(Some)) {
@@ -349,12 +349,12 @@ fn floating_kernels_match_the_local_frame_algorithms() {
             let j = ff::frame_jacobian::<f64, N, NV>(&tables, &frame, &q, sc);
             let want = frames::floating_jacobian(&p, &st, &qj, &fp);
             agree("frame Jacobian", j.as_flattened(), &want.concat());
-            let gj = ff::generalized_jacobian::<f64, N>(&tables, &t.inertia, &base, &frame, &q, sc);
+            let gj = ff::generalized_jacobian::<f64, N>(&tables, inertia, &base, &frame, &q, sc);
             let want = frames::generalized_jacobian(&p, &fb, &st, &qj, &fp);
             agree("generalized Jacobian", gj.as_flattened(), &want.concat());
         }
         let (dq, dv) = dk::floating_inverse_dynamics_derivatives::<f64, N, NV>(
-            &tables, &t.inertia, &base, &q, &nu, &nu_dot, sc,
+            &tables, inertia, &base, &q, &nu, &nu_dot, sc,
         );
         let gv = Vec3::new(g[0], g[1], g[2]);
         let (wq, wv) = derivatives::rnea::floating_derivatives(
@@ -369,12 +369,11 @@ fn floating_kernels_match_the_local_frame_algorithms() {
         );
         let got = [dq.as_flattened(), dv.as_flattened()].concat();
         agree("(∂τ/∂q, ∂τ/∂ν)", &got, &[wq.concat(), wv.concat()].concat());
-        let minv =
-            dk::floating_mass_matrix_inverse::<f64, N, NV>(&tables, &t.inertia, &base, &q, sc);
+        let minv = dk::floating_mass_matrix_inverse::<f64, N, NV>(&tables, inertia, &base, &q, sc);
         let want = derivatives::minverse::floating_mass_matrix_inverse(&p, &fb, &qj);
         agree("M⁻¹", minv.as_flattened(), &want.concat());
         let (aq, av, ainv) = dk::floating_forward_dynamics_derivatives::<f64, N, NV>(
-            &tables, &t.inertia, &base, &q, &nu, &tau, sc,
+            &tables, inertia, &base, &q, &nu, &tau, sc,
         );
         let (wq, wv, winv) =
             derivatives::aba::floating_derivatives(&p, &fb, &st, &qj, &nu[6..], &tau, Some(&gv));
@@ -414,6 +413,7 @@ fn derivative_kernels_match_the_local_frame_derivatives() {
         let g = [0.4, -0.7, -9.81];
         let t = KernelTables::new(&p, Some(g));
         let tables = t.tables();
+        let inertia = &t.numbers.inertia[..];
         let gravity = Vec3::new(g[0], g[1], g[2]);
         let mut r = rng(seed);
         let v = |r: &mut _, s| -> [f64; N] { random_vec(r, N, s).try_into().unwrap() };
@@ -434,13 +434,12 @@ fn derivative_kernels_match_the_local_frame_derivatives() {
             assert!(e < 1e-12, "{} {what}: {e:e}", m.name());
             worst = worst.max(e);
         };
-        let (dq, dv) = dk::inverse_dynamics_derivatives(&tables, &t.inertia, &q, &qd, &qdd, sc);
+        let (dq, dv) = dk::inverse_dynamics_derivatives(&tables, inertia, &q, &qd, &qdd, sc);
         let (wq, wv) = id::derivatives(&p, &q, &qd, &qdd, Some(&gravity));
         agree("(∂τ/∂q, ∂τ/∂q̇)", &[&dq, &dv], &[&wq, &wv]);
-        let minv = dk::mass_matrix_inverse(&tables, &t.inertia, &q, sc);
+        let minv = dk::mass_matrix_inverse(&tables, inertia, &q, sc);
         agree("M⁻¹", &[&minv], &[&minverse::mass_matrix_inverse(&p, &q)]);
-        let (aq, av, ainv) =
-            dk::forward_dynamics_derivatives(&tables, &t.inertia, &q, &qd, &tau, sc);
+        let (aq, av, ainv) = dk::forward_dynamics_derivatives(&tables, inertia, &q, &qd, &tau, sc);
         let (wq, wv, winv) = fd::derivatives(&p, &q, &qd, &tau, Some(&gravity));
         agree(
             "(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)",
