@@ -2,7 +2,7 @@
 //! (`f64x4`, `f64x2`; `f32x8`, `f32x4` for `f32` code) each lane's results are bit for bit the
 //! scalar function's at that lane's state, for random states, on the checked-in files (SSRMS
 //! plain, `f32`, `fma`; the free-floating 7-dof arm) and on `dynamics!` code (UR5 with gravity,
-//! straight-line and compact; a random chain with a runtime payload; libm's sine–cosine; the
+//! straight-line and compact; a random chain with a runtime payload, compact with libm's and with fused products; libm's sine–cosine; the
 //! `f64::mul_add` fma path).
 
 use kanegen::runtime::lanes::{f32x4, f32x8, f64x2, f64x4, LaneValue, Lanes};
@@ -21,6 +21,19 @@ kanegen::dynamics!(
     "tests/data/erd/ur5_robot.urdf",
     gravity = [0.0, 0.0, -9.81],
     form = "compact"
+);
+kanegen::dynamics!(
+    Random5CompactLibm,
+    "tests/data/codegen/random5.toml",
+    form = "compact",
+    libm_trig = true
+);
+kanegen::dynamics!(
+    Random5CompactFma,
+    "tests/data/codegen/random5.toml",
+    gravity = [0.3, -1.2, -9.81],
+    form = "compact",
+    fma = true
 );
 kanegen::dynamics!(
     Random5Payload,
@@ -250,7 +263,10 @@ fn ur5_lanes_are_the_scalar_functions() {
     assert_eq!(ur5_functions!(Ur5, f64, f64x2, 11), 18);
 }
 
-/// The compact form has no lane body: its `_lanes` evaluates the scalar function lane by lane.
+/// The compact form's `_lanes` run its kernels on `Lane<S>` (the tables' numbers splat over the
+/// lanes), each lane bit for bit the scalar function; `M`, `(M, c)` and the named frames'
+/// evaluate the scalar function lane by lane. Also with libm's sine–cosine and with fused products (whose
+/// sine–cosine is never fused).
 #[test]
 fn compact_lanes_are_the_scalar_functions() {
     // Only emitted code fuses products: the compact mass matrix is a kernel's call.
@@ -261,6 +277,20 @@ fn compact_lanes_are_the_scalar_functions() {
     assert!(unrolled.unwrap().fma > 0);
     assert_eq!(compact.unwrap().fma, 0);
     assert_eq!(ur5_functions!(Ur5Compact, f64, f64x4, 12), 18);
+    assert_eq!(ur5_functions!(Ur5Compact, f64, f64x2, 19), 18);
+    let n = lanes_equal_scalar!(Random5CompactLibm, f64, f64x4, 20, [];
+        inverse_dynamics / inverse_dynamics_lanes(q, qd, qdd),
+        forward_dynamics / forward_dynamics_lanes(q, qd, tau),
+        forward_dynamics_derivatives / forward_dynamics_derivatives_lanes(q, qd, tau),
+    );
+    assert_eq!(n, 3);
+    let n = lanes_equal_scalar!(Random5CompactFma, f64, f64x4, 21, [];
+        nonlinear_effects / nonlinear_effects_lanes(q, qd),
+        gravity / gravity_lanes(q),
+        forward_dynamics_with_wrenches / forward_dynamics_with_wrenches_lanes(q, qd, tau, f_ext),
+        inverse_dynamics_derivatives / inverse_dynamics_derivatives_lanes(q, qd, qdd),
+    );
+    assert_eq!(n, 4);
 }
 
 #[test]
@@ -346,12 +376,20 @@ fn batches_are_the_scalar_calls() {
         let want = Random5F32Payload::gravity(&q[k], &p);
         assert_eq!(format!("{:?}", out[k]), format!("{want:?}"), "k = {k}");
     }
-    // A compact function's batch: its `_lanes` calls the scalar function lane by lane.
+    // A compact function's batch (the mass matrix: one state per call whatever `S` is).
     let q: Vec<[f64; 6]> = (0..6).map(|_| Random::random(&mut rng)).collect();
     let mut out = vec![[[0.0; 6]; 6]; 6];
     Ur5Compact::mass_matrix_batch::<f64x4>(&q, &mut out);
     for k in 0..6 {
         assert_eq!(out[k], Ur5Compact::mass_matrix(&q[k]));
+    }
+    // And one whose kernel runs on lanes (a padded last chunk of 2 states).
+    let qd: Vec<[f64; 6]> = (0..6).map(|_| Random::random(&mut rng)).collect();
+    let mut out = vec![[0.0; 6]; 6];
+    Ur5Compact::forward_dynamics_batch::<f64x4>(&q, &qd, &qd, &mut out);
+    for k in 0..6 {
+        let want = Ur5Compact::forward_dynamics(&q[k], &qd[k], &qd[k]);
+        assert_eq!(format!("{:?}", out[k]), format!("{want:?}"), "k = {k}");
     }
 }
 

@@ -743,41 +743,118 @@ pub fn body(
     if floating {
         return Ok(floating_body(f, &k, &i, &sincos, n));
     }
-    Ok(Some(match f {
-        Function::MassMatrix => quote!(#k::mass_matrix(&Self::CX, #i, q, #sincos)),
+    let frame = |f: usize| {
+        let f = Literal::usize_unsuffixed(f);
+        quote!(&Self::CX_FRAMES[#f])
+    };
+    let cx = quote!(Self::CX);
+    Ok(fixed_call(f, &k, &cx, &i, &|a| quote!(#a), &sincos, &frame))
+}
+
+/// The kernel call of function `f` on a fixed base: tables `cx`, inertias `i`, each argument
+/// `a` as `arg(a)`, sines and cosines by `sincos`, named frame `j` as `frame(j)`.
+fn fixed_call(
+    f: Function,
+    k: &TokenStream,
+    cx: &TokenStream,
+    i: &TokenStream,
+    arg: &dyn Fn(syn::Ident) -> TokenStream,
+    sincos: &TokenStream,
+    frame: &dyn Fn(usize) -> TokenStream,
+) -> Option<TokenStream> {
+    let [q, qd, qdd, tau, f_ext] =
+        ["q", "qd", "qdd", "tau", "f_ext"].map(|a| arg(quote::format_ident!("{a}")));
+    Some(match f {
+        Function::MassMatrix => quote!(#k::mass_matrix(&#cx, #i, #q, #sincos)),
         Function::NonlinearEffects => {
-            quote!(#k::nonlinear_effects(&Self::CX, #i, q, qd, #sincos))
+            quote!(#k::nonlinear_effects(&#cx, #i, #q, #qd, #sincos))
         }
-        Function::Gravity => quote!(#k::gravity(&Self::CX, #i, q, #sincos)),
+        Function::Gravity => quote!(#k::gravity(&#cx, #i, #q, #sincos)),
         Function::InverseDynamics => {
-            quote!(#k::inverse_dynamics(&Self::CX, #i, q, qd, qdd, #sincos))
+            quote!(#k::inverse_dynamics(&#cx, #i, #q, #qd, #qdd, #sincos))
         }
         Function::MassMatrixAndNonlinearEffects => {
-            quote!(#k::mass_matrix_and_nonlinear_effects(&Self::CX, #i, q, qd, #sincos))
+            quote!(#k::mass_matrix_and_nonlinear_effects(&#cx, #i, #q, #qd, #sincos))
         }
         Function::ForwardDynamics => {
-            quote!(#k::forward_dynamics(&Self::CX, #i, q, qd, tau, #sincos))
+            quote!(#k::forward_dynamics(&#cx, #i, #q, #qd, #tau, #sincos))
         }
         Function::ForwardDynamicsWithWrenches => quote! {
-            #k::forward_dynamics_with_wrenches(&Self::CX, #i, q, qd, tau, f_ext, #sincos)
+            #k::forward_dynamics_with_wrenches(&#cx, #i, #q, #qd, #tau, #f_ext, #sincos)
         },
         Function::FramePlacement(f) => {
-            let f = Literal::usize_unsuffixed(f);
-            quote!(#k::frame_placement(&Self::CX, &Self::CX_FRAMES[#f], q, #sincos))
+            let f = frame(f);
+            quote!(#k::frame_placement(&#cx, #f, #q, #sincos))
         }
         Function::FrameJacobian(f) => {
-            let f = Literal::usize_unsuffixed(f);
-            quote!(#k::frame_jacobian(&Self::CX, &Self::CX_FRAMES[#f], q, #sincos))
+            let f = frame(f);
+            quote!(#k::frame_jacobian(&#cx, #f, #q, #sincos))
         }
         Function::InverseDynamicsDerivatives => quote! {
-            #k::derivatives::inverse_dynamics_derivatives(&Self::CX, #i, q, qd, qdd, #sincos)
+            #k::derivatives::inverse_dynamics_derivatives(&#cx, #i, #q, #qd, #qdd, #sincos)
         },
         Function::ForwardDynamicsDerivatives => quote! {
-            #k::derivatives::forward_dynamics_derivatives(&Self::CX, #i, q, qd, tau, #sincos)
+            #k::derivatives::forward_dynamics_derivatives(&#cx, #i, #q, #qd, #tau, #sincos)
         },
         Function::MassMatrixInverse => {
-            quote!(#k::derivatives::mass_matrix_inverse(&Self::CX, #i, q, #sincos))
+            quote!(#k::derivatives::mass_matrix_inverse(&#cx, #i, #q, #sincos))
         }
-        _ => return Ok(None),
+        _ => return None,
+    })
+}
+
+/// The body of `NAME_lanes` of a compact function on a fixed base: the same kernel call on the
+/// tables' numbers as [`Lane`](kanegen_runtime::lanes::Lane)s of `S` (a stack copy of the
+/// `f64` tables, `TablesStore`), the arguments wrapped and the result unwrapped, so each lane
+/// is bit for bit the `f64` function's result for its state. `None` where the function has no
+/// such body (it then evaluates the scalar function lane by lane): `f32` code, a free-floating
+/// base, mimic joints, a runtime payload, the named frames (whose tables stay `f64`), and `M`
+/// and `(M, c)`: the composite-rigid-body kernel's rows are vectorized across the joints
+/// already, and on lanes it ran slower than the scalar function state by state (random chains,
+/// `f64x4`, 256 states: 0.68× at N = 16 and 32; docs/performance.md).
+pub fn lanes_body(
+    f: Function,
+    opts: &Options,
+    model: &Model,
+    floating: bool,
+) -> Result<Option<TokenStream>, Error> {
+    if opts.float != Float::F64
+        || floating
+        || model.has_mimics()
+        || opts.runtime_payload
+        || matches!(
+            f,
+            Function::FramePlacement(_)
+                | Function::FrameJacobian(_)
+                | Function::MassMatrix
+                | Function::MassMatrixAndNonlinearEffects
+        )
+    {
+        return Ok(None);
+    }
+    let rt = opts.runtime()?;
+    let lane = quote!(#rt::lanes::Lane);
+    let sincos = match (opts.table_sincos(), !opts.fma && opts.target_fma) {
+        (true, true) => quote!(#lane::sincos_table),
+        (true, false) => quote!(#lane::sincos_table_unfused),
+        (false, _) => quote!(#lane::sincos_libm),
+    };
+    let k = quote!(#rt::compact);
+    let (cx, i) = (quote!(cx), quote!(cx.inertia));
+    let arg = |a: syn::Ident| {
+        if a == "f_ext" {
+            quote!(&#rt::lanes::wrap_rows(#a))
+        } else {
+            quote!(&#rt::lanes::wrap(#a))
+        }
+    };
+    let Some(call) = fixed_call(f, &k, &cx, &i, &arg, &sincos, &|_| quote!()) else {
+        return Ok(None);
+    };
+    let nl = Literal::usize_unsuffixed(model.dof());
+    Ok(Some(quote! {
+        let store = #k::TablesStore::<#lane<S>, #nl>::new(&Self::CX);
+        let cx = store.tables(&Self::CX);
+        #rt::lanes::Unlane::unlane(#call)
     }))
 }

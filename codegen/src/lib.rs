@@ -381,7 +381,13 @@ fn function_item(
         .collect();
     let payload_arg_batch = opts.runtime_payload.then(|| quote!(payload: &#payload_ty,));
     let unrolled = fp.kernel == Kernel::Unrolled;
-    let batch_doc = if unrolled {
+    // A compact function whose kernel runs on lanes: the same kernel on `Lane<S>`.
+    let kernel_lanes = match fp.kernel {
+        Kernel::Compact(_) => compact::lanes_body(fp.function, opts, &plan.model, plan.floating())?,
+        _ => None,
+    };
+    let lane_body = unrolled || kernel_lanes.is_some();
+    let batch_doc = if lane_body {
         format!(
             " [`Self::{name}`] of every state of the slices, `S::LANES` states per call of \
              [`Self::{lanes_name}`]: `out[k]` is `{name}` of the `k`-th entries, for `k` below \
@@ -398,7 +404,18 @@ fn function_item(
         )
     };
     let body = body.tokens;
-    let (scalar_body, lanes_body, lanes_doc) = if !unrolled {
+    let (scalar_body, lanes_body, lanes_doc) = if let Some(kernel) = kernel_lanes {
+        (
+            body,
+            kernel,
+            format!(
+                " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`f64` \
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the \
+                 same kernel on the tables' numbers as `kanegen_runtime::lanes::Lane`s of `S`, \
+                 each lane's results bit for bit the scalar function's for that lane's state."
+            ),
+        )
+    } else if !unrolled {
         let lane_of = arg_names
             .iter()
             .map(|a| quote!(&#rt::lanes::lane::<#fl, S, _>(#a, i)));
@@ -435,7 +452,7 @@ fn function_item(
             ),
         )
     };
-    let batch_body = if unrolled {
+    let batch_body = if lane_body {
         quote! {
             #rt::lanes::batch::<#fl, S, _>(out, n, |start| {
                 Self::#lanes_name::<S>(#(&#rt::lanes::gather::<#fl, S, _>(#arg_names, start, n)),* #payload_pass)

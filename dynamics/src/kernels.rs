@@ -218,19 +218,7 @@ impl<S: kanegen_runtime::Scalar + Copy> TablesIn<S> {
     /// came from).
     #[must_use]
     pub fn tables<'a>(&'a self, t: &'a KernelTables) -> Tables<'a, S> {
-        Tables {
-            parent: &t.parent,
-            revolute: &t.revolute,
-            a: &self.a,
-            b: &self.b,
-            c: &self.c,
-            l: &self.l,
-            slide: &self.slide,
-            s: &self.s,
-            inertia: &self.inertia,
-            ancestor: t.ancestor.as_deref(),
-            a0: self.a0,
-        }
+        kanegen_runtime::tables_with_numbers!(&t.parent, &t.revolute, t.ancestor.as_deref(); self)
     }
 }
 

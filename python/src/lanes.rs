@@ -9,73 +9,18 @@ use kanegen_dynamics::kernels::{ArticulatedVecs, BodyVecs, KernelTables, TablesI
 use kanegen_runtime::compact::aba::aba_on_world;
 use kanegen_runtime::compact::spatial::{transforms, world};
 use kanegen_runtime::compact::Rates;
-use kanegen_runtime::lanes::{f64x4, Lanes};
+use kanegen_runtime::lanes::{f64x4, Lane, Lanes};
 use kanegen_runtime::Scalar;
-use std::ops::{Add, Div, Mul, Neg, Sub};
 
 /// The number of states per call.
 pub const LANES: usize = 4;
 
-/// Four `f64` values side by side, a [`Scalar`] for the kernels.
-#[derive(Clone, Copy, Debug)]
-pub struct L4(f64x4);
+/// Four `f64` values side by side, a [`Scalar`] for the kernels (the runtime's [`Lane`]).
+pub type L4 = Lane<f64x4>;
 
-impl L4 {
-    /// Lane `i` is `f(i)`.
-    fn from_fn(f: impl FnMut(usize) -> f64) -> L4 {
-        L4(<f64x4 as Lanes<f64>>::from_fn(f))
-    }
-
-    /// Lane `i`.
-    fn lane(self, i: usize) -> f64 {
-        Lanes::lane(self.0, i)
-    }
-
-    /// `f` on each lane.
-    fn map(self, f: impl Fn(f64) -> f64) -> L4 {
-        L4::from_fn(|i| f(self.lane(i)))
-    }
-}
-
-macro_rules! binary {
-    ($($tr:ident $f:ident),*) => {$(
-        impl $tr for L4 {
-            type Output = L4;
-            #[inline(always)]
-            fn $f(self, o: L4) -> L4 {
-                L4(self.0.$f(o.0))
-            }
-        }
-    )*};
-}
-binary!(Add add, Sub sub, Mul mul, Div div);
-
-impl Neg for L4 {
-    type Output = L4;
-    #[inline(always)]
-    fn neg(self) -> L4 {
-        L4(Lanes::neg(self.0))
-    }
-}
-
-impl Scalar for L4 {
-    #[inline(always)]
-    fn constant(x: f64) -> Self {
-        L4(f64x4::splat(x))
-    }
-    fn sin(self) -> Self {
-        self.map(f64::sin)
-    }
-    fn cos(self) -> Self {
-        self.map(f64::cos)
-    }
-    fn sqrt(self) -> Self {
-        self.map(f64::sqrt)
-    }
-    fn sin_cos(self) -> (Self, Self) {
-        let sc: [(f64, f64); LANES] = core::array::from_fn(|i| self.lane(i).sin_cos());
-        (L4::from_fn(|i| sc[i].0), L4::from_fn(|i| sc[i].1))
-    }
+/// Lane `i` is `f(i)`.
+fn from_fn(f: impl FnMut(usize) -> f64) -> L4 {
+    Lane(<f64x4 as Lanes<f64>>::from_fn(f))
 }
 
 /// The tables on lanes: every number splat over the four.
@@ -119,7 +64,7 @@ pub fn forward_dynamics(
     let [ql, qdl, taul, qddl] = &mut d.rows;
     for (x, rows) in [(&mut *ql, q), (&mut *qdl, qd), (&mut *taul, tau)] {
         for (j, xj) in x.iter_mut().enumerate() {
-            *xj = L4::from_fn(|i| rows[i.min(m - 1) * n + j]);
+            *xj = from_fn(|i| rows[i.min(m - 1) * n + j]);
         }
     }
     let tables = lt.tables(t);
@@ -136,7 +81,7 @@ pub fn forward_dynamics(
     aba_on_world(&tables, rates, &b, &mut ab, qddl);
     for (i, row) in out.chunks_mut(n).enumerate() {
         for (o, x) in row.iter_mut().zip(qddl.iter()) {
-            *o = x.lane(i);
+            *o = x.0.lane(i);
         }
     }
 }

@@ -26,10 +26,19 @@ use core::ops::{Add, Div, Mul, Sub};
 
 pub use wide::{f32x4, f32x8, f64x2, f64x4};
 
+mod lane;
+pub use lane::{wrap, wrap_rows, Lane, Unlane};
+
 /// `L` values of the element type `F` (`f64` or `f32`) side by side, with the operations of
 /// generated code, each lane computed as the scalar operation computes it (bit for bit).
 pub trait Lanes<F: Copy>:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+    Copy
+    + core::fmt::Debug
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
 {
     /// Number of lanes `L`.
     const LANES: usize;

@@ -67,4 +67,4 @@ pub use frames::{frame_jacobian, frame_placement, Frame};
 pub use payload::{payload_inertia, with_payload};
 pub use rnea::{gravity, inverse_dynamics, nonlinear_effects, Motions};
 pub use spatial::Transform;
-pub use tables::{Bodies, BodyStore, Tables};
+pub use tables::{Bodies, BodyStore, Tables, TablesStore};

@@ -97,3 +97,76 @@ impl<S: Scalar + Copy, const N: usize> Default for BodyStore<S, N> {
         Self::new()
     }
 }
+
+/// The numbers of a model's `f64` [`Tables`] of `N` joints in another scalar `S` (a
+/// [`Lane`](crate::lanes::Lane) of several states), on the stack: what a generated compact
+/// `NAME_lanes` runs its kernel on. Each number is `S::constant` of the table's.
+#[derive(Clone, Copy, Debug)]
+pub struct TablesStore<S, const N: usize> {
+    a: [[[S; 3]; 3]; N],
+    b: [[[S; 3]; 3]; N],
+    c: [[[S; 3]; 3]; N],
+    l: [[S; 3]; N],
+    slide: [[S; 3]; N],
+    s: [[S; 6]; N],
+    inertia: [[S; 10]; N],
+    a0: [S; 6],
+}
+
+impl<S: Scalar + Copy, const N: usize> TablesStore<S, N> {
+    /// The numbers of `t` (at least `N` joints) in `S`.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(t: &Tables<'_, f64>) -> Self {
+        let x = |v: &f64| S::constant(*v);
+        let m = |j: usize, m: &[[[f64; 3]; 3]]| {
+            m.get(j)
+                .map_or([[S::zero(); 3]; 3], |m| m.map(|r| r.each_ref().map(x)))
+        };
+        let v = |j: usize, v: &[[f64; 3]]| v.get(j).map_or([S::zero(); 3], |v| v.each_ref().map(x));
+        TablesStore {
+            a: core::array::from_fn(|j| m(j, t.a)),
+            b: core::array::from_fn(|j| m(j, t.b)),
+            c: core::array::from_fn(|j| m(j, t.c)),
+            l: core::array::from_fn(|j| v(j, t.l)),
+            slide: core::array::from_fn(|j| v(j, t.slide)),
+            s: core::array::from_fn(|j| t.s.get(j).map_or([S::zero(); 6], |v| v.each_ref().map(x))),
+            inertia: core::array::from_fn(|j| {
+                t.inertia
+                    .get(j)
+                    .map_or([S::zero(); 10], |v| v.each_ref().map(x))
+            }),
+            a0: t.a0.each_ref().map(x),
+        }
+    }
+
+    /// The tables in `S`, with the structure (parents, joint kinds, ancestors) of `t`.
+    #[inline(always)]
+    #[must_use]
+    pub fn tables<'a>(&'a self, t: &Tables<'a, f64>) -> Tables<'a, S> {
+        crate::tables_with_numbers!(t.parent, t.revolute, t.ancestor; self)
+    }
+}
+
+/// A [`Tables`] of the structure `parent`, `revolute`, `ancestor` (slices) and the numbers held
+/// in the fields `a`, `b`, `c`, `l`, `slide`, `s`, `inertia` (arrays or `Vec`s) and `a0` of
+/// `numbers`: how [`TablesStore`] and the run-time path's tables in another scalar
+/// (`kanegen_dynamics::kernels::TablesIn`) lend theirs to the kernels.
+#[macro_export]
+macro_rules! tables_with_numbers {
+    ($parent:expr, $revolute:expr, $ancestor:expr; $numbers:expr) => {
+        $crate::compact::Tables {
+            parent: $parent,
+            revolute: $revolute,
+            a: &$numbers.a,
+            b: &$numbers.b,
+            c: &$numbers.c,
+            l: &$numbers.l,
+            slide: &$numbers.slide,
+            s: &$numbers.s,
+            inertia: &$numbers.inertia,
+            ancestor: $ancestor,
+            a0: $numbers.a0,
+        }
+    };
+}
