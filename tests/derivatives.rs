@@ -374,3 +374,47 @@ fn derivatives_match_pinocchio() {
     println!("{checked} matrices against Pinocchio, worst {worst:.2e}");
     assert!(checked >= 6 * 2 * 5);
 }
+
+/// `forward_dynamics_derivatives_lanes` of a composed function (its parts' lane forms, the two
+/// loops on `Lane<S>`) at `S::LANES` random states against the scalar function at each: every
+/// lane the same bits (checked through `{:?}`, which shows the sign of zero).
+macro_rules! composed_lanes_equal_scalar {
+    ($ty:ty, $s:ty, $nq:literal, $nv:literal, $n:literal, $seed:expr) => {{
+        use kanegen::runtime::lanes::{lane, Lanes};
+        const L: usize = <$s as Lanes<f64>>::LANES;
+        type D = ([[f64; $nv]; $nv], [[f64; $nv]; $nv], [[f64; $nv]; $nv]);
+        let mut r = rng($seed);
+        let states: Vec<([f64; $nq], [f64; $nv], [f64; $n])> = (0..L)
+            .map(|_| {
+                let q = arr(&random_vec(&mut r, $nq, 2.0));
+                (
+                    q,
+                    arr(&random_vec(&mut r, $nv, 1.5)),
+                    arr(&random_vec(&mut r, $n, 4.0)),
+                )
+            })
+            .collect();
+        let q: [$s; $nq] = core::array::from_fn(|j| <$s>::from_fn(|i| states[i].0[j]));
+        let v: [$s; $nv] = core::array::from_fn(|j| <$s>::from_fn(|i| states[i].1[j]));
+        let tau: [$s; $n] = core::array::from_fn(|j| <$s>::from_fn(|i| states[i].2[j]));
+        let lanes = <$ty>::forward_dynamics_derivatives_lanes::<$s>(&q, &v, &tau);
+        for (i, (q, v, tau)) in states.iter().enumerate() {
+            let have: D = lane::<f64, $s, D>(&lanes, i);
+            let want = <$ty>::forward_dynamics_derivatives(q, v, tau);
+            assert_eq!(format!("{have:?}"), format!("{want:?}"), "lane {i}");
+        }
+    }};
+}
+
+/// A composed `forward_dynamics_derivatives` (past the size rule: `q̈ = M⁻¹ (τ − c)`, then
+/// `−M⁻¹ ∂τ/∂x`) on lanes: the random 8-joint chain (its `∂τ` in the compact kernels, on lanes)
+/// and the free-floating 7-dof arm, on `f64x4` and `f64x2`.
+#[test]
+fn composed_lanes_are_the_scalar_function() {
+    use kanegen::runtime::lanes::{f64x2, f64x4};
+    for seed in 0..4 {
+        composed_lanes_equal_scalar!(Chain8, f64x4, 8, 8, 8, 40 + seed);
+        composed_lanes_equal_scalar!(Chain8, f64x2, 8, 8, 8, 50 + seed);
+        composed_lanes_equal_scalar!(FreeFloating7, f64x4, 14, 13, 7, 60 + seed);
+    }
+}

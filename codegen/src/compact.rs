@@ -803,12 +803,19 @@ fn fixed_call(
     })
 }
 
+/// The most joints for which a compact function gets a lane body ([`lanes_body`]): at 64 the
+/// tables' copy on `f64x4` lanes is 100 KB of the caller's stack (a thread of `rayon`'s pool has
+/// 2 MB).
+pub const LANES_BODY_MAX_DOF: usize = 64;
+
 /// The body of `NAME_lanes` of a compact function on a fixed base: the same kernel call on the
 /// tables' numbers as [`Lane`](kanegen_runtime::lanes::Lane)s of `S` (a stack copy of the
 /// `f64` tables, `TablesStore`), the arguments wrapped and the result unwrapped, so each lane
 /// is bit for bit the `f64` function's result for its state. `None` where the function has no
 /// such body (it then evaluates the scalar function lane by lane): `f32` code, a free-floating
-/// base, mimic joints, a runtime payload, the named frames (whose tables stay `f64`), and `M`
+/// base, mimic joints, a runtime payload, more than [`LANES_BODY_MAX_DOF`] joints (the copy of
+/// the tables is 49 N + 6 numbers on the caller's stack per lane), the named frames (whose
+/// tables stay `f64`), and `M`
 /// and `(M, c)`: the composite-rigid-body kernel's rows are vectorized across the joints
 /// already, and on lanes it ran slower than the scalar function state by state (random chains,
 /// `f64x4`, 256 states: 0.68× at N = 16 and 32; docs/performance.md).
@@ -820,6 +827,7 @@ pub fn lanes_body(
 ) -> Result<Option<TokenStream>, Error> {
     if opts.float != Float::F64
         || floating
+        || model.dof() > LANES_BODY_MAX_DOF
         || model.has_mimics()
         || opts.runtime_payload
         || matches!(

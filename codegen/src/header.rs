@@ -95,16 +95,17 @@ fn lanes_line(plan: &Plan, opts: &Options) -> String {
     if plan
         .functions
         .iter()
-        .any(|fp| matches!(fp.kernel, crate::plan::Kernel::Compact(_)))
+        .any(|fp| !matches!(fp.kernel, crate::plan::Kernel::Unrolled))
     {
         line.push_str(" A straight-line `NAME` is its `NAME_lanes` at `S = ");
         line.push_str(f);
         line.push_str(
             "` (one body); a function in loops runs its kernel on `kanegen_runtime::lanes::Lane<S>` \
              (the tables' numbers splat over the lanes) where it has a lane body \
-             (`kanegen_codegen::compact::lanes_body`: fixed-base `f64` code without a runtime \
-             payload or mimic joints, but for `M`, `(M, c)` and the frames), and evaluates `NAME` \
-             lane by lane otherwise.",
+             (`kanegen_codegen::compact::lanes_body`: fixed-base `f64` code of at most 64 \
+             joints without a runtime payload or mimic joints, but for `M`, `(M, c)` and the \
+             frames), a composed `f64` one composes its parts' lane forms, and any other \
+             evaluates `NAME` lane by lane.",
         );
     } else {
         line.push_str(" `NAME` is its `NAME_lanes` at `S = ");

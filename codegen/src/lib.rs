@@ -289,28 +289,79 @@ fn function_body(
     Ok(body)
 }
 
+/// What a composed function calls: its parts `M⁻¹`, `c` and `∂τ` (the type's functions named
+/// with `suffix`), its arguments `q`, `q̇`, `τ` and the payload argument.
+struct Composed {
+    parts: [syn::Ident; 3],
+    args: [syn::Ident; 3],
+    payload: Option<TokenStream>,
+}
+
+impl Composed {
+    fn new(plan: &Plan, fp: &FunctionPlan, opts: &Options, suffix: &str) -> Result<Self, Error> {
+        let part = |f: Function| -> Result<syn::Ident, Error> {
+            let fp = (plan.functions.iter().find(|g| g.function == f))
+                .ok_or_else(|| Error(format!("`{}` composes `{}`", fp.name, f.name())))?;
+            Ok(format_ident!("{}{suffix}", fp.name))
+        };
+        Ok(Composed {
+            parts: [
+                part(Function::MassMatrixInverse)?,
+                part(Function::NonlinearEffects)?,
+                part(Function::InverseDynamicsDerivatives)?,
+            ],
+            args: [0, 1, 2].map(|k| format_ident!("{}", fp.args[k].0.name())),
+            payload: opts.runtime_payload.then(|| quote!(, payload)),
+        })
+    }
+}
+
 /// The body of a composed function ([`Kernel::Composed`]): `M⁻¹` and `c` from the type's own
 /// functions, `q̈ = M⁻¹ (τ − c)`, then `−M⁻¹ ∂τ/∂x` from its inverse-dynamics derivatives
 /// (`kanegen_runtime::composed`).
 fn composed_body(plan: &Plan, fp: &FunctionPlan, opts: &Options) -> Result<TokenStream, Error> {
     let rt = opts.runtime()?;
-    let name = |f: Function| -> Result<syn::Ident, Error> {
-        let fp = (plan.functions.iter().find(|g| g.function == f))
-            .ok_or_else(|| Error(format!("`{}` composes `{}`", fp.name, f.name())))?;
-        Ok(format_ident!("{}", fp.name))
-    };
-    let (minv, c, id) = (
-        name(Function::MassMatrixInverse)?,
-        name(Function::NonlinearEffects)?,
-        name(Function::InverseDynamicsDerivatives)?,
-    );
-    let [q, qd, tau] = [0, 1, 2].map(|k| format_ident!("{}", fp.args[k].0.name()));
-    let p = opts.runtime_payload.then(|| quote!(, payload));
+    let Composed {
+        parts: [minv, c, id],
+        args: [q, qd, tau],
+        payload: p,
+    } = Composed::new(plan, fp, opts, "")?;
     Ok(quote! {
         let minv = Self::#minv(#q #p);
         let qdd = #rt::composed::accelerations(&minv, #tau, &Self::#c(#q, #qd #p));
         #rt::composed::forward_dynamics_derivatives(minv, Self::#id(#q, #qd, &qdd #p))
     })
+}
+
+/// The body of a composed `forward_dynamics_derivatives_lanes` (`f64` code): [`composed_body`]
+/// on lanes, each part's own `_lanes` (a lane body, or its scalar function lane by lane) and the
+/// two loops of `kanegen_runtime::composed` on `kanegen_runtime::lanes::Lane<S>`, so each lane
+/// is bit for bit the scalar function's result; `None` for `f32` code.
+fn composed_lanes_body(
+    plan: &Plan,
+    fp: &FunctionPlan,
+    opts: &Options,
+) -> Result<Option<TokenStream>, Error> {
+    if opts.float != Float::F64 {
+        return Ok(None);
+    }
+    let rt = opts.runtime()?;
+    let Composed {
+        parts: [minv, c, id],
+        args: [q, qd, tau],
+        payload: p,
+    } = Composed::new(plan, fp, opts, "_lanes")?;
+    let l = quote!(#rt::lanes);
+    Ok(Some(quote! {
+        let minv = #l::wrap_rows(&Self::#minv::<S>(#q #p));
+        let c = #l::wrap(&Self::#c::<S>(#q, #qd #p));
+        let qdd = #l::Unlane::unlane(#rt::composed::accelerations(&minv, &#l::wrap(#tau), &c));
+        let (dq, dv) = Self::#id::<S>(#q, #qd, &qdd #p);
+        #l::Unlane::unlane(#rt::composed::forward_dynamics_derivatives(
+            minv,
+            (#l::wrap_rows(&dq), #l::wrap_rows(&dv)),
+        ))
+    }))
 }
 
 /// The placeholder of the `k`-th formatted body ([`generate_file`]).
@@ -381,10 +432,12 @@ fn function_item(
         .collect();
     let payload_arg_batch = opts.runtime_payload.then(|| quote!(payload: &#payload_ty,));
     let unrolled = fp.kernel == Kernel::Unrolled;
-    // A compact function whose kernel runs on lanes: the same kernel on `Lane<S>`.
+    // A compact function whose kernel runs on lanes (the same kernel on `Lane<S>`), or a
+    // composed one (its parts' lane forms).
     let kernel_lanes = match fp.kernel {
         Kernel::Compact(_) => compact::lanes_body(fp.function, opts, &plan.model, plan.floating())?,
-        _ => None,
+        Kernel::Composed(_) => composed_lanes_body(plan, fp, opts)?,
+        Kernel::Unrolled => None,
     };
     let lane_body = unrolled || kernel_lanes.is_some();
     let batch_doc = if lane_body {
@@ -410,9 +463,15 @@ fn function_item(
             kernel,
             format!(
                 " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`f64` \
-                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): the \
-                 same kernel on the tables' numbers as `kanegen_runtime::lanes::Lane`s of `S`, \
-                 each lane's results bit for bit the scalar function's for that lane's state."
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): {}, \
+                 each lane's results bit for bit the scalar function's for that lane's state.",
+                if matches!(fp.kernel, Kernel::Composed(_)) {
+                    "composed from the lane forms of its parts, the two loops on \
+                     `kanegen_runtime::lanes::Lane`s of `S`"
+                } else {
+                    "the same kernel on the tables' numbers as `kanegen_runtime::lanes::Lane`s \
+                     of `S`"
+                }
             ),
         )
     } else if !unrolled {
