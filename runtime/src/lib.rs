@@ -16,12 +16,13 @@
 //! - [`sincos`]: the table sine–cosine of generated `f64` code; [`fma`]: its fused multiply-add.
 //! - [`lanes`]: the [`Lanes`](lanes::Lanes) trait of generated `NAME_lanes` functions, which
 //!   evaluate several states per call on SIMD vector types (`wide`'s), lane by lane bit for bit
-//!   the scalar function.
+//!   the scalar function, and [`Lane`](lanes::Lane), a lane type as the [`Scalar`](scalar::Scalar)
+//!   of the compact kernels and the composed loops.
 //! - [`scene`]: a scene's right-hand side (drives, damping, friction, wrenches, rotor inertia,
 //!   flexible joints, a free-floating base's kinematics) over a dynamics provider, written once
 //!   for the interpreted simulator and `scene!`.
 //! - `par` (feature `rayon`; targets with the standard library): a batch split across threads, each thread running a
-//!   generated `NAME_batch` on its chunk of the states.
+//!   generated `NAME_batch` on its chunk of the states, and `par::install` for a loop of batches.
 //! - [`ldlt`]: LDLᵀ factorization and solve over slices, allocating nothing.
 //! - [`inertia`]: the parallel-axis shift of a rigid body's inertia.
 #![no_std]
