@@ -304,6 +304,8 @@ fn empty_and_garbage_files() {
                 vec![s("generate"), p.clone()],
                 vec![s("simulate"), p.clone()],
                 vec![s("accuracy"), p.clone()],
+                vec![s("sweep"), p.clone()],
+                vec![s("merge"), p.clone(), s("--out"), p.clone() + ".merged"],
             ] {
                 check(&args).unwrap();
             }

@@ -94,6 +94,13 @@ enum Command {
     /// Simulate a scene file (TOML, docs/scenes.md): write trajectory.csv,
     /// summary.json and SVG plots into --out, print a summary.
     Simulate(SimulateArgs),
+    /// Run a sweep file (a scene over drawn or gridded numbers, docs/scenes.md#sweeps), whole
+    /// or one shard (--shard INDEX/COUNT): write runs.csv and sweep.json into --out, print the
+    /// statistics over the complete runs.
+    Sweep(SweepArgs),
+    /// Merge the --out directories of every shard of a sweep into the whole sweep's runs.csv
+    /// and sweep.json (the files the unsharded sweep writes, byte for byte).
+    Merge(MergeArgs),
 }
 
 // The arguments of `kanegen eval` (its help is the variant's doc).
@@ -309,6 +316,43 @@ struct SimulateArgs {
     linearize: bool,
 }
 
+// The arguments of `kanegen sweep` (its help is the variant's doc).
+#[derive(Args)]
+struct SweepArgs {
+    /// Sweep file (.toml: a scene, runs, seed and [[parameter]]s).
+    sweep: PathBuf,
+    /// Run only shard INDEX of COUNT (0 <= INDEX < COUNT), a contiguous block of the runs, as
+    /// a Slurm array task: `--shard $SLURM_ARRAY_TASK_ID/16`.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Write runs.csv and sweep.json into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print sweep.json to stdout (and no progress bar).
+    #[arg(long)]
+    json: bool,
+    /// Replace existing files in --out.
+    #[arg(long)]
+    force: bool,
+}
+
+// The arguments of `kanegen merge` (its help is the variant's doc).
+#[derive(Args)]
+struct MergeArgs {
+    /// The shards' --out directories (any order; each shard once).
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Write the merged runs.csv and sweep.json into this directory.
+    #[arg(long)]
+    out: PathBuf,
+    /// Print the merged sweep.json to stdout.
+    #[arg(long)]
+    json: bool,
+    /// Replace existing files in --out.
+    #[arg(long)]
+    force: bool,
+}
+
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<Model> {
     let v = kanegen_model::Validation {
         allow_nonphysical_inertia: allow_nonphysical,
@@ -391,6 +435,8 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
         Command::Bench(a) => bench(a, out),
         Command::Accuracy(a) => accuracy(a, out, interactive),
         Command::Simulate(a) => simulate(a, out, interactive),
+        Command::Sweep(a) => sweep(a, out, interactive),
+        Command::Merge(a) => merge(a, out),
     }
 }
 
@@ -710,5 +756,89 @@ fn simulate(a: SimulateArgs, out: &mut dyn Write, interactive: Interactive) -> R
                 ""
             }
         ),
+    }
+}
+
+/// `kanegen sweep`: runs the sweep's runs of `--shard` on every core (Ctrl-C stops them and
+/// writes nothing), writes runs.csv and sweep.json, prints the statistics.
+fn sweep(a: SweepArgs, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    use kanegen_sim::sweep::{Shard, Sweep};
+    let shard = match &a.shard {
+        Some(s) => Shard::parse(s).context("--shard")?,
+        None => Shard::WHOLE,
+    };
+    let sw = Sweep::load(&a.sweep)?;
+    let scene = sw
+        .scene_text_for(&[])
+        .and_then(|t| sw.parse_scene(&t))
+        .with_context(|| format!("scene `{}`", sw.scene_path.display()))?;
+    let planned = a
+        .out
+        .as_deref()
+        .map(|d| {
+            OutputDir::plan(
+                d,
+                &commands::sweep::FILES,
+                a.force,
+                &[a.sweep.clone(), sw.scene_path.clone()],
+            )
+        })
+        .transpose()?;
+    let total = shard.runs(sw.runs());
+    let n = usize::try_from(total.end - total.start).unwrap_or(usize::MAX);
+    let progress = crate::progress::Progress::bar(interactive.0 && !a.json, "sweep");
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    if interactive.0 {
+        STOP.store(false, Ordering::SeqCst);
+        install_ctrlc();
+    }
+    let started = std::time::Instant::now();
+    let runs = sw.run_shard(shard, interactive.0.then_some(&STOP), &|| {
+        progress.set(done.fetch_add(1, Ordering::Relaxed) + 1, n);
+    });
+    progress.finish();
+    if interactive.0 && STOP.load(Ordering::SeqCst) {
+        return Err(Interrupted.into());
+    }
+    let (table, failures) = commands::sweep::table(&sw, &scene, &runs);
+    let report = commands::sweep::report(&sw, shard, &table, failures, &a.sweep);
+    if let Some(d) = &planned {
+        d.write_all(&commands::sweep::files(&table, &report)?)?;
+        say(&format!(
+            "wrote runs.csv, sweep.json to {} ({n} run{} in {:.1} s)",
+            d.dir().display(),
+            if n == 1 { "" } else { "s" },
+            started.elapsed().as_secs_f64()
+        ));
+    }
+    if a.json {
+        print(out, &json(&report)?)
+    } else {
+        print(out, &commands::sweep::render_text(&report))
+    }
+}
+
+/// `kanegen merge`: the shards' runs.csv and sweep.json merged into `--out`.
+fn merge(a: MergeArgs, out: &mut dyn Write) -> Result<()> {
+    let dirs: Vec<&Path> = a.shards.iter().map(PathBuf::as_path).collect();
+    let mut inputs = Vec::new();
+    for d in &dirs {
+        for f in commands::sweep::FILES {
+            inputs.push(d.join(f));
+        }
+    }
+    let planned = OutputDir::plan(&a.out, &commands::sweep::FILES, a.force, &inputs)?;
+    let (table, report) = commands::sweep::merge(&dirs)?;
+    planned.write_all(&commands::sweep::files(&table, &report)?)?;
+    say(&format!(
+        "merged {} shards ({} runs) into {}",
+        dirs.len(),
+        report.runs,
+        planned.dir().display()
+    ));
+    if a.json {
+        print(out, &json(&report)?)
+    } else {
+        print(out, &commands::sweep::render_text(&report))
     }
 }

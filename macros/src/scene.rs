@@ -736,7 +736,11 @@ mod tests {
         let mut scenes = 0;
         for dir in ["scenes", "tests/data/scenes"] {
             for entry in std::fs::read_dir(root.join(dir)).unwrap() {
-                let file = entry.unwrap().file_name().into_string().unwrap();
+                let entry = entry.unwrap();
+                if entry.file_type().unwrap().is_dir() {
+                    continue; // scenes/sweeps: sweep files, not scenes
+                }
+                let file = entry.file_name().into_string().unwrap();
                 let rel = format!("../{dir}/{file}");
                 let items = super::expand(&runtime, &name, &rel).unwrap();
                 let unqualified = kanegen_codegen::paths::unqualified(items).unwrap();

@@ -175,8 +175,9 @@ impl Coulomb {
     }
 }
 
-/// 1-based line of byte offset `at` in `text`.
-fn line_of(text: &str, at: usize) -> usize {
+/// 1-based line of byte offset `at` in `text` (the line of a `toml::Spanned` value).
+#[must_use]
+pub fn line_of(text: &str, at: usize) -> usize {
     text[..at.min(text.len())].matches('\n').count() + 1
 }
 

@@ -6,7 +6,8 @@
 //! the stiff Rodas4, those of `kanegen_runtime::ode` with heap scratch),
 //! flexible joints ([`flexible`], Spong 1987), and the simulation loop with its energy and
 //! momentum monitors ([`simulate`]), payload capture and release ([`events`]), and a watch of the
-//! generalized Jacobian's dynamic singularities ([`singularity`]). Only the effects a scene names
+//! generalized Jacobian's dynamic singularities ([`singularity`]), and sweeps: a scene run many
+//! times over drawn or gridded numbers, in shards that merge exactly ([`sweep`]). Only the effects a scene names
 //! enter the equations. Plots and files are the CLI's.
 #![warn(missing_docs)]
 
@@ -20,4 +21,5 @@ pub use kanegen_scene as scene;
 pub mod simulate;
 pub mod singularity;
 pub mod sinks;
+pub mod sweep;
 pub mod system;

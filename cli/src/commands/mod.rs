@@ -10,4 +10,5 @@ pub mod info;
 pub mod linearize;
 pub mod simulate;
 pub mod simulate_text;
+pub mod sweep;
 pub mod table1;
