@@ -51,6 +51,13 @@ kanegen::dynamics!(
     scalar = f32,
     fma = true,
 );
+// The same chain in `f32`: its composed derivatives on `f32` lanes.
+kanegen::dynamics!(
+    Chain8F32,
+    "benches/data/random_n8.toml",
+    gravity = [0.3, -1.2, -9.81],
+    scalar = f32,
+);
 kanegen::dynamics!(
     Tree10Compact,
     "tests/data/compact/tree10.toml",
@@ -376,21 +383,25 @@ fn derivatives_match_pinocchio() {
 }
 
 /// `forward_dynamics_derivatives_lanes` of a composed function (its parts' lane forms, the two
-/// loops on `Lane<S>`) at `S::LANES` random states against the scalar function at each: every
-/// lane the same bits (checked through `{:?}`, which shows the sign of zero).
+/// loops on the lane type) at `S::LANES` random states against the scalar function at each:
+/// every lane the same bits (checked through `{:?}`, which shows the sign of zero).
 macro_rules! composed_lanes_equal_scalar {
-    ($ty:ty, $s:ty, $nq:literal, $nv:literal, $n:literal, $seed:expr) => {{
+    ($ty:ty, $s:ty, $nq:literal, $nv:literal, $n:literal, $seed:expr) => {
+        composed_lanes_equal_scalar!($ty, $s, f64, $nq, $nv, $n, $seed)
+    };
+    ($ty:ty, $s:ty, $f:ty, $nq:literal, $nv:literal, $n:literal, $seed:expr) => {{
         use kanegen::runtime::lanes::{lane, Lanes};
-        const L: usize = <$s as Lanes<f64>>::LANES;
-        type D = ([[f64; $nv]; $nv], [[f64; $nv]; $nv], [[f64; $nv]; $nv]);
+        const L: usize = <$s as Lanes<$f>>::LANES;
+        type D = ([[$f; $nv]; $nv], [[$f; $nv]; $nv], [[$f; $nv]; $nv]);
         let mut r = rng($seed);
-        let states: Vec<([f64; $nq], [f64; $nv], [f64; $n])> = (0..L)
+        let f = |v: Vec<f64>| -> Vec<$f> { v.into_iter().map(|x| x as $f).collect() };
+        let states: Vec<([$f; $nq], [$f; $nv], [$f; $n])> = (0..L)
             .map(|_| {
-                let q = arr(&random_vec(&mut r, $nq, 2.0));
+                let q = f(random_vec(&mut r, $nq, 2.0)).try_into().unwrap();
                 (
                     q,
-                    arr(&random_vec(&mut r, $nv, 1.5)),
-                    arr(&random_vec(&mut r, $n, 4.0)),
+                    f(random_vec(&mut r, $nv, 1.5)).try_into().unwrap(),
+                    f(random_vec(&mut r, $n, 4.0)).try_into().unwrap(),
                 )
             })
             .collect();
@@ -399,7 +410,7 @@ macro_rules! composed_lanes_equal_scalar {
         let tau: [$s; $n] = core::array::from_fn(|j| <$s>::from_fn(|i| states[i].2[j]));
         let lanes = <$ty>::forward_dynamics_derivatives_lanes::<$s>(&q, &v, &tau);
         for (i, (q, v, tau)) in states.iter().enumerate() {
-            let have: D = lane::<f64, $s, D>(&lanes, i);
+            let have: D = lane::<$f, $s, D>(&lanes, i);
             let want = <$ty>::forward_dynamics_derivatives(q, v, tau);
             assert_eq!(format!("{have:?}"), format!("{want:?}"), "lane {i}");
         }
@@ -408,13 +419,18 @@ macro_rules! composed_lanes_equal_scalar {
 
 /// A composed `forward_dynamics_derivatives` (past the size rule: `q̈ = M⁻¹ (τ − c)`, then
 /// `−M⁻¹ ∂τ/∂x`) on lanes: the random 8-joint chain (its `∂τ` in the compact kernels, on lanes)
-/// and the free-floating 7-dof arm, on `f64x4` and `f64x2`.
+/// and the free-floating 7-dof arm, on `f64x2`, `f64x4` and `f64x8`, and the chain in `f32` on
+/// `f32x8` and `f32x16`.
 #[test]
 fn composed_lanes_are_the_scalar_function() {
-    use kanegen::runtime::lanes::{f64x2, f64x4};
+    use kanegen::runtime::lanes::{f32x16, f32x8, f64x2, f64x4, f64x8};
     for seed in 0..4 {
         composed_lanes_equal_scalar!(Chain8, f64x4, 8, 8, 8, 40 + seed);
         composed_lanes_equal_scalar!(Chain8, f64x2, 8, 8, 8, 50 + seed);
+        composed_lanes_equal_scalar!(Chain8, f64x8, 8, 8, 8, 70 + seed);
         composed_lanes_equal_scalar!(FreeFloating7, f64x4, 14, 13, 7, 60 + seed);
+        composed_lanes_equal_scalar!(FreeFloating7, f64x8, 14, 13, 7, 80 + seed);
+        composed_lanes_equal_scalar!(Chain8F32, f32x8, f32, 8, 8, 8, 90 + seed);
+        composed_lanes_equal_scalar!(Chain8F32, f32x16, f32, 8, 8, 8, 100 + seed);
     }
 }

@@ -1,11 +1,11 @@
 //! The `_lanes` form of every generated function (`NAME_lanes<S: Lanes<F>>`): on SIMD vectors
-//! (`f64x4`, `f64x2`; `f32x8`, `f32x4` for `f32` code) each lane's results are bit for bit the
+//! (`f64x2`, `f64x4`, `f64x8`; `f32x4`, `f32x8`, `f32x16` for `f32` code) each lane's results are bit for bit the
 //! scalar function's at that lane's state, for random states, on the checked-in files (SSRMS
 //! plain, `f32`, `fma`; the free-floating 7-dof arm) and on `dynamics!` code (UR5 with gravity,
 //! straight-line and compact; a random chain with a runtime payload, compact with libm's and with fused products; libm's sine–cosine; the
 //! `f64::mul_add` fma path).
 
-use kanegen::runtime::lanes::{f32x4, f32x8, f64x2, f64x4, LaneValue, Lanes};
+use kanegen::runtime::lanes::{f32x16, f32x4, f32x8, f64x2, f64x4, f64x8, LaneValue, Lanes};
 use kanegen_generated::{
     free_floating_7dof::FreeFloating7, ssrms::Ssrms, ssrms_f32::SsrmsF32, ssrms_fma::SsrmsFma,
 };
@@ -218,6 +218,7 @@ macro_rules! random5_functions {
 fn ssrms_lanes_are_the_scalar_functions() {
     assert_eq!(ssrms_functions!(Ssrms, f64, f64x4, 1), 9);
     assert_eq!(ssrms_functions!(Ssrms, f64, f64x2, 2), 9);
+    assert_eq!(ssrms_functions!(Ssrms, f64, f64x8, 22), 9);
     assert_eq!(ssrms_functions!(Ssrms, f64, f64, 3), 9);
 }
 
@@ -225,12 +226,14 @@ fn ssrms_lanes_are_the_scalar_functions() {
 fn ssrms_fma_lanes_are_the_scalar_functions() {
     assert_eq!(ssrms_functions!(SsrmsFma, f64, f64x4, 4), 9);
     assert_eq!(ssrms_functions!(SsrmsFma, f64, f64x2, 5), 9);
+    assert_eq!(ssrms_functions!(SsrmsFma, f64, f64x8, 23), 9);
 }
 
 #[test]
 fn ssrms_f32_lanes_are_the_scalar_functions() {
     assert_eq!(ssrms_functions!(SsrmsF32, f32, f32x8, 6), 9);
     assert_eq!(ssrms_functions!(SsrmsF32, f32, f32x4, 7), 9);
+    assert_eq!(ssrms_functions!(SsrmsF32, f32, f32x16, 24), 9);
 }
 
 #[test]
@@ -261,6 +264,7 @@ fn free_floating_lanes_are_the_scalar_functions() {
 fn ur5_lanes_are_the_scalar_functions() {
     assert_eq!(ur5_functions!(Ur5, f64, f64x4, 10), 18);
     assert_eq!(ur5_functions!(Ur5, f64, f64x2, 11), 18);
+    assert_eq!(ur5_functions!(Ur5, f64, f64x8, 25), 18);
 }
 
 /// The compact form's `_lanes` run its kernels on `Lane<S>` (the tables' numbers splat over the
@@ -278,6 +282,7 @@ fn compact_lanes_are_the_scalar_functions() {
     assert_eq!(compact.unwrap().fma, 0);
     assert_eq!(ur5_functions!(Ur5Compact, f64, f64x4, 12), 18);
     assert_eq!(ur5_functions!(Ur5Compact, f64, f64x2, 19), 18);
+    assert_eq!(ur5_functions!(Ur5Compact, f64, f64x8, 26), 18);
     let n = lanes_equal_scalar!(Random5CompactLibm, f64, f64x4, 20, [];
         inverse_dynamics / inverse_dynamics_lanes(q, qd, qdd),
         forward_dynamics / forward_dynamics_lanes(q, qd, tau),
@@ -456,7 +461,7 @@ fn sincos_lanes_are_the_scalar<S: Lanes<f64>, const K: usize>(angles: &[f64]) ->
     calls
 }
 
-/// The table sine–cosine on `f64x2` and `f64x4` (vector arithmetic, the table read per lane) is
+/// The table sine–cosine on `f64x2`, `f64x4` and `f64x8` (vector arithmetic, the table read per lane) is
 /// the scalar routine on each lane, fused and unfused, for one and several angles per lane.
 #[test]
 fn table_sincos_lanes_are_the_scalar() {
@@ -466,6 +471,8 @@ fn table_sincos_lanes_are_the_scalar() {
     assert_eq!(sincos_lanes_are_the_scalar::<f64x4, 1>(&angles), n);
     assert_eq!(sincos_lanes_are_the_scalar::<f64x2, 3>(&angles), n);
     assert_eq!(sincos_lanes_are_the_scalar::<f64x4, 7>(&angles), n);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x8, 1>(&angles), n);
+    assert_eq!(sincos_lanes_are_the_scalar::<f64x8, 7>(&angles), n);
 }
 
 /// `runtime::par::batch` over a generated batch (feature `rayon`) equals the serial batch bit

@@ -104,7 +104,7 @@ fn lanes_line(plan: &Plan, opts: &Options) -> String {
              (the tables' numbers splat over the lanes) where it has a lane body \
              (`kanegen_codegen::compact::lanes_body`: fixed-base `f64` code of at most 64 \
              joints without a runtime payload or mimic joints, but for `M`, `(M, c)` and the \
-             frames), a composed `f64` one composes its parts' lane forms, and any other \
+             frames), a composed one composes its parts' lane forms, and any other \
              evaluates `NAME` lane by lane.",
         );
     } else {

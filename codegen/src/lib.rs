@@ -320,48 +320,51 @@ impl Composed {
 /// functions, `q̈ = M⁻¹ (τ − c)`, then `−M⁻¹ ∂τ/∂x` from its inverse-dynamics derivatives
 /// (`kanegen_runtime::composed`).
 fn composed_body(plan: &Plan, fp: &FunctionPlan, opts: &Options) -> Result<TokenStream, Error> {
-    let rt = opts.runtime()?;
-    let Composed {
-        parts: [minv, c, id],
-        args: [q, qd, tau],
-        payload: p,
-    } = Composed::new(plan, fp, opts, "")?;
-    Ok(quote! {
-        let minv = Self::#minv(#q #p);
-        let qdd = #rt::composed::accelerations(&minv, #tau, &Self::#c(#q, #qd #p));
-        #rt::composed::forward_dynamics_derivatives(minv, Self::#id(#q, #qd, &qdd #p))
-    })
+    composed_parts(plan, fp, opts, "", &quote!())
 }
 
-/// The body of a composed `forward_dynamics_derivatives_lanes` (`f64` code): [`composed_body`]
-/// on lanes, each part's own `_lanes` (a lane body, or its scalar function lane by lane) and the
-/// two loops of `kanegen_runtime::composed` on `kanegen_runtime::lanes::Lane<S>`, so each lane
-/// is bit for bit the scalar function's result; `None` for `f32` code.
+/// The body of a composed `forward_dynamics_derivatives_lanes`: [`composed_body`] on lanes,
+/// each part's own `_lanes` (a lane body, or its scalar function lane by lane) and the two loops
+/// of `kanegen_runtime::composed` on the lane type itself (a `Ring`: `+ − ×` lane by lane), so
+/// each lane is bit for bit the scalar function's result.
 fn composed_lanes_body(
     plan: &Plan,
     fp: &FunctionPlan,
     opts: &Options,
 ) -> Result<Option<TokenStream>, Error> {
-    if opts.float != Float::F64 {
-        return Ok(None);
-    }
+    composed_parts(plan, fp, opts, "_lanes", &quote!(::<S>)).map(Some)
+}
+
+/// [`composed_body`] calling the parts `NAME{suffix}{generics}`.
+fn composed_parts(
+    plan: &Plan,
+    fp: &FunctionPlan,
+    opts: &Options,
+    suffix: &str,
+    generics: &TokenStream,
+) -> Result<TokenStream, Error> {
     let rt = opts.runtime()?;
     let Composed {
         parts: [minv, c, id],
         args: [q, qd, tau],
         payload: p,
-    } = Composed::new(plan, fp, opts, "_lanes")?;
-    let l = quote!(#rt::lanes);
-    Ok(Some(quote! {
-        let minv = #l::wrap_rows(&Self::#minv::<S>(#q #p));
-        let c = #l::wrap(&Self::#c::<S>(#q, #qd #p));
-        let qdd = #l::Unlane::unlane(#rt::composed::accelerations(&minv, &#l::wrap(#tau), &c));
-        let (dq, dv) = Self::#id::<S>(#q, #qd, &qdd #p);
-        #l::Unlane::unlane(#rt::composed::forward_dynamics_derivatives(
-            minv,
-            (#l::wrap_rows(&dq), #l::wrap_rows(&dv)),
-        ))
-    }))
+    } = Composed::new(plan, fp, opts, suffix)?;
+    let zero = quote!(#rt::Ring::zero());
+    let nv = Literal::usize_unsuffixed(fp.speeds());
+    Ok(quote! {
+        let mut d = ([[#zero; #nv]; #nv], [[#zero; #nv]; #nv], Self::#minv #generics(#q #p));
+        let qdd = #rt::composed::accelerations(&d.2, #tau, &Self::#c #generics(#q, #qd #p));
+        #rt::composed::forward_dynamics_derivatives(&mut d, &Self::#id #generics(#q, #qd, &qdd #p));
+        d
+    })
+}
+
+/// A lane vector of `float` named in the generated docs.
+fn vector_example(float: Float) -> &'static str {
+    match float {
+        Float::F64 => "f64x4",
+        Float::F32 => "f32x8",
+    }
 }
 
 /// The placeholder of the `k`-th formatted body ([`generate_file`]).
@@ -462,12 +465,14 @@ fn function_item(
             body,
             kernel,
             format!(
-                " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`f64` \
-                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::f64x4`): {}, \
+                " [`Self::{name}`] of `S::LANES` states at once, one per lane of `S` (`{}` \
+                 itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): {}, \
                  each lane's results bit for bit the scalar function's for that lane's state.",
+                opts.float.name(),
+                vector_example(opts.float),
                 if matches!(fp.kernel, Kernel::Composed(_)) {
-                    "composed from the lane forms of its parts, the two loops on \
-                     `kanegen_runtime::lanes::Lane`s of `S`"
+                    "composed from the lane forms of its parts, the two loops of \
+                     `kanegen_runtime::composed` on `S` itself"
                 } else {
                     "the same kernel on the tables' numbers as `kanegen_runtime::lanes::Lane`s \
                      of `S`"
@@ -488,10 +493,7 @@ fn function_item(
                  itself, or a SIMD vector of it such as `kanegen_runtime::lanes::{}`): a \
                  function in loops or composed evaluates the scalar function lane by lane.",
                 opts.float.name(),
-                match opts.float {
-                    Float::F64 => "f64x4",
-                    Float::F32 => "f32x8",
-                }
+                vector_example(opts.float)
             ),
         )
     } else {
@@ -504,10 +506,7 @@ fn function_item(
                  straight-line code, each lane's results bit for bit the scalar function's for \
                  that lane's state.",
                 opts.float.name(),
-                match opts.float {
-                    Float::F64 => "f64x4",
-                    Float::F32 => "f32x8",
-                }
+                vector_example(opts.float)
             ),
         )
     };

@@ -97,7 +97,7 @@ impl FunctionPlan {
     }
 
     /// The side of its square matrices (the speeds) for [`Shape::Matrices`], else 0.
-    fn speeds(&self) -> usize {
+    pub(crate) fn speeds(&self) -> usize {
         match self.shape {
             Shape::Matrices(_, nv) => nv,
             _ => 0,

@@ -8,12 +8,12 @@
 //! needs of `S`: arithmetic, constants ([`Lanes::splat`]), the generated code's fused
 //! multiply-adds, square roots and sines and cosines, each applied lane by lane with the scalar
 //! routine's rounding: the table sine–cosine of `f64` code ([`crate::sincos`]) is one routine,
-//! generic over the lane type, run as vector arithmetic on `f64x2` and `f64x4`; libm's sines and
-//! cosines (and `f32`'s) are the scalar routines applied to each lane.
+//! generic over the lane type, run as vector arithmetic on `f64x2`, `f64x4` and `f64x8`; libm's
+//! sines and cosines (and `f32`'s) are the scalar routines applied to each lane.
 //!
-//! Implemented for `f64` and `f32` (one lane) and for `wide`'s [`f64x2`], [`f64x4`],
-//! [`f32x4`] and [`f32x8`]. Negation is [`Lanes::neg`], a sign flip (`wide`'s `-x` is `0 − x`,
-//! which turns `-0.0` into `+0.0`).
+//! Implemented for `f64` and `f32` (one lane) and for `wide`'s [`f64x2`], [`f64x4`], [`f64x8`]
+//! (one AVX-512 register where the build targets AVX-512, two AVX ones elsewhere), [`f32x4`],
+//! [`f32x8`] and [`f32x16`]. Negation is [`Lanes::neg`], a sign flip, `-0.0` of `0.0`.
 //!
 //! ```
 //! use kanegen_runtime::lanes::{Lanes, f64x4};
@@ -24,7 +24,7 @@
 
 use core::ops::{Add, Div, Mul, Sub};
 
-pub use wide::{f32x4, f32x8, f64x2, f64x4};
+pub use wide::{f32x16, f32x4, f32x8, f64x2, f64x4, f64x8};
 
 mod lane;
 pub use lane::{wrap, wrap_rows, Lane, Unlane};
@@ -32,7 +32,7 @@ pub use lane::{wrap, wrap_rows, Lane, Unlane};
 /// `L` values of the element type `F` (`f64` or `f32`) side by side, with the operations of
 /// generated code, each lane computed as the scalar operation computes it (bit for bit).
 pub trait Lanes<F: Copy>:
-    Copy
+    crate::scalar::Ring
     + core::fmt::Debug
     + 'static
     + Add<Output = Self>
@@ -184,6 +184,13 @@ const WIDE_SQRT: bool = cfg!(any(
 /// by lane, the scalar routine on each lane elsewhere.
 macro_rules! wide_lanes {
     ($v:ident, $t:ident, $l:literal, $sincos_n:expr, $sincos_n_unfused:expr) => {
+        impl crate::scalar::Ring for $v {
+            #[inline(always)]
+            fn zero() -> Self {
+                $v::splat(0.0)
+            }
+        }
+
         impl Lanes<$t> for $v {
             const LANES: usize = $l;
             #[inline(always)]
@@ -192,7 +199,7 @@ macro_rules! wide_lanes {
             }
             #[inline(always)]
             fn lane(self, i: usize) -> $t {
-                self.as_array_ref()[i]
+                self.as_array()[i]
             }
             #[inline(always)]
             fn from_fn(f: impl FnMut(usize) -> $t) -> Self {
@@ -303,6 +310,13 @@ wide_lanes!(
     crate::sincos::lanes::<f64x4, K, false>
 );
 wide_lanes!(
+    f64x8,
+    f64,
+    8,
+    crate::sincos::lanes::<f64x8, K, true>,
+    crate::sincos::lanes::<f64x8, K, false>
+);
+wide_lanes!(
     f32x4,
     f32,
     4,
@@ -315,6 +329,13 @@ wide_lanes!(
     8,
     |x| per_lane::<_, _, K, 8>(x, |x: [f32; K]| x.map(libm::sincosf)),
     |x| per_lane::<_, _, K, 8>(x, |x: [f32; K]| x.map(libm::sincosf))
+);
+wide_lanes!(
+    f32x16,
+    f32,
+    16,
+    |x| per_lane::<_, _, K, 16>(x, |x: [f32; K]| x.map(libm::sincosf)),
+    |x| per_lane::<_, _, K, 16>(x, |x: [f32; K]| x.map(libm::sincosf))
 );
 
 /// A value of the element type `F` (a number, an array of them, a tuple of those) and its form
@@ -329,6 +350,12 @@ pub trait LaneValue<F, S>: Sized {
     fn lane(lanes: &Self::Lanes, i: usize) -> Self;
     /// Sets lane `i` of `lanes` to `self`.
     fn set_lane(&self, lanes: &mut Self::Lanes, i: usize);
+    /// The value over `S` whose lane `l` is `*f(l)`, each number read once (a batch's gather).
+    fn from_lanes<'a>(f: impl Fn(usize) -> &'a Self + Copy) -> Self::Lanes
+    where
+        Self: 'a;
+    /// Lane `i` of `lanes` written into `out` in place (a batch's scatter).
+    fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self);
 }
 
 macro_rules! number_value {
@@ -346,6 +373,14 @@ macro_rules! number_value {
             #[inline(always)]
             fn set_lane(&self, lanes: &mut S, i: usize) {
                 *lanes = lanes.replace(i, *self);
+            }
+            #[inline(always)]
+            fn from_lanes<'a>(f: impl Fn(usize) -> &'a Self + Copy) -> S {
+                S::from_fn(|l| *f(l))
+            }
+            #[inline(always)]
+            fn write_lane(lanes: &S, i: usize, out: &mut Self) {
+                *out = lanes.lane(i);
             }
         }
     };
@@ -370,6 +405,19 @@ impl<F, S, T: LaneValue<F, S>, const N: usize> LaneValue<F, S> for [T; N] {
             v.set_lane(l, i);
         }
     }
+    #[inline(always)]
+    fn from_lanes<'a>(f: impl Fn(usize) -> &'a Self + Copy) -> Self::Lanes
+    where
+        Self: 'a,
+    {
+        core::array::from_fn(|k| T::from_lanes(move |l| &f(l)[k]))
+    }
+    #[inline(always)]
+    fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self) {
+        for (l, o) in lanes.iter().zip(out.iter_mut()) {
+            T::write_lane(l, i, o);
+        }
+    }
 }
 
 macro_rules! tuple_value {
@@ -387,6 +435,17 @@ macro_rules! tuple_value {
             #[inline(always)]
             fn set_lane(&self, lanes: &mut Self::Lanes, i: usize) {
                 $(self.$k.set_lane(&mut lanes.$k, i);)+
+            }
+            #[inline(always)]
+            fn from_lanes<'a>(f: impl Fn(usize) -> &'a Self + Copy) -> Self::Lanes
+            where
+                Self: 'a,
+            {
+                ($($t::from_lanes(move |l| &f(l).$k),)+)
+            }
+            #[inline(always)]
+            fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self) {
+                $($t::write_lane(&lanes.$k, i, &mut out.$k);)+
             }
         }
     };
@@ -425,11 +484,7 @@ pub fn gather<F: Copy, S: Lanes<F>, T: LaneValue<F, S>>(
     n: usize,
 ) -> T::Lanes {
     let last = n - 1;
-    let mut out = states[start.min(last)].splat();
-    for l in 1..S::LANES {
-        states[(start + l).min(last)].set_lane(&mut out, l);
-    }
-    out
+    T::from_lanes(|l| &states[(start + l).min(last)])
 }
 
 /// `out[k]` for the first `n` states (`n ≤ out.len()`), `S::LANES` at a time: `f(start)` gives
@@ -444,7 +499,7 @@ pub fn batch<F: Copy, S: Lanes<F>, R: LaneValue<F, S>>(
     for (c, chunk) in out[..n].chunks_mut(S::LANES).enumerate() {
         let r = f(c * S::LANES);
         for (l, o) in chunk.iter_mut().enumerate() {
-            *o = R::lane(&r, l);
+            R::write_lane(&r, l, o);
         }
     }
 }
@@ -532,6 +587,16 @@ mod tests {
     #[test]
     fn f64x4_lanes_are_the_scalar() {
         check!(f64x4, f64, same64);
+    }
+
+    #[test]
+    fn f64x8_lanes_are_the_scalar() {
+        check!(f64x8, f64, same64);
+    }
+
+    #[test]
+    fn f32x16_lanes_are_the_scalar() {
+        check!(f32x16, f32, same32);
     }
 
     #[test]

@@ -45,4 +45,4 @@ pub mod scalar;
 pub mod scene;
 pub mod sincos;
 
-pub use scalar::{Real, Scalar, Symbolic};
+pub use scalar::{Real, Ring, Scalar, Symbolic};

@@ -103,6 +103,22 @@ macro_rules! impl_float_scalar {
 impl_float_scalar!(f64, sin, cos, sqrt, sincos);
 impl_float_scalar!(f32, sinf, cosf, sqrtf, sincosf);
 
+/// What a matrix product needs of its numbers: `+ − ×` and zero. Every [`Scalar`] is one, and so
+/// is each SIMD vector of [`crate::lanes`] (`f64x4`: four numbers side by side, each operation
+/// IEEE lane by lane), so the loops written over it ([`crate::composed`], the products of
+/// [`crate::compact::derivatives`]) run one state or `LANES` states, bit for bit alike.
+pub trait Ring: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
+    /// Zero.
+    fn zero() -> Self;
+}
+
+impl<S: Scalar + Copy> Ring for S {
+    #[inline(always)]
+    fn zero() -> Self {
+        Scalar::zero()
+    }
+}
+
 /// A scalar that records operations instead of computing them (the tracer `Sym` of
 /// `kanegen-trace`). Functions that only make sense for op-count bookkeeping — not as dynamics
 /// algorithms — take `S: Symbolic`, so they cannot be evaluated numerically by mistake.

@@ -23,7 +23,7 @@
 //! and 2 ulp of the value wherever it is at least 1/16.
 //!
 //! The steps are written once, generic over the lane type: [`sincos_n`] is their `f64` case, and
-//! `Lanes::sincos_n` of `f64x2` and `f64x4` ([`crate::lanes`]) runs the same operations on
+//! `Lanes::sincos_n` of `f64x2`, `f64x4` and `f64x8` ([`crate::lanes`]) runs the same operations on
 //! vectors, the table read lane by lane, so each lane is bit for bit [`sincos_n`] of its angles;
 //! where some lane's angle is beyond the range (or NaN), each lane runs [`sincos_n`] on its own.
 //!
@@ -38,8 +38,7 @@
 //! assert!((s - libm::sin(1.0)).abs() < 1e-15 && (c - libm::cos(1.0)).abs() < 1e-15);
 //! ```
 
-use crate::lanes::{f64x2, f64x4, Lanes};
-use wide::{CmpGt, CmpLt};
+use crate::lanes::{f64x2, f64x4, f64x8, Lanes};
 
 /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded (computed in 300-bit arithmetic by
 /// `mpmath`; `tests` checks them against `libm::sin` and each other).
@@ -267,7 +266,7 @@ const CHUNK: usize = 4;
 
 /// What steps 1–4 need of a lane type ([`Lanes`]) beyond its arithmetic: the range test, the
 /// table lookup and the path beyond the range. Implemented for `f64` (the scalar routine) and
-/// `wide`'s `f64x2` and `f64x4`, whose [`Lanes::sincos_n`] runs the steps as vector arithmetic,
+/// `wide`'s `f64x2`, `f64x4` and `f64x8`, whose [`Lanes::sincos_n`] runs the steps as vector arithmetic,
 /// each lane bit for bit the scalar routine on that lane's angles.
 pub(crate) trait TableLanes: Lanes<f64> {
     /// Whether every lane of every angle is within `(−LIMIT, LIMIT)` (not NaN).
@@ -318,7 +317,7 @@ macro_rules! table_lanes {
                 let (lo, hi) = ($v::splat(-LIMIT), $v::splat(LIMIT));
                 let mut fast = $v::splat(f64::from_bits(u64::MAX));
                 for &v in x {
-                    fast = fast & v.cmp_gt(lo) & v.cmp_lt(hi);
+                    fast = fast & v.simd_gt(lo) & v.simd_lt(hi);
                 }
                 fast.all()
             }
@@ -337,6 +336,7 @@ macro_rules! table_lanes {
 
 table_lanes!(f64x2, 2);
 table_lanes!(f64x4, 4);
+table_lanes!(f64x8, 8);
 
 /// `a·b + c`: [`Lanes::mul_add`] (fused as [`crate::fma::mul_add`]) with `FUSE`, two roundings
 /// without.

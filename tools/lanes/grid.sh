@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # 256 forward dynamics and 256 forward-dynamics derivatives of one model (GRiD's benchmark:
 # 256 states of a 7-dof arm), µs per 256 states, side by side in one run: one state per call on
-# one core, `NAME_batch::<f64x2>` / `::<f64x4>` on one core, and the same batches split over all
+# one core, `NAME_batch::<f64x4>` / `::<f64x8>` on one core, and the same batches split over all
 # cores by `kanegen::runtime::par::batch` (feature `rayon`; the rounds inside `par::install`,
 # on a thread of the pool). ROUNDS rounds (default 400), each
 # running every candidate once in rotating order; the least and the median round are printed.
@@ -17,7 +17,7 @@ source "$root/tools/lanes/crate.sh"
 export LANES_CRATE_SEP=$'\n'
 for model in "$@"; do
   lanes_crate "$dir" grid '"rayon"' "$model" <<'RS'
-use kanegen::runtime::lanes::{f64x2, f64x4};
+use kanegen::runtime::lanes::{f64x4, f64x8};
 use kanegen::runtime::par;
 use std::hint::black_box;
 use std::time::Instant;
@@ -35,21 +35,21 @@ fn main() {
     let (q, qd, tau) = (&q[..], &qd[..], &tau[..]);
     let mut fd = [(); 5].map(|()| vec![[0.0; N]; B]);
     let mut dd: [Vec<D>; 5] = [(); 5].map(|()| vec![([[0.0; N]; N], [[0.0; N]; N], [[0.0; N]; N]); B]);
-    let names = ["1 state, 1 core", "f64x2, 1 core", "f64x4, 1 core", "f64x2, all cores", "f64x4, all cores"];
+    let names = ["1 state, 1 core", "f64x4, 1 core", "f64x8, 1 core", "f64x4, all cores", "f64x8, all cores"];
     // One run of candidate i: 0..5 forward dynamics, 5..10 its derivatives.
     let mut run = |i: usize| {
         let (w, fd, dd) = (i % 5, &mut fd[i % 5], &mut dd[i % 5]);
         match (i / 5, w) {
             (0, 0) => fd.iter_mut().enumerate().for_each(|(k, o)| *o = R::forward_dynamics(&q[k], &qd[k], &tau[k])),
-            (0, 1) => R::forward_dynamics_batch::<f64x2>(q, qd, tau, fd),
-            (0, 2) => R::forward_dynamics_batch::<f64x4>(q, qd, tau, fd),
-            (0, 3) => par::batch(fd, |r, o| R::forward_dynamics_batch::<f64x2>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
-            (0, 4) => par::batch(fd, |r, o| R::forward_dynamics_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
+            (0, 1) => R::forward_dynamics_batch::<f64x4>(q, qd, tau, fd),
+            (0, 2) => R::forward_dynamics_batch::<f64x8>(q, qd, tau, fd),
+            (0, 3) => par::batch(fd, |r, o| R::forward_dynamics_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
+            (0, 4) => par::batch(fd, |r, o| R::forward_dynamics_batch::<f64x8>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
             (1, 0) => dd.iter_mut().enumerate().for_each(|(k, o)| *o = R::forward_dynamics_derivatives(&q[k], &qd[k], &tau[k])),
-            (1, 1) => R::forward_dynamics_derivatives_batch::<f64x2>(q, qd, tau, dd),
-            (1, 2) => R::forward_dynamics_derivatives_batch::<f64x4>(q, qd, tau, dd),
-            (1, 3) => par::batch(dd, |r, o| R::forward_dynamics_derivatives_batch::<f64x2>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
-            _ => par::batch(dd, |r, o| R::forward_dynamics_derivatives_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
+            (1, 1) => R::forward_dynamics_derivatives_batch::<f64x4>(q, qd, tau, dd),
+            (1, 2) => R::forward_dynamics_derivatives_batch::<f64x8>(q, qd, tau, dd),
+            (1, 3) => par::batch(dd, |r, o| R::forward_dynamics_derivatives_batch::<f64x4>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
+            _ => par::batch(dd, |r, o| R::forward_dynamics_derivatives_batch::<f64x8>(&q[r.clone()], &qd[r.clone()], &tau[r], o)),
         }
         black_box((&fd, &dd));
     };

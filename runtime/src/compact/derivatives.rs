@@ -36,7 +36,7 @@ use super::frames::supports;
 use super::rnea::{rnea, Motions};
 use super::spatial::{add, crf, crm, cross, dot, inertia_mul, scale, sub, transforms, world};
 use super::tables::{Bodies, BodyStore, Tables};
-use crate::scalar::Scalar;
+use crate::scalar::{Ring, Scalar};
 
 /// One joint's quantities of the passes ([module docs](self)), in base coordinates.
 #[derive(Clone, Copy, Debug)]
@@ -422,10 +422,10 @@ pub fn inverse_in<S: Scalar + Copy>(m: &mut [S], n: usize, d_inv: &mut [S], out:
 /// `out = −A B` of `n × n` matrices (rows first), row by row as `−Σ_k A_rk B_k·` so that the
 /// inner loop runs along rows of `B` and `out` (contiguous: the compiler vectorizes it).
 #[inline(always)]
-pub fn neg_product<S: Scalar + Copy>(a: &[S], b: &[S], n: usize, out: &mut [S]) {
+pub fn neg_product<S: Ring>(a: &[S], b: &[S], n: usize, out: &mut [S]) {
     let n = n.max(1);
     for (orow, arow) in out.chunks_exact_mut(n).zip(a.chunks_exact(n)) {
-        orow.fill(S::zero());
+        orow.fill(Ring::zero());
         for (&x, brow) in arow.iter().zip(b.chunks_exact(n)) {
             for (o, &y) in orow.iter_mut().zip(brow) {
                 *o = *o - x * y;
@@ -491,10 +491,10 @@ pub fn forward_dynamics_derivatives<S: Scalar + Copy, const N: usize>(
 
 /// `q̈ = M⁻¹ (τ − c)` into `qdd`.
 #[inline(always)]
-pub fn accelerations<S: Scalar + Copy>(minv: &[S], tau: &[S], c: &[S], qdd: &mut [S]) {
+pub fn accelerations<S: Ring>(minv: &[S], tau: &[S], c: &[S], qdd: &mut [S]) {
     let n = qdd.len();
     for (r, x) in qdd.iter_mut().enumerate() {
-        let mut acc = S::zero();
+        let mut acc = <S as Ring>::zero();
         for (k, (t, c)) in tau.iter().zip(c).enumerate() {
             if let Some(&m) = minv.get(r * n + k) {
                 acc = acc + m * (*t - *c);

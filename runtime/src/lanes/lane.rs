@@ -1,15 +1,16 @@
-//! [`Lane`]: a lane type as a scalar of the compact kernels ([`crate::compact`]) and the composed
-//! loops ([`crate::composed`]), so that one call evaluates `S::LANES` states, each lane bit for bit the `f64` kernel's result for
-//! its state: `+ − × ÷` are the vector operations (IEEE, lane by lane), the negation flips the
-//! sign bit as the scalar `-x` does (`wide`'s own `Neg` computes `0 − x`, which makes `+0.0` of
-//! `+0.0`), and the sine, cosine and square root are the `f64` routines on each lane.
+//! [`Lane`]: a lane type as a [`Scalar`] of the compact kernels ([`crate::compact`]), so that one
+//! call evaluates `S::LANES` states, each lane bit for bit the `f64` kernel's result for its
+//! state: `+ − × ÷` are the vector operations (IEEE, lane by lane), the negation flips the sign
+//! bit as the scalar `-x` does ([`Lanes::neg`]), and the sine, cosine and square root are the
+//! `f64` routines on each lane. (The composed loops, [`crate::composed`], need only `+ − ×` and
+//! run on the lane type itself, a [`crate::Ring`].)
 
 use super::Lanes;
 use crate::scalar::Scalar;
 use core::ops::{Add, Div, Mul, Neg, Sub};
 
-/// `S::LANES` `f64` values side by side (`f64` itself, `f64x2`, `f64x4`), a [`Scalar`] for the
-/// compact kernels and the composed loops.
+/// `S::LANES` `f64` values side by side (`f64` itself, `f64x2`, `f64x4`, `f64x8`), a [`Scalar`]
+/// for the compact kernels.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(transparent)]
 pub struct Lane<S>(pub S);
