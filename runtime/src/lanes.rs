@@ -341,7 +341,7 @@ wide_lanes!(
 /// A value of the element type `F` (a number, an array of them, a tuple of those) and its form
 /// over the lane type `S` (each number a lane vector): how functions without a lane body (the
 /// compact form's kernels) evaluate `L` states, one lane at a time ([`lanewise`]).
-pub trait LaneValue<F, S>: Sized {
+pub trait LaneValue<F, S>: Sized + 'static {
     /// The value over `S`: `[S; N]` for `[F; N]`.
     type Lanes;
     /// Every lane `self`.
@@ -354,8 +354,32 @@ pub trait LaneValue<F, S>: Sized {
     fn from_lanes<'a>(f: impl Fn(usize) -> &'a Self + Copy) -> Self::Lanes
     where
         Self: 'a;
-    /// Lane `i` of `lanes` written into `out` in place (a batch's scatter).
-    fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self);
+    /// Lane `l` of `lanes` written into `at(&mut out[l])` for each `l < out.len()` (a batch's
+    /// scatter): number by number, each lane vector read once and its lanes stored where they
+    /// go, in place.
+    fn write_lanes<R: 'static>(
+        lanes: &Self::Lanes,
+        out: &mut [R],
+        at: impl Fn(&mut R) -> &mut Self + Copy,
+    );
+}
+
+/// `at` followed by the field `f` of what it gives.
+#[inline(always)]
+fn field<R: 'static, T: 'static, U: 'static>(
+    at: impl Fn(&mut R) -> &mut T + Copy,
+    f: impl Fn(&mut T) -> &mut U + Copy,
+) -> impl Fn(&mut R) -> &mut U + Copy {
+    move |r| f(at(r))
+}
+
+/// `at` followed by element `k` of the array it gives.
+#[inline(always)]
+fn element<R: 'static, T: 'static, const N: usize>(
+    at: impl Fn(&mut R) -> &mut [T; N] + Copy,
+    k: usize,
+) -> impl Fn(&mut R) -> &mut T + Copy {
+    move |r| &mut at(r)[k]
 }
 
 macro_rules! number_value {
@@ -379,8 +403,14 @@ macro_rules! number_value {
                 S::from_fn(|l| *f(l))
             }
             #[inline(always)]
-            fn write_lane(lanes: &S, i: usize, out: &mut Self) {
-                *out = lanes.lane(i);
+            fn write_lanes<R: 'static>(
+                lanes: &S,
+                out: &mut [R],
+                at: impl Fn(&mut R) -> &mut Self + Copy,
+            ) {
+                for (l, o) in out.iter_mut().enumerate() {
+                    *at(o) = lanes.lane(l);
+                }
             }
         }
     };
@@ -413,9 +443,13 @@ impl<F, S, T: LaneValue<F, S>, const N: usize> LaneValue<F, S> for [T; N] {
         core::array::from_fn(|k| T::from_lanes(move |l| &f(l)[k]))
     }
     #[inline(always)]
-    fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self) {
-        for (l, o) in lanes.iter().zip(out.iter_mut()) {
-            T::write_lane(l, i, o);
+    fn write_lanes<R: 'static>(
+        lanes: &Self::Lanes,
+        out: &mut [R],
+        at: impl Fn(&mut R) -> &mut Self + Copy,
+    ) {
+        for (k, l) in lanes.iter().enumerate() {
+            T::write_lanes(l, out, element(at, k));
         }
     }
 }
@@ -444,8 +478,12 @@ macro_rules! tuple_value {
                 ($($t::from_lanes(move |l| &f(l).$k),)+)
             }
             #[inline(always)]
-            fn write_lane(lanes: &Self::Lanes, i: usize, out: &mut Self) {
-                $($t::write_lane(&lanes.$k, i, &mut out.$k);)+
+            fn write_lanes<R: 'static>(
+                lanes: &Self::Lanes,
+                out: &mut [R],
+                at: impl Fn(&mut R) -> &mut Self + Copy,
+            ) {
+                $($t::write_lanes(&lanes.$k, out, field::<R, Self, $t>(at, |x| &mut x.$k));)+
             }
         }
     };
@@ -498,9 +536,7 @@ pub fn batch<F: Copy, S: Lanes<F>, R: LaneValue<F, S>>(
 ) {
     for (c, chunk) in out[..n].chunks_mut(S::LANES).enumerate() {
         let r = f(c * S::LANES);
-        for (l, o) in chunk.iter_mut().enumerate() {
-            R::write_lane(&r, l, o);
-        }
+        R::write_lanes(&r, chunk, |o| o);
     }
 }
 
