@@ -113,22 +113,28 @@ pub struct ShardJson {
     pub count: u64,
 }
 
-/// The table of `runs` of `sweep` (its nominal `scene` names the columns).
+/// The table of `runs` of `sweep` (its nominal `scene` names the columns), and the runs that
+/// failed.
 #[must_use]
 pub fn table(sweep: &Sweep, scene: &Scene, runs: &[SweepRun]) -> (Table, Vec<Failure>) {
+    let (columns, summary_columns) = columns(sweep, scene);
+    let (rows, failures) = runs
+        .iter()
+        .map(|r| row(sweep, scene, r, columns.len()))
+        .unzip::<_, _, Vec<Row>, Vec<Option<Failure>>>();
+    let table = Table {
+        columns,
+        summary_columns,
+        rows,
+    };
+    (table, failures.into_iter().flatten().collect())
+}
+
+/// The columns: the parameters, the run's summary, then the final state under the names of
+/// `trajectory.csv`; and how many come before the final state.
+fn columns(sweep: &Sweep, scene: &Scene) -> (Vec<String>, usize) {
     let mut columns: Vec<String> = sweep.parameters.iter().map(|p| p.key.clone()).collect();
-    columns.extend(
-        [
-            "t_end",
-            "steps",
-            "rejected_steps",
-            "evals",
-            "energy_drift",
-            "linear_momentum_drift",
-            "angular_momentum_drift",
-        ]
-        .map(String::from),
-    );
+    columns.extend(SUMMARY.map(String::from));
     for i in 0..scene.events.len() {
         for q in [
             "energy_change",
@@ -143,80 +149,75 @@ pub fn table(sweep: &Sweep, scene: &Scene, runs: &[SweepRun]) -> (Table, Vec<Fai
     }
     let summary_columns = columns.len();
     columns.extend(csv_header(scene).into_iter().skip(1));
-    let mut failures = Vec::new();
-    let rows = runs
-        .iter()
-        .map(|r| {
-            let mut cells: Vec<Option<f64>> = r.values.iter().copied().map(Some).collect();
-            let status = match &r.outcome {
-                Outcome::Invalid(why) => {
-                    failures.push(Failure {
-                        run: r.index,
-                        status: "invalid".into(),
-                        reason: why.clone(),
-                    });
-                    "invalid"
-                }
-                Outcome::Ran { summary: s, last } => {
-                    cells.extend(
-                        [
-                            s.t_end,
-                            s.steps as f64,
-                            s.rejected_steps as f64,
-                            s.evals as f64,
-                        ]
-                        .map(Some),
-                    );
-                    cells.extend([
-                        s.max_energy_drift_rel,
-                        s.max_linear_momentum_drift_rel,
-                        s.max_angular_momentum_drift_rel,
-                    ]);
-                    for e in &s.events {
-                        cells.extend(
-                            [
-                                e.energy_change,
-                                e.linear_momentum_error_rel,
-                                e.angular_momentum_error_rel,
-                            ]
-                            .map(Some),
-                        );
-                    }
-                    cells.resize(sweep.parameters.len() + 7 + 3 * scene.events.len(), None);
-                    if scene.is_floating() {
-                        let sigma = s.singularity.as_ref();
-                        cells.extend([sigma.map(|m| m.sigma_min), sigma.map(|m| m.t)]);
-                    }
-                    cells.extend(csv_values(scene, last).into_iter().skip(1).map(Some));
-                    match &s.stopped {
-                        None => "complete",
-                        Some(why) => {
-                            failures.push(Failure {
-                                run: r.index,
-                                status: "stopped".into(),
-                                reason: format!("at t = {}: {why}", s.t_end),
-                            });
-                            "stopped"
-                        }
-                    }
-                }
-            };
-            cells.resize(columns.len(), None);
-            Row {
-                run: r.index,
-                status: status.into(),
-                cells,
+    (columns, summary_columns)
+}
+
+/// The summary columns every run has.
+const SUMMARY: [&str; 7] = [
+    "t_end",
+    "steps",
+    "rejected_steps",
+    "evals",
+    "energy_drift",
+    "linear_momentum_drift",
+    "angular_momentum_drift",
+];
+
+/// One run's row of `width` cells (empty where the run has no value), and its failure.
+fn row(sweep: &Sweep, scene: &Scene, r: &SweepRun, width: usize) -> (Row, Option<Failure>) {
+    let mut cells: Vec<Option<f64>> = r.values.iter().copied().map(Some).collect();
+    let failure = |status: &str, reason: String| Failure {
+        run: r.index,
+        status: status.into(),
+        reason,
+    };
+    let (status, failure) = match &r.outcome {
+        Outcome::Invalid(why) => ("invalid", Some(failure("invalid", why.clone()))),
+        Outcome::Ran { summary: s, last } => {
+            cells.extend(
+                [
+                    s.t_end,
+                    s.steps as f64,
+                    s.rejected_steps as f64,
+                    s.evals as f64,
+                ]
+                .map(Some),
+            );
+            cells.extend([
+                s.max_energy_drift_rel,
+                s.max_linear_momentum_drift_rel,
+                s.max_angular_momentum_drift_rel,
+            ]);
+            for e in &s.events {
+                let errors = [e.linear_momentum_error_rel, e.angular_momentum_error_rel];
+                cells.extend([e.energy_change, errors[0], errors[1]].map(Some));
             }
-        })
-        .collect();
-    (
-        Table {
-            columns,
-            summary_columns,
-            rows,
-        },
-        failures,
-    )
+            // A run stopped before an event has no numbers for it.
+            cells.resize(
+                sweep.parameters.len() + SUMMARY.len() + 3 * scene.events.len(),
+                None,
+            );
+            if scene.is_floating() {
+                let sigma = s.singularity.as_ref();
+                cells.extend([sigma.map(|m| m.sigma_min), sigma.map(|m| m.t)]);
+            }
+            cells.extend(csv_values(scene, last).into_iter().skip(1).map(Some));
+            match &s.stopped {
+                None => ("complete", None),
+                Some(why) => (
+                    "stopped",
+                    Some(failure("stopped", format!("at t = {}: {why}", s.t_end))),
+                ),
+            }
+        }
+    };
+    cells.resize(width, None);
+    let row = Row {
+        run: r.index,
+        status: status.into(),
+        cells,
+    };
+    (row, failure)
 }
 
 /// The report of `table` (the runs `first..end` of `sweep`, shard `shard`).
