@@ -206,13 +206,13 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         scene_linearize::availability(scene, &scene.effects(&profiles), has_derivatives);
     let (derivatives, step_jacobians) = match linearize {
         Ok(()) => (
-            scene_linearize::derivatives(&shape),
+            scene_linearize::derivatives(scene, &shape),
             scene_linearize::step_jacobians(
                 rt,
                 scene,
                 &layout.state_ty,
                 &model_ty,
-                (layout.n, layout.dim),
+                (layout.n, layout.dim, scene.effects(&profiles).floating),
             ),
         ),
         Err(_) => (TokenStream::new(), TokenStream::new()),

@@ -26,6 +26,16 @@ pub fn availability(
     if scene.simulation.integrator == Integrator::Rosenbrock {
         return Err("its step is a Rodas4 step".into());
     }
+    if effects.floating && scene.simulation.integrator == Integrator::Midpoint {
+        return Err(
+            "its step is the implicit midpoint rule on a free-floating base (step Jacobians there \
+             are RK4's)"
+                .into(),
+        );
+    }
+    if effects.floating && scene.model.has_mimics() {
+        return Err("its free-floating model has mimic joints".into());
+    }
     if !has_derivatives {
         return Err(
             "the generated dynamics carry no derivatives (unrolled with more than 24 speeds)"
@@ -49,8 +59,9 @@ pub fn doc(name: &Ident, available: &Result<(), String>) -> String {
 
 /// `impl SceneDerivatives for <shape.ty>`: forwards to the generated derivative functions of
 /// the provider's phase.
-pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
+pub fn derivatives(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
     let Shape { rt, ty, .. } = sh;
+    let gravity = crate::scene_provider::arr(&scene.gravity.unwrap_or([0.0; 3]));
     let nvl = Literal::usize_unsuffixed(sh.nv);
     let f64 = paths::primitive("f64");
     let nan = quote!([[#f64::NAN; #nvl]; #nvl]);
@@ -65,7 +76,7 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
         |dy| quote!(#dy::inverse_dynamics_derivatives(q, v, qdd)),
     );
     let forward_args = as_arrays(
-        &[("q", sh.n), ("v", sh.n), ("tau", sh.n)],
+        &[("q", sh.nq), ("v", sh.nv), ("tau", sh.n)],
         &quote! {
             dq.fill(#f64::NAN);
             dv.fill(#f64::NAN);
@@ -73,7 +84,7 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
         },
     );
     let inverse_args = as_arrays(
-        &[("q", sh.n), ("v", sh.n), ("qdd", sh.n)],
+        &[("q", sh.nq), ("v", sh.nv), ("qdd", sh.nv)],
         &quote! {
             dq.fill(#f64::NAN);
             return dv.fill(#f64::NAN);
@@ -97,6 +108,10 @@ pub fn derivatives(sh: &Shape<'_>) -> TokenStream {
                         #rt::scene::copy_into(d, row);
                     }
                 }
+            }
+
+            fn gravity(&self) -> [#f64; 3] {
+                #gravity
             }
 
             fn inverse_derivatives(
@@ -126,21 +141,33 @@ pub fn step_jacobians(
     scene: &Scene,
     state_ty: &Ident,
     model_ty: &Ident,
-    (n, dim): (usize, usize),
+    (n, dim, floating): (usize, usize, bool),
 ) -> TokenStream {
     let ode = quote!(#rt::ode);
-    let (nl, dl) = (Literal::usize_unsuffixed(n), Literal::usize_unsuffixed(dim));
+    // The Jacobians' rows and columns: the tangent space's on a free-floating base.
+    let tangent = if floating { dim - 1 } else { dim };
+    let (nl, dl, tl) = (
+        Literal::usize_unsuffixed(n),
+        Literal::usize_unsuffixed(dim),
+        Literal::usize_unsuffixed(tangent),
+    );
     let f64 = paths::primitive("f64");
     let result = paths::result_type(
-        &quote!((#state_ty, [[#f64; #dl]; #dl], [[#f64; #nl]; #dl])),
+        &quote!((#state_ty, [[#f64; #tl]; #tl], [[#f64; #nl]; #tl])),
         &quote!(#ode::Stop),
     );
     let done = paths::ok(quote! {(
         #state_ty::from_array(&x),
-        ::core::array::from_fn(|i| ::core::array::from_fn(|j| a[i * #dl + j])),
+        ::core::array::from_fn(|i| ::core::array::from_fn(|j| a[i * #tl + j])),
         ::core::array::from_fn(|i| ::core::array::from_fn(|j| b[i * #nl + j])),
     )});
-    let (call, scratch, scheme) = if scene.simulation.integrator == Integrator::Midpoint {
+    let (call, scratch, scheme) = if floating {
+        (
+            quote!(#ode::floating_rk4_step_jacobians),
+            quote!(#ode::ArrayScratch::<{ #ode::linearize::floating_rk4_scratch_len(#dl, #nl) }>::new()),
+            "RK4",
+        )
+    } else if scene.simulation.integrator == Integrator::Midpoint {
         (
             quote!(#ode::midpoint_step_jacobians),
             quote!(#ode::ArrayScratch::<{ #ode::linearize::midpoint_scratch_len(#dl, #nl) }, #dl>::new()),
@@ -153,11 +180,18 @@ pub fn step_jacobians(
             "RK4",
         )
     };
+    let tangent_doc = if floating {
+        ", the base's pose in the tangent space of Pinocchio's `integrate` (its 7 numbers as 6 \
+         directions `[δp; δθ]` in base coordinates: `A` and `B` have `DIM − 1` rows, `A` as many \
+         columns; `kanegen::runtime::ode::floating_rk4_step_jacobians`)"
+    } else {
+        ""
+    };
     let doc = format!(
         " One {scheme} step of size `h` from `(t, state)` (what [`Self::step`] takes) with the \
          joint torques `u` added to the scene's drive, and its Jacobians `(A, B)`: \
          `A[i][j] = ∂x⁺_i/∂x_j`, `B[i][j] = ∂x⁺_i/∂u_j` over the flat state \
-         ([`{state_ty}::to_array`]). Exact for the scheme: the chain rule through its stages \
+         ([`{state_ty}::to_array`]){tangent_doc}. Exact for the scheme: the chain rule through its stages \
          (`kanegen::runtime::ode::linearize`) from the generated derivatives of forward and \
          inverse dynamics and the drive's own. With `u = 0` the new state is `step`'s, bit for bit."
     );
@@ -182,7 +216,7 @@ pub fn step_jacobians(
                 effects: &Self::EFFECTS,
                 work: &mut work,
             };
-            let (mut a, mut b) = ([0.0f64; #dl * #dl], [0.0f64; #dl * #nl]);
+            let (mut a, mut b) = ([0.0f64; #tl * #tl], [0.0f64; #tl * #nl]);
             #call(&mut sys, t, h, &mut x, u, &mut a, &mut b, &mut #scratch)?;
             #done
         }

@@ -7,7 +7,9 @@
 use crate::scene::Integrator;
 use crate::system::SceneSystem;
 use anyhow::{bail, Result};
-use kanegen_runtime::ode::{midpoint_step_jacobians, rk4_step_jacobians, VecScratch};
+use kanegen_runtime::ode::{
+    floating_rk4_step_jacobians, midpoint_step_jacobians, rk4_step_jacobians, VecScratch,
+};
 use kanegen_runtime::scene::linearize::jacobian_work_len;
 use kanegen_runtime::scene::{linearizable, SceneControl};
 
@@ -16,28 +18,42 @@ use kanegen_runtime::scene::{linearizable, SceneControl};
 pub struct StepJacobians {
     /// The state after the step.
     pub state: Vec<f64>,
-    /// `A = ∂x⁺/∂x`, `d × d` (row `i` = `x⁺_i`).
+    /// `A = ∂x⁺/∂x`, `d × d` (row `i` = `x⁺_i`); on a free-floating base `(d − 1) × (d − 1)`
+    /// in the tangent space ([`kanegen_runtime::ode::floating_rk4_step_jacobians`]).
     pub a: Vec<Vec<f64>>,
-    /// `B = ∂x⁺/∂u`, `d × N`.
+    /// `B = ∂x⁺/∂u`, `d × N` (`(d − 1) × N` on a free-floating base).
     pub b: Vec<Vec<f64>>,
+    /// The names of `A`'s rows and columns (and `B`'s rows): the state's components
+    /// ([`SceneSystem::component_name`]), on a free-floating base with the pose's tangent
+    /// directions `dp0_x`, `dp0_y`, `dp0_z`, `dtheta_x`, `dtheta_y`, `dtheta_z` (base
+    /// coordinates) for `p0_*` and `quat_*`.
+    pub names: Vec<String>,
     /// The scheme stepped: `"rk4"` or `"midpoint"`.
     pub scheme: &'static str,
 }
 
 /// The scheme whose step a scene's `step` takes and whose Jacobians are exact: RK4 for RK4 and
-/// dopri5 scenes, the implicit midpoint rule for midpoint scenes.
+/// dopri5 scenes, the implicit midpoint rule for midpoint scenes on a fixed base.
 ///
 /// # Errors
-/// Rodas4 (rosenbrock) scenes, and effects the Jacobians do not cover
-/// ([`linearizable`]), named.
+/// Rodas4 (rosenbrock) scenes, midpoint scenes and mimic joints on a free-floating base, and
+/// effects the Jacobians do not cover ([`linearizable`]), named.
 pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let scene = sys.scene();
     let profiles = scene.wrench_profiles();
-    if let Err(what) = linearizable(&scene.effects(&profiles)) {
-        bail!("step Jacobians cover fixed-base scenes without external wrenches or flexible joints; this scene has {what}");
+    let effects = scene.effects(&profiles);
+    if let Err(what) = linearizable(&effects) {
+        bail!("step Jacobians cover scenes without external wrenches, flexible joints or rotor inertia on a free-floating base; this scene has {what}");
+    }
+    if effects.floating && scene.model.has_mimics() {
+        bail!("step Jacobians on a free-floating base cover models without mimic joints; this model has mimic joints");
     }
     match scene.simulation.integrator {
         Integrator::Rk4 | Integrator::Dopri5 => Ok("rk4"),
+        Integrator::Midpoint if effects.floating => bail!(
+            "step Jacobians on a free-floating base are those of an RK4 step (rk4 and dopri5 \
+             scenes); this scene integrates with the implicit midpoint rule"
+        ),
         Integrator::Midpoint => Ok("midpoint"),
         Integrator::Rosenbrock => bail!(
             "step Jacobians are those of an RK4 step (rk4 and dopri5 scenes) or of an implicit \
@@ -60,7 +76,9 @@ pub fn step_jacobians(
 ) -> Result<StepJacobians> {
     let scheme = scheme(sys)?;
     let scene = sys.scene();
-    let (d, n) = (2 * sys.n(), sys.n());
+    let profiles = scene.wrench_profiles();
+    let effects = scene.effects(&profiles);
+    let (d, n) = (effects.dim(), sys.n());
     if x.len() != d || u.len() != n {
         bail!(
             "a state of {} and an input of {} numbers, for {d} and {n}",
@@ -68,17 +86,28 @@ pub fn step_jacobians(
             u.len()
         );
     }
-    let profiles = scene.wrench_profiles();
-    let effects = scene.effects(&profiles);
+    // The Jacobians' rows and columns: the tangent space's on a free-floating base.
+    let td = if effects.floating { d - 1 } else { d };
     let mut work = vec![0.0; jacobian_work_len(&effects)];
     let mut control = SceneControl {
         dynamics: &mut sys.dynamics,
         effects: &effects,
         work: &mut work,
     };
-    let (mut state, mut a, mut b) = (x.to_vec(), vec![0.0; d * d], vec![0.0; d * n]);
+    let (mut state, mut a, mut b) = (x.to_vec(), vec![0.0; td * td], vec![0.0; td * n]);
     let mut scratch = VecScratch::default();
-    let stepped = if scheme == "rk4" {
+    let stepped = if effects.floating {
+        floating_rk4_step_jacobians(
+            &mut control,
+            t,
+            h,
+            &mut state,
+            u,
+            &mut a,
+            &mut b,
+            &mut scratch,
+        )
+    } else if scheme == "rk4" {
         rk4_step_jacobians(
             &mut control,
             t,
@@ -105,10 +134,20 @@ pub fn step_jacobians(
         bail!("{stop}");
     }
     let rows = |m: &[f64], cols: usize| m.chunks_exact(cols).map(<[f64]>::to_vec).collect();
+    let names = if effects.floating {
+        let pose = [
+            "dp0_x", "dp0_y", "dp0_z", "dtheta_x", "dtheta_y", "dtheta_z",
+        ];
+        let rest = (7..d).map(|i| sys.component_name(i));
+        pose.iter().map(|s| (*s).to_string()).chain(rest).collect()
+    } else {
+        (0..d).map(|i| sys.component_name(i)).collect()
+    };
     Ok(StepJacobians {
         state,
-        a: rows(&a, d),
+        a: rows(&a, td),
         b: rows(&b, n),
+        names,
         scheme,
     })
 }

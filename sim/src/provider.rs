@@ -278,8 +278,9 @@ fn copy_rows(src: &[Vec<f64>], dst: &mut [f64]) {
     }
 }
 
-/// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`) on a
-/// fixed base, no external wrench (what [`kanegen_runtime::scene::linearize`] covers).
+/// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`), no
+/// external wrench (what [`kanegen_runtime::scene::linearize`] covers): forward dynamics on a
+/// fixed or free-floating base (mimic joints on a fixed one), inverse dynamics on a fixed base.
 impl SceneDerivatives for RunTimeDynamics {
     fn forward_derivatives(
         &mut self,
@@ -294,8 +295,13 @@ impl SceneDerivatives for RunTimeDynamics {
             self.set_loads(Some(tau), &[]);
         }
         let g = self.loads.gravity.as_ref();
-        let (a, b, m) = match &self.coupling {
-            Some(c) => {
+        let (a, b, m) = match (&self.coupling, &self.base) {
+            (None, Some(base)) => {
+                let st = floating_state(q, v);
+                let (qj, vj) = (&q[7..], &v[6..]);
+                derivatives::aba::floating_derivatives(&self.params, base, &st, qj, vj, tau, g)
+            }
+            (Some(c), _) => {
                 let (qf, vf) = self.full_joints(q, v);
                 let d = self.full_dynamics(q, v);
                 derivatives::coupled::forward_dynamics_derivatives(
@@ -306,11 +312,15 @@ impl SceneDerivatives for RunTimeDynamics {
                     |qdd| derivatives::rnea::derivatives(&self.params, &qf, &vf, qdd, g),
                 )
             }
-            None => derivatives::aba::derivatives(&self.params, q, v, tau, g),
+            (None, None) => derivatives::aba::derivatives(&self.params, q, v, tau, g),
         };
         copy_rows(&a, dq);
         copy_rows(&b, dv);
         copy_rows(&m, minv);
+    }
+
+    fn gravity(&self) -> [f64; 3] {
+        self.loads.gravity.as_ref().map_or([0.0; 3], |g| g.0)
     }
 
     fn inverse_derivatives(

@@ -31,6 +31,7 @@ pub fn to_json(
         "t": 0.0,
         "h": scene.simulation.step,
         "state": names,
+        "tangent": j.names,
         "inputs": scene.coordinate_names(),
         "x": x,
         "x_next": j.state,
@@ -41,10 +42,8 @@ pub fn to_json(
 
 /// The text report: a line on what was linearized, then `A` and `B`, a row a state component.
 #[must_use]
-pub fn render_text(
-    scene: &Scene,
-    (j, names, _): &(StepJacobians, Vec<String>, Vec<f64>),
-) -> String {
+pub fn render_text(scene: &Scene, (j, _, _): &(StepJacobians, Vec<String>, Vec<f64>)) -> String {
+    let names = &j.names;
     let width = names.iter().map(String::len).max().unwrap_or(0);
     let matrix = |m: &[Vec<f64>]| -> String {
         m.iter()
@@ -59,7 +58,7 @@ pub fn render_text(
     format!(
         "x⁺ = Φ(x, u): one {} step of {} s from the initial state at t = 0, u = 0 (u: joint \
          torques added to the drive: {}); exact for the scheme\nA = ∂x⁺/∂x ({d} × {d}; columns in \
-         the order of the rows)\n{}B = ∂x⁺/∂u ({d} × {})\n{}",
+         the order of the rows{})\n{}B = ∂x⁺/∂u ({d} × {})\n{}",
         if j.scheme == "rk4" {
             "RK4"
         } else {
@@ -67,6 +66,12 @@ pub fn render_text(
         },
         scene.simulation.step,
         inputs.join(", "),
+        if names.len() + 1 == j.state.len() {
+            "; the free-floating base's pose in the tangent space of Pinocchio's integrate, \
+             base coordinates"
+        } else {
+            ""
+        },
         matrix(&j.a),
         inputs.len(),
         matrix(&j.b),

@@ -14,15 +14,26 @@
 //!   `(I − h/2 F) ∂x_m = ∂x + h/2 G ∂u`, so `A = 2 (I − h/2 F)⁻¹ − I` and
 //!   `B = h (I − h/2 F)⁻¹ G` with `F`, `G` at the midpoint.
 //!
-//! Both take additive states (no Lie-group component: a free-floating base's quaternion is not
-//! covered). The new state is the one [`rk4_step`](super::rk4_step) and
-//! [`midpoint_step`](super::midpoint_step) give for the same input, bit for bit.
-//! Matrices are row-major slices: `A` is `d × d`, `B` is `d × m`.
+//! - [`floating_rk4_step_jacobians`], the RK4 step of a free-floating state
+//!   `[p₀, quat, q, v_b, ω_b, q̇]` (the quaternion advanced additively, then renormalized, as
+//!   [`rk4_step`](super::rk4_step) with the projection of a free-floating scene does it), with
+//!   `A` and `B` in the tangent space of Pinocchio's `integrate`/`difference`
+//!   (`d − 1` directions, the base's `[δp; δθ]` in base coordinates): the additive Jacobians
+//!   of the step over the quaternion's four numbers, between the state's tangent directions
+//!   and the tangent coordinates of the renormalized new state
+//!   ([`floating_tangent_in`], [`floating_tangent_out`]): `A = T_out A₄ T_in`, `B = T_out B₄`.
+//!
+//! [`rk4_step_jacobians`] and [`midpoint_step_jacobians`] take additive states. The new state
+//! is the one [`rk4_step`](super::rk4_step) and [`midpoint_step`](super::midpoint_step) give
+//! for the same input (projected, for a free-floating state), bit for bit.
+//! Matrices are row-major slices: `A` is `d × d`, `B` is `d × m` (`d − 1` rows and columns for
+//! a free-floating state).
 
 // Index loops over matrix entries.
 #![allow(clippy::needless_range_loop)]
 
 use super::lu::{lu_factor, lu_solve};
+use super::quaternion::{floating_tangent_in, floating_tangent_out, normalize_quaternion};
 use super::{midpoint, non_finite, Scratch, Stats, Stop, System};
 
 /// A first-order system with inputs, `ẋ = f(t, x, u)`, and its Jacobians.
@@ -177,6 +188,73 @@ pub fn rk4_step_jacobians<S: ControlledSystem + ?Sized>(
         evals: 4,
     };
     accept(t + h, x, xs, stats)
+}
+
+/// The scratch floats of [`floating_rk4_step_jacobians`] for a free-floating state of `d`
+/// numbers and `m` inputs: [`rk4_scratch_len`]`(d, m)`, the additive `A₄`, `B₄`, the two
+/// tangent maps and one product.
+#[must_use]
+pub const fn floating_rk4_scratch_len(d: usize, m: usize) -> usize {
+    rk4_scratch_len(d, m) + d * d + d * m + 3 * d * (d - 1)
+}
+
+/// One RK4 step of size `h` of a free-floating state `x = [p₀, quat, q, v_b, ω_b, q̇]` (`d ≥ 13`
+/// numbers) under the held input `u`, in place and renormalized (as `rk4_step` with the
+/// projection of a free-floating scene), with its Jacobians in the tangent space (module doc):
+/// `A` (`(d − 1) × (d − 1)`) and `B` (`(d − 1) × m`). `x` holds a unit quaternion. `scratch`:
+/// at least [`floating_rk4_scratch_len`]`(d, m)` floats. Four evaluations of the Jacobians.
+///
+/// # Errors
+/// [`Stop::NonFinite`] at `t + h` when the new state is not finite (`x` unchanged),
+/// [`Stop::Invalid`] for a state shorter than 13, lengths that do not match or too little
+/// scratch.
+#[allow(clippy::too_many_arguments)]
+pub fn floating_rk4_step_jacobians<S: ControlledSystem + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    h: f64,
+    x: &mut [f64],
+    u: &[f64],
+    a: &mut [f64],
+    b: &mut [f64],
+    scratch: &mut (impl Scratch + ?Sized),
+) -> Result<Stats, Stop> {
+    let (d, m) = (sys.dim(), sys.inputs());
+    let tn = d.saturating_sub(1);
+    if d < 13 || x.len() != d || u.len() != m || a.len() != tn * tn || b.len() != tn * m {
+        return Err(Stop::Invalid {
+            t,
+            what: "a free-floating state of at least 13 numbers, with matching input and Jacobian lengths",
+        });
+    }
+    let (work, _) = super::take(scratch, t, floating_rk4_scratch_len(d, m), 0)?;
+    let (step_work, work) = work.split_at_mut(rk4_scratch_len(d, m));
+    let (a4, work) = work.split_at_mut(d * d);
+    let (b4, work) = work.split_at_mut(d * m);
+    let (t_in, work) = work.split_at_mut(d * tn);
+    let (t_out, prod) = work.split_at_mut(tn * d);
+    floating_tangent_in(x, t_in);
+    let stats = rk4_step_jacobians(sys, t, h, x, u, a4, b4, &mut Slices(step_work))?;
+    floating_tangent_out(x, t_out);
+    normalize_quaternion(x);
+    // A = T_out (A₄ T_in), B = T_out B₄.
+    matmul(&mut prod[..d * tn], a4, t_in, (d, d, tn));
+    matmul(a, t_out, &prod[..d * tn], (tn, d, tn));
+    matmul(b, t_out, b4, (tn, d, m));
+    Ok(stats)
+}
+
+/// `out = P Q` for `P` (`r × k`) and `Q` (`k × c`), row-major.
+fn matmul(out: &mut [f64], p: &[f64], q: &[f64], (r, k, c): (usize, usize, usize)) {
+    for i in 0..r {
+        for j in 0..c {
+            let mut s = 0.0;
+            for l in 0..k {
+                s += p[i * k + l] * q[l * c + j];
+            }
+            out[i * c + j] = s;
+        }
+    }
 }
 
 /// `x` takes `new` when it is finite.

@@ -35,7 +35,9 @@ mod scratch;
 mod system;
 
 pub use dopri5::{dopri5, Dopri5Options};
-pub use linearize::{midpoint_step_jacobians, rk4_step_jacobians, ControlledSystem};
+pub use linearize::{
+    floating_rk4_step_jacobians, midpoint_step_jacobians, rk4_step_jacobians, ControlledSystem,
+};
 pub use lu::solve_spd;
 pub use midpoint::{midpoint, midpoint_step};
 pub use profile::{quintic, table};

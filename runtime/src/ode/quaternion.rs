@@ -84,3 +84,179 @@ pub fn quat_to_matrix(q: &[f64; 4]) -> [[f64; 3]; 3] {
         ],
     ]
 }
+
+/// `∂(R(quat) v)/∂quat` (3 × 4, columns `x, y, z, w`) of the rotation formula of
+/// [`quat_to_matrix`], `R v = v + 2w (u × v) + 2 u × (u × v)`, at any quaternion (unit or not):
+/// `∂/∂u = −2w [v]× − 2 [u × v]× − 2 [u]× [v]×`, `∂/∂w = 2 u × v`. With `transpose`, of
+/// `R(quat)ᵀ v` (the same formula with `−w`).
+#[must_use]
+pub fn rotation_jacobian(quat: &[f64; 4], v: &[f64; 3], transpose: bool) -> [[f64; 4]; 3] {
+    let u = [quat[0], quat[1], quat[2]];
+    let w = if transpose { -quat[3] } else { quat[3] };
+    let uxv = cross(&u, v);
+    let (sv, suxv, su) = (skew(v), skew(&uxv), skew(&u));
+    core::array::from_fn(|r| {
+        core::array::from_fn(|c| {
+            if c == 3 {
+                let d = 2.0 * uxv[r];
+                if transpose {
+                    -d
+                } else {
+                    d
+                }
+            } else {
+                let su_sv = su[r][0] * sv[0][c] + su[r][1] * sv[1][c] + su[r][2] * sv[2][c];
+                -2.0 * (w * sv[r][c] + suxv[r][c] + su_sv)
+            }
+        })
+    })
+}
+
+/// The tangent directions of a free-floating state `x = [p₀, quat, q, v_b, ω_b, q̇]` (`d`
+/// numbers, `d − 1` directions): the first-order change of `x` along each direction `δ` of
+/// Pinocchio's `integrate(x, δ)` (`M₀ ← M₀ exp(δ_b)`, `δ_b = [δp; δθ]` in base coordinates), as
+/// a `d × (d − 1)` row-major matrix into `m`: `dp₀ = R₀ δp`, `dquat = ½ quat ⊗ (δθ, 0)`
+/// (`du = ½ (w δθ + u × δθ)`, `dw = −½ u · δθ`), every other number its own direction.
+pub fn floating_tangent_in(x: &[f64], m: &mut [f64]) {
+    let d = x.len();
+    let t = d - 1;
+    m.fill(0.0);
+    let (u, w) = ([x[3], x[4], x[5]], x[6]);
+    let r = quat_to_matrix(&[u[0], u[1], u[2], w]);
+    let su = skew(&u);
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i * t + j] = r[i][j];
+            let diag = if i == j { w } else { 0.0 };
+            m[(3 + i) * t + 3 + j] = 0.5 * (diag + su[i][j]);
+        }
+        m[6 * t + 3 + i] = -0.5 * u[i];
+    }
+    for i in 7..d {
+        m[i * t + i - 1] = 1.0;
+    }
+}
+
+/// The tangent coordinates of a first-order change of the free-floating state `r` (`d`
+/// numbers) that [`normalize_quaternion`] takes to `x⁺`: Pinocchio's `difference(x⁺, ·)` to
+/// first order through the normalization, a `(d − 1) × d` row-major matrix into `m`:
+/// `δp = R⁺ᵀ dp₀`, `δθ = 2 vec(q̂* ⊗ dquat) / |quat| = 2 ((ŵ 1 − [û]×) du − û dw) / |quat|`
+/// (`q̂ = quat / |quat| = (û, ŵ)`: the radial part of `dquat` has no rotation), every other
+/// number its own coordinate.
+pub fn floating_tangent_out(r: &[f64], m: &mut [f64]) {
+    let d = r.len();
+    m.fill(0.0);
+    let norm = Scalar::sqrt(r[3] * r[3] + r[4] * r[4] + r[5] * r[5] + r[6] * r[6]);
+    let (u, w) = ([r[3] / norm, r[4] / norm, r[5] / norm], r[6] / norm);
+    let rot = quat_to_matrix(&[u[0], u[1], u[2], w]);
+    let su = skew(&u);
+    let k = 2.0 / norm;
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i * d + j] = rot[j][i];
+            let diag = if i == j { w } else { 0.0 };
+            m[(3 + i) * d + 3 + j] = k * (diag - su[i][j]);
+        }
+        m[(3 + i) * d + 6] = -k * u[i];
+    }
+    for i in 6..d - 1 {
+        m[i * d + i + 1] = 1.0;
+    }
+}
+
+/// `a × b`.
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `[a]×`, the matrix of `b ↦ a × b`.
+fn skew(a: &[f64; 3]) -> [[f64; 3]; 3] {
+    [[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]]
+}
+
+#[cfg(test)]
+mod tests {
+    //! The Jacobians here against central differences of the formulas they differentiate, and
+    //! the tangent maps against each other.
+
+    use super::*;
+
+    /// `(R(quat) v, R(quat)ᵀ v)` by [`quat_to_matrix`].
+    fn rotated(quat: &[f64; 4], v: &[f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let r = quat_to_matrix(quat);
+        (
+            core::array::from_fn(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2]),
+            core::array::from_fn(|i| r[0][i] * v[0] + r[1][i] * v[1] + r[2][i] * v[2]),
+        )
+    }
+
+    #[test]
+    fn rotation_jacobian_matches_central_differences() {
+        // Not a unit quaternion: the RK4 stages are not either.
+        let (quat, v) = ([0.3, -0.5, 0.2, 0.9], [1.5, -0.7, 2.2]);
+        for transpose in [false, true] {
+            let j = rotation_jacobian(&quat, &v, transpose);
+            for c in 0..4 {
+                let e = 1e-6;
+                let (mut p, mut m) = (quat, quat);
+                p[c] += e;
+                m[c] -= e;
+                let pick = |q: &[f64; 4]| {
+                    let (a, b) = rotated(q, &v);
+                    if transpose {
+                        b
+                    } else {
+                        a
+                    }
+                };
+                let (fp, fm) = (pick(&p), pick(&m));
+                for r in 0..3 {
+                    let d = (fp[r] - fm[r]) / (2.0 * e);
+                    assert!(
+                        (d - j[r][c]).abs() < 1e-8,
+                        "{transpose} {r} {c}: {d} {}",
+                        j[r][c]
+                    );
+                }
+            }
+        }
+    }
+
+    /// At a unit quaternion the tangent coordinates of the tangent directions are the identity.
+    #[test]
+    fn tangent_out_inverts_tangent_in() {
+        const D: usize = 13 + 2 * 2;
+        let d = D;
+        let mut x: [f64; D] = core::array::from_fn(|i| 0.1 * i as f64 - 0.4);
+        x[3..7].copy_from_slice(&[0.1, -0.2, 0.3, 0.9]);
+        normalize_quaternion(&mut x);
+        let (mut tin, mut tout) = ([0.0; D * (D - 1)], [0.0; (D - 1) * D]);
+        floating_tangent_in(&x, &mut tin);
+        floating_tangent_out(&x, &mut tout);
+        for i in 0..d - 1 {
+            for j in 0..d - 1 {
+                let s: f64 = (0..d).map(|k| tout[i * d + k] * tin[k * (d - 1) + j]).sum();
+                let want = f64::from(u8::from(i == j));
+                assert!((s - want).abs() < 1e-15, "{i} {j}: {s}");
+            }
+        }
+    }
+
+    /// The tangent coordinates see a rotation of the new state's quaternion, not its length.
+    #[test]
+    fn tangent_out_ignores_the_length() {
+        let d = 13;
+        let mut r = [0.0; 13];
+        r[3..7].copy_from_slice(&[0.2, 0.1, -0.4, 1.3]);
+        let mut m = [0.0; 12 * 13];
+        floating_tangent_out(&r, &mut m);
+        for i in 3..6 {
+            let radial: f64 = (3..7).map(|k| m[i * d + k] * r[k]).sum();
+            assert!(radial.abs() < 1e-15, "{radial}");
+        }
+    }
+}

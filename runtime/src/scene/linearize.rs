@@ -16,13 +16,28 @@
 //! `∂ID/∂q − M diag(k_p)`, `∂ID/∂q̇ − M diag(k_d)` for computed torque; `−diag(b)` of joint
 //! damping and `−diag(τ_c / v_s · sech²(q̇ / v_s))` of Coulomb friction on `∂τ/∂q̇`.
 //!
-//! Covered ([`linearizable`]): a fixed base without external wrenches or flexible joints.
+//! On a free-floating base, `x = [p₀, quat, q, v_b, ω_b, q̇]` and the same blocks take the base's
+//! speeds in (`(∂ν̇/∂q, ∂ν̇/∂ν, M⁻¹)`, `(6 + N)²`, of which the `N` joint columns of `M⁻¹` are
+//! `∂ν̇/∂u`), around the derivatives of the kinematics ([`floating_kinematics`]) over the
+//! quaternion's four numbers: `ṗ₀ = R(quat) v_b`, `q̇uat = ½ quat ⊗ (ω_b, 0)`, and gravity, the
+//! one place the dynamics read the pose: a uniform field accelerates every body alike, so
+//! `ν̇ = ν̇|_{g=0} + [R(quat)ᵀ g; 0; 0]` and `∂ν̇/∂quat = [∂(R(quat)ᵀ g)/∂quat; 0; 0]`
+//! ([`rotation_jacobian`]), exact at any quaternion the RK4 stages reach, unit or not.
+//! [`crate::ode::floating_rk4_step_jacobians`] takes these to the tangent space.
+//!
+//! Covered ([`linearizable`]): no external wrenches, no flexible joints, and on a free-floating
+//! base no rotor inertia.
+//!
+//! [`floating_kinematics`]: super::floating_kinematics
+//! [`rotation_jacobian`]: crate::ode::quaternion::rotation_jacobian
 
 // Index loops over matrix entries.
 #![allow(clippy::needless_range_loop)]
 
+use super::floating::floating_kinematics_jacobian;
 use super::{deriv_input, drive_torques, Drive, SceneDynamics, SceneEffects};
 use crate::ldlt::{factor_in_place, solve_in_place};
+use crate::ode::quaternion::rotation_jacobian;
 use crate::ode::ControlledSystem;
 
 /// The derivatives of a provider's dynamics (no external wrench), row-major `N × N` each.
@@ -37,6 +52,10 @@ pub trait SceneDerivatives: SceneDynamics {
         dv: &mut [f64],
         minv: &mut [f64],
     );
+
+    /// The gravity `g` the dynamics apply, in the inertial frame on a free-floating base (the
+    /// frame the base's quaternion turns; read there only), zero for none.
+    fn gravity(&self) -> [f64; 3];
 
     /// `(∂τ/∂q, ∂τ/∂q̇)` of inverse dynamics at `(q, q̇, q̈)` into `dq`, `dv`.
     fn inverse_derivatives(
@@ -54,8 +73,8 @@ pub trait SceneDerivatives: SceneDynamics {
 /// # Errors
 /// The first effect not covered, in words.
 pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
-    if fx.floating {
-        Err("a free-floating base (its quaternion has no additive step Jacobian here)")
+    if fx.floating && fx.armature.is_some() {
+        Err("rotor inertia on a free-floating base")
     } else if !fx.wrenches.is_empty() {
         Err("external wrenches")
     } else if fx.flexible.is_some() {
@@ -65,11 +84,12 @@ pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
     }
 }
 
-/// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side and six
-/// `N × N` matrices.
+/// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side, three
+/// `N × N` and three `nv × nv` matrices and a joint vector.
 #[must_use]
 pub const fn jacobian_work_len(fx: &SceneEffects<'_>) -> usize {
-    fx.work_len() + 6 * fx.dof * fx.dof + fx.dof
+    let (n, nv) = (fx.dof, fx.sizes().1);
+    fx.work_len() + 3 * n * n + 3 * nv * nv + n
 }
 
 /// `f(t, x, u)` into `dx` (as [`deriv_input`]), `∂f/∂x` into `fxm` (`d × d`, row-major) and
@@ -87,7 +107,7 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     fum: &mut [f64],
     work: &mut [f64],
 ) {
-    let (n, d) = (fx.dof, fx.dim());
+    let (n, d, (nq, nv)) = (fx.dof, fx.dim(), fx.sizes());
     if linearizable(fx).is_err()
         || fxm.len() != d * d
         || fum.len() != d * n
@@ -101,38 +121,58 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     }
     let (rhs_work, work) = work.split_at_mut(fx.work_len());
     deriv_input(dynamics, fx, t, x, u, dx, rhs_work);
-    let (q, qd) = x.split_at(n);
-    let [tq, tv, dq, dv, minv, mm] = matrices(work, n);
+    let (q, v) = x.split_at(nq);
+    let (qj, vj) = (&q[nq - n..], &v[nv - n..]);
+    let [tq, tv, mm, dq, dv, minv] = matrices(work, n, nv);
     let (tau, rest) = rhs_work.split_at_mut(n);
-    drive_torques(dynamics, fx, t, q, qd, &[], tau, &mut mm[..n]);
+    drive_torques(dynamics, fx, t, qj, vj, &[], tau, &mut mm[..n]);
     for (ti, ui) in tau.iter_mut().zip(u) {
         *ti += ui;
     }
-    drive_jacobians(dynamics, fx, t, q, qd, tq, tv, mm);
+    drive_jacobians(dynamics, fx, t, qj, vj, tq, tv, mm);
     match fx.armature {
-        None => dynamics.forward_derivatives(q, qd, tau, dq, dv, minv),
+        None => dynamics.forward_derivatives(q, v, tau, dq, dv, minv),
         Some(a) => {
-            // The scene's own work holds `nv² + 2 nv` more with an armature ([`work_len`]).
+            // A fixed base ([`linearizable`]); the scene's own work holds `nv² + 2 nv` more
+            // with an armature ([`work_len`]).
             let (d_inv, col) = rest[..2 * n].split_at_mut(n);
             let qdd = &dx[n..];
             let f = [&mut *dq, &mut *dv, &mut *minv];
-            armature_derivatives(dynamics, q, qd, qdd, a, f, &mut mm[..n * n], d_inv, col);
+            armature_derivatives(dynamics, q, v, qdd, a, f, &mut mm[..n * n], d_inv, col);
         }
     }
-    // F: the kinematic rows [0 I], then ∂q̈ + M⁻¹ ∂τ; G: [0; M⁻¹].
     fxm.fill(0.0);
     fum.fill(0.0);
-    for i in 0..n {
-        fxm[i * d + n + i] = 1.0;
+    // The kinematic rows: `[0 I]`, or those of the free-floating base.
+    if fx.floating {
+        floating_kinematics_jacobian(q, v, fxm);
+    } else {
+        for i in 0..n {
+            fxm[i * d + n + i] = 1.0;
+        }
+    }
+    // The acceleration rows: `∂ν̇ + M⁻¹ ∂τ` on the joints, `M⁻¹` (joint columns) for `u`.
+    let b = nv - n;
+    for i in 0..nv {
+        let (row, mrow) = (
+            &mut fxm[(nq + i) * d..(nq + i + 1) * d],
+            &minv[i * nv + b..],
+        );
+        let drive = |m: &[f64], j: usize| (0..n).map(|k| mrow[k] * m[k * n + j]).sum::<f64>();
         for j in 0..n {
-            let (mut sq, mut sv) = (dq[i * n + j], dv[i * n + j]);
-            for k in 0..n {
-                sq += minv[i * n + k] * tq[k * n + j];
-                sv += minv[i * n + k] * tv[k * n + j];
-            }
-            fxm[(n + i) * d + j] = sq;
-            fxm[(n + i) * d + n + j] = sv;
-            fum[(n + i) * n + j] = minv[i * n + j];
+            row[nq - n + j] = dq[i * nv + b + j] + drive(tq, j);
+            fum[(nq + i) * n + j] = mrow[j];
+        }
+        for c in 0..nv {
+            row[nq + c] = dv[i * nv + c] + if c >= b { drive(tv, c - b) } else { 0.0 };
+        }
+    }
+    if fx.floating {
+        // ∂ν̇/∂quat = [∂(R(quat)ᵀ g)/∂quat; 0; 0] (module doc).
+        let quat = [q[3], q[4], q[5], q[6]];
+        let dg = rotation_jacobian(&quat, &dynamics.gravity(), true);
+        for (r, dr) in dg.iter().enumerate() {
+            fxm[(nq + r) * d + 3..(nq + r) * d + 7].copy_from_slice(dr);
         }
     }
 }
@@ -188,14 +228,14 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     }
 }
 
-/// Six `N × N` matrices at the start of `work`.
-fn matrices(work: &mut [f64], n: usize) -> [&mut [f64]; 6] {
+/// At the start of `work`: two `N × N` matrices, one of `N² + N`, three `nv × nv`.
+fn matrices(work: &mut [f64], n: usize, nv: usize) -> [&mut [f64]; 6] {
     let (a, w) = work.split_at_mut(n * n);
     let (b, w) = w.split_at_mut(n * n);
-    let (c, w) = w.split_at_mut(n * n);
-    let (d, w) = w.split_at_mut(n * n);
-    let (e, w) = w.split_at_mut(n * n);
-    [a, b, c, d, e, &mut w[..n * n + n]]
+    let (c, w) = w.split_at_mut(n * n + n);
+    let (d, w) = w.split_at_mut(nv * nv);
+    let (e, w) = w.split_at_mut(nv * nv);
+    [a, b, c, d, e, &mut w[..nv * nv]]
 }
 
 /// `∂τ/∂q` into `tq` and `∂τ/∂q̇` into `tv` of the applied torques `τ(t, q, q̇)` of the drive,
