@@ -15,7 +15,10 @@
 //! `tests/data/scenes/linearize_ct_midpoint.toml` (UR5 under gravity, a computed-torque drive
 //! along a quintic, viscous and Coulomb friction, implicit midpoint) and
 //! `scenes/ur5_torque_input.toml` (UR5 under gravity, damping, no drive, RK4) and
-//! `scenes/ssrms_drives.toml` (rotor inertia, stiff PD, viscous and Coulomb friction, RK4).
+//! `scenes/ssrms_drives.toml` (rotor inertia, stiff PD, viscous and Coulomb friction, RK4),
+//! `tests/data/scenes/linearize_flexible.toml` (Spong's flexible joints under gravity, PD and
+//! friction on the motors, RK4) and, in the tangent space, `tests/data/scenes/linearize_floating.toml`
+//! (a free-floating base under gravity, module [`floating`]).
 
 use kanegen::sim::linearize::{scheme, step_jacobians};
 use kanegen::sim::scene::Scene;
@@ -210,6 +213,17 @@ scene_tests!(
     "scenes/ssrms_drives.toml",
     0.0,
     50.0
+);
+
+kanegen::scene!(Flexible, "tests/data/scenes/linearize_flexible.toml");
+
+scene_tests!(
+    flexible_joints,
+    Flexible,
+    FlexibleState,
+    "tests/data/scenes/linearize_flexible.toml",
+    0.1,
+    3.0
 );
 
 kanegen::scene!(Floating, "tests/data/scenes/linearize_floating.toml");
@@ -408,7 +422,7 @@ fn uncovered_scenes_are_refused_by_name() {
             "rotor inertia on a free-floating base",
         ),
         ("scenes/ssrms_effects.toml", "external wrenches"),
-        ("scenes/ssrms_flexible.toml", "flexible joints"),
+        ("scenes/ssrms_flexible.toml", "rosenbrock (Rodas4)"),
     ] {
         let scene = interpreted(file);
         let sys = SceneSystem::new(&scene);

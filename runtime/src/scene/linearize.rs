@@ -25,8 +25,11 @@
 //! ([`rotation_jacobian`]), exact at any quaternion the RK4 stages reach, unit or not.
 //! [`crate::ode::floating_rk4_step_jacobians`] takes these to the tangent space.
 //!
-//! Covered ([`linearizable`]): no external wrenches, no flexible joints, and on a free-floating
-//! base no rotor inertia.
+//! With Spong's flexible joints, `x = [q, q̇, θ, θ̇]`: the links under the springs, the motors
+//! under the drive (`flexible_jacobians`).
+//!
+//! Covered ([`linearizable`]): no external wrenches, and on a free-floating base no rotor
+//! inertia.
 //!
 //! [`floating_kinematics`]: super::floating_kinematics
 //! [`rotation_jacobian`]: crate::ode::quaternion::rotation_jacobian
@@ -35,7 +38,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::floating::floating_kinematics_jacobian;
-use super::{deriv_input, drive_torques, Drive, SceneDynamics, SceneEffects};
+use super::{deriv_input, drive_torques, Drive, Flexible, SceneDynamics, SceneEffects};
 use crate::ldlt::{factor_in_place, solve_in_place};
 use crate::ode::quaternion::rotation_jacobian;
 use crate::ode::ControlledSystem;
@@ -77,8 +80,6 @@ pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
         Err("rotor inertia on a free-floating base")
     } else if !fx.wrenches.is_empty() {
         Err("external wrenches")
-    } else if fx.flexible.is_some() {
-        Err("flexible joints")
     } else {
         Ok(())
     }
@@ -121,15 +122,30 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     }
     let (rhs_work, work) = work.split_at_mut(fx.work_len());
     deriv_input(dynamics, fx, t, x, u, dx, rhs_work);
-    let (q, v) = x.split_at(nq);
-    let (qj, vj) = (&q[nq - n..], &v[nv - n..]);
+    let (q, rest) = x.split_at(nq);
+    let (v, motors) = rest.split_at(nv);
+    // The coordinates the drive acts on: the joints', or the motors' with flexible joints.
+    let (dq_drive, dv_drive) = match fx.flexible {
+        None => (&q[nq - n..], &v[nv - n..]),
+        Some(_) => motors.split_at(n),
+    };
     let [tq, tv, mm, dq, dv, minv] = matrices(work, n, nv);
     let (tau, rest) = rhs_work.split_at_mut(n);
-    drive_torques(dynamics, fx, t, qj, vj, &[], tau, &mut mm[..n]);
+    drive_torques(dynamics, fx, t, dq_drive, dv_drive, &[], tau, &mut mm[..n]);
     for (ti, ui) in tau.iter_mut().zip(u) {
         *ti += ui;
     }
-    drive_jacobians(dynamics, fx, t, qj, vj, tq, tv, mm);
+    drive_jacobians(dynamics, fx, t, dq_drive, dv_drive, tq, tv, mm);
+    if let Some(f) = fx.flexible {
+        // The links move under the springs' torques.
+        let (th, thd) = motors.split_at(n);
+        let springs = &mut rest[..n];
+        for i in 0..n {
+            springs[i] = f.stiffness[i] * (th[i] - q[i]) + f.damping[i] * (thd[i] - v[i]);
+        }
+        dynamics.forward_derivatives(q, v, springs, dq, dv, minv);
+        return flexible_jacobians(&f, [tq, tv], [dq, dv, minv], fxm, fum);
+    }
     match fx.armature {
         None => dynamics.forward_derivatives(q, v, tau, dq, dv, minv),
         Some(a) => {
@@ -174,6 +190,51 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
         for (r, dr) in dg.iter().enumerate() {
             fxm[(nq + r) * d + 3..(nq + r) * d + 7].copy_from_slice(dr);
         }
+    }
+}
+
+/// `F` (`4N × 4N`) and `G` (`4N × N`) of Spong's flexible joints, `x = [q, q̇, θ, θ̇]`, the
+/// links under the springs `τ_s = K (θ − q) + D (θ̇ − q̇)` and the motors under the drive
+/// `τ_m(θ, θ̇) + u` (`θ̈ = B⁻¹ (τ_m − τ_s)`), from the drive's `∂τ_m/∂θ`, `∂τ_m/∂θ̇`
+/// (`drive`) and `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at `τ_s` (`links`), `K`, `D`, `B`
+/// diagonal:
+///
+/// ```text
+/// F = [ 0                  I                  0                    0                   ]
+///     [ ∂q̈/∂q − M⁻¹K       ∂q̈/∂q̇ − M⁻¹D       M⁻¹K                 M⁻¹D                ]
+///     [ 0                  0                  0                    I                   ]
+///     [ B⁻¹K               B⁻¹D               B⁻¹(∂τ_m/∂θ − K)     B⁻¹(∂τ_m/∂θ̇ − D)    ]
+/// G = [0; 0; 0; B⁻¹]
+/// ```
+fn flexible_jacobians(
+    f: &Flexible<'_>,
+    [tq, tv]: [&mut [f64]; 2],
+    [dq, dv, minv]: [&mut [f64]; 3],
+    fxm: &mut [f64],
+    fum: &mut [f64],
+) {
+    let n = f.stiffness.len();
+    let d = 4 * n;
+    let (k, c, b) = (f.stiffness, f.damping, f.reflected);
+    fxm.fill(0.0);
+    fum.fill(0.0);
+    for i in 0..n {
+        fxm[i * d + n + i] = 1.0;
+        fxm[(2 * n + i) * d + 3 * n + i] = 1.0;
+        let (link, motor) = ((n + i) * d, (3 * n + i) * d);
+        for j in 0..n {
+            let m = minv[i * n + j];
+            fxm[link + j] = dq[i * n + j] - m * k[j];
+            fxm[link + n + j] = dv[i * n + j] - m * c[j];
+            fxm[link + 2 * n + j] = m * k[j];
+            fxm[link + 3 * n + j] = m * c[j];
+            let (kd, cd) = if i == j { (k[i], c[i]) } else { (0.0, 0.0) };
+            fxm[motor + j] = kd / b[i];
+            fxm[motor + n + j] = cd / b[i];
+            fxm[motor + 2 * n + j] = (tq[i * n + j] - kd) / b[i];
+            fxm[motor + 3 * n + j] = (tv[i * n + j] - cd) / b[i];
+        }
+        fum[(3 * n + i) * n + i] = 1.0 / b[i];
     }
 }
 
