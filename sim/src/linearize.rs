@@ -43,7 +43,7 @@ pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let profiles = scene.wrench_profiles();
     let effects = scene.effects(&profiles);
     if let Err(what) = linearizable(&effects) {
-        bail!("step Jacobians cover scenes without external wrenches (nor rotor inertia on a free-floating base); this scene has {what}");
+        bail!("step Jacobians cover scenes without external wrenches; this scene has {what}");
     }
     if effects.floating && scene.model.has_mimics() {
         bail!("step Jacobians on a free-floating base cover models without mimic joints; this model has mimic joints");

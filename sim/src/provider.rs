@@ -279,8 +279,8 @@ fn copy_rows(src: &[Vec<f64>], dst: &mut [f64]) {
 }
 
 /// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`), no
-/// external wrench (what [`kanegen_runtime::scene::linearize`] covers): forward dynamics on a
-/// fixed or free-floating base (mimic joints on a fixed one), inverse dynamics on a fixed base.
+/// external wrench (what [`kanegen_runtime::scene::linearize`] covers), on a fixed or
+/// free-floating base (mimic joints on a fixed one).
 impl SceneDerivatives for RunTimeDynamics {
     fn forward_derivatives(
         &mut self,
@@ -332,6 +332,22 @@ impl SceneDerivatives for RunTimeDynamics {
         dv: &mut [f64],
     ) {
         let g = self.loads.gravity.as_ref();
+        if let (None, Some(base)) = (&self.coupling, &self.base) {
+            let st = floating_state(q, v);
+            let acc: [f64; 6] = core::array::from_fn(|k| qdd[k]);
+            let (a, b) = derivatives::rnea::floating_derivatives(
+                &self.params,
+                base,
+                &st,
+                &q[7..],
+                &v[6..],
+                &acc,
+                &qdd[6..],
+                g,
+            );
+            copy_rows(&a, dq);
+            return copy_rows(&b, dv);
+        }
         let (qf, vf) = self.full_joints(q, v);
         let qddf = self.full_rates(qdd);
         let full = derivatives::rnea::derivatives(&self.params, &qf, &vf, &qddf, g);

@@ -28,8 +28,7 @@
 //! With Spong's flexible joints, `x = [q, q̇, θ, θ̇]`: the links under the springs, the motors
 //! under the drive (`flexible_jacobians`).
 //!
-//! Covered ([`linearizable`]): no external wrenches, and on a free-floating base no rotor
-//! inertia.
+//! Covered ([`linearizable`]): no external wrenches.
 //!
 //! [`floating_kinematics`]: super::floating_kinematics
 //! [`rotation_jacobian`]: crate::ode::quaternion::rotation_jacobian
@@ -76,21 +75,19 @@ pub trait SceneDerivatives: SceneDynamics {
 /// # Errors
 /// The first effect not covered, in words.
 pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
-    if fx.floating && fx.armature.is_some() {
-        Err("rotor inertia on a free-floating base")
-    } else if !fx.wrenches.is_empty() {
+    if !fx.wrenches.is_empty() {
         Err("external wrenches")
     } else {
         Ok(())
     }
 }
 
-/// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side, three
-/// `N × N` and three `nv × nv` matrices and a joint vector.
+/// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side, two
+/// `N × N` and four `nv × nv` matrices and a vector of speeds.
 #[must_use]
 pub const fn jacobian_work_len(fx: &SceneEffects<'_>) -> usize {
     let (n, nv) = (fx.dof, fx.sizes().1);
-    fx.work_len() + 3 * n * n + 3 * nv * nv + n
+    fx.work_len() + 2 * n * n + 4 * nv * nv + nv
 }
 
 /// `f(t, x, u)` into `dx` (as [`deriv_input`]), `∂f/∂x` into `fxm` (`d × d`, row-major) and
@@ -149,12 +146,11 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     match fx.armature {
         None => dynamics.forward_derivatives(q, v, tau, dq, dv, minv),
         Some(a) => {
-            // A fixed base ([`linearizable`]); the scene's own work holds `nv² + 2 nv` more
-            // with an armature ([`work_len`]).
-            let (d_inv, col) = rest[..2 * n].split_at_mut(n);
-            let qdd = &dx[n..];
+            // The scene's own work holds `nv² + 2 nv` more with an armature ([`work_len`]).
+            let (d_inv, col) = rest[..2 * nv].split_at_mut(nv);
+            let qdd = &dx[nq..nq + nv];
             let f = [&mut *dq, &mut *dv, &mut *minv];
-            armature_derivatives(dynamics, q, v, qdd, a, f, &mut mm[..n * n], d_inv, col);
+            armature_derivatives(dynamics, q, v, qdd, a, f, &mut mm[..nv * nv], d_inv, col);
         }
     }
     fxm.fill(0.0);
@@ -238,13 +234,13 @@ fn flexible_jacobians(
     }
 }
 
-/// `(∂q̈/∂q, ∂q̈/∂q̇, (M + A)⁻¹)` into `f` with the armature `A = diag(a)` on the joint diagonal
-/// (RBDA Sec. 9.1): `(M + A) q̈ = τ − c` differentiated at fixed `τ` is
-/// `(M + A) ∂q̈ = −∂ID/∂x` with `ID(q, q̇, q̈) = M q̈ + c` (no armature) at the scene's `q̈`
-/// (Carpentier & Mansard, RSS 2018, eq. (3), with `M + A` for `M`): the provider's
-/// inverse-dynamics derivatives, then LDLᵀ solves ([`crate::ldlt`]) of `M + A` column by column.
-/// `m` (`N²`), `d_inv` and `col` (`N` each) are work memory; a pivot that is not positive gives
-/// NaN.
+/// `(∂ν̇/∂q, ∂ν̇/∂ν, (M + A)⁻¹)` into `f` (`nv × nv` each) with the armature `A = diag(a)` on
+/// the joint diagonal (RBDA Sec. 9.1; the base of a free-floating one has none):
+/// `(M + A) ν̇ = τ − c` differentiated at fixed `τ` is `(M + A) ∂ν̇ = −∂ID/∂x` with
+/// `ID(q, ν, ν̇) = M ν̇ + c` (no armature) at the scene's `ν̇` (Carpentier & Mansard, RSS 2018,
+/// eq. (3), with `M + A` for `M`): the provider's inverse-dynamics derivatives, then LDLᵀ
+/// solves ([`crate::ldlt`]) of `M + A` column by column. `m` (`nv²`), `d_inv` and `col` (`nv`
+/// each) are work memory; a pivot that is not positive gives NaN.
 #[allow(clippy::too_many_arguments)]
 fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     dynamics: &mut D,
@@ -257,12 +253,13 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     d_inv: &mut [f64],
     col: &mut [f64],
 ) {
-    let n = q.len();
+    let n = qd.len();
     let [dq, dv, minv] = f;
     dynamics.inverse_derivatives(q, qd, qdd, dq, dv);
     dynamics.mass_matrix(q, m);
+    let b = n - a.len();
     for (i, ai) in a.iter().enumerate() {
-        m[i * n + i] += ai;
+        m[(b + i) * n + b + i] += ai;
     }
     if factor_in_place(m, n, d_inv).is_err() || !d_inv.iter().all(|d| *d > 0.0 && d.is_finite()) {
         for x in [dq, dv, minv] {
@@ -280,7 +277,7 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
                     sign * x[i * n + j]
                 };
             }
-            // Lengths hold: `m` is `N²`, `d_inv` and `col` `N`.
+            // Lengths hold: `m` is `nv²`, `d_inv` and `col` `nv`.
             let _ = solve_in_place(m, n, d_inv, col);
             for i in 0..n {
                 x[i * n + j] = col[i];
@@ -289,11 +286,11 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     }
 }
 
-/// At the start of `work`: two `N × N` matrices, one of `N² + N`, three `nv × nv`.
+/// At the start of `work`: two `N × N` matrices, one of `nv² + nv`, three `nv × nv`.
 fn matrices(work: &mut [f64], n: usize, nv: usize) -> [&mut [f64]; 6] {
     let (a, w) = work.split_at_mut(n * n);
     let (b, w) = w.split_at_mut(n * n);
-    let (c, w) = w.split_at_mut(n * n + n);
+    let (c, w) = w.split_at_mut(nv * nv + nv);
     let (d, w) = w.split_at_mut(nv * nv);
     let (e, w) = w.split_at_mut(nv * nv);
     [a, b, c, d, e, &mut w[..nv * nv]]
@@ -326,6 +323,7 @@ fn drive_jacobians<D: SceneDerivatives + ?Sized>(
         Drive::ComputedTorque { kp, kd, .. } => {
             // τ = ID(q, q̇, q̈_cmd), q̈_cmd = q̈_d + k_d (q̇_d − q̇) + k_p (q_d − q).
             let (m, cmd) = mm.split_at_mut(n * n);
+            let cmd = &mut cmd[..n];
             super::drives::commanded_acceleration(&fx.drive, t, q, qd, cmd);
             dynamics.inverse_derivatives(q, qd, cmd, tq, tv);
             dynamics.mass_matrix(q, m);
