@@ -9,6 +9,9 @@
 use nalgebra::{SMatrix, SVector};
 use std::time::Instant;
 
+#[path = "support/ilqr.rs"]
+mod ilqr;
+
 kanegen::scene!(Ur5, "scenes/ur5_torque_input.toml");
 
 const D: usize = Ur5::DIM;
@@ -17,9 +20,7 @@ const N: usize = Ur5::N;
 const K: usize = 60;
 
 type X = SVector<f64, D>;
-type U = SVector<f64, N>;
 type A = SMatrix<f64, D, D>;
-type B = SMatrix<f64, D, N>;
 
 /// The goal: these joint angles, at rest.
 fn goal() -> X {
@@ -27,14 +28,7 @@ fn goal() -> X {
     X::from_fn(|i, _| if i < N { q[i] } else { 0.0 })
 }
 
-/// Running and terminal weights: `½ (x − x_g)ᵀ Q (x − x_g) + ½ uᵀ R u`, `½ (x − x_g)ᵀ Q_f (…)`.
-struct Weights {
-    q: A,
-    r: SMatrix<f64, N, N>,
-    qf: A,
-}
-
-fn weights() -> Weights {
+fn weights() -> ilqr::Weights<D, N> {
     let diag = |p: f64, v: f64| {
         A::from_fn(|i, j| {
             if i != j {
@@ -46,133 +40,46 @@ fn weights() -> Weights {
             }
         })
     };
-    Weights {
+    ilqr::Weights {
         q: diag(1.0, 0.01),
         r: SMatrix::<f64, N, N>::identity() * 1e-4,
         qf: diag(2000.0, 50.0),
     }
 }
 
-/// A trajectory: states `x_0 … x_K`, torques `u_0 … u_{K−1}`, the step Jacobians at each knot.
-struct Trajectory {
-    x: Vec<X>,
-    u: Vec<U>,
-    a: Vec<A>,
-    b: Vec<B>,
-    cost: f64,
-}
+/// The UR5's steps: `[q, q̇]` additive.
+struct Arm;
 
-/// Rolls out `u_k = ū_k + α k_k + K_k (x_k − x̄_k)` from the initial state with the step
-/// Jacobians at every knot (`gains` empty: the torques `ū` as they are).
-fn rollout(
-    w: &Weights,
-    nominal: &Trajectory,
-    gains: &[(U, SMatrix<f64, N, D>)],
-    alpha: f64,
-) -> Trajectory {
-    let g = goal();
-    let mut x = X::from_column_slice(&Ur5::initial_state().to_array());
-    let mut t = Trajectory {
-        x: vec![x],
-        u: Vec::with_capacity(K),
-        a: Vec::with_capacity(K),
-        b: Vec::with_capacity(K),
-        cost: 0.0,
-    };
-    for k in 0..K {
-        let mut u = nominal.u[k];
-        if let Some((kf, kb)) = gains.get(k) {
-            u += alpha * kf + kb * (x - nominal.x[k]);
-        }
-        let e = x - g;
-        t.cost += 0.5 * (e.dot(&(w.q * e)) + u.dot(&(w.r * u)));
-        let s = kanegen_state(&x);
-        let (next, a, b) = Ur5::step_jacobians(k as f64 * Ur5::STEP, &s, &u.into(), Ur5::STEP)
+impl ilqr::Problem<D, N> for Arm {
+    type X = X;
+
+    fn initial(&self) -> X {
+        X::from_column_slice(&Ur5::initial_state().to_array())
+    }
+
+    fn step(&self, k: usize, x: &X, u: &SVector<f64, N>) -> (X, A, SMatrix<f64, D, N>) {
+        let s = Ur5State::from_array(&core::array::from_fn(|i| x[i]));
+        let (next, a, b) = Ur5::step_jacobians(k as f64 * Ur5::STEP, &s, &(*u).into(), Ur5::STEP)
             .expect("a finite step");
-        x = X::from_column_slice(&next.to_array());
-        t.u.push(u);
-        t.a.push(A::from_fn(|i, j| a[i][j]));
-        t.b.push(B::from_fn(|i, j| b[i][j]));
-        t.x.push(x);
+        (
+            X::from_column_slice(&next.to_array()),
+            A::from_fn(|i, j| a[i][j]),
+            SMatrix::from_fn(|i, j| b[i][j]),
+        )
     }
-    let e = x - g;
-    t.cost += 0.5 * e.dot(&(w.qf * e));
-    t
-}
 
-fn kanegen_state(x: &X) -> Ur5State {
-    Ur5State::from_array(&core::array::from_fn(|i| x[i]))
-}
-
-/// The backward pass (Riccati recursion on the local quadratic model, Levenberg–Marquardt
-/// regularization `μ` on `Q_uu`): the feedforward and feedback gains of every knot.
-fn backward(w: &Weights, t: &Trajectory, mu: f64) -> Option<Vec<(U, SMatrix<f64, N, D>)>> {
-    let g = goal();
-    let mut vx = w.qf * (t.x[K] - g);
-    let mut vxx = w.qf;
-    let mut gains = vec![(U::zeros(), SMatrix::<f64, N, D>::zeros()); K];
-    for k in (0..K).rev() {
-        let (a, b, u) = (&t.a[k], &t.b[k], &t.u[k]);
-        let qx = w.q * (t.x[k] - g) + a.transpose() * vx;
-        let qu = w.r * u + b.transpose() * vx;
-        let qxx = w.q + a.transpose() * vxx * a;
-        let quu = w.r + b.transpose() * vxx * b + SMatrix::<f64, N, N>::identity() * mu;
-        let qux = b.transpose() * vxx * a;
-        let chol = quu.cholesky()?;
-        let kf = -chol.solve(&qu);
-        let kb = -chol.solve(&qux);
-        vx = qx + kb.transpose() * quu * kf + kb.transpose() * qu + qux.transpose() * kf;
-        vxx = qxx + kb.transpose() * quu * kb + kb.transpose() * qux + qux.transpose() * kb;
-        vxx = 0.5 * (vxx + vxx.transpose());
-        gains[k] = (kf, kb);
+    fn difference(&self, x: &X, y: &X) -> X {
+        y - x
     }
-    Some(gains)
+
+    fn error(&self, x: &X) -> X {
+        x - goal()
+    }
 }
 
 fn main() {
-    let w = weights();
-    let zero = Trajectory {
-        x: vec![X::zeros(); K + 1],
-        u: vec![U::zeros(); K],
-        a: Vec::new(),
-        b: Vec::new(),
-        cost: 0.0,
-    };
     let start = Instant::now();
-    let mut t = rollout(&w, &zero, &[], 0.0);
-    let mut rollouts = 1;
-    println!("iter  cost          step α   μ");
-    println!("{:>4}  {:<12.6e}", 0, t.cost);
-    let mut mu = 1e-6;
-    for iter in 1..=100 {
-        let Some(gains) = backward(&w, &t, mu) else {
-            mu *= 10.0;
-            continue;
-        };
-        let mut accepted = None;
-        for alpha in [1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125] {
-            let cand = rollout(&w, &t, &gains, alpha);
-            rollouts += 1;
-            if cand.cost < t.cost {
-                accepted = Some((cand, alpha));
-                break;
-            }
-        }
-        let Some((cand, alpha)) = accepted else {
-            mu *= 10.0;
-            if mu > 1e6 {
-                break;
-            }
-            continue;
-        };
-        let gain = (t.cost - cand.cost) / t.cost;
-        t = cand;
-        mu = (mu / 10.0).max(1e-9);
-        println!("{iter:>4}  {:<12.6e}  {alpha:<7}  {mu:.0e}", t.cost);
-        if gain < 1e-7 {
-            break;
-        }
-    }
+    let (t, rollouts) = ilqr::optimize(&Arm, &weights(), K);
     let secs = start.elapsed().as_secs_f64();
     let e = t.x[K] - goal();
     println!(

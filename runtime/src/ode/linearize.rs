@@ -96,17 +96,13 @@ fn check<S: ControlledSystem + ?Sized>(
     Ok((d, m))
 }
 
-/// `out = base + c · F · X` for `F` (`d × d`) and `X` (`d × cols`), all row-major.
+/// `out = base + c · F · X` for `F` (`d × d`) and `X` (`d × cols`), all row-major ([`matmul`],
+/// then the affine part row by row).
 fn affine_product(out: &mut [f64], base: &[f64], c: f64, f: &[f64], x: &[f64], cols: usize) {
     let d = out.len() / cols.max(1);
-    for i in 0..d {
-        for j in 0..cols {
-            let mut s = 0.0;
-            for k in 0..d {
-                s += f[i * d + k] * x[k * cols + j];
-            }
-            out[i * cols + j] = base[i * cols + j] + c * s;
-        }
+    matmul(out, f, x, (d, d, cols));
+    for (o, b) in out.iter_mut().zip(base) {
+        *o = b + c * *o;
     }
 }
 
@@ -244,15 +240,19 @@ pub fn floating_rk4_step_jacobians<S: ControlledSystem + ?Sized>(
     Ok(stats)
 }
 
-/// `out = P Q` for `P` (`r × k`) and `Q` (`k × c`), row-major.
+/// `out = P Q` for `P` (`r × k`) and `Q` (`k × c`), row-major: each row of `out` the sum over
+/// `l` of `P[i][l]` times row `l` of `Q` (contiguous rows, which the compiler vectorizes), the
+/// zeros of `P` skipped (the right-hand side's Jacobians and the tangent maps are mostly zeros).
+/// Each entry is summed in the order of `l`, as the dot product of row and column would be.
 fn matmul(out: &mut [f64], p: &[f64], q: &[f64], (r, k, c): (usize, usize, usize)) {
-    for i in 0..r {
-        for j in 0..c {
-            let mut s = 0.0;
-            for l in 0..k {
-                s += p[i * k + l] * q[l * c + j];
+    for (prow, orow) in p.chunks_exact(k).zip(out.chunks_exact_mut(c)).take(r) {
+        orow.fill(0.0);
+        for (pil, qrow) in prow.iter().zip(q.chunks_exact(c)) {
+            if *pil != 0.0 {
+                for (o, qv) in orow.iter_mut().zip(qrow) {
+                    *o += pil * qv;
+                }
             }
-            out[i * c + j] = s;
         }
     }
 }

@@ -164,6 +164,27 @@ pub fn floating_tangent_out(r: &[f64], m: &mut [f64]) {
     }
 }
 
+/// `y ⊖ x` of two free-floating states `[p₀, quat, q, v_b, ω_b, q̇]` (`d` numbers each) in the
+/// tangent space at `x` (`d − 1` numbers into `out`), the coordinates in which
+/// [`floating_rk4_step_jacobians`](super::floating_rk4_step_jacobians) gives `A` and `B`:
+/// `[R(x)ᵀ (p_y − p_x); 2 vec(quat_x* ⊗ quat_y); the rest subtracted]` for unit quaternions.
+/// Pinocchio's `difference(x, y)` to first order in `y − x` (its derivative in `y` at `y = x`
+/// is [`floating_tangent_out`]'s), what a controller's feedback and cost take of a state.
+pub fn floating_difference(x: &[f64], y: &[f64], out: &mut [f64]) {
+    let (u, w) = ([x[3], x[4], x[5]], x[6]);
+    let (uy, wy) = ([y[3], y[4], y[5]], y[6]);
+    let r = quat_to_matrix(&[u[0], u[1], u[2], w]);
+    // vec(quat_x* ⊗ quat_y) = w u_y − w_y u − u × u_y.
+    let c = cross(&u, &uy);
+    for i in 0..3 {
+        out[i] = (0..3).map(|j| r[j][i] * (y[j] - x[j])).sum();
+        out[3 + i] = 2.0 * (w * uy[i] - wy * u[i] - c[i]);
+    }
+    for i in 6..out.len().min(x.len() - 1).min(y.len() - 1) {
+        out[i] = y[i + 1] - x[i + 1];
+    }
+}
+
 /// `a × b`.
 fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [
@@ -242,6 +263,38 @@ mod tests {
                 let s: f64 = (0..d).map(|k| tout[i * d + k] * tin[k * (d - 1) + j]).sum();
                 let want = f64::from(u8::from(i == j));
                 assert!((s - want).abs() < 1e-15, "{i} {j}: {s}");
+            }
+        }
+    }
+
+    /// `floating_difference(x, ·)` has the derivative `floating_tangent_out(x)` at `x`, and
+    /// `floating_difference(x, x) = 0`.
+    #[test]
+    fn difference_is_the_tangent_chart() {
+        const D: usize = 15;
+        let mut x: [f64; D] = core::array::from_fn(|i| 0.2 * i as f64 - 0.7);
+        x[3..7].copy_from_slice(&[0.3, 0.1, -0.2, 0.9]);
+        normalize_quaternion(&mut x);
+        let mut zero = [1.0; D - 1];
+        floating_difference(&x, &x, &mut zero);
+        assert!(zero.iter().all(|z| z.abs() < 1e-16), "{zero:?}");
+        let mut m = [0.0; (D - 1) * D];
+        floating_tangent_out(&x, &mut m);
+        let e = 1e-6;
+        for c in 0..D {
+            let (mut p, mut n) = (x, x);
+            p[c] += e;
+            n[c] -= e;
+            let (mut dp, mut dn) = ([0.0; D - 1], [0.0; D - 1]);
+            floating_difference(&x, &p, &mut dp);
+            floating_difference(&x, &n, &mut dn);
+            for r in 0..D - 1 {
+                let d = (dp[r] - dn[r]) / (2.0 * e);
+                assert!(
+                    (d - m[r * D + c]).abs() < 1e-9,
+                    "{r} {c}: {d} {}",
+                    m[r * D + c]
+                );
             }
         }
     }
