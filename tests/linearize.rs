@@ -18,8 +18,10 @@
 //! `scenes/ssrms_drives.toml` (rotor inertia, stiff PD, viscous and Coulomb friction, RK4),
 //! `tests/data/scenes/linearize_flexible.toml` (Spong's flexible joints under gravity, PD and
 //! friction on the motors, RK4) and, in the tangent space, `tests/data/scenes/linearize_floating.toml`
-//! and `tests/data/scenes/linearize_floating_rotor.toml` (a free-floating base under gravity,
-//! without and with rotor inertia, module [`tangent`]).
+//! `tests/data/scenes/linearize_floating_rotor.toml` and
+//! `tests/data/scenes/linearize_floating_midpoint.toml` (a free-floating base under gravity,
+//! RK4 without and with rotor inertia, and the Lie-group implicit midpoint rule; module
+//! [`tangent`]).
 
 use kanegen::sim::linearize::{scheme, step_jacobians};
 use kanegen::sim::scene::Scene;
@@ -231,6 +233,10 @@ kanegen::scene!(Floating, "tests/data/scenes/linearize_floating.toml");
 kanegen::scene!(
     FloatingRotor,
     "tests/data/scenes/linearize_floating_rotor.toml"
+);
+kanegen::scene!(
+    FloatingMidpoint,
+    "tests/data/scenes/linearize_floating_midpoint.toml"
 );
 
 /// A free-floating base: `A` and `B` in the tangent space of Pinocchio's `integrate` (the pose's
@@ -447,6 +453,12 @@ floating_tests!(
     "tests/data/scenes/linearize_floating.toml"
 );
 floating_tests!(
+    floating_midpoint,
+    FloatingMidpoint,
+    FloatingMidpointState,
+    "tests/data/scenes/linearize_floating_midpoint.toml"
+);
+floating_tests!(
     floating_rotor,
     FloatingRotor,
     FloatingRotorState,
@@ -457,10 +469,6 @@ floating_tests!(
 #[test]
 fn uncovered_scenes_are_refused_by_name() {
     for (file, words) in [
-        (
-            "tests/data/scenes/floating_midpoint.toml",
-            "implicit midpoint rule",
-        ),
         ("scenes/ssrms_effects.toml", "external wrenches"),
         ("scenes/ssrms_flexible.toml", "rosenbrock (Rodas4)"),
     ] {

@@ -26,13 +26,6 @@ pub fn availability(
     if scene.simulation.integrator == Integrator::Rosenbrock {
         return Err("its step is a Rodas4 step".into());
     }
-    if effects.floating && scene.simulation.integrator == Integrator::Midpoint {
-        return Err(
-            "its step is the implicit midpoint rule on a free-floating base (step Jacobians there \
-             are RK4's)"
-                .into(),
-        );
-    }
     if effects.floating && scene.model.has_mimics() {
         return Err("its free-floating model has mimic joints".into());
     }
@@ -161,13 +154,20 @@ pub fn step_jacobians(
         ::core::array::from_fn(|i| ::core::array::from_fn(|j| a[i * #tl + j])),
         ::core::array::from_fn(|i| ::core::array::from_fn(|j| b[i * #nl + j])),
     )});
-    let (call, scratch, scheme) = if floating {
+    let midpoint = scene.simulation.integrator == Integrator::Midpoint;
+    let (call, scratch, scheme) = if floating && midpoint {
+        (
+            quote!(#ode::floating_midpoint_step_jacobians),
+            quote!(#ode::ArrayScratch::<{ #ode::linearize::floating_midpoint_scratch_len(#dl, #nl) }, #dl>::new()),
+            "implicit midpoint",
+        )
+    } else if floating {
         (
             quote!(#ode::floating_rk4_step_jacobians),
             quote!(#ode::ArrayScratch::<{ #ode::linearize::floating_rk4_scratch_len(#dl, #nl) }>::new()),
             "RK4",
         )
-    } else if scene.simulation.integrator == Integrator::Midpoint {
+    } else if midpoint {
         (
             quote!(#ode::midpoint_step_jacobians),
             quote!(#ode::ArrayScratch::<{ #ode::linearize::midpoint_scratch_len(#dl, #nl) }, #dl>::new()),
@@ -183,7 +183,8 @@ pub fn step_jacobians(
     let tangent_doc = if floating {
         ", the base's pose in the tangent space of Pinocchio's `integrate` (its 7 numbers as 6 \
          directions `[δp; δθ]` in base coordinates: `A` and `B` have `DIM − 1` rows, `A` as many \
-         columns; `kanegen::runtime::ode::floating_rk4_step_jacobians`)"
+         columns; `kanegen::runtime::ode::floating_rk4_step_jacobians` and \
+         `floating_midpoint_step_jacobians`)"
     } else {
         ""
     };

@@ -8,7 +8,8 @@ use crate::scene::Integrator;
 use crate::system::SceneSystem;
 use anyhow::{bail, Result};
 use kanegen_runtime::ode::{
-    floating_rk4_step_jacobians, midpoint_step_jacobians, rk4_step_jacobians, VecScratch,
+    floating_midpoint_step_jacobians, floating_rk4_step_jacobians, midpoint_step_jacobians,
+    rk4_step_jacobians, VecScratch,
 };
 use kanegen_runtime::scene::linearize::jacobian_work_len;
 use kanegen_runtime::scene::{linearizable, SceneControl};
@@ -33,10 +34,10 @@ pub struct StepJacobians {
 }
 
 /// The scheme whose step a scene's `step` takes and whose Jacobians are exact: RK4 for RK4 and
-/// dopri5 scenes, the implicit midpoint rule for midpoint scenes on a fixed base.
+/// dopri5 scenes, the implicit midpoint rule for midpoint scenes.
 ///
 /// # Errors
-/// Rodas4 (rosenbrock) scenes, midpoint scenes and mimic joints on a free-floating base, and
+/// Rodas4 (rosenbrock) scenes, mimic joints on a free-floating base, and
 /// effects the Jacobians do not cover ([`linearizable`]), named.
 pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let scene = sys.scene();
@@ -50,10 +51,6 @@ pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     }
     match scene.simulation.integrator {
         Integrator::Rk4 | Integrator::Dopri5 => Ok("rk4"),
-        Integrator::Midpoint if effects.floating => bail!(
-            "step Jacobians on a free-floating base are those of an RK4 step (rk4 and dopri5 \
-             scenes); this scene integrates with the implicit midpoint rule"
-        ),
         Integrator::Midpoint => Ok("midpoint"),
         Integrator::Rosenbrock => bail!(
             "step Jacobians are those of an RK4 step (rk4 and dopri5 scenes) or of an implicit \
@@ -96,7 +93,18 @@ pub fn step_jacobians(
     };
     let (mut state, mut a, mut b) = (x.to_vec(), vec![0.0; td * td], vec![0.0; td * n]);
     let mut scratch = VecScratch::default();
-    let stepped = if effects.floating {
+    let stepped = if effects.floating && scheme == "midpoint" {
+        floating_midpoint_step_jacobians(
+            &mut control,
+            t,
+            h,
+            &mut state,
+            u,
+            &mut a,
+            &mut b,
+            &mut scratch,
+        )
+    } else if effects.floating {
         floating_rk4_step_jacobians(
             &mut control,
             t,

@@ -33,7 +33,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::lu::{lu_factor, lu_solve};
-use super::quaternion::{floating_tangent_in, floating_tangent_out, normalize_quaternion};
+use super::quaternion::{
+    exp_map_jacobian, floating_tangent_in, floating_tangent_out, left_product_matrix,
+    normalize_quaternion, right_product_matrix,
+};
 use super::{midpoint, non_finite, Scratch, Stats, Stop, System};
 
 /// A first-order system with inputs, `ẋ = f(t, x, u)`, and its Jacobians.
@@ -202,8 +205,8 @@ pub const fn floating_rk4_scratch_len(d: usize, m: usize) -> usize {
 ///
 /// # Errors
 /// [`Stop::NonFinite`] at `t + h` when the new state is not finite (`x` unchanged),
-/// [`Stop::Invalid`] for a state shorter than 13, lengths that do not match or too little
-/// scratch.
+/// [`Stop::Invalid`] for a state that is not free-floating, lengths that do not match or too
+/// little scratch.
 #[allow(clippy::too_many_arguments)]
 pub fn floating_rk4_step_jacobians<S: ControlledSystem + ?Sized>(
     sys: &mut S,
@@ -215,14 +218,7 @@ pub fn floating_rk4_step_jacobians<S: ControlledSystem + ?Sized>(
     b: &mut [f64],
     scratch: &mut (impl Scratch + ?Sized),
 ) -> Result<Stats, Stop> {
-    let (d, m) = (sys.dim(), sys.inputs());
-    let tn = d.saturating_sub(1);
-    if d < 13 || x.len() != d || u.len() != m || a.len() != tn * tn || b.len() != tn * m {
-        return Err(Stop::Invalid {
-            t,
-            what: "a free-floating state of at least 13 numbers, with matching input and Jacobian lengths",
-        });
-    }
+    let (d, m, tn) = check_floating(sys, t, x, u, a, b)?;
     let (work, _) = super::take(scratch, t, floating_rk4_scratch_len(d, m), 0)?;
     let (step_work, work) = work.split_at_mut(rk4_scratch_len(d, m));
     let (a4, work) = work.split_at_mut(d * d);
@@ -238,6 +234,28 @@ pub fn floating_rk4_step_jacobians<S: ControlledSystem + ?Sized>(
     matmul(a, t_out, &prod[..d * tn], (tn, d, tn));
     matmul(b, t_out, b4, (tn, d, m));
     Ok(stats)
+}
+
+/// `Ok((d, m, d − 1))` when the system's state is free-floating (`d = 13 + 2N` numbers) and `x`,
+/// `u`, `a`, `b` have the lengths of it, its `m` inputs and its tangent space.
+fn check_floating<S: ControlledSystem + ?Sized>(
+    sys: &S,
+    t: f64,
+    x: &[f64],
+    u: &[f64],
+    a: &[f64],
+    b: &[f64],
+) -> Result<(usize, usize, usize), Stop> {
+    let (d, m) = (sys.dim(), sys.inputs());
+    let tn = d.saturating_sub(1);
+    let lengths = x.len() == d && u.len() == m && a.len() == tn * tn && b.len() == tn * m;
+    if d < 13 || (d - 13) % 2 != 0 || !lengths {
+        return Err(Stop::Invalid {
+            t,
+            what: "a free-floating state of 13 + 2N numbers, with matching input and Jacobian (tangent space) lengths",
+        });
+    }
+    Ok((d, m, tn))
 }
 
 /// `out = P Q` for `P` (`r × k`) and `Q` (`k × c`), row-major: each row of `out` the sum over
@@ -266,10 +284,12 @@ fn accept(t: f64, x: &mut [f64], new: &[f64], stats: Stats) -> Result<Stats, Sto
     Ok(stats)
 }
 
-/// A [`ControlledSystem`] with its input held, as a [`System`] (for the midpoint step).
+/// A [`ControlledSystem`] with its input held, as a [`System`] (for the midpoint step), with
+/// the exponential-map update of a free-floating state when `floating`.
 struct Held<'a, S: ?Sized> {
     sys: &'a mut S,
     u: &'a [f64],
+    floating: bool,
 }
 
 impl<S: ControlledSystem + ?Sized> System for Held<'_, S> {
@@ -279,6 +299,14 @@ impl<S: ControlledSystem + ?Sized> System for Held<'_, S> {
 
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
         self.sys.deriv(t, x, self.u, dx);
+    }
+
+    fn advance(&self, x: &[f64], h: f64, at: &[f64], f: &[f64], out: &mut [f64]) {
+        if self.floating {
+            super::quaternion::advance_floating(x, h, at, f, out);
+        } else {
+            super::quaternion::advance_additive(x, h, f, out);
+        }
     }
 }
 
@@ -311,7 +339,11 @@ pub fn midpoint_step_jacobians<S: ControlledSystem + ?Sized>(
     let (f, g) = work.split_at_mut(d * d);
     x0.copy_from_slice(x);
     let mut step_scratch = Slices(step_work);
-    let mut held = Held { sys: &mut *sys, u };
+    let mut held = Held {
+        sys: &mut *sys,
+        u,
+        floating: false,
+    };
     let stats = midpoint::midpoint_step(&mut held, t, h, x, &mut step_scratch)?;
     // The midpoint the step solved for: x_m = (x + x⁺)/2.
     for i in 0..d {
@@ -349,6 +381,189 @@ pub fn midpoint_step_jacobians<S: ControlledSystem + ?Sized>(
         }
     }
     Ok(stats)
+}
+
+/// The scratch floats of [`floating_midpoint_step_jacobians`] for a free-floating state of `d`
+/// numbers and `m` inputs; [`midpoint_pivots`]`(d)` pivots.
+#[must_use]
+pub const fn floating_midpoint_scratch_len(d: usize, m: usize) -> usize {
+    midpoint::scratch_len(d) + 3 * d + 2 * d * d + 2 * d * m + 5 * d * (d - 1) + d * m
+}
+
+/// One implicit midpoint step of size `h` of a free-floating state `x = [p₀, quat, q, v_b, ω_b,
+/// q̇]` (`d = 13 + 2N` numbers) under the held input `u`, in place (exactly
+/// [`midpoint_step`](super::midpoint_step) of `f(·, ·, u)` with the exponential-map update of
+/// the quaternion, [`advance_floating`](super::quaternion::advance_floating)), with its
+/// Jacobians in the tangent space (`A`: `(d − 1)²`, `B`: `(d − 1) × m`, as
+/// [`floating_rk4_step_jacobians`]). The step is `x_m = Ψ_{h/2}(x, x_m)`,
+/// `x⁺ = Ψ_h(x, x_m)` with `Ψ_c(x, y)` additive `x + c f(y)` but for the quaternion,
+/// `quat ⊗ E(c, ω(y))`; differentiating the solved equation over the quaternion's four numbers,
+/// `(1 − ∂_y Ψ_{h/2}) ∂x_m = ∂_x Ψ_{h/2} ∂x + ∂_u Ψ_{h/2} ∂u` and
+/// `∂x⁺ = ∂_x Ψ_h ∂x + ∂_y Ψ_h ∂x_m + ∂_u Ψ_h ∂u`, where `∂_y Ψ_c` is `c F` on the additive rows
+/// and `∂(quat ⊗ E)/∂E · ∂E/∂ω` on the quaternion's ([`exp_map_jacobian`]), and `∂_x Ψ_c` the
+/// identity but for `∂(quat ⊗ E)/∂quat`; then the tangent maps at `x` and `x⁺`
+/// ([`floating_tangent_in`], [`floating_tangent_out`]). `scratch`: at least
+/// [`floating_midpoint_scratch_len`]`(d, m)` floats and [`midpoint_pivots`]`(d)` pivots.
+///
+/// # Errors
+/// The step's [`Stop`] (`x` unchanged); [`Stop::NonFinite`] when `1 − ∂_y Ψ_{h/2}` is singular
+/// or not finite; [`Stop::Invalid`] for a state that is not free-floating, lengths that do not
+/// match or too little scratch.
+///
+/// [`exp_map_jacobian`]: super::quaternion::exp_map_jacobian
+#[allow(clippy::too_many_arguments, clippy::many_single_char_names)]
+pub fn floating_midpoint_step_jacobians<S: ControlledSystem + ?Sized>(
+    sys: &mut S,
+    t: f64,
+    h: f64,
+    x: &mut [f64],
+    u: &[f64],
+    a: &mut [f64],
+    b: &mut [f64],
+    scratch: &mut (impl Scratch + ?Sized),
+) -> Result<Stats, Stop> {
+    let (d, m, tn) = check_floating(sys, t, x, u, a, b)?;
+    // ω_b, the speeds the quaternion turns with.
+    let w0 = 10 + (d - 13) / 2;
+    let floats = floating_midpoint_scratch_len(d, m);
+    let (work, piv) = super::take(scratch, t, floats, midpoint_pivots(d))?;
+    let (step_work, work) = work.split_at_mut(midpoint::scratch_len(d));
+    let (x0, work) = work.split_at_mut(d);
+    let (xm, work) = work.split_at_mut(d);
+    let (col, work) = work.split_at_mut(d);
+    let (f, work) = work.split_at_mut(d * d);
+    let (k, work) = work.split_at_mut(d * d);
+    let (g, work) = work.split_at_mut(d * m);
+    let (wm, work) = work.split_at_mut(d * m);
+    let (dup, work) = work.split_at_mut(d * m);
+    let (t_in, work) = work.split_at_mut(d * tn);
+    let (t_out, work) = work.split_at_mut(tn * d);
+    let (z, work) = work.split_at_mut(d * tn);
+    let (dxp, work) = work.split_at_mut(d * tn);
+    let psi = &mut work[..d * tn];
+    x0.copy_from_slice(x);
+    floating_tangent_in(x0, t_in);
+    let mut held = Held {
+        sys: &mut *sys,
+        u,
+        floating: true,
+    };
+    let stats = midpoint::midpoint_step(&mut held, t, h, x, &mut Slices(step_work))?;
+    // The midpoint the step solved for: additive (x + x⁺)/2, the quaternion quat ⊗ E(h/2, ω_m).
+    for i in 0..d {
+        xm[i] = 0.5 * (x0[i] + x[i]);
+    }
+    let om = [xm[w0], xm[w0 + 1], xm[w0 + 2]];
+    let quat0 = [x0[3], x0[4], x0[5], x0[6]];
+    let lq = left_product_matrix(&quat0);
+    let (e_half, de_half) = exp_map_jacobian(0.5 * h, &om);
+    let (e_full, de_full) = exp_map_jacobian(h, &om);
+    for r in 0..4 {
+        xm[3 + r] = (0..4).map(|c| lq[r][c] * e_half[c]).sum();
+    }
+    sys.jacobians(t + 0.5 * h, xm, u, col, f, g);
+    // ∂_y Ψ_c on the quaternion rows: ∂(quat ⊗ E)/∂E ∂E/∂ω, at the ω columns.
+    let quat_rows = |de: &[[f64; 3]; 4]| -> [[f64; 3]; 4] {
+        core::array::from_fn(|r| {
+            core::array::from_fn(|j| (0..4).map(|c| lq[r][c] * de[c][j]).sum())
+        })
+    };
+    let (q_half, q_full) = (quat_rows(&de_half), quat_rows(&de_full));
+    // K = 1 − ∂_y Ψ_{h/2}, factored in place.
+    for i in 0..d {
+        for j in 0..d {
+            let dy = if (3..7).contains(&i) {
+                if (w0..w0 + 3).contains(&j) {
+                    q_half[i - 3][j - w0]
+                } else {
+                    0.0
+                }
+            } else {
+                0.5 * h * f[i * d + j]
+            };
+            k[i * d + j] = f64::from(u8::from(i == j)) - dy;
+        }
+    }
+    if !lu_factor(k, piv, d) {
+        x.copy_from_slice(x0);
+        let index = non_finite(k).unwrap_or(0);
+        return Err(Stop::NonFinite { t, index, stats });
+    }
+    // ∂_x Ψ_c T_in: T_in with its quaternion rows turned by ∂(quat ⊗ E)/∂quat.
+    let psi_x = |e: &[f64; 4], out: &mut [f64]| {
+        out.copy_from_slice(t_in);
+        let rq = right_product_matrix(e);
+        for r in 0..4 {
+            for j in 0..tn {
+                out[(3 + r) * tn + j] = (0..4).map(|c| rq[r][c] * t_in[(3 + c) * tn + j]).sum();
+            }
+        }
+    };
+    // Z = ∂x_m/∂δ = K⁻¹ ∂_x Ψ_{h/2} T_in, column by column.
+    psi_x(&e_half, psi);
+    solve_columns(k, piv, psi, z, col, tn);
+    // W = ∂x_m/∂u = K⁻¹ (h/2) G (no input on the quaternion rows).
+    for i in 0..d {
+        for j in 0..m {
+            dup[i * m + j] = if (3..7).contains(&i) {
+                0.0
+            } else {
+                0.5 * h * g[i * m + j]
+            };
+        }
+    }
+    solve_columns(k, piv, dup, wm, col, m);
+    // ∂x⁺ = ∂_x Ψ_h T_in + ∂_y Ψ_h Z, and ∂x⁺/∂u = h G + ∂_y Ψ_h W.
+    psi_x(&e_full, dxp);
+    let phi_y = |i: usize, src: &[f64], cols: usize, jcol: usize| -> f64 {
+        if (3..7).contains(&i) {
+            (0..3)
+                .map(|l| q_full[i - 3][l] * src[(w0 + l) * cols + jcol])
+                .sum()
+        } else {
+            h * (0..d)
+                .map(|l| f[i * d + l] * src[l * cols + jcol])
+                .sum::<f64>()
+        }
+    };
+    for i in 0..d {
+        for j in 0..tn {
+            dxp[i * tn + j] += phi_y(i, z, tn, j);
+        }
+        for j in 0..m {
+            let direct = if (3..7).contains(&i) {
+                0.0
+            } else {
+                h * g[i * m + j]
+            };
+            dup[i * m + j] = direct + phi_y(i, wm, m, j);
+        }
+    }
+    floating_tangent_out(x, t_out);
+    matmul(a, t_out, dxp, (tn, d, tn));
+    matmul(b, t_out, dup, (tn, d, m));
+    Ok(stats)
+}
+
+/// `out = K⁻¹ rhs` column by column (`d × cols`, row-major), `K` LU-factored with `piv`.
+fn solve_columns(
+    k: &[f64],
+    piv: &[usize],
+    rhs: &[f64],
+    out: &mut [f64],
+    col: &mut [f64],
+    cols: usize,
+) {
+    let d = col.len();
+    for j in 0..cols {
+        for i in 0..d {
+            col[i] = rhs[i * cols + j];
+        }
+        lu_solve(k, piv, col, d);
+        for i in 0..d {
+            out[i * cols + j] = col[i];
+        }
+    }
 }
 
 /// Scratch over a borrowed slice (the midpoint step's part of the caller's scratch).
@@ -513,6 +728,7 @@ mod tests {
             let mut held = Held {
                 sys: &mut Pendulum,
                 u: &u,
+                floating: false,
             };
             if plain {
                 let mut s = ArrayScratch::<{ crate::ode::rk4::scratch_len(2) }>::new();

@@ -36,7 +36,8 @@ mod system;
 
 pub use dopri5::{dopri5, Dopri5Options};
 pub use linearize::{
-    floating_rk4_step_jacobians, midpoint_step_jacobians, rk4_step_jacobians, ControlledSystem,
+    floating_midpoint_step_jacobians, floating_rk4_step_jacobians, midpoint_step_jacobians,
+    rk4_step_jacobians, ControlledSystem,
 };
 pub use lu::solve_spd;
 pub use midpoint::{midpoint, midpoint_step};

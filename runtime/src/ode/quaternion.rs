@@ -185,6 +185,70 @@ pub fn floating_difference(x: &[f64], y: &[f64], out: &mut [f64]) {
     }
 }
 
+/// The unit quaternion `E = [sin(|ω| h/2) ω/|ω|; cos(|ω| h/2)]` of [`advance_floating`]'s
+/// exponential map (`quat ⊗ E`), and its derivative `∂E/∂ω` (4 × 3):
+/// `∂E_vec/∂ω = s 1 + (h/2 cos(|ω| h/2) − s)/|ω|² ω ωᵀ`, `∂E_w/∂ω = −(h/2) s ωᵀ` with
+/// `s = sin(|ω| h/2)/|ω|` (below `|ω| h/2 = 1e-8` their Taylor series, as the map's).
+#[must_use]
+pub fn exp_map_jacobian(h: f64, om: &[f64; 3]) -> ([f64; 4], [[f64; 3]; 4]) {
+    let a = Scalar::sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
+    let half = 0.5 * h * a;
+    let small = libm::fabs(half) < 1e-8;
+    let s = if small {
+        0.5 * h * (1.0 - half * half / 6.0)
+    } else {
+        Scalar::sin(half) / a
+    };
+    let c = Scalar::cos(half);
+    let k = if small {
+        -h * h * h / 24.0
+    } else {
+        (0.5 * h * c - s) / (a * a)
+    };
+    let e = [s * om[0], s * om[1], s * om[2], c];
+    let de = core::array::from_fn(|r| {
+        core::array::from_fn(|j| {
+            if r == 3 {
+                -0.5 * h * s * om[j]
+            } else {
+                let diag = if r == j { s } else { 0.0 };
+                diag + k * om[r] * om[j]
+            }
+        })
+    });
+    (e, de)
+}
+
+/// `∂(q ⊗ e)/∂q` (4 × 4) for quaternions `[x, y, z, w]`: `[e_w 1 − [e_v]×, e_v; −e_vᵀ, e_w]`.
+#[must_use]
+pub fn right_product_matrix(e: &[f64; 4]) -> [[f64; 4]; 4] {
+    let (ev, ew) = ([e[0], e[1], e[2]], e[3]);
+    let se = skew(&ev);
+    core::array::from_fn(|r| {
+        core::array::from_fn(|c| match (r, c) {
+            (3, 3) => ew,
+            (3, c) => -ev[c],
+            (r, 3) => ev[r],
+            (r, c) => (if r == c { ew } else { 0.0 }) - se[r][c],
+        })
+    })
+}
+
+/// `∂(q ⊗ e)/∂e` (4 × 4) for quaternions `[x, y, z, w]`: `[q_w 1 + [q_v]×, q_v; −q_vᵀ, q_w]`.
+#[must_use]
+pub fn left_product_matrix(q: &[f64; 4]) -> [[f64; 4]; 4] {
+    let (qv, qw) = ([q[0], q[1], q[2]], q[3]);
+    let sq = skew(&qv);
+    core::array::from_fn(|r| {
+        core::array::from_fn(|c| match (r, c) {
+            (3, 3) => qw,
+            (3, c) => -qv[c],
+            (r, 3) => qv[r],
+            (r, c) => (if r == c { qw } else { 0.0 }) + sq[r][c],
+        })
+    })
+}
+
 /// `a × b`.
 fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
     [
@@ -263,6 +327,47 @@ mod tests {
                 let s: f64 = (0..d).map(|k| tout[i * d + k] * tin[k * (d - 1) + j]).sum();
                 let want = f64::from(u8::from(i == j));
                 assert!((s - want).abs() < 1e-15, "{i} {j}: {s}");
+            }
+        }
+    }
+
+    /// `q ⊗ E(h, ω)` against central differences in `q` and `ω`, by the two product matrices
+    /// and `∂E/∂ω`, at an ordinary and at a tiny `ω` (the series branch).
+    #[test]
+    fn exp_map_jacobians_match_central_differences() {
+        let q = [0.3, -0.2, 0.4, 0.8];
+        let h = 0.05;
+        for om in [[0.7, -1.1, 0.4], [1e-9, -2e-9, 5e-10]] {
+            let (e, de) = exp_map_jacobian(h, &om);
+            let (rq, lq) = (right_product_matrix(&e), left_product_matrix(&q));
+            let prod = |q: [f64; 4], om: [f64; 3]| {
+                let x = [
+                    0.0, 0.0, 0.0, q[0], q[1], q[2], q[3], 0.0, 0.0, 0.0, om[0], om[1], om[2],
+                ];
+                let mut out = [0.0; 13];
+                advance_floating(&x, h, &x, &[0.0; 13], &mut out);
+                [out[3], out[4], out[5], out[6]]
+            };
+            let eps = 1e-6;
+            for c in 0..7 {
+                let (mut qp, mut qm, mut op, mut omm) = (q, q, om, om);
+                if c < 4 {
+                    qp[c] += eps;
+                    qm[c] -= eps;
+                } else {
+                    op[c - 4] += eps;
+                    omm[c - 4] -= eps;
+                }
+                let (fp, fm) = (prod(qp, op), prod(qm, omm));
+                for r in 0..4 {
+                    let d = (fp[r] - fm[r]) / (2.0 * eps);
+                    let exact = if c < 4 {
+                        rq[r][c]
+                    } else {
+                        (0..4).map(|k| lq[r][k] * de[k][c - 4]).sum::<f64>()
+                    };
+                    assert!((d - exact).abs() < 1e-9, "{om:?} {r} {c}: {d} {exact}");
+                }
             }
         }
     }
