@@ -520,6 +520,27 @@ fn cli_linearize_prints_the_step_jacobians() {
         text.contains("A = ∂x⁺/∂x (12 × 12") && text.contains("qd_wrist_roll"),
         "{text}"
     );
+    // A free-floating scene: `A` in the tangent space, rows named by their directions.
+    let file = "tests/data/scenes/linearize_floating.toml";
+    let o = cli(&[file, "--linearize", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let s = Floating::initial_state();
+    let (_, a, _) = Floating::step_jacobians(0.0, &s, &[0.0; Floating::N], Floating::STEP).unwrap();
+    let ca = rows(&v["A"]);
+    assert_eq!(
+        (ca.len(), ca[0].len()),
+        (Floating::DIM - 1, Floating::DIM - 1)
+    );
+    let worst = (0..Floating::DIM - 1)
+        .flat_map(|i| (0..Floating::DIM - 1).map(move |j| (i, j)))
+        .fold(0.0_f64, |m, (i, j)| m.max((ca[i][j] - a[i][j]).abs()));
+    assert!(worst <= 1e-10, "{worst:e}");
+    let names: Vec<String> = serde_json::from_value(v["tangent"].clone()).unwrap();
+    assert_eq!(
+        names[..6],
+        ["dp0_x", "dp0_y", "dp0_z", "dtheta_x", "dtheta_y", "dtheta_z"]
+    );
     let err = cli(&["scenes/ssrms_effects.toml", "--linearize"]);
     let msg = String::from_utf8_lossy(&err.stderr);
     assert!(
