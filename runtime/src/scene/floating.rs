@@ -2,7 +2,7 @@
 //! configuration `[p₀, quat (x y z w), q]`, speeds `[v_b, ω_b, q̇]` in base coordinates).
 
 use crate::ode::quat_to_matrix;
-use crate::ode::quaternion::rotation_jacobian;
+use crate::ode::quaternion::{rotation_jacobian, skew};
 
 /// `dq = [ṗ₀, q̇uat, q̇]` (`7 + N`) from positions `q` (`7 + N`) and speeds `v` (`6 + N`):
 /// `ṗ₀ = R₀ v_b`, `q̇uat = ½ quat ⊗ (ω_b, 0)`, i.e. `u̇ = ½ (w ω + u × ω)`, `ẇ = −½ u · ω`
@@ -46,23 +46,15 @@ pub fn floating_kinematics_jacobian(q: &[f64], v: &[f64], f: &mut [f64]) {
     let (u, w, om) = ([q[3], q[4], q[5]], q[6], [v[3], v[4], v[5]]);
     let r = quat_to_matrix(&quat);
     let dp = rotation_jacobian(&quat, &[v[0], v[1], v[2]], false);
-    let skew = |a: &[f64; 3], i: usize, j: usize| match (i, j) {
-        (0, 1) => -a[2],
-        (0, 2) => a[1],
-        (1, 0) => a[2],
-        (1, 2) => -a[0],
-        (2, 0) => -a[1],
-        (2, 1) => a[0],
-        _ => 0.0,
-    };
+    let (s_om, s_u) = (skew(&om), skew(&u));
     for i in 0..3 {
         let (prow, urow) = (i * d, (3 + i) * d);
         f[prow + 3..prow + 7].copy_from_slice(&dp[i]);
         for j in 0..3 {
             f[prow + nq + j] = r[i][j];
-            f[urow + 3 + j] = -0.5 * skew(&om, i, j);
+            f[urow + 3 + j] = -0.5 * s_om[i][j];
             let diag = if i == j { w } else { 0.0 };
-            f[urow + nq + 3 + j] = 0.5 * (diag + skew(&u, i, j));
+            f[urow + nq + 3 + j] = 0.5 * (diag + s_u[i][j]);
         }
         f[urow + 6] = 0.5 * om[i];
         f[6 * d + 3 + i] = -0.5 * om[i];
