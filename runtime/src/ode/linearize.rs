@@ -371,15 +371,10 @@ pub fn midpoint_step_jacobians<S: ControlledSystem + ?Sized>(
         }
     }
     // B = h K⁻¹ G, column by column.
-    for j in 0..m {
-        for i in 0..d {
-            col[i] = h * g[i * m + j];
-        }
-        lu_solve(f, piv, col, d);
-        for i in 0..d {
-            b[i * m + j] = col[i];
-        }
+    for gi in g.iter_mut() {
+        *gi *= h;
     }
+    solve_columns(f, piv, g, b, col, m);
     Ok(stats)
 }
 
