@@ -13,7 +13,9 @@
 //!
 //! Scenes: `scenes/srms.toml` (dopri5, so its step is RK4; PD drives and damping, fixed base),
 //! `tests/data/scenes/linearize_ct_midpoint.toml` (UR5 under gravity, a computed-torque drive
-//! along a quintic, viscous and Coulomb friction, implicit midpoint) and
+//! along a quintic, viscous and Coulomb friction, a wrench fixed in a body and one fixed in the
+//! base frame, implicit midpoint), `tests/data/scenes/rotor_wrench.toml` (interpreted: rotor
+//! inertia, a tabulated body-frame wrench and a base-frame one, RK4) and
 //! `scenes/ur5_torque_input.toml` (UR5 under gravity, damping, no drive, RK4) and
 //! `scenes/ssrms_drives.toml` (rotor inertia, stiff PD, viscous and Coulomb friction, RK4),
 //! `tests/data/scenes/linearize_flexible.toml` (Spong's flexible joints under gravity, PD and
@@ -23,104 +25,20 @@
 //! RK4 without and with rotor inertia, and the Lie-group implicit midpoint rule; module
 //! [`tangent`]).
 
+use common::linearize::{
+    against_differences, assert_matches_differences, interpreted, interpreted_step, scale,
+    worst_between, Jac,
+};
 use kanegen::sim::linearize::{scheme, step_jacobians};
 use kanegen::sim::scene::Scene;
 use kanegen::sim::system::SceneSystem;
-use std::path::Path;
+
+mod common;
 
 kanegen::scene!(Srms, "scenes/srms.toml");
 kanegen::scene!(CtMidpoint, "tests/data/scenes/linearize_ct_midpoint.toml");
 kanegen::scene!(FreeUr5, "scenes/ur5_torque_input.toml");
 kanegen::scene!(SsrmsDrives, "scenes/ssrms_drives.toml");
-
-/// One step with its Jacobians at `(x, u)`: the new state, `A` (`D × D`) and `B` (`D × N`).
-type Jac<const D: usize, const N: usize> = ([f64; D], [[f64; D]; D], [[f64; N]; D]);
-
-/// The largest entry of `A` and `B` in magnitude.
-fn scale<const D: usize, const N: usize>(j: &Jac<D, N>) -> f64 {
-    let a = j.1.iter().flatten().fold(0.0_f64, |m, v| m.max(v.abs()));
-    j.2.iter().flatten().fold(a, |m, v| m.max(v.abs()))
-}
-
-/// `(worst |J − D(e)|, worst |D(e) − D(2e)|)` of the central differences `D` of the step over
-/// every column of `x` and `u` (`e` relative to each component).
-fn against_differences<const D: usize, const N: usize>(
-    step: impl Fn(&[f64; D], &[f64; N]) -> Jac<D, N>,
-    x: [f64; D],
-    u: [f64; N],
-) -> (f64, f64, f64) {
-    let j = step(&x, &u);
-    let (mut worst, mut own) = (0.0_f64, 0.0_f64);
-    for col in 0..D + N {
-        let diff = |e: f64| -> [f64; D] {
-            let (mut xp, mut xm, mut up, mut um) = (x, x, u, u);
-            let h = if col < D {
-                let h = e * (1.0 + x[col].abs());
-                xp[col] += h;
-                xm[col] -= h;
-                h
-            } else {
-                let h = e * (1.0 + u[col - D].abs());
-                up[col - D] += h;
-                um[col - D] -= h;
-                h
-            };
-            let (p, m) = (step(&xp, &up).0, step(&xm, &um).0);
-            core::array::from_fn(|i| (p[i] - m[i]) / (2.0 * h))
-        };
-        let (d1, d2) = (diff(1e-6), diff(2e-6));
-        for i in 0..D {
-            let exact = if col < D {
-                j.1[i][col]
-            } else {
-                j.2[i][col - D]
-            };
-            worst = worst.max((exact - d1[i]).abs());
-            own = own.max((d1[i] - d2[i]).abs());
-        }
-    }
-    (worst, own, scale(&j))
-}
-
-fn assert_matches_differences(name: &str, (worst, own, scale): (f64, f64, f64)) {
-    eprintln!("{name}: worst |J − D| {worst:.2e}, the differences' own error {own:.2e}, max|J| {scale:.2e}");
-    assert!(
-        worst <= 4.0 * own + 1e-9 * scale,
-        "{name}: {worst:e} > 4 · {own:e} + 1e-9 · {scale:e}"
-    );
-}
-
-/// The interpreted system of a scene file.
-fn interpreted(file: &str) -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join(file)).unwrap()
-}
-
-/// The interpreted Jacobians as fixed-size arrays.
-fn interpreted_step<const D: usize, const N: usize>(
-    scene: &Scene,
-    t: f64,
-    x: &[f64; D],
-    u: &[f64; N],
-    h: f64,
-) -> Jac<D, N> {
-    let mut sys = SceneSystem::new(scene);
-    let j = step_jacobians(&mut sys, t, x, u, h).unwrap();
-    (
-        j.state.try_into().unwrap(),
-        core::array::from_fn(|i| j.a[i].clone().try_into().unwrap()),
-        core::array::from_fn(|i| j.b[i].clone().try_into().unwrap()),
-    )
-}
-
-/// Worst `|J_generated − J_interpreted|` over `A`, `B` and the new state.
-fn worst_between<const D: usize, const N: usize>(g: &Jac<D, N>, i: &Jac<D, N>) -> f64 {
-    let a = g.1.iter().flatten().zip(i.1.iter().flatten());
-    let b = g.2.iter().flatten().zip(i.2.iter().flatten());
-    let x = g.0.iter().zip(i.0.iter());
-    a.chain(b)
-        .chain(x)
-        .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()))
-}
 
 macro_rules! scene_tests {
     ($mod:ident, $ty:ident, $st:ident, $file:literal, $t:expr, $du:expr) => {
@@ -217,6 +135,25 @@ scene_tests!(
     0.0,
     50.0
 );
+
+/// External wrenches on the RK4 path with rotor inertia: `tests/data/scenes/rotor_wrench.toml`
+/// (SSRMS under gravity, a wrench fixed in the base frame and a tabulated one fixed in a body,
+/// Coulomb friction; dopri5, so its step is RK4), interpreted, inside the table's ramp.
+#[test]
+fn wrenches_with_rotor_inertia_match_central_differences() {
+    let scene = interpreted("tests/data/scenes/rotor_wrench.toml");
+    let q = [0.1, 0.3, -0.7, 0.4, 0.1, 0.2, 0.0];
+    let x: [f64; 14] = core::array::from_fn(|i| {
+        if i < 7 {
+            q[i] + 0.05 * ((i as f64) * 0.7).sin()
+        } else {
+            0.03 * ((i as f64) * 1.3).cos()
+        }
+    });
+    let u: [f64; 7] = core::array::from_fn(|i| 20.0 * (1.0 + i as f64));
+    let f = |x: &[f64; 14], u: &[f64; 7]| interpreted_step(&scene, 0.4, x, u, 0.01);
+    assert_matches_differences("rotor_wrench (interpreted)", against_differences(f, x, u));
+}
 
 kanegen::scene!(Flexible, "tests/data/scenes/linearize_flexible.toml");
 
@@ -469,7 +406,11 @@ floating_tests!(
 #[test]
 fn uncovered_scenes_are_refused_by_name() {
     for (file, words) in [
-        ("scenes/ssrms_effects.toml", "external wrenches"),
+        (
+            "tests/data/scenes/floating_wrenches.toml",
+            "external wrenches on a free-floating base",
+        ),
+        ("tests/data/scenes/panda_mimic_pd.toml", "mimic joints"),
         ("scenes/ssrms_flexible.toml", "rosenbrock (Rodas4)"),
     ] {
         let scene = interpreted(file);
@@ -541,10 +482,17 @@ fn cli_linearize_prints_the_step_jacobians() {
         names[..6],
         ["dp0_x", "dp0_y", "dp0_z", "dtheta_x", "dtheta_y", "dtheta_z"]
     );
-    let err = cli(&["scenes/ssrms_effects.toml", "--linearize"]);
+    let err = cli(&["tests/data/scenes/floating_wrenches.toml", "--linearize"]);
     let msg = String::from_utf8_lossy(&err.stderr);
     assert!(
-        !err.status.success() && msg.contains("external wrenches"),
+        !err.status.success() && msg.contains("external wrenches on a free-floating base"),
         "{msg}"
+    );
+    // A fixed-base scene with wrenches in both frames (the SSRMS effects scene).
+    let ok = cli(&["scenes/ssrms_effects.toml", "--linearize"]);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
     );
 }

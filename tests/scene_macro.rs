@@ -427,3 +427,46 @@ fn scene_types_named_like_primitives_and_prelude_items_simulate_what_plain_ones_
     same_trajectory!(crowded::shadowed::CaptureRotor, CaptureRotor);
     same_trajectory!(crowded::shadowed::Flexible, Flexible);
 }
+
+/// Step Jacobians with external wrenches on a fixed base, from the generated derivatives and
+/// the generated Jacobians of the wrenches' bodies: against central differences of the step
+/// (`common::linearize`) and the interpreted Jacobians (which `tests/linearize.rs` checks
+/// against differences too), at a time inside the tabulated wrenches' ramp.
+macro_rules! wrench_jacobians {
+    ($name:ident, $ty:ident, $st:ident, $file:literal) => {
+        #[test]
+        fn $name() {
+            use common::linearize::{
+                against_differences, assert_matches_differences, interpreted, interpreted_step,
+                scale, worst_between,
+            };
+            let t = 0.4;
+            let x0 = $ty::initial_state().to_array();
+            let x = core::array::from_fn(|i| x0[i] + 0.05 * ((i as f64) * 0.7).sin());
+            let u = core::array::from_fn(|i| 20.0 * (1.0 + i as f64));
+            let step = |x: &[f64; $ty::DIM], u: &[f64; $ty::N]| {
+                let (s, a, b) = $ty::step_jacobians(t, &$st::from_array(x), u, $ty::STEP).unwrap();
+                (s.to_array(), a, b)
+            };
+            assert_matches_differences(stringify!($ty), against_differences(step, x, u));
+            let g = step(&x, &u);
+            let i = interpreted_step(&interpreted($file), t, &x, &u, $ty::STEP);
+            let w = worst_between(&g, &i);
+            eprintln!("{}: generated vs interpreted {w:.2e}", stringify!($ty));
+            assert!(w <= 1e-10 * scale(&g).max(1.0), "{w:e}");
+        }
+    };
+}
+
+wrench_jacobians!(
+    wrenches_in_the_body_frame_step_jacobians,
+    GravityWrench,
+    GravityWrenchState,
+    "tests/data/scenes/gravity_wrench.toml"
+);
+wrench_jacobians!(
+    wrenches_with_rotor_inertia_step_jacobians,
+    RotorWrench,
+    RotorWrenchState,
+    "tests/data/scenes/rotor_wrench.toml"
+);

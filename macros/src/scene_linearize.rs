@@ -7,11 +7,12 @@
 //! runs over the run-time algorithms.
 
 use crate::scene_provider::{as_arrays, phase_match, Shape};
+use kanegen_codegen::kanegen_dynamics::LoadFrame;
 use kanegen_codegen::paths;
 use kanegen_runtime::scene::{linearizable, SceneEffects};
 use kanegen_scene::{Integrator, Scene};
 use proc_macro2::{Literal, TokenStream};
-use quote::quote;
+use quote::{format_ident, quote};
 use syn::Ident;
 
 /// Whether `scene!` emits `step_jacobians`, or why not (the sentence of the scene's doc).
@@ -28,6 +29,9 @@ pub fn availability(
     }
     if effects.floating && scene.model.has_mimics() {
         return Err("its free-floating model has mimic joints".into());
+    }
+    if !effects.wrenches.is_empty() && scene.model.has_mimics() {
+        return Err("it has external wrenches on a model with mimic joints".into());
     }
     if !has_derivatives {
         return Err(
@@ -83,6 +87,7 @@ pub fn derivatives(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
             return dv.fill(#f64::NAN);
         },
     );
+    let wrench_body = wrench_body(scene, sh);
     quote! {
         impl #rt::scene::SceneDerivatives for #ty {
             fn forward_derivatives(
@@ -122,6 +127,54 @@ pub fn derivatives(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
                         #rt::scene::copy_into(d, row);
                     }
                 }
+            }
+
+            #wrench_body
+        }
+    }
+}
+
+/// `wrench_body` of `SceneDerivatives`: the generated Jacobian and placement of the frame
+/// `scene!` puts at the origin of each wrench's body (fixed base), NaN otherwise.
+fn wrench_body(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
+    let Shape { rt, .. } = sh;
+    let (f64, usize) = (paths::primitive("f64"), paths::primitive("usize"));
+    let nl = Literal::usize_unsuffixed(sh.n);
+    let nan = quote! {{
+        jac.fill(#f64::NAN);
+        #rt::scene::WrenchBody { rotation: [[#f64::NAN; 3]; 3], body_fixed: false }
+    }};
+    let dyn_ty = &sh.phases[0];
+    let arms = scene.wrenches.iter().enumerate().filter_map(|(k, w)| {
+        let fname = sh.wrench_frames[k].as_ref()?;
+        let (pl, jc) = (
+            format_ident!("{}_placement", fname),
+            format_ident!("{}_jacobian", fname),
+        );
+        let body_fixed = w.frame == LoadFrame::Body;
+        let k = Literal::usize_unsuffixed(k);
+        Some(quote! {
+            #k => {
+                let j = #dyn_ty::#jc(q);
+                for (row, d) in j.iter().zip(jac.chunks_exact_mut(#nl)) {
+                    #rt::scene::copy_into(d, row);
+                }
+                #rt::scene::WrenchBody { rotation: #dyn_ty::#pl(q).1, body_fixed: #body_fixed }
+            }
+        })
+    });
+    let args = as_arrays(&[("q", sh.n)], &quote!(return #nan;));
+    if scene.wrenches.is_empty() || scene.is_floating() {
+        return quote! {
+            fn wrench_body(&mut self, _k: #usize, _q: &[#f64], jac: &mut [#f64]) -> #rt::scene::WrenchBody #nan
+        };
+    }
+    quote! {
+        fn wrench_body(&mut self, k: #usize, q: &[#f64], jac: &mut [#f64]) -> #rt::scene::WrenchBody {
+            #args
+            match k {
+                #(#arms)*
+                _ => #nan,
             }
         }
     }

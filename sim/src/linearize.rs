@@ -37,17 +37,20 @@ pub struct StepJacobians {
 /// dopri5 scenes, the implicit midpoint rule for midpoint scenes.
 ///
 /// # Errors
-/// Rodas4 (rosenbrock) scenes, mimic joints on a free-floating base, and
-/// effects the Jacobians do not cover ([`linearizable`]), named.
+/// Rodas4 (rosenbrock) scenes, mimic joints on a free-floating base or with external
+/// wrenches, and effects the Jacobians do not cover ([`linearizable`]), named.
 pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let scene = sys.scene();
     let profiles = scene.wrench_profiles();
     let effects = scene.effects(&profiles);
     if let Err(what) = linearizable(&effects) {
-        bail!("step Jacobians cover scenes without external wrenches; this scene has {what}");
+        bail!("step Jacobians cover external wrenches on a fixed base; this scene has {what}");
     }
     if effects.floating && scene.model.has_mimics() {
         bail!("step Jacobians on a free-floating base cover models without mimic joints; this model has mimic joints");
+    }
+    if !effects.wrenches.is_empty() && scene.model.has_mimics() {
+        bail!("step Jacobians with external wrenches cover models without mimic joints; this model has mimic joints");
     }
     match scene.simulation.integrator {
         Integrator::Rk4 | Integrator::Dopri5 => Ok("rk4"),

@@ -11,12 +11,15 @@
 use crate::scene::Scene;
 use kanegen_dynamics::algorithms::derivatives;
 use kanegen_dynamics::algorithms::floating;
+use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
+use kanegen_dynamics::linalg::Mat3;
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::mimic::Coupling;
 use kanegen_dynamics::{Dynamics, ForwardMethod, Loads, Methods, Params};
-use kanegen_runtime::scene::{forward_with_armature, SceneDerivatives, SceneDynamics};
+use kanegen_dynamics::{FrameParams, LoadFrame};
+use kanegen_runtime::scene::{forward_with_armature, SceneDerivatives, SceneDynamics, WrenchBody};
 
 /// The state of a free-floating base from the provider's positions `q = [p₀, quat, …]` and
 /// speeds `v = [v_b, ω_b, …]`.
@@ -278,9 +281,9 @@ fn copy_rows(src: &[Vec<f64>], dst: &mut [f64]) {
     }
 }
 
-/// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`), no
-/// external wrench (what [`kanegen_runtime::scene::linearize`] covers), on a fixed or
-/// free-floating base (mimic joints on a fixed one).
+/// The derivatives of the run-time algorithms (Carpentier & Mansard's, `kanegen-dynamics`), on
+/// a fixed or free-floating base (mimic joints on a fixed one), and the frames of the wrenches'
+/// bodies (what [`kanegen_runtime::scene::linearize`] takes external wrenches through).
 impl SceneDerivatives for RunTimeDynamics {
     fn forward_derivatives(
         &mut self,
@@ -357,5 +360,32 @@ impl SceneDerivatives for RunTimeDynamics {
         };
         copy_rows(&a, dq);
         copy_rows(&b, dv);
+    }
+
+    /// The frame algorithms at the body origin ([`frames::jacobian`], [`frames::placement`]);
+    /// NaN on a free-floating base, with mimic joints or for a wrench the scene does not have.
+    fn wrench_body(&mut self, k: usize, q: &[f64], jac: &mut [f64]) -> WrenchBody {
+        let wrench = self.loads.external.get(k);
+        let (Some(w), None, None) = (wrench, &self.base, &self.coupling) else {
+            jac.fill(f64::NAN);
+            return WrenchBody {
+                rotation: [[f64::NAN; 3]; 3],
+                body_fixed: false,
+            };
+        };
+        let origin = FrameParams {
+            parent: Some(w.body),
+            translation: Vec3::zero(),
+            rotation: Mat3::identity(),
+        };
+        let j = frames::jacobian(&self.params, q, &origin);
+        for (row, d) in j.iter().zip(jac.chunks_exact_mut(q.len().max(1))) {
+            d.copy_from_slice(row);
+        }
+        let (_, r) = frames::placement(&self.params, q, &origin);
+        WrenchBody {
+            rotation: core::array::from_fn(|i| core::array::from_fn(|c| r.at(i, c))),
+            body_fixed: w.frame == LoadFrame::Body,
+        }
     }
 }

@@ -4,6 +4,8 @@
 // Each test crate uses some of them.
 #![allow(dead_code)]
 
+pub mod linearize;
+
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::Run;
 use std::path::PathBuf;

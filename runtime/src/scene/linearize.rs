@@ -28,7 +28,13 @@
 //! With Spong's flexible joints, `x = [q, q̇, θ, θ̇]`: the links under the springs, the motors
 //! under the drive (`flexible_jacobians`).
 //!
-//! Covered ([`linearizable`]): no external wrenches.
+//! External wrenches (fixed base) load the joints by `τ_ext(q) = Σ J_wᵀ [F_w; n_w]`, which
+//! depends on `q` ([`super::wrenches`]): then, and with rotor inertia, the acceleration rows come
+//! from `(M + A) ∂q̈ = ∂τ_ext − ∂ID` at the scene's `q̈` (inverse-dynamics derivatives and LDLᵀ
+//! solves, `implicit_derivatives`), and a computed-torque drive, which cancels the wrenches,
+//! has `∂τ/∂q −= ∂τ_ext/∂q`.
+//!
+//! Covered ([`linearizable`]): external wrenches on a fixed base only.
 //!
 //! [`floating_kinematics`]: super::floating_kinematics
 //! [`rotation_jacobian`]: crate::ode::quaternion::rotation_jacobian
@@ -37,12 +43,14 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::floating::floating_kinematics_jacobian;
+use super::wrenches::{add_wrench_torque_derivatives, rotate};
 use super::{deriv_input, drive_torques, Drive, Flexible, SceneDynamics, SceneEffects};
 use crate::ldlt::{factor_in_place, solve_in_place};
 use crate::ode::quaternion::rotation_jacobian;
 use crate::ode::ControlledSystem;
 
-/// The derivatives of a provider's dynamics (no external wrench), row-major `N × N` each.
+/// The derivatives of a provider's dynamics (without external wrenches: their part is
+/// [`super::wrenches`]), row-major `N × N` each.
 pub trait SceneDerivatives: SceneDynamics {
     /// `(∂q̈/∂q, ∂q̈/∂q̇, M⁻¹)` of forward dynamics at `(q, q̇, τ)` into `dq`, `dv`, `minv`.
     fn forward_derivatives(
@@ -68,6 +76,21 @@ pub trait SceneDerivatives: SceneDynamics {
         dq: &mut [f64],
         dv: &mut [f64],
     );
+
+    /// The body that wrench `k` of the scene acts on, at `q` (fixed base): the Jacobian of its
+    /// origin into `jac` (`6 × N`, row-major, rows `[v; ω]` in base axes), its rotation and
+    /// the wrench's frame returned. NaN where the provider has no frame for it.
+    fn wrench_body(&mut self, k: usize, q: &[f64], jac: &mut [f64]) -> WrenchBody;
+}
+
+/// The body a wrench acts on, at a configuration ([`SceneDerivatives::wrench_body`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WrenchBody {
+    /// The body's rotation `R`, `x_base = R x_body`.
+    pub rotation: [[f64; 3]; 3],
+    /// Whether the wrench is given in the body's frame (it turns with the body), else in the
+    /// base frame.
+    pub body_fixed: bool,
 }
 
 /// `Ok` when [`deriv_jacobians`] covers the effects `fx`; else what it does not cover.
@@ -75,19 +98,32 @@ pub trait SceneDerivatives: SceneDynamics {
 /// # Errors
 /// The first effect not covered, in words.
 pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
-    if !fx.wrenches.is_empty() {
-        Err("external wrenches")
+    if !fx.wrenches.is_empty() && fx.floating {
+        Err("external wrenches on a free-floating base")
     } else {
         Ok(())
     }
 }
 
 /// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side, two
-/// `N × N` and four `nv × nv` matrices and a vector of speeds.
+/// `N × N` and four `nv × nv` matrices and a vector of speeds; with wrenches `∂τ_ext/∂q`
+/// (`N × N`) and a Jacobian (`6 × N`); with wrenches or an armature two more vectors of speeds.
 #[must_use]
 pub const fn jacobian_work_len(fx: &SceneEffects<'_>) -> usize {
     let (n, nv) = (fx.dof, fx.sizes().1);
-    fx.work_len() + 2 * n * n + 4 * nv * nv + nv
+    let wrenches = if fx.wrenches.is_empty() {
+        0
+    } else {
+        n * n + 6 * n
+    };
+    let implicit = if implicit(fx) { 2 * nv } else { 0 };
+    fx.work_len() + 2 * n * n + 4 * nv * nv + nv + wrenches + implicit
+}
+
+/// Whether the acceleration rows come from the inverse-dynamics derivatives
+/// (`implicit_derivatives`): with an armature or wrenches.
+const fn implicit(fx: &SceneEffects<'_>) -> bool {
+    fx.armature.is_some() || !fx.wrenches.is_empty()
 }
 
 /// `f(t, x, u)` into `dx` (as [`deriv_input`]), `∂f/∂x` into `fxm` (`d × d`, row-major) and
@@ -126,32 +162,46 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
         None => (&q[nq - n..], &v[nv - n..]),
         Some(_) => motors.split_at(n),
     };
-    let [tq, tv, mm, dq, dv, minv] = matrices(work, n, nv);
+    let [tq, tv, mm, dq, dv, minv, tail] = matrices(work, n, nv);
     let (tau, rest) = rhs_work.split_at_mut(n);
+    // ∂τ_ext/∂q of the wrench values `deriv_input` left after `τ` and a joint vector.
+    let (ext, tail) = tail.split_at_mut(if fx.wrenches.is_empty() { 0 } else { n * n });
+    let (jac, tail) = tail.split_at_mut(if ext.is_empty() { 0 } else { 6 * n });
+    let ext = if ext.is_empty() {
+        None
+    } else {
+        let w = &rest[n..n + 6 * fx.wrenches.len()];
+        wrench_torque_derivatives(dynamics, q, w, ext, jac);
+        Some(&*ext)
+    };
     drive_torques(dynamics, fx, t, dq_drive, dv_drive, &[], tau, &mut mm[..n]);
     for (ti, ui) in tau.iter_mut().zip(u) {
         *ti += ui;
     }
-    drive_jacobians(dynamics, fx, t, dq_drive, dv_drive, tq, tv, mm);
-    if let Some(f) = fx.flexible {
-        // The links move under the springs' torques.
-        let (th, thd) = motors.split_at(n);
-        let springs = &mut rest[..n];
-        for i in 0..n {
-            springs[i] = f.stiffness[i] * (th[i] - q[i]) + f.damping[i] * (thd[i] - v[i]);
+    drive_jacobians(dynamics, fx, t, dq_drive, dv_drive, ext, tq, tv, mm);
+    // The torques the links move under: the springs' with flexible joints.
+    let applied = match fx.flexible {
+        None => &*tau,
+        Some(f) => {
+            let (th, thd) = motors.split_at(n);
+            let springs = &mut rest[..n];
+            for i in 0..n {
+                springs[i] = f.stiffness[i] * (th[i] - q[i]) + f.damping[i] * (thd[i] - v[i]);
+            }
+            &*springs
         }
-        dynamics.forward_derivatives(q, v, springs, dq, dv, minv);
-        return flexible_jacobians(&f, [tq, tv], [dq, dv, minv], fxm, fum);
+    };
+    if implicit(fx) {
+        let (d_inv, col) = tail[..2 * nv].split_at_mut(nv);
+        let qdd = &dx[nq..nq + nv];
+        let f = [&mut *dq, &mut *dv, &mut *minv];
+        let m = &mut mm[..nv * nv];
+        implicit_derivatives(dynamics, [q, v, qdd], fx.armature, ext, f, m, d_inv, col);
+    } else {
+        dynamics.forward_derivatives(q, v, applied, dq, dv, minv);
     }
-    match fx.armature {
-        None => dynamics.forward_derivatives(q, v, tau, dq, dv, minv),
-        Some(a) => {
-            // The scene's own work holds `nv² + 2 nv` more with an armature ([`work_len`]).
-            let (d_inv, col) = rest[..2 * nv].split_at_mut(nv);
-            let qdd = &dx[nq..nq + nv];
-            let f = [&mut *dq, &mut *dv, &mut *minv];
-            armature_derivatives(dynamics, q, v, qdd, a, f, &mut mm[..nv * nv], d_inv, col);
-        }
+    if let Some(f) = fx.flexible {
+        return flexible_jacobians(&f, [tq, tv], [dq, dv, minv], fxm, fum);
     }
     fxm.fill(0.0);
     fum.fill(0.0);
@@ -235,19 +285,20 @@ fn flexible_jacobians(
 }
 
 /// `(∂ν̇/∂q, ∂ν̇/∂ν, (M + A)⁻¹)` into `f` (`nv × nv` each) with the armature `A = diag(a)` on
-/// the joint diagonal (RBDA Sec. 9.1; the base of a free-floating one has none):
-/// `(M + A) ν̇ = τ − c` differentiated at fixed `τ` is `(M + A) ∂ν̇ = −∂ID/∂x` with
-/// `ID(q, ν, ν̇) = M ν̇ + c` (no armature) at the scene's `ν̇` (Carpentier & Mansard, RSS 2018,
-/// eq. (3), with `M + A` for `M`): the provider's inverse-dynamics derivatives, then LDLᵀ
-/// solves ([`crate::ldlt`]) of `M + A` column by column. `m` (`nv²`), `d_inv` and `col` (`nv`
-/// each) are work memory; a pivot that is not positive gives NaN.
+/// the joint diagonal (RBDA Sec. 9.1; the base of a free-floating one has none) and the joint
+/// torques of external wrenches `τ_ext(q)` on a fixed base (`ext` = `∂τ_ext/∂q`):
+/// `(M + A) ν̇ = τ + τ_ext − c` differentiated at fixed `τ` is
+/// `(M + A) ∂ν̇ = ∂τ_ext − ∂ID/∂x` with `ID(q, ν, ν̇) = M ν̇ + c` (no armature, no wrench) at the
+/// scene's `ν̇` (Carpentier & Mansard, RSS 2018, eq. (3), with `M + A` for `M`): the provider's
+/// inverse-dynamics derivatives, then LDLᵀ solves ([`crate::ldlt`]) of `M + A` column by
+/// column. `m` (`nv²`), `d_inv` and `col` (`nv` each) are work memory; a pivot that is not
+/// positive gives NaN.
 #[allow(clippy::too_many_arguments)]
-fn armature_derivatives<D: SceneDerivatives + ?Sized>(
+fn implicit_derivatives<D: SceneDerivatives + ?Sized>(
     dynamics: &mut D,
-    q: &[f64],
-    qd: &[f64],
-    qdd: &[f64],
-    a: &[f64],
+    [q, qd, qdd]: [&[f64]; 3],
+    a: Option<&[f64]>,
+    ext: Option<&[f64]>,
     f: [&mut [f64]; 3],
     m: &mut [f64],
     d_inv: &mut [f64],
@@ -256,7 +307,13 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     let n = qd.len();
     let [dq, dv, minv] = f;
     dynamics.inverse_derivatives(q, qd, qdd, dq, dv);
+    if let Some(ext) = ext {
+        for (d, e) in dq.iter_mut().zip(ext) {
+            *d -= e;
+        }
+    }
     dynamics.mass_matrix(q, m);
+    let a = a.unwrap_or(&[]);
     let b = n - a.len();
     for (i, ai) in a.iter().enumerate() {
         m[(b + i) * n + b + i] += ai;
@@ -286,18 +343,44 @@ fn armature_derivatives<D: SceneDerivatives + ?Sized>(
     }
 }
 
-/// At the start of `work`: two `N × N` matrices, one of `nv² + nv`, three `nv × nv`.
-fn matrices(work: &mut [f64], n: usize, nv: usize) -> [&mut [f64]; 6] {
+/// At the start of `work`: two `N × N` matrices, one of `nv² + nv`, three `nv × nv`; then the
+/// rest.
+fn matrices(work: &mut [f64], n: usize, nv: usize) -> [&mut [f64]; 7] {
     let (a, w) = work.split_at_mut(n * n);
     let (b, w) = w.split_at_mut(n * n);
     let (c, w) = w.split_at_mut(nv * nv + nv);
     let (d, w) = w.split_at_mut(nv * nv);
     let (e, w) = w.split_at_mut(nv * nv);
-    [a, b, c, d, e, &mut w[..nv * nv]]
+    let (f, w) = w.split_at_mut(nv * nv);
+    [a, b, c, d, e, f, w]
+}
+
+/// `∂τ_ext/∂q` into `ext` (`N × N`) of the scene's wrenches, values `w` (6 a wrench, force then
+/// moment in the frame the scene names), on a fixed base ([`super::wrenches`]); `jac`
+/// (`6 × N`) is work memory.
+fn wrench_torque_derivatives<D: SceneDerivatives + ?Sized>(
+    dynamics: &mut D,
+    q: &[f64],
+    w: &[f64],
+    ext: &mut [f64],
+    jac: &mut [f64],
+) {
+    ext.fill(0.0);
+    for (k, wk) in w.chunks_exact(6).enumerate() {
+        let body = dynamics.wrench_body(k, q, jac);
+        let (f, m) = ([wk[0], wk[1], wk[2]], [wk[3], wk[4], wk[5]]);
+        let (f, m) = if body.body_fixed {
+            (rotate(&body.rotation, &f), rotate(&body.rotation, &m))
+        } else {
+            (f, m)
+        };
+        add_wrench_torque_derivatives(jac, &f, &m, body.body_fixed, ext);
+    }
 }
 
 /// `∂τ/∂q` into `tq` and `∂τ/∂q̇` into `tv` of the applied torques `τ(t, q, q̇)` of the drive,
-/// damping and friction of `fx` (module doc); `mm` (`N² + N`) is work memory.
+/// damping and friction of `fx` (module doc), `ext` the wrenches' `∂τ_ext/∂q` (a
+/// computed-torque drive cancels them); `mm` (`N² + N`) is work memory.
 #[allow(clippy::too_many_arguments)]
 fn drive_jacobians<D: SceneDerivatives + ?Sized>(
     dynamics: &mut D,
@@ -305,6 +388,7 @@ fn drive_jacobians<D: SceneDerivatives + ?Sized>(
     t: f64,
     q: &[f64],
     qd: &[f64],
+    ext: Option<&[f64]>,
     tq: &mut [f64],
     tv: &mut [f64],
     mm: &mut [f64],
@@ -327,9 +411,12 @@ fn drive_jacobians<D: SceneDerivatives + ?Sized>(
             super::drives::commanded_acceleration(&fx.drive, t, q, qd, cmd);
             dynamics.inverse_derivatives(q, qd, cmd, tq, tv);
             dynamics.mass_matrix(q, m);
+            // The drive cancels the wrenches: τ = ID(…) − τ_ext(q).
+            let ext = ext.unwrap_or(&[]);
             for i in 0..n {
                 for j in 0..n {
-                    tq[i * n + j] -= m[i * n + j] * kp[j];
+                    let e = ext.get(i * n + j).copied().unwrap_or(0.0);
+                    tq[i * n + j] -= m[i * n + j] * kp[j] + e;
                     tv[i * n + j] -= m[i * n + j] * kd[j];
                 }
             }
