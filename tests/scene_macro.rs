@@ -458,6 +458,13 @@ macro_rules! wrench_jacobians {
     };
 }
 
+common::linearize::floating_tests!(
+    floating_wrenches_step_jacobians,
+    FloatingWrenches,
+    FloatingWrenchesState,
+    "tests/data/scenes/floating_wrenches.toml"
+);
+
 wrench_jacobians!(
     wrenches_in_the_body_frame_step_jacobians,
     GravityWrench,

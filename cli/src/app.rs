@@ -310,8 +310,7 @@ struct SimulateArgs {
     allow_long: bool,
     /// Instead of running: print the Jacobians (A, B) of one step of the scene's integrator
     /// from its initial state (t = 0, no added torque u, the scene's step), exact for the scheme
-    /// (RK4 for rk4 and dopri5 scenes, implicit midpoint; not rosenbrock, nor external wrenches
-    /// on a free-floating base); with --json as JSON.
+    /// (RK4 for rk4 and dopri5 scenes, implicit midpoint; not rosenbrock); with --json as JSON.
     #[arg(long, conflicts_with_all = ["out", "force"])]
     linearize: bool,
 }

@@ -17,7 +17,6 @@
 use crate::scene_linearize;
 use crate::scene_provider::{self, arr, lit, Shape};
 use kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
-use kanegen_codegen::kanegen_dynamics::LoadFrame;
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Model, Placement};
 use kanegen_codegen::paths;
 use kanegen_scene::{BaseSpec, Drives, EventKind, Integrator, Scene};
@@ -54,14 +53,13 @@ fn load(rel: &str) -> Result<Source, String> {
 }
 
 /// The model the dynamics are generated for: the scene's payload merged already; its base kind
-/// and inertial the scene's; one identity frame on each body loaded by an inertial-frame wrench
-/// (its generated `<frame>_placement` gives the body's rotation; on a fixed base every wrench gets
-/// one, whose Jacobian maps the wrench to the joints for a computed-torque drive and the step
-/// Jacobians); one frame at each
+/// and inertial the scene's; one identity frame on each body loaded by a wrench (its generated
+/// `<frame>_placement` gives the body's rotation for an inertial-frame wrench, its Jacobian
+/// maps the wrench to the joints for a computed-torque drive and the step Jacobians); one frame
+/// at each
 /// captured payload's centre of mass (its Jacobian and placement give the capture impulse).
 /// Also the frame name of each wrench that has one.
 fn scene_model(scene: &Scene, rel: &str) -> Result<(Model, Vec<Option<String>>), String> {
-    let computed_torque = matches!(scene.drives, Drives::ComputedTorque { .. });
     let mut model = scene.model.clone();
     if let BaseSpec::FreeFloating { inertial, .. } = &scene.base {
         if model.base_inertial() != Some(inertial) {
@@ -76,8 +74,7 @@ fn scene_model(scene: &Scene, rel: &str) -> Result<(Model, Vec<Option<String>>),
     let mut frames: Vec<Frame> = model.frames().to_vec();
     let mut wrench_frames = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
-        let needs = (w.frame == LoadFrame::Base || computed_torque || !scene.is_floating())
-            && w.body != BASE_BODY;
+        let needs = w.body != BASE_BODY;
         wrench_frames.push(needs.then(|| {
             let name = unused_name(&format!("scene_wrench_{k}"), &frames);
             frames.push(Frame {

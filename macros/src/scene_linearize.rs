@@ -9,7 +9,7 @@
 use crate::scene_provider::{as_arrays, phase_match, Shape};
 use kanegen_codegen::kanegen_dynamics::LoadFrame;
 use kanegen_codegen::paths;
-use kanegen_runtime::scene::{linearizable, SceneEffects};
+use kanegen_runtime::scene::SceneEffects;
 use kanegen_scene::{Integrator, Scene};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -21,9 +21,6 @@ pub fn availability(
     effects: &SceneEffects<'_>,
     has_derivatives: bool,
 ) -> Result<(), String> {
-    if let Err(what) = linearizable(effects) {
-        return Err(format!("the scene has {what}"));
-    }
     if scene.simulation.integrator == Integrator::Rosenbrock {
         return Err("its step is a Rodas4 step".into());
     }
@@ -135,36 +132,64 @@ pub fn derivatives(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
 }
 
 /// `wrench_body` of `SceneDerivatives`: the generated Jacobian and placement of the frame
-/// `scene!` puts at the origin of each wrench's body (fixed base), NaN otherwise.
+/// `scene!` puts at the origin of each wrench's body, on a free-floating base evaluated with the
+/// base at the inertial origin unturned (so inertial axes are base coordinates); the base's
+/// speed columns for a wrench on the base; NaN otherwise.
 fn wrench_body(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
     let Shape { rt, .. } = sh;
     let (f64, usize) = (paths::primitive("f64"), paths::primitive("usize"));
-    let nl = Literal::usize_unsuffixed(sh.n);
+    let nl = Literal::usize_unsuffixed(sh.nv);
     let nan = quote! {{
         jac.fill(#f64::NAN);
         #rt::scene::WrenchBody { rotation: [[#f64::NAN; 3]; 3], body_fixed: false }
     }};
     let dyn_ty = &sh.phases[0];
-    let arms = scene.wrenches.iter().enumerate().filter_map(|(k, w)| {
-        let fname = sh.wrench_frames[k].as_ref()?;
+    let floating = scene.is_floating();
+    let arms = scene.wrenches.iter().enumerate().map(|(k, w)| {
+        let body_fixed = w.frame == LoadFrame::Body;
+        let frame = sh.wrench_frames[k].as_ref();
+        let k = Literal::usize_unsuffixed(k);
+        let Some(fname) = frame else {
+            // The base of a free-floating one: its own speeds, unit columns.
+            return quote! {
+                #k => {
+                    jac.fill(0.0);
+                    for m in 0..6 {
+                        jac[m * #nl + m] = 1.0;
+                    }
+                    #rt::scene::WrenchBody {
+                        rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                        body_fixed: #body_fixed,
+                    }
+                }
+            };
+        };
         let (pl, jc) = (
             format_ident!("{}_placement", fname),
             format_ident!("{}_jacobian", fname),
         );
-        let body_fixed = w.frame == LoadFrame::Body;
-        let k = Literal::usize_unsuffixed(k);
-        Some(quote! {
+        let at = if floating {
+            quote! {
+                let mut at = *q;
+                at[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+                let q = &at;
+            }
+        } else {
+            quote!()
+        };
+        quote! {
             #k => {
+                #at
                 let j = #dyn_ty::#jc(q);
                 for (row, d) in j.iter().zip(jac.chunks_exact_mut(#nl)) {
                     #rt::scene::copy_into(d, row);
                 }
                 #rt::scene::WrenchBody { rotation: #dyn_ty::#pl(q).1, body_fixed: #body_fixed }
             }
-        })
+        }
     });
-    let args = as_arrays(&[("q", sh.n)], &quote!(return #nan;));
-    if scene.wrenches.is_empty() || scene.is_floating() {
+    let args = as_arrays(&[("q", sh.nq)], &quote!(return #nan;));
+    if scene.wrenches.is_empty() {
         return quote! {
             fn wrench_body(&mut self, _k: #usize, _q: &[#f64], jac: &mut [#f64]) -> #rt::scene::WrenchBody #nan
         };
@@ -172,6 +197,9 @@ fn wrench_body(scene: &Scene, sh: &Shape<'_>) -> TokenStream {
     quote! {
         fn wrench_body(&mut self, k: #usize, q: &[#f64], jac: &mut [#f64]) -> #rt::scene::WrenchBody {
             #args
+            if jac.len() != 6 * #nl {
+                return #nan;
+            }
             match k {
                 #(#arms)*
                 _ => #nan,

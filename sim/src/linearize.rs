@@ -12,7 +12,7 @@ use kanegen_runtime::ode::{
     rk4_step_jacobians, VecScratch,
 };
 use kanegen_runtime::scene::linearize::jacobian_work_len;
-use kanegen_runtime::scene::{linearizable, SceneControl};
+use kanegen_runtime::scene::SceneControl;
 
 /// One step with its Jacobians.
 #[derive(Clone, Debug, PartialEq)]
@@ -37,15 +37,12 @@ pub struct StepJacobians {
 /// dopri5 scenes, the implicit midpoint rule for midpoint scenes.
 ///
 /// # Errors
-/// Rodas4 (rosenbrock) scenes, mimic joints on a free-floating base or with external
-/// wrenches, and effects the Jacobians do not cover ([`linearizable`]), named.
+/// Rodas4 (rosenbrock) scenes, and mimic joints on a free-floating base or with external
+/// wrenches, named.
 pub fn scheme(sys: &SceneSystem<'_>) -> Result<&'static str> {
     let scene = sys.scene();
     let profiles = scene.wrench_profiles();
     let effects = scene.effects(&profiles);
-    if let Err(what) = linearizable(&effects) {
-        bail!("step Jacobians cover external wrenches on a fixed base; this scene has {what}");
-    }
     if effects.floating && scene.model.has_mimics() {
         bail!("step Jacobians on a free-floating base cover models without mimic joints; this model has mimic joints");
     }

@@ -12,7 +12,7 @@ use crate::scene::Scene;
 use kanegen_dynamics::algorithms::derivatives;
 use kanegen_dynamics::algorithms::floating;
 use kanegen_dynamics::algorithms::frames;
-use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::kernels::{self, KernelData, KernelTables};
 use kanegen_dynamics::linalg::Mat3;
 use kanegen_dynamics::linalg::Vec3;
@@ -362,27 +362,50 @@ impl SceneDerivatives for RunTimeDynamics {
         copy_rows(&b, dv);
     }
 
-    /// The frame algorithms at the body origin ([`frames::jacobian`], [`frames::placement`]);
-    /// NaN on a free-floating base, with mimic joints or for a wrench the scene does not have.
+    /// The frame algorithms at the body origin ([`frames::jacobian`], [`frames::placement`]) in
+    /// base coordinates, the columns of a free-floating base's speeds before them (the base's own
+    /// origin for a wrench on the base); NaN with mimic joints or for a wrench the scene does not
+    /// have.
     fn wrench_body(&mut self, k: usize, q: &[f64], jac: &mut [f64]) -> WrenchBody {
-        let wrench = self.loads.external.get(k);
-        let (Some(w), None, None) = (wrench, &self.base, &self.coupling) else {
+        let (off, dof) = (self.offset(), self.params.dof());
+        let nv = off + dof;
+        let sizes = jac.len() == 6 * nv && q.len() == nv + usize::from(off > 0);
+        let (Some(w), None, true) = (self.loads.external.get(k), &self.coupling, sizes) else {
             jac.fill(f64::NAN);
             return WrenchBody {
                 rotation: [[f64::NAN; 3]; 3],
                 body_fixed: false,
             };
         };
-        let origin = FrameParams {
-            parent: Some(w.body),
-            translation: Vec3::zero(),
-            rotation: Mat3::identity(),
+        let qj = &q[q.len() - dof..];
+        jac.fill(0.0);
+        let (x, r) = if w.body == BASE_BODY {
+            (Vec3::zero(), Mat3::identity())
+        } else {
+            let origin = FrameParams {
+                parent: Some(w.body),
+                translation: Vec3::zero(),
+                rotation: Mat3::identity(),
+            };
+            let j = frames::jacobian(&self.params, qj, &origin);
+            for (row, d) in j.iter().zip(jac.chunks_exact_mut(nv)) {
+                d[off..].copy_from_slice(row);
+            }
+            frames::placement(&self.params, qj, &origin)
         };
-        let j = frames::jacobian(&self.params, q, &origin);
-        for (row, d) in j.iter().zip(jac.chunks_exact_mut(q.len().max(1))) {
-            d.copy_from_slice(row);
+        if off > 0 {
+            // v_b,m moves the origin by e_m; ω_b,m by e_m × x and turns it about e_m.
+            for m in 0..3 {
+                jac[m * nv + m] = 1.0;
+                jac[(3 + m) * nv + 3 + m] = 1.0;
+                let mut e = Vec3::zero();
+                e.0[m] = 1.0;
+                let ex = e.cross(&x);
+                for i in 0..3 {
+                    jac[i * nv + 3 + m] = ex.at(i);
+                }
+            }
         }
-        let (_, r) = frames::placement(&self.params, q, &origin);
         WrenchBody {
             rotation: core::array::from_fn(|i| core::array::from_fn(|c| r.at(i, c))),
             body_fixed: w.frame == LoadFrame::Body,

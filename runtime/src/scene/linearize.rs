@@ -28,13 +28,13 @@
 //! With Spong's flexible joints, `x = [q, q̇, θ, θ̇]`: the links under the springs, the motors
 //! under the drive (`flexible_jacobians`).
 //!
-//! External wrenches (fixed base) load the joints by `τ_ext(q) = Σ J_wᵀ [F_w; n_w]`, which
-//! depends on `q` ([`super::wrenches`]): then, and with rotor inertia, the acceleration rows come
-//! from `(M + A) ∂q̈ = ∂τ_ext − ∂ID` at the scene's `q̈` (inverse-dynamics derivatives and LDLᵀ
-//! solves, `implicit_derivatives`), and a computed-torque drive, which cancels the wrenches,
-//! has `∂τ/∂q −= ∂τ_ext/∂q`.
-//!
-//! Covered ([`linearizable`]): external wrenches on a fixed base only.
+//! External wrenches load the speeds by `τ_ext(q) = Σ J_wᵀ [F_w; n_w]` (base coordinates),
+//! which depends on `q` ([`super::wrenches`]): then, and with rotor inertia, the acceleration
+//! rows come from `(M + A) ∂ν̇ = ∂τ_ext − ∂ID` at the scene's `ν̇` (inverse-dynamics derivatives
+//! and LDLᵀ solves, `implicit_derivatives`), and a computed-torque drive, which cancels the
+//! wrenches, has `∂τ/∂q −= ∂τ_ext/∂q`. On a free-floating base a wrench fixed in the inertial
+//! frame is `R(quat)ᵀ [F; n]` in base coordinates, so it adds
+//! `(M + A)⁻¹ J_wᵀ ∂(R(quat)ᵀ [F; n])/∂quat` to the attitude columns, as gravity does.
 //!
 //! [`floating_kinematics`]: super::floating_kinematics
 //! [`rotation_jacobian`]: crate::ode::quaternion::rotation_jacobian
@@ -43,9 +43,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::floating::floating_kinematics_jacobian;
-use super::wrenches::{add_wrench_torque_derivatives, rotate};
+use super::wrenches::{add_wrench_torque_derivatives, rotate, rotate_back};
 use super::{deriv_input, drive_torques, Drive, Flexible, SceneDynamics, SceneEffects};
 use crate::ldlt::{factor_in_place, solve_in_place};
+use crate::ode::quaternion::quat_to_matrix;
 use crate::ode::quaternion::rotation_jacobian;
 use crate::ode::ControlledSystem;
 
@@ -77,44 +78,36 @@ pub trait SceneDerivatives: SceneDynamics {
         dv: &mut [f64],
     );
 
-    /// The body that wrench `k` of the scene acts on, at `q` (fixed base): the Jacobian of its
-    /// origin into `jac` (`6 × N`, row-major, rows `[v; ω]` in base axes), its rotation and
-    /// the wrench's frame returned. NaN where the provider has no frame for it.
+    /// The body that wrench `k` of the scene acts on, at `q`: the Jacobian of its origin into
+    /// `jac` (`6 × nv`, row-major, rows `[v; ω]` in base coordinates, Pinocchio's
+    /// `LOCAL_WORLD_ALIGNED` of a fixed base; on a free-floating base that of the base at the
+    /// inertial origin unturned, the base's columns `[e_m; 0]` and `[e_m × x; e_m]`), its
+    /// rotation in base coordinates and the wrench's frame returned. NaN where the provider has
+    /// no frame for it.
     fn wrench_body(&mut self, k: usize, q: &[f64], jac: &mut [f64]) -> WrenchBody;
 }
 
 /// The body a wrench acts on, at a configuration ([`SceneDerivatives::wrench_body`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WrenchBody {
-    /// The body's rotation `R`, `x_base = R x_body`.
+    /// The body's rotation `R` in base coordinates, `x_base = R x_body`.
     pub rotation: [[f64; 3]; 3],
     /// Whether the wrench is given in the body's frame (it turns with the body), else in the
     /// base frame.
     pub body_fixed: bool,
 }
 
-/// `Ok` when [`deriv_jacobians`] covers the effects `fx`; else what it does not cover.
-///
-/// # Errors
-/// The first effect not covered, in words.
-pub const fn linearizable(fx: &SceneEffects<'_>) -> Result<(), &'static str> {
-    if !fx.wrenches.is_empty() && fx.floating {
-        Err("external wrenches on a free-floating base")
-    } else {
-        Ok(())
-    }
-}
-
 /// Length of the work memory of [`deriv_jacobians`]: that of the right-hand side, two
 /// `N × N` and four `nv × nv` matrices and a vector of speeds; with wrenches `∂τ_ext/∂q`
-/// (`N × N`) and a Jacobian (`6 × N`); with wrenches or an armature two more vectors of speeds.
+/// (`nv × nv`), a Jacobian (`6 × nv`) and `∂τ_ext/∂quat` (`nv × 4`); with wrenches or an
+/// armature two more vectors of speeds.
 #[must_use]
 pub const fn jacobian_work_len(fx: &SceneEffects<'_>) -> usize {
     let (n, nv) = (fx.dof, fx.sizes().1);
     let wrenches = if fx.wrenches.is_empty() {
         0
     } else {
-        n * n + 6 * n
+        nv * nv + 10 * nv
     };
     let implicit = if implicit(fx) { 2 * nv } else { 0 };
     fx.work_len() + 2 * n * n + 4 * nv * nv + nv + wrenches + implicit
@@ -127,8 +120,8 @@ const fn implicit(fx: &SceneEffects<'_>) -> bool {
 }
 
 /// `f(t, x, u)` into `dx` (as [`deriv_input`]), `∂f/∂x` into `fxm` (`d × d`, row-major) and
-/// `∂f/∂u` into `fum` (`d × N`), `work` of [`jacobian_work_len`] (module doc). Effects that
-/// [`linearizable`] refuses, or slices of the wrong length, give NaN.
+/// `∂f/∂u` into `fum` (`d × N`), `work` of [`jacobian_work_len`] (module doc). Slices of the
+/// wrong length give NaN.
 #[allow(clippy::too_many_arguments)]
 pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     dynamics: &mut D,
@@ -142,8 +135,7 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     work: &mut [f64],
 ) {
     let (n, d, (nq, nv)) = (fx.dof, fx.dim(), fx.sizes());
-    if linearizable(fx).is_err()
-        || fxm.len() != d * d
+    if fxm.len() != d * d
         || fum.len() != d * n
         || u.len() != n
         || work.len() < jacobian_work_len(fx)
@@ -164,14 +156,16 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
     };
     let [tq, tv, mm, dq, dv, minv, tail] = matrices(work, n, nv);
     let (tau, rest) = rhs_work.split_at_mut(n);
-    // ∂τ_ext/∂q of the wrench values `deriv_input` left after `τ` and a joint vector.
-    let (ext, tail) = tail.split_at_mut(if fx.wrenches.is_empty() { 0 } else { n * n });
-    let (jac, tail) = tail.split_at_mut(if ext.is_empty() { 0 } else { 6 * n });
+    // ∂τ_ext/∂q and ∂τ_ext/∂quat of the wrench values `deriv_input` left after `τ` and a
+    // joint vector.
+    let (ext, tail) = tail.split_at_mut(if fx.wrenches.is_empty() { 0 } else { nv * nv });
+    let (jac, tail) = tail.split_at_mut(if ext.is_empty() { 0 } else { 6 * nv });
+    let (equat, tail) = tail.split_at_mut(if ext.is_empty() { 0 } else { 4 * nv });
     let ext = if ext.is_empty() {
         None
     } else {
         let w = &rest[n..n + 6 * fx.wrenches.len()];
-        wrench_torque_derivatives(dynamics, q, w, ext, jac);
+        wrench_torque_derivatives(dynamics, fx.floating, q, w, [&mut *ext, jac, &mut *equat]);
         Some(&*ext)
     };
     drive_torques(dynamics, fx, t, dq_drive, dv_drive, &[], tau, &mut mm[..n]);
@@ -235,6 +229,13 @@ pub fn deriv_jacobians<D: SceneDerivatives + ?Sized>(
         let dg = rotation_jacobian(&quat, &dynamics.gravity(), true);
         for (r, dr) in dg.iter().enumerate() {
             fxm[(nq + r) * d + 3..(nq + r) * d + 7].copy_from_slice(dr);
+        }
+        // Wrenches fixed in the inertial frame: (M + A)⁻¹ ∂τ_ext/∂quat.
+        for i in 0..nv.min(equat.len() / 4) {
+            for c in 0..4 {
+                let e = (0..nv).map(|k| minv[i * nv + k] * equat[k * 4 + c]);
+                fxm[(nq + i) * d + 3 + c] += e.sum::<f64>();
+            }
         }
     }
 }
@@ -355,26 +356,48 @@ fn matrices(work: &mut [f64], n: usize, nv: usize) -> [&mut [f64]; 7] {
     [a, b, c, d, e, f, w]
 }
 
-/// `∂τ_ext/∂q` into `ext` (`N × N`) of the scene's wrenches, values `w` (6 a wrench, force then
-/// moment in the frame the scene names), on a fixed base ([`super::wrenches`]); `jac`
-/// (`6 × N`) is work memory.
+/// `∂τ_ext/∂q` into `ext` (`nv × nv`; on a free-floating base its joint columns) and
+/// `∂τ_ext/∂quat` into `equat` (`nv × 4`, zero on a fixed base) of the scene's wrenches, values
+/// `w` (6 a wrench, force then moment in the frame the scene names), in base coordinates
+/// ([`super::wrenches`]): a body-fixed wrench turned by its body's rotation, one fixed in the
+/// inertial frame of a free-floating base by `R(quat)ᵀ`. `jac` (`6 × nv`) is work memory.
 fn wrench_torque_derivatives<D: SceneDerivatives + ?Sized>(
     dynamics: &mut D,
+    floating: bool,
     q: &[f64],
     w: &[f64],
-    ext: &mut [f64],
-    jac: &mut [f64],
+    [ext, jac, equat]: [&mut [f64]; 3],
 ) {
     ext.fill(0.0);
+    equat.fill(0.0);
+    let nv = jac.len() / 6;
+    let quat = floating.then(|| [q[3], q[4], q[5], q[6]]);
     for (k, wk) in w.chunks_exact(6).enumerate() {
         let body = dynamics.wrench_body(k, q, jac);
         let (f, m) = ([wk[0], wk[1], wk[2]], [wk[3], wk[4], wk[5]]);
-        let (f, m) = if body.body_fixed {
-            (rotate(&body.rotation, &f), rotate(&body.rotation, &m))
-        } else {
-            (f, m)
+        let (fb, mb) = match (body.body_fixed, quat) {
+            (true, _) => (rotate(&body.rotation, &f), rotate(&body.rotation, &m)),
+            (false, Some(qt)) => {
+                let r = quat_to_matrix(&qt);
+                (rotate_back(&r, &f), rotate_back(&r, &m))
+            }
+            (false, None) => (f, m),
         };
-        add_wrench_torque_derivatives(jac, &f, &m, body.body_fixed, ext);
+        add_wrench_torque_derivatives(jac, &fb, &mb, body.body_fixed, ext);
+        if let (false, Some(qt)) = (body.body_fixed, quat) {
+            // τ_ext = Jᵀ R(quat)ᵀ [F; n]: ∂/∂quat = Jᵀ ∂(R(quat)ᵀ [F; n])/∂quat.
+            let (df, dm) = (
+                rotation_jacobian(&qt, &f, true),
+                rotation_jacobian(&qt, &m, true),
+            );
+            for row in 0..nv {
+                for c in 0..4 {
+                    equat[row * 4 + c] += (0..3)
+                        .map(|r| jac[r * nv + row] * df[r][c] + jac[(3 + r) * nv + row] * dm[r][c])
+                        .sum::<f64>();
+                }
+            }
+        }
     }
 }
 

@@ -29,7 +29,7 @@ pub use armature::forward_with_armature;
 pub use capture::{capture_velocity, CapturedPayload};
 pub use drives::{drive_torques, quintic_reference};
 pub use floating::floating_kinematics;
-pub use linearize::{linearizable, SceneControl, SceneDerivatives, WrenchBody};
+pub use linearize::{SceneControl, SceneDerivatives, WrenchBody};
 
 /// The time profile of an external wrench: force and moment (N, N·m) in the frame the scene
 /// names for it (the provider applies them).

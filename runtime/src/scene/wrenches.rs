@@ -1,6 +1,5 @@
 //! The joint torques of an external wrench and their derivative with respect to the joint
-//! positions, on a fixed base: what an external wrench adds to the step Jacobians
-//! ([`super::linearize`]).
+//! positions: what an external wrench adds to the step Jacobians ([`super::linearize`]).
 //!
 //! A wrench (force `F`, moment `n`, base axes) at the origin `p` of body `i` loads the joints by
 //! `τ_ext = Jᵀ [F; n]`, `J` the Jacobian of `p` (rows `[v; ω]`, base axes, Pinocchio's
@@ -16,6 +15,12 @@
 //!   `ω_k = 0` for a prismatic one);
 //! - a wrench fixed in the base frame has `∂F/∂q = ∂n/∂q = 0`; one fixed in the body turns with
 //!   it, `∂F/∂q_j = ω_j × F`, `∂n/∂q_j = ω_j × n` for every supporting `j`.
+//!
+//! A free-floating base enters as six more columns before the joints', its speeds in base
+//! coordinates (`[e_m; 0]` and `[e_m × p; e_m]`, the columns of a fixed root with three
+//! prismatic and three revolute joints at the base origin): the same formulas give the base's
+//! rows; its own columns (the pose) are not these (the step Jacobians take the attitude through
+//! `R(quat)`).
 //!
 //! Together, for `j < k`: `∂τ_k/∂q_j = (ω_j × v_k) · F + (ω_j × ω_k) · n` in the base frame,
 //! and `0` in the body (the turn of the wrench cancels that of the columns); for `j ≥ k`:
@@ -39,6 +44,12 @@ fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 #[must_use]
 pub fn rotate(r: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
     core::array::from_fn(|i| dot(&r[i], x))
+}
+
+/// `Rᵀ x`.
+#[must_use]
+pub fn rotate_back(r: &[[f64; 3]; 3], x: &[f64; 3]) -> [f64; 3] {
+    core::array::from_fn(|i| r[0][i] * x[0] + r[1][i] * x[1] + r[2][i] * x[2])
 }
 
 /// Adds `∂τ_ext/∂q` (module doc) of the wrench `(force, moment)` (base axes) at the origin of a
