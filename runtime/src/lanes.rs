@@ -82,6 +82,58 @@ pub trait Lanes<F: Copy>:
     fn sincos_n<const K: usize>(x: [Self; K]) -> [(Self, Self); K];
     /// [`Lanes::sincos_n`] never fused ([`crate::sincos::sincos_n_unfused`]).
     fn sincos_n_unfused<const K: usize>(x: [Self; K]) -> [(Self, Self); K];
+
+    /// Lane `l` of `vs[k]` written to `at(&mut out[l])[k]` for each `l < out.len()` (at most
+    /// [`Lanes::LANES`]) and `k < K`: a batch's scatter of `K` numbers a state. Number by number
+    /// here; the vector types store a whole chunk's rows `LANES` numbers at a time
+    /// ([`write_rows_blocked`]).
+    #[inline(always)]
+    fn write_rows<R: 'static, const K: usize>(
+        vs: &[Self; K],
+        out: &mut [R],
+        at: impl Fn(&mut R) -> &mut [F; K] + Copy,
+    ) {
+        for (k, v) in vs.iter().enumerate() {
+            for (l, o) in out.iter_mut().enumerate() {
+                at(o)[k] = v.lane(l);
+            }
+        }
+    }
+}
+
+/// [`Lanes::write_rows`] of a vector type of `L` lanes: a whole chunk of `L` rows as `L × L`
+/// blocks, lane `l` of `L` consecutive numbers stored together into row `l` (one vector store
+/// where the compiler transposes the block in registers, instead of `L` scalar ones), the rest
+/// and a partial chunk number by number. The same values land in the same places.
+#[inline(always)]
+fn write_rows_blocked<F: Copy, S: Lanes<F>, R: 'static, const K: usize, const L: usize>(
+    vs: &[S; K],
+    out: &mut [R],
+    at: impl Fn(&mut R) -> &mut [F; K] + Copy,
+) {
+    let Ok(chunk) = <&mut [R; L]>::try_from(&mut *out) else {
+        for (k, v) in vs.iter().enumerate() {
+            for (l, o) in out.iter_mut().enumerate() {
+                at(o)[k] = v.lane(l);
+            }
+        }
+        return;
+    };
+    let mut rows: [&mut [F; K]; L] = chunk.each_mut().map(at);
+    let full = K / L * L;
+    for k in (0..full).step_by(L) {
+        let block: [[F; L]; L] =
+            core::array::from_fn(|j| core::array::from_fn(|l| vs[k + j].lane(l)));
+        for (l, row) in rows.iter_mut().enumerate() {
+            let t: [F; L] = core::array::from_fn(|j| block[j][l]);
+            row[k..k + L].copy_from_slice(&t);
+        }
+    }
+    for k in full..K {
+        for (l, row) in rows.iter_mut().enumerate() {
+            row[k] = vs[k].lane(l);
+        }
+    }
 }
 
 /// The one-lane implementations: the scalar routines themselves.
@@ -256,6 +308,14 @@ macro_rules! wide_lanes {
             fn sincos_n_unfused<const K: usize>(x: [Self; K]) -> [(Self, Self); K] {
                 $sincos_n_unfused(x)
             }
+            #[inline(always)]
+            fn write_rows<R: 'static, const K: usize>(
+                vs: &[Self; K],
+                out: &mut [R],
+                at: impl Fn(&mut R) -> &mut [$t; K] + Copy,
+            ) {
+                write_rows_blocked::<$t, Self, R, K, $l>(vs, out, at);
+            }
         }
     };
 }
@@ -362,6 +422,19 @@ pub trait LaneValue<F, S>: Sized + 'static {
         out: &mut [R],
         at: impl Fn(&mut R) -> &mut Self + Copy,
     );
+
+    /// [`LaneValue::write_lanes`] of an array of `N` values: element by element, but a number's
+    /// rows whole ([`Lanes::write_rows`]).
+    #[inline(always)]
+    fn write_lanes_array<R: 'static, const N: usize>(
+        lanes: &[Self::Lanes; N],
+        out: &mut [R],
+        at: impl Fn(&mut R) -> &mut [Self; N] + Copy,
+    ) {
+        for (k, l) in lanes.iter().enumerate() {
+            Self::write_lanes(l, out, element(at, k));
+        }
+    }
 }
 
 /// `at` followed by the field `f` of what it gives.
@@ -412,6 +485,14 @@ macro_rules! number_value {
                     *at(o) = lanes.lane(l);
                 }
             }
+            #[inline(always)]
+            fn write_lanes_array<R: 'static, const N: usize>(
+                lanes: &[S; N],
+                out: &mut [R],
+                at: impl Fn(&mut R) -> &mut [Self; N] + Copy,
+            ) {
+                S::write_rows(lanes, out, at);
+            }
         }
     };
 }
@@ -448,9 +529,7 @@ impl<F, S, T: LaneValue<F, S>, const N: usize> LaneValue<F, S> for [T; N] {
         out: &mut [R],
         at: impl Fn(&mut R) -> &mut Self + Copy,
     ) {
-        for (k, l) in lanes.iter().enumerate() {
-            T::write_lanes(l, out, element(at, k));
-        }
+        T::write_lanes_array(lanes, out, at);
     }
 }
 
