@@ -93,10 +93,20 @@ pub trait Lanes<F: Copy>:
         out: &mut [R],
         at: impl Fn(&mut R) -> &mut [F; K] + Copy,
     ) {
-        for (k, v) in vs.iter().enumerate() {
-            for (l, o) in out.iter_mut().enumerate() {
-                at(o)[k] = v.lane(l);
-            }
+        write_numbers(vs, out, at);
+    }
+}
+
+/// [`Lanes::write_rows`] number by number.
+#[inline(always)]
+fn write_numbers<F: Copy, S: Lanes<F>, R: 'static, const K: usize>(
+    vs: &[S; K],
+    out: &mut [R],
+    at: impl Fn(&mut R) -> &mut [F; K] + Copy,
+) {
+    for (k, v) in vs.iter().enumerate() {
+        for (l, o) in out.iter_mut().enumerate() {
+            at(o)[k] = v.lane(l);
         }
     }
 }
@@ -164,12 +174,7 @@ fn write_rows_blocked<F: Copy, S: Lanes<F>, R: 'static, const K: usize, const L:
     at: impl Fn(&mut R) -> &mut [F; K] + Copy,
 ) {
     let Ok(chunk) = <&mut [R; L]>::try_from(&mut *out) else {
-        for (k, v) in vs.iter().enumerate() {
-            for (l, o) in out.iter_mut().enumerate() {
-                at(o)[k] = v.lane(l);
-            }
-        }
-        return;
+        return write_numbers(vs, out, at);
     };
     let mut rows: [&mut [F; K]; L] = chunk.each_mut().map(at);
     let full = K / L * L;
